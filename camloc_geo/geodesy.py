@@ -1,0 +1,127 @@
+"""Local metric frames around an anchor point, built with pyproj.
+
+The ``enu`` frame of the scene contract: east/north metres around an anchor (lat, lon),
+with up along the local vertical. Horizontal coordinates come from an azimuthal
+equidistant projection centred on the anchor, so distances and bearings from the
+anchor are exact and the scale error within 2 km is below 1e-7. The 111 111 m per
+degree shortcut of the paper is never used.
+
+Coordinates are always passed as ``(lon, lat)`` / ``(east, north)`` in that order,
+like pyproj's ``always_xy=True``.
+
+Examples
+--------
+>>> frame = LocalFrame(39.2851, -76.6120)
+>>> e, n = frame.enu_from_geographic(-76.6120, 39.2860)
+>>> round(float(e), 6), round(float(n), 1)
+(0.0, 99.9)
+>>> lon, lat = frame.geographic_from_enu(e, n)
+>>> round(float(lat), 7)
+39.286
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from pyproj import CRS, Geod, Transformer
+
+__all__ = [
+    "GEOD",
+    "LocalFrame",
+    "bearing_deg",
+    "distance_m",
+    "normalize_bearing_deg",
+]
+
+GEOD = Geod(ellps="WGS84")
+"""The WGS 84 ellipsoid, for geodesic distances and bearings."""
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def normalize_bearing_deg(bearing_deg: Any) -> Any:
+    """Wrap bearings into [0, 360).
+
+    Parameters
+    ----------
+    bearing_deg
+        One bearing or an array of bearings, degrees.
+
+    Returns
+    -------
+    The same kind of value, wrapped into [0, 360).
+    """
+    wrapped = np.mod(np.asarray(bearing_deg, dtype=float), 360.0)
+    wrapped = np.where(wrapped >= 360.0, 0.0, wrapped)
+    return float(wrapped) if np.ndim(wrapped) == 0 else wrapped
+
+
+def bearing_deg(lon1: float, lat1: float, lon2: float, lat2: float) -> float:
+    """Geodesic bearing from point 1 to point 2, degrees clockwise from true north in [0, 360)."""
+    fwd, _back, _dist = GEOD.inv(lon1, lat1, lon2, lat2)
+    return float(normalize_bearing_deg(fwd))
+
+
+def distance_m(lon1: Any, lat1: Any, lon2: Any, lat2: Any) -> Any:
+    """Geodesic distance on WGS 84, metres (scalars or arrays)."""
+    _fwd, _back, dist = GEOD.inv(lon1, lat1, lon2, lat2)
+    return dist
+
+
+@lru_cache(maxsize=256)
+def _transformer_pair(lat0: float, lon0: float) -> tuple[Transformer, Transformer]:
+    local = CRS.from_proj4(
+        f"+proj=aeqd +lat_0={lat0:.10f} +lon_0={lon0:.10f} +x_0=0 +y_0=0 +ellps=WGS84 +units=m"
+    )
+    fwd = Transformer.from_crs("EPSG:4326", local, always_xy=True)
+    inv = Transformer.from_crs(local, "EPSG:4326", always_xy=True)
+    return fwd, inv
+
+
+class LocalFrame:
+    """A local east/north frame in metres around an anchor point.
+
+    Parameters
+    ----------
+    lat0, lon0
+        The anchor, degrees WGS 84. It is the frame's origin.
+    """
+
+    def __init__(self, lat0: float, lon0: float) -> None:
+        if not (math.isfinite(lat0) and math.isfinite(lon0)):
+            raise ValueError(f"anchor must be finite, got lat={lat0}, lon={lon0}")
+        if not (-90.0 <= lat0 <= 90.0 and -180.0 <= lon0 <= 180.0):
+            raise ValueError(f"anchor out of range: lat={lat0}, lon={lon0}")
+        self.lat0 = float(lat0)
+        self.lon0 = float(lon0)
+        self._enu_from_lonlat, self._lonlat_from_enu = _transformer_pair(self.lat0, self.lon0)
+
+    def __repr__(self) -> str:
+        return f"LocalFrame(lat0={self.lat0!r}, lon0={self.lon0!r})"
+
+    def enu_from_geographic(self, lon: Any, lat: Any) -> tuple[Any, Any]:
+        """Project geographic coordinates to (east, north) metres; scalars or arrays."""
+        east, north = self._enu_from_lonlat.transform(lon, lat)
+        return east, north
+
+    def geographic_from_enu(self, east: Any, north: Any) -> tuple[Any, Any]:
+        """Inverse of :meth:`enu_from_geographic`: (lon, lat) degrees."""
+        lon, lat = self._lonlat_from_enu.transform(east, north)
+        return lon, lat
+
+    def points_enu_from_geographic(self, lonlat: npt.ArrayLike) -> FloatArray:
+        """(N, 2) array of ``[lon, lat]`` to (N, 2) array of ``[east, north]``."""
+        arr = np.asarray(lonlat, dtype=float).reshape(-1, 2)
+        east, north = self._enu_from_lonlat.transform(arr[:, 0], arr[:, 1])
+        return np.column_stack([east, north]).astype(np.float64)
+
+    def points_geographic_from_enu(self, en: npt.ArrayLike) -> FloatArray:
+        """(N, 2) array of ``[east, north]`` to (N, 2) array of ``[lon, lat]``."""
+        arr = np.asarray(en, dtype=float).reshape(-1, 2)
+        lon, lat = self._lonlat_from_enu.transform(arr[:, 0], arr[:, 1])
+        return np.column_stack([lon, lat]).astype(np.float64)
