@@ -1,0 +1,44 @@
+"""The OpenStreetMap layer: streets, intersection kerb corners and buildings around a point.
+
+>>> from camloc_geo.osm import load_map                      # doctest: +SKIP
+>>> m = load_map("sample_maps/baltimore.osm.pbf", 39.2851, -76.5934, radius_m=200)
+>>> x = m.find_intersection("Eastern Ave & S Broadway")
+>>> [(c.order, c.streets) for c in x.corners], x.corner_distances_m
+
+See :mod:`camloc_geo.osm._intersections` for how intersections and corners are modelled
+and :mod:`camloc_geo.osm._widths` for carriageway widths.
+"""
+
+from __future__ import annotations
+
+from camloc_geo.osm._geojson import intersections_geojson, streets_json
+from camloc_geo.osm._intersections import (
+    ARM_SAMPLE_M,
+    MAX_CORNER_GAP_DEG,
+    MIN_CORNER_GAP_DEG,
+)
+from camloc_geo.osm._load import STREET_HIGHWAYS, clear_cache
+from camloc_geo.osm._map import DEFAULT_TOLERANCE_M, MapData, load_map
+from camloc_geo.osm._model import Building, Corner, IncidentStreet, Intersection, Street
+from camloc_geo.osm._names import normalize_name
+from camloc_geo.osm._widths import resolve_width_m
+
+__all__ = [
+    "ARM_SAMPLE_M",
+    "DEFAULT_TOLERANCE_M",
+    "MAX_CORNER_GAP_DEG",
+    "MIN_CORNER_GAP_DEG",
+    "STREET_HIGHWAYS",
+    "Building",
+    "Corner",
+    "IncidentStreet",
+    "Intersection",
+    "MapData",
+    "Street",
+    "clear_cache",
+    "intersections_geojson",
+    "load_map",
+    "normalize_name",
+    "resolve_width_m",
+    "streets_json",
+]

@@ -1,0 +1,488 @@
+"""Consolidated intersections, their incident streets and kerb corners.
+
+Method
+------
+1. The simplified street graph (osmnx) is projected to the map's local azimuthal
+   equidistant frame and consolidated with :func:`osmnx.consolidate_intersections`
+   (``tolerance`` metres buffer per node: nodes closer than twice that and connected
+   inside the cluster become one intersection, e.g. the four nodes of a dual carriageway
+   crossing).
+2. Each edge leaving a consolidated node is an *arm*. Its direction is measured near the
+   junction: from the node where it leaves the cluster to the point :data:`ARM_SAMPLE_M`
+   metres along it (the whole edge if shorter), with :func:`osmnx.bearing.calculate_bearing`.
+   Slip roads (``*_link``) are ignored; the two one-way carriageways of a dual road (same
+   name, opposite flow, bearings within :data:`DUAL_MAX_ANGLE_DEG`) are merged into one
+   street whose kerbs are the outer kerbs of the pair.
+3. Each street's kerbs are its centre line offset by half the carriageway width
+   (:mod:`camloc_geo.osm._widths`). The kerb corner between two angularly adjacent
+   streets is where the clockwise-side kerb of the first meets the counter-clockwise-side
+   kerb of the next.
+
+Which gaps get a corner (consistency matters more than anything for sequence matching):
+
+- a gap between adjacent streets of :data:`MAX_CORNER_GAP_DEG` or more has no corner:
+  the kerb runs on (nearly) straight, so the side of a T junction opposite the stem has
+  no corner; a T has 2 corners, a crossing 4, a Y 3, a five-way junction 5;
+- a gap under :data:`MIN_CORNER_GAP_DEG` (two streets leaving almost together), a kerb
+  intersection behind the junction or farther than :data:`MAX_CORNER_DISTANCE_M`, or more
+  than :data:`MAX_STREETS` streets makes the junction ``"unmodelled"``: no corners at all,
+  and a warning saying why;
+- roundabouts (``junction=roundabout|circular``) are ``"roundabout"``, without corners.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+import networkx as nx
+import numpy as np
+import osmnx as ox
+from shapely.geometry import LineString
+
+from camloc_geo.geodesy import LocalFrame, bearing_deg
+from camloc_geo.osm._model import Corner, IncidentStreet, Intersection
+from camloc_geo.osm._names import normalize_name
+from camloc_geo.osm._widths import _first, parse_lanes, resolve_width_m
+
+__all__ = [
+    "ARM_SAMPLE_M",
+    "DUAL_MAX_ANGLE_DEG",
+    "MAX_CORNER_DISTANCE_M",
+    "MAX_CORNER_GAP_DEG",
+    "MAX_STREETS",
+    "MIN_CORNER_GAP_DEG",
+    "build_intersections",
+    "street_label",
+]
+
+log = logging.getLogger(__name__)
+
+ARM_SAMPLE_M = 20.0
+"""Length of street near the junction whose direction gives a street's bearing, metres."""
+DUAL_MAX_ANGLE_DEG = 35.0
+"""Two opposite one-way carriageways of one name closer than this in bearing are one street."""
+MIN_CORNER_GAP_DEG = 15.0
+"""Adjacent streets closer than this in bearing make the junction unmodelled."""
+MAX_CORNER_GAP_DEG = 160.0
+"""Adjacent streets this far apart or more have no kerb corner between them."""
+MAX_CORNER_DISTANCE_M = 40.0
+"""A kerb corner farther than this from the centre means the junction is unmodelled."""
+MAX_STREETS = 6
+"""Junctions with more streets are unmodelled."""
+
+_ROUNDABOUT = {"roundabout", "circular"}
+
+
+def street_label(data: dict[str, Any]) -> tuple[str, tuple[str, ...]]:
+    """A street's display name and all its names from osmnx edge data.
+
+    ``name``; else ``ref``; else ``"unnamed <highway>"``.
+    """
+    raw = data.get("name")
+    names: list[str] = []
+    for value in raw if isinstance(raw, list) else [raw]:
+        if isinstance(value, str) and value.strip():
+            names.extend(v.strip() for v in value.split(";") if v.strip())
+    if not names:
+        ref = _first(data.get("ref"))
+        if isinstance(ref, str) and ref.strip():
+            names = [ref.strip()]
+    if not names:
+        return f"unnamed {highway_of(data)}", ()
+    names = list(dict.fromkeys(names))
+    return names[0], tuple(names)
+
+
+def highway_of(data: dict[str, Any]) -> str:
+    """The ``highway`` value of osmnx edge data (the first one of a merged edge)."""
+    value = _first(data.get("highway"))
+    return str(value) if value else "road"
+
+
+def _is_oneway(data: dict[str, Any]) -> bool:
+    value = data.get("oneway")
+    if isinstance(value, list):
+        return bool(all(value))
+    return bool(value)
+
+
+@dataclass
+class _Arm:
+    coords: np.ndarray  # (N, 2) ENU, outward from the intersection
+    origin: np.ndarray  # (2,)
+    direction: np.ndarray  # (2,) unit
+    bearing: float
+    flow: str  # "both" | "out" | "in"
+    data: dict[str, Any]
+    name: str
+    names: tuple[str, ...]
+    highway: str
+    width_m: float
+    width_source: str
+    lanes: float | None
+    edge: tuple[int, int]
+
+
+@dataclass
+class _Street:
+    name: str
+    names: tuple[str, ...]
+    highway: str
+    oneway: bool
+    lanes: float | None
+    width_m: float
+    width_source: str
+    carriageways: int
+    origin: np.ndarray
+    direction: np.ndarray
+    s_left: float  # signed offsets along the right normal: left kerb (negative)
+    s_right: float  # right kerb (positive)
+    bearing: float
+    edge: tuple[int, int]
+
+
+def _right_normal(d: np.ndarray) -> np.ndarray:
+    return np.array([d[1], -d[0]])
+
+
+def _bearing_enu(frame: LocalFrame, p0: np.ndarray, p1: np.ndarray) -> float:
+    (lon0, lon1), (lat0, lat1) = frame.geographic_from_enu(
+        np.array([p0[0], p1[0]]), np.array([p0[1], p1[1]])
+    )
+    return float(ox.bearing.calculate_bearing(lat0, lon0, lat1, lon1)) % 360.0
+
+
+def _angle_diff(a: float, b: float) -> float:
+    d = abs(a - b) % 360.0
+    return min(d, 360.0 - d)
+
+
+def _make_arm(
+    coords: list[tuple[float, float]],
+    flow: str,
+    data: dict[str, Any],
+    edge: tuple[int, int],
+    frame: LocalFrame,
+    north_america: bool,
+) -> _Arm | None:
+    line = LineString(coords)
+    if line.length < 0.5:
+        return None
+    p0 = np.asarray(coords[0], dtype=float)
+    p1_pt = line.interpolate(min(ARM_SAMPLE_M, line.length))
+    p1 = np.array([p1_pt.x, p1_pt.y])
+    vec = p1 - p0
+    norm = float(np.hypot(*vec))
+    if norm < 1e-3:
+        return None
+    name, names = street_label(data)
+    highway = highway_of(data)
+    oneway = flow != "both"
+    width, source = resolve_width_m(
+        width=data.get("width"),
+        lanes=data.get("lanes"),
+        highway=highway,
+        oneway=oneway,
+        north_america=north_america,
+    )
+    return _Arm(
+        coords=np.asarray(coords, dtype=float),
+        origin=p0,
+        direction=vec / norm,
+        bearing=_bearing_enu(frame, p0, p1),
+        flow=flow,
+        data=data,
+        name=name,
+        names=names,
+        highway=highway,
+        width_m=width,
+        width_source=source,
+        lanes=parse_lanes(data.get("lanes")),
+        edge=edge,
+    )
+
+
+def _arms_of(
+    Gc: nx.MultiDiGraph, node: Any, frame: LocalFrame, north_america: bool
+) -> tuple[list[_Arm], list[str]]:
+    multi = isinstance(Gc.nodes[node].get("osmid_original"), list)
+    found: dict[tuple[Any, ...], tuple[list[tuple[float, float]], set[str], dict[str, Any], Any]]
+    found = {}
+    warnings: list[str] = []
+    for u, v, data in Gc.out_edges(node, data=True):
+        if u == v:
+            warnings.append("a loop street at the junction was ignored")
+            continue
+        coords = list(data["geometry"].coords)
+        if multi:
+            coords = coords[1:]
+        edge = (data.get("u_original", u), data.get("v_original", v))
+        key = (v, tuple(np.round(np.asarray(coords), 2).ravel().tolist()))
+        entry = found.setdefault(key, (coords, set(), data, edge))
+        entry[1].add("out")
+    for u, v, data in Gc.in_edges(node, data=True):
+        if u == v:
+            continue
+        coords = list(data["geometry"].coords)[::-1]
+        if multi:
+            coords = coords[1:]
+        edge = (data.get("v_original", v), data.get("u_original", u))
+        key = (u, tuple(np.round(np.asarray(coords), 2).ravel().tolist()))
+        entry = found.setdefault(key, (coords, set(), data, edge))
+        entry[1].add("in")
+    arms: list[_Arm] = []
+    for coords, flows, data, edge in found.values():
+        flow = "both" if len(flows) == 2 or not _is_oneway(data) else next(iter(flows))
+        arm = _make_arm(coords, flow, data, edge, frame, north_america)
+        if arm is not None:
+            arms.append(arm)
+    return arms, list(dict.fromkeys(warnings))
+
+
+def _name_key(arm: _Arm) -> str:
+    return normalize_name(arm.name) if arm.names else f"~{arm.highway}"
+
+
+def _single_street(arm: _Arm) -> _Street:
+    half = arm.width_m / 2.0
+    return _Street(
+        name=arm.name,
+        names=arm.names,
+        highway=arm.highway,
+        oneway=arm.flow != "both",
+        lanes=arm.lanes,
+        width_m=arm.width_m,
+        width_source=arm.width_source,
+        carriageways=1,
+        origin=arm.origin,
+        direction=arm.direction,
+        s_left=-half,
+        s_right=half,
+        bearing=arm.bearing,
+        edge=arm.edge,
+    )
+
+
+def _dual_street(a: _Arm, b: _Arm, frame: LocalFrame) -> _Street:
+    d = a.direction + b.direction
+    d = d / float(np.hypot(*d))
+    r = _right_normal(d)
+    origin = (a.origin + b.origin) / 2.0
+    offs = [float((arm.origin - origin) @ r) for arm in (a, b)]
+    s_right = max(off + arm.width_m / 2.0 for off, arm in zip(offs, (a, b), strict=True))
+    s_left = min(off - arm.width_m / 2.0 for off, arm in zip(offs, (a, b), strict=True))
+    lanes = a.lanes + b.lanes if a.lanes is not None and b.lanes is not None else None
+    out_arm = a if a.flow == "out" else b
+    return _Street(
+        name=a.name,
+        names=tuple(dict.fromkeys(a.names + b.names)),
+        highway=a.highway,
+        oneway=False,
+        lanes=lanes,
+        width_m=s_right - s_left,
+        width_source=a.width_source if a.width_source == b.width_source else "mixed",
+        carriageways=2,
+        origin=origin,
+        direction=d,
+        s_left=s_left,
+        s_right=s_right,
+        bearing=_bearing_enu(frame, origin, origin + ARM_SAMPLE_M * d),
+        edge=out_arm.edge,
+    )
+
+
+def _group_streets(arms: list[_Arm], frame: LocalFrame) -> list[_Street]:
+    """Merge the two carriageways of dual roads; one street per remaining arm."""
+    pairs: list[tuple[float, int, int]] = []
+    for i, a in enumerate(arms):
+        for j in range(i + 1, len(arms)):
+            b = arms[j]
+            if {a.flow, b.flow} != {"in", "out"} or _name_key(a) != _name_key(b):
+                continue
+            diff = _angle_diff(a.bearing, b.bearing)
+            if diff <= DUAL_MAX_ANGLE_DEG:
+                pairs.append((diff, i, j))
+    used: set[int] = set()
+    streets: list[_Street] = []
+    for _diff, i, j in sorted(pairs):
+        if i in used or j in used:
+            continue
+        used.update((i, j))
+        streets.append(_dual_street(arms[i], arms[j], frame))
+    streets.extend(_single_street(arm) for k, arm in enumerate(arms) if k not in used)
+    streets.sort(key=lambda s: s.bearing)
+    return streets
+
+
+def _kerb_corner(a: _Street, b: _Street) -> np.ndarray | None:
+    """Where a's right (clockwise-side) kerb meets b's left kerb; None if they do not."""
+    ra, rb = _right_normal(a.direction), _right_normal(b.direction)
+    pa = a.origin + a.s_right * ra
+    pb = b.origin + b.s_left * rb
+    mat = np.column_stack([a.direction, -b.direction])
+    if abs(float(np.linalg.det(mat))) < 1e-9:
+        return None
+    t, u = np.linalg.solve(mat, pb - pa)
+    slack = -max(a.width_m, b.width_m)
+    if t < slack or u < slack:
+        return None
+    return np.asarray(pa + t * a.direction, dtype=float)
+
+
+def _is_roundabout(G: nx.MultiDiGraph, osm_nodes: list[Any]) -> bool:
+    for n in osm_nodes:
+        if n not in G:
+            continue
+        for _u, _v, data in list(G.out_edges(n, data=True)) + list(G.in_edges(n, data=True)):
+            junction = data.get("junction")
+            values = junction if isinstance(junction, list) else [junction]
+            if any(str(j) in _ROUNDABOUT for j in values if j):
+                return True
+    return False
+
+
+def _model_corners(
+    streets: list[_Street], centre: np.ndarray
+) -> tuple[list[tuple[np.ndarray, _Street, _Street]], str | None]:
+    """Kerb corners between adjacent streets, or the reason the junction is unmodelled."""
+    if len(streets) > MAX_STREETS:
+        return [], f"{len(streets)} streets meet (more than {MAX_STREETS})"
+    corners: list[tuple[np.ndarray, _Street, _Street]] = []
+    n = len(streets)
+    for i in range(n):
+        a, b = streets[i], streets[(i + 1) % n]
+        gap = (b.bearing - a.bearing) % 360.0
+        if gap >= MAX_CORNER_GAP_DEG:
+            continue
+        if gap < MIN_CORNER_GAP_DEG:
+            return [], f"{a.name!r} and {b.name!r} leave only {gap:.0f}° apart"
+        point = _kerb_corner(a, b)
+        if point is None:
+            return [], f"the kerbs of {a.name!r} and {b.name!r} do not meet"
+        dist = float(np.hypot(*(point - centre)))
+        if dist > MAX_CORNER_DISTANCE_M:
+            return [], f"the kerbs of {a.name!r} and {b.name!r} meet {dist:.0f} m from the centre"
+        corners.append((point, a, b))
+    return corners, None
+
+
+def build_intersections(
+    G: nx.MultiDiGraph,
+    frame: LocalFrame,
+    *,
+    tolerance_m: float = 10.0,
+    radius_m: float | None = None,
+    north_america: bool = False,
+) -> list[Intersection]:
+    """Consolidated intersections of an unprojected osmnx street graph.
+
+    Parameters
+    ----------
+    G
+        Simplified osmnx graph in lon/lat (``x``/``y`` node attributes).
+    frame
+        The map's local frame; the graph is projected to its azimuthal equidistant CRS.
+    tolerance_m
+        Buffer per node for :func:`osmnx.consolidate_intersections`, metres.
+    radius_m
+        Keep intersections whose centre is within this distance of the frame's anchor;
+        None keeps all.
+    north_america
+        Apply US/Canada width conventions.
+
+    Returns
+    -------
+    Intersections (kind ``junction``, ``roundabout`` or ``unmodelled``), nearest first.
+    """
+    if G.number_of_edges() == 0:
+        return []
+    crs = (
+        f"+proj=aeqd +lat_0={frame.lat0:.10f} +lon_0={frame.lon0:.10f} "
+        "+x_0=0 +y_0=0 +ellps=WGS84 +units=m"
+    )
+    Gp = ox.project_graph(G, to_crs=crs)
+    Gc = ox.consolidate_intersections(
+        Gp, tolerance=tolerance_m, rebuild_graph=True, dead_ends=True, reconnect_edges=True
+    )
+    out: list[tuple[float, Intersection]] = []
+    for node, ndata in Gc.nodes(data=True):
+        if Gc.degree(node) < 3:
+            continue
+        centre = np.array([ndata["x"], ndata["y"]], dtype=float)
+        dist_centre = float(np.hypot(*centre))
+        if radius_m is not None and dist_centre > radius_m:
+            continue
+        arms, warnings = _arms_of(Gc, node, frame, north_america)
+        links = [a for a in arms if a.highway.endswith("_link")]
+        arms = [a for a in arms if not a.highway.endswith("_link")]
+        if links:
+            warnings.append(f"{len(links)} slip road(s) ignored")
+        streets = _group_streets(arms, frame)
+        if len(streets) < 3:
+            continue
+        raw = ndata.get("osmid_original")
+        osm_nodes = [int(x) for x in (raw if isinstance(raw, list) else [raw])]
+        ident = f"n{osm_nodes[0]}" if len(osm_nodes) == 1 else f"c{min(osm_nodes)}"
+        lon, lat = frame.geographic_from_enu(centre[0], centre[1])
+        kind = "junction"
+        modelled: list[tuple[np.ndarray, _Street, _Street]] = []
+        if _is_roundabout(Gp, osm_nodes):
+            kind = "roundabout"
+            warnings.append("roundabout: kerb corners not modelled")
+        else:
+            modelled, reason = _model_corners(streets, centre)
+            if reason:
+                kind = "unmodelled"
+                warnings.append(f"unmodelled junction: {reason}")
+        corner_rows = []
+        for point, a, b in modelled:
+            clon, clat = frame.geographic_from_enu(point[0], point[1])
+            corner_rows.append(
+                (bearing_deg(float(lon), float(lat), float(clon), float(clat)), clat, clon, a, b)
+            )
+        corner_rows.sort(key=lambda row: row[0])
+        corners = tuple(
+            Corner(
+                intersection_id=ident,
+                order=k,
+                lat=float(clat),
+                lon=float(clon),
+                streets=(a.name, b.name),
+            )
+            for k, (_b, clat, clon, a, b) in enumerate(corner_rows)
+        )
+        incident = tuple(
+            IncidentStreet(
+                name=s.name,
+                bearing_deg=round(s.bearing, 9) % 360.0,
+                highway=s.highway,
+                oneway=s.oneway,
+                lanes=s.lanes,
+                width_m=round(s.width_m, 6),
+                width_source=s.width_source,
+                carriageways=s.carriageways,
+                names=s.names,
+                edge=(int(s.edge[0]), int(s.edge[1])),
+            )
+            for s in streets
+        )
+        out.append(
+            (
+                dist_centre,
+                Intersection(
+                    id=ident,
+                    lat=float(lat),
+                    lon=float(lon),
+                    streets=incident,
+                    corners=corners,
+                    kind=kind,
+                    warnings=tuple(dict.fromkeys(warnings)),
+                    osm_nodes=tuple(osm_nodes),
+                ),
+            )
+        )
+    out.sort(key=lambda row: row[0])
+    log.debug("%d intersections built", len(out))
+    return [row[1] for row in out]

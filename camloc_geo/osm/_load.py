@@ -1,0 +1,396 @@
+"""Loading OSM data around a point: local extracts (pyosmium + osmnx) or live Overpass.
+
+Offline, the extract is read once with pyosmium (PBF or XML, plain/gzip/bzip2), keeping only
+the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
+``radius_m + CLIP_MARGIN_M`` of the point (whole ways, so every street through a kept
+intersection is complete). Those are written to a small temporary OSM XML file from which
+:func:`osmnx.graph_from_xml` builds the simplified street graph. Online,
+:func:`osmnx.graph_from_point` and :func:`osmnx.features_from_point` query Overpass with
+osmnx's HTTP cache; osmnx settings are changed only inside :func:`osmnx_settings`.
+
+Loaded maps are cached in process, keyed by file path, modification time and size, the
+point, the radius and the options (or the Overpass URL), so the same area is not parsed
+twice.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import os
+import tempfile
+import threading
+from collections import OrderedDict
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+from xml.sax.saxutils import quoteattr
+
+import networkx as nx
+import osmium
+import osmnx as ox
+import requests
+
+from camloc_geo._errors import MapDataError, MapSourceError
+from camloc_geo.geodesy import GEOD
+from camloc_geo.osm._model import Building, polygon_from_lonlat
+from camloc_geo.osm._widths import parse_lanes, parse_width_m
+
+__all__ = [
+    "CLIP_MARGIN_M",
+    "EXTRACT_SUFFIXES",
+    "STREET_HIGHWAYS",
+    "RawMap",
+    "clear_cache",
+    "osmnx_settings",
+    "read_extract",
+    "read_overpass",
+]
+
+log = logging.getLogger(__name__)
+
+STREET_HIGHWAYS: frozenset[str] = frozenset(
+    {
+        "motorway",
+        "trunk",
+        "primary",
+        "secondary",
+        "tertiary",
+        "unclassified",
+        "residential",
+        "living_street",
+        "road",
+        "busway",
+        "motorway_link",
+        "trunk_link",
+        "primary_link",
+        "secondary_link",
+        "tertiary_link",
+    }
+)
+"""``highway`` values that form the street network (no service roads, paths or footways)."""
+
+CLIP_MARGIN_M = 60.0
+"""Data is kept this far beyond the requested radius so edge clusters are complete."""
+
+EXTRACT_SUFFIXES = (".osm", ".osm.gz", ".osm.bz2", ".osm.pbf", ".pbf", ".xml", ".osm.xml")
+
+_BUILDING_KEYS = ("name", "addr:housename", "brand", "height", "building:levels", "building")
+
+
+@dataclass
+class RawMap:
+    """What a source yields before intersections are built."""
+
+    graph: nx.MultiDiGraph
+    buildings: list[Building] = field(default_factory=list)
+    bounds: tuple[float, float, float, float] | None = None  # (south, west, north, east)
+    source: str = ""
+
+
+_SETTINGS_LOCK = threading.RLock()
+
+
+@contextlib.contextmanager
+def osmnx_settings(**values: Any) -> Iterator[None]:
+    """Set ``osmnx.settings`` attributes for the duration of a block, then restore them.
+
+    Values that are None are left alone.
+    """
+    saved: dict[str, Any] = {}
+    with _SETTINGS_LOCK:
+        try:
+            for key, value in values.items():
+                if value is None:
+                    continue
+                saved[key] = getattr(ox.settings, key)
+                setattr(ox.settings, key, value)
+            yield
+        finally:
+            for key, value in saved.items():
+                setattr(ox.settings, key, value)
+
+
+def _clip_box(lat: float, lon: float, radius_m: float) -> tuple[float, float, float, float]:
+    """(south, west, north, east) of the box enclosing a circle, degrees."""
+    _lon, north, _ = GEOD.fwd(lon, lat, 0.0, radius_m)
+    _lon, south, _ = GEOD.fwd(lon, lat, 180.0, radius_m)
+    east, _lat, _ = GEOD.fwd(lon, lat, 90.0, radius_m)
+    west, _lat, _ = GEOD.fwd(lon, lat, 270.0, radius_m)
+    return float(south), float(west), float(north), float(east)
+
+
+def _num(value: str | None) -> float | None:
+    if value is None:
+        return None
+    return parse_lanes(value) if value else None
+
+
+def _building_from_tags(ident: str, tags: dict[str, str], poly: Any) -> Building:
+    name = tags.get("name") or tags.get("addr:housename") or tags.get("brand") or None
+    return Building(
+        id=ident,
+        name=name,
+        footprint=poly,
+        height_m=parse_width_m(tags.get("height")) if tags.get("height") else None,
+        levels=_num(tags.get("building:levels")),
+        building=tags.get("building") or "yes",
+    )
+
+
+def _check_extract_path(path: Path) -> None:
+    if not path.exists():
+        raise MapDataError(f"OSM extract not found: {path}")
+    if not path.is_file():
+        raise MapDataError(f"OSM extract is not a file: {path}")
+    name = path.name.lower()
+    if not name.endswith(EXTRACT_SUFFIXES):
+        raise MapDataError(
+            f"unsupported OSM extract {path.name!r}: expected .osm, .osm.gz, .osm.bz2 or .osm.pbf"
+        )
+    if path.stat().st_size == 0:
+        raise MapDataError(f"OSM extract is empty: {path}")
+
+
+def _header_box(path: Path) -> tuple[float, float, float, float] | None:
+    try:
+        reader = osmium.io.Reader(str(path), osmium.osm.NOTHING)
+        try:
+            box = reader.header().box()
+        finally:
+            reader.close()
+    except RuntimeError:
+        return None
+    if not box.valid():
+        return None
+    return (box.bottom_left.lat, box.bottom_left.lon, box.top_right.lat, box.top_right.lon)
+
+
+def read_extract(
+    path: Path,
+    lat: float,
+    lon: float,
+    radius_m: float | None,
+    *,
+    highways: frozenset[str] = STREET_HIGHWAYS,
+) -> RawMap:
+    """Read the streets and buildings of an extract around a point.
+
+    Parameters
+    ----------
+    path
+        ``.osm``, ``.osm.gz``, ``.osm.bz2`` or ``.osm.pbf`` file.
+    lat, lon
+        The point, degrees.
+    radius_m
+        Keep ways with a node within ``radius_m + CLIP_MARGIN_M``; None keeps everything.
+    highways
+        ``highway`` values to keep as streets.
+
+    Raises
+    ------
+    MapDataError
+        Unreadable or empty extract, point outside it, or no streets near the point.
+    """
+    _check_extract_path(path)
+    box = None if radius_m is None else _clip_box(lat, lon, radius_m + CLIP_MARGIN_M)
+    street_ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]] = []
+    buildings: list[Building] = []
+    s_min, w_min, n_max, e_max = math.inf, math.inf, -math.inf, -math.inf
+    n_ways = 0
+    try:
+        processor = (
+            osmium.FileProcessor(str(path), osmium.osm.NODE | osmium.osm.WAY)
+            .with_locations()
+            .with_filter(osmium.filter.EntityFilter(osmium.osm.WAY))
+            .with_filter(osmium.filter.KeyFilter("highway", "building"))
+        )
+        for obj in processor:
+            if not isinstance(obj, osmium.osm.Way):
+                continue
+            way = obj
+            n_ways += 1
+            highway = way.tags.get("highway")
+            is_street = highway in highways
+            is_building = "building" in way.tags and not is_street
+            if not (is_street or is_building):
+                continue
+            nodes: list[tuple[int, float, float]] = []
+            inside = box is None
+            for nd in way.nodes:
+                loc = nd.location
+                if not loc.valid():
+                    continue
+                y, x = loc.lat, loc.lon
+                nodes.append((nd.ref, y, x))
+                s_min, n_max = min(s_min, y), max(n_max, y)
+                w_min, e_max = min(w_min, x), max(e_max, x)
+                if not inside and box is not None:
+                    inside = box[0] <= y <= box[2] and box[1] <= x <= box[3]
+            if not inside or len(nodes) < 2:
+                continue
+            if is_street:
+                street_ways.append((way.id, dict(way.tags), nodes))
+            elif way.is_closed() and len(nodes) >= 4:
+                poly = polygon_from_lonlat([(x, y) for _r, y, x in nodes])
+                if poly is not None:
+                    tags = {k: way.tags[k] for k in _BUILDING_KEYS if k in way.tags}
+                    buildings.append(_building_from_tags(f"way/{way.id}", tags, poly))
+    except RuntimeError as exc:  # osmium's parse errors
+        raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
+    except (OSError, EOFError, ValueError) as exc:
+        raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
+
+    bounds = _header_box(path)
+    if bounds is None and math.isfinite(s_min):
+        bounds = (s_min, w_min, n_max, e_max)
+    if n_ways == 0 or bounds is None:
+        raise MapDataError(f"OSM extract {path.name} holds no streets or buildings")
+    if not (bounds[0] <= lat <= bounds[2] and bounds[1] <= lon <= bounds[3]):
+        raise MapDataError(
+            f"point lat={lat:.6f}, lon={lon:.6f} is outside the extract {path.name} "
+            f"(it covers lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
+            f"lon {bounds[1]:.5f}..{bounds[3]:.5f})"
+        )
+    if not street_ways:
+        raise MapDataError(
+            f"no streets within {radius_m:.0f} m of lat={lat:.6f}, lon={lon:.6f} in {path.name}"
+        )
+    graph = _graph_from_ways(street_ways)
+    return RawMap(graph=graph, buildings=buildings, bounds=bounds, source=str(path))
+
+
+def _graph_from_ways(ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]]) -> Any:
+    """Build the simplified osmnx graph from street ways via a temporary OSM XML file."""
+    nodes: dict[int, tuple[float, float]] = {}
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="camloc_geo">']
+    way_lines: list[str] = []
+    for way_id, tags, refs in ways:
+        way_lines.append(f'<way id="{way_id}">')
+        for ref, y, x in refs:
+            nodes[ref] = (y, x)
+            way_lines.append(f'<nd ref="{ref}"/>')
+        way_lines.extend(f"<tag k={quoteattr(k)} v={quoteattr(v)}/>" for k, v in tags.items())
+        way_lines.append("</way>")
+    lines.extend(f'<node id="{ref}" lat="{y:.7f}" lon="{x:.7f}"/>' for ref, (y, x) in nodes.items())
+    lines.extend(way_lines)
+    lines.append("</osm>")
+    with tempfile.TemporaryDirectory(prefix="camloc_osm_") as tmp:
+        xml_path = Path(tmp) / "streets.osm"
+        xml_path.write_text("\n".join(lines), encoding="utf-8")
+        with osmnx_settings(log_console=False):
+            return ox.graph_from_xml(xml_path, bidirectional=False, simplify=True, retain_all=True)
+
+
+def overpass_filter(highways: frozenset[str]) -> str:
+    """The osmnx ``custom_filter`` selecting :data:`STREET_HIGHWAYS` ways."""
+    alternatives = "|".join(sorted(highways))
+    return f'["highway"~"^({alternatives})$"]["area"!~"yes"]'
+
+
+def read_overpass(
+    lat: float,
+    lon: float,
+    radius_m: float,
+    *,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+    overpass_rate_limit: bool = True,
+    timeout_s: float = 60.0,
+    highways: frozenset[str] = STREET_HIGHWAYS,
+) -> RawMap:
+    """Query streets and buildings around a point from Overpass through osmnx.
+
+    Raises
+    ------
+    MapSourceError
+        The server could not be reached or answered with an error.
+    MapDataError
+        The server returned no streets there.
+    """
+    settings: dict[str, Any] = {
+        "use_cache": True,
+        "overpass_rate_limit": overpass_rate_limit,
+        "requests_timeout": timeout_s,
+        "log_console": False,
+    }
+    if cache_folder is not None:
+        settings["cache_folder"] = str(cache_folder)
+    if overpass_url is not None:
+        settings["overpass_url"] = overpass_url.rstrip("/")
+    where = f"lat={lat:.6f}, lon={lon:.6f}"
+    try:
+        with osmnx_settings(**settings):
+            graph = ox.graph_from_point(
+                (lat, lon),
+                dist=radius_m + CLIP_MARGIN_M,
+                dist_type="bbox",
+                simplify=True,
+                retain_all=True,
+                truncate_by_edge=True,
+                custom_filter=overpass_filter(highways),
+            )
+            try:
+                features = ox.features_from_point(
+                    (lat, lon), tags={"building": True}, dist=radius_m
+                )
+            except ox._errors.InsufficientResponseError:
+                features = None
+    except ox._errors.InsufficientResponseError as exc:
+        raise MapDataError(
+            f"Overpass returned no streets within {radius_m:.0f} m of {where}"
+        ) from exc
+    except ox._errors.ResponseStatusCodeError as exc:
+        raise MapSourceError(f"Overpass server error for {where}: {exc}") from exc
+    except requests.exceptions.RequestException as exc:
+        raise MapSourceError(
+            f"cannot reach the Overpass server {overpass_url or ox.settings.overpass_url}: "
+            f"{type(exc).__name__}"
+        ) from exc
+    buildings: list[Building] = []
+    if features is not None and len(features):
+        for idx, row in features.iterrows():
+            geom = row.geometry
+            if geom is None or geom.geom_type not in ("Polygon", "MultiPolygon"):
+                continue
+            if geom.geom_type == "MultiPolygon":
+                geom = max(geom.geoms, key=lambda g: g.area)
+            tags = {
+                k: str(row[k])
+                for k in _BUILDING_KEYS
+                if k in row.index and isinstance(row[k], str) and row[k]
+            }
+            element, osm_id = idx if isinstance(idx, tuple) else ("way", idx)
+            buildings.append(_building_from_tags(f"{element}/{osm_id}", tags, geom))
+    return RawMap(graph=graph, buildings=buildings, source=overpass_url or "overpass")
+
+
+_CACHE: OrderedDict[tuple[Any, ...], Any] = OrderedDict()
+_CACHE_SIZE = 16
+_CACHE_LOCK = threading.Lock()
+
+
+def cache_get(key: tuple[Any, ...]) -> Any:
+    """Cached value for a key (moved to most recent), or None."""
+    with _CACHE_LOCK:
+        value = _CACHE.get(key)
+        if value is not None:
+            _CACHE.move_to_end(key)
+        return value
+
+
+def cache_put(key: tuple[Any, ...], value: Any) -> None:
+    """Store a value, evicting the least recently used beyond the cache size."""
+    with _CACHE_LOCK:
+        _CACHE[key] = value
+        _CACHE.move_to_end(key)
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.popitem(last=False)
+
+
+def clear_cache() -> None:
+    """Forget every map loaded in this process."""
+    with _CACHE_LOCK:
+        _CACHE.clear()

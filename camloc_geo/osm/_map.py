@@ -1,0 +1,411 @@
+"""The :class:`MapData` object and :func:`load_map`."""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import networkx as nx
+import numpy as np
+import osmnx as ox
+from shapely.geometry import LineString, Point
+
+from camloc_geo._errors import MapDataError
+from camloc_geo.geodesy import LocalFrame
+from camloc_geo.osm._intersections import build_intersections, highway_of, street_label
+from camloc_geo.osm._load import (
+    STREET_HIGHWAYS,
+    RawMap,
+    cache_get,
+    cache_put,
+    read_extract,
+    read_overpass,
+)
+from camloc_geo.osm._model import Building, Intersection, Street
+from camloc_geo.osm._names import close_matches, normalize_name, split_street_query
+from camloc_geo.osm._widths import in_north_america, parse_lanes, resolve_width_m
+
+__all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
+
+log = logging.getLogger(__name__)
+
+DEFAULT_TOLERANCE_M = 10.0
+"""Default node buffer for intersection consolidation, metres (nodes < 20 m apart merge)."""
+
+
+def _streets_of(G: nx.MultiDiGraph, north_america: bool) -> list[Street]:
+    seen: set[tuple[int, int, int]] = set()
+    streets: list[Street] = []
+    for u, v, data in G.edges(data=True):
+        length = round(float(data.get("length", 0.0)))
+        key = (min(u, v), max(u, v), length)
+        if key in seen:
+            continue
+        seen.add(key)
+        geom = data.get("geometry")
+        if geom is None:
+            geom = LineString(
+                [(G.nodes[u]["x"], G.nodes[u]["y"]), (G.nodes[v]["x"], G.nodes[v]["y"])]
+            )
+        name, names = street_label(data)
+        highway = highway_of(data)
+        oneway_raw = data.get("oneway")
+        oneway = bool(all(oneway_raw)) if isinstance(oneway_raw, list) else bool(oneway_raw)
+        width, _src = resolve_width_m(
+            width=data.get("width"),
+            lanes=data.get("lanes"),
+            highway=highway,
+            oneway=oneway,
+            north_america=north_america,
+        )
+        osmid = data.get("osmid")
+        way_ids = tuple(int(i) for i in (osmid if isinstance(osmid, list) else [osmid]) if i)
+        streets.append(
+            Street(
+                name=name,
+                highway=highway,
+                oneway=oneway,
+                lanes=parse_lanes(data.get("lanes")),
+                width_m=width,
+                geometry=geom,
+                names=names,
+                way_ids=way_ids,
+                u=int(u),
+                v=int(v),
+            )
+        )
+    return streets
+
+
+class MapData:
+    """Streets, intersections and buildings around a point.
+
+    Built by :func:`load_map`; treat as read-only (it is shared through the load cache).
+
+    Attributes
+    ----------
+    frame
+        :class:`~camloc_geo.geodesy.LocalFrame` anchored at the requested point.
+    radius_m
+        The requested radius (None: the whole extract).
+    graph
+        The simplified osmnx street graph (lon/lat, unprojected, not consolidated).
+    bounds
+        ``(south, west, north, east)`` of the extract, when known.
+    source
+        The extract path or the Overpass URL.
+    """
+
+    def __init__(
+        self,
+        raw: RawMap,
+        lat: float,
+        lon: float,
+        radius_m: float | None,
+        *,
+        tolerance_m: float = DEFAULT_TOLERANCE_M,
+    ) -> None:
+        self.frame = LocalFrame(lat, lon)
+        self.radius_m = radius_m
+        self.graph = raw.graph
+        self.bounds = raw.bounds
+        self.source = raw.source
+        north_america = in_north_america(lat, lon)
+        self._intersections = tuple(
+            build_intersections(
+                raw.graph,
+                self.frame,
+                tolerance_m=tolerance_m,
+                radius_m=radius_m,
+                north_america=north_america,
+            )
+        )
+        self._streets = tuple(_streets_of(raw.graph, north_america))
+        self._buildings = tuple(raw.buildings)
+        self._streets_enu: list[LineString] | None = None
+
+    def __repr__(self) -> str:
+        return (
+            f"MapData(lat={self.frame.lat0}, lon={self.frame.lon0}, radius_m={self.radius_m}, "
+            f"{len(self._intersections)} intersections, {len(self._streets)} streets, "
+            f"{len(self._buildings)} buildings)"
+        )
+
+    @property
+    def intersections(self) -> list[Intersection]:
+        """Consolidated intersections within the radius, nearest to the point first."""
+        return list(self._intersections)
+
+    @property
+    def streets(self) -> list[Street]:
+        """Street segments (edges of the simplified graph, each once)."""
+        return list(self._streets)
+
+    @property
+    def buildings(self) -> list[Building]:
+        """Building footprints."""
+        return list(self._buildings)
+
+    # -- look-ups -----------------------------------------------------------------------
+
+    def _dist_from(self, near: tuple[float, float] | None, lat: float, lon: float) -> float:
+        lat0, lon0 = near if near is not None else (self.frame.lat0, self.frame.lon0)
+        frame = LocalFrame(lat0, lon0)
+        e, n = frame.enu_from_geographic(lon, lat)
+        return float(math.hypot(e, n))
+
+    def nearest_intersection(self, lat: float, lon: float) -> Intersection:
+        """The intersection whose centre is nearest to a point.
+
+        Raises
+        ------
+        MapDataError
+            The map has no intersections.
+        """
+        if not self._intersections:
+            raise MapDataError(
+                f"no intersections within {self.radius_m} m of "
+                f"lat={self.frame.lat0:.6f}, lon={self.frame.lon0:.6f}"
+            )
+        return min(self._intersections, key=lambda x: self._dist_from((lat, lon), x.lat, x.lon))
+
+    def intersection(self, ident: str) -> Intersection:
+        """The intersection with this id (MapDataError if unknown)."""
+        for inter in self._intersections:
+            if inter.id == ident:
+                return inter
+        raise MapDataError(f"no intersection with id {ident!r}")
+
+    def street_names(self) -> list[str]:
+        """Every street name of the map, sorted."""
+        names = {n for s in self._streets for n in (s.names or (s.name,))}
+        names.update(s.name for x in self._intersections for s in x.streets)
+        return sorted(names)
+
+    def find_intersection(
+        self, streets: str | Sequence[str], near: tuple[float, float] | None = None
+    ) -> Intersection:
+        """The intersection where the named streets meet.
+
+        Parameters
+        ----------
+        streets
+            ``"Eastern Avenue & South Broadway"`` (also ``/``, `` and ``, ``×``) or a list of
+            names. Case, punctuation and common abbreviations do not matter (St/Street,
+            Ave/Avenue, N/North...). A name that equals none exactly may match a street whose
+            name contains all its words ("Broadway" for "South Broadway").
+        near
+            ``(lat, lon)``: among several matches take the nearest to it (default: the map's
+            point).
+
+        Raises
+        ------
+        MapDataError
+            Fewer than two names, or the streets do not meet here; the message lists close
+            matches of each name.
+        """
+        wanted = split_street_query(streets)
+        if len(wanted) < 2:
+            raise MapDataError(f"give at least two street names, got {streets!r}")
+        norms = [normalize_name(w) for w in wanted]
+
+        def street_norms(inter: Intersection) -> list[set[str]]:
+            return [{normalize_name(n) for n in (s.names or (s.name,))} for s in inter.streets]
+
+        def matches(inter: Intersection, loose: bool) -> bool:
+            sets = street_norms(inter)
+            for q in norms:
+                q_tokens = set(q.split())
+                ok = any(q in names for names in sets) or (
+                    loose and any(q_tokens <= set(n.split()) for names in sets for n in names)
+                )
+                if not ok:
+                    return False
+            return True
+
+        for loose in (False, True):
+            hits = [x for x in self._intersections if matches(x, loose)]
+            if hits:
+                return min(hits, key=lambda x: self._dist_from(near, x.lat, x.lon))
+        all_names = self.street_names()
+        hints = []
+        for w in wanted:
+            close = close_matches(w, all_names)
+            hints.append(f"{w!r}: " + (", ".join(repr(c) for c in close) if close else "no match"))
+        raise MapDataError(
+            f"streets {' & '.join(repr(w) for w in wanted)} do not meet within "
+            f"{self.radius_m} m of lat={self.frame.lat0:.6f}, lon={self.frame.lon0:.6f}; "
+            f"close matches: {'; '.join(hints)}"
+        )
+
+    def street_bearings(
+        self, lat: float, lon: float, radius_m: float = 50.0
+    ) -> list[tuple[str, float]]:
+        """Streets passing within ``radius_m`` of a point and their local bearings.
+
+        Returns
+        -------
+        ``(name, bearing_deg)`` pairs, nearest street first; the bearing (in [0, 180),
+        osmnx's :func:`~osmnx.bearing.calculate_bearing`) is that of the street over
+        ±10 m around its point nearest to the query point. A street is listed once per
+        distinct direction (5° apart).
+        """
+        if self._streets_enu is None:
+            self._streets_enu = [
+                LineString(self.frame.points_enu_from_geographic(np.asarray(s.geometry.coords)))
+                for s in self._streets
+            ]
+        e, n = self.frame.enu_from_geographic(lon, lat)
+        pt = Point(float(e), float(n))
+        rows: list[tuple[float, str, float]] = []
+        for street, line in zip(self._streets, self._streets_enu, strict=True):
+            dist = line.distance(pt)
+            if dist > radius_m or line.length < 0.5:
+                continue
+            s = line.project(pt)
+            a = line.interpolate(max(0.0, s - 10.0))
+            b = line.interpolate(min(line.length, s + 10.0))
+            (lon_a, lon_b), (lat_a, lat_b) = self.frame.geographic_from_enu(
+                np.array([a.x, b.x]), np.array([a.y, b.y])
+            )
+            brg = float(ox.bearing.calculate_bearing(lat_a, lon_a, lat_b, lon_b)) % 180.0
+            rows.append((float(dist), street.name, brg))
+        rows.sort()
+        out: list[tuple[str, float]] = []
+        for _d, name, brg in rows:
+            if any(
+                name == n2 and min(abs(brg - b2), 180.0 - abs(brg - b2)) < 5.0 for n2, b2 in out
+            ):
+                continue
+            out.append((name, brg))
+        return out
+
+    def find_building(self, name: str, near: tuple[float, float] | None = None) -> Building:
+        """The building with this name (``name``, ``addr:housename`` or ``brand``).
+
+        Exact normalised matches win over names containing all the query's words; among
+        several, the nearest to ``near`` (default: the map's point).
+
+        Raises
+        ------
+        MapDataError
+            No such building; the message lists close matches.
+        """
+        q = normalize_name(name)
+        named = [b for b in self._buildings if b.name]
+        for loose in (False, True):
+            hits = [
+                b
+                for b in named
+                if (normalize_name(b.name or "") == q)
+                or (loose and set(q.split()) <= set(normalize_name(b.name or "").split()))
+            ]
+            if hits:
+                return min(hits, key=lambda b: self._dist_from(near, b.centroid[1], b.centroid[0]))
+        close = close_matches(name, [b.name for b in named if b.name])
+        raise MapDataError(
+            f"no building named {name!r} within {self.radius_m} m of "
+            f"lat={self.frame.lat0:.6f}, lon={self.frame.lon0:.6f}; close matches: "
+            + (", ".join(repr(c) for c in close) if close else "none")
+        )
+
+
+def load_map(
+    source: str | os.PathLike[str] | None,
+    lat: float,
+    lon: float,
+    radius_m: float | None = 300.0,
+    *,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+    overpass_rate_limit: bool = True,
+    timeout_s: float = 60.0,
+    tolerance_m: float = DEFAULT_TOLERANCE_M,
+    highways: frozenset[str] = STREET_HIGHWAYS,
+) -> MapData:
+    """Load streets, intersections and buildings around a point.
+
+    Parameters
+    ----------
+    source
+        Path to an ``.osm``, ``.osm.gz``, ``.osm.bz2`` or ``.osm.pbf`` extract; None queries
+        Overpass live through osmnx.
+    lat, lon
+        The point, degrees WGS 84; the map's frame is anchored there.
+    radius_m
+        Intersections within this distance of the point are built; None: the whole extract
+        (files only).
+    cache_folder
+        osmnx HTTP cache folder (online only; default: osmnx's).
+    overpass_url
+        Overpass API base URL (online only; default: osmnx's).
+    overpass_rate_limit
+        Let osmnx ask the server for a slot before querying (online only).
+    timeout_s
+        HTTP timeout, seconds (online only).
+    tolerance_m
+        Intersection consolidation buffer, metres.
+    highways
+        ``highway`` values forming the street network.
+
+    Returns
+    -------
+    The map; the same object again for the same file (unchanged), area and options.
+
+    Raises
+    ------
+    MapDataError
+        Unreadable or empty extract, point outside it, no streets there, bad arguments.
+    MapSourceError
+        Overpass could not be reached or failed.
+    """
+    if not (math.isfinite(lat) and math.isfinite(lon)) or not (
+        -90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0
+    ):
+        raise MapDataError(f"invalid point lat={lat}, lon={lon}")
+    if radius_m is not None and not (math.isfinite(radius_m) and radius_m > 0):
+        raise MapDataError(f"radius_m must be a positive number of metres, got {radius_m}")
+    options: tuple[Any, ...] = (
+        round(float(lat), 7),
+        round(float(lon), 7),
+        radius_m,
+        tolerance_m,
+        tuple(sorted(highways)),
+    )
+    raw: RawMap
+    if source is None:
+        if radius_m is None:
+            raise MapDataError("radius_m is required when loading from Overpass")
+        key: tuple[Any, ...] = ("overpass", overpass_url, *options)
+        cached = cache_get(key)
+        if cached is not None:
+            return cached
+        raw = read_overpass(
+            lat,
+            lon,
+            radius_m,
+            cache_folder=cache_folder,
+            overpass_url=overpass_url,
+            overpass_rate_limit=overpass_rate_limit,
+            timeout_s=timeout_s,
+            highways=highways,
+        )
+    else:
+        path = Path(source).expanduser()
+        try:
+            stat = path.resolve().stat()
+            key = ("file", str(path.resolve()), stat.st_mtime_ns, stat.st_size, *options)
+        except OSError:
+            key = ("file", str(path), *options)
+        cached = cache_get(key)
+        if cached is not None:
+            log.debug("map cache hit for %s", path)
+            return cached
+        raw = read_extract(path, lat, lon, radius_m, highways=highways)
+    result = MapData(raw, lat, lon, radius_m, tolerance_m=tolerance_m)
+    cache_put(key, result)
+    return result
