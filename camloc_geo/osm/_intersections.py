@@ -265,69 +265,87 @@ def _single_street(arm: _Arm) -> _Street:
     )
 
 
-def _dual_street(a: _Arm, b: _Arm, frame: LocalFrame) -> _Street:
-    d = a.direction + b.direction
+def _merged_street(group: list[_Arm], frame: LocalFrame) -> _Street:
+    """One street from several parallel carriageways: kerbs are the outermost ones."""
+    d = np.sum([arm.direction for arm in group], axis=0)
     d = d / float(np.hypot(*d))
     r = _right_normal(d)
-    origin = (a.origin + b.origin) / 2.0
-    offs = [float((arm.origin - origin) @ r) for arm in (a, b)]
-    s_right = max(off + arm.width_m / 2.0 for off, arm in zip(offs, (a, b), strict=True))
-    s_left = min(off - arm.width_m / 2.0 for off, arm in zip(offs, (a, b), strict=True))
-    lanes = a.lanes + b.lanes if a.lanes is not None and b.lanes is not None else None
-    out_arm = a if a.flow == "out" else b
+    origin = np.mean([arm.origin for arm in group], axis=0)
+    offs = [float((arm.origin - origin) @ r) for arm in group]
+    s_right = max(off + arm.width_m / 2.0 for off, arm in zip(offs, group, strict=True))
+    s_left = min(off - arm.width_m / 2.0 for off, arm in zip(offs, group, strict=True))
+    lanes_each = [arm.lanes for arm in group]
+    lanes = None
+    if all(n is not None for n in lanes_each):
+        lanes = float(sum(n for n in lanes_each if n is not None))
+    sources = {arm.width_source for arm in group}
+    out_arms = [arm for arm in group if arm.flow in ("out", "both")] or group
+    flows = {arm.flow for arm in group}
     return _Street(
-        name=a.name,
-        names=tuple(dict.fromkeys(a.names + b.names)),
-        highway=a.highway,
-        oneway=False,
+        name=group[0].name,
+        names=tuple(dict.fromkeys(n for arm in group for n in arm.names)),
+        highway=group[0].highway,
+        oneway=flows in ({"out"}, {"in"}),
         lanes=lanes,
         width_m=s_right - s_left,
-        width_source=a.width_source if a.width_source == b.width_source else "mixed",
-        carriageways=2,
+        width_source=sources.pop() if len(sources) == 1 else "mixed",
+        carriageways=len(group),
         origin=origin,
         direction=d,
         s_left=s_left,
         s_right=s_right,
         bearing=_bearing_enu(frame, origin, origin + ARM_SAMPLE_M * d),
-        edge=out_arm.edge,
+        edge=out_arms[0].edge,
     )
 
 
 def _group_streets(arms: list[_Arm], frame: LocalFrame) -> list[_Street]:
-    """Merge the two carriageways of dual roads; one street per remaining arm."""
-    pairs: list[tuple[float, int, int]] = []
+    """Merge parallel carriageways of one road; one street per remaining arm.
+
+    Arms with the same name (or both unnamed of the same ``highway``), bearings within
+    :data:`DUAL_MAX_ANGLE_DEG` and at least one of them one-way are carriageways of one
+    road (dual carriageways, frontage roads): they are merged transitively.
+    """
+    parent = list(range(len(arms)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
     for i, a in enumerate(arms):
         for j in range(i + 1, len(arms)):
             b = arms[j]
-            if {a.flow, b.flow} != {"in", "out"} or _name_key(a) != _name_key(b):
+            if a.flow == "both" and b.flow == "both":
                 continue
-            diff = _angle_diff(a.bearing, b.bearing)
-            if diff <= DUAL_MAX_ANGLE_DEG:
-                pairs.append((diff, i, j))
-    used: set[int] = set()
-    streets: list[_Street] = []
-    for _diff, i, j in sorted(pairs):
-        if i in used or j in used:
-            continue
-        used.update((i, j))
-        streets.append(_dual_street(arms[i], arms[j], frame))
-    streets.extend(_single_street(arm) for k, arm in enumerate(arms) if k not in used)
+            if _name_key(a) != _name_key(b):
+                continue
+            if _angle_diff(a.bearing, b.bearing) <= DUAL_MAX_ANGLE_DEG:
+                parent[find(i)] = find(j)
+    groups: dict[int, list[_Arm]] = {}
+    for i, arm in enumerate(arms):
+        groups.setdefault(find(i), []).append(arm)
+    streets = [
+        _single_street(g[0]) if len(g) == 1 else _merged_street(g, frame) for g in groups.values()
+    ]
     streets.sort(key=lambda s: s.bearing)
     return streets
 
 
 def _kerb_corner(a: _Street, b: _Street) -> np.ndarray | None:
-    """Where a's right (clockwise-side) kerb meets b's left kerb; None if they do not."""
+    """Where a's right (clockwise-side) kerb line meets b's left kerb line; None if parallel.
+
+    The kerb lines are straight and extended both ways, so arms of a consolidated cluster
+    that start at different nodes still meet near the cluster centre.
+    """
     ra, rb = _right_normal(a.direction), _right_normal(b.direction)
     pa = a.origin + a.s_right * ra
     pb = b.origin + b.s_left * rb
     mat = np.column_stack([a.direction, -b.direction])
     if abs(float(np.linalg.det(mat))) < 1e-9:
         return None
-    t, u = np.linalg.solve(mat, pb - pa)
-    slack = -max(a.width_m, b.width_m)
-    if t < slack or u < slack:
-        return None
+    t, _u = np.linalg.solve(mat, pb - pa)
     return np.asarray(pa + t * a.direction, dtype=float)
 
 

@@ -33,7 +33,7 @@ __all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
 
 log = logging.getLogger(__name__)
 
-DEFAULT_TOLERANCE_M = 10.0
+DEFAULT_TOLERANCE_M = 12.0
 """Default node buffer for intersection consolidation, metres (nodes < 20 m apart merge)."""
 
 
