@@ -1,0 +1,1017 @@
+"""Automatic vanishing points, focal length and camera tilt from one image.
+
+This is the "CamLoc-Auto" step: when nobody has drawn lines, find the three mutually
+orthogonal (Manhattan) vanishing points from the picture itself.
+
+Pipeline
+--------
+1. Line segments: OpenCV's LSD (``cv2.createLineSegmentDetector``) when available, else
+   Canny plus ``cv2.HoughLinesP``. Short segments are dropped, the longest are kept.
+2. Hypotheses (RANSAC): two segments give a first vanishing point; either two more
+   segments give a second one and, through orthogonality, the focal length, or a third
+   segment plus a focal-length sample give the second one. The third vanishing direction
+   is the cross product of the first two. Each hypothesis is scored by the
+   length-weighted consensus of all segments (truncated quadratic of the endpoint
+   distance to the line joining the segment's midpoint and the vanishing point).
+3. Refinement: ``scipy.optimize.least_squares`` with a robust loss over the rotation
+   and the focal length (principal point fixed at the image centre unless given), on
+   the inliers of the best hypotheses; the best refined model wins.
+
+Conventions (see ``spec/SCENE.md``): image pixels are continuous, origin at the
+top-left corner, x right, y down, the centre of the top-left pixel is ``(0.5, 0.5)``;
+the camera frame is x right, y down, z forward. Vanishing points are kept homogeneous
+throughout (``[x, y, w]`` in pixels), so points at infinity (``w = 0``) never cause a
+division by zero; in pixel form they are reported as ``None``.
+
+The vertical vanishing point is the one of the world's up axis. It is identified as the
+vanishing direction closest to the image's vertical axis (street cameras and photos are
+seldom rolled by more than 45 degrees and seldom pitched by more than 45 degrees).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from camloc_geo._errors import InputError, NotEnoughStructureError
+
+__all__ = [
+    "AutoVPResult",
+    "detect_segments",
+    "detect_vanishing_points",
+    "draw_segments",
+    "load_image",
+    "segments_for_axis",
+]
+
+log = logging.getLogger(__name__)
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Focal length bounds, as multiples of the longer image side, searched when unknown.
+FOCAL_BOUNDS_REL = (0.3, 6.0)
+#: A vanishing direction this close (degrees) to the image plane is reported at infinity.
+INFINITY_TOL_DEG = 0.05
+#: Prior on the focal length (relative to the longer side): log-normal centre and sigma.
+_F_PRIOR_REL = 1.0
+_F_PRIOR_SIGMA = 1.0
+_MIN_SEGMENTS = 6
+_MIN_SUPPORT = 3  # inlier segments needed by each of the two best-supported VPs
+
+
+# --------------------------------------------------------------------------- images
+
+
+def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
+    """Return an 8-bit grayscale image from a path or an array.
+
+    Parameters
+    ----------
+    image
+        A path to an image file, or an array: ``(H, W)`` gray, ``(H, W, 3)`` BGR or
+        ``(H, W, 4)`` BGRA, any numeric dtype (floats are taken in ``[0, 1]`` when their
+        maximum is at most 1, else in ``[0, 255]``).
+
+    Raises
+    ------
+    InputError
+        The file cannot be read or decoded, or the array is not an image.
+    """
+    import cv2
+
+    if isinstance(image, (str, os.PathLike)):
+        path = Path(image)
+        try:
+            buf = np.fromfile(str(path), dtype=np.uint8)
+        except OSError as exc:
+            raise InputError(f"cannot read image {str(path)!r}: {exc.strerror or exc}") from exc
+        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE) if buf.size else None
+        if arr is None:
+            raise InputError(f"cannot decode image {str(path)!r} (not a supported image file)")
+        return np.asarray(arr, dtype=np.uint8)
+    arr = np.asarray(image)
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[:, :, 0]
+    if arr.ndim not in (2, 3) or (arr.ndim == 3 and arr.shape[2] not in (3, 4)):
+        raise InputError(f"image array must be (H, W), (H, W, 3) or (H, W, 4), got {arr.shape}")
+    if min(arr.shape[:2]) < 8:
+        raise InputError(f"image is too small: {arr.shape[1]}x{arr.shape[0]} pixels")
+    if arr.dtype != np.uint8:
+        a = arr.astype(np.float64)
+        if not np.all(np.isfinite(a)):
+            raise InputError("image array contains NaN or infinite values")
+        if a.size and a.max() <= 1.0:
+            a = a * 255.0
+        arr = np.clip(np.rint(a), 0, 255).astype(np.uint8)
+    if arr.ndim == 3:
+        code = cv2.COLOR_BGR2GRAY if arr.shape[2] == 3 else cv2.COLOR_BGRA2GRAY
+        arr = cv2.cvtColor(np.ascontiguousarray(arr), code)
+    return np.ascontiguousarray(arr, dtype=np.uint8)
+
+
+# ------------------------------------------------------------------------- segments
+
+
+def detect_segments(
+    image: str | os.PathLike[str] | npt.NDArray[Any],
+    *,
+    min_length_px: float | None = None,
+    max_segments: int = 400,
+    max_side_px: int = 1280,
+    method: str = "auto",
+) -> FloatArray:
+    """Detect straight line segments.
+
+    Parameters
+    ----------
+    image
+        Path or array (see :func:`load_image`).
+    min_length_px
+        Shortest segment kept, in pixels of the input image. Default: 2.5 % of the image
+        diagonal, at least 12 px.
+    max_segments
+        Keep at most this many segments, the longest first.
+    max_side_px
+        Larger images are shrunk to this longer side for detection (the segments are
+        scaled back to the input's pixels).
+    method
+        ``"auto"`` (LSD when available, else Hough), ``"lsd"`` or ``"hough"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N, 4)`` rows ``x1, y1, x2, y2`` in continuous pixel coordinates (the centre of
+        the top-left pixel is ``(0.5, 0.5)``), longest first. Possibly empty.
+    """
+    import cv2
+
+    gray = load_image(image)
+    h, w = gray.shape
+    scale = 1.0
+    if max(h, w) > max_side_px:
+        scale = max_side_px / max(h, w)
+        small = cv2.resize(gray, (round(w * scale), round(h * scale)), interpolation=cv2.INTER_AREA)
+        gray = np.asarray(small, dtype=np.uint8)
+    if min_length_px is None:
+        min_length_px = max(12.0, 0.025 * math.hypot(w, h))
+    segs = np.zeros((0, 4))
+    if method not in ("auto", "lsd", "hough"):
+        raise InputError(f"method must be 'auto', 'lsd' or 'hough', got {method!r}")
+    lsd_failed = False
+    if method in ("auto", "lsd"):
+        try:
+            lsd = cv2.createLineSegmentDetector(cv2.LSD_REFINE_STD)
+            lsd_out = lsd.detect(gray)[0]
+            if lsd_out is not None:
+                segs = np.asarray(lsd_out, dtype=np.float64).reshape(-1, 4)
+        except (cv2.error, AttributeError) as exc:  # LSD missing from some builds
+            if method == "lsd":
+                raise
+            log.debug("LSD unavailable (%s); using Canny + HoughLinesP", exc)
+            lsd_failed = True
+    if method == "hough" or lsd_failed:
+        edges = cv2.Canny(gray, 50, 150, L2gradient=True)
+        hough_out = cv2.HoughLinesP(
+            edges,
+            1,
+            np.pi / 360,
+            threshold=30,
+            minLineLength=max(4.0, min_length_px * scale),
+            maxLineGap=3,
+        )
+        if hough_out is not None:
+            segs = np.asarray(hough_out, dtype=np.float64).reshape(-1, 4)
+    # OpenCV's segment end points are in pixel-index coordinates (centre of the
+    # top-left pixel at 0, 0): shift to the continuous convention, then undo the shrink.
+    segs = (segs + 0.5) / scale
+    if len(segs) == 0:
+        return np.zeros((0, 4))
+    lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
+    keep = lengths >= min_length_px
+    segs, lengths = segs[keep], lengths[keep]
+    order = np.argsort(-lengths, kind="stable")[:max_segments]
+    return np.ascontiguousarray(segs[order])
+
+
+# ------------------------------------------------------------------------ geometry
+
+
+def _unit(v: FloatArray, axis: int = -1) -> FloatArray:
+    n = np.linalg.norm(v, axis=axis, keepdims=True)
+    return np.asarray(v / np.where(n > 0, n, 1.0), dtype=np.float64)
+
+
+@dataclass
+class _Segs:
+    """Segments in normalised image coordinates: ``(pixel - pp) / scale``."""
+
+    mid: FloatArray  # (N, 2)
+    dirn: FloatArray  # (N, 2) unit
+    length_px: FloatArray  # (N,)
+    lines: FloatArray  # (N, 3) homogeneous lines, unit normal
+    weight: FloatArray  # (N,)
+
+
+def _prepare(segs_px: FloatArray, pp: FloatArray, scale: float) -> _Segs:
+    p1 = (segs_px[:, 0:2] - pp) / scale
+    p2 = (segs_px[:, 2:4] - pp) / scale
+    d = p2 - p1
+    length = np.hypot(d[:, 0], d[:, 1])
+    dirn = d / length[:, None]
+    ones = np.ones((len(p1), 1))
+    lines = np.cross(np.hstack([p1, ones]), np.hstack([p2, ones]))
+    lines = lines / np.hypot(lines[:, 0], lines[:, 1])[:, None]
+    return _Segs(
+        mid=0.5 * (p1 + p2),
+        dirn=dirn,
+        length_px=length * scale,
+        lines=lines,
+        weight=length * scale,
+    )
+
+
+def _endpoint_residual(vps: FloatArray, s: _Segs) -> FloatArray:
+    """Distance in pixels of a segment's end points to the line (midpoint, VP).
+
+    ``vps`` is ``(..., 3)`` homogeneous in normalised coordinates; the result broadcasts
+    to ``(..., N)``. Signed; well defined for VPs at infinity.
+    """
+    vx = vps[..., 0:1]
+    vy = vps[..., 1:2]
+    vw = vps[..., 2:3]
+    dx = vx - vw * s.mid[:, 0]
+    dy = vy - vw * s.mid[:, 1]
+    cross = s.dirn[:, 0] * dy - s.dirn[:, 1] * dx
+    norm = np.sqrt(dx * dx + dy * dy) + 1e-12
+    return np.asarray(0.5 * s.length_px * cross / norm, dtype=np.float64)
+
+
+def _sin_angle(vps: FloatArray, s: _Segs) -> FloatArray:
+    r = _endpoint_residual(vps, s)
+    return np.asarray(np.abs(r) / (0.5 * s.length_px), dtype=np.float64)
+
+
+def _vps_from_rotation(R: FloatArray, f_n: float) -> FloatArray:
+    """Rows: homogeneous VPs (normalised coords) of the columns of ``R``."""
+    K = np.diag([f_n, f_n, 1.0])
+    return np.asarray((K @ R).T, dtype=np.float64)
+
+
+# ---------------------------------------------------------------------- hypotheses
+
+
+def _hypotheses(
+    s: _Segs,
+    rng: np.random.Generator,
+    n_hyp: int,
+    f_fixed: float | None,
+    f_bounds: tuple[float, float],
+) -> tuple[FloatArray, FloatArray]:
+    """Random Manhattan hypotheses: ``(H, 3, 3)`` camera directions (rows) and ``(H,)`` focal."""
+    n = len(s.mid)
+    p = s.weight / s.weight.sum()
+    dirs_all: list[FloatArray] = []
+    f_all: list[FloatArray] = []
+    lo, hi = f_bounds
+    if f_fixed is None:
+        # Type A: two VPs from four segments; orthogonality gives the focal length.
+        m = 4 * n_hyp
+        idx = rng.choice(n, size=(m, 4), p=p)
+        v1 = np.cross(s.lines[idx[:, 0]], s.lines[idx[:, 1]])
+        v2 = np.cross(s.lines[idx[:, 2]], s.lines[idx[:, 3]])
+        den = v1[:, 2] * v2[:, 2]
+        num = -(v1[:, 0] * v2[:, 0] + v1[:, 1] * v2[:, 1])
+        ok = np.abs(den) > 1e-12 * (np.linalg.norm(v1, axis=1) * np.linalg.norm(v2, axis=1))
+        f2 = np.full(m, -1.0)
+        f2[ok] = num[ok] / den[ok]
+        ok &= (f2 > lo * lo) & (f2 < hi * hi)
+        ok &= (idx[:, 0] != idx[:, 1]) & (idx[:, 2] != idx[:, 3])
+        sel = np.flatnonzero(ok)[: n_hyp // 2 + 1]
+        if len(sel):
+            fa = np.sqrt(f2[sel])
+            d1 = _unit(np.column_stack([v1[sel, 0] / fa, v1[sel, 1] / fa, v1[sel, 2]]))
+            d2 = _unit(np.column_stack([v2[sel, 0] / fa, v2[sel, 1] / fa, v2[sel, 2]]))
+            d2 = _unit(d2 - np.sum(d1 * d2, axis=1, keepdims=True) * d1)
+            dirs_all.append(np.stack([d1, d2, np.cross(d1, d2)], axis=1))
+            f_all.append(fa)
+        n_b = n_hyp - sum(len(x) for x in f_all)
+    else:
+        n_b = n_hyp
+    # Type B: one VP from two segments, a third segment and a focal length give the rest.
+    idx = rng.choice(n, size=(n_b, 3), p=p)
+    if f_fixed is None:
+        fb = np.exp(rng.uniform(math.log(lo), math.log(hi), size=n_b))
+    else:
+        fb = np.full(n_b, f_fixed)
+    v1 = np.cross(s.lines[idx[:, 0]], s.lines[idx[:, 1]])
+    d1 = _unit(np.column_stack([v1[:, 0] / fb, v1[:, 1] / fb, v1[:, 2]]))
+    l3 = s.lines[idx[:, 2]]
+    n3 = _unit(np.column_stack([l3[:, 0] * fb, l3[:, 1] * fb, l3[:, 2]]))  # K^T l
+    d2 = np.cross(n3, d1)
+    nd2 = np.linalg.norm(d2, axis=1)
+    good = (nd2 > 1e-6) & (idx[:, 0] != idx[:, 1]) & (np.linalg.norm(v1, axis=1) > 1e-12)
+    d1, d2, fb = d1[good], _unit(d2[good]), fb[good]
+    dirs_all.append(np.stack([d1, d2, np.cross(d1, d2)], axis=1))
+    f_all.append(fb)
+    return np.concatenate(dirs_all), np.concatenate(f_all)
+
+
+def _score(dirs: FloatArray, f_n: FloatArray, s: _Segs, tau_px: float) -> FloatArray:
+    """Length-weighted truncated-quadratic consensus of hypotheses, ``(H,)``.
+
+    Computed in float32: it only ranks hypotheses.
+    """
+    f32 = np.float32
+    vps = dirs.astype(f32)
+    vps[..., 0] *= f_n[:, None].astype(f32)
+    vps[..., 1] *= f_n[:, None].astype(f32)
+    mx, my = s.mid[:, 0].astype(f32), s.mid[:, 1].astype(f32)
+    ux, uy = s.dirn[:, 0].astype(f32), s.dirn[:, 1].astype(f32)
+    hl2 = ((0.5 * s.length_px / tau_px) ** 2).astype(f32)
+    vx, vy, vw = vps[..., 0:1], vps[..., 1:2], vps[..., 2:3]
+    dx = vx - vw * mx
+    dy = vy - vw * my
+    cross = ux * dy - uy * dx
+    cost = np.square(cross)
+    cost *= hl2
+    cost /= dx * dx + dy * dy + f32(1e-12)
+    best = np.maximum(f32(0.0), f32(1.0) - cost.min(axis=1))
+    return np.asarray(best @ s.weight.astype(f32), dtype=np.float64)
+
+
+def _subset(s: _Segs, idx: Any) -> _Segs:
+    return _Segs(s.mid[idx], s.dirn[idx], s.length_px[idx], s.lines[idx], s.weight[idx])
+
+
+# --------------------------------------------------------------------- refinement
+
+
+@dataclass
+class _Model:
+    R: FloatArray  # columns = unit vanishing directions in the camera frame
+    f_n: float
+    labels: npt.NDArray[np.int64]
+    score: float
+    logf_std: float = float("nan")
+
+
+def _labels(
+    R: FloatArray, f_n: float, s: _Segs, tau_px: float, max_angle_deg: float
+) -> tuple[npt.NDArray[np.int64], float]:
+    vps = _vps_from_rotation(R, f_n)
+    r = np.abs(_endpoint_residual(vps, s))  # (3, N)
+    sin_a = r / (0.5 * s.length_px)
+    k = r.argmin(axis=0)
+    rk = r[k, np.arange(r.shape[1])]
+    ok = (rk < tau_px) & (sin_a[k, np.arange(r.shape[1])] < math.sin(math.radians(max_angle_deg)))
+    labels = np.where(ok, k, -1).astype(np.int64)
+    score = float(np.sum(np.maximum(0.0, 1.0 - (rk / tau_px) ** 2) * s.weight * ok))
+    return labels, score
+
+
+def _refine(
+    R0: FloatArray,
+    f0: float,
+    s: _Segs,
+    labels: npt.NDArray[np.int64],
+    tau_px: float,
+    f_free: bool,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+) -> tuple[FloatArray, float, float]:
+    inl = labels >= 0
+    ss = _Segs(
+        mid=s.mid[inl],
+        dirn=s.dirn[inl],
+        length_px=s.length_px[inl],
+        lines=s.lines[inl],
+        weight=s.weight[inl],
+    )
+    lab = labels[inl]
+    cols = np.arange(len(lab))
+    n_par = 4 if f_free else 3
+    step = 1e-7
+
+    def batch(X: FloatArray) -> FloatArray:
+        """Residuals ``(k, M)`` for ``k`` parameter vectors."""
+        Rs = Rotation.from_rotvec(X[:, :3]).as_matrix() @ R0  # (k, 3, 3)
+        fk = f0 * np.exp(X[:, 3]) if f_free else np.full(len(X), f0)
+        vps = np.swapaxes(Rs, 1, 2).copy()  # rows = directions
+        vps[..., 0] *= fk[:, None]
+        vps[..., 1] *= fk[:, None]
+        res = _endpoint_residual(vps, ss)[:, lab, cols]
+        if f_free:
+            # A weak prior keeps the focal length finite when the image cannot fix it.
+            res = np.hstack([res, (0.05 * tau_px * np.log(fk / f_prior))[:, None]])
+        return res
+
+    def fun(x: FloatArray) -> FloatArray:
+        return batch(x[None, :])[0]
+
+    def jac(x: FloatArray) -> FloatArray:
+        X = np.vstack([x, x + step * np.eye(n_par)])
+        r = batch(X)
+        return np.asarray(((r[1:] - r[0]) / step).T, dtype=np.float64)
+
+    def unpack(x: FloatArray) -> tuple[FloatArray, float]:
+        R = Rotation.from_rotvec(x[:3]).as_matrix() @ R0
+        f = f0 * math.exp(x[3]) if f_free else f0
+        return R, f
+
+    x0 = np.zeros(n_par)
+    lo, hi = f_bounds
+    if f_free:
+        lb = np.array([-np.inf, -np.inf, -np.inf, math.log(lo / f0)])
+        ub = np.array([np.inf, np.inf, np.inf, math.log(hi / f0)])
+        x0[3] = min(max(x0[3], lb[3] + 1e-9), ub[3] - 1e-9)
+        bounds: Any = (lb, ub)
+    else:
+        bounds = (-np.inf, np.inf)
+    sol = least_squares(
+        fun,
+        x0,
+        jac=jac,
+        loss="soft_l1",
+        f_scale=tau_px,
+        bounds=bounds,
+        max_nfev=40,
+        xtol=1e-7,
+        ftol=1e-7,
+    )
+    R, f = unpack(sol.x)
+    logf_std = float("nan")
+    if f_free:
+        J = sol.jac
+        # Covariance of the parameters with the robust loss folded into the Jacobian.
+        dof = max(1, len(sol.fun) - len(sol.x))
+        sigma2 = max(float(2.0 * sol.cost / dof), (0.3) ** 2)
+        try:
+            cov = np.linalg.inv(J.T @ J) * sigma2
+            logf_std = float(math.sqrt(max(cov[3, 3], 0.0)))
+        except np.linalg.LinAlgError:
+            logf_std = float("inf")
+    return R, f, logf_std
+
+
+# ------------------------------------------------------------------------- result
+
+
+def _jsonable_float(x: float | None, nd: int = 4) -> float | None:
+    if x is None or not math.isfinite(x):
+        return None
+    return round(float(x), nd)
+
+
+@dataclass
+class AutoVPResult:
+    """Vanishing points, intrinsics and tilt found in one image.
+
+    Attributes
+    ----------
+    vanishing_points
+        ``(3, 3)`` homogeneous vanishing points in pixels (rows ``[x, y, w]``), ordered
+        ``[vertical, horizontal-1, horizontal-2]`` (horizontal-1 has the most support).
+    directions_in_cam
+        ``(3, 3)`` unit vanishing directions in the camera frame, same order; the first
+        points up in the world, the others point forward (``z >= 0``).
+    focal_px, principal_point
+        Intrinsics used (given, or estimated).
+    focal_source
+        ``"given"``, ``"estimated"`` (fixed by the image) or ``"prior"`` (the image could
+        not fix it, a default was used; see ``focal_std_rel``).
+    focal_std_rel
+        Standard deviation of ``log(focal)``, i.e. relative uncertainty, when estimated.
+    pitch_deg, roll_deg
+        Optical axis angle below the horizon, and rotation about the optical axis
+        (positive when image-right tilts downward).
+    horizon
+        ``a, b, c`` of the horizon ``a x + b y + c = 0`` with ``a^2 + b^2 = 1``.
+    segments, labels
+        ``(N, 4)`` detected segments and the index (0..2) of the VP each supports, -1
+        for outliers.
+    confidence
+        0..1, how much structure supports the answer.
+    vertical_identified
+        False when no direction stands out as the vertical one.
+    image_size
+        ``(width, height)`` in pixels.
+    """
+
+    vanishing_points: FloatArray
+    directions_in_cam: FloatArray
+    focal_px: float
+    principal_point: tuple[float, float]
+    focal_source: str
+    focal_std_rel: float
+    pitch_deg: float
+    roll_deg: float
+    horizon: FloatArray
+    segments: FloatArray
+    labels: npt.NDArray[np.int64]
+    confidence: float
+    vertical_identified: bool
+    image_size: tuple[int, int]
+    n_inliers: tuple[int, int, int] = field(default=(0, 0, 0))
+
+    @property
+    def vanishing_points_px(self) -> list[list[float] | None]:
+        """``[x, y]`` of each vanishing point, ``None`` where it is at infinity."""
+        out: list[list[float] | None] = []
+        tol = math.sin(math.radians(INFINITY_TOL_DEG))
+        for d, v in zip(self.directions_in_cam, self.vanishing_points, strict=True):
+            if abs(d[2]) < tol or v[2] == 0.0:
+                out.append(None)
+            else:
+                out.append([float(v[0] / v[2]), float(v[1] / v[2])])
+        return out
+
+    @property
+    def up_in_cam(self) -> FloatArray:
+        """Unit world-up direction in the camera frame."""
+        return np.asarray(self.directions_in_cam[0], dtype=np.float64)
+
+    @property
+    def horizon_endpoints(self) -> list[list[float]] | None:
+        """The horizon at the left (x = 0) and right (x = width) image borders, or None."""
+        a, b, c = (float(x) for x in self.horizon)
+        if abs(b) < 1e-9:
+            return None
+        w = float(self.image_size[0])
+        return [[0.0, -c / b], [w, -(a * w + c) / b]]
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON object ``camloc vp`` prints."""
+        vps_px = self.vanishing_points_px
+        ep = self.horizon_endpoints
+        return {
+            "vanishing_points": [
+                None if v is None else [_jsonable_float(v[0], 3), _jsonable_float(v[1], 3)]
+                for v in vps_px
+            ],
+            "vanishing_point_roles": ["vertical", "horizontal", "horizontal"],
+            "vanishing_points_homogeneous": [
+                [float(x) for x in _unit(np.asarray(v, dtype=np.float64))]
+                for v in self.vanishing_points
+            ],
+            "directions_in_cam": [[round(float(x), 8) for x in d] for d in self.directions_in_cam],
+            "focal_px": _jsonable_float(self.focal_px, 3),
+            "focal_source": self.focal_source,
+            "focal_std_rel": _jsonable_float(self.focal_std_rel, 4),
+            "principal_point": [float(self.principal_point[0]), float(self.principal_point[1])],
+            "horizon": {
+                "line": [float(x) for x in self.horizon],
+                "endpoints": None
+                if ep is None
+                else [[_jsonable_float(p[0], 3), _jsonable_float(p[1], 3)] for p in ep],
+            },
+            "pitch_deg": _jsonable_float(self.pitch_deg, 4),
+            "roll_deg": _jsonable_float(self.roll_deg, 4),
+            "confidence": _jsonable_float(self.confidence, 4),
+            "vertical_identified": bool(self.vertical_identified),
+            "n_segments": len(self.segments),
+            "n_inliers": [int(n) for n in self.n_inliers],
+            "image_size": [int(self.image_size[0]), int(self.image_size[1])],
+        }
+
+
+def pitch_roll_from_up(up_in_cam: FloatArray) -> tuple[float, float]:
+    """Pitch and roll (degrees) of a camera from the world-up direction in its frame.
+
+    Pitch is the optical axis angle below the horizon; roll is
+    ``atan2(r . d0, r . r0)`` with ``r`` the camera x axis, ``r0 = unit(z x up)`` and
+    ``d0 = z x r0`` (positive when image-right tilts downward).
+
+    >>> pitch_roll_from_up(np.array([0.0, -1.0, 0.0]))
+    (0.0, 0.0)
+    """
+    u = _unit(np.asarray(up_in_cam, dtype=np.float64))
+    pitch = math.degrees(math.asin(float(np.clip(-u[2], -1.0, 1.0))))
+    fwd = np.array([0.0, 0.0, 1.0])
+    r0 = np.cross(fwd, u)
+    if np.linalg.norm(r0) < 1e-12:
+        return pitch, 0.0
+    r0 = _unit(r0)
+    d0 = np.cross(fwd, r0)
+    roll = math.degrees(math.atan2(float(d0[0]), float(r0[0])))
+    return pitch + 0.0, roll + 0.0
+
+
+def horizon_from_up(
+    up_in_cam: FloatArray, focal_px: float, principal_point: tuple[float, float]
+) -> FloatArray:
+    """Horizon line ``[a, b, c]`` (``a x + b y + c = 0``, ``a^2 + b^2 = 1``) in pixels."""
+    u = np.asarray(up_in_cam, dtype=np.float64)
+    cx, cy = principal_point
+    line = np.array([u[0], u[1], focal_px * u[2] - cx * u[0] - cy * u[1]])
+    n = math.hypot(line[0], line[1])
+    if n < 1e-15:  # camera looking straight up or down: no horizon in the image
+        return np.array([0.0, 0.0, 1.0])
+    line = line / n
+    if line[1] < 0 or (line[1] == 0 and line[0] < 0):
+        line = -line
+    return np.asarray(line, dtype=np.float64)
+
+
+# ---------------------------------------------------------------------- main entry
+
+
+def detect_vanishing_points(
+    image: str | os.PathLike[str] | npt.NDArray[Any] | None,
+    *,
+    focal_px: float | None = None,
+    principal_point: tuple[float, float] | None = None,
+    seed: int = 0,
+    max_iterations: int = 2000,
+    segments: FloatArray | None = None,
+    image_size: tuple[int, int] | None = None,
+    inlier_px: float | None = None,
+    focal_bounds_rel: tuple[float, float] = FOCAL_BOUNDS_REL,
+) -> AutoVPResult:
+    """Find three orthogonal vanishing points, the focal length, pitch and roll.
+
+    Parameters
+    ----------
+    image
+        Path or array (BGR or gray); ignored for detection when ``segments`` is given
+        (pass ``None`` then, with ``image_size``).
+    focal_px
+        Known focal length in pixels; estimated when None.
+    principal_point
+        Known principal point ``[x, y]`` in pixels; the image centre when None.
+    seed
+        Random seed (the result is deterministic for a given seed).
+    max_iterations
+        Number of RANSAC hypotheses.
+    segments
+        Use these ``(N, 4)`` segments instead of detecting them.
+    image_size
+        ``(width, height)``; needed only when ``image`` is None.
+    inlier_px
+        Inlier distance of a segment end point to the line joining its midpoint and the
+        vanishing point. Default: 1.5 px per 800 px of image diagonal, at least 1 px.
+    focal_bounds_rel
+        Range of focal lengths searched, as multiples of the longer image side.
+
+    Returns
+    -------
+    AutoVPResult
+
+    Raises
+    ------
+    NotEnoughStructureError
+        Too few straight lines, or no two directions supported by enough of them.
+    InputError
+        The image cannot be read.
+    """
+    if image is not None:
+        gray = load_image(image)
+        h, w = gray.shape
+    elif image_size is not None:
+        w, h = int(image_size[0]), int(image_size[1])
+        gray = None
+    else:
+        raise InputError("give an image, or segments with image_size")
+    if focal_px is not None and not (math.isfinite(focal_px) and focal_px > 0):
+        raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
+    if segments is None:
+        assert gray is not None
+        segs_px = detect_segments(gray)
+    else:
+        segs_px = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
+        ln = np.hypot(segs_px[:, 2] - segs_px[:, 0], segs_px[:, 3] - segs_px[:, 1])
+        segs_px = segs_px[np.isfinite(ln) & (ln > 1e-6)]
+    if len(segs_px) < _MIN_SEGMENTS:
+        raise NotEnoughStructureError(
+            f"not enough structure: {len(segs_px)} straight line segments found "
+            f"(at least {_MIN_SEGMENTS} needed)"
+        )
+    pp = np.array(principal_point if principal_point is not None else (w / 2.0, h / 2.0), float)
+    scale = float(max(w, h))
+    diag = math.hypot(w, h)
+    tau = inlier_px if inlier_px is not None else max(1.0, 1.5 * diag / 800.0)
+    s = _prepare(segs_px, pp, scale)
+    f_bounds = (focal_bounds_rel[0], focal_bounds_rel[1])
+    f_fixed = None if focal_px is None else focal_px / scale
+    f_prior = _F_PRIOR_REL if f_fixed is None else f_fixed
+
+    rng = np.random.default_rng(seed)
+    # Score hypotheses on the longest segments (they are sorted longest first).
+    s_sc = _subset(s, slice(0, 150))
+    dirs, fs = _hypotheses(s_sc, rng, max_iterations, f_fixed, f_bounds)
+    if len(dirs) == 0:
+        raise NotEnoughStructureError("not enough structure: no vanishing point hypothesis")
+    # Preemptive scoring: all hypotheses on a spread subset of segments, the best tenth
+    # on the 150 longest.
+    n_sc = len(s_sc.mid)
+    sub = np.unique(np.linspace(0, n_sc - 1, min(n_sc, 48)).round().astype(int))
+    prior = _focal_prior(fs, f_prior) if f_fixed is None else np.ones(len(fs))
+    scores = _score(dirs, fs, _subset(s_sc, sub), tau) * prior
+    keep = np.argsort(-scores, kind="stable")[: max(20, len(dirs) // 10)]
+    scores = _score(dirs[keep], fs[keep], s_sc, tau) * prior[keep]
+    order = keep[np.argsort(-scores, kind="stable")]
+
+    # Refine the best few distinct hypotheses; keep the best refined model.
+    models: list[_Model] = []
+    tried: list[FloatArray] = []
+    for i in order[:40]:
+        R0 = dirs[i].T
+        if any(_same_frame(R0, Rt) for Rt in tried):
+            continue
+        tried.append(R0)
+        models.append(_fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds))
+        if len(tried) >= 3:
+            break
+    if f_fixed is None:
+        best = max(
+            models, key=lambda m: m.score * float(_focal_prior(np.array([m.f_n]), f_prior)[0])
+        )
+    else:
+        best = max(models, key=lambda m: m.score)
+    return _finish(best, s, segs_px, pp, scale, (w, h), f_fixed is None, f_bounds)
+
+
+def _n_distinct_lines(segs: FloatArray, merge_px: float = 4.0) -> int:
+    """Number of distinct straight lines among segments (greedy, longest first)."""
+    if len(segs) == 0:
+        return 0
+    p1, p2 = segs[:, :2], segs[:, 2:]
+    d = p2 - p1
+    ln = np.hypot(d[:, 0], d[:, 1])
+    u = d / ln[:, None]
+    mid = 0.5 * (p1 + p2)
+    free = np.ones(len(segs), bool)
+    n = 0
+    for i in np.argsort(-ln):
+        if not free[i]:
+            continue
+        n += 1
+        rel = mid - mid[i]
+        dist = np.abs(u[i, 0] * rel[:, 1] - u[i, 1] * rel[:, 0])
+        same = (dist < merge_px) & (np.abs(u @ u[i]) > math.cos(math.radians(3.0)))
+        free &= ~same
+    return n
+
+
+def _focal_prior(f_n: FloatArray, f_prior: float) -> FloatArray:
+    """Mild log-normal preference for usual focal lengths; decides near ties only."""
+    return np.asarray(
+        np.exp(-0.5 * (np.log(f_n / f_prior) / _F_PRIOR_SIGMA) ** 2), dtype=np.float64
+    )
+
+
+def _same_frame(Ra: FloatArray, Rb: FloatArray, tol_deg: float = 3.0) -> bool:
+    c = np.abs(Ra.T @ Rb)  # |cos| between all pairs of directions
+    return bool(np.all(c.max(axis=1) > math.cos(math.radians(tol_deg))))
+
+
+def _fit(
+    R0: FloatArray,
+    f0: float,
+    s: _Segs,
+    tau: float,
+    f_free: bool,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+) -> _Model:
+    R, f = R0, f0
+    logf_std = float("nan")
+    labels, score = _labels(R, f, s, 2.0 * tau, 5.0)
+    for _ in range(3):
+        if np.count_nonzero(labels >= 0) < 4:
+            break
+        R, f, logf_std = _refine(R, f, s, labels, tau, f_free, f_prior, f_bounds)
+        new_labels, score = _labels(R, f, s, tau * 1.5, 3.0)
+        if np.array_equal(new_labels, labels):
+            break
+        labels = new_labels
+    # re-orthonormalise against numerical drift
+    U, _, Vt = np.linalg.svd(R)
+    R = U @ Vt
+    return _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
+
+
+def _finish(
+    m: _Model,
+    s: _Segs,
+    segs_px: FloatArray,
+    pp: FloatArray,
+    scale: float,
+    size: tuple[int, int],
+    f_free: bool,
+    f_bounds: tuple[float, float],
+) -> AutoVPResult:
+    dirs = m.R.T.copy()  # rows
+    support = np.array([s.weight[m.labels == k].sum() for k in range(3)])
+    counts = np.array([np.count_nonzero(m.labels == k) for k in range(3)])
+    # Count distinct lines (both edges of a drawn line, or a broken edge, are one line).
+    merge_px = max(4.0, 0.01 * math.hypot(*size))
+    distinct = np.array([_n_distinct_lines(segs_px[m.labels == k], merge_px) for k in range(3)])
+    srt = np.sort(distinct)[::-1]
+    if srt[1] < _MIN_SUPPORT:
+        raise NotEnoughStructureError(
+            "not enough structure: fewer than two line directions are supported by "
+            f"{_MIN_SUPPORT} or more distinct lines (support {srt.tolist()})"
+        )
+    # Vertical: the direction closest to the image's vertical axis.
+    ay = np.abs(dirs[:, 1])
+    kv = int(np.argmax(ay))
+    others = [k for k in range(3) if k != kv]
+    others.sort(key=lambda k: -support[k])
+    perm = [kv, *others]
+    ay_sorted = np.sort(ay)[::-1]
+    vertical_identified = bool(ay_sorted[0] - ay_sorted[1] > 0.15)
+    dirs = dirs[perm]
+    if dirs[0, 1] > 0:  # up points to image-up (-y)
+        dirs[0] = -dirs[0]
+    for k in (1, 2):
+        if dirs[k, 2] < 0 or (dirs[k, 2] == 0 and dirs[k, 0] < 0):
+            dirs[k] = -dirs[k]
+    inv = np.full(4, -1, dtype=np.int64)
+    for new, old in enumerate(perm):
+        inv[old] = new
+    labels = np.where(m.labels >= 0, inv[np.clip(m.labels, 0, 2)], -1)
+    counts = counts[perm]
+    support = support[perm]
+
+    f_px = m.f_n * scale
+    K = np.array([[f_px, 0.0, pp[0]], [0.0, f_px, pp[1]], [0.0, 0.0, 1.0]])
+    vps = (K @ dirs.T).T
+    pitch, roll = pitch_roll_from_up(dirs[0])
+    pp_t = (float(pp[0]), float(pp[1]))
+    horizon = horizon_from_up(dirs[0], f_px, pp_t)
+
+    # Confidence: share of segment length explained, number of supporting segments,
+    # and, when estimated, how well the image fixes the focal length.
+    explained = float(s.weight[labels >= 0].sum() / s.weight.sum())
+    c_support = min(1.0, explained / 0.5)
+    c_count = min(1.0, float(srt[1]) / 8.0) * (0.5 + 0.5 * min(1.0, srt.sum() / 20.0))
+    c_vert = 1.0 if distinct[perm[0]] >= _MIN_SUPPORT else 0.6
+    focal_source = "given"
+    c_focal = 1.0
+    logf_std = m.logf_std
+    if f_free:
+        lo_b, hi_b = f_bounds
+        at_bound = not (lo_b * 1.02 < m.f_n < hi_b / 1.02)
+        if at_bound:
+            focal_source = "bound"
+            c_focal = 0.25
+        elif not math.isfinite(logf_std) or logf_std > 0.25:
+            focal_source = "prior"
+            c_focal = 0.5
+        else:
+            focal_source = "estimated"
+            c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2)
+    confidence = float(np.clip(c_support * c_count * c_vert * c_focal, 0.0, 1.0))
+    log.debug(
+        "autovp: f=%.1f px (%s, std %.3f) support=%s explained=%.2f confidence=%.2f",
+        f_px,
+        focal_source,
+        logf_std,
+        counts.tolist(),
+        explained,
+        confidence,
+    )
+    return AutoVPResult(
+        vanishing_points=vps,
+        directions_in_cam=dirs,
+        focal_px=float(f_px),
+        principal_point=pp_t,
+        focal_source=focal_source,
+        focal_std_rel=float(logf_std),
+        pitch_deg=pitch,
+        roll_deg=roll,
+        horizon=horizon,
+        segments=segs_px,
+        labels=labels,
+        confidence=confidence,
+        vertical_identified=vertical_identified,
+        image_size=(int(size[0]), int(size[1])),
+        n_inliers=(int(counts[0]), int(counts[1]), int(counts[2])),
+    )
+
+
+# --------------------------------------------------------------------- axis helper
+
+
+def segments_for_axis(
+    res: AutoVPResult,
+    origin_px: npt.ArrayLike,
+    end_px: npt.ArrayLike,
+    min_segments: int = 2,
+    *,
+    max_angle_deg: float = 10.0,
+) -> FloatArray:
+    """Segments of the vanishing point that an annotated axis points at.
+
+    Parameters
+    ----------
+    res
+        Result of :func:`detect_vanishing_points`.
+    origin_px, end_px
+        The axis as annotated, e.g. a car's ground corner and the end of its length edge.
+    min_segments
+        Fewest segments to return.
+    max_angle_deg
+        Largest angle between the axis and the image direction, at ``origin_px``,
+        towards the vanishing point.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M, 4)`` segments ``x1, y1, x2, y2`` supporting that vanishing point.
+
+    Raises
+    ------
+    NotEnoughStructureError
+        No vanishing point within ``max_angle_deg`` of the axis, two of them equally
+        close, or fewer than ``min_segments`` segments support it.
+    """
+    o = np.asarray(origin_px, dtype=np.float64).reshape(2)
+    e = np.asarray(end_px, dtype=np.float64).reshape(2)
+    axis = e - o
+    if not (np.all(np.isfinite(axis)) and np.hypot(*axis) > 1e-9):
+        raise InputError("axis origin and end must be two distinct finite pixels")
+    axis = axis / np.hypot(*axis)
+    angles = np.full(3, np.inf)
+    for k, v in enumerate(res.vanishing_points):
+        d = v[:2] - v[2] * o
+        n = float(np.hypot(*d))
+        # Skip a VP that lies (nearly) on the origin: no direction there.
+        if n <= 1e-9 * max(1.0, float(np.linalg.norm(v))) or (v[2] != 0 and n / abs(v[2]) < 1.0):
+            continue
+        c = abs(float(axis @ d) / n)
+        angles[k] = math.degrees(math.acos(min(1.0, c)))
+    order = np.argsort(angles)
+    k = int(order[0])
+    if not angles[k] <= max_angle_deg:
+        raise NotEnoughStructureError(
+            f"not enough structure: no vanishing point within {max_angle_deg:g} deg of the "
+            f"axis (closest {angles[k]:.1f} deg)"
+        )
+    second = float(angles[order[1]])
+    if second <= max_angle_deg and second - angles[k] < 2.0:
+        raise NotEnoughStructureError(
+            "not enough structure: the axis is ambiguous between two vanishing points "
+            f"({angles[k]:.1f} and {second:.1f} deg)"
+        )
+    segs = res.segments[res.labels == k]
+    if len(segs) < min_segments:
+        raise NotEnoughStructureError(
+            f"not enough structure: {len(segs)} segments support the axis' vanishing point "
+            f"({min_segments} needed)"
+        )
+    return np.asarray(segs, dtype=np.float64)
+
+
+# ------------------------------------------------------------------------- drawing
+
+
+def draw_segments(
+    image: str | os.PathLike[str] | npt.NDArray[Any],
+    res: AutoVPResult,
+    out_path: str | os.PathLike[str],
+) -> None:
+    """Write a PNG of the image with segments coloured by vanishing point.
+
+    Red: vertical, green: horizontal-1, blue: horizontal-2, grey: outliers; the horizon
+    is drawn in yellow.
+    """
+    import cv2
+
+    gray = load_image(image)
+    canvas = cv2.cvtColor((gray // 2 + 64).astype(np.uint8), cv2.COLOR_GRAY2BGR)
+    colours = {-1: (160, 160, 160), 0: (0, 0, 255), 1: (0, 200, 0), 2: (255, 64, 0)}
+    shift = 4  # sub-pixel drawing
+    for seg, lab in zip(res.segments, res.labels, strict=True):
+        p = np.rint((seg - 0.5) * (1 << shift)).astype(np.int64)
+        cv2.line(
+            canvas,
+            (int(p[0]), int(p[1])),
+            (int(p[2]), int(p[3])),
+            colours[int(lab)],
+            1 if lab < 0 else 2,
+            cv2.LINE_AA,
+            shift,
+        )
+    ep = res.horizon_endpoints
+    if ep is not None and all(math.isfinite(c) and abs(c) < 1e6 for pt in ep for c in pt):
+        cv2.line(
+            canvas,
+            (round(ep[0][0]), round(ep[0][1])),
+            (round(ep[1][0]), round(ep[1][1])),
+            (0, 220, 255),
+            1,
+            cv2.LINE_AA,
+        )
+    ok = cv2.imwrite(str(out_path), canvas)
+    if not ok:
+        raise InputError(f"cannot write {str(out_path)!r}")

@@ -1,0 +1,59 @@
+"""``camloc vp IMAGE``: vanishing points, focal length, horizon, pitch and roll of a photo."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from typing import Any
+
+from camloc_geo._errors import InputError
+
+__all__ = ["register", "run"]
+
+log = logging.getLogger(__name__)
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``vp`` sub-command to the ``camloc`` parser."""
+    p = subparsers.add_parser(
+        "vp",
+        help="find the three orthogonal vanishing points, focal length and horizon of a photo",
+        description=(
+            "Detect line segments, find three mutually orthogonal vanishing points and "
+            "the focal length, and print them with the horizon line, pitch and roll as "
+            "JSON. Vanishing points at infinity are null."
+        ),
+    )
+    p.add_argument("image", metavar="IMAGE", help="photo (any format OpenCV reads)")
+    p.add_argument("--focal-px", type=float, default=None, help="known focal length, pixels")
+    p.add_argument(
+        "--principal-point",
+        type=float,
+        nargs=2,
+        metavar=("X", "Y"),
+        default=None,
+        help="known principal point, pixels (default: the image centre)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--draw", metavar="OUT.png", default=None, help="draw segments coloured by VP")
+    p.add_argument("-o", "--output", metavar="OUT.json", default=None, help="write JSON here")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``camloc vp``."""
+    from camloc_geo.autovp import detect_vanishing_points, draw_segments, load_image
+    from camloc_geo.cli import write_json
+
+    if args.focal_px is not None and not args.focal_px > 0:
+        raise InputError(f"--focal-px must be positive, got {args.focal_px}")
+    image = load_image(args.image)
+    pp = tuple(args.principal_point) if args.principal_point else None
+    res = detect_vanishing_points(image, focal_px=args.focal_px, principal_point=pp, seed=args.seed)
+    if args.draw:
+        draw_segments(image, res, args.draw)
+        log.info("segments drawn to %s", args.draw)
+    out = res.to_json()
+    out["image"] = str(args.image)
+    write_json(out, args.output)
+    return 0

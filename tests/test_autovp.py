@@ -1,0 +1,335 @@
+"""Tests of camloc_geo.autovp: synthetic Manhattan scenes with a known camera, York Urban photos."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+
+from camloc_geo import InputError, NotEnoughStructureError  # noqa: E402
+from camloc_geo.autovp import (  # noqa: E402
+    AutoVPResult,
+    detect_segments,
+    detect_vanishing_points,
+    horizon_from_up,
+    pitch_roll_from_up,
+    segments_for_axis,
+)
+
+YUD = Path(__file__).resolve().parents[2] / "shared" / "data" / "yud" / "YorkUrbanDB"
+
+
+# ----------------------------------------------------------------- synthetic scenes
+
+
+def cam_from_world(yaw_deg: float, pitch_deg: float, roll_deg: float) -> np.ndarray:
+    """Rotation with rows = camera right, down, forward in a z-up world."""
+    ps, th, ph = (math.radians(a) for a in (yaw_deg, pitch_deg, roll_deg))
+    fwd = np.array([math.cos(ps) * math.cos(th), math.sin(ps) * math.cos(th), -math.sin(th)])
+    r0 = np.cross(fwd, [0.0, 0.0, 1.0])
+    r0 /= np.linalg.norm(r0)
+    d0 = np.cross(fwd, r0)
+    right = math.cos(ph) * r0 + math.sin(ph) * d0
+    down = math.cos(ph) * d0 - math.sin(ph) * r0
+    return np.array([right, down, fwd])
+
+
+def render_scene(
+    R: np.ndarray,
+    f: float,
+    size: tuple[int, int] = (800, 600),
+    *,
+    n_lines: int = 150,
+    clutter: int = 20,
+    seed: int = 1,
+) -> np.ndarray:
+    """Draw random world-axis-aligned segments seen by camera ``R`` (pp = image centre)."""
+    rng = np.random.default_rng(seed)
+    w, h = size
+    K = np.array([[f, 0, w / 2], [0, f, h / 2], [0, 0, 1.0]])
+    img = np.full((h, w), 235, np.uint8)
+    fwd_w = R[2]
+    drawn = 0
+    tries = 0
+    while drawn < n_lines + clutter and tries < 20000:
+        tries += 1
+        depth = rng.uniform(8, 40)
+        lateral = rng.uniform(-1, 1, 3) * depth * 0.8
+        p = fwd_w * depth + lateral
+        if drawn < n_lines:
+            axis = np.eye(3)[drawn % 3]
+        else:
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+        q = p + axis * rng.uniform(2, 8) * (1 if rng.random() < 0.5 else -1)
+        pc, qc = R @ p, R @ q
+        if pc[2] < 1 or qc[2] < 1:
+            continue
+        a = K @ pc
+        b = K @ qc
+        a, b = a[:2] / a[2], b[:2] / b[2]
+        if not (all(a >= 0) and all(b >= 0) and a[0] < w and b[0] < w and a[1] < h and b[1] < h):
+            continue
+        if np.hypot(*(a - b)) < 30:
+            continue
+        pa = tuple(int(v) for v in np.rint((a - 0.5) * 16))
+        pb = tuple(int(v) for v in np.rint((b - 0.5) * 16))
+        cv2.line(img, pa, pb, 30, 2, cv2.LINE_AA, 4)
+        drawn += 1
+    return img
+
+
+def dir_errors_deg(est: np.ndarray, true_rows: np.ndarray) -> np.ndarray:
+    """For each true direction, the angle to the closest estimated one (up to sign)."""
+    c = np.abs(true_rows @ est.T).max(axis=1)
+    return np.degrees(np.arccos(np.clip(c, 0, 1)))
+
+
+@pytest.fixture(scope="module")
+def tilted_scene() -> tuple[np.ndarray, np.ndarray, float]:
+    R = cam_from_world(30.0, 12.0, 4.0)
+    f = 700.0
+    return render_scene(R, f), R, f
+
+
+def test_synthetic_three_vps_and_focal(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, R, f = tilted_scene
+    res = detect_vanishing_points(img)
+    assert isinstance(res, AutoVPResult)
+    true_dirs = R.T  # rows: world x, y, z axes in the camera frame
+    assert dir_errors_deg(res.directions_in_cam, true_dirs).max() < 0.5
+    assert res.focal_px == pytest.approx(f, rel=0.03)
+    # vertical first, pointing up; pitch and roll as rendered
+    assert np.degrees(np.arccos(abs(res.directions_in_cam[0] @ R[:, 2]))) < 0.5
+    assert res.directions_in_cam[0] @ R[:, 2] > 0
+    assert res.pitch_deg == pytest.approx(12.0, abs=0.5)
+    assert res.roll_deg == pytest.approx(4.0, abs=0.5)
+    assert res.confidence > 0.7
+    assert res.focal_source == "estimated"
+    assert res.segments.shape[1] == 4
+    assert res.labels.shape == (len(res.segments),)
+    assert set(np.unique(res.labels)) <= {-1, 0, 1, 2}
+    # the pixel VPs agree with the homogeneous ones
+    for v, px in zip(res.vanishing_points, res.vanishing_points_px, strict=True):
+        if px is not None:
+            assert px == pytest.approx([v[0] / v[2], v[1] / v[2]])
+    # horizon passes through both horizontal vanishing points
+    a, b, c = res.horizon
+    for v in res.vanishing_points[1:]:
+        assert abs(a * v[0] + b * v[1] + c * v[2]) / np.linalg.norm(v) < 1e-6
+
+
+def test_synthetic_known_focal_is_used(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, R, f = tilted_scene
+    res = detect_vanishing_points(img, focal_px=f)
+    assert res.focal_px == f
+    assert res.focal_source == "given"
+    assert dir_errors_deg(res.directions_in_cam, R.T).max() < 0.5
+
+
+def test_deterministic_for_a_seed(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, _, _ = tilted_scene
+    a = detect_vanishing_points(img, seed=3)
+    b = detect_vanishing_points(img, seed=3)
+    np.testing.assert_array_equal(a.directions_in_cam, b.directions_in_cam)
+
+
+def test_vps_at_infinity_are_null() -> None:
+    # Level camera square to a facade: vertical and one horizontal VP at infinity.
+    R = cam_from_world(0.0, 0.0, 0.0)
+    img = render_scene(R, 600.0, seed=4)
+    res = detect_vanishing_points(img, focal_px=600.0)
+    px = res.vanishing_points_px
+    assert px[0] is None  # vertical
+    assert sum(p is None for p in px) == 2
+    finite = next(p for p in px if p is not None)
+    assert finite == pytest.approx([400.0, 300.0], abs=3.0)
+    assert res.pitch_deg == pytest.approx(0.0, abs=0.3)
+    assert res.roll_deg == pytest.approx(0.0, abs=0.3)
+    js = res.to_json()
+    assert js["vanishing_points"][0] is None
+    assert np.all(np.isfinite(res.vanishing_points))
+
+
+def test_segments_for_axis(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, R, f = tilted_scene
+    res = detect_vanishing_points(img)
+    K = np.array([[f, 0, 400.0], [0, f, 300.0], [0, 0, 1]])
+    origin = np.array([400.0, 420.0])
+    # the image of world-x through origin: towards the VP of world x
+    for axis in range(3):
+        v = K @ R[:, axis]
+        d = v[:2] - v[2] * origin
+        end = origin + 60 * d / np.linalg.norm(d)
+        segs = segments_for_axis(res, origin, end)
+        assert len(segs) >= 2
+        # every returned segment points at the same VP as the axis
+        mid = 0.5 * (segs[:, :2] + segs[:, 2:])
+        u = segs[:, 2:] - segs[:, :2]
+        to_v = v[:2] - v[2] * mid
+        cos = np.abs(np.sum(u * to_v, 1)) / np.linalg.norm(u, axis=1) / np.linalg.norm(to_v, axis=1)
+        assert np.degrees(np.arccos(np.clip(cos, 0, 1))).max() < 3.0
+    # an axis pointing nowhere near a VP
+    v0, v1 = (K @ R[:, 0]), (K @ R[:, 1])
+    d0 = v0[:2] / v0[2] - origin if abs(v0[2]) > 1e-9 else v0[:2]
+    d1 = v1[:2] / v1[2] - origin if abs(v1[2]) > 1e-9 else v1[:2]
+    d0, d1 = d0 / np.linalg.norm(d0), d1 / np.linalg.norm(d1)
+    bis = d0 + d1 if np.dot(d0, d1) > 0 else d0 - d1
+    dirs = [origin + 50 * bis / np.linalg.norm(bis)]
+    for end in dirs:
+        angles = []
+        for vk in res.vanishing_points:
+            dk = vk[:2] - vk[2] * origin
+            dd = end - origin
+            angles.append(
+                math.degrees(
+                    math.acos(min(1, abs(dd @ dk) / np.linalg.norm(dd) / np.linalg.norm(dk)))
+                )
+            )
+        if min(angles) > 10:
+            with pytest.raises(NotEnoughStructureError):
+                segments_for_axis(res, origin, end)
+    with pytest.raises(InputError):
+        segments_for_axis(res, origin, origin)
+
+
+def test_segments_for_axis_far_off_raises(
+    tilted_scene: tuple[np.ndarray, np.ndarray, float],
+) -> None:
+    img, _, _ = tilted_scene
+    res = detect_vanishing_points(img)
+    origin = np.array([400.0, 300.0])
+    # search a direction at least 15 deg from every VP direction at origin
+    angs = []
+    for v in res.vanishing_points:
+        d = v[:2] - v[2] * origin
+        angs.append(math.degrees(math.atan2(d[1], d[0])) % 180)
+    for cand in np.arange(0, 180, 1.0):
+        if all(min(abs(cand - a), 180 - abs(cand - a)) > 15 for a in angs):
+            end = origin + 50 * np.array(
+                [math.cos(math.radians(cand)), math.sin(math.radians(cand))]
+            )
+            with pytest.raises(NotEnoughStructureError, match="not enough structure"):
+                segments_for_axis(res, origin, end)
+            break
+    else:
+        pytest.fail("no direction far from all VPs")
+
+
+# --------------------------------------------------------------------- conventions
+
+
+def test_pitch_roll_conventions() -> None:
+    assert pitch_roll_from_up(np.array([0.0, -1.0, 0.0])) == (0.0, 0.0)
+    for yaw, pitch, roll in [(10, 20, 5), (200, -15, -8), (75, 40, 0)]:
+        R = cam_from_world(yaw, pitch, roll)
+        up_in_cam = R @ np.array([0.0, 0.0, 1.0])
+        p, r = pitch_roll_from_up(up_in_cam)
+        assert p == pytest.approx(pitch, abs=1e-9)
+        assert r == pytest.approx(roll, abs=1e-9)
+
+
+def test_horizon_from_up_level_camera() -> None:
+    line = horizon_from_up(np.array([0.0, -1.0, 0.0]), 500.0, (320.0, 240.0))
+    np.testing.assert_allclose(line, [0.0, 1.0, -240.0], atol=1e-12)
+    # looking down 10 deg: horizon above the centre by f tan(10 deg)
+    R = cam_from_world(0, 10, 0)
+    line = horizon_from_up(R @ [0, 0, 1.0], 500.0, (320.0, 240.0))
+    y = -(line[0] * 320 + line[2]) / line[1]
+    assert y == pytest.approx(240 - 500 * math.tan(math.radians(10)))
+
+
+# ----------------------------------------------------------------------- bad input
+
+
+def test_blank_image_is_not_enough_structure() -> None:
+    with pytest.raises(NotEnoughStructureError, match="not enough structure"):
+        detect_vanishing_points(np.full((480, 640, 3), 127, np.uint8))
+
+
+def test_noise_image_is_refused_or_unconfident() -> None:
+    rng = np.random.default_rng(0)
+    img = cv2.GaussianBlur(rng.integers(0, 255, (480, 640), dtype=np.uint8), (5, 5), 0)
+    try:
+        res = detect_vanishing_points(img)
+    except NotEnoughStructureError:
+        return
+    assert res.confidence < 0.3
+
+
+def test_too_few_lines() -> None:
+    img = np.full((480, 640), 255, np.uint8)
+    cv2.rectangle(img, (200, 150), (440, 330), 0, 3)
+    with pytest.raises(NotEnoughStructureError):
+        detect_vanishing_points(img)
+
+
+def test_unreadable_file(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.jpg"
+    bad.write_text("not an image")
+    with pytest.raises(InputError, match="cannot decode"):
+        detect_vanishing_points(bad)
+    with pytest.raises(InputError, match="cannot read"):
+        detect_vanishing_points(tmp_path / "missing.png")
+
+
+def test_bad_arrays_and_focal() -> None:
+    with pytest.raises(InputError):
+        detect_vanishing_points(np.zeros((4, 4)))
+    with pytest.raises(InputError):
+        detect_vanishing_points(np.zeros((10, 10, 2)))
+    with pytest.raises(InputError):
+        detect_vanishing_points(np.zeros((100, 100)), focal_px=-3.0)
+
+
+def test_detect_segments_convention() -> None:
+    img = np.full((200, 300), 255, np.uint8)
+    img[:, 150:] = 0  # vertical edge between pixel columns 149 and 150: x = 150
+    segs = detect_segments(img, method="lsd")
+    assert len(segs) >= 1
+    assert np.median(segs[:, [0, 2]]) == pytest.approx(150.0, abs=0.6)
+    segs_h = detect_segments(img, method="hough")
+    assert len(segs_h) >= 1
+
+
+def test_float_and_gray_inputs_agree(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, _, _ = tilted_scene
+    a = detect_segments(img)
+    b = detect_segments(img.astype(np.float64) / 255.0)
+    c = detect_segments(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR))
+    np.testing.assert_allclose(a, b)
+    np.testing.assert_allclose(a, c)
+
+
+# ---------------------------------------------------------------------- York Urban
+
+YUD_CASES = ["P1020171", "P1020826", "P1040813", "P1080020", "P1020838"]
+
+
+def _yud_truth(name: str) -> tuple[Path, np.ndarray, float]:
+    sio = pytest.importorskip("scipy.io")
+    cam = sio.loadmat(str(YUD / "cameraParameters.mat"))
+    f = float(cam["focal"][0, 0] / cam["pixelSize"][0, 0])
+    orth = sio.loadmat(str(YUD / name / f"{name}GroundTruthVP_Orthogonal_CamParams.mat"))
+    dirs = (np.diag([1.0, -1.0, 1.0]) @ orth["vp_orthogonal"]).T
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    return YUD / name / f"{name}.jpg", dirs, f
+
+
+@pytest.mark.skipif(not YUD.exists(), reason="York Urban DB not available")
+@pytest.mark.parametrize("name", YUD_CASES)
+def test_york_urban_photo(name: str) -> None:
+    path, true_dirs, f_true = _yud_truth(name)
+    res = detect_vanishing_points(path)
+    assert res.focal_px == pytest.approx(f_true, rel=0.15)
+    errs = dir_errors_deg(res.directions_in_cam, true_dirs)
+    assert errs.max() < 3.0, errs
+    assert res.confidence > 0.5
+    assert res.vertical_identified
+    # the vertical VP is the ground truth's most vertical direction
+    kv = int(np.argmax(np.abs(true_dirs[:, 1])))
+    assert abs(res.directions_in_cam[0] @ true_dirs[kv]) > math.cos(math.radians(3.0))

@@ -1,0 +1,123 @@
+"""``camloc vp``: JSON output, drawing, exit statuses."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+
+from camloc_geo.cli import main  # noqa: E402
+
+
+def _load_scene_helpers() -> object:
+    """The synthetic-scene renderer of test_autovp.py, whatever the import mode."""
+    spec = importlib.util.spec_from_file_location(
+        "_camloc_autovp_scene", Path(__file__).with_name("test_autovp.py")
+    )
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_scene = _load_scene_helpers()
+cam_from_world = _scene.cam_from_world  # type: ignore[attr-defined]
+render_scene = _scene.render_scene  # type: ignore[attr-defined]
+
+
+@pytest.fixture(scope="module")
+def scene_png(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("vp") / "scene.png"
+    cv2.imwrite(str(path), render_scene(cam_from_world(25.0, 8.0, -3.0), 650.0, seed=2))
+    return path
+
+
+def test_vp_prints_json(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in (
+        "vanishing_points",
+        "focal_px",
+        "principal_point",
+        "horizon",
+        "pitch_deg",
+        "roll_deg",
+        "confidence",
+        "n_segments",
+    ):
+        assert key in out
+    assert len(out["vanishing_points"]) == 3
+    assert out["focal_px"] == pytest.approx(650.0, rel=0.05)
+    assert out["pitch_deg"] == pytest.approx(8.0, abs=0.7)
+    assert out["roll_deg"] == pytest.approx(-3.0, abs=0.7)
+    assert out["principal_point"] == [400.0, 300.0]
+    assert 0.0 <= out["confidence"] <= 1.0
+
+
+def test_vp_focal_and_draw(
+    scene_png: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    drawing = tmp_path / "segs.png"
+    assert main(["vp", str(scene_png), "--focal-px", "650", "--draw", str(drawing)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["focal_px"] == 650.0
+    assert out["focal_source"] == "given"
+    img = cv2.imread(str(drawing))
+    assert img is not None
+    assert img.shape == (600, 800, 3)
+    assert (img[:, :, 2] > 200).sum() > 100  # red (vertical) segments drawn
+
+
+@pytest.mark.parametrize("kind", ["blank", "garbage", "missing"])
+def test_vp_bad_input_exit_2(kind: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "in.png"
+    if kind == "blank":
+        cv2.imwrite(str(path), np.full((480, 640), 200, np.uint8))
+    elif kind == "garbage":
+        path.write_bytes(b"\x00not a png")
+    assert main(["vp", str(path)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    err = captured.err.strip()
+    assert err.startswith("camloc vp: error:")
+    assert "\n" not in err
+    assert "Traceback" not in err
+    if kind == "blank":
+        assert "not enough structure" in err
+
+
+def test_vp_negative_focal_exit_2(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png), "--focal-px", "-5"]) == 2
+    assert "focal" in capsys.readouterr().err
+
+
+def test_vp_subprocess(scene_png: Path, tmp_path: Path) -> None:
+    blank = tmp_path / "blank.png"
+    cv2.imwrite(str(blank), np.zeros((100, 100), np.uint8))
+    root = Path(__file__).resolve().parents[1]
+    ok = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", "vp", str(scene_png)],
+        capture_output=True,
+        text=True,
+        cwd=root,
+        check=False,
+    )
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["n_segments"] > 10
+    bad = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", "vp", str(blank)],
+        capture_output=True,
+        text=True,
+        cwd=root,
+        check=False,
+    )
+    assert bad.returncode == 2
+    assert "not enough structure" in bad.stderr
