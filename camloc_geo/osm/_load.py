@@ -248,7 +248,8 @@ def read_extract(
         bounds = (s_min, w_min, n_max, e_max)
     if n_ways == 0 or bounds is None:
         raise MapDataError(f"OSM extract {path.name} holds no streets or buildings")
-    if not (bounds[0] <= lat <= bounds[2] and bounds[1] <= lon <= bounds[3]):
+    inside = bounds[0] <= lat <= bounds[2] and bounds[1] <= lon <= bounds[3]
+    if radius_m is not None and not inside:
         raise MapDataError(
             f"point lat={lat:.6f}, lon={lon:.6f} is outside the extract {path.name} "
             f"(it covers lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
@@ -262,7 +263,9 @@ def read_extract(
     return RawMap(graph=graph, buildings=buildings, bounds=bounds, source=str(path))
 
 
-def _graph_from_ways(ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]]) -> Any:
+def _graph_from_ways(
+    ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]],
+) -> nx.MultiDiGraph:
     """Build the simplified osmnx graph from street ways via a temporary OSM XML file."""
     nodes: dict[int, tuple[float, float]] = {}
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="camloc_geo">']
@@ -281,7 +284,19 @@ def _graph_from_ways(ways: list[tuple[int, dict[str, str], list[tuple[int, float
         xml_path = Path(tmp) / "streets.osm"
         xml_path.write_text("\n".join(lines), encoding="utf-8")
         with osmnx_settings(log_console=False):
-            return ox.graph_from_xml(xml_path, bidirectional=False, simplify=True, retain_all=True)
+            graph = ox.graph_from_xml(
+                xml_path, bidirectional=False, simplify=False, retain_all=True
+            )
+    return simplify(graph)
+
+
+SIMPLIFY_EDGE_ATTRS_DIFFER = ("name",)
+"""Graph nodes where the street name changes are kept (an edge never mixes two names)."""
+
+
+def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
+    """osmnx simplification that keeps nodes where the street name changes."""
+    return ox.simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
 
 
 def overpass_filter(highways: frozenset[str]) -> str:
@@ -327,11 +342,12 @@ def read_overpass(
                 (lat, lon),
                 dist=radius_m + CLIP_MARGIN_M,
                 dist_type="bbox",
-                simplify=True,
+                simplify=False,
                 retain_all=True,
                 truncate_by_edge=True,
                 custom_filter=overpass_filter(highways),
             )
+            graph = simplify(graph)
             try:
                 features = ox.features_from_point(
                     (lat, lon), tags={"building": True}, dist=radius_m
