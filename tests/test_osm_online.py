@@ -7,6 +7,7 @@ import json
 import threading
 from collections.abc import Iterator
 from pathlib import Path
+from typing import ClassVar
 
 import osmnx as ox
 import pytest
@@ -19,10 +20,10 @@ LAT, LON = 39.28549, -76.59535  # Eastern Avenue & South Bond Street, Baltimore
 
 
 class _Handler(http.server.BaseHTTPRequestHandler):
-    responses: dict[str, bytes] = {}
-    queries: list[str] = []
+    responses: ClassVar[dict[str, bytes]] = {}
+    queries: ClassVar[list[str]] = []
 
-    def do_POST(self) -> None:  # noqa: N802
+    def do_POST(self) -> None:
         length = int(self.headers.get("Content-Length", "0"))
         body = self.rfile.read(length).decode("utf-8", "replace")
         type(self).queries.append(body)
@@ -36,7 +37,7 @@ class _Handler(http.server.BaseHTTPRequestHandler):
 
     do_GET = do_POST  # noqa: N815
 
-    def log_message(self, format: str, *args: object) -> None:  # noqa: A002
+    def log_message(self, format: str, *args: object) -> None:
         pass
 
 
