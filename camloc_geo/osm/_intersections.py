@@ -159,6 +159,35 @@ def _angle_diff(a: float, b: float) -> float:
     return min(d, 360.0 - d)
 
 
+def _continued_label(
+    G: nx.MultiDiGraph, edge: tuple[Any, Any], data: dict[str, Any], max_steps: int = 4
+) -> tuple[str, tuple[str, ...]]:
+    """The arm's label; an unnamed piece takes the name of the street it continues into.
+
+    Short unnamed pieces (bridges, split ways) at a junction would otherwise label the whole
+    arm "unnamed ...". Only plain continuations are followed (nodes joining exactly two
+    streets), at most ``max_steps`` edges.
+    """
+    name, names = street_label(data)
+    if names or G is None:
+        return name, names
+    prev, cur = edge
+    for _ in range(max_steps):
+        if cur not in G:
+            break
+        nbrs = (set(G.successors(cur)) | set(G.predecessors(cur))) - {prev, cur}
+        if len(nbrs) != 1:
+            break
+        nxt = nbrs.pop()
+        edata = G.get_edge_data(cur, nxt) or G.get_edge_data(nxt, cur)
+        nxt_data = next(iter(edata.values()))
+        n2, names2 = street_label(nxt_data)
+        if names2:
+            return n2, names2
+        prev, cur = cur, nxt
+    return name, names
+
+
 def _make_arm(
     coords: list[tuple[float, float]],
     flow: str,
@@ -166,6 +195,7 @@ def _make_arm(
     edge: tuple[int, int],
     frame: LocalFrame,
     north_america: bool,
+    G: nx.MultiDiGraph | None = None,
 ) -> _Arm | None:
     line = LineString(coords)
     if line.length < 0.5:
@@ -177,7 +207,7 @@ def _make_arm(
     norm = float(np.hypot(*vec))
     if norm < 1e-3:
         return None
-    name, names = street_label(data)
+    name, names = _continued_label(G, edge, data) if G is not None else street_label(data)
     highway = highway_of(data)
     oneway = flow != "both"
     width, source = resolve_width_m(
@@ -205,7 +235,11 @@ def _make_arm(
 
 
 def _arms_of(
-    Gc: nx.MultiDiGraph, node: Any, frame: LocalFrame, north_america: bool
+    Gc: nx.MultiDiGraph,
+    node: Any,
+    frame: LocalFrame,
+    north_america: bool,
+    Gp: nx.MultiDiGraph | None = None,
 ) -> tuple[list[_Arm], list[str]]:
     multi = isinstance(Gc.nodes[node].get("osmid_original"), list)
     found: dict[tuple[Any, ...], tuple[list[tuple[float, float]], set[str], dict[str, Any], Any]]
@@ -235,7 +269,7 @@ def _arms_of(
     arms: list[_Arm] = []
     for coords, flows, data, edge in found.values():
         flow = "both" if len(flows) == 2 or not _is_oneway(data) else next(iter(flows))
-        arm = _make_arm(coords, flow, data, edge, frame, north_america)
+        arm = _make_arm(coords, flow, data, edge, frame, north_america, Gp)
         if arm is not None:
             arms.append(arm)
     return arms, list(dict.fromkeys(warnings))
@@ -432,7 +466,7 @@ def build_intersections(
         dist_centre = float(np.hypot(*centre))
         if radius_m is not None and dist_centre > radius_m:
             continue
-        arms, warnings = _arms_of(Gc, node, frame, north_america)
+        arms, warnings = _arms_of(Gc, node, frame, north_america, Gp)
         links = [a for a in arms if a.highway.endswith("_link")]
         arms = [a for a in arms if not a.highway.endswith("_link")]
         if links:

@@ -134,7 +134,7 @@ def _building_from_tags(ident: str, tags: dict[str, str], poly: Any) -> Building
         id=ident,
         name=name,
         footprint=poly,
-        height_m=parse_width_m(tags.get("height")) if tags.get("height") else None,
+        height_m=parse_width_m(tags.get("height"), max_m=1000.0),
         levels=_num(tags.get("building:levels")),
         building=tags.get("building") or "yes",
     )

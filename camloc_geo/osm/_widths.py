@@ -85,8 +85,10 @@ def _first(value: Any) -> Any:
     return value
 
 
-def parse_width_m(value: Any) -> float | None:
-    """Parse an OSM ``width`` value to metres, or None if absent or unparsable.
+def parse_width_m(value: Any, *, max_m: float = 100.0) -> float | None:
+    """Parse an OSM ``width`` (or ``height``) value to metres, or None if absent or bad.
+
+    Values outside (0.5, ``max_m``] are rejected as tagging errors.
 
     Examples
     --------
@@ -112,7 +114,7 @@ def parse_width_m(value: Any) -> float | None:
                 width *= 0.3048
             elif "cm" in text:
                 width /= 100.0
-    if not math.isfinite(width) or width <= 0.5 or width > 100.0:
+    if not math.isfinite(width) or width <= 0.5 or width > max_m:
         return None
     return round(width, 6)
 
