@@ -82,7 +82,8 @@ def test_grid_four_way_corners(baltimore: MapData) -> None:
     x = baltimore.find_intersection("Eastern Avenue & South Bond Street")
     assert x.id == "n49478228"
     assert x.kind == "junction"
-    assert x.lat == pytest.approx(39.2854942) and x.lon == pytest.approx(-76.5953525)
+    assert x.lat == pytest.approx(39.2854942)
+    assert x.lon == pytest.approx(-76.5953525)
     assert [s.name for s in x.streets] == [
         "Eastern Avenue",
         "South Bond Street",
@@ -127,7 +128,8 @@ def test_dual_carriageway_is_one_intersection(baltimore: MapData) -> None:
     assert x.kind == "junction"
     broadway = [s for s in x.streets if s.name == "South Broadway"]
     eastern = [s for s in x.streets if s.name == "Eastern Avenue"]
-    assert len(broadway) == 2 and len(eastern) == 2
+    assert len(broadway) == 2
+    assert len(eastern) == 2
     assert all(s.carriageways == 2 and not s.oneway for s in broadway)
     # the outer kerbs of the pair: wider than both carriageways together
     assert all(s.width_m > 20.0 for s in broadway)
@@ -191,8 +193,10 @@ def test_streets_that_do_not_meet(baltimore: MapData) -> None:
     with pytest.raises(MapDataError) as info:
         baltimore.find_intersection("Eastern Ave & Fleet St")
     msg = str(info.value)
-    assert "'Eastern Ave'" in msg and "'Fleet St'" in msg
-    assert "Eastern Avenue" in msg and "Fleet Street" in msg  # close matches
+    assert "'Eastern Ave'" in msg
+    assert "'Fleet St'" in msg
+    assert "Eastern Avenue" in msg
+    assert "Fleet Street" in msg
     with pytest.raises(MapDataError, match="Nowhere Road"):
         baltimore.find_intersection("Nowhere Road & Eastern Avenue")
     with pytest.raises(MapDataError, match="two street names"):
