@@ -24,8 +24,10 @@ throughout (``[x, y, w]`` in pixels), so points at infinity (``w = 0``) never ca
 division by zero; in pixel form they are reported as ``None``.
 
 The vertical vanishing point is the one of the world's up axis. It is identified as the
-vanishing direction closest to the image's vertical axis (street cameras and photos are
-seldom rolled by more than 45 degrees and seldom pitched by more than 45 degrees).
+vanishing direction closest to the image's vertical axis, with a penalty for
+interpretations in which the camera looks up steeply (see ``_vertical_cost``): street
+cameras and photos are seldom rolled by more than 45 degrees, and a camera that looks
+down steeply is likelier than one that looks up steeply.
 """
 
 from __future__ import annotations
@@ -790,6 +792,21 @@ def _refine_free_direction(d0: FloatArray, f_n: float, s: _Segs, tau_px: float) 
     return _unit(d0 + sol.x[0] * a + sol.x[1] * b)
 
 
+def _vertical_cost(dirs: FloatArray) -> FloatArray:
+    """How unlikely each direction is to be the world's vertical (degrees-like cost).
+
+    The angle between the direction and the image's vertical axis, plus a penalty for
+    the camera looking up by more than 20 degrees were it the vertical: a camera pitched
+    down 50 degrees (a mast-mounted street camera) and one pitched up 40 degrees see the
+    same Manhattan frame; the first is the likelier.
+    """
+    ay = np.clip(np.abs(dirs[:, 1]), 0.0, 1.0)
+    angle = np.degrees(np.arccos(ay))
+    up = dirs * -np.sign(dirs[:, 1:2] + 1e-300)  # each candidate pointing image-up
+    pitch = np.degrees(np.arcsin(np.clip(-up[:, 2], -1.0, 1.0)))
+    return np.asarray(angle + np.maximum(0.0, -pitch - 20.0), dtype=np.float64)
+
+
 def _n_distinct_lines(segs: FloatArray, merge_px: float = 4.0) -> int:
     """Number of distinct straight lines among segments (greedy, longest first)."""
     if len(segs) == 0:
@@ -872,14 +889,12 @@ def _finish(
             "not enough structure: fewer than two line directions are supported by "
             f"{_MIN_SUPPORT} or more distinct lines (support {srt.tolist()})"
         )
-    # Vertical: the direction closest to the image's vertical axis.
-    ay = np.abs(dirs[:, 1])
-    kv = int(np.argmax(ay))
+    cost = _vertical_cost(dirs)
+    kv = int(np.argmin(cost))
     others = [k for k in range(3) if k != kv]
     others.sort(key=lambda k: -support[k])
     perm = [kv, *others]
-    ay_sorted = np.sort(ay)[::-1]
-    vertical_identified = bool(ay_sorted[0] - ay_sorted[1] > 0.15)
+    vertical_identified = bool(np.sort(cost)[1] - cost[kv] > 25.0)
     dirs = dirs[perm]
     if dirs[0, 1] > 0:  # up points to image-up (-y)
         dirs[0] = -dirs[0]

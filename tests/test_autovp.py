@@ -333,3 +333,44 @@ def test_york_urban_photo(name: str) -> None:
     # the vertical VP is the ground truth's most vertical direction
     kv = int(np.argmax(np.abs(true_dirs[:, 1])))
     assert abs(res.directions_in_cam[0] @ true_dirs[kv]) > math.cos(math.radians(3.0))
+
+
+@pytest.mark.parametrize(
+    ("size", "f", "yaw", "pitch", "roll"),
+    [
+        ((1920, 1080), 1400.0, 35.0, 25.0, 2.0),  # HD street camera, shrunk for detection
+        ((1280, 720), 900.0, 45.0, 50.0, 0.0),  # mast camera looking down steeply
+        ((640, 480), 600.0, 20.0, -20.0, 0.0),  # photo looking up at buildings
+    ],
+)
+def test_synthetic_cameras(
+    size: tuple[int, int], f: float, yaw: float, pitch: float, roll: float
+) -> None:
+    R = cam_from_world(yaw, pitch, roll)
+    res = detect_vanishing_points(render_scene(R, f, size, n_lines=200, seed=5))
+    assert res.image_size == size
+    assert res.focal_px == pytest.approx(f, rel=0.03)
+    assert res.pitch_deg == pytest.approx(pitch, abs=0.5)
+    assert res.roll_deg == pytest.approx(roll, abs=0.5)
+    assert dir_errors_deg(res.directions_in_cam, R.T).max() < 0.5
+
+
+def test_principal_point_refinement_moves_towards_truth() -> None:
+    w, h, f = 800, 600, 700.0
+    R = cam_from_world(30.0, 15.0, 0.0)
+    true_pp = np.array([w / 2 + 20.0, h / 2 - 15.0])
+    # render with an off-centre principal point: shift the centred rendering
+    img = render_scene(R, f, (w, h), n_lines=250, seed=7)
+    shift = np.float64([[1, 0, true_pp[0] - w / 2], [0, 1, true_pp[1] - h / 2]])
+    img = cv2.warpAffine(img, shift, (w, h), borderValue=235)
+    fixed = detect_vanishing_points(img, focal_px=f)
+    free = detect_vanishing_points(img, focal_px=f, estimate_principal_point=True)
+    assert fixed.principal_point == (400.0, 300.0)
+    err_fixed = np.hypot(*(np.array(fixed.principal_point) - true_pp))
+    err_free = np.hypot(*(np.array(free.principal_point) - true_pp))
+    assert err_free < 0.5 * err_fixed
+    assert dir_errors_deg(free.directions_in_cam, R.T).max() < dir_errors_deg(
+        fixed.directions_in_cam, R.T
+    ).max()
+    given = detect_vanishing_points(img, focal_px=f, principal_point=tuple(true_pp))
+    assert dir_errors_deg(given.directions_in_cam, R.T).max() < 0.3
