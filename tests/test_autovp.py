@@ -369,8 +369,9 @@ def test_principal_point_refinement_moves_towards_truth() -> None:
     err_fixed = np.hypot(*(np.array(fixed.principal_point) - true_pp))
     err_free = np.hypot(*(np.array(free.principal_point) - true_pp))
     assert err_free < 0.5 * err_fixed
-    assert dir_errors_deg(free.directions_in_cam, R.T).max() < dir_errors_deg(
-        fixed.directions_in_cam, R.T
-    ).max()
+    assert (
+        dir_errors_deg(free.directions_in_cam, R.T).max()
+        < dir_errors_deg(fixed.directions_in_cam, R.T).max()
+    )
     given = detect_vanishing_points(img, focal_px=f, principal_point=tuple(true_pp))
     assert dir_errors_deg(given.directions_in_cam, R.T).max() < 0.3
