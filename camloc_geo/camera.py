@@ -1,0 +1,348 @@
+"""Frames and the pinhole camera model.
+
+Conventions (written down once, used everywhere; see ``shared/spec/SCENE.md``):
+
+image
+    Continuous pixel coordinates ``[x, y]``: origin at the top-left corner of the image,
+    x right, y down. The centre of the top-left pixel is ``[0.5, 0.5]``; the image centre
+    is ``[width / 2, height / 2]``.
+camera
+    x right, y down, z forward along the optical axis. ``img_from_cam`` is the intrinsic
+    matrix ``K = [[f, 0, cx], [0, f, cy], [0, 0, 1]]`` (square pixels, no skew).
+world
+    The scene's metric frame, metres: origin at the annotated ground corner of the reference
+    object, x along its length, z up, y = z × x (right-handed). The ground is z = 0.
+pose
+    ``cam_from_world = [R | t]``: ``points_in_cam = R @ points_in_world + t``. The camera
+    centre in the world frame is ``-Rᵀ t``.
+angles
+    Headings are degrees clockwise from north (in the world frame, "north" is +y and "east"
+    is +x, so the world-frame heading is measured clockwise from +y). Pitch is the optical
+    axis' angle below the horizon (positive = looking down). Roll is the rotation about the
+    optical axis: with ``f`` the optical axis, ``r`` the camera x axis (image right),
+    ``r0 = normalize(f × up)`` and ``d0 = f × r0``, ``roll = atan2(r·d0, r·r0)``; positive when
+    the image's right side tilts downward, i.e. the scene appears rotated anticlockwise.
+
+Pixels that look at or above the horizon have no ground point. Every function that casts
+pixels onto the ground takes ``above_horizon="nan"`` (NaN rows, the default for batches) or
+``"error"`` (raise :class:`~camloc_geo.DegenerateGeometryError`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo._errors import DegenerateGeometryError
+
+__all__ = [
+    "Camera",
+    "angles_from_rotation",
+    "project_to_rotation",
+    "rotation_from_angles",
+]
+
+FloatArray = npt.NDArray[np.float64]
+HorizonPolicy = Literal["nan", "error"]
+
+_UP = np.array([0.0, 0.0, 1.0])
+# Minimum cosine between a viewing ray and the ground (below the horizon) to count as a ground hit.
+_GROUND_EPS = 1e-9
+
+
+def project_to_rotation(matrix: npt.ArrayLike) -> FloatArray:
+    """Nearest proper rotation (Frobenius norm) to a 3×3 matrix, by SVD with det = +1.
+
+    Parameters
+    ----------
+    matrix
+        A 3×3 matrix, roughly a rotation.
+
+    Returns
+    -------
+    The closest matrix ``R`` with ``RᵀR = I`` and ``det R = +1``.
+    """
+    m = np.asarray(matrix, dtype=float).reshape(3, 3)
+    if not np.all(np.isfinite(m)):
+        raise DegenerateGeometryError("rotation estimate is not finite")
+    u, _s, vt = np.linalg.svd(m)
+    d = np.sign(np.linalg.det(u @ vt)) or 1.0
+    return np.asarray(u @ np.diag([1.0, 1.0, d]) @ vt, dtype=np.float64)
+
+
+def rotation_from_angles(heading_deg: float, pitch_deg: float, roll_deg: float) -> FloatArray:
+    """``cam_from_world`` rotation of a camera with the given heading, pitch and roll.
+
+    The world frame here is z up with heading measured clockwise from +y ("north")
+    towards +x ("east"); use it with an ENU frame (x east, y north, z up).
+
+    Parameters
+    ----------
+    heading_deg
+        Bearing of the optical axis projected on the ground, clockwise from +y.
+    pitch_deg
+        Angle of the optical axis below the horizon (positive = looking down).
+    roll_deg
+        Rotation about the optical axis, positive when image-right tilts downward.
+
+    Returns
+    -------
+    The 3×3 rotation ``R`` with ``points_in_cam = R @ points_in_world + t``.
+    """
+    h, p, r = np.radians([heading_deg, pitch_deg, roll_deg])
+    forward = np.array([math.sin(h) * math.cos(p), math.cos(h) * math.cos(p), -math.sin(p)])
+    right0 = np.array([math.cos(h), -math.sin(h), 0.0])  # forward × up, normalised
+    down0 = np.cross(forward, right0)
+    right = math.cos(r) * right0 + math.sin(r) * down0
+    down = np.cross(forward, right)
+    world_from_cam = np.column_stack([right, down, forward])
+    return np.asarray(world_from_cam.T, dtype=np.float64)
+
+
+def angles_from_rotation(cam_from_world_rotation: npt.ArrayLike) -> tuple[float, float, float]:
+    """Heading, pitch and roll (degrees) of a ``cam_from_world`` rotation; z is up.
+
+    Heading is clockwise from +y in [0, 360); it is undefined (returned as 0) for a camera
+    looking straight down or up, where roll absorbs the rotation.
+    """
+    R = np.asarray(cam_from_world_rotation, dtype=float).reshape(3, 3)
+    right, _down, forward = R[0], R[1], R[2]  # rows of R = camera axes in the world
+    pitch = math.degrees(math.asin(float(np.clip(-forward[2], -1.0, 1.0))))
+    horiz = math.hypot(forward[0], forward[1])
+    if horiz < 1e-12:
+        heading = 0.0
+        right0 = np.array([1.0, 0.0, 0.0])
+    else:
+        heading = math.degrees(math.atan2(forward[0], forward[1])) % 360.0
+        right0 = np.array([forward[1], -forward[0], 0.0]) / horiz
+    down0 = np.cross(forward, right0)
+    roll = math.degrees(math.atan2(float(right @ down0), float(right @ right0)))
+    return heading, pitch, roll
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole camera: intrinsics and the ``cam_from_world`` pose.
+
+    Parameters
+    ----------
+    focal_px
+        Focal length in pixels (square pixels).
+    principal_point
+        ``(cx, cy)`` in image pixels.
+    cam_from_world_rotation
+        ``R``, a proper 3×3 rotation.
+    cam_from_world_translation
+        ``t``, metres: the world origin in the camera frame.
+    """
+
+    focal_px: float
+    principal_point: tuple[float, float]
+    cam_from_world_rotation: FloatArray
+    cam_from_world_translation: FloatArray
+
+    def __post_init__(self) -> None:
+        R = np.asarray(self.cam_from_world_rotation, dtype=np.float64).reshape(3, 3)
+        t = np.asarray(self.cam_from_world_translation, dtype=np.float64).reshape(3)
+        if not (math.isfinite(self.focal_px) and self.focal_px > 0):
+            raise DegenerateGeometryError(f"focal_px must be positive, got {self.focal_px}")
+        if not np.all(np.isfinite(R)) or not np.all(np.isfinite(t)):
+            raise DegenerateGeometryError("camera pose is not finite")
+        object.__setattr__(self, "cam_from_world_rotation", R)
+        object.__setattr__(self, "cam_from_world_translation", t)
+        cx, cy = self.principal_point
+        object.__setattr__(self, "principal_point", (float(cx), float(cy)))
+
+    # ----------------------------------------------------------------- factories
+    @classmethod
+    def from_center(
+        cls,
+        focal_px: float,
+        principal_point: tuple[float, float],
+        cam_from_world_rotation: npt.ArrayLike,
+        center_in_world: npt.ArrayLike,
+    ) -> Camera:
+        """Build a camera from its centre in the world frame instead of ``t``."""
+        R = np.asarray(cam_from_world_rotation, dtype=float).reshape(3, 3)
+        c = np.asarray(center_in_world, dtype=float).reshape(3)
+        return cls(focal_px, principal_point, R, -R @ c)
+
+    # ---------------------------------------------------------------- properties
+    @property
+    def img_from_cam(self) -> FloatArray:
+        """The intrinsic matrix ``K``."""
+        cx, cy = self.principal_point
+        f = self.focal_px
+        return np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]])
+
+    @property
+    def cam_from_img(self) -> FloatArray:
+        """``K⁻¹``: pixels (homogeneous) to viewing rays in the camera frame."""
+        cx, cy = self.principal_point
+        f = self.focal_px
+        return np.array([[1.0 / f, 0.0, -cx / f], [0.0, 1.0 / f, -cy / f], [0.0, 0.0, 1.0]])
+
+    @property
+    def cam_from_world(self) -> FloatArray:
+        """The 3×4 matrix ``[R | t]``."""
+        return np.column_stack([self.cam_from_world_rotation, self.cam_from_world_translation])
+
+    @property
+    def img_from_world(self) -> FloatArray:
+        """The 3×4 projection matrix ``K [R | t]``."""
+        return self.img_from_cam @ self.cam_from_world
+
+    @property
+    def center_in_world(self) -> FloatArray:
+        """Camera centre in the world frame, ``-Rᵀ t``."""
+        R = self.cam_from_world_rotation
+        return np.asarray(-R.T @ self.cam_from_world_translation, dtype=np.float64)
+
+    @property
+    def height_m(self) -> float:
+        """Height of the camera centre above the ground plane z = 0."""
+        return float(self.center_in_world[2])
+
+    @property
+    def angles_deg(self) -> tuple[float, float, float]:
+        """``(heading, pitch, roll)`` in degrees; see the module conventions."""
+        return angles_from_rotation(self.cam_from_world_rotation)
+
+    def horizon_line(self) -> FloatArray:
+        """The horizon as a homogeneous image line ``(a, b, c)``, ``a x + b y + c = 0``.
+
+        Scaled so that ``a x + b y + c > 0`` below the horizon (on the ground side).
+        """
+        # Image of the plane through the camera centre parallel to the ground: K⁻ᵀ R up.
+        line = self.cam_from_img.T @ (self.cam_from_world_rotation @ _UP)
+        # Ground pixels have rays with negative world z: flip so that ground is positive.
+        return np.asarray(-line / np.linalg.norm(line[:2]), dtype=np.float64)
+
+    # ------------------------------------------------------------------ mappings
+    def project(self, points_in_world: npt.ArrayLike) -> FloatArray:
+        """Project world points to pixels.
+
+        Parameters
+        ----------
+        points_in_world
+            ``(3,)`` or ``(N, 3)`` metres.
+
+        Returns
+        -------
+        ``(2,)`` or ``(N, 2)`` pixels; NaN rows for points at or behind the camera plane.
+        """
+        pts = np.asarray(points_in_world, dtype=float)
+        single = pts.ndim == 1
+        pts = pts.reshape(-1, 3)
+        points_in_cam = pts @ self.cam_from_world_rotation.T + self.cam_from_world_translation
+        z = points_in_cam[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            uv = points_in_cam[:, :2] / z[:, None]
+        uv = uv * self.focal_px + np.asarray(self.principal_point)
+        uv[z <= 1e-12] = np.nan
+        return uv[0] if single else uv
+
+    def rays_in_world(self, pixels: npt.ArrayLike) -> FloatArray:
+        """Unit viewing directions, in the world frame, of ``(2,)`` or ``(N, 2)`` pixels."""
+        px = np.asarray(pixels, dtype=float)
+        single = px.ndim == 1
+        px = px.reshape(-1, 2)
+        rays_in_cam = np.column_stack([px, np.ones(len(px))]) @ self.cam_from_img.T
+        rays = rays_in_cam @ self.cam_from_world_rotation  # Rᵀ applied to each row
+        rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+        return rays[0] if single else rays
+
+    def ground_from_pixels(
+        self,
+        pixels: npt.ArrayLike,
+        *,
+        ground_z_m: float = 0.0,
+        above_horizon: HorizonPolicy = "nan",
+    ) -> FloatArray:
+        """Cast pixels onto the horizontal plane ``z = ground_z_m``.
+
+        Parameters
+        ----------
+        pixels
+            ``(2,)`` or ``(N, 2)`` image pixels.
+        ground_z_m
+            Height of the plane, metres (0 = the ground).
+        above_horizon
+            ``"nan"``: pixels whose ray does not reach the plane in front of the camera give
+            NaN rows; ``"error"``: raise :class:`DegenerateGeometryError` naming them.
+
+        Returns
+        -------
+        ``(3,)`` or ``(N, 3)`` world points with z = ``ground_z_m``.
+        """
+        px = np.asarray(pixels, dtype=float)
+        single = px.ndim == 1
+        rays = self.rays_in_world(px.reshape(-1, 2)).reshape(-1, 3)
+        center = self.center_in_world
+        dz = ground_z_m - center[2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lam = dz / rays[:, 2]
+        bad = ~np.isfinite(lam) | (lam <= 0) | (np.abs(rays[:, 2]) < _GROUND_EPS)
+        if np.any(bad) and above_horizon == "error":
+            first = np.asarray(px.reshape(-1, 2)[bad][0]).tolist()
+            raise DegenerateGeometryError(
+                f"pixel {first} is at or above the horizon: its ray never meets the plane "
+                f"z = {ground_z_m} m in front of the camera"
+            )
+        points = center + lam[:, None] * rays
+        points[bad] = np.nan
+        return points[0] if single else points
+
+    def height_on_vertical(
+        self,
+        foot_pixel: npt.ArrayLike,
+        top_pixel: npt.ArrayLike,
+        *,
+        above_horizon: HorizonPolicy = "error",
+    ) -> float:
+        """Height of a point on the vertical line standing on a ground pixel.
+
+        The foot pixel is cast onto the ground; the top pixel's ray is intersected (in the
+        least-squares sense) with the vertical line through that ground point. This is the
+        paper's virtual clinometer.
+
+        Returns
+        -------
+        Height above the ground, metres.
+        """
+        foot = self.ground_from_pixels(np.asarray(foot_pixel, float), above_horizon=above_horizon)
+        if not np.all(np.isfinite(foot)):
+            return math.nan
+        return float(self.point_on_vertical(foot[:2], top_pixel)[2])
+
+    def point_on_vertical(self, ground_xy: npt.ArrayLike, pixel: npt.ArrayLike) -> FloatArray:
+        """World point on the vertical line through ``ground_xy`` closest to a pixel's ray."""
+        c = self.center_in_world
+        d = self.rays_in_world(np.asarray(pixel, float))
+        g = np.array([*np.asarray(ground_xy, float)[:2], 0.0])
+        # Closest points between the ray c + s d and the line g + h z.
+        A = np.array([[d @ d, -(d @ _UP)], [d @ _UP, -(_UP @ _UP)]])
+        b = np.array([(g - c) @ d, (g - c) @ _UP])
+        try:
+            _s, h = np.linalg.solve(A, b)
+        except np.linalg.LinAlgError as exc:
+            raise DegenerateGeometryError("the pixel's ray is parallel to the vertical") from exc
+        return np.asarray(g + h * _UP, dtype=np.float64)
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-ready description (lists of floats)."""
+        heading, pitch, roll = self.angles_deg
+        return {
+            "focal_px": self.focal_px,
+            "principal_point": list(self.principal_point),
+            "cam_from_world": self.cam_from_world.tolist(),
+            "camera_in_world": self.center_in_world.tolist(),
+            "height_m": self.height_m,
+            "heading_deg": heading,
+            "pitch_deg": pitch,
+            "roll_deg": roll,
+        }

@@ -1,0 +1,977 @@
+"""Relative pose: from a scene's annotations to the camera in the object's world frame.
+
+Two stages, both reported:
+
+1. **Per-annotator closed form** (the paper). For each annotator: a vanishing point per
+   axis from their segments, intrinsics from the vanishing points
+   (:func:`camloc_geo.vanishing.estimate_intrinsics`), the rotation from the vanishing
+   directions with signs fixed by the annotated axes, and the translation from the origin
+   pixel and one known dimension, solved separately with the length end and with the width
+   end (the paper's two estimates) and with the height end as a check. All candidates are
+   clustered by distance; the largest cluster's centroid is the paper's answer.
+2. **Joint robust fit** (bundle adjustment). One pose and focal length fitted to every
+   annotator's segments and axis pixels at once with :func:`scipy.optimize.least_squares`
+   and a soft-L1 loss, annotators re-weighted by their residuals (iteratively reweighted,
+   Cauchy weights) so that one who clicked the wrong corner is down-weighted and reported.
+   The principal point is fixed (given, else the image centre) unless freeing it improves
+   the fit by more than the BIC penalty. The covariance of the fit gives uncertainties.
+
+Noise model used for weighting (and documented for the benchmarks): a clicked point is
+off by ``sigma_point_px`` (default 0.15 % of the image diagonal, 3.3 px at 1080p), a drawn
+segment's endpoints by ``sigma_line_px`` (0.1 %), and a preset object's size is off by
+``size_sigma_rel`` (5 %, added to the position uncertainty when the size is a preset).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+from scipy.cluster.hierarchy import fcluster, linkage
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
+from camloc_geo.camera import Camera
+from camloc_geo.objects import ObjectSize
+from camloc_geo.scene import Annotation, Scene
+from camloc_geo.vanishing import (
+    AXES,
+    IntrinsicsEstimate,
+    VanishingPoint,
+    direction_sign,
+    estimate_intrinsics,
+    fit_vanishing_point,
+    rotation_from_vanishing_directions,
+    segment_residuals_px,
+)
+
+__all__ = [
+    "AnnotatorSolution",
+    "CalibrationResult",
+    "CalibrationSettings",
+    "calibrate",
+    "solve_annotator",
+]
+
+log = logging.getLogger(__name__)
+FloatArray = npt.NDArray[np.float64]
+
+_AXIS_INDEX = {"length": 0, "width": 1, "height": 2}
+
+
+@dataclass(frozen=True)
+class CalibrationSettings:
+    """Tuning of :func:`calibrate`; the defaults are what the benchmarks measure.
+
+    Attributes
+    ----------
+    joint_fit
+        Run the joint robust fit (else the paper's cluster centroid is the answer).
+    sigma_point_rel, sigma_line_rel
+        Annotation noise, as fractions of the image diagonal.
+    size_sigma_rel
+        Relative error of a preset object size (added to the uncertainty).
+    cluster_threshold_rel, cluster_threshold_min_m
+        Candidates closer than ``max(min_m, rel × median camera distance)`` are linked.
+    outlier_weight
+        Annotators whose final weight falls below this are reported as outliers.
+    """
+
+    joint_fit: bool = True
+    sigma_point_rel: float = 0.0015
+    sigma_line_rel: float = 0.0010
+    size_sigma_rel: float = 0.05
+    cluster_threshold_rel: float = 0.15
+    cluster_threshold_min_m: float = 1.5
+    outlier_weight: float = 0.3
+    free_principal_point: bool | None = None  # None = decided by BIC
+
+
+@dataclass
+class AnnotatorSolution:
+    """The paper's closed-form solution from one annotator's work."""
+
+    index: int
+    annotator: str
+    vanishing_points: dict[str, VanishingPoint]
+    intrinsics: IntrinsicsEstimate | None = None
+    camera: Camera | None = None
+    width_sign: float = 1.0
+    candidates: dict[str, FloatArray] = field(default_factory=dict)
+    height_check: float | None = None
+    error: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        out: dict[str, Any] = {"index": self.index, "annotator": self.annotator}
+        if self.error:
+            out["error"] = self.error
+        out["vanishing_points"] = {
+            k: (None if v.pixel is None else v.pixel.tolist()) for k, v in self.vanishing_points.items()
+        }
+        out["vp_rms_px"] = {k: v.rms_px for k, v in self.vanishing_points.items()}
+        if self.intrinsics is not None:
+            out["focal_px"] = self.intrinsics.focal_px
+            out["principal_point"] = list(self.intrinsics.principal_point)
+            out["intrinsics_method"] = self.intrinsics.method
+        if self.camera is not None:
+            out["camera_in_world"] = self.camera.center_in_world.tolist()
+            out["height_m"] = self.camera.height_m
+        out["width_sign"] = self.width_sign
+        out["candidates"] = {k: v.tolist() for k, v in self.candidates.items()}
+        if self.height_check is not None:
+            out["height_check_ratio"] = self.height_check
+        return out
+
+
+@dataclass
+class CalibrationResult:
+    """Everything :func:`calibrate` found.
+
+    Attributes
+    ----------
+    camera
+        The final camera (joint fit, or the cluster answer when the fit is off or failed).
+    method
+        ``joint_fit`` or ``cluster_centroid``.
+    intrinsics_method, intrinsics_reason
+        Which intrinsics fallback was used and why.
+    annotators
+        Per-annotator closed-form solutions.
+    cluster
+        Members (``(annotator index, dimension)``), centroid and threshold of the largest
+        cluster of candidates.
+    annotator_weights
+        Final weight of each annotator in the joint fit (1 = fully trusted).
+    outlier_annotators
+        Names of annotators reported as outliers.
+    position_sigma_m
+        1-sigma uncertainty of the camera centre (x, y, z) in the world frame.
+    """
+
+    camera: Camera
+    method: str
+    intrinsics_method: str
+    intrinsics_reason: str
+    annotators: list[AnnotatorSolution]
+    cluster: dict[str, Any]
+    annotator_weights: list[float]
+    outlier_annotators: list[str]
+    position_sigma_m: FloatArray | None = None
+    focal_sigma_px: float | None = None
+    rms_residual_px: float | None = None
+    width_signs: list[float] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def height_m(self) -> float:
+        """Camera height above the ground."""
+        return self.camera.height_m
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON that ``camloc calibrate`` prints."""
+        cam = self.camera
+        _heading, pitch, roll = cam.angles_deg
+        out: dict[str, Any] = {
+            "focal_px": cam.focal_px,
+            "principal_point": list(cam.principal_point),
+            "height_m": cam.height_m,
+            "camera_in_world": cam.center_in_world.tolist(),
+            "pitch_deg": pitch,
+            "roll_deg": roll,
+            "cam_from_world": cam.cam_from_world.tolist(),
+            "rotation": cam.cam_from_world_rotation.tolist(),
+            "method": self.method,
+            "intrinsics_method": self.intrinsics_method,
+            "fallback": self.intrinsics_method,
+            "intrinsics_reason": self.intrinsics_reason,
+            "distance_to_origin_m": float(np.linalg.norm(cam.center_in_world)),
+        }
+        if self.position_sigma_m is not None:
+            out["camera_in_world_sigma_m"] = self.position_sigma_m.tolist()
+            out["height_sigma_m"] = float(self.position_sigma_m[2])
+        if self.focal_sigma_px is not None:
+            out["focal_sigma_px"] = self.focal_sigma_px
+        if self.rms_residual_px is not None:
+            out["rms_residual_px"] = self.rms_residual_px
+        out["annotator_weights"] = self.annotator_weights
+        out["outlier_annotators"] = self.outlier_annotators
+        out["cluster"] = self.cluster
+        out["annotators"] = [a.to_dict() for a in self.annotators]
+        if self.warnings:
+            out["warnings"] = self.warnings
+        return out
+
+
+# --------------------------------------------------------------------------- closed form
+def _segments(ann: Annotation, axis: str) -> FloatArray:
+    return np.asarray(getattr(ann.vp_lines, axis), dtype=float).reshape(-1, 4)
+
+
+def _check_axes_geometry(ann: Annotation, where: str) -> None:
+    o = np.asarray(ann.axes.origin, float)
+    steps = {k: np.asarray(getattr(ann.axes, k), float) - o for k in AXES}
+    for k, s in steps.items():
+        if np.linalg.norm(s) < 1.0:
+            raise DegenerateGeometryError(
+                f"{where}.axes.{k}: coincides with the origin pixel (less than 1 px away)"
+            )
+    for a, b in (("length", "width"), ("length", "height"), ("width", "height")):
+        sa, sb = steps[a], steps[b]
+        sin = abs(sa[0] * sb[1] - sa[1] * sb[0]) / (np.linalg.norm(sa) * np.linalg.norm(sb))
+        if sin < math.sin(math.radians(1.0)) and float(sa @ sb) > 0:
+            raise DegenerateGeometryError(
+                f"{where}.axes: the {a} and {b} edges are collinear in the image"
+            )
+
+
+def solve_annotator(
+    scene: Scene,
+    index: int,
+    segments: dict[str, FloatArray],
+    *,
+    size: ObjectSize,
+) -> AnnotatorSolution:
+    """The paper's closed-form solution for one annotator (raises on degenerate input)."""
+    ann = scene.annotations[index]
+    where = f"annotations[{index}]"
+    width, height = scene.image_size
+    diag = math.hypot(width, height)
+    _check_axes_geometry(ann, where)
+    vps = {
+        axis: fit_vanishing_point(segments[axis], scale_px=diag, name=f"{where}.vp_lines.{axis}")
+        for axis in AXES
+    }
+    sol = AnnotatorSolution(index, ann.annotator, vps)
+    intr = estimate_intrinsics(
+        {k: v.homogeneous for k, v in vps.items()},
+        (width, height),
+        focal_px=scene.camera.focal_px,
+        principal_point=scene.camera.principal_point,
+    )
+    sol.intrinsics = intr
+    f = intr.focal_px
+    cx, cy = intr.principal_point
+    cam_from_img = np.array([[1 / f, 0, -cx / f], [0, 1 / f, -cy / f], [0, 0, 1.0]])
+    dirs = {}
+    for k, v in vps.items():
+        d = cam_from_img @ v.homogeneous
+        dirs[k] = d / np.linalg.norm(d)
+    # Orthogonality of the vanishing directions (collinear axes end here).
+    for a, b in (("length", "width"), ("length", "height"), ("width", "height")):
+        ang = math.degrees(math.acos(min(1.0, abs(float(dirs[a] @ dirs[b])))))
+        if ang < 30.0:
+            raise DegenerateGeometryError(
+                f"{where}.vp_lines: the {a} and {b} vanishing directions are only {ang:.1f}° "
+                "apart; they must be orthogonal (are the lines drawn for the right axes?)"
+            )
+    origin = np.asarray(ann.axes.origin, float)
+    m0 = cam_from_img @ np.array([*origin, 1.0])
+    signs = {}
+    for k in ("length", "height"):
+        s = direction_sign(dirs[k], m0, np.asarray(getattr(ann.axes, k), float) - origin)
+        if s == 0.0:
+            raise DegenerateGeometryError(
+                f"{where}.axes.{k}: the edge is perpendicular to its vanishing direction in "
+                "the image, so its sign is ambiguous; check the axis annotations"
+            )
+        signs[k] = s
+    d_len = signs["length"] * dirs["length"]
+    d_up = signs["height"] * dirs["height"]
+    y_ref = np.cross(d_up, d_len)
+    d_wid = dirs["width"] if float(dirs["width"] @ y_ref) >= 0 else -dirs["width"]
+    s_w = direction_sign(d_wid, m0, np.asarray(ann.axes.width, float) - origin)
+    if s_w == 0.0:
+        raise DegenerateGeometryError(
+            f"{where}.axes.width: the edge is perpendicular to its vanishing direction in the "
+            "image, so its side is ambiguous"
+        )
+    sol.width_sign = s_w
+    R = rotation_from_vanishing_directions({"length": d_len, "width": d_wid, "height": d_up})
+    ends = _object_points(size, s_w)
+    lam = {}
+    num_total = den_total = 0.0
+    for k in AXES:
+        mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
+        mk /= np.linalg.norm(mk)
+        a = np.cross(mk, m0)
+        b = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
+        den = float(a @ a)
+        if den < 1e-18:
+            raise DegenerateGeometryError(f"{where}.axes.{k}: end pixel on the origin's ray")
+        lam[k] = -float(a @ b) / den
+        num_total += -float(a @ b)
+        den_total += den
+    for k in AXES:
+        if not lam[k] > 0:
+            raise DegenerateGeometryError(
+                f"{where}.axes.{k}: puts the object behind the camera; check that the axis "
+                "end pixels match the vanishing lines"
+            )
+    for k in ("length", "width", "height"):
+        t = lam[k] * m0
+        sol.candidates[k] = np.asarray(-R.T @ t, dtype=np.float64)
+    lam_all = num_total / den_total
+    sol.height_check = lam["height"] / (0.5 * (lam["length"] + lam["width"]))
+    sol.camera = Camera(f, (cx, cy), R, lam_all * m0)
+    return sol
+
+
+def _object_points(size: ObjectSize, width_sign: float) -> FloatArray:
+    """World points: origin, length end, width end, height end."""
+    return np.array(
+        [
+            [0.0, 0.0, 0.0],
+            [size.length_m, 0.0, 0.0],
+            [0.0, width_sign * size.width_m, 0.0],
+            [0.0, 0.0, size.height_m],
+        ]
+    )
+
+
+def _cluster(candidates: list[tuple[int, str, FloatArray]], settings: CalibrationSettings) -> dict[str, Any]:
+    pts = np.array([c[2] for c in candidates])
+    dist_scale = float(np.median(np.linalg.norm(pts, axis=1)))
+    threshold = max(settings.cluster_threshold_min_m, settings.cluster_threshold_rel * dist_scale)
+    if len(pts) == 1:
+        labels = np.array([1])
+    else:
+        labels = fcluster(linkage(pts, method="single"), t=threshold, criterion="distance")
+    best_label, best_key = None, None
+    for lab in np.unique(labels):
+        members = pts[labels == lab]
+        spread = float(np.mean(np.linalg.norm(members - members.mean(axis=0), axis=1)))
+        n_annot = len({candidates[i][0] for i in np.flatnonzero(labels == lab)})
+        key = (n_annot, len(members), -spread)
+        if best_key is None or key > best_key:
+            best_key, best_label = key, lab
+    idx = np.flatnonzero(labels == best_label)
+    centroid = pts[idx].mean(axis=0)
+    return {
+        "threshold_m": threshold,
+        "members": [{"annotator": candidates[i][0], "dimension": candidates[i][1]} for i in idx],
+        "centroid": centroid.tolist(),
+        "n_candidates": len(pts),
+        "n_clusters": int(len(np.unique(labels))),
+    }
+
+
+# ----------------------------------------------------------------------------- joint fit
+def _rodrigues(rotvecs: FloatArray) -> FloatArray:
+    """Rotation matrices ``(P, 3, 3)`` of rotation vectors ``(P, 3)``."""
+    theta = np.linalg.norm(rotvecs, axis=1)
+    small = theta < 1e-12
+    safe = np.where(small, 1.0, theta)
+    k = rotvecs / safe[:, None]
+    K = np.zeros((len(rotvecs), 3, 3))
+    K[:, 0, 1], K[:, 0, 2] = -k[:, 2], k[:, 1]
+    K[:, 1, 0], K[:, 1, 2] = k[:, 2], -k[:, 0]
+    K[:, 2, 0], K[:, 2, 1] = -k[:, 1], k[:, 0]
+    s = np.where(small, 0.0, np.sin(theta))[:, None, None]
+    c = np.where(small, 0.0, 1.0 - np.cos(theta))[:, None, None]
+    return np.asarray(np.eye(3) + s * K + c * (K @ K), dtype=np.float64)
+
+
+class _JointProblem:
+    """Stacked residuals of all annotators for one pose + intrinsics."""
+
+    def __init__(
+        self,
+        scene: Scene,
+        segments: list[dict[str, FloatArray]],
+        indices: list[int],
+        width_signs: list[float],
+        size: ObjectSize,
+        settings: CalibrationSettings,
+    ) -> None:
+        width, height = scene.image_size
+        diag = math.hypot(width, height)
+        self.sigma_pt = settings.sigma_point_rel * diag
+        self.sigma_line = settings.sigma_line_rel * diag
+        seg_rows, seg_axis, seg_ann = [], [], []
+        pt_world, pt_pix, pt_ann = [], [], []
+        for slot, (i, segs, ws) in enumerate(zip(indices, segments, width_signs, strict=True)):
+            ann = scene.annotations[i]
+            for axis in AXES:
+                s = segs[axis]
+                seg_rows.append(s)
+                seg_axis += [_AXIS_INDEX[axis]] * len(s)
+                seg_ann += [slot] * len(s)
+            world = _object_points(size, ws)
+            for j, name in enumerate(("origin", "length", "width", "height")):
+                pt_world.append(world[j])
+                pt_pix.append(getattr(ann.axes, name))
+                pt_ann.append(slot)
+        self.segments = np.vstack(seg_rows)
+        self.seg_axis = np.asarray(seg_axis)
+        self.seg_ann = np.asarray(seg_ann)
+        self.pt_world = np.asarray(pt_world, float)
+        self.pt_pix = np.asarray(pt_pix, float)
+        self.pt_ann = np.asarray(pt_ann)
+        self.n_annotators = len(indices)
+        self._z_min = 0.05
+        seg = self.segments
+        self._a = np.column_stack([seg[:, 0:2], np.ones(len(seg))])
+        self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
+        self.weights = np.ones(self.n_annotators)
+        self.f_bounds = (0.15 * width, 15.0 * width)
+        self.image_wh = (float(width), float(height))
+
+    def unpack(
+        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> tuple[float, tuple[float, float], FloatArray, FloatArray]:
+        """Focal length, principal point, rotation and camera centre of a parameter vector."""
+        f, pp, R, C = self._unpack_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)
+        return float(f[0]), (float(pp[0, 0]), float(pp[0, 1])), R[0], C[0]
+
+    def _unpack_batch(
+        self, X: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        P = len(X)
+        k = 0
+        if f_fixed is None:
+            f = np.exp(np.minimum(X[:, 0], 30.0))
+            k = 1
+        else:
+            f = np.full(P, float(f_fixed))
+        if pp_fixed is None:
+            pp = X[:, k : k + 2]
+            k += 2
+        else:
+            pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
+        R = _rodrigues(X[:, k : k + 3]) @ R0
+        C = X[:, k + 3 : k + 6]
+        return f, pp, R, C
+
+    def residuals(
+        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> FloatArray:
+        """Normalised residuals (segments, then point u, then point v)."""
+        return self.residuals_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)[0]
+
+    def jacobian(
+        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> FloatArray:
+        """Forward-difference Jacobian from one batched evaluation."""
+        n = len(x)
+        h = 1e-7 * np.maximum(1.0, np.abs(x))
+        X = np.vstack([x, x + np.diag(h)])
+        Rb = self.residuals_batch(X, R0, pp_fixed, f_fixed)
+        return np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
+
+    def residuals_batch(
+        self, X: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> FloatArray:
+        """Residuals of a batch of parameter vectors ``(P, n)`` → ``(P, m)``."""
+        f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
+        cx, cy = pp[:, 0:1], pp[:, 1:2]
+        fc = f[:, None]
+        # Vanishing point of world axis i: K R e_i, i.e. column i of K R.
+        vx = fc * R[:, 0, :] + cx * R[:, 2, :]
+        vy = fc * R[:, 1, :] + cy * R[:, 2, :]
+        vw = R[:, 2, :]
+        ax = self.seg_axis
+        px, py, pw = vx[:, ax], vy[:, ax], vw[:, ax]
+        mx, my = self._mid[:, 0], self._mid[:, 1]
+        # Line through the midpoint (mx, my, 1) and the vanishing point (px, py, pw).
+        la = my * pw - py
+        lb = px - mx * pw
+        lc = mx * py - my * px
+        norm = np.sqrt(la * la + lb * lb)
+        r_seg = (la * self._a[:, 0] + lb * self._a[:, 1] + lc) / np.maximum(norm, 1e-300)
+        r_seg = r_seg * (self._w_seg / self.sigma_line)
+        d = self.pt_world[None, :, :] - C[:, None, :]
+        pc = np.einsum("pij,pnj->pni", R, d)
+        z = np.maximum(pc[:, :, 2], self._z_min)
+        wpt = self._w_pt / self.sigma_pt
+        u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * wpt
+        v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * wpt
+        return np.concatenate([r_seg, u, v], axis=1)
+
+    @property
+    def weights(self) -> FloatArray:
+        return self._weights
+
+    @weights.setter
+    def weights(self, value: FloatArray) -> None:
+        self._weights = np.asarray(value, dtype=float)
+        self._w_seg = np.sqrt(self._weights[self.seg_ann])
+        self._w_pt = np.sqrt(self._weights[self.pt_ann])
+
+    def per_annotator_rms(
+        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+    ) -> FloatArray:
+        saved = self.weights
+        self.weights = np.ones(self.n_annotators)
+        r = self.residuals(x, R0, pp_fixed, f_fixed)
+        self.weights = saved
+        n_seg, n_pt = len(self.segments), len(self.pt_pix)
+        sq_seg = r[:n_seg] ** 2
+        sq_pt = r[n_seg : n_seg + n_pt] ** 2 + r[n_seg + n_pt :] ** 2
+        num = np.bincount(self.seg_ann, sq_seg, self.n_annotators) + np.bincount(
+            self.pt_ann, sq_pt, self.n_annotators
+        )
+        den = np.bincount(self.seg_ann, None, self.n_annotators) + 2 * np.bincount(
+            self.pt_ann, None, self.n_annotators
+        )
+        return np.asarray(np.sqrt(num / np.maximum(den, 1)), dtype=np.float64)
+
+
+def _fit(
+    prob: _JointProblem,
+    x0: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+    *,
+    tol: float = 1e-12,
+    max_nfev: int = 200,
+) -> Any:
+    lo = np.full(len(x0), -np.inf)
+    hi = np.full(len(x0), np.inf)
+    k = 0
+    if f_fixed is None:
+        lo[0], hi[0] = math.log(prob.f_bounds[0]), math.log(prob.f_bounds[1])
+        k = 1
+    if pp_fixed is None:
+        w, h = prob.image_wh
+        lo[k : k + 2] = (0.0, 0.0)
+        hi[k : k + 2] = (w, h)
+    fin = np.isfinite(lo)
+    margin = np.where(fin, 1e-9 * (hi - lo), 0.0)
+    x0 = np.where(fin, np.clip(x0, lo + margin, hi - margin), x0)
+    return least_squares(
+        prob.residuals,
+        x0,
+        jac=prob.jacobian,
+        args=(R0, pp_fixed, f_fixed),
+        bounds=(lo, hi),
+        loss="soft_l1",
+        f_scale=2.5,
+        method="trf",
+        x_scale="jac",
+        xtol=tol,
+        ftol=tol,
+        gtol=tol,
+        max_nfev=max_nfev,
+    )
+
+
+def _pack(f: float, pp: tuple[float, float], C: FloatArray, free_f: bool, free_pp: bool) -> FloatArray:
+    parts: list[float] = []
+    if free_f:
+        parts.append(math.log(f))
+    if free_pp:
+        parts += [pp[0], pp[1]]
+    return np.array([*parts, 0.0, 0.0, 0.0, *C], dtype=float)
+
+
+# ------------------------------------------------------------------------------- driver
+def _gather_segments(scene: Scene, index: int) -> tuple[dict[str, FloatArray], list[str]]:
+    """An annotator's segments per axis, completed from the image where it lacks some.
+
+    Returns the segments and the names of the axes that still have fewer than two.
+    """
+    ann = scene.annotations[index]
+    out = {axis: _segments(ann, axis) for axis in AXES}
+    short = [axis for axis in AXES if len(out[axis]) < 2]
+    if short:
+        filled = _auto_segments(scene, index, short)
+        for axis, segs in filled.items():
+            if len(segs) >= 2:
+                out[axis] = segs
+        short = [axis for axis in AXES if len(out[axis]) < 2]
+    return out, short
+
+
+def _check_segment_counts(scene: Scene, shorts: list[list[str]], segs: list[dict[str, FloatArray]]) -> list[str]:
+    """Raise if an axis cannot be determined at all; warnings for annotators that lack lines.
+
+    A crowd annotator who drew fewer than two lines for an axis gets no closed-form
+    solution of their own, but their lines and axis pixels still count in the joint fit.
+    The scene is rejected only when the pooled lines of an axis are fewer than two, or
+    when every annotator lacks lines (so no closed form can seed the fit).
+    """
+    warnings = []
+    for axis in AXES:
+        total = sum(len(s[axis]) for s in segs)
+        if total < 2:
+            i = next(i for i, sh in enumerate(shorts) if axis in sh)
+            raise SceneError(
+                f"needs at least 2 segments parallel to the {axis} axis, got "
+                f"{len(segs[i][axis])}"
+                + ("" if scene.image_file() else " (and the scene has no image to detect them in)"),
+                f"annotations[{i}].vp_lines.{axis}",
+            )
+    if all(shorts):
+        i, axis = 0, shorts[0][0]
+        raise SceneError(
+            f"needs at least 2 segments parallel to the {axis} axis, got {len(segs[i][axis])}",
+            f"annotations[{i}].vp_lines.{axis}",
+        )
+    for i, sh in enumerate(shorts):
+        for axis in sh:
+            warnings.append(
+                f"annotations[{i}].vp_lines.{axis}: fewer than 2 segments; this annotator has "
+                "no closed-form solution and counts only in the joint fit"
+            )
+    return warnings
+
+
+_AUTO_CACHE: dict[str, Any] = {}
+
+
+def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
+    """Segments for axes an annotator drew no lines for, from the image (if any)."""
+    path = scene.image_file()
+    if path is None or not path.exists():
+        return {}
+    try:
+        from camloc_geo import autovp
+    except ImportError:  # pragma: no cover - autovp ships with the package
+        return {}
+    key = str(path)
+    if key not in _AUTO_CACHE:
+        _AUTO_CACHE.clear()
+        _AUTO_CACHE[key] = autovp.detect_vanishing_points(str(path))
+    res = _AUTO_CACHE[key]
+    ann = scene.annotations[index]
+    out = {}
+    for axis in axes:
+        try:
+            out[axis] = np.asarray(
+                autovp.segments_for_axis(res, ann.axes.origin, getattr(ann.axes, axis)), float
+            ).reshape(-1, 4)
+            log.info("annotations[%d]: %s segments detected in the image", index, axis)
+        except InputError as exc:
+            log.info("annotations[%d]: no %s segments in the image: %s", index, axis, exc)
+    return out
+
+
+def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> CalibrationResult:
+    """Camera intrinsics, orientation and position relative to the annotated object.
+
+    Parameters
+    ----------
+    scene
+        A validated scene with at least one annotation.
+    settings
+        Tuning; defaults documented in :class:`CalibrationSettings`.
+
+    Returns
+    -------
+    CalibrationResult
+
+    Raises
+    ------
+    SceneError
+        No annotations, or an annotator without enough segments for an axis.
+    DegenerateGeometryError
+        When no annotator's work determines a camera (the first annotator's problem is named).
+    """
+    settings = settings or CalibrationSettings()
+    if not scene.annotations:
+        raise SceneError("at least one annotation is needed to calibrate", "annotations")
+    size = scene.object_size
+    gathered = [_gather_segments(scene, i) for i in range(len(scene.annotations))]
+    segs = [g[0] for g in gathered]
+    shorts = [g[1] for g in gathered]
+    count_warnings = _check_segment_counts(scene, shorts, segs)
+    sols: list[AnnotatorSolution] = []
+    first_error: DegenerateGeometryError | None = None
+    for i in range(len(scene.annotations)):
+        if shorts[i]:
+            sols.append(
+                AnnotatorSolution(
+                    i,
+                    scene.annotations[i].annotator,
+                    {},
+                    error=next(w for w in count_warnings if w.startswith(f"annotations[{i}]")),
+                )
+            )
+            continue
+        try:
+            sols.append(solve_annotator(scene, i, segs[i], size=size))
+        except DegenerateGeometryError as exc:
+            if first_error is None:
+                first_error = exc
+            vps: dict[str, VanishingPoint] = {}
+            sols.append(AnnotatorSolution(i, scene.annotations[i].annotator, vps, error=str(exc)))
+            log.info("annotator %d skipped by the closed form: %s", i, exc)
+    good = [s for s in sols if s.camera is not None]
+    if not good:
+        assert first_error is not None
+        raise first_error
+    candidates = [
+        (s.index, k, s.candidates[k]) for s in good for k in ("length", "width")
+    ]
+    cluster = _cluster(candidates, settings)
+    centroid = np.asarray(cluster["centroid"])
+    member_idx = sorted({m["annotator"] for m in cluster["members"]})
+    # Seed: the cluster member whose combined camera is closest to the centroid.
+    seed = min(
+        (s for s in good if s.index in member_idx),
+        key=lambda s: float(np.linalg.norm(s.camera.center_in_world - centroid)),  # type: ignore[union-attr]
+    )
+    assert seed.camera is not None and seed.intrinsics is not None
+    intr_method, intr_reason = seed.intrinsics.method, seed.intrinsics.reason
+    cluster_camera = Camera.from_center(
+        seed.camera.focal_px, seed.camera.principal_point, seed.camera.cam_from_world_rotation, centroid
+    )
+    warnings: list[str] = list(count_warnings)
+    n_ann = len(scene.annotations)
+    if not settings.joint_fit:
+        weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
+        outliers = [s.annotator for s in sols if s.index not in member_idx]
+        return CalibrationResult(
+            cluster_camera, "cluster_centroid", intr_method, intr_reason, sols, cluster,
+            weights, outliers, width_signs=[s.width_sign for s in sols], warnings=warnings,
+        )
+    try:
+        result = _joint(scene, sols, segs, seed, cluster, cluster_camera, size, settings)
+        result.warnings = warnings + result.warnings
+        return result
+    except (DegenerateGeometryError, np.linalg.LinAlgError, ValueError) as exc:
+        warnings.append(f"joint fit failed ({exc}); using the cluster centroid")
+        log.warning("joint fit failed: %s", exc)
+        weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
+        outliers = [s.annotator for s in sols if s.index not in member_idx]
+        return CalibrationResult(
+            cluster_camera, "cluster_centroid", intr_method, intr_reason, sols, cluster,
+            weights[:n_ann], outliers, width_signs=[s.width_sign for s in sols], warnings=warnings,
+        )
+
+
+def _width_sign_for(scene: Scene, index: int, camera: Camera) -> float:
+    ann = scene.annotations[index]
+    R = camera.cam_from_world_rotation
+    m0 = camera.cam_from_img @ np.array([*ann.axes.origin, 1.0])
+    s = direction_sign(R[:, 1], m0, np.asarray(ann.axes.width, float) - np.asarray(ann.axes.origin))
+    return s or 1.0
+
+
+def _robust_vp(segments: FloatArray, diag: float, name: str) -> VanishingPoint:
+    """Vanishing point of pooled segments, dropping segments that disagree (3 × MAD)."""
+    vp = fit_vanishing_point(segments, scale_px=diag, name=name)
+    keep = np.ones(len(segments), bool)
+    for _ in range(3):
+        r = np.abs(segment_residuals_px(segments, vp.homogeneous))
+        scale = max(1.4826 * float(np.median(r[keep])), 0.002 * diag)
+        new_keep = r <= 3.0 * scale
+        if new_keep.sum() < 2 or np.array_equal(new_keep, keep):
+            break
+        keep = new_keep
+        vp = fit_vanishing_point(segments[keep], scale_px=diag, name=name)
+    return vp
+
+
+def _pooled_seed(scene: Scene, segs: list[dict[str, FloatArray]], size: ObjectSize) -> Camera:
+    """Closed-form camera from all annotators' segments pooled per axis.
+
+    Every annotator draws lines of the same three world directions in the same image, so
+    pooling them gives one, much better determined, vanishing point per axis. Axis signs are
+    a majority vote; the position is the coordinate-wise median over annotators.
+    """
+    width, height = scene.image_size
+    diag = math.hypot(width, height)
+    vps = {
+        axis: _robust_vp(np.vstack([s[axis] for s in segs]), diag, f"vp_lines.{axis} (pooled)")
+        for axis in AXES
+    }
+    intr = estimate_intrinsics(
+        {k: v.homogeneous for k, v in vps.items()},
+        (width, height),
+        focal_px=scene.camera.focal_px,
+        principal_point=scene.camera.principal_point,
+    )
+    f = intr.focal_px
+    cx, cy = intr.principal_point
+    cam_from_img = np.array([[1 / f, 0, -cx / f], [0, 1 / f, -cy / f], [0, 0, 1.0]])
+    dirs = {}
+    for k, v in vps.items():
+        d = cam_from_img @ v.homogeneous
+        dirs[k] = d / np.linalg.norm(d)
+    votes = {"length": 0.0, "height": 0.0}
+    for ann in scene.annotations:
+        o = np.asarray(ann.axes.origin, float)
+        m0 = cam_from_img @ np.array([*o, 1.0])
+        for k in votes:
+            votes[k] += direction_sign(dirs[k], m0, np.asarray(getattr(ann.axes, k), float) - o)
+    d_len = (1.0 if votes["length"] >= 0 else -1.0) * dirs["length"]
+    d_up = (1.0 if votes["height"] >= 0 else -1.0) * dirs["height"]
+    y_ref = np.cross(d_up, d_len)
+    d_wid = dirs["width"] if float(dirs["width"] @ y_ref) >= 0 else -dirs["width"]
+    R = rotation_from_vanishing_directions({"length": d_len, "width": d_wid, "height": d_up})
+    centres = []
+    for ann in scene.annotations:
+        o = np.asarray(ann.axes.origin, float)
+        m0 = cam_from_img @ np.array([*o, 1.0])
+        ws = direction_sign(R[:, 1], m0, np.asarray(ann.axes.width, float) - o) or 1.0
+        ends = _object_points(size, ws)
+        num = den = 0.0
+        for k in AXES:
+            mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
+            mk /= np.linalg.norm(mk)
+            a = np.cross(mk, m0)
+            b = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
+            lam = -float(a @ b) / max(float(a @ a), 1e-18)
+            if lam > 0:
+                num += -float(a @ b)
+                den += float(a @ a)
+        if den > 0:
+            centres.append(-R.T @ ((num / den) * m0))
+    if not centres:
+        raise DegenerateGeometryError("no annotator's axes put the object in front of the camera")
+    return Camera.from_center(f, (cx, cy), R, np.median(np.asarray(centres), axis=0))
+
+
+def _param_sigma(res: Any, sl: slice) -> float | None:
+    """Largest 1-sigma of a block of fitted parameters (Gauss-Newton covariance)."""
+    dof = max(len(res.fun) - len(res.x), 1)
+    s2 = max(2.0 * res.cost / dof, 1e-12)
+    try:
+        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
+    except np.linalg.LinAlgError:
+        return None
+    return float(np.sqrt(np.max(np.clip(np.diag(cov)[sl], 0, None))))
+
+
+def _cauchy_weights(rms: FloatArray) -> FloatArray:
+    scale = max(1.0, float(np.median(rms)))
+    w = 1.0 / (1.0 + (rms / (2.0 * scale)) ** 2)
+    return np.asarray(w / w.max(), dtype=np.float64)
+
+
+def _joint(
+    scene: Scene,
+    sols: list[AnnotatorSolution],
+    segs: list[dict[str, FloatArray]],
+    seed: AnnotatorSolution,
+    cluster: dict[str, Any],
+    cluster_camera: Camera,
+    size: ObjectSize,
+    settings: CalibrationSettings,
+) -> CalibrationResult:
+    assert seed.intrinsics is not None
+    indices = list(range(len(scene.annotations)))
+    f_fixed = scene.camera.focal_px
+    pp_given = scene.camera.principal_point
+    width, height = scene.image_size
+    centre = (width / 2.0, height / 2.0)
+    pp_fixed: tuple[float, float] = (
+        (float(pp_given[0]), float(pp_given[1])) if pp_given is not None else centre
+    )
+    seeds = [cluster_camera]
+    try:
+        seeds.insert(0, _pooled_seed(scene, segs, size))
+    except DegenerateGeometryError as exc:
+        log.info("pooled seed unavailable: %s", exc)
+    best: tuple[float, _JointProblem, Any, FloatArray, list[float]] | None = None
+    for cam0 in seeds:
+        width_signs = [_width_sign_for(scene, i, cam0) for i in indices]
+        prob = _JointProblem(scene, segs, indices, width_signs, size, settings)
+        R0 = cam0.cam_from_world_rotation
+        x0 = _pack(cam0.focal_px, pp_fixed, cam0.center_in_world, f_fixed is None, False)
+        prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
+        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=60)
+        score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
+        if best is None or score < best[0]:
+            best = (score, prob, res, R0, width_signs)
+    assert best is not None
+    _score, prob, res, R0, width_signs = best
+    x0 = res.x
+    for _ in range(3):  # iteratively reweighted over annotators
+        new_w = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
+        if np.allclose(new_w, prob.weights, atol=0.02):
+            break
+        prob.weights = new_w
+        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-8, max_nfev=100).x
+    res = _fit(prob, x0, R0, pp_fixed, f_fixed)
+    chosen = (res, pp_fixed)
+    free_pp = settings.free_principal_point
+    n_res = len(res.fun)
+    if pp_given is None and free_pp is not False:
+        f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
+        x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+        x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+        res_free = _fit(prob, x1, R0, None, f_fixed)
+        cost_fixed, cost_free = 2.0 * res.cost, 2.0 * res_free.cost
+        k_free = len(res_free.x)
+        s2 = max(cost_free / max(n_res - k_free, 1), 1e-12)
+        improvement = (cost_fixed - cost_free) / s2
+        # Freeing the principal point must pay for itself clearly: a chi-square(2) jump at
+        # p < 1e-6 (27.6) on top of the BIC penalty, and a well-determined result.
+        _f1, pp_free, _R1, _C1 = prob.unpack(res_free.x, R0, None, f_fixed)
+        pp_sigma = _param_sigma(res_free, slice(int(f_fixed is None), int(f_fixed is None) + 2))
+        well_determined = pp_sigma is not None and pp_sigma < 0.02 * math.hypot(width, height)
+        justified = improvement > 27.6 + 2.0 * math.log(n_res) and well_determined
+        if free_pp or (justified and res_free.success):
+            chosen = (res_free, None)
+    res, pp_model = chosen
+    f, pp, R, C = prob.unpack(res.x, R0, pp_model, f_fixed)
+    camera = Camera.from_center(f, pp, R, C)
+    # Uncertainty from the Gauss-Newton covariance, scaled by the residual variance.
+    J = res.jac
+    dof = max(len(res.fun) - len(res.x), 1)
+    s2 = max(2.0 * res.cost / dof, 1e-12)
+    sigma_c: FloatArray | None = None
+    sigma_f: float | None = None
+    try:
+        cov = np.linalg.pinv(J.T @ J) * s2
+        sigma_c = np.sqrt(np.clip(np.diag(cov)[-3:], 0, None))
+        if f_fixed is None:
+            sigma_f = float(f * math.sqrt(max(cov[0, 0], 0.0)))
+    except np.linalg.LinAlgError:
+        pass
+    if sigma_c is not None and not _size_given(scene):
+        sigma_c = np.sqrt(sigma_c**2 + (settings.size_sigma_rel * np.abs(C)) ** 2)
+    weights = [float(w) for w in prob.weights]
+    outliers = [
+        scene.annotations[i].annotator for i, w in enumerate(weights) if w < settings.outlier_weight
+    ]
+    prob.weights = np.ones(prob.n_annotators)
+    r = prob.residuals(res.x, R0, pp_model, f_fixed)
+    n_seg = len(prob.segments)
+    rms_seg = float(np.sqrt(np.mean(r[:n_seg] ** 2))) * prob.sigma_line
+    rms_pt = float(np.sqrt(np.mean(r[n_seg:] ** 2))) * prob.sigma_pt
+    if pp_model is None:
+        method, reason = "joint_fit_free_principal_point", (
+            "principal point fitted with the focal length: freeing it improved the fit by more "
+            "than the BIC penalty"
+        )
+    elif f_fixed is not None:
+        method = "given" if pp_given is not None else "given_focal"
+        reason = "focal length given in the scene; principal point " + (
+            "given" if pp_given is not None else "at the image centre"
+        )
+    else:
+        method = "joint_fit_centre_principal_point"
+        reason = "focal length fitted to all vanishing lines; principal point " + (
+            "given" if pp_given is not None else "at the image centre (freeing it was not "
+            "justified by the data)"
+        )
+    result = CalibrationResult(
+        camera,
+        "joint_fit",
+        method,
+        f"{reason}; closed-form seed used {seed.intrinsics.method} ({seed.intrinsics.reason})",
+        sols,
+        cluster,
+        weights,
+        outliers,
+        position_sigma_m=sigma_c,
+        focal_sigma_px=sigma_f,
+        rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
+        width_signs=width_signs,
+    )
+    return result
+
+
+def _size_given(scene: Scene) -> bool:
+    o = scene.object
+    return o.length_m is not None and o.width_m is not None and o.height_m is not None

@@ -1,0 +1,452 @@
+"""Vanishing points from annotated segments, intrinsics and rotation from vanishing points.
+
+Vanishing points are kept homogeneous, ``v = (x, y, w)`` in image pixels (``w = 0`` for a
+point at infinity, i.e. segments parallel in the image), so nothing divides by zero.
+
+References: Caprile & Torre (1990) and Hartley & Zisserman, *Multiple View Geometry*, 8.6-8.8
+(principal point as the orthocentre of three orthogonal vanishing points; focal length from
+two of them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo._errors import DegenerateGeometryError
+from camloc_geo.camera import project_to_rotation
+
+__all__ = [
+    "AXES",
+    "IntrinsicsEstimate",
+    "VanishingPoint",
+    "direction_sign",
+    "estimate_intrinsics",
+    "fit_vanishing_point",
+    "focal_from_vanishing_pair",
+    "principal_point_from_orthocentre",
+    "rotation_from_vanishing_directions",
+    "segment_residuals_px",
+]
+
+FloatArray = npt.NDArray[np.float64]
+Axis = Literal["length", "width", "height"]
+AXES: tuple[Axis, Axis, Axis] = ("length", "width", "height")
+
+# A vanishing point farther from the image centre than this many image diagonals is reported
+# as "at infinity" (the segments are parallel in the image to within ~0.06°).
+_INFINITY_DIAGONALS = 1e3
+
+
+def segment_residuals_px(segments_px: npt.ArrayLike, vp_h: npt.ArrayLike) -> FloatArray:
+    """Misfit of segments to a vanishing point, pixels.
+
+    For each segment, the distance of its first endpoint from the line through the
+    segment's midpoint and the vanishing point (the standard consistency measure; it is
+    defined for vanishing points at infinity too).
+
+    Parameters
+    ----------
+    segments_px
+        ``(N, 4)`` segments ``[x1, y1, x2, y2]``.
+    vp_h
+        Homogeneous vanishing point ``(3,)``.
+
+    Returns
+    -------
+    ``(N,)`` signed distances in pixels.
+    """
+    seg = np.asarray(segments_px, dtype=float).reshape(-1, 4)
+    px, py, pw = np.asarray(vp_h, dtype=float).reshape(3)
+    mx = (seg[:, 0] + seg[:, 2]) / 2.0
+    my = (seg[:, 1] + seg[:, 3]) / 2.0
+    # Line through (mx, my, 1) and the vanishing point: the cross product, written out.
+    la = my * pw - py
+    lb = px - mx * pw
+    lc = mx * py - my * px
+    norm = np.sqrt(la * la + lb * lb)
+    norm = np.where(norm < 1e-300, 1e-300, norm)
+    return np.asarray((la * seg[:, 0] + lb * seg[:, 1] + lc) / norm, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class VanishingPoint:
+    """A vanishing point fitted to segments.
+
+    Attributes
+    ----------
+    homogeneous
+        Unit 3-vector ``(x, y, w)`` in pixels; ``w = 0`` at infinity.
+    residuals_px
+        Per-segment misfit (see :func:`segment_residuals_px`).
+    finite
+        False when the segments are parallel in the image (the point is at infinity).
+    """
+
+    homogeneous: FloatArray
+    residuals_px: FloatArray
+    finite: bool
+
+    @property
+    def pixel(self) -> FloatArray | None:
+        """``[x, y]`` pixels, or None when at infinity."""
+        if not self.finite:
+            return None
+        return np.asarray(self.homogeneous[:2] / self.homogeneous[2], dtype=np.float64)
+
+    @property
+    def rms_px(self) -> float:
+        """RMS of the per-segment residuals."""
+        return float(np.sqrt(np.mean(self.residuals_px**2)))
+
+
+def _is_finite(vp_h: FloatArray, scale_px: float) -> bool:
+    return bool(abs(vp_h[2]) * _INFINITY_DIAGONALS * scale_px > np.linalg.norm(vp_h[:2]))
+
+
+def fit_vanishing_point(
+    segments_px: npt.ArrayLike,
+    *,
+    scale_px: float | None = None,
+    name: str = "segments",
+) -> VanishingPoint:
+    """Least-squares vanishing point of two or more segments.
+
+    A linear estimate (smallest singular vector of the conditioned, length-weighted line
+    matrix) is refined by minimising the geometric residuals of
+    :func:`segment_residuals_px` over the unit sphere of homogeneous points.
+
+    Parameters
+    ----------
+    segments_px
+        ``(N, 4)`` segments ``[x1, y1, x2, y2]``, ``N >= 2``.
+    scale_px
+        A typical image size (the diagonal) for conditioning and the at-infinity test;
+        default: the segments' extent.
+    name
+        Used in error messages (for example ``annotations[0].vp_lines.length``).
+
+    Returns
+    -------
+    VanishingPoint
+
+    Raises
+    ------
+    DegenerateGeometryError
+        Fewer than two segments, a zero-length segment, or all segments on one line.
+    """
+    seg = np.asarray(segments_px, dtype=float)
+    if seg.ndim != 2 or seg.shape[1] != 4:
+        raise DegenerateGeometryError(f"{name}: segments must be [x1, y1, x2, y2] rows")
+    if len(seg) < 2:
+        raise DegenerateGeometryError(f"{name}: needs at least 2 segments, got {len(seg)}")
+    if not np.all(np.isfinite(seg)):
+        raise DegenerateGeometryError(f"{name}: segments contain NaN or infinite values")
+    lengths = np.hypot(seg[:, 2] - seg[:, 0], seg[:, 3] - seg[:, 1])
+    if np.any(lengths < 1e-6):
+        i = int(np.argmin(lengths))
+        raise DegenerateGeometryError(f"{name}[{i}]: segment has zero length")
+    pts = seg.reshape(-1, 2)
+    center = pts.mean(axis=0)
+    spread = float(np.max(np.abs(pts - center))) or 1.0
+    scale = float(scale_px) if scale_px else spread
+    # Conditioned homogeneous lines through each segment, normalised to unit normals.
+    p1 = np.column_stack([(seg[:, 0:2] - center) / scale, np.ones(len(seg))])
+    p2 = np.column_stack([(seg[:, 2:4] - center) / scale, np.ones(len(seg))])
+    lines = np.cross(p1, p2)
+    lines /= np.linalg.norm(lines[:, :2], axis=1, keepdims=True)
+    weights = np.sqrt(lengths / lengths.mean())
+    _u, s, vt = np.linalg.svd(lines * weights[:, None])
+    if s[-2] < 1e-9 * max(s[0], 1e-300):
+        raise DegenerateGeometryError(
+            f"{name}: all segments lie on one line, so they do not define a vanishing point"
+        )
+    v0 = vt[-1]
+
+    def to_pixels(vc: FloatArray) -> FloatArray:
+        # Conditioned homogeneous point back to pixel homogeneous coordinates.
+        return np.array([vc[0] * scale + center[0] * vc[2], vc[1] * scale + center[1] * vc[2], vc[2]])
+
+    def unit(theta_phi: FloatArray) -> FloatArray:
+        th, ph = theta_phi
+        return np.array([math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)])
+
+    # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
+    if v0[2] < 0:
+        v0 = -v0
+    theta0 = math.acos(float(np.clip(v0[2], -1.0, 1.0)))
+    phi0 = math.atan2(v0[1], v0[0])
+    seg_c = np.column_stack([(seg[:, 0:2] - center) / scale, (seg[:, 2:4] - center) / scale])
+
+    def fun(x: FloatArray) -> FloatArray:
+        return segment_residuals_px(seg_c, unit(x)) * weights
+
+    if len(seg) > 2:
+        # A few damped Gauss-Newton steps (2 parameters: cheaper than a general solver).
+        x = np.array([theta0, phi0])
+        r = fun(x)
+        cost = float(r @ r)
+        lam = 1e-6
+        for _ in range(10):
+            J = np.empty((len(r), 2))
+            for j in range(2):
+                step = np.zeros(2)
+                step[j] = 1e-7
+                J[:, j] = (fun(x + step) - r) / 1e-7
+            JtJ, Jtr = J.T @ J, J.T @ r
+            try:
+                dx = -np.linalg.solve(JtJ + lam * np.diag(np.diag(JtJ) + 1e-12), Jtr)
+            except np.linalg.LinAlgError:
+                break
+            r_new = fun(x + dx)
+            cost_new = float(r_new @ r_new)
+            if cost_new < cost:
+                x, r = x + dx, r_new
+                done = cost - cost_new <= 1e-10 * cost or np.max(np.abs(dx)) < 1e-12
+                cost, lam = cost_new, lam * 0.3
+                if done:
+                    break
+            else:
+                lam *= 10.0
+                if lam > 1e6:
+                    break
+        vc = unit(x)
+    else:
+        vc = v0  # two segments: the linear solution is exact
+    vp_h = to_pixels(vc)
+    vp_h = vp_h / np.linalg.norm(vp_h)
+    residuals = segment_residuals_px(seg, vp_h)
+    diag = float(scale_px) if scale_px else 2.0 * spread
+    return VanishingPoint(vp_h.astype(np.float64), residuals, _is_finite(vp_h, diag))
+
+
+def principal_point_from_orthocentre(
+    v1: npt.ArrayLike, v2: npt.ArrayLike, v3: npt.ArrayLike
+) -> FloatArray:
+    """Orthocentre of the triangle of three finite orthogonal vanishing points (pixels).
+
+    Raises
+    ------
+    DegenerateGeometryError
+        When the three points are (nearly) collinear.
+    """
+    a, b, c = (np.asarray(v, dtype=float).reshape(2) for v in (v1, v2, v3))
+    # (H - a)·(b - c) = 0 and (H - b)·(a - c) = 0
+    A = np.array([b - c, a - c])
+    rhs = np.array([a @ (b - c), b @ (a - c)])
+    det = float(np.linalg.det(A))
+    if abs(det) < 1e-12 * max(float(np.linalg.norm(A)) ** 2, 1e-300):
+        raise DegenerateGeometryError("the three vanishing points are collinear")
+    return np.asarray(np.linalg.solve(A, rhs), dtype=np.float64)
+
+
+def focal_from_vanishing_pair(
+    v1_h: npt.ArrayLike, v2_h: npt.ArrayLike, principal_point: npt.ArrayLike
+) -> float:
+    """Focal length (pixels) from two orthogonal vanishing points and the principal point.
+
+    With ``v = (x, y, w)`` and ``p = (cx, cy)``:
+    ``(x1 - cx w1)(x2 - cx w2) + (y1 - cy w1)(y2 - cy w2) + f² w1 w2 = 0``.
+
+    Raises
+    ------
+    DegenerateGeometryError
+        If a point is at infinity (f is then not determined by this pair) or the points are
+        inconsistent with orthogonal directions (f² ≤ 0).
+    """
+    a = np.asarray(v1_h, dtype=float).reshape(3)
+    b = np.asarray(v2_h, dtype=float).reshape(3)
+    cx, cy = np.asarray(principal_point, dtype=float).reshape(2)
+    a = a / np.linalg.norm(a)
+    b = b / np.linalg.norm(b)
+    ww = a[2] * b[2]
+    dot = (a[0] - cx * a[2]) * (b[0] - cx * b[2]) + (a[1] - cy * a[2]) * (b[1] - cy * b[2])
+    scale = math.sqrt(
+        ((a[0] - cx * a[2]) ** 2 + (a[1] - cy * a[2]) ** 2)
+        * ((b[0] - cx * b[2]) ** 2 + (b[1] - cy * b[2]) ** 2)
+    )
+    if abs(ww) < 1e-12 * max(scale, 1e-300):
+        raise DegenerateGeometryError(
+            "a vanishing point is at infinity: this pair does not determine the focal length"
+        )
+    f2 = -dot / ww
+    if not f2 > 0:
+        raise DegenerateGeometryError(
+            "the vanishing points are not consistent with orthogonal directions (f² ≤ 0): "
+            "they lie on the same side of the principal point"
+        )
+    return math.sqrt(f2)
+
+
+@dataclass(frozen=True)
+class IntrinsicsEstimate:
+    """Focal length and principal point with the method that gave them and why."""
+
+    focal_px: float
+    principal_point: tuple[float, float]
+    method: str
+    reason: str
+
+
+def estimate_intrinsics(
+    vps_h: Mapping[str, npt.ArrayLike | None],
+    image_size: tuple[float, float],
+    *,
+    focal_px: float | None = None,
+    principal_point: tuple[float, float] | None = None,
+    max_pp_offset: float = 0.25,
+) -> IntrinsicsEstimate:
+    """Intrinsics from up to three orthogonal vanishing points, with documented fallbacks.
+
+    In order:
+
+    1. ``given``: focal length and principal point both given.
+    2. ``orthocentre``: three finite vanishing points; the principal point is their
+       orthocentre, accepted when it lies within ``max_pp_offset`` image diagonals of the
+       image centre and gives a real focal length.
+    3. ``two_vp``: the principal point is the given one or the image centre, and the focal
+       length comes from the best-conditioned pair of finite vanishing points (the pair
+       whose points are farthest apart relative to the image).
+    4. ``given_focal``: focal length given, principal point given or the image centre.
+
+    Parameters
+    ----------
+    vps_h
+        Homogeneous vanishing points by axis name; None or missing for an unknown axis.
+    image_size
+        ``(width, height)`` pixels.
+    focal_px, principal_point
+        Known values; each optional.
+    max_pp_offset
+        Largest accepted distance of an orthocentre from the image centre, in image diagonals.
+
+    Raises
+    ------
+    DegenerateGeometryError
+        When no method applies (for example two vanishing points at infinity and no focal
+        length given).
+    """
+    width, height = image_size
+    centre = np.array([width / 2.0, height / 2.0])
+    diag = math.hypot(width, height)
+    pp = np.asarray(principal_point, dtype=float) if principal_point is not None else None
+    if focal_px is not None and pp is not None:
+        return IntrinsicsEstimate(float(focal_px), (pp[0], pp[1]), "given", "scene gives both")
+
+    vps = {k: np.asarray(v, dtype=float) for k, v in vps_h.items() if v is not None}
+    finite = {k: v for k, v in vps.items() if _is_finite(v / np.linalg.norm(v), diag)}
+    why = ""
+    if focal_px is None and pp is None and len(finite) == 3:
+        px = [finite[k][:2] / finite[k][2] for k in AXES]
+        try:
+            ortho = principal_point_from_orthocentre(*px)
+            f = focal_from_vanishing_pair(finite["length"], finite["width"], ortho)
+            if np.linalg.norm(ortho - centre) <= max_pp_offset * diag:
+                return IntrinsicsEstimate(
+                    f, (float(ortho[0]), float(ortho[1])), "orthocentre",
+                    "three finite vanishing points; principal point = their orthocentre",
+                )
+            why = (
+                f"orthocentre {np.round(ortho, 1).tolist()} is more than {max_pp_offset} "
+                "diagonals from the image centre; "
+            )
+        except DegenerateGeometryError as exc:
+            why = f"orthocentre rejected ({exc}); "
+    pp_used = pp if pp is not None else centre
+    pp_word = "given principal point" if pp is not None else "principal point at the image centre"
+    if focal_px is not None:
+        return IntrinsicsEstimate(
+            float(focal_px), (float(pp_used[0]), float(pp_used[1])), "given_focal",
+            f"{why}focal length given; {pp_word}",
+        )
+    best: tuple[float, float, str] | None = None
+    names = sorted(finite)
+    for i in range(len(names)):
+        for j in range(i + 1, len(names)):
+            a, b = finite[names[i]], finite[names[j]]
+            try:
+                f = focal_from_vanishing_pair(a, b, pp_used)
+            except DegenerateGeometryError:
+                continue
+            # Conditioning: a pair whose points are both far out gives an unstable f.
+            da = np.linalg.norm(a[:2] / a[2] - pp_used)
+            db = np.linalg.norm(b[:2] / b[2] - pp_used)
+            quality = -max(da, db) / diag
+            if best is None or quality > best[0]:
+                best = (quality, f, f"{names[i]}+{names[j]}")
+    if best is not None:
+        return IntrinsicsEstimate(
+            best[1], (float(pp_used[0]), float(pp_used[1])), "two_vp",
+            f"{why}focal length from the {best[2]} vanishing points; {pp_word}",
+        )
+    raise DegenerateGeometryError(
+        f"{why}cannot estimate the focal length: fewer than two finite, mutually consistent "
+        "vanishing points; give camera.focal_px in the scene"
+    )
+
+
+def direction_sign(
+    direction_in_cam: npt.ArrayLike,
+    origin_ray_in_cam: npt.ArrayLike,
+    image_step: npt.ArrayLike,
+) -> float:
+    """Sign (+1 or -1) that makes a 3-D direction move the origin's image toward a step.
+
+    Moving a point at depth ``z`` along ``d`` moves its normalised image point in the
+    direction ``d_xy - m_xy d_z`` (``m`` the point's ray with ``m_z = 1``), whatever ``z``.
+    Returns the sign of its dot product with the annotated image step (normalised
+    coordinates), or 0.0 when the two are (nearly) perpendicular: the sign is then ambiguous.
+    """
+    d = np.asarray(direction_in_cam, dtype=float).reshape(3)
+    m = np.asarray(origin_ray_in_cam, dtype=float).reshape(3)
+    m = m / m[2]
+    step = np.asarray(image_step, dtype=float).reshape(2)
+    g = d[:2] - m[:2] * d[2]
+    dot = float(g @ step)
+    denom = float(np.linalg.norm(g) * np.linalg.norm(step))
+    if denom <= 0 or abs(dot) < 0.05 * denom:
+        return 0.0
+    return 1.0 if dot > 0 else -1.0
+
+
+def rotation_from_vanishing_directions(
+    directions_in_cam: Mapping[str, npt.ArrayLike],
+    weights: Mapping[str, float] | None = None,
+) -> FloatArray:
+    """Proper rotation whose columns best match sign-fixed axis directions.
+
+    Parameters
+    ----------
+    directions_in_cam
+        Unit directions of the world x (``length``), y (``width``) and z (``height``) axes in
+        the camera frame, signs already fixed; at least two of them.
+    weights
+        Optional confidence per axis.
+
+    Returns
+    -------
+    ``cam_from_world`` rotation: the weighted orthogonal Procrustes solution (SVD, det = +1).
+    A missing third axis is completed by the right-handed cross product.
+    """
+    cols = {"length": 0, "width": 1, "height": 2}
+    dirs = {k: np.asarray(v, dtype=float) / np.linalg.norm(v) for k, v in directions_in_cam.items()}
+    if len(dirs) < 2:
+        raise DegenerateGeometryError("at least two axis directions are needed for a rotation")
+    w = dict(weights or {})
+    M = np.zeros((3, 3))
+    for k, d in dirs.items():
+        M += w.get(k, 1.0) * np.outer(d, np.eye(3)[cols[k]])
+    if len(dirs) == 2:
+        (k1, d1), (k2, d2) = sorted(dirs.items(), key=lambda kv: cols[kv[0]])
+        i1, i2 = cols[k1], cols[k2]
+        third = ({0, 1, 2} - {i1, i2}).pop()
+        # e_third = e_i1 × e_i2 up to the cyclic sign.
+        sign = 1.0 if (i1, i2, third) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
+        d3 = sign * np.cross(d1, d2)
+        M += np.outer(d3 / np.linalg.norm(d3), np.eye(3)[third])
+    return project_to_rotation(M)
