@@ -123,13 +123,16 @@ def gt_horizon(gt: dict[str, Any], mode: str = "hvps") -> np.ndarray:
     ``hvps``: the line through the two horizontal ground-truth vanishing points (the
     definition of the horizon; the ground-truth ``vp`` are measured independently and are
     not exactly orthogonal). ``vertical``: the vanishing line of the plane orthogonal to
-    the ground-truth vertical direction.
+    the ground-truth vertical direction. ``orthogonal``: the same with the
+    orthogonalised ground truth (``vp_orthogonal``).
     """
     d = gt["dirs"]
     kv = int(np.argmax(np.abs(d[:, 1])))
     pp = (float(gt["pp"][0]), float(gt["pp"][1]))
     if mode == "vertical":
         return horizon_from_up(up_of(d), gt["f"], pp)
+    if mode == "orthogonal":
+        return horizon_from_up(up_of(gt["dirs_orth"]), gt["f"], pp)
     h1, h2 = (d[k] for k in range(3) if k != kv)
     up = np.cross(h1, h2)
     up = up / np.linalg.norm(up)
@@ -194,6 +197,8 @@ def summarise(rows: list[dict[str, Any]], with_focal: bool) -> dict[str, Any]:
         "horizon_auc_pct": 100.0 * horizon_auc(hz),
         "horizon_auc_vertical_gt_pct": 100.0
         * horizon_auc([r.get("hz_err_vertical", math.inf) for r in rows]),
+        "horizon_auc_orthogonal_gt_pct": 100.0
+        * horizon_auc([r.get("hz_err_orthogonal", math.inf) for r in rows]),
         "time_median_ms": 1000.0 * float(np.median([r["time_s"] for r in rows])),
         "time_mean_ms": 1000.0 * float(np.mean([r["time_s"] for r in rows])),
     }
@@ -205,7 +210,9 @@ def summarise(rows: list[dict[str, Any]], with_focal: bool) -> dict[str, Any]:
     return out
 
 
-def run_ours(data: list[dict[str, Any]], focal: float | None) -> list[dict[str, Any]]:
+def run_ours(
+    data: list[dict[str, Any]], focal: float | None, **kwargs: Any
+) -> list[dict[str, Any]]:
     import cv2
 
     rows = []
@@ -214,7 +221,7 @@ def run_ours(data: list[dict[str, Any]], focal: float | None) -> list[dict[str, 
         h, w = img.shape[:2]
         t0 = time.perf_counter()
         try:
-            res = detect_vanishing_points(img, focal_px=focal, seed=0)
+            res = detect_vanishing_points(img, focal_px=focal, seed=0, **kwargs)
         except NotEnoughStructureError as exc:
             rows.append({"name": gt["name"], "error": str(exc), "time_s": time.perf_counter() - t0})
             continue
@@ -230,6 +237,9 @@ def run_ours(data: list[dict[str, Any]], focal: float | None) -> list[dict[str, 
                 "hz_err": horizon_error(res.up_in_cam, res.focal_px, res.principal_point, gt, w, h),
                 "hz_err_vertical": horizon_error(
                     res.up_in_cam, res.focal_px, res.principal_point, gt, w, h, "vertical"
+                ),
+                "hz_err_orthogonal": horizon_error(
+                    res.up_in_cam, res.focal_px, res.principal_point, gt, w, h, "orthogonal"
                 ),
                 "dir_err_orth": direction_errors(res.directions_in_cam, gt["dirs_orth"]),
             }
@@ -265,6 +275,9 @@ def run_lu(data: list[dict[str, Any]], python: str) -> dict[str, list[dict[str, 
                 row["hz_err"] = horizon_error(up_of(d), f, (320.0, 240.0), gt, 640, 480)
                 row["hz_err_vertical"] = horizon_error(
                     up_of(d), f, (320.0, 240.0), gt, 640, 480, "vertical"
+                )
+                row["hz_err_orthogonal"] = horizon_error(
+                    up_of(d), f, (320.0, 240.0), gt, 640, 480, "orthogonal"
                 )
             else:
                 row["error"] = r["error"]
@@ -349,12 +362,13 @@ def main(argv: list[str] | None = None) -> int:
     results: dict[str, list[dict[str, Any]]] = {}
     results["ours (focal unknown)"] = run_ours(data, None)
     results["ours (true focal given)"] = run_ours(data, F_TRUE)
+    results["ours (f unknown, pp refined)"] = run_ours(data, None, estimate_principal_point=True)
     if not args.no_lu:
         lu = run_lu(data, args.lu_python)
         results["lu-vp-detect (true focal)"] = lu["true"]
         results["lu-vp-detect (focal x1.5)"] = lu["x1.5"]
     summary = {
-        name: summarise(rows, with_focal=name == "ours (focal unknown)")
+        name: summarise(rows, with_focal=name.startswith("ours (f"))
         for name, rows in results.items()
     }
     args.out.mkdir(parents=True, exist_ok=True)
@@ -367,6 +381,7 @@ def main(argv: list[str] | None = None) -> int:
         ("dir_err_orth_median_deg", "dir-orth med", "{:.2f}"),
         ("horizon_auc_pct", "hz AUC %", "{:.1f}"),
         ("horizon_auc_vertical_gt_pct", "hzAUC vertGT", "{:.1f}"),
+        ("horizon_auc_orthogonal_gt_pct", "hzAUC orthGT", "{:.1f}"),
         ("horizon_err_median", "hz med", "{:.4f}"),
         ("share_focal_within_10pct", "f<=10%", "{:.2f}"),
         ("focal_rel_err_median", "f med err", "{:.3f}"),
