@@ -159,6 +159,37 @@ def _angle_diff(a: float, b: float) -> float:
     return min(d, 360.0 - d)
 
 
+def _extend_arm(
+    G: nx.MultiDiGraph, edge: tuple[Any, Any], coords: list[tuple[float, float]]
+) -> list[tuple[float, float]]:
+    """Extend an arm shorter than :data:`ARM_SAMPLE_M` along plain continuations.
+
+    Graph nodes where only a tag changes (lanes, name...) split a street into short edges;
+    the direction near the junction is still measured over :data:`ARM_SAMPLE_M` metres.
+    """
+    length = LineString(coords).length
+    prev, cur = edge
+    for _ in range(6):
+        if length >= ARM_SAMPLE_M or cur not in G:
+            break
+        nbrs = (set(G.successors(cur)) | set(G.predecessors(cur))) - {prev, cur}
+        if len(nbrs) != 1:
+            break
+        nxt = nbrs.pop()
+        forward = G.get_edge_data(cur, nxt)
+        data = next(iter((forward or G.get_edge_data(nxt, cur)).values()))
+        if "geometry" in data:
+            more = list(data["geometry"].coords)
+            if not forward:
+                more = more[::-1]
+        else:
+            more = [(G.nodes[cur]["x"], G.nodes[cur]["y"]), (G.nodes[nxt]["x"], G.nodes[nxt]["y"])]
+        coords = coords + more[1:]
+        length = LineString(coords).length
+        prev, cur = cur, nxt
+    return coords
+
+
 def _continued_label(
     G: nx.MultiDiGraph, edge: tuple[Any, Any], data: dict[str, Any], max_steps: int = 4
 ) -> tuple[str, tuple[str, ...]]:
@@ -267,7 +298,8 @@ def _arms_of(
         entry = found.setdefault(key, (coords, set(), data, edge))
         entry[1].add("in")
     arms: list[_Arm] = []
-    for coords, flows, data, edge in found.values():
+    for coords_found, flows, data, edge in found.values():
+        coords = _extend_arm(Gp, edge, coords_found) if Gp is not None else coords_found
         flow = "both" if len(flows) == 2 or not _is_oneway(data) else next(iter(flows))
         arm = _make_arm(coords, flow, data, edge, frame, north_america, Gp)
         if arm is not None:

@@ -290,12 +290,13 @@ def _graph_from_ways(
     return simplify(graph)
 
 
-SIMPLIFY_EDGE_ATTRS_DIFFER = ("name",)
-"""Graph nodes where the street name changes are kept (an edge never mixes two names)."""
+SIMPLIFY_EDGE_ATTRS_DIFFER = ("name", "highway", "lanes", "width", "junction")
+"""Graph nodes where these tags change are kept, so every simplified edge has one value of
+each (osmnx would otherwise merge them into lists in arbitrary order)."""
 
 
 def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
-    """osmnx simplification that keeps nodes where the street name changes."""
+    """osmnx simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
     return ox.simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
 
 
