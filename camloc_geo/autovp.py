@@ -67,6 +67,11 @@ INFINITY_TOL_DEG = 0.05
 _F_PRIOR_REL = 1.0
 _F_PRIOR_SIGMA = 1.0
 _PP_SIGMA_REL = 0.03
+#: Inlier distance (px per 800 px of image diagonal) of segment end points.
+_TAU_PER_800 = 1.5
+#: Final labelling: distance (in inlier distances) and angle limits.
+_LABEL_TAU = 1.5
+_LABEL_ANGLE_DEG = 3.0
 _MIN_SEGMENTS = 6
 _MIN_SUPPORT = 3  # inlier segments needed by each of the two best-supported VPs
 
@@ -128,9 +133,11 @@ def detect_segments(
     image: str | os.PathLike[str] | npt.NDArray[Any],
     *,
     min_length_px: float | None = None,
-    max_segments: int = 400,
+    max_segments: int = 500,
     max_side_px: int = 1280,
     method: str = "auto",
+    mask: npt.NDArray[Any] | None = None,
+    trim_borders: bool = True,
 ) -> FloatArray:
     """Detect straight line segments.
 
@@ -148,6 +155,12 @@ def detect_segments(
         scaled back to the input's pixels).
     method
         ``"auto"`` (LSD when available, else Hough), ``"lsd"`` or ``"hough"``.
+    mask
+        Optional ``(H, W)`` boolean array, True where segments may lie (both end points
+        and the midpoint); use it to ignore time stamps, logos and other overlays.
+    trim_borders
+        Ignore uniform bars along the image borders (letterboxing, black frames), whose
+        edges would otherwise pose as long horizontal or vertical lines.
 
     Returns
     -------
@@ -158,6 +171,13 @@ def detect_segments(
     import cv2
 
     gray = load_image(image)
+    full_h, full_w = gray.shape
+    if mask is not None:
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != gray.shape:
+            raise InputError(f"mask shape {mask.shape} differs from the image's {gray.shape}")
+    x0, y0, x1, y1 = _content_box(gray) if trim_borders else (0, 0, full_w, full_h)
+    gray = np.ascontiguousarray(gray[y0:y1, x0:x1])
     h, w = gray.shape
     scale = 1.0
     if max(h, w) > max_side_px:
@@ -165,7 +185,7 @@ def detect_segments(
         small = cv2.resize(gray, (round(w * scale), round(h * scale)), interpolation=cv2.INTER_AREA)
         gray = np.asarray(small, dtype=np.uint8)
     if min_length_px is None:
-        min_length_px = max(12.0, 0.025 * math.hypot(w, h))
+        min_length_px = max(12.0, 0.025 * math.hypot(full_w, full_h))
     segs = np.zeros((0, 4))
     if method not in ("auto", "lsd", "hough"):
         raise InputError(f"method must be 'auto', 'lsd' or 'hough', got {method!r}")
@@ -195,14 +215,40 @@ def detect_segments(
             segs = np.asarray(hough_out, dtype=np.float64).reshape(-1, 4)
     # OpenCV's segment end points are in pixel-index coordinates (centre of the
     # top-left pixel at 0, 0): shift to the continuous convention, then undo the shrink.
-    segs = (segs + 0.5) / scale
+    segs = (segs + 0.5) / scale + np.array([x0, y0, x0, y0], dtype=np.float64)
     if len(segs) == 0:
         return np.zeros((0, 4))
+    if mask is not None:
+        pts = [segs[:, 0:2], segs[:, 2:4], 0.5 * (segs[:, 0:2] + segs[:, 2:4])]
+        inside = np.ones(len(segs), dtype=bool)
+        for p in pts:
+            ix = np.clip(np.floor(p[:, 0]).astype(np.int64), 0, full_w - 1)
+            iy = np.clip(np.floor(p[:, 1]).astype(np.int64), 0, full_h - 1)
+            inside &= mask[iy, ix]
+        segs = segs[inside]
     lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
     keep = lengths >= min_length_px
     segs, lengths = segs[keep], lengths[keep]
     order = np.argsort(-lengths, kind="stable")[:max_segments]
     return np.ascontiguousarray(segs[order])
+
+
+def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
+    """``x0, y0, x1, y1`` of the image without uniform bars along its borders."""
+    h, w = gray.shape
+    g = gray.astype(np.float32)
+    flat_rows = g.std(axis=1) < tol
+    flat_cols = g.std(axis=0) < tol
+
+    def run(flags: npt.NDArray[np.bool_]) -> int:
+        idx = np.flatnonzero(~flags)
+        return int(idx[0]) if len(idx) else len(flags)
+
+    y0, y1 = run(flat_rows), h - run(flat_rows[::-1])
+    x0, x1 = run(flat_cols), w - run(flat_cols[::-1])
+    if y1 - y0 < 8 or x1 - x0 < 8:
+        return 0, 0, w, h
+    return x0, y0, x1, y1
 
 
 # ------------------------------------------------------------------------ geometry
@@ -649,6 +695,7 @@ def detect_vanishing_points(
     inlier_px: float | None = None,
     focal_bounds_rel: tuple[float, float] = FOCAL_BOUNDS_REL,
     estimate_principal_point: bool = False,
+    mask: npt.NDArray[Any] | None = None,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -679,6 +726,9 @@ def detect_vanishing_points(
         the image centre (sigma 3 % of the longer side). Off by default: on York Urban it
         lowers the direction error a little but does not find the true principal point
         (the estimates scatter around the centre), and it costs focal accuracy.
+    mask
+        ``(H, W)`` boolean array, True where segments may lie (see
+        :func:`detect_segments`); ignored when ``segments`` is given.
 
     Returns
     -------
@@ -703,7 +753,7 @@ def detect_vanishing_points(
         raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
     if segments is None:
         assert gray is not None
-        segs_px = detect_segments(gray)
+        segs_px = detect_segments(gray, mask=mask)
     else:
         segs_px = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
         ln = np.hypot(segs_px[:, 2] - segs_px[:, 0], segs_px[:, 3] - segs_px[:, 1])
@@ -716,7 +766,7 @@ def detect_vanishing_points(
     pp = np.array(principal_point if principal_point is not None else (w / 2.0, h / 2.0), float)
     scale = float(max(w, h))
     diag = math.hypot(w, h)
-    tau = inlier_px if inlier_px is not None else max(1.0, 1.5 * diag / 800.0)
+    tau = inlier_px if inlier_px is not None else max(1.0, _TAU_PER_800 * diag / 800.0)
     s = _prepare(segs_px, pp, scale)
     f_bounds = (focal_bounds_rel[0], focal_bounds_rel[1])
     f_fixed = None if focal_px is None else focal_px / scale
@@ -771,7 +821,7 @@ def detect_vanishing_points(
         )
         pp = pp + delta * scale
         s = _prepare(segs_px, pp, scale)
-        labels, score = _labels(R, f, s, tau * 1.5, 3.0)
+        labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         best = _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
     return _finish(best, s, segs_px, pp, scale, (w, h), f_fixed is None, f_bounds)
 
@@ -857,7 +907,7 @@ def _fit(
         if np.count_nonzero(labels >= 0) < 4:
             break
         R, f, logf_std, _ = _refine(R, f, s, labels, tau, f_free, f_prior, f_bounds)
-        new_labels, score = _labels(R, f, s, tau * 1.5, 3.0)
+        new_labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         if np.array_equal(new_labels, labels):
             break
         labels = new_labels

@@ -375,3 +375,29 @@ def test_principal_point_refinement_moves_towards_truth() -> None:
     )
     given = detect_vanishing_points(img, focal_px=f, principal_point=tuple(true_pp))
     assert dir_errors_deg(given.directions_in_cam, R.T).max() < 0.3
+
+
+def test_letterbox_bars_and_mask(tilted_scene: tuple[np.ndarray, np.ndarray, float]) -> None:
+    img, R, f = tilted_scene
+    h, w = img.shape
+    boxed = np.zeros((h + 120, w), np.uint8)  # black bars above and below
+    boxed[60 : 60 + h] = img
+    segs = detect_segments(boxed)
+    # no segment along the bars' edges
+    flat = np.abs(segs[:, 1] - segs[:, 3]) < 1.0
+    near_bar = (np.abs(segs[:, 1] - 60) < 2) | (np.abs(segs[:, 1] - (60 + h)) < 2)
+    assert not np.any(flat & near_bar & (np.abs(segs[:, 0] - segs[:, 2]) > 0.5 * w))
+    res = detect_vanishing_points(boxed)
+    assert res.principal_point == (w / 2, (h + 120) / 2)
+    # the camera's principal point is the centre of the picture inside the bars
+    res = detect_vanishing_points(boxed, principal_point=(w / 2, 60 + h / 2))
+    assert dir_errors_deg(res.directions_in_cam, R.T).max() < 0.5
+    assert res.focal_px == pytest.approx(f, rel=0.03)
+    # a mask drops segments
+    mask = np.ones(boxed.shape, bool)
+    mask[:, : w // 2] = False
+    masked = detect_segments(boxed, mask=mask)
+    assert len(masked) > 0
+    assert np.all(masked[:, [0, 2]] >= w // 2)
+    with pytest.raises(InputError, match="mask"):
+        detect_segments(boxed, mask=np.ones((5, 5), bool))

@@ -121,3 +121,25 @@ def test_vp_subprocess(scene_png: Path, tmp_path: Path) -> None:
     )
     assert bad.returncode == 2
     assert "not enough structure" in bad.stderr
+
+
+def test_vp_ignore_boxes(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    n_all = json.loads(capsys.readouterr().out)["n_segments"]
+    args = [
+        "vp",
+        str(scene_png),
+        "--ignore",
+        "0",
+        "0",
+        "400",
+        "600",
+        "--ignore",
+        "400",
+        "0",
+        "500",
+        "100",
+    ]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert 0 < out["n_segments"] < n_all

@@ -6,6 +6,8 @@ import argparse
 import logging
 from typing import Any
 
+import numpy as np
+
 from camloc_geo._errors import InputError
 
 __all__ = ["register", "run"]
@@ -34,6 +36,20 @@ def register(subparsers: Any) -> None:
         default=None,
         help="known principal point, pixels (default: the image centre)",
     )
+    p.add_argument(
+        "--ignore",
+        type=float,
+        nargs=4,
+        action="append",
+        metavar=("X0", "Y0", "X1", "Y1"),
+        default=None,
+        help="ignore segments in this pixel box (time stamps, logos); repeatable",
+    )
+    p.add_argument(
+        "--estimate-principal-point",
+        action="store_true",
+        help="also refine the principal point around the image centre",
+    )
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--draw", metavar="OUT.png", default=None, help="draw segments coloured by VP")
     p.add_argument("-o", "--output", metavar="OUT.json", default=None, help="write JSON here")
@@ -49,7 +65,27 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--focal-px must be positive, got {args.focal_px}")
     image = load_image(args.image)
     pp = tuple(args.principal_point) if args.principal_point else None
-    res = detect_vanishing_points(image, focal_px=args.focal_px, principal_point=pp, seed=args.seed)
+    mask = None
+    if args.ignore:
+        h, w = image.shape[:2]
+        mask = np.ones((h, w), dtype=bool)
+        for x0, y0, x1, y1 in args.ignore:
+            if not all(np.isfinite([x0, y0, x1, y1])):
+                raise InputError("--ignore: box corners must be finite numbers")
+            xa, xb = sorted((x0, x1))
+            ya, yb = sorted((y0, y1))
+            mask[
+                max(0, int(ya)) : max(0, int(np.ceil(yb))),
+                max(0, int(xa)) : max(0, int(np.ceil(xb))),
+            ] = False
+    res = detect_vanishing_points(
+        image,
+        focal_px=args.focal_px,
+        principal_point=pp,
+        seed=args.seed,
+        mask=mask,
+        estimate_principal_point=args.estimate_principal_point,
+    )
     if args.draw:
         draw_segments(image, res, args.draw)
         log.info("segments drawn to %s", args.draw)
