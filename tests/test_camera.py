@@ -49,7 +49,12 @@ def test_angles_round_trip(heading: float, pitch: float, roll: float) -> None:
 
 def test_heading_is_clockwise_from_north() -> None:
     """World +y is north, +x east: heading 90 looks along +x, heading 180 along -y."""
-    for heading, forward in ((0.0, [0, 1, 0]), (90.0, [1, 0, 0]), (180.0, [0, -1, 0]), (270.0, [-1, 0, 0])):
+    for heading, forward in (
+        (0.0, [0, 1, 0]),
+        (90.0, [1, 0, 0]),
+        (180.0, [0, -1, 0]),
+        (270.0, [-1, 0, 0]),
+    ):
         R = rotation_from_angles(heading, 0.0, 0.0)
         np.testing.assert_allclose(R[2], forward, atol=1e-12)  # optical axis in the world
         np.testing.assert_allclose(R[0], np.cross(forward, [0, 0, 1]), atol=1e-12)  # image right
@@ -180,7 +185,9 @@ def test_project_then_ground_round_trip(
     assume(depth > 0.5)
     back = cam.ground_from_pixels(px, ground_z_m=z)
     assume(np.all(np.isfinite(back)))  # rays parallel to the plane are NaN by policy
-    np.testing.assert_allclose(back, point, atol=1e-6 * max(1.0, np.linalg.norm(point - cam.center_in_world)))
+    np.testing.assert_allclose(
+        back, point, atol=1e-6 * max(1.0, np.linalg.norm(point - cam.center_in_world))
+    )
 
 
 def test_above_horizon_policy() -> None:
@@ -190,7 +197,9 @@ def test_above_horizon_policy() -> None:
     out = cam.ground_from_pixels(np.array([sky, ground]))
     assert np.all(np.isnan(out[0]))
     assert np.all(np.isfinite(out[1]))
-    with pytest.raises(DegenerateGeometryError, match=r"pixel \[640.0, 10.0\] is at or above the horizon"):
+    with pytest.raises(
+        DegenerateGeometryError, match=r"pixel \[640.0, 10.0\] is at or above the horizon"
+    ):
         cam.ground_from_pixels(np.array([ground, sky]), above_horizon="error")
     # Single pixel in, single row out.
     assert cam.ground_from_pixels(ground).shape == (3,)
@@ -200,7 +209,9 @@ def test_horizon_line_sign_and_position() -> None:
     cam = _camera(30.0, 10.0, 4.0, 5.0)
     line = cam.horizon_line()
     # A far-away point at camera height lies on the horizon.
-    far = cam.center_in_world + 1e7 * np.array([math.sin(math.radians(30)), math.cos(math.radians(30)), 0])
+    far = cam.center_in_world + 1e7 * np.array(
+        [math.sin(math.radians(30)), math.cos(math.radians(30)), 0]
+    )
     px = cam.project(far)
     assert line @ [*px, 1.0] == pytest.approx(0.0, abs=1e-3)
     # Ground pixels are on the positive side.
