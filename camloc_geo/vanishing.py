@@ -162,7 +162,8 @@ def fit_vanishing_point(
     lines /= np.linalg.norm(lines[:, :2], axis=1, keepdims=True)
     weights = np.sqrt(lengths / lengths.mean())
     _u, s, vt = np.linalg.svd(lines * weights[:, None])
-    if s[-2] < 1e-9 * max(s[0], 1e-300):
+    # s[1], not s[-2]: with two segments there are only two singular values.
+    if s[1] < 1e-9 * max(s[0], 1e-300):
         raise DegenerateGeometryError(
             f"{name}: all segments lie on one line, so they do not define a vanishing point"
         )

@@ -56,7 +56,7 @@ def _vp_pixel(cam: Camera, direction: np.ndarray) -> np.ndarray:
     st.integers(2, 6),
     st.integers(0, 10_000),
 )
-def test_vanishing_point_of_projected_parallel_lines_is_KRd(
+def test_vanishing_point_of_projected_parallel_lines_is_k_r_d(
     heading: float, pitch: float, roll: float, f: float, axis: int, n: int, seed: int
 ) -> None:
     cam = _cam(heading, pitch, roll, f, (990.0, 520.0))
@@ -103,6 +103,8 @@ def test_two_segments_exact_intersection() -> None:
         ([[0, 0, 10, 10]], "needs at least 2 segments, got 1"),
         (np.zeros((0, 4)), "needs at least 2 segments, got 0"),
         ([[0, 0, 10, 10], [5, 5, 5, 5]], r"x\[1\]: segment has zero length"),
+        ([[0, 0, 10, 10], [20, 20, 30, 30]], "all segments lie on one line"),
+        ([[0, 0, 10, 10], [20, 20, 30, 30], [-5, -5, 40, 40]], "all segments lie on one line"),
         ([[0, 0, 10, float("nan")], [20, 20, 30, 31]], "NaN or infinite"),
         ([[0, 0, 10], [20, 20, 30]], r"must be \[x1, y1, x2, y2\] rows"),
     ],
