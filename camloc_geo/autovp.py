@@ -51,7 +51,9 @@ __all__ = [
     "detect_segments",
     "detect_vanishing_points",
     "draw_segments",
+    "horizon_from_up",
     "load_image",
+    "pitch_roll_from_up",
     "segments_for_axis",
 ]
 
@@ -302,11 +304,6 @@ def _endpoint_residual(vps: FloatArray, s: _Segs) -> FloatArray:
     cross = s.dirn[:, 0] * dy - s.dirn[:, 1] * dx
     norm = np.sqrt(dx * dx + dy * dy) + 1e-12
     return np.asarray(0.5 * s.length_px * cross / norm, dtype=np.float64)
-
-
-def _sin_angle(vps: FloatArray, s: _Segs) -> FloatArray:
-    r = _endpoint_residual(vps, s)
-    return np.asarray(np.abs(r) / (0.5 * s.length_px), dtype=np.float64)
 
 
 def _vps_from_rotation(R: FloatArray, f_n: float) -> FloatArray:
