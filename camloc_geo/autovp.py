@@ -136,7 +136,7 @@ def detect_segments(
     *,
     min_length_px: float | None = None,
     max_segments: int = 500,
-    max_side_px: int = 1280,
+    max_side_px: int = 1024,
     method: str = "auto",
     mask: npt.NDArray[Any] | None = None,
     trim_borders: bool = True,

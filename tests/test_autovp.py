@@ -401,3 +401,58 @@ def test_letterbox_bars_and_mask(tilted_scene: tuple[np.ndarray, np.ndarray, flo
     assert np.all(masked[:, [0, 2]] >= w // 2)
     with pytest.raises(InputError, match="mask"):
         detect_segments(boxed, mask=np.ones((5, 5), bool))
+
+
+def project_segments(
+    R: np.ndarray, f: float, size: tuple[int, int], n: int = 60, seed: int = 0
+) -> np.ndarray:
+    """Exact image segments of random world-axis-aligned 3-D segments (no rendering)."""
+    rng = np.random.default_rng(seed)
+    w, h = size
+    K = np.array([[f, 0, w / 2], [0, f, h / 2], [0, 0, 1.0]])
+    out = []
+    while len(out) < n:
+        depth = rng.uniform(8, 40)
+        p = R[2] * depth + rng.uniform(-1, 1, 3) * depth * 0.6
+        q = p + np.eye(3)[len(out) % 3] * rng.uniform(2, 8)
+        a, b = K @ (R @ p), K @ (R @ q)
+        if a[2] < 1 or b[2] < 1:
+            continue
+        a, b = a[:2] / a[2], b[:2] / b[2]
+        if (
+            np.all((a > 0) & (a < size))
+            and np.all((b > 0) & (b < size))
+            and np.hypot(*(a - b)) > 25
+        ):
+            out.append([*a, *b])
+    return np.array(out)
+
+
+def test_exact_segments_without_image() -> None:
+    R = cam_from_world(40.0, 10.0, -2.0)
+    segs = project_segments(R, 900.0, (1000, 750))
+    res = detect_vanishing_points(None, segments=segs, image_size=(1000, 750))
+    assert dir_errors_deg(res.directions_in_cam, R.T).max() < 0.01
+    assert res.focal_px == pytest.approx(900.0, rel=1e-3)
+    assert res.image_size == (1000, 750)
+    with pytest.raises(InputError):
+        detect_vanishing_points(None, segments=segs)
+
+
+def test_exact_vps_at_infinity_without_warnings() -> None:
+    # Level camera square to the world axes: two VPs exactly at infinity (w = 0).
+    R = cam_from_world(0.0, 0.0, 0.0)
+    segs = project_segments(R, 800.0, (800, 600), seed=2)
+    res = detect_vanishing_points(None, segments=segs, image_size=(800, 600), focal_px=800.0)
+    px = res.vanishing_points_px
+    assert px[0] is None
+    assert sum(p is None for p in px) == 2
+    assert next(p for p in px if p is not None) == pytest.approx([400.0, 300.0], abs=1e-3)
+    assert res.pitch_deg == pytest.approx(0.0, abs=1e-3)
+    assert res.roll_deg == pytest.approx(0.0, abs=1e-3)
+    assert res.horizon == pytest.approx([0.0, 1.0, -300.0], abs=1e-3)
+    assert np.all(np.isfinite(res.vanishing_points))
+    # focal unknown and unobservable here: flagged, not a confident number
+    res = detect_vanishing_points(None, segments=segs, image_size=(800, 600))
+    assert res.focal_source in ("prior", "bound")
+    assert res.confidence <= 0.5
