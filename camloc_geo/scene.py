@@ -280,6 +280,9 @@ def parse_scene(data: Any, *, base_dir: str | Path | None = None) -> Scene:
         )
     except ValidationError as exc:
         err = exc.errors()[0]
+        cause = err.get("ctx", {}).get("error")
+        if isinstance(cause, SceneError) and exc.error_count() == 1:
+            raise cause from None  # raised by a validator of ours: it knows its field
         # Drop pydantic's union/type tags from the location.
         loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and "[" in p))
         msg = err["msg"]

@@ -163,6 +163,7 @@ def test_parse_errors_name_the_field(
     edit(data)
     with pytest.raises(SceneError) as info:
         parse_scene(data)
+    assert info.value.field == field
     assert str(info.value).startswith(f"{field}: ")
     assert message in str(info.value)
 
@@ -202,7 +203,7 @@ def test_preset_with_overrides(good: dict[str, Any]) -> None:
 
 @pytest.mark.parametrize("bad", [0, -1.0, float("nan"), 1e5])
 def test_object_size_rejects_nonsense(bad: float) -> None:
-    with pytest.raises(SceneError, match="object.length_m: must be a positive size"):
+    with pytest.raises(SceneError, match=r"object\.length_m: must be a positive size"):
         ObjectSize(bad, 1.8, 1.45)
 
 
