@@ -77,6 +77,13 @@ class ObjectSpec(_Model):
     width_m: float | None = Field(default=None, gt=0, lt=1e4)
     height_m: float | None = Field(default=None, gt=0, lt=1e4)
 
+    @field_validator("preset")
+    @classmethod
+    def _known_preset(cls, value: str | None) -> str | None:
+        if value is not None:
+            object_preset(value)  # SceneError naming object.preset and the known names
+        return value
+
     def size(self) -> ObjectSize:
         """The resolved :class:`ObjectSize`."""
         base = object_preset(self.preset or DEFAULT_PRESET)
