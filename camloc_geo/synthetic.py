@@ -28,7 +28,14 @@ import numpy.typing as npt
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import ObjectSize
 
-__all__ = ["NoiseModel", "SyntheticScene", "make_scene", "random_camera"]
+__all__ = [
+    "LocatedScene",
+    "NoiseModel",
+    "SyntheticScene",
+    "make_located_scene",
+    "make_scene",
+    "random_camera",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -174,6 +181,7 @@ def make_scene(
     width_sign: float = 1.0,
     give_focal: bool = False,
     scene_id: str = "synthetic",
+    true_size: ObjectSize | None = None,
 ) -> SyntheticScene:
     """Annotate a synthetic camera's view of a car at the world origin.
 
@@ -184,8 +192,8 @@ def make_scene(
     """
     noise = noise or NoiseModel()
     w, h = image_size
-    true = ObjectSize(*(d * (1.0 + rng.normal(0.0, noise.size_rel)) for d in
-                        (preset.length_m, preset.width_m, preset.height_m)))
+    true = true_size or ObjectSize(*(d * (1.0 + rng.normal(0.0, noise.size_rel)) for d in
+                                     (preset.length_m, preset.width_m, preset.height_m)))
     ws = width_sign
     L, W, H = true.length_m, ws * true.width_m, true.height_m
     annotations = []
@@ -239,3 +247,180 @@ def make_scene(
     if give_focal:
         scene["camera"] = {"focal_px": camera.focal_px, "principal_point": list(camera.principal_point)}
     return SyntheticScene(scene, camera, true, ws, wrong)
+
+
+@dataclass
+class LocatedScene:
+    """A synthetic scene placed at a real intersection, with its truth in the local frame."""
+
+    scene: dict[str, Any]
+    camera_enu: Camera
+    camera_world: Camera
+    lat: float
+    lon: float
+    intersection_id: str
+    visible_corner_orders: list[int]
+
+
+def make_located_scene(
+    map_data: Any,
+    intersection: Any,
+    rng: np.random.Generator,
+    *,
+    noise: NoiseModel | None = None,
+    corner_sigma_m: float = 1.5,
+    n_annotators: int = 5,
+    image_size: tuple[int, int] = (1920, 1080),
+    n_references: int = 0,
+    min_corners: int = 1,
+    max_corners: int = 4,
+    give_streets: bool = False,
+    max_tries: int = 300,
+) -> LocatedScene | None:
+    """A camera near a real intersection of ``map_data`` looking at a car and kerb corners.
+
+    The car stands in a lane of one of the intersection's streets, parallel to it; the
+    camera, 2.5-14 m high, 12-45 m from the intersection centre, looks towards it. The
+    real kerb corners differ from the map's by ``corner_sigma_m`` (the map model's error);
+    their pixels (with click noise) are listed clockwise on screen. Returns None when no
+    placement shows the car and ``min_corners`` corners within ``max_tries``.
+    """
+    noise = noise or NoiseModel()
+    frame = map_data.frame
+    w, h = image_size
+    centre = np.array(frame.enu_from_geographic(intersection.lon, intersection.lat), float)
+    map_corners = np.array(
+        [frame.enu_from_geographic(c.lon, c.lat) for c in intersection.corners], float
+    ).reshape(-1, 2)
+    if len(map_corners) == 0:
+        return None
+    real_corners = map_corners + rng.normal(0.0, corner_sigma_m / math.sqrt(2), map_corners.shape)
+    preset = ObjectSize(4.6, 1.8, 1.45)
+    buildings = _buildings_enu(map_data, centre, 120.0)
+    for _ in range(max_tries):
+        street = intersection.streets[int(rng.integers(len(intersection.streets)))]
+        b = math.radians(street.bearing_deg)
+        along = np.array([math.sin(b), math.cos(b)])
+        right = np.array([along[1], -along[0]])
+        dist = float(rng.uniform(8.0, 25.0))
+        lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice([-1.0, 1.0])
+        car_centre = centre + dist * along + lateral * right
+        car_dir = along * rng.choice([-1.0, 1.0])
+        yaw = math.radians(rng.normal(0.0, 2.0))
+        car_dir = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]) @ car_dir
+        car_side = np.array([-car_dir[1], car_dir[0]])
+        az = rng.uniform(0, 2 * math.pi)
+        cam_xy = centre + rng.uniform(12.0, 45.0) * np.array([math.cos(az), math.sin(az)])
+        cam_h = float(rng.uniform(2.5, 14.0))
+        if _inside_any(buildings, cam_xy, 0.5):
+            continue
+        target = 0.5 * (centre + car_centre) + rng.normal(0, 3.0, 2)
+        fwd = np.array([*(target - cam_xy), -cam_h])
+        heading = math.degrees(math.atan2(fwd[0], fwd[1]))
+        pitch = math.degrees(math.atan2(-fwd[2], math.hypot(fwd[0], fwd[1])))
+        hfov = math.radians(rng.uniform(45.0, 95.0))
+        f = (w / 2.0) / math.tan(hfov / 2.0)
+        R = rotation_from_angles(heading, pitch, float(rng.uniform(-3, 3)))
+        cam_enu = Camera.from_center(f, (w / 2.0, h / 2.0), R, [*cam_xy, cam_h])
+        true = ObjectSize(*(d * (1.0 + rng.normal(0.0, noise.size_rel)) for d in
+                            (preset.length_m, preset.width_m, preset.height_m)))
+        half_l, half_w = true.length_m / 2, true.width_m / 2
+        ground = [car_centre + sl * half_l * car_dir + sw * half_w * car_side
+                  for sl in (-1, 1) for sw in (-1, 1)]
+        dists = [np.linalg.norm(g - cam_xy) for g in ground]
+        o = ground[int(np.argmin(dists))]
+        x_dir = car_dir if np.dot(car_centre - o, car_dir) > 0 else -car_dir
+        z = np.array([0.0, 0.0, 1.0])
+        x3 = np.array([*x_dir, 0.0])
+        y3 = np.cross(z, x3)
+        ws = 1.0 if np.dot(car_centre - o, y3[:2]) > 0 else -1.0
+        # world -> enu: p_enu = Rw p_world + o
+        Rw = np.column_stack([x3, y3, z])
+        box = np.array([[x, y, zz] for x in (0, true.length_m) for y in (0, ws * true.width_m)
+                        for zz in (0, true.height_m)])
+        box_enu = box @ Rw.T + np.array([*o, 0.0])
+        pix = cam_enu.project(box_enu)
+        if not np.all(np.isfinite(pix)) or np.any(pix < 5) or np.any(pix[:, 0] > w - 5) or np.any(pix[:, 1] > h - 5):
+            continue
+        if np.ptp(pix[:, 0]) < 60:
+            continue
+        corner_pix = cam_enu.project(np.column_stack([real_corners, np.zeros(len(real_corners))]))
+        horizon = cam_enu.horizon_line()
+        vis = [
+            i for i, p in enumerate(corner_pix)
+            if np.all(np.isfinite(p)) and 10 <= p[0] <= w - 10 and 10 <= p[1] <= h - 10
+            and horizon @ np.array([p[0], p[1], 1.0]) > 20
+        ]
+        vis = [i for i in vis if not _blocked(buildings, cam_xy, real_corners[i])]
+        if len(vis) < min_corners or _blocked(buildings, cam_xy, car_centre):
+            continue
+        vis = vis[:max_corners] if len(vis) <= max_corners else sorted(rng.choice(vis, max_corners, replace=False).tolist())
+        # Clockwise on screen = map order; start the list at a random visible corner.
+        start = int(rng.integers(len(vis)))
+        vis = vis[start:] + vis[:start]
+        R_world = cam_enu.cam_from_world_rotation @ Rw
+        C_world = Rw.T @ (cam_enu.center_in_world - np.array([*o, 0.0]))
+        cam_world = Camera.from_center(f, (w / 2.0, h / 2.0), R_world, C_world)
+        syn = make_scene(cam_world, rng, preset=preset, noise=replace_size(noise), n_annotators=n_annotators,
+                         image_size=image_size, width_sign=ws, true_size=true)
+        if any(len(a["vp_lines"][k]) < 2 for a in syn.scene["annotations"] for k in ("length", "width", "height")):
+            continue
+        scene = syn.scene
+        lon, lat = frame.geographic_from_enu(float(cam_xy[0]), float(cam_xy[1]))
+        clicks = corner_pix[vis] + rng.normal(0.0, noise.point_px, (len(vis), 2))
+        scene["intersection"] = {"corners": np.clip(clicks, 0, [w, h]).tolist()}
+        if give_streets:
+            scene["intersection"]["streets"] = sorted({s.name for s in intersection.streets})[:2]
+        else:
+            scene["intersection"]["lat"] = intersection.lat
+            scene["intersection"]["lon"] = intersection.lon
+        plon, plat = frame.geographic_from_enu(float(centre[0] + rng.normal(0, 20)), float(centre[1] + rng.normal(0, 20)))
+        scene["prior"] = {"lat": float(plat), "lon": float(plon), "radius_m": 150.0}
+        refs = []
+        for _k in range(n_references):
+            for _t in range(50):
+                q = car_centre + rng.normal(0, 12.0, 2)
+                p = cam_enu.project([*q, 0.0])
+                if np.all(np.isfinite(p)) and 5 < p[0] < w - 5 and 5 < p[1] < h - 5 and horizon @ np.array([*p, 1.0]) > 20:
+                    qlon, qlat = frame.geographic_from_enu(float(q[0] + rng.normal(0, 0.5)), float(q[1] + rng.normal(0, 0.5)))
+                    pp = p + rng.normal(0.0, noise.point_px, 2)
+                    refs.append({"pixel": np.clip(pp, 0, [w, h]).tolist(), "lat": float(qlat), "lon": float(qlon)})
+                    break
+        if refs:
+            scene["references"] = refs
+        return LocatedScene(scene, cam_enu, cam_world, float(lat), float(lon), intersection.id,
+                            [intersection.corners[i].order for i in vis])
+    return None
+
+
+def _buildings_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[Any]:
+    from shapely.geometry import Point, Polygon
+
+    out = []
+    around = Point(float(centre[0]), float(centre[1])).buffer(radius_m)
+    for b in getattr(map_data, "buildings", []):
+        coords = np.asarray(b.footprint.exterior.coords, dtype=float)
+        poly = Polygon(map_data.frame.points_enu_from_geographic(coords))
+        if poly.is_valid and poly.intersects(around):
+            out.append(poly)
+    return out
+
+
+def _inside_any(polys: list[Any], xy: FloatArray, depth_m: float) -> bool:
+    from shapely.geometry import Point
+
+    pt = Point(float(xy[0]), float(xy[1]))
+    return any(p.contains(pt) and p.exterior.distance(pt) > depth_m for p in polys)
+
+
+def _blocked(polys: list[Any], a: FloatArray, b: FloatArray) -> bool:
+    from shapely.geometry import LineString
+
+    line = LineString([(float(a[0]), float(a[1])), (float(b[0]), float(b[1]))])
+    return any(line.intersects(p) and line.intersection(p).length > 1.0 for p in polys)
+
+
+def replace_size(noise: NoiseModel) -> NoiseModel:
+    """The noise model without the size term (the caller already drew the true size)."""
+    return NoiseModel(noise.point_px, noise.line_px, noise.wrong_corner_prob, noise.sloppy_prob, 0.0,
+                      noise.min_segment_px)
