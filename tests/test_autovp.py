@@ -261,6 +261,25 @@ def test_noise_image_is_refused_or_unconfident() -> None:
     assert res.confidence < 0.3
 
 
+@pytest.mark.parametrize("kind", ["blobs", "random_lines"])
+def test_unstructured_images_are_not_confident(kind: str) -> None:
+    rng = np.random.default_rng(1)
+    img = np.full((480, 640), 200, np.uint8)
+    for _ in range(70):
+        if kind == "blobs":
+            centre = (int(rng.integers(0, 640)), int(rng.integers(0, 480)))
+            cv2.circle(img, centre, int(rng.integers(5, 80)), int(rng.integers(0, 255)), -1)
+        else:
+            p = (int(rng.integers(0, 640)), int(rng.integers(0, 480)))
+            q = (int(rng.integers(0, 640)), int(rng.integers(0, 480)))
+            cv2.line(img, p, q, 0, 2)
+    try:
+        res = detect_vanishing_points(img)
+    except NotEnoughStructureError:
+        return
+    assert res.confidence < 0.3
+
+
 def test_too_few_lines() -> None:
     img = np.full((480, 640), 255, np.uint8)
     cv2.rectangle(img, (200, 150), (440, 330), 0, 3)
