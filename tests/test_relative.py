@@ -1,0 +1,403 @@
+"""Relative pose: closed form per annotator, clustering, joint robust fit."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import camera_aimed_at_car, exact_scene
+
+from camloc_geo import DegenerateGeometryError, SceneError
+from camloc_geo.camera import Camera
+from camloc_geo.objects import ObjectSize
+from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
+from camloc_geo.scene import parse_scene
+from camloc_geo.synthetic import NoiseModel, make_scene
+
+EXACT = 1e-6
+CLUSTER = CalibrationSettings(joint_fit=False)
+
+# id: (camera keyword arguments, camera hints given in the scene)
+CASES: dict[str, tuple[dict[str, Any], dict[str, Any]]] = {
+    "h1.5_level_pitch0": ({"height_m": 1.5, "distance_m": 30.0, "pitch_deg": 0.0}, {}),
+    "h1.5_looking_up": (
+        {"height_m": 1.5, "distance_m": 30.0, "pitch_deg": -1.5, "roll_deg": 2.0},
+        {},
+    ),
+    "h1.5_pitch0_pp_given": (
+        {"height_m": 1.5, "distance_m": 25.0, "pitch_deg": 0.0, "principal_point": (1000.0, 520.0)},
+        {"principal_point": [1000.0, 520.0]},
+    ),
+    "h6_roll5_pp_off": (
+        {"height_m": 6.0, "distance_m": 20.0, "roll_deg": 5.0, "principal_point": (1010.0, 500.0)},
+        {},
+    ),
+    "h3_roll_neg12": (
+        {"height_m": 3.0, "distance_m": 12.0, "roll_deg": -12.0, "focal_px": 900.0},
+        {},
+    ),
+    "h40_pitch66": (
+        {
+            "height_m": 40.0,
+            "distance_m": 15.0,
+            "roll_deg": -8.0,
+            "focal_px": 1000.0,
+            "principal_point": (900.0, 580.0),
+        },
+        {},
+    ),
+    "h40_steep81": ({"height_m": 40.0, "distance_m": 4.0, "roll_deg": 3.0, "focal_px": 900.0}, {}),
+    "h25_wide": (
+        {"height_m": 25.0, "distance_m": 10.0, "focal_px": 600.0, "azimuth_deg": 240.0},
+        {},
+    ),
+    "tele_f8000": ({"height_m": 10.0, "distance_m": 80.0, "roll_deg": 2.0, "focal_px": 8000.0}, {}),
+    "tele_f8000_pp_off": (
+        {
+            "height_m": 10.0,
+            "distance_m": 80.0,
+            "roll_deg": 2.0,
+            "focal_px": 8000.0,
+            "principal_point": (1000.0, 560.0),
+        },
+        {},
+    ),
+    "width_neg_y": (
+        {
+            "height_m": 5.0,
+            "distance_m": 15.0,
+            "roll_deg": -4.0,
+            "width_sign": -1.0,
+            "principal_point": (930.0, 560.0),
+        },
+        {},
+    ),
+    "width_neg_y_high": (
+        {
+            "height_m": 20.0,
+            "distance_m": 30.0,
+            "roll_deg": 6.0,
+            "width_sign": -1.0,
+            "azimuth_deg": 205.0,
+        },
+        {},
+    ),
+    "focal_given": ({"height_m": 8.0, "distance_m": 25.0, "roll_deg": 1.0}, {"focal_px": 1400.0}),
+    "all_given": (
+        {"height_m": 8.0, "distance_m": 25.0, "principal_point": (950.0, 530.0)},
+        {"focal_px": 1400.0, "principal_point": [950.0, 530.0]},
+    ),
+}
+
+
+def _case(name: str) -> tuple[Camera, dict[str, Any], float]:
+    kwargs, hints = CASES[name]
+    cam = camera_aimed_at_car(**kwargs)
+    ws = kwargs.get("width_sign", 1.0)
+    return cam, exact_scene(cam, width_sign=ws, **hints), ws
+
+
+def _assert_recovered(camera: Camera, truth: Camera, rel: float = EXACT) -> None:
+    c_true = truth.center_in_world
+    dist = float(np.linalg.norm(c_true))
+    assert np.linalg.norm(camera.center_in_world - c_true) <= rel * dist
+    assert camera.height_m == pytest.approx(truth.height_m, rel=rel)
+    assert camera.focal_px == pytest.approx(truth.focal_px, rel=rel)
+    np.testing.assert_allclose(
+        camera.principal_point, truth.principal_point, atol=rel * truth.focal_px
+    )
+    np.testing.assert_allclose(
+        camera.cam_from_world_rotation, truth.cam_from_world_rotation, atol=rel
+    )
+
+
+@pytest.fixture(scope="module", params=sorted(CASES))
+def exact_case(request: pytest.FixtureRequest) -> tuple[Camera, dict[str, Any], float]:
+    return _case(request.param)
+
+
+# ----------------------------------------------------------------- noise-free recovery
+def test_joint_fit_recovers_exact_camera(exact_case: tuple[Camera, dict[str, Any], float]) -> None:
+    cam, data, ws = exact_case
+    result = calibrate(parse_scene(data))
+    assert result.method == "joint_fit"
+    _assert_recovered(result.camera, cam)
+    assert result.width_signs == [ws] * len(data["annotations"])
+    assert result.outlier_annotators == []
+
+
+def test_cluster_baseline_recovers_exact_camera(
+    exact_case: tuple[Camera, dict[str, Any], float],
+) -> None:
+    cam, data, _ws = exact_case
+    result = calibrate(parse_scene(data), CLUSTER)
+    assert result.method == "cluster_centroid"
+    _assert_recovered(result.camera, cam)
+    assert result.cluster["n_candidates"] == 2 * len(data["annotations"])
+    assert len(result.cluster["members"]) == result.cluster["n_candidates"]
+
+
+def test_closed_form_per_annotator_is_exact(
+    exact_case: tuple[Camera, dict[str, Any], float],
+) -> None:
+    cam, data, ws = exact_case
+    result = calibrate(parse_scene(data), CLUSTER)
+    c_true = cam.center_in_world
+    for sol in result.annotators:
+        assert sol.error is None
+        assert sol.camera is not None
+        _assert_recovered(sol.camera, cam)
+        assert sol.width_sign == ws
+        # The paper's two estimates (length end, width end) and the height check.
+        for dim in ("length", "width", "height"):
+            assert np.linalg.norm(sol.candidates[dim] - c_true) <= EXACT * np.linalg.norm(c_true)
+        assert sol.height_check == pytest.approx(1.0, abs=EXACT)
+
+
+def test_intrinsics_method_reported() -> None:
+    _cam, data, _ = _case("h1.5_level_pitch0")
+    res = calibrate(parse_scene(data), CLUSTER)
+    # Vertical lines are parallel in the image: no orthocentre, principal point at the centre.
+    assert res.intrinsics_method == "two_vp"
+    assert "image centre" in res.intrinsics_reason
+    _cam, data, _ = _case("h6_roll5_pp_off")
+    assert calibrate(parse_scene(data), CLUSTER).intrinsics_method == "orthocentre"
+    # The joint fit frees the principal point only when the data ask for it.
+    assert calibrate(parse_scene(data)).intrinsics_method == "joint_fit_free_principal_point"
+    _cam, data, _ = _case("h3_roll_neg12")
+    assert calibrate(parse_scene(data)).intrinsics_method == "joint_fit_centre_principal_point"
+    _cam, data, _ = _case("focal_given")
+    assert calibrate(parse_scene(data)).intrinsics_method == "given_focal"
+    _cam, data, _ = _case("all_given")
+    assert calibrate(parse_scene(data)).intrinsics_method == "given"
+    assert calibrate(parse_scene(data), CLUSTER).intrinsics_method == "given"
+
+
+def test_principal_point_setting() -> None:
+    cam, data, _ = _case("h6_roll5_pp_off")
+    scene = parse_scene(data)
+    fixed = calibrate(scene, CalibrationSettings(free_principal_point=False))
+    assert fixed.camera.principal_point == (960.0, 540.0)
+    assert fixed.intrinsics_method == "joint_fit_centre_principal_point"
+    free = calibrate(scene, CalibrationSettings(free_principal_point=True))
+    _assert_recovered(free.camera, cam)
+
+
+# ------------------------------------------------------------------- sign conventions
+@pytest.mark.parametrize(
+    ("pitch", "roll"), [(0.0, 0.0), (12.0, 7.0), (30.0, -9.0), (-2.0, 3.0), (75.0, 15.0)]
+)
+def test_reported_angles_follow_the_conventions(pitch: float, roll: float) -> None:
+    height = 1.5 if pitch <= 0 else 30.0 * math.tan(math.radians(pitch))
+    cam = camera_aimed_at_car(
+        height + 0.7, 30.0 if pitch < 70 else 8.0, roll_deg=roll, pitch_deg=pitch, focal_px=1200.0
+    )
+    result = calibrate(parse_scene(exact_scene(cam, focal_px=1200.0)))
+    out = result.to_dict()
+    assert out["pitch_deg"] == pytest.approx(pitch, abs=1e-6)
+    assert out["roll_deg"] == pytest.approx(roll, abs=1e-6)
+    heading, _p, _r = result.camera.angles_deg
+    assert heading == pytest.approx(cam.angles_deg[0], abs=1e-6)
+    # The camera stands on the -x, -y side of the car looking at it: heading north-east.
+    assert 0.0 < heading < 90.0
+    assert result.camera.center_in_world[0] < 0
+    assert result.camera.center_in_world[1] < 0
+
+
+def test_width_on_minus_y_keeps_a_right_handed_frame() -> None:
+    _cam, data, _ = _case("width_neg_y")
+    result = calibrate(parse_scene(data))
+    R = result.camera.cam_from_world_rotation
+    assert np.linalg.det(R) == pytest.approx(1.0)
+    # The width end is at y = -W: it projects where the annotator clicked.
+    end = result.camera.project([0.0, -1.8, 0.0])
+    np.testing.assert_allclose(end, data["annotations"][0]["axes"]["width"], atol=1e-6)
+    assert result.camera.center_in_world[1] > 0  # the camera is on the +y side
+
+
+# -------------------------------------------------------------- output and JSON
+def test_result_json(basic_scene: dict[str, Any]) -> None:
+    result = calibrate(parse_scene(basic_scene))
+    out = result.to_dict()
+    for key in (
+        "focal_px",
+        "principal_point",
+        "height_m",
+        "camera_in_world",
+        "pitch_deg",
+        "roll_deg",
+        "method",
+        "fallback",
+        "intrinsics_method",
+        "intrinsics_reason",
+        "annotators",
+        "cluster",
+        "outlier_annotators",
+        "annotator_weights",
+    ):
+        assert key in out, key
+    json.dumps(out, allow_nan=False)
+    assert len(out["camera_in_world"]) == 3
+    assert out["height_m"] == pytest.approx(out["camera_in_world"][2])
+    assert out["fallback"] == out["intrinsics_method"]
+    ann = out["annotators"][0]
+    assert set(ann["candidates"]) == {"length", "width", "height"}
+    assert {"focal_px", "principal_point", "intrinsics_method", "vanishing_points"} <= set(ann)
+    assert {"members", "centroid", "threshold_m", "n_candidates"} <= set(out["cluster"])
+    assert out["cluster"]["members"][0] == {"annotator": 0, "dimension": "length"}
+
+
+# -------------------------------------------------------------------- crowd, noise
+def _wrong_corner(data: dict[str, Any], cam: Camera, index: int, size: ObjectSize) -> None:
+    """Annotator ``index`` marks the far end of the length edge as the origin."""
+    L, W, H = size.length_m, size.width_m, size.height_m
+    pts = cam.project(np.array([[L, 0, 0], [0, 0, 0], [L, W, 0], [L, 0, H]], float))
+    rng = np.random.default_rng(index)
+    pts = pts + rng.normal(0.0, 1.0, pts.shape)
+    data["annotations"][index]["axes"] = {
+        k: p.tolist() for k, p in zip(("origin", "length", "width", "height"), pts, strict=True)
+    }
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_wrong_corner_annotator_is_reported(seed: int) -> None:
+    cam = camera_aimed_at_car(7.0, 22.0, roll_deg=3.0, azimuth_deg=220.0 + 5 * seed)
+    noise = NoiseModel(
+        point_px=1.5, line_px=0.7, wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0
+    )
+    data = make_scene(cam, np.random.default_rng(seed), noise=noise, n_annotators=5).scene
+    bad = 1 + seed
+    _wrong_corner(data, cam, bad, ObjectSize(4.6, 1.8, 1.45))
+    scene = parse_scene(data)
+    dist = float(np.linalg.norm(cam.center_in_world))
+    # Each annotator's own vanishing points are noisy (short car edges): the paper's
+    # cluster centroid is much less accurate than the joint fit of everybody's lines.
+    for settings, tol, tol_h in ((CalibrationSettings(), 0.03, 0.3), (CLUSTER, 0.25, 2.0)):
+        result = calibrate(scene, settings)
+        assert result.outlier_annotators == [f"w{bad + 1}"], settings
+        err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
+        assert err < tol * dist, (settings, err)
+        assert abs(result.height_m - cam.height_m) < tol_h
+    joint = calibrate(scene)
+    assert joint.annotator_weights[bad] < 0.3
+    assert min(w for i, w in enumerate(joint.annotator_weights) if i != bad) > 0.5
+    assert joint.position_sigma_m is not None
+    assert np.all(np.isfinite(joint.position_sigma_m))
+    assert np.all(joint.position_sigma_m > 0)
+
+
+def test_noisy_scene_is_close() -> None:
+    cam = camera_aimed_at_car(6.0, 20.0, roll_deg=2.0)
+    noise = NoiseModel(
+        point_px=1.0, line_px=0.5, wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0
+    )
+    data = make_scene(cam, np.random.default_rng(5), noise=noise, n_annotators=5).scene
+    result = calibrate(parse_scene(data))
+    assert np.linalg.norm(result.camera.center_in_world - cam.center_in_world) < 1.0
+    assert result.camera.focal_px == pytest.approx(1400.0, rel=0.05)
+    assert result.rms_residual_px is not None
+    assert result.rms_residual_px < 3.0
+
+
+def test_annotator_without_enough_lines_still_counts() -> None:
+    cam = camera_aimed_at_car(6.0, 20.0)
+    data = exact_scene(cam, n_annotators=3)
+    data["annotations"][1]["vp_lines"]["width"] = data["annotations"][1]["vp_lines"]["width"][:1]
+    result = calibrate(parse_scene(data))
+    assert result.annotators[1].error is not None
+    assert "annotations[1].vp_lines.width: fewer than 2 segments" in result.annotators[1].error
+    assert any("annotations[1].vp_lines.width" in w for w in result.warnings)
+    _assert_recovered(result.camera, cam)
+
+
+# ------------------------------------------------------------------------- bad input
+def _single(cam: Camera | None = None) -> dict[str, Any]:
+    return exact_scene(cam or camera_aimed_at_car(6.0, 20.0, roll_deg=3.0), n_annotators=1)
+
+
+def test_fewer_than_two_lines_for_an_axis() -> None:
+    data = _single()
+    data["annotations"][0]["vp_lines"]["height"] = data["annotations"][0]["vp_lines"]["height"][:1]
+    with pytest.raises(SceneError) as info:
+        calibrate(parse_scene(data))
+    assert info.value.field == "annotations[0].vp_lines.height"
+    assert "needs at least 2 segments parallel to the height axis, got 1" in str(info.value)
+    assert "no image to detect them in" in str(info.value)
+
+
+def test_no_annotations() -> None:
+    data = _single()
+    data["annotations"] = []
+    with pytest.raises(SceneError, match=r"^annotations: at least one annotation is needed"):
+        calibrate(parse_scene(data))
+
+
+def test_parallel_lines_everywhere_without_focal() -> None:
+    """Level camera looking along the car: width and height lines parallel in the image."""
+    from camloc_geo.camera import rotation_from_angles
+
+    cam = Camera.from_center(
+        1400.0, (960.0, 540.0), rotation_from_angles(90.0, 0.0, 0.0), [-20.0, 0.9, 1.5]
+    )
+    data = _single(cam)
+    for settings in (CalibrationSettings(), CLUSTER):
+        with pytest.raises(DegenerateGeometryError) as info:
+            calibrate(parse_scene(data), settings)
+        msg = str(info.value)
+        assert "cannot estimate the focal length" in msg
+        assert "give camera.focal_px in the scene" in msg
+    # With the focal length given the same scene is solved exactly.
+    data["camera"] = {"focal_px": 1400.0}
+    result = calibrate(parse_scene(data))
+    assert result.intrinsics_method == "given_focal"
+    _assert_recovered(result.camera, cam)
+
+
+def test_collinear_axes() -> None:
+    data = _single()
+    axes = data["annotations"][0]["axes"]
+    o, e = np.array(axes["origin"]), np.array(axes["length"])
+    axes["width"] = (o + 0.4 * (e - o)).tolist()
+    with pytest.raises(
+        DegenerateGeometryError,
+        match=r"^annotations\[0\]\.axes: the length and width edges are collinear",
+    ):
+        calibrate(parse_scene(data))
+
+
+def test_axis_end_on_the_origin() -> None:
+    data = _single()
+    axes = data["annotations"][0]["axes"]
+    axes["height"] = [axes["origin"][0] + 0.3, axes["origin"][1]]
+    with pytest.raises(
+        DegenerateGeometryError, match=r"annotations\[0\]\.axes\.height: coincides with the origin"
+    ):
+        calibrate(parse_scene(data))
+
+
+def test_lines_drawn_for_the_wrong_axis() -> None:
+    data = _single()
+    lines = data["annotations"][0]["vp_lines"]
+    lines["width"] = copy.deepcopy(lines["length"])
+    lines["width"][0][0] += 3.0  # not identical, still the length direction
+    with pytest.raises(DegenerateGeometryError, match=r"vanishing directions are only .* apart"):
+        calibrate(parse_scene(data), CLUSTER)
+
+
+def test_first_annotators_problem_is_named_when_nobody_succeeds() -> None:
+    data = exact_scene(camera_aimed_at_car(6.0, 20.0), n_annotators=2)
+    for ann in data["annotations"]:
+        o, e = np.array(ann["axes"]["origin"]), np.array(ann["axes"]["length"])
+        ann["axes"]["width"] = (o + 0.5 * (e - o)).tolist()
+    with pytest.raises(DegenerateGeometryError, match=r"^annotations\[0\]\.axes"):
+        calibrate(parse_scene(data))
+
+
+def test_result_type(basic_scene: dict[str, Any]) -> None:
+    result = calibrate(parse_scene(basic_scene))
+    assert isinstance(result, CalibrationResult)
+    assert result.height_m == pytest.approx(6.0, rel=EXACT)
