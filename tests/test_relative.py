@@ -276,7 +276,7 @@ def test_wrong_corner_annotator_is_reported(seed: int) -> None:
     dist = float(np.linalg.norm(cam.center_in_world))
     # Each annotator's own vanishing points are noisy (short car edges): the paper's
     # cluster centroid is much less accurate than the joint fit of everybody's lines.
-    for settings, tol, tol_h in ((CalibrationSettings(), 0.03, 0.3), (CLUSTER, 0.25, 2.0)):
+    for settings, tol, tol_h in ((CalibrationSettings(), 0.03, 0.3), (CLUSTER, 0.25, 2.5)):
         result = calibrate(scene, settings)
         assert result.outlier_annotators == [f"w{bad + 1}"], settings
         err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
