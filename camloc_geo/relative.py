@@ -420,6 +420,7 @@ class _JointProblem:
         self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
         self.weights = np.ones(self.n_annotators)
         self.f_bounds = (0.15 * width, 15.0 * width)
+        self.log_f_bounds = (math.log(self.f_bounds[0]), math.log(self.f_bounds[1]))
         self.image_wh = (float(width), float(height))
 
     def unpack(
@@ -435,7 +436,7 @@ class _JointProblem:
         P = len(X)
         k = 0
         if f_fixed is None:
-            f = np.exp(np.minimum(X[:, 0], 30.0))
+            f = np.exp(np.clip(X[:, 0], self.log_f_bounds[0], self.log_f_bounds[1]))
             k = 1
         else:
             f = np.full(P, float(f_fixed))
@@ -529,28 +530,19 @@ def _fit(
     pp_fixed: tuple[float, float] | None,
     f_fixed: float | None,
     *,
-    tol: float = 1e-12,
+    tol: float = 1e-10,
     max_nfev: int = 200,
 ) -> Any:
-    lo = np.full(len(x0), -np.inf)
-    hi = np.full(len(x0), np.inf)
-    k = 0
+    """One robust fit (soft-L1). The focal length is clamped to plausible fields of view
+    inside the parameterisation, which keeps the cheaper unbounded trust-region path."""
     if f_fixed is None:
-        lo[0], hi[0] = math.log(prob.f_bounds[0]), math.log(prob.f_bounds[1])
-        k = 1
-    if pp_fixed is None:
-        w, h = prob.image_wh
-        lo[k : k + 2] = (0.0, 0.0)
-        hi[k : k + 2] = (w, h)
-    fin = np.isfinite(lo)
-    margin = np.where(fin, 1e-9 * (hi - lo), 0.0)
-    x0 = np.where(fin, np.clip(x0, lo + margin, hi - margin), x0)
+        x0 = x0.copy()
+        x0[0] = float(np.clip(x0[0], *prob.log_f_bounds))
     return least_squares(
         prob.residuals,
         x0,
         jac=prob.jacobian,
         args=(R0, pp_fixed, f_fixed),
-        bounds=(lo, hi),
         loss="soft_l1",
         f_scale=2.5,
         method="trf",
@@ -560,6 +552,35 @@ def _fit(
         gtol=tol,
         max_nfev=max_nfev,
     )
+
+
+def _score_test(
+    prob: _JointProblem,
+    x_fixed: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float],
+    f_fixed: float | None,
+) -> float:
+    """Expected cost drop from freeing the principal point (Rao score statistic).
+
+    Evaluated at the fixed-principal-point solution: with ``g`` the gradient and ``H`` the
+    Gauss-Newton Hessian of the full model, ``gᵀ H⁻¹ g`` approximates how much the cost
+    would fall, at the price of one Jacobian.
+    """
+    f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
+    x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+    x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+    r = prob.residuals(x1, R0, None, f_fixed)
+    J = prob.jacobian(x1, R0, None, f_fixed)
+    # Robust (soft-L1) weights at the current residuals, as the fit sees them.
+    z = (r / 2.5) ** 2
+    w = 1.0 / np.sqrt(1.0 + z)
+    Jw = J * np.sqrt(w)[:, None]
+    g = Jw.T @ (r * np.sqrt(w))
+    try:
+        return float(g @ np.linalg.pinv(Jw.T @ Jw) @ g)
+    except np.linalg.LinAlgError:
+        return 0.0
 
 
 def _pack(f: float, pp: tuple[float, float], C: FloatArray, free_f: bool, free_pp: bool) -> FloatArray:
@@ -890,12 +911,18 @@ def _joint(
         if np.allclose(new_w, prob.weights, atol=0.02):
             break
         prob.weights = new_w
-        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-8, max_nfev=100).x
+        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
     res = _fit(prob, x0, R0, pp_fixed, f_fixed)
     chosen = (res, pp_fixed)
     free_pp = settings.free_principal_point
     n_res = len(res.fun)
-    if pp_given is None and free_pp is not False:
+    worth_trying = free_pp is True or (
+        free_pp is None
+        and _score_test(prob, res.x, R0, pp_fixed, f_fixed)
+        / max(2.0 * res.cost / max(n_res - len(res.x), 1), 1e-12)
+        > 0.5 * (27.6 + 2.0 * math.log(n_res))
+    )
+    if pp_given is None and free_pp is not False and worth_trying:
         f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
         x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
         x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
