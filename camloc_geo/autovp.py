@@ -6,16 +6,31 @@ orthogonal (Manhattan) vanishing points from the picture itself.
 Pipeline
 --------
 1. Line segments: OpenCV's LSD (``cv2.createLineSegmentDetector``) when available, else
-   Canny plus ``cv2.HoughLinesP``. Short segments are dropped, the longest are kept.
-2. Hypotheses (RANSAC): two segments give a first vanishing point; either two more
-   segments give a second one and, through orthogonality, the focal length, or a third
-   segment plus a focal-length sample give the second one. The third vanishing direction
-   is the cross product of the first two. Each hypothesis is scored by the
-   length-weighted consensus of all segments (truncated quadratic of the endpoint
-   distance to the line joining the segment's midpoint and the vanishing point).
-3. Refinement: ``scipy.optimize.least_squares`` with a robust loss over the rotation
-   and the focal length (principal point fixed at the image centre unless given), on
-   the inliers of the best hypotheses; the best refined model wins.
+   Canny plus ``cv2.HoughLinesP``, on the image without uniform border bars (letterbox)
+   and shrunk to at most 1024 px. Short segments are dropped, the longest 500 kept.
+2. Hypotheses (RANSAC, length-weighted sampling): two segments give a first vanishing
+   point; either two more segments give a second one and, through orthogonality, the
+   focal length, or a third segment plus a focal-length sample give the second one.
+   The third vanishing direction is the cross product of the first two. Hypotheses are
+   scored by the length-weighted consensus of the segments (truncated quadratic of the
+   distance of a segment's end points to the line joining its midpoint and the
+   vanishing point), first on a subset, then the best tenth on the 150 longest
+   segments; a mild log-normal prior on the focal length breaks near ties.
+3. Refinement: ``scipy.optimize.least_squares`` (soft-L1 loss) over the rotation and the
+   focal length (principal point at the image centre unless given or asked for), on the
+   inliers of the three best distinct hypotheses, with relabelling; the best refined
+   model wins.
+4. Checks: at least two directions must each be supported by three distinct lines and
+   the vanishing points must explain 20 % of the segments' length, else
+   :class:`~camloc_geo.NotEnoughStructureError`. The confidence combines the explained
+   share, the number of distinct supporting lines and, when estimated, the focal
+   length's standard deviation; a focal length the image cannot fix is flagged
+   (``focal_source`` ``"prior"`` or ``"bound"``).
+
+Measured on the 102 York Urban photos (``benchmarks/vp_yud.py``, focal length not
+given): focal length within 10 % on about 92 % of the photos, median vanishing-direction
+error 0.9 degrees against the orthogonalised ground truth, horizon AUC 95 %, about 50 ms
+per 640x480 photo. Lens distortion is not modelled.
 
 Conventions (see ``spec/SCENE.md``): image pixels are continuous, origin at the
 top-left corner, x right, y down, the centre of the top-left pixel is ``(0.5, 0.5)``;
@@ -835,22 +850,6 @@ def detect_vanishing_points(
         labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         best = _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
     return _finish(best, s, segs_px, pp, scale, (w, h), f_fixed is None, f_bounds, min_inlier_share)
-
-
-def _refine_free_direction(d0: FloatArray, f_n: float, s: _Segs, tau_px: float) -> FloatArray:
-    """Re-estimate one vanishing direction from its own segments (not forced orthogonal)."""
-    d0 = _unit(np.asarray(d0, dtype=np.float64))
-    a = np.cross(d0, [1.0, 0.0, 0.0] if abs(d0[0]) < 0.9 else [0.0, 1.0, 0.0])
-    a = _unit(a)
-    b = np.cross(d0, a)
-    K = np.array([f_n, f_n, 1.0])
-
-    def fun(x: FloatArray) -> FloatArray:
-        d = d0 + x[0] * a + x[1] * b
-        return _endpoint_residual((K * d)[None, :], s)[0]
-
-    sol = least_squares(fun, np.zeros(2), loss="soft_l1", f_scale=tau_px, max_nfev=30)
-    return _unit(d0 + sol.x[0] * a + sol.x[1] * b)
 
 
 def _vertical_cost(dirs: FloatArray) -> FloatArray:
