@@ -47,9 +47,11 @@ down steeply is likelier than one that looks up steeply.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -718,6 +720,7 @@ def detect_vanishing_points(
     estimate_principal_point: bool = False,
     mask: npt.NDArray[Any] | None = None,
     min_inlier_share: float = 0.2,
+    axes_hint: Sequence[tuple[npt.ArrayLike, npt.ArrayLike]] | None = None,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -755,6 +758,13 @@ def detect_vanishing_points(
         Refuse (``NotEnoughStructureError``) when the vanishing points explain less than
         this share of the segments' total length (York Urban photos: 62 % or more;
         random lines or blobs: 20 to 40 %, which also get a confidence near 0).
+    axes_hint
+        Up to three image axes ``(origin_px, end_px)`` known to be parallel to distinct
+        orthogonal world directions, e.g. a car's annotated length, width and height
+        edges: among the Manhattan frames the image supports, the one whose vanishing
+        points these axes point at (within a few degrees) is preferred, so that the
+        result is aligned with the annotated object rather than, say, a building at an
+        angle to it.
 
     Returns
     -------
@@ -809,6 +819,9 @@ def detect_vanishing_points(
     n_sc = len(s_sc.mid)
     sub = np.unique(np.linspace(0, n_sc - 1, min(n_sc, 48)).round().astype(int))
     prior = _focal_prior(fs, f_prior) if f_fixed is None else np.ones(len(fs))
+    hints = _prepare_hints(axes_hint, pp, scale)
+    if hints is not None:
+        prior = prior * _hint_factor(dirs, fs, hints)
     scores = _score(dirs, fs, _subset(s_sc, sub), tau) * prior
     keep = np.argsort(-scores, kind="stable")[: max(20, len(dirs) // 10)]
     scores = _score(dirs[keep], fs[keep], s_sc, tau) * prior[keep]
@@ -825,12 +838,16 @@ def detect_vanishing_points(
         models.append(_fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds))
         if len(tried) >= 3:
             break
-    if f_fixed is None:
-        best = max(
-            models, key=lambda m: m.score * float(_focal_prior(np.array([m.f_n]), f_prior)[0])
-        )
-    else:
-        best = max(models, key=lambda m: m.score)
+
+    def model_weight(m: _Model) -> float:
+        wgt = m.score
+        if f_fixed is None:
+            wgt *= float(_focal_prior(np.array([m.f_n]), f_prior)[0])
+        if hints is not None:
+            wgt *= float(_hint_factor(m.R.T[None], np.array([m.f_n]), hints)[0])
+        return wgt
+
+    best = max(models, key=model_weight)
     if estimate_principal_point and principal_point is None:
         # Free the principal point around the image centre (a Gaussian prior), on the
         # final inliers.
@@ -850,6 +867,55 @@ def detect_vanishing_points(
         labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         best = _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
     return _finish(best, s, segs_px, pp, scale, (w, h), f_fixed is None, f_bounds, min_inlier_share)
+
+
+def _prepare_hints(
+    axes_hint: Sequence[tuple[npt.ArrayLike, npt.ArrayLike]] | None,
+    pp: FloatArray,
+    scale: float,
+) -> tuple[FloatArray, FloatArray] | None:
+    """Hint axes as normalised origins ``(K, 2)`` and unit directions ``(K, 2)``."""
+    if not axes_hint:
+        return None
+    if len(axes_hint) > 3:
+        raise InputError(f"axes_hint: at most 3 axes, got {len(axes_hint)}")
+    origins, units = [], []
+    for i, (o, e) in enumerate(axes_hint):
+        o_arr = np.asarray(o, dtype=np.float64).reshape(-1)
+        e_arr = np.asarray(e, dtype=np.float64).reshape(-1)
+        if o_arr.shape != (2,) or e_arr.shape != (2,):
+            raise InputError(f"axes_hint[{i}]: origin and end must be [x, y] pixels")
+        d = e_arr - o_arr
+        n = float(np.hypot(*d))
+        if not (np.all(np.isfinite(d)) and n > 1e-9):
+            raise InputError(f"axes_hint[{i}]: origin and end must be distinct finite pixels")
+        origins.append((o_arr - pp) / scale)
+        units.append(d / n)
+    return np.array(origins), np.array(units)
+
+
+def _hint_factor(
+    dirs: FloatArray, f_n: FloatArray, hints: tuple[FloatArray, FloatArray], sigma_deg: float = 5.0
+) -> FloatArray:
+    """``(H,)`` agreement of hypotheses with hint axes, each axis to its own VP."""
+    origins, units = hints
+    vps = dirs.copy()
+    vps[..., 0] *= f_n[:, None]
+    vps[..., 1] *= f_n[:, None]
+    # (H, K hints, 3 VPs): image direction towards each VP at each hint's origin
+    dx = vps[:, None, :, 0] - vps[:, None, :, 2] * origins[None, :, 0, None]
+    dy = vps[:, None, :, 1] - vps[:, None, :, 2] * origins[None, :, 1, None]
+    cross = np.abs(units[None, :, 0, None] * dy - units[None, :, 1, None] * dx)
+    sin = cross / (np.hypot(dx, dy) + 1e-12)
+    ang = np.degrees(np.arcsin(np.clip(sin, 0.0, 1.0)))
+    k = ang.shape[1]
+    best = np.full(len(dirs), np.inf)
+    for perm in itertools.permutations(range(3), k):
+        total = sum(ang[:, i, perm[i]] ** 2 for i in range(k))
+        best = np.minimum(best, total)
+    # beyond 30 degrees per axis a hypothesis simply disagrees; the image decides then
+    best = np.minimum(best, k * 30.0**2)
+    return np.asarray(np.exp(-0.5 * best / sigma_deg**2), dtype=np.float64)
 
 
 def _vertical_cost(dirs: FloatArray) -> FloatArray:

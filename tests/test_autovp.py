@@ -46,6 +46,7 @@ def render_scene(
     n_lines: int = 150,
     clutter: int = 20,
     seed: int = 1,
+    world_axes: np.ndarray | None = None,
 ) -> np.ndarray:
     """Draw random world-axis-aligned segments seen by camera ``R`` (pp = image centre)."""
     rng = np.random.default_rng(seed)
@@ -61,7 +62,7 @@ def render_scene(
         lateral = rng.uniform(-1, 1, 3) * depth * 0.8
         p = fwd_w * depth + lateral
         if drawn < n_lines:
-            axis = np.eye(3)[drawn % 3]
+            axis = (np.eye(3) if world_axes is None else world_axes)[drawn % 3]
         else:
             axis = rng.normal(size=3)
             axis /= np.linalg.norm(axis)
@@ -475,3 +476,35 @@ def test_exact_vps_at_infinity_without_warnings() -> None:
     res = detect_vanishing_points(None, segments=segs, image_size=(800, 600))
     assert res.focal_source in ("prior", "bound")
     assert res.confidence <= 0.5
+
+
+def test_axes_hint_selects_the_annotated_frame() -> None:
+    size, f = (800, 600), 700.0
+    R = cam_from_world(20.0, 10.0, 0.0)
+    yaw = math.radians(35.0)
+    other = np.array(
+        [[math.cos(yaw), math.sin(yaw), 0.0], [-math.sin(yaw), math.cos(yaw), 0.0], [0, 0, 1.0]]
+    )
+    img = np.minimum(
+        render_scene(R, f, size, n_lines=180, clutter=0, seed=11),
+        render_scene(R, f, size, n_lines=90, clutter=0, seed=12, world_axes=other),
+    )
+    plain = detect_vanishing_points(img, focal_px=f)
+    assert dir_errors_deg(plain.directions_in_cam, R.T).max() < 0.5  # the dominant frame
+    # annotated axes of an object aligned with the other frame, at pixel (400, 450)
+    K = np.array([[f, 0, 400.0], [0, f, 300.0], [0, 0, 1]])
+    origin = np.array([400.0, 450.0])
+    hint = []
+    for axis in other[:2]:
+        v = K @ (R @ axis)
+        d = v[:2] - v[2] * origin
+        hint.append((origin, origin + 40 * d / np.linalg.norm(d)))
+    hinted = detect_vanishing_points(img, focal_px=f, axes_hint=hint)
+    assert dir_errors_deg(hinted.directions_in_cam, (R @ other.T).T).max() < 0.5
+    for o, e in hint:
+        assert len(segments_for_axis(hinted, o, e)) >= 5
+    free = detect_vanishing_points(img, axes_hint=hint)  # focal length unknown too
+    assert dir_errors_deg(free.directions_in_cam, (R @ other.T).T).max() < 1.0
+    assert free.focal_px == pytest.approx(f, rel=0.05)
+    with pytest.raises(InputError, match="axes_hint"):
+        detect_vanishing_points(img, focal_px=f, axes_hint=[(origin, origin)])

@@ -143,3 +143,10 @@ def test_vp_ignore_boxes(scene_png: Path, capsys: pytest.CaptureFixture[str]) ->
     assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
     assert 0 < out["n_segments"] < n_all
+
+
+def test_vp_axis_hint_option(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png), "--axis", "400", "500", "450", "490"]) == 0
+    assert json.loads(capsys.readouterr().out)["confidence"] > 0.5
+    assert main(["vp", str(scene_png), "--axis", "400", "500", "400", "500"]) == 2
+    assert "axes_hint[0]" in capsys.readouterr().err

@@ -46,6 +46,18 @@ def register(subparsers: Any) -> None:
         help="ignore segments in this pixel box (time stamps, logos); repeatable",
     )
     p.add_argument(
+        "--axis",
+        type=float,
+        nargs=4,
+        action="append",
+        metavar=("OX", "OY", "EX", "EY"),
+        default=None,
+        help=(
+            "an annotated object axis from origin to end pixel (e.g. a car's length edge);"
+            " prefer the vanishing points it points at; up to 3"
+        ),
+    )
+    p.add_argument(
         "--estimate-principal-point",
         action="store_true",
         help="also refine the principal point around the image centre",
@@ -85,6 +97,7 @@ def run(args: argparse.Namespace) -> int:
         seed=args.seed,
         mask=mask,
         estimate_principal_point=args.estimate_principal_point,
+        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in args.axis] if args.axis else None,
     )
     if args.draw:
         draw_segments(image, res, args.draw)
