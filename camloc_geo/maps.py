@@ -1,0 +1,1081 @@
+"""Review maps (Leaflet, via folium): candidate maps for one scene and summary maps.
+
+A reviewer decides from the candidate map which candidate position is right:
+
+- candidates are numbered by rank, coloured by score on one sequential scale (dark red =
+  most of the weight, pale yellow = almost none) and sized by rank, the best drawn on top
+  with a heavy outline; their popups list every property of the candidate GeoJSON
+  (:func:`camloc_geo.absolute.candidates_geojson`) and show the image overlay
+  (:mod:`camloc_geo.overlay`) of the leading candidates;
+- view cones (60 m) of the three best candidates are shown, the others' in a hidden layer;
+- the intersection's kerb corners are shown with their map order (``m0``, ``m1``... clockwise
+  from above); for each leading candidate a layer numbers the map corners with the index of
+  the scene corner matched to them (``intersection.corners[i]``) and joins them to the
+  camera position;
+- the streets (centre lines and modelled carriageways) and buildings near the scene are
+  vector layers; a layer control, a legend and a scale bar complete the page.
+
+Offline pages (``offline=True``) are one self-contained HTML file: Leaflet's JS and CSS
+and jQuery (which folium's popups use) are inlined from the ``xstatic-leaflet`` and
+``xstatic-jquery`` packages, Leaflet's images become data URIs, every other asset folium
+references (bootstrap, font-awesome, awesome-markers) is dropped, markers are DivIcons, and
+there is no tile layer: the page makes no request at all. Online pages use folium's CDN links
+and may add a tile basemap (OpenStreetMap by default, with its attribution).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import logging
+import math
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from functools import lru_cache
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import folium
+import numpy as np
+from branca.element import Figure, MacroElement
+from jinja2 import Template
+from shapely.geometry import LineString, Point, Polygon
+
+from camloc_geo import overlay as _overlay
+
+if TYPE_CHECKING:
+    from camloc_geo.absolute import LocateResult
+    from camloc_geo.osm import MapData
+    from camloc_geo.scene import Scene
+
+__all__ = [
+    "MAX_PAGE_BYTES",
+    "SCORE_SCALE",
+    "build_candidates_map",
+    "build_summary_map",
+    "candidates_map",
+    "inline_assets",
+    "rank_style",
+    "score_colour",
+    "summary_map",
+]
+
+log = logging.getLogger(__name__)
+
+MAX_PAGE_BYTES = 1_500_000
+"""Size budget of a one-scene page (offline pages embed their overlays within it)."""
+
+SCORE_SCALE: tuple[tuple[float, str, str], ...] = (
+    (0.5, "#800026", "≥ 0.5"),
+    (0.2, "#e31a1c", "0.2 – 0.5"),
+    (0.05, "#fd8d3c", "0.05 – 0.2"),
+    (0.01, "#fed976", "0.01 – 0.05"),
+    (0.0, "#ffffcc", "< 0.01"),
+)
+"""Score bins (lower bound, fill colour, legend text), best first (ColorBrewer YlOrRd)."""
+
+OSM_ATTRIBUTION = "Map data © OpenStreetMap contributors, ODbL"
+_OSM_TILES_ATTR = (
+    '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors'
+)
+
+_STYLE: dict[str, Any] = {
+    "building": {"color": "#8d6e63", "weight": 1, "fillColor": "#d7ccc8", "fillOpacity": 0.7},
+    "carriageway": {"color": "#616161", "weight": 1.2, "fillColor": "#ffffff", "fillOpacity": 0.9},
+    "centre": {"color": "#9e9e9e", "weight": 1.5, "dashArray": "6 4"},
+    "corner": "#1565c0",
+    "match": "#6a1b9a",
+    "prior": "#00897b",
+}
+_OVERLAY_TOP = 5
+_MATCH_LAYERS = 5
+_CONES_SHOWN = 3
+
+
+# ----------------------------------------------------------------------------- styling
+def score_colour(score: float) -> str:
+    """Fill colour of a score on :data:`SCORE_SCALE`."""
+    s = float(score) if score is not None and math.isfinite(score) else 0.0
+    for lower, colour, _text in SCORE_SCALE:
+        if s >= lower:
+            return colour
+    return SCORE_SCALE[-1][1]
+
+
+def rank_style(rank: int) -> tuple[int, float, int]:
+    """``(diameter_px, outline_px, z_index_offset)`` of a candidate marker of a rank."""
+    if rank <= 1:
+        return 34, 3.5, 10_000
+    if rank <= 3:
+        return 26, 2.0, 5_000 - rank
+    return 20, 1.2, 1_000 - min(rank, 999)
+
+
+def _text_colour(fill: str) -> str:
+    r, g, b = (int(fill[i : i + 2], 16) for i in (1, 3, 5))
+    return "#000" if 0.299 * r + 0.587 * g + 0.114 * b > 150 else "#fff"
+
+
+def _fmt(value: Any, unit: str = "", digits: int = 2) -> str:
+    if value is None:
+        return "—"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            return "—"
+        return f"{value:.{digits}f}{unit}"
+    if isinstance(value, (list, tuple)):
+        return ", ".join(str(v) for v in value) if value else "none"
+    return f"{value}{unit}"
+
+
+# ------------------------------------------------------------------------ map elements
+class _Control(MacroElement):
+    """A Leaflet control holding static HTML (legend, title)."""
+
+    _template = Template(
+        """
+{% macro header(this, kwargs) %}
+<style>{{ this.css }}</style>
+{% endmacro %}
+{% macro script(this, kwargs) %}
+var {{ this.get_name() }} = L.control({position: {{ this.position|tojson }}});
+{{ this.get_name() }}.onAdd = function (map) {
+    var div = L.DomUtil.create("div", {{ this.css_class|tojson }});
+    div.innerHTML = {{ this.html|tojson }};
+    L.DomEvent.disableClickPropagation(div);
+    L.DomEvent.disableScrollPropagation(div);
+    return div;
+};
+{{ this.get_name() }}.addTo({{ this._parent.get_name() }});
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, html_text: str, *, position: str, css_class: str, css: str = "") -> None:
+        super().__init__()
+        self._name = "CamlocControl"
+        self.html = html_text
+        self.position = position
+        self.css_class = css_class
+        self.css = css
+
+
+_PAGE_CSS = """
+.camloc-legend, .camloc-title { background: rgba(255,255,255,0.93); padding: 6px 9px;
+  border-radius: 5px; box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif;
+  color: #222; }
+.camloc-legend { max-width: 260px; }
+.leaflet-control-layers-expanded { font: 12px/1.4 sans-serif; padding: 4px 8px; }
+.leaflet-container { font-family: sans-serif; }
+.camloc-legend h4, .camloc-title h4 { margin: 0 0 4px; font-size: 13px; }
+.camloc-legend .sw { display: inline-block; width: 14px; height: 14px; border-radius: 50%;
+  border: 1px solid #333; vertical-align: middle; margin-right: 5px; }
+.camloc-legend .ln { display: inline-block; width: 18px; height: 0; vertical-align: middle;
+  margin-right: 5px; border-top: 3px solid #333; }
+.camloc-legend .bx { display: inline-block; width: 14px; height: 10px; vertical-align: middle;
+  margin-right: 5px; border: 1px solid #333; }
+.camloc-legend small { color: #555; }
+.camloc-candidate, .camloc-summary-marker { background: transparent; border: none; }
+.camloc-dot { box-sizing: border-box; border-radius: 50%; border-style: solid; border-color: #111;
+  display: flex; align-items: center; justify-content: center; font: bold 12px sans-serif;
+  box-shadow: 0 1px 4px rgba(0,0,0,0.5); width: 100%; height: 100%; }
+.camloc-corner-label { background: transparent; border: none; }
+.camloc-corner-label div { font: bold 11px sans-serif; color: #fff; border-radius: 8px;
+  padding: 0 4px; text-align: center; white-space: nowrap; border: 1px solid #fff; }
+.camloc-popup { font: 12px/1.3 sans-serif; }
+.camloc-popup table { border-collapse: collapse; }
+.camloc-popup td, .camloc-popup th { padding: 1px 6px 1px 0; text-align: left;
+  vertical-align: top; }
+.camloc-popup img { display: block; max-width: 100%; margin-top: 6px; border: 1px solid #999; }
+"""
+
+
+def _legend_html(*, scene_id: str | None, has_corners: bool, has_prior: bool, summary: bool) -> str:
+    rows = []
+    title = "Camera positions" if summary else "Candidate camera positions"
+    rows.append(f"<h4>{html.escape(title)}</h4>")
+    if summary:
+        rows.append("<small>best candidate per camera; arrow = heading</small><br>")
+    else:
+        rows.append("<small>number = rank (1 = most likely); larger = better</small><br>")
+    rows.append("<b>score</b><br>")
+    for _lower, colour, text in SCORE_SCALE:
+        rows.append(f'<span class="sw" style="background:{colour}"></span>{html.escape(text)}<br>')
+    if not summary:
+        rows.append(
+            f'<span class="bx" style="background:{score_colour(0.6)};opacity:.45"></span>'
+            "view cone (60 m)<br>"
+        )
+        if has_corners:
+            rows.append(
+                f'<span class="sw" style="background:{_STYLE["corner"]}"></span>'
+                "map kerb corner m<i>j</i> (clockwise)<br>"
+            )
+            rows.append(
+                f'<span class="sw" style="background:{_STYLE["match"]}"></span>'
+                "scene corner <i>i</i> matched here<br>"
+            )
+        rows.append(
+            f'<span class="bx" style="background:{_STYLE["carriageway"]["fillColor"]}"></span>'
+            "carriageway (modelled width)<br>"
+        )
+        rows.append(
+            f'<span class="ln" style="border-top:2px dashed {_STYLE["centre"]["color"]}"></span>'
+            "street centre line<br>"
+        )
+        rows.append(
+            f'<span class="bx" style="background:{_STYLE["building"]["fillColor"]}"></span>'
+            "building<br>"
+        )
+        if has_prior:
+            rows.append(
+                f'<span class="ln" style="border-top:2px dashed {_STYLE["prior"]}"></span>'
+                "prior area<br>"
+            )
+    rows.append(f"<small>{html.escape(OSM_ATTRIBUTION)}</small>")
+    return "".join(rows)
+
+
+# ---------------------------------------------------------------------------- geometry
+def _round_coords(coords: Any, nd: int = 6) -> Any:
+    if isinstance(coords, (list, tuple)):
+        if coords and isinstance(coords[0], (int, float)):
+            return [round(float(v), nd) for v in coords]
+        return [_round_coords(c, nd) for c in coords]
+    return coords
+
+
+def _geom_lonlat(geom_en: Any, frame: Any) -> Any:
+    """A shapely geometry in frame metres → GeoJSON geometry dict in lon/lat (6 decimals)."""
+
+    def conv(coords: Any) -> list[list[float]]:
+        arr = np.asarray(coords, dtype=float)[:, :2]
+        out: list[list[float]] = frame.points_geographic_from_enu(arr).tolist()
+        return out
+
+    def one(g: Any) -> dict[str, Any] | None:
+        if g.is_empty:
+            return None
+        if isinstance(g, Polygon):
+            return {
+                "type": "Polygon",
+                "coordinates": [conv(g.exterior.coords)] + [conv(r.coords) for r in g.interiors],
+            }
+        if isinstance(g, LineString):
+            return {"type": "LineString", "coordinates": conv(g.coords)}
+        return None
+
+    parts = [one(g) for g in getattr(geom_en, "geoms", [geom_en])]
+    polys = [p["coordinates"] for p in parts if p and p["type"] == "Polygon"]
+    lines = [p["coordinates"] for p in parts if p and p["type"] == "LineString"]
+    if polys:
+        return {"type": "MultiPolygon", "coordinates": _round_coords(polys)}
+    if lines:
+        return {"type": "MultiLineString", "coordinates": _round_coords(lines)}
+    return None
+
+
+def _focus(result: LocateResult, candidates: list[dict[str, Any]]) -> tuple[np.ndarray, float]:
+    """Centre (east, north in result.frame) and radius of the area the reviewer needs."""
+    frame = result.frame
+    pts = []
+    inter = result.intersection
+    if inter is not None:
+        pts.append(frame.enu_from_geographic(inter.lon, inter.lat))
+    for c in candidates[:8]:
+        pts.append(frame.enu_from_geographic(c["properties"]["lon"], c["properties"]["lat"]))
+    if not pts:
+        return np.zeros(2), 150.0
+    arr = np.asarray(pts, dtype=float)
+    centre = arr[0] if inter is not None else arr.mean(axis=0)
+    radius = float(np.max(np.linalg.norm(arr - centre, axis=1))) + 90.0
+    return centre, float(min(max(radius, 120.0), 350.0))
+
+
+def _map_layers(
+    fmap: folium.Map, map_data: MapData, result: LocateResult, centre: np.ndarray, radius: float
+) -> None:
+    frame = result.frame
+    disc = Point(float(centre[0]), float(centre[1])).buffer(radius, quad_segs=16)
+    carriage = _overlay.carriageways_enu(map_data.streets, frame, centre, radius)
+    geom = _geom_lonlat(carriage, frame)
+    if geom is not None:
+        folium.GeoJson(
+            {"type": "Feature", "geometry": geom, "properties": {"kind": "carriageway"}},
+            name="Carriageways (modelled width)",
+            style_function=lambda _f: _STYLE["carriageway"],
+            interactive=False,
+        ).add_to(fmap)
+    lines = []
+    for st in map_data.streets:
+        coords = np.asarray(st.geometry.coords, dtype=float)
+        en = frame.points_enu_from_geographic(coords[:, :2])
+        line = LineString(en)
+        if not line.intersects(disc):
+            continue
+        g = _geom_lonlat(line.intersection(disc), frame)
+        if g is None:
+            continue
+        lines.append(
+            {
+                "type": "Feature",
+                "geometry": g,
+                "properties": {
+                    "name": st.name or "(unnamed)",
+                    "highway": st.highway,
+                    "width_m": round(float(st.width_m), 1),
+                },
+            }
+        )
+    if lines:
+        folium.GeoJson(
+            {"type": "FeatureCollection", "features": lines},
+            name="Street centre lines",
+            style_function=lambda _f: _STYLE["centre"],
+            tooltip=folium.GeoJsonTooltip(
+                fields=["name", "highway", "width_m"], aliases=["street", "highway", "width (m)"]
+            ),
+        ).add_to(fmap)
+    blds = []
+    for b in map_data.buildings:
+        ring = np.asarray(b.footprint.exterior.coords, dtype=float)
+        en = frame.points_enu_from_geographic(ring[:, :2])
+        if not Polygon(en).intersects(disc):
+            continue
+        h = _overlay.building_height_m(b)
+        blds.append(
+            {
+                "type": "Feature",
+                "geometry": {
+                    "type": "Polygon",
+                    "coordinates": [_round_coords(ring[:, :2].tolist())],
+                },
+                "properties": {
+                    "name": b.name or "(building)",
+                    "building": b.building,
+                    "height_m": "unknown" if h is None else f"{h:.0f}",
+                },
+            }
+        )
+    if blds:
+        folium.GeoJson(
+            {"type": "FeatureCollection", "features": blds},
+            name="Buildings",
+            style_function=lambda _f: _STYLE["building"],
+            tooltip=folium.GeoJsonTooltip(
+                fields=["name", "building", "height_m"], aliases=["name", "building", "height (m)"]
+            ),
+        ).add_to(fmap)
+
+
+def _candidate_popup(
+    props: Mapping[str, Any], image_src: str | None, image_link: str | None
+) -> str:
+    rows = [
+        ("rank", _fmt(props.get("rank"))),
+        ("score", _fmt(props.get("score"), digits=4)),
+        ("method", html.escape(str(props.get("method")))),
+        ("lat, lon", f"{props.get('lat', math.nan):.7f}, {props.get('lon', math.nan):.7f}"),
+        ("height", _fmt(props.get("height_m"), " m")),
+        ("heading", _fmt(props.get("heading_deg"), "°", 1)),
+        ("pitch", _fmt(props.get("pitch_deg"), "°", 1)),
+        ("roll", _fmt(props.get("roll_deg"), "°", 1)),
+        ("focal", _fmt(props.get("focal_px"), " px", 1)),
+        ("residual_m", _fmt(props.get("residual_m"), " m")),
+        ("sigma_m", _fmt(props.get("sigma_m"), " m")),
+        ("flags", html.escape(_fmt(list(props.get("flags") or [])))),
+    ]
+    shown = {
+        "kind",
+        "rank",
+        "score",
+        "method",
+        "lat",
+        "lon",
+        "height_m",
+        "heading_deg",
+        "pitch_deg",
+        "roll_deg",
+        "focal_px",
+        "residual_m",
+        "sigma_m",
+        "flags",
+        "matches",
+    }
+    for key, value in props.items():
+        if key not in shown:
+            digits = 3 if key == "scale" else 2
+            rows.append((html.escape(str(key)), html.escape(_fmt(value, digits=digits))))
+    body = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows)
+    parts = [
+        f'<div class="camloc-popup"><b>Candidate {int(props.get("rank", 0))}</b>',
+        f"<table>{body}</table>",
+    ]
+    matches = props.get("matches") or []
+    if matches:
+        mrows = []
+        for m in matches:
+            target = m.get("map_corner") or _fmt(m.get("map_lonlat"), digits=6)
+            mrows.append(
+                f"<tr><td>{html.escape(str(m.get('label')))}</td><td>→ {html.escape(str(target))}"
+                f"</td><td>{_fmt(m.get('misfit_m'), ' m')}</td></tr>"
+            )
+        parts.append("<b>matches</b> (scene → map, misfit)<table>" + "".join(mrows) + "</table>")
+    if image_src:
+        img = f'<img src="{image_src}" alt="overlay of candidate {int(props.get("rank", 0))}">'
+        if image_link:
+            img = f'<a href="{html.escape(image_link)}" target="_blank">{img}</a>'
+        parts.append(img)
+    parts.append("</div>")
+    return "".join(parts)
+
+
+def _dot_icon(label: str, fill: str, size: int, outline: float, css_class: str) -> folium.DivIcon:
+    text = _text_colour(fill)
+    inner = (
+        f'<div class="camloc-dot" style="background:{fill};color:{text};'
+        f'border-width:{outline}px">{html.escape(label)}</div>'
+    )
+    return folium.DivIcon(
+        html=inner, icon_size=(size, size), icon_anchor=(size // 2, size // 2), class_name=css_class
+    )
+
+
+def _corner_icon(text: str, colour: str, *, above: bool = False) -> folium.DivIcon:
+    """A small label; below the point (map corners) or above it (matched scene corners)."""
+    inner = f'<div style="background:{colour}">{html.escape(text)}</div>'
+    anchor = (-4, 20) if above else (-4, -4)
+    return folium.DivIcon(
+        html=inner, icon_size=(34, 16), icon_anchor=anchor, class_name="camloc-corner-label"
+    )
+
+
+def _new_map(offline: bool, tiles: str | None, location: Sequence[float]) -> folium.Map:
+    fmap = folium.Map(
+        location=list(location),
+        zoom_start=18,
+        tiles=None,
+        control_scale=True,
+        max_zoom=22,
+        prefer_canvas=False,
+    )
+    if not offline and tiles:
+        if tiles == "OpenStreetMap":
+            folium.TileLayer(
+                "OpenStreetMap",
+                name="OpenStreetMap",
+                attr=_OSM_TILES_ATTR,
+                max_zoom=22,
+                max_native_zoom=19,
+            ).add_to(fmap)
+        else:
+            folium.TileLayer(tiles, name="Basemap", max_zoom=22, max_native_zoom=19).add_to(fmap)
+    root = fmap.get_root()
+    assert isinstance(root, Figure)
+    root.header.add_child(
+        folium.Element(
+            "<style>"
+            + _PAGE_CSS
+            + (".leaflet-container { background: #eef0ea; }" if offline or not tiles else "")
+            + "</style>"
+        ),
+        name="camloc_css",
+    )
+    return fmap
+
+
+# ------------------------------------------------------------------------ candidate map
+def build_candidates_map(
+    result: LocateResult,
+    map_data: MapData | None,
+    *,
+    scene: Scene | None = None,
+    offline: bool = False,
+    tiles: str | None = "OpenStreetMap",
+    overlay_images: Mapping[int, str] | None = None,
+    overlay_links: Mapping[int, str] | None = None,
+) -> folium.Map:
+    """The review map of one scene's candidates, as a :class:`folium.Map`.
+
+    Parameters
+    ----------
+    result
+        A :func:`camloc_geo.absolute.locate` result.
+    map_data
+        The map the result was computed with (streets and buildings layers); may be None.
+    scene
+        The scene (its prior is drawn); optional.
+    offline
+        No tile layer (the assets are inlined only when saving, see :func:`candidates_map`).
+    tiles
+        folium tile name or URL template for online pages; None for none.
+    overlay_images
+        ``rank → img src`` (a data URI or a relative path) shown in the candidate's popup.
+    overlay_links
+        ``rank → href`` of the full-size overlay (the thumbnail links to it).
+
+    Returns
+    -------
+    folium.Map
+        With layers, layer control, legend and scale bar.
+    """
+    from camloc_geo.absolute import candidates_geojson
+
+    gj = candidates_geojson(result)
+    feats = gj["features"]
+    cands = [f for f in feats if f["properties"]["kind"] == "candidate"]
+    cones = [f for f in feats if f["properties"]["kind"] == "view_cone"]
+    corners = [f for f in feats if f["properties"]["kind"] == "corner"]
+    frame = result.frame
+    centre_en, radius = _focus(result, cands)
+    lon0, lat0 = frame.geographic_from_enu(float(centre_en[0]), float(centre_en[1]))
+    fmap = _new_map(offline, None if offline else tiles, (float(lat0), float(lon0)))
+
+    if map_data is not None:
+        _map_layers(fmap, map_data, result, centre_en, radius)
+
+    if scene is not None and scene.prior is not None and scene.prior.radius_m:
+        fg_prior = folium.FeatureGroup(name="Prior area", show=True)
+        folium.Circle(
+            [scene.prior.lat, scene.prior.lon],
+            radius=float(scene.prior.radius_m),
+            color=_STYLE["prior"],
+            weight=1.5,
+            dash_array="8 6",
+            fill=False,
+            interactive=False,
+        ).add_to(fg_prior)
+        fg_prior.add_to(fmap)
+
+    # View cones: the best few shown, the others available.
+    fg_cones = folium.FeatureGroup(name=f"View cones (top {_CONES_SHOWN})", show=True)
+    fg_cones_rest = folium.FeatureGroup(name="View cones (other candidates)", show=False)
+    for cone in sorted(cones, key=lambda f: -f["properties"]["rank"]):
+        rank = int(cone["properties"]["rank"])
+        score = float(cone["properties"]["score"])
+        colour = score_colour(score)
+        style = {
+            "color": colour,
+            "weight": 2.5 if rank == 1 else 1.0,
+            "fillColor": colour,
+            "fillOpacity": 0.12 + 0.3 * min(score, 1.0),
+            "opacity": 0.9,
+        }
+        folium.GeoJson(
+            {
+                "type": "Feature",
+                "geometry": {
+                    "type": "Polygon",
+                    "coordinates": _round_coords(cone["geometry"]["coordinates"]),
+                },
+                "properties": {"rank": rank},
+            },
+            style_function=lambda _f, s=style: s,
+            interactive=False,
+        ).add_to(fg_cones if rank <= _CONES_SHOWN else fg_cones_rest)
+    fg_cones.add_to(fmap)
+    if len(cones) > _CONES_SHOWN:
+        fg_cones_rest.add_to(fmap)
+
+    # Map kerb corners, in map order.
+    if corners:
+        fg_corners = folium.FeatureGroup(name="Map kerb corners (m = clockwise order)", show=True)
+        for f in corners:
+            p = f["properties"]
+            lon, lat = f["geometry"]["coordinates"]
+            tip = html.escape(
+                f"map corner {p['order']} of {p['intersection']}: "
+                + " / ".join(p.get("streets") or [])
+            )
+            folium.CircleMarker(
+                [lat, lon],
+                radius=4,
+                color="#fff",
+                weight=1.5,
+                fill=True,
+                fill_color=_STYLE["corner"],
+                fill_opacity=1.0,
+                tooltip=tip,
+            ).add_to(fg_corners)
+            folium.Marker(
+                [lat, lon], icon=_corner_icon(f"m{p['order']}", _STYLE["corner"]), tooltip=tip
+            ).add_to(fg_corners)
+        fg_corners.add_to(fmap)
+
+    # Matches of the leading candidates: scene index on the matched map point.
+    for f in cands[:_MATCH_LAYERS]:
+        p = f["properties"]
+        matches = p.get("matches") or []
+        if not matches:
+            continue
+        rank = int(p["rank"])
+        fg = folium.FeatureGroup(name=f"Scene points → map, candidate {rank}", show=rank == 1)
+        for m in matches:
+            mlon, mlat = m["map_lonlat"]
+            label = str(m.get("label", ""))
+            idx = label.rsplit("[", 1)[-1].rstrip("]")
+            text = (
+                idx if m["kind"] == "corner" else ("R" if m["kind"] == "reference" else "L") + idx
+            )
+            folium.PolyLine(
+                [[p["lat"], p["lon"]], [mlat, mlon]],
+                color=_STYLE["match"],
+                weight=1.2,
+                opacity=0.7,
+                dash_array="3 4",
+                interactive=False,
+            ).add_to(fg)
+            folium.Marker(
+                [mlat, mlon],
+                icon=_corner_icon(text, _STYLE["match"], above=True),
+                tooltip=html.escape(
+                    f"candidate {rank}: {label} → "
+                    f"{m.get('map_corner', 'map point')}, misfit "
+                    f"{_fmt(m.get('misfit_m'), ' m')}"
+                ),
+            ).add_to(fg)
+        fg.add_to(fmap)
+
+    # Candidates last (on top), best drawn above the others.
+    fg_cands = folium.FeatureGroup(name="Candidates", show=True)
+    for f in sorted(cands, key=lambda f: -f["properties"]["rank"]):
+        p = f["properties"]
+        rank = int(p["rank"])
+        size, outline, z = rank_style(rank)
+        img = (overlay_images or {}).get(rank)
+        link = (overlay_links or {}).get(rank)
+        popup = folium.Popup(_candidate_popup(p, img, link), max_width=520 if img else 360)
+        folium.Marker(
+            [p["lat"], p["lon"]],
+            icon=_dot_icon(str(rank), score_colour(p["score"]), size, outline, "camloc-candidate"),
+            popup=popup,
+            tooltip=f"#{rank} score {p['score']:.3f} ({html.escape(str(p['method']))})",
+            z_index_offset=z,
+        ).add_to(fg_cands)
+    fg_cands.add_to(fmap)
+
+    folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _Control(
+        _legend_html(
+            scene_id=result.scene_id,
+            has_corners=bool(corners),
+            has_prior=scene is not None and scene.prior is not None,
+            summary=False,
+        ),
+        position="bottomleft",
+        css_class="camloc-legend",
+    ).add_to(fmap)
+    cal = gj["properties"]["calibration"]
+    title = (
+        f"<h4>{html.escape(str(result.scene_id))}</h4>"
+        f"{len(cands)} candidate(s); methods tried: "
+        f"{html.escape(', '.join(result.methods_tried) or 'none')}"
+        f"<br><small>calibration: f = {_fmt(cal['focal_px'], ' px', 0)}, h = "
+        f"{_fmt(cal['height_m'], ' m', 1)} ({html.escape(str(cal['method']))})</small>"
+    )
+    if not cands:
+        title += f"<br><b>no candidates</b>: {html.escape(str(result.reason))}"
+    _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
+
+    pts = [[f["properties"]["lat"], f["properties"]["lon"]] for f in cands[:6]]
+    for f in corners:
+        pts.append([f["geometry"]["coordinates"][1], f["geometry"]["coordinates"][0]])
+    if len(pts) >= 2:
+        arr = np.asarray(pts)
+        fmap.fit_bounds([arr.min(axis=0).tolist(), arr.max(axis=0).tolist()], padding=(40, 40))
+    return fmap
+
+
+def _overlay_sources(
+    result: LocateResult,
+    map_data: MapData | None,
+    scene: Scene | None,
+    out_path: Path,
+    overlay_dir: str | None,
+    embed: bool,
+    top: int,
+) -> tuple[dict[int, Any], dict[int, str]]:
+    """Overlay images of the leading candidates; written to ``overlay_dir`` when given."""
+    images: dict[int, Any] = {}
+    links: dict[int, str] = {}
+    background = None
+    if scene is not None:
+        background = _overlay._read_background(scene, result.image_size)
+    for c in result.candidates[:top]:
+        path = None
+        if overlay_dir is not None:
+            path = Path(overlay_dir) / f"{_safe(result.scene_id)}_rank{c.rank}.png"
+        img = _overlay.candidate_overlay(
+            result, c, map_data, scene=scene, path=path, background=background
+        )
+        images[c.rank] = img
+        if path is not None:
+            links[c.rank] = _relative(path, out_path.parent)
+    return images, links
+
+
+def _safe(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name) or "scene"
+
+
+def _relative(path: Path, start: Path) -> str:
+    import os
+
+    return Path(os.path.relpath(path.resolve(), start.resolve())).as_posix()
+
+
+def _render(fmap: folium.Map, offline: bool) -> str:
+    page = fmap.get_root().render()
+    return inline_assets(page) if offline else page
+
+
+def candidates_map(
+    result: LocateResult,
+    map_data: MapData | None,
+    path: str | Path,
+    *,
+    offline: bool = False,
+    scene: Scene | None = None,
+    overlay_dir: str | None = None,
+    tiles: str | None = "OpenStreetMap",
+    overlay_top: int = _OVERLAY_TOP,
+    thumbnail_width: int = 480,
+    max_bytes: int = MAX_PAGE_BYTES,
+) -> Path:
+    """Write the review map of one scene's candidates as an HTML page.
+
+    Parameters
+    ----------
+    result
+        A :func:`camloc_geo.absolute.locate` result.
+    map_data
+        The map used (None when the scene needed none).
+    path
+        Output HTML file.
+    offline
+        One self-contained file making no request (no tiles; Leaflet, jQuery and the overlays
+        inlined). Otherwise folium's CDN links and a tile basemap.
+    scene
+        The scene: its snapshot is the overlays' background and its prior is drawn.
+    overlay_dir
+        Write the full-size overlay PNGs of the leading candidates here; online pages then
+        show them by relative link. Offline pages (or online pages without a folder) embed
+        base64 PNG thumbnails.
+    tiles
+        Basemap for online pages (folium tile name or URL template; None for none).
+    overlay_top
+        How many leading candidates get an overlay.
+    thumbnail_width
+        Width of embedded thumbnails, pixels (reduced, and the number of embedded overlays
+        cut, until the page fits ``max_bytes``).
+    max_bytes
+        Size budget of a page with embedded overlays.
+
+    Returns
+    -------
+    Path
+        The page written.
+    """
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    embed = offline or overlay_dir is None
+    images, links = (
+        ({}, {})
+        if overlay_top <= 0
+        else _overlay_sources(result, map_data, scene, out, overlay_dir, embed, overlay_top)
+    )
+    if not embed:
+        fmap = build_candidates_map(
+            result,
+            map_data,
+            scene=scene,
+            offline=offline,
+            tiles=tiles,
+            overlay_images=links,
+            overlay_links=links,
+        )
+        page = _render(fmap, offline)
+    else:
+        width = thumbnail_width
+        ranks = sorted(images)
+        while True:
+            srcs = {
+                r: "data:image/png;base64,"
+                + base64.b64encode(_overlay.encode_png(images[r], max_width=width)).decode("ascii")
+                for r in ranks
+            }
+            fmap = build_candidates_map(
+                result,
+                map_data,
+                scene=scene,
+                offline=offline,
+                tiles=tiles,
+                overlay_images=srcs,
+                overlay_links=links,
+            )
+            page = _render(fmap, offline)
+            size = len(page.encode("utf-8"))
+            if size <= max_bytes or not ranks:
+                break
+            if width > 240:
+                width = int(width * 0.8)
+            else:
+                ranks = ranks[:-1]
+            log.info(
+                "page %d bytes > %d: overlays at %d px for %d candidates",
+                size,
+                max_bytes,
+                width,
+                len(ranks),
+            )
+    out.write_text(page, encoding="utf-8")
+    log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
+    return out
+
+
+# --------------------------------------------------------------------------- summary map
+def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
+    """The best candidate feature of a GeoJSON dict or LocateResult, and the scene's reason."""
+    if isinstance(item, Mapping):
+        gj = item
+    else:
+        from camloc_geo.absolute import candidates_geojson
+
+        gj = candidates_geojson(item, view_cones=False)
+    cands = [
+        f for f in gj.get("features", []) if f.get("properties", {}).get("kind") == "candidate"
+    ]
+    reason = (gj.get("properties") or {}).get("reason")
+    if not cands:
+        return None, reason
+    return min(cands, key=lambda f: f["properties"].get("rank", 1 << 30)), reason
+
+
+def _arrow_icon(heading: float | None, fill: str, css_class: str) -> folium.DivIcon:
+    if heading is None or not math.isfinite(heading):
+        shape = '<circle r="6" />'
+    else:
+        shape = f'<path transform="rotate({heading:.1f})" d="M0,-11 L6,6 L0,2 L-6,6 Z" />'
+    svg = (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="26" height="26" viewBox="-13 -13 26 26">'
+        f'<g fill="{fill}" stroke="#111" stroke-width="1.5">{shape}</g></svg>'
+    )
+    return folium.DivIcon(html=svg, icon_size=(26, 26), icon_anchor=(13, 13), class_name=css_class)
+
+
+def build_summary_map(
+    items: Iterable[tuple[str, Any]],
+    *,
+    offline: bool = False,
+    tiles: str | None = "OpenStreetMap",
+    cluster: bool = True,
+) -> folium.Map:
+    """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
+
+    Parameters
+    ----------
+    items
+        ``(scene_id, candidates)`` pairs; ``candidates`` is a candidate GeoJSON dict
+        (:func:`camloc_geo.absolute.candidates_geojson`) or a ``LocateResult``.
+    offline
+        No tiles and no clustering plugin (its script would come from a CDN): plain markers.
+    tiles
+        Basemap for online pages.
+    cluster
+        Cluster markers (online pages only; ``leaflet.markercluster`` from its CDN).
+    """
+    rows = []
+    missing = []
+    for scene_id, item in items:
+        best, reason = _best_feature(item)
+        if best is None:
+            missing.append((scene_id, reason))
+        else:
+            rows.append((scene_id, best))
+    if rows:
+        lats = np.array([f["properties"]["lat"] for _s, f in rows])
+        lons = np.array([f["properties"]["lon"] for _s, f in rows])
+        location = (float(lats.mean()), float(lons.mean()))
+    else:
+        location = (0.0, 0.0)
+    fmap = _new_map(offline, None if offline else tiles, location)
+    parent: Any
+    if cluster and not offline:
+        from folium.plugins import MarkerCluster
+
+        parent = MarkerCluster(name="Cameras (best candidate)")
+    else:
+        parent = folium.FeatureGroup(name="Cameras (best candidate)")
+    for scene_id, f in sorted(rows, key=lambda r: r[1]["properties"].get("score", 0.0)):
+        p = f["properties"]
+        body = "".join(
+            f"<tr><th>{k}</th><td>{v}</td></tr>"
+            for k, v in (
+                ("camera", html.escape(str(scene_id))),
+                ("score", _fmt(p.get("score"), digits=3)),
+                ("method", html.escape(str(p.get("method")))),
+                ("lat, lon", f"{p['lat']:.7f}, {p['lon']:.7f}"),
+                ("height", _fmt(p.get("height_m"), " m")),
+                ("heading", _fmt(p.get("heading_deg"), "°", 1)),
+                ("residual_m", _fmt(p.get("residual_m"), " m")),
+                ("sigma_m", _fmt(p.get("sigma_m"), " m")),
+                ("flags", html.escape(_fmt(list(p.get("flags") or [])))),
+            )
+        )
+        popup = folium.Popup(
+            f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>'
+            f"<table>{body}</table></div>",
+            max_width=320,
+        )
+        folium.Marker(
+            [p["lat"], p["lon"]],
+            popup=popup,
+            icon=_arrow_icon(
+                p.get("heading_deg"), score_colour(p.get("score", 0.0)), "camloc-summary-marker"
+            ),
+            tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})",
+        ).add_to(parent)
+    parent.add_to(fmap)
+    folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _Control(
+        _legend_html(scene_id=None, has_corners=False, has_prior=False, summary=True),
+        position="bottomleft",
+        css_class="camloc-legend",
+    ).add_to(fmap)
+    title = f"<h4>{len(rows)} camera(s) located</h4>"
+    if missing:
+        title += (
+            f"{len(missing)} without candidates: "
+            + html.escape(", ".join(str(s) for s, _r in missing[:10]))
+            + (" …" if len(missing) > 10 else "")
+        )
+    _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
+    if len(rows) >= 2:
+        fmap.fit_bounds(
+            [[float(lats.min()), float(lons.min())], [float(lats.max()), float(lons.max())]],
+            padding=(30, 30),
+            max_zoom=18,
+        )
+    return fmap
+
+
+def summary_map(
+    items: Iterable[tuple[str, Any]],
+    path: str | Path,
+    *,
+    offline: bool = False,
+    tiles: str | None = "OpenStreetMap",
+    cluster: bool = True,
+) -> Path:
+    """Write the summary map of many cameras; see :func:`build_summary_map`.
+
+    Returns
+    -------
+    Path
+        The page written.
+    """
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    page = _render(build_summary_map(items, offline=offline, tiles=tiles, cluster=cluster), offline)
+    out.write_text(page, encoding="utf-8")
+    log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
+    return out
+
+
+# ------------------------------------------------------------------------------ offline
+@lru_cache(maxsize=1)
+def _assets() -> dict[str, str]:
+    """Leaflet JS/CSS (images as data URIs) and jQuery from the xstatic packages."""
+    import xstatic.pkg.jquery as xjquery
+    import xstatic.pkg.leaflet as xleaflet
+
+    lbase = Path(xleaflet.BASE_DIR)
+    css = (lbase / "leaflet.css").read_text(encoding="utf-8")
+
+    def data_uri(match: re.Match[str]) -> str:
+        name = match.group(1)
+        blob = (lbase / "images" / name).read_bytes()
+        return "url(data:image/png;base64," + base64.b64encode(blob).decode("ascii") + ")"
+
+    css = re.sub(r"url\(images/([A-Za-z0-9_.-]+\.png)\)", data_uri, css)
+    css = css.replace("url(#default#VML)", "none")
+    js = (lbase / "leaflet.js").read_text(encoding="utf-8")
+    js = re.sub(r"//# sourceMappingURL=\S+", "", js)
+    jq = (Path(xjquery.BASE_DIR) / "jquery.min.js").read_text(encoding="utf-8")
+    jq = re.sub(r"//# sourceMappingURL=\S+", "", jq)
+    for name, text in (("leaflet.js", js), ("jquery.min.js", jq)):
+        if "</script" in text.lower():
+            raise ValueError(f"{name} contains '</script' and cannot be inlined")
+    return {"leaflet_js": js, "leaflet_css": css, "jquery_js": jq}
+
+
+_SCRIPT_SRC = re.compile(r"<script\b[^>]*\bsrc=\"([^\"]+)\"[^>]*>\s*</script>", re.IGNORECASE)
+_CSS_LINK = re.compile(r"<link\b[^>]*\bhref=\"([^\"]+)\"[^>]*/?>", re.IGNORECASE)
+
+
+def inline_assets(page: str) -> str:
+    """Make a folium page self-contained: inline Leaflet and jQuery, drop other remote assets.
+
+    Parameters
+    ----------
+    page
+        HTML rendered by folium.
+
+    Returns
+    -------
+    The page with Leaflet's and jQuery's ``<script src>``/``<link>`` replaced by inline copies
+    from the xstatic packages and every other external script or stylesheet removed.
+
+    Raises
+    ------
+    ValueError
+        When a remote resource reference is left (a tile layer, an ``<img>`` from the web).
+    """
+    assets = _assets()
+
+    placeholders = {
+        "leaflet_js": "<!--camloc:leaflet_js-->",
+        "jquery_js": "<!--camloc:jquery_js-->",
+        "leaflet_css": "<!--camloc:leaflet_css-->",
+    }
+
+    def script(match: re.Match[str]) -> str:
+        url = match.group(1)
+        name = url.rsplit("/", 1)[-1].lower()
+        if re.fullmatch(r"leaflet(-src)?\.js", name):
+            return placeholders["leaflet_js"]
+        if re.fullmatch(r"jquery(-[\d.]+)?(\.min)?\.js", name):
+            return placeholders["jquery_js"]
+        log.debug("offline page: dropped script %s", url)
+        return ""
+
+    def link(match: re.Match[str]) -> str:
+        url = match.group(1)
+        if "stylesheet" not in match.group(0).lower():
+            return match.group(0)
+        if url.rsplit("/", 1)[-1].lower() == "leaflet.css":
+            return placeholders["leaflet_css"]
+        log.debug("offline page: dropped stylesheet %s", url)
+        return ""
+
+    out = _SCRIPT_SRC.sub(script, page)
+    out = _CSS_LINK.sub(link, out)
+    leftovers = re.findall(
+        r"""<(?:script|img|link|iframe|source|video|audio)\b[^>]*\b(?:src|href)=["']?"""
+        r"""(?:https?:)?//[^"'\s>]+""",
+        out,
+        flags=re.IGNORECASE,
+    )
+    leftovers += re.findall(r"url\(\s*[\"']?(?:https?:)?//[^)]*\)", out, flags=re.IGNORECASE)
+    if re.search(r"L\.tileLayer\(", out):
+        leftovers.append("L.tileLayer(...)")
+    if leftovers:
+        raise ValueError(f"offline page still references remote resources: {leftovers[:3]}")
+    out = out.replace(
+        placeholders["leaflet_css"], "<style>" + assets["leaflet_css"] + "</style>", 1
+    )
+    for key in ("leaflet_js", "jquery_js"):
+        out = out.replace(placeholders[key], "<script>" + assets[key] + "</script>", 1)
+    return out
