@@ -56,7 +56,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import least_squares
 
 from camloc_geo._errors import MapDataError, SceneError
 from camloc_geo.camera import Camera, angles_from_rotation
@@ -302,6 +301,7 @@ class _Evidence:
     prior_en: FloatArray | None
     prior_radius_m: float | None
     streets_enu: list[tuple[Any, float]] = field(default_factory=list)
+    buildings_tree: Any = None
     street_tree: Any = None
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
 
@@ -496,21 +496,22 @@ def _plausibility(
     factor = 1.0
     flags: list[str] = []
     C = cam.center_in_world
-    if ev.buildings_enu:
+    if ev.buildings_enu and ev.buildings_tree is not None:
         from shapely.geometry import LineString, Point
 
         pt = Point(float(C[0]), float(C[1]))
-        for poly in ev.buildings_enu:
-            if poly.contains(pt) and poly.exterior.distance(pt) > 2.0:
-                factor *= settings.inside_building_factor
-                flags.append("inside_building")
-                break
+        around = [ev.buildings_enu[int(i)] for i in ev.buildings_tree.query(pt)]
+        home = [poly for poly in around if poly.contains(pt)]
+        if any(poly.exterior.distance(pt) > 2.0 for poly in home):
+            factor *= settings.inside_building_factor
+            flags.append("inside_building")
         for m in matches:
             if m["kind"] != "corner":
                 continue
             line = LineString([(C[0], C[1]), tuple(m["map_en"])])
-            for poly in ev.buildings_enu:
-                if poly.contains(pt):
+            for i in ev.buildings_tree.query(line):
+                poly = ev.buildings_enu[int(i)]
+                if poly in home:
                     continue
                 if line.crosses(poly) and line.intersection(poly).length > 1.0:
                     factor *= settings.occluded_corner_factor
@@ -578,27 +579,53 @@ def _refine(
             obs_q.append((o, np.asarray(by_label[o.label]["map_en"])))
     if not obs_q:
         return cand
-    def resid(x: FloatArray) -> FloatArray:
+    # Whitening at the starting similarity (the rotation and scale change little here).
+    R20 = _rot2(cand.theta_rad)
+    L = np.stack([np.linalg.cholesky(_obs_precision(o, R20, cand.scale)) for o, _q in obs_q])
+    P = np.array([o.world_xy for o, _q in obs_q])
+    Q = np.array([q for _o, q in obs_q])
+    s_sigma = max(settings.scale_sigma_rel, 1e-6)
+
+    def resid_jac(x: FloatArray) -> tuple[FloatArray, FloatArray]:
         theta, tx, ty, ls = x
         s = math.exp(ls)
         R2 = _rot2(theta)
-        out = []
-        for o, q in obs_q:
-            cov = (s**2) * (R2 @ o.cov_world @ R2.T) + o.sigma_map_m**2 * np.eye(2)
-            L = np.linalg.cholesky(np.linalg.inv(cov))
-            out.append(L.T @ (s * R2 @ o.world_xy + np.array([tx, ty]) - q))
-        out.append(np.array([ls / max(settings.scale_sigma_rel, 1e-6)]))
-        return np.concatenate(out)
+        dR2 = np.array([[-R2[1, 0], -R2[0, 0]], [R2[0, 0], -R2[1, 0]]])
+        sp = s * P @ R2.T
+        d = sp + np.array([tx, ty]) - Q
+        r = np.einsum("nji,nj->ni", L, d).ravel()
+        cols = [
+            s * P @ dR2.T,
+            np.broadcast_to([1.0, 0.0], P.shape),
+            np.broadcast_to([0.0, 1.0], P.shape),
+            sp,
+        ]
+        J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
+        r = np.concatenate([r, [ls / s_sigma]])
+        J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
+        return r, J
 
-    x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
-    sol = least_squares(resid, x0, method="lm", xtol=1e-12, ftol=1e-12)
-    theta, tx, ty, ls = sol.x
+    x = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    r, J = resid_jac(x)
+    for _ in range(8):  # Gauss-Newton: the problem is nearly linear
+        try:
+            dx = -np.linalg.lstsq(J, r, rcond=None)[0]
+        except np.linalg.LinAlgError:
+            break
+        x_new = x + dx
+        r_new, J_new = resid_jac(x_new)
+        if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
+            break
+        x, r, J = x_new, r_new, J_new
+        if np.max(np.abs(dx)) < 1e-10:
+            break
+    theta, tx, ty, ls = x
     T = np.array([tx, ty])
     s = math.exp(ls)
     cam = _camera_in_enu(world_cam, theta, T, s)
     sigma = None
     try:
-        cov = np.linalg.pinv(sol.jac.T @ sol.jac)
+        cov = np.linalg.pinv(J.T @ J)
         # Jacobian of the camera's ENU position w.r.t. (θ, tx, ty, ln s).
         Cw = world_cam.center_in_world[:2]
         R2 = _rot2(theta)
@@ -639,6 +666,31 @@ def _streets_index(map_data: MapData, frame: LocalFrame) -> tuple[list[tuple[Any
         _STREETS_CACHE.clear()
     _STREETS_CACHE[key] = (rows, tree)
     return rows, tree
+
+
+_BUILDINGS_CACHE: dict[tuple[int, float, float], tuple[list[Any], Any]] = {}
+
+
+def _buildings_index(map_data: MapData, frame: LocalFrame) -> tuple[list[Any], Any]:
+    """Building footprints in the local frame and an STRtree over them (cached per map)."""
+    key = (id(map_data), frame.lat0, frame.lon0)
+    hit = _BUILDINGS_CACHE.get(key)
+    if hit is not None and len(hit[0]) <= len(map_data.buildings):
+        return hit
+    from shapely import STRtree
+    from shapely.geometry import Polygon
+
+    polys = []
+    for b in map_data.buildings:
+        coords = np.asarray(b.footprint.exterior.coords, dtype=float)
+        poly = Polygon(frame.points_enu_from_geographic(coords))
+        if poly.is_valid and poly.area > 1.0:
+            polys.append(poly)
+    tree = STRtree(polys) if polys else None
+    if len(_BUILDINGS_CACHE) > 16:
+        _BUILDINGS_CACHE.clear()
+    _BUILDINGS_CACHE[key] = (polys, tree)
+    return polys, tree
 
 
 def _frame_anchor(scene: Scene, map_data: MapData | None) -> LocalFrame:
@@ -791,15 +843,10 @@ def locate(
                 bearings.append(b)
     bearings = _unique_bearings(bearings)
 
-    buildings_enu = []
+    buildings_enu: list[Any] = []
+    buildings_tree = None
     if map_data is not None and map_data.buildings:
-        from shapely.geometry import Polygon
-
-        for b in map_data.buildings:
-            coords = np.asarray(b.footprint.exterior.coords, dtype=float)
-            poly = Polygon(frame.points_enu_from_geographic(coords))
-            if poly.is_valid and poly.area > 1.0:
-                buildings_enu.append(poly)
+        buildings_enu, buildings_tree = _buildings_index(map_data, frame)
     prior_en = None
     prior_r = None
     if scene.prior is not None:
@@ -807,6 +854,7 @@ def locate(
         prior_r = scene.prior.radius_m
     ev = _Evidence(refs, corners, map_corners, map_corner_ids, landmarks, bearings,
                    buildings_enu, prior_en, prior_r)
+    ev.buildings_tree = buildings_tree
     if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
         ev.streets_enu, ev.street_tree = _streets_index(map_data, frame)
     size = scene.object_size
@@ -889,16 +937,19 @@ def _normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> li
         c.score = float(wi)
     cands.sort(key=lambda c: -c.score)
     kept: list[Candidate] = []
+    kept_heading: list[float] = []
     for c in cands:
-        for k in kept:
+        h = c.heading_deg
+        for k, hk in zip(kept, kept_heading, strict=True):
             close = np.linalg.norm(c.east_north - k.east_north) < settings.merge_distance_m
-            dh = abs((c.heading_deg - k.heading_deg + 180.0) % 360.0 - 180.0)
+            dh = abs((h - hk + 180.0) % 360.0 - 180.0)
             if close and dh < settings.merge_heading_deg:
                 k.score += c.score
                 k.merged += c.merged
                 break
         else:
             kept.append(c)
+            kept_heading.append(h)
     kept.sort(key=lambda c: -c.score)
     return kept
 
