@@ -342,7 +342,7 @@ def make_located_scene(
         pix = cam_enu.project(box_enu)
         if not np.all(np.isfinite(pix)) or np.any(pix < 5) or np.any(pix[:, 0] > w - 5) or np.any(pix[:, 1] > h - 5):
             continue
-        if np.ptp(pix[:, 0]) < 60:
+        if np.ptp(pix[:, 0]) < 60 or _axes_degenerate(pix[0], pix[4], pix[2], pix[1]):
             continue
         corner_pix = cam_enu.project(np.column_stack([real_corners, np.zeros(len(real_corners))]))
         horizon = cam_enu.horizon_line()
@@ -391,6 +391,27 @@ def make_located_scene(
         return LocatedScene(scene, cam_enu, cam_world, float(lat), float(lon), intersection.id,
                             [intersection.corners[i].order for i in vis])
     return None
+
+
+def _axes_degenerate(
+    origin: FloatArray, length: FloatArray, width: FloatArray, height: FloatArray,
+    min_px: float = 15.0, min_angle_deg: float = 5.0,
+) -> bool:
+    """True when two of the car's edges from the origin corner (nearly) coincide on screen.
+
+    Such a view (the camera looking straight along the car) cannot be annotated, and
+    :func:`camloc_geo.relative.calibrate` rightly rejects it.
+    """
+    steps = [np.asarray(p, float) - np.asarray(origin, float) for p in (length, width, height)]
+    if min(float(np.linalg.norm(s)) for s in steps) < min_px:
+        return True
+    for i in range(3):
+        for j in range(i + 1, 3):
+            a, b = steps[i], steps[j]
+            sin = abs(a[0] * b[1] - a[1] * b[0]) / (np.linalg.norm(a) * np.linalg.norm(b))
+            if sin < math.sin(math.radians(min_angle_deg)):
+                return True
+    return False
 
 
 def _buildings_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[Any]:

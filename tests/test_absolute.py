@@ -1,0 +1,416 @@
+"""Absolute localisation (:mod:`camloc_geo.absolute`) on real OSM extracts.
+
+Synthetic cameras stand at real intersections (:func:`camloc_geo.synthetic.make_located_scene`);
+noise-free annotations must give the true position exactly, and the candidate list must keep
+the contract of ``../shared/spec/SCENE.md``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from camloc_geo._errors import InputError, MapDataError, SceneError
+from camloc_geo.absolute import LocateResult, candidates_geojson, locate
+from camloc_geo.geodesy import distance_m
+from camloc_geo.osm import MapData, load_map
+from camloc_geo.relative import calibrate
+from camloc_geo.scene import parse_scene
+from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
+
+OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
+
+pytestmark = pytest.mark.skipif(not OSM.is_dir(), reason="shared OSM extracts not available")
+
+# (extract, lat, lon): a row-house grid, two old towns, a hilly town with irregular streets.
+PLACES = {
+    "baltimore": ("baltimore.osm.pbf", 39.2851, -76.5934),
+    "heidelberg": ("heidelberg_altstadt.osm.pbf", 49.4120, 8.7080),
+    "krems": ("krems.osm.gz", 48.4095, 15.6100),
+    "monaco": ("monaco.osm.pbf", 43.7384, 7.4246),
+}
+EXACT = 0.1  # metres
+
+
+@pytest.fixture(scope="module")
+def maps() -> dict[str, MapData]:
+    out = {}
+    for key, (name, lat, lon) in PLACES.items():
+        out[key] = load_map(OSM / name, lat, lon, radius_m=300)
+    return out
+
+
+def junctions(m: MapData) -> list[Any]:
+    return [i for i in m.intersections if i.kind == "junction" and len(i.corners) >= 3]
+
+
+def exact_located(m: MapData, inter: Any, seed: int, **kw: Any) -> LocatedScene:
+    kw.setdefault("min_corners", 2)
+    ls = make_located_scene(
+        m, inter, np.random.default_rng(seed), noise=NoiseModel.exact(), corner_sigma_m=0.0, **kw
+    )
+    assert ls is not None, f"no placement at {inter.id}"
+    return ls
+
+
+def errors_m(result: LocateResult, ls: LocatedScene) -> list[float]:
+    return [float(distance_m(c.lon, c.lat, ls.lon, ls.lat)) for c in result.candidates]
+
+
+def car_bearing_deg(ls: LocatedScene) -> float:
+    """Bearing of the car's length axis (the world x axis) in the local frame."""
+    cam_from_enu = ls.camera_enu.cam_from_world_rotation
+    enu_from_world = cam_from_enu.T @ ls.camera_world.cam_from_world_rotation
+    x = enu_from_world[:, 0]
+    return math.degrees(math.atan2(x[0], x[1])) % 360.0
+
+
+def ground_refs(
+    m: MapData, ls: LocatedScene, pixels: list[tuple[float, float]]
+) -> list[dict[str, Any]]:
+    """Exact references: the true ground points under the given pixels."""
+    g = ls.camera_enu.ground_from_pixels(np.asarray(pixels, dtype=float))
+    assert np.all(np.isfinite(g))
+    refs = []
+    for px, p in zip(pixels, g, strict=True):
+        lon, lat = m.frame.geographic_from_enu(float(p[0]), float(p[1]))
+        refs.append({"pixel": list(px), "lat": float(lat), "lon": float(lon)})
+    return refs
+
+
+def check_contract(result: LocateResult) -> None:
+    cands = result.candidates
+    assert cands
+    assert sum(c.score for c in cands) == pytest.approx(1.0, abs=1e-9)
+    assert [c.rank for c in cands] == list(range(1, len(cands) + 1))
+    scores = [c.score for c in cands]
+    assert scores == sorted(scores, reverse=True)
+    assert all(0.0 <= s <= 1.0 for s in scores)
+
+
+# ------------------------------------------------------------------ noise-free corners
+@pytest.mark.parametrize("place", list(PLACES))
+def test_exact_corners_found_at_real_intersections(maps: dict[str, MapData], place: str) -> None:
+    m = maps[place]
+    js = junctions(m)[:3]
+    assert js, f"no junction with three or more corners in {place}"
+    for k, inter in enumerate(js):
+        ls = exact_located(m, inter, seed=10 + k)
+        result = locate(parse_scene(ls.scene), m)
+        check_contract(result)
+        errs = errors_m(result, ls)
+        best = int(np.argmin(errs))
+        assert errs[best] < EXACT, (inter.id, errs)
+        true = result.candidates[best]
+        assert true.method == "corners"
+        assert true.residual_m < 0.05
+        heading, _pitch, _roll = ls.camera_enu.angles_deg
+        assert (true.heading_deg - heading + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=0.05)
+        assert true.camera.height_m == pytest.approx(ls.camera_enu.height_m, abs=0.05)
+        top = result.candidates[0]
+        if errs[0] > EXACT:
+            # Only an exact symmetric twin may outrank the truth: it fits as well and its
+            # score differs only through the map plausibility factors.
+            assert top.residual_m < 0.05, (inter.id, errs[0], top.residual_m)
+            assert true.score > 0.5 * top.score, (inter.id, true.score, top.score)
+
+
+@pytest.mark.parametrize(
+    ("place", "inter_id"),
+    [("baltimore", "n49471343"), ("krems", "n271438768"), ("monaco", None)],
+)
+def test_exact_corners_top_candidate_at_asymmetric_junctions(
+    maps: dict[str, MapData], place: str, inter_id: str | None
+) -> None:
+    """All corners visible at a junction whose corner distances have no symmetry."""
+    m = maps[place]
+    if inter_id is None:
+        inter = max(junctions(m), key=lambda i: _asymmetry(i.corner_distances_m))
+    else:
+        inter = m.intersection(inter_id)
+    assert _asymmetry(inter.corner_distances_m) > 2.0
+    n = len(inter.corners)
+    ls = exact_located(m, inter, seed=3, min_corners=n, max_corners=n)
+    result = locate(parse_scene(ls.scene), m)
+    errs = errors_m(result, ls)
+    assert errs[0] < EXACT, (inter.id, errs)
+    assert result.candidates[0].score > 0.5
+
+
+def _asymmetry(d: list[float]) -> float:
+    a = np.asarray(d)
+    return float(min(np.abs(a - np.roll(a, s)).max() for s in range(1, len(a))))
+
+
+# ------------------------------------------------------------------------ references
+def test_two_references_unique_and_exact(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[0], seed=5)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(400.0, 1000.0), (1500.0, 950.0)])
+    result = locate(parse_scene(scene), m)
+    check_contract(result)
+    assert result.methods_tried == ["two_references"]
+    assert len(result.candidates) == 1
+    c = result.candidates[0]
+    assert c.method == "two_references"
+    assert errors_m(result, ls)[0] < EXACT
+    assert c.residual_m < 0.01
+    assert c.sigma_m is not None
+    assert c.sigma_m > 0.0
+
+
+def test_two_references_without_map(maps: dict[str, MapData]) -> None:
+    m = maps["krems"]
+    ls = exact_located(m, junctions(m)[0], seed=6)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(300.0, 900.0), (1600.0, 1000.0)])
+    result = locate(parse_scene(scene))
+    assert len(result.candidates) == 1
+    assert errors_m(result, ls)[0] < EXACT
+
+
+@pytest.mark.xfail(strict=True, reason="worst reference not flagged yet")
+def test_three_references_one_wrong_flags_the_worst(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[1], seed=7)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    refs = ground_refs(m, ls, [(300.0, 1000.0), (1600.0, 1000.0), (960.0, 800.0)])
+    e, n = m.frame.enu_from_geographic(refs[1]["lon"], refs[1]["lat"])
+    refs[1]["lon"], refs[1]["lat"] = (float(v) for v in m.frame.geographic_from_enu(e + 20.0, n))
+    scene["references"] = refs
+    result = locate(parse_scene(scene), m)
+    assert len(result.candidates) == 1
+    c = result.candidates[0]
+    misfits = {mt["label"]: mt["misfit_m"] for mt in c.matches if mt["kind"] == "reference"}
+    assert max(misfits, key=misfits.__getitem__) == "references[1]"
+    assert misfits["references[1]"] > 5.0
+    assert "worst_reference:references[1]" in c.flags
+    assert c.residual_m > 3.0
+
+
+def test_one_reference_with_street_bearing_gives_two_candidates(maps: dict[str, MapData]) -> None:
+    m = maps["heidelberg"]
+    ls = exact_located(m, junctions(m)[0], seed=8)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(900.0, 950.0)])
+    scene["street_bearing_deg"] = (car_bearing_deg(ls) + 180.0) % 360.0  # either direction
+    result = locate(parse_scene(scene), m)
+    check_contract(result)
+    assert result.methods_tried == ["one_reference"]
+    assert len(result.candidates) == 2
+    assert {c.method for c in result.candidates} == {"one_reference"}
+    errs = errors_m(result, ls)
+    assert min(errs) < EXACT
+    # The other is the car turned end for end about the reference point.
+    assert max(errs) > 1.0
+
+
+def test_one_reference_with_map_bearings(maps: dict[str, MapData]) -> None:
+    """Without a stated bearing the streets near the reference give them: two per direction."""
+    m = maps["baltimore"]
+    inter = junctions(m)[0]
+    ls = exact_located(m, inter, seed=9)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(900.0, 950.0)])
+    result = locate(parse_scene(scene), m)
+    check_contract(result)
+    ref = scene["references"][0]
+    n_bearings = len({round(b) % 180 for _n, b in m.street_bearings(ref["lat"], ref["lon"], 25.0)})
+    assert 2 <= len(result.candidates) <= 2 * n_bearings
+    # The synthetic car is parallel to its street within a couple of degrees.
+    assert min(errors_m(result, ls)) < 3.0
+
+
+# -------------------------------------------------------------------------- output
+def test_geojson_contract(maps: dict[str, MapData]) -> None:
+    m = maps["krems"]
+    ls = exact_located(m, junctions(m)[0], seed=11)
+    result = locate(parse_scene(ls.scene), m)
+    doc = json.loads(json.dumps(candidates_geojson(result), allow_nan=False))
+    assert doc["type"] == "FeatureCollection"
+    cands = [f for f in doc["features"] if f["properties"]["kind"] == "candidate"]
+    cones = [f for f in doc["features"] if f["properties"]["kind"] == "view_cone"]
+    assert len(cands) == len(result.candidates)
+    required = {
+        "kind",
+        "rank",
+        "score",
+        "lat",
+        "lon",
+        "height_m",
+        "heading_deg",
+        "pitch_deg",
+        "roll_deg",
+        "focal_px",
+        "method",
+        "residual_m",
+    }
+    for f, c in zip(cands, result.candidates, strict=True):
+        p = f["properties"]
+        assert required <= set(p), required - set(p)
+        assert f["geometry"]["type"] == "Point"
+        assert f["geometry"]["coordinates"] == [p["lon"], p["lat"]]
+        assert p["lon"] == pytest.approx(c.lon)
+        assert p["lat"] == pytest.approx(c.lat)
+        assert 0.0 <= p["heading_deg"] < 360.0
+        assert p["method"] in {"two_references", "one_reference", "corners", "landmark"}
+    assert [f["properties"]["rank"] for f in cands] == list(range(1, len(cands) + 1))
+    assert sum(f["properties"]["score"] for f in cands) == pytest.approx(1.0)
+    # [lon, lat] order: Krems is at 15.6° E, 48.4° N.
+    lon, lat = cands[0]["geometry"]["coordinates"]
+    assert 15.5 < lon < 15.7
+    assert 48.3 < lat < 48.5
+    assert len(cones) == len(cands)
+    for cone, cand in zip(cones, cands, strict=True):
+        assert cone["geometry"]["type"] == "Polygon"
+        ring = cone["geometry"]["coordinates"][0]
+        assert len(ring) >= 4
+        assert ring[0] == ring[-1]
+        assert distance_m(*ring[0], *cand["geometry"]["coordinates"]) < 0.01
+        assert cone["properties"]["rank"] == cand["properties"]["rank"]
+    kinds = {f["properties"]["kind"] for f in doc["features"]}
+    assert {"intersection", "corner"} <= kinds
+
+
+# ------------------------------------------------------------------------- bad input
+def test_no_geographic_evidence_gives_reason(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[0], seed=12)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    result = locate(parse_scene(scene), m)
+    assert result.candidates == []
+    assert result.reason is not None
+    assert "no geographic evidence" in result.reason
+    del scene["prior"]
+    with pytest.raises(SceneError, match="prior"):
+        locate(parse_scene(scene))
+
+
+def test_corners_without_map_is_an_error(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[0], seed=13)
+    with pytest.raises(MapDataError, match="no map"):
+        locate(parse_scene(ls.scene))
+
+
+def test_more_corners_than_the_map_has(maps: dict[str, MapData]) -> None:
+    m = maps["krems"]
+    inter = junctions(m)[0]
+    ls = exact_located(m, inter, seed=14)
+    scene = dict(ls.scene)
+    px = scene["intersection"]["corners"][0]
+    scene["intersection"] = {**scene["intersection"], "corners": [px] * (len(inter.corners) + 1)}
+    result = locate(parse_scene(scene), m)
+    assert result.candidates == []
+    assert result.reason is not None
+    assert "visible corners" in result.reason
+
+
+@pytest.mark.xfail(strict=True, reason="no fit gate yet")
+def test_corners_that_no_assignment_fits(maps: dict[str, MapData]) -> None:
+    """Corners of a far bigger junction than the map's: an empty list with the reason."""
+    m = maps["krems"]
+    inter = min(junctions(m), key=lambda i: max(i.corner_distances_m))
+    ls = exact_located(m, inter, seed=15, min_corners=3)
+    scene = dict(ls.scene)
+    # Stretch the clicks away from their centre: the ground quadrilateral grows several-fold.
+    cam = ls.camera_enu
+    centre = np.array(m.frame.enu_from_geographic(inter.lon, inter.lat))
+    corners = cam.ground_from_pixels(np.asarray(scene["intersection"]["corners"]))[:, :2]
+    far = centre + 6.0 * (corners - centre)
+    pix = cam.project(np.column_stack([far, np.zeros(len(far))]))
+    w, h = scene["image"]["width"], scene["image"]["height"]
+    keep = [
+        p
+        for p in pix
+        if np.all(np.isfinite(p))
+        and 0 < p[0] < w
+        and 0 < p[1] < h
+        and cam.horizon_line() @ [p[0], p[1], 1.0] > 5
+    ]
+    if len(keep) < 2:
+        pytest.skip("stretched corners left the image")
+    scene["intersection"] = {**scene["intersection"], "corners": [p.tolist() for p in keep]}
+    result = locate(parse_scene(scene), m)
+    assert result.candidates == [] or all("poor_fit" in c.flags for c in result.candidates)
+    if not result.candidates:
+        assert result.reason is not None
+        assert "fit" in result.reason
+
+
+@pytest.mark.xfail(strict=True, reason="no prior gate yet")
+def test_references_far_from_the_prior(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[0], seed=16)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(400.0, 1000.0), (1500.0, 950.0)])
+    # The listed location is 5 km north of where the references are.
+    scene["prior"] = {**scene["prior"], "lat": scene["prior"]["lat"] + 0.045, "radius_m": 100.0}
+    result = locate(parse_scene(scene), m)
+    assert result.candidates == []
+    assert result.reason is not None
+    assert "prior" in result.reason
+
+
+def test_unknown_streets_name_the_streets(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[0], seed=17)
+    scene = dict(ls.scene)
+    scene["intersection"] = {
+        "corners": scene["intersection"]["corners"],
+        "streets": ["Nowhere Lane", "Imaginary Street"],
+    }
+    with pytest.raises(MapDataError, match="Nowhere Lane") as info:
+        locate(parse_scene(scene), m)
+    assert isinstance(info.value, InputError)
+    assert "Imaginary Street" in str(info.value)
+
+
+def test_corner_above_the_horizon_is_ignored_with_a_warning(maps: dict[str, MapData]) -> None:
+    m = maps["krems"]
+    ls = exact_located(m, junctions(m)[0], seed=18, min_corners=3)
+    scene = dict(ls.scene)
+    corners = [*scene["intersection"]["corners"]]
+    hx = ls.camera_enu.horizon_line()
+    sky = [960.0, 1.0]
+    assert hx @ [*sky, 1.0] < 0
+    corners[0] = sky
+    scene["intersection"] = {**scene["intersection"], "corners": corners}
+    result = locate(parse_scene(scene), m)
+    assert any("horizon" in w for w in result.warnings)
+    assert result.candidates
+
+
+def test_precomputed_calibration_is_reused(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[2], seed=19)
+    scene = parse_scene(ls.scene)
+    cal = calibrate(scene)
+    a = locate(scene, m, calibration=cal)
+    b = locate(scene, m)
+    assert a.calibration is cal
+    got = [(c.lat, c.lon) for c in a.candidates]
+    assert got == pytest.approx([(c.lat, c.lon) for c in b.candidates])
+
+
+# ------------------------------------------------------------------------- generator
+def test_located_scenes_can_be_calibrated(maps: dict[str, MapData]) -> None:
+    """The generator never looks straight along the car (collinear edges on screen)."""
+    m = maps["krems"]
+    for k, inter in enumerate(junctions(m)[:3]):
+        ls = exact_located(m, inter, seed=10 + k)
+        cal = calibrate(parse_scene(ls.scene))
+        assert cal.camera.focal_px == pytest.approx(ls.camera_world.focal_px, rel=1e-6)
