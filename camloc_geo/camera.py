@@ -293,8 +293,8 @@ class Camera:
                 f"pixel {first} is at or above the horizon: its ray never meets the plane "
                 f"z = {ground_z_m} m in front of the camera"
             )
+        lam = np.where(bad, np.nan, lam)  # inf x 0 would warn for rays exactly on the horizon
         points = center + lam[:, None] * rays
-        points[bad] = np.nan
         return points[0] if single else points
 
     def height_on_vertical(

@@ -254,3 +254,16 @@ def test_height_on_vertical_clinometer(basic_camera: Camera) -> None:
     with pytest.raises(DegenerateGeometryError, match="above the horizon"):
         cam.height_on_vertical(sky, foot)
     assert math.isnan(cam.height_on_vertical(sky, foot, above_horizon="nan"))
+
+
+def test_pixel_exactly_on_the_horizon_is_nan_without_warnings() -> None:
+    """A level camera's principal point looks exactly along the horizon (ray z = 0)."""
+    cam = Camera.from_center(
+        1000.0, (640.0, 360.0), rotation_from_angles(0.0, 0.0, 0.0), [0, 0, 5.0]
+    )
+    assert cam.rays_in_world([640.0, 360.0])[2] == 0.0
+    out = cam.ground_from_pixels(np.array([[640.0, 360.0], [640.0, 700.0]]))  # warnings are errors
+    assert np.all(np.isnan(out[0]))
+    assert np.all(np.isfinite(out[1]))
+    with pytest.raises(DegenerateGeometryError, match="at or above the horizon"):
+        cam.ground_from_pixels([640.0, 360.0], above_horizon="error")
