@@ -280,3 +280,20 @@ def test_five_way_paris() -> None:
     _assert_clockwise(x)
     _assert_kerbs_at_half_widths(x)
     assert len(x.corner_distances_m) == 5
+
+
+def test_consolidation_matches_osmnx() -> None:
+    """Our cluster centres are osmnx.consolidate_intersections' (dead_ends=True)."""
+    from camloc_geo.osm._intersections import consolidate_nodes
+
+    m = _load("paris_bss.osm.pbf", 48.8660, 2.3630, 250)
+    crs = f"+proj=aeqd +lat_0={m.frame.lat0} +lon_0={m.frame.lon0} +ellps=WGS84 +units=m"
+    Gp = ox.project_graph(m.graph, to_crs=crs)
+    ours = consolidate_nodes(Gp, 12.0)
+    Gc = ox.consolidate_intersections(Gp.copy(), tolerance=12.0, dead_ends=True)
+    theirs = np.array(sorted((d["x"], d["y"]) for _n, d in Gc.nodes(data=True)))
+    mine = np.array(sorted((x, y) for _m, x, y in ours))
+    assert mine.shape == theirs.shape
+    np.testing.assert_allclose(mine, theirs, atol=1e-6)
+    merged = [members for members, _x, _y in ours if len(members) > 1]
+    assert len(merged) >= 5

@@ -19,6 +19,7 @@ import contextlib
 import logging
 import math
 import os
+import struct
 import tempfile
 import threading
 from collections import OrderedDict
@@ -200,6 +201,7 @@ def read_extract(
     buildings: list[Building] = []
     s_min, w_min, n_max, e_max = math.inf, math.inf, -math.inf, -math.inf
     n_ways = 0
+    wkb_factory = osmium.geom.WKBFactory()
     try:
         processor = (
             osmium.FileProcessor(str(path), osmium.osm.NODE | osmium.osm.WAY)
@@ -207,29 +209,42 @@ def read_extract(
             .with_filter(osmium.filter.EntityFilter(osmium.osm.WAY))
             .with_filter(osmium.filter.KeyFilter("highway", "building"))
         )
-        for obj in processor:
-            if not isinstance(obj, osmium.osm.Way):
+        for way in processor:
+            if not isinstance(way, osmium.osm.Way):
                 continue
-            way = obj
             n_ways += 1
             highway = way.tags.get("highway")
             is_street = highway in highways
             is_building = "building" in way.tags and not is_street
             if not (is_street or is_building):
                 continue
-            nodes: list[tuple[int, float, float]] = []
-            inside = box is None
-            for nd in way.nodes:
-                loc = nd.location
-                if not loc.valid():
-                    continue
-                y, x = loc.lat, loc.lon
-                nodes.append((nd.ref, y, x))
-                s_min, n_max = min(s_min, y), max(n_max, y)
-                w_min, e_max = min(w_min, x), max(e_max, x)
-                if not inside and box is not None:
-                    inside = box[0] <= y <= box[2] and box[1] <= x <= box[3]
-            if not inside or len(nodes) < 2:
+            # one C++ call builds the geometry (WKB); nodes are visited in Python only if kept
+            try:
+                wkb = bytes.fromhex(wkb_factory.create_linestring(way))
+            except (osmium.InvalidLocationError, RuntimeError, ValueError):
+                continue  # fewer than two located nodes (clipped at the extract's edge)
+            coords = struct.unpack(f"<{(len(wkb) - 9) // 8}d", wkb[9:])  # x, y pairs
+            xs, ys = coords[0::2], coords[1::2]
+            x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+            s_min, n_max = min(s_min, y0), max(n_max, y1)
+            w_min, e_max = min(w_min, x0), max(e_max, x1)
+            if box is not None and (
+                y1 < box[0]
+                or y0 > box[2]
+                or x1 < box[1]
+                or x0 > box[3]
+                or not any(
+                    box[0] <= y <= box[2] and box[1] <= x <= box[3]
+                    for x, y in zip(xs, ys, strict=True)
+                )
+            ):
+                continue
+            nodes = [
+                (nd.ref, nd.location.lat, nd.location.lon)
+                for nd in way.nodes
+                if nd.location.valid()
+            ]
+            if len(nodes) < 2:
                 continue
             if is_street:
                 street_ways.append((way.id, dict(way.tags), nodes))
