@@ -20,6 +20,7 @@ def _street_props(inter: Intersection) -> list[dict[str, Any]]:
         {
             "name": s.name,
             "bearing_deg": round(s.bearing_deg, 3),
+            "back_bearing_deg": round(s.back_bearing_deg, 3),
             "highway": s.highway,
             "oneway": s.oneway,
             "lanes": s.lanes,

@@ -3,31 +3,40 @@
 Method
 ------
 1. The simplified street graph (osmnx) is projected to the map's local azimuthal
-   equidistant frame and consolidated with :func:`osmnx.consolidate_intersections`
-   (``tolerance`` metres buffer per node: nodes closer than twice that and connected
-   inside the cluster become one intersection, e.g. the four nodes of a dual carriageway
-   crossing).
-2. Each edge leaving a consolidated node is an *arm*. Its direction is measured near the
-   junction: from the node where it leaves the cluster to the point :data:`ARM_SAMPLE_M`
-   metres along it (the whole edge if shorter), with :func:`osmnx.bearing.calculate_bearing`.
-   Slip roads (``*_link``) are ignored; the two one-way carriageways of a dual road (same
-   name, opposite flow, bearings within :data:`DUAL_MAX_ANGLE_DEG`) are merged into one
-   street whose kerbs are the outer kerbs of the pair.
-3. Each street's kerbs are its centre line offset by half the carriageway width
-   (:mod:`camloc_geo.osm._widths`). The kerb corner between two angularly adjacent
-   streets is where the clockwise-side kerb of the first meets the counter-clockwise-side
-   kerb of the next.
+   equidistant frame and its nodes are consolidated as
+   :func:`osmnx.consolidate_intersections` does (``tolerance_m`` buffer per node: nodes
+   closer than twice that and connected inside the cluster are one intersection, e.g. the
+   four nodes of a dual carriageway crossing), see :func:`consolidate_nodes`.
+2. Each edge leaving a cluster is an *arm*. Its direction is measured near the junction:
+   from the node where it leaves the cluster to the point :data:`ARM_SAMPLE_M` metres
+   along it (continuing through nodes where only a tag changes), with
+   :func:`osmnx.bearing.calculate_bearing`. For a straight edge this is osmnx's own edge
+   bearing (:func:`osmnx.add_edge_bearings`). Slip roads (``*_link``) are ignored. Parallel
+   carriageways of one road (same name, at least one one-way, bearings within
+   :data:`DUAL_MAX_ANGLE_DEG`: dual carriageways, frontage roads) are merged into one street
+   whose kerbs are the outermost kerbs of the group. An unnamed piece takes the name of the
+   street it continues into.
+3. Each street's kerbs are its centre line, straight along the arm's direction, offset by
+   half the carriageway width (:mod:`camloc_geo.osm._widths`). The kerb corner between two
+   angularly adjacent streets is where the clockwise-side kerb of the first meets the
+   counter-clockwise-side kerb of the next.
 
 Which gaps get a corner (consistency matters more than anything for sequence matching):
 
-- a gap between adjacent streets of :data:`MAX_CORNER_GAP_DEG` or more has no corner:
-  the kerb runs on (nearly) straight, so the side of a T junction opposite the stem has
-  no corner; a T has 2 corners, a crossing 4, a Y 3, a five-way junction 5;
-- a gap under :data:`MIN_CORNER_GAP_DEG` (two streets leaving almost together), a kerb
-  intersection behind the junction or farther than :data:`MAX_CORNER_DISTANCE_M`, or more
-  than :data:`MAX_STREETS` streets makes the junction ``"unmodelled"``: no corners at all,
+- a gap between adjacent streets of :data:`MAX_CORNER_GAP_DEG` or more has no corner: the
+  kerb runs on (nearly) straight, so the side of a T junction opposite the stem has no
+  corner. A T has 2 corners, a crossing 4, a Y 3, a five-way junction 5;
+- a gap under :data:`MIN_CORNER_GAP_DEG` (two streets leaving almost together), parallel
+  kerb lines, a corner farther than :data:`MAX_CORNER_DISTANCE_M` from the centre, or more
+  than :data:`MAX_STREETS` streets make the junction ``"unmodelled"``: no corners at all,
   and a warning saying why;
-- roundabouts (``junction=roundabout|circular``) are ``"roundabout"``, without corners.
+- roundabouts (``junction=roundabout|circular`` on a street at the cluster) are
+  ``"roundabout"``, without corners. Mini-roundabouts (a node tag) are ordinary junctions.
+- Nodes joining fewer than three streets (after merging carriageways and dropping slip
+  roads) are not intersections.
+
+Corners are ordered by their bearing from the intersection centre (clockwise seen from
+above, 0 = smallest bearing) and labelled with the two streets they lie between.
 """
 
 from __future__ import annotations
@@ -521,7 +530,7 @@ def build_intersections(
     G: nx.MultiDiGraph,
     frame: LocalFrame,
     *,
-    tolerance_m: float = 10.0,
+    tolerance_m: float = 12.0,
     radius_m: float | None = None,
     north_america: bool = False,
 ) -> list[Intersection]:
@@ -534,7 +543,7 @@ def build_intersections(
     frame
         The map's local frame; the graph is projected to its azimuthal equidistant CRS.
     tolerance_m
-        Buffer per node for :func:`osmnx.consolidate_intersections`, metres.
+        Buffer per node for the consolidation (see :func:`consolidate_nodes`), metres.
     radius_m
         Keep intersections whose centre is within this distance of the frame's anchor;
         None keeps all.

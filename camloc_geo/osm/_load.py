@@ -1,16 +1,22 @@
 """Loading OSM data around a point: local extracts (pyosmium + osmnx) or live Overpass.
 
-Offline, the extract is read once with pyosmium (PBF or XML, plain/gzip/bzip2), keeping only
-the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
-``radius_m + CLIP_MARGIN_M`` of the point (whole ways, so every street through a kept
-intersection is complete). Those are written to a small temporary OSM XML file from which
-:func:`osmnx.graph_from_xml` builds the simplified street graph. Online,
-:func:`osmnx.graph_from_point` and :func:`osmnx.features_from_point` query Overpass with
-osmnx's HTTP cache; osmnx settings are changed only inside :func:`osmnx_settings`.
+Offline, the extract (PBF or XML, plain/gzip/bzip2) is read once with pyosmium, keeping
+only the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
+``radius_m + CLIP_MARGIN_M`` of the point; ways are kept whole, so every street through a
+kept intersection is complete. Each way's geometry is built in C++ (WKB) and its nodes are
+only visited in Python when it is kept. The street ways are written to a small temporary OSM
+XML file from which :func:`osmnx.graph_from_xml` builds the graph, simplified with
+:func:`osmnx.simplify_graph` keeping nodes where name, highway, lanes or width change.
+Buildings are closed ``building=*`` ways (multipolygon building relations are skipped
+offline; online, osmnx returns them and the largest polygon is kept).
 
-Loaded maps are cached in process, keyed by file path, modification time and size, the
-point, the radius and the options (or the Overpass URL), so the same area is not parsed
-twice.
+Online, :func:`osmnx.graph_from_point` (same highway filter, as an Overpass
+``custom_filter``) and :func:`osmnx.features_from_point` query Overpass with osmnx's HTTP
+cache. osmnx settings are changed only inside :func:`osmnx_settings`, which restores them.
+
+Loaded maps are cached in process (least recently used, :data:`_CACHE_SIZE` maps), keyed by
+file path, modification time and size, the point, the radius and the options (or the
+Overpass URL), so the same area is not parsed twice.
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ __all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
 log = logging.getLogger(__name__)
 
 DEFAULT_TOLERANCE_M = 12.0
-"""Default node buffer for intersection consolidation, metres (nodes < 20 m apart merge)."""
+"""Default node buffer for intersection consolidation, metres (nodes < 24 m apart merge)."""
 
 
 def _streets_of(G: nx.MultiDiGraph, north_america: bool) -> list[Street]:
