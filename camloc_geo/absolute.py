@@ -304,6 +304,7 @@ class _Evidence:
     buildings_tree: Any = None
     street_tree: Any = None
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
+    worst_reference: str | None = None
 
 
 def _mahal(obs: Observation, q: FloatArray, theta: float, T: FloatArray, s: float) -> float:
@@ -411,6 +412,33 @@ def _gen_references(ev: _Evidence, settings: LocateSettings) -> list[_Hypothesis
     wts = np.array([1.0 / (np.trace(o.cov_world) / 2 + o.sigma_map_m**2) for o, _ in refs])
     theta, T, s = _similarity_fit(world, enu, wts, settings.scale_sigma_rel)
     return [_Hypothesis("two_references", theta, T, s)]
+
+
+def _worst_reference(
+    refs: list[tuple[Observation, FloatArray]], settings: LocateSettings
+) -> tuple[str, float] | None:
+    """The reference that disagrees most with the others, and its misfit to their fit (m).
+
+    The largest residual of the joint fit is a poor guide with few points (the fit leans
+    towards the wrong one and spreads its error): leave each reference out in turn, fit the
+    others, and name the one whose removal leaves the most consistent set.
+    """
+    if len(refs) < 3:
+        return None
+    world = np.array([o.world_xy for o, _ in refs])
+    enu = np.array([q for _, q in refs])
+    wts = np.array([1.0 / (np.trace(o.cov_world) / 2 + o.sigma_map_m**2) for o, _ in refs])
+    best: tuple[float, str, float] | None = None
+    for i in range(len(refs)):
+        keep = [j for j in range(len(refs)) if j != i]
+        theta, T, s = _similarity_fit(world[keep], enu[keep], wts[keep], settings.scale_sigma_rel)
+        cost = sum(_mahal(refs[j][0], refs[j][1], theta, T, s) for j in keep)
+        cost += ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
+        miss = float(np.linalg.norm(s * _rot2(theta) @ world[i] + T - enu[i]))
+        if best is None or cost < best[0]:
+            best = (cost, refs[i][0].label, miss)
+    assert best is not None
+    return best[1], best[2]
 
 
 def _gen_bearing_point(
@@ -555,6 +583,8 @@ def _plausibility(
         factor *= settings.parallel_floor + (1.0 - settings.parallel_floor) * par
         if diff > 2.5 * settings.bearing_sigma_deg:
             flags.append("car_not_parallel_to_street")
+    if ev.worst_reference is not None:
+        flags.append(f"worst_reference:{ev.worst_reference}")
     return factor, flags
 
 
@@ -861,6 +891,13 @@ def locate(
     ws = 1.0 if sum(cal.width_signs or [1.0]) >= 0 else -1.0
     ev.car_center_world = np.array([size.length_m / 2.0, ws * size.width_m / 2.0])
     result.observations = [o for o, _ in refs] + corners + [o for o, _ in landmarks]
+    worst = _worst_reference(refs, settings)
+    if worst is not None:
+        ev.worst_reference = worst[0]
+        result.warnings.append(
+            f"{worst[0]} is the reference that agrees least with the others: "
+            f"{worst[1]:.1f} m from where they put it"
+        )
 
     hyps: list[_Hypothesis] = []
     if len(refs) >= 2:

@@ -177,7 +177,6 @@ def test_two_references_without_map(maps: dict[str, MapData]) -> None:
     assert errors_m(result, ls)[0] < EXACT
 
 
-@pytest.mark.xfail(strict=True, reason="worst reference not flagged yet")
 def test_three_references_one_wrong_flags_the_worst(maps: dict[str, MapData]) -> None:
     m = maps["baltimore"]
     ls = exact_located(m, junctions(m)[1], seed=7)
@@ -190,11 +189,28 @@ def test_three_references_one_wrong_flags_the_worst(maps: dict[str, MapData]) ->
     result = locate(parse_scene(scene), m)
     assert len(result.candidates) == 1
     c = result.candidates[0]
+    # The joint fit spreads the 20 m error over all three (its largest residual may be at
+    # another point); the flag comes from leaving each reference out in turn.
     misfits = {mt["label"]: mt["misfit_m"] for mt in c.matches if mt["kind"] == "reference"}
-    assert max(misfits, key=misfits.__getitem__) == "references[1]"
-    assert misfits["references[1]"] > 5.0
-    assert "worst_reference:references[1]" in c.flags
+    assert set(misfits) == {"references[0]", "references[1]", "references[2]"}
+    assert max(misfits.values()) > 3.0
     assert c.residual_m > 3.0
+    assert "worst_reference:references[1]" in c.flags
+    warning = next(w for w in result.warnings if w.startswith("references[1]"))
+    assert "20.0 m" in warning
+
+
+def test_three_exact_references_flag_nothing_far(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[1], seed=7)
+    scene = dict(ls.scene)
+    del scene["intersection"]
+    scene["references"] = ground_refs(m, ls, [(300.0, 1000.0), (1600.0, 1000.0), (960.0, 800.0)])
+    result = locate(parse_scene(scene), m)
+    c = result.candidates[0]
+    assert errors_m(result, ls)[0] < EXACT
+    assert c.residual_m < 0.01
+    assert any(w.endswith("0.0 m from where they put it") for w in result.warnings)
 
 
 def test_one_reference_with_street_bearing_gives_two_candidates(maps: dict[str, MapData]) -> None:
