@@ -387,6 +387,10 @@ def read_overpass(
             f"cannot reach the Overpass server {overpass_url or ox.settings.overpass_url}: "
             f"{type(exc).__name__}"
         ) from exc
+    except ValueError as exc:  # a reply that is not Overpass JSON
+        raise MapSourceError(
+            f"unreadable answer from the Overpass server for {where}: {exc}"
+        ) from exc
     buildings: list[Building] = []
     if features is not None and len(features):
         for idx, row in features.iterrows():
