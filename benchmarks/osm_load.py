@@ -43,7 +43,8 @@ log = logging.getLogger("osm_load")
 
 _CHILD = r"""
 import json, resource, sys, time
-case, path, lat, lon, xml = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), sys.argv[5]
+case, path, xml = sys.argv[1], sys.argv[2], sys.argv[5]
+lat, lon = float(sys.argv[3]), float(sys.argv[4])
 import osmnx as ox
 from camloc_geo.osm import load_map
 def rss_mib():
