@@ -463,13 +463,14 @@ def _refine(
     lab = labels[inl]
     cols = np.arange(len(lab))
     n_par = 3 + int(f_free) + (2 if pp_sigma else 0)
+    lo, hi = f_bounds
     i_pp = 3 + int(f_free)
     step = 1e-7
 
     def batch(X: FloatArray) -> FloatArray:
         """Residuals ``(k, M)`` for ``k`` parameter vectors."""
         Rs = Rotation.from_rotvec(X[:, :3]).as_matrix() @ R0  # (k, 3, 3)
-        fk = f0 * np.exp(X[:, 3]) if f_free else np.full(len(X), f0)
+        fk = np.clip(f0 * np.exp(X[:, 3]), lo, hi) if f_free else np.full(len(X), f0)
         vps = np.swapaxes(Rs, 1, 2).copy()  # rows = directions
         vps[..., 0] *= fk[:, None]
         vps[..., 1] *= fk[:, None]
@@ -495,26 +496,18 @@ def _refine(
 
     def unpack(x: FloatArray) -> tuple[FloatArray, float]:
         R = Rotation.from_rotvec(x[:3]).as_matrix() @ R0
-        f = f0 * math.exp(x[3]) if f_free else f0
+        f = min(max(f0 * math.exp(x[3]), lo), hi) if f_free else f0
         return R, f
 
+    # Unbounded trust region (much cheaper than the bounded one); the focal length is
+    # clamped to its bounds inside the model instead.
     x0 = np.zeros(n_par)
-    lo, hi = f_bounds
-    if f_free:
-        lb = np.full(n_par, -np.inf)
-        ub = np.full(n_par, np.inf)
-        lb[3], ub[3] = math.log(lo / f0), math.log(hi / f0)
-        x0[3] = min(max(x0[3], lb[3] + 1e-9), ub[3] - 1e-9)
-        bounds: Any = (lb, ub)
-    else:
-        bounds = (-np.inf, np.inf)
     sol = least_squares(
         fun,
         x0,
         jac=jac,
         loss="soft_l1",
         f_scale=tau_px,
-        bounds=bounds,
         max_nfev=40,
         xtol=1e-7,
         ftol=1e-7,
