@@ -105,8 +105,9 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
     ----------
     image
         A path to an image file, or an array: ``(H, W)`` gray, ``(H, W, 3)`` BGR or
-        ``(H, W, 4)`` BGRA, any numeric dtype (floats are taken in ``[0, 1]`` when their
-        maximum is at most 1, else in ``[0, 255]``).
+        ``(H, W, 4)`` BGRA, any numeric dtype (integers span their dtype's range, floats
+        are taken in ``[0, 1]`` when their maximum is at most 1, else in ``[0, 255]``).
+        Files are decoded by OpenCV, which applies the EXIF orientation.
 
     Raises
     ------
@@ -133,10 +134,16 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
     if min(arr.shape[:2]) < 8:
         raise InputError(f"image is too small: {arr.shape[1]}x{arr.shape[0]} pixels")
     if arr.dtype != np.uint8:
+        if not (np.issubdtype(arr.dtype, np.number) or arr.dtype == np.bool_):
+            raise InputError(f"image array must be numeric, got dtype {arr.dtype}")
         a = arr.astype(np.float64)
         if not np.all(np.isfinite(a)):
             raise InputError("image array contains NaN or infinite values")
-        if a.size and a.max() <= 1.0:
+        if arr.dtype == np.bool_:
+            a = a * 255.0
+        elif np.issubdtype(arr.dtype, np.integer):
+            a = a * (255.0 / float(np.iinfo(arr.dtype.str).max))  # e.g. 16-bit images
+        elif a.size and a.max() <= 1.0:
             a = a * 255.0
         arr = np.clip(np.rint(a), 0, 255).astype(np.uint8)
     if arr.ndim == 3:

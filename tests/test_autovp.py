@@ -321,8 +321,10 @@ def test_float_and_gray_inputs_agree(tilted_scene: tuple[np.ndarray, np.ndarray,
     a = detect_segments(img)
     b = detect_segments(img.astype(np.float64) / 255.0)
     c = detect_segments(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR))
+    d = detect_segments(img.astype(np.uint16) * 257)  # 16-bit
     np.testing.assert_allclose(a, b)
     np.testing.assert_allclose(a, c)
+    np.testing.assert_allclose(a, d)
 
 
 # ---------------------------------------------------------------------- York Urban
