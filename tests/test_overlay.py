@@ -89,8 +89,12 @@ def test_camera_below_the_ground_draws_no_ground_feature() -> None:
 def test_true_pose_projects_map_corners_onto_annotated_pixels(fremantle: object) -> None:
     inter = _junction(fremantle)
     ls = make_located_scene(
-        fremantle, inter, np.random.default_rng(1), noise=NoiseModel.exact(),
-        corner_sigma_m=0.0, min_corners=3,
+        fremantle,
+        inter,
+        np.random.default_rng(1),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        min_corners=3,
     )
     assert ls is not None
     corners_en = inter.corners_enu(fremantle.frame)  # type: ignore[attr-defined]
@@ -102,8 +106,9 @@ def test_true_pose_projects_map_corners_onto_annotated_pixels(fremantle: object)
 def test_true_pose_lands_within_click_noise(fremantle: object) -> None:
     inter = _junction(fremantle)
     noise = NoiseModel(point_px=2.0)
-    ls = make_located_scene(fremantle, inter, np.random.default_rng(5), noise=noise,
-                            corner_sigma_m=0.0, min_corners=3)
+    ls = make_located_scene(
+        fremantle, inter, np.random.default_rng(5), noise=noise, corner_sigma_m=0.0, min_corners=3
+    )
     assert ls is not None
     corners_en = inter.corners_enu(fremantle.frame)  # type: ignore[attr-defined]
     px = overlay.project_ground_points(ls.camera_enu, corners_en[ls.visible_corner_orders])
@@ -113,8 +118,14 @@ def test_true_pose_lands_within_click_noise(fremantle: object) -> None:
 
 def test_best_candidate_overlay_points_match_annotations(fremantle: object, tmp_path: Path) -> None:
     inter = _junction(fremantle)
-    ls = make_located_scene(fremantle, inter, np.random.default_rng(2), noise=NoiseModel.exact(),
-                            corner_sigma_m=0.0, min_corners=3)
+    ls = make_located_scene(
+        fremantle,
+        inter,
+        np.random.default_rng(2),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        min_corners=3,
+    )
     assert ls is not None
     scene = parse_scene(ls.scene)
     res = locate(scene, fremantle)
@@ -149,8 +160,9 @@ def test_snapshot_is_the_background(fremantle: object, tmp_path: Path) -> None:
     ls.scene["image"]["path"] = "snap.png"
     scene = parse_scene(ls.scene, base_dir=tmp_path)
     res = locate(scene, fremantle)
-    img = overlay.candidate_overlay(res, res.candidates[0], fremantle, scene=scene,
-                                    path=tmp_path / "o.png")
+    img = overlay.candidate_overlay(
+        res, res.candidates[0], fremantle, scene=scene, path=tmp_path / "o.png"
+    )
     assert img.shape == (1080, 1920, 3)
     b, g, r = (int(v) for v in img[1075, 5])
     assert r > 100  # dimmed red photo, not the blank canvas

@@ -1,0 +1,262 @@
+"""Review maps: offline pages are self-contained, popups carry every property, size budget."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+
+from camloc_geo import maps
+from camloc_geo.absolute import LocateResult, candidates_geojson, locate
+from camloc_geo.cli import main
+from camloc_geo.osm import MapData, load_map
+from camloc_geo.scene import Scene, parse_scene
+from camloc_geo.synthetic import NoiseModel, make_located_scene
+
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
+FREMANTLE = (-32.036172, 115.755714)
+CONTRACT = (
+    "rank",
+    "score",
+    "lat",
+    "lon",
+    "height_m",
+    "heading_deg",
+    "pitch_deg",
+    "roll_deg",
+    "focal_px",
+    "method",
+    "residual_m",
+)
+REMOTE = re.compile(
+    r"""<(?:script|img|link|iframe)\b[^>]*\b(?:src|href)=["']?(?:https?:)?//""", re.IGNORECASE
+)
+
+
+def fremantle_map() -> MapData:
+    """The Fremantle sample extract around Stirling Hwy × Tydeman Rd."""
+    return load_map(SAMPLES / "fremantle.osm", *FREMANTLE, radius_m=250)
+
+
+def located(map_data: MapData, seed: int, **kwargs: Any) -> tuple[Scene, LocateResult]:
+    """A synthetic scene at the extract's main junction and its locate result."""
+    inter = next(i for i in map_data.intersections if i.kind == "junction" and len(i.corners) >= 4)
+    kwargs.setdefault("min_corners", 3)
+    ls = make_located_scene(map_data, inter, np.random.default_rng(seed), **kwargs)
+    assert ls is not None
+    ls.scene["id"] = f"fremantle-{seed}"
+    scene = parse_scene(ls.scene)
+    return scene, locate(scene, map_data)
+
+
+def div_icons(page: str, class_name: str) -> list[str]:
+    """Inner HTML of the page's Leaflet DivIcons of a class."""
+    found = re.findall(r"L\.divIcon\((\{.*?\})\s*\)", page, flags=re.DOTALL)
+    icons = [json.loads(re.sub(r",\s*\}$", "}", m)) for m in found]
+    return [i["html"] for i in icons if i.get("className") == class_name]
+
+
+def remote_references(page: str) -> list[str]:
+    """Remote resource references left outside the inlined scripts."""
+    outside = re.sub(r"<script>.*?</script>", "", page, flags=re.DOTALL)
+    return REMOTE.findall(outside) + re.findall(r"L\.tileLayer\(", outside)
+
+
+@pytest.fixture(scope="module")
+def fremantle() -> MapData:
+    return fremantle_map()
+
+
+@pytest.fixture(scope="module")
+def scene_result(fremantle: MapData) -> tuple[Scene, LocateResult]:
+    return located(fremantle, 0)
+
+
+@pytest.fixture(scope="module")
+def offline_page(
+    tmp_path_factory: pytest.TempPathFactory,
+    fremantle: MapData,
+    scene_result: tuple[Scene, LocateResult],
+) -> str:
+    scene, res = scene_result
+    out = tmp_path_factory.mktemp("maps") / "scene.html"
+    maps.candidates_map(res, fremantle, out, offline=True, scene=scene)
+    return out.read_text(encoding="utf-8")
+
+
+def test_offline_page_is_self_contained(offline_page: str) -> None:
+    assert remote_references(offline_page) == []
+    assert "<script>" in offline_page
+    assert "L.map(" in offline_page  # folium's map script
+    assert "window.L" in offline_page or "leaflet" in offline_page.lower()  # Leaflet inlined
+    assert "jQuery" in offline_page
+    assert "bootstrap" not in offline_page.lower()
+    assert "awesome-markers" not in offline_page.lower()
+    assert "url(images/" not in offline_page  # Leaflet's images are data URIs
+
+
+def test_offline_page_fits_the_size_budget(offline_page: str) -> None:
+    assert len(offline_page.encode("utf-8")) < 1_500_000
+
+
+def test_one_marker_per_candidate_and_every_property_in_popups(
+    offline_page: str, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    _scene, res = scene_result
+    n = len(res.candidates)
+    assert n >= 2
+    assert len(div_icons(offline_page, "camloc-candidate")) == n
+    gj = candidates_geojson(res)
+    best = gj["features"][0]["properties"]
+    for key in (*CONTRACT, "sigma_m", "flags", "scale", "merged", "refined"):
+        assert f"<th>{key}</th>" in offline_page, key
+    assert f"<td>{best['lat']:.7f}°</td>" in offline_page
+    assert "data:image/png;base64," in offline_page  # overlay thumbnails embedded
+    assert "camloc-legend" in offline_page
+    assert "L.control.scale" in offline_page
+    assert "L.control.layers" in offline_page
+
+
+def test_scene_corner_numbers_label_the_matched_map_corners(
+    offline_page: str, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    _scene, res = scene_result
+    best = res.candidates[0]
+    assert res.intersection is not None
+    labels = [re.sub(r"<[^>]+>", "", h) for h in div_icons(offline_page, "camloc-corner-label")]
+    assert best.matches
+    for i, m in enumerate(best.matches):
+        assert m["label"] == f"intersection.corners[{i}]"
+        assert str(i) in labels  # the scene's index labels the matched map corner
+    for corner in res.intersection.corners:
+        assert f"m{corner.order}" in labels
+
+
+def test_online_page_has_osm_tiles_and_links_overlays(
+    tmp_path: Path, fremantle: MapData, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    scene, res = scene_result
+    out = tmp_path / "html" / "online.html"
+    maps.candidates_map(res, fremantle, out, scene=scene, overlay_dir=str(tmp_path / "png"))
+    page = out.read_text(encoding="utf-8")
+    assert "tile.openstreetmap.org" in page
+    assert "openstreetmap.org/copyright" in page  # tile attribution
+    pngs = sorted((tmp_path / "png").glob("*.png"))
+    assert len(pngs) == min(5, len(res.candidates))
+    assert f'src="../png/{pngs[0].name}"' in page
+    assert "base64" not in page
+    img = cv2.imread(str(pngs[0]))
+    assert img is not None
+    assert img.shape[:2] == (1080, 1920)
+
+
+def test_page_without_map_data(tmp_path: Path, fremantle: MapData) -> None:
+    inter = next(i for i in fremantle.intersections if i.kind == "junction")
+    ls = make_located_scene(
+        fremantle,
+        inter,
+        np.random.default_rng(4),
+        n_references=2,
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+    )
+    assert ls is not None
+    del ls.scene["intersection"]
+    scene = parse_scene(ls.scene)
+    res = locate(scene, None)
+    assert res.candidates
+    out = maps.candidates_map(res, None, tmp_path / "refs.html", offline=True, scene=scene)
+    page = out.read_text(encoding="utf-8")
+    assert remote_references(page) == []
+    assert len(div_icons(page, "camloc-candidate")) == len(res.candidates)
+
+
+def test_size_budget_shrinks_photo_overlays(tmp_path: Path, fremantle: MapData) -> None:
+    scene, _res = located(fremantle, 1)
+    noise = np.random.default_rng(0).integers(0, 255, (1080, 1920, 3), dtype=np.uint8)
+    cv2.imwrite(str(tmp_path / "snap.png"), noise)  # incompressible "photo"
+    data = scene.model_dump(mode="json", exclude_none=True)
+    data["image"]["path"] = "snap.png"
+    scene = parse_scene(data, base_dir=tmp_path)
+    res = locate(scene, fremantle)
+    out = maps.candidates_map(res, fremantle, tmp_path / "photo.html", offline=True, scene=scene)
+    size = out.stat().st_size
+    assert size < maps.MAX_PAGE_BYTES
+    assert "data:image/png;base64," in out.read_text(encoding="utf-8")
+
+
+def test_inline_assets_refuses_remote_leftovers() -> None:
+    page = (
+        '<html><head><script src="https://cdn.jsdelivr.net/npm/leaflet@1.9.3/dist/leaflet.js">'
+        '</script></head><body><img src="https://example.org/x.png"></body></html>'
+    )
+    with pytest.raises(ValueError, match="remote"):
+        maps.inline_assets(page)
+    ok = maps.inline_assets(page.replace('<img src="https://example.org/x.png">', ""))
+    assert "cdn.jsdelivr" not in ok
+
+
+def test_score_scale_is_ordered() -> None:
+    scores = [0.9, 0.3, 0.1, 0.02, 0.001]
+    colours = [maps.score_colour(s) for s in scores]
+    assert colours == [c for _l, c, _t in maps.SCORE_SCALE]
+    sizes = [maps.rank_style(r)[0] for r in (1, 2, 5)]
+    assert sizes == sorted(sizes, reverse=True)
+    z = [maps.rank_style(r)[2] for r in (1, 2, 3, 4, 40)]
+    assert z == sorted(z, reverse=True)
+
+
+def test_summary_map_best_candidate_per_camera(
+    tmp_path: Path, fremantle: MapData, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    _scene, res0 = scene_result
+    _s1, res1 = located(fremantle, 2)
+    empty = {"type": "FeatureCollection", "features": [], "properties": {"reason": "no evidence"}}
+    items = [("cam-a", candidates_geojson(res0)), ("cam-b", res1), ("cam-c", empty)]
+    out = maps.summary_map(items, tmp_path / "summary.html", offline=True)
+    page = out.read_text(encoding="utf-8")
+    assert remote_references(page) == []
+    assert len(div_icons(page, "camloc-summary-marker")) == 2
+    assert "cam-a" in page
+    assert "cam-b" in page
+    assert "1 without candidates: cam-c" in page
+    online = maps.summary_map(items, tmp_path / "summary_online.html").read_text(encoding="utf-8")
+    assert "markercluster" in online.lower()
+
+
+def test_cli_locate_writes_offline_map(tmp_path: Path, fremantle: MapData) -> None:
+    inter = next(i for i in fremantle.intersections if i.kind == "junction" and len(i.corners) >= 4)
+    ls = make_located_scene(fremantle, inter, np.random.default_rng(7), min_corners=3)
+    assert ls is not None
+    scene_file = tmp_path / "scene.json"
+    scene_file.write_text(json.dumps(ls.scene), encoding="utf-8")
+    out = tmp_path / "map.html"
+    rc = main(
+        [
+            "locate",
+            str(scene_file),
+            "--osm",
+            str(SAMPLES / "fremantle.osm"),
+            "--offline",
+            "--map",
+            str(out),
+            "--overlays",
+            str(tmp_path / "ov"),
+            "-o",
+            str(tmp_path / "c.geojson"),
+        ]
+    )
+    assert rc == 0
+    page = out.read_text(encoding="utf-8")
+    assert remote_references(page) == []
+    n = sum(
+        f["properties"]["kind"] == "candidate"
+        for f in json.loads((tmp_path / "c.geojson").read_text())["features"]
+    )
+    assert len(div_icons(page, "camloc-candidate")) == n
+    assert list((tmp_path / "ov").glob("*.png"))
