@@ -167,3 +167,21 @@ def test_empty_response_is_map_data_error(
             overpass_url=url,
             overpass_rate_limit=False,
         )
+
+
+def test_non_json_answer_is_map_source_error(
+    overpass_server: tuple[str, type[_Handler]], tmp_path: Path
+) -> None:
+    url, handler = overpass_server
+    handler.responses = dict.fromkeys(("streets", "buildings"), b"<html>rate limited</html>")
+    clear_cache()
+    with pytest.raises(MapSourceError, match="Overpass"):
+        load_map(
+            None,
+            11.0,
+            11.0,
+            100,
+            cache_folder=tmp_path,
+            overpass_url=url,
+            overpass_rate_limit=False,
+        )

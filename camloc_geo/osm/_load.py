@@ -377,6 +377,10 @@ def read_overpass(
             except ox._errors.InsufficientResponseError:
                 features = None
     except ox._errors.InsufficientResponseError as exc:
+        if "responded" in str(exc):  # osmnx: the reply was not JSON (an error page)
+            raise MapSourceError(
+                f"unreadable answer from the Overpass server for {where}: {exc}"
+            ) from exc
         raise MapDataError(
             f"Overpass returned no streets within {radius_m:.0f} m of {where}"
         ) from exc
