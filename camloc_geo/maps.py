@@ -45,6 +45,7 @@ from camloc_geo import overlay as _overlay
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult
+    from camloc_geo.geodesy import LocalFrame
     from camloc_geo.osm import MapData
     from camloc_geo.scene import Scene
 
@@ -188,7 +189,8 @@ _PAGE_CSS = """
 .camloc-popup table { border-collapse: collapse; }
 .camloc-popup td, .camloc-popup th { padding: 1px 6px 1px 0; text-align: left;
   vertical-align: top; }
-.camloc-popup img { display: block; max-width: 100%; margin-top: 6px; border: 1px solid #999; }
+.camloc-popup img { display: block; width: 460px; max-width: 100%; margin-top: 6px;
+  border: 1px solid #999; }
 """
 
 
@@ -295,9 +297,9 @@ def _focus(result: LocateResult, candidates: list[dict[str, Any]]) -> tuple[np.n
 
 
 def _map_layers(
-    fmap: folium.Map, map_data: MapData, result: LocateResult, centre: np.ndarray, radius: float
+    fmap: folium.Map, map_data: MapData, frame: LocalFrame, centre: np.ndarray, radius: float
 ) -> None:
-    frame = result.frame
+    """Carriageways, street centre lines and buildings within ``radius`` of ``centre``."""
     disc = Point(float(centre[0]), float(centre[1])).buffer(radius, quad_segs=16)
     carriage = _overlay.carriageways_enu(map_data.streets, frame, centre, radius)
     geom = _geom_lonlat(carriage, frame)
@@ -436,8 +438,8 @@ def _candidate_popup(
 def _dot_icon(label: str, fill: str, size: int, outline: float, css_class: str) -> folium.DivIcon:
     text = _text_colour(fill)
     inner = (
-        f'<div class="camloc-dot" style="background:{fill};color:{text};'
-        f'border-width:{outline}px">{html.escape(label)}</div>'
+        f'<div class="camloc-dot" data-rank="{html.escape(label)}" style="background:{fill};'
+        f'color:{text};border-width:{outline}px">{html.escape(label)}</div>'
     )
     return folium.DivIcon(
         html=inner, icon_size=(size, size), icon_anchor=(size // 2, size // 2), class_name=css_class
@@ -535,7 +537,7 @@ def build_candidates_map(
     fmap = _new_map(offline, None if offline else tiles, (float(lat0), float(lon0)))
 
     if map_data is not None:
-        _map_layers(fmap, map_data, result, centre_en, radius)
+        _map_layers(fmap, map_data, result.frame, centre_en, radius)
 
     if scene is not None and scene.prior is not None and scene.prior.radius_m:
         fg_prior = folium.FeatureGroup(name="Prior area", show=True)
@@ -561,7 +563,7 @@ def build_candidates_map(
             "color": colour,
             "weight": 2.5 if rank == 1 else 1.0,
             "fillColor": colour,
-            "fillOpacity": 0.12 + 0.3 * min(score, 1.0),
+            "fillOpacity": 0.06 + 0.16 * min(score, 1.0),
             "opacity": 0.9,
         }
         folium.GeoJson(
@@ -647,7 +649,7 @@ def build_candidates_map(
         size, outline, z = rank_style(rank)
         img = (overlay_images or {}).get(rank)
         link = (overlay_links or {}).get(rank)
-        popup = folium.Popup(_candidate_popup(p, img, link), max_width=520 if img else 360)
+        popup = folium.Popup(_candidate_popup(p, img, link), max_width=500 if img else 360)
         folium.Marker(
             [p["lat"], p["lon"]],
             icon=_dot_icon(str(rank), score_colour(p["score"]), size, outline, "camloc-candidate"),
@@ -872,6 +874,7 @@ def build_summary_map(
     offline: bool = False,
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
+    map_data: MapData | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -886,6 +889,9 @@ def build_summary_map(
         Basemap for online pages.
     cluster
         Cluster markers (online pages only; ``leaflet.markercluster`` from its CDN).
+    map_data
+        A map to draw under the cameras (streets and buildings within 400 m of their
+        centre): the only context an offline page has.
     """
     rows = []
     missing = []
@@ -902,6 +908,13 @@ def build_summary_map(
     else:
         location = (0.0, 0.0)
     fmap = _new_map(offline, None if offline else tiles, location)
+    if map_data is not None and rows:
+        from camloc_geo.geodesy import LocalFrame
+
+        frame = LocalFrame(*location)
+        en = frame.points_enu_from_geographic(np.column_stack([lons, lats]))
+        radius = float(min(np.max(np.linalg.norm(en, axis=1)) + 100.0, 400.0))
+        _map_layers(fmap, map_data, frame, np.zeros(2), radius)
     parent: Any
     if cluster and not offline:
         from folium.plugins import MarkerCluster
@@ -971,6 +984,7 @@ def summary_map(
     offline: bool = False,
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
+    map_data: MapData | None = None,
 ) -> Path:
     """Write the summary map of many cameras; see :func:`build_summary_map`.
 
@@ -981,7 +995,10 @@ def summary_map(
     """
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    page = _render(build_summary_map(items, offline=offline, tiles=tiles, cluster=cluster), offline)
+    fmap = build_summary_map(
+        items, offline=offline, tiles=tiles, cluster=cluster, map_data=map_data
+    )
+    page = _render(fmap, offline)
     out.write_text(page, encoding="utf-8")
     log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
     return out
