@@ -86,6 +86,8 @@ INFINITY_TOL_DEG = 0.05
 _F_PRIOR_REL = 1.0
 _F_PRIOR_SIGMA = 1.0
 _PP_SIGMA_REL = 0.03
+#: Number of distinct best hypotheses refined.
+_N_REFINED = 3
 #: Inlier distance (px per 800 px of image diagonal) of segment end points.
 _TAU_PER_800 = 1.5
 #: Final labelling: distance (in inlier distances) and angle limits.
@@ -835,8 +837,9 @@ def detect_vanishing_points(
         if any(_same_frame(R0, Rt) for Rt in tried):
             continue
         tried.append(R0)
-        models.append(_fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds))
-        if len(tried) >= 3:
+        # one round each: enough to rank the candidates
+        models.append(_fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds, rounds=1))
+        if len(tried) >= _N_REFINED:
             break
 
     def model_weight(m: _Model) -> float:
@@ -848,6 +851,9 @@ def detect_vanishing_points(
         return wgt
 
     best = max(models, key=model_weight)
+    best = _fit(
+        best.R, best.f_n, s, tau, f_fixed is None, f_prior, f_bounds, rounds=2, labels0=best.labels
+    )
     if estimate_principal_point and principal_point is None:
         # Free the principal point around the image centre (a Gaussian prior), on the
         # final inliers.
@@ -975,11 +981,16 @@ def _fit(
     f_free: bool,
     f_prior: float,
     f_bounds: tuple[float, float],
+    rounds: int = 3,
+    labels0: npt.NDArray[np.int64] | None = None,
 ) -> _Model:
     R, f = R0, f0
     logf_std = float("nan")
-    labels, score = _labels(R, f, s, 2.0 * tau, 5.0)
-    for _ in range(3):
+    if labels0 is None:
+        labels, score = _labels(R, f, s, 2.0 * tau, 5.0)
+    else:
+        labels, score = labels0, 0.0
+    for _ in range(rounds):
         if np.count_nonzero(labels >= 0) < 4:
             break
         R, f, logf_std, _ = _refine(R, f, s, labels, tau, f_free, f_prior, f_bounds)
