@@ -189,7 +189,7 @@ def summarise(rows: list[dict[str, Any]], with_focal: bool) -> dict[str, Any]:
         "dir_err_median_of_image_means_deg": float(np.median([np.mean(r["dir_err"]) for r in ok]))
         if ok
         else None,
-        "share_dir_err_below_2deg": float(np.mean([max(r["dir_err"]) < 2 for r in rows if ok]))
+        "share_dir_err_below_2deg": float(np.mean([max(r["dir_err"]) < 2 for r in ok]))
         if ok
         else None,
         "dir_err_orth_median_deg": float(np.median([e for r in ok for e in r["dir_err_orth"]]))
