@@ -890,7 +890,7 @@ def build_summary_map(
     cluster
         Cluster markers (online pages only; ``leaflet.markercluster`` from its CDN).
     map_data
-        A map to draw under the cameras (streets and buildings within 400 m of their
+        A map to draw under the cameras (its streets and buildings within 500 m of its
         centre): the only context an offline page has.
     """
     rows = []
@@ -908,13 +908,9 @@ def build_summary_map(
     else:
         location = (0.0, 0.0)
     fmap = _new_map(offline, None if offline else tiles, location)
-    if map_data is not None and rows:
-        from camloc_geo.geodesy import LocalFrame
-
-        frame = LocalFrame(*location)
-        en = frame.points_enu_from_geographic(np.column_stack([lons, lats]))
-        radius = float(min(np.max(np.linalg.norm(en, axis=1)) + 100.0, 400.0))
-        _map_layers(fmap, map_data, frame, np.zeros(2), radius)
+    if map_data is not None:
+        radius = float(min(getattr(map_data, "radius_m", 400.0) or 400.0, 500.0))
+        _map_layers(fmap, map_data, map_data.frame, np.zeros(2), radius)
     parent: Any
     if cluster and not offline:
         from folium.plugins import MarkerCluster
