@@ -789,6 +789,12 @@ def detect_vanishing_points(
         raise InputError("give an image, or segments with image_size")
     if focal_px is not None and not (math.isfinite(focal_px) and focal_px > 0):
         raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
+    if principal_point is not None and not (
+        np.shape(principal_point) == (2,) and np.all(np.isfinite(principal_point))
+    ):
+        raise InputError(f"principal_point must be two finite numbers, got {principal_point!r}")
+    if max_iterations < 1:
+        raise InputError(f"max_iterations must be positive, got {max_iterations}")
     if segments is None:
         assert gray is not None
         segs_px = detect_segments(gray, mask=mask)

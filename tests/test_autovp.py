@@ -304,6 +304,10 @@ def test_bad_arrays_and_focal() -> None:
         detect_vanishing_points(np.zeros((10, 10, 2)))
     with pytest.raises(InputError):
         detect_vanishing_points(np.zeros((100, 100)), focal_px=-3.0)
+    with pytest.raises(InputError, match="principal_point"):
+        detect_vanishing_points(np.zeros((100, 100)), principal_point=(np.nan, 3.0))
+    with pytest.raises(InputError, match="max_iterations"):
+        detect_vanishing_points(np.zeros((100, 100)), max_iterations=0)
 
 
 def test_detect_segments_convention() -> None:
