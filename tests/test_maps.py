@@ -260,3 +260,42 @@ def test_cli_locate_writes_offline_map(tmp_path: Path, fremantle: MapData) -> No
     )
     assert len(div_icons(page, "camloc-candidate")) == n
     assert list((tmp_path / "ov").glob("*.png"))
+
+
+def test_cli_summary_map(
+    tmp_path: Path, fremantle: MapData, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    _scene, res = scene_result
+    a = tmp_path / "a.geojson"
+    a.write_text(json.dumps(candidates_geojson(res)), encoding="utf-8")
+    empty = tmp_path / "b.geojson"
+    empty.write_text(json.dumps({"type": "FeatureCollection", "features": []}), encoding="utf-8")
+    out = tmp_path / "s.html"
+    rc = main(
+        [
+            "summary-map",
+            str(a),
+            str(empty),
+            "-o",
+            str(out),
+            "--offline",
+            "--osm",
+            str(SAMPLES / "fremantle.osm"),
+        ]
+    )
+    assert rc == 0
+    page = out.read_text(encoding="utf-8")
+    assert remote_references(page) == []
+    assert len(div_icons(page, "camloc-summary-marker")) == 1
+    assert res.scene_id in page
+    assert "1 without candidates: b" in page
+    assert "Buildings" in page
+
+
+def test_cli_summary_map_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.geojson"
+    bad.write_text("[1, 2]", encoding="utf-8")
+    assert main(["summary-map", str(bad), "-o", str(tmp_path / "x.html")]) == 2
+    err = capsys.readouterr().err
+    assert "not a GeoJSON FeatureCollection" in err
+    assert "Traceback" not in err
