@@ -1,0 +1,74 @@
+"""`calibrate` fills an axis an annotator drew no lines for from the scene's image."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from camloc_geo import SceneError
+from camloc_geo.camera import Camera, rotation_from_angles
+from camloc_geo.relative import calibrate
+from camloc_geo.scene import load_scene
+from camloc_geo.synthetic import NoiseModel, make_scene
+
+
+def _camera() -> Camera:
+    centre = np.array([-12.0, -9.0, 6.0])
+    fwd = np.array([2.3, 0.9, 0.7]) - centre
+    heading = math.degrees(math.atan2(fwd[0], fwd[1]))
+    pitch = math.degrees(math.atan2(-fwd[2], math.hypot(fwd[0], fwd[1])))
+    return Camera.from_center(1200.0, (640.0, 360.0), rotation_from_angles(heading, pitch, 2.0), centre)
+
+
+def _render(cam: Camera, size: tuple[int, int]) -> np.ndarray:
+    """A grey image of box-like buildings: edges along the three world axes."""
+    w, h = size
+    img = np.full((h, w, 3), 90, np.uint8)
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        x0, y0 = rng.uniform(-10, 30), rng.uniform(6, 30)
+        dx, dy, hz = rng.uniform(3, 10), rng.uniform(3, 8), rng.uniform(4, 15)
+        corners = [(x0, y0), (x0 + dx, y0), (x0 + dx, y0 + dy), (x0, y0 + dy)]
+        edges = []
+        for i in range(4):
+            a, b = corners[i], corners[(i + 1) % 4]
+            edges += [((*a, 0.0), (*b, 0.0)), ((*a, hz), (*b, hz)), ((*a, 0.0), (*a, hz))]
+        for a, b in edges:
+            pa, pb = cam.project(np.array(a)), cam.project(np.array(b))
+            if np.all(np.isfinite(pa)) and np.all(np.isfinite(pb)):
+                cv2.line(img, tuple(int(v) for v in pa), tuple(int(v) for v in pb), (230, 230, 230), 2,
+                         cv2.LINE_AA)
+    return img
+
+
+def test_missing_height_lines_come_from_the_image(tmp_path: Path) -> None:
+    cam = _camera()
+    size = (1280, 720)
+    syn = make_scene(cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1,
+                     image_size=size)
+    scene = syn.scene
+    scene["annotations"][0]["vp_lines"]["height"] = []
+    cv2.imwrite(str(tmp_path / "snap.png"), _render(cam, size))
+    scene["image"]["path"] = "snap.png"
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    result = calibrate(load_scene(path))
+    err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
+    assert err < 0.05 * np.linalg.norm(cam.center_in_world)
+    assert abs(result.camera.focal_px - cam.focal_px) < 0.05 * cam.focal_px
+
+
+def test_missing_lines_without_image_is_a_clear_error(tmp_path: Path) -> None:
+    cam = _camera()
+    syn = make_scene(cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1,
+                     image_size=(1280, 720))
+    syn.scene["annotations"][0]["vp_lines"]["height"] = []
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(syn.scene))
+    with pytest.raises(SceneError, match=r"annotations\[0\]\.vp_lines\.height.*at least 2"):
+        calibrate(load_scene(path))
