@@ -104,6 +104,14 @@ class LocateSettings:
     bearing_sigma_deg
         Spread of the car's heading around a street's bearing (the car-parallel-to-street
         prior); ``parallel_floor`` is the prior weight of a car not parallel to any street.
+    fit_gate
+        A candidate whose matched points' mean squared Mahalanobis misfit exceeds this is
+        flagged ``poor_fit``; when every candidate is, none is returned (the evidence fits
+        no hypothesis). 16: four standard deviations RMS (the noise model is generous: on
+        the benchmark the right candidate's mean stays below 10).
+    prior_gate_radii
+        Hypotheses farther than this many ``prior.radius_m`` from the prior are dropped;
+        when all are, none is returned (the evidence contradicts the prior).
     """
 
     sigma_pixel_rel: float = 0.0015
@@ -123,6 +131,8 @@ class LocateSettings:
     occluded_corner_factor: float = 0.5
     street_search_m: float = 25.0
     view_cone_range_m: float = 60.0
+    fit_gate: float = 16.0
+    prior_gate_radii: float = 3.0
 
 
 @dataclass(frozen=True)
@@ -329,7 +339,8 @@ def _score(
         d = s * R2 @ obs.world_xy + T - q
         sq.append(float(d @ d))
         matches.append({"kind": "reference", "label": obs.label, "pixel": list(obs.pixel),
-                        "map_en": q.tolist(), "misfit_m": float(np.linalg.norm(d))})
+                        "map_en": q.tolist(), "misfit_m": float(np.linalg.norm(d)),
+                        "mahalanobis2": float(m2)})
     if ev.corners and len(ev.map_corners):
         if corner_assignment is None:
             corner_assignment = _best_assignment(theta, T, s, ev)
@@ -341,7 +352,8 @@ def _score(
             sq.append(float(d @ d))
             matches.append({"kind": "corner", "label": obs.label, "pixel": list(obs.pixel),
                             "map_en": q.tolist(), "map_corner": ev.map_corner_ids[j],
-                            "order": int(j), "misfit_m": float(np.linalg.norm(d))})
+                            "order": int(j), "misfit_m": float(np.linalg.norm(d)),
+                            "mahalanobis2": float(m2)})
     for obs, pts in ev.landmarks:
         m2s = [_mahal(obs, q, theta, T, s) for q in pts]
         k = int(np.argmin(m2s))
@@ -349,7 +361,8 @@ def _score(
         d = s * R2 @ obs.world_xy + T - pts[k]
         sq.append(float(d @ d))
         matches.append({"kind": "landmark", "label": obs.label, "pixel": list(obs.pixel),
-                        "map_en": pts[k].tolist(), "misfit_m": float(np.linalg.norm(d))})
+                        "map_en": pts[k].tolist(), "misfit_m": float(np.linalg.norm(d)),
+                        "mahalanobis2": float(m2s[k])})
     ll -= 0.5 * ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
     rms = math.sqrt(sum(sq) / len(sq)) if sq else math.nan
     return ll, rms, matches, sq
@@ -585,6 +598,9 @@ def _plausibility(
             flags.append("car_not_parallel_to_street")
     if ev.worst_reference is not None:
         flags.append(f"worst_reference:{ev.worst_reference}")
+    m2 = [m["mahalanobis2"] for m in matches]
+    if m2 and sum(m2) / len(m2) > settings.fit_gate:
+        flags.append("poor_fit")
     return factor, flags
 
 
@@ -943,6 +959,24 @@ def locate(
             Candidate(h.method, h.theta, h.T, h.s, cam, log_likelihood=ll + h.log_prior,
                       prior=plaus, residual_m=rms, matches=matches, flags=flags)
         )
+    if ev.prior_en is not None and ev.prior_radius_m:
+        limit = settings.prior_gate_radii * ev.prior_radius_m
+        dist = [float(np.linalg.norm(c.east_north - ev.prior_en)) for c in cands]
+        near = [c for c, d in zip(cands, dist, strict=True) if d <= limit]
+        if not near:
+            result.reason = (
+                f"every hypothesis puts the camera more than {limit:.0f} m "
+                f"({settings.prior_gate_radii:g} x prior.radius_m) from the prior, the nearest "
+                f"{min(dist):.0f} m: the {', '.join(result.methods_tried)} evidence contradicts "
+                "the prior (or the calibration is wrong: it puts the camera "
+                f"{float(np.linalg.norm(world_cam.center_in_world[:2])):.0f} m from the car)"
+            )
+            return result
+        if len(near) < len(cands):
+            result.warnings.append(
+                f"{len(cands) - len(near)} hypotheses more than {limit:.0f} m from the prior dropped"
+            )
+        cands = near
     cands = _normalise_and_merge(cands, settings)
     # Refine the leaders, then score again.
     for i in range(min(settings.refine_top, len(cands))):
@@ -954,6 +988,15 @@ def locate(
         )
         cands[i] = replace(c, log_likelihood=ll, prior=plaus, residual_m=rms, matches=matches, flags=flags)
     cands = _normalise_and_merge(cands, settings)[: settings.max_candidates]
+    if all("poor_fit" in c.flags for c in cands):
+        best = min(cands, key=lambda c: c.residual_m)
+        result.reason = (
+            f"no hypothesis fits the {', '.join(result.methods_tried)} evidence: the best misfits "
+            f"by {best.residual_m:.1f} m RMS, more than {math.sqrt(settings.fit_gate):.0f} "
+            "standard deviations of the noise model (wrong intersection, corners out of order, "
+            "or a wrong calibration?)"
+        )
+        return result
     total = sum(c.score for c in cands) or 1.0
     for rank, c in enumerate(cands, start=1):
         c.score = c.score / total
