@@ -73,6 +73,7 @@ COLOURS: dict[str, tuple[int, int, int]] = {
     "horizon": (160, 160, 160),
     "annotated": (60, 230, 60),  # green
     "projected": (40, 40, 255),  # red
+    "map_corner": (255, 140, 30),  # blue
     "text": (255, 255, 255),
 }
 
@@ -462,6 +463,7 @@ def render_overlay(
     *,
     background: ImageArray | None = None,
     points: Sequence[OverlayPoint] = (),
+    map_corners: Sequence[tuple[str, FloatArray]] = (),
     title: str | None = None,
 ) -> ImageArray:
     """Draw map features and matched points into an image.
@@ -478,6 +480,9 @@ def render_overlay(
         The snapshot (BGR), resized to ``image_size`` if needed; a dark blank canvas when None.
     points
         Annotated pixels with their matched map points (:func:`overlay_points`).
+    map_corners
+        ``(label, pixel)`` of the intersection's kerb corners (all of them, matched or not);
+        non-finite pixels are skipped.
     title
         A caption drawn in the top-left corner.
 
@@ -518,6 +523,16 @@ def render_overlay(
             _draw_polyline(img, px, COLOURS["kerb"], thick)
     scale = 0.45 * unit
     r = round(6 * unit)
+    matched = {p.map_label for p in points}
+    for label, px in map_corners:
+        if not np.all(np.isfinite(px)) or not (-r <= px[0] <= w + r and -r <= px[1] <= h + r):
+            continue
+        ic = _to_cv(np.asarray(px, dtype=float), 0)
+        cv2.circle(
+            img, (int(ic[0]), int(ic[1])), max(2, r // 2), COLOURS["map_corner"], -1, cv2.LINE_AA
+        )
+        if label not in matched:
+            _label(img, label, px + np.array([-3.5 * r, 2.2 * r]), COLOURS["map_corner"], scale)
     for p in points:
         a = p.annotated_px
         q = p.projected_px
@@ -549,6 +564,7 @@ def _draw_key(img: ImageArray, unit: float, title: str | None) -> None:
         ("roof", "roofline (known height)"),
         ("annotated", "annotated pixel (scene index)"),
         ("projected", "matched map point (m = map corner)"),
+        ("map_corner", "map kerb corner (clockwise order)"),
     ]
     scale = 0.42 * unit
     line_h = round(18 * unit)
@@ -634,12 +650,18 @@ def candidate_overlay(
     title = (
         f"{result.scene_id}: rank {candidate.rank}, score {candidate.score:.3f}, {candidate.method}"
     )
+    corners: list[tuple[str, FloatArray]] = []
+    if result.intersection is not None and result.intersection.corners:
+        en = result.intersection.corners_enu(result.frame)
+        px = project_ground_points(candidate.camera, en)
+        corners = [(f"m{c.order}", px[i]) for i, c in enumerate(result.intersection.corners)]
     img = render_overlay(
         candidate.camera,
         size,
         features,
         background=background,
         points=overlay_points(candidate, result),
+        map_corners=corners,
         title=title,
     )
     if path is not None:
