@@ -168,11 +168,13 @@ def _plot(results: dict[str, Any], png: Path) -> None:
     width = 0.8 / len(cases)
     for i, case in enumerate(cases):
         xs = [k + i * width for k in range(len(names))]
-        ax_t.bar(xs, [results["extracts"][n][case]["seconds"] for n in names], width, label=case)
+        ax_t.bar(
+            xs, [results["extracts"][n][case]["cpu_seconds"] for n in names], width, label=case
+        )
         ax_m.bar(
             xs, [results["extracts"][n][case]["peak_rss_mib"] for n in names], width, label=case
         )
-    for ax, title in ((ax_t, "time (s)"), (ax_m, "peak RSS (MiB)")):
+    for ax, title in ((ax_t, "CPU time (s)"), (ax_m, "peak RSS (MiB)")):
         ax.set_xticks([k + 0.4 - width / 2 for k in range(len(names))], names)
         ax.set_title(title)
     ax_t.legend(fontsize=8)
