@@ -355,8 +355,15 @@ def make_located_scene(
         if len(vis) < min_corners or _blocked(buildings, cam_xy, car_centre):
             continue
         vis = vis[:max_corners] if len(vis) <= max_corners else sorted(rng.choice(vis, max_corners, replace=False).tolist())
-        # Clockwise on screen = map order; start the list at a random visible corner.
-        start = int(rng.integers(len(vis)))
+        # Clockwise on screen = map order. All corners seen: the list may start anywhere.
+        # Part of them: a person lists the visible arc clockwise from its first corner, so
+        # the list starts after the widest gap (two corners are not listed the long way round).
+        if len(vis) < len(real_corners):
+            nc = len(real_corners)
+            gaps = [(vis[(i + 1) % len(vis)] - vis[i]) % nc or nc for i in range(len(vis))]
+            start = (int(np.argmax(gaps)) + 1) % len(vis)
+        else:
+            start = int(rng.integers(len(vis)))
         vis = vis[start:] + vis[:start]
         R_world = cam_enu.cam_from_world_rotation @ Rw
         C_world = Rw.T @ (cam_enu.center_in_world - np.array([*o, 0.0]))

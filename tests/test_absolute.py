@@ -417,3 +417,16 @@ def test_located_scenes_can_be_calibrated(maps: dict[str, MapData]) -> None:
         ls = exact_located(m, inter, seed=10 + k)
         cal = calibrate(parse_scene(ls.scene))
         assert cal.camera.focal_px == pytest.approx(ls.camera_world.focal_px, rel=1e-6)
+
+
+def test_located_scenes_list_a_partial_view_as_its_clockwise_arc(maps: dict[str, MapData]) -> None:
+    """Two of four corners seen are listed the short way round, as a person would."""
+    m = maps["baltimore"]
+    for k, inter in enumerate(junctions(m)[:6]):
+        n = len(inter.corners)
+        for seed in range(3):
+            ls = exact_located(m, inter, seed=100 * k + seed, max_corners=n - 1)
+            vis = ls.visible_corner_orders
+            steps = [(vis[(i + 1) % len(vis)] - vis[i]) % n for i in range(len(vis))]
+            # The wrap-around step (last back to first) crosses the unseen corners.
+            assert steps[-1] == max(steps), (inter.id, vis)
