@@ -189,7 +189,7 @@ _PAGE_CSS = """
 .camloc-popup table { border-collapse: collapse; }
 .camloc-popup td, .camloc-popup th { padding: 1px 6px 1px 0; text-align: left;
   vertical-align: top; }
-.camloc-popup img { display: block; width: 460px; max-width: 100%; margin-top: 6px;
+.camloc-popup img { display: block; width: 460px; margin-top: 6px;
   border: 1px solid #999; }
 """
 

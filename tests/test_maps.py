@@ -299,3 +299,17 @@ def test_cli_summary_map_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture
     err = capsys.readouterr().err
     assert "not a GeoJSON FeatureCollection" in err
     assert "Traceback" not in err
+
+
+def test_page_without_candidates_says_why(
+    tmp_path: Path, fremantle: MapData, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    from dataclasses import replace
+
+    scene, res = scene_result
+    empty = replace(res, candidates=[], reason="every candidate misfits")
+    page = maps.candidates_map(empty, fremantle, tmp_path / "none.html", offline=True, scene=scene)
+    text = page.read_text(encoding="utf-8")
+    assert div_icons(text, "camloc-candidate") == []
+    assert "no candidates" in text
+    assert "every candidate misfits" in text
