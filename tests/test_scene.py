@@ -88,7 +88,10 @@ def test_contract_example_parses() -> None:
             "malformed JSON in bad_nan_pixel.json: NaN is not a number JSON allows",
         ),
         ("bad_malformed.json", "malformed JSON in bad_malformed.json at line 37, column"),
-        ("bad_unknown_preset.json", "object.preset: unknown object preset 'limousine'; known: bus,"),
+        (
+            "bad_unknown_preset.json",
+            "object.preset: unknown object preset 'limousine'; known: bus,",
+        ),
     ],
 )
 def test_bad_scene_files(filename: str, message: str) -> None:
@@ -173,7 +176,9 @@ def test_unknown_preset_is_rejected_when_the_scene_is_read(good: dict[str, Any])
     """Not only when the size is first used (a scene with references may never use it)."""
     data = copy.deepcopy(good)
     data["object"] = {"preset": "limousine", "length_m": 5.0}
-    with pytest.raises(SceneError, match="^object.preset: unknown object preset 'limousine'") as info:
+    with pytest.raises(
+        SceneError, match=r"^object\.preset: unknown object preset 'limousine'"
+    ) as info:
         parse_scene(data)
     assert info.value.field == "object.preset"
 
