@@ -876,16 +876,21 @@ def locate(
     if scene.street_bearing_deg is not None:
         bearings = [scene.street_bearing_deg]
     elif map_data is not None:
-        spots = [(q, "reference") for _, q in refs]
+        spots = [(q, settings.street_search_m) for _, q in refs]
         if inter is not None:
-            spots.append((np.array(frame.enu_from_geographic(inter.lon, inter.lat)), "intersection"))
+            spots.append((np.array(frame.enu_from_geographic(inter.lon, inter.lat)),
+                          settings.street_search_m))
         for _, pts in landmarks:
-            spots.append((pts.mean(axis=0), "landmark"))
+            # The streets along any side of the building, not only near its centre.
+            mid = pts.mean(axis=0)
+            reach = float(np.max(np.linalg.norm(pts - mid, axis=1)))
+            spots.append((mid, settings.street_search_m + reach))
         if not spots and scene.prior is not None:
-            spots.append((np.zeros(2), "prior"))
-        for q, _why in spots:
+            spots.append((np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat)),
+                          settings.street_search_m))
+        for q, radius in spots:
             lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
-            for _name, b in map_data.street_bearings(float(lat), float(lon), settings.street_search_m):
+            for _name, b in map_data.street_bearings(float(lat), float(lon), radius):
                 bearings.append(b)
     bearings = _unique_bearings(bearings)
 
@@ -939,6 +944,8 @@ def locate(
         hyps += _gen_corners(ev, settings)
     if scene.landmarks:
         result.methods_tried.append("landmark")
+        if len(landmarks) == 1 and not bearings:
+            result.warnings.append("landmark: one landmark and no street bearing (scene or map) near it")
         hyps += _gen_landmarks(ev, settings)
     if not result.methods_tried:
         result.reason = (

@@ -248,12 +248,15 @@ def solve_annotator(
         for axis in AXES
     }
     sol = AnnotatorSolution(index, ann.annotator, vps)
-    intr = estimate_intrinsics(
-        {k: v.homogeneous for k, v in vps.items()},
-        (width, height),
-        focal_px=scene.camera.focal_px,
-        principal_point=scene.camera.principal_point,
-    )
+    try:
+        intr = estimate_intrinsics(
+            {k: v.homogeneous for k, v in vps.items()},
+            (width, height),
+            focal_px=scene.camera.focal_px,
+            principal_point=scene.camera.principal_point,
+        )
+    except DegenerateGeometryError as exc:
+        raise DegenerateGeometryError(f"{where}.vp_lines: {exc}") from None
     sol.intrinsics = intr
     f = intr.focal_px
     cx, cy = intr.principal_point

@@ -276,6 +276,9 @@ def make_located_scene(
     max_corners: int = 4,
     give_streets: bool = False,
     max_tries: int = 300,
+    n_landmarks: int = 0,
+    landmark_kind: str = "building_corner",
+    landmark_sigma_m: float = 1.0,
 ) -> LocatedScene | None:
     """A camera near a real intersection of ``map_data`` looking at a car and kerb corners.
 
@@ -284,6 +287,12 @@ def make_located_scene(
     real kerb corners differ from the map's by ``corner_sigma_m`` (the map model's error);
     their pixels (with click noise) are listed clockwise on screen. Returns None when no
     placement shows the car and ``min_corners`` corners within ``max_tries``.
+
+    ``n_references`` ground pixels near the car get their lat/lon, off by 0.5 m per axis.
+    ``n_landmarks`` visible ground points of named buildings (``landmark_kind``:
+    ``building_corner`` or ``face_midpoint`` of the map's footprint, the real one off by
+    ``landmark_sigma_m``; in view, below the horizon, not hidden by a building, within 80 m)
+    are listed by name; a placement without them is rejected (None when none has them).
     """
     noise = noise or NoiseModel()
     frame = map_data.frame
@@ -297,6 +306,9 @@ def make_located_scene(
     real_corners = map_corners + rng.normal(0.0, corner_sigma_m / math.sqrt(2), map_corners.shape)
     preset = ObjectSize(4.6, 1.8, 1.45)
     buildings = _buildings_enu(map_data, centre, 120.0)
+    marks = _landmark_points(map_data, centre, landmark_kind, 90.0) if n_landmarks else []
+    if n_landmarks and not marks:
+        return None
     for _ in range(max_tries):
         street = intersection.streets[int(rng.integers(len(intersection.streets)))]
         b = math.radians(street.bearing_deg)
@@ -354,6 +366,17 @@ def make_located_scene(
         vis = [i for i in vis if not _blocked(buildings, cam_xy, real_corners[i])]
         if len(vis) < min_corners or _blocked(buildings, cam_xy, car_centre):
             continue
+        seen_marks = []
+        if n_landmarks:
+            for name, q in marks:
+                p = cam_enu.project([*q, 0.0])
+                if (np.all(np.isfinite(p)) and 10 <= p[0] <= w - 10 and 10 <= p[1] <= h - 10
+                        and horizon @ np.array([p[0], p[1], 1.0]) > 20
+                        and np.linalg.norm(q - cam_xy) < 80.0
+                        and not _blocked(buildings, cam_xy, q)):
+                    seen_marks.append((name, q))
+            if len(seen_marks) < n_landmarks:
+                continue
         vis = vis[:max_corners] if len(vis) <= max_corners else sorted(rng.choice(vis, max_corners, replace=False).tolist())
         # Clockwise on screen = map order. All corners seen: the list may start anywhere.
         # Part of them: a person lists the visible arc clockwise from its first corner, so
@@ -395,9 +418,46 @@ def make_located_scene(
                     break
         if refs:
             scene["references"] = refs
+        if n_landmarks:
+            pick = rng.choice(len(seen_marks), n_landmarks, replace=False)
+            lms = []
+            for j in sorted(int(v) for v in pick):
+                name, q = seen_marks[j]
+                real = q + rng.normal(0.0, landmark_sigma_m / math.sqrt(2), 2)
+                p = cam_enu.project([*real, 0.0]) + rng.normal(0.0, noise.point_px, 2)
+                lms.append({"pixel": np.clip(p, 0, [w, h]).tolist(), "kind": landmark_kind,
+                            "name": name})
+            scene["landmarks"] = lms
         return LocatedScene(scene, cam_enu, cam_world, float(lat), float(lon), intersection.id,
                             [intersection.corners[i].order for i in vis])
     return None
+
+
+def _landmark_points(
+    map_data: Any, centre: FloatArray, kind: str, radius_m: float
+) -> list[tuple[str, FloatArray]]:
+    """Corners or face midpoints (ENU) of the named buildings near ``centre``.
+
+    Only names that find the same building from the map's point are kept (a name shared by
+    several buildings would be found elsewhere).
+    """
+    out = []
+    for b in getattr(map_data, "buildings", []):
+        if not b.name:
+            continue
+        lon, lat = b.centroid
+        c = np.array(map_data.frame.enu_from_geographic(lon, lat), float)
+        if np.linalg.norm(c - centre) > radius_m:
+            continue
+        try:
+            if map_data.find_building(b.name).id != b.id:
+                continue
+        except ValueError:
+            continue
+        pts = b.corners if kind == "building_corner" else b.face_midpoints
+        for q in map_data.frame.points_enu_from_geographic(np.asarray(pts, float)):
+            out.append((b.name, q))
+    return out
 
 
 def _axes_degenerate(

@@ -385,6 +385,9 @@ def estimate_intrinsics(
             best[1], (float(pp_used[0]), float(pp_used[1])), "two_vp",
             f"{why}focal length from the {best[2]} vanishing points; {pp_word}",
         )
+    at_infinity = sorted(set(vps) - set(finite))
+    if at_infinity:
+        why += f"the {' and '.join(at_infinity)} lines are parallel in the image; "
     raise DegenerateGeometryError(
         f"{why}cannot estimate the focal length: fewer than two finite, mutually consistent "
         "vanishing points; give camera.focal_px in the scene"

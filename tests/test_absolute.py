@@ -430,3 +430,43 @@ def test_located_scenes_list_a_partial_view_as_its_clockwise_arc(maps: dict[str,
             steps = [(vis[(i + 1) % len(vis)] - vis[i]) % n for i in range(len(vis))]
             # The wrap-around step (last back to first) crosses the unseen corners.
             assert steps[-1] == max(steps), (inter.id, vis)
+
+
+# ------------------------------------------------------------------------- landmarks
+def landmark_scene(m: MapData, inter_id: str, n: int, kind: str) -> LocatedScene:
+    ls = make_located_scene(
+        m,
+        m.intersection(inter_id),
+        np.random.default_rng(1),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        landmark_sigma_m=0.0,
+        n_landmarks=n,
+        landmark_kind=kind,
+    )
+    assert ls is not None
+    del ls.scene["intersection"]
+    return ls
+
+
+@pytest.mark.parametrize("kind", ["building_corner", "face_midpoint"])
+def test_two_landmarks_exact(maps: dict[str, MapData], kind: str) -> None:
+    m = maps["baltimore"]
+    ls = landmark_scene(m, "c49471330", 2, kind)
+    assert all(lm["kind"] == kind for lm in ls.scene["landmarks"])
+    result = locate(parse_scene(ls.scene), m)
+    check_contract(result)
+    assert result.methods_tried == ["landmark"]
+    errs = errors_m(result, ls)
+    assert errs[0] < EXACT
+    assert result.candidates[0].method == "landmark"
+
+
+def test_one_landmark_uses_the_streets_along_the_building(maps: dict[str, MapData]) -> None:
+    """The car's street runs along a side of the building, not past its centre."""
+    m = maps["baltimore"]
+    ls = landmark_scene(m, "c49471330", 1, "building_corner")
+    result = locate(parse_scene(ls.scene), m)
+    check_contract(result)
+    # The synthetic car is parallel to its street within a couple of degrees.
+    assert min(errors_m(result, ls)) < 3.0

@@ -348,6 +348,8 @@ def test_parallel_lines_everywhere_without_focal() -> None:
         with pytest.raises(DegenerateGeometryError) as info:
             calibrate(parse_scene(data), settings)
         msg = str(info.value)
+        assert msg.startswith("annotations[0].vp_lines: ")
+        assert "the height and width lines are parallel in the image" in msg
         assert "cannot estimate the focal length" in msg
         assert "give camera.focal_px in the scene" in msg
     # With the focal length given the same scene is solved exactly.
