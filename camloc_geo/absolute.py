@@ -525,6 +525,33 @@ def _gen_one_reference(ev: _Evidence, street_bearing: float | None) -> list[_Hyp
 
 
 # ---------------------------------------------------------------------------- priors
+def _street_angle_under_car(theta: float, T: FloatArray, s: float, ev: _Evidence) -> float | None:
+    """Signed angle (degrees, in [-90, 90)) from the street under the car to the car's axis.
+
+    None when the car (its centre under the similarity) is on no carriageway (farther than
+    half the street's width + 2.5 m from every centre line); else the smallest angle among the
+    streets it stands on.
+    """
+    from shapely.geometry import Point
+
+    car_bearing = (90.0 - math.degrees(theta)) % 180.0
+    car = s * _rot2(theta) @ ev.car_center_world + T
+    pt = Point(float(car[0]), float(car[1]))
+    best: float | None = None
+    for idx in ev.street_tree.query(pt.buffer(25.0)):
+        line, half_w = ev.streets_enu[int(idx)]
+        if line.distance(pt) > half_w + 2.5:
+            continue
+        sproj = line.project(pt)
+        a = line.interpolate(max(0.0, sproj - 5.0))
+        b = line.interpolate(min(line.length, sproj + 5.0))
+        brg = math.degrees(math.atan2(b.x - a.x, b.y - a.y)) % 180.0
+        diff = (car_bearing - brg + 90.0) % 180.0 - 90.0
+        if best is None or abs(diff) < abs(best):
+            best = diff
+    return best
+
+
 def _plausibility(
     cam: Camera,
     theta: float,
@@ -567,25 +594,12 @@ def _plausibility(
     car_bearing = (90.0 - math.degrees(theta)) % 180.0
     if ev.street_tree is not None:
         # The car stands on a carriageway and is parallel to it (the street under the car).
-        from shapely.geometry import Point
-
-        car = s * _rot2(theta) @ ev.car_center_world + T
-        pt = Point(float(car[0]), float(car[1]))
-        best_diff = None
-        for idx in ev.street_tree.query(pt.buffer(25.0)):
-            line, half_w = ev.streets_enu[int(idx)]
-            if line.distance(pt) > half_w + 2.5:
-                continue
-            sproj = line.project(pt)
-            a = line.interpolate(max(0.0, sproj - 5.0))
-            b = line.interpolate(min(line.length, sproj + 5.0))
-            brg = math.degrees(math.atan2(b.x - a.x, b.y - a.y)) % 180.0
-            diff = min(abs(car_bearing - brg), 180.0 - abs(car_bearing - brg))
-            best_diff = diff if best_diff is None else min(best_diff, diff)
-        if best_diff is None:
+        signed = _street_angle_under_car(theta, T, s, ev)
+        if signed is None:
             factor *= settings.parallel_floor
             flags.append("car_off_street")
         else:
+            best_diff = abs(signed)
             par = math.exp(-0.5 * (best_diff / settings.bearing_sigma_deg) ** 2)
             factor *= settings.parallel_floor + (1.0 - settings.parallel_floor) * par
             if best_diff > 2.5 * settings.bearing_sigma_deg:
@@ -649,6 +663,12 @@ def _refine(
         J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
         r = np.concatenate([r, [ls / s_sigma]])
         J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
+        if ev.street_tree is not None:
+            # The car is parallel to the street it stands on, within bearing_sigma_deg.
+            diff = _street_angle_under_car(theta, np.array([tx, ty]), s, ev)
+            if diff is not None:
+                r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
+                J = np.vstack([J, [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]])
         return r, J
 
     x = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])

@@ -13,7 +13,8 @@ Noise model (:class:`NoiseModel`), per annotator:
   car (the far end of the length edge), with the edges that start from that corner;
 - with probability ``sloppy_prob`` an annotator is sloppy: 4× the pixel noise;
 - the car's true size differs from the preset by ``size_rel`` (relative, Gaussian, per
-  dimension), while the scene only states the preset.
+  dimension), while the scene only states the preset;
+- (located scenes) the car's axis is ``car_yaw_deg`` (Gaussian) off its street's bearing.
 """
 
 from __future__ import annotations
@@ -50,11 +51,12 @@ class NoiseModel:
     sloppy_prob: float = 0.1
     size_rel: float = 0.05
     min_segment_px: float = 25.0
+    car_yaw_deg: float = 2.0
 
     @classmethod
     def exact(cls) -> NoiseModel:
-        """No noise at all."""
-        return cls(0.0, 0.0, 0.0, 0.0, 0.0)
+        """No noise at all (and a car exactly parallel to its street)."""
+        return cls(0.0, 0.0, 0.0, 0.0, 0.0, car_yaw_deg=0.0)
 
 
 @dataclass
@@ -318,7 +320,7 @@ def make_located_scene(
         lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice([-1.0, 1.0])
         car_centre = centre + dist * along + lateral * right
         car_dir = along * rng.choice([-1.0, 1.0])
-        yaw = math.radians(rng.normal(0.0, 2.0))
+        yaw = math.radians(rng.normal(0.0, noise.car_yaw_deg)) if noise.car_yaw_deg > 0 else 0.0
         car_dir = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]) @ car_dir
         car_side = np.array([-car_dir[1], car_dir[0]])
         az = rng.uniform(0, 2 * math.pi)
@@ -510,5 +512,6 @@ def _blocked(polys: list[Any], a: FloatArray, b: FloatArray) -> bool:
 
 def replace_size(noise: NoiseModel) -> NoiseModel:
     """The noise model without the size term (the caller already drew the true size)."""
-    return NoiseModel(noise.point_px, noise.line_px, noise.wrong_corner_prob, noise.sloppy_prob, 0.0,
-                      noise.min_segment_px)
+    from dataclasses import replace
+
+    return replace(noise, size_rel=0.0)
