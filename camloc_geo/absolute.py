@@ -1031,6 +1031,15 @@ def locate(
         lon, lat = frame.geographic_from_enu(float(c.camera.center_in_world[0]), float(c.camera.center_in_world[1]))
         c.lon, c.lat = float(lon), float(lat)
     result.candidates = cands
+    if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
+        gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
+        if gap > 2.0 * settings.merge_distance_m:
+            result.warnings.append(
+                f"ambiguous: candidates 1 and 2 fit the evidence equally well (scores "
+                f"{cands[0].score:.2f} and {cands[1].score:.2f}) but stand {gap:.0f} m apart; "
+                "a symmetric junction cannot tell them apart: more evidence (a reference pixel, "
+                "a landmark, another corner) or a tighter prior decides"
+            )
     return result
 
 
