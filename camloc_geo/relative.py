@@ -999,6 +999,12 @@ def _joint(
         rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
         width_signs=width_signs,
     )
+    lo, hi = prob.f_bounds
+    if f_fixed is None and not lo * 1.001 < f < hi / 1.001:
+        result.warnings.append(
+            f"focal length {f:.0f} px is at the limit of the fit's range ({lo:.0f}-{hi:.0f} px): "
+            "the lines do not determine it and the position is unreliable; give camera.focal_px"
+        )
     return result
 
 

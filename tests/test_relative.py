@@ -403,3 +403,15 @@ def test_result_type(basic_scene: dict[str, Any]) -> None:
     result = calibrate(parse_scene(basic_scene))
     assert isinstance(result, CalibrationResult)
     assert result.height_m == pytest.approx(6.0, rel=EXACT)
+
+
+def test_focal_length_at_the_search_limit_is_flagged() -> None:
+    """A 2.9° field of view (f = 20 × width) is beyond the fit's focal range: say so."""
+    cam = camera_aimed_at_car(15.0, 150.0, focal_px=20 * 1920.0, roll_deg=1.0)
+    data = exact_scene(cam)
+    result = calibrate(parse_scene(data))
+    assert any("focal length" in w and "limit" in w for w in result.warnings), result.warnings
+    assert "warnings" in result.to_dict()
+    # Within the range, no such warning.
+    ok = calibrate(parse_scene(exact_scene(camera_aimed_at_car(10.0, 80.0, focal_px=8000.0))))
+    assert not any("limit" in w for w in ok.warnings)
