@@ -22,7 +22,9 @@ def _camera() -> Camera:
     fwd = np.array([2.3, 0.9, 0.7]) - centre
     heading = math.degrees(math.atan2(fwd[0], fwd[1]))
     pitch = math.degrees(math.atan2(-fwd[2], math.hypot(fwd[0], fwd[1])))
-    return Camera.from_center(1200.0, (640.0, 360.0), rotation_from_angles(heading, pitch, 2.0), centre)
+    return Camera.from_center(
+        1200.0, (640.0, 360.0), rotation_from_angles(heading, pitch, 2.0), centre
+    )
 
 
 def _render(cam: Camera, size: tuple[int, int]) -> np.ndarray:
@@ -41,16 +43,23 @@ def _render(cam: Camera, size: tuple[int, int]) -> np.ndarray:
         for a, b in edges:
             pa, pb = cam.project(np.array(a)), cam.project(np.array(b))
             if np.all(np.isfinite(pa)) and np.all(np.isfinite(pb)):
-                cv2.line(img, tuple(int(v) for v in pa), tuple(int(v) for v in pb), (230, 230, 230), 2,
-                         cv2.LINE_AA)
+                cv2.line(
+                    img,
+                    tuple(int(v) for v in pa),
+                    tuple(int(v) for v in pb),
+                    (230, 230, 230),
+                    2,
+                    cv2.LINE_AA,
+                )
     return img
 
 
 def test_missing_height_lines_come_from_the_image(tmp_path: Path) -> None:
     cam = _camera()
     size = (1280, 720)
-    syn = make_scene(cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1,
-                     image_size=size)
+    syn = make_scene(
+        cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1, image_size=size
+    )
     scene = syn.scene
     scene["annotations"][0]["vp_lines"]["height"] = []
     cv2.imwrite(str(tmp_path / "snap.png"), _render(cam, size))
@@ -65,8 +74,13 @@ def test_missing_height_lines_come_from_the_image(tmp_path: Path) -> None:
 
 def test_missing_lines_without_image_is_a_clear_error(tmp_path: Path) -> None:
     cam = _camera()
-    syn = make_scene(cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1,
-                     image_size=(1280, 720))
+    syn = make_scene(
+        cam,
+        np.random.default_rng(0),
+        noise=NoiseModel.exact(),
+        n_annotators=1,
+        image_size=(1280, 720),
+    )
     syn.scene["annotations"][0]["vp_lines"]["height"] = []
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(syn.scene))

@@ -26,7 +26,7 @@ from camloc_geo._errors import InputError
 
 __all__ = ["main", "write_json"]
 
-_COMMAND_MODULES = ("calibrate", "locate", "corners", "streets", "vp", "summary_map")
+_COMMAND_MODULES = ("calibrate", "locate", "corners", "streets", "vp", "summary_map", "schema")
 
 log = logging.getLogger("camloc_geo.cli")
 
