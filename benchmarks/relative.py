@@ -110,8 +110,13 @@ def _summary(rows: list[dict[str, Any]], method: str) -> dict[str, Any]:
     outliers_true = sum(r["n_wrong_corner"] for r in rows)
     caught = sum(r[method].get("wrong_corner_caught", 0) for r in rows)
     flagged = sum(r[method].get("n_flagged", 0) for r in rows)
+    warned = [bool(r[method].get("focal_limit_warning")) for r in rows]
     return {
         "n_scenes": n,
+        "n_focal_limit_warnings": int(sum(warned)),
+        "n_focal_limit_warnings_with_position_error_gt_10m": int(
+            sum(w and p >= 10.0 for w, p in zip(warned, pos, strict=True))
+        ),
         "n_failures": int(np.sum(~np.isfinite(pos))),
         "failures_by_error": failures,
         "position_error_m": _percentiles(pos),
@@ -155,6 +160,7 @@ def run_scene(syn: Any, method: str) -> dict[str, Any]:
         "method": res.method,
         "wrong_corner_caught": len(wrong & set(res.outlier_annotators)),
         "n_flagged": len(res.outlier_annotators),
+        "focal_limit_warning": any("focal length" in w and "limit" in w for w in res.warnings),
     }
 
 
