@@ -311,6 +311,7 @@ def make_located_scene(
     marks = _landmark_points(map_data, centre, landmark_kind, 90.0) if n_landmarks else []
     if n_landmarks and not marks:
         return None
+    lines = _street_lines_enu(map_data, centre, 80.0)
     for _ in range(max_tries):
         street = intersection.streets[int(rng.integers(len(intersection.streets)))]
         b = math.radians(street.bearing_deg)
@@ -319,6 +320,15 @@ def make_located_scene(
         dist = float(rng.uniform(8.0, 25.0))
         lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice([-1.0, 1.0])
         car_centre = centre + dist * along + lateral * right
+        # In a lane of the street's real centre line (it may bend), parallel to it there.
+        on_line = _along_street(lines, street.name, centre + dist * along, along)
+        if on_line is not None:
+            base, along = on_line
+            right = np.array([along[1], -along[0]])
+            car_centre = base + lateral * right
+            on_line = _along_street(lines, street.name, car_centre, along)
+            if on_line is not None:
+                along = on_line[1]
         car_dir = along * rng.choice([-1.0, 1.0])
         yaw = math.radians(rng.normal(0.0, noise.car_yaw_deg)) if noise.car_yaw_deg > 0 else 0.0
         car_dir = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]) @ car_dir
@@ -433,6 +443,51 @@ def make_located_scene(
         return LocatedScene(scene, cam_enu, cam_world, float(lat), float(lon), intersection.id,
                             [intersection.corners[i].order for i in vis])
     return None
+
+
+def _street_lines_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[tuple[str, Any]]:
+    """Street centre lines (ENU LineStrings) passing within ``radius_m`` of ``centre``."""
+    from shapely.geometry import LineString, Point
+
+    around = Point(float(centre[0]), float(centre[1]))
+    out = []
+    for st in getattr(map_data, "streets", []):
+        coords = np.asarray(st.geometry.coords, dtype=float)
+        if len(coords) < 2:
+            continue
+        line = LineString(map_data.frame.points_enu_from_geographic(coords))
+        if line.length > 1.0 and line.distance(around) < radius_m:
+            out.append((st.name, line))
+    return out
+
+
+def _along_street(
+    lines: list[tuple[str, Any]], name: str, point: FloatArray, along: FloatArray
+) -> tuple[FloatArray, FloatArray] | None:
+    """The nearest point of the named street's centre line and its direction there.
+
+    The direction is the chord over ±5 m (as :mod:`camloc_geo.absolute` measures a street
+    under the car), oriented like ``along``; None when the street is not within 10 m.
+    """
+    from shapely.geometry import Point
+
+    pt = Point(float(point[0]), float(point[1]))
+    near = [(line.distance(pt), line) for n, line in lines if n == name]
+    near = [x for x in near if x[0] < 10.0]
+    if not near:
+        return None
+    line = min(near, key=lambda x: x[0])[1]
+    s = line.project(pt)
+    a = line.interpolate(max(0.0, s - 5.0))
+    b = line.interpolate(min(line.length, s + 5.0))
+    d = np.array([b.x - a.x, b.y - a.y])
+    if np.linalg.norm(d) < 1e-6:
+        return None
+    d = d / np.linalg.norm(d)
+    if float(d @ along) < 0:
+        d = -d
+    p = line.interpolate(s)
+    return np.array([p.x, p.y]), d
 
 
 def _landmark_points(
