@@ -14,7 +14,8 @@ Hypotheses for (θ, T, s) come from generators, one per kind of evidence, each a
     regularised towards 1). With a right-handed world frame the fit is unique: the paper
     needed the left/right order of the pixels to choose between two circle intersections
     because its distance-only construction loses the handedness that the frame keeps.
-    With three or more points the worst one is flagged.
+    With three or more points the one that agrees least with the others (leave-one-out)
+    is flagged, and the fit without it is a second hypothesis.
 ``one_reference``
     One known ground pixel plus a street bearing (from the scene, else the streets that
     pass near the reference in the map): the car's length axis is parallel to the street,
@@ -317,6 +318,10 @@ class _Evidence:
     worst_reference: str | None = None
 
 
+# A matched point's squared Mahalanobis misfit counts up to this much (a robust likelihood).
+_OUTLIER_M2 = 50.0
+
+
 def _mahal(obs: Observation, q: FloatArray, theta: float, T: FloatArray, s: float) -> float:
     R2 = _rot2(theta)
     p = s * R2 @ obs.world_xy + T
@@ -335,7 +340,7 @@ def _score(
     R2 = _rot2(theta)
     for obs, q in ev.refs:
         m2 = _mahal(obs, q, theta, T, s)
-        ll -= 0.5 * m2
+        ll -= 0.5 * min(m2, _OUTLIER_M2)  # robust: one outlier costs at most 25
         d = s * R2 @ obs.world_xy + T - q
         sq.append(float(d @ d))
         matches.append({"kind": "reference", "label": obs.label, "pixel": list(obs.pixel),
@@ -347,7 +352,7 @@ def _score(
         for obs, j in zip(ev.corners, corner_assignment, strict=True):
             q = ev.map_corners[j]
             m2 = _mahal(obs, q, theta, T, s)
-            ll -= 0.5 * min(m2, 50.0)
+            ll -= 0.5 * min(m2, _OUTLIER_M2)
             d = s * R2 @ obs.world_xy + T - q
             sq.append(float(d @ d))
             matches.append({"kind": "corner", "label": obs.label, "pixel": list(obs.pixel),
@@ -357,7 +362,7 @@ def _score(
     for obs, pts in ev.landmarks:
         m2s = [_mahal(obs, q, theta, T, s) for q in pts]
         k = int(np.argmin(m2s))
-        ll -= 0.5 * min(m2s[k], 50.0)
+        ll -= 0.5 * min(m2s[k], _OUTLIER_M2)
         d = s * R2 @ obs.world_xy + T - pts[k]
         sq.append(float(d @ d))
         matches.append({"kind": "landmark", "label": obs.label, "pixel": list(obs.pixel),
@@ -424,7 +429,13 @@ def _gen_references(ev: _Evidence, settings: LocateSettings) -> list[_Hypothesis
     enu = np.array([q for _, q in refs])
     wts = np.array([1.0 / (np.trace(o.cov_world) / 2 + o.sigma_map_m**2) for o, _ in refs])
     theta, T, s = _similarity_fit(world, enu, wts, settings.scale_sigma_rel)
-    return [_Hypothesis("two_references", theta, T, s)]
+    out = [_Hypothesis("two_references", theta, T, s)]
+    if ev.worst_reference is not None:
+        # The robust alternative: the fit of the others, the worst one an outlier.
+        keep = [i for i, (o, _) in enumerate(refs) if o.label != ev.worst_reference]
+        theta, T, s = _similarity_fit(world[keep], enu[keep], wts[keep], settings.scale_sigma_rel)
+        out.append(_Hypothesis("two_references", theta, T, s))
+    return out
 
 
 def _worst_reference(
@@ -612,7 +623,8 @@ def _plausibility(
             flags.append("car_not_parallel_to_street")
     if ev.worst_reference is not None:
         flags.append(f"worst_reference:{ev.worst_reference}")
-    m2 = [m["mahalanobis2"] for m in matches]
+    # The flagged worst reference is reported, not held against the whole fit.
+    m2 = [m["mahalanobis2"] for m in matches if m["label"] != ev.worst_reference]
     if m2 and sum(m2) / len(m2) > settings.fit_gate:
         flags.append("poor_fit")
     return factor, flags
@@ -637,6 +649,14 @@ def _refine(
     for o, _pts in ev.landmarks:
         if o.label in by_label:
             obs_q.append((o, np.asarray(by_label[o.label]["map_en"])))
+    # Points beyond the likelihood's cap are outliers to this hypothesis (they add a
+    # constant): leave them out, or one wrong reference drags the fit back onto itself.
+    inliers = [
+        (o, q) for o, q in obs_q
+        if by_label.get(o.label, {}).get("mahalanobis2", 0.0) <= _OUTLIER_M2
+    ]
+    if len(inliers) >= 2:
+        obs_q = inliers
     if not obs_q:
         return cand
     # Whitening at the starting similarity (the rotation and scale change little here).
