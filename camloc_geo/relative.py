@@ -90,6 +90,7 @@ class CalibrationSettings:
     cluster_threshold_min_m: float = 1.5
     outlier_weight: float = 0.3
     free_principal_point: bool | None = None  # None = decided by BIC
+    reassign_corners: bool = True
 
 
 @dataclass
@@ -112,7 +113,8 @@ class AnnotatorSolution:
         if self.error:
             out["error"] = self.error
         out["vanishing_points"] = {
-            k: (None if v.pixel is None else v.pixel.tolist()) for k, v in self.vanishing_points.items()
+            k: (None if v.pixel is None else v.pixel.tolist())
+            for k, v in self.vanishing_points.items()
         }
         out["vp_rms_px"] = {k: v.rms_px for k, v in self.vanishing_points.items()}
         if self.intrinsics is not None:
@@ -167,11 +169,23 @@ class CalibrationResult:
     rms_residual_px: float | None = None
     width_signs: list[float] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    annotator_corners: list[str] = field(default_factory=list)
+    width_sign: float = 1.0
 
     @property
     def height_m(self) -> float:
         """Camera height above the ground."""
         return self.camera.height_m
+
+    @property
+    def corner_mistakes(self) -> list[str]:
+        """Annotators who marked another corner of the car than the world origin.
+
+        The joint fit re-interprets their clicks (they still count); this names them for
+        crowd quality control.
+        """
+        names = [a.annotator for a in self.annotators]
+        return [n for n, c in zip(names, self.annotator_corners, strict=False) if c != "origin"]
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON that ``camloc calibrate`` prints."""
@@ -199,7 +213,11 @@ class CalibrationResult:
             out["focal_sigma_px"] = self.focal_sigma_px
         if self.rms_residual_px is not None:
             out["rms_residual_px"] = self.rms_residual_px
+        out["width_sign"] = self.width_sign
         out["annotator_weights"] = self.annotator_weights
+        if self.annotator_corners:
+            out["annotator_corners"] = self.annotator_corners
+            out["corner_mistakes"] = self.corner_mistakes
         out["outlier_annotators"] = self.outlier_annotators
         out["cluster"] = self.cluster
         out["annotators"] = [a.to_dict() for a in self.annotators]
@@ -325,6 +343,47 @@ def solve_annotator(
     return sol
 
 
+_CORNER_NAMES = ("origin", "far_length", "far_width", "diagonal")
+
+
+def _corner_points(size: ObjectSize, width_sign: float, corner: int) -> FloatArray:
+    """World points of the four clicks of an annotator who started at ``corner``.
+
+    The car's footprint is ``[0, L] × [0, width_sign·W]``; corner 0 = (0, 0), 1 = (L, 0),
+    2 = (0, width_sign·W), 3 = (L, width_sign·W). Rows: origin, length end, width end,
+    height end.
+    """
+    L, W, H = size.length_m, width_sign * size.width_m, size.height_m
+    x0 = L if corner in (1, 3) else 0.0
+    y0 = W if corner in (2, 3) else 0.0
+    return np.array([[x0, y0, 0.0], [L - x0, y0, 0.0], [x0, W - y0, 0.0], [x0, y0, H]], dtype=float)
+
+
+def _frame_at_corner(
+    size: ObjectSize, width_sign: float, corner: int
+) -> tuple[FloatArray, FloatArray, float]:
+    """The frame whose origin is ``corner`` of the common frame's footprint.
+
+    Returns ``M`` (rotation, common-from-new), the new origin in the common frame and the
+    new frame's width sign: ``p_common = M p_new + origin``. The new x axis runs along the
+    length edge from that corner, z stays up, y = z × x.
+    """
+    L, W = size.length_m, width_sign * size.width_m
+    x0 = L if corner in (1, 3) else 0.0
+    y0 = W if corner in (2, 3) else 0.0
+    sx = -1.0 if corner in (1, 3) else 1.0
+    M = np.diag([sx, sx, 1.0])
+    # The width edge runs from y0 to W - y0 in the common frame; in the new frame y' = sx·(y - y0).
+    ws_new = float(np.sign(sx * ((W - y0) - y0))) or 1.0
+    return M, np.array([x0, y0, 0.0]), ws_new
+
+
+def _relabel_corner(corner: int, origin_corner: int) -> int:
+    """A corner's index relative to a frame whose origin is ``origin_corner``."""
+    # Corners are (length bit, width bit); moving the origin flips the bits it differs in.
+    return corner ^ origin_corner
+
+
 def _object_points(size: ObjectSize, width_sign: float) -> FloatArray:
     """World points: origin, length end, width end, height end."""
     return np.array(
@@ -337,7 +396,9 @@ def _object_points(size: ObjectSize, width_sign: float) -> FloatArray:
     )
 
 
-def _cluster(candidates: list[tuple[int, str, FloatArray]], settings: CalibrationSettings) -> dict[str, Any]:
+def _cluster(
+    candidates: list[tuple[int, str, FloatArray]], settings: CalibrationSettings
+) -> dict[str, Any]:
     pts = np.array([c[2] for c in candidates])
     dist_scale = float(np.median(np.linalg.norm(pts, axis=1)))
     threshold = max(settings.cluster_threshold_min_m, settings.cluster_threshold_rel * dist_scale)
@@ -391,6 +452,7 @@ class _JointProblem:
         width_signs: list[float],
         size: ObjectSize,
         settings: CalibrationSettings,
+        size_sigma_rel: float = 0.0,
     ) -> None:
         width, height = scene.image_size
         diag = math.hypot(width, height)
@@ -410,12 +472,23 @@ class _JointProblem:
                 pt_world.append(world[j])
                 pt_pix.append(getattr(ann.axes, name))
                 pt_ann.append(slot)
+        self.size = size
+        self.ws_common = 1.0 if sum(width_signs) >= 0 else -1.0
+        self.corners = np.zeros(len(indices), dtype=int)
         self.segments = np.vstack(seg_rows)
         self.seg_axis = np.asarray(seg_axis)
         self.seg_ann = np.asarray(seg_ann)
         self.pt_world = np.asarray(pt_world, float)
         self.pt_pix = np.asarray(pt_pix, float)
         self.pt_ann = np.asarray(pt_ann)
+        # An edge end's pixel is uncertain by the click noise and, along the edge, by the
+        # object's size uncertainty (a preset's 5 % of the edge's length in pixels).
+        edge_px = np.zeros(len(self.pt_pix))
+        for j in range(0, len(self.pt_pix), 4):
+            edge_px[j + 1 : j + 4] = np.linalg.norm(
+                self.pt_pix[j + 1 : j + 4] - self.pt_pix[j], axis=1
+            )
+        self._sigma_pt_each = np.sqrt(self.sigma_pt**2 + (size_sigma_rel * edge_px) ** 2)
         self.n_annotators = len(indices)
         self._z_min = 0.05
         seg = self.segments
@@ -426,15 +499,52 @@ class _JointProblem:
         self.log_f_bounds = (math.log(self.f_bounds[0]), math.log(self.f_bounds[1]))
         self.image_wh = (float(width), float(height))
 
+    def set_corners(self, corners: npt.ArrayLike) -> None:
+        """Which ground corner of the car each annotator marked as the origin.
+
+        0 is the common frame's origin, 1 the far end of its length edge, 2 the far end of
+        its width edge, 3 the diagonal corner; the edges an annotator marks start at their
+        corner, so their four clicks are the world points :func:`_corner_points` gives.
+        """
+        self.corners = np.asarray(corners, dtype=int)
+        self.pt_world = np.vstack(
+            [_corner_points(self.size, self.ws_common, int(c)) for c in self.corners]
+        )
+
+    def best_corners(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> npt.NDArray[np.int_]:
+        """For each annotator, the corner hypothesis whose points best explain their clicks."""
+        f, (cx, cy), R, C = self.unpack(x, R0, pp_fixed, f_fixed)
+        hyp = np.stack([_corner_points(self.size, self.ws_common, c) for c in range(4)])  # (4,4,3)
+        pc = (hyp.reshape(-1, 3) - C) @ R.T
+        z = np.maximum(pc[:, 2], self._z_min)
+        proj = (pc[:, :2] / z[:, None] * f + np.array([cx, cy])).reshape(4, 4, 2)
+        clicks = self.pt_pix.reshape(-1, 4, 2)  # (n_annotators, 4, 2)
+        err = np.linalg.norm(clicks[:, None, :, :] - proj[None, :, :, :], axis=3).sum(axis=2)
+        return np.asarray(np.argmin(err, axis=1), dtype=int)
+
     def unpack(
-        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> tuple[float, tuple[float, float], FloatArray, FloatArray]:
         """Focal length, principal point, rotation and camera centre of a parameter vector."""
         f, pp, R, C = self._unpack_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)
         return float(f[0]), (float(pp[0, 0]), float(pp[0, 1])), R[0], C[0]
 
     def _unpack_batch(
-        self, X: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        X: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         P = len(X)
         k = 0
@@ -453,13 +563,21 @@ class _JointProblem:
         return f, pp, R, C
 
     def residuals(
-        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> FloatArray:
         """Normalised residuals (segments, then point u, then point v)."""
         return self.residuals_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)[0]
 
     def jacobian(
-        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> FloatArray:
         """Forward-difference Jacobian from one batched evaluation."""
         n = len(x)
@@ -469,7 +587,11 @@ class _JointProblem:
         return np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
 
     def residuals_batch(
-        self, X: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        X: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> FloatArray:
         """Residuals of a batch of parameter vectors ``(P, n)`` → ``(P, m)``."""
         f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
@@ -492,7 +614,7 @@ class _JointProblem:
         d = self.pt_world[None, :, :] - C[:, None, :]
         pc = np.einsum("pij,pnj->pni", R, d)
         z = np.maximum(pc[:, :, 2], self._z_min)
-        wpt = self._w_pt / self.sigma_pt
+        wpt = self._w_pt / self._sigma_pt_each
         u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * wpt
         v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * wpt
         return np.concatenate([r_seg, u, v], axis=1)
@@ -508,7 +630,11 @@ class _JointProblem:
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
 
     def per_annotator_rms(
-        self, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None, f_fixed: float | None
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
     ) -> FloatArray:
         saved = self.weights
         self.weights = np.ones(self.n_annotators)
@@ -586,7 +712,9 @@ def _score_test(
         return 0.0
 
 
-def _pack(f: float, pp: tuple[float, float], C: FloatArray, free_f: bool, free_pp: bool) -> FloatArray:
+def _pack(
+    f: float, pp: tuple[float, float], C: FloatArray, free_f: bool, free_pp: bool
+) -> FloatArray:
     parts: list[float] = []
     if free_f:
         parts.append(math.log(f))
@@ -613,7 +741,9 @@ def _gather_segments(scene: Scene, index: int) -> tuple[dict[str, FloatArray], l
     return out, short
 
 
-def _check_segment_counts(scene: Scene, shorts: list[list[str]], segs: list[dict[str, FloatArray]]) -> list[str]:
+def _check_segment_counts(
+    scene: Scene, shorts: list[list[str]], segs: list[dict[str, FloatArray]]
+) -> list[str]:
     """Raise if an axis cannot be determined at all; warnings for annotators that lack lines.
 
     A crowd annotator who drew fewer than two lines for an axis gets no closed-form
@@ -731,9 +861,7 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     if not good:
         assert first_error is not None
         raise first_error
-    candidates = [
-        (s.index, k, s.candidates[k]) for s in good for k in ("length", "width")
-    ]
+    candidates = [(s.index, k, s.candidates[k]) for s in good for k in ("length", "width")]
     cluster = _cluster(candidates, settings)
     centroid = np.asarray(cluster["centroid"])
     member_idx = sorted({m["annotator"] for m in cluster["members"]})
@@ -745,7 +873,10 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     assert seed.camera is not None and seed.intrinsics is not None
     intr_method, intr_reason = seed.intrinsics.method, seed.intrinsics.reason
     cluster_camera = Camera.from_center(
-        seed.camera.focal_px, seed.camera.principal_point, seed.camera.cam_from_world_rotation, centroid
+        seed.camera.focal_px,
+        seed.camera.principal_point,
+        seed.camera.cam_from_world_rotation,
+        centroid,
     )
     warnings: list[str] = list(count_warnings)
     n_ann = len(scene.annotations)
@@ -753,8 +884,16 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
         outliers = [s.annotator for s in sols if s.index not in member_idx]
         return CalibrationResult(
-            cluster_camera, "cluster_centroid", intr_method, intr_reason, sols, cluster,
-            weights, outliers, width_signs=[s.width_sign for s in sols], warnings=warnings,
+            cluster_camera,
+            "cluster_centroid",
+            intr_method,
+            intr_reason,
+            sols,
+            cluster,
+            weights,
+            outliers,
+            width_signs=[s.width_sign for s in sols],
+            warnings=warnings,
         )
     try:
         result = _joint(scene, sols, segs, seed, cluster, cluster_camera, size, settings)
@@ -766,8 +905,16 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
         outliers = [s.annotator for s in sols if s.index not in member_idx]
         return CalibrationResult(
-            cluster_camera, "cluster_centroid", intr_method, intr_reason, sols, cluster,
-            weights[:n_ann], outliers, width_signs=[s.width_sign for s in sols], warnings=warnings,
+            cluster_camera,
+            "cluster_centroid",
+            intr_method,
+            intr_reason,
+            sols,
+            cluster,
+            weights[:n_ann],
+            outliers,
+            width_signs=[s.width_sign for s in sols],
+            warnings=warnings,
         )
 
 
@@ -854,6 +1001,74 @@ def _pooled_seed(scene: Scene, segs: list[dict[str, FloatArray]], size: ObjectSi
     return Camera.from_center(f, (cx, cy), R, np.median(np.asarray(centres), axis=0))
 
 
+def _robust_cost(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float],
+    f_fixed: float | None,
+) -> float:
+    """Soft-L1 cost of all residuals with every annotator weighted equally."""
+    saved = prob.weights
+    prob.weights = np.ones(prob.n_annotators)
+    r = prob.residuals(x, R0, pp_fixed, f_fixed)
+    prob.weights = saved
+    z = (r / 2.5) ** 2
+    return float(np.sum(2.0 * (np.sqrt(1.0 + z) - 1.0)))
+
+
+def _reassign_corners(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float],
+    f_fixed: float | None,
+) -> FloatArray:
+    """Re-interpret annotators who marked another corner of the car instead of dropping them.
+
+    An annotator who started at the wrong corner still marked the car's edges; their clicks
+    are the world points of that corner (:func:`_corner_points`). Starting from the
+    reweighted fit, each down-weighted or poorly fitting annotator is moved to the corner
+    that explains their clicks clearly better (by half, and by more than the click noise);
+    the move is kept only if the refit lowers the total robust cost with every annotator
+    weighted equally.
+    """
+    for _ in range(2):
+        best = prob.best_corners(x, R0, pp_fixed, f_fixed)
+        f, (cx, cy), R, C = prob.unpack(x, R0, pp_fixed, f_fixed)
+        clicks = prob.pt_pix.reshape(-1, 4, 2)
+        proposal = prob.corners.copy()
+        for a in range(prob.n_annotators):
+            if best[a] == prob.corners[a]:
+                continue
+            errs = []
+            for c in (int(prob.corners[a]), int(best[a])):
+                pts = _corner_points(prob.size, prob.ws_common, c)
+                pc = (pts - C) @ R.T
+                z = np.maximum(pc[:, 2], prob._z_min)
+                proj = pc[:, :2] / z[:, None] * f + np.array([cx, cy])
+                errs.append(float(np.linalg.norm(proj - clicks[a], axis=1).mean()))
+            if errs[1] < 0.5 * errs[0] and errs[0] - errs[1] > 3.0 * prob.sigma_pt:
+                proposal[a] = best[a]
+        if np.array_equal(proposal, prob.corners):
+            return x
+        before = _robust_cost(prob, x, R0, pp_fixed, f_fixed)
+        saved_corners, saved_w = prob.corners.copy(), prob.weights.copy()
+        prob.set_corners(proposal)
+        prob.weights = np.ones(prob.n_annotators)
+        x_new = _fit(prob, x, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        prob.weights = _cauchy_weights(prob.per_annotator_rms(x_new, R0, pp_fixed, f_fixed))
+        x_new = _fit(prob, x_new, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        after = _robust_cost(prob, x_new, R0, pp_fixed, f_fixed)
+        if after < before:
+            x = x_new
+            continue
+        prob.set_corners(saved_corners)
+        prob.weights = saved_w
+        return x
+    return x
+
+
 def _param_sigma(res: Any, sl: slice) -> float | None:
     """Largest 1-sigma of a block of fitted parameters (Gauss-Newton covariance)."""
     dof = max(len(res.fun) - len(res.x), 1)
@@ -898,9 +1113,18 @@ def _joint(
     best: tuple[float, _JointProblem, Any, FloatArray, list[float]] | None = None
     for cam0 in seeds:
         width_signs = [_width_sign_for(scene, i, cam0) for i in indices]
-        prob = _JointProblem(scene, segs, indices, width_signs, size, settings)
+        prob = _JointProblem(
+            scene,
+            segs,
+            indices,
+            width_signs,
+            size,
+            settings,
+            size_sigma_rel=0.0 if _size_given(scene) else settings.size_sigma_rel,
+        )
         R0 = cam0.cam_from_world_rotation
         x0 = _pack(cam0.focal_px, pp_fixed, cam0.center_in_world, f_fixed is None, False)
+        prob.set_corners([0 if w == prob.ws_common else 2 for w in width_signs])
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
         res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=60)
         score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
@@ -915,6 +1139,8 @@ def _joint(
             break
         prob.weights = new_w
         x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+    if settings.reassign_corners:
+        x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed)
     chosen = (res, pp_fixed)
     free_pp = settings.free_principal_point
@@ -944,7 +1170,20 @@ def _joint(
             chosen = (res_free, None)
     res, pp_model = chosen
     f, pp, R, C = prob.unpack(res.x, R0, pp_model, f_fixed)
+    # The output frame: the corner the annotators chose; where they disagree, the one the
+    # instructions ask for (the corner nearest to the camera).
+    trusted = [
+        int(c)
+        for c, w in zip(prob.corners, prob.weights, strict=True)
+        if w >= settings.outlier_weight
+    ]
+    chosen_corners = sorted(set(trusted or [int(c) for c in prob.corners]))
+    corner_xyz = np.array([_corner_points(size, prob.ws_common, c)[0] for c in chosen_corners])
+    out_corner = chosen_corners[int(np.argmin(np.linalg.norm(corner_xyz - C, axis=1)))]
+    M, origin, ws_out = _frame_at_corner(size, prob.ws_common, out_corner)
+    R, C = R @ M, M.T @ (C - origin)
     camera = Camera.from_center(f, pp, R, C)
+    corner_names = [_CORNER_NAMES[_relabel_corner(int(c), out_corner)] for c in prob.corners]
     # Uncertainty from the Gauss-Newton covariance, scaled by the residual variance.
     J = res.jac
     dof = max(len(res.fun) - len(res.x), 1)
@@ -970,9 +1209,12 @@ def _joint(
     rms_seg = float(np.sqrt(np.mean(r[:n_seg] ** 2))) * prob.sigma_line
     rms_pt = float(np.sqrt(np.mean(r[n_seg:] ** 2))) * prob.sigma_pt
     if pp_model is None:
-        method, reason = "joint_fit_free_principal_point", (
-            "principal point fitted with the focal length: freeing it improved the fit by more "
-            "than the BIC penalty"
+        method, reason = (
+            "joint_fit_free_principal_point",
+            (
+                "principal point fitted with the focal length: freeing it improved the fit by more "
+                "than the BIC penalty"
+            ),
         )
     elif f_fixed is not None:
         method = "given" if pp_given is not None else "given_focal"
@@ -982,8 +1224,9 @@ def _joint(
     else:
         method = "joint_fit_centre_principal_point"
         reason = "focal length fitted to all vanishing lines; principal point " + (
-            "given" if pp_given is not None else "at the image centre (freeing it was not "
-            "justified by the data)"
+            "given"
+            if pp_given is not None
+            else "at the image centre (freeing it was not justified by the data)"
         )
     result = CalibrationResult(
         camera,
@@ -998,7 +1241,17 @@ def _joint(
         focal_sigma_px=sigma_f,
         rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
         width_signs=width_signs,
+        annotator_corners=corner_names,
+        width_sign=ws_out,
     )
+    if len(chosen_corners) > 1:
+        result.warnings.append(
+            "annotators marked different corners of the car ("
+            + ", ".join(
+                f"{scene.annotations[i].annotator}: {n}" for i, n in enumerate(corner_names)
+            )
+            + "); the world origin is the corner nearest to the camera, as the instructions ask"
+        )
     lo, hi = prob.f_bounds
     if f_fixed is None and not lo * 1.001 < f < hi / 1.001:
         result.warnings.append(

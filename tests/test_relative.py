@@ -276,15 +276,26 @@ def test_wrong_corner_annotator_is_reported(seed: int) -> None:
     dist = float(np.linalg.norm(cam.center_in_world))
     # Each annotator's own vanishing points are noisy (short car edges): the paper's
     # cluster centroid is much less accurate than the joint fit of everybody's lines.
-    for settings, tol, tol_h in ((CalibrationSettings(), 0.03, 0.3), (CLUSTER, 0.25, 2.5)):
-        result = calibrate(scene, settings)
-        assert result.outlier_annotators == [f"w{bad + 1}"], settings
-        err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
-        assert err < tol * dist, (settings, err)
-        assert abs(result.height_m - cam.height_m) < tol_h
+    # The paper's cluster reports the annotator as an outlier.
+    cluster = calibrate(scene, CLUSTER)
+    assert cluster.outlier_annotators == [f"w{bad + 1}"]
+    err = np.linalg.norm(cluster.camera.center_in_world - cam.center_in_world)
+    assert err < 0.25 * dist
+    assert abs(cluster.height_m - cam.height_m) < 2.5
+    # The joint fit re-interprets the clicks as the far end of the length edge: the
+    # annotator keeps counting, is named as a corner mistake, and the fit is accurate.
     joint = calibrate(scene)
-    assert joint.annotator_weights[bad] < 0.3
-    assert min(w for i, w in enumerate(joint.annotator_weights) if i != bad) > 0.5
+    assert joint.annotator_corners[bad] == "far_length"
+    assert joint.corner_mistakes == [f"w{bad + 1}"]
+    assert joint.outlier_annotators == []
+    assert min(joint.annotator_weights) > 0.5
+    err = np.linalg.norm(joint.camera.center_in_world - cam.center_in_world)
+    assert err < 0.03 * dist
+    assert abs(joint.height_m - cam.height_m) < 0.3
+    # Without the re-interpretation, the annotator is down-weighted and reported instead.
+    plain = calibrate(scene, CalibrationSettings(reassign_corners=False))
+    assert plain.outlier_annotators == [f"w{bad + 1}"]
+    assert plain.annotator_weights[bad] < 0.3
     assert joint.position_sigma_m is not None
     assert np.all(np.isfinite(joint.position_sigma_m))
     assert np.all(joint.position_sigma_m > 0)
@@ -415,3 +426,27 @@ def test_focal_length_at_the_search_limit_is_flagged() -> None:
     # Within the range, no such warning.
     ok = calibrate(parse_scene(exact_scene(camera_aimed_at_car(10.0, 80.0, focal_px=8000.0))))
     assert not any("limit" in w for w in ok.warnings)
+
+
+def test_majority_on_the_wrong_corner_still_gives_the_nearest_corner_frame() -> None:
+    """Two of three annotators start at the far end of the length edge.
+
+    Their clicks are re-interpreted; the annotators disagree, so the world origin is the
+    corner the instructions ask for (the nearest to the camera), where the truth is.
+    """
+    cam = camera_aimed_at_car(6.0, 18.0, roll_deg=2.0, azimuth_deg=225.0)
+    noise = NoiseModel(
+        point_px=1.0, line_px=0.5, wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0
+    )
+    data = make_scene(cam, np.random.default_rng(5), noise=noise, n_annotators=3).scene
+    for bad in (0, 2):
+        _wrong_corner(data, cam, bad, ObjectSize(4.6, 1.8, 1.45))
+    result = calibrate(parse_scene(data))
+    err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
+    assert err < 0.03 * np.linalg.norm(cam.center_in_world)
+    assert result.annotator_corners == ["far_length", "origin", "far_length"]
+    assert result.corner_mistakes == ["w1", "w3"]
+    assert any("different corners" in w for w in result.warnings)
+    # Without re-interpretation the majority's frame wins and the camera is a car length off.
+    plain = calibrate(parse_scene(data), CalibrationSettings(reassign_corners=False))
+    assert np.linalg.norm(plain.camera.center_in_world - cam.center_in_world) > 3.0
