@@ -543,13 +543,15 @@ def _street_angle_under_car(theta: float, T: FloatArray, s: float, ev: _Evidence
     half the street's width + 2.5 m from every centre line); else the smallest angle among the
     streets it stands on.
     """
-    from shapely.geometry import Point
+    from shapely.geometry import Point, box
 
     car_bearing = (90.0 - math.degrees(theta)) % 180.0
     car = s * _rot2(theta) @ ev.car_center_world + T
-    pt = Point(float(car[0]), float(car[1]))
+    x, y = float(car[0]), float(car[1])
+    pt = Point(x, y)
     best: float | None = None
-    for idx in ev.street_tree.query(pt.buffer(25.0)):
+    # A box, not a buffered disc: the tree only tests envelopes, and buffering is costly.
+    for idx in ev.street_tree.query(box(x - 25.0, y - 25.0, x + 25.0, y + 25.0)):
         line, half_w = ev.streets_enu[int(idx)]
         if line.distance(pt) > half_w + 2.5:
             continue
