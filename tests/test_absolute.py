@@ -474,3 +474,30 @@ def test_one_landmark_uses_the_streets_along_the_building(maps: dict[str, MapDat
     check_contract(result)
     # The synthetic car is parallel to its street within a couple of degrees.
     assert min(errors_m(result, ls)) < 3.0
+
+
+def test_unknown_landmark_names_the_building(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = landmark_scene(m, "c49471330", 1, "building_corner")
+    ls.scene["landmarks"][0]["name"] = "Nonexistent Cathedral"
+    with pytest.raises(MapDataError, match="Nonexistent Cathedral"):
+        locate(parse_scene(ls.scene), m)
+
+
+def test_one_landmark_with_stated_bearing_gives_two_candidates_per_point(
+    maps: dict[str, MapData],
+) -> None:
+    """A landmark given by lat/lon (no map): like one reference, two candidates."""
+    m = maps["baltimore"]
+    ls = landmark_scene(m, "c49471330", 1, "building_corner")
+    px = ls.scene["landmarks"][0]["pixel"]
+    g = ls.camera_enu.ground_from_pixels(np.asarray([px], dtype=float))[0]
+    lon, lat = m.frame.geographic_from_enu(float(g[0]), float(g[1]))
+    ls.scene["landmarks"] = [
+        {"pixel": px, "kind": "building_corner", "lat": float(lat), "lon": float(lon)}
+    ]
+    ls.scene["street_bearing_deg"] = car_bearing_deg(ls)
+    result = locate(parse_scene(ls.scene))
+    check_contract(result)
+    assert len(result.candidates) == 2
+    assert min(errors_m(result, ls)) < EXACT
