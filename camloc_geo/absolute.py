@@ -685,7 +685,7 @@ def _refine(
         J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
         r = np.concatenate([r, [ls / s_sigma]])
         J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
-        if ev.street_tree is not None:
+        if use_street:
             # The car is parallel to the street it stands on, within bearing_sigma_deg.
             diff = _street_angle_under_car(theta, np.array([tx, ty]), s, ev)
             if diff is not None:
@@ -694,6 +694,12 @@ def _refine(
         return r, J
 
     x = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    # The street prior only pulls a candidate that already (nearly) meets it: one whose car
+    # is flagged off the street or across it is the evidence's, not the prior's, to move.
+    use_street = False
+    if ev.street_tree is not None:
+        diff0 = _street_angle_under_car(cand.theta_rad, cand.translation_en, cand.scale, ev)
+        use_street = diff0 is not None and abs(diff0) <= 2.5 * settings.bearing_sigma_deg
     r, J = resid_jac(x)
     for _ in range(8):  # Gauss-Newton: the problem is nearly linear
         try:

@@ -501,3 +501,16 @@ def test_one_landmark_with_stated_bearing_gives_two_candidates_per_point(
     check_contract(result)
     assert len(result.candidates) == 2
     assert min(errors_m(result, ls)) < EXACT
+
+
+@pytest.mark.parametrize("seed", [2, 4])
+def test_street_prior_does_not_move_an_exact_fit(seed: int) -> None:
+    """At Stirling Hwy x Tydeman Rd the true car is judged across its street (a divided
+    highway's carriageway lines): the refinement must not pull the exact corner fit onto
+    the street prior (it moved it by 4-7 m)."""
+    m = load_map(OSM / "fremantle.osm", -32.036172, 115.755714, radius_m=250)
+    inter = next(i for i in m.intersections if i.kind == "junction" and len(i.corners) >= 4)
+    ls = exact_located(m, inter, seed=seed, min_corners=3)
+    result = locate(parse_scene(ls.scene), m)
+    assert errors_m(result, ls)[0] < EXACT
+    assert result.candidates[0].residual_m < 0.05
