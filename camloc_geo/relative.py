@@ -748,8 +748,8 @@ def _check_segment_counts(
 
     A crowd annotator who drew fewer than two lines for an axis gets no closed-form
     solution of their own, but their lines and axis pixels still count in the joint fit.
-    The scene is rejected only when the pooled lines of an axis are fewer than two, or
-    when every annotator lacks lines (so no closed form can seed the fit).
+    The scene is rejected only when the pooled lines of an axis are fewer than two; when no
+    annotator has a closed form of their own, the pooled lines seed the joint fit.
     """
     warnings = []
     for axis in AXES:
@@ -762,12 +762,6 @@ def _check_segment_counts(
                 + ("" if scene.image_file() else " (and the scene has no image to detect them in)"),
                 f"annotations[{i}].vp_lines.{axis}",
             )
-    if all(shorts):
-        i, axis = 0, shorts[0][0]
-        raise SceneError(
-            f"needs at least 2 segments parallel to the {axis} axis, got {len(segs[i][axis])}",
-            f"annotations[{i}].vp_lines.{axis}",
-        )
     for i, sh in enumerate(shorts):
         for axis in sh:
             warnings.append(
@@ -859,8 +853,46 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
             log.info("annotator %d skipped by the closed form: %s", i, exc)
     good = [s for s in sols if s.camera is not None]
     if not good:
-        assert first_error is not None
-        raise first_error
+        if first_error is None:
+            first_error = DegenerateGeometryError(
+                "no annotator drew at least 2 segments for every axis"
+            )
+        axes_problem = any(".axes" in (sl.error or "") for sl in sols)
+        if not settings.joint_fit or axes_problem:
+            raise first_error
+        # No annotator alone determines a camera (their own lines are too few or too noisy);
+        # everybody's lines pooled may still do. Degenerate axis clicks are not rescued.
+        try:
+            pooled = _pooled_seed(scene, segs, size)
+        except DegenerateGeometryError:
+            raise first_error from None
+        pseudo = AnnotatorSolution(
+            -1,
+            "pooled",
+            {},
+            IntrinsicsEstimate(
+                pooled.focal_px,
+                pooled.principal_point,
+                "pooled",
+                f"every annotator's closed form failed (first: {first_error}); "
+                "vanishing points of all annotators' lines pooled",
+            ),
+            camera=pooled,
+        )
+        cluster = {
+            "threshold_m": None,
+            "members": [],
+            "centroid": pooled.center_in_world.tolist(),
+            "n_candidates": 0,
+            "n_clusters": 0,
+        }
+        result = _joint(scene, sols, segs, pseudo, cluster, pooled, size, settings)
+        result.warnings = [
+            *count_warnings,
+            f"no closed-form solution: {first_error}",
+            *result.warnings,
+        ]
+        return result
     candidates = [(s.index, k, s.candidates[k]) for s in good for k in ("length", "width")]
     cluster = _cluster(candidates, settings)
     centroid = np.asarray(cluster["centroid"])

@@ -450,3 +450,16 @@ def test_majority_on_the_wrong_corner_still_gives_the_nearest_corner_frame() -> 
     # Without re-interpretation the majority's frame wins and the camera is a car length off.
     plain = calibrate(parse_scene(data), CalibrationSettings(reassign_corners=False))
     assert np.linalg.norm(plain.camera.center_in_world - cam.center_in_world) > 3.0
+
+
+def test_pooled_lines_rescue_a_crowd_where_nobody_has_every_axis() -> None:
+    """Each of three annotators drew one line for a different axis: no closed form of their
+    own, but the pooled lines determine every vanishing point."""
+    cam = camera_aimed_at_car(6.0, 20.0, roll_deg=2.0)
+    data = exact_scene(cam, n_annotators=3)
+    for i, axis in enumerate(("length", "width", "height")):
+        data["annotations"][i]["vp_lines"][axis] = data["annotations"][i]["vp_lines"][axis][:1]
+    result = calibrate(parse_scene(data))
+    assert np.linalg.norm(result.camera.center_in_world - cam.center_in_world) < 1e-6 * 20
+    assert any("no closed-form solution" in w for w in result.warnings)
+    assert all(a.error for a in result.annotators)
