@@ -59,7 +59,7 @@ import numpy as np
 import numpy.typing as npt
 
 from camloc_geo._errors import MapDataError, SceneError
-from camloc_geo.camera import Camera, angles_from_rotation
+from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame, normalize_bearing_deg
 from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
 from camloc_geo.scene import Scene
@@ -263,8 +263,13 @@ def _camera_in_enu(world_cam: Camera, theta: float, T: FloatArray, s: float) -> 
 
 # ------------------------------------------------------------------------ observations
 def _ground_observation(
-    camera: Camera, pixel: Sequence[float], kind: str, label: str, sigma_map: float,
-    settings: LocateSettings, diag: float,
+    camera: Camera,
+    pixel: Sequence[float],
+    kind: str,
+    label: str,
+    sigma_map: float,
+    settings: LocateSettings,
+    diag: float,
 ) -> Observation:
     px = np.asarray(pixel, dtype=float)
     g = camera.ground_from_pixels(px)
@@ -330,7 +335,11 @@ def _mahal(obs: Observation, q: FloatArray, theta: float, T: FloatArray, s: floa
 
 
 def _score(
-    theta: float, T: FloatArray, s: float, ev: _Evidence, settings: LocateSettings,
+    theta: float,
+    T: FloatArray,
+    s: float,
+    ev: _Evidence,
+    settings: LocateSettings,
     corner_assignment: Sequence[int] | None,
 ) -> tuple[float, float, list[dict[str, Any]], list[float]]:
     """Log-likelihood, RMS misfit (m), the matches, and squared distances of the evidence."""
@@ -343,9 +352,16 @@ def _score(
         ll -= 0.5 * min(m2, _OUTLIER_M2)  # robust: one outlier costs at most 25
         d = s * R2 @ obs.world_xy + T - q
         sq.append(float(d @ d))
-        matches.append({"kind": "reference", "label": obs.label, "pixel": list(obs.pixel),
-                        "map_en": q.tolist(), "misfit_m": float(np.linalg.norm(d)),
-                        "mahalanobis2": float(m2)})
+        matches.append(
+            {
+                "kind": "reference",
+                "label": obs.label,
+                "pixel": list(obs.pixel),
+                "map_en": q.tolist(),
+                "misfit_m": float(np.linalg.norm(d)),
+                "mahalanobis2": float(m2),
+            }
+        )
     if ev.corners and len(ev.map_corners):
         if corner_assignment is None:
             corner_assignment = _best_assignment(theta, T, s, ev)
@@ -355,19 +371,34 @@ def _score(
             ll -= 0.5 * min(m2, _OUTLIER_M2)
             d = s * R2 @ obs.world_xy + T - q
             sq.append(float(d @ d))
-            matches.append({"kind": "corner", "label": obs.label, "pixel": list(obs.pixel),
-                            "map_en": q.tolist(), "map_corner": ev.map_corner_ids[j],
-                            "order": int(j), "misfit_m": float(np.linalg.norm(d)),
-                            "mahalanobis2": float(m2)})
+            matches.append(
+                {
+                    "kind": "corner",
+                    "label": obs.label,
+                    "pixel": list(obs.pixel),
+                    "map_en": q.tolist(),
+                    "map_corner": ev.map_corner_ids[j],
+                    "order": int(j),
+                    "misfit_m": float(np.linalg.norm(d)),
+                    "mahalanobis2": float(m2),
+                }
+            )
     for obs, pts in ev.landmarks:
         m2s = [_mahal(obs, q, theta, T, s) for q in pts]
         k = int(np.argmin(m2s))
         ll -= 0.5 * min(m2s[k], _OUTLIER_M2)
         d = s * R2 @ obs.world_xy + T - pts[k]
         sq.append(float(d @ d))
-        matches.append({"kind": "landmark", "label": obs.label, "pixel": list(obs.pixel),
-                        "map_en": pts[k].tolist(), "misfit_m": float(np.linalg.norm(d)),
-                        "mahalanobis2": float(m2s[k])})
+        matches.append(
+            {
+                "kind": "landmark",
+                "label": obs.label,
+                "pixel": list(obs.pixel),
+                "map_en": pts[k].tolist(),
+                "misfit_m": float(np.linalg.norm(d)),
+                "mahalanobis2": float(m2s[k]),
+            }
+        )
     ll -= 0.5 * ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
     rms = math.sqrt(sum(sq) / len(sq)) if sq else math.nan
     return ll, rms, matches, sq
@@ -377,7 +408,10 @@ def _best_assignment(theta: float, T: FloatArray, s: float, ev: _Evidence) -> li
     """The cyclic, order-preserving assignment of image corners to map corners that fits best."""
     best: tuple[float, list[int]] | None = None
     for assign, _prior in _assignments(len(ev.corners), len(ev.map_corners)):
-        cost = sum(_mahal(o, ev.map_corners[j], theta, T, s) for o, j in zip(ev.corners, assign, strict=True))
+        cost = sum(
+            _mahal(o, ev.map_corners[j], theta, T, s)
+            for o, j in zip(ev.corners, assign, strict=True)
+        )
         if best is None or cost < best[0]:
             best = (cost, list(assign))
     assert best is not None
@@ -618,7 +652,9 @@ def _plausibility(
             if best_diff > 2.5 * settings.bearing_sigma_deg:
                 flags.append("car_not_parallel_to_street")
     elif ev.street_bearings:
-        diff = min(min(abs(car_bearing - b), 180.0 - abs(car_bearing - b)) for b in ev.street_bearings)
+        diff = min(
+            min(abs(car_bearing - b), 180.0 - abs(car_bearing - b)) for b in ev.street_bearings
+        )
         par = math.exp(-0.5 * (diff / settings.bearing_sigma_deg) ** 2)
         factor *= settings.parallel_floor + (1.0 - settings.parallel_floor) * par
         if diff > 2.5 * settings.bearing_sigma_deg:
@@ -654,7 +690,8 @@ def _refine(
     # Points beyond the likelihood's cap are outliers to this hypothesis (they add a
     # constant): leave them out, or one wrong reference drags the fit back onto itself.
     inliers = [
-        (o, q) for o, q in obs_q
+        (o, q)
+        for o, q in obs_q
         if by_label.get(o.label, {}).get("mahalanobis2", 0.0) <= _OUTLIER_M2
     ]
     if len(inliers) >= 2:
@@ -730,7 +767,13 @@ def _refine(
     except np.linalg.LinAlgError:
         pass
     return replace(
-        cand, theta_rad=float(theta), translation_en=T, scale=s, camera=cam, sigma_m=sigma, refined=True
+        cand,
+        theta_rad=float(theta),
+        translation_en=T,
+        scale=s,
+        camera=cam,
+        sigma_m=sigma,
+        refined=True,
     )
 
 
@@ -870,8 +913,12 @@ def locate(
 
     refs = []
     for i, ref in enumerate(scene.references):
-        obs = observe(ref.pixel, "reference", f"references[{i}]",
-                      settings.sigma_reference_m / math.sqrt(ref.weight))
+        obs = observe(
+            ref.pixel,
+            "reference",
+            f"references[{i}]",
+            settings.sigma_reference_m / math.sqrt(ref.weight),
+        )
         if obs is not None:
             refs.append((obs, np.array(frame.enu_from_geographic(ref.lon, ref.lat), dtype=float)))
     corners: list[Observation] = []
@@ -902,22 +949,33 @@ def locate(
     if scene.landmarks:
         for i, lm in enumerate(scene.landmarks):
             label = f"landmarks[{i}]"
-            sigma = settings.sigma_landmark_corner_m if lm.kind == "building_corner" else settings.sigma_face_midpoint_m
+            sigma = (
+                settings.sigma_landmark_corner_m
+                if lm.kind == "building_corner"
+                else settings.sigma_face_midpoint_m
+            )
             lm_obs = observe(lm.pixel, "landmark", label, sigma)
             if lm_obs is None:
                 continue
             pts_ll: list[tuple[float, float]]
             if lm.name is not None and map_data is not None:
-                near = (lm.lat, lm.lon) if lm.lat is not None else (
-                    (scene.prior.lat, scene.prior.lon) if scene.prior is not None else None)
-                b = map_data.find_building(lm.name, near=near)
-                pts_ll = list(b.corners if lm.kind == "building_corner" else b.face_midpoints)
+                near_lm: tuple[float, float] | None = None
+                if lm.lat is not None and lm.lon is not None:
+                    near_lm = (lm.lat, lm.lon)
+                elif scene.prior is not None:
+                    near_lm = (scene.prior.lat, scene.prior.lon)
+                building = map_data.find_building(lm.name, near=near_lm)
+                pts_ll = list(
+                    building.corners if lm.kind == "building_corner" else building.face_midpoints
+                )
             elif lm.lat is not None and lm.lon is not None:
                 pts_ll = [(lm.lon, lm.lat)]
             else:
                 raise MapDataError(f"{label}: landmark {lm.name!r} needs a map or lat/lon")
             if not pts_ll:
-                raise MapDataError(f"{label}: the building has no usable {lm.kind.replace('_', ' ')}s")
+                raise MapDataError(
+                    f"{label}: the building has no usable {lm.kind.replace('_', ' ')}s"
+                )
             pts = frame.points_enu_from_geographic(np.asarray(pts_ll, dtype=float))
             landmarks.append((lm_obs, pts))
     # Street bearings near the evidence.
@@ -926,20 +984,28 @@ def locate(
     elif map_data is not None:
         spots = [(q, settings.street_search_m) for _, q in refs]
         if inter is not None:
-            spots.append((np.array(frame.enu_from_geographic(inter.lon, inter.lat)),
-                          settings.street_search_m))
+            spots.append(
+                (
+                    np.array(frame.enu_from_geographic(inter.lon, inter.lat)),
+                    settings.street_search_m,
+                )
+            )
         for _, pts in landmarks:
             # The streets along any side of the building, not only near its centre.
             mid = pts.mean(axis=0)
             reach = float(np.max(np.linalg.norm(pts - mid, axis=1)))
             spots.append((mid, settings.street_search_m + reach))
         if not spots and scene.prior is not None:
-            spots.append((np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat)),
-                          settings.street_search_m))
+            spots.append(
+                (
+                    np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat)),
+                    settings.street_search_m,
+                )
+            )
         for q, radius in spots:
             lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
-            for _name, b in map_data.street_bearings(float(lat), float(lon), radius):
-                bearings.append(b)
+            for _name, street_brg in map_data.street_bearings(float(lat), float(lon), radius):
+                bearings.append(street_brg)
     bearings = _unique_bearings(bearings)
 
     buildings_enu: list[Any] = []
@@ -949,10 +1015,21 @@ def locate(
     prior_en = None
     prior_r = None
     if scene.prior is not None:
-        prior_en = np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat), dtype=float)
+        prior_en = np.array(
+            frame.enu_from_geographic(scene.prior.lon, scene.prior.lat), dtype=float
+        )
         prior_r = scene.prior.radius_m
-    ev = _Evidence(refs, corners, map_corners, map_corner_ids, landmarks, bearings,
-                   buildings_enu, prior_en, prior_r)
+    ev = _Evidence(
+        refs,
+        corners,
+        map_corners,
+        map_corner_ids,
+        landmarks,
+        bearings,
+        buildings_enu,
+        prior_en,
+        prior_r,
+    )
     ev.buildings_tree = buildings_tree
     if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
         ev.streets_enu, ev.street_tree = _streets_index(map_data, frame)
@@ -975,7 +1052,9 @@ def locate(
     if len(refs) == 1 and not corners and not scene.landmarks:
         result.methods_tried.append("one_reference")
         if not bearings:
-            result.warnings.append("one_reference: no street bearing (scene or map) near the reference")
+            result.warnings.append(
+                "one_reference: no street bearing (scene or map) near the reference"
+            )
         hyps += _gen_one_reference(ev, scene.street_bearing_deg)
     if scene.intersection is not None:
         result.methods_tried.append("corners")
@@ -993,16 +1072,19 @@ def locate(
     if scene.landmarks:
         result.methods_tried.append("landmark")
         if len(landmarks) == 1 and not bearings:
-            result.warnings.append("landmark: one landmark and no street bearing (scene or map) near it")
+            result.warnings.append(
+                "landmark: one landmark and no street bearing (scene or map) near it"
+            )
         hyps += _gen_landmarks(ev, settings)
     if not result.methods_tried:
         result.reason = (
-            "no geographic evidence: the scene has no references, intersection corners or "
-            "landmarks"
+            "no geographic evidence: the scene has no references, intersection corners or landmarks"
         )
         return result
     if not hyps:
-        result.reason = "no hypothesis: " + "; ".join(result.warnings or ["the evidence fits nothing"])
+        result.reason = "no hypothesis: " + "; ".join(
+            result.warnings or ["the evidence fits nothing"]
+        )
         return result
 
     cands = []
@@ -1011,14 +1093,24 @@ def locate(
         cam = _camera_in_enu(world_cam, h.theta, h.T, h.s)
         plaus, flags = _plausibility(cam, h.theta, h.T, h.s, ev, settings, matches)
         cands.append(
-            Candidate(h.method, h.theta, h.T, h.s, cam, log_likelihood=ll + h.log_prior,
-                      prior=plaus, residual_m=rms, matches=matches, flags=flags)
+            Candidate(
+                h.method,
+                h.theta,
+                h.T,
+                h.s,
+                cam,
+                log_likelihood=ll + h.log_prior,
+                prior=plaus,
+                residual_m=rms,
+                matches=matches,
+                flags=flags,
+            )
         )
     if ev.prior_en is not None and ev.prior_radius_m:
         limit = settings.prior_gate_radii * ev.prior_radius_m
         dist = [float(np.linalg.norm(c.east_north - ev.prior_en)) for c in cands]
-        near = [c for c, d in zip(cands, dist, strict=True) if d <= limit]
-        if not near:
+        kept_near = [c for c, d in zip(cands, dist, strict=True) if d <= limit]
+        if not kept_near:
             result.reason = (
                 f"every hypothesis puts the camera more than {limit:.0f} m "
                 f"({settings.prior_gate_radii:g} x prior.radius_m) from the prior, the nearest "
@@ -1027,11 +1119,12 @@ def locate(
                 f"{float(np.linalg.norm(world_cam.center_in_world[:2])):.0f} m from the car)"
             )
             return result
-        if len(near) < len(cands):
+        if len(kept_near) < len(cands):
             result.warnings.append(
-                f"{len(cands) - len(near)} hypotheses more than {limit:.0f} m from the prior dropped"
+                f"{len(cands) - len(kept_near)} hypotheses more than {limit:.0f} m from the prior "
+                "dropped"
             )
-        cands = near
+        cands = kept_near
     cands = _normalise_and_merge(cands, settings)
     # Refine the leaders, then score again.
     for i in range(min(settings.refine_top, len(cands))):
@@ -1041,7 +1134,9 @@ def locate(
         plaus, flags = _plausibility(
             c.camera, c.theta_rad, c.translation_en, c.scale, ev, settings, matches
         )
-        cands[i] = replace(c, log_likelihood=ll, prior=plaus, residual_m=rms, matches=matches, flags=flags)
+        cands[i] = replace(
+            c, log_likelihood=ll, prior=plaus, residual_m=rms, matches=matches, flags=flags
+        )
     cands = _normalise_and_merge(cands, settings)[: settings.max_candidates]
     if all("poor_fit" in c.flags for c in cands):
         best = min(cands, key=lambda c: c.residual_m)
@@ -1056,7 +1151,9 @@ def locate(
     for rank, c in enumerate(cands, start=1):
         c.score = c.score / total
         c.rank = rank
-        lon, lat = frame.geographic_from_enu(float(c.camera.center_in_world[0]), float(c.camera.center_in_world[1]))
+        lon, lat = frame.geographic_from_enu(
+            float(c.camera.center_in_world[0]), float(c.camera.center_in_world[1])
+        )
         c.lon, c.lat = float(lon), float(lat)
     result.candidates = cands
     if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
@@ -1103,7 +1200,7 @@ def _view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray
     """Ground footprint of the view, clipped at ``range_m`` horizontally (ENU polygon)."""
     w, h = size
     C = cam.center_in_world
-    border = []
+    border: list[tuple[float, float]] = []
     n = 12
     for i in range(n + 1):
         border.append((w * i / n, h))
@@ -1164,35 +1261,76 @@ def candidates_geojson(result: LocateResult, *, view_cones: bool = True) -> dict
             "flags": c.flags,
             "scene": result.scene_id,
             "matches": [
-                {**{k: v for k, v in m.items() if k != "map_en"},
-                 "map_lonlat": list(frame.geographic_from_enu(*m["map_en"]))}
+                {
+                    **{k: v for k, v in m.items() if k != "map_en"},
+                    "map_lonlat": list(frame.geographic_from_enu(*m["map_en"])),
+                }
                 for m in c.matches
             ],
         }
-        feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [c.lon, c.lat]},
-                      "properties": props})
+        feats.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [c.lon, c.lat]},
+                "properties": props,
+            }
+        )
     if view_cones:
         for c in result.candidates:
             poly = _view_cone(c.camera, result.image_size, 60.0)
             ll = frame.points_geographic_from_enu(poly)
-            feats.append({"type": "Feature", "geometry": {"type": "Polygon", "coordinates": [ll.tolist()]},
-                          "properties": {"kind": "view_cone", "rank": c.rank, "score": c.score}})
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Polygon", "coordinates": [ll.tolist()]},
+                    "properties": {"kind": "view_cone", "rank": c.rank, "score": c.score},
+                }
+            )
     for c in result.candidates:
         for m in c.matches:
             lon, lat = frame.geographic_from_enu(*m["map_en"])
-            feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [float(lon), float(lat)]},
-                          "properties": {"kind": "matched_point", "rank": c.rank, "label": m["label"],
-                                         "match_kind": m["kind"], "pixel": m["pixel"],
-                                         "misfit_m": m["misfit_m"], **({"map_corner": m["map_corner"]} if "map_corner" in m else {})}})
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Point", "coordinates": [float(lon), float(lat)]},
+                    "properties": {
+                        "kind": "matched_point",
+                        "rank": c.rank,
+                        "label": m["label"],
+                        "match_kind": m["kind"],
+                        "pixel": m["pixel"],
+                        "misfit_m": m["misfit_m"],
+                        **({"map_corner": m["map_corner"]} if "map_corner" in m else {}),
+                    },
+                }
+            )
     inter = result.intersection
     if inter is not None:
-        feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [inter.lon, inter.lat]},
-                      "properties": {"kind": "intersection", "id": inter.id,
-                                     "streets": [s.name for s in inter.streets], "intersection_kind": inter.kind}})
+        feats.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [inter.lon, inter.lat]},
+                "properties": {
+                    "kind": "intersection",
+                    "id": inter.id,
+                    "streets": [s.name for s in inter.streets],
+                    "intersection_kind": inter.kind,
+                },
+            }
+        )
         for corner in inter.corners:
-            feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [corner.lon, corner.lat]},
-                          "properties": {"kind": "corner", "intersection": inter.id, "order": corner.order,
-                                         "streets": list(corner.streets)}})
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Point", "coordinates": [corner.lon, corner.lat]},
+                    "properties": {
+                        "kind": "corner",
+                        "intersection": inter.id,
+                        "order": corner.order,
+                        "streets": list(corner.streets),
+                    },
+                }
+            )
     out: dict[str, Any] = {
         "type": "FeatureCollection",
         "features": feats,
@@ -1215,4 +1353,3 @@ def candidates_geojson(result: LocateResult, *, view_cones: bool = True) -> dict
         },
     }
     return out
-

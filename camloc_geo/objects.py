@@ -44,7 +44,9 @@ class ObjectSize:
         for name in ("length_m", "width_m", "height_m"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and value > 0 and value < 1e4):
-                raise SceneError(f"must be a positive size in metres, got {value!r}", f"object.{name}")
+                raise SceneError(
+                    f"must be a positive size in metres, got {value!r}", f"object.{name}"
+                )
 
     def dimension(self, axis: str) -> float:
         """The size along ``length``, ``width`` or ``height``."""

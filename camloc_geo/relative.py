@@ -315,18 +315,18 @@ def solve_annotator(
     sol.width_sign = s_w
     R = rotation_from_vanishing_directions({"length": d_len, "width": d_wid, "height": d_up})
     ends = _object_points(size, s_w)
-    lam = {}
+    lam: dict[str, float] = {}
     num_total = den_total = 0.0
     for k in AXES:
         mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
         mk /= np.linalg.norm(mk)
-        a = np.cross(mk, m0)
-        b = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
-        den = float(a @ a)
+        cross_o = np.cross(mk, m0)
+        cross_e = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
+        den = float(cross_o @ cross_o)
         if den < 1e-18:
             raise DegenerateGeometryError(f"{where}.axes.{k}: end pixel on the origin's ray")
-        lam[k] = -float(a @ b) / den
-        num_total += -float(a @ b)
+        lam[k] = -float(cross_o @ cross_e) / den
+        num_total += -float(cross_o @ cross_e)
         den_total += den
     for k in AXES:
         if not lam[k] > 0:
@@ -421,7 +421,7 @@ def _cluster(
         "members": [{"annotator": candidates[i][0], "dimension": candidates[i][1]} for i in idx],
         "centroid": centroid.tolist(),
         "n_candidates": len(pts),
-        "n_clusters": int(len(np.unique(labels))),
+        "n_clusters": len(np.unique(labels)),
     }
 
 
@@ -902,7 +902,8 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         (s for s in good if s.index in member_idx),
         key=lambda s: float(np.linalg.norm(s.camera.center_in_world - centroid)),  # type: ignore[union-attr]
     )
-    assert seed.camera is not None and seed.intrinsics is not None
+    assert seed.camera is not None
+    assert seed.intrinsics is not None
     intr_method, intr_reason = seed.intrinsics.method, seed.intrinsics.reason
     cluster_camera = Camera.from_center(
         seed.camera.focal_px,
@@ -1174,7 +1175,7 @@ def _joint(
     if settings.reassign_corners:
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed)
-    chosen = (res, pp_fixed)
+    chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
     free_pp = settings.free_principal_point
     n_res = len(res.fun)
     worth_trying = free_pp is True or (
@@ -1194,13 +1195,13 @@ def _joint(
         improvement = (cost_fixed - cost_free) / s2
         # Freeing the principal point must pay for itself clearly: a chi-square(2) jump at
         # p < 1e-6 (27.6) on top of the BIC penalty, and a well-determined result.
-        _f1, pp_free, _R1, _C1 = prob.unpack(res_free.x, R0, None, f_fixed)
         pp_sigma = _param_sigma(res_free, slice(int(f_fixed is None), int(f_fixed is None) + 2))
         well_determined = pp_sigma is not None and pp_sigma < 0.02 * math.hypot(width, height)
         justified = improvement > 27.6 + 2.0 * math.log(n_res) and well_determined
         if free_pp or (justified and res_free.success):
             chosen = (res_free, None)
-    res, pp_model = chosen
+    res, pp_model_or_none = chosen
+    pp_model: tuple[float, float] | None = pp_model_or_none
     f, pp, R, C = prob.unpack(res.x, R0, pp_model, f_fixed)
     # The output frame: the corner the annotators chose; where they disagree, the one the
     # instructions ask for (the corner nearest to the camera).

@@ -250,9 +250,7 @@ def _check_pixel(values: tuple[float, ...], width: int, height: int, path: str) 
         if not (math.isfinite(x) and math.isfinite(y)):
             raise SceneError(f"pixel [{x}, {y}] is not finite", path)
         if not (0.0 <= x <= width and 0.0 <= y <= height):
-            raise SceneError(
-                f"pixel [{x:g}, {y:g}] is outside the {width}x{height} image", path
-            )
+            raise SceneError(f"pixel [{x:g}, {y:g}] is outside the {width}x{height} image", path)
 
 
 def _loc_to_path(loc: tuple[int | str, ...]) -> str:

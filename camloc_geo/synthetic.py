@@ -27,7 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from camloc_geo.camera import Camera, rotation_from_angles
-from camloc_geo.objects import ObjectSize
+from camloc_geo.objects import PRESETS, ObjectSize
 
 __all__ = [
     "LocatedScene",
@@ -93,7 +93,10 @@ def random_camera(
         f = (w / 2.0) / math.tan(hfov / 2.0)
     else:
         f = float(rng.uniform(*focal_px))
-    pp = (w / 2.0 + rng.uniform(-pp_offset_px, pp_offset_px), h / 2.0 + rng.uniform(-pp_offset_px, pp_offset_px))
+    pp = (
+        w / 2.0 + rng.uniform(-pp_offset_px, pp_offset_px),
+        h / 2.0 + rng.uniform(-pp_offset_px, pp_offset_px),
+    )
     cam_h = float(rng.uniform(*height_m))
     dist = float(rng.uniform(*distance_m))
     az = math.radians(rng.uniform(200.0, 250.0))  # direction from the car to the camera
@@ -128,7 +131,9 @@ def _clip_segment(p: FloatArray, q: FloatArray, w: int, h: int) -> FloatArray | 
     return np.array([*(p + t0 * d), *(p + t1 * d)])
 
 
-def _visible_segment(cam: Camera, a: FloatArray, b: FloatArray, size: tuple[int, int]) -> FloatArray | None:
+def _visible_segment(
+    cam: Camera, a: FloatArray, b: FloatArray, size: tuple[int, int]
+) -> FloatArray | None:
     """Project a 3-D segment (clipped to the front of the camera and to the image)."""
     R, t = cam.cam_from_world_rotation, cam.cam_from_world_translation
     za, zb = (R @ a + t)[2], (R @ b + t)[2]
@@ -158,7 +163,10 @@ def _scene_lines(
             x0 = float(rng.uniform(-30, 10))
             scene.append((np.array([x0, y, 0.0]), np.array([x0 + rng.uniform(8, 40), y, 0.0])))
     elif axis == 1:
-        car = [(np.array([x, 0, z]), np.array([x, W, z])) for x, z in ((0, 0.3), (0, H * 0.8), (L, 0.3))]
+        car = [
+            (np.array([x, 0, z]), np.array([x, W, z]))
+            for x, z in ((0, 0.3), (0, H * 0.8), (L, 0.3))
+        ]
         for _ in range(4):  # stop lines, crossings
             x = float(rng.uniform(-20, 25))
             y0 = float(rng.uniform(-12, 0))
@@ -176,7 +184,7 @@ def make_scene(
     camera: Camera,
     rng: np.random.Generator,
     *,
-    preset: ObjectSize = ObjectSize(4.6, 1.8, 1.45),
+    preset: ObjectSize = PRESETS["sedan"],
     noise: NoiseModel | None = None,
     n_annotators: int = 5,
     image_size: tuple[int, int] = (1920, 1080),
@@ -194,8 +202,12 @@ def make_scene(
     """
     noise = noise or NoiseModel()
     w, h = image_size
-    true = true_size or ObjectSize(*(d * (1.0 + rng.normal(0.0, noise.size_rel)) for d in
-                                     (preset.length_m, preset.width_m, preset.height_m)))
+    true = true_size or ObjectSize(
+        *(
+            d * (1.0 + rng.normal(0.0, noise.size_rel))
+            for d in (preset.length_m, preset.width_m, preset.height_m)
+        )
+    )
     ws = width_sign
     L, W, H = true.length_m, ws * true.width_m, true.height_m
     annotations = []
@@ -218,7 +230,10 @@ def make_scene(
             got: list[list[float]] = []
             for p, q in _scene_lines(rng, axis, true, ws):
                 seg = _visible_segment(camera, p, q, image_size)
-                if seg is None or math.hypot(seg[2] - seg[0], seg[3] - seg[1]) < noise.min_segment_px:
+                if (
+                    seg is None
+                    or math.hypot(seg[2] - seg[0], seg[3] - seg[1]) < noise.min_segment_px
+                ):
                     continue
                 seg = seg + rng.normal(0.0, noise.line_px * k, 4)
                 seg[[0, 2]] = np.clip(seg[[0, 2]], 0.0, w)
@@ -243,11 +258,18 @@ def make_scene(
         "format": "camloc-scene/1",
         "id": scene_id,
         "image": {"width": w, "height": h},
-        "object": {"length_m": preset.length_m, "width_m": preset.width_m, "height_m": preset.height_m},
+        "object": {
+            "length_m": preset.length_m,
+            "width_m": preset.width_m,
+            "height_m": preset.height_m,
+        },
         "annotations": annotations,
     }
     if give_focal:
-        scene["camera"] = {"focal_px": camera.focal_px, "principal_point": list(camera.principal_point)}
+        scene["camera"] = {
+            "focal_px": camera.focal_px,
+            "principal_point": list(camera.principal_point),
+        }
     return SyntheticScene(scene, camera, true, ws, wrong)
 
 
@@ -318,7 +340,9 @@ def make_located_scene(
         along = np.array([math.sin(b), math.cos(b)])
         right = np.array([along[1], -along[0]])
         dist = float(rng.uniform(8.0, 25.0))
-        lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice([-1.0, 1.0])
+        lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice(
+            [-1.0, 1.0]
+        )
         car_centre = centre + dist * along + lateral * right
         # In a lane of the street's real centre line (it may bend), parallel to it there.
         on_line = _along_street(lines, street.name, centre + dist * along, along)
@@ -331,7 +355,9 @@ def make_located_scene(
                 along = on_line[1]
         car_dir = along * rng.choice([-1.0, 1.0])
         yaw = math.radians(rng.normal(0.0, noise.car_yaw_deg)) if noise.car_yaw_deg > 0 else 0.0
-        car_dir = np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]) @ car_dir
+        car_dir = (
+            np.array([[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]) @ car_dir
+        )
         car_side = np.array([-car_dir[1], car_dir[0]])
         az = rng.uniform(0, 2 * math.pi)
         cam_xy = centre + rng.uniform(12.0, 45.0) * np.array([math.cos(az), math.sin(az)])
@@ -346,11 +372,18 @@ def make_located_scene(
         f = (w / 2.0) / math.tan(hfov / 2.0)
         R = rotation_from_angles(heading, pitch, float(rng.uniform(-3, 3)))
         cam_enu = Camera.from_center(f, (w / 2.0, h / 2.0), R, [*cam_xy, cam_h])
-        true = ObjectSize(*(d * (1.0 + rng.normal(0.0, noise.size_rel)) for d in
-                            (preset.length_m, preset.width_m, preset.height_m)))
+        true = ObjectSize(
+            *(
+                d * (1.0 + rng.normal(0.0, noise.size_rel))
+                for d in (preset.length_m, preset.width_m, preset.height_m)
+            )
+        )
         half_l, half_w = true.length_m / 2, true.width_m / 2
-        ground = [car_centre + sl * half_l * car_dir + sw * half_w * car_side
-                  for sl in (-1, 1) for sw in (-1, 1)]
+        ground = [
+            car_centre + sl * half_l * car_dir + sw * half_w * car_side
+            for sl in (-1, 1)
+            for sw in (-1, 1)
+        ]
         dists = [np.linalg.norm(g - cam_xy) for g in ground]
         o = ground[int(np.argmin(dists))]
         x_dir = car_dir if np.dot(car_centre - o, car_dir) > 0 else -car_dir
@@ -360,19 +393,33 @@ def make_located_scene(
         ws = 1.0 if np.dot(car_centre - o, y3[:2]) > 0 else -1.0
         # world -> enu: p_enu = Rw p_world + o
         Rw = np.column_stack([x3, y3, z])
-        box = np.array([[x, y, zz] for x in (0, true.length_m) for y in (0, ws * true.width_m)
-                        for zz in (0, true.height_m)])
+        box = np.array(
+            [
+                [x, y, zz]
+                for x in (0, true.length_m)
+                for y in (0, ws * true.width_m)
+                for zz in (0, true.height_m)
+            ]
+        )
         box_enu = box @ Rw.T + np.array([*o, 0.0])
         pix = cam_enu.project(box_enu)
-        if not np.all(np.isfinite(pix)) or np.any(pix < 5) or np.any(pix[:, 0] > w - 5) or np.any(pix[:, 1] > h - 5):
+        if (
+            not np.all(np.isfinite(pix))
+            or np.any(pix < 5)
+            or np.any(pix[:, 0] > w - 5)
+            or np.any(pix[:, 1] > h - 5)
+        ):
             continue
         if np.ptp(pix[:, 0]) < 60 or _axes_degenerate(pix[0], pix[4], pix[2], pix[1]):
             continue
         corner_pix = cam_enu.project(np.column_stack([real_corners, np.zeros(len(real_corners))]))
         horizon = cam_enu.horizon_line()
         vis = [
-            i for i, p in enumerate(corner_pix)
-            if np.all(np.isfinite(p)) and 10 <= p[0] <= w - 10 and 10 <= p[1] <= h - 10
+            i
+            for i, p in enumerate(corner_pix)
+            if np.all(np.isfinite(p))
+            and 10 <= p[0] <= w - 10
+            and 10 <= p[1] <= h - 10
             and horizon @ np.array([p[0], p[1], 1.0]) > 20
         ]
         vis = [i for i in vis if not _blocked(buildings, cam_xy, real_corners[i])]
@@ -382,14 +429,22 @@ def make_located_scene(
         if n_landmarks:
             for name, q in marks:
                 p = cam_enu.project([*q, 0.0])
-                if (np.all(np.isfinite(p)) and 10 <= p[0] <= w - 10 and 10 <= p[1] <= h - 10
-                        and horizon @ np.array([p[0], p[1], 1.0]) > 20
-                        and np.linalg.norm(q - cam_xy) < 80.0
-                        and not _blocked(buildings, cam_xy, q)):
+                if (
+                    np.all(np.isfinite(p))
+                    and 10 <= p[0] <= w - 10
+                    and 10 <= p[1] <= h - 10
+                    and horizon @ np.array([p[0], p[1], 1.0]) > 20
+                    and np.linalg.norm(q - cam_xy) < 80.0
+                    and not _blocked(buildings, cam_xy, q)
+                ):
                     seen_marks.append((name, q))
             if len(seen_marks) < n_landmarks:
                 continue
-        vis = vis[:max_corners] if len(vis) <= max_corners else sorted(rng.choice(vis, max_corners, replace=False).tolist())
+        vis = (
+            vis[:max_corners]
+            if len(vis) <= max_corners
+            else sorted(rng.choice(vis, max_corners, replace=False).tolist())
+        )
         # Clockwise on screen = map order. All corners seen: the list may start anywhere.
         # Part of them: a person lists the visible arc clockwise from its first corner, so
         # the list starts after the widest gap (two corners are not listed the long way round).
@@ -403,9 +458,21 @@ def make_located_scene(
         R_world = cam_enu.cam_from_world_rotation @ Rw
         C_world = Rw.T @ (cam_enu.center_in_world - np.array([*o, 0.0]))
         cam_world = Camera.from_center(f, (w / 2.0, h / 2.0), R_world, C_world)
-        syn = make_scene(cam_world, rng, preset=preset, noise=replace_size(noise), n_annotators=n_annotators,
-                         image_size=image_size, width_sign=ws, true_size=true)
-        if any(len(a["vp_lines"][k]) < 2 for a in syn.scene["annotations"] for k in ("length", "width", "height")):
+        syn = make_scene(
+            cam_world,
+            rng,
+            preset=preset,
+            noise=replace_size(noise),
+            n_annotators=n_annotators,
+            image_size=image_size,
+            width_sign=ws,
+            true_size=true,
+        )
+        if any(
+            len(a["vp_lines"][k]) < 2
+            for a in syn.scene["annotations"]
+            for k in ("length", "width", "height")
+        ):
             continue
         scene = syn.scene
         lon, lat = frame.geographic_from_enu(float(cam_xy[0]), float(cam_xy[1]))
@@ -416,17 +483,32 @@ def make_located_scene(
         else:
             scene["intersection"]["lat"] = intersection.lat
             scene["intersection"]["lon"] = intersection.lon
-        plon, plat = frame.geographic_from_enu(float(centre[0] + rng.normal(0, 20)), float(centre[1] + rng.normal(0, 20)))
+        plon, plat = frame.geographic_from_enu(
+            float(centre[0] + rng.normal(0, 20)), float(centre[1] + rng.normal(0, 20))
+        )
         scene["prior"] = {"lat": float(plat), "lon": float(plon), "radius_m": 150.0}
         refs = []
         for _k in range(n_references):
             for _t in range(50):
                 q = car_centre + rng.normal(0, 12.0, 2)
                 p = cam_enu.project([*q, 0.0])
-                if np.all(np.isfinite(p)) and 5 < p[0] < w - 5 and 5 < p[1] < h - 5 and horizon @ np.array([*p, 1.0]) > 20:
-                    qlon, qlat = frame.geographic_from_enu(float(q[0] + rng.normal(0, 0.5)), float(q[1] + rng.normal(0, 0.5)))
+                if (
+                    np.all(np.isfinite(p))
+                    and 5 < p[0] < w - 5
+                    and 5 < p[1] < h - 5
+                    and horizon @ np.array([*p, 1.0]) > 20
+                ):
+                    qlon, qlat = frame.geographic_from_enu(
+                        float(q[0] + rng.normal(0, 0.5)), float(q[1] + rng.normal(0, 0.5))
+                    )
                     pp = p + rng.normal(0.0, noise.point_px, 2)
-                    refs.append({"pixel": np.clip(pp, 0, [w, h]).tolist(), "lat": float(qlat), "lon": float(qlon)})
+                    refs.append(
+                        {
+                            "pixel": np.clip(pp, 0, [w, h]).tolist(),
+                            "lat": float(qlat),
+                            "lon": float(qlon),
+                        }
+                    )
                     break
         if refs:
             scene["references"] = refs
@@ -437,11 +519,19 @@ def make_located_scene(
                 name, q = seen_marks[j]
                 real = q + rng.normal(0.0, landmark_sigma_m / math.sqrt(2), 2)
                 p = cam_enu.project([*real, 0.0]) + rng.normal(0.0, noise.point_px, 2)
-                lms.append({"pixel": np.clip(p, 0, [w, h]).tolist(), "kind": landmark_kind,
-                            "name": name})
+                lms.append(
+                    {"pixel": np.clip(p, 0, [w, h]).tolist(), "kind": landmark_kind, "name": name}
+                )
             scene["landmarks"] = lms
-        return LocatedScene(scene, cam_enu, cam_world, float(lat), float(lon), intersection.id,
-                            [intersection.corners[i].order for i in vis])
+        return LocatedScene(
+            scene,
+            cam_enu,
+            cam_world,
+            float(lat),
+            float(lon),
+            intersection.id,
+            [intersection.corners[i].order for i in vis],
+        )
     return None
 
 
@@ -518,8 +608,12 @@ def _landmark_points(
 
 
 def _axes_degenerate(
-    origin: FloatArray, length: FloatArray, width: FloatArray, height: FloatArray,
-    min_px: float = 15.0, min_angle_deg: float = 5.0,
+    origin: FloatArray,
+    length: FloatArray,
+    width: FloatArray,
+    height: FloatArray,
+    min_px: float = 15.0,
+    min_angle_deg: float = 5.0,
 ) -> bool:
     """True when two of the car's edges from the origin corner (nearly) coincide on screen.
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -35,8 +34,8 @@ __all__ = [
 ]
 
 FloatArray = npt.NDArray[np.float64]
-Axis = Literal["length", "width", "height"]
-AXES: tuple[Axis, Axis, Axis] = ("length", "width", "height")
+AXES: tuple[str, str, str] = ("length", "width", "height")
+"""World axis names, in the order x, y, z of the world frame."""
 
 # A vanishing point farther from the image centre than this many image diagonals is reported
 # as "at infinity" (the segments are parallel in the image to within ~0.06°).
@@ -171,7 +170,9 @@ def fit_vanishing_point(
 
     def to_pixels(vc: FloatArray) -> FloatArray:
         # Conditioned homogeneous point back to pixel homogeneous coordinates.
-        return np.array([vc[0] * scale + center[0] * vc[2], vc[1] * scale + center[1] * vc[2], vc[2]])
+        return np.array(
+            [vc[0] * scale + center[0] * vc[2], vc[1] * scale + center[1] * vc[2], vc[2]]
+        )
 
     def unit(theta_phi: FloatArray) -> FloatArray:
         th, ph = theta_phi
@@ -349,7 +350,9 @@ def estimate_intrinsics(
             f = focal_from_vanishing_pair(finite["length"], finite["width"], ortho)
             if np.linalg.norm(ortho - centre) <= max_pp_offset * diag:
                 return IntrinsicsEstimate(
-                    f, (float(ortho[0]), float(ortho[1])), "orthocentre",
+                    f,
+                    (float(ortho[0]), float(ortho[1])),
+                    "orthocentre",
                     "three finite vanishing points; principal point = their orthocentre",
                 )
             why = (
@@ -362,7 +365,9 @@ def estimate_intrinsics(
     pp_word = "given principal point" if pp is not None else "principal point at the image centre"
     if focal_px is not None:
         return IntrinsicsEstimate(
-            float(focal_px), (float(pp_used[0]), float(pp_used[1])), "given_focal",
+            float(focal_px),
+            (float(pp_used[0]), float(pp_used[1])),
+            "given_focal",
             f"{why}focal length given; {pp_word}",
         )
     best: tuple[float, float, str] | None = None
@@ -377,12 +382,14 @@ def estimate_intrinsics(
             # Conditioning: a pair whose points are both far out gives an unstable f.
             da = np.linalg.norm(a[:2] / a[2] - pp_used)
             db = np.linalg.norm(b[:2] / b[2] - pp_used)
-            quality = -max(da, db) / diag
+            quality = -float(max(da, db)) / diag
             if best is None or quality > best[0]:
                 best = (quality, f, f"{names[i]}+{names[j]}")
     if best is not None:
         return IntrinsicsEstimate(
-            best[1], (float(pp_used[0]), float(pp_used[1])), "two_vp",
+            best[1],
+            (float(pp_used[0]), float(pp_used[1])),
+            "two_vp",
             f"{why}focal length from the {best[2]} vanishing points; {pp_word}",
         )
     at_infinity = sorted(set(vps) - set(finite))

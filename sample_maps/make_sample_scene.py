@@ -32,7 +32,13 @@ def main() -> None:
     ls = None
     while ls is None:
         ls = make_located_scene(
-            m, inter, rng, noise=noise, n_annotators=3, min_corners=3, max_corners=3,
+            m,
+            inter,
+            rng,
+            noise=noise,
+            n_annotators=3,
+            min_corners=3,
+            max_corners=3,
             give_streets=True,
         )
     scene = ls.scene
@@ -43,14 +49,21 @@ def main() -> None:
         ann["vp_lines"] = {
             k: [[round(v, 1) for v in seg] for seg in segs] for k, segs in ann["vp_lines"].items()
         }
-    scene["intersection"]["corners"] = [[round(v, 1) for v in p] for p in scene["intersection"]["corners"]]
+    scene["intersection"]["corners"] = [
+        [round(v, 1) for v in p] for p in scene["intersection"]["corners"]
+    ]
     scene["prior"] = {"lat": 39.2856, "lon": -76.5935, "radius_m": 150}
     (HERE / "sample_scene.json").write_text(json.dumps(scene, indent=1) + "\n")
     heading, pitch, roll = ls.camera_enu.angles_deg
     truth = {
-        "lat": ls.lat, "lon": ls.lon, "height_m": ls.camera_enu.height_m,
-        "heading_deg": heading, "pitch_deg": pitch, "roll_deg": roll,
-        "focal_px": ls.camera_enu.focal_px, "intersection": ls.intersection_id,
+        "lat": ls.lat,
+        "lon": ls.lon,
+        "height_m": ls.camera_enu.height_m,
+        "heading_deg": heading,
+        "pitch_deg": pitch,
+        "roll_deg": roll,
+        "focal_px": ls.camera_enu.focal_px,
+        "intersection": ls.intersection_id,
         "visible_corner_orders": ls.visible_corner_orders,
     }
     (HERE / "sample_scene.truth.json").write_text(json.dumps(truth, indent=1) + "\n")

@@ -24,19 +24,33 @@ def register(subparsers: Any) -> None:
         ),
     )
     p.add_argument("scene", help="scene file (camloc-scene/1 JSON)")
-    p.add_argument("--osm", metavar="EXTRACT", help="local OSM extract (.osm, .osm.bz2, .osm.gz, .osm.pbf)")
-    p.add_argument("-o", "--output", metavar="OUT.geojson", help="write GeoJSON here (default stdout)")
+    p.add_argument(
+        "--osm", metavar="EXTRACT", help="local OSM extract (.osm, .osm.bz2, .osm.gz, .osm.pbf)"
+    )
+    p.add_argument(
+        "-o", "--output", metavar="OUT.geojson", help="write GeoJSON here (default stdout)"
+    )
     p.add_argument("--map", metavar="OUT.html", help="also write a Leaflet review map")
     p.add_argument(
         "--offline",
         action="store_true",
         help="never use the network: no Overpass, and --map inlines Leaflet into one HTML file",
     )
-    p.add_argument("--radius-m", type=float, default=None, help="map radius around the scene (default: prior radius + 200 m, at least 300 m)")
+    p.add_argument(
+        "--radius-m",
+        type=float,
+        default=None,
+        help="map radius around the scene (default: prior radius + 200 m, at least 300 m)",
+    )
     p.add_argument("--cache-folder", default=None, help="osmnx HTTP cache folder for Overpass")
     p.add_argument("--overpass-url", default=None, help="Overpass API endpoint")
     p.add_argument("--max-candidates", type=int, default=None, help="at most this many candidates")
-    p.add_argument("--overlays", metavar="DIR", default=None, help="with --map: write candidate image overlays (PNG) here")
+    p.add_argument(
+        "--overlays",
+        metavar="DIR",
+        default=None,
+        help="with --map: write candidate image overlays (PNG) here",
+    )
     p.set_defaults(func=run)
 
 
@@ -56,8 +70,10 @@ def _map_centre(scene: Scene) -> tuple[float, float] | None:
         return scene.references[0].lat, scene.references[0].lon
     lms = [lm for lm in scene.landmarks if lm.lat is not None and lm.lon is not None]
     if lms:
-        assert lms[0].lat is not None and lms[0].lon is not None
-        return lms[0].lat, lms[0].lon
+        lat, lon = lms[0].lat, lms[0].lon
+        assert lat is not None
+        assert lon is not None
+        return lat, lon
     return None
 
 
@@ -90,8 +106,12 @@ def run(args: argparse.Namespace) -> int:
                     "and --offline forbids fetching one: give --osm EXTRACT"
                 )
             map_data = load_map(
-                None, centre[0], centre[1], radius_m=radius,
-                cache_folder=args.cache_folder, overpass_url=args.overpass_url,
+                None,
+                centre[0],
+                centre[1],
+                radius_m=radius,
+                cache_folder=args.cache_folder,
+                overpass_url=args.overpass_url,
             )
     settings = LocateSettings()
     if args.max_candidates is not None:
