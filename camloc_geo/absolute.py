@@ -722,21 +722,23 @@ def _refine(
         J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
         r = np.concatenate([r, [ls / s_sigma]])
         J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
-        if use_street:
-            # The car is parallel to the street it stands on, within bearing_sigma_deg.
-            diff = _street_angle_under_car(theta, np.array([tx, ty]), s, ev)
-            if diff is not None:
-                r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
-                J = np.vstack([J, [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]])
+        if street_brg is not None:
+            # The car is parallel to the street it stands on, within bearing_sigma_deg (the
+            # street found under the car at the start; the refinement moves it little).
+            car_brg = (90.0 - math.degrees(theta)) % 180.0
+            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
+            r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
+            J = np.vstack([J, [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]])
         return r, J
 
     x = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
     # The street prior only pulls a candidate that already (nearly) meets it: one whose car
     # is flagged off the street or across it is the evidence's, not the prior's, to move.
-    use_street = False
+    street_brg: float | None = None
     if ev.street_tree is not None:
         diff0 = _street_angle_under_car(cand.theta_rad, cand.translation_en, cand.scale, ev)
-        use_street = diff0 is not None and abs(diff0) <= 2.5 * settings.bearing_sigma_deg
+        if diff0 is not None and abs(diff0) <= 2.5 * settings.bearing_sigma_deg:
+            street_brg = ((90.0 - math.degrees(cand.theta_rad)) - diff0) % 180.0
     r, J = resid_jac(x)
     for _ in range(8):  # Gauss-Newton: the problem is nearly linear
         try:
