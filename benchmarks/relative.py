@@ -158,8 +158,12 @@ def run_scene(syn: Any, method: str) -> dict[str, Any]:
         "focal_rel_error": float(abs(cam.focal_px - truth.focal_px) / truth.focal_px),
         "intrinsics_method": res.intrinsics_method,
         "method": res.method,
-        "wrong_corner_caught": len(wrong & set(res.outlier_annotators)),
-        "n_flagged": len(res.outlier_annotators),
+        # An annotator who marked the wrong corner is caught when the fit names them: as a
+        # corner mistake (the joint fit re-interprets their clicks) or as an outlier.
+        "wrong_corner_caught": len(
+            wrong & (set(res.outlier_annotators) | set(res.corner_mistakes))
+        ),
+        "n_flagged": len(set(res.outlier_annotators) | set(res.corner_mistakes)),
         "focal_limit_warning": any("focal length" in w and "limit" in w for w in res.warnings),
     }
 
