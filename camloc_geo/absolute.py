@@ -185,6 +185,7 @@ class Candidate:
     flags: list[str] = field(default_factory=list)
     refined: bool = False
     merged: int = 1
+    corner_assignment: tuple[int, ...] | None = None  # map corner per visible corner, -1 = none
 
     @property
     def east_north(self) -> FloatArray:
@@ -341,8 +342,11 @@ def _score(
     ev: _Evidence,
     settings: LocateSettings,
     corner_assignment: Sequence[int] | None,
-) -> tuple[float, float, list[dict[str, Any]], list[float]]:
-    """Log-likelihood, RMS misfit (m), the matches, and squared distances of the evidence."""
+) -> tuple[float, float, list[dict[str, Any]], list[float], tuple[int, ...] | None]:
+    """Log-likelihood, RMS misfit (m), the matches, squared distances, corner assignment.
+
+    ``-1`` in a corner assignment leaves that image corner unmatched.
+    """
     ll = 0.0
     sq: list[float] = []
     matches: list[dict[str, Any]] = []
@@ -366,6 +370,11 @@ def _score(
         if corner_assignment is None:
             corner_assignment = _best_assignment(theta, T, s, ev)
         for obs, j in zip(ev.corners, corner_assignment, strict=True):
+            if j < 0:
+                # A visible corner the map's junction has no counterpart for (more corners
+                # listed than modelled): it costs what an outlier costs.
+                ll -= 0.5 * _OUTLIER_M2
+                continue
             q = ev.map_corners[j]
             m2 = _mahal(obs, q, theta, T, s)
             ll -= 0.5 * min(m2, _OUTLIER_M2)
@@ -401,7 +410,15 @@ def _score(
         )
     ll -= 0.5 * ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
     rms = math.sqrt(sum(sq) / len(sq)) if sq else math.nan
-    return ll, rms, matches, sq
+    assignment = tuple(int(j) for j in corner_assignment) if corner_assignment is not None else None
+    return ll, rms, matches, sq, assignment
+
+
+def _unmatched_flags(ev: _Evidence, assignment: tuple[int, ...] | None) -> list[str]:
+    """``unmatched:<label>`` for visible corners a hypothesis leaves without a map corner."""
+    if assignment is None:
+        return []
+    return [f"unmatched:{o.label}" for o, j in zip(ev.corners, assignment, strict=True) if j < 0]
 
 
 def _best_assignment(theta: float, T: FloatArray, s: float, ev: _Evidence) -> list[int]:
@@ -409,7 +426,7 @@ def _best_assignment(theta: float, T: FloatArray, s: float, ev: _Evidence) -> li
     best: tuple[float, list[int]] | None = None
     for assign, _prior in _assignments(len(ev.corners), len(ev.map_corners)):
         cost = sum(
-            _mahal(o, ev.map_corners[j], theta, T, s)
+            _mahal(o, ev.map_corners[j], theta, T, s) if j >= 0 else _OUTLIER_M2
             for o, j in zip(ev.corners, assign, strict=True)
         )
         if best is None or cost < best[0]:
@@ -422,10 +439,21 @@ def _assignments(k: int, n: int) -> Iterable[tuple[tuple[int, ...], float]]:
     """Order-preserving cyclic assignments of k visible corners to n map corners, with priors.
 
     Consecutive runs (the usual case) get prior 1; other order-preserving choices (a corner
-    hidden or missing in between) get :attr:`LocateSettings.non_consecutive_prior`, applied by
-    the caller through the returned flag value 0.
+    hidden or missing in between, or, with more visible corners than map corners, image
+    corners left unmatched as ``-1``) get :attr:`LocateSettings.non_consecutive_prior`,
+    applied by the caller through the returned flag value 0.
     """
-    if k > n or k == 0:
+    if k == 0 or n == 0:
+        return
+    if k > n:
+        # More visible corners than the map models: leave k - n of them unmatched (-1),
+        # the rest in order on every cyclic run of the map's corners.
+        for keep in itertools.combinations(range(k), n):
+            for start in range(n):
+                assign = [-1] * k
+                for step, i in enumerate(keep):
+                    assign[i] = (start + step) % n
+                yield tuple(assign), 0.0
         return
     seen = set()
     for start in range(n):
@@ -527,12 +555,25 @@ def _gen_corners(ev: _Evidence, settings: LocateSettings) -> list[_Hypothesis]:
         return []
     if k == 1:
         return _gen_bearing_point("corners", ev.corners[0], ev.map_corners, ev.street_bearings)
+    if n == 1:
+        # One modelled corner, several visible: each visible one in turn is that corner.
+        out_one = []
+        for ci in range(k):
+            assign = tuple(0 if i == ci else -1 for i in range(k))
+            for h in _gen_bearing_point(
+                "corners", ev.corners[ci], ev.map_corners, ev.street_bearings
+            ):
+                out_one.append(replace(h, corner_assignment=assign))
+        return out_one
     out = []
     world = np.array([o.world_xy for o in ev.corners])
     wts = np.array([1.0 / (np.trace(o.cov_world) / 2 + o.sigma_map_m**2) for o in ev.corners])
     for assign, consecutive in _assignments(k, n):
-        enu = ev.map_corners[list(assign)]
-        theta, T, s = _similarity_fit(world, enu, wts, settings.scale_sigma_rel)
+        used = [i for i, j in enumerate(assign) if j >= 0]
+        if len(used) < 2:
+            continue
+        enu = ev.map_corners[[assign[i] for i in used]]
+        theta, T, s = _similarity_fit(world[used], enu, wts[used], settings.scale_sigma_rel)
         lp = 0.0 if consecutive else math.log(settings.non_consecutive_prior)
         out.append(_Hypothesis("corners", theta, T, s, lp, tuple(assign)))
     return out
@@ -929,6 +970,15 @@ def locate(
     inter = None
     bearings: list[float] = []
     if scene.intersection is not None:
+        listed = np.asarray(scene.intersection.corners, dtype=float)
+        for i in range(len(listed)):
+            for j in range(i):
+                if np.linalg.norm(listed[i] - listed[j]) < 2.0:
+                    raise SceneError(
+                        f"is the same pixel as intersection.corners[{j}] (less than 2 px "
+                        "apart): each visible kerb corner is listed once",
+                        f"intersection.corners[{i}]",
+                    )
         for i, px in enumerate(scene.intersection.corners):
             c_obs = observe(px, "corner", f"intersection.corners[{i}]", settings.sigma_corner_m)
             if c_obs is not None:
@@ -1068,7 +1118,8 @@ def locate(
         elif len(corners) > len(map_corners):
             result.warnings.append(
                 f"corners: the scene lists {len(corners)} visible corners but the map's "
-                f"intersection has {len(map_corners)}"
+                f"intersection has {len(map_corners)}; every hypothesis leaves "
+                f"{len(corners) - len(map_corners)} of them unmatched"
             )
         hyps += _gen_corners(ev, settings)
     if scene.landmarks:
@@ -1091,9 +1142,10 @@ def locate(
 
     cands = []
     for h in hyps:
-        ll, rms, matches, _sq = _score(h.theta, h.T, h.s, ev, settings, h.corner_assignment)
+        ll, rms, matches, _sq, assign = _score(h.theta, h.T, h.s, ev, settings, h.corner_assignment)
         cam = _camera_in_enu(world_cam, h.theta, h.T, h.s)
         plaus, flags = _plausibility(cam, h.theta, h.T, h.s, ev, settings, matches)
+        flags += _unmatched_flags(ev, assign)
         cands.append(
             Candidate(
                 h.method,
@@ -1106,6 +1158,7 @@ def locate(
                 residual_m=rms,
                 matches=matches,
                 flags=flags,
+                corner_assignment=assign,
             )
         )
     if ev.prior_en is not None and ev.prior_radius_m:
@@ -1131,11 +1184,13 @@ def locate(
     # Refine the leaders, then score again.
     for i in range(min(settings.refine_top, len(cands))):
         c = _refine(cands[i], world_cam, ev, settings)
-        assign = tuple(m["order"] for m in c.matches if m["kind"] == "corner") or None
-        ll, rms, matches, _sq = _score(c.theta_rad, c.translation_en, c.scale, ev, settings, assign)
+        ll, rms, matches, _sq, assign = _score(
+            c.theta_rad, c.translation_en, c.scale, ev, settings, c.corner_assignment
+        )
         plaus, flags = _plausibility(
             c.camera, c.theta_rad, c.translation_en, c.scale, ev, settings, matches
         )
+        flags += _unmatched_flags(ev, assign)
         cands[i] = replace(
             c, log_likelihood=ll, prior=plaus, residual_m=rms, matches=matches, flags=flags
         )

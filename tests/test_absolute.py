@@ -325,17 +325,15 @@ def test_corners_without_map_is_an_error(maps: dict[str, MapData]) -> None:
         locate(parse_scene(ls.scene))
 
 
-def test_more_corners_than_the_map_has(maps: dict[str, MapData]) -> None:
+def test_duplicate_corner_pixels_are_an_error(maps: dict[str, MapData]) -> None:
     m = maps["krems"]
     inter = junctions(m)[0]
     ls = exact_located(m, inter, seed=14)
     scene = dict(ls.scene)
     px = scene["intersection"]["corners"][0]
     scene["intersection"] = {**scene["intersection"], "corners": [px] * (len(inter.corners) + 1)}
-    result = locate(parse_scene(scene), m)
-    assert result.candidates == []
-    assert result.reason is not None
-    assert "visible corners" in result.reason
+    with pytest.raises(SceneError, match=r"intersection\.corners\[1\].*same pixel"):
+        locate(parse_scene(scene), m)
 
 
 def test_corners_that_no_assignment_fits(maps: dict[str, MapData]) -> None:
@@ -514,3 +512,33 @@ def test_street_prior_does_not_move_an_exact_fit(seed: int) -> None:
     result = locate(parse_scene(ls.scene), m)
     assert errors_m(result, ls)[0] < EXACT
     assert result.candidates[0].residual_m < 0.05
+
+
+def test_more_visible_corners_than_the_map_models(maps: dict[str, MapData]) -> None:
+    """A listed corner the map has no counterpart for is left unmatched, not fatal."""
+    found = 0
+    pairs = [(maps[k], i) for k in ("heidelberg", "krems") for i in junctions(maps[k])[:4]]
+    for seed, (m, inter) in enumerate(pairs):
+        ls = make_located_scene(
+            m,
+            inter,
+            np.random.default_rng(seed),
+            noise=NoiseModel.exact(),
+            corner_sigma_m=0.0,
+            min_corners=len(inter.corners),
+        )
+        if ls is None or len(ls.scene["intersection"]["corners"]) != len(inter.corners):
+            continue
+        corners = ls.scene["intersection"]["corners"]
+        bogus = ((np.array(corners[0]) + np.array(corners[1])) / 2 + [0.0, 40.0]).tolist()
+        ls.scene["intersection"]["corners"] = [corners[0], bogus, *corners[1:]]
+        result = locate(parse_scene(ls.scene), m)
+        check_contract(result)
+        assert any("unmatched" in w for w in result.warnings)
+        d = errors_m(result, ls)
+        best = result.candidates[int(np.argmin(d))]
+        assert min(d) < EXACT
+        assert "unmatched:intersection.corners[1]" in best.flags
+        assert all(mt["label"] != "intersection.corners[1]" for mt in best.matches)
+        found += 1
+    assert found >= 2
