@@ -42,6 +42,7 @@ from camloc_geo._errors import DegenerateGeometryError
 __all__ = [
     "Camera",
     "angles_from_rotation",
+    "clip_segment_to_image",
     "project_to_rotation",
     "rotation_from_angles",
 ]
@@ -346,3 +347,33 @@ class Camera:
             "pitch_deg": pitch,
             "roll_deg": roll,
         }
+
+
+def clip_segment_to_image(
+    p: FloatArray, q: FloatArray, w: float, h: float, m: float = 0.0
+) -> FloatArray | None:
+    """Liang-Barsky clip of a 2-D segment to ``[-m, w + m] × [-m, h + m]``.
+
+    Returns the clipped segment as a (2, 2) array of endpoints, or None when it misses the
+    rectangle.
+    """
+    t0, t1 = 0.0, 1.0
+    d = q - p
+    for pk, qk in (
+        (-d[0], p[0] + m),
+        (d[0], w + m - p[0]),
+        (-d[1], p[1] + m),
+        (d[1], h + m - p[1]),
+    ):
+        if pk == 0:
+            if qk < 0:
+                return None
+            continue
+        r = qk / pk
+        if pk < 0:
+            t0 = max(t0, r)
+        else:
+            t1 = min(t1, r)
+        if t0 > t1:
+            return None
+    return np.array([p + t0 * d, p + t1 * d])

@@ -35,7 +35,7 @@ import numpy.typing as npt
 import shapely
 from shapely.geometry import LineString, MultiLineString, Point, Polygon
 
-from camloc_geo.camera import Camera
+from camloc_geo.camera import Camera, clip_segment_to_image
 from camloc_geo.geodesy import LocalFrame
 
 if TYPE_CHECKING:
@@ -321,30 +321,6 @@ def _to_cv(px: FloatArray, shift: int) -> npt.NDArray[np.int32]:
     return np.round((px - 0.5) * (1 << shift)).astype(np.int32)
 
 
-def _clip_2d(p: FloatArray, q: FloatArray, w: float, h: float, m: float) -> FloatArray | None:
-    """Liang-Barsky clip of a segment to ``[-m, w + m] × [-m, h + m]``."""
-    t0, t1 = 0.0, 1.0
-    d = q - p
-    for pk, qk in (
-        (-d[0], p[0] + m),
-        (d[0], w + m - p[0]),
-        (-d[1], p[1] + m),
-        (d[1], h + m - p[1]),
-    ):
-        if pk == 0:
-            if qk < 0:
-                return None
-            continue
-        r = qk / pk
-        if pk < 0:
-            t0 = max(t0, r)
-        else:
-            t1 = min(t1, r)
-        if t0 > t1:
-            return None
-    return np.array([p + t0 * d, p + t1 * d])
-
-
 def _draw_polyline(
     img: ImageArray,
     px: FloatArray,
@@ -356,7 +332,7 @@ def _draw_polyline(
     h, w = img.shape[:2]
     shift = 4
     for i in range(1, len(px)):
-        seg = _clip_2d(px[i - 1], px[i], float(w), float(h), 4.0)
+        seg = clip_segment_to_image(px[i - 1], px[i], float(w), float(h), 4.0)
         if seg is None:
             continue
         if dashed:
@@ -406,7 +382,7 @@ def _horizon_segment(camera: Camera, w: int, h: int) -> FloatArray | None:
         p, q = np.array([0.0, -(c) / b]), np.array([float(w), -(c + a * w) / b])
     else:
         p, q = np.array([-(c) / a, 0.0]), np.array([-(c + b * h) / a, float(h)])
-    return _clip_2d(p, q, float(w), float(h), 0.0)
+    return clip_segment_to_image(p, q, float(w), float(h), 0.0)
 
 
 @dataclass

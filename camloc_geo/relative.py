@@ -961,10 +961,9 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         centroid,
     )
     warnings: list[str] = list(count_warnings)
-    n_ann = len(scene.annotations)
-    if not settings.joint_fit:
-        weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
-        outliers = [s.annotator for s in sols if s.index not in member_idx]
+
+    def cluster_result() -> CalibrationResult:
+        # The paper's answer: the centroid of the largest cluster, its members trusted.
         return CalibrationResult(
             cluster_camera,
             "cluster_centroid",
@@ -972,11 +971,14 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
             intr_reason,
             sols,
             cluster,
-            weights,
-            outliers,
+            [1.0 if s.index in member_idx else 0.0 for s in sols],
+            [s.annotator for s in sols if s.index not in member_idx],
             width_signs=[s.width_sign for s in sols],
             warnings=warnings,
         )
+
+    if not settings.joint_fit:
+        return cluster_result()
     try:
         result = _joint(scene, sols, segs, seed, cluster, cluster_camera, size, settings)
         result.warnings = warnings + result.warnings
@@ -984,20 +986,7 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     except (DegenerateGeometryError, np.linalg.LinAlgError, ValueError) as exc:
         warnings.append(f"joint fit failed ({exc}); using the cluster centroid")
         log.warning("joint fit failed: %s", exc)
-        weights = [1.0 if s.index in member_idx else 0.0 for s in sols]
-        outliers = [s.annotator for s in sols if s.index not in member_idx]
-        return CalibrationResult(
-            cluster_camera,
-            "cluster_centroid",
-            intr_method,
-            intr_reason,
-            sols,
-            cluster,
-            weights[:n_ann],
-            outliers,
-            width_signs=[s.width_sign for s in sols],
-            warnings=warnings,
-        )
+        return cluster_result()
 
 
 def _width_sign_for(scene: Scene, index: int, camera: Camera) -> float:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from camloc_geo.camera import Camera, rotation_from_angles
+from camloc_geo.camera import Camera, clip_segment_to_image, rotation_from_angles
 from camloc_geo.objects import PRESETS, ObjectSize
 
 __all__ = [
@@ -112,25 +112,6 @@ def random_camera(
     return Camera.from_center(f, pp, R, center)
 
 
-def _clip_segment(p: FloatArray, q: FloatArray, w: int, h: int) -> FloatArray | None:
-    """Clip a 2-D segment to the image rectangle (Liang-Barsky)."""
-    t0, t1 = 0.0, 1.0
-    d = q - p
-    for pk, qk in ((-d[0], p[0]), (d[0], w - p[0]), (-d[1], p[1]), (d[1], h - p[1])):
-        if pk == 0:
-            if qk < 0:
-                return None
-            continue
-        r = qk / pk
-        if pk < 0:
-            t0 = max(t0, r)
-        else:
-            t1 = min(t1, r)
-        if t0 > t1:
-            return None
-    return np.array([*(p + t0 * d), *(p + t1 * d)])
-
-
 def _visible_segment(
     cam: Camera, a: FloatArray, b: FloatArray, size: tuple[int, int]
 ) -> FloatArray | None:
@@ -145,7 +126,8 @@ def _visible_segment(
     elif zb < near:
         b = b + (a - b) * (near - zb) / (za - zb)
     pa, pb = cam.project(a), cam.project(b)
-    return _clip_segment(pa, pb, size[0], size[1])
+    clipped = clip_segment_to_image(pa, pb, size[0], size[1], 0.0)
+    return None if clipped is None else clipped.ravel()
 
 
 def _scene_lines(
