@@ -407,8 +407,10 @@ def test_precomputed_calibration_is_reused(maps: dict[str, MapData]) -> None:
     a = locate(scene, m, calibration=cal)
     b = locate(scene, m)
     assert a.calibration is cal
-    got = [(c.lat, c.lon) for c in a.candidates]
-    assert got == pytest.approx([(c.lat, c.lon) for c in b.candidates])
+    got = np.array([(c.lat, c.lon) for c in a.candidates])
+    want = np.array([(c.lat, c.lon) for c in b.candidates])
+    assert got.shape == want.shape
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
 
 
 # ------------------------------------------------------------------------- generator
