@@ -249,6 +249,20 @@ def _check_axes_geometry(ann: Annotation, where: str) -> None:
             )
 
 
+def _vanishing_directions(
+    vps: dict[str, VanishingPoint], intr: IntrinsicsEstimate
+) -> tuple[FloatArray, dict[str, FloatArray]]:
+    """``cam_from_img`` of the intrinsics and the unit direction of each vanishing point."""
+    f = intr.focal_px
+    cx, cy = intr.principal_point
+    cam_from_img = np.array([[1 / f, 0, -cx / f], [0, 1 / f, -cy / f], [0, 0, 1.0]])
+    dirs = {}
+    for k, v in vps.items():
+        d = cam_from_img @ v.homogeneous
+        dirs[k] = d / np.linalg.norm(d)
+    return cam_from_img, dirs
+
+
 def solve_annotator(
     scene: Scene,
     index: int,
@@ -279,11 +293,7 @@ def solve_annotator(
     sol.intrinsics = intr
     f = intr.focal_px
     cx, cy = intr.principal_point
-    cam_from_img = np.array([[1 / f, 0, -cx / f], [0, 1 / f, -cy / f], [0, 0, 1.0]])
-    dirs = {}
-    for k, v in vps.items():
-        d = cam_from_img @ v.homogeneous
-        dirs[k] = d / np.linalg.norm(d)
+    cam_from_img, dirs = _vanishing_directions(vps, intr)
     # Orthogonality of the vanishing directions (collinear axes end here).
     for a, b in (("length", "width"), ("length", "height"), ("width", "height")):
         ang = math.degrees(math.acos(min(1.0, abs(float(dirs[a] @ dirs[b])))))
@@ -1033,11 +1043,7 @@ def _pooled_seed(scene: Scene, segs: list[dict[str, FloatArray]], size: ObjectSi
     )
     f = intr.focal_px
     cx, cy = intr.principal_point
-    cam_from_img = np.array([[1 / f, 0, -cx / f], [0, 1 / f, -cy / f], [0, 0, 1.0]])
-    dirs = {}
-    for k, v in vps.items():
-        d = cam_from_img @ v.homogeneous
-        dirs[k] = d / np.linalg.norm(d)
+    cam_from_img, dirs = _vanishing_directions(vps, intr)
     votes = {"length": 0.0, "height": 0.0}
     for ann in scene.annotations:
         o = np.asarray(ann.axes.origin, float)
