@@ -70,6 +70,11 @@ PLACES = [
     ("West-Oakland.osm.bz2", 37.8076, -122.3004, 800.0),
     ("fremantle.osm", -32.0362, 115.7556, 400.0),
     ("taipei.osm", 25.0529, 121.5248, 600.0),
+    ("helsinki.osm.pbf", 60.171635, 24.944295, 600.0),
+    ("paris_bss.osm.pbf", 48.86378, 2.366105, 700.0),
+    ("berlin_alexanderplatz.osm.pbf", 52.521915, 13.413215, 600.0),
+    ("kotka.osm.pbf", 60.529995, 26.95, 600.0),
+    ("singapore_bayfront.osm.pbf", 1.28455, 103.859, 600.0),
 ]
 METHODS = ("corners", "two_references", "one_reference", "landmark", "one_landmark")
 LANDMARK_METHODS = ("landmark", "one_landmark")

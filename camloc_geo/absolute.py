@@ -1054,10 +1054,23 @@ def locate(
                     settings.street_search_m,
                 )
             )
-        for q, radius in spots:
-            lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
-            for _name, street_brg in map_data.street_bearings(float(lat), float(lon), radius):
-                bearings.append(street_brg)
+        # Widen the search where nothing passes close (a reference on a plaza, a landmark
+        # set back from the street): 1x, 3x, 8x the radius, then at least 200 m.
+        base = settings.street_search_m
+        for widen in (1.0, 3.0, 8.0, max(8.0, 200.0 / max(base, 1e-9))):
+            for q, radius in spots:
+                lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
+                for _name, street_brg in map_data.street_bearings(
+                    float(lat), float(lon), widen * radius
+                ):
+                    bearings.append(street_brg)
+            if bearings or not spots:
+                if widen > 1.0:
+                    result.warnings.append(
+                        f"street bearings: no street within {settings.street_search_m:g} m of the "
+                        f"evidence; used those within {widen * settings.street_search_m:g} m"
+                    )
+                break
     bearings = _unique_bearings(bearings)
 
     buildings_enu: list[Any] = []
@@ -1130,9 +1143,17 @@ def locate(
             )
         hyps += _gen_landmarks(ev, settings)
     if not result.methods_tried:
-        result.reason = (
-            "no geographic evidence: the scene has no references, intersection corners or landmarks"
-        )
+        if scene.references or scene.intersection is not None or scene.landmarks:
+            result.reason = (
+                "every reference, corner or landmark pixel is at or above the calibrated "
+                "camera's horizon, so none is a ground point (is the calibration wrong? its "
+                f"focal length is {world_cam.focal_px:.0f} px): " + "; ".join(result.warnings)
+            )
+        else:
+            result.reason = (
+                "no geographic evidence: the scene has no references, intersection corners or "
+                "landmarks"
+            )
         return result
     if not hyps:
         result.reason = "no hypothesis: " + "; ".join(

@@ -544,3 +544,45 @@ def test_more_visible_corners_than_the_map_models(maps: dict[str, MapData]) -> N
         assert all(mt["label"] != "intersection.corners[1]" for mt in best.matches)
         found += 1
     assert found >= 2
+
+
+def test_one_reference_widens_the_street_search(maps: dict[str, MapData]) -> None:
+    """No street within the search radius of the reference: widen it and say so."""
+    from camloc_geo.absolute import LocateSettings
+
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[1], seed=23)
+    w, h = ls.scene["image"]["width"], ls.scene["image"]["height"]
+    scene = dict(ls.scene)
+    scene.pop("intersection")
+    scene["references"] = ground_refs(m, ls, [(w / 2, h * 0.9)])
+    ref = scene["references"][0]
+    # The reference's distance to the nearest street: search half as far, so only the
+    # widened search finds it.
+    dist = next(
+        r for r in np.geomspace(0.05, 500.0, 400) if m.street_bearings(ref["lat"], ref["lon"], r)
+    )
+    settings = LocateSettings(street_search_m=0.5 * dist)
+    result = locate(parse_scene(scene), m, settings=settings)
+    assert result.candidates
+    assert any("street bearings" in x and "used those within" in x for x in result.warnings)
+    assert min(errors_m(result, ls)) < 1.0
+
+
+def test_evidence_above_the_calibrated_horizon_is_explained(maps: dict[str, MapData]) -> None:
+    m = maps["baltimore"]
+    ls = exact_located(m, junctions(m)[1], seed=23)
+    scene_obj = parse_scene(ls.scene)
+    cal = calibrate(scene_obj)
+    line = cal.camera.horizon_line()  # > 0 below the horizon
+    w = ls.scene["image"]["width"]
+    above = [(x, y) for x in (5.0, w / 2, w - 5.0) for y in (1.0, 3.0) if line @ [x, y, 1.0] < 0]
+    if len(above) < 2:
+        pytest.skip("the horizon of this camera is above the image")
+    scene = dict(ls.scene)
+    scene.pop("intersection")
+    scene["references"] = [{"pixel": list(px), "lat": ls.lat, "lon": ls.lon} for px in above[:2]]
+    result = locate(parse_scene(scene), m, calibration=cal)
+    assert result.candidates == []
+    assert result.reason is not None
+    assert "above the calibrated camera's horizon" in result.reason
