@@ -263,6 +263,28 @@ def _vanishing_directions(
     return cam_from_img, dirs
 
 
+def _origin_depth_terms(
+    cam_from_img: FloatArray, ann: Annotation, R: FloatArray, ends: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Least-squares terms of the origin's depth from each edge end (length, width, height).
+
+    With ``m0`` the origin's ray (z = 1) and ``mk`` the unit ray of an edge end, the end
+    ``λ0 m0 + R e`` must lie on ``mk``: ``λ0 (mk × m0) = -(mk × R e)``. Returns the numerators
+    ``-(a·b)`` and denominators ``a·a`` (``a = mk × m0``, ``b = mk × R e``) per axis, so that
+    ``λ0 = num / den`` for one axis and ``Σnum / Σden`` for several.
+    """
+    m0 = cam_from_img @ np.array([*ann.axes.origin, 1.0])
+    nums, dens = np.zeros(3), np.zeros(3)
+    for i, k in enumerate(AXES):
+        mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
+        mk /= np.linalg.norm(mk)
+        a = np.cross(mk, m0)
+        b = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
+        nums[i] = -float(a @ b)
+        dens[i] = float(a @ a)
+    return nums, dens
+
+
 def solve_annotator(
     scene: Scene,
     index: int,
@@ -326,19 +348,13 @@ def solve_annotator(
     sol.width_sign = s_w
     R = rotation_from_vanishing_directions({"length": d_len, "width": d_wid, "height": d_up})
     ends = _object_points(size, s_w)
+    nums, dens = _origin_depth_terms(cam_from_img, ann, R, ends)
     lam: dict[str, float] = {}
-    num_total = den_total = 0.0
-    for k in AXES:
-        mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
-        mk /= np.linalg.norm(mk)
-        cross_o = np.cross(mk, m0)
-        cross_e = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
-        den = float(cross_o @ cross_o)
-        if den < 1e-18:
+    for i, k in enumerate(AXES):
+        if dens[i] < 1e-18:
             raise DegenerateGeometryError(f"{where}.axes.{k}: end pixel on the origin's ray")
-        lam[k] = -float(cross_o @ cross_e) / den
-        num_total += -float(cross_o @ cross_e)
-        den_total += den
+        lam[k] = nums[i] / dens[i]
+    num_total, den_total = float(nums.sum()), float(dens.sum())
     for k in AXES:
         if not lam[k] > 0:
             raise DegenerateGeometryError(
@@ -1061,16 +1077,9 @@ def _pooled_seed(scene: Scene, segs: list[dict[str, FloatArray]], size: ObjectSi
         m0 = cam_from_img @ np.array([*o, 1.0])
         ws = direction_sign(R[:, 1], m0, np.asarray(ann.axes.width, float) - o) or 1.0
         ends = _object_points(size, ws)
-        num = den = 0.0
-        for k in AXES:
-            mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
-            mk /= np.linalg.norm(mk)
-            a = np.cross(mk, m0)
-            b = np.cross(mk, R @ ends[_AXIS_INDEX[k] + 1])
-            lam = -float(a @ b) / max(float(a @ a), 1e-18)
-            if lam > 0:
-                num += -float(a @ b)
-                den += float(a @ a)
+        nums, dens = _origin_depth_terms(cam_from_img, ann, R, ends)
+        ahead = nums / np.maximum(dens, 1e-18) > 0
+        num, den = float(nums[ahead].sum()), float(dens[ahead].sum())
         if den > 0:
             centres.append(-R.T @ ((num / den) * m0))
     if not centres:
