@@ -57,7 +57,7 @@ from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 OUT = HERE / "out"
-OSM = HERE.parents[1] / "shared" / "data" / "osm"
+OSM = HERE.parents[0] / "data" / "osm"
 
 # (extract, lat, lon, radius_m): the area around a point whose junctions are used.
 PLACES = [

@@ -1,6 +1,6 @@
 """Benchmark the OSM layer: time and peak memory, camloc_geo.osm vs osmnx.
 
-For each extract (default: the largest ones in ../shared/data/osm):
+For each extract (default: the largest ones in data/osm):
 
 - ``camloc_full``: :func:`camloc_geo.osm.load_map` on the whole extract (``radius_m=None``):
   every intersection with its kerb corners, plus streets and buildings;
@@ -32,7 +32,7 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 OUT = HERE / "out"
-OSM = HERE.parents[1] / "shared" / "data" / "osm"
+OSM = HERE.parents[0] / "data" / "osm"
 POINTS = {  # one point per extract for the "around a point" case
     "baltimore.osm.pbf": (39.28558, -76.59348),
     "monaco.osm.pbf": (43.7384, 7.4246),
@@ -116,7 +116,7 @@ def _run(case: str, path: Path, lat: float, lon: float, xml: Path) -> dict[str, 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark and write JSON and a PNG plot to benchmarks/out/."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--extract", action="append", help="file name in shared/data/osm")
+    parser.add_argument("--extract", action="append", help="file name in data/osm")
     parser.add_argument("--repeat", type=int, default=3, help="runs per case (best time kept)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")

@@ -33,6 +33,7 @@ import itertools
 import json
 import logging
 import math
+import os
 import subprocess
 import sys
 import time
@@ -50,7 +51,11 @@ from camloc_geo.autovp import detect_vanishing_points, horizon_from_up
 log = logging.getLogger("vp_yud")
 
 HERE = Path(__file__).resolve().parent
-DEFAULT_YUD = HERE.parents[1] / "shared" / "data" / "yud" / "YorkUrbanDB"
+DEFAULT_YUD = Path(
+    os.environ.get(
+        "CAMLOC_YUD_DIR", str(HERE.parents[1] / "shared" / "data" / "yud" / "YorkUrbanDB")
+    )
+)
 F_TRUE = 6.05317059 / 0.00896875  # 674.918 px
 
 _LU_SCRIPT = r"""

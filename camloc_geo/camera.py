@@ -1,6 +1,6 @@
 """Frames and the pinhole camera model.
 
-Conventions (written down once, used everywhere; see ``shared/spec/SCENE.md``):
+Conventions (written down once, used everywhere; see ``docs/contract.md``):
 
 image
     Continuous pixel coordinates ``[x, y]``: origin at the top-left corner of the image,

@@ -1,6 +1,6 @@
 """The scene file (``camloc-scene/1``) as a validated pydantic model.
 
-See ``shared/spec/SCENE.md`` for the contract. Every violation becomes a
+See ``docs/contract.md`` for the contract. Every violation becomes a
 :class:`~camloc_geo.SceneError` whose message starts with the dotted path of the field
 (``annotations[1].vp_lines.width[0]: ...``). Unknown fields are kept (the format may be
 extended by other tools) and logged at debug level.

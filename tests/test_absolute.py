@@ -2,7 +2,7 @@
 
 Synthetic cameras stand at real intersections (:func:`camloc_geo.synthetic.make_located_scene`);
 noise-free annotations must give the true position exactly, and the candidate list must keep
-the contract of ``../shared/spec/SCENE.md``.
+the contract of ``../docs/contract.md``.
 """
 
 from __future__ import annotations
@@ -23,9 +23,8 @@ from camloc_geo.relative import calibrate
 from camloc_geo.scene import parse_scene
 from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
 
-OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 
-pytestmark = pytest.mark.skipif(not OSM.is_dir(), reason="shared OSM extracts not available")
 
 # (extract, lat, lon): a row-house grid, two old towns, a hilly town with irregular streets.
 PLACES = {

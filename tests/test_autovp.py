@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,17 @@ from camloc_geo.autovp import (  # noqa: E402
     segments_for_axis,
 )
 
-YUD = Path(__file__).resolve().parents[2] / "shared" / "data" / "yud" / "YorkUrbanDB"
+YUD = Path(
+    os.environ.get(
+        "CAMLOC_YUD_DIR",
+        str(Path(__file__).resolve().parents[2] / "shared" / "data" / "yud" / "YorkUrbanDB"),
+    )
+)
+YUD_MISSING = (
+    "York Urban DB not available (research use only, not in this repository): download the "
+    "York Urban Line Segment Database (Denis, Elder, Estrada, ECCV 2008, Elder Lab, York "
+    "University) and set CAMLOC_YUD_DIR to its YorkUrbanDB folder"
+)
 
 
 # ----------------------------------------------------------------- synthetic scenes
@@ -346,7 +357,7 @@ def _yud_truth(name: str) -> tuple[Path, np.ndarray, float]:
     return YUD / name / f"{name}.jpg", dirs, f
 
 
-@pytest.mark.skipif(not YUD.exists(), reason="York Urban DB not available")
+@pytest.mark.skipif(not YUD.exists(), reason=YUD_MISSING)
 @pytest.mark.parametrize("name", YUD_CASES)
 def test_york_urban_photo(name: str) -> None:
     path, true_dirs, f_true = _yud_truth(name)

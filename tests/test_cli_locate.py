@@ -16,10 +16,8 @@ from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import load_map
 from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
 
-OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 BALTIMORE = OSM / "baltimore.osm.pbf"
-
-pytestmark = pytest.mark.skipif(not BALTIMORE.is_file(), reason="shared OSM extracts not available")
 
 
 @pytest.fixture(scope="module")

@@ -11,10 +11,9 @@ import pytest
 
 from camloc_geo.cli import main
 
-OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
 
-pytestmark = pytest.mark.skipif(not OSM.is_dir(), reason="shared OSM extracts not available")
 
 BALTIMORE = str(OSM / "baltimore.osm.pbf")
 LAT, LON = "39.28558", "-76.59348"  # Eastern Avenue & South Broadway

@@ -1,4 +1,4 @@
-"""Intersections and kerb corners on real OSM extracts (../shared/data/osm)."""
+"""Intersections and kerb corners on real OSM extracts (data/osm in this repository)."""
 
 from __future__ import annotations
 
@@ -13,9 +13,7 @@ from camloc_geo import MapDataError
 from camloc_geo.geodesy import LocalFrame, bearing_deg
 from camloc_geo.osm import ARM_SAMPLE_M, Intersection, MapData, load_map
 
-OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
-
-pytestmark = pytest.mark.skipif(not OSM.is_dir(), reason="shared OSM extracts not available")
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 
 
 def _load(name: str, lat: float, lon: float, radius_m: float = 150.0) -> MapData:

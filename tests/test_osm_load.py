@@ -14,9 +14,8 @@ from shapely.geometry import Point
 from camloc_geo import MapDataError
 from camloc_geo.osm import clear_cache, load_map
 
-OSM = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm"
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 
-pytestmark = pytest.mark.skipif(not OSM.is_dir(), reason="shared OSM extracts not available")
 
 AGUAS = (21.8700, -102.2720)
 

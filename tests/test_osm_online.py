@@ -115,9 +115,7 @@ def test_online_load_uses_server_cache_and_restores_settings(
 def test_online_matches_offline_extract(
     overpass_server: tuple[str, type[_Handler]], tmp_path: Path
 ) -> None:
-    extract = Path(__file__).resolve().parents[2] / "shared" / "data" / "osm" / "baltimore.osm.pbf"
-    if not extract.exists():
-        pytest.skip("shared OSM extracts not available")
+    extract = Path(__file__).resolve().parents[1] / "data" / "osm" / "baltimore.osm.pbf"
     url, _handler = overpass_server
     clear_cache()
     online = load_map(

@@ -16,7 +16,7 @@ from pathlib import Path
 import osmium
 
 HERE = Path(__file__).resolve().parent
-EXTRACT = HERE.parents[3] / "shared" / "data" / "osm" / "baltimore.osm.pbf"
+EXTRACT = HERE.parents[2] / "data" / "osm" / "baltimore.osm.pbf"
 SOUTH, WEST, NORTH, EAST = 39.2840, -76.5970, 39.2870, -76.5937
 STREETS = {"primary", "secondary", "tertiary", "residential", "unclassified"}
 
