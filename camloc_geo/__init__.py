@@ -14,7 +14,24 @@ from camloc_geo._errors import (
 
 __version__ = "0.1.0"
 
+_API = ("calibrate_scene", "corners_near", "locate_scene", "map_for_scene", "streets_near")
+
+
+def __getattr__(name: str) -> object:
+    """The API entry points, imported on first use (keeps ``import camloc_geo`` light)."""
+    if name in _API:
+        from camloc_geo import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'camloc_geo' has no attribute {name!r}")
+
+
 __all__ = [
+    "calibrate_scene",
+    "corners_near",
+    "locate_scene",
+    "map_for_scene",
+    "streets_near",
     "CamlocError",
     "DegenerateGeometryError",
     "InputError",

@@ -1,0 +1,322 @@
+"""The library entry points every front end calls (CLI, QGIS plugin, service, batch).
+
+Each takes a scene as a path, a dict or a :class:`~camloc_geo.scene.Scene`, plus keyword-only
+options, and returns typed results. Domain decisions (where to anchor the map, how far to
+load it, whether a map is needed, when the network may be used) live here and nowhere in the
+front ends.
+
+Network policy (one rule for every command): an extract given as ``map_source`` is always
+used and the network never is; without one, Overpass is queried through osmnx (cached) when
+``network`` is true, and a scene that needs a map fails with a :class:`MapDataError` naming
+``--osm EXTRACT`` when it is false.
+
+Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Union
+
+from camloc_geo._errors import MapDataError, SceneError
+
+if TYPE_CHECKING:
+    from camloc_geo.absolute import LocateResult, LocateSettings
+    from camloc_geo.osm import MapData
+    from camloc_geo.relative import CalibrationResult, CalibrationSettings
+    from camloc_geo.scene import Scene
+
+__all__ = [
+    "DEFAULT_MIN_RADIUS_M",
+    "LocateOutput",
+    "MapSource",
+    "SceneLike",
+    "calibrate_scene",
+    "corners_near",
+    "locate_scene",
+    "map_for_scene",
+    "scene_from",
+    "streets_near",
+]
+
+SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
+"""A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
+
+MapSource = Union[str, os.PathLike, "MapData", None]
+"""A map: an extract path, an already loaded :class:`~camloc_geo.osm.MapData`, or None."""
+
+DEFAULT_MIN_RADIUS_M = 300.0
+"""The smallest map radius loaded around a scene (metres)."""
+
+_PRIOR_MARGIN_M = 200.0
+
+
+def scene_from(scene: SceneLike) -> Scene:
+    """A validated :class:`Scene` from a model, a dict or a path.
+
+    Raises
+    ------
+    SceneError
+        The scene does not validate; the message names the field.
+    """
+    from camloc_geo.scene import Scene, load_scene, parse_scene
+
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, dict):
+        return parse_scene(scene)
+    if isinstance(scene, (str, os.PathLike)):
+        return load_scene(Path(scene))
+    raise SceneError(f"a scene must be a path, a dict or a Scene, not {type(scene).__name__}")
+
+
+def calibrate_scene(
+    scene: SceneLike,
+    *,
+    settings: CalibrationSettings | None = None,
+    joint_fit: bool = True,
+    principal_point: str = "auto",
+) -> CalibrationResult:
+    """Relative pose of the camera from the scene's annotations.
+
+    Parameters
+    ----------
+    scene
+        Path, dict or model.
+    settings
+        Full settings; when given, ``joint_fit`` and ``principal_point`` are ignored.
+    joint_fit
+        True: the joint robust fit of all annotators (default); False: the paper's
+        per-annotator candidates and their largest cluster.
+    principal_point
+        ``"auto"`` (freed only when the data justify it), ``"centre"`` or ``"free"``.
+    """
+    from camloc_geo.relative import CalibrationSettings, calibrate
+
+    sc = scene_from(scene)
+    if settings is None:
+        modes = {"auto": None, "centre": False, "center": False, "free": True}
+        if principal_point not in modes:
+            raise SceneError(
+                f"principal_point must be one of auto, centre, free, not {principal_point!r}"
+            )
+        settings = CalibrationSettings(
+            joint_fit=joint_fit, free_principal_point=modes[principal_point]
+        )
+    return calibrate(sc, settings)
+
+
+def scene_needs_map(scene: Scene) -> bool:
+    """True when the scene's evidence can only be used with map data."""
+    if scene.intersection is not None or scene.landmarks:
+        return True
+    return len(scene.references) == 1 and scene.street_bearing_deg is None
+
+
+def scene_anchor(scene: Scene) -> tuple[float, float] | None:
+    """``(lat, lon)`` to load the map around: prior, intersection, a reference or a landmark."""
+    if scene.prior is not None:
+        return scene.prior.lat, scene.prior.lon
+    if scene.intersection is not None and scene.intersection.lat is not None:
+        assert scene.intersection.lon is not None
+        return scene.intersection.lat, scene.intersection.lon
+    if scene.references:
+        return scene.references[0].lat, scene.references[0].lon
+    for lm in scene.landmarks:
+        if lm.lat is not None and lm.lon is not None:
+            return lm.lat, lm.lon
+    return None
+
+
+def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
+    """The map radius for a scene: ``radius_m``, or the prior's radius + 200 m (≥ 300 m)."""
+    if radius_m is not None:
+        return float(radius_m)
+    return max(
+        DEFAULT_MIN_RADIUS_M, (scene.prior.radius_m if scene.prior else 0.0) + _PRIOR_MARGIN_M
+    )
+
+
+def map_for_scene(
+    scene: SceneLike,
+    *,
+    map_source: MapSource = None,
+    network: bool = True,
+    radius_m: float | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+    required: bool | None = None,
+) -> MapData | None:
+    """The map data a scene needs, or None when it needs none and no extract was given.
+
+    Parameters
+    ----------
+    map_source
+        Extract path or a loaded map; None: Overpass when ``network`` allows it.
+    network
+        May Overpass be queried (only when no ``map_source`` is given).
+    radius_m
+        Map radius around the scene's anchor (default :func:`scene_map_radius_m`).
+    required
+        Force loading (True) or skipping (False) the map; None: load when an extract is given
+        or the scene needs one.
+    """
+    from camloc_geo.osm import MapData, load_map
+
+    sc = scene_from(scene)
+    if isinstance(map_source, MapData):
+        return map_source
+    need = scene_needs_map(sc) if required is None else required
+    if map_source is None and not need:
+        return None
+    centre = scene_anchor(sc)
+    if centre is None:
+        raise SceneError(
+            "no location to load the map around: give prior (lat/lon), intersection lat/lon "
+            "or references",
+            "prior",
+        )
+    radius = scene_map_radius_m(sc, radius_m)
+    if map_source is not None:
+        return load_map(map_source, centre[0], centre[1], radius_m=radius)
+    if not network:
+        raise MapDataError(
+            "this scene needs a map (intersection corners, landmarks or street bearings) and "
+            "the network is off: give --osm EXTRACT (map_source=...)"
+        )
+    return load_map(
+        None,
+        centre[0],
+        centre[1],
+        radius_m=radius,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+
+
+@dataclass(frozen=True)
+class LocateOutput:
+    """What :func:`locate_scene` returns: the result and what it was computed from."""
+
+    scene: Scene
+    result: LocateResult
+    map_data: MapData | None
+
+    @property
+    def calibration(self) -> CalibrationResult:
+        """The relative pose used."""
+        return self.result.calibration
+
+    def to_geojson(self) -> dict[str, Any]:
+        """The candidate GeoJSON FeatureCollection (``docs/contract.md``)."""
+        from camloc_geo.absolute import candidates_geojson
+
+        return candidates_geojson(self.result)
+
+
+def locate_scene(
+    scene: SceneLike,
+    *,
+    map_source: MapSource = None,
+    network: bool = True,
+    radius_m: float | None = None,
+    max_candidates: int | None = None,
+    calibration: CalibrationResult | None = None,
+    settings: LocateSettings | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> LocateOutput:
+    """Candidate absolute camera positions for a scene, best first.
+
+    Parameters
+    ----------
+    scene
+        Path, dict or model.
+    map_source, network, radius_m, cache_folder, overpass_url
+        Where the map comes from (see :func:`map_for_scene` and the module's network policy).
+    max_candidates
+        At most this many candidates (≥ 1).
+    calibration
+        A relative pose computed before (default: :func:`calibrate_scene`).
+    settings
+        Noise model and ranking knobs.
+
+    Raises
+    ------
+    SceneError, MapDataError, MapSourceError
+        Bad scene, unusable map, unreachable Overpass; each names the problem.
+    """
+    from dataclasses import replace
+
+    from camloc_geo.absolute import LocateSettings, locate
+
+    sc = scene_from(scene)
+    map_data = map_for_scene(
+        sc,
+        map_source=map_source,
+        network=network,
+        radius_m=radius_m,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    settings = settings or LocateSettings()
+    if max_candidates is not None:
+        if max_candidates < 1:
+            raise SceneError("max_candidates must be at least 1", "max_candidates")
+        settings = replace(settings, max_candidates=max_candidates)
+    result = locate(sc, map_data, calibration=calibration, settings=settings)
+    return LocateOutput(scene=sc, result=result, map_data=map_data)
+
+
+def corners_near(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+    streets: str | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> dict[str, Any]:
+    """Intersections with their kerb corners around a point, as GeoJSON (``docs/contract.md``).
+
+    ``streets`` (``"A & B"``) keeps only the intersection of those streets.
+    """
+    from camloc_geo.osm import MapData, intersections_geojson, load_map
+
+    if isinstance(map_source, MapData):
+        m = map_source
+    else:
+        if map_source is None and not network:
+            raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
+        m = load_map(
+            map_source,
+            lat,
+            lon,
+            radius_m,
+            cache_folder=cache_folder,
+            overpass_url=overpass_url,
+        )
+    inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
+    return intersections_geojson(inters)
+
+
+def streets_near(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+) -> MapData:
+    """The map around a point (its ``streets`` carry names and bearings)."""
+    from camloc_geo.osm import MapData, load_map
+
+    if isinstance(map_source, MapData):
+        return map_source
+    if map_source is None and not network:
+        raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
+    return load_map(map_source, lat, lon, radius_m)
