@@ -27,11 +27,6 @@ def __getattr__(name: str) -> object:
 
 
 __all__ = [
-    "calibrate_scene",
-    "corners_near",
-    "locate_scene",
-    "map_for_scene",
-    "streets_near",
     "CamlocError",
     "DegenerateGeometryError",
     "InputError",
@@ -40,4 +35,9 @@ __all__ = [
     "NotEnoughStructureError",
     "SceneError",
     "__version__",
+    "calibrate_scene",
+    "corners_near",
+    "locate_scene",
+    "map_for_scene",
+    "streets_near",
 ]
