@@ -1,0 +1,413 @@
+"""Stage 1, evidence: the scene's ground pixels and the map features they may match, in ENU."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo._errors import MapDataError, SceneError
+from camloc_geo.absolute._model import EvidenceKind, LocateResult, LocateSettings, Observation
+from camloc_geo.camera import Camera
+from camloc_geo.geodesy import LocalFrame
+from camloc_geo.scene import Scene
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import Intersection, MapData
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass
+class Evidence:
+    """Everything a hypothesis is scored against, in the local frame."""
+
+    refs: list[tuple[Observation, FloatArray]]
+    corners: list[Observation]
+    map_corners: FloatArray  # (n, 2) ENU, clockwise
+    map_corner_ids: list[str]
+    landmarks: list[tuple[Observation, FloatArray]]  # (obs, candidate map points (k, 2))
+    street_bearings: list[float]
+    buildings_enu: list[Any]
+    prior_en: FloatArray | None
+    prior_radius_m: float | None
+    streets_enu: list[tuple[Any, float]] = field(default_factory=list)
+    buildings_tree: Any = None
+    street_tree: Any = None
+    car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
+    worst_reference: str | None = None
+
+    @property
+    def observations(self) -> list[Observation]:
+        """Every usable ground pixel: references, corners, landmarks."""
+        return [o for o, _ in self.refs] + self.corners + [o for o, _ in self.landmarks]
+
+
+def ground_observation(
+    camera: Camera,
+    pixel: Sequence[float],
+    kind: EvidenceKind,
+    label: str,
+    sigma_map: float,
+    settings: LocateSettings,
+    diag: float,
+) -> Observation:
+    """A ground pixel's world position and its covariance (click noise, scale error)."""
+    px = np.asarray(pixel, dtype=float)
+    g = camera.ground_from_pixels(px)
+    if not np.all(np.isfinite(g)):
+        raise SceneError(
+            f"pixel {px.tolist()} is at or above the horizon of the calibrated camera, so it "
+            "cannot be a ground point",
+            label,
+        )
+    # Jacobian of the ground point w.r.t. the pixel (central differences).
+    J = np.empty((2, 2))
+    for j in range(2):
+        d = np.zeros(2)
+        d[j] = 0.5
+        gp = camera.ground_from_pixels(px + d)
+        gm = camera.ground_from_pixels(px - d)
+        J[:, j] = (gp[:2] - gm[:2]) / 1.0
+    sig_px = settings.sigma_pixel_rel * diag
+    cov = sig_px**2 * (J @ J.T)
+    foot = camera.center_in_world[:2]
+    rng = float(np.linalg.norm(g[:2] - foot)) + float(np.linalg.norm(foot))
+    cov = cov + (settings.scale_sigma_rel * 0.5 * rng) ** 2 * np.eye(2)
+    if not np.all(np.isfinite(cov)):
+        cov = np.eye(2) * 1e6
+    return Observation(kind, label, (float(px[0]), float(px[1])), g[:2].copy(), cov, sigma_map)
+
+
+def frame_anchor(scene: Scene, map_data: MapData | None) -> LocalFrame:
+    """The local frame: the map's, else one anchored at the scene's first geographic hint."""
+    if map_data is not None:
+        return map_data.frame
+    if scene.prior is not None:
+        return LocalFrame(scene.prior.lat, scene.prior.lon)
+    if scene.references:
+        return LocalFrame(
+            float(np.mean([r.lat for r in scene.references])),
+            float(np.mean([r.lon for r in scene.references])),
+        )
+    if scene.intersection is not None and scene.intersection.lat is not None:
+        assert scene.intersection.lon is not None
+        return LocalFrame(scene.intersection.lat, scene.intersection.lon)
+    raise SceneError(
+        "no geographic hint: give prior, references, intersection lat/lon, or a map", "prior"
+    )
+
+
+class _Observer:
+    """Turns the scene's pixels into observations; pixels above the horizon become warnings."""
+
+    def __init__(self, camera: Camera, settings: LocateSettings, scene: Scene) -> None:
+        self.camera = camera
+        self.settings = settings
+        self.diag = math.hypot(*scene.image_size)
+        self.warnings: list[str] = []
+
+    def __call__(
+        self, pixel: Sequence[float], kind: EvidenceKind, label: str, sigma: float
+    ) -> Observation | None:
+        try:
+            return ground_observation(
+                self.camera, pixel, kind, label, sigma, self.settings, self.diag
+            )
+        except SceneError as exc:
+            self.warnings.append(f"{exc}; ignored")
+            return None
+
+
+def _references(
+    scene: Scene, frame: LocalFrame, observe: _Observer
+) -> list[tuple[Observation, FloatArray]]:
+    refs = []
+    for i, ref in enumerate(scene.references):
+        sigma = observe.settings.sigma_reference_m / math.sqrt(ref.weight)
+        obs = observe(ref.pixel, "reference", f"references[{i}]", sigma)
+        if obs is not None:
+            refs.append((obs, np.array(frame.enu_from_geographic(ref.lon, ref.lat), dtype=float)))
+    return refs
+
+
+def _check_distinct_corners(scene: Scene) -> None:
+    assert scene.intersection is not None
+    listed = np.asarray(scene.intersection.corners, dtype=float)
+    for i in range(len(listed)):
+        for j in range(i):
+            if np.linalg.norm(listed[i] - listed[j]) < 2.0:
+                raise SceneError(
+                    f"is the same pixel as intersection.corners[{j}] (less than 2 px "
+                    "apart): each visible kerb corner is listed once",
+                    f"intersection.corners[{i}]",
+                )
+
+
+def choose_intersection(scene: Scene, map_data: MapData, frame: LocalFrame) -> Intersection:
+    """The map intersection the scene's corners belong to."""
+    hint = scene.intersection
+    assert hint is not None
+    near = (scene.prior.lat, scene.prior.lon) if scene.prior is not None else None
+    if hint.streets:
+        return map_data.find_intersection(list(hint.streets), near=near)
+    if hint.lat is not None and hint.lon is not None:
+        return map_data.nearest_intersection(hint.lat, hint.lon)
+    if scene.prior is not None:
+        return map_data.nearest_intersection(scene.prior.lat, scene.prior.lon)
+    return map_data.nearest_intersection(frame.lat0, frame.lon0)
+
+
+@dataclass
+class _CornerEvidence:
+    corners: list[Observation] = field(default_factory=list)
+    map_corners: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    map_corner_ids: list[str] = field(default_factory=list)
+    intersection: Intersection | None = None
+    bearings: list[float] = field(default_factory=list)
+
+
+def _corners(
+    scene: Scene, map_data: MapData | None, frame: LocalFrame, observe: _Observer
+) -> _CornerEvidence:
+    out = _CornerEvidence()
+    if scene.intersection is None:
+        return out
+    _check_distinct_corners(scene)
+    for i, px in enumerate(scene.intersection.corners):
+        label = f"intersection.corners[{i}]"
+        c_obs = observe(px, "corner", label, observe.settings.sigma_corner_m)
+        if c_obs is not None:
+            out.corners.append(c_obs)
+    if map_data is None:
+        raise MapDataError("the scene lists intersection corners but no map was given")
+    inter = choose_intersection(scene, map_data, frame)
+    out.intersection = inter
+    if inter.kind != "junction":
+        observe.warnings.append(
+            f"intersection {inter.id} is a {inter.kind}: " + "; ".join(inter.warnings)
+        )
+    if inter.corners:
+        out.map_corners = np.array(
+            [frame.enu_from_geographic(c.lon, c.lat) for c in inter.corners], dtype=float
+        )
+        out.map_corner_ids = [f"{inter.id}:{c.order}" for c in inter.corners]
+    out.bearings = [st.bearing_deg for st in inter.streets]
+    return out
+
+
+def _landmarks(
+    scene: Scene, map_data: MapData | None, frame: LocalFrame, observe: _Observer
+) -> list[tuple[Observation, FloatArray]]:
+    landmarks = []
+    settings = observe.settings
+    for i, lm in enumerate(scene.landmarks or []):
+        label = f"landmarks[{i}]"
+        sigma = (
+            settings.sigma_landmark_corner_m
+            if lm.kind == "building_corner"
+            else settings.sigma_face_midpoint_m
+        )
+        lm_obs = observe(lm.pixel, "landmark", label, sigma)
+        if lm_obs is None:
+            continue
+        pts_ll: list[tuple[float, float]]
+        if lm.name is not None and map_data is not None:
+            near_lm: tuple[float, float] | None = None
+            if lm.lat is not None and lm.lon is not None:
+                near_lm = (lm.lat, lm.lon)
+            elif scene.prior is not None:
+                near_lm = (scene.prior.lat, scene.prior.lon)
+            building = map_data.find_building(lm.name, near=near_lm)
+            pts_ll = list(
+                building.corners if lm.kind == "building_corner" else building.face_midpoints
+            )
+        elif lm.lat is not None and lm.lon is not None:
+            pts_ll = [(lm.lon, lm.lat)]
+        else:
+            raise MapDataError(f"{label}: landmark {lm.name!r} needs a map or lat/lon")
+        if not pts_ll:
+            raise MapDataError(f"{label}: the building has no usable {lm.kind.replace('_', ' ')}s")
+        pts = frame.points_enu_from_geographic(np.asarray(pts_ll, dtype=float))
+        landmarks.append((lm_obs, pts))
+    return landmarks
+
+
+def unique_bearings(bearings: Iterable[float]) -> list[float]:
+    """Bearings folded into [0, 180), those within 5° of an earlier one dropped."""
+    out: list[float] = []
+    for b in bearings:
+        b = float(b) % 180.0
+        if all(min(abs(b - c), 180.0 - abs(b - c)) > 5.0 for c in out):
+            out.append(b)
+    return out
+
+
+def _search_spots(
+    scene: Scene,
+    frame: LocalFrame,
+    settings: LocateSettings,
+    refs: list[tuple[Observation, FloatArray]],
+    inter: Intersection | None,
+    landmarks: list[tuple[Observation, FloatArray]],
+) -> list[tuple[FloatArray, float]]:
+    """Where to look for street bearings, with the search radius around each spot."""
+    spots = [(q, settings.street_search_m) for _, q in refs]
+    if inter is not None:
+        en = np.array(frame.enu_from_geographic(inter.lon, inter.lat))
+        spots.append((en, settings.street_search_m))
+    for _, pts in landmarks:
+        # The streets along any side of the building, not only near its centre.
+        mid = pts.mean(axis=0)
+        reach = float(np.max(np.linalg.norm(pts - mid, axis=1)))
+        spots.append((mid, settings.street_search_m + reach))
+    if not spots and scene.prior is not None:
+        en = np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat))
+        spots.append((en, settings.street_search_m))
+    return spots
+
+
+def _map_street_bearings(
+    map_data: MapData,
+    frame: LocalFrame,
+    settings: LocateSettings,
+    spots: list[tuple[FloatArray, float]],
+    bearings: list[float],
+    warnings: list[str],
+) -> None:
+    """Add the bearings of the map's streets near the spots to ``bearings``.
+
+    The search widens where nothing passes close (a reference on a plaza, a landmark set
+    back from the street) and nothing is known yet: 1x, 3x, 8x the radius, then at least
+    200 m.
+    """
+    base = settings.street_search_m
+    for widen in (1.0, 3.0, 8.0, max(8.0, 200.0 / max(base, 1e-9))):
+        for q, radius in spots:
+            lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
+            for _name, street_brg in map_data.street_bearings(
+                float(lat), float(lon), widen * radius
+            ):
+                bearings.append(street_brg)
+        if bearings or not spots:
+            if widen > 1.0:
+                warnings.append(
+                    f"street bearings: no street within {settings.street_search_m:g} m of the "
+                    f"evidence; used those within {widen * settings.street_search_m:g} m"
+                )
+            break
+
+
+def gather_evidence(
+    scene: Scene,
+    map_data: MapData | None,
+    world_cam: Camera,
+    settings: LocateSettings,
+    result: LocateResult,
+) -> Evidence:
+    """Stage 1: every ground pixel of the scene with the map points it may match (ENU)."""
+    frame = result.frame
+    observe = _Observer(world_cam, settings, scene)
+    observe.warnings = result.warnings
+    refs = _references(scene, frame, observe)
+    ce = _corners(scene, map_data, frame, observe)
+    result.intersection = ce.intersection
+    landmarks = _landmarks(scene, map_data, frame, observe)
+    bearings = ce.bearings
+    if scene.street_bearing_deg is not None:
+        bearings = [scene.street_bearing_deg]
+    elif map_data is not None:
+        spots = _search_spots(scene, frame, settings, refs, ce.intersection, landmarks)
+        _map_street_bearings(map_data, frame, settings, spots, bearings, result.warnings)
+    ev = Evidence(
+        refs,
+        ce.corners,
+        ce.map_corners,
+        ce.map_corner_ids,
+        landmarks,
+        unique_bearings(bearings),
+        [],
+        None,
+        None,
+    )
+    _add_map_context(ev, scene, map_data, frame, settings)
+    size = scene.object_size
+    ws = 1.0 if sum(result.calibration.width_signs or [1.0]) >= 0 else -1.0
+    ev.car_center_world = np.array([size.length_m / 2.0, ws * size.width_m / 2.0])
+    result.observations = ev.observations
+    return ev
+
+
+def _add_map_context(
+    ev: Evidence,
+    scene: Scene,
+    map_data: MapData | None,
+    frame: LocalFrame,
+    settings: LocateSettings,
+) -> None:
+    """Buildings and streets (projected, indexed) and the prior, for the plausibility factors."""
+    if map_data is not None and map_data.buildings:
+        ev.buildings_enu, ev.buildings_tree = _buildings_index(map_data, frame)
+    if scene.prior is not None:
+        ev.prior_en = np.array(
+            frame.enu_from_geographic(scene.prior.lon, scene.prior.lat), dtype=float
+        )
+        ev.prior_radius_m = scene.prior.radius_m
+    if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
+        ev.streets_enu, ev.street_tree = _streets_index(map_data, frame)
+
+
+_STREETS_CACHE: dict[tuple[int, float, float], tuple[list[tuple[Any, float]], Any]] = {}
+
+
+def _streets_index(map_data: MapData, frame: LocalFrame) -> tuple[list[tuple[Any, float]], Any]:
+    """Street centre lines in the local frame with half carriageway widths, and an STRtree."""
+    key = (id(map_data), frame.lat0, frame.lon0)
+    hit = _STREETS_CACHE.get(key)
+    if hit is not None and hit[0] and len(hit[0]) == len(map_data.streets):
+        return hit
+    from shapely import STRtree
+    from shapely.geometry import LineString
+
+    rows = []
+    for st in map_data.streets:
+        coords = np.asarray(st.geometry.coords, dtype=float)
+        if len(coords) < 2:
+            continue
+        line = LineString(frame.points_enu_from_geographic(coords))
+        if line.length > 0.5:
+            rows.append((line, float(st.width_m) / 2.0))
+    tree = STRtree([r[0] for r in rows]) if rows else None
+    if len(_STREETS_CACHE) > 16:
+        _STREETS_CACHE.clear()
+    _STREETS_CACHE[key] = (rows, tree)
+    return rows, tree
+
+
+_BUILDINGS_CACHE: dict[tuple[int, float, float], tuple[list[Any], Any]] = {}
+
+
+def _buildings_index(map_data: MapData, frame: LocalFrame) -> tuple[list[Any], Any]:
+    """Building footprints in the local frame and an STRtree over them (cached per map)."""
+    key = (id(map_data), frame.lat0, frame.lon0)
+    hit = _BUILDINGS_CACHE.get(key)
+    if hit is not None and len(hit[0]) <= len(map_data.buildings):
+        return hit
+    from shapely import STRtree
+    from shapely.geometry import Polygon
+
+    polys = []
+    for b in map_data.buildings:
+        coords = np.asarray(b.footprint.exterior.coords, dtype=float)
+        poly = Polygon(frame.points_enu_from_geographic(coords))
+        if poly.is_valid and poly.area > 1.0:
+            polys.append(poly)
+    tree = STRtree(polys) if polys else None
+    if len(_BUILDINGS_CACHE) > 16:
+        _BUILDINGS_CACHE.clear()
+    _BUILDINGS_CACHE[key] = (polys, tree)
+    return polys, tree

@@ -1,0 +1,231 @@
+"""Stage 2, hypotheses: candidate ``enu_from_world`` similarities, one generator per evidence."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo.absolute._evidence import Evidence, unique_bearings
+from camloc_geo.absolute._model import LocateResult, LocateSettings, Observation
+from camloc_geo.absolute._scoring import assignments, mahal
+from camloc_geo.absolute._similarity import Similarity2D, rot2, similarity_fit, theta_for_bearing
+from camloc_geo.scene import Scene
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass
+class Hypothesis:
+    """A candidate similarity, the generator that proposed it, and its prior."""
+
+    method: str
+    enu_from_world: Similarity2D
+    log_prior: float = 0.0
+    corner_assignment: tuple[int, ...] | None = None
+
+
+class NoCandidatesError(Exception):
+    """A stage found nothing to go on; the message is the result's ``reason``."""
+
+
+def _weights(observations: Sequence[Observation]) -> FloatArray:
+    return np.array([1.0 / (np.trace(o.cov_world) / 2 + o.sigma_map_m**2) for o in observations])
+
+
+def _gen_references(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    refs = ev.refs
+    if len(refs) < 2:
+        return []
+    world = np.array([o.world_xy for o, _ in refs])
+    enu = np.array([q for _, q in refs])
+    wts = _weights([o for o, _ in refs])
+    out = [Hypothesis("two_references", similarity_fit(world, enu, wts, settings.scale_sigma_rel))]
+    if ev.worst_reference is not None:
+        # The robust alternative: the fit of the others, the worst one an outlier.
+        keep = [i for i, (o, _) in enumerate(refs) if o.label != ev.worst_reference]
+        sim = similarity_fit(world[keep], enu[keep], wts[keep], settings.scale_sigma_rel)
+        out.append(Hypothesis("two_references", sim))
+    return out
+
+
+def worst_reference(
+    refs: list[tuple[Observation, FloatArray]], settings: LocateSettings
+) -> tuple[str, float] | None:
+    """The reference that disagrees most with the others, and its misfit to their fit (m).
+
+    The largest residual of the joint fit is a poor guide with few points (the fit leans
+    towards the wrong one and spreads its error): leave each reference out in turn, fit the
+    others, and name the one whose removal leaves the most consistent set.
+    """
+    if len(refs) < 3:
+        return None
+    world = np.array([o.world_xy for o, _ in refs])
+    enu = np.array([q for _, q in refs])
+    wts = _weights([o for o, _ in refs])
+    best: tuple[float, str, float] | None = None
+    for i in range(len(refs)):
+        keep = [j for j in range(len(refs)) if j != i]
+        sim = similarity_fit(world[keep], enu[keep], wts[keep], settings.scale_sigma_rel)
+        cost = sum(mahal(refs[j][0], refs[j][1], sim) for j in keep)
+        cost += ((sim.scale - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
+        miss = float(np.linalg.norm(sim.apply(world[i]) - enu[i]))
+        if best is None or cost < best[0]:
+            best = (cost, refs[i][0].label, miss)
+    assert best is not None
+    return best[1], best[2]
+
+
+def _gen_bearing_point(
+    method: str, obs: Observation, points: FloatArray, bearings: Sequence[float]
+) -> list[Hypothesis]:
+    """The car's axis along each street bearing (both ways), the pixel on each map point."""
+    out = []
+    for q in points:
+        for b in bearings:
+            for flip in (0.0, 180.0):
+                theta = theta_for_bearing(b + flip)
+                T = q - rot2(theta) @ obs.world_xy
+                out.append(Hypothesis(method, Similarity2D(theta, T, 1.0)))
+    return out
+
+
+def _gen_corners(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    k, n = len(ev.corners), len(ev.map_corners)
+    if k == 0 or n == 0:
+        return []
+    if k == 1:
+        return _gen_bearing_point("corners", ev.corners[0], ev.map_corners, ev.street_bearings)
+    if n == 1:
+        # One modelled corner, several visible: each visible one in turn is that corner.
+        out_one = []
+        for ci in range(k):
+            assign = tuple(0 if i == ci else -1 for i in range(k))
+            for h in _gen_bearing_point(
+                "corners", ev.corners[ci], ev.map_corners, ev.street_bearings
+            ):
+                out_one.append(replace(h, corner_assignment=assign))
+        return out_one
+    out = []
+    world = np.array([o.world_xy for o in ev.corners])
+    wts = _weights(ev.corners)
+    for assign, consecutive in assignments(k, n):
+        used = [i for i, j in enumerate(assign) if j >= 0]
+        if len(used) < 2:
+            continue
+        enu = ev.map_corners[[assign[i] for i in used]]
+        sim = similarity_fit(world[used], enu, wts[used], settings.scale_sigma_rel)
+        lp = 0.0 if consecutive else math.log(settings.non_consecutive_prior)
+        out.append(Hypothesis("corners", sim, lp, tuple(assign)))
+    return out
+
+
+def _gen_landmarks(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    lms = ev.landmarks
+    if not lms:
+        return []
+    if len(lms) == 1:
+        obs, pts = lms[0]
+        return _gen_bearing_point("landmark", obs, pts, ev.street_bearings)
+    out = []
+    world = np.array([o.world_xy for o, _ in lms])
+    wts = _weights([o for o, _ in lms])
+    pools = [range(len(pts)) for _, pts in lms]
+    combos = list(itertools.product(*pools))
+    if len(combos) > 5000:
+        combos = combos[:5000]
+    for combo in combos:
+        enu = np.array([lms[i][1][j] for i, j in enumerate(combo)])
+        if np.ptp(enu, axis=0).max() < 1.0:
+            continue
+        sim = similarity_fit(world, enu, wts, settings.scale_sigma_rel)
+        out.append(Hypothesis("landmark", sim))
+    return out
+
+
+def _gen_one_reference(ev: Evidence, street_bearing: float | None) -> list[Hypothesis]:
+    if len(ev.refs) != 1:
+        return []
+    obs, q = ev.refs[0]
+    bearings = [street_bearing] if street_bearing is not None else ev.street_bearings
+    return _gen_bearing_point("one_reference", obs, q[None, :], unique_bearings(bearings))
+
+
+def flag_worst_reference(ev: Evidence, settings: LocateSettings, result: LocateResult) -> None:
+    """Name the reference that agrees least with the others (three or more references)."""
+    worst = worst_reference(ev.refs, settings)
+    if worst is not None:
+        ev.worst_reference = worst[0]
+        result.warnings.append(
+            f"{worst[0]} is the reference that agrees least with the others: "
+            f"{worst[1]:.1f} m from where they put it"
+        )
+
+
+def generate_hypotheses(
+    scene: Scene, ev: Evidence, settings: LocateSettings, result: LocateResult
+) -> list[Hypothesis]:
+    """Stage 2: every generator the evidence allows; ``result.methods_tried`` lists them.
+
+    Raises
+    ------
+    NoCandidatesError
+        No method applies, or none proposes anything.
+    """
+    flag_worst_reference(ev, settings, result)
+    tried, warn = result.methods_tried, result.warnings
+    hyps: list[Hypothesis] = []
+    if len(ev.refs) >= 2:
+        tried.append("two_references")
+        hyps += _gen_references(ev, settings)
+    if len(ev.refs) == 1 and not ev.corners and not scene.landmarks:
+        tried.append("one_reference")
+        if not ev.street_bearings:
+            warn.append("one_reference: no street bearing (scene or map) near the reference")
+        hyps += _gen_one_reference(ev, scene.street_bearing_deg)
+    if scene.intersection is not None:
+        tried.append("corners")
+        _warn_corner_counts(ev, result)
+        hyps += _gen_corners(ev, settings)
+    if scene.landmarks:
+        tried.append("landmark")
+        if len(ev.landmarks) == 1 and not ev.street_bearings:
+            warn.append("landmark: one landmark and no street bearing (scene or map) near it")
+        hyps += _gen_landmarks(ev, settings)
+    if not tried:
+        raise NoCandidatesError(_no_method_reason(scene, result))
+    if not hyps:
+        reasons = warn or ["the evidence fits nothing"]
+        raise NoCandidatesError("no hypothesis: " + "; ".join(reasons))
+    return hyps
+
+
+def _warn_corner_counts(ev: Evidence, result: LocateResult) -> None:
+    k, n = len(ev.corners), len(ev.map_corners)
+    inter = result.intersection
+    if not n:
+        result.warnings.append(
+            f"corners: the map has no modelled kerb corners at intersection "
+            f"{inter.id if inter else '?'}"
+        )
+    elif k > n:
+        result.warnings.append(
+            f"corners: the scene lists {k} visible corners but the map's "
+            f"intersection has {n}; every hypothesis leaves "
+            f"{k - n} of them unmatched"
+        )
+
+
+def _no_method_reason(scene: Scene, result: LocateResult) -> str:
+    if scene.references or scene.intersection is not None or scene.landmarks:
+        return (
+            "every reference, corner or landmark pixel is at or above the calibrated "
+            "camera's horizon, so none is a ground point (is the calibration wrong? its "
+            f"focal length is {result.calibration.camera.focal_px:.0f} px): "
+            + "; ".join(result.warnings)
+        )
+    return "no geographic evidence: the scene has no references, intersection corners or landmarks"

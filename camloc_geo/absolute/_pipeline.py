@@ -1,0 +1,219 @@
+"""The :func:`locate` pipeline.
+
+evidence → hypotheses → scores → prior gate → refinement → ranking.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from camloc_geo.absolute._evidence import Evidence, frame_anchor, gather_evidence
+from camloc_geo.absolute._hypotheses import Hypothesis, NoCandidatesError, generate_hypotheses
+from camloc_geo.absolute._model import Candidate, FlagKind, LocateResult, LocateSettings
+from camloc_geo.absolute._refine import refine
+from camloc_geo.absolute._scoring import plausibility, score, unmatched_flags
+from camloc_geo.camera import Camera
+from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
+from camloc_geo.scene import Scene
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import MapData
+
+__all__ = ["locate", "normalise_and_merge", "prior_gate", "rank", "refine_leaders"]
+
+
+def locate(
+    scene: Scene,
+    map_data: MapData | None = None,
+    *,
+    calibration: CalibrationResult | None = None,
+    settings: LocateSettings | None = None,
+    calibration_settings: CalibrationSettings | None = None,
+) -> LocateResult:
+    """Candidate camera positions for a scene, best first.
+
+    Parameters
+    ----------
+    scene
+        A validated scene with annotations and at least one kind of geographic evidence
+        (references, an intersection's corners, landmarks).
+    map_data
+        The map around the scene (:func:`camloc_geo.osm.load_map`); needed for corners,
+        landmarks and street bearings, optional for references.
+    calibration
+        A precomputed :func:`camloc_geo.relative.calibrate` result (computed if None).
+    settings
+        Noise model and ranking; see :class:`LocateSettings`.
+
+    Returns
+    -------
+    LocateResult
+        ``candidates`` is empty, with ``reason`` saying why, when no method applies or no
+        hypothesis survives.
+
+    Raises
+    ------
+    SceneError, MapDataError
+        Malformed evidence (a reference pixel above the horizon, an unknown street or
+        building name).
+    """
+    settings = settings or LocateSettings()
+    cal = calibration or calibrate(scene, calibration_settings)
+    frame = frame_anchor(scene, map_data)
+    width, height = scene.image_size
+    result = LocateResult([], frame, cal, [], scene_id=scene.id, image_size=(width, height))
+    world_cam = cal.camera
+    ev = gather_evidence(scene, map_data, world_cam, settings, result)
+    try:
+        hyps = generate_hypotheses(scene, ev, settings, result)
+        cands = [score_hypothesis(h, world_cam, ev, settings) for h in hyps]
+        cands = prior_gate(cands, ev, settings, result)
+        cands = normalise_and_merge(cands, settings)
+        cands = refine_leaders(cands, world_cam, ev, settings)
+        result.candidates = rank(cands, settings, result)
+    except NoCandidatesError as exc:
+        result.reason = str(exc)
+    return result
+
+
+def _rescore(
+    cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings, log_prior: float
+) -> Candidate:
+    """The candidate with its likelihood, plausibility, matches and flags (re)computed."""
+    fit = score(cand.enu_from_world, ev, settings, cand.corner_assignment)
+    plaus, flags = plausibility(cand.camera, cand.enu_from_world, ev, settings, fit.matches)
+    flags += unmatched_flags(ev, fit.corner_assignment)
+    return replace(
+        cand,
+        log_likelihood=fit.log_likelihood + log_prior,
+        prior=plaus,
+        residual_m=fit.residual_m,
+        matches=fit.matches,
+        flags=flags,
+        corner_assignment=fit.corner_assignment,
+    )
+
+
+def score_hypothesis(
+    h: Hypothesis, world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> Candidate:
+    """Stage 3: a hypothesis scored against all the evidence, as a candidate."""
+    cam = h.enu_from_world.camera(world_cam)
+    cand = Candidate(h.method, h.enu_from_world, cam, corner_assignment=h.corner_assignment)
+    return _rescore(cand, world_cam, ev, settings, h.log_prior)
+
+
+def prior_gate(
+    cands: list[Candidate], ev: Evidence, settings: LocateSettings, result: LocateResult
+) -> list[Candidate]:
+    """Stage 4: drop hypotheses farther than ``prior_gate_radii`` prior radii from the prior.
+
+    Raises
+    ------
+    NoCandidatesError
+        Every hypothesis is that far: the evidence contradicts the prior.
+    """
+    if ev.prior_en is None or not ev.prior_radius_m:
+        return cands
+    limit = settings.prior_gate_radii * ev.prior_radius_m
+    dist = [float(np.linalg.norm(c.east_north - ev.prior_en)) for c in cands]
+    kept_near = [c for c, d in zip(cands, dist, strict=True) if d <= limit]
+    if not kept_near:
+        cam_dist = float(np.linalg.norm(result.calibration.camera.center_in_world[:2]))
+        raise NoCandidatesError(
+            f"every hypothesis puts the camera more than {limit:.0f} m "
+            f"({settings.prior_gate_radii:g} x prior.radius_m) from the prior, the nearest "
+            f"{min(dist):.0f} m: the {', '.join(result.methods_tried)} evidence contradicts "
+            "the prior (or the calibration is wrong: it puts the camera "
+            f"{cam_dist:.0f} m from the car)"
+        )
+    if len(kept_near) < len(cands):
+        result.warnings.append(
+            f"{len(cands) - len(kept_near)} hypotheses more than {limit:.0f} m from the prior "
+            "dropped"
+        )
+    return kept_near
+
+
+def refine_leaders(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Stage 5: refine the ``refine_top`` leading candidates, then score them again."""
+    cands = list(cands)
+    for i in range(min(settings.refine_top, len(cands))):
+        c = refine(cands[i], world_cam, ev, settings)
+        cands[i] = _rescore(c, world_cam, ev, settings, 0.0)
+    return cands
+
+
+def normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> list[Candidate]:
+    """Scores from likelihood × plausibility, summing to 1; near-duplicates merged."""
+    if not cands:
+        return cands
+    logw = np.array([c.log_likelihood + math.log(max(c.prior, 1e-300)) for c in cands])
+    w = np.exp(logw - logw.max())
+    w /= w.sum()
+    for c, wi in zip(cands, w, strict=True):
+        c.score = float(wi)
+    cands.sort(key=lambda c: -c.score)
+    kept: list[Candidate] = []
+    kept_heading: list[float] = []
+    for c in cands:
+        h = c.heading_deg
+        for k, hk in zip(kept, kept_heading, strict=True):
+            close = np.linalg.norm(c.east_north - k.east_north) < settings.merge_distance_m
+            dh = abs((h - hk + 180.0) % 360.0 - 180.0)
+            if close and dh < settings.merge_heading_deg:
+                k.score += c.score
+                k.merged += c.merged
+                break
+        else:
+            kept.append(c)
+            kept_heading.append(h)
+    kept.sort(key=lambda c: -c.score)
+    return kept
+
+
+def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> list[Candidate]:
+    """Stage 6: merged, cut to ``max_candidates``, ranked, placed on the map; ties named.
+
+    Raises
+    ------
+    NoCandidatesError
+        Every candidate fits the evidence poorly (``poor_fit``).
+    """
+    cands = normalise_and_merge(cands, settings)[: settings.max_candidates]
+    if all(FlagKind.POOR_FIT in {f.kind for f in c.flags} for c in cands):
+        best = min(cands, key=lambda c: c.residual_m)
+        raise NoCandidatesError(
+            f"no hypothesis fits the {', '.join(result.methods_tried)} evidence: the best misfits "
+            f"by {best.residual_m:.1f} m RMS, more than {math.sqrt(settings.fit_gate):.0f} "
+            "standard deviations of the noise model (wrong intersection, corners out of order, "
+            "or a wrong calibration?)"
+        )
+    total = sum(c.score for c in cands) or 1.0
+    for i, c in enumerate(cands, start=1):
+        c.score = c.score / total
+        c.rank = i
+        C = c.camera.center_in_world
+        lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
+        c.lon, c.lat = float(lon), float(lat)
+    _mark_ties(cands, settings, result)
+    return cands
+
+
+def _mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
+    """Warn when the two leaders fit equally well yet stand apart."""
+    if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
+        gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
+        if gap > 2.0 * settings.merge_distance_m:
+            result.warnings.append(
+                f"ambiguous: candidates 1 and 2 fit the evidence equally well (scores "
+                f"{cands[0].score:.2f} and {cands[1].score:.2f}) but stand {gap:.0f} m apart; "
+                "a symmetric junction cannot tell them apart: more evidence (a reference pixel, "
+                "a landmark, another corner) or a tighter prior decides"
+            )

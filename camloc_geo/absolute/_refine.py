@@ -1,0 +1,162 @@
+"""Stage 5, refinement: one least-squares fit of ``enu_from_world`` to all matched evidence."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import replace
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo.absolute._evidence import Evidence
+from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
+from camloc_geo.absolute._scoring import OUTLIER_M2, obs_precision, street_angle_under_car
+from camloc_geo.absolute._similarity import Similarity2D, rot2
+from camloc_geo.camera import Camera
+
+FloatArray = npt.NDArray[np.float64]
+ResidualJacobian = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
+
+
+def _matched_points(cand: Candidate, ev: Evidence) -> list[tuple[Observation, FloatArray]]:
+    """The candidate's inlier observations and their matched map points.
+
+    Points beyond the likelihood's cap are outliers to this hypothesis (they add a
+    constant): leave them out, or one wrong reference drags the fit back onto itself.
+    """
+    obs_q: list[tuple[Observation, FloatArray]] = list(ev.refs)
+    by_label = {m.label: m for m in cand.matches}
+    for o in ev.corners:
+        if o.label in by_label:
+            obs_q.append((o, np.asarray(by_label[o.label].map_en)))
+    for o, _pts in ev.landmarks:
+        if o.label in by_label:
+            obs_q.append((o, np.asarray(by_label[o.label].map_en)))
+    inliers = [
+        (o, q)
+        for o, q in obs_q
+        if (by_label[o.label].mahalanobis2 if o.label in by_label else 0.0) <= OUTLIER_M2
+    ]
+    return inliers if len(inliers) >= 2 else obs_q
+
+
+def _street_bearing_prior(cand: Candidate, ev: Evidence, settings: LocateSettings) -> float | None:
+    """The bearing of the street under the car, when the car (nearly) lies along it.
+
+    The street prior only pulls a candidate that already (nearly) meets it: one whose car
+    is flagged off the street or across it is the evidence's, not the prior's, to move.
+    """
+    if ev.street_tree is None:
+        return None
+    diff0 = street_angle_under_car(cand.enu_from_world, ev)
+    if diff0 is not None and abs(diff0) <= 2.5 * settings.bearing_sigma_deg:
+        return ((90.0 - math.degrees(cand.theta_rad)) - diff0) % 180.0
+    return None
+
+
+def _residuals(
+    obs_q: list[tuple[Observation, FloatArray]],
+    start: Similarity2D,
+    settings: LocateSettings,
+    street_brg: float | None,
+) -> ResidualJacobian:
+    """Whitened residuals and Jacobian in x = (θ, tx, ty, ln s)."""
+    # Whitening at the starting similarity (the rotation and scale change little here).
+    R20 = start.rotation
+    L = np.stack([np.linalg.cholesky(obs_precision(o, R20, start.scale)) for o, _q in obs_q])
+    P = np.array([o.world_xy for o, _q in obs_q])
+    Q = np.array([q for _o, q in obs_q])
+    s_sigma = max(settings.scale_sigma_rel, 1e-6)
+
+    def resid_jac(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        theta, tx, ty, ls = x
+        s = math.exp(ls)
+        R2 = rot2(theta)
+        dR2 = np.array([[-R2[1, 0], -R2[0, 0]], [R2[0, 0], -R2[1, 0]]])
+        sp = s * P @ R2.T
+        d = sp + np.array([tx, ty]) - Q
+        r = np.einsum("nji,nj->ni", L, d).ravel()
+        cols = [
+            s * P @ dR2.T,
+            np.broadcast_to([1.0, 0.0], P.shape),
+            np.broadcast_to([0.0, 1.0], P.shape),
+            sp,
+        ]
+        J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
+        r = np.concatenate([r, [ls / s_sigma]])
+        J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
+        if street_brg is not None:
+            # The car is parallel to the street it stands on, within bearing_sigma_deg (the
+            # street found under the car at the start; the refinement moves it little).
+            car_brg = (90.0 - math.degrees(theta)) % 180.0
+            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
+            r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
+            J = np.vstack([J, [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]])
+        return r, J
+
+    return resid_jac
+
+
+def _gauss_newton(
+    resid_jac: ResidualJacobian, x: FloatArray, max_iter: int = 8
+) -> tuple[FloatArray, FloatArray]:
+    """Gauss-Newton from ``x`` (the problem is nearly linear); the solution and its Jacobian."""
+    r, J = resid_jac(x)
+    for _ in range(max_iter):
+        try:
+            dx = -np.linalg.lstsq(J, r, rcond=None)[0]
+        except np.linalg.LinAlgError:
+            break
+        x_new = x + dx
+        r_new, J_new = resid_jac(x_new)
+        if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
+            break
+        x, r, J = x_new, r_new, J_new
+        if np.max(np.abs(dx)) < 1e-10:
+            break
+    return x, J
+
+
+def _position_sigma_m(
+    J: FloatArray, enu_from_world: Similarity2D, world_cam: Camera
+) -> float | None:
+    """1-sigma position uncertainty of the camera, propagated from the fit's covariance."""
+    try:
+        cov = np.linalg.pinv(J.T @ J)
+        # Jacobian of the camera's ENU position w.r.t. (θ, tx, ty, ln s).
+        theta, s = enu_from_world.rotation_rad, enu_from_world.scale
+        Cw = world_cam.center_in_world[:2]
+        R2 = rot2(theta)
+        dR = np.array([[-math.sin(theta), -math.cos(theta)], [math.cos(theta), -math.sin(theta)]])
+        Jp = np.column_stack([s * dR @ Cw, [1.0, 0.0], [0.0, 1.0], s * R2 @ Cw])
+        cov_p = Jp @ cov @ Jp.T
+        return float(math.sqrt(max(np.trace(cov_p), 0.0)))
+    except np.linalg.LinAlgError:
+        return None
+
+
+def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings) -> Candidate:
+    """Refine ``enu_from_world`` and so the camera's position against all matched evidence.
+
+    The world-frame pose of the camera is kept from the relative fit (its own uncertainty
+    enters through the observation covariances); the car-to-map similarity is fitted by
+    least squares on the Mahalanobis residuals of every matched point plus the scale prior,
+    and its covariance is propagated to the camera position.
+    """
+    obs_q = _matched_points(cand, ev)
+    if not obs_q:
+        return cand
+    street_brg = _street_bearing_prior(cand, ev, settings)
+    resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
+    x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    x, J = _gauss_newton(resid_jac, x0)
+    theta, tx, ty, ls = x
+    sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
+    return replace(
+        cand,
+        enu_from_world=sim,
+        camera=sim.camera(world_cam),
+        sigma_m=_position_sigma_m(J, sim, world_cam),
+        refined=True,
+    )

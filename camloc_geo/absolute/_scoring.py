@@ -1,0 +1,298 @@
+"""Stage 3, scores: each hypothesis against all the evidence, and its map plausibility."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo.absolute._evidence import Evidence
+from camloc_geo.absolute._model import Flag, FlagKind, LocateSettings, Match, Observation
+from camloc_geo.absolute._similarity import Similarity2D
+from camloc_geo.camera import Camera
+
+FloatArray = npt.NDArray[np.float64]
+
+# A matched point's squared Mahalanobis misfit counts up to this much (a robust likelihood).
+OUTLIER_M2 = 50.0
+
+
+def obs_precision(obs: Observation, R2: FloatArray, s: float) -> FloatArray:
+    """Inverse covariance of an observation's ENU position under rotation ``R2``, scale ``s``."""
+    cov = (s**2) * (R2 @ obs.cov_world @ R2.T) + obs.sigma_map_m**2 * np.eye(2)
+    return np.asarray(np.linalg.inv(cov), dtype=np.float64)
+
+
+def mahal(obs: Observation, q: FloatArray, enu_from_world: Similarity2D) -> float:
+    """Squared Mahalanobis distance between an observation (carried to ENU) and a map point."""
+    r = enu_from_world.apply(obs.world_xy) - q
+    return float(r @ obs_precision(obs, enu_from_world.rotation, enu_from_world.scale) @ r)
+
+
+@dataclass
+class Fit:
+    """How a hypothesis fits the evidence."""
+
+    log_likelihood: float = 0.0
+    matches: list[Match] = field(default_factory=list)
+    sq_misfits_m2: list[float] = field(default_factory=list)
+    corner_assignment: tuple[int, ...] | None = None
+
+    @property
+    def residual_m(self) -> float:
+        """RMS misfit of the matched points, metres (NaN with none)."""
+        sq = self.sq_misfits_m2
+        return math.sqrt(sum(sq) / len(sq)) if sq else math.nan
+
+    def add(
+        self,
+        obs: Observation,
+        q: FloatArray,
+        m2: float,
+        enu_from_world: Similarity2D,
+        corner: tuple[str, int] | None = None,
+    ) -> None:
+        """Count one matched point (its misfit capped at the outlier cost)."""
+        self.log_likelihood -= 0.5 * min(m2, OUTLIER_M2)  # robust: one outlier costs at most 25
+        d = enu_from_world.apply(obs.world_xy) - q
+        self.sq_misfits_m2.append(float(d @ d))
+        self.matches.append(
+            Match(
+                obs.kind,
+                obs.label,
+                obs.pixel,
+                np.asarray(q, dtype=np.float64).copy(),
+                float(np.linalg.norm(d)),
+                float(m2),
+                None if corner is None else corner[0],
+                None if corner is None else corner[1],
+            )
+        )
+
+
+def score(
+    enu_from_world: Similarity2D,
+    ev: Evidence,
+    settings: LocateSettings,
+    corner_assignment: Sequence[int] | None,
+) -> Fit:
+    """Log-likelihood, RMS misfit, matches and corner assignment of one hypothesis.
+
+    ``-1`` in a corner assignment leaves that image corner unmatched.
+    """
+    fit = Fit()
+    for obs, q in ev.refs:
+        fit.add(obs, q, mahal(obs, q, enu_from_world), enu_from_world)
+    if ev.corners and len(ev.map_corners):
+        if corner_assignment is None:
+            corner_assignment = best_assignment(enu_from_world, ev)
+        _score_corners(fit, enu_from_world, ev, corner_assignment)
+    for obs, pts in ev.landmarks:
+        m2s = [mahal(obs, q, enu_from_world) for q in pts]
+        k = int(np.argmin(m2s))
+        fit.add(obs, pts[k], m2s[k], enu_from_world)
+    s = enu_from_world.scale
+    fit.log_likelihood -= 0.5 * ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
+    if corner_assignment is not None:
+        fit.corner_assignment = tuple(int(j) for j in corner_assignment)
+    return fit
+
+
+def _score_corners(
+    fit: Fit, enu_from_world: Similarity2D, ev: Evidence, assignment: Sequence[int]
+) -> None:
+    for obs, j in zip(ev.corners, assignment, strict=True):
+        if j < 0:
+            # A visible corner the map's junction has no counterpart for (more corners
+            # listed than modelled): it costs what an outlier costs.
+            fit.log_likelihood -= 0.5 * OUTLIER_M2
+            continue
+        q = ev.map_corners[j]
+        m2 = mahal(obs, q, enu_from_world)
+        fit.add(obs, q, m2, enu_from_world, corner=(ev.map_corner_ids[j], int(j)))
+
+
+def unmatched_flags(ev: Evidence, assignment: tuple[int, ...] | None) -> list[Flag]:
+    """``unmatched:<label>`` for visible corners a hypothesis leaves without a map corner."""
+    if assignment is None:
+        return []
+    return [
+        Flag(FlagKind.UNMATCHED, o.label)
+        for o, j in zip(ev.corners, assignment, strict=True)
+        if j < 0
+    ]
+
+
+def best_assignment(enu_from_world: Similarity2D, ev: Evidence) -> list[int]:
+    """The cyclic, order-preserving assignment of image corners to map corners that fits best."""
+    best: tuple[float, list[int]] | None = None
+    for assign, _prior in assignments(len(ev.corners), len(ev.map_corners)):
+        cost = sum(
+            mahal(o, ev.map_corners[j], enu_from_world) if j >= 0 else OUTLIER_M2
+            for o, j in zip(ev.corners, assign, strict=True)
+        )
+        if best is None or cost < best[0]:
+            best = (cost, list(assign))
+    assert best is not None
+    return best[1]
+
+
+def assignments(k: int, n: int) -> Iterable[tuple[tuple[int, ...], float]]:
+    """Order-preserving cyclic assignments of k visible corners to n map corners, with priors.
+
+    Consecutive runs (the usual case) get prior 1; other order-preserving choices (a corner
+    hidden or missing in between, or, with more visible corners than map corners, image
+    corners left unmatched as ``-1``) get :attr:`LocateSettings.non_consecutive_prior`,
+    applied by the caller through the returned flag value 0.
+    """
+    if k == 0 or n == 0:
+        return
+    if k > n:
+        # More visible corners than the map models: leave k - n of them unmatched (-1),
+        # the rest in order on every cyclic run of the map's corners.
+        for keep in itertools.combinations(range(k), n):
+            for start in range(n):
+                assign = [-1] * k
+                for step, i in enumerate(keep):
+                    assign[i] = (start + step) % n
+                yield tuple(assign), 0.0
+        return
+    seen = set()
+    for start in range(n):
+        run = tuple((start + i) % n for i in range(k))
+        seen.add(run)
+        yield run, 1.0
+    if k >= 2 and k < n:
+        for combo in itertools.combinations(range(n), k):
+            for rot in range(k):
+                cyc = combo[rot:] + combo[:rot]
+                # Keep only cyclically increasing sequences (clockwise order preserved).
+                steps = [(cyc[(i + 1) % k] - cyc[i]) % n for i in range(k - 1)]
+                if sum(steps) >= n or cyc in seen:
+                    continue
+                seen.add(cyc)
+                yield cyc, 0.0
+
+
+# ---------------------------------------------------------------------------- priors
+def car_bearing_deg(enu_from_world: Similarity2D) -> float:
+    """Bearing of the car's length axis (world x), folded into [0, 180)."""
+    return (90.0 - math.degrees(enu_from_world.rotation_rad)) % 180.0
+
+
+def street_angle_under_car(enu_from_world: Similarity2D, ev: Evidence) -> float | None:
+    """Signed angle (degrees, in [-90, 90)) from the street under the car to the car's axis.
+
+    None when the car (its centre under the similarity) is on no carriageway (farther than
+    half the street's width + 2.5 m from every centre line); else the smallest angle among the
+    streets it stands on.
+    """
+    from shapely.geometry import Point, box
+
+    car_bearing = car_bearing_deg(enu_from_world)
+    car = enu_from_world.apply(ev.car_center_world)
+    x, y = float(car[0]), float(car[1])
+    pt = Point(x, y)
+    best: float | None = None
+    # A box, not a buffered disc: the tree only tests envelopes, and buffering is costly.
+    for idx in ev.street_tree.query(box(x - 25.0, y - 25.0, x + 25.0, y + 25.0)):
+        line, half_w = ev.streets_enu[int(idx)]
+        if line.distance(pt) > half_w + 2.5:
+            continue
+        sproj = line.project(pt)
+        a = line.interpolate(max(0.0, sproj - 5.0))
+        b = line.interpolate(min(line.length, sproj + 5.0))
+        brg = math.degrees(math.atan2(b.x - a.x, b.y - a.y)) % 180.0
+        diff = (car_bearing - brg + 90.0) % 180.0 - 90.0
+        if best is None or abs(diff) < abs(best):
+            best = diff
+    return best
+
+
+def _building_factor(
+    C: FloatArray, ev: Evidence, settings: LocateSettings, matches: list[Match]
+) -> tuple[float, list[Flag]]:
+    """The camera is not deep inside a building; the corners it sees are not hidden."""
+    from shapely.geometry import LineString, Point
+
+    factor = 1.0
+    flags: list[Flag] = []
+    pt = Point(float(C[0]), float(C[1]))
+    around = [ev.buildings_enu[int(i)] for i in ev.buildings_tree.query(pt)]
+    home = [poly for poly in around if poly.contains(pt)]
+    if any(poly.exterior.distance(pt) > 2.0 for poly in home):
+        factor *= settings.inside_building_factor
+        flags.append(Flag(FlagKind.INSIDE_BUILDING))
+    for m in matches:
+        if m.kind != "corner":
+            continue
+        line = LineString([(C[0], C[1]), tuple(m.map_en.tolist())])
+        for i in ev.buildings_tree.query(line):
+            poly = ev.buildings_enu[int(i)]
+            if poly in home:
+                continue
+            if line.crosses(poly) and line.intersection(poly).length > 1.0:
+                factor *= settings.occluded_corner_factor
+                flags.append(Flag(FlagKind.OCCLUDED, m.label))
+                break
+    return factor, flags
+
+
+def _parallel_factor(
+    enu_from_world: Similarity2D, ev: Evidence, settings: LocateSettings
+) -> tuple[float, list[Flag]]:
+    """The car's length axis is parallel to a street (the one under it, when streets are known)."""
+    if ev.street_tree is not None:
+        signed = street_angle_under_car(enu_from_world, ev)
+        if signed is None:
+            return settings.parallel_floor, [Flag(FlagKind.CAR_OFF_STREET)]
+        diff = abs(signed)
+    elif ev.street_bearings:
+        car_bearing = car_bearing_deg(enu_from_world)
+        diff = min(
+            min(abs(car_bearing - b), 180.0 - abs(car_bearing - b)) for b in ev.street_bearings
+        )
+    else:
+        return 1.0, []
+    par = math.exp(-0.5 * (diff / settings.bearing_sigma_deg) ** 2)
+    factor = settings.parallel_floor + (1.0 - settings.parallel_floor) * par
+    if diff > 2.5 * settings.bearing_sigma_deg:
+        return factor, [Flag(FlagKind.CAR_NOT_PARALLEL_TO_STREET)]
+    return factor, []
+
+
+def plausibility(
+    cam: Camera,
+    enu_from_world: Similarity2D,
+    ev: Evidence,
+    settings: LocateSettings,
+    matches: list[Match],
+) -> tuple[float, list[Flag]]:
+    """The map plausibility factor of a hypothesis (buildings, prior, streets) and its flags."""
+    factor = 1.0
+    flags: list[Flag] = []
+    C = cam.center_in_world
+    if ev.buildings_enu and ev.buildings_tree is not None:
+        f, fl = _building_factor(C, ev, settings, matches)
+        factor *= f
+        flags += fl
+    if ev.prior_en is not None and ev.prior_radius_m:
+        # A soft prior: a Gaussian of the listed radius (0.61 at the radius, 0.14 at twice).
+        d = float(np.linalg.norm(C[:2] - ev.prior_en))
+        factor *= math.exp(-0.5 * (d / ev.prior_radius_m) ** 2)
+        if d > ev.prior_radius_m:
+            flags.append(Flag(FlagKind.OUTSIDE_PRIOR))
+    f, fl = _parallel_factor(enu_from_world, ev, settings)
+    factor *= f
+    flags += fl
+    if ev.worst_reference is not None:
+        flags.append(Flag(FlagKind.WORST_REFERENCE, ev.worst_reference))
+    # The flagged worst reference is reported, not held against the whole fit.
+    m2 = [m.mahalanobis2 for m in matches if m.label != ev.worst_reference]
+    if m2 and sum(m2) / len(m2) > settings.fit_gate:
+        flags.append(Flag(FlagKind.POOR_FIT))
+    return factor, flags
