@@ -138,7 +138,10 @@ def _entry(res: LocateResult, ls: LocatedScene) -> dict[str, Any]:
 
 
 def _errors(result: LocateResult, ls: LocatedScene) -> list[float]:
-    return [float(distance_m(c.lon, c.lat, ls.lon, ls.lat)) for c in result.candidates]
+    return [
+        float(distance_m(lat1=c.lat, lon1=c.lon, lat2=ls.lat, lon2=ls.lon))
+        for c in result.candidates
+    ]
 
 
 def run_scenes(

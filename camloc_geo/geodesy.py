@@ -6,13 +6,20 @@ equidistant projection centred on the anchor, so distances and bearings from the
 anchor are exact and the scale error within 2 km is below 1e-7. The 111 111 m per
 degree shortcut of the paper is never used.
 
-Coordinates are always passed as ``(lon, lat)`` / ``(east, north)`` in that order,
-like pyproj's ``always_xy=True``.
+Coordinate rule (the whole package follows it)
+----------------------------------------------
+- **Scalars by keyword**: a latitude and a longitude are passed as keyword-only ``lat=`` and
+  ``lon=`` (``LocalFrame(lat=..., lon=...)``, ``frame.enu_from_geographic(lat=..., lon=...)``,
+  ``distance_m(lat1=..., lon1=..., lat2=..., lon2=...)``), so their order never matters.
+- **Arrays are ``lonlat``**: point arrays are ``(N, 2)`` with columns ``(lon, lat)``, x before y
+  like GeoJSON and pyproj's ``always_xy=True``, and the parameter is named ``lonlat``. Local
+  metric arrays are ``(east, north)``, named ``en`` / ``*_en``.
+- Functions that return a geographic pair return ``(lon, lat)`` (x, y), like GeoJSON.
 
 Examples
 --------
->>> frame = LocalFrame(39.2851, -76.6120)
->>> e, n = frame.enu_from_geographic(-76.6120, 39.2860)
+>>> frame = LocalFrame(lat=39.2851, lon=-76.6120)
+>>> e, n = frame.enu_from_geographic(lat=39.2860, lon=-76.6120)
 >>> round(float(e), 6), round(float(n), 1)
 (0.0, 99.9)
 >>> lon, lat = frame.geographic_from_enu(e, n)
@@ -61,13 +68,13 @@ def normalize_bearing_deg(bearing_deg: Any) -> Any:
     return float(wrapped) if np.ndim(wrapped) == 0 else wrapped
 
 
-def bearing_deg(lon1: float, lat1: float, lon2: float, lat2: float) -> float:
+def bearing_deg(*, lat1: float, lon1: float, lat2: float, lon2: float) -> float:
     """Geodesic bearing from point 1 to point 2, degrees clockwise from true north in [0, 360)."""
     fwd, _back, _dist = GEOD.inv(lon1, lat1, lon2, lat2)
     return float(normalize_bearing_deg(fwd))
 
 
-def distance_m(lon1: Any, lat1: Any, lon2: Any, lat2: Any) -> Any:
+def distance_m(*, lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
     """Geodesic distance on WGS 84, metres (scalars or arrays)."""
     _fwd, _back, dist = GEOD.inv(lon1, lat1, lon2, lat2)
     return dist
@@ -88,29 +95,33 @@ class LocalFrame:
 
     Parameters
     ----------
-    lat0, lon0
-        The anchor, degrees WGS 84. It is the frame's origin.
+    lat, lon
+        The anchor, degrees WGS 84 (keyword-only). It is the frame's origin, kept as
+        ``lat0`` and ``lon0``.
     """
 
-    def __init__(self, lat0: float, lon0: float) -> None:
-        if not (math.isfinite(lat0) and math.isfinite(lon0)):
-            raise ValueError(f"anchor must be finite, got lat={lat0}, lon={lon0}")
-        if not (-90.0 <= lat0 <= 90.0 and -180.0 <= lon0 <= 180.0):
-            raise ValueError(f"anchor out of range: lat={lat0}, lon={lon0}")
-        self.lat0 = float(lat0)
-        self.lon0 = float(lon0)
+    def __init__(self, *, lat: float, lon: float) -> None:
+        if not (math.isfinite(lat) and math.isfinite(lon)):
+            raise ValueError(f"anchor must be finite, got lat={lat}, lon={lon}")
+        if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0):
+            raise ValueError(f"anchor out of range: lat={lat}, lon={lon}")
+        self.lat0 = float(lat)
+        self.lon0 = float(lon)
         self._enu_from_lonlat, self._lonlat_from_enu = _transformer_pair(self.lat0, self.lon0)
 
     def __repr__(self) -> str:
-        return f"LocalFrame(lat0={self.lat0!r}, lon0={self.lon0!r})"
+        return f"LocalFrame(lat={self.lat0!r}, lon={self.lon0!r})"
 
-    def enu_from_geographic(self, lon: Any, lat: Any) -> tuple[Any, Any]:
-        """Project geographic coordinates to (east, north) metres; scalars or arrays."""
+    def enu_from_geographic(self, *, lat: Any, lon: Any) -> tuple[Any, Any]:
+        """Project geographic coordinates to (east, north) metres; scalars or arrays.
+
+        For an ``(N, 2)`` ``lonlat`` array use :meth:`points_enu_from_geographic`.
+        """
         east, north = self._enu_from_lonlat.transform(lon, lat)
         return east, north
 
     def geographic_from_enu(self, east: Any, north: Any) -> tuple[Any, Any]:
-        """Inverse of :meth:`enu_from_geographic`: (lon, lat) degrees."""
+        """Inverse of :meth:`enu_from_geographic`: ``(lon, lat)`` degrees (x, y)."""
         lon, lat = self._lonlat_from_enu.transform(east, north)
         return lon, lat
 

@@ -285,9 +285,11 @@ def _focus(result: LocateResult, candidates: list[dict[str, Any]]) -> tuple[np.n
     pts = []
     inter = result.intersection
     if inter is not None:
-        pts.append(frame.enu_from_geographic(inter.lon, inter.lat))
+        pts.append(frame.enu_from_geographic(lat=inter.lat, lon=inter.lon))
     for c in candidates[:8]:
-        pts.append(frame.enu_from_geographic(c["properties"]["lon"], c["properties"]["lat"]))
+        pts.append(
+            frame.enu_from_geographic(lat=c["properties"]["lat"], lon=c["properties"]["lon"])
+        )
     if not pts:
         return np.zeros(2), 150.0
     arr = np.asarray(pts, dtype=float)

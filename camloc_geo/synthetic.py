@@ -303,9 +303,9 @@ def make_located_scene(
     noise = noise or NoiseModel()
     frame = map_data.frame
     w, h = image_size
-    centre = np.array(frame.enu_from_geographic(intersection.lon, intersection.lat), float)
+    centre = np.array(frame.enu_from_geographic(lat=intersection.lat, lon=intersection.lon), float)
     map_corners = np.array(
-        [frame.enu_from_geographic(c.lon, c.lat) for c in intersection.corners], float
+        [frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in intersection.corners], float
     ).reshape(-1, 2)
     if len(map_corners) == 0:
         return None
@@ -575,7 +575,7 @@ def _landmark_points(
         if not b.name:
             continue
         lon, lat = b.centroid
-        c = np.array(map_data.frame.enu_from_geographic(lon, lat), float)
+        c = np.array(map_data.frame.enu_from_geographic(lat=lat, lon=lon), float)
         if np.linalg.norm(c - centre) > radius_m:
             continue
         try:

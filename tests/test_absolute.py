@@ -58,7 +58,10 @@ def exact_located(m: MapData, inter: Any, seed: int, **kw: Any) -> LocatedScene:
 
 
 def errors_m(result: LocateResult, ls: LocatedScene) -> list[float]:
-    return [float(distance_m(c.lon, c.lat, ls.lon, ls.lat)) for c in result.candidates]
+    return [
+        float(distance_m(lat1=c.lat, lon1=c.lon, lat2=ls.lat, lon2=ls.lon))
+        for c in result.candidates
+    ]
 
 
 def car_bearing_deg(ls: LocatedScene) -> float:
@@ -182,7 +185,7 @@ def test_three_references_one_wrong_flags_the_worst(maps: dict[str, MapData]) ->
     scene = dict(ls.scene)
     del scene["intersection"]
     refs = ground_refs(m, ls, [(300.0, 1000.0), (1600.0, 1000.0), (960.0, 800.0)])
-    e, n = m.frame.enu_from_geographic(refs[1]["lon"], refs[1]["lat"])
+    e, n = m.frame.enu_from_geographic(lat=refs[1]["lat"], lon=refs[1]["lon"])
     refs[1]["lon"], refs[1]["lat"] = (float(v) for v in m.frame.geographic_from_enu(e + 20.0, n))
     scene["references"] = refs
     result = locate(parse_scene(scene), m)
@@ -296,7 +299,8 @@ def test_geojson_contract(maps: dict[str, MapData]) -> None:
         ring = cone["geometry"]["coordinates"][0]
         assert len(ring) >= 4
         assert ring[0] == ring[-1]
-        assert distance_m(*ring[0], *cand["geometry"]["coordinates"]) < 0.01
+        (lon1, lat1), (lon2, lat2) = ring[0], cand["geometry"]["coordinates"]
+        assert distance_m(lat1=lat1, lon1=lon1, lat2=lat2, lon2=lon2) < 0.01
         assert cone["properties"]["rank"] == cand["properties"]["rank"]
     kinds = {f["properties"]["kind"] for f in doc["features"]}
     assert {"intersection", "corner"} <= kinds

@@ -60,7 +60,15 @@ def test_locate_geojson_on_stdout(
     assert cands
     assert doc["properties"]["n_candidates"] == len(cands)
     assert sum(f["properties"]["score"] for f in cands) == pytest.approx(1.0)
-    errs = [distance_m(*f["geometry"]["coordinates"], located.lon, located.lat) for f in cands]
+    errs = [
+        distance_m(
+            lat1=f["geometry"]["coordinates"][1],
+            lon1=f["geometry"]["coordinates"][0],
+            lat2=located.lat,
+            lon2=located.lon,
+        )
+        for f in cands
+    ]
     assert min(errs) < 0.1
     assert any(f["properties"]["kind"] == "view_cone" for f in doc["features"])
 

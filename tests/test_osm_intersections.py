@@ -32,8 +32,8 @@ def _angle_diff(a: float, b: float) -> float:
 
 def _perp_distance_m(x: Intersection, corner_lonlat: tuple[float, float], bearing: float) -> float:
     """Distance from a corner to the straight line through the centre with this bearing."""
-    frame = LocalFrame(x.lat, x.lon)
-    e, n = frame.enu_from_geographic(*corner_lonlat)
+    frame = LocalFrame(lat=x.lat, lon=x.lon)
+    e, n = frame.enu_from_geographic(lat=corner_lonlat[1], lon=corner_lonlat[0])
     t = math.radians(bearing)
     return abs(e * math.cos(t) - n * math.sin(t))
 
@@ -42,7 +42,9 @@ def _assert_clockwise(x: Intersection) -> None:
     bearings = [s.bearing_deg for s in x.streets]
     assert bearings == sorted(bearings)
     assert all(0.0 <= b < 360.0 for b in bearings)
-    corner_bearings = [bearing_deg(x.lon, x.lat, c.lon, c.lat) for c in x.corners]
+    corner_bearings = [
+        bearing_deg(lat1=x.lat, lon1=x.lon, lat2=c.lat, lon2=c.lon) for c in x.corners
+    ]
     assert corner_bearings == sorted(corner_bearings)
     assert [c.order for c in x.corners] == list(range(len(x.corners)))
     assert all(c.intersection_id == x.id for c in x.corners)
@@ -62,7 +64,7 @@ def _assert_kerbs_at_half_widths(x: Intersection) -> None:
         corner = min(
             (c for c in x.corners if c.streets == (a.name, b.name)),
             key=lambda c: _angle_diff(
-                bearing_deg(x.lon, x.lat, c.lon, c.lat), a.bearing_deg + gap / 2
+                bearing_deg(lat1=x.lat, lon1=x.lon, lat2=c.lat, lon2=c.lon), a.bearing_deg + gap / 2
             ),
         )
         assert _perp_distance_m(x, (corner.lon, corner.lat), a.bearing_deg) == pytest.approx(

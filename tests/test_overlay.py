@@ -182,7 +182,7 @@ def test_missing_snapshot_falls_back_to_blank(fremantle: object, tmp_path: Path)
 
 # ------------------------------------------------------------------------ features
 def test_features_kerbs_and_rooflines() -> None:
-    frame = LocalFrame(0.0, 0.0)
+    frame = LocalFrame(lat=0.0, lon=0.0)
 
     def lonlat(en: list[tuple[float, float]]) -> list[tuple[float, float]]:
         return [tuple(p) for p in frame.points_geographic_from_enu(np.asarray(en)).tolist()]

@@ -88,15 +88,15 @@ def frame_anchor(scene: Scene, map_data: MapData | None) -> LocalFrame:
     if map_data is not None:
         return map_data.frame
     if scene.prior is not None:
-        return LocalFrame(scene.prior.lat, scene.prior.lon)
+        return LocalFrame(lat=scene.prior.lat, lon=scene.prior.lon)
     if scene.references:
         return LocalFrame(
-            float(np.mean([r.lat for r in scene.references])),
-            float(np.mean([r.lon for r in scene.references])),
+            lat=float(np.mean([r.lat for r in scene.references])),
+            lon=float(np.mean([r.lon for r in scene.references])),
         )
     if scene.intersection is not None and scene.intersection.lat is not None:
         assert scene.intersection.lon is not None
-        return LocalFrame(scene.intersection.lat, scene.intersection.lon)
+        return LocalFrame(lat=scene.intersection.lat, lon=scene.intersection.lon)
     raise SceneError(
         "no geographic hint: give prior, references, intersection lat/lon, or a map", "prior"
     )
@@ -131,7 +131,9 @@ def _references(
         sigma = observe.settings.sigma_reference_m / math.sqrt(ref.weight)
         obs = observe(ref.pixel, "reference", f"references[{i}]", sigma)
         if obs is not None:
-            refs.append((obs, np.array(frame.enu_from_geographic(ref.lon, ref.lat), dtype=float)))
+            refs.append(
+                (obs, np.array(frame.enu_from_geographic(lat=ref.lat, lon=ref.lon), dtype=float))
+            )
     return refs
 
 
@@ -156,10 +158,10 @@ def choose_intersection(scene: Scene, map_data: MapData, frame: LocalFrame) -> I
     if hint.streets:
         return map_data.find_intersection(list(hint.streets), near=near)
     if hint.lat is not None and hint.lon is not None:
-        return map_data.nearest_intersection(hint.lat, hint.lon)
+        return map_data.nearest_intersection(lat=hint.lat, lon=hint.lon)
     if scene.prior is not None:
-        return map_data.nearest_intersection(scene.prior.lat, scene.prior.lon)
-    return map_data.nearest_intersection(frame.lat0, frame.lon0)
+        return map_data.nearest_intersection(lat=scene.prior.lat, lon=scene.prior.lon)
+    return map_data.nearest_intersection(lat=frame.lat0, lon=frame.lon0)
 
 
 @dataclass
@@ -193,7 +195,7 @@ def _corners(
         )
     if inter.corners:
         out.map_corners = np.array(
-            [frame.enu_from_geographic(c.lon, c.lat) for c in inter.corners], dtype=float
+            [frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in inter.corners], dtype=float
         )
         out.map_corner_ids = [f"{inter.id}:{c.order}" for c in inter.corners]
     out.bearings = [st.bearing_deg for st in inter.streets]
@@ -258,7 +260,7 @@ def _search_spots(
     """Where to look for street bearings, with the search radius around each spot."""
     spots = [(q, settings.street_search_m) for _, q in refs]
     if inter is not None:
-        en = np.array(frame.enu_from_geographic(inter.lon, inter.lat))
+        en = np.array(frame.enu_from_geographic(lat=inter.lat, lon=inter.lon))
         spots.append((en, settings.street_search_m))
     for _, pts in landmarks:
         # The streets along any side of the building, not only near its centre.
@@ -266,7 +268,7 @@ def _search_spots(
         reach = float(np.max(np.linalg.norm(pts - mid, axis=1)))
         spots.append((mid, settings.street_search_m + reach))
     if not spots and scene.prior is not None:
-        en = np.array(frame.enu_from_geographic(scene.prior.lon, scene.prior.lat))
+        en = np.array(frame.enu_from_geographic(lat=scene.prior.lat, lon=scene.prior.lon))
         spots.append((en, settings.street_search_m))
     return spots
 
@@ -290,7 +292,7 @@ def _map_street_bearings(
         for q, radius in spots:
             lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
             for _name, street_brg in map_data.street_bearings(
-                float(lat), float(lon), widen * radius
+                lat=float(lat), lon=float(lon), radius_m=widen * radius
             ):
                 bearings.append(street_brg)
         if bearings or not spots:
@@ -354,7 +356,7 @@ def _add_map_context(
         ev.buildings_enu, ev.buildings_tree = _buildings_index(map_data, frame)
     if scene.prior is not None:
         ev.prior_en = np.array(
-            frame.enu_from_geographic(scene.prior.lon, scene.prior.lat), dtype=float
+            frame.enu_from_geographic(lat=scene.prior.lat, lon=scene.prior.lon), dtype=float
         )
         ev.prior_radius_m = scene.prior.radius_m
     if map_data is not None and map_data.streets and scene.street_bearing_deg is None:

@@ -77,8 +77,8 @@ def run(args: argparse.Namespace) -> int:
         if pts:
             lat = sum(p[0] for p in pts) / len(pts)
             lon = sum(p[1] for p in pts) / len(pts)
-            frame = LocalFrame(lat, lon)
-            radius = max(math.hypot(*frame.enu_from_geographic(q[1], q[0])) for q in pts)
+            frame = LocalFrame(lat=lat, lon=lon)
+            radius = max(math.hypot(*frame.enu_from_geographic(lat=q[0], lon=q[1])) for q in pts)
             map_data = load_map(args.osm, lat, lon, radius_m=min(radius + 150.0, 2000.0))
     summary_map(
         items, args.output, offline=args.offline, cluster=not args.no_cluster, map_data=map_data

@@ -596,7 +596,15 @@ def build_intersections(
         for point, a, b in modelled:
             clon, clat = frame.geographic_from_enu(point[0], point[1])
             corner_rows.append(
-                (bearing_deg(float(lon), float(lat), float(clon), float(clat)), clat, clon, a, b)
+                (
+                    bearing_deg(
+                        lat1=float(lat), lon1=float(lon), lat2=float(clat), lon2=float(clon)
+                    ),
+                    clat,
+                    clon,
+                    a,
+                    b,
+                )
             )
         corner_rows.sort(key=lambda row: row[0])
         corners = tuple(

@@ -109,7 +109,7 @@ class MapData:
         *,
         tolerance_m: float = DEFAULT_TOLERANCE_M,
     ) -> None:
-        self.frame = LocalFrame(lat, lon)
+        self.frame = LocalFrame(lat=lat, lon=lon)
         self.radius_m = radius_m
         self.graph = raw.graph
         self.bounds = raw.bounds
@@ -154,8 +154,8 @@ class MapData:
 
     def _dist_from(self, near: tuple[float, float] | None, lat: float, lon: float) -> float:
         lat0, lon0 = near if near is not None else (self.frame.lat0, self.frame.lon0)
-        frame = LocalFrame(lat0, lon0)
-        e, n = frame.enu_from_geographic(lon, lat)
+        frame = LocalFrame(lat=lat0, lon=lon0)
+        e, n = frame.enu_from_geographic(lat=lat, lon=lon)
         return float(math.hypot(e, n))
 
     def nearest_intersection(self, lat: float, lon: float) -> Intersection:
@@ -259,7 +259,7 @@ class MapData:
                 LineString(self.frame.points_enu_from_geographic(np.asarray(s.geometry.coords)))
                 for s in self._streets
             ]
-        e, n = self.frame.enu_from_geographic(lon, lat)
+        e, n = self.frame.enu_from_geographic(lat=lat, lon=lon)
         pt = Point(float(e), float(n))
         rows: list[tuple[float, str, float]] = []
         for street, line in zip(self._streets, self._streets_enu, strict=True):

@@ -162,7 +162,7 @@ class Intersection:
             return []
         lons = np.array([c.lon for c in self.corners])
         lats = np.array([c.lat for c in self.corners])
-        dist = distance_m(lons, lats, np.roll(lons, -1), np.roll(lats, -1))
+        dist = distance_m(lat1=lats, lon1=lons, lat2=np.roll(lats, -1), lon2=np.roll(lons, -1))
         return [float(d) for d in np.atleast_1d(dist)]
 
     def corners_enu(self, frame: LocalFrame) -> FloatArray:
@@ -238,7 +238,7 @@ class Building:
         if len(coords) < 3:
             return coords
         centroid = self.footprint.centroid
-        frame = LocalFrame(centroid.y, centroid.x)
+        frame = LocalFrame(lat=centroid.y, lon=centroid.x)
         en = frame.points_enu_from_geographic(coords)
         keep = []
         n = len(coords)
@@ -271,8 +271,8 @@ class Building:
         out: list[tuple[float, float]] = []
         for i, (lon1, lat1) in enumerate(corners):
             lon2, lat2 = corners[(i + 1) % len(corners)]
-            frame = LocalFrame(lat1, lon1)
-            e, n = frame.enu_from_geographic(lon2, lat2)
+            frame = LocalFrame(lat=lat1, lon=lon1)
+            e, n = frame.enu_from_geographic(lat=lat2, lon=lon2)
             lon_m, lat_m = frame.geographic_from_enu(e / 2.0, n / 2.0)
             out.append((float(lon_m), float(lat_m)))
         return out
