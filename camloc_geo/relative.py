@@ -25,6 +25,7 @@ segment's endpoints by ``sigma_line_px`` (0.1 %), and a preset object's size is 
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from dataclasses import dataclass, field
@@ -846,7 +847,12 @@ def _check_segment_counts(
     return warnings
 
 
-_AUTO_CACHE: dict[str, Any] = {}
+@functools.lru_cache(maxsize=4)
+def _detect_vps(path: str, _mtime_ns: int, _size: int) -> Any:
+    """The image's detected vanishing points, cached per file version (thread-safe)."""
+    from camloc_geo import autovp
+
+    return autovp.detect_vanishing_points(path)
 
 
 def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
@@ -858,11 +864,8 @@ def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, Float
         from camloc_geo import autovp
     except ImportError:  # pragma: no cover - autovp ships with the package
         return {}
-    key = str(path)
-    if key not in _AUTO_CACHE:
-        _AUTO_CACHE.clear()
-        _AUTO_CACHE[key] = autovp.detect_vanishing_points(str(path))
-    res = _AUTO_CACHE[key]
+    stat = path.stat()
+    res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
     ann = scene.annotations[index]
     out = {}
     for axis in axes:

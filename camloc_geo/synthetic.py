@@ -517,17 +517,19 @@ def make_located_scene(
     return None
 
 
+def _projected(map_data: Any, name: str) -> tuple[Any, ...]:
+    """The map's streets or buildings in its local frame (``MapData.streets_enu`` ...)."""
+    return tuple(getattr(map_data, name, ()))
+
+
 def _street_lines_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[tuple[str, Any]]:
     """Street centre lines (ENU LineStrings) passing within ``radius_m`` of ``centre``."""
-    from shapely.geometry import LineString, Point
+    from shapely.geometry import Point
 
     around = Point(float(centre[0]), float(centre[1]))
     out = []
-    for st in getattr(map_data, "streets", []):
-        coords = np.asarray(st.geometry.coords, dtype=float)
-        if len(coords) < 2:
-            continue
-        line = LineString(map_data.frame.points_enu_from_geographic(coords))
+    streets = getattr(map_data, "streets", [])
+    for st, line in zip(streets, _projected(map_data, "streets_enu"), strict=True):
         if line.length > 1.0 and line.distance(around) < radius_m:
             out.append((st.name, line))
     return out
@@ -615,13 +617,11 @@ def _axes_degenerate(
 
 
 def _buildings_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[Any]:
-    from shapely.geometry import Point, Polygon
+    from shapely.geometry import Point
 
     out = []
     around = Point(float(centre[0]), float(centre[1])).buffer(radius_m)
-    for b in getattr(map_data, "buildings", []):
-        coords = np.asarray(b.footprint.exterior.coords, dtype=float)
-        poly = Polygon(map_data.frame.points_enu_from_geographic(coords))
+    for poly in _projected(map_data, "buildings_enu"):
         if poly.is_valid and poly.intersects(around):
             out.append(poly)
     return out

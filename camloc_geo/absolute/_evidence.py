@@ -14,6 +14,7 @@ from camloc_geo._errors import MapDataError, SceneError
 from camloc_geo.absolute._model import EvidenceKind, LocateResult, LocateSettings, Observation
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
+from camloc_geo.osm._local import LocalIndex
 from camloc_geo.scene import Scene
 
 if TYPE_CHECKING:
@@ -32,14 +33,22 @@ class Evidence:
     map_corner_ids: list[str]
     landmarks: list[tuple[Observation, FloatArray]]  # (obs, candidate map points (k, 2))
     street_bearings: list[float]
-    buildings_enu: list[Any]
-    prior_en: FloatArray | None
-    prior_radius_m: float | None
-    streets_enu: list[tuple[Any, float]] = field(default_factory=list)
-    buildings_tree: Any = None
-    street_tree: Any = None
+    prior_en: FloatArray | None = None
+    prior_radius_m: float | None = None
+    buildings: LocalIndex | None = None  # the map's footprints (ENU) and their STRtree
+    streets: LocalIndex | None = None  # the map's centre lines (ENU), half widths, STRtree
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
+
+    @property
+    def buildings_tree(self) -> Any:
+        """STRtree over the building footprints, None without any."""
+        return None if self.buildings is None else self.buildings.tree
+
+    @property
+    def street_tree(self) -> Any:
+        """STRtree over the street centre lines, None without any (or with a scene bearing)."""
+        return None if self.streets is None else self.streets.tree
 
     @property
     def observations(self) -> list[Observation]:
@@ -332,9 +341,6 @@ def gather_evidence(
         ce.map_corner_ids,
         landmarks,
         unique_bearings(bearings),
-        [],
-        None,
-        None,
     )
     _add_map_context(ev, scene, map_data, frame, settings)
     size = scene.object_size
@@ -353,63 +359,11 @@ def _add_map_context(
 ) -> None:
     """Buildings and streets (projected, indexed) and the prior, for the plausibility factors."""
     if map_data is not None and map_data.buildings:
-        ev.buildings_enu, ev.buildings_tree = _buildings_index(map_data, frame)
+        ev.buildings = map_data.building_index
     if scene.prior is not None:
         ev.prior_en = np.array(
             frame.enu_from_geographic(lat=scene.prior.lat, lon=scene.prior.lon), dtype=float
         )
         ev.prior_radius_m = scene.prior.radius_m
     if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
-        ev.streets_enu, ev.street_tree = _streets_index(map_data, frame)
-
-
-_STREETS_CACHE: dict[tuple[int, float, float], tuple[list[tuple[Any, float]], Any]] = {}
-
-
-def _streets_index(map_data: MapData, frame: LocalFrame) -> tuple[list[tuple[Any, float]], Any]:
-    """Street centre lines in the local frame with half carriageway widths, and an STRtree."""
-    key = (id(map_data), frame.lat0, frame.lon0)
-    hit = _STREETS_CACHE.get(key)
-    if hit is not None and hit[0] and len(hit[0]) == len(map_data.streets):
-        return hit
-    from shapely import STRtree
-    from shapely.geometry import LineString
-
-    rows = []
-    for st in map_data.streets:
-        coords = np.asarray(st.geometry.coords, dtype=float)
-        if len(coords) < 2:
-            continue
-        line = LineString(frame.points_enu_from_geographic(coords))
-        if line.length > 0.5:
-            rows.append((line, float(st.width_m) / 2.0))
-    tree = STRtree([r[0] for r in rows]) if rows else None
-    if len(_STREETS_CACHE) > 16:
-        _STREETS_CACHE.clear()
-    _STREETS_CACHE[key] = (rows, tree)
-    return rows, tree
-
-
-_BUILDINGS_CACHE: dict[tuple[int, float, float], tuple[list[Any], Any]] = {}
-
-
-def _buildings_index(map_data: MapData, frame: LocalFrame) -> tuple[list[Any], Any]:
-    """Building footprints in the local frame and an STRtree over them (cached per map)."""
-    key = (id(map_data), frame.lat0, frame.lon0)
-    hit = _BUILDINGS_CACHE.get(key)
-    if hit is not None and len(hit[0]) <= len(map_data.buildings):
-        return hit
-    from shapely import STRtree
-    from shapely.geometry import Polygon
-
-    polys = []
-    for b in map_data.buildings:
-        coords = np.asarray(b.footprint.exterior.coords, dtype=float)
-        poly = Polygon(frame.points_enu_from_geographic(coords))
-        if poly.is_valid and poly.area > 1.0:
-            polys.append(poly)
-    tree = STRtree(polys) if polys else None
-    if len(_BUILDINGS_CACHE) > 16:
-        _BUILDINGS_CACHE.clear()
-    _BUILDINGS_CACHE[key] = (polys, tree)
-    return polys, tree
+        ev.streets = map_data.street_index

@@ -199,8 +199,9 @@ def street_angle_under_car(enu_from_world: Similarity2D, ev: Evidence) -> float 
     pt = Point(x, y)
     best: float | None = None
     # A box, not a buffered disc: the tree only tests envelopes, and buffering is costly.
+    assert ev.streets is not None
     for idx in ev.street_tree.query(box(x - 25.0, y - 25.0, x + 25.0, y + 25.0)):
-        line, half_w = ev.streets_enu[int(idx)]
+        line, half_w = ev.streets.geometries[int(idx)], ev.streets.values[int(idx)]
         if line.distance(pt) > half_w + 2.5:
             continue
         sproj = line.project(pt)
@@ -221,8 +222,10 @@ def _building_factor(
 
     factor = 1.0
     flags: list[Flag] = []
+    assert ev.buildings is not None
+    polys = ev.buildings.geometries
     pt = Point(float(C[0]), float(C[1]))
-    around = [ev.buildings_enu[int(i)] for i in ev.buildings_tree.query(pt)]
+    around = [polys[int(i)] for i in ev.buildings_tree.query(pt)]
     home = [poly for poly in around if poly.contains(pt)]
     if any(poly.exterior.distance(pt) > 2.0 for poly in home):
         factor *= settings.inside_building_factor
@@ -232,7 +235,7 @@ def _building_factor(
             continue
         line = LineString([(C[0], C[1]), tuple(m.map_en.tolist())])
         for i in ev.buildings_tree.query(line):
-            poly = ev.buildings_enu[int(i)]
+            poly = polys[int(i)]
             if poly in home:
                 continue
             if line.crosses(poly) and line.intersection(poly).length > 1.0:
@@ -276,7 +279,7 @@ def plausibility(
     factor = 1.0
     flags: list[Flag] = []
     C = cam.center_in_world
-    if ev.buildings_enu and ev.buildings_tree is not None:
+    if ev.buildings_tree is not None:
         f, fl = _building_factor(C, ev, settings, matches)
         factor *= f
         flags += fl

@@ -5,9 +5,10 @@ from __future__ import annotations
 import logging
 import math
 import os
-from collections.abc import Sequence
+import threading
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import networkx as nx
 import numpy as np
@@ -25,6 +26,13 @@ from camloc_geo.osm._load import (
     read_extract,
     read_overpass,
 )
+from camloc_geo.osm._local import (
+    LocalIndex,
+    building_index,
+    project_buildings,
+    project_streets,
+    street_index,
+)
 from camloc_geo.osm._model import Building, Intersection, Street
 from camloc_geo.osm._names import close_matches, normalize_name, split_street_query
 from camloc_geo.osm._widths import in_north_america, parse_lanes, resolve_width_m
@@ -32,6 +40,8 @@ from camloc_geo.osm._widths import in_north_america, parse_lanes, resolve_width_
 __all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
 
 log = logging.getLogger(__name__)
+
+_T = TypeVar("_T")
 
 DEFAULT_TOLERANCE_M = 12.0
 """Default node buffer for intersection consolidation, metres (nodes < 24 m apart merge)."""
@@ -126,7 +136,55 @@ class MapData:
         )
         self._streets = tuple(_streets_of(raw.graph, north_america))
         self._buildings = tuple(raw.buildings)
-        self._streets_enu: list[LineString] | None = None
+        self._cache: dict[str, Any] = {}
+        self._cache_lock = threading.RLock()
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        del state["_cache_lock"]
+        state["_cache"] = {}
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._cache_lock = threading.RLock()
+
+    # -- derived data, computed once per map (thread-safe) -----------------------------
+
+    def cached(self, key: str, build: Callable[[], _T]) -> _T:
+        """``build()`` computed once per map and key, under the map's lock.
+
+        For data derived from the map (projections, indexes, name tables) that every
+        caller shares; thread-safe, and it lives as long as the map.
+        """
+        try:
+            return self._cache[key]
+        except KeyError:
+            pass
+        with self._cache_lock:
+            if key not in self._cache:
+                self._cache[key] = build()
+            return self._cache[key]
+
+    @property
+    def streets_enu(self) -> tuple[LineString, ...]:
+        """Street centre lines in :attr:`frame` (ENU LineStrings), aligned with :attr:`streets`."""
+        return self.cached("streets_enu", lambda: project_streets(self._streets, self.frame))
+
+    @property
+    def buildings_enu(self) -> tuple[Any, ...]:
+        """Building footprints in :attr:`frame` (ENU Polygons), aligned with :attr:`buildings`."""
+        return self.cached("buildings_enu", lambda: project_buildings(self._buildings, self.frame))
+
+    @property
+    def street_index(self) -> LocalIndex:
+        """Street centre lines (ENU) with half carriageway widths, and their STRtree."""
+        return self.cached("street_index", lambda: street_index(self._streets, self.streets_enu))
+
+    @property
+    def building_index(self) -> LocalIndex:
+        """Valid building footprints larger than 1 m² (ENU), and their STRtree."""
+        return self.cached("building_index", lambda: building_index(self.buildings_enu))
 
     def __repr__(self) -> str:
         return (
@@ -254,15 +312,10 @@ class MapData:
         ±10 m around its point nearest to the query point. A street is listed once per
         distinct direction (5° apart).
         """
-        if self._streets_enu is None:
-            self._streets_enu = [
-                LineString(self.frame.points_enu_from_geographic(np.asarray(s.geometry.coords)))
-                for s in self._streets
-            ]
         e, n = self.frame.enu_from_geographic(lat=lat, lon=lon)
         pt = Point(float(e), float(n))
         rows: list[tuple[float, str, float]] = []
-        for street, line in zip(self._streets, self._streets_enu, strict=True):
+        for street, line in zip(self._streets, self.streets_enu, strict=True):
             dist = line.distance(pt)
             if dist > radius_m or line.length < 0.5:
                 continue
