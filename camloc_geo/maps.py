@@ -42,6 +42,7 @@ from jinja2 import Template
 from shapely.geometry import LineString, Point, Polygon
 
 from camloc_geo import overlay as _overlay
+from camloc_geo.results import ATTRIBUTION
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult
@@ -75,7 +76,7 @@ SCORE_SCALE: tuple[tuple[float, str, str], ...] = (
 )
 """Score bins (lower bound, fill colour, legend text), best first (ColorBrewer YlOrRd)."""
 
-OSM_ATTRIBUTION = "Map data © OpenStreetMap contributors, ODbL"
+OSM_ATTRIBUTION = ATTRIBUTION
 _OSM_TILES_ATTR = (
     '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors'
 )

@@ -190,41 +190,13 @@ class CalibrationResult:
         return [n for n, c in zip(names, self.annotator_corners, strict=False) if c != "origin"]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON that ``camloc calibrate`` prints."""
-        cam = self.camera
-        _heading, pitch, roll = cam.angles_deg
-        out: dict[str, Any] = {
-            "focal_px": cam.focal_px,
-            "principal_point": list(cam.principal_point),
-            "height_m": cam.height_m,
-            "camera_in_world": cam.center_in_world.tolist(),
-            "pitch_deg": pitch,
-            "roll_deg": roll,
-            "cam_from_world": cam.cam_from_world.tolist(),
-            "rotation": cam.cam_from_world_rotation.tolist(),
-            "method": self.method,
-            "intrinsics_method": self.intrinsics_method,
-            "fallback": self.intrinsics_method,
-            "intrinsics_reason": self.intrinsics_reason,
-            "distance_to_origin_m": float(np.linalg.norm(cam.center_in_world)),
-        }
-        if self.position_sigma_m is not None:
-            out["camera_in_world_sigma_m"] = self.position_sigma_m.tolist()
-            out["height_sigma_m"] = float(self.position_sigma_m[2])
-        if self.focal_sigma_px is not None:
-            out["focal_sigma_px"] = self.focal_sigma_px
-        if self.rms_residual_px is not None:
-            out["rms_residual_px"] = self.rms_residual_px
-        out["width_sign"] = self.width_sign
-        out["annotator_weights"] = self.annotator_weights
-        if self.annotator_corners:
-            out["annotator_corners"] = self.annotator_corners
-            out["corner_mistakes"] = self.corner_mistakes
-        out["outlier_annotators"] = self.outlier_annotators
-        out["cluster"] = self.cluster
-        out["annotators"] = [a.to_dict() for a in self.annotators]
-        if self.warnings:
-            out["warnings"] = self.warnings
+        """The JSON that ``camloc calibrate`` prints.
+
+        Built from :class:`camloc_geo.results.CalibrationOutput`.
+        """
+        from camloc_geo.results import calibration_output, to_json
+
+        out: dict[str, Any] = to_json(calibration_output(self))
         return out
 
 

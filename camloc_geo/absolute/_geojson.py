@@ -11,6 +11,20 @@ import numpy.typing as npt
 from camloc_geo.absolute._model import Candidate, LocateResult, Match
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame, normalize_bearing_deg
+from camloc_geo.results import (
+    CalibrationSummary,
+    CandidateCollection,
+    CandidateCollectionProperties,
+    CandidateProperties,
+    Feature,
+    MatchedPointProperties,
+    MatchProperties,
+    PolygonGeometry,
+    ViewConeProperties,
+    intersection_features,
+    point,
+    to_json,
+)
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -46,131 +60,117 @@ def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
     return np.asarray(pts, dtype=np.float64)
 
 
-def _feature(geometry: dict[str, Any], properties: dict[str, Any]) -> dict[str, Any]:
-    return {"type": "Feature", "geometry": geometry, "properties": properties}
-
-
-def _point(lon: float, lat: float) -> dict[str, Any]:
-    return {"type": "Point", "coordinates": [lon, lat]}
-
-
-def _match_properties(m: Match, frame: LocalFrame) -> dict[str, Any]:
-    d = m.as_dict()
-    del d["map_en"]
-    d["map_lonlat"] = list(frame.geographic_from_enu(*m.map_en.tolist()))
-    return d
-
-
-def _candidate_feature(c: Candidate, result: LocateResult) -> dict[str, Any]:
-    heading, pitch_c, roll_c = c.camera.angles_deg
-    props = {
-        "kind": "candidate",
-        "rank": c.rank,
-        "score": c.score,
-        "lat": c.lat,
-        "lon": c.lon,
-        "height_m": c.camera.height_m,
-        "heading_deg": float(normalize_bearing_deg(heading)),
-        "pitch_deg": pitch_c,
-        "roll_deg": roll_c,
-        "focal_px": c.camera.focal_px,
-        "method": c.method,
-        "residual_m": None if math.isnan(c.residual_m) else c.residual_m,
-        "sigma_m": c.sigma_m,
-        "scale": c.scale,
-        "refined": c.refined,
-        "merged": c.merged,
-        "flags": [str(f) for f in c.flags],
-        "scene": result.scene_id,
-        "matches": [_match_properties(m, result.frame) for m in c.matches],
-    }
-    return _feature(_point(c.lon, c.lat), props)
-
-
-def _view_cone_feature(c: Candidate, result: LocateResult, range_m: float) -> dict[str, Any]:
-    poly = view_cone(c.camera, result.image_size, range_m)
-    ll = result.frame.points_geographic_from_enu(poly)
-    return _feature(
-        {"type": "Polygon", "coordinates": [ll.tolist()]},
-        {"kind": "view_cone", "rank": c.rank, "score": c.score},
+def _match_properties(m: Match, frame: LocalFrame) -> MatchProperties:
+    lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
+    return MatchProperties(
+        kind=m.kind,
+        label=m.label,
+        pixel=list(m.pixel),
+        map_corner=m.map_corner,
+        order=m.order,
+        misfit_m=m.misfit_m,
+        mahalanobis2=m.mahalanobis2,
+        map_lonlat=[lon, lat],
     )
 
 
-def _matched_point_feature(c: Candidate, m: Match, frame: LocalFrame) -> dict[str, Any]:
+def _candidate_feature(c: Candidate, result: LocateResult) -> Feature:
+    heading, pitch_c, roll_c = c.camera.angles_deg
+    props = CandidateProperties(
+        rank=c.rank,
+        score=c.score,
+        lat=c.lat,
+        lon=c.lon,
+        height_m=c.camera.height_m,
+        heading_deg=float(normalize_bearing_deg(heading)),
+        pitch_deg=pitch_c,
+        roll_deg=roll_c,
+        focal_px=c.camera.focal_px,
+        method=c.method,
+        residual_m=None if math.isnan(c.residual_m) else c.residual_m,
+        sigma_m=c.sigma_m,
+        scale=c.scale,
+        refined=c.refined,
+        merged=c.merged,
+        flags=[str(f) for f in c.flags],
+        scene=result.scene_id,
+        matches=[_match_properties(m, result.frame) for m in c.matches],
+        ambiguous_with=list(c.ambiguous_with),
+    )
+    return Feature(geometry=point(c.lon, c.lat), properties=props)
+
+
+def _view_cone_feature(c: Candidate, result: LocateResult, range_m: float) -> Feature:
+    poly = view_cone(c.camera, result.image_size, range_m)
+    ll = result.frame.points_geographic_from_enu(poly)
+    return Feature(
+        geometry=PolygonGeometry(coordinates=[ll.tolist()]),
+        properties=ViewConeProperties(rank=c.rank, score=c.score),
+    )
+
+
+def _matched_point_feature(c: Candidate, m: Match, frame: LocalFrame) -> Feature:
     lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
-    props = {
-        "kind": "matched_point",
-        "rank": c.rank,
-        "label": m.label,
-        "match_kind": m.kind,
-        "pixel": list(m.pixel),
-        "misfit_m": m.misfit_m,
-        **({"map_corner": m.map_corner} if m.map_corner is not None else {}),
-    }
-    return _feature(_point(float(lon), float(lat)), props)
+    props = MatchedPointProperties(
+        rank=c.rank,
+        label=m.label,
+        match_kind=m.kind,
+        pixel=list(m.pixel),
+        misfit_m=m.misfit_m,
+        map_corner=m.map_corner,
+    )
+    return Feature(geometry=point(float(lon), float(lat)), properties=props)
 
 
-def _intersection_features(result: LocateResult) -> list[dict[str, Any]]:
-    inter = result.intersection
-    if inter is None:
-        return []
-    props = {
-        "kind": "intersection",
-        "id": inter.id,
-        "streets": [s.name for s in inter.streets],
-        "intersection_kind": inter.kind,
-    }
-    feats = [_feature(_point(inter.lon, inter.lat), props)]
-    for corner in inter.corners:
-        corner_props = {
-            "kind": "corner",
-            "intersection": inter.id,
-            "order": corner.order,
-            "streets": list(corner.streets),
-        }
-        feats.append(_feature(_point(corner.lon, corner.lat), corner_props))
-    return feats
-
-
-def _collection_properties(result: LocateResult) -> dict[str, Any]:
+def _collection_properties(result: LocateResult) -> CandidateCollectionProperties:
     cal = result.calibration
     _h, pitch, roll = cal.camera.angles_deg
-    return {
-        "scene": result.scene_id,
-        "methods_tried": result.methods_tried,
-        "n_candidates": len(result.candidates),
-        "reason": result.reason,
-        "warnings": result.warnings + cal.warnings,
-        "calibration": {
-            "focal_px": cal.camera.focal_px,
-            "height_m": cal.camera.height_m,
-            "pitch_deg": pitch,
-            "roll_deg": roll,
-            "method": cal.method,
-            "intrinsics_method": cal.intrinsics_method,
-            "outlier_annotators": cal.outlier_annotators,
-        },
-        "attribution": "Map data © OpenStreetMap contributors, ODbL",
-    }
+    return CandidateCollectionProperties(
+        scene=result.scene_id,
+        methods_tried=result.methods_tried,
+        n_candidates=len(result.candidates),
+        reason=result.reason,
+        warnings=result.warnings + cal.warnings,
+        calibration=CalibrationSummary(
+            focal_px=cal.camera.focal_px,
+            height_m=cal.camera.height_m,
+            pitch_deg=pitch,
+            roll_deg=roll,
+            method=cal.method,
+            intrinsics_method=cal.intrinsics_method,
+            outlier_annotators=cal.outlier_annotators,
+        ),
+    )
 
 
-def candidates_geojson(result: LocateResult, *, view_cones: bool = True) -> dict[str, Any]:
-    """The candidate GeoJSON FeatureCollection of the scene contract.
+def candidates_collection(
+    result: LocateResult, *, view_cones: bool = True, view_cone_range_m: float | None = None
+) -> CandidateCollection:
+    """The typed candidate FeatureCollection (:class:`camloc_geo.results.CandidateCollection`)."""
+    cands = result.candidates
+    range_m = result.view_cone_range_m if view_cone_range_m is None else view_cone_range_m
+    feats = [_candidate_feature(c, result) for c in cands]
+    if view_cones:
+        feats += [_view_cone_feature(c, result, range_m) for c in cands]
+    feats += [_matched_point_feature(c, m, result.frame) for c in cands for m in c.matches]
+    if result.intersection is not None:
+        feats += intersection_features(result.intersection, detailed=False)
+    return CandidateCollection(features=feats, properties=_collection_properties(result))
+
+
+def candidates_geojson(
+    result: LocateResult, *, view_cones: bool = True, view_cone_range_m: float | None = None
+) -> dict[str, Any]:
+    """The candidate GeoJSON FeatureCollection of the scene contract (``docs/candidates.md``).
 
     Candidate Point features (``kind: "candidate"``, best first) carry every property of
     the contract plus ``sigma_m`` (1-sigma position uncertainty), ``scale``, ``flags``,
-    ``matches`` and ``merged``. Extra features: ``view_cone`` polygons (one per candidate),
-    ``matched_point`` points (the map points each candidate matched), and the
-    ``intersection`` used, with its ``corner`` points.
+    ``matches``, ``merged`` and ``ambiguous_with``. Extra features: ``view_cone`` polygons
+    (one per candidate, reaching ``view_cone_range_m``, default the result's
+    :attr:`LocateSettings.view_cone_range_m`), ``matched_point`` points (the map points each
+    candidate matched), and the ``intersection`` used, with its ``corner`` points.
     """
-    cands = result.candidates
-    feats = [_candidate_feature(c, result) for c in cands]
-    if view_cones:
-        feats += [_view_cone_feature(c, result, 60.0) for c in cands]
-    feats += [_matched_point_feature(c, m, result.frame) for c in cands for m in c.matches]
-    feats += _intersection_features(result)
-    return {
-        "type": "FeatureCollection",
-        "features": feats,
-        "properties": _collection_properties(result),
-    }
+    doc: dict[str, Any] = to_json(
+        candidates_collection(result, view_cones=view_cones, view_cone_range_m=view_cone_range_m)
+    )
+    return doc

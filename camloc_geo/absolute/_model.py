@@ -289,3 +289,4 @@ class LocateResult:
     warnings: list[str] = field(default_factory=list)
     scene_id: str = "scene"
     image_size: tuple[int, int] = (0, 0)
+    view_cone_range_m: float = 60.0  # LocateSettings.view_cone_range_m of the run

@@ -5,6 +5,7 @@ evidence → hypotheses → scores → prior gate → refinement → ranking.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import replace
 from typing import TYPE_CHECKING
@@ -65,7 +66,15 @@ def locate(
     cal = calibration or calibrate(scene, calibration_settings)
     frame = frame_anchor(scene, map_data)
     width, height = scene.image_size
-    result = LocateResult([], frame, cal, [], scene_id=scene.id, image_size=(width, height))
+    result = LocateResult(
+        [],
+        frame,
+        cal,
+        [],
+        scene_id=scene.id,
+        image_size=(width, height),
+        view_cone_range_m=settings.view_cone_range_m,
+    )
     world_cam = cal.camera
     ev = gather_evidence(scene, map_data, world_cam, settings, result)
     try:
@@ -206,8 +215,25 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
     return cands
 
 
+def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
+    lo, hi = sorted((a.score, b.score))
+    gap = float(np.linalg.norm(a.east_north - b.east_north))
+    return lo >= 0.8 * hi and gap > 2.0 * settings.merge_distance_m
+
+
 def _mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
-    """Warn when the two leaders fit equally well yet stand apart."""
+    """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
+
+    Two candidates tie when the weaker scores at least 0.8 of the stronger yet they stand
+    more than ``2 * merge_distance_m`` apart (a symmetric junction: the evidence cannot tell
+    them apart).
+    """
+    for a, b in itertools.combinations(cands, 2):
+        if _tie(a, b, settings):
+            a.ambiguous_with.append(b.rank)
+            b.ambiguous_with.append(a.rank)
+    for c in cands:
+        c.ambiguous_with.sort()
     if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
         gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
         if gap > 2.0 * settings.merge_distance_m:

@@ -1,0 +1,440 @@
+"""Typed outputs of every command and front end, one serialiser, and their JSON Schemas.
+
+Three documents leave the library:
+
+``candidates``
+    The candidate GeoJSON of :func:`camloc_geo.api.locate_scene` (``camloc locate``): a
+    FeatureCollection in EPSG:4326 (``[lon, lat]``) of ``candidate`` points (best first),
+    ``view_cone`` polygons, ``matched_point`` points, and the ``intersection`` used with its
+    ``corner`` points. See ``docs/candidates.md``.
+``calibration``
+    The relative pose of :func:`camloc_geo.api.calibrate_scene` (``camloc calibrate``).
+``corners``
+    Intersections and their kerb corners (``camloc corners``), a FeatureCollection.
+
+Each is a tree of the dataclasses below; :func:`to_json` turns any of them into plain JSON
+(optional fields are left out when ``None``), and :func:`output_json_schema` gives
+the JSON Schema (draft 2020-12, through pydantic) of each.
+
+Intersection features carry the intersection's kind under two names with the same value:
+``kind_detail`` (the name ``camloc corners`` has always used) and ``intersection_kind`` (the
+name ``camloc locate`` has always used). New code should read ``kind_detail``.
+
+This module imports only the standard library (pydantic on :func:`output_json_schema`), so
+front ends may import it at start-up.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Literal
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import Intersection
+    from camloc_geo.relative import CalibrationResult
+
+__all__ = [
+    "ATTRIBUTION",
+    "CalibrationOutput",
+    "CalibrationSummary",
+    "CandidateCollection",
+    "CandidateCollectionProperties",
+    "CandidateProperties",
+    "CornerProperties",
+    "CornersCollection",
+    "Feature",
+    "IncidentStreetProperties",
+    "IntersectionProperties",
+    "MatchProperties",
+    "MatchedPointProperties",
+    "OutputKind",
+    "PointGeometry",
+    "PolygonGeometry",
+    "ViewConeProperties",
+    "calibration_output",
+    "corners_collection",
+    "intersection_features",
+    "output_json_schema",
+    "point",
+    "to_json",
+]
+
+ATTRIBUTION = "Map data © OpenStreetMap contributors, ODbL 1.0"
+"""The one attribution string of every output built from OpenStreetMap data."""
+
+OutputKind = Literal["candidates", "calibration", "corners"]
+
+
+_OMIT_NONE = {"omit_none": True}  # field metadata: left out of the JSON when None
+
+
+# ------------------------------------------------------------------------- geometries
+@dataclass(kw_only=True)
+class PointGeometry:
+    """A GeoJSON Point, ``[lon, lat]`` degrees WGS 84."""
+
+    type: Literal["Point"] = "Point"
+    coordinates: list[float]
+
+
+@dataclass(kw_only=True)
+class PolygonGeometry:
+    """A GeoJSON Polygon: one closed ring of ``[lon, lat]``."""
+
+    type: Literal["Polygon"] = "Polygon"
+    coordinates: list[list[list[float]]]
+
+
+def point(lon: float, lat: float) -> PointGeometry:
+    """A Point at ``lon``, ``lat`` (degrees)."""
+    return PointGeometry(coordinates=[lon, lat])
+
+
+# ------------------------------------------------------------------ candidate features
+@dataclass(kw_only=True)
+class MatchProperties:
+    """One annotated ground pixel matched to a map point by a candidate."""
+
+    kind: Literal["reference", "corner", "landmark"]
+    label: str
+    pixel: list[float]
+    map_corner: str | None = field(default=None, metadata=_OMIT_NONE)
+    order: int | None = field(default=None, metadata=_OMIT_NONE)
+    misfit_m: float
+    mahalanobis2: float
+    map_lonlat: list[float]
+
+
+@dataclass(kw_only=True)
+class CandidateProperties:
+    """A candidate camera position (``kind: "candidate"``); see ``docs/candidates.md``."""
+
+    kind: Literal["candidate"] = "candidate"
+    rank: int
+    score: float
+    lat: float
+    lon: float
+    height_m: float
+    heading_deg: float
+    pitch_deg: float
+    roll_deg: float
+    focal_px: float
+    method: str
+    residual_m: float | None
+    sigma_m: float | None
+    scale: float
+    refined: bool
+    merged: int
+    flags: list[str]
+    scene: str
+    matches: list[MatchProperties]
+    ambiguous_with: list[int] = field(default_factory=list)
+
+
+@dataclass(kw_only=True)
+class ViewConeProperties:
+    """The ground footprint of a candidate's view (``kind: "view_cone"``)."""
+
+    kind: Literal["view_cone"] = "view_cone"
+    rank: int
+    score: float
+
+
+@dataclass(kw_only=True)
+class MatchedPointProperties:
+    """A map point a candidate matched (``kind: "matched_point"``)."""
+
+    kind: Literal["matched_point"] = "matched_point"
+    rank: int
+    label: str
+    match_kind: Literal["reference", "corner", "landmark"]
+    pixel: list[float]
+    misfit_m: float
+    map_corner: str | None = field(default=None, metadata=_OMIT_NONE)
+
+
+@dataclass(kw_only=True)
+class IncidentStreetProperties:
+    """A street meeting at an intersection (``camloc corners``)."""
+
+    name: str
+    bearing_deg: float
+    back_bearing_deg: float
+    highway: str
+    oneway: bool
+    lanes: float | None
+    width_m: float
+    width_source: str
+    carriageways: int
+
+
+@dataclass(kw_only=True)
+class IntersectionProperties:
+    """An intersection (``kind: "intersection"``).
+
+    ``kind_detail`` and ``intersection_kind`` hold the same value (``junction``,
+    ``roundabout``, ``unmodelled``...): both names are kept for older readers.
+    """
+
+    kind: Literal["intersection"] = "intersection"
+    id: str
+    streets: list[str]
+    kind_detail: str
+    intersection_kind: str
+    warnings: list[str] | None = field(default=None, metadata=_OMIT_NONE)
+    incident_streets: list[IncidentStreetProperties] | None = field(
+        default=None, metadata=_OMIT_NONE
+    )
+    corner_distances_m: list[float] | None = field(default=None, metadata=_OMIT_NONE)
+    osm_nodes: list[int] | None = field(default=None, metadata=_OMIT_NONE)
+
+
+@dataclass(kw_only=True)
+class CornerProperties:
+    """A modelled kerb corner of an intersection (``kind: "corner"``)."""
+
+    kind: Literal["corner"] = "corner"
+    intersection: str
+    order: int
+    streets: list[str]
+
+
+Properties = (
+    CandidateProperties
+    | ViewConeProperties
+    | MatchedPointProperties
+    | IntersectionProperties
+    | CornerProperties
+)
+
+
+@dataclass(kw_only=True)
+class Feature:
+    """A GeoJSON Feature."""
+
+    type: Literal["Feature"] = "Feature"
+    geometry: PointGeometry | PolygonGeometry
+    properties: Properties
+
+
+@dataclass(kw_only=True)
+class CalibrationSummary:
+    """The relative pose a candidate list was computed from."""
+
+    focal_px: float
+    height_m: float
+    pitch_deg: float
+    roll_deg: float
+    method: str
+    intrinsics_method: str
+    outlier_annotators: list[str]
+
+
+@dataclass(kw_only=True)
+class CandidateCollectionProperties:
+    """What the candidate list as a whole says."""
+
+    scene: str
+    methods_tried: list[str]
+    n_candidates: int
+    reason: str | None
+    warnings: list[str]
+    calibration: CalibrationSummary
+    attribution: str = ATTRIBUTION
+
+
+@dataclass(kw_only=True)
+class CandidateCollection:
+    """The candidate GeoJSON (``camloc locate``), EPSG:4326."""
+
+    type: Literal["FeatureCollection"] = "FeatureCollection"
+    features: list[Feature]
+    properties: CandidateCollectionProperties
+
+
+@dataclass(kw_only=True)
+class CornersCollection:
+    """Intersections and their corners (``camloc corners``), EPSG:4326."""
+
+    type: Literal["FeatureCollection"] = "FeatureCollection"
+    features: list[Feature]
+    attribution: str = ATTRIBUTION
+
+
+# ------------------------------------------------------------------------- calibration
+@dataclass(kw_only=True)
+class CalibrationOutput:
+    """The relative pose (``camloc calibrate``): camera in the scene's world frame.
+
+    ``fallback`` repeats ``intrinsics_method`` for older readers. ``annotators`` holds one
+    free-form record per annotator (closed-form solution, vanishing points).
+    """
+
+    focal_px: float
+    principal_point: list[float]
+    height_m: float
+    camera_in_world: list[float]
+    pitch_deg: float
+    roll_deg: float
+    cam_from_world: list[list[float]]
+    rotation: list[list[float]]
+    method: str
+    intrinsics_method: str
+    fallback: str
+    intrinsics_reason: str
+    distance_to_origin_m: float
+    camera_in_world_sigma_m: list[float] | None = field(default=None, metadata=_OMIT_NONE)
+    height_sigma_m: float | None = field(default=None, metadata=_OMIT_NONE)
+    focal_sigma_px: float | None = field(default=None, metadata=_OMIT_NONE)
+    rms_residual_px: float | None = field(default=None, metadata=_OMIT_NONE)
+    width_sign: float = 1.0
+    annotator_weights: list[float] = field(default_factory=list)
+    annotator_corners: list[str] | None = field(default=None, metadata=_OMIT_NONE)
+    corner_mistakes: list[str] | None = field(default=None, metadata=_OMIT_NONE)
+    outlier_annotators: list[str] = field(default_factory=list)
+    cluster: dict[str, Any] = field(default_factory=dict)
+    annotators: list[dict[str, Any]] = field(default_factory=list)
+    warnings: list[str] | None = field(default=None, metadata=_OMIT_NONE)
+
+
+def calibration_output(cal: CalibrationResult) -> CalibrationOutput:
+    """The typed output of a calibration."""
+    import numpy as np
+
+    cam = cal.camera
+    _heading, pitch, roll = cam.angles_deg
+    sigma = cal.position_sigma_m
+    return CalibrationOutput(
+        focal_px=cam.focal_px,
+        principal_point=list(cam.principal_point),
+        height_m=cam.height_m,
+        camera_in_world=cam.center_in_world.tolist(),
+        pitch_deg=pitch,
+        roll_deg=roll,
+        cam_from_world=cam.cam_from_world.tolist(),
+        rotation=cam.cam_from_world_rotation.tolist(),
+        method=cal.method,
+        intrinsics_method=cal.intrinsics_method,
+        fallback=cal.intrinsics_method,
+        intrinsics_reason=cal.intrinsics_reason,
+        distance_to_origin_m=float(np.linalg.norm(cam.center_in_world)),
+        camera_in_world_sigma_m=None if sigma is None else sigma.tolist(),
+        height_sigma_m=None if sigma is None else float(sigma[2]),
+        focal_sigma_px=cal.focal_sigma_px,
+        rms_residual_px=cal.rms_residual_px,
+        width_sign=cal.width_sign,
+        annotator_weights=cal.annotator_weights,
+        annotator_corners=cal.annotator_corners or None,
+        corner_mistakes=cal.corner_mistakes if cal.annotator_corners else None,
+        outlier_annotators=cal.outlier_annotators,
+        cluster=cal.cluster,
+        annotators=[a.to_dict() for a in cal.annotators],
+        warnings=cal.warnings or None,
+    )
+
+
+# --------------------------------------------------------------------------- corners
+def _intersection_properties(inter: Intersection, *, detailed: bool) -> IntersectionProperties:
+    if not detailed:
+        return IntersectionProperties(
+            id=inter.id,
+            streets=[s.name for s in inter.streets],
+            kind_detail=inter.kind,
+            intersection_kind=inter.kind,
+        )
+    streets = [
+        IncidentStreetProperties(
+            name=s.name,
+            bearing_deg=round(s.bearing_deg, 3),
+            back_bearing_deg=round(s.back_bearing_deg, 3),
+            highway=s.highway,
+            oneway=s.oneway,
+            lanes=s.lanes,
+            width_m=round(s.width_m, 2),
+            width_source=s.width_source,
+            carriageways=s.carriageways,
+        )
+        for s in inter.streets
+    ]
+    return IntersectionProperties(
+        id=inter.id,
+        streets=list(inter.street_names),
+        kind_detail=inter.kind,
+        intersection_kind=inter.kind,
+        warnings=list(inter.warnings),
+        incident_streets=streets,
+        corner_distances_m=[round(d, 3) for d in inter.corner_distances_m],
+        osm_nodes=list(inter.osm_nodes),
+    )
+
+
+def intersection_features(inter: Intersection, *, detailed: bool = True) -> list[Feature]:
+    """An intersection's feature and its corners' (``detailed``: with incident streets...)."""
+    feats = [
+        Feature(
+            geometry=point(inter.lon, inter.lat),
+            properties=_intersection_properties(inter, detailed=detailed),
+        )
+    ]
+    for corner in inter.corners:
+        props = CornerProperties(
+            intersection=inter.id, order=corner.order, streets=list(corner.streets)
+        )
+        feats.append(Feature(geometry=point(corner.lon, corner.lat), properties=props))
+    return feats
+
+
+def corners_collection(intersections: Iterable[Intersection]) -> CornersCollection:
+    """The ``camloc corners`` FeatureCollection of intersections and their corners."""
+    feats = [f for inter in intersections for f in intersection_features(inter)]
+    return CornersCollection(features=feats)
+
+
+# ------------------------------------------------------------------------ serialiser
+def to_json(value: Any) -> Any:
+    """Plain JSON (dicts, lists, numbers, strings) of an output dataclass tree.
+
+    Fields with ``omit_none`` metadata are left out when None; floats are Python floats.
+    """
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(value):
+            v = getattr(value, f.name)
+            if v is None and f.metadata.get("omit_none"):
+                continue
+            out[f.name] = to_json(v)
+        return out
+    if isinstance(value, dict):
+        return {str(k): to_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_json(v) for v in value]
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return to_json(value.tolist())
+    return value
+
+
+_SCHEMA_ROOTS: dict[str, Any] = {
+    "candidates": CandidateCollection,
+    "calibration": CalibrationOutput,
+    "corners": CornersCollection,
+}
+
+
+def output_json_schema(kind: OutputKind) -> dict[str, Any]:
+    """The JSON Schema (draft 2020-12) of an output: ``candidates``, ``calibration``, ``corners``.
+
+    Raises
+    ------
+    ValueError
+        An unknown kind.
+    """
+    if kind not in _SCHEMA_ROOTS:
+        raise ValueError(f"unknown output {kind!r}: expected one of {', '.join(_SCHEMA_ROOTS)}")
+    from pydantic import TypeAdapter
+
+    schema: dict[str, Any] = TypeAdapter(_SCHEMA_ROOTS[kind]).json_schema(mode="serialization")
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = f"camloc {kind} output"
+    return schema
