@@ -29,8 +29,7 @@ import functools
 import logging
 import math
 from dataclasses import dataclass, field
-from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -51,6 +50,9 @@ from camloc_geo.vanishing import (
     rotation_from_vanishing_directions,
     segment_residuals_px,
 )
+
+if TYPE_CHECKING:
+    from camloc_geo._optimize import LeastSquaresResult
 
 __all__ = [
     "AnnotatorSolution",
@@ -426,21 +428,6 @@ def _cluster(
 
 
 # ----------------------------------------------------------------------------- joint fit
-def _rodrigues(rotvecs: FloatArray) -> FloatArray:
-    """Rotation matrices ``(P, 3, 3)`` of rotation vectors ``(P, 3)``."""
-    theta = np.linalg.norm(rotvecs, axis=1)
-    small = theta < 1e-12
-    safe = np.where(small, 1.0, theta)
-    k = rotvecs / safe[:, None]
-    K = np.zeros((len(rotvecs), 3, 3))
-    K[:, 0, 1], K[:, 0, 2] = -k[:, 2], k[:, 1]
-    K[:, 1, 0], K[:, 1, 2] = k[:, 2], -k[:, 0]
-    K[:, 2, 0], K[:, 2, 1] = -k[:, 1], k[:, 0]
-    s = np.where(small, 0.0, np.sin(theta))[:, None, None]
-    c = np.where(small, 0.0, 1.0 - np.cos(theta))[:, None, None]
-    return np.asarray(np.eye(3) + s * K + c * (K @ K), dtype=np.float64)
-
-
 class _JointProblem:
     """Stacked residuals of all annotators for one pose + intrinsics."""
 
@@ -558,7 +545,7 @@ class _JointProblem:
             k += 2
         else:
             pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
-        R = _rodrigues(X[:, k : k + 3]) @ R0
+        R = Rotation.from_rotvec(X[:, k : k + 3]).as_matrix() @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
 
@@ -664,70 +651,28 @@ def _fit(
     *,
     tol: float = 1e-10,
     max_nfev: int = 200,
-) -> Any:
-    """One robust fit: Levenberg-Marquardt on soft-L1 reweighted residuals.
+    method: Literal["lm", "scipy"] = "lm",
+) -> LeastSquaresResult:
+    """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`.
 
-    The problem is small (7-9 parameters, ~100 residuals), so a plain damped Gauss-Newton
-    loop with one batched residual evaluation per Jacobian is several times cheaper than a
-    general trust-region solver. The focal length is clamped to plausible fields of view
-    inside the parameterisation. Returns an object with scipy's ``least_squares`` fields
-    ``x``, ``cost`` (0.5 Σ ρ(r²)), ``fun``, ``jac`` (robustly weighted: ``jacᵀjac`` is the
-    Gauss-Newton Hessian of the cost), ``success`` and ``nfev``.
+    The focal length is clamped to plausible fields of view inside the parameterisation.
     """
-    x = np.asarray(x0, dtype=float).copy()
-    if f_fixed is None:
+    from camloc_geo._optimize import soft_l1_least_squares
+
+    def clamp_focal(x: FloatArray) -> FloatArray:
+        x = x.copy()
         x[0] = float(np.clip(x[0], *prob.log_f_bounds))
-    c2 = _F_SCALE**2
+        return x
 
-    def cost_of(r: FloatArray) -> float:
-        return float(0.5 * np.sum(2.0 * c2 * (np.sqrt(1.0 + r * r / c2) - 1.0)))
-
-    r = prob.residuals(x, R0, pp_fixed, f_fixed)
-    cost = cost_of(r)
-    lam = 1e-3
-    nfev = 1
-    success = False
-    J = prob.jacobian(x, R0, pp_fixed, f_fixed)
-    while nfev < max_nfev:
-        w = 1.0 / np.sqrt(1.0 + r * r / c2)  # soft-L1 IRLS weights
-        Jw = J * w[:, None]
-        A = J.T @ Jw
-        g = Jw.T @ r
-        if np.max(np.abs(g)) * max(1.0, float(np.max(np.abs(x)))) < tol * max(cost, 1e-300):
-            success = True
-            break
-        diag = np.diag(A).copy()
-        diag[diag <= 0] = 1e-12
-        try:
-            dx = -np.linalg.solve(A + lam * np.diag(diag), g)
-        except np.linalg.LinAlgError:
-            lam *= 10.0
-            if lam > 1e12:
-                break
-            continue
-        x_new = x + dx
-        if f_fixed is None:
-            x_new[0] = float(np.clip(x_new[0], *prob.log_f_bounds))
-        r_new = prob.residuals(x_new, R0, pp_fixed, f_fixed)
-        nfev += 1
-        cost_new = cost_of(r_new)
-        if cost_new <= cost:
-            step_small = np.max(np.abs(dx)) <= tol * (1e-3 + float(np.max(np.abs(x))))
-            gain_small = cost - cost_new <= tol * max(cost, 1e-300)
-            x, r, cost = x_new, r_new, cost_new
-            lam = max(lam * 0.3, 1e-12)
-            J = prob.jacobian(x, R0, pp_fixed, f_fixed)
-            if step_small or gain_small:
-                success = True
-                break
-        else:
-            lam *= 10.0
-            if lam > 1e12:
-                success = True  # no descent direction left: at a (local) minimum
-                break
-    w = 1.0 / np.sqrt(1.0 + r * r / c2)
-    return SimpleNamespace(
-        x=x, cost=cost, fun=r, jac=J * np.sqrt(w)[:, None], success=success, nfev=nfev
+    return soft_l1_least_squares(
+        lambda x: prob.residuals(x, R0, pp_fixed, f_fixed),
+        lambda x: prob.jacobian(x, R0, pp_fixed, f_fixed),
+        x0,
+        f_scale=_F_SCALE,
+        project=clamp_focal if f_fixed is None else None,
+        method=method,
+        tol=tol,
+        max_nfev=max_nfev,
     )
 
 

@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import numpy.typing as npt
 
+from camloc_geo._optimize import gauss_newton
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
 from camloc_geo.absolute._scoring import OUTLIER_M2, obs_precision, street_angle_under_car
@@ -98,26 +99,6 @@ def _residuals(
     return resid_jac
 
 
-def _gauss_newton(
-    resid_jac: ResidualJacobian, x: FloatArray, max_iter: int = 8
-) -> tuple[FloatArray, FloatArray]:
-    """Gauss-Newton from ``x`` (the problem is nearly linear); the solution and its Jacobian."""
-    r, J = resid_jac(x)
-    for _ in range(max_iter):
-        try:
-            dx = -np.linalg.lstsq(J, r, rcond=None)[0]
-        except np.linalg.LinAlgError:
-            break
-        x_new = x + dx
-        r_new, J_new = resid_jac(x_new)
-        if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
-            break
-        x, r, J = x_new, r_new, J_new
-        if np.max(np.abs(dx)) < 1e-10:
-            break
-    return x, J
-
-
 def _position_sigma_m(
     J: FloatArray, enu_from_world: Similarity2D, world_cam: Camera
 ) -> float | None:
@@ -150,7 +131,7 @@ def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSet
     street_brg = _street_bearing_prior(cand, ev, settings)
     resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
     x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
-    x, J = _gauss_newton(resid_jac, x0)
+    x, J = gauss_newton(resid_jac, x0)
     theta, tx, ty, ls = x
     sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
     return replace(

@@ -1,0 +1,225 @@
+"""Nonlinear least squares: the one module every fit in the package goes through.
+
+Two problems, two solvers, both typed and tested against
+:func:`scipy.optimize.least_squares` on the same problems (``tests/test_optimize.py``):
+
+:func:`soft_l1_least_squares`
+    Robust (soft-L1) least squares, the relative pose's joint fit. ``method="lm"`` is a
+    small Levenberg-Marquardt loop on iteratively reweighted residuals; ``method="scipy"``
+    calls ``least_squares(loss="soft_l1")``. Both minimise the same cost
+    ``0.5 Σ 2 f² (√(1 + r²/f²) − 1)`` and return the same :class:`LeastSquaresResult`.
+    The loop stays because it earns its place, modestly: on 40 calibration fits
+    (``benchmarks/optimize.py``) it reaches the same minimum (median relative cost
+    difference 3e-10) 1.35x faster per fit (median) and 2.3x faster in total, with no
+    trust-region bookkeeping on a 7-9 parameter problem.
+:func:`gauss_newton`
+    Plain Gauss-Newton for nearly linear problems with an analytic Jacobian (the absolute
+    refinement of ``enu_from_world``): a handful of steps, stopping when the cost stops
+    falling.
+
+scipy is imported only inside :func:`soft_l1_least_squares` with ``method="scipy"``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "LeastSquaresResult",
+    "gauss_newton",
+    "soft_l1_cost",
+    "soft_l1_least_squares",
+]
+
+FloatArray = npt.NDArray[np.float64]
+Residuals = Callable[[FloatArray], FloatArray]
+ResidualsAndJacobian = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
+
+
+@dataclass(frozen=True)
+class LeastSquaresResult:
+    """The fields of :func:`scipy.optimize.least_squares`'s result that callers use.
+
+    Attributes
+    ----------
+    x
+        The solution.
+    cost
+        The robust cost at ``x``, ``0.5 Σ ρ(r²)`` (scipy's definition).
+    fun
+        The residuals at ``x``.
+    jac
+        The robustly weighted Jacobian at ``x``: ``jacᵀ jac`` is the Gauss-Newton Hessian
+        of the cost (as scipy returns it).
+    success
+        Converged (tolerance met, or no descent direction left).
+    nfev
+        Residual evaluations (each Jacobian counts as one: it is one batched evaluation).
+    """
+
+    x: FloatArray
+    cost: float
+    fun: FloatArray
+    jac: FloatArray
+    success: bool
+    nfev: int
+
+
+def soft_l1_cost(r: FloatArray, f_scale: float) -> float:
+    """``0.5 Σ 2 f² (√(1 + r²/f²) − 1)``: scipy's soft-L1 cost of residuals ``r``."""
+    c2 = f_scale**2
+    return float(0.5 * np.sum(2.0 * c2 * (np.sqrt(1.0 + r * r / c2) - 1.0)))
+
+
+def soft_l1_least_squares(
+    fun: Residuals,
+    jac: Residuals,
+    x0: npt.ArrayLike,
+    *,
+    f_scale: float,
+    project: Callable[[FloatArray], FloatArray] | None = None,
+    method: Literal["lm", "scipy"] = "lm",
+    tol: float = 1e-10,
+    max_nfev: int = 200,
+) -> LeastSquaresResult:
+    """Minimise the soft-L1 cost of ``fun(x)`` from ``x0``.
+
+    Parameters
+    ----------
+    fun, jac
+        Residuals ``(m,)`` and their Jacobian ``(m, n)`` at ``x``.
+    f_scale
+        Soft margin between inlier and outlier residuals (scipy's ``f_scale``).
+    project
+        Maps a trial ``x`` back into the feasible set (``lm`` only; e.g. clamps a focal
+        length). None: unconstrained.
+    method
+        ``lm``: the Levenberg-Marquardt loop; ``scipy``: ``least_squares(loss="soft_l1")``.
+    tol, max_nfev
+        Relative tolerance on the gradient, step and cost decrease; evaluation budget.
+    """
+    x = np.asarray(x0, dtype=np.float64).copy()
+    if project is not None:
+        x = project(x)
+    if method == "scipy":
+        return _scipy_soft_l1(fun, jac, x, f_scale=f_scale, tol=tol, max_nfev=max_nfev)
+    return _lm_soft_l1(fun, jac, x, f_scale=f_scale, project=project, tol=tol, max_nfev=max_nfev)
+
+
+def _scipy_soft_l1(
+    fun: Residuals, jac: Residuals, x: FloatArray, *, f_scale: float, tol: float, max_nfev: int
+) -> LeastSquaresResult:
+    from scipy.optimize import least_squares
+
+    res = least_squares(
+        fun,
+        x,
+        jac=jac,
+        loss="soft_l1",
+        f_scale=f_scale,
+        method="trf",
+        x_scale="jac",
+        ftol=tol,
+        xtol=tol,
+        gtol=tol,
+        max_nfev=max_nfev,
+    )
+    return LeastSquaresResult(
+        x=np.asarray(res.x, dtype=np.float64),
+        cost=float(res.cost),
+        fun=np.asarray(res.fun, dtype=np.float64),
+        jac=np.asarray(res.jac, dtype=np.float64),
+        success=bool(res.success),
+        nfev=int(res.nfev),
+    )
+
+
+def _lm_soft_l1(
+    fun: Residuals,
+    jac: Residuals,
+    x: FloatArray,
+    *,
+    f_scale: float,
+    project: Callable[[FloatArray], FloatArray] | None,
+    tol: float,
+    max_nfev: int,
+) -> LeastSquaresResult:
+    """Levenberg-Marquardt on soft-L1 reweighted residuals (IRLS weights per step)."""
+    c2 = f_scale**2
+    r = fun(x)
+    cost = soft_l1_cost(r, f_scale)
+    lam = 1e-3
+    nfev = 1
+    success = False
+    J = jac(x)
+    while nfev < max_nfev:
+        w = 1.0 / np.sqrt(1.0 + r * r / c2)  # soft-L1 IRLS weights
+        Jw = J * w[:, None]
+        A = J.T @ Jw
+        g = Jw.T @ r
+        if np.max(np.abs(g)) * max(1.0, float(np.max(np.abs(x)))) < tol * max(cost, 1e-300):
+            success = True
+            break
+        diag = np.diag(A).copy()
+        diag[diag <= 0] = 1e-12
+        try:
+            dx = -np.linalg.solve(A + lam * np.diag(diag), g)
+        except np.linalg.LinAlgError:
+            lam *= 10.0
+            if lam > 1e12:
+                break
+            continue
+        x_new = x + dx
+        if project is not None:
+            x_new = project(x_new)
+        r_new = fun(x_new)
+        nfev += 1
+        cost_new = soft_l1_cost(r_new, f_scale)
+        if cost_new <= cost:
+            step_small = np.max(np.abs(dx)) <= tol * (1e-3 + float(np.max(np.abs(x))))
+            gain_small = cost - cost_new <= tol * max(cost, 1e-300)
+            x, r, cost = x_new, r_new, cost_new
+            lam = max(lam * 0.3, 1e-12)
+            J = jac(x)
+            if step_small or gain_small:
+                success = True
+                break
+        else:
+            lam *= 10.0
+            if lam > 1e12:
+                success = True  # no descent direction left: at a (local) minimum
+                break
+    w = 1.0 / np.sqrt(1.0 + r * r / c2)
+    return LeastSquaresResult(
+        x=x, cost=cost, fun=r, jac=J * np.sqrt(w)[:, None], success=success, nfev=nfev
+    )
+
+
+def gauss_newton(
+    resid_jac: ResidualsAndJacobian, x0: npt.ArrayLike, *, max_iter: int = 8
+) -> tuple[FloatArray, FloatArray]:
+    """Gauss-Newton from ``x0``; the solution and the Jacobian there.
+
+    For nearly linear problems: each step solves the linearised problem by least squares
+    and is taken only if the squared residual does not grow; stops on a step below 1e-10.
+    """
+    x = np.asarray(x0, dtype=np.float64)
+    r, J = resid_jac(x)
+    for _ in range(max_iter):
+        try:
+            dx = -np.linalg.lstsq(J, r, rcond=None)[0]
+        except np.linalg.LinAlgError:
+            break
+        x_new = x + dx
+        r_new, J_new = resid_jac(x_new)
+        if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
+            break
+        x, r, J = x_new, r_new, J_new
+        if np.max(np.abs(dx)) < 1e-10:
+            break
+    return x, J
