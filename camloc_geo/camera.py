@@ -158,6 +158,28 @@ class Camera:
         cx, cy = self.principal_point
         object.__setattr__(self, "principal_point", (float(cx), float(cy)))
 
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Camera):
+            return NotImplemented
+        return (
+            self.focal_px == other.focal_px
+            and self.principal_point == other.principal_point
+            and bool(np.array_equal(self.cam_from_world_rotation, other.cam_from_world_rotation))
+            and bool(
+                np.array_equal(self.cam_from_world_translation, other.cam_from_world_translation)
+            )
+        )
+
+    def __hash__(self) -> int:
+        return hash(
+            (
+                self.focal_px,
+                self.principal_point,
+                self.cam_from_world_rotation.tobytes(),
+                self.cam_from_world_translation.tobytes(),
+            )
+        )
+
     # ----------------------------------------------------------------- factories
     @classmethod
     def from_center(
@@ -352,28 +374,26 @@ class Camera:
 def clip_segment_to_image(
     p: FloatArray, q: FloatArray, w: float, h: float, m: float = 0.0
 ) -> FloatArray | None:
-    """Liang-Barsky clip of a 2-D segment to ``[-m, w + m] × [-m, h + m]``.
+    """Clip a 2-D segment to ``[-m, w + m] × [-m, h + m]`` (shapely's ``clip_by_rect``).
 
-    Returns the clipped segment as a (2, 2) array of endpoints, or None when it misses the
-    rectangle.
+    Returns the clipped segment as a (2, 2) array of endpoints, in the direction from ``p``
+    to ``q``, or None when it misses the rectangle (or only touches it at a point).
     """
-    t0, t1 = 0.0, 1.0
-    d = q - p
-    for pk, qk in (
-        (-d[0], p[0] + m),
-        (d[0], w + m - p[0]),
-        (-d[1], p[1] + m),
-        (d[1], h + m - p[1]),
-    ):
-        if pk == 0:
-            if qk < 0:
-                return None
-            continue
-        r = qk / pk
-        if pk < 0:
-            t0 = max(t0, r)
-        else:
-            t1 = min(t1, r)
-        if t0 > t1:
-            return None
-    return np.array([p + t0 * d, p + t1 * d])
+    import shapely
+    from shapely.geometry import LineString
+
+    a = np.asarray(p, dtype=np.float64)
+    b = np.asarray(q, dtype=np.float64)
+    lo, hi = (-m, -m), (w + m, h + m)
+    if np.array_equal(a, b):
+        inside = lo[0] <= a[0] <= hi[0] and lo[1] <= a[1] <= hi[1]
+        return np.array([a, b]) if inside else None
+    clipped = shapely.clip_by_rect(LineString([a, b]), lo[0], lo[1], hi[0], hi[1])
+    if clipped.is_empty or clipped.geom_type != "LineString":
+        return None
+    coords = np.asarray(clipped.coords, dtype=np.float64)
+    ends = np.array([coords[0], coords[-1]])
+    d = b - a
+    if float((ends[1] - ends[0]) @ d) < 0:  # keep the direction p → q
+        ends = ends[::-1]
+    return ends

@@ -267,3 +267,56 @@ def test_pixel_exactly_on_the_horizon_is_nan_without_warnings() -> None:
     assert np.all(np.isfinite(out[1]))
     with pytest.raises(DegenerateGeometryError, match="at or above the horizon"):
         cam.ground_from_pixels([640.0, 360.0], above_horizon="error")
+
+
+def test_cameras_compare_and_hash_without_raising() -> None:
+    from camloc_geo.camera import Camera, rotation_from_angles
+
+    R = rotation_from_angles(30.0, 10.0, 0.0)
+    a = Camera.from_center(1000.0, (960.0, 540.0), R, np.array([1.0, 2.0, 5.0]))
+    b = Camera.from_center(1000.0, (960.0, 540.0), R.copy(), np.array([1.0, 2.0, 5.0]))
+    c = Camera.from_center(1001.0, (960.0, 540.0), R, np.array([1.0, 2.0, 5.0]))
+    assert a == b
+    assert hash(a) == hash(b)
+    assert a != c
+    assert a != "camera"
+    assert len({a, b, c}) == 2
+
+
+def _liang_barsky(p, q, w, h, m):  # type: ignore[no-untyped-def]
+    t0, t1 = 0.0, 1.0
+    d = q - p
+    for pk, qk in (
+        (-d[0], p[0] + m),
+        (d[0], w + m - p[0]),
+        (-d[1], p[1] + m),
+        (d[1], h + m - p[1]),
+    ):
+        if pk == 0:
+            if qk < 0:
+                return None
+            continue
+        r = qk / pk
+        if pk < 0:
+            t0 = max(t0, r)
+        else:
+            t1 = min(t1, r)
+        if t0 > t1:
+            return None
+    return np.array([p + t0 * d, p + t1 * d])
+
+
+def test_clip_segment_to_image_agrees_with_liang_barsky() -> None:
+    from camloc_geo.camera import clip_segment_to_image
+
+    rng = np.random.default_rng(0)
+    for _ in range(500):
+        p, q = rng.uniform(-300.0, 2200.0, (2, 2))
+        m = float(rng.choice([0.0, 4.0]))
+        got = clip_segment_to_image(p, q, 1920.0, 1080.0, m)
+        want = _liang_barsky(p, q, 1920.0, 1080.0, m)
+        if want is None or np.allclose(want[0], want[1]):
+            assert got is None or np.allclose(got[0], got[1], atol=1e-6)
+        else:
+            assert got is not None
+            np.testing.assert_allclose(got, want, atol=1e-6)
