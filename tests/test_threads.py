@@ -73,3 +73,15 @@ def test_locate_from_eight_threads_matches_serial() -> None:
     for (_t, i), text in got.items():
         assert text == serial[i], f"scene {i} differs from the serial result"
     assert any('"kind": "candidate"' in s for s in serial)
+
+
+def test_map_cache_survives_pickling() -> None:
+    """The per-map cache and its lock do not stop a map from going to another process."""
+    import pickle
+
+    m = map_for_scene(SCENE, map_source=EXTRACT)
+    assert m is not None
+    n = len(m.street_index)
+    copy = pickle.loads(pickle.dumps(m))
+    assert len(copy.street_index) == n
+    assert len(copy.building_index) == len(m.building_index)
