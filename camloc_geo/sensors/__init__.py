@@ -1,0 +1,264 @@
+"""Virtual sensors on a calibrated camera: the scale and the clinometer.
+
+Once :func:`camloc_geo.relative.calibrate` has found the camera in the car's metric world
+frame (ground plane ``z = 0``), pixels on the ground become points in metres:
+
+- :func:`ground_distance` (virtual scale): length of the path through clicked ground pixels;
+- :func:`point_height` (virtual clinometer): height of a point vertically above a ground point.
+
+Uncertainty model (``sigma_m``)
+-------------------------------
+Monte Carlo with a fixed seed (reproducible): ``n_samples`` draws of
+
+- the camera centre, perturbed independently per axis by ``calibration.position_sigma_m``
+  (zero when the calibration has none), the rotation kept fixed;
+- the focal length, perturbed by ``calibration.focal_sigma_px`` when known;
+- every clicked pixel, perturbed by ``click_sigma_px`` (default 1.5 px) per coordinate.
+
+``sigma_m`` is the standard deviation of the measurement over the draws. The rotation's
+uncertainty is not propagated (the calibration does not report it), so ``sigma_m`` is a lower
+bound when the orientation is poorly determined. Draws in which a pixel's ray misses the
+ground are dropped; if more than half are dropped the measurement is refused.
+
+Radar (vehicle speeds from video) and guide (matching people to GPS traces) are not built.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo._errors import InputError
+
+if TYPE_CHECKING:
+    from camloc_geo.relative import CalibrationResult
+
+__all__ = ["Measurement", "ground_distance", "point_height"]
+
+FloatArray = npt.NDArray[np.float64]
+
+_HORIZON_EPS = 1e-9
+_SEED = 20261123
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A length measured with the calibrated camera.
+
+    Attributes
+    ----------
+    quantity
+        ``"distance"`` (virtual scale) or ``"height"`` (virtual clinometer).
+    value_m
+        The measurement with the calibrated camera, metres.
+    sigma_m
+        1-sigma uncertainty, metres (model in the module docstring).
+    n_samples
+        Monte Carlo draws that reached the ground.
+    """
+
+    quantity: str
+    value_m: float
+    sigma_m: float
+    n_samples: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``{"distance_m"|"height_m": ..., "sigma_m": ..., "n_samples": ...}``."""
+        return {
+            f"{self.quantity}_m": self.value_m,
+            "sigma_m": self.sigma_m,
+            "n_samples": self.n_samples,
+        }
+
+
+def _pixels(pixels_px: npt.ArrayLike, what: str) -> FloatArray:
+    try:
+        px = np.asarray(pixels_px, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{what}: pixels must be numbers (u, v)") from exc
+    if px.ndim == 1:
+        px = px.reshape(1, -1)
+    if px.ndim != 2 or px.shape[1] != 2:
+        raise InputError(f"{what}: pixels must be (u, v) pairs, got shape {px.shape}")
+    if not np.all(np.isfinite(px)):
+        raise InputError(f"{what}: pixels must be finite numbers")
+    return px
+
+
+def _rays(
+    pixels: FloatArray, focal: FloatArray, pp: tuple[float, float], R: FloatArray
+) -> FloatArray:
+    """World viewing directions (not normalised) of pixels ``(S, N, 2)`` for focals ``(S,)``."""
+    f = focal[:, None]
+    d_cam = np.stack(
+        [(pixels[..., 0] - pp[0]) / f, (pixels[..., 1] - pp[1]) / f, np.ones(pixels.shape[:2])],
+        axis=-1,
+    )
+    return np.asarray(d_cam @ R, dtype=np.float64)  # Rᵀ applied to each row
+
+
+def _ground(centres: FloatArray, rays: FloatArray) -> FloatArray:
+    """Ground points ``(S, N, 3)``; NaN where a ray does not reach ``z = 0`` in front."""
+    dz = rays[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = -centres[:, None, 2] / dz
+    bad = ~np.isfinite(lam) | (lam <= 0) | (np.abs(dz) < _HORIZON_EPS)
+    lam = np.where(bad, np.nan, lam)
+    return np.asarray(centres[:, None, :] + lam[..., None] * rays, dtype=np.float64)
+
+
+def _draws(
+    calibration: CalibrationResult,
+    pixels: FloatArray,
+    n_samples: int,
+    click_sigma_px: float,
+    seed: int,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Centres ``(S+1, 3)``, focals ``(S+1,)`` and pixels ``(S+1, N, 2)``; row 0 nominal."""
+    cam = calibration.camera
+    rng = np.random.default_rng(seed)
+    sig_c = calibration.position_sigma_m
+    sig_c = np.zeros(3) if sig_c is None else np.nan_to_num(np.asarray(sig_c, float).reshape(3))
+    sig_f = calibration.focal_sigma_px
+    sig_f = 0.0 if sig_f is None or not np.isfinite(sig_f) else float(sig_f)
+    centres = cam.center_in_world + rng.normal(0.0, 1.0, (n_samples, 3)) * sig_c
+    focals = cam.focal_px + rng.normal(0.0, sig_f, n_samples)
+    focals = np.clip(focals, 0.1 * cam.focal_px, None)
+    px = pixels[None] + rng.normal(0.0, click_sigma_px, (n_samples, *pixels.shape))
+    return (
+        np.vstack([cam.center_in_world[None], centres]),
+        np.concatenate([[cam.focal_px], focals]),
+        np.concatenate([pixels[None], px]),
+    )
+
+
+def _check_ground(points: FloatArray, pixels: FloatArray) -> None:
+    bad = ~np.all(np.isfinite(points), axis=-1)
+    if np.any(bad):
+        u, v = pixels[int(np.argmax(bad))]
+        raise InputError(
+            f"pixel ({u:g}, {v:g}) is at or above the horizon: its ray never meets the ground"
+        )
+
+
+def _summary(quantity: str, values: FloatArray) -> Measurement:
+    nominal = float(values[0])
+    draws = values[1:]
+    ok = draws[np.isfinite(draws)]
+    if len(ok) < max(2, len(draws) // 2):
+        raise InputError(
+            f"the {quantity} is too close to the horizon to measure: most perturbed cameras "
+            "see the clicked pixels above it"
+        )
+    return Measurement(quantity, nominal, float(np.std(ok, ddof=1)), len(ok))
+
+
+def ground_distance(
+    calibration: CalibrationResult,
+    pixels_px: npt.ArrayLike,
+    *,
+    click_sigma_px: float = 1.5,
+    n_samples: int = 400,
+    seed: int = _SEED,
+) -> Measurement:
+    """Virtual scale: length of the path through clicked ground pixels.
+
+    Parameters
+    ----------
+    calibration
+        The calibrated camera (:class:`camloc_geo.relative.CalibrationResult`).
+    pixels_px
+        ``(N, 2)`` image pixels of points on the ground, ``N >= 2``, in path order.
+    click_sigma_px
+        Standard deviation of a click, pixels per coordinate.
+    n_samples, seed
+        Monte Carlo draws for ``sigma_m`` and their seed.
+
+    Returns
+    -------
+    Measurement
+        ``quantity="distance"``: the summed length of the ground segments, metres.
+
+    Raises
+    ------
+    InputError
+        Fewer than two pixels, or a pixel at or above the horizon (named in the message).
+    """
+    pixels = _pixels(pixels_px, "ground")
+    if len(pixels) < 2:
+        raise InputError("ground: give at least two pixels")
+    cam = calibration.camera
+    centres, focals, px = _draws(calibration, pixels, n_samples, click_sigma_px, seed)
+    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    points = _ground(centres, rays)
+    _check_ground(points[0], pixels)
+    lengths = np.linalg.norm(np.diff(points[..., :2], axis=1), axis=-1).sum(axis=1)
+    return _summary("distance", lengths)
+
+
+def point_height(
+    calibration: CalibrationResult,
+    base_px: npt.ArrayLike,
+    top_px: npt.ArrayLike,
+    *,
+    click_sigma_px: float = 1.5,
+    n_samples: int = 400,
+    seed: int = _SEED,
+) -> Measurement:
+    """Virtual clinometer: height of a point vertically above a ground point.
+
+    The base pixel is cast onto the ground; the top pixel's ray is intersected (least squares)
+    with the vertical line through that ground point.
+
+    Parameters
+    ----------
+    calibration
+        The calibrated camera.
+    base_px
+        ``(u, v)`` where the vertical meets the ground (e.g. the foot of a building's face).
+    top_px
+        ``(u, v)`` of the point above it (e.g. the roof edge).
+    click_sigma_px, n_samples, seed
+        As in :func:`ground_distance`.
+
+    Returns
+    -------
+    Measurement
+        ``quantity="height"``, metres above the ground.
+
+    Raises
+    ------
+    InputError
+        The base pixel is at or above the horizon, or the top pixel is below its base.
+    """
+    base = _pixels(base_px, "height base")
+    top = _pixels(top_px, "height top")
+    if len(base) != 1 or len(top) != 1:
+        raise InputError("height: give one base pixel and one top pixel")
+    pixels = np.vstack([base, top])
+    cam = calibration.camera
+    centres, focals, px = _draws(calibration, pixels, n_samples, click_sigma_px, seed)
+    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    foot = _ground(centres, rays[:, :1])[:, 0]
+    _check_ground(foot[:1], base)
+    d = rays[:, 1]
+    w_xy = centres[:, :2] - foot[:, :2]
+    d_xy2 = np.einsum("ij,ij->i", d[:, :2], d[:, :2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = -np.einsum("ij,ij->i", w_xy, d[:, :2]) / d_xy2
+    heights = centres[:, 2] + s * d[:, 2]
+    heights = np.where((d_xy2 > _HORIZON_EPS) & (s > 0), heights, np.nan)
+    if not np.isfinite(heights[0]):
+        raise InputError(
+            f"top pixel ({top[0, 0]:g}, {top[0, 1]:g}) is straight along the vertical through "
+            "the camera or behind it: no height"
+        )
+    if heights[0] < 0.0:
+        raise InputError(
+            f"top pixel ({top[0, 0]:g}, {top[0, 1]:g}) is below its base pixel "
+            f"({base[0, 0]:g}, {base[0, 1]:g}): the point would be underground"
+        )
+    return _summary("height", heights)

@@ -1,0 +1,156 @@
+"""Virtual scale and clinometer (camloc_geo.sensors, ``camloc measure``)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from conftest import camera_aimed_at_car, exact_scene
+
+from camloc_geo._errors import InputError
+from camloc_geo.api import calibrate_scene
+from camloc_geo.camera import Camera
+from camloc_geo.cli import main
+from camloc_geo.relative import CalibrationResult
+from camloc_geo.sensors import ground_distance, point_height
+from camloc_geo.synthetic import NoiseModel, make_scene
+
+GROUND_PTS = np.array([[3.0, -4.0, 0.0], [10.0, -2.0, 0.0], [12.0, 3.0, 0.0]])
+TRUE_LENGTH = float(np.linalg.norm(np.diff(GROUND_PTS, axis=0), axis=1).sum())
+BASE, TOP = np.array([8.0, 4.0, 0.0]), np.array([8.0, 4.0, 7.5])
+
+
+@pytest.fixture(scope="module")
+def camera() -> Camera:
+    return camera_aimed_at_car(6.0, 20.0)
+
+
+@pytest.fixture(scope="module")
+def scene(camera: Camera) -> dict[str, Any]:
+    return exact_scene(camera)
+
+
+@pytest.fixture(scope="module")
+def calibration(scene: dict[str, Any]) -> CalibrationResult:
+    return calibrate_scene(scene)
+
+
+def test_ground_distance_exact(camera: Camera, calibration: CalibrationResult) -> None:
+    m = ground_distance(calibration, camera.project(GROUND_PTS))
+    assert m.value_m == pytest.approx(TRUE_LENGTH, rel=1e-3)
+    # 1.5 px clicks at ~20 m give decimetres, not metres
+    assert 0.0 < m.sigma_m < 0.05 * TRUE_LENGTH
+    assert m.to_dict()["distance_m"] == m.value_m
+
+
+def test_point_height_exact(camera: Camera, calibration: CalibrationResult) -> None:
+    base, top = camera.project(np.array([BASE, TOP]))
+    m = point_height(calibration, base, top)
+    assert m.value_m == pytest.approx(7.5, rel=1e-3)
+    assert 0.0 < m.sigma_m < 0.5
+    assert set(m.to_dict()) == {"height_m", "sigma_m", "n_samples"}
+
+
+def test_sigma_grows_with_click_noise(camera: Camera, calibration: CalibrationResult) -> None:
+    px = camera.project(GROUND_PTS)
+    small = ground_distance(calibration, px, click_sigma_px=0.5).sigma_m
+    large = ground_distance(calibration, px, click_sigma_px=3.0).sigma_m
+    assert large > 3.0 * small
+
+
+def test_noisy_scenes_within_sigma_bound() -> None:
+    """With annotation noise, the errors stay within 3 sigma in most scenes."""
+    rng = np.random.default_rng(7)
+    noise = NoiseModel(wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0)
+    inside_d = inside_h = 0
+    n = 6
+    for i in range(n):
+        cam = camera_aimed_at_car(5.0 + i, 15.0 + 2 * i, azimuth_deg=200.0 + 10 * i)
+        syn = make_scene(cam, rng, noise=noise, n_annotators=5)
+        cal = calibrate_scene(syn.scene)
+        d = ground_distance(cal, cam.project(GROUND_PTS))
+        h = point_height(cal, *cam.project(np.array([BASE, TOP])))
+        inside_d += abs(d.value_m - TRUE_LENGTH) <= 3.0 * d.sigma_m + 0.05 * TRUE_LENGTH
+        inside_h += abs(h.value_m - 7.5) <= 3.0 * h.sigma_m + 0.05 * 7.5
+        assert abs(d.value_m - TRUE_LENGTH) < 0.2 * TRUE_LENGTH
+        assert abs(h.value_m - 7.5) < 0.25 * 7.5
+    assert inside_d >= n - 1
+    assert inside_h >= n - 1
+
+
+def test_above_horizon_is_refused(camera: Camera, calibration: CalibrationResult) -> None:
+    px = camera.project(GROUND_PTS)
+    sky = [960.0, 5.0]
+    with pytest.raises(InputError, match=r"pixel \(960, 5\) is at or above the horizon"):
+        ground_distance(calibration, [px[0], sky])
+    with pytest.raises(InputError, match="above the horizon"):
+        point_height(calibration, sky, [960.0, 0.0])
+
+
+def test_top_below_base_is_refused(camera: Camera, calibration: CalibrationResult) -> None:
+    base = camera.project(BASE)
+    top = base + np.array([0.0, 40.0])
+    with pytest.raises(InputError, match="is below its base pixel"):
+        point_height(calibration, base, top)
+
+
+def test_bad_pixel_arrays(calibration: CalibrationResult) -> None:
+    with pytest.raises(InputError, match="at least two"):
+        ground_distance(calibration, [[900.0, 900.0]])
+    with pytest.raises(InputError, match="finite"):
+        ground_distance(calibration, [[900.0, float("nan")], [900.0, 800.0]])
+    with pytest.raises(InputError, match="pairs"):
+        ground_distance(calibration, [[1.0, 2.0, 3.0]])
+
+
+# ---------------------------------------------------------------- command line
+@pytest.fixture(scope="module")
+def scene_file(scene: dict[str, Any], tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("measure") / "scene.json"
+    path.write_text(json.dumps(scene))
+    return path
+
+
+def _uv(p: np.ndarray) -> str:
+    return f"{p[0]:.6f},{p[1]:.6f}"
+
+
+def test_cli_ground_and_height(
+    camera: Camera, scene_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    px = camera.project(GROUND_PTS)
+    assert main(["measure", str(scene_file), "--ground", *(_uv(p) for p in px)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["distance_m"] == pytest.approx(TRUE_LENGTH, rel=1e-3)
+    assert out["sigma_m"] > 0
+    base, top = camera.project(np.array([BASE, TOP]))
+    assert main(["measure", str(scene_file), "--height", _uv(base), _uv(top)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["height_m"] == pytest.approx(7.5, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--ground", "960,5", "900,900"], "above the horizon"),
+        (["--ground", "900,900"], "at least two"),
+        (["--ground", "900;900", "900,800"], "is not U,V"),
+        (["--height", "900,900", "900,1000"], "below its base"),
+    ],
+)
+def test_cli_bad_pixels_exit_2(
+    scene_file: Path, capsys: pytest.CaptureFixture[str], extra: list[str], message: str
+) -> None:
+    assert main(["measure", str(scene_file), *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err
+
+
+def test_cli_missing_scene_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["measure", str(tmp_path / "nope.json"), "--ground", "1,2", "3,4"]) == 2
+    assert "Traceback" not in capsys.readouterr().err
