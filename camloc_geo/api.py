@@ -163,11 +163,9 @@ def map_for_scene(
         Force loading (True) or skipping (False) the map; None: load when an extract is given
         or the scene needs one.
     """
-    from camloc_geo.osm import MapData, load_map
-
     sc = scene_from(scene)
-    if isinstance(map_source, MapData):
-        return map_source
+    if map_source is not None and not isinstance(map_source, (str, os.PathLike)):
+        return map_source  # an already loaded MapData
     need = scene_needs_map(sc) if required is None else required
     if map_source is None and not need:
         return None
@@ -179,13 +177,15 @@ def map_for_scene(
             "prior",
         )
     radius = scene_map_radius_m(sc, radius_m)
-    if map_source is not None:
-        return load_map(map_source, centre[0], centre[1], radius_m=radius)
-    if not network:
+    if map_source is None and not network:
         raise MapDataError(
             "this scene needs a map (intersection corners, landmarks or street bearings) and "
             "the network is off: give --osm EXTRACT (map_source=...)"
         )
+    from camloc_geo.osm import load_map
+
+    if map_source is not None:
+        return load_map(map_source, centre[0], centre[1], radius_m=radius)
     return load_map(
         None,
         centre[0],
@@ -270,6 +270,15 @@ def locate_scene(
     return LocateOutput(scene=sc, result=result, map_data=map_data)
 
 
+def _require_source(map_source: MapSource, network: bool) -> None:
+    """Fail at once (before any heavy import) when no map can be had."""
+    if map_source is None and not network:
+        raise MapDataError(
+            "no map: the network is off and no extract was given: give --osm EXTRACT "
+            "(map_source=...)"
+        )
+
+
 def corners_near(
     *,
     lat: float,
@@ -283,23 +292,20 @@ def corners_near(
 ) -> dict[str, Any]:
     """Intersections with their kerb corners around a point, as GeoJSON (``docs/contract.md``).
 
-    ``streets`` (``"A & B"``) keeps only the intersection of those streets.
+    ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
+    from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
     """
-    from camloc_geo.osm import MapData, intersections_geojson, load_map
+    from camloc_geo.osm import intersections_geojson
 
-    if isinstance(map_source, MapData):
-        m = map_source
-    else:
-        if map_source is None and not network:
-            raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
-        m = load_map(
-            map_source,
-            lat,
-            lon,
-            radius_m,
-            cache_folder=cache_folder,
-            overpass_url=overpass_url,
-        )
+    m = streets_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
     inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
     return intersections_geojson(inters)
 
@@ -311,12 +317,25 @@ def streets_near(
     radius_m: float = 150.0,
     map_source: MapSource = None,
     network: bool = True,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
 ) -> MapData:
-    """The map around a point (its ``streets`` carry names and bearings)."""
+    """The map around a point (its ``streets`` carry names and bearings).
+
+    The map comes from ``map_source`` or, when ``network`` allows it, Overpass.
+
+    Raises
+    ------
+    MapDataError
+        No extract and the network is off (at once), unreadable extract, no streets there.
+    MapSourceError
+        Overpass could not be reached (within a few seconds) or failed.
+    """
+    _require_source(map_source, network)
     from camloc_geo.osm import MapData, load_map
 
     if isinstance(map_source, MapData):
         return map_source
-    if map_source is None and not network:
-        raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
-    return load_map(map_source, lat, lon, radius_m)
+    return load_map(
+        map_source, lat, lon, radius_m, cache_folder=cache_folder, overpass_url=overpass_url
+    )

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from camloc_geo.scene import scene_json_schema
-
 
 def register(subparsers: Any) -> None:
     """Add the ``schema`` command."""
@@ -22,6 +20,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.cli import write_json
+    from camloc_geo.scene import scene_json_schema
 
     write_json(scene_json_schema(), args.output)
     return 0

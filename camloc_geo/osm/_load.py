@@ -327,6 +327,41 @@ def overpass_filter(highways: frozenset[str]) -> str:
     return f'["highway"~"^({alternatives})$"]["area"!~"yes"]'
 
 
+CONNECT_TIMEOUT_S = 5.0
+"""How long to wait for the Overpass server to accept a connection, seconds."""
+
+_OFFLINE_HINT = "give --osm EXTRACT (a local OSM extract) to work without the network"
+
+
+def probe_server(url: str, timeout_s: float) -> str | None:
+    """None when a TCP connection to the URL's host opens within ``timeout_s``.
+
+    Otherwise why not: ``"timeout"``, ``"connection refused"``, ``"unknown host"``...
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(url)
+    host = parts.hostname
+    if not host:
+        return "no host in the URL"
+    try:
+        port = parts.port or (443 if parts.scheme == "https" else 80)
+    except ValueError:
+        return "bad port in the URL"
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            return None
+    except TimeoutError:
+        return "timeout"
+    except socket.gaierror:
+        return "unknown host"
+    except ConnectionRefusedError:
+        return "connection refused"
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+
+
 def read_overpass(
     lat: float,
     lon: float,
@@ -337,8 +372,15 @@ def read_overpass(
     overpass_rate_limit: bool = True,
     timeout_s: float = 60.0,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    connect_timeout_s: float = CONNECT_TIMEOUT_S,
 ) -> RawMap:
     """Query streets and buildings around a point from Overpass through osmnx.
+
+    The server is first probed with a TCP connection of ``connect_timeout_s``: when it does
+    not answer in time the call fails at once (osmnx would otherwise wait its rate-limit
+    pause, 60 s, then the full HTTP timeout). When the connection is refused or the name
+    does not resolve, osmnx still runs without its rate-limit query, so answers in its HTTP
+    cache are served and anything else fails immediately.
 
     Raises
     ------
@@ -358,6 +400,15 @@ def read_overpass(
     if overpass_url is not None:
         settings["overpass_url"] = overpass_url.rstrip("/")
     where = f"lat={lat:.6f}, lon={lon:.6f}"
+    url = overpass_url or ox.settings.overpass_url
+    problem = probe_server(url, connect_timeout_s)
+    if problem == "timeout":
+        raise MapSourceError(
+            f"cannot reach the Overpass server {url} (no answer in {connect_timeout_s:g} s): "
+            f"{_OFFLINE_HINT}"
+        )
+    if problem is not None:
+        settings["overpass_rate_limit"] = False
     try:
         with osmnx_settings(**settings):
             graph = ox.graph_from_point(
@@ -388,8 +439,8 @@ def read_overpass(
         raise MapSourceError(f"Overpass server error for {where}: {exc}") from exc
     except requests.exceptions.RequestException as exc:
         raise MapSourceError(
-            f"cannot reach the Overpass server {overpass_url or ox.settings.overpass_url}: "
-            f"{type(exc).__name__}"
+            f"cannot reach the Overpass server {url} ({problem or type(exc).__name__}): "
+            f"{_OFFLINE_HINT}"
         ) from exc
     except ValueError as exc:  # a reply that is not Overpass JSON
         raise MapSourceError(
