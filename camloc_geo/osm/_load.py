@@ -37,8 +37,6 @@ from xml.sax.saxutils import quoteattr
 
 import networkx as nx
 import osmium
-import osmnx as ox
-import requests
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
@@ -100,12 +98,20 @@ class RawMap:
 _SETTINGS_LOCK = threading.RLock()
 
 
+def _osmnx() -> Any:
+    """osmnx, imported on first use (half a second: it pulls in geopandas and matplotlib)."""
+    import osmnx
+
+    return osmnx
+
+
 @contextlib.contextmanager
 def osmnx_settings(**values: Any) -> Iterator[None]:
     """Set ``osmnx.settings`` attributes for the duration of a block, then restore them.
 
     Values that are None are left alone.
     """
+    ox = _osmnx()
     saved: dict[str, Any] = {}
     with _SETTINGS_LOCK:
         try:
@@ -305,7 +311,7 @@ def _graph_from_ways(
         xml_path = Path(tmp) / "streets.osm"
         xml_path.write_text("\n".join(lines), encoding="utf-8")
         with osmnx_settings(log_console=False):
-            graph = ox.graph_from_xml(
+            graph = _osmnx().graph_from_xml(
                 xml_path, bidirectional=False, simplify=False, retain_all=True
             )
     return simplify(graph)
@@ -318,7 +324,7 @@ each (osmnx would otherwise merge them into lists in arbitrary order)."""
 
 def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
     """osmnx simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
-    return ox.simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
+    return _osmnx().simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
 
 
 def overpass_filter(highways: frozenset[str]) -> str:
@@ -400,6 +406,9 @@ def read_overpass(
     if overpass_url is not None:
         settings["overpass_url"] = overpass_url.rstrip("/")
     where = f"lat={lat:.6f}, lon={lon:.6f}"
+    import requests
+
+    ox = _osmnx()
     url = overpass_url or ox.settings.overpass_url
     problem = probe_server(url, connect_timeout_s)
     if problem == "timeout":
