@@ -12,9 +12,6 @@ file holds both sides of a change::
 
 Targets (issue 9): ``camloc --help`` under 0.2 s, ``camloc calibrate`` on the sample under
 0.6 s, ``camloc locate`` on the bundled sample with its extract under 1 s of CPU.
-
-Also times ``locate_scene`` on the Fremantle scene in-process (the figure a timed test used to
-assert on: under 2 s including the map load).
 """
 
 from __future__ import annotations
@@ -27,7 +24,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
 
@@ -119,21 +115,6 @@ def import_profile(cmd: list[str], top: int = 12) -> dict[str, Any]:
     }
 
 
-def locate_in_process() -> dict[str, float]:
-    """``locate_scene`` on the Fremantle test scene, map load included (seconds)."""
-    sys.path.insert(0, str(ROOT))
-    from camloc_geo.api import locate_scene
-
-    scene = ROOT / "tests" / "data" / "fremantle_scene.json"
-    extract = ROOT / "data" / "osm" / "fremantle.osm"
-    if not scene.exists():
-        return {}
-    t0 = time.perf_counter()
-    out = locate_scene(scene, map_source=extract, network=False)
-    elapsed = time.perf_counter() - t0
-    return {"fremantle_locate_s": elapsed, "candidates": float(len(out.result.candidates))}
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -163,7 +144,6 @@ def main(argv: list[str] | None = None) -> int:
             f"{ns.label:7s} {name:10s} wall {med['wall_s']:.3f} s  cpu {med['cpu_s']:.3f} s  "
             f"rss {med['max_rss_mb']:.0f} MB  (target {key} < {target})"
         )
-    res["in_process"] = locate_in_process()
     doc[ns.label] = res
     tmp = out_path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(doc, indent=2) + "\n")
