@@ -295,8 +295,6 @@ def corners_near(
     ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
     from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
     """
-    from camloc_geo.osm import intersections_geojson
-
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -306,6 +304,8 @@ def corners_near(
         cache_folder=cache_folder,
         overpass_url=overpass_url,
     )
+    from camloc_geo.osm import intersections_geojson
+
     inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
     return intersections_geojson(inters)
 
