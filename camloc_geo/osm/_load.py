@@ -1,12 +1,13 @@
-"""Loading OSM data around a point: local extracts (pyosmium + osmnx) or live Overpass.
+"""Loading OSM data around a point: local extracts (pyosmium) or live Overpass (osmnx).
 
 Offline, the extract (PBF or XML, plain/gzip/bzip2) is read once with pyosmium, keeping
 only the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
 ``radius_m + CLIP_MARGIN_M`` of the point; ways are kept whole, so every street through a
 kept intersection is complete. Each way's geometry is built in C++ (WKB) and its nodes are
-only visited in Python when it is kept. The street ways are written to a small temporary OSM
-XML file from which :func:`osmnx.graph_from_xml` builds the graph, simplified with
-:func:`osmnx.simplify_graph` keeping nodes where name, highway, lanes or width change.
+only visited in Python when it is kept. The street graph is built from the ways by
+:mod:`camloc_geo.osm._graph`, which follows :func:`osmnx.graph_from_xml` and
+:func:`osmnx.simplify_graph` (nodes kept where name, highway, lanes, width or junction
+change) without importing osmnx.
 Buildings are closed ``building=*`` ways (multipolygon building relations are skipped
 offline; online, osmnx returns them and the largest polygon is kept).
 
@@ -26,20 +27,19 @@ import logging
 import math
 import os
 import struct
-import tempfile
 import threading
 from collections import OrderedDict
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import quoteattr
 
 import networkx as nx
 import osmium
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
+from camloc_geo.osm._graph import graph_from_ways, simplify_graph
 from camloc_geo.osm._model import Building, polygon_from_lonlat
 from camloc_geo.osm._widths import parse_lanes, parse_width_m
 
@@ -293,28 +293,8 @@ def read_extract(
 def _graph_from_ways(
     ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]],
 ) -> nx.MultiDiGraph:
-    """Build the simplified osmnx graph from street ways via a temporary OSM XML file."""
-    nodes: dict[int, tuple[float, float]] = {}
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="camloc_geo">']
-    way_lines: list[str] = []
-    for way_id, tags, refs in ways:
-        way_lines.append(f'<way id="{way_id}">')
-        for ref, y, x in refs:
-            nodes[ref] = (y, x)
-            way_lines.append(f'<nd ref="{ref}"/>')
-        way_lines.extend(f"<tag k={quoteattr(k)} v={quoteattr(v)}/>" for k, v in tags.items())
-        way_lines.append("</way>")
-    lines.extend(f'<node id="{ref}" lat="{y:.7f}" lon="{x:.7f}"/>' for ref, (y, x) in nodes.items())
-    lines.extend(way_lines)
-    lines.append("</osm>")
-    with tempfile.TemporaryDirectory(prefix="camloc_osm_") as tmp:
-        xml_path = Path(tmp) / "streets.osm"
-        xml_path.write_text("\n".join(lines), encoding="utf-8")
-        with osmnx_settings(log_console=False):
-            graph = _osmnx().graph_from_xml(
-                xml_path, bidirectional=False, simplify=False, retain_all=True
-            )
-    return simplify(graph)
+    """The simplified street graph of the ways (osmnx's, built without importing osmnx)."""
+    return simplify(graph_from_ways(ways))
 
 
 SIMPLIFY_EDGE_ATTRS_DIFFER = ("name", "highway", "lanes", "width", "junction")
@@ -323,8 +303,8 @@ each (osmnx would otherwise merge them into lists in arbitrary order)."""
 
 
 def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
-    """osmnx simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
-    return _osmnx().simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
+    """osmnx's simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
+    return simplify_graph(graph, edge_attrs_differ=SIMPLIFY_EDGE_ATTRS_DIFFER)
 
 
 def overpass_filter(highways: frozenset[str]) -> str:
