@@ -7,7 +7,8 @@ imports, and the slowest of them), and writes ``benchmarks/out/startup.json``.
 The results of earlier runs are kept under their ``--label`` (``before`` / ``after``), so one
 file holds both sides of a change::
 
-    git stash; python benchmarks/startup.py --label before; git stash pop
+    git archive BASE | tar -x -C /tmp/base     # the code before the change
+    python benchmarks/startup.py --label before --root /tmp/base
     python benchmarks/startup.py --label after
 
 Targets (issue 9): ``camloc --help`` under 0.2 s, ``camloc calibrate`` on the sample under
@@ -45,13 +46,16 @@ TARGETS_S = {"help": ("wall_s", 0.2), "calibrate": ("wall_s", 0.6), "locate": ("
 HEAVY = ("numpy", "scipy", "osmnx", "geopandas", "cv2", "folium", "pandas", "networkx", "shapely")
 
 
+CODE = ROOT  # the checkout whose code is measured (--root)
+
+
 def _camloc(args: list[str]) -> list[str]:
     return [sys.executable, "-m", "camloc_geo.cli", *args]
 
 
 def _env() -> dict[str, str]:
     env = dict(os.environ)
-    env["PYTHONPATH"] = str(ROOT)
+    env["PYTHONPATH"] = str(CODE)
     env.pop("PYTHONPROFILEIMPORTTIME", None)
     return env
 
@@ -61,7 +65,7 @@ def time_once(cmd: list[str]) -> dict[str, float]:
     with tempfile.NamedTemporaryFile("r", suffix=".txt") as tf:
         proc = subprocess.run(
             ["/usr/bin/time", "-v", "-o", tf.name, *cmd],
-            cwd=ROOT,
+            cwd=CODE,
             env=_env(),
             stdout=subprocess.DEVNULL,
             stderr=subprocess.PIPE,
@@ -92,7 +96,7 @@ def import_profile(cmd: list[str], top: int = 12) -> dict[str, Any]:
     """``python -X importtime``: total import time, the slowest modules, heavy ones present."""
     proc = subprocess.run(
         [cmd[0], "-X", "importtime", *cmd[1:]],
-        cwd=ROOT,
+        cwd=CODE,
         env=_env(),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
@@ -120,12 +124,15 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--label", default="after", help="key in startup.json (before / after)")
     ap.add_argument("--runs", type=int, default=7, help="counted runs per command (7)")
+    ap.add_argument("--root", type=Path, default=ROOT, help="checkout to measure (this one)")
     ns = ap.parse_args(argv)
+    global CODE
+    CODE = ns.root.resolve()
 
     OUT.mkdir(parents=True, exist_ok=True)
     out_path = OUT / "startup.json"
     doc: dict[str, Any] = json.loads(out_path.read_text()) if out_path.exists() else {}
-    res: dict[str, Any] = {"python": sys.version.split()[0], "commands": {}}
+    res: dict[str, Any] = {"python": sys.version.split()[0], "root": str(CODE), "commands": {}}
     for name, args in COMMANDS.items():
         cmd = _camloc(args)
         time_once(cmd)  # warm-up (page cache, .pyc)
