@@ -16,6 +16,7 @@ Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -24,6 +25,7 @@ from camloc_geo._errors import MapDataError, SceneError
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
+    from camloc_geo.autovp import AutoVPResult
     from camloc_geo.osm import MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
@@ -36,9 +38,11 @@ __all__ = [
     "calibrate_scene",
     "corners_near",
     "locate_scene",
+    "map_around",
     "map_for_scene",
     "scene_from",
     "streets_near",
+    "vanishing_points",
 ]
 
 SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
@@ -339,3 +343,92 @@ def streets_near(
     return load_map(
         map_source, lat, lon, radius_m, cache_folder=cache_folder, overpass_url=overpass_url
     )
+
+
+def vanishing_points(
+    image: str | os.PathLike[str] | Any,
+    *,
+    focal_px: float | None = None,
+    principal_point: tuple[float, float] | None = None,
+    ignore_boxes_px: Sequence[Sequence[float]] = (),
+    axes_px: Sequence[Sequence[float]] = (),
+    estimate_principal_point: bool = False,
+    seed: int = 0,
+) -> AutoVPResult:
+    """Three orthogonal vanishing points, focal length, horizon, pitch and roll of a photo.
+
+    Parameters
+    ----------
+    image
+        Path of a photo (any format OpenCV reads) or a grey/colour image array.
+    focal_px, principal_point
+        Known intrinsics, pixels (default: estimated / the image centre).
+    ignore_boxes_px
+        ``(x0, y0, x1, y1)`` pixel boxes whose segments are ignored (time stamps, logos).
+    axes_px
+        ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
+    estimate_principal_point
+        Also refine the principal point around the image centre.
+
+    Raises
+    ------
+    InputError
+        Unreadable image, non-positive focal length, non-finite box, too little structure.
+    """
+    import numpy as np
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.autovp import detect_vanishing_points, load_image
+
+    if focal_px is not None and not focal_px > 0:
+        raise InputError(f"focal_px must be positive, got {focal_px}")
+    img = load_image(image)
+    mask = None
+    if ignore_boxes_px:
+        h, w = img.shape[:2]
+        mask = np.ones((h, w), dtype=bool)
+        for box in ignore_boxes_px:
+            if len(box) != 4 or not all(np.isfinite(box)):
+                raise InputError("ignore box: give four finite numbers x0 y0 x1 y1")
+            xa, xb = sorted((box[0], box[2]))
+            ya, yb = sorted((box[1], box[3]))
+            mask[
+                max(0, int(ya)) : max(0, int(np.ceil(yb))),
+                max(0, int(xa)) : max(0, int(np.ceil(xb))),
+            ] = False
+    return detect_vanishing_points(
+        img,
+        focal_px=focal_px,
+        principal_point=principal_point,
+        seed=seed,
+        mask=mask,
+        estimate_principal_point=estimate_principal_point,
+        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+    )
+
+
+def map_around(
+    points: Sequence[tuple[float, float]],
+    *,
+    map_source: MapSource = None,
+    network: bool = False,
+    margin_m: float = 150.0,
+    max_radius_m: float = 2000.0,
+) -> MapData | None:
+    """The map covering ``(lat, lon)`` points (cameras), or None without points.
+
+    Centred on the points' mean, with a radius reaching the farthest point plus
+    ``margin_m`` (at most ``max_radius_m``).
+    """
+    if not points:
+        return None
+    _require_source(map_source, network)
+    from camloc_geo.geodesy import distance_m
+    from camloc_geo.osm import MapData, load_map
+
+    if isinstance(map_source, MapData):
+        return map_source
+    lat = sum(p[0] for p in points) / len(points)
+    lon = sum(p[1] for p in points) / len(points)
+    radius = max(distance_m(lon, lat, q[1], q[0]) for q in points)
+    return load_map(map_source, lat, lon, radius_m=min(radius + margin_m, max_radius_m))

@@ -347,3 +347,22 @@ def test_calibrate_imports_no_map_code() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
     )
     assert proc.stdout.splitlines()[-1] == "RC 0 False False False"
+
+
+def test_summary_map_with_extract_draws_its_streets(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.api import map_around
+
+    gj = tmp_path / "a.geojson"
+    gj.write_text(json.dumps(_collection([_candidate(39.2856, -76.5935)])))
+    plain, with_map = tmp_path / "plain.html", tmp_path / "map.html"
+    assert main(["summary-map", str(gj), "-o", str(plain), "--inline"]) == 0
+    argv = ["summary-map", str(gj), "-o", str(with_map), "--inline", "--osm", str(BALTIMORE)]
+    assert main(argv) == 0
+    assert "Eastern" not in plain.read_text()
+    assert "Eastern" in with_map.read_text()  # street names of the extract in the page
+    m = map_around([(39.2856, -76.5935), (39.2900, -76.5935)], map_source=BALTIMORE)
+    assert m is not None
+    assert m.radius_m == pytest.approx(245 + 150, abs=5)  # half of 490 m, plus the margin
+    assert map_around([], map_source=BALTIMORE) is None

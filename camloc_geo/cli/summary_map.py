@@ -117,15 +117,10 @@ def run(args: argparse.Namespace) -> int:
     if not pts and any(n > 0 for _s, _g, n in cleaned):
         raise InputError("no usable camera position in the inputs (every candidate was skipped)")
     map_data = None
-    if args.osm and pts:
-        from camloc_geo.geodesy import LocalFrame
-        from camloc_geo.osm import load_map
+    if args.osm:
+        from camloc_geo.api import map_around
 
-        lat = sum(p[0] for p in pts) / len(pts)
-        lon = sum(p[1] for p in pts) / len(pts)
-        frame = LocalFrame(lat, lon)
-        radius = max(math.hypot(*frame.enu_from_geographic(q[1], q[0])) for q in pts)
-        map_data = load_map(args.osm, lat, lon, radius_m=min(radius + 150.0, 2000.0))
+        map_data = map_around(pts, map_source=args.osm)
     from camloc_geo.maps import summary_map
 
     with atomic_output(out) as tmp:
