@@ -61,7 +61,16 @@ NETWORK_HELP = (
 
 atomic_output = atomic_path
 
-_COMMAND_MODULES = ("calibrate", "locate", "corners", "streets", "vp", "summary_map", "schema")
+_COMMAND_MODULES = (
+    "calibrate",
+    "locate",
+    "corners",
+    "streets",
+    "vp",
+    "summary_map",
+    "schema",
+    "serve",
+)
 
 log = logging.getLogger("camloc_geo.cli")
 
