@@ -33,7 +33,6 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy.cluster.hierarchy import fcluster, linkage
 from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
@@ -407,6 +406,8 @@ def _cluster(
     if len(pts) == 1:
         labels = np.array([1])
     else:
+        from scipy.cluster.hierarchy import fcluster, linkage  # 0.25 s to import: only here
+
         labels = fcluster(linkage(pts, method="single"), t=threshold, criterion="distance")
     best_label, best_key = None, None
     for lab in np.unique(labels):

@@ -1,12 +1,13 @@
-"""Loading OSM data around a point: local extracts (pyosmium + osmnx) or live Overpass.
+"""Loading OSM data around a point: local extracts (pyosmium) or live Overpass (osmnx).
 
 Offline, the extract (PBF or XML, plain/gzip/bzip2) is read once with pyosmium, keeping
 only the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
 ``radius_m + CLIP_MARGIN_M`` of the point; ways are kept whole, so every street through a
 kept intersection is complete. Each way's geometry is built in C++ (WKB) and its nodes are
-only visited in Python when it is kept. The street ways are written to a small temporary OSM
-XML file from which :func:`osmnx.graph_from_xml` builds the graph, simplified with
-:func:`osmnx.simplify_graph` keeping nodes where name, highway, lanes or width change.
+only visited in Python when it is kept. The street graph is built from the ways by
+:mod:`camloc_geo.osm._graph`, which follows :func:`osmnx.graph_from_xml` and
+:func:`osmnx.simplify_graph` (nodes kept where name, highway, lanes, width or junction
+change) without importing osmnx.
 Buildings are closed ``building=*`` ways (multipolygon building relations are skipped
 offline; online, osmnx returns them and the largest polygon is kept).
 
@@ -26,22 +27,19 @@ import logging
 import math
 import os
 import struct
-import tempfile
 import threading
 from collections import OrderedDict
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import quoteattr
 
 import networkx as nx
 import osmium
-import osmnx as ox
-import requests
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
+from camloc_geo.osm._graph import graph_from_ways, simplify_graph
 from camloc_geo.osm._model import Building, polygon_from_lonlat
 from camloc_geo.osm._widths import parse_lanes, parse_width_m
 
@@ -100,12 +98,20 @@ class RawMap:
 _SETTINGS_LOCK = threading.RLock()
 
 
+def _osmnx() -> Any:
+    """osmnx, imported on first use (half a second: it pulls in geopandas and matplotlib)."""
+    import osmnx
+
+    return osmnx
+
+
 @contextlib.contextmanager
 def osmnx_settings(**values: Any) -> Iterator[None]:
     """Set ``osmnx.settings`` attributes for the duration of a block, then restore them.
 
     Values that are None are left alone.
     """
+    ox = _osmnx()
     saved: dict[str, Any] = {}
     with _SETTINGS_LOCK:
         try:
@@ -287,28 +293,8 @@ def read_extract(
 def _graph_from_ways(
     ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]],
 ) -> nx.MultiDiGraph:
-    """Build the simplified osmnx graph from street ways via a temporary OSM XML file."""
-    nodes: dict[int, tuple[float, float]] = {}
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="camloc_geo">']
-    way_lines: list[str] = []
-    for way_id, tags, refs in ways:
-        way_lines.append(f'<way id="{way_id}">')
-        for ref, y, x in refs:
-            nodes[ref] = (y, x)
-            way_lines.append(f'<nd ref="{ref}"/>')
-        way_lines.extend(f"<tag k={quoteattr(k)} v={quoteattr(v)}/>" for k, v in tags.items())
-        way_lines.append("</way>")
-    lines.extend(f'<node id="{ref}" lat="{y:.7f}" lon="{x:.7f}"/>' for ref, (y, x) in nodes.items())
-    lines.extend(way_lines)
-    lines.append("</osm>")
-    with tempfile.TemporaryDirectory(prefix="camloc_osm_") as tmp:
-        xml_path = Path(tmp) / "streets.osm"
-        xml_path.write_text("\n".join(lines), encoding="utf-8")
-        with osmnx_settings(log_console=False):
-            graph = ox.graph_from_xml(
-                xml_path, bidirectional=False, simplify=False, retain_all=True
-            )
-    return simplify(graph)
+    """The simplified street graph of the ways (osmnx's, built without importing osmnx)."""
+    return simplify(graph_from_ways(ways))
 
 
 SIMPLIFY_EDGE_ATTRS_DIFFER = ("name", "highway", "lanes", "width", "junction")
@@ -317,14 +303,49 @@ each (osmnx would otherwise merge them into lists in arbitrary order)."""
 
 
 def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
-    """osmnx simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
-    return ox.simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
+    """osmnx's simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
+    return simplify_graph(graph, edge_attrs_differ=SIMPLIFY_EDGE_ATTRS_DIFFER)
 
 
 def overpass_filter(highways: frozenset[str]) -> str:
     """The osmnx ``custom_filter`` selecting :data:`STREET_HIGHWAYS` ways."""
     alternatives = "|".join(sorted(highways))
     return f'["highway"~"^({alternatives})$"]["area"!~"yes"]'
+
+
+CONNECT_TIMEOUT_S = 5.0
+"""How long to wait for the Overpass server to accept a connection, seconds."""
+
+_OFFLINE_HINT = "give --osm EXTRACT (a local OSM extract) to work without the network"
+
+
+def probe_server(url: str, timeout_s: float) -> str | None:
+    """None when a TCP connection to the URL's host opens within ``timeout_s``.
+
+    Otherwise why not: ``"timeout"``, ``"connection refused"``, ``"unknown host"``...
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(url)
+    host = parts.hostname
+    if not host:
+        return "no host in the URL"
+    try:
+        port = parts.port or (443 if parts.scheme == "https" else 80)
+    except ValueError:
+        return "bad port in the URL"
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            return None
+    except TimeoutError:
+        return "timeout"
+    except socket.gaierror:
+        return "unknown host"
+    except ConnectionRefusedError:
+        return "connection refused"
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
 
 
 def read_overpass(
@@ -337,8 +358,15 @@ def read_overpass(
     overpass_rate_limit: bool = True,
     timeout_s: float = 60.0,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    connect_timeout_s: float = CONNECT_TIMEOUT_S,
 ) -> RawMap:
     """Query streets and buildings around a point from Overpass through osmnx.
+
+    The server is first probed with a TCP connection of ``connect_timeout_s``: when it does
+    not answer in time the call fails at once (osmnx would otherwise wait its rate-limit
+    pause, 60 s, then the full HTTP timeout). When the connection is refused or the name
+    does not resolve, osmnx still runs without its rate-limit query, so answers in its HTTP
+    cache are served and anything else fails immediately.
 
     Raises
     ------
@@ -358,6 +386,18 @@ def read_overpass(
     if overpass_url is not None:
         settings["overpass_url"] = overpass_url.rstrip("/")
     where = f"lat={lat:.6f}, lon={lon:.6f}"
+    import requests
+
+    ox = _osmnx()
+    url = overpass_url or ox.settings.overpass_url
+    problem = probe_server(url, connect_timeout_s)
+    if problem == "timeout":
+        raise MapSourceError(
+            f"cannot reach the Overpass server {url} (no answer in {connect_timeout_s:g} s): "
+            f"{_OFFLINE_HINT}"
+        )
+    if problem is not None:
+        settings["overpass_rate_limit"] = False
     try:
         with osmnx_settings(**settings):
             graph = ox.graph_from_point(
@@ -388,8 +428,8 @@ def read_overpass(
         raise MapSourceError(f"Overpass server error for {where}: {exc}") from exc
     except requests.exceptions.RequestException as exc:
         raise MapSourceError(
-            f"cannot reach the Overpass server {overpass_url or ox.settings.overpass_url}: "
-            f"{type(exc).__name__}"
+            f"cannot reach the Overpass server {url} ({problem or type(exc).__name__}): "
+            f"{_OFFLINE_HINT}"
         ) from exc
     except ValueError as exc:  # a reply that is not Overpass JSON
         raise MapSourceError(

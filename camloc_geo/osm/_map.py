@@ -12,12 +12,16 @@ from typing import Any, TypeVar
 
 import networkx as nx
 import numpy as np
-import osmnx as ox
 from shapely.geometry import LineString, Point
 
 from camloc_geo._errors import MapDataError
 from camloc_geo.geodesy import LocalFrame
-from camloc_geo.osm._intersections import build_intersections, highway_of, street_label
+from camloc_geo.osm._intersections import (
+    build_intersections,
+    highway_of,
+    initial_bearing_deg,
+    street_label,
+)
 from camloc_geo.osm._load import (
     STREET_HIGHWAYS,
     RawMap,
@@ -325,7 +329,7 @@ class MapData:
             (lon_a, lon_b), (lat_a, lat_b) = self.frame.geographic_from_enu(
                 np.array([a.x, b.x]), np.array([a.y, b.y])
             )
-            brg = float(ox.bearing.calculate_bearing(lat_a, lon_a, lat_b, lon_b)) % 180.0
+            brg = initial_bearing_deg(lat_a, lon_a, lat_b, lon_b) % 180.0
             rows.append((float(dist), street.name, brg))
         rows.sort()
         out: list[tuple[str, float]] = []
