@@ -865,7 +865,7 @@ _AUTO_CACHE: dict[str, Any] = {}
 def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
     """Segments for axes an annotator drew no lines for, from the image (if any)."""
     path = scene.image_file()
-    if path is None or not path.exists():
+    if path is None or not path.is_file():  # is_file: a FIFO or a device would block
         return {}
     try:
         from camloc_geo import autovp
@@ -874,7 +874,11 @@ def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, Float
     key = str(path)
     if key not in _AUTO_CACHE:
         _AUTO_CACHE.clear()
-        _AUTO_CACHE[key] = autovp.detect_vanishing_points(str(path))
+        try:
+            _AUTO_CACHE[key] = autovp.detect_vanishing_points(str(path))
+        except InputError as exc:
+            log.warning("image.path: no lines detected in %s: %s", path, exc)
+            return {}
     res = _AUTO_CACHE[key]
     ann = scene.annotations[index]
     out = {}
@@ -987,6 +991,7 @@ def _screen_annotations(scene: Scene) -> _Screening:
         clamped += n
     if clamped:
         log.info("%d click(s) just outside the image clamped onto it", clamped)
+    anns, kept = _screen_segments(scene, anns, kept, excluded, warnings)
     update: dict[str, Any] = {"annotations": anns}
     hints: dict[str, Any] = {}
     w, h = scene.image_size
@@ -1012,6 +1017,114 @@ def _screen_annotations(scene: Scene) -> _Screening:
     if hints:
         update["camera"] = scene.camera.model_copy(update=hints)
     return _Screening(scene.model_copy(update=update), kept, excluded, clamped, warnings)
+
+
+def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
+    """Residuals (px) of segments to their least-median-of-squares vanishing point.
+
+    Candidates are the intersections of pairs of segments (all pairs up to 25 segments, 300
+    seeded random pairs beyond); the one with the smallest median residual is refined by a
+    fit to its inliers. Robust to nearly half the segments being slips, however long.
+    """
+    n = len(segments)
+    ones = np.ones((n, 1))
+    lines = np.cross(np.hstack([segments[:, :2], ones]), np.hstack([segments[:, 2:], ones]))
+    lines /= np.maximum(np.linalg.norm(lines[:, :2], axis=1), 1e-12)[:, None]
+    if n <= 25:
+        pairs = np.array([(i, j) for i in range(n) for j in range(i + 1, n)])
+    else:
+        rng = np.random.default_rng(0)
+        pairs = rng.integers(0, n, (300, 2))
+        pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    best: tuple[float, FloatArray] | None = None
+    for i, j in pairs:
+        v = np.cross(lines[i], lines[j])
+        if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
+            continue
+        med = float(np.median(np.abs(segment_residuals_px(segments, v))))
+        if best is None or med < best[0]:
+            best = (med, v)
+    if best is None:
+        return None
+    r = np.abs(segment_residuals_px(segments, best[1]))
+    scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
+    inliers = r <= 3.0 * scale
+    if inliers.sum() >= 2:
+        try:
+            vp = fit_vanishing_point(segments[inliers], scale_px=diag, name="pooled")
+            r = np.abs(segment_residuals_px(segments, vp.homogeneous))
+        except (DegenerateGeometryError, np.linalg.LinAlgError):
+            pass
+    return np.asarray(r, dtype=np.float64)
+
+
+def _screen_segments(
+    scene: Scene,
+    anns: list[Annotation],
+    kept: list[int],
+    excluded: list[dict[str, Any]],
+    warnings: list[str],
+) -> tuple[list[Annotation], list[int]]:
+    """Leave out segments that disagree grossly with everybody's vanishing point of their axis.
+
+    Per axis, the vanishing point of all annotators' segments pooled (with a robust 3 × MAD
+    rejection) is the reference; a segment farther from it than ``max(8 × the robust scale,
+    1 % of the image diagonal)`` is a slip (an end dragged away, a line drawn for another
+    axis) and is dropped with a warning. An annotator (of three or more) most of whose
+    segments of an axis are such slips drew that axis wrong and is left out.
+    """
+    w, h = scene.image_size
+    diag = math.hypot(w, h)
+    gross: dict[tuple[int, str], npt.NDArray[np.bool_]] = {}
+    for axis in AXES:
+        segs = [np.asarray(getattr(a.vp_lines, axis), float).reshape(-1, 4) for a in anns]
+        pooled = np.vstack(segs) if segs else np.zeros((0, 4))
+        if len(pooled) < 3:
+            continue
+        r = _lmeds_residuals(pooled, diag)
+        if r is None:
+            continue
+        scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
+        bad = r > max(8.0 * scale, 0.01 * diag)
+        start = 0
+        for slot, sg in enumerate(segs):
+            gross[(slot, axis)] = bad[start : start + len(sg)]
+            start += len(sg)
+    out_anns: list[Annotation] = []
+    out_kept: list[int] = []
+    for slot, (ann, i) in enumerate(zip(anns, kept, strict=True)):
+        reason = None
+        lines: dict[str, list[Any]] = {}
+        for axis in AXES:
+            flags = gross.get((slot, axis))
+            segs_list = list(getattr(ann.vp_lines, axis))
+            if flags is None or not flags.any():
+                lines[axis] = segs_list
+                continue
+            n_bad = int(flags.sum())
+            if len(anns) >= 3 and n_bad >= 2 and n_bad * 2 > len(segs_list):
+                reason = (
+                    f"vp_lines.{axis}: {n_bad} of {len(segs_list)} segments disagree with "
+                    "everybody else's (drawn for another axis?)"
+                )
+                break
+            for j in np.flatnonzero(flags):
+                warnings.append(
+                    f"annotations[{i}].vp_lines.{axis}[{j}] ({ann.annotator}): far from "
+                    "everybody's vanishing point of that axis; left out"
+                )
+            lines[axis] = [sg for sg, f in zip(segs_list, flags, strict=True) if not f]
+        if reason is not None:
+            excluded.append(
+                {"annotator": ann.annotator, "index": i, "reason": reason, "geometry": True}
+            )
+            warnings.append(f"annotator {ann.annotator!r} (annotations[{i}]) left out: {reason}")
+            continue
+        if lines != {axis: list(getattr(ann.vp_lines, axis)) for axis in AXES}:
+            ann = ann.model_copy(update={"vp_lines": ann.vp_lines.model_copy(update=lines)})
+        out_anns.append(ann)
+        out_kept.append(i)
+    return out_anns, out_kept
 
 
 def implausibility(result: CalibrationResult, image_size: tuple[int, int]) -> str | None:

@@ -168,9 +168,7 @@ class ObjectSpec(_Model):
         if value is not None:
             lo, hi = OBJECT_SIZE_RANGES_M[info.field_name]
             if not lo <= value <= hi:  # also false for NaN
-                raise ValueError(
-                    f"must be {lo:g}-{hi:g} m, the range of road vehicles (got {value:g})"
-                )
+                raise ValueError(f"must be {lo:g}-{hi:g} m, the range of road vehicles")
         return value
 
     @field_validator("preset")
