@@ -1036,16 +1036,22 @@ def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
         rng = np.random.default_rng(0)
         pairs = rng.integers(0, n, (300, 2))
         pairs = pairs[pairs[:, 0] != pairs[:, 1]]
-    best: tuple[float, FloatArray] | None = None
-    for i, j in pairs:
-        v = np.cross(lines[i], lines[j])
-        if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
-            continue
-        med = float(np.median(np.abs(segment_residuals_px(segments, v))))
-        if best is None or med < best[0]:
-            best = (med, v)
-    if best is None:
+    if len(pairs) == 0:
         return None
+    V = np.cross(lines[pairs[:, 0]], lines[pairs[:, 1]])  # candidate vanishing points (P, 3)
+    V = V[np.all(np.isfinite(V), axis=1) & (np.linalg.norm(V, axis=1) > 0)]
+    if len(V) == 0:
+        return None
+    V /= np.linalg.norm(V, axis=1)[:, None]
+    # segment_residuals_px for every candidate at once: (P, n).
+    mx = (segments[:, 0] + segments[:, 2]) / 2.0
+    my = (segments[:, 1] + segments[:, 3]) / 2.0
+    px, py, pw = V[:, 0:1], V[:, 1:2], V[:, 2:3]
+    la, lb = my * pw - py, px - mx * pw
+    lc = mx * py - my * px
+    res = (la * segments[:, 0] + lb * segments[:, 1] + lc) / np.maximum(np.hypot(la, lb), 1e-300)
+    med = np.median(np.abs(res), axis=1)
+    best = (float(med.min()), V[int(np.argmin(med))])
     r = np.abs(segment_residuals_px(segments, best[1]))
     scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
     inliers = r <= 3.0 * scale
@@ -1069,8 +1075,9 @@ def _screen_segments(
 
     Per axis, the vanishing point of all annotators' segments pooled (with a robust 3 × MAD
     rejection) is the reference; a segment farther from it than ``max(8 × the robust scale,
-    1 % of the image diagonal)`` is a slip (an end dragged away, a line drawn for another
-    axis) and is dropped with a warning. An annotator (of three or more) most of whose
+    1 % of the image diagonal)``, or pointing more than 30° away from it and farther than
+    3 × the robust scale, is a slip (an end dragged away, a line drawn for another axis)
+    and is dropped with a warning. An annotator (of three or more) most of whose
     segments of an axis are such slips drew that axis wrong and is left out.
     """
     w, h = scene.image_size
@@ -1085,7 +1092,9 @@ def _screen_segments(
         if r is None:
             continue
         scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
-        bad = r > max(8.0 * scale, 0.01 * diag)
+        half = 0.5 * np.hypot(pooled[:, 2] - pooled[:, 0], pooled[:, 3] - pooled[:, 1])
+        angle = np.degrees(np.arcsin(np.clip(r / np.maximum(half, 1e-9), 0.0, 1.0)))
+        bad = (r > max(8.0 * scale, 0.01 * diag)) | ((angle > 30.0) & (r > 3.0 * scale))
         start = 0
         for slot, sg in enumerate(segs):
             gross[(slot, axis)] = bad[start : start + len(sg)]
