@@ -1086,7 +1086,7 @@ def _screen_segments(
     for axis in AXES:
         segs = [np.asarray(getattr(a.vp_lines, axis), float).reshape(-1, 4) for a in anns]
         pooled = np.vstack(segs) if segs else np.zeros((0, 4))
-        if len(pooled) < 3:
+        if len(pooled) < 5:  # too few to tell a slip from the others' noise
             continue
         r = _lmeds_residuals(pooled, diag)
         if r is None:

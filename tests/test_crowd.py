@@ -63,6 +63,7 @@ def _cli(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
 def test_reference_is_plausible(reference: CalibrationResult) -> None:
     assert reference.height_m == pytest.approx(9.4, abs=0.1)
     assert reference.excluded_annotators == []
+    assert reference.warnings == []
     assert reference.clamped_clicks == 0
 
 
@@ -70,7 +71,7 @@ def _extended_past_border(seg: list[float], offset: float) -> list[float]:
     """The segment's second end moved along its line to ``offset`` px past the image border."""
     p, q = np.array(seg[:2]), np.array(seg[2:])
     d = (q - p) / np.linalg.norm(q - p)
-    ts = [t for t in ((0 - p[0]) / d[0], (W - p[0]) / d[0], (0 - p[1]) / d[1], (H - p[1]) / d[1])]
+    ts = ((0 - p[0]) / d[0], (W - p[0]) / d[0], (0 - p[1]) / d[1], (H - p[1]) / d[1])
     t = min(t for t in ts if t > 0)
     return [*p.tolist(), *(p + (t + offset) * d).tolist()]
 
@@ -240,15 +241,33 @@ def test_implausible_object_size_is_refused(
 
 
 def test_single_implausible_annotator_fails_with_the_reason(sample: dict[str, Any]) -> None:
+    """A height edge clicked downwards puts the camera underground: refused, not returned."""
     data = copy.deepcopy(sample)
     data["annotations"] = data["annotations"][:1]
-    data["camera"] = {"focal_px": 300.0}  # plausible alone, wrong for these lines
-    try:
-        result = _cal(data)
-    except DegenerateGeometryError as exc:
-        assert "no plausible camera" in str(exc)
-    else:
-        assert implausibility(result, (W, H)) is None
+    axes = data["annotations"][0]["axes"]
+    o, h = axes["origin"], axes["height"]
+    axes["height"] = [2 * o[0] - h[0], 2 * o[1] - h[1]]
+    with pytest.raises(
+        DegenerateGeometryError,
+        match=r"^no plausible camera: the camera is [0-9.]+ m below the ground; the only usable "
+        r"annotator \(w1\)",
+    ):
+        _cal(data)
+
+
+def test_downward_height_edge_of_one_annotator_of_three(
+    sample: dict[str, Any], reference: CalibrationResult
+) -> None:
+    data = copy.deepcopy(sample)
+    axes = data["annotations"][1]["axes"]
+    o, h = axes["origin"], axes["height"]
+    axes["height"] = [2 * o[0] - h[0], 2 * o[1] - h[1]]
+    result = _cal(data)
+    assert implausibility(result, (W, H)) is None
+    assert reference.position_sigma_m is not None
+    assert result.height_m == pytest.approx(
+        reference.height_m, abs=3 * reference.position_sigma_m[2]
+    )
 
 
 def test_implausibility_reasons(reference: CalibrationResult) -> None:
@@ -308,9 +327,9 @@ def test_calibrate_json_reports_clamps_and_exclusions(
     assert out["clamped_clicks"] == 1
     assert [e["annotator"] for e in out["excluded_annotators"]] == ["w2"]
     assert out["excluded_annotators"][0]["index"] == 1
-    assert "axes.width: pixel [900, -300] is 300 px outside" in out["excluded_annotators"][0][
-        "reason"
-    ]
+    assert (
+        "axes.width: pixel [900, -300] is 300 px outside" in out["excluded_annotators"][0]["reason"]
+    )
     assert "WARNING: annotator 'w2' (annotations[1]) left out" in proc.stderr
 
 
