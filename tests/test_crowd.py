@@ -494,8 +494,9 @@ def test_one_perturbed_annotator_is_named_or_harmless(
     named |= set(result.corner_mistakes)
     if name in named:
         return
-    sigma = reference.position_sigma_m
-    assert sigma is not None
+    assert reference.position_sigma_m is not None
+    assert result.position_sigma_m is not None
+    sigma = np.hypot(reference.position_sigma_m, result.position_sigma_m)
     dev = np.abs(result.camera.center_in_world - reference.camera.center_in_world)
     assert np.all(dev <= 3.0 * sigma + 0.5), (kind, dev, sigma)
     assert math.isfinite(result.height_m)
