@@ -119,6 +119,12 @@ def run(args: argparse.Namespace) -> int:
             raise SceneError("--max-candidates must be at least 1")
         settings = LocateSettings(max_candidates=args.max_candidates)
     result = locate(scene, map_data, settings=settings)
+    from camloc_geo.cues import apply_cues
+
+    apply_cues(result, scene, map_data, merge_distance_m=settings.merge_distance_m)
+    for warning in result.warnings:
+        if warning.startswith("ambiguous"):
+            log.warning("%s", warning)  # a tie is never only in the GeoJSON
     gj = candidates_geojson(result)
     write_json(gj, args.output)
     if args.map:
