@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -152,3 +154,29 @@ def test_no_cue_leaves_the_result_alone(heidelberg: MapData) -> None:
     before = [(c.rank, c.score) for c in result.candidates]
     apply_cues(result, sc, heidelberg)
     assert [(c.rank, c.score) for c in result.candidates] == before
+
+
+def test_locate_prints_the_tie_and_the_hint_breaks_it(
+    heidelberg: MapData, tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from camloc_geo.cli import main
+
+    ls, scene = _flip_scene(heidelberg)
+    path = tmp_path / "tie.json"
+    path.write_text(json.dumps(scene))
+    osm = str(OSM / "heidelberg_altstadt.osm.pbf")
+    with caplog.at_level("WARNING", logger="camloc_geo.cli.locate"):
+        assert main(["locate", str(path), "--osm", osm, "-o", str(tmp_path / "a.geojson")]) == 0
+    ties = [r.message for r in caplog.records if r.message.startswith("ambiguous")]
+    assert len(ties) == 1
+    assert "candidates 1 and 2" in ties[0]
+    caplog.clear()
+    heading = float(ls.camera_enu.angles_deg[0])
+    scene["view_hint"] = {"bearing_deg": heading, "tolerance_deg": 30}
+    path.write_text(json.dumps(scene))
+    with caplog.at_level("WARNING", logger="camloc_geo.cli.locate"):
+        assert main(["locate", str(path), "--osm", osm, "-o", str(tmp_path / "b.geojson")]) == 0
+    assert not [r for r in caplog.records if r.message.startswith("ambiguous")]
+    out = json.loads((tmp_path / "b.geojson").read_text())
+    first = next(f for f in out["features"] if f["properties"].get("rank") == 1)
+    assert first["properties"]["score"] > 0.9
