@@ -1319,6 +1319,17 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     """
     n = len(scene.annotations)
     c = result.camera.center_in_world
+    # The refits keep the main fit's model choices (principal point, corners): cheaper, and
+    # the spread then measures the annotators, not the model selection.
+    free_pp = result.intrinsics_method == "joint_fit_free_principal_point"
+    sub_settings = replace(
+        settings,
+        jackknife=False,
+        free_principal_point=(
+            free_pp if settings.free_principal_point is None else settings.free_principal_point
+        ),
+        reassign_corners=settings.reassign_corners and bool(result.corner_mistakes),
+    )
     centres: list[FloatArray] = []
     influence: list[float | None] = []
     for j in range(n):
@@ -1326,7 +1337,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             update={"annotations": [a for k, a in enumerate(scene.annotations) if k != j]}
         )
         try:
-            res = _calibrate_usable(sub, replace(settings, jackknife=False))
+            res = _calibrate_usable(sub, sub_settings)
         except (InputError, np.linalg.LinAlgError):
             influence.append(None)
             continue
