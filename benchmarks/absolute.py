@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from camloc_geo.absolute import LocateResult, locate
+from camloc_geo.cues import apply_cues
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
@@ -76,7 +77,14 @@ PLACES = [
     ("kotka.osm.pbf", 60.529995, 26.95, 600.0),
     ("singapore_bayfront.osm.pbf", 1.28455, 103.859, 600.0),
 ]
-METHODS = ("corners", "two_references", "one_reference", "landmark", "one_landmark")
+METHODS = (
+    "corners",
+    "corners_view_hint",
+    "two_references",
+    "one_reference",
+    "landmark",
+    "one_landmark",
+)
 LANDMARK_METHODS = ("landmark", "one_landmark")
 # The paper's figures: (method, which candidate, threshold m, fraction).
 PAPER = [
@@ -84,7 +92,7 @@ PAPER = [
     ("corners", "closest", 10.0, 0.80),
     ("corners", "closest", 15.0, 1.00),
 ]
-AIM = [("corners", "top", 10.0, 0.80)]
+AIM = [("corners_view_hint", "top", 10.0, 0.80)]
 MAP_POINT = ("baltimore.osm.pbf", 39.28558, -76.59348, 300.0)
 
 log = logging.getLogger("bench_absolute")
@@ -94,11 +102,25 @@ def _junctions(m: MapData) -> list[Any]:
     return [i for i in m.intersections if i.kind == "junction" and len(i.corners) >= 3]
 
 
+_COMPASS_8 = ("north", "NE", "east", "SE", "south", "SW", "west", "NW")
+
+
+def with_view_hint(scene: dict[str, Any], ls: LocatedScene) -> dict[str, Any]:
+    """The scene with a webcam listing's viewing direction: the true heading rounded to the
+    nearest of eight compass points, as words ("looking NE"), read with the default 45°
+    tolerance."""
+    heading = float(ls.camera_enu.angles_deg[0]) % 360.0
+    scene["view_hint"] = {"text": f"looking {_COMPASS_8[round(heading / 45.0) % 8]}"}
+    return scene
+
+
 def _variant(ls: LocatedScene, method: str) -> dict[str, Any] | None:
     scene = json.loads(json.dumps(ls.scene))
     refs = scene.pop("references", [])
     if method == "corners":
         return scene
+    if method == "corners_view_hint":
+        return with_view_hint(scene, ls)
     scene.pop("intersection", None)
     if method == "two_references":
         if len(refs) < 2:
@@ -230,7 +252,7 @@ def run_scenes(
             sc = parse_scene(data)
             t0 = time.perf_counter()
             try:
-                res = locate(sc, m, calibration=c)
+                res = apply_cues(locate(sc, m, calibration=c), sc, m)
             except ValueError as exc:
                 row["methods"][method] = {"error": f"{type(exc).__name__}: {exc}"}
                 continue
