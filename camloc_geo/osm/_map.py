@@ -18,6 +18,7 @@ from camloc_geo._errors import MapDataError
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.osm._intersections import build_intersections, highway_of, street_label
 from camloc_geo.osm._load import (
+    NAMED_STREET_HIGHWAYS,
     STREET_HIGHWAYS,
     RawMap,
     cache_get,
@@ -95,7 +96,8 @@ class MapData:
     graph
         The simplified osmnx street graph (lon/lat, unprojected, not consolidated).
     bounds
-        ``(south, west, north, east)`` of the extract, when known.
+        ``(south, west, north, east)`` of the data (an extract's streets and buildings, not
+        its header's declared box), when known.
     source
         The extract path or the Overpass URL.
     """
@@ -114,7 +116,11 @@ class MapData:
         self.graph = raw.graph
         self.bounds = raw.bounds
         self.source = raw.source
+        self.warnings: list[str] = list(raw.warnings)
+        """Notes on the data itself (an extract ending inside the radius asked for)."""
         north_america = in_north_america(lat, lon)
+        self.rejected: dict[int, str] = {}
+        """``{osm node id: reason}`` for junction nodes that gave no intersection."""
         self._intersections = tuple(
             build_intersections(
                 raw.graph,
@@ -122,6 +128,7 @@ class MapData:
                 tolerance_m=tolerance_m,
                 radius_m=radius_m,
                 north_america=north_america,
+                rejected=self.rejected,
             )
         )
         self._streets = tuple(_streets_of(raw.graph, north_america))
@@ -326,6 +333,7 @@ def load_map(
     timeout_s: float = 60.0,
     tolerance_m: float = DEFAULT_TOLERANCE_M,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> MapData:
     """Load streets, intersections and buildings around a point.
 
@@ -351,6 +359,9 @@ def load_map(
         Intersection consolidation buffer, metres.
     highways
         ``highway`` values forming the street network.
+    named_highways
+        ``highway`` values that are streets when named (named service streets and alleys,
+        pedestrian segments of named streets).
 
     Returns
     -------
@@ -375,6 +386,7 @@ def load_map(
         radius_m,
         tolerance_m,
         tuple(sorted(highways)),
+        tuple(sorted(named_highways)),
     )
     raw: RawMap
     if source is None:
@@ -393,6 +405,7 @@ def load_map(
             overpass_rate_limit=overpass_rate_limit,
             timeout_s=timeout_s,
             highways=highways,
+            named_highways=named_highways,
         )
     else:
         path = Path(source).expanduser()
@@ -405,7 +418,9 @@ def load_map(
         if cached is not None:
             log.debug("map cache hit for %s", path)
             return cached
-        raw = read_extract(path, lat, lon, radius_m, highways=highways)
+        raw = read_extract(
+            path, lat, lon, radius_m, highways=highways, named_highways=named_highways
+        )
     result = MapData(raw, lat, lon, radius_m, tolerance_m=tolerance_m)
     cache_put(key, result)
     return result
