@@ -26,7 +26,6 @@ import contextlib
 import logging
 import math
 import os
-import struct
 import threading
 from collections import OrderedDict
 from collections.abc import Iterator
@@ -35,7 +34,9 @@ from pathlib import Path
 from typing import Any
 
 import networkx as nx
+import numpy as np
 import osmium
+import shapely
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
@@ -46,6 +47,7 @@ from camloc_geo.osm._widths import parse_lanes, parse_width_m
 __all__ = [
     "CLIP_MARGIN_M",
     "EXTRACT_SUFFIXES",
+    "NAMED_STREET_HIGHWAYS",
     "STREET_HIGHWAYS",
     "RawMap",
     "clear_cache",
@@ -77,6 +79,11 @@ STREET_HIGHWAYS: frozenset[str] = frozenset(
 )
 """``highway`` values that form the street network (no service roads, paths or footways)."""
 
+NAMED_STREET_HIGHWAYS: frozenset[str] = frozenset({"service", "pedestrian"})
+"""``highway`` values that are streets when they carry a ``name`` (and are not areas): named
+service streets and alleys (row-house streets, ``service=alley``) and pedestrian segments of
+named streets, so their junctions exist and they are junction arms."""
+
 CLIP_MARGIN_M = 60.0
 """Data is kept this far beyond the requested radius so edge clusters are complete."""
 
@@ -93,6 +100,7 @@ class RawMap:
     buildings: list[Building] = field(default_factory=list)
     bounds: tuple[float, float, float, float] | None = None  # (south, west, north, east)
     source: str = ""
+    warnings: list[str] = field(default_factory=list)
 
 
 _SETTINGS_LOCK = threading.RLock()
@@ -167,20 +175,6 @@ def _check_extract_path(path: Path) -> None:
         raise MapDataError(f"OSM extract is empty: {path}")
 
 
-def _header_box(path: Path) -> tuple[float, float, float, float] | None:
-    try:
-        reader = osmium.io.Reader(str(path), osmium.osm.NOTHING)
-        try:
-            box = reader.header().box()
-        finally:
-            reader.close()
-    except RuntimeError:
-        return None
-    if not box.valid():
-        return None
-    return (box.bottom_left.lat, box.bottom_left.lon, box.top_right.lat, box.top_right.lon)
-
-
 def read_extract(
     path: Path,
     lat: float,
@@ -188,6 +182,7 @@ def read_extract(
     radius_m: float | None,
     *,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> RawMap:
     """Read the streets and buildings of an extract around a point.
 
@@ -201,11 +196,14 @@ def read_extract(
         Keep ways with a node within ``radius_m + CLIP_MARGIN_M``; None keeps everything.
     highways
         ``highway`` values to keep as streets.
+    named_highways
+        ``highway`` values kept as streets when the way has a ``name`` and is not an area.
 
     Raises
     ------
     MapDataError
-        Unreadable or empty extract, point outside it, or no streets near the point.
+        Unreadable or empty extract, point outside the data it holds, or no streets near
+        the point.
     """
     _check_extract_path(path)
     box = None if radius_m is None else _clip_box(lat, lon, radius_m + CLIP_MARGIN_M)
@@ -226,18 +224,23 @@ def read_extract(
                 continue
             n_ways += 1
             highway = way.tags.get("highway")
-            is_street = highway in highways
+            is_street = highway in highways or (
+                highway in named_highways and "name" in way.tags and way.tags.get("area") != "yes"
+            )
             is_building = "building" in way.tags and not is_street
             if not (is_street or is_building):
                 continue
             # one C++ call builds the geometry (WKB); nodes are visited in Python only if kept
             try:
-                wkb = bytes.fromhex(wkb_factory.create_linestring(way))
+                xy = shapely.get_coordinates(shapely.from_wkb(wkb_factory.create_linestring(way)))
             except (osmium.InvalidLocationError, RuntimeError, ValueError):
-                continue  # fewer than two located nodes (clipped at the extract's edge)
-            coords = struct.unpack(f"<{(len(wkb) - 9) // 8}d", wkb[9:])  # x, y pairs
-            xs, ys = coords[0::2], coords[1::2]
-            x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+                # a way clipped at the extract's edge: keep the part the extract holds
+                xy = [(nd.location.lon, nd.location.lat) for nd in way.nodes if nd.location.valid()]
+                if len(xy) < 2:
+                    continue
+            xy = np.asarray(xy, dtype=float)
+            xs, ys = xy[:, 0], xy[:, 1]
+            x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
             s_min, n_max = min(s_min, y0), max(n_max, y1)
             w_min, e_max = min(w_min, x0), max(e_max, x1)
             if box is not None and (
@@ -245,10 +248,7 @@ def read_extract(
                 or y0 > box[2]
                 or x1 < box[1]
                 or x0 > box[3]
-                or not any(
-                    box[0] <= y <= box[2] and box[1] <= x <= box[3]
-                    for x, y in zip(xs, ys, strict=True)
-                )
+                or not np.any((box[0] <= ys) & (ys <= box[2]) & (box[1] <= xs) & (xs <= box[3]))
             ):
                 continue
             nodes = [
@@ -270,24 +270,53 @@ def read_extract(
     except (OSError, EOFError, ValueError) as exc:
         raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
 
-    bounds = _header_box(path)
-    if bounds is None and math.isfinite(s_min):
-        bounds = (s_min, w_min, n_max, e_max)
-    if n_ways == 0 or bounds is None:
+    if n_ways == 0 or not math.isfinite(s_min):
         raise MapDataError(f"OSM extract {path.name} holds no streets or buildings")
+    # the data's own extent, not the header's declared box: clipped extracts hold whole
+    # ways a few metres beyond it, and a box may declare more than the data covers
+    bounds = (s_min, w_min, n_max, e_max)
     inside = bounds[0] <= lat <= bounds[2] and bounds[1] <= lon <= bounds[3]
     if radius_m is not None and not inside:
         raise MapDataError(
             f"point lat={lat:.6f}, lon={lon:.6f} is outside the extract {path.name} "
-            f"(it covers lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
+            f"(its streets and buildings cover lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
             f"lon {bounds[1]:.5f}..{bounds[3]:.5f})"
         )
+    warnings = []
+    if radius_m is not None:
+        edges = _edge_distances_m(lat, lon, bounds)
+        thin = {side: d for side, d in edges.items() if d < radius_m}
+        if thin:
+            sides = ", ".join(f"{d:.0f} m to the {side}" for side, d in thin.items())
+            warnings.append(
+                f"the extract {path.name} ends {sides} of lat={lat:.6f}, lon={lon:.6f}, "
+                f"inside the {radius_m:.0f} m asked for: junctions beyond are missing"
+            )
     if not street_ways:
         raise MapDataError(
             f"no streets within {radius_m:.0f} m of lat={lat:.6f}, lon={lon:.6f} in {path.name}"
         )
     graph = _graph_from_ways(street_ways)
-    return RawMap(graph=graph, buildings=buildings, bounds=bounds, source=str(path))
+    return RawMap(
+        graph=graph, buildings=buildings, bounds=bounds, source=str(path), warnings=warnings
+    )
+
+
+def _edge_distances_m(
+    lat: float, lon: float, bounds: tuple[float, float, float, float]
+) -> dict[str, float]:
+    """Distance from a point inside a box to each of its sides, metres."""
+    south, west, north, east = bounds
+    out = {}
+    for side, (lon2, lat2) in {
+        "south": (lon, south),
+        "north": (lon, north),
+        "west": (west, lat),
+        "east": (east, lat),
+    }.items():
+        _a, _b, dist = GEOD.inv(lon, lat, lon2, lat2)
+        out[side] = float(dist)
+    return out
 
 
 def _graph_from_ways(
@@ -307,10 +336,16 @@ def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
     return simplify_graph(graph, edge_attrs_differ=SIMPLIFY_EDGE_ATTRS_DIFFER)
 
 
-def overpass_filter(highways: frozenset[str]) -> str:
-    """The osmnx ``custom_filter`` selecting :data:`STREET_HIGHWAYS` ways."""
+def overpass_filter(
+    highways: frozenset[str], named_highways: frozenset[str] = frozenset()
+) -> list[str]:
+    """The osmnx ``custom_filter`` (a union of filters) selecting the street ways."""
     alternatives = "|".join(sorted(highways))
-    return f'["highway"~"^({alternatives})$"]["area"!~"yes"]'
+    filters = [f'["highway"~"^({alternatives})$"]["area"!~"yes"]']
+    if named_highways:
+        named = "|".join(sorted(named_highways))
+        filters.append(f'["highway"~"^({named})$"]["name"]["area"!~"yes"]')
+    return filters
 
 
 CONNECT_TIMEOUT_S = 5.0
@@ -359,6 +394,7 @@ def read_overpass(
     timeout_s: float = 60.0,
     highways: frozenset[str] = STREET_HIGHWAYS,
     connect_timeout_s: float = CONNECT_TIMEOUT_S,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> RawMap:
     """Query streets and buildings around a point from Overpass through osmnx.
 
@@ -407,7 +443,7 @@ def read_overpass(
                 simplify=False,
                 retain_all=True,
                 truncate_by_edge=True,
-                custom_filter=overpass_filter(highways),
+                custom_filter=overpass_filter(highways, named_highways),
             )
             graph = simplify(graph)
             try:
