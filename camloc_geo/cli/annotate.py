@@ -42,7 +42,8 @@ def junction_geojson(
     Returns the GeoJSON of :func:`camloc_geo.api.corners_near` reduced to one intersection,
     plus ``kind: "street"`` LineStrings within ``radius_m`` of it for context.
     """
-    from shapely.geometry import Point, mapping
+    import numpy as np
+    from shapely.geometry import LineString, Point, mapping
 
     from camloc_geo._errors import MapDataError
     from camloc_geo.api import corners_near, streets_near
@@ -65,12 +66,11 @@ def junction_geojson(
     ]
     jlon, jlat = first["geometry"]["coordinates"]
     east, north = m.frame.enu_from_geographic(jlon, jlat)
-    near = Point(east, north).buffer(120.0)
-    from shapely.ops import transform
-
+    centre = Point(east, north)
     for street in m.streets:
-        line_en = transform(lambda x, y, z=None: m.frame.enu_from_geographic(x, y), street.geometry)
-        if not line_en.intersects(near):
+        lonlat = np.asarray(street.geometry.coords, dtype=float)
+        e, n = m.frame.enu_from_geographic(lonlat[:, 0], lonlat[:, 1])
+        if LineString(np.column_stack([e, n])).distance(centre) > 120.0:
             continue
         feats.append(
             {

@@ -250,6 +250,13 @@ def annotation_page_html(
             + "</script>"
         )
     page = _asset("annotate.html")
+    connect = "'none'"
+    if mode == "crowd" and submit_url:
+        from urllib.parse import urlsplit
+
+        parts = urlsplit(submit_url)
+        connect = "'self'" + (f" {parts.scheme}://{parts.netloc}" if parts.netloc else "")
+    page = page.replace("CAMLOC_CONNECT_SRC", connect, 1)
     replacements = {
         "<!--camloc:title-->": html.escape(title or f"Annotate {info.name}"),
         "<!--camloc:css-->": "<style>" + _asset("annotate.css") + "</style>",
