@@ -348,6 +348,7 @@
   var extrasKind = "reference";
   var analysis = analyse(S, W, H, {});
   var lastSaved = null;
+  var leafletMap = null;
 
   function snapshot() { return JSON.stringify(S); }
   function commit() {
@@ -756,8 +757,8 @@
     }
     var a = toScreen(pts[0]), b = toScreen(pts[1]);
     seg(a, b, "#7fdbff", 2, [12, 6]);
-    var mid = toScreen([(pts[0][0] + pts[1][0]) / 2 + W * 0.3, (pts[0][1] + pts[1][1]) / 2 + (pts[1][1] - pts[0][1]) * 0.3]);
-    label(mid, "horizon (eye level of the camera)", "#7fdbff");
+    var at = toScreen([pts[0][0] + (pts[1][0] - pts[0][0]) * 0.04, pts[0][1] + (pts[1][1] - pts[0][1]) * 0.04]);
+    label(at, "horizon (the camera's eye level)", "#7fdbff");
   }
   function drawVpGuides() {
     AXES.forEach(function (k, ai) {
@@ -857,6 +858,14 @@
       ol.appendChild(li);
     });
     var key = STEPS[step].key;
+    var mapBox = $("map-box");
+    if (!mapBox.hidden) {
+      var before = key === "corners" ? $("checks") : $("file-box");
+      if (mapBox.nextElementSibling !== before) {
+        before.parentNode.insertBefore(mapBox, before);
+        if (leafletMap) setTimeout(function () { leafletMap.invalidateSize(); }, 0);
+      }
+    }
     $("step-title").textContent = "Step " + (step + 1) + " of " + STEPS.length + ": " + STEPS[step].title;
     $("step-text").innerHTML = STEP_TEXT[key]();
     var miss = missing(key);
@@ -866,7 +875,8 @@
       mEl.textContent = (optional(key) ? "Optional; missing: " : "Still missing: ") + miss.join("; ") + ".";
     } else {
       mEl.className = "missing ok";
-      mEl.textContent = key === "save" ? "Everything required is there." : "Done. Go on with Next, or add more.";
+      mEl.textContent = key === "save" ? "Everything required is there." :
+        (key === "car" ? "Done. Drag a point to adjust it, or go on with Next." : "Done. Go on with Next, or add more.");
     }
     if (key === "car" && !carComplete()) {
       var next = AXIS_POINTS.filter(function (k) { return !S.axes[k]; })[0];
@@ -959,12 +969,14 @@
     });
   }
 
-  function check(cls, html) { return "<div class='check " + cls + "'>" + html + "</div>"; }
+  var checkList = [];
+  function check(cls, html) { checkList.push([cls, html]); return ""; }
   function fmt(x) { return Math.round(x).toLocaleString("en-US"); }
 
   function renderChecks() {
     var a = analysis;
     var h = "";
+    checkList = [];
     AXES.forEach(function (k) {
       var n = S.lines[k].length;
       var vp = a.vps[k];
@@ -1014,8 +1026,17 @@
       h += check("bad", "&#9888; Wrong corner? The " + a.wrongCorner + " end you clicked looks nearer to the camera than the " +
         "origin. Click the car's ground corner <b>nearest the camera</b> first (drag the points or undo).");
     }
-    if (!h) h = check("info", "Checks appear here as you click.");
-    $("checks-body").innerHTML = h;
+    if (!checkList.length) check("info", "Checks appear here as you click.");
+    // problems first, so they are seen without scrolling
+    var rank = { bad: 0, warn: 1, ok: 2, info: 3 };
+    checkList.sort(function (x, y) { return rank[x[0]] - rank[y[0]]; });
+    $("checks-body").innerHTML = h + checkList.map(function (c) {
+      return "<div class='check " + c[0] + "'>" + c[1] + "</div>";
+    }).join("");
+    var alerts = checkList.filter(function (c) { return c[0] === "bad" || c[0] === "warn"; });
+    var al = $("alerts");
+    al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[1] + "</div>"; }).join("");
+    al.hidden = !alerts.length;
   }
 
   function changed(keepForm) {
@@ -1116,6 +1137,7 @@
     if (!mapIntersections().length || typeof L === "undefined") return;
     $("map-box").hidden = false;
     var map = L.map("map", { zoomControl: true, attributionControl: true });
+    leafletMap = map;
     map.attributionControl.setPrefix(false);
     if (config.corners.attribution) map.attributionControl.addAttribution(esc(config.corners.attribution));
     var bounds = [];
@@ -1256,6 +1278,7 @@
     changed();
   }
   try { setupMap(); } catch (e) { $("map-box").hidden = true; }
+  renderPanel();
 
   /* Hooks for tests and for the service: read-only views and view control. */
   window.camloc = {
