@@ -416,3 +416,34 @@ def test_crowd_mode_submits(browser: Any, files: dict[str, Any], tmp_path: Path)
         assert posted == [files["truth"]]
     finally:
         tab.close()
+
+
+def test_live_warnings_for_lines(tab: Tab, files: dict[str, Any]) -> None:
+    """Lines of one axis that do not meet, and an implausible focal length, are flagged."""
+    tab.open(files["page"])
+    page = tab.page
+    page.keyboard.press("2")
+    vp = np.array([3000.0, 500.0])
+    for start in ([200.0, 900.0], [300.0, 700.0]):
+        a = np.array(start)
+        b = a + 0.4 * (vp - a)
+        tab.click_image(*a)
+        tab.click_image(*b)
+    assert "Length lines meet at (3,000, 500)" in page.inner_text("#checks-body")
+    tab.click_image(200.0, 300.0)  # a third line, far from parallel to the others
+    tab.click_image(700.0, 600.0)
+    checks = page.inner_text("#checks-body")
+    assert "do not meet in one point" in checks
+    assert "line L3" in checks
+    assert "do not meet" in page.inner_text("#alerts")
+    tab.shot("15_lines_do_not_meet")
+    page.keyboard.press("Control+z")
+    # Width lines meeting on the same side as the length lines: no real focal length.
+    page.keyboard.press("3")
+    for start in ([1000.0, 1000.0], [1400.0, 1000.0]):
+        a = np.array(start)
+        b = a + 0.3 * (np.array([2600.0, 520.0]) - a)
+        tab.click_image(*a)
+        tab.click_image(*b)
+    checks = page.inner_text("#checks-body")
+    assert "No focal length" in checks or "implausible" in checks

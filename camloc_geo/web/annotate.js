@@ -860,7 +860,7 @@
     var key = STEPS[step].key;
     var mapBox = $("map-box");
     if (!mapBox.hidden) {
-      var before = key === "corners" ? $("checks") : $("file-box");
+      var before = key === "corners" ? $("checks") : $("help");
       if (mapBox.nextElementSibling !== before) {
         before.parentNode.insertBefore(mapBox, before);
         if (leafletMap) setTimeout(function () { leafletMap.invalidateSize(); }, 0);
@@ -936,6 +936,8 @@
           " (" + PRESETS[p].join(" × ") + " m)</option>";
       });
       h += "</select></label>";
+      h += "<button type='button' id='btn-save-step' class='primary'>" +
+        (config.mode === "crowd" ? "Submit my work" : "Save the scene file") + "</button>";
     }
     f.innerHTML = h;
     Array.prototype.forEach.call(f.querySelectorAll("input[data-ref]"), function (inp) {
@@ -961,6 +963,8 @@
       S.object = pr.value === "scene" ? null : { preset: pr.value };
       changed(true);
     });
+    var ss = $("btn-save-step");
+    if (ss) ss.addEventListener("click", save);
     var ap = $("ann-pick");
     if (ap) ap.addEventListener("change", function () {
       base = buildScene();
