@@ -36,6 +36,7 @@ _COMMAND_MODULES = (
     "schema",
     "annotate",
     "merge",
+    "serve",
 )
 
 log = logging.getLogger("camloc_geo.cli")
