@@ -69,6 +69,8 @@ _COMMAND_MODULES = (
     "vp",
     "summary_map",
     "schema",
+    "annotate",
+    "merge",
     "serve",
 )
 
