@@ -21,6 +21,7 @@ from camloc_geo.geocode._geocode import (
     match_name,
 )
 from camloc_geo.geocode._index import GeocodeIndex, index_for
+from camloc_geo.geocode._maps import extract_paths, geocode_title_in_maps, whole_map
 from camloc_geo.geocode._normalize import core_tokens, name_tokens
 from camloc_geo.geocode._parse import ParsedTitle, parse_compass_words, parse_title
 
@@ -32,10 +33,13 @@ __all__ = [
     "ParsedTitle",
     "TitleMatch",
     "core_tokens",
+    "extract_paths",
     "geocode_title",
+    "geocode_title_in_maps",
     "index_for",
     "match_name",
     "name_tokens",
     "parse_compass_words",
     "parse_title",
+    "whole_map",
 ]

@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FUZZY_MIN_RATIO",
+    "PLACED_STATUSES",
     "STATUSES",
     "NameHit",
     "TitleMatch",
@@ -51,6 +52,8 @@ __all__ = [
 ]
 
 STATUSES = ("junction", "street", "address", "landmark", "ambiguous", "not_found")
+PLACED_STATUSES = frozenset({"junction", "address", "landmark", "ambiguous"})
+"""Statuses that come with a point (an ``address`` without an OSM point has none)."""
 FUZZY_MIN_RATIO = 88.0
 """Least rapidfuzz ``ratio`` (0-100) of a whole name core to count as a fuzzy match."""
 TOKEN_MIN_RATIO = 80.0
