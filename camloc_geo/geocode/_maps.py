@@ -53,6 +53,8 @@ def _extract_box(path: Path) -> tuple[float, float, float, float]:
     s, w, n, e = math.inf, math.inf, -math.inf, -math.inf
     try:
         for node in osmium.FileProcessor(str(path), osmium.osm.NODE):
+            if not isinstance(node, osmium.osm.Node):
+                continue
             loc = node.location
             if loc.valid():
                 s, n = min(s, loc.lat), max(n, loc.lat)
