@@ -1,10 +1,13 @@
 """Geocoding webcam titles: the junction, street, address or landmark a title names.
 
->>> from camloc_geo.osm import load_map                                # doctest: +SKIP
->>> from camloc_geo.geocode import geocode_title
->>> m = load_map("data/osm/baltimore.osm.pbf", 39.2826, -76.5685, radius_m=None)
->>> best = geocode_title("625 - Milton & E Biddle St", map_data=m)[0]
->>> best.status, best.names_matched, (best.lat, best.lon)
+Example::
+
+    from camloc_geo.osm import load_map
+    from camloc_geo.geocode import geocode_title
+
+    m = load_map("data/osm/baltimore.osm.pbf", 39.2826, -76.5685, radius_m=None)
+    best = geocode_title("625 - Milton & E Biddle St", map_data=m)[0]
+    best.status, best.names_matched, (best.lat, best.lon)
 
 See :mod:`camloc_geo.geocode._parse` (reading titles), :mod:`camloc_geo.geocode._normalize`
 (street-name normalisation) and :mod:`camloc_geo.geocode._geocode` (matching).

@@ -282,7 +282,7 @@ def match_name(name: str, index: GeocodeIndex) -> list[NameHit]:
 def _fuzzy(toks: tuple[str, ...], name: str, index: GeocodeIndex) -> list[NameHit]:
     from rapidfuzz import fuzz, process
 
-    vocab = set(index.vocab)
+    vocab = index.vocab_set
     # 1. word by word against the map's words
     fixed = list(toks)
     ratios: list[float] = []
@@ -302,11 +302,20 @@ def _fuzzy(toks: tuple[str, ...], name: str, index: GeocodeIndex) -> list[NameHi
         if hits:
             ratio = min(ratios) / 100.0
             return [NameHit(h.tokens, h.display, "fuzzy", h.score * ratio * 0.85) for h in hits]
-    # 2. the whole core against the map's cores
     core = " ".join(core_tokens(toks))
-    if len(core) < 4:
-        return []
+    if len(core) < 6:
+        return []  # one edit in a short name is another name
     out: list[NameHit] = []
+    # 2. the whole name, spaces dropped, against the map's names ("Münzsraße")
+    compact = "".join(toks)
+    for choice, ratio, _i in process.extract(
+        compact, index.compact_choices, scorer=fuzz.ratio, score_cutoff=FUZZY_MIN_RATIO, limit=3
+    ):
+        full = index.compact_full[str(choice)]
+        factor = _compatible(toks, full)
+        if factor is not None:
+            out.append(NameHit(full, index.display(full), "fuzzy", 0.8 * ratio / 100.0 * factor))
+    # 3. the core against the map's cores (the street type or directional differs too)
     for choice, ratio, _i in process.extract(
         core, index.core_choices, scorer=fuzz.ratio, score_cutoff=FUZZY_MIN_RATIO, limit=5
     ):
@@ -315,7 +324,11 @@ def _fuzzy(toks: tuple[str, ...], name: str, index: GeocodeIndex) -> list[NameHi
             if factor is None:
                 continue
             out.append(NameHit(full, index.display(full), "fuzzy", 0.8 * ratio / 100.0 * factor))
-    return out
+    by_name: dict[tuple[str, ...], NameHit] = {}
+    for hit in out:
+        if hit.tokens not in by_name or by_name[hit.tokens].score < hit.score:
+            by_name[hit.tokens] = hit
+    return list(by_name.values())
 
 
 def suggestions_for(name: str, index: GeocodeIndex, n: int = 5) -> list[str]:
@@ -333,8 +346,8 @@ def _landmark_hits(name: str, index: GeocodeIndex) -> list[tuple[Landmark, str, 
     from rapidfuzz import fuzz, process
 
     toks = name_tokens(name)
-    if not toks:
-        return []
+    if not toks or not any(len(t) >= 3 and not t.isdigit() for t in core_tokens(toks)):
+        return []  # a landmark needs a word: "2", "St" name nothing
     out: list[tuple[Landmark, str, float]] = []
     raw_fold = fold(name)
     for mark in index.landmarks.get(toks, ()):
@@ -444,39 +457,66 @@ def _junction_candidates(
     return out
 
 
+def _vertices(tokens: tuple[str, ...], index: GeocodeIndex) -> frozenset[tuple[float, float]]:
+    """The street's vertices (lon, lat rounded to 1e-7 deg), cached in the index."""
+    key = ("vertices", tokens)
+    found: frozenset[tuple[float, float]] | None = index.cache.get(key)
+    if found is None:
+        found = frozenset(
+            (round(x, 7), round(y, 7))
+            for line in index.lines.get(tokens, ())
+            for x, y in line.coords
+        )
+        index.cache[key] = found
+    return found
+
+
+def _endpoints(lines: list[LineString]) -> list[tuple[float, float]]:
+    out = []
+    for line in lines:
+        coords = line.coords
+        out.extend([coords[0], coords[-1]])
+    return out
+
+
 def _geometric_candidates(
     a: list[NameHit], b: list[NameHit], index: GeocodeIndex
 ) -> list[_Candidate]:
+    """Where the two streets' own lines share a node, or one ends next to the other.
+
+    A shared OSM node is a junction whatever the junction model made of it (named
+    ``service`` streets, pedestrian segments, a bend where the name changes). Lines that
+    merely cross (a bridge over a street) share no node and do not count; a street that
+    ends within :data:`GEOMETRIC_GAP_M` of the other (a way cut at the extract's edge, a
+    gap in the data) does.
+    """
     out: list[_Candidate] = []
     for ha in a:
         lines_a = index.lines.get(ha.tokens)
         if not lines_a:
             continue
-        geom_a = MultiLineString([list(line.coords) for line in lines_a])
+        verts_a = _vertices(ha.tokens, index)
         for hb in b:
             if hb.tokens == ha.tokens:
                 continue
             lines_b = index.lines.get(hb.tokens)
             if not lines_b:
                 continue
-            geom_b = MultiLineString([list(line.coords) for line in lines_b])
-            lat_c = geom_a.centroid.y
-            kx = _M_PER_DEG * math.cos(math.radians(lat_c))
-            gap_deg = GEOMETRIC_GAP_M / kx
-            if not geom_a.buffer(gap_deg, quad_segs=2).intersects(geom_b):
-                continue
-            points: list[tuple[float, float, float]] = []  # lon, lat, gap m
-            crossing = geom_a.intersection(geom_b)
-            if not crossing.is_empty:
-                for part in getattr(crossing, "geoms", [crossing]):
-                    p = part if part.geom_type == "Point" else part.representative_point()
-                    points.append((p.x, p.y, 0.0))
-            else:
+            s = ha.score * hb.score
+            shared = verts_a & _vertices(hb.tokens, index)
+            points: list[tuple[float, float, float]] = [(x, y, 0.0) for x, y in shared]
+            if not points:
+                geom_a = MultiLineString([list(line.coords) for line in lines_a])
+                geom_b = MultiLineString([list(line.coords) for line in lines_b])
+                kx = _M_PER_DEG * math.cos(math.radians(lines_a[0].coords[0][1]))
+                if geom_a.distance(geom_b) * kx > GEOMETRIC_GAP_M * 1.5:
+                    continue
+                ends = shapely.MultiPoint(_endpoints(lines_a) + _endpoints(lines_b))
                 pa, pb = shapely.ops.nearest_points(geom_a, geom_b)
                 gap = _dist_m(pa.y, pa.x, pb.y, pb.x)
-                if gap <= GEOMETRIC_GAP_M:
+                near_end = min(ends.distance(pa), ends.distance(pb)) * kx < 1.0
+                if gap <= GEOMETRIC_GAP_M and near_end:
                     points.append(((pa.x + pb.x) / 2.0, (pa.y + pb.y) / 2.0, gap))
-            s = ha.score * hb.score * 0.97
             for lon, lat, gap in points:
                 out.append(
                     _Candidate(
@@ -487,9 +527,9 @@ def _geometric_candidates(
                         intersection=None,
                         uncertainty_m=15.0 + gap,
                         how=(
-                            "where the two streets' lines cross (the junction model lacks it)"
+                            "a node the two streets share (the junction model lacks it)"
                             if gap == 0.0
-                            else f"where the two streets' lines pass {gap:.0f} m apart "
+                            else f"where one street ends {gap:.0f} m from the other "
                             "(the junction model lacks it)"
                         ),
                     )
@@ -497,17 +537,45 @@ def _geometric_candidates(
     return out
 
 
-def _dedupe(cands: list[_Candidate]) -> list[_Candidate]:
-    kept: list[_Candidate] = []
+def _group(cands: list[_Candidate]) -> list[_Candidate]:
+    """One candidate per place: those of one name pair within :data:`SAME_JUNCTION_M` merge.
+
+    The merged candidate keeps the best member's junction (a model junction before a
+    geometric one) and sits at the members' mean position (the two clusters of a dual
+    carriageway crossing become its centre).
+    """
+    groups: list[list[_Candidate]] = []
     for c in cands:
-        if any(
-            _dist_m(k.lat, k.lon, c.lat, c.lon) < SAME_JUNCTION_M
-            and {h.tokens for h in k.hits} == {h.tokens for h in c.hits}
-            for k in kept
-        ):
-            continue
-        kept.append(c)
-    return kept
+        pair = frozenset(h.tokens for h in c.hits)
+        for g in groups:
+            if frozenset(h.tokens for h in g[0].hits) == pair and any(
+                _dist_m(k.lat, k.lon, c.lat, c.lon) < SAME_JUNCTION_M for k in g
+            ):
+                g.append(c)
+                break
+        else:
+            groups.append([c])
+    out: list[_Candidate] = []
+    for g in groups:
+        best = g[0]
+        if len(g) > 1:
+            model = [c for c in g if c.intersection is not None] or g
+            best = model[0]
+            lat = sum(c.lat for c in model) / len(model)
+            lon = sum(c.lon for c in model) / len(model)
+            spread = max(_dist_m(lat, lon, c.lat, c.lon) for c in model)
+            best = _Candidate(
+                lat=lat,
+                lon=lon,
+                score=max(c.score for c in g),
+                hits=best.hits,
+                intersection=best.intersection,
+                uncertainty_m=max(c.uncertainty_m for c in model) + spread,
+                how=best.how + (f" ({len(model)} nodes merged)" if len(model) > 1 else ""),
+                dist_m=best.dist_m,
+            )
+        out.append(best)
+    return out
 
 
 def _base(parsed: ParsedTitle, title: str, map_data: MapData) -> dict[str, Any]:
@@ -600,7 +668,10 @@ def _filter_rank(
             c.dist_m = _dist_m(near[0], near[1], c.lat, c.lon)
         if radius_m is not None:
             cands = [c for c in cands if c.dist_m <= radius_m]
-    cands.sort(key=lambda c: (-round(c.score, 6), c.dist_m, c.lat, c.lon))
+    if near is not None:
+        cands.sort(key=lambda c: (-round(c.score, 6), c.dist_m, c.intersection is None))
+    else:
+        cands.sort(key=lambda c: (-round(c.score, 6), c.intersection is None, c.lat, c.lon))
     return cands
 
 
@@ -619,15 +690,11 @@ def _two_names(
     for i, j in pairs:
         if not hits[i] or not hits[j]:
             continue
+        # the model's junctions first, then nodes the streets share that it lacks
         found = _junction_candidates(hits[i], hits[j], index, map_data)
+        found += _geometric_candidates(hits[i], hits[j], index)
         found = _filter_rank(found, near, radius_m)
-        if not found or found[0].score < max(h.score for h in hits[i]) * max(
-            h.score for h in hits[j]
-        ):
-            # the best-matching names may meet only where the model has no junction
-            geo = _filter_rank(_geometric_candidates(hits[i], hits[j], index), near, radius_m)
-            found = _filter_rank(found + geo, near, radius_m)
-        cands.extend((i, j, c) for c in _dedupe(found))
+        cands.extend((i, j, c) for c in _group(found))
     base = _base(parsed, title, map_data)
     if cands:
         cands.sort(key=lambda r: (-round(r[2].score, 6), r[2].dist_m))

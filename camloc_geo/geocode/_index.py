@@ -19,7 +19,6 @@ from __future__ import annotations
 import logging
 import math
 import re
-import struct
 import threading
 from collections import defaultdict
 from dataclasses import dataclass, field
@@ -98,8 +97,11 @@ class GeocodeIndex:
         default_factory=lambda: defaultdict(set)
     )
     vocab: list[str] = field(default_factory=list)
+    vocab_set: frozenset[str] = frozenset()
     core_choices: list[str] = field(default_factory=list)
     full_choices: list[str] = field(default_factory=list)
+    compact_choices: list[str] = field(default_factory=list)
+    compact_full: dict[str, tuple[str, ...]] = field(default_factory=dict)
     landmark_choices: list[str] = field(default_factory=list)
     cache: dict[Any, Any] = field(default_factory=dict)
     lock: threading.Lock = field(default_factory=threading.Lock)
@@ -124,8 +126,11 @@ class GeocodeIndex:
     def finish(self) -> None:
         vocab = {t for core in self.by_core for t in core}
         self.vocab = sorted(vocab)
+        self.vocab_set = frozenset(vocab)
         self.core_choices = [" ".join(c) for c in self.by_core]
         self.full_choices = [" ".join(f) for f in self.displays]
+        self.compact_full = {"".join(f): f for f in self.displays}
+        self.compact_choices = list(self.compact_full)
         self.landmark_choices = [" ".join(f) for f in self.landmarks]
 
     def display(self, toks: tuple[str, ...]) -> str:
@@ -173,8 +178,6 @@ def _scan_file(path: Path, map_data: MapData) -> _FileScan:
     """What the street loader does not keep: all names, minor ways, addresses, features."""
     import osmium
 
-    from camloc_geo.osm import STREET_HIGHWAYS
-
     scan = _FileScan()
     inside = _within(map_data)
     graph_ways: set[int] = set()
@@ -183,7 +186,6 @@ def _scan_file(path: Path, map_data: MapData) -> _FileScan:
         for i in osmid if isinstance(osmid, list) else [osmid]:
             if i is not None:
                 graph_ways.add(int(i))
-    wkb = osmium.geom.WKBFactory()
     processor = (
         osmium.FileProcessor(str(path), osmium.osm.NODE | osmium.osm.WAY)
         .with_locations()
@@ -197,13 +199,13 @@ def _scan_file(path: Path, map_data: MapData) -> _FileScan:
             continue
         is_way = isinstance(obj, osmium.osm.Way)
         if isinstance(obj, osmium.osm.Way):
-            try:
-                raw = bytes.fromhex(wkb.create_linestring(obj))
-            except (osmium.InvalidLocationError, RuntimeError, ValueError):
+            # located nodes only: ways crossing the extract's edge keep their inside part
+            pts = [(nd.lon, nd.lat) for nd in obj.nodes if nd.location.valid()]
+            if len(pts) < 2:
                 continue
-            coords = struct.unpack(f"<{(len(raw) - 9) // 8}d", raw[9:])
-            xs, ys = coords[0::2], coords[1::2]
-            if not any(inside(y, x) for x, y in zip(xs, ys, strict=True)):
+            xs = [p[0] for p in pts]
+            ys = [p[1] for p in pts]
+            if not any(inside(y, x) for x, y in pts):
                 continue
             lon = sum(xs) / len(xs)
             lat = sum(ys) / len(ys)
@@ -221,8 +223,9 @@ def _scan_file(path: Path, map_data: MapData) -> _FileScan:
         highway = tags.get("highway")
         if is_way and highway and names and tags.get("area") != "yes":
             scan.way_names[obj.id] = names
-            if obj.id not in graph_ways and highway not in STREET_HIGHWAYS:
-                scan.extra_lines.append((names, LineString(list(zip(xs, ys, strict=True)))))
+            if obj.id not in graph_ways:
+                # minor ways (service, pedestrian...) and ways the loader could not place
+                scan.extra_lines.append((names, LineString(pts)))
             continue
         if housenumber and tags.get("addr:street"):
             mark = Landmark(

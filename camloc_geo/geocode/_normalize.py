@@ -190,6 +190,9 @@ for _line in _TYPE_TABLE.strip().splitlines():
     for _sp in _spellings.split():
         STREET_TYPES.setdefault(_sp, _canon.strip())
 
+_TYPE_VALUES = frozenset(STREET_TYPES.values())
+_DIRECTIONAL_VALUES = frozenset(DIRECTIONALS.values())
+
 _TITLES: dict[str, str] = {
     "ste": "sainte",
     "saint": "saint",
@@ -353,30 +356,33 @@ def name_tokens(name: str) -> tuple[str, ...]:
 
 
 def core_tokens(tokens: tuple[str, ...]) -> tuple[str, ...]:
-    """The name without street types, directionals and articles (the whole name if empty).
+    """The name without directionals, articles and the street types at its ends.
+
+    Types are stripped from both ends while another word remains, so ``Port Street`` keeps
+    ``port`` and ``Rue du Faubourg Saint-Antoine`` keeps ``saint antoine``.
 
     Examples
     --------
     >>> core_tokens(name_tokens("North Collington Avenue"))
     ('collington',)
+    >>> core_tokens(name_tokens("South Port Street"))
+    ('port',)
     >>> core_tokens(name_tokens("North Avenue"))
-    ('north', 'avenue')
+    ('avenue',)
     """
-    canon_types = set(STREET_TYPES.values())
-    directionals = set(DIRECTIONALS.values())
-    core = tuple(
-        t for t in tokens if t not in canon_types and t not in directionals and t not in ARTICLES
-    )
-    return core or tokens
+    core = [t for t in tokens if t not in _DIRECTIONAL_VALUES and t not in ARTICLES]
+    while len(core) > 1 and core[-1] in _TYPE_VALUES:
+        core.pop()
+    while len(core) > 1 and core[0] in _TYPE_VALUES:
+        core.pop(0)
+    return tuple(core) or tokens
 
 
 def directionals_of(tokens: tuple[str, ...]) -> frozenset[str]:
     """The directionals among a name's tokens."""
-    values = set(DIRECTIONALS.values())
-    return frozenset(t for t in tokens if t in values)
+    return frozenset(t for t in tokens if t in _DIRECTIONAL_VALUES)
 
 
 def types_of(tokens: tuple[str, ...]) -> frozenset[str]:
     """The street types among a name's tokens."""
-    values = set(STREET_TYPES.values())
-    return frozenset(t for t in tokens if t in values)
+    return frozenset(t for t in tokens if t in _TYPE_VALUES)

@@ -214,6 +214,7 @@ def _split_names(segment: str) -> list[str]:
     # control characters were removed: \x01 and \x02 stand for protected spaces and slashes
     protected = _MALCOLM_RE.sub(lambda m: m.group(0).replace(" ", "\x01"), segment)
     protected = re.sub(r"\bc/", "c\x02", protected, flags=re.IGNORECASE)  # Spanish calle
+    protected = re.sub(r"(?<=\d)/(?=\d)", "\x02", protected)  # fractions: 5 1/2 Street
     parts = _SEPARATOR_RE.split(protected)
     return [
         p.replace("\x01", " ").replace("\x02", "/").strip(" ,;.-")
