@@ -378,7 +378,11 @@ def _dist_m(lat0: float, lon0: float, lat: float, lon: float) -> float:
     return math.hypot((lon - lon0) * kx, (lat - lat0) * 110_574.0)
 
 
-def _junction_size_m(inter: Intersection, map_data: MapData) -> float:
+def _junction_size_m(inter: Intersection, map_data: MapData, index: GeocodeIndex) -> float:
+    key = ("size", inter.id)
+    cached: float | None = index.cache.get(key)
+    if cached is not None:
+        return cached
     G = map_data.graph
     spread = 0.0
     for n in inter.osm_nodes:
@@ -386,7 +390,9 @@ def _junction_size_m(inter: Intersection, map_data: MapData) -> float:
             node = G.nodes[n]
             spread = max(spread, _dist_m(inter.lat, inter.lon, node["y"], node["x"]))
     half_width = max((s.width_m for s in inter.streets), default=10.0) / 2.0
-    return max(8.0, spread + half_width)
+    size = max(8.0, spread + half_width)
+    index.cache[key] = size
+    return size
 
 
 def _street_geometry(lines: list[LineString]) -> dict[str, Any] | None:
@@ -414,7 +420,7 @@ class _Candidate:
 def _junction_candidates(
     a: list[NameHit], b: list[NameHit], index: GeocodeIndex, map_data: MapData
 ) -> list[_Candidate]:
-    inters = map_data.intersections
+    inters = index.intersections
     best_a: dict[int, dict[int, NameHit]] = {}
     for hit in a:
         for i, j in index.junctions.get(hit.tokens, ()):
@@ -450,7 +456,7 @@ def _junction_candidates(
                 score=best[0],
                 hits=(best[1], best[2]),
                 intersection=inter,
-                uncertainty_m=_junction_size_m(inter, map_data),
+                uncertainty_m=_junction_size_m(inter, map_data, index),
                 how="junction of the map's model",
             )
         )
@@ -471,12 +477,18 @@ def _vertices(tokens: tuple[str, ...], index: GeocodeIndex) -> frozenset[tuple[f
     return found
 
 
-def _endpoints(lines: list[LineString]) -> list[tuple[float, float]]:
-    out = []
-    for line in lines:
-        coords = line.coords
-        out.extend([coords[0], coords[-1]])
-    return out
+def _shapes(tokens: tuple[str, ...], index: GeocodeIndex) -> tuple[Any, Any, float]:
+    """The street's lines as one geometry, its line ends, metres per degree of longitude."""
+    key = ("shapes", tokens)
+    found: tuple[Any, Any, float] | None = index.cache.get(key)
+    if found is None:
+        lines = index.lines.get(tokens, [])
+        geom = shapely.multilinestrings(lines)
+        ends = shapely.multipoints([p for line in lines for p in (line.coords[0], line.coords[-1])])
+        kx = _M_PER_DEG * math.cos(math.radians(lines[0].coords[0][1])) if lines else _M_PER_DEG
+        found = (geom, ends, kx)
+        index.cache[key] = found
+    return found
 
 
 def _geometric_candidates(
@@ -506,15 +518,13 @@ def _geometric_candidates(
             shared = verts_a & _vertices(hb.tokens, index)
             points: list[tuple[float, float, float]] = [(x, y, 0.0) for x, y in shared]
             if not points:
-                geom_a = MultiLineString([list(line.coords) for line in lines_a])
-                geom_b = MultiLineString([list(line.coords) for line in lines_b])
-                kx = _M_PER_DEG * math.cos(math.radians(lines_a[0].coords[0][1]))
+                geom_a, ends_a, kx = _shapes(ha.tokens, index)
+                geom_b, ends_b, _kx = _shapes(hb.tokens, index)
                 if geom_a.distance(geom_b) * kx > GEOMETRIC_GAP_M * 1.5:
                     continue
-                ends = shapely.MultiPoint(_endpoints(lines_a) + _endpoints(lines_b))
                 pa, pb = shapely.ops.nearest_points(geom_a, geom_b)
                 gap = _dist_m(pa.y, pa.x, pb.y, pb.x)
-                near_end = min(ends.distance(pa), ends.distance(pb)) * kx < 1.0
+                near_end = min(ends_a.distance(pa), ends_b.distance(pb)) * kx < 1.0
                 if gap <= GEOMETRIC_GAP_M and near_end:
                     points.append(((pa.x + pb.x) / 2.0, (pa.y + pb.y) / 2.0, gap))
             for lon, lat, gap in points:

@@ -30,7 +30,7 @@ from shapely.geometry import LineString
 from camloc_geo.geocode._normalize import core_tokens, fold, name_tokens
 
 if TYPE_CHECKING:
-    from camloc_geo.osm import MapData
+    from camloc_geo.osm import Intersection, MapData
 
 __all__ = ["NAME_TAG_RE", "GeocodeIndex", "Landmark", "index_for"]
 
@@ -103,6 +103,7 @@ class GeocodeIndex:
     compact_choices: list[str] = field(default_factory=list)
     compact_full: dict[str, tuple[str, ...]] = field(default_factory=dict)
     landmark_choices: list[str] = field(default_factory=list)
+    intersections: list[Intersection] = field(default_factory=list)
     cache: dict[Any, Any] = field(default_factory=dict)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
@@ -289,7 +290,8 @@ def _build(map_data: MapData) -> GeocodeIndex:
             toks = index.add_street_name(name)
             if toks:
                 index.lines[toks].append(line)
-    for i, inter in enumerate(map_data.intersections):
+    index.intersections = map_data.intersections
+    for i, inter in enumerate(index.intersections):
         for j, inc in enumerate(inter.streets):
             names = list(inc.names)
             for wid in _way_ids_of_edge(map_data, *inc.edge):

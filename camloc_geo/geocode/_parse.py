@@ -108,6 +108,9 @@ _SEPARATOR_RE = re.compile(
     r"\s(?:и)\s)\s*",
     re.IGNORECASE,
 )
+_CALLE_SLASH_RE = re.compile(r"\bc/", re.IGNORECASE)
+_FRACTION_RE = re.compile(r"(?<=\d)/(?=\d)")
+_NUMBER_ONLY_RE = re.compile(r"#?\d{1,6}[a-z]?", re.IGNORECASE)
 _MALCOLM_RE = re.compile(r"\bmalcolm\s+x\b", re.IGNORECASE)
 _HOUSE_FIRST_RE = re.compile(
     r"^\s*(\d{1,6}(?:[-/]\d{1,4})?[a-z]?)\s+(?:block\s+(?:of\s+)?)?(?=[^\W\d])", re.IGNORECASE
@@ -213,8 +216,8 @@ def _clean(title: str, notes: list[str]) -> str:
 def _split_names(segment: str) -> list[str]:
     # control characters were removed: \x01 and \x02 stand for protected spaces and slashes
     protected = _MALCOLM_RE.sub(lambda m: m.group(0).replace(" ", "\x01"), segment)
-    protected = re.sub(r"\bc/", "c\x02", protected, flags=re.IGNORECASE)  # Spanish calle
-    protected = re.sub(r"(?<=\d)/(?=\d)", "\x02", protected)  # fractions: 5 1/2 Street
+    protected = _CALLE_SLASH_RE.sub("c\x02", protected)  # Spanish calle
+    protected = _FRACTION_RE.sub("\x02", protected)  # fractions: 5 1/2 Street
     parts = _SEPARATOR_RE.split(protected)
     return [
         p.replace("\x01", " ").replace("\x02", "/").strip(" ,;.-")
@@ -319,7 +322,7 @@ def parse_title(title: str) -> ParsedTitle:
         brg = parse_compass_words(seg)
         if brg is not None:
             compass.append((seg, brg))
-        elif re.fullmatch(r"#?\d{1,6}[a-z]?", seg, re.IGNORECASE):
+        elif _NUMBER_ONLY_RE.fullmatch(seg):
             if parsed.camera_number is None and not kept:
                 parsed.camera_number = seg.lstrip("#")
             else:
