@@ -449,15 +449,29 @@ def _junction_candidates(
         if best is None:
             continue
         inter = inters[i]
+        size = _junction_size_m(inter, map_data, index)
+        lat, lon = inter.lat, inter.lon
+        how = "junction of the map's model"
+        if len(inter.osm_nodes) > 1:
+            # a consolidated cluster: the nodes the two streets share inside it, if any
+            shared = [
+                (x, y)
+                for x, y in _vertices(best[1].tokens, index) & _vertices(best[2].tokens, index)
+                if _dist_m(inter.lat, inter.lon, y, x) <= size
+            ]
+            if shared:
+                lon = sum(x for x, _y in shared) / len(shared)
+                lat = sum(y for _x, y in shared) / len(shared)
+                how += ", at the nodes the two streets share"
         out.append(
             _Candidate(
-                lat=inter.lat,
-                lon=inter.lon,
+                lat=lat,
+                lon=lon,
                 score=best[0],
                 hits=(best[1], best[2]),
                 intersection=inter,
-                uncertainty_m=_junction_size_m(inter, map_data, index),
-                how="junction of the map's model",
+                uncertainty_m=size,
+                how=how,
             )
         )
     return out
