@@ -252,6 +252,8 @@ def reference_titles(
         # names that read alike (one contains the other) are not a fair test
         if a.lower() in b.lower() or b.lower() in a.lower() or "(" in a + b:
             continue
+        if re.sub(r"\W", "", a.lower()) == re.sub(r"\W", "", b.lower()):
+            continue  # two spellings of one street
         near = None
         if spread > SAME_PLACE_M:
             near = (lat, lon)  # the pair meets at several places: a point says which

@@ -64,6 +64,7 @@ GEOMETRIC_GAP_M = 15.0
 """Two streets whose lines pass this close without touching meet there (geometric)."""
 MAX_MATCHES = 5
 
+_LONG_TYPES = sorted(k for k in STREET_TYPES if len(k) >= 5)
 _SCORES = {"exact": 1.0, "abbreviation": 0.97, "partial": 0.88}
 _M_PER_DEG = 111_320.0
 
@@ -199,6 +200,9 @@ def _fuzzy_token(tok: str, index: GeocodeIndex, last: bool) -> tuple[str, float]
         return None
     if len(tok) >= 5:
         best = process.extractOne(tok, index.vocab, scorer=fuzz.ratio, score_cutoff=TOKEN_MIN_RATIO)
+        typ = process.extractOne(tok, _LONG_TYPES, scorer=fuzz.ratio, score_cutoff=TOKEN_MIN_RATIO)
+        if typ is not None and (best is None or typ[1] > best[1]):
+            return STREET_TYPES[str(typ[0])], float(typ[1])  # "Aveida" -> avenue
         if best is not None:
             return str(best[0]), float(best[1])
     if last and 2 <= len(tok) <= 4:
@@ -562,7 +566,8 @@ def _geometric_candidates(
 
 
 def _group(cands: list[_Candidate]) -> list[_Candidate]:
-    """One candidate per place: those of one name pair within :data:`SAME_JUNCTION_M` merge.
+    """One candidate per place: those of one name pair within :data:`SAME_JUNCTION_M` of the
+    group's best merge.
 
     The merged candidate keeps the best member's junction (a model junction before a
     geometric one) and sits at the members' mean position (the two clusters of a dual
@@ -572,8 +577,9 @@ def _group(cands: list[_Candidate]) -> list[_Candidate]:
     for c in cands:
         pair = frozenset(h.tokens for h in c.hits)
         for g in groups:
-            if frozenset(h.tokens for h in g[0].hits) == pair and any(
-                _dist_m(k.lat, k.lon, c.lat, c.lon) < SAME_JUNCTION_M for k in g
+            if (
+                frozenset(h.tokens for h in g[0].hits) == pair
+                and _dist_m(g[0].lat, g[0].lon, c.lat, c.lon) < SAME_JUNCTION_M
             ):
                 g.append(c)
                 break

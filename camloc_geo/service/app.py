@@ -5,7 +5,6 @@ Nothing is built at import. Errors from the library become 4xx through one table
 never reach the client.
 """
 
-
 import asyncio
 import csv
 import hmac
