@@ -71,6 +71,7 @@ _COMMAND_MODULES = (
     "schema",
     "annotate",
     "merge",
+    "geocode",
     "serve",
 )
 
