@@ -35,6 +35,7 @@ _COMMAND_MODULES = (
     "summary_map",
     "schema",
     "batch",
+    "serve",
 )
 
 log = logging.getLogger("camloc_geo.cli")
