@@ -10,6 +10,7 @@ plot of memory against cameras done, next to the paper's 0.41 s per image. Write
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import shutil
 import sys
@@ -58,10 +59,8 @@ def main() -> int:
         procs = [me, *me.children(recursive=True)]
         total = 0
         for p in procs:
-            try:
+            with contextlib.suppress(psutil.Error):
                 total += p.memory_info().rss
-            except psutil.Error:
-                pass
         return total / 2**20
 
     samples.append((0, rss_mb()))
