@@ -168,6 +168,7 @@ def test_layers_and_summary_map(world: dict[str, Path], local_run: dict[str, Any
     assert len(layers["view_cones"]) >= 4
     page = (world["base"] / "local" / "summary.html").read_text(encoding="utf-8")
     assert "markerClusterGroup" in page
+    assert "maxZoom: 22" in page  # the cluster plug-in fails on a map without maxZoom
     assert 'src="http' not in page
     assert "camera(s) located" in page
 

@@ -640,6 +640,10 @@ def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
             lambda _m: "<!--camloc:markercluster_css-->",
             page,
         )
+        # without a tile layer the map has no maxZoom, which the cluster plug-in needs
+        page = re.sub(
+            r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
+        )
         page = inline_assets(page)
         page = page.replace("<!--camloc:markercluster_css-->", "<style>" + css + "</style>", 1)
         page = page.replace("<!--camloc:markercluster_css-->", "")
