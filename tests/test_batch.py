@@ -137,9 +137,9 @@ def test_positions_against_truth(world: dict[str, Path], local_run: dict[str, An
     )
     title = good["status"] == "title_only"
     no_scene = good["scene"].isna()
-    # a title-only camera without scene is placed on the junction it watches (two streets
-    # may meet twice, 25 m apart: then the one nearer the list's point or the map's centre)
-    on_junction = err[title & no_scene] < 1.0
+    # a title-only camera without scene is placed on the junction it watches, within its
+    # size (two streets may meet twice, 25 m apart: then the one nearer the list's point)
+    on_junction = err[title & no_scene] < 30.0
     assert on_junction.mean() >= 0.9
     assert (err[title & no_scene] < 60.0).all()
     located = good["status"] == "located"
