@@ -72,6 +72,7 @@ _COMMAND_MODULES = (
     "annotate",
     "merge",
     "geocode",
+    "batch",
     "serve",
 )
 
