@@ -582,13 +582,15 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
 
 
 def _task_check_scene(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
-    """``scene`` (dict or path): validate; ``save_to``: write the normalised scene there."""
+    """``scene`` (dict or path): validate (``info.scene``: normalised); ``save_to``: write it."""
     from camloc_geo.api import scene_from
 
     sc = scene_from(job["scene"])
     data = sc.model_dump(mode="json", exclude_none=True)
     if job.get("save_to"):
-        Path(job["save_to"]).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+        # the scene as given (only what the analyst set), once it validates
+        given = job["scene"] if isinstance(job["scene"], dict) else data
+        Path(job["save_to"]).write_text(json.dumps(given, indent=1) + "\n", encoding="utf-8")
     return {"layers": {}, "warnings": [], "info": {"scene": data}}
 
 

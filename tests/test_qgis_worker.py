@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from camloc_geo._errors import InputError
 from camloc_geo.qgis_worker import CANDIDATE_FIELDS, candidate_rows, run_job
 
 REPO = Path(__file__).resolve().parent.parent
@@ -120,11 +121,11 @@ def test_geocodelist_job_isolates_bad_rows(tmp_path):
     assert res["layers"]["candidates"]["count"] == 12
 
 
-def test_check_scene_job_saves_the_normalised_scene(tmp_path):
+def test_check_scene_job_validates_and_saves_the_scene(tmp_path):
     data = json.loads(SCENE.read_text())
     out = tmp_path / "s.json"
     res = run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
-    assert json.loads(out.read_text()) == res["info"]["scene"]
+    assert json.loads(out.read_text()) == data
     assert res["info"]["scene"]["intersection"]["corners"] == data["intersection"]["corners"]
 
 
@@ -163,3 +164,12 @@ def test_probe_job():
     info = run_job({"task": "probe", "out_dir": "."})["info"]
     assert info["version"]
     assert isinstance(info["sensors"], bool)
+
+
+def test_check_scene_job_rejects_a_bad_scene(tmp_path):
+    data = json.loads(SCENE.read_text())
+    data["intersection"]["lat"] = 39.0
+    out = tmp_path / "s.json"
+    with pytest.raises(InputError, match="give both lat and lon"):
+        run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
+    assert not out.exists()

@@ -102,7 +102,7 @@ class CamlocDock(QDockWidget):
         self.steps = QListWidget()
         for _key, label, _kind in STEPS:
             self.steps.addItem(label)
-        self.steps.setMaximumHeight(150)
+        self.steps.setFixedHeight(self.steps.sizeHintForRow(0) * len(STEPS) + 8)
         self.steps.currentRowChanged.connect(self._step_changed)
         lay.addWidget(self.steps)
         self.view = ImageView()
@@ -190,8 +190,21 @@ class CamlocDock(QDockWidget):
         self.steps.blockSignals(False)
         self.redraw()
 
+    def _update_step_labels(self) -> None:
+        a = self.annotation
+        for row, (key, label, kind) in enumerate(STEPS):
+            if kind == "point":
+                extra = "  ✓" if key in a.axes else ""
+            elif kind == "line":
+                n = len(a.lines[key.split("_", 1)[1]])
+                extra = f"  ({n})" if n else ""
+            else:
+                extra = f"  ({len(a.corners)})" if a.corners else ""
+            self.steps.item(row).setText(label + extra)
+
     def redraw(self) -> None:
         """Draw the annotation over the image."""
+        self._update_step_labels()
         sc = self.view.scene()
         for item in self.overlays:
             sc.removeItem(item)

@@ -139,19 +139,25 @@ def style_candidates(layer: QgsVectorLayer) -> None:
 
 
 def style_view_cones(layer: QgsVectorLayer) -> None:
-    """Translucent cones, ties outlined in red."""
+    """Cones filled by score (the likely ones stand out), ties outlined in red."""
+    from qgis.core import QgsSingleSymbolRenderer
+
     sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
-    sym.setColor(QColor(255, 200, 0, 50))
+    sym.setColor(QColor(255, 200, 0, 60))
     sl = sym.symbolLayer(0)
     sl.setStrokeColor(QColor(180, 120, 0))
     sl.setDataDefinedProperty(
-        QgsSymbolLayer.PropertyStrokeColor,
-        QgsProperty.fromExpression("CASE WHEN \"tie\" THEN '#d7191c' ELSE '#b47800' END"),
+        QgsSymbolLayer.PropertyFillColor,
+        QgsProperty.fromExpression('color_rgba(255, 190, 0, 10 + 150 * coalesce("score", 0))'),
     )
-    from qgis.core import QgsSingleSymbolRenderer
-
+    sl.setDataDefinedProperty(
+        QgsSymbolLayer.PropertyStrokeColor,
+        QgsProperty.fromExpression(
+            "CASE WHEN \"tie\" THEN '#d7191c' "
+            'ELSE color_rgba(180, 120, 0, 30 + 200 * coalesce("score", 0)) END'
+        ),
+    )
     layer.setRenderer(QgsSingleSymbolRenderer(sym))
-    layer.setOpacity(0.8)
     layer.triggerRepaint()
 
 
@@ -187,7 +193,9 @@ STYLES = {
     "candidates": style_candidates,
     "list_candidates": style_candidates,
     "view_cones": style_view_cones,
-    "matched_corners": lambda lyr: style_points(lyr, "#7b3294", '"label"'),
+    "matched_corners": lambda lyr: style_points(
+        lyr, "#7b3294", 'CASE WHEN "rank" = 1 THEN \'matched \' || "label" END'
+    ),
     "intersection": lambda lyr: style_points(
         lyr,
         "#008837",

@@ -57,5 +57,5 @@ def provider(qgis_processing):
         assert reg.addProvider(added)
         prov = added
     yield prov
-    if added is not None:
-        reg.removeProvider(added)
+    if added is not None and reg.providerById("camloc") is not None:
+        reg.removeProvider(reg.providerById("camloc"))
