@@ -173,3 +173,29 @@ def test_check_scene_job_rejects_a_bad_scene(tmp_path):
     with pytest.raises(InputError, match="give both lat and lon"):
         run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
     assert not out.exists()
+
+
+def test_geocodelist_uses_the_batch_engine_when_present(tmp_path, monkeypatch):
+    import types
+
+    import camloc_geo.qgis_worker as worker
+
+    def geocode_camera(row, *, map_data=None, map_source=None, network=False):
+        if row["id"] == "bad":
+            return types.SimpleNamespace(id="bad", status="error", reason="no scene", candidates=[])
+        cand = {"rank": 1, "score": 1.0, "lat": 39.28, "lon": -76.59, "sigma_m": 3.0}
+        return types.SimpleNamespace(id=row["id"], status="ok", reason=None, candidates=[cand])
+
+    fake = types.SimpleNamespace(
+        read_camera_list=lambda path: iter([{"id": "a"}, {"id": "bad"}]),
+        geocode_camera=geocode_camera,
+    )
+    monkeypatch.setattr(worker, "_batch_module", lambda: fake)
+    res = run_job({"task": "geocodelist", "list": "cams.csv", "out_dir": str(tmp_path)})
+    assert res["info"]["engine"] == "camloc_geo.batch"
+    cams = {f["properties"]["camera_id"]: f for f in _read(res["layers"]["cameras"])}
+    assert cams["a"]["properties"]["status"] == "ok"
+    assert cams["a"]["geometry"]["coordinates"] == [-76.59, 39.28]
+    assert cams["a"]["properties"]["tie"] is False
+    assert cams["bad"]["properties"]["reason"] == "no scene"
+    assert res["layers"]["candidates"]["count"] == 1

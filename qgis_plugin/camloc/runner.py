@@ -4,8 +4,9 @@ QGIS loads the system GEOS/PROJ into its own process and the shapely/pyproj whee
 camloc_geo needs crash there, so nothing heavy is imported in QGIS: the plugin finds an
 interpreter that can ``import camloc_geo`` and talks to it through a job file and JSON lines.
 
-The interpreter is, in order: the environment variable ``CAMLOC_PYTHON``, the plugin setting
-``camloc/python`` (QgsSettings), QGIS's own Python, then ``python3``/``python`` on ``PATH``.
+The interpreter is the first that can import camloc_geo of: the environment variable
+``CAMLOC_PYTHON``, the plugin setting ``camloc/python`` (QgsSettings), QGIS's own Python, the venv
+``~/.local/share/camloc-venv``, then ``python3``/``python`` on ``PATH``.
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from pathlib import Path
 from typing import Any
 
 SETTING_KEY = "camloc/python"
+DEFAULT_VENV = "~/.local/share/camloc-venv"
+"""A venv the plugin looks in without configuration (its ``bin/python``)."""
 PIP_PACKAGE = "camloc-geo"
 
 _found: dict[str, str | None] = {}
@@ -57,21 +60,32 @@ def qgis_python() -> str:
 def pip_command() -> str:
     """The command that installs camloc_geo into QGIS's Python."""
     py = qgis_python()
-    extra = " --user" if sys.platform.startswith("linux") and py.startswith("/usr/") else ""
-    return (
-        f'"{py}" -m pip install{extra} {PIP_PACKAGE}'
-        if " " in py
-        else (f"{py} -m pip install{extra} {PIP_PACKAGE}")
-    )
+    py = f'"{py}"' if " " in py else py
+    return f"{py} -m pip install {PIP_PACKAGE}"
+
+
+def _externally_managed() -> bool:
+    """True for a distribution's Python that refuses pip installs (PEP 668, Debian bookworm)."""
+    import sysconfig
+
+    stdlib = sysconfig.get_paths().get("stdlib") or ""
+    return bool(stdlib) and os.path.exists(os.path.join(stdlib, "EXTERNALLY-MANAGED"))
 
 
 def missing_message() -> str:
     """What to tell the user when no interpreter can import camloc_geo."""
-    return (
-        "The camloc plugin needs the camloc_geo library, and no Python interpreter found can "
-        f"import it. Install it into QGIS's Python with:  {pip_command()}  "
-        "(or set the environment variable CAMLOC_PYTHON, or the setting camloc/python, to a "
-        "Python that has camloc_geo) and restart QGIS."
+    msg = (
+        "The camloc plugin needs the camloc_geo library, and no Python found can import it. "
+        f"Install it into QGIS's Python with:  {pip_command()}"
+    )
+    if _externally_managed() or sys.platform.startswith("linux"):
+        msg += (
+            f"  — or, where that Python refuses pip (Debian, Ubuntu):  python3 -m venv "
+            f"{DEFAULT_VENV} && {DEFAULT_VENV}/bin/python -m pip install {PIP_PACKAGE}"
+        )
+    return msg + (
+        "  The plugin also uses the Python named by the environment variable CAMLOC_PYTHON or the "
+        "setting camloc/python. Then restart QGIS."
     )
 
 
@@ -94,6 +108,10 @@ def _candidates() -> list[str]:
     if s:
         out.append(s)
     out.append(qgis_python())
+    venv = Path(os.path.expanduser(DEFAULT_VENV))
+    for rel in ("bin/python", "Scripts/python.exe"):
+        if (venv / rel).exists():
+            out.append(str(venv / rel))
     for name in ("python3", "python"):
         w = shutil.which(name)
         if w:

@@ -216,6 +216,13 @@ def test_corners_in_a_canvas_extent(provider, tmp_path):
     layer = _layer(res["CORNERS"])
     n_inter = sum(1 for f in layer.getFeatures() if f["kind"] == "intersection")
     assert n_inter >= 2
+
+
+def test_corners_needs_a_point_or_an_extent(provider):
+    # (a test of its own: a layer kept alive by an exception's frames until QGIS exits
+    # crashes the interpreter at exit)
+    import processing
+
     with pytest.raises(QgsProcessingException, match="give a point"):
         processing.run("camloc:corners", {"OSM": str(SAMPLE_OSM), "CORNERS": "TEMPORARY_OUTPUT"})
 
