@@ -26,7 +26,16 @@ from camloc_geo._errors import InputError
 
 __all__ = ["main", "write_json"]
 
-_COMMAND_MODULES = ("calibrate", "locate", "corners", "streets", "vp", "summary_map", "schema")
+_COMMAND_MODULES = (
+    "calibrate",
+    "locate",
+    "corners",
+    "streets",
+    "vp",
+    "summary_map",
+    "schema",
+    "serve",
+)
 
 log = logging.getLogger("camloc_geo.cli")
 

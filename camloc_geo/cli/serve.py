@@ -1,0 +1,56 @@
+"""``camloc serve``: the HTTP service under uvicorn (settings from ``CAMLOC_*`` variables)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``serve`` command."""
+    p: argparse.ArgumentParser = subparsers.add_parser(
+        "serve",
+        help="run the HTTP service (FastAPI + uvicorn)",
+        description=(
+            "Serve the camloc HTTP API. Configuration comes from environment variables: "
+            "CAMLOC_MAP_DIR (folder of OSM extracts), CAMLOC_API_KEY (key for write endpoints), "
+            "CAMLOC_DATA_DIR (jobs and tasks database), CAMLOC_NETWORK (allow Overpass), "
+            "and the limits documented in docs/service.md."
+        ),
+    )
+    p.add_argument("--host", default="127.0.0.1", help="address to listen on (127.0.0.1)")
+    p.add_argument("--port", type=int, default=8000, help="port (8000)")
+    p.add_argument("--workers", type=int, default=1, help="worker processes (1)")
+    p.add_argument("--log-level", default="info", help="uvicorn log level")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the command."""
+    from camloc_geo._errors import InputError
+
+    try:
+        import uvicorn
+    except ImportError:
+        raise InputError(
+            'the service needs its extra: python -m pip install "camloc-geo[service]"'
+        ) from None
+    if not (0 < args.port < 65536):
+        raise InputError(f"--port must be 1-65535, not {args.port}")
+    if args.workers < 1:
+        raise InputError("--workers must be at least 1")
+    from camloc_geo.service.settings import Settings
+
+    try:
+        Settings()
+    except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
+        raise InputError(f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}") from None
+    uvicorn.run(
+        "camloc_geo.service:app_from_env",
+        factory=True,
+        host=args.host,
+        port=args.port,
+        workers=args.workers,
+        log_level=args.log_level,
+    )
+    return 0

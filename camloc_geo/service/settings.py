@@ -1,0 +1,61 @@
+"""Service settings, read from ``CAMLOC_*`` environment variables (pydantic-settings)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import Field, SecretStr
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+__all__ = ["Settings"]
+
+
+class Settings(BaseSettings):
+    """The service's configuration; each field is ``CAMLOC_<NAME>`` in the environment.
+
+    Map data comes from here only: a folder of extracts (``CAMLOC_MAP_DIR``) and, when
+    ``CAMLOC_NETWORK`` is true, Overpass with an HTTP cache. Clients never name server files.
+    """
+
+    model_config = SettingsConfigDict(env_prefix="CAMLOC_", extra="ignore")
+
+    map_dir: Path | None = Field(
+        default=None, description="folder of OSM extracts (.osm, .osm.gz, .osm.bz2, .osm.pbf)"
+    )
+    network: bool = Field(
+        default=False, description="query Overpass where no extract covers a point"
+    )
+    cache_folder: Path | None = Field(
+        default=None, description="osmnx HTTP cache folder for Overpass"
+    )
+    overpass_url: str | None = Field(default=None, description="Overpass API endpoint")
+    api_key: SecretStr | None = Field(
+        default=None,
+        description="when set, write endpoints need the header X-API-Key with this value",
+    )
+    data_dir: Path = Field(
+        default=Path("camloc-service-data"),
+        description="folder for the job and task database (SQLite) and uploaded snapshots",
+    )
+    max_request_bytes: int = Field(
+        default=2_000_000, ge=1_000, description="largest JSON body accepted"
+    )
+    max_upload_bytes: int = Field(
+        default=12_000_000, ge=1_000, description="largest snapshot upload accepted (bytes)"
+    )
+    max_upload_pixels: int = Field(
+        default=40_000_000, ge=1, description="largest snapshot accepted (width × height)"
+    )
+    max_annotations: int = Field(default=50, ge=1, description="most annotators in one scene")
+    max_lines_per_axis: int = Field(
+        default=100, ge=2, description="most vp_lines per axis per annotator"
+    )
+    max_references: int = Field(default=50, ge=1, description="most references in one scene")
+    max_cameras_per_job: int = Field(default=10_000, ge=1, description="most cameras in one job")
+    request_timeout_s: float = Field(
+        default=20.0, gt=0, description="processing time limit of one request (seconds)"
+    )
+    annotations_per_task: int = Field(
+        default=3, ge=1, le=50, description="default annotations collected before a task is located"
+    )
+    max_radius_m: float = Field(default=2_000.0, gt=0, description="largest corners/streets radius")
