@@ -132,6 +132,8 @@ def with_view_hint(scene: dict[str, Any], ls: LocatedScene) -> dict[str, Any]:
     heading = float(ls.camera_enu.angles_deg[0]) % 360.0
     scene["view_hint"] = {"text": f"looking {_COMPASS_8[round(heading / 45.0) % 8]}"}
     return scene
+
+
 def _oracle_points(name: str, m: MapData) -> list[dict[str, Any]]:
     """The oracle junctions of an extract within the place's radius, nearest first."""
     sys.path.insert(0, str(HERE))

@@ -87,7 +87,9 @@ def _merge_intersection(
     if merged is None:
         return copy.deepcopy(inter)
     if merged.get("lat") is not None and inter.get("lat") is not None:
-        d = float(distance_m(merged["lon"], merged["lat"], inter["lon"], inter["lat"]))
+        d = float(
+            distance_m(lat1=merged["lat"], lon1=merged["lon"], lat2=inter["lat"], lon2=inter["lon"])
+        )
         if d > _INTERSECTION_TOLERANCE_M:
             raise SceneError(
                 f"{label} marks a different intersection than {label_m}: their positions are "
@@ -195,7 +197,9 @@ def merge_scenes(scenes: Sequence[Any], *, scene_id: str | None = None) -> dict[
             if data.get(key) and out.get(key) and data[key] != out[key]:
                 if key == "prior":
                     a, b = out["prior"], data["prior"]
-                    d = float(distance_m(a["lon"], a["lat"], b["lon"], b["lat"]))
+                    d = float(
+                        distance_m(lat1=a["lat"], lon1=a["lon"], lat2=b["lat"], lon2=b["lon"])
+                    )
                     if d <= max(a.get("radius_m", 150.0), b.get("radius_m", 150.0)):
                         continue
                     raise SceneError(f"{label}'s prior is {d:.0f} m from {label0}'s")

@@ -170,17 +170,14 @@ def _compass(text: str | None) -> float | None:
     v = _finite(text.replace("°", "").strip())
     if v is not None:
         return v % 360.0
+    from camloc_geo.scene import parse_compass
+
     try:
-        from camloc_geo.scene import parse_compass  # type: ignore[attr-defined]
-    except ImportError:
-        parse_compass = None
-    if parse_compass is not None:
-        try:
-            b = parse_compass(text)
-        except Exception:  # a parser's bug must not stop the batch
-            b = None
-        if b is not None:
-            return float(b)
+        b = parse_compass(text)
+    except Exception:  # a parser's bug must not stop the batch
+        b = None
+    if b is not None:
+        return float(b)
     try:
         from camloc_geo.geocode import parse_title
 
@@ -230,7 +227,7 @@ def _title_matches(row: CameraRow, m: MapData, res: CameraResult) -> tuple[list[
         query = row.title
     else:
         return [], None
-    near = (row.lat, row.lon) if row.has_point else None
+    near = (row.lat, row.lon) if row.lat is not None and row.lon is not None else None
     radius = None
     if near is not None:
         radius = (row.radius_m or 150.0) + 150.0
@@ -342,7 +339,7 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
 
 
 def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | None) -> None:
-    from camloc_geo.absolute import _view_cone
+    from camloc_geo.absolute._geojson import view_cone as _view_cone
     from camloc_geo.api import locate_scene
     from camloc_geo.geodesy import normalize_bearing_deg
 
@@ -379,7 +376,7 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
                 "heading_deg": heading,
                 "height_m": _finite(c.camera.height_m),
                 "method": c.method,
-                "detail": ", ".join(c.flags) or None,
+                "detail": ", ".join(str(f) for f in c.flags) or None,
                 "intersection": getattr(r.intersection, "id", None),
                 "extract": res.extract,
             }

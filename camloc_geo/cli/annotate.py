@@ -65,11 +65,11 @@ def junction_geojson(
         if f["properties"]["kind"] == "corner" and f["properties"]["intersection"] == ident
     ]
     jlon, jlat = first["geometry"]["coordinates"]
-    east, north = m.frame.enu_from_geographic(jlon, jlat)
+    east, north = m.frame.enu_from_geographic(lat=jlat, lon=jlon)
     centre = Point(east, north)
     for street in m.streets:
         lonlat = np.asarray(street.geometry.coords, dtype=float)
-        e, n = m.frame.enu_from_geographic(lonlat[:, 0], lonlat[:, 1])
+        e, n = m.frame.enu_from_geographic(lat=lonlat[:, 1], lon=lonlat[:, 0])
         if LineString(np.column_stack([e, n])).distance(centre) > 120.0:
             continue
         feats.append(

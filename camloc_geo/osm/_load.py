@@ -175,6 +175,25 @@ def _check_extract_path(path: Path) -> None:
         raise MapDataError(f"OSM extract is empty: {path}")
 
 
+def _header_box(path: Path) -> tuple[float, float, float, float] | None:
+    """``(south, west, north, east)`` declared in the extract's header, or None.
+
+    Only a hint (clipped extracts hold data beyond it): choosing which extract of a folder
+    covers a point; the map itself uses the data's own extent.
+    """
+    try:
+        reader = osmium.io.Reader(str(path), osmium.osm.NOTHING)
+        try:
+            box = reader.header().box()
+        finally:
+            reader.close()
+    except RuntimeError:
+        return None
+    if not box.valid():
+        return None
+    return (box.bottom_left.lat, box.bottom_left.lon, box.top_right.lat, box.top_right.lon)
+
+
 def read_extract(
     path: Path,
     lat: float,
