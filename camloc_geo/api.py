@@ -16,6 +16,7 @@ Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -24,6 +25,7 @@ from camloc_geo._errors import MapDataError, SceneError
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
+    from camloc_geo.autovp import AutoVPResult
     from camloc_geo.osm import MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
@@ -36,9 +38,11 @@ __all__ = [
     "calibrate_scene",
     "corners_near",
     "locate_scene",
+    "map_around",
     "map_for_scene",
     "scene_from",
     "streets_near",
+    "vanishing_points",
 ]
 
 SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
@@ -163,11 +167,9 @@ def map_for_scene(
         Force loading (True) or skipping (False) the map; None: load when an extract is given
         or the scene needs one.
     """
-    from camloc_geo.osm import MapData, load_map
-
     sc = scene_from(scene)
-    if isinstance(map_source, MapData):
-        return map_source
+    if map_source is not None and not isinstance(map_source, (str, os.PathLike)):
+        return map_source  # an already loaded MapData
     need = scene_needs_map(sc) if required is None else required
     if map_source is None and not need:
         return None
@@ -179,13 +181,15 @@ def map_for_scene(
             "prior",
         )
     radius = scene_map_radius_m(sc, radius_m)
-    if map_source is not None:
-        return load_map(map_source, centre[0], centre[1], radius_m=radius)
-    if not network:
+    if map_source is None and not network:
         raise MapDataError(
             "this scene needs a map (intersection corners, landmarks or street bearings) and "
             "the network is off: give --osm EXTRACT (map_source=...)"
         )
+    from camloc_geo.osm import load_map
+
+    if map_source is not None:
+        return load_map(map_source, centre[0], centre[1], radius_m=radius)
     return load_map(
         None,
         centre[0],
@@ -267,7 +271,19 @@ def locate_scene(
             raise SceneError("max_candidates must be at least 1", "max_candidates")
         settings = replace(settings, max_candidates=max_candidates)
     result = locate(sc, map_data, calibration=calibration, settings=settings)
+    from camloc_geo.cues import apply_cues
+
+    apply_cues(result, sc, map_data, merge_distance_m=settings.merge_distance_m)
     return LocateOutput(scene=sc, result=result, map_data=map_data)
+
+
+def _require_source(map_source: MapSource, network: bool) -> None:
+    """Fail at once (before any heavy import) when no map can be had."""
+    if map_source is None and not network:
+        raise MapDataError(
+            "no map: the network is off and no extract was given: give --osm EXTRACT "
+            "(map_source=...)"
+        )
 
 
 def corners_near(
@@ -283,23 +299,20 @@ def corners_near(
 ) -> dict[str, Any]:
     """Intersections with their kerb corners around a point, as GeoJSON (``docs/contract.md``).
 
-    ``streets`` (``"A & B"``) keeps only the intersection of those streets.
+    ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
+    from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
     """
-    from camloc_geo.osm import MapData, intersections_geojson, load_map
+    m = streets_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    from camloc_geo.osm import intersections_geojson
 
-    if isinstance(map_source, MapData):
-        m = map_source
-    else:
-        if map_source is None and not network:
-            raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
-        m = load_map(
-            map_source,
-            lat,
-            lon,
-            radius_m,
-            cache_folder=cache_folder,
-            overpass_url=overpass_url,
-        )
     inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
     return intersections_geojson(inters)
 
@@ -311,12 +324,114 @@ def streets_near(
     radius_m: float = 150.0,
     map_source: MapSource = None,
     network: bool = True,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
 ) -> MapData:
-    """The map around a point (its ``streets`` carry names and bearings)."""
+    """The map around a point (its ``streets`` carry names and bearings).
+
+    The map comes from ``map_source`` or, when ``network`` allows it, Overpass.
+
+    Raises
+    ------
+    MapDataError
+        No extract and the network is off (at once), unreadable extract, no streets there.
+    MapSourceError
+        Overpass could not be reached (within a few seconds) or failed.
+    """
+    _require_source(map_source, network)
     from camloc_geo.osm import MapData, load_map
 
     if isinstance(map_source, MapData):
         return map_source
-    if map_source is None and not network:
-        raise MapDataError("no extract given and the network is off: give --osm EXTRACT")
-    return load_map(map_source, lat, lon, radius_m)
+    return load_map(
+        map_source, lat, lon, radius_m, cache_folder=cache_folder, overpass_url=overpass_url
+    )
+
+
+def vanishing_points(
+    image: str | os.PathLike[str] | Any,
+    *,
+    focal_px: float | None = None,
+    principal_point: tuple[float, float] | None = None,
+    ignore_boxes_px: Sequence[Sequence[float]] = (),
+    axes_px: Sequence[Sequence[float]] = (),
+    estimate_principal_point: bool = False,
+    seed: int = 0,
+) -> AutoVPResult:
+    """Three orthogonal vanishing points, focal length, horizon, pitch and roll of a photo.
+
+    Parameters
+    ----------
+    image
+        Path of a photo (any format OpenCV reads) or a grey/colour image array.
+    focal_px, principal_point
+        Known intrinsics, pixels (default: estimated / the image centre).
+    ignore_boxes_px
+        ``(x0, y0, x1, y1)`` pixel boxes whose segments are ignored (time stamps, logos).
+    axes_px
+        ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
+    estimate_principal_point
+        Also refine the principal point around the image centre.
+
+    Raises
+    ------
+    InputError
+        Unreadable image, non-positive focal length, non-finite box, too little structure.
+    """
+    import numpy as np
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.autovp import detect_vanishing_points, load_image
+
+    if focal_px is not None and not focal_px > 0:
+        raise InputError(f"focal_px must be positive, got {focal_px}")
+    img = load_image(image)
+    mask = None
+    if ignore_boxes_px:
+        h, w = img.shape[:2]
+        mask = np.ones((h, w), dtype=bool)
+        for box in ignore_boxes_px:
+            if len(box) != 4 or not all(np.isfinite(box)):
+                raise InputError("ignore box: give four finite numbers x0 y0 x1 y1")
+            xa, xb = sorted((box[0], box[2]))
+            ya, yb = sorted((box[1], box[3]))
+            mask[
+                max(0, int(ya)) : max(0, int(np.ceil(yb))),
+                max(0, int(xa)) : max(0, int(np.ceil(xb))),
+            ] = False
+    return detect_vanishing_points(
+        img,
+        focal_px=focal_px,
+        principal_point=principal_point,
+        seed=seed,
+        mask=mask,
+        estimate_principal_point=estimate_principal_point,
+        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+    )
+
+
+def map_around(
+    points: Sequence[tuple[float, float]],
+    *,
+    map_source: MapSource = None,
+    network: bool = False,
+    margin_m: float = 150.0,
+    max_radius_m: float = 2000.0,
+) -> MapData | None:
+    """The map covering ``(lat, lon)`` points (cameras), or None without points.
+
+    Centred on the points' mean, with a radius reaching the farthest point plus
+    ``margin_m`` (at most ``max_radius_m``).
+    """
+    if not points:
+        return None
+    _require_source(map_source, network)
+    from camloc_geo.geodesy import distance_m
+    from camloc_geo.osm import MapData, load_map
+
+    if isinstance(map_source, MapData):
+        return map_source
+    lat = sum(p[0] for p in points) / len(points)
+    lon = sum(p[1] for p in points) / len(points)
+    radius = max(distance_m(lat1=lat, lon1=lon, lat2=q[0], lon2=q[1]) for q in points)
+    return load_map(map_source, lat, lon, radius_m=min(radius + margin_m, max_radius_m))

@@ -119,7 +119,10 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
     import cv2
 
     if isinstance(image, (str, os.PathLike)):
+        from camloc_geo._limits import check_image_file
+
         path = Path(image)
+        check_image_file(path)  # regular file, size from the header before decoding
         try:
             buf = np.fromfile(str(path), dtype=np.uint8)
         except OSError as exc:

@@ -836,7 +836,9 @@ def candidates_map(
                 width,
                 len(ranks),
             )
-    out.write_text(page, encoding="utf-8")
+    from camloc_geo._io import write_text_atomic
+
+    write_text_atomic(out, page)
     log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
     return out
 
@@ -998,7 +1000,9 @@ def summary_map(
         items, offline=offline, tiles=tiles, cluster=cluster, map_data=map_data
     )
     page = _render(fmap, offline)
-    out.write_text(page, encoding="utf-8")
+    from camloc_geo._io import write_text_atomic
+
+    write_text_atomic(out, page)
     log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
     return out
 

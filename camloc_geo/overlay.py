@@ -642,9 +642,12 @@ def candidate_overlay(
     )
     if path is not None:
         p = Path(path)
+        from camloc_geo._io import atomic_path
+
         p.parent.mkdir(parents=True, exist_ok=True)
-        if not cv2.imwrite(str(p), img):
-            raise OSError(f"cannot write overlay PNG {p}")
+        with atomic_path(p) as tmp:
+            if not cv2.imwrite(str(tmp), img):
+                raise OSError(f"cannot write overlay PNG {p}")
     return img
 
 

@@ -28,18 +28,18 @@ from __future__ import annotations
 import functools
 import logging
 import math
-from dataclasses import dataclass, field
+import re
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy.cluster.hierarchy import fcluster, linkage
 from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo.camera import Camera
 from camloc_geo.objects import ObjectSize
-from camloc_geo.scene import Annotation, Scene
+from camloc_geo.scene import Annotation, Scene, pixel_problem
 from camloc_geo.vanishing import (
     AXES,
     IntrinsicsEstimate,
@@ -59,6 +59,7 @@ __all__ = [
     "CalibrationResult",
     "CalibrationSettings",
     "calibrate",
+    "implausibility",
     "solve_annotator",
 ]
 
@@ -95,6 +96,7 @@ class CalibrationSettings:
     outlier_weight: float = 0.3
     free_principal_point: bool | None = None  # None = decided by BIC
     reassign_corners: bool = True
+    jackknife: bool = True
 
 
 @dataclass
@@ -157,7 +159,17 @@ class CalibrationResult:
     outlier_annotators
         Names of annotators reported as outliers.
     position_sigma_m
-        1-sigma uncertainty of the camera centre (x, y, z) in the world frame.
+        1-sigma uncertainty of the camera centre (x, y, z) in the world frame: the fit's
+        covariance and, with 2-12 annotators, their jackknife spread.
+    position_sigma_fit_m
+        The fit's covariance part alone (when the jackknife was added).
+    excluded_annotators
+        ``{annotator, index, reason}`` of each annotator left out.
+    clamped_clicks
+        Clicks up to the margin outside the image, moved onto it.
+    annotator_influence_m
+        Per annotation, how far the camera moves when it is left out (None: not computed, or
+        no comparable answer without it).
     """
 
     camera: Camera
@@ -175,6 +187,10 @@ class CalibrationResult:
     warnings: list[str] = field(default_factory=list)
     annotator_corners: list[str] = field(default_factory=list)
     width_sign: float = 1.0
+    excluded_annotators: list[dict[str, Any]] = field(default_factory=list)
+    clamped_clicks: int = 0
+    annotator_influence_m: list[float | None] = field(default_factory=list)
+    position_sigma_fit_m: FloatArray | None = None
 
     @property
     def height_m(self) -> float:
@@ -189,16 +205,57 @@ class CalibrationResult:
         crowd quality control.
         """
         names = [a.annotator for a in self.annotators]
-        return [n for n, c in zip(names, self.annotator_corners, strict=False) if c != "origin"]
+        return [
+            n
+            for n, c in zip(names, self.annotator_corners, strict=False)
+            if c not in ("origin", "excluded")
+        ]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON that ``camloc calibrate`` prints.
-
-        Built from :class:`camloc_geo.results.CalibrationOutput`.
-        """
-        from camloc_geo.results import calibration_output, to_json
-
-        out: dict[str, Any] = to_json(calibration_output(self))
+        """The JSON that ``camloc calibrate`` prints."""
+        cam = self.camera
+        _heading, pitch, roll = cam.angles_deg
+        out: dict[str, Any] = {
+            "focal_px": cam.focal_px,
+            "principal_point": list(cam.principal_point),
+            "height_m": cam.height_m,
+            "camera_in_world": cam.center_in_world.tolist(),
+            "pitch_deg": pitch,
+            "roll_deg": roll,
+            "cam_from_world": cam.cam_from_world.tolist(),
+            "rotation": cam.cam_from_world_rotation.tolist(),
+            "method": self.method,
+            "intrinsics_method": self.intrinsics_method,
+            "fallback": self.intrinsics_method,
+            "intrinsics_reason": self.intrinsics_reason,
+            "distance_to_origin_m": float(np.linalg.norm(cam.center_in_world)),
+        }
+        if self.position_sigma_m is not None:
+            out["camera_in_world_sigma_m"] = self.position_sigma_m.tolist()
+            out["height_sigma_m"] = float(self.position_sigma_m[2])
+        if self.focal_sigma_px is not None:
+            out["focal_sigma_px"] = self.focal_sigma_px
+        if self.rms_residual_px is not None:
+            out["rms_residual_px"] = self.rms_residual_px
+        out["width_sign"] = self.width_sign
+        out["annotator_weights"] = self.annotator_weights
+        if self.annotator_corners:
+            out["annotator_corners"] = self.annotator_corners
+            out["corner_mistakes"] = self.corner_mistakes
+        out["outlier_annotators"] = self.outlier_annotators
+        out["excluded_annotators"] = [
+            {"annotator": e["annotator"], "index": e["index"], "reason": e["reason"]}
+            for e in self.excluded_annotators
+        ]
+        out["clamped_clicks"] = self.clamped_clicks
+        if self.annotator_influence_m:
+            out["annotator_influence_m"] = self.annotator_influence_m
+        if self.position_sigma_fit_m is not None:
+            out["camera_in_world_sigma_fit_m"] = self.position_sigma_fit_m.tolist()
+        out["cluster"] = self.cluster
+        out["annotators"] = [a.to_dict() for a in self.annotators]
+        if self.warnings:
+            out["warnings"] = self.warnings
         return out
 
 
@@ -407,6 +464,8 @@ def _cluster(
     if len(pts) == 1:
         labels = np.array([1])
     else:
+        from scipy.cluster.hierarchy import fcluster, linkage  # 0.25 s to import: only here
+
         labels = fcluster(linkage(pts, method="single"), t=threshold, criterion="distance")
     best_label, best_key = None, None
     for lab in np.unique(labels):
@@ -775,14 +834,18 @@ def _detect_vps(path: str, _mtime_ns: int, _size: int) -> Any:
 def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
     """Segments for axes an annotator drew no lines for, from the image (if any)."""
     path = scene.image_file()
-    if path is None or not path.exists():
+    if path is None or not path.is_file():  # is_file: a FIFO or a device would block
         return {}
     try:
         from camloc_geo import autovp
     except ImportError:  # pragma: no cover - autovp ships with the package
         return {}
     stat = path.stat()
-    res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    try:
+        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except InputError as exc:
+        log.warning("image.path: no lines detected in %s: %s", path, exc)
+        return {}
     ann = scene.annotations[index]
     out = {}
     for axis in axes:
@@ -796,8 +859,345 @@ def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, Float
     return out
 
 
+# ------------------------------------------------------------------ crowd input screening
+PLAUSIBLE_HEIGHT_M = (0.3, 300.0)
+"""A mounted camera stands between these heights above the car's ground plane (metres)."""
+PLAUSIBLE_DISTANCE_M = 1000.0
+"""A camera farther than this from the car (horizontally, metres) cannot resolve it."""
+PLAUSIBLE_FOCAL_DIAG = (0.15, 20.0)
+"""Plausible focal lengths, as multiples of the image diagonal (fish-eye to long zoom)."""
+MIN_SEGMENT_PX = 2.0
+"""Segments shorter than this are degenerate: dropped, with a warning."""
+_MAX_LEAVE_OUT = 12
+_MAX_JACKKNIFE = 12
+
+
+@dataclass
+class _Screening:
+    """What :func:`_screen_annotations` kept, clamped and left out."""
+
+    scene: Scene
+    kept: list[int]
+    excluded: list[dict[str, Any]]
+    clamped_clicks: int
+    warnings: list[str]
+
+
+def _screen_annotation(
+    scene: Scene, index: int, margin: float
+) -> tuple[Annotation | None, str | None, int, list[str]]:
+    """One annotator's work, clamped onto the image, or the reason it is unusable."""
+    ann = scene.annotations[index]
+    w, h = scene.image_size
+    clamped = 0
+    notes: list[str] = []
+    axes: dict[str, tuple[float, ...]] = {}
+    for name in ("origin", "length", "width", "height"):
+        problem, values, n = pixel_problem(getattr(ann.axes, name), w, h, margin)
+        if problem is not None:
+            return None, f"axes.{name}: {problem}", 0, []
+        axes[name], clamped = values, clamped + n
+    lines: dict[str, list[tuple[float, ...]]] = {}
+    for axis in AXES:
+        kept_segs = []
+        for j, seg in enumerate(getattr(ann.vp_lines, axis)):
+            problem, values, n = pixel_problem(seg, w, h, margin)
+            if problem is not None:
+                return None, f"vp_lines.{axis}[{j}]: {problem}", 0, []
+            clamped += n
+            if math.hypot(values[2] - values[0], values[3] - values[1]) < MIN_SEGMENT_PX:
+                notes.append(
+                    f"annotations[{index}].vp_lines.{axis}[{j}] ({ann.annotator}): shorter than "
+                    f"{MIN_SEGMENT_PX:g} px; left out"
+                )
+                continue
+            kept_segs.append(values)
+        lines[axis] = kept_segs
+    new = ann.model_copy(
+        update={
+            "axes": ann.axes.model_copy(update=axes),
+            "vp_lines": ann.vp_lines.model_copy(update=lines),
+        }
+    )
+    try:
+        _check_axes_geometry(new, "annotation")
+    except DegenerateGeometryError as exc:
+        return None, str(exc).removeprefix("annotation."), 0, []
+    if len({tuple(np.round(getattr(new.axes, k), 6)) for k in ("length", "width", "height")}) < 3:
+        return None, "axes: two edge ends on the same pixel", 0, []
+    return new, None, clamped, notes
+
+
+def _screen_annotations(scene: Scene) -> _Screening:
+    """Clamp slips onto the image; leave out annotators and hints that cannot be used.
+
+    An annotator is left out (with a warning naming them and the reason) when a click is not
+    finite or lies farther outside the image than the margin
+    (:attr:`~camloc_geo.scene.Scene.pixel_margin_px`), or when their axes are degenerate (an
+    edge end on the origin, two edges collinear). Clicks within the margin are clamped and
+    counted. Camera hints outside plausible ranges are ignored with a warning.
+    """
+    margin = scene.pixel_margin_px
+    kept: list[int] = []
+    anns: list[Annotation] = []
+    excluded: list[dict[str, Any]] = []
+    warnings: list[str] = list(scene.input_warnings)
+    clamped = 0
+    for i, ann in enumerate(scene.annotations):
+        new, reason, n, notes = _screen_annotation(scene, i, margin)
+        if new is None:
+            geometry = not (reason or "").split(": ", 1)[-1].startswith("pixel")
+            excluded.append(
+                {"annotator": ann.annotator, "index": i, "reason": reason, "geometry": geometry}
+            )
+            warnings.append(f"annotator {ann.annotator!r} (annotations[{i}]) left out: {reason}")
+            continue
+        warnings += notes
+        kept.append(i)
+        anns.append(new)
+        clamped += n
+    if clamped:
+        log.info("%d click(s) just outside the image clamped onto it", clamped)
+    anns, kept = _screen_segments(scene, anns, kept, excluded, warnings)
+    update: dict[str, Any] = {"annotations": anns}
+    hints: dict[str, Any] = {}
+    w, h = scene.image_size
+    diag = math.hypot(w, h)
+    f = scene.camera.focal_px
+    lo, hi = PLAUSIBLE_FOCAL_DIAG
+    if f is not None and not lo * diag <= f <= hi * diag:
+        hints["focal_px"] = None
+        excluded_value = (
+            f"camera.focal_px: {f:g} px is implausible for a {w}x{h} image "
+            f"(plausible {lo * diag:.0f}-{hi * diag:.0f} px); ignored, estimated instead"
+        )
+        warnings.append(excluded_value)
+    pp = scene.camera.principal_point
+    if pp is not None and not (
+        math.isfinite(pp[0]) and math.isfinite(pp[1]) and 0 <= pp[0] <= w and 0 <= pp[1] <= h
+    ):
+        hints["principal_point"] = None
+        msg = (
+            f"camera.principal_point: [{pp[0]:g}, {pp[1]:g}] is outside the {w}x{h} image; ignored"
+        )
+        warnings.append(msg)
+    if hints:
+        update["camera"] = scene.camera.model_copy(update=hints)
+    return _Screening(scene.model_copy(update=update), kept, excluded, clamped, warnings)
+
+
+def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
+    """Residuals (px) of segments to their least-median-of-squares vanishing point.
+
+    Candidates are the intersections of pairs of segments (all pairs up to 25 segments, 300
+    seeded random pairs beyond); the one with the smallest median residual is refined by a
+    fit to its inliers. Robust to nearly half the segments being slips, however long.
+    """
+    n = len(segments)
+    ones = np.ones((n, 1))
+    lines = np.cross(np.hstack([segments[:, :2], ones]), np.hstack([segments[:, 2:], ones]))
+    lines /= np.maximum(np.linalg.norm(lines[:, :2], axis=1), 1e-12)[:, None]
+    if n <= 25:
+        pairs = np.array([(i, j) for i in range(n) for j in range(i + 1, n)])
+    else:
+        rng = np.random.default_rng(0)
+        pairs = rng.integers(0, n, (300, 2))
+        pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    if len(pairs) == 0:
+        return None
+    V = np.cross(lines[pairs[:, 0]], lines[pairs[:, 1]])  # candidate vanishing points (P, 3)
+    V = V[np.all(np.isfinite(V), axis=1) & (np.linalg.norm(V, axis=1) > 0)]
+    if len(V) == 0:
+        return None
+    V /= np.linalg.norm(V, axis=1)[:, None]
+    # segment_residuals_px for every candidate at once: (P, n).
+    mx = (segments[:, 0] + segments[:, 2]) / 2.0
+    my = (segments[:, 1] + segments[:, 3]) / 2.0
+    px, py, pw = V[:, 0:1], V[:, 1:2], V[:, 2:3]
+    la, lb = my * pw - py, px - mx * pw
+    lc = mx * py - my * px
+    res = (la * segments[:, 0] + lb * segments[:, 1] + lc) / np.maximum(np.hypot(la, lb), 1e-300)
+    med = np.median(np.abs(res), axis=1)
+    best = (float(med.min()), V[int(np.argmin(med))])
+    r = np.abs(segment_residuals_px(segments, best[1]))
+    scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
+    inliers = r <= 3.0 * scale
+    if inliers.sum() >= 2:
+        try:
+            vp = fit_vanishing_point(segments[inliers], scale_px=diag, name="pooled")
+            r = np.abs(segment_residuals_px(segments, vp.homogeneous))
+        except (DegenerateGeometryError, np.linalg.LinAlgError):
+            pass
+    return np.asarray(r, dtype=np.float64)
+
+
+def _screen_segments(
+    scene: Scene,
+    anns: list[Annotation],
+    kept: list[int],
+    excluded: list[dict[str, Any]],
+    warnings: list[str],
+) -> tuple[list[Annotation], list[int]]:
+    """Leave out segments that disagree grossly with everybody's vanishing point of their axis.
+
+    Per axis, the vanishing point of all annotators' segments pooled (with a robust 3 × MAD
+    rejection) is the reference; a segment farther from it than ``max(8 × the robust scale,
+    1 % of the image diagonal)``, or pointing more than 30° away from it and farther than
+    3 × the robust scale, is a slip (an end dragged away, a line drawn for another axis)
+    and is dropped with a warning. An annotator (of three or more) most of whose
+    segments of an axis are such slips drew that axis wrong and is left out.
+    """
+    w, h = scene.image_size
+    diag = math.hypot(w, h)
+    gross: dict[tuple[int, str], npt.NDArray[np.bool_]] = {}
+    for axis in AXES:
+        segs = [np.asarray(getattr(a.vp_lines, axis), float).reshape(-1, 4) for a in anns]
+        pooled = np.vstack(segs) if segs else np.zeros((0, 4))
+        if len(pooled) < 5:  # too few to tell a slip from the others' noise
+            continue
+        r = _lmeds_residuals(pooled, diag)
+        if r is None:
+            continue
+        scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
+        half = 0.5 * np.hypot(pooled[:, 2] - pooled[:, 0], pooled[:, 3] - pooled[:, 1])
+        angle = np.degrees(np.arcsin(np.clip(r / np.maximum(half, 1e-9), 0.0, 1.0)))
+        bad = (r > max(8.0 * scale, 0.01 * diag)) | ((angle > 30.0) & (r > 3.0 * scale))
+        start = 0
+        for slot, sg in enumerate(segs):
+            gross[(slot, axis)] = bad[start : start + len(sg)]
+            start += len(sg)
+    out_anns: list[Annotation] = []
+    out_kept: list[int] = []
+    for slot, (ann, i) in enumerate(zip(anns, kept, strict=True)):
+        reason = None
+        lines: dict[str, list[Any]] = {}
+        for axis in AXES:
+            flags = gross.get((slot, axis))
+            segs_list = list(getattr(ann.vp_lines, axis))
+            if flags is None or not flags.any():
+                lines[axis] = segs_list
+                continue
+            n_bad = int(flags.sum())
+            if len(anns) >= 3 and n_bad >= 2 and n_bad * 2 > len(segs_list):
+                reason = (
+                    f"vp_lines.{axis}: {n_bad} of {len(segs_list)} segments disagree with "
+                    "everybody else's (drawn for another axis?)"
+                )
+                break
+            for j in np.flatnonzero(flags):
+                warnings.append(
+                    f"annotations[{i}].vp_lines.{axis}[{j}] ({ann.annotator}): far from "
+                    "everybody's vanishing point of that axis; left out"
+                )
+            lines[axis] = [sg for sg, f in zip(segs_list, flags, strict=True) if not f]
+        if reason is not None:
+            excluded.append(
+                {"annotator": ann.annotator, "index": i, "reason": reason, "geometry": True}
+            )
+            warnings.append(f"annotator {ann.annotator!r} (annotations[{i}]) left out: {reason}")
+            continue
+        if lines != {axis: list(getattr(ann.vp_lines, axis)) for axis in AXES}:
+            ann = ann.model_copy(update={"vp_lines": ann.vp_lines.model_copy(update=lines)})
+        out_anns.append(ann)
+        out_kept.append(i)
+    return out_anns, out_kept
+
+
+def implausibility(result: CalibrationResult, image_size: tuple[int, int]) -> str | None:
+    """Why a calibration is physically impossible, or None when it is plausible.
+
+    Checks the camera height (:data:`PLAUSIBLE_HEIGHT_M`), its horizontal distance from the
+    car (:data:`PLAUSIBLE_DISTANCE_M`), the focal length (:data:`PLAUSIBLE_FOCAL_DIAG`) and
+    that the principal point lies in the image.
+    """
+    cam = result.camera
+    w, h = image_size
+    diag = math.hypot(w, h)
+    c = cam.center_in_world
+    if not np.all(np.isfinite(c)) or not math.isfinite(cam.focal_px):
+        return "the camera is not finite"
+    z = float(c[2])
+    if z < 0:
+        return f"the camera is {-z:.1f} m below the ground"
+    if z < PLAUSIBLE_HEIGHT_M[0]:
+        return f"the camera is {z:.2f} m above the ground, lower than any mount"
+    if z > PLAUSIBLE_HEIGHT_M[1]:
+        top = PLAUSIBLE_HEIGHT_M[1]
+        return f"the camera is {z:.0f} m above the ground (plausible up to {top:g} m)"
+    dist = float(np.hypot(c[0], c[1]))
+    if dist > PLAUSIBLE_DISTANCE_M:
+        return (
+            f"the camera is {dist / 1000:.1f} km from the car "
+            f"(plausible up to {PLAUSIBLE_DISTANCE_M:g} m)"
+        )
+    lo, hi = PLAUSIBLE_FOCAL_DIAG
+    if not lo * diag <= cam.focal_px <= hi * diag:
+        return (
+            f"the focal length {cam.focal_px:.0f} px is implausible "
+            f"(plausible {lo * diag:.0f}-{hi * diag:.0f} px)"
+        )
+    px, py = cam.principal_point
+    if not (0 <= px <= w and 0 <= py <= h):
+        return f"the principal point [{px:.0f}, {py:.0f}] is outside the {w}x{h} image"
+    return None
+
+
+def _remap(
+    result: CalibrationResult,
+    kept: list[int],
+    n_total: int,
+    excluded: list[dict[str, Any]],
+    names: list[str],
+) -> CalibrationResult:
+    """Express a result fitted on the kept annotators in the scene's own indices."""
+
+    def fix(text: str) -> str:
+        return re.sub(
+            r"annotations\[(\d+)\]", lambda m: f"annotations[{kept[int(m.group(1))]}]", text
+        )
+
+    for sol in result.annotators:
+        if 0 <= sol.index < len(kept):
+            sol.index = kept[sol.index]
+        if sol.error:
+            sol.error = fix(sol.error)
+    for member in result.cluster.get("members", []):
+        if isinstance(member.get("annotator"), int) and 0 <= member["annotator"] < len(kept):
+            member["annotator"] = kept[member["annotator"]]
+    result.warnings = [fix(wn) for wn in result.warnings]
+    weights = [0.0] * n_total
+    for k, wgt in zip(kept, result.annotator_weights, strict=False):
+        weights[k] = wgt
+    result.annotator_weights = weights
+    if result.annotator_influence_m:
+        influence: list[float | None] = [None] * n_total
+        for k, inf in zip(kept, result.annotator_influence_m, strict=False):
+            influence[k] = inf
+        result.annotator_influence_m = influence
+    if result.annotator_corners:
+        corners = ["excluded"] * n_total
+        for k, c in zip(kept, result.annotator_corners, strict=False):
+            corners[k] = c
+        result.annotator_corners = corners
+    by_index = {s.index: s for s in result.annotators}
+    for ex in excluded:
+        i = ex["index"]
+        if i not in by_index:
+            by_index[i] = AnnotatorSolution(i, names[i], {}, error=f"left out: {ex['reason']}")
+    result.annotators = [by_index[i] for i in sorted(by_index) if i >= 0] + [
+        s for s in result.annotators if s.index < 0
+    ]
+    return result
+
+
 def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> CalibrationResult:
     """Camera intrinsics, orientation and position relative to the annotated object.
+
+    Crowd input degrades gracefully: clicks just outside the image are clamped (counted in
+    ``clamped_clicks``), annotators whose work is unusable are left out with a warning
+    (``excluded_annotators``), and a physically impossible result (see
+    :func:`implausibility`) is never returned: the fit is repeated without each annotator in
+    turn and the best plausible one kept, naming the annotator left out.
 
     Parameters
     ----------
@@ -813,10 +1213,157 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     Raises
     ------
     SceneError
-        No annotations, or an annotator without enough segments for an axis.
+        No annotations, no usable annotator left, or an axis without enough segments.
     DegenerateGeometryError
-        When no annotator's work determines a camera (the first annotator's problem is named).
+        When no annotator's work determines a camera (the first annotator's problem is named),
+        or no plausible camera is found (the reason is named).
     """
+    settings = settings or CalibrationSettings()
+    if not scene.annotations:
+        raise SceneError("at least one annotation is needed to calibrate", "annotations")
+    names = [a.annotator for a in scene.annotations]
+    screening = _screen_annotations(scene)
+    if not screening.kept:
+        raise _no_usable_annotator(screening.excluded)
+    for msg in screening.warnings[len(scene.input_warnings) :]:
+        log.warning("%s", msg)  # the scene's own were logged when it was read
+    clean = screening.scene
+    excluded = list(screening.excluded)
+    kept = list(screening.kept)
+    result = _calibrate_usable(clean, settings)
+    problem = implausibility(result, scene.image_size)
+    if problem is not None:
+        result, dropped = _leave_one_out(clean, settings, result, problem)
+        slot_name = clean.annotations[dropped].annotator
+        reason = f"without this annotator the result is plausible (with: {problem})"
+        msg = f"annotator {slot_name!r} (annotations[{kept[dropped]}]) left out: {reason}"
+        log.warning("%s", msg)
+        excluded.append({"annotator": slot_name, "index": kept[dropped], "reason": reason})
+        screening.warnings.append(msg)
+        # The result was fitted without the dropped slot: its indices skip it.
+        kept = [k for j, k in enumerate(kept) if j != dropped]
+        clean = clean.model_copy(
+            update={"annotations": [a for j, a in enumerate(clean.annotations) if j != dropped]}
+        )
+    if settings.joint_fit and settings.jackknife and 2 <= len(kept) <= _MAX_JACKKNIFE:
+        _jackknife(result, clean, settings)
+    result = _remap(result, kept, len(scene.annotations), excluded, names)
+    result.excluded_annotators = sorted(excluded, key=lambda e: int(e["index"]))
+    result.clamped_clicks = screening.clamped_clicks
+    result.warnings = screening.warnings + result.warnings
+    result.outlier_annotators = list(
+        dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
+    )
+    return result
+
+
+def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSettings) -> None:
+    """Add the annotators' spread to the uncertainty: leave-one-annotator-out refits.
+
+    The Gauss-Newton covariance trusts every click's noise model; crowd annotators also differ
+    in ways the model does not know (a long line drawn a little off). The jackknife variance
+    ``(n-1)/n Σ (C₋ᵢ - C̄)²`` of the camera centre over the refits without each annotator
+    measures that, and is added to ``position_sigma_m``; each annotator's influence (how far
+    the camera moves without them) goes to ``annotator_influence_m``.
+    """
+    n = len(scene.annotations)
+    c = result.camera.center_in_world
+    # The refits keep the main fit's model choices (principal point, corners): cheaper, and
+    # the spread then measures the annotators, not the model selection.
+    free_pp = result.intrinsics_method == "joint_fit_free_principal_point"
+    sub_settings = replace(
+        settings,
+        jackknife=False,
+        free_principal_point=(
+            free_pp if settings.free_principal_point is None else settings.free_principal_point
+        ),
+        reassign_corners=settings.reassign_corners and bool(result.corner_mistakes),
+    )
+    centres: list[FloatArray] = []
+    influence: list[float | None] = []
+    for j in range(n):
+        sub = scene.model_copy(
+            update={"annotations": [a for k, a in enumerate(scene.annotations) if k != j]}
+        )
+        try:
+            res = _calibrate_usable(sub, sub_settings)
+        except (InputError, np.linalg.LinAlgError):
+            influence.append(None)
+            continue
+        if res.width_sign != result.width_sign or implausibility(res, scene.image_size):
+            influence.append(None)  # another frame, or no answer without them
+            continue
+        centres.append(res.camera.center_in_world)
+        influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
+    result.annotator_influence_m = influence
+    if len(centres) < 2:
+        return
+    arr = np.asarray(centres)
+    m = len(arr)
+    sigma_jack = np.sqrt((m - 1) / m * ((arr - arr.mean(axis=0)) ** 2).sum(axis=0))
+    base = result.position_sigma_m if result.position_sigma_m is not None else np.zeros(3)
+    result.position_sigma_fit_m = base
+    result.position_sigma_m = np.sqrt(base**2 + sigma_jack**2)
+
+
+def _no_usable_annotator(excluded: list[dict[str, Any]]) -> InputError:
+    """The error when every annotator was left out: their reasons, one line."""
+    parts = [f"annotations[{e['index']}].{e['reason']}" for e in excluded[:3]]
+    more = f" (+{len(excluded) - 3} more)" if len(excluded) > 3 else ""
+    geometric = all(e.get("geometry") for e in excluded)
+    if len(excluded) == 1:
+        text = parts[0]
+    else:
+        text = "no usable annotator: " + "; ".join(
+            f"{p} ({e['annotator']})" for p, e in zip(parts, excluded, strict=False)
+        )
+    return (DegenerateGeometryError if geometric else SceneError)(text + more)
+
+
+def _leave_one_out(
+    scene: Scene, settings: CalibrationSettings, result: CalibrationResult, problem: str
+) -> tuple[CalibrationResult, int]:
+    """The best plausible fit without one annotator, and that annotator's slot.
+
+    Annotators are tried from the least trusted (lowest weight in the implausible fit); the
+    plausible refit with the smallest residual wins.
+
+    Raises
+    ------
+    DegenerateGeometryError
+        Naming ``problem`` when no annotator's removal gives a plausible camera.
+    """
+    n = len(scene.annotations)
+    if n < 2:
+        raise DegenerateGeometryError(
+            f"no plausible camera: {problem}; the only usable annotator "
+            f"({scene.annotations[0].annotator}) cannot be checked against others"
+        )
+    weights = result.annotator_weights if len(result.annotator_weights) == n else [1.0] * n
+    order = sorted(range(n), key=lambda j: weights[j])[:_MAX_LEAVE_OUT]
+    best: tuple[float, CalibrationResult, int] | None = None
+    for j in order:
+        sub = scene.model_copy(
+            update={"annotations": [a for k, a in enumerate(scene.annotations) if k != j]}
+        )
+        try:
+            res = _calibrate_usable(sub, settings)
+        except InputError:
+            continue
+        if implausibility(res, scene.image_size) is not None:
+            continue
+        score = res.rms_residual_px if res.rms_residual_px is not None else 0.0
+        if best is None or score < best[0]:
+            best = (score, res, j)
+    if best is None:
+        raise DegenerateGeometryError(
+            f"no plausible camera: {problem}, and leaving out any one annotator does not help"
+        )
+    return best[1], best[2]
+
+
+def _calibrate_usable(scene: Scene, settings: CalibrationSettings) -> CalibrationResult:
+    """:func:`calibrate` on annotations already screened."""
     settings = settings or CalibrationSettings()
     if not scene.annotations:
         raise SceneError("at least one annotation is needed to calibrate", "annotations")

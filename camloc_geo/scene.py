@@ -10,6 +10,16 @@ Extensions beyond the contract (all optional):
 - ``object.preset``: a name from :data:`camloc_geo.objects.PRESETS` instead of, or as the
   base for, explicit sizes.
 - ``references[].weight``: relative confidence of a reference pixel.
+- ``view_hint``: the camera's viewing direction (a bearing with a tolerance, or a compass
+  phrase from a webcam listing, read by :func:`parse_compass`).
+- ``object.street``: the street the car stands on; ``object.front``: which end of the
+  annotated length edge is the car's front.
+
+Crowd input is validated for what it is, not for how carefully it was clicked: pixels are
+any finite numbers (a click a few pixels outside the image is clamped, an annotator whose
+work is unusable is left out with a warning by :func:`camloc_geo.relative.calibrate`).
+Scene size is bounded (:mod:`camloc_geo._limits`): a refusal names the limit. Every field is
+described in ``docs/scene-format.md`` and in ``camloc schema``.
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import re
 from pathlib import Path
 from typing import Any, Literal
 
@@ -24,19 +35,34 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    PrivateAttr,
     ValidationError,
     field_validator,
     model_validator,
 )
 
-from camloc_geo._errors import SceneError
+from camloc_geo._errors import InputError, SceneError
+from camloc_geo._limits import (
+    MAX_ANNOTATORS,
+    MAX_LANDMARKS,
+    MAX_LINES_PER_AXIS,
+    MAX_REFERENCES,
+    MAX_SCENE_BYTES,
+    MAX_WEIGHT,
+    MIN_WEIGHT,
+    check_regular_file,
+)
 from camloc_geo.objects import DEFAULT_PRESET, ObjectSize, object_preset
 
 __all__ = [
+    "OBJECT_SIZE_RANGES_M",
+    "PIXEL_MARGIN_REL",
     "SCENE_FORMAT",
     "Annotation",
     "Scene",
+    "ViewHint",
     "load_scene",
+    "parse_compass",
     "parse_scene",
     "scene_json_schema",
 ]
@@ -45,8 +71,21 @@ log = logging.getLogger(__name__)
 
 SCENE_FORMAT = "camloc-scene/1"
 
+PIXEL_MARGIN_REL = 0.005
+"""Clicks up to ``max(4 px, this × image diagonal)`` outside the image are clamped onto it;
+farther ones make the evidence unusable (left out with a warning)."""
+
+OBJECT_SIZE_RANGES_M: dict[str, tuple[float, float]] = {
+    "length_m": (1.0, 30.0),
+    "width_m": (0.4, 5.0),
+    "height_m": (0.5, 6.0),
+}
+"""Plausible sizes of a road vehicle, from a motorbike to an articulated bus (metres)."""
+
 Pixel = tuple[float, float]
 Segment = tuple[float, float, float, float]
+
+_PIXEL_DOC = "image pixel [x, y]: origin at the image's top-left corner, x right, y down"
 
 
 class _Model(BaseModel):
@@ -56,26 +95,81 @@ class _Model(BaseModel):
 class ImageInfo(_Model):
     """The snapshot: its size in pixels and, optionally, its file."""
 
-    width: int = Field(gt=0, le=100_000)
-    height: int = Field(gt=0, le=100_000)
-    path: str | None = None
+    width: int = Field(gt=0, le=100_000, description="image width, pixels")
+    height: int = Field(gt=0, le=100_000, description="image height, pixels")
+    path: str | None = Field(
+        default=None,
+        description=(
+            "the snapshot's file, relative to the scene file (optional; used to detect "
+            "lines an annotator did not draw, and as the overlay's background)"
+        ),
+    )
 
 
 class Prior(_Model):
     """The coarse location a camera list gives."""
 
-    lat: float = Field(ge=-90, le=90)
-    lon: float = Field(ge=-180, le=180)
-    radius_m: float = Field(default=150.0, gt=0, le=50_000)
+    lat: float = Field(ge=-90, le=90, description="latitude, degrees WGS 84")
+    lon: float = Field(ge=-180, le=180, description="longitude, degrees WGS 84")
+    radius_m: float = Field(
+        default=150.0,
+        gt=0,
+        le=50_000,
+        description="how far the camera may be from lat/lon, metres",
+    )
+
+
+def _size_field(name: str, what: str) -> Any:
+    lo, hi = OBJECT_SIZE_RANGES_M[name]
+    return Field(
+        default=None,
+        json_schema_extra={"minimum": lo, "maximum": hi},
+        description=(
+            f"the object's {what}, metres (plausible for a road vehicle: {lo:g}-{hi:g} m); "
+            "absent: from preset"
+        ),
+    )
 
 
 class ObjectSpec(_Model):
     """The reference object's size; missing numbers come from ``preset`` (default sedan)."""
 
-    preset: str | None = None
-    length_m: float | None = Field(default=None, gt=0, lt=1e4)
-    width_m: float | None = Field(default=None, gt=0, lt=1e4)
-    height_m: float | None = Field(default=None, gt=0, lt=1e4)
+    preset: str | None = Field(
+        default=None,
+        description=(
+            "a named vehicle size (sedan, hatchback, suv, pickup, van, minivan, taxi_ny, "
+            "bus...; see camloc_geo.objects.PRESETS), the base for sizes not given; "
+            "default sedan"
+        ),
+    )
+    length_m: float | None = _size_field("length_m", "length (along the annotated length edge)")
+    width_m: float | None = _size_field("width_m", "width")
+    height_m: float | None = _size_field("height_m", "height")
+    street: str | None = Field(
+        default=None,
+        max_length=200,
+        description=(
+            "name of the street the car stands on, as OSM names it (a cue for locate: "
+            "candidates whose car is not on that street are less likely)"
+        ),
+    )
+    front: Literal["length_end", "origin"] | None = Field(
+        default=None,
+        description=(
+            "which end of the annotated length edge is the car's front: 'length_end' (the "
+            "car drives from the origin towards the length end) or 'origin' (a cue for "
+            "locate: candidates that put the car against a one-way street are less likely)"
+        ),
+    )
+
+    @field_validator("length_m", "width_m", "height_m")
+    @classmethod
+    def _plausible_size(cls, value: float | None, info: Any) -> float | None:
+        if value is not None:
+            lo, hi = OBJECT_SIZE_RANGES_M[info.field_name]
+            if not lo <= value <= hi:  # also false for NaN
+                raise ValueError(f"must be {lo:g}-{hi:g} m, the range of road vehicles")
+        return value
 
     @field_validator("preset")
     @classmethod
@@ -97,51 +191,108 @@ class ObjectSpec(_Model):
 class CameraHints(_Model):
     """Known intrinsics, each optional."""
 
-    focal_px: float | None = Field(default=None, gt=0, lt=1e6)
-    principal_point: Pixel | None = None
+    focal_px: float | None = Field(
+        default=None,
+        gt=0,
+        lt=1e6,
+        description=(
+            "known focal length, pixels (absent: estimated from the vanishing lines; a value "
+            "outside 0.15-20 × the image diagonal is implausible and ignored with a warning)"
+        ),
+    )
+    principal_point: Pixel | None = Field(
+        default=None,
+        description=(
+            f"known principal point, {_PIXEL_DOC} (absent: the image centre unless the data "
+            "justify fitting it; a point outside the image is ignored with a warning)"
+        ),
+    )
 
 
 class Axes(_Model):
     """Pixels of the object's ground corner and of the ends of its three edges."""
 
-    origin: Pixel
-    length: Pixel
-    width: Pixel
-    height: Pixel
+    origin: Pixel = Field(
+        description=f"the car's ground corner nearest the camera (the world origin), {_PIXEL_DOC}"
+    )
+    length: Pixel = Field(description=f"far end of the length edge from the origin, {_PIXEL_DOC}")
+    width: Pixel = Field(description=f"far end of the width edge from the origin, {_PIXEL_DOC}")
+    height: Pixel = Field(description=f"top of the vertical edge above the origin, {_PIXEL_DOC}")
+
+
+def _lines_field(axis: str) -> Any:
+    return Field(
+        default_factory=list,
+        max_length=MAX_LINES_PER_AXIS,
+        description=(
+            f"segments [x1, y1, x2, y2] (image pixels) parallel in the world to the {axis} "
+            f"axis; two or more; at most {MAX_LINES_PER_AXIS}"
+        ),
+    )
 
 
 class VPLines(_Model):
     """Segments parallel in the world to each object axis."""
 
-    length: list[Segment] = Field(default_factory=list)
-    width: list[Segment] = Field(default_factory=list)
-    height: list[Segment] = Field(default_factory=list)
+    length: list[Segment] = _lines_field("length")
+    width: list[Segment] = _lines_field("width")
+    height: list[Segment] = _lines_field("height (vertical)")
 
 
 class Annotation(_Model):
     """One annotator's work."""
 
-    annotator: str = "anonymous"
-    axes: Axes
-    vp_lines: VPLines = Field(default_factory=VPLines)
+    annotator: str = Field(
+        default="anonymous",
+        max_length=200,
+        description="the annotator's name or id, used in warnings and reports",
+    )
+    axes: Axes = Field(description="the car's corner and the ends of its three edges")
+    vp_lines: VPLines = Field(
+        default_factory=VPLines,
+        description="vanishing-line segments per axis (completed from the image when too few)",
+    )
 
 
 class Reference(_Model):
     """A ground pixel whose geographic position is known."""
 
-    pixel: Pixel
-    lat: float = Field(ge=-90, le=90)
-    lon: float = Field(ge=-180, le=180)
-    weight: float = Field(default=1.0, gt=0)
+    pixel: Pixel = Field(description=f"the ground point, {_PIXEL_DOC}")
+    lat: float = Field(ge=-90, le=90, description="its latitude, degrees WGS 84")
+    lon: float = Field(ge=-180, le=180, description="its longitude, degrees WGS 84")
+    weight: float = Field(
+        default=1.0,
+        ge=MIN_WEIGHT,
+        le=MAX_WEIGHT,
+        description=(
+            f"relative confidence (its position sigma is divided by √weight); "
+            f"{MIN_WEIGHT:g}-{MAX_WEIGHT:g}, default 1"
+        ),
+    )
 
 
 class IntersectionHint(_Model):
     """The visible kerb corners of the nearest intersection, clockwise on screen."""
 
-    corners: list[Pixel] = Field(min_length=1)
-    lat: float | None = Field(default=None, ge=-90, le=90)
-    lon: float | None = Field(default=None, ge=-180, le=180)
-    streets: list[str] | None = None
+    corners: list[Pixel] = Field(
+        min_length=1,
+        max_length=MAX_LANDMARKS,
+        description=(
+            "visible kerb corners of the intersection, image pixels, listed clockwise around "
+            "the intersection as the picture is seen on screen"
+        ),
+    )
+    lat: float | None = Field(
+        default=None, ge=-90, le=90, description="which intersection: latitude, degrees"
+    )
+    lon: float | None = Field(
+        default=None, ge=-180, le=180, description="which intersection: longitude, degrees"
+    )
+    streets: list[str] | None = Field(
+        default=None,
+        max_length=20,
+        description="which intersection: names of (some of) its streets",
+    )
 
     @model_validator(mode="after")
     def _lat_lon_together(self) -> IntersectionHint:
@@ -153,11 +304,17 @@ class IntersectionHint(_Model):
 class Landmark(_Model):
     """A visible building corner or face midpoint."""
 
-    pixel: Pixel
-    kind: Literal["building_corner", "face_midpoint"]
-    name: str | None = None
-    lat: float | None = Field(default=None, ge=-90, le=90)
-    lon: float | None = Field(default=None, ge=-180, le=180)
+    pixel: Pixel = Field(description=f"the landmark's foot on the ground, {_PIXEL_DOC}")
+    kind: Literal["building_corner", "face_midpoint"] = Field(
+        description="a building's corner, or the midpoint of one of its faces"
+    )
+    name: str | None = Field(default=None, description="the building's name in OSM")
+    lat: float | None = Field(
+        default=None, ge=-90, le=90, description="its latitude, degrees (instead of name)"
+    )
+    lon: float | None = Field(
+        default=None, ge=-180, le=180, description="its longitude, degrees (instead of name)"
+    )
 
     @model_validator(mode="after")
     def _identified(self) -> Landmark:
@@ -168,23 +325,97 @@ class Landmark(_Model):
         return self
 
 
+class ViewHint(_Model):
+    """The camera's viewing direction, as far as it is known (a tie-breaking cue)."""
+
+    bearing_deg: float | None = Field(
+        default=None,
+        description=(
+            "bearing of the camera's optical axis on the ground, degrees clockwise from true "
+            "north; absent: read from text"
+        ),
+    )
+    tolerance_deg: float = Field(
+        default=45.0,
+        gt=0,
+        le=180,
+        description="how far the real heading may be from bearing_deg, degrees (default 45)",
+    )
+    text: str | None = Field(
+        default=None,
+        max_length=500,
+        description=(
+            "the viewing direction in words, e.g. a webcam listing's 'looking north', 'NB', "
+            "'facing SW', '(Eastside)'; read by camloc_geo.scene.parse_compass when "
+            "bearing_deg is absent"
+        ),
+    )
+
+    @field_validator("bearing_deg")
+    @classmethod
+    def _finite(cls, value: float | None) -> float | None:
+        if value is not None:
+            if not math.isfinite(value):
+                raise ValueError("must be a finite number of degrees")
+            value = value % 360.0
+        return value
+
+    @property
+    def resolved_bearing_deg(self) -> float | None:
+        """``bearing_deg``, else the bearing read from ``text``, else None."""
+        if self.bearing_deg is not None:
+            return self.bearing_deg
+        return parse_compass(self.text) if self.text else None
+
+
 class Scene(_Model):
     """A ``camloc-scene/1`` scene."""
 
-    format: str
-    id: str = "scene"
-    image: ImageInfo
-    prior: Prior | None = None
-    object: ObjectSpec = Field(default_factory=ObjectSpec)
-    camera: CameraHints = Field(default_factory=CameraHints)
-    annotations: list[Annotation] = Field(default_factory=list)
-    references: list[Reference] = Field(default_factory=list)
-    intersection: IntersectionHint | None = None
-    landmarks: list[Landmark] = Field(default_factory=list)
-    street_bearing_deg: float | None = None
+    format: str = Field(description=f"format version, always {SCENE_FORMAT!r}")
+    id: str = Field(default="scene", description="the scene's (camera's) id, used in outputs")
+    image: ImageInfo = Field(description="the snapshot's size and file")
+    prior: Prior | None = Field(default=None, description="the coarse location a camera list gives")
+    object: ObjectSpec = Field(
+        default_factory=ObjectSpec,
+        description="the reference object (a car): its size, street and front",
+    )
+    camera: CameraHints = Field(
+        default_factory=CameraHints, description="known intrinsics, each optional"
+    )
+    annotations: list[Annotation] = Field(
+        default_factory=list,
+        max_length=MAX_ANNOTATORS,
+        description=f"one entry per annotator (at most {MAX_ANNOTATORS})",
+    )
+    references: list[Reference] = Field(
+        default_factory=list,
+        max_length=MAX_REFERENCES,
+        description="ground pixels whose geographic position is known",
+    )
+    intersection: IntersectionHint | None = Field(
+        default=None, description="the visible kerb corners of the nearest intersection"
+    )
+    landmarks: list[Landmark] = Field(
+        default_factory=list,
+        max_length=MAX_LANDMARKS,
+        description="visible building corners or face midpoints",
+    )
+    street_bearing_deg: float | None = Field(
+        default=None,
+        description=(
+            "bearing of the street the car is parallel to (either direction), degrees "
+            "clockwise from north, when known without a map"
+        ),
+    )
+    view_hint: ViewHint | None = Field(
+        default=None,
+        description="the camera's viewing direction (a bearing or a compass phrase), if known",
+    )
 
     # Set by load_scene: the folder that image.path is relative to.
     base_dir: str | None = Field(default=None, exclude=True)
+    # Evidence left out or clamped while reading (one line each), see input_warnings.
+    _input_warnings: list[str] = PrivateAttr(default_factory=list)
 
     @field_validator("format")
     @classmethod
@@ -200,11 +431,15 @@ class Scene(_Model):
             raise ValueError("must be a finite number of degrees")
         return value
 
-    @model_validator(mode="after")
-    def _pixels_in_image(self) -> Scene:
-        for path, pixel in self.iter_pixels():
-            _check_pixel(pixel, self.image.width, self.image.height, path)
-        return self
+    @property
+    def input_warnings(self) -> list[str]:
+        """References, corners and landmarks clamped or left out when the scene was read."""
+        return list(self._input_warnings)
+
+    @property
+    def pixel_margin_px(self) -> float:
+        """How far outside the image a click is clamped rather than refused (pixels)."""
+        return max(4.0, PIXEL_MARGIN_REL * math.hypot(self.image.width, self.image.height))
 
     def iter_pixels(self) -> list[tuple[str, tuple[float, ...]]]:
         """Every pixel-valued field with its dotted path (segments give two pixels)."""
@@ -244,13 +479,95 @@ class Scene(_Model):
         return p
 
 
-def _check_pixel(values: tuple[float, ...], width: int, height: int, path: str) -> None:
+def pixel_problem(
+    values: tuple[float, ...] | list[float], width: int, height: int, margin_px: float
+) -> tuple[str | None, tuple[float, ...], int]:
+    """Check the pixels of one field (a point or a segment's two ends).
+
+    Returns
+    -------
+    problem, clamped, n_clamped
+        ``problem`` is None when the values are usable: then ``clamped`` holds them moved onto
+        the image and ``n_clamped`` counts the pixels that were up to ``margin_px`` outside.
+        Otherwise ``problem`` says what is wrong (not finite, or too far outside).
+    """
+    out: list[float] = []
+    n_clamped = 0
     for k in range(0, len(values), 2):
-        x, y = values[k], values[k + 1]
+        x, y = float(values[k]), float(values[k + 1])
         if not (math.isfinite(x) and math.isfinite(y)):
-            raise SceneError(f"pixel [{x}, {y}] is not finite", path)
-        if not (0.0 <= x <= width and 0.0 <= y <= height):
-            raise SceneError(f"pixel [{x:g}, {y:g}] is outside the {width}x{height} image", path)
+            return f"pixel [{x}, {y}] is not finite", tuple(values), 0
+        off = max(-x, x - width, -y, y - height, 0.0)
+        if off > margin_px:
+            return (
+                f"pixel [{x:g}, {y:g}] is {off:.3g} px outside the {width}x{height} image "
+                f"(clicks up to {margin_px:.3g} px outside are clamped)",
+                tuple(values),
+                0,
+            )
+        if off > 0.0:
+            n_clamped += 1
+        out += [min(max(x, 0.0), float(width)), min(max(y, 0.0), float(height))]
+    return None, tuple(out), n_clamped
+
+
+def _drop_unusable_evidence(scene: Scene) -> Scene:
+    """Clamp references, corners and landmarks just off the image; leave out the unusable.
+
+    Each change is logged as a warning and kept in :attr:`Scene.input_warnings`. The
+    annotations are screened by the calibration, which reports them per annotator.
+    """
+    w, h = scene.image_size
+    margin = scene.pixel_margin_px
+    notes: list[str] = []
+    update: dict[str, Any] = {}
+
+    def screen(items: list[Any], name: str, attr: str) -> list[Any] | None:
+        kept, changed = [], False
+        for i, item in enumerate(items):
+            problem, clamped, n = pixel_problem(getattr(item, attr), w, h, margin)
+            path = f"{name}[{i}]" + (f".{attr}" if attr != "corner" else "")
+            if problem is not None:
+                notes.append(f"{path}: {problem}; left out")
+                changed = True
+                continue
+            if n:
+                notes.append(f"{path}: clamped onto the image")
+                changed = True
+                item = clamped if attr == "corner" else item.model_copy(update={attr: clamped})
+            kept.append(item)
+        return kept if changed else None
+
+    refs = screen(scene.references, "references", "pixel")
+    if refs is not None:
+        update["references"] = refs
+    lms = screen(scene.landmarks, "landmarks", "pixel")
+    if lms is not None:
+        update["landmarks"] = lms
+    if scene.intersection is not None:
+        wrapped = [_CornerBox(c) for c in scene.intersection.corners]
+        corners = screen(wrapped, "intersection.corners", "corner")
+        if corners is not None:
+            values = [c.corner if isinstance(c, _CornerBox) else c for c in corners]
+            if values:
+                update["intersection"] = scene.intersection.model_copy(update={"corners": values})
+            else:
+                notes.append("intersection: no usable corner left; the intersection hint is unused")
+                update["intersection"] = None
+    if not notes:
+        return scene
+    for note in notes:
+        log.warning("%s", note)
+    out = scene.model_copy(update=update)
+    out._input_warnings = notes
+    return out
+
+
+class _CornerBox:
+    """A corner pixel seen through the same interface as references (``.corner``)."""
+
+    def __init__(self, corner: tuple[float, ...]) -> None:
+        self.corner = corner
 
 
 def _loc_to_path(loc: tuple[int | str, ...]) -> str:
@@ -279,6 +596,7 @@ def parse_scene(data: Any, *, base_dir: str | Path | None = None) -> Scene:
     for key in data:
         if key not in known:
             log.debug("scene field %r is not part of %s; kept as is", key, SCENE_FORMAT)
+    _check_sizes(data)
     try:
         scene = Scene.model_validate(
             {**data, "base_dir": str(base_dir) if base_dir is not None else None}
@@ -301,7 +619,40 @@ def parse_scene(data: Any, *, base_dir: str | Path | None = None) -> Scene:
                 msg = f"{msg} (got {shown})"
         extra = f" (+{exc.error_count() - 1} more problems)" if exc.error_count() > 1 else ""
         raise SceneError(msg + extra, _loc_to_path(loc) or None) from None
-    return scene
+    except RecursionError:
+        raise SceneError("the scene is nested too deeply to be a scene") from None
+    return _drop_unusable_evidence(scene)
+
+
+def _check_sizes(data: dict[str, Any]) -> None:
+    """Refuse, before validating anything, a scene whose size is beyond the limits."""
+    limits = (
+        ("annotations", MAX_ANNOTATORS, "annotators"),
+        ("references", MAX_REFERENCES, "references"),
+        ("landmarks", MAX_LANDMARKS, "landmarks"),
+    )
+    for key, limit, what in limits:
+        items = data.get(key)
+        if isinstance(items, list) and len(items) > limit:
+            raise SceneError(f"{len(items)} {what}; the limit is {limit}", key)
+    for i, ann in enumerate(data.get("annotations") or []):
+        lines = ann.get("vp_lines") if isinstance(ann, dict) else None
+        if not isinstance(lines, dict):
+            continue
+        for axis, segs in lines.items():
+            if isinstance(segs, list) and len(segs) > MAX_LINES_PER_AXIS:
+                raise SceneError(
+                    f"{len(segs)} segments; the limit is {MAX_LINES_PER_AXIS} per axis and "
+                    "annotator",
+                    f"annotations[{i}].vp_lines.{axis}",
+                )
+    inter = data.get("intersection")
+    if isinstance(inter, dict):
+        corners = inter.get("corners")
+        if isinstance(corners, list) and len(corners) > MAX_LANDMARKS:
+            raise SceneError(
+                f"{len(corners)} corners; the limit is {MAX_LANDMARKS}", "intersection.corners"
+            )
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -315,13 +666,23 @@ def load_scene(path: str | Path) -> Scene:
     """
     p = Path(path)
     try:
+        check_regular_file(p, "scene file")  # a FIFO or a device would block
+        size = p.stat().st_size
+        if size > MAX_SCENE_BYTES:
+            raise SceneError(
+                f"scene file {p} is {size / 1e6:.1f} MB; the limit is {MAX_SCENE_BYTES / 1e6:g} MB"
+            )
         text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SceneError(f"scene file not found: {p}") from None
+    except SceneError:
+        raise
+    except InputError as exc:
+        raise SceneError(str(exc)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(f"cannot read scene file {p}: {exc}") from None
     try:
         data = json.loads(text, parse_constant=_reject_constant)
+    except RecursionError:
+        raise SceneError(f"malformed JSON in {p.name}: nested too deeply") from None
     except json.JSONDecodeError as exc:
         raise SceneError(
             f"malformed JSON in {p.name} at line {exc.lineno}, column {exc.colno}: {exc.msg}"
@@ -339,6 +700,94 @@ def scene_json_schema() -> dict[str, Any]:
     """JSON Schema of the scene format (draft 2020-12, from the pydantic model)."""
     schema = Scene.model_json_schema()
     schema["properties"].pop("base_dir", None)
+    schema["description"] = (
+        "A camloc scene: one snapshot of a street camera, the crowd's annotations of a car in "
+        "it, and the evidence that places it on the map. Pixels are image pixels (origin at "
+        "the top-left corner, x right, y down); metres in the car's world frame (origin at the "
+        "annotated ground corner, x along the length edge, z up); bearings in degrees "
+        "clockwise from true north. See docs/scene-format.md."
+    )
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = SCENE_FORMAT
     return schema
+
+
+# ------------------------------------------------------------------------- compass words
+_POINTS = (
+    "n", "nne", "ne", "ene", "e", "ese", "se", "sse",
+    "s", "ssw", "sw", "wsw", "w", "wnw", "nw", "nnw",
+)  # fmt: skip
+_WORD_LETTER = {"north": "n", "east": "e", "south": "s", "west": "w"}
+_COMPASS_WORD = r"(?:north|south|east|west)"
+# "north", "north-east", "northeast", "north north east", "north-by-east" is not read.
+_WORDS = rf"{_COMPASS_WORD}(?:[\s-]?{_COMPASS_WORD}){{0,2}}"
+_ABBR = r"[nsew]{1,3}"
+_VERBS = (
+    r"(?:looking|looks|look|facing|faces|face|view(?:ing)?|views|pointing|points|"
+    r"aimed|aiming|heading|towards?|direction|dir\.?|cam(?:era)?|->|→)"
+)
+_VERB_RE = re.compile(
+    rf"\b{_VERBS}\s*(?:to|towards?|at|the|:|\s)*\s*(?P<dir>{_WORDS}|{_ABBR})\b\.?(?:ward|wards)?",
+    re.IGNORECASE,
+)
+_BOUND_RE = re.compile(rf"\b(?P<dir>{_WORDS}|{_ABBR})\s*(?:/\s*)?(?:bound|b)\b", re.IGNORECASE)
+_SIDE_RE = re.compile(
+    rf"(?:\b(?P<dir>{_WORDS})side\b|\(\s*(?P<dir2>{_WORDS})[\s-]side\s*\))", re.IGNORECASE
+)
+_WARD_RE = re.compile(rf"\b(?P<dir>{_WORDS})wards?\b", re.IGNORECASE)
+_ALONE_RE = re.compile(rf"^\W*(?:the\s+)?(?P<dir>{_WORDS}|{_ABBR})\W*$", re.IGNORECASE)
+_PAREN_RE = re.compile(rf"\(\s*(?P<dir>{_WORDS}|{_ABBR})\s*\)", re.IGNORECASE)
+
+
+def _bearing_of(direction: str) -> float | None:
+    """Bearing of a compass word or abbreviation ("north-east", "NE", "nne"), else None."""
+    d = direction.lower().strip(". ")
+    words = re.findall(_COMPASS_WORD, d)
+    letters = "".join(_WORD_LETTER[w] for w in words) if words else re.sub(r"[^nsew]", "", d)
+    if words and re.sub(rf"{_COMPASS_WORD}|[\s-]", "", d):
+        return None  # other letters in between: not a compass word
+    if letters in _POINTS:
+        return 22.5 * _POINTS.index(letters)
+    return None
+
+
+def parse_compass(text: str | None) -> float | None:
+    """The viewing bearing a webcam listing's words give, in degrees clockwise from north.
+
+    Reads english compass words and abbreviations where they say a direction: after a verb
+    of looking ("looking north", "facing SW", "view to the west", "cam N"), as a direction
+    of travel ("NB", "northbound", "S/B", "westward"), a side ("(Eastside)", "north side"),
+    in parentheses ("(NE)") or alone ("south-east"). A lone letter inside a street name
+    ("E 5th St") is not read.
+
+    Parameters
+    ----------
+    text
+        The words, e.g. a camera's title in a webcam list.
+
+    Returns
+    -------
+    float or None
+        Bearing in [0, 360), or None when nothing is read.
+
+    Examples
+    --------
+    >>> parse_compass("I-95 at Exit 4 looking north")
+    0.0
+    >>> parse_compass("Main St NB")
+    0.0
+    >>> parse_compass("facing SW")
+    225.0
+    >>> parse_compass("Main St & E 5th St") is None
+    True
+    """
+    if not text:
+        return None
+    text = text[:500]
+    for rx in (_VERB_RE, _BOUND_RE, _WARD_RE, _SIDE_RE, _PAREN_RE, _ALONE_RE):
+        for m in rx.finditer(text):
+            groups = m.groupdict()
+            bearing = _bearing_of(groups.get("dir") or groups.get("dir2") or "")
+            if bearing is not None:
+                return bearing
+    return None

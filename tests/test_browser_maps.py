@@ -5,7 +5,6 @@ Screenshots are kept under ``tests/artifacts/`` (git-ignored) for a person to lo
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -78,12 +77,13 @@ class _Page:
             self.blocked.append(url)
             route.abort()
 
-    def open(self, path: Path, selector: str) -> float:
-        """Load a page; seconds until ``selector`` is in the DOM and the load event fired."""
-        t0 = time.perf_counter()
+    def open(self, path: Path, selector: str) -> None:
+        """Load a page and wait until ``selector`` is in the DOM and the load event fired.
+
+        How long that takes is measured by ``benchmarks/page_render.py``, not here.
+        """
         self.page.goto(path.resolve().as_uri(), wait_until="load")
         self.page.wait_for_selector(selector, state="attached", timeout=5000)
-        return time.perf_counter() - t0
 
     def popup_text(self) -> str:
         """Text of the open popup, once its fade-in animation has finished."""
@@ -108,7 +108,7 @@ def tab(browser: Any) -> Iterator[_Page]:
 
 def test_candidate_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> None:
     res = pages["result"]
-    seconds = tab.open(pages["candidates"], ".camloc-candidate")
+    tab.open(pages["candidates"], ".camloc-candidate")
     page = tab.page
     assert page.locator(".leaflet-marker-icon.camloc-candidate").count() == len(res.candidates)
     assert page.locator(".camloc-legend").count() == 1
@@ -120,7 +120,6 @@ def test_candidate_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> Non
     page.screenshot(path=str(ARTIFACTS / "candidates_map.png"))
     assert tab.blocked == []
     assert tab.errors == []
-    assert seconds < 2.0, f"render took {seconds:.2f} s"
 
 
 def test_candidate_popup_shows_properties_and_overlay(tab: _Page, pages: dict[str, Any]) -> None:
@@ -144,7 +143,7 @@ def test_candidate_popup_shows_properties_and_overlay(tab: _Page, pages: dict[st
 
 
 def test_summary_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> None:
-    seconds = tab.open(pages["summary"], ".camloc-summary-marker")
+    tab.open(pages["summary"], ".camloc-summary-marker")
     page = tab.page
     assert page.locator(".leaflet-marker-icon.camloc-summary-marker").count() == 2
     assert page.locator(".camloc-legend").count() == 1
@@ -157,4 +156,3 @@ def test_summary_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> None:
     page.screenshot(path=str(ARTIFACTS / "summary_map.png"))
     assert tab.blocked == []
     assert tab.errors == []
-    assert seconds < 2.0

@@ -236,6 +236,7 @@ def test_cli_locate_writes_offline_map(tmp_path: Path, fremantle: MapData) -> No
     scene_file = tmp_path / "scene.json"
     scene_file.write_text(json.dumps(ls.scene), encoding="utf-8")
     out = tmp_path / "map.html"
+    (tmp_path / "ov").mkdir()  # output folders are never created by the command line
     rc = main(
         [
             "locate",

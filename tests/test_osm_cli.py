@@ -88,7 +88,8 @@ def test_streets_json(capsys: pytest.CaptureFixture[str]) -> None:
             ["--osm", BALTIMORE, "--lat", LAT, "--lon", LON, "--streets", "Eastern Ave & Fleet St"],
             "do not meet",
         ),
-        (["--lat", LAT, "--lon", LON], "--osm"),
+        (["--no-network", "--lat", LAT, "--lon", LON], "--osm"),
+        (["--offline", "--lat", LAT, "--lon", LON], "--osm"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(

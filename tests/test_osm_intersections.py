@@ -259,10 +259,17 @@ def test_y_junction_and_roundabout_krems() -> None:
     m = _load("krems.osm.gz", 48.4043, 15.6555, 120)
     y = m.nearest_intersection(48.403791, 15.655438)
     assert y.id[1:] == "327615581"
-    assert [s.name for s in y.streets] == ["Gewerbeparkstraße", "An der Schütt", "An der Schütt"]
-    gaps = [(y.streets[(i + 1) % 3].bearing_deg - y.streets[i].bearing_deg) % 360 for i in range(3)]
+    # Gewerbeparkstraße bends through the node; An der Schütt leaves as a residential
+    # street and, opposite, as a named service street (a junction arm since issue 10)
+    assert [(s.name, s.highway) for s in y.streets] == [
+        ("Gewerbeparkstraße", "residential"),
+        ("An der Schütt", "residential"),
+        ("Gewerbeparkstraße", "residential"),
+        ("An der Schütt", "service"),
+    ]
+    gaps = [(y.streets[(i + 1) % 4].bearing_deg - y.streets[i].bearing_deg) % 360 for i in range(4)]
     assert all(g < 160 for g in gaps)
-    assert len(y.corners) == 3
+    assert len(y.corners) == 4
     _assert_clockwise(y)
     r = m.nearest_intersection(48.404903, 15.655551)
     assert r.kind == "roundabout"

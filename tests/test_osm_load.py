@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import os
 import shutil
-import time
 from pathlib import Path
+from typing import Any
 
 import osmnx as ox
 import pytest
 from shapely.geometry import Point
 
 from camloc_geo import MapDataError
+from camloc_geo.osm import _map as _map_module
 from camloc_geo.osm import clear_cache, load_map
 
 OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
@@ -62,19 +63,27 @@ def test_clip_keeps_whole_streets_but_only_nearby_intersections() -> None:
         assert x.corners == big_by_id[x.id].corners
 
 
-def test_same_area_is_not_parsed_twice(tmp_path: Path) -> None:
+def test_same_area_is_not_parsed_twice(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     src = tmp_path / "oakland.osm.bz2"
     shutil.copy(OSM / "West-Oakland.osm.bz2", src)
     clear_cache()
     first = load_map(src, 37.8076, -122.3004, 150)
-    t0 = time.perf_counter()
+    reads: list[Path] = []
+    real_read = _map_module.read_extract
+
+    def counting_read(path: Path, *args: Any, **kwargs: Any) -> Any:
+        reads.append(path)
+        return real_read(path, *args, **kwargs)
+
+    monkeypatch.setattr(_map_module, "read_extract", counting_read)
     again = load_map(str(src), 37.8076, -122.3004, 150.0)
     assert again is first
-    assert time.perf_counter() - t0 < 0.05
+    assert reads == []  # served from the cache: the file is not read again
     assert load_map(src, 37.8076, -122.3004, 100) is not first  # another area
     stat = src.stat()
     os.utime(src, ns=(stat.st_atime_ns, stat.st_mtime_ns + 2_000_000_000))
     assert load_map(src, 37.8076, -122.3004, 150) is not first  # file changed
+    assert len(reads) == 2  # the other area and the changed file were read
     clear_cache()
 
 

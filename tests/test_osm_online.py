@@ -8,6 +8,7 @@ import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import ClassVar
+from urllib.parse import unquote_plus
 
 import osmnx as ox
 import pytest
@@ -81,8 +82,11 @@ def test_online_load_uses_server_cache_and_restores_settings(
         timeout_s=5,
     )
     assert _settings_snapshot() == before
-    assert len(handler.queries) == 2  # streets, buildings
-    assert any("highway" in q for q in handler.queries)
+    # streets (one query per filter: the street highways, named service/pedestrian), buildings
+    assert len(handler.queries) == 3
+    decoded = [unquote_plus(q) for q in handler.queries]
+    assert any("residential" in q for q in decoded)
+    assert any('["name"]' in q and "service" in q for q in decoded)
     x = m.find_intersection("Eastern Ave & S Bond St")
     assert x.kind == "junction"
     assert len(x.corners) == 4
@@ -93,7 +97,7 @@ def test_online_load_uses_server_cache_and_restores_settings(
 
     # same area again: in-process cache, no request
     assert load_map(None, LAT, LON, radius_m=100, overpass_url=url) is m
-    assert len(handler.queries) == 2
+    assert len(handler.queries) == 3
 
     # new process state: osmnx's HTTP cache answers, still no request
     clear_cache()
@@ -107,7 +111,7 @@ def test_online_load_uses_server_cache_and_restores_settings(
         overpass_rate_limit=False,
         timeout_s=5,  # part of the query text, hence of osmnx's cache key
     )
-    assert len(handler.queries) == 2
+    assert len(handler.queries) == 3
     assert m2.find_intersection("Eastern Avenue & South Bond Street").id == x.id
     clear_cache()
 

@@ -406,7 +406,9 @@ def test_first_annotators_problem_is_named_when_nobody_succeeds() -> None:
     for ann in data["annotations"]:
         o, e = np.array(ann["axes"]["origin"]), np.array(ann["axes"]["length"])
         ann["axes"]["width"] = (o + 0.5 * (e - o)).tolist()
-    with pytest.raises(DegenerateGeometryError, match=r"^annotations\[0\]\.axes"):
+    with pytest.raises(
+        DegenerateGeometryError, match=r"^no usable annotator: annotations\[0\]\.axes"
+    ):
         calibrate(parse_scene(data))
 
 

@@ -9,6 +9,21 @@ the only place where library errors become exit statuses:
 - 1: any other failure, one line on stderr (a traceback only with ``--debug``).
 
 Data goes to stdout, logging to stderr.
+
+Shared rules, implemented once here and used by every command:
+
+- **Network** (:func:`add_map_options`, :func:`network_of`): with ``--osm EXTRACT`` the
+  network is never used; without it Overpass is queried (osmnx HTTP cache) unless
+  ``--no-network`` (or ``--offline``). A command that needs a map with neither fails at once
+  (exit 2, one line naming ``--osm EXTRACT``).
+- **Pages** (``--inline``): the HTML page inlines Leaflet and jQuery and makes no request.
+  ``--offline`` is ``--no-network --inline`` (kept for the tools that use it).
+- **Output paths** (:func:`output_path`, :func:`write_json`, :func:`atomic_output`): a
+  missing directory is exit 2 (never created), writes are atomic (a temporary file in the
+  same directory, then a rename), an output never overwrites an input.
+
+Building the parser imports no heavy module (numpy, scipy, osmnx...): command modules import
+those inside ``run()``, so ``camloc --help`` starts fast.
 """
 
 from __future__ import annotations
@@ -18,13 +33,33 @@ import importlib
 import json
 import logging
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from pathlib import Path
 from typing import Any
 
 from camloc_geo import __version__
 from camloc_geo._errors import InputError
+from camloc_geo._io import atomic_path, check_output_path, read_json_file, write_text_atomic
 
-__all__ = ["main", "write_json"]
+__all__ = [
+    "NETWORK_HELP",
+    "add_map_options",
+    "atomic_output",
+    "inline_of",
+    "main",
+    "network_of",
+    "output_path",
+    "read_json_file",
+    "write_json",
+]
+
+NETWORK_HELP = (
+    "Network: with --osm EXTRACT the network is never used; without it the map is fetched "
+    "from Overpass (osmnx HTTP cache) unless --no-network (or --offline)."
+)
+"""The one network rule, quoted in every command's --help."""
+
+atomic_output = atomic_path
 
 _COMMAND_MODULES = (
     "calibrate",
@@ -34,6 +69,10 @@ _COMMAND_MODULES = (
     "vp",
     "summary_map",
     "schema",
+    "annotate",
+    "merge",
+    "geocode",
+    "batch",
     "serve",
     "measure",
 )
@@ -41,14 +80,101 @@ _COMMAND_MODULES = (
 log = logging.getLogger("camloc_geo.cli")
 
 
-def write_json(data: Any, out: str | None = None) -> None:
-    """Write JSON to ``out`` (a path) or to stdout when ``out`` is None or ``-``."""
-    text = json.dumps(data, indent=2, allow_nan=False)
-    if out in (None, "-"):
-        sys.stdout.write(text + "\n")
+def output_path(
+    path: str | Path | None,
+    *,
+    inputs: Iterable[str | Path | None] = (),
+    option: str = "-o",
+    directory: bool = False,
+) -> Path | None:
+    """Check an output path before any work; None for stdout (None or ``-``).
+
+    Raises
+    ------
+    InputError
+        Missing directory, a directory given as a file, or an output naming an input
+        (exit 2, one line).
+    """
+    if path is None or (str(path) == "-" and not directory):
+        return None
+    return check_output_path(path, inputs=inputs, option=option, directory=directory)
+
+
+def write_json(
+    data: Any, out: str | Path | None = None, *, inputs: Iterable[str | Path | None] = ()
+) -> None:
+    """Write JSON to ``out`` (atomically, see :func:`output_path`) or to stdout.
+
+    The text is built first, so a value that cannot be serialised writes nothing.
+    """
+    text = json.dumps(data, indent=2, allow_nan=False) + "\n"
+    path = output_path(out, inputs=inputs)
+    if path is None:
+        sys.stdout.write(text)
     else:
-        with open(str(out), "w", encoding="utf-8") as fh:
-            fh.write(text + "\n")
+        write_text_atomic(path, text)
+
+
+def add_map_options(
+    p: argparse.ArgumentParser,
+    *,
+    page: bool = False,
+    online_flag: bool = False,
+    cache: bool = True,
+) -> None:
+    """The map source and network options, the same for every command.
+
+    Parameters
+    ----------
+    page
+        The command writes an HTML page: add ``--inline``.
+    online_flag
+        Accept ``--online`` (a no-op kept for old scripts: the network is the default).
+    cache
+        Add ``--cache-folder`` and ``--overpass-url``.
+    """
+    p.add_argument(
+        "--osm",
+        metavar="EXTRACT",
+        help="local OSM extract (.osm, .osm.gz, .osm.bz2, .osm.pbf); then no network is used",
+    )
+    p.add_argument(
+        "--no-network",
+        action="store_true",
+        help="never query Overpass (without --osm, a command that needs a map fails at once)",
+    )
+    if page:
+        p.add_argument(
+            "--inline",
+            action="store_true",
+            help="one self-contained HTML page: Leaflet and jQuery inlined, no tiles, no request",
+        )
+        p.add_argument("--offline", action="store_true", help="--no-network --inline")
+    else:
+        p.add_argument("--offline", action="store_true", help="same as --no-network")
+    if online_flag:
+        p.add_argument(
+            "--online",
+            action="store_true",
+            help="query Overpass when no --osm is given (the default; kept for old scripts)",
+        )
+    if cache:
+        p.add_argument(
+            "--cache-folder", metavar="DIR", default=None, help="osmnx HTTP cache for Overpass"
+        )
+        p.add_argument("--overpass-url", metavar="URL", default=None, help="Overpass API endpoint")
+
+
+def network_of(args: argparse.Namespace) -> bool:
+    """May Overpass be queried: not with ``--no-network`` / ``--offline``."""
+    if getattr(args, "online", False) and (args.no_network or args.offline):
+        raise InputError("--online contradicts --no-network / --offline")
+    return not (args.no_network or args.offline)
+
+
+def inline_of(args: argparse.Namespace) -> bool:
+    """Should the HTML page be self-contained: ``--inline`` or ``--offline``."""
+    return bool(getattr(args, "inline", False) or args.offline)
 
 
 def _build_parser() -> argparse.ArgumentParser:

@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from camloc_geo.relative import CalibrationSettings, calibrate
-from camloc_geo.scene import load_scene
+from camloc_geo.cli import write_json
+
+__all__ = ["register", "run"]
 
 
 def register(subparsers: Any) -> None:
@@ -16,7 +17,7 @@ def register(subparsers: Any) -> None:
         help="camera intrinsics, orientation and position relative to the annotated car",
         description=(
             "Estimate focal length, principal point, rotation and the camera position in the "
-            "car's world frame from a scene's annotations. Prints JSON."
+            "car's world frame from a scene's annotations. Prints JSON. Never uses the network."
         ),
     )
     p.add_argument("scene", help="scene file (camloc-scene/1 JSON)")
@@ -37,12 +38,13 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
-    from camloc_geo.cli import write_json
+    from camloc_geo.api import calibrate_scene, scene_from
+    from camloc_geo.cli import output_path
 
-    scene = load_scene(args.scene)
-    free = {"auto": None, "centre": False, "free": True}[args.principal_point]
-    settings = CalibrationSettings(joint_fit=not args.no_joint_fit, free_principal_point=free)
-    result = calibrate(scene, settings)
-    out: dict[str, Any] = {"scene": scene.id, **result.to_dict()}
-    write_json(out, args.output)
+    output_path(args.output, inputs=[args.scene])
+    scene = scene_from(args.scene)
+    result = calibrate_scene(
+        scene, joint_fit=not args.no_joint_fit, principal_point=args.principal_point
+    )
+    write_json({"scene": scene.id, **result.to_dict()}, args.output, inputs=[args.scene])
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from camloc_geo.cli import write_json
+from camloc_geo.cli import NETWORK_HELP, add_map_options, network_of, write_json
 
 __all__ = ["register", "run"]
 
@@ -19,15 +19,10 @@ def register(subparsers: Any) -> None:
             "Write a GeoJSON FeatureCollection of the road intersections within --radius-m "
             "of the point (or the one where --streets meet): Point features kind=intersection "
             "(id, streets) and kind=corner (intersection, order clockwise from above, streets). "
-            "Map data © OpenStreetMap contributors (ODbL)."
+            "Map data © OpenStreetMap contributors (ODbL). " + NETWORK_HELP
         ),
     )
-    parser.add_argument(
-        "--osm",
-        metavar="EXTRACT",
-        help=".osm/.osm.gz/.osm.bz2/.osm.pbf extract (omit with --online to query Overpass)",
-    )
-    parser.add_argument("--online", action="store_true", help="query Overpass live via osmnx")
+    add_map_options(parser, online_flag=True)
     parser.add_argument("--lat", type=float, required=True, help="latitude, degrees WGS 84")
     parser.add_argument("--lon", type=float, required=True, help="longitude, degrees WGS 84")
     parser.add_argument("--radius-m", type=float, default=150.0, help="search radius (150)")
@@ -38,15 +33,19 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc corners``."""
-    from camloc_geo._errors import InputError
-    from camloc_geo.osm import intersections_geojson, load_map
+    from camloc_geo.api import corners_near
+    from camloc_geo.cli import output_path
 
-    if not args.osm and not args.online:
-        raise InputError("give --osm EXTRACT or --online")
-    m = load_map(args.osm if not args.online else None, args.lat, args.lon, args.radius_m)
-    if args.streets:
-        inters = [m.find_intersection(args.streets, near=(args.lat, args.lon))]
-    else:
-        inters = m.intersections
-    write_json(intersections_geojson(inters), args.output)
+    output_path(args.output, inputs=[args.osm])
+    gj = corners_near(
+        lat=args.lat,
+        lon=args.lon,
+        radius_m=args.radius_m,
+        map_source=args.osm,
+        network=network_of(args),
+        streets=args.streets,
+        cache_folder=args.cache_folder,
+        overpass_url=args.overpass_url,
+    )
+    write_json(gj, args.output, inputs=[args.osm])
     return 0

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from camloc_geo.cli import write_json
+from camloc_geo.cli import NETWORK_HELP, add_map_options, network_of, write_json
 
 __all__ = ["register", "run"]
 
@@ -18,11 +18,11 @@ def register(subparsers: Any) -> None:
         description=(
             "Print JSON: 'near' lists the streets passing within --near-m of the point with "
             "their local bearing in [0, 180) degrees from true north; 'streets' lists every "
-            "street loaded within --radius-m. Map data © OpenStreetMap contributors (ODbL)."
+            "street loaded within --radius-m. Map data © OpenStreetMap contributors (ODbL). "
+            + NETWORK_HELP
         ),
     )
-    parser.add_argument("--osm", metavar="EXTRACT", help=".osm/.osm.gz/.osm.bz2/.osm.pbf extract")
-    parser.add_argument("--online", action="store_true", help="query Overpass live via osmnx")
+    add_map_options(parser, online_flag=True)
     parser.add_argument("--lat", type=float, required=True, help="latitude, degrees WGS 84")
     parser.add_argument("--lon", type=float, required=True, help="longitude, degrees WGS 84")
     parser.add_argument("--radius-m", type=float, default=150.0, help="area loaded (150)")
@@ -33,11 +33,19 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc streets``."""
-    from camloc_geo._errors import InputError
-    from camloc_geo.osm import load_map, streets_json
+    from camloc_geo.api import streets_near
+    from camloc_geo.cli import output_path
+    from camloc_geo.osm import streets_json
 
-    if not args.osm and not args.online:
-        raise InputError("give --osm EXTRACT or --online")
-    m = load_map(args.osm if not args.online else None, args.lat, args.lon, args.radius_m)
-    write_json(streets_json(m, args.lat, args.lon, args.near_m), args.output)
+    output_path(args.output, inputs=[args.osm])
+    m = streets_near(
+        lat=args.lat,
+        lon=args.lon,
+        radius_m=args.radius_m,
+        map_source=args.osm,
+        network=network_of(args),
+        cache_folder=args.cache_folder,
+        overpass_url=args.overpass_url,
+    )
+    write_json(streets_json(m, args.lat, args.lon, args.near_m), args.output, inputs=[args.osm])
     return 0

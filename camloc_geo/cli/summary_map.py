@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import math
 from pathlib import Path
@@ -24,16 +23,19 @@ def register(subparsers: Any) -> None:
         description=(
             "Read candidate GeoJSON files written by `camloc locate` and write one HTML page with "
             "the best candidate of each camera (arrow = heading, colour = score; popups with id, "
-            "score, method). Cameras without candidates are listed in the page's title box."
+            "score, method). Cameras without candidates are listed in the page's title box; "
+            "features without properties or with coordinates out of range are skipped with a "
+            "warning. Never uses the network (map data only from --osm)."
         ),
     )
     p.add_argument("inputs", nargs="+", metavar="CANDIDATES.geojson", help="camloc locate output")
     p.add_argument("-o", "--output", metavar="OUT.html", required=True, help="page to write")
     p.add_argument(
-        "--offline",
+        "--inline",
         action="store_true",
         help="one self-contained file (Leaflet inlined, no tiles, plain markers)",
     )
+    p.add_argument("--offline", action="store_true", help="same as --inline")
     p.add_argument(
         "--osm",
         metavar="EXTRACT",
@@ -43,44 +45,103 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _read(path: str) -> tuple[str, dict[str, Any]]:
-    try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError as exc:
-        raise InputError(f"{path}: no such file") from exc
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{path}: not a JSON file ({exc})") from exc
+def _finite_lat_lon(lat: Any, lon: Any) -> bool:
+    return (
+        isinstance(lat, (int, float))
+        and isinstance(lon, (int, float))
+        and not isinstance(lat, bool)
+        and not isinstance(lon, bool)
+        and math.isfinite(lat)
+        and math.isfinite(lon)
+        and -90.0 <= lat <= 90.0
+        and -180.0 <= lon <= 180.0
+    )
+
+
+def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
+    """Validate one candidate GeoJSON; drop (with a warning) features that cannot be drawn.
+
+    Returns
+    -------
+    The scene id, the cleaned FeatureCollection and how many features were skipped.
+
+    Raises
+    ------
+    InputError
+        Not a FeatureCollection.
+    """
     if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
         raise InputError(f"{path}: not a GeoJSON FeatureCollection (camloc locate output)")
-    props = data.get("properties") or {}
+    props = data.get("properties")
+    props = props if isinstance(props, dict) else {}
+    feats = data.get("features")
+    if not isinstance(feats, list):
+        raise InputError(f"{path}: 'features' must be a list")
+    kept = []
+    skipped = 0
+    for i, f in enumerate(feats):
+        fp = f.get("properties") if isinstance(f, dict) else None
+        if not isinstance(fp, dict):
+            log.warning("%s: feature %d has no properties: skipped", path, i)
+            skipped += 1
+            continue
+        if fp.get("kind") == "candidate" and not _finite_lat_lon(fp.get("lat"), fp.get("lon")):
+            log.warning(
+                "%s: feature %d: lat=%r, lon=%r is not a position: skipped",
+                path,
+                i,
+                fp.get("lat"),
+                fp.get("lon"),
+            )
+            skipped += 1
+            continue
+        kept.append(f)
     scene_id = str(props.get("scene") or Path(path).stem)
-    return scene_id, data
+    return scene_id, {**data, "properties": props, "features": kept}, skipped
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
-    from camloc_geo.maps import summary_map
+    from camloc_geo.cli import atomic_output, output_path, read_json_file
 
-    items = [_read(p) for p in args.inputs]
+    out = output_path(args.output, inputs=[*args.inputs, args.osm], option="-o")
+    if out is None:
+        raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
+    cleaned = [
+        clean_candidates(p, read_json_file(p, what="GeoJSON file (camloc locate output)"))
+        for p in args.inputs
+    ]
+    items = [(scene_id, gj) for scene_id, gj, _n in cleaned]
+    best = [_best_lat_lon(gj) for _s, gj in items]
+    pts = [p for p in best if p is not None]
+    if not pts and any(n > 0 for _s, _g, n in cleaned):
+        raise InputError("no usable camera position in the inputs (every candidate was skipped)")
     map_data = None
     if args.osm:
-        from camloc_geo.geodesy import LocalFrame
-        from camloc_geo.osm import load_map
+        from camloc_geo.api import map_around
 
-        pts = [
-            (f["properties"]["lat"], f["properties"]["lon"])
-            for _s, gj in items
-            for f in gj.get("features", [])
-            if (f.get("properties") or {}).get("kind") == "candidate"
-            and f["properties"].get("rank") == 1
-        ]
-        if pts:
-            lat = sum(p[0] for p in pts) / len(pts)
-            lon = sum(p[1] for p in pts) / len(pts)
-            frame = LocalFrame(lat=lat, lon=lon)
-            radius = max(math.hypot(*frame.enu_from_geographic(lat=q[0], lon=q[1])) for q in pts)
-            map_data = load_map(args.osm, lat, lon, radius_m=min(radius + 150.0, 2000.0))
-    summary_map(
-        items, args.output, offline=args.offline, cluster=not args.no_cluster, map_data=map_data
-    )
+        map_data = map_around(pts, map_source=args.osm)
+    from camloc_geo.maps import summary_map
+
+    with atomic_output(out) as tmp:
+        summary_map(
+            items,
+            tmp,
+            offline=args.inline or args.offline,
+            cluster=not args.no_cluster,
+            map_data=map_data,
+        )
     return 0
+
+
+def _best_lat_lon(gj: dict[str, Any]) -> tuple[float, float] | None:
+    cands = [f["properties"] for f in gj["features"] if f["properties"].get("kind") == "candidate"]
+    if not cands:
+        return None
+    p = min(cands, key=_rank)
+    return float(p["lat"]), float(p["lon"])
+
+
+def _rank(props: dict[str, Any]) -> int:
+    rank = props.get("rank")
+    return rank if isinstance(rank, int) else 1 << 30

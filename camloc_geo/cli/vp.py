@@ -6,13 +6,13 @@ import argparse
 import logging
 from typing import Any
 
-import numpy as np
-
 from camloc_geo._errors import InputError
 
 __all__ = ["register", "run"]
 
 log = logging.getLogger(__name__)
+
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp")
 
 
 def register(subparsers: Any) -> None:
@@ -23,7 +23,7 @@ def register(subparsers: Any) -> None:
         description=(
             "Detect line segments, find three mutually orthogonal vanishing points and "
             "the focal length, and print them with the horizon line, pitch and roll as "
-            "JSON. Vanishing points at infinity are null."
+            "JSON. Vanishing points at infinity are null. Never uses the network."
         ),
     )
     p.add_argument("image", metavar="IMAGE", help="photo (any format OpenCV reads)")
@@ -70,39 +70,28 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc vp``."""
-    from camloc_geo.autovp import detect_vanishing_points, draw_segments, load_image
-    from camloc_geo.cli import write_json
+    from camloc_geo.api import vanishing_points
+    from camloc_geo.autovp import draw_segments
+    from camloc_geo.cli import atomic_output, output_path, write_json
 
-    if args.focal_px is not None and not args.focal_px > 0:
-        raise InputError(f"--focal-px must be positive, got {args.focal_px}")
-    image = load_image(args.image)
-    pp = tuple(args.principal_point) if args.principal_point else None
-    mask = None
-    if args.ignore:
-        h, w = image.shape[:2]
-        mask = np.ones((h, w), dtype=bool)
-        for x0, y0, x1, y1 in args.ignore:
-            if not all(np.isfinite([x0, y0, x1, y1])):
-                raise InputError("--ignore: box corners must be finite numbers")
-            xa, xb = sorted((x0, x1))
-            ya, yb = sorted((y0, y1))
-            mask[
-                max(0, int(ya)) : max(0, int(np.ceil(yb))),
-                max(0, int(xa)) : max(0, int(np.ceil(xb))),
-            ] = False
-    res = detect_vanishing_points(
-        image,
+    output_path(args.output, inputs=[args.image])
+    draw_path = output_path(args.draw, inputs=[args.image], option="--draw")
+    if draw_path is not None and draw_path.suffix.lower() not in _IMAGE_SUFFIXES:
+        raise InputError(f"--draw {draw_path}: give a .png or .jpg file name")
+    res = vanishing_points(
+        args.image,
         focal_px=args.focal_px,
-        principal_point=pp,
-        seed=args.seed,
-        mask=mask,
+        principal_point=tuple(args.principal_point) if args.principal_point else None,
+        ignore_boxes_px=args.ignore or (),
+        axes_px=args.axis or (),
         estimate_principal_point=args.estimate_principal_point,
-        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in args.axis] if args.axis else None,
+        seed=args.seed,
     )
-    if args.draw:
-        draw_segments(image, res, args.draw)
-        log.info("segments drawn to %s", args.draw)
+    if draw_path is not None:
+        with atomic_output(draw_path) as tmp:
+            draw_segments(args.image, res, tmp)
+        log.info("segments drawn to %s", draw_path)
     out = res.to_json()
     out["image"] = str(args.image)
-    write_json(out, args.output)
+    write_json(out, args.output, inputs=[args.image])
     return 0

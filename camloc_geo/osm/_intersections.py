@@ -42,12 +42,12 @@ above, 0 = smallest bearing) and labelled with the two streets they lie between.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 from typing import Any
 
 import networkx as nx
 import numpy as np
-import osmnx as ox
 import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
@@ -61,12 +61,17 @@ from camloc_geo.osm._widths import _first, parse_lanes, resolve_width_m
 __all__ = [
     "ARM_SAMPLE_M",
     "DUAL_MAX_ANGLE_DEG",
+    "GROUP_DIVIDED_M",
+    "GROUP_NEAR_M",
     "MAX_CORNER_DISTANCE_M",
     "MAX_CORNER_GAP_DEG",
+    "MAX_GROUP_SPAN_M",
     "MAX_STREETS",
     "MIN_CORNER_GAP_DEG",
     "build_intersections",
     "consolidate_nodes",
+    "group_junction_nodes",
+    "junction_nodes",
     "street_label",
 ]
 
@@ -84,6 +89,14 @@ MAX_CORNER_DISTANCE_M = 40.0
 """A kerb corner farther than this from the centre means the junction is unmodelled."""
 MAX_STREETS = 6
 """Junctions with more streets are unmodelled."""
+
+GROUP_NEAR_M = 12.0
+"""Junction nodes joined by a street piece shorter than this are one junction."""
+GROUP_DIVIDED_M = 32.0
+"""Junction nodes joined by a piece this short that crosses (or is) a one-way carriageway
+(dual carriageway, one-way pair) are one junction."""
+MAX_GROUP_SPAN_M = 45.0
+"""A grouped junction never spans more than this (no chains of junctions)."""
 
 _ROUNDABOUT = {"roundabout", "circular"}
 
@@ -164,7 +177,49 @@ def _bearing_enu(frame: LocalFrame, p0: np.ndarray, p1: np.ndarray) -> float:
     (lon0, lon1), (lat0, lat1) = frame.geographic_from_enu(
         np.array([p0[0], p1[0]]), np.array([p0[1], p1[1]])
     )
-    return float(ox.bearing.calculate_bearing(lat0, lon0, lat1, lon1)) % 360.0
+    return initial_bearing_deg(lat0, lon0, lat1, lon1)
+
+
+def initial_bearing_deg(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Initial great-circle bearing from point 1 to point 2, degrees in [0, 360).
+
+    The formula of :func:`osmnx.bearing.calculate_bearing` (kept here so that a local
+    extract needs no osmnx import for it).
+    """
+    phi1, phi2 = math.radians(lat1), math.radians(lat2)
+    dlon = math.radians(lon2 - lon1)
+    y = math.sin(dlon) * math.cos(phi2)
+    x = math.cos(phi1) * math.sin(phi2) - math.sin(phi1) * math.cos(phi2) * math.cos(dlon)
+    return math.degrees(math.atan2(y, x)) % 360.0
+
+
+def project_graph_enu(G: nx.MultiDiGraph, frame: LocalFrame) -> nx.MultiDiGraph:
+    """A copy of a lon/lat graph with node ``x``/``y`` and edge geometries in the frame's metres.
+
+    What :func:`osmnx.project_graph` to the frame's azimuthal equidistant CRS gives, without
+    the round trip through GeoDataFrames (a quarter of a second per map).
+    """
+    Gp = G.copy()
+    nodes = list(Gp.nodes)
+    if nodes:
+        lonlat = np.array([[Gp.nodes[n]["x"], Gp.nodes[n]["y"]] for n in nodes], dtype=float)
+        en = frame.points_enu_from_geographic(lonlat)
+        for n, (x, y) in zip(nodes, en.tolist(), strict=True):
+            Gp.nodes[n]["x"] = x
+            Gp.nodes[n]["y"] = y
+    edges = [d for _u, _v, d in Gp.edges(data=True) if d.get("geometry") is not None]
+    if edges:
+        geoms = shapely.transform(
+            np.array([d["geometry"] for d in edges], dtype=object),
+            frame.points_enu_from_geographic,
+        )
+        for d, g in zip(edges, geoms, strict=True):
+            d["geometry"] = g
+    Gp.graph["crs"] = (
+        f"+proj=aeqd +lat_0={frame.lat0:.10f} +lon_0={frame.lon0:.10f} "
+        "+x_0=0 +y_0=0 +ellps=WGS84 +units=m"
+    )
+    return Gp
 
 
 def _angle_diff(a: float, b: float) -> float:
@@ -331,6 +386,97 @@ def consolidate_nodes(
     return clusters
 
 
+def junction_nodes(G: nx.MultiDiGraph) -> list[Any]:
+    """Nodes where three or more street edges meet: osmnx's own street count.
+
+    :func:`osmnx.stats.count_streets_per_node` counts each physical street piece once
+    whatever its direction, parallel pieces between the same two nodes separately (two
+    streets leaving a node towards the same next node still make a junction).
+    """
+    counts = count_streets_per_node(G)
+    return [node for node in G.nodes if counts.get(node, 0) >= 3]
+
+
+def count_streets_per_node(G: nx.MultiDiGraph) -> dict[Any, int]:
+    """osmnx's ``stats.count_streets_per_node`` (same steps), without importing osmnx."""
+    import itertools
+    from collections import Counter
+
+    Gu = G.to_undirected(reciprocal=False, as_view=True)
+    self_loops = set(nx.selfloop_edges(Gu))
+    edges = [e for e in Gu.edges(keys=False) if e not in self_loops] + list(self_loops)
+    counts = Counter(itertools.chain.from_iterable(edges))
+    return {node: counts[node] for node in G.nodes}
+
+
+def group_junction_nodes(
+    Gp: nx.MultiDiGraph,
+    nodes: list[Any],
+    *,
+    near_m: float = GROUP_NEAR_M,
+    divided_m: float = GROUP_DIVIDED_M,
+    max_span_m: float = MAX_GROUP_SPAN_M,
+) -> list[tuple[list[Any], float, float]]:
+    """Group junction nodes a person at the corner sees as one junction.
+
+    Two junction nodes are grouped when one street piece joins them and it is shorter than
+    ``near_m`` (one junction drawn as two nodes), or shorter than ``divided_m`` and it is a
+    one-way carriageway or crosses one (the nodes of a dual carriageway or a one-way pair).
+    Pieces are taken shortest first and a group never grows wider than ``max_span_m``, so
+    junctions along a street never chain into one.
+
+    Returns
+    -------
+    ``(nodes, x, y)`` per group in the projected coordinates of ``Gp``; the centre is the mean
+    of the member nodes.
+    """
+    index = {n: i for i, n in enumerate(nodes)}
+    xy = np.array([[Gp.nodes[n]["x"], Gp.nodes[n]["y"]] for n in nodes], dtype=float)
+    oneway_at: dict[Any, int] = {}
+    for n in nodes:
+        count = 0
+        for u, v, data in list(Gp.out_edges(n, data=True)) + list(Gp.in_edges(n, data=True)):
+            if u != v and _is_oneway(data):
+                count += 1
+        oneway_at[n] = count
+    pairs: list[tuple[float, int, int]] = []
+    for u, v, data in Gp.edges(data=True):
+        if u == v or u not in index or v not in index:
+            continue
+        length = float(data.get("length") or LineString(_edge_coords(Gp, u, v, data)).length)
+        divided = _is_oneway(data) or (oneway_at[u] >= 2 and oneway_at[v] >= 2)
+        if length < near_m or (length < divided_m and divided):
+            pairs.append((length, index[u], index[v]))
+    pairs.sort()
+    parent = list(range(len(nodes)))
+    members: dict[int, list[int]] = {i: [i] for i in range(len(nodes))}
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for _length, i, j in pairs:
+        ri, rj = find(i), find(j)
+        if ri == rj:
+            continue
+        both = members[ri] + members[rj]
+        pts = xy[both]
+        span = float(np.max(np.hypot(*(pts[:, None, :] - pts[None, :, :]).T)))
+        if span > max_span_m:
+            continue
+        parent[rj] = ri
+        members[ri] = both
+        del members[rj]
+    out = []
+    for group in members.values():
+        ids = [nodes[i] for i in sorted(group)]
+        c = xy[group].mean(axis=0)
+        out.append((ids, float(c[0]), float(c[1])))
+    return out
+
+
 def _edge_coords(G: nx.MultiDiGraph, u: Any, v: Any, data: dict[str, Any]) -> list[Any]:
     geom = data.get("geometry")
     if geom is not None:
@@ -352,7 +498,14 @@ def _arms_of(
     for node in members:
         for u, v, data in Gp.out_edges(node, data=True):
             if u == v:
-                warnings.append("a loop street at the junction was ignored")
+                # a loop (a street leaving and coming back to the node): two arms
+                coords = _edge_coords(Gp, u, v, data)
+                if len(coords) < 3:
+                    continue
+                for way, flow in ((coords, "out"), (coords[::-1], "in")):
+                    key = (u, v, tuple(np.round(np.asarray(way), 2).ravel().tolist()))
+                    entry = found.setdefault(key, (way, set(), data, (u, v)))
+                    entry[1].add(flow)
                 continue
             if v in inside:
                 continue
@@ -530,11 +683,12 @@ def build_intersections(
     G: nx.MultiDiGraph,
     frame: LocalFrame,
     *,
-    tolerance_m: float = 12.0,
+    tolerance_m: float = GROUP_NEAR_M,
     radius_m: float | None = None,
     north_america: bool = False,
+    rejected: dict[int, str] | None = None,
 ) -> list[Intersection]:
-    """Consolidated intersections of an unprojected osmnx street graph.
+    """Intersections of an unprojected osmnx street graph.
 
     Parameters
     ----------
@@ -543,12 +697,16 @@ def build_intersections(
     frame
         The map's local frame; the graph is projected to its azimuthal equidistant CRS.
     tolerance_m
-        Buffer per node for the consolidation (see :func:`consolidate_nodes`), metres.
+        Junction nodes joined by a street piece shorter than this are one intersection
+        (see :func:`group_junction_nodes`), metres.
     radius_m
         Keep intersections whose centre is within this distance of the frame's anchor;
         None keeps all.
     north_america
         Apply US/Canada width conventions.
+    rejected
+        If given, filled with ``{osm node id: reason}`` for junction nodes that gave no
+        intersection (diagnostics for benchmarks).
 
     Returns
     -------
@@ -556,31 +714,36 @@ def build_intersections(
     """
     if G.number_of_edges() == 0:
         return []
-    crs = (
-        f"+proj=aeqd +lat_0={frame.lat0:.10f} +lon_0={frame.lon0:.10f} "
-        "+x_0=0 +y_0=0 +ellps=WGS84 +units=m"
-    )
-    Gp = ox.project_graph(G, to_crs=crs)
+    Gp = project_graph_enu(G, frame)
     out: list[tuple[float, Intersection]] = []
-    for members, cx, cy in consolidate_nodes(Gp, tolerance_m):
-        if len(members) == 1:
-            node = members[0]
-            if len(set(Gp.successors(node)) | set(Gp.predecessors(node))) < 3:
-                continue
+    groups = group_junction_nodes(
+        Gp, junction_nodes(Gp), near_m=tolerance_m, divided_m=max(GROUP_DIVIDED_M, tolerance_m)
+    )
+    for members, cx, cy in groups:
         centre = np.array([cx, cy], dtype=float)
         dist_centre = float(np.hypot(*centre))
         if radius_m is not None and dist_centre > radius_m:
             continue
         arms, warnings = _arms_of(Gp, members, frame, north_america)
         links = [a for a in arms if a.highway.endswith("_link")]
-        arms = [a for a in arms if not a.highway.endswith("_link")]
-        if links:
-            warnings.append(f"{len(links)} slip road(s) ignored")
-        streets = _group_streets(arms, frame)
+        plain = [a for a in arms if not a.highway.endswith("_link")]
+        streets = _group_streets(plain, frame)
+        if len(streets) >= 3:
+            if links:
+                warnings.append(f"{len(links)} slip road(s) ignored")
+        else:
+            # a slip road joining a street, a carriageway splitting, a fork: every arm counts
+            streets = _group_streets(arms, frame)
+            if len(streets) < 3:
+                streets = sorted((_single_street(a) for a in arms), key=lambda s: s.bearing)
         if len(streets) < 3:
+            if rejected is not None:
+                for node in members:
+                    rejected[int(node)] = f"{len(arms)} street arm(s) leave the node group"
             continue
         osm_nodes = [int(x) for x in members]
         ident = f"n{osm_nodes[0]}" if len(osm_nodes) == 1 else f"c{min(osm_nodes)}"
+        member_lonlat = tuple((float(G.nodes[n]["x"]), float(G.nodes[n]["y"])) for n in members)
         lon, lat = frame.geographic_from_enu(centre[0], centre[1])
         kind = "junction"
         modelled: list[tuple[np.ndarray, _Street, _Street]] = []
@@ -644,6 +807,7 @@ def build_intersections(
                     kind=kind,
                     warnings=tuple(dict.fromkeys(warnings)),
                     osm_nodes=tuple(osm_nodes),
+                    osm_node_lonlat=member_lonlat,
                 ),
             )
         )

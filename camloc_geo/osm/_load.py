@@ -1,12 +1,13 @@
-"""Loading OSM data around a point: local extracts (pyosmium + osmnx) or live Overpass.
+"""Loading OSM data around a point: local extracts (pyosmium) or live Overpass (osmnx).
 
 Offline, the extract (PBF or XML, plain/gzip/bzip2) is read once with pyosmium, keeping
 only the street ways (:data:`STREET_HIGHWAYS`) and building ways that have a node within
 ``radius_m + CLIP_MARGIN_M`` of the point; ways are kept whole, so every street through a
 kept intersection is complete. Each way's geometry is built in C++ (WKB) and its nodes are
-only visited in Python when it is kept. The street ways are written to a small temporary OSM
-XML file from which :func:`osmnx.graph_from_xml` builds the graph, simplified with
-:func:`osmnx.simplify_graph` keeping nodes where name, highway, lanes or width change.
+only visited in Python when it is kept. The street graph is built from the ways by
+:mod:`camloc_geo.osm._graph`, which follows :func:`osmnx.graph_from_xml` and
+:func:`osmnx.simplify_graph` (nodes kept where name, highway, lanes, width or junction
+change) without importing osmnx.
 Buildings are closed ``building=*`` ways (multipolygon building relations are skipped
 offline; online, osmnx returns them and the largest polygon is kept).
 
@@ -25,29 +26,28 @@ import contextlib
 import logging
 import math
 import os
-import struct
-import tempfile
 import threading
 from collections import OrderedDict
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-from xml.sax.saxutils import quoteattr
 
 import networkx as nx
+import numpy as np
 import osmium
-import osmnx as ox
-import requests
+import shapely
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
+from camloc_geo.osm._graph import graph_from_ways, simplify_graph
 from camloc_geo.osm._model import Building, polygon_from_lonlat
 from camloc_geo.osm._widths import parse_lanes, parse_width_m
 
 __all__ = [
     "CLIP_MARGIN_M",
     "EXTRACT_SUFFIXES",
+    "NAMED_STREET_HIGHWAYS",
     "STREET_HIGHWAYS",
     "RawMap",
     "clear_cache",
@@ -79,6 +79,11 @@ STREET_HIGHWAYS: frozenset[str] = frozenset(
 )
 """``highway`` values that form the street network (no service roads, paths or footways)."""
 
+NAMED_STREET_HIGHWAYS: frozenset[str] = frozenset({"service", "pedestrian"})
+"""``highway`` values that are streets when they carry a ``name`` (and are not areas): named
+service streets and alleys (row-house streets, ``service=alley``) and pedestrian segments of
+named streets, so their junctions exist and they are junction arms."""
+
 CLIP_MARGIN_M = 60.0
 """Data is kept this far beyond the requested radius so edge clusters are complete."""
 
@@ -95,9 +100,17 @@ class RawMap:
     buildings: list[Building] = field(default_factory=list)
     bounds: tuple[float, float, float, float] | None = None  # (south, west, north, east)
     source: str = ""
+    warnings: list[str] = field(default_factory=list)
 
 
 _SETTINGS_LOCK = threading.RLock()
+
+
+def _osmnx() -> Any:
+    """osmnx, imported on first use (half a second: it pulls in geopandas and matplotlib)."""
+    import osmnx
+
+    return osmnx
 
 
 @contextlib.contextmanager
@@ -106,6 +119,7 @@ def osmnx_settings(**values: Any) -> Iterator[None]:
 
     Values that are None are left alone.
     """
+    ox = _osmnx()
     saved: dict[str, Any] = {}
     with _SETTINGS_LOCK:
         try:
@@ -162,6 +176,11 @@ def _check_extract_path(path: Path) -> None:
 
 
 def _header_box(path: Path) -> tuple[float, float, float, float] | None:
+    """``(south, west, north, east)`` declared in the extract's header, or None.
+
+    Only a hint (clipped extracts hold data beyond it): choosing which extract of a folder
+    covers a point; the map itself uses the data's own extent.
+    """
     try:
         reader = osmium.io.Reader(str(path), osmium.osm.NOTHING)
         try:
@@ -182,6 +201,7 @@ def read_extract(
     radius_m: float | None,
     *,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> RawMap:
     """Read the streets and buildings of an extract around a point.
 
@@ -195,11 +215,14 @@ def read_extract(
         Keep ways with a node within ``radius_m + CLIP_MARGIN_M``; None keeps everything.
     highways
         ``highway`` values to keep as streets.
+    named_highways
+        ``highway`` values kept as streets when the way has a ``name`` and is not an area.
 
     Raises
     ------
     MapDataError
-        Unreadable or empty extract, point outside it, or no streets near the point.
+        Unreadable or empty extract, point outside the data it holds, or no streets near
+        the point.
     """
     _check_extract_path(path)
     box = None if radius_m is None else _clip_box(lat, lon, radius_m + CLIP_MARGIN_M)
@@ -220,18 +243,23 @@ def read_extract(
                 continue
             n_ways += 1
             highway = way.tags.get("highway")
-            is_street = highway in highways
+            is_street = highway in highways or (
+                highway in named_highways and "name" in way.tags and way.tags.get("area") != "yes"
+            )
             is_building = "building" in way.tags and not is_street
             if not (is_street or is_building):
                 continue
             # one C++ call builds the geometry (WKB); nodes are visited in Python only if kept
             try:
-                wkb = bytes.fromhex(wkb_factory.create_linestring(way))
+                xy = shapely.get_coordinates(shapely.from_wkb(wkb_factory.create_linestring(way)))
             except (osmium.InvalidLocationError, RuntimeError, ValueError):
-                continue  # fewer than two located nodes (clipped at the extract's edge)
-            coords = struct.unpack(f"<{(len(wkb) - 9) // 8}d", wkb[9:])  # x, y pairs
-            xs, ys = coords[0::2], coords[1::2]
-            x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+                # a way clipped at the extract's edge: keep the part the extract holds
+                xy = [(nd.location.lon, nd.location.lat) for nd in way.nodes if nd.location.valid()]
+                if len(xy) < 2:
+                    continue
+            xy = np.asarray(xy, dtype=float)
+            xs, ys = xy[:, 0], xy[:, 1]
+            x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
             s_min, n_max = min(s_min, y0), max(n_max, y1)
             w_min, e_max = min(w_min, x0), max(e_max, x1)
             if box is not None and (
@@ -239,10 +267,7 @@ def read_extract(
                 or y0 > box[2]
                 or x1 < box[1]
                 or x0 > box[3]
-                or not any(
-                    box[0] <= y <= box[2] and box[1] <= x <= box[3]
-                    for x, y in zip(xs, ys, strict=True)
-                )
+                or not np.any((box[0] <= ys) & (ys <= box[2]) & (box[1] <= xs) & (xs <= box[3]))
             ):
                 continue
             nodes = [
@@ -264,51 +289,60 @@ def read_extract(
     except (OSError, EOFError, ValueError) as exc:
         raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
 
-    bounds = _header_box(path)
-    if bounds is None and math.isfinite(s_min):
-        bounds = (s_min, w_min, n_max, e_max)
-    if n_ways == 0 or bounds is None:
+    if n_ways == 0 or not math.isfinite(s_min):
         raise MapDataError(f"OSM extract {path.name} holds no streets or buildings")
+    # the data's own extent, not the header's declared box: clipped extracts hold whole
+    # ways a few metres beyond it, and a box may declare more than the data covers
+    bounds = (s_min, w_min, n_max, e_max)
     inside = bounds[0] <= lat <= bounds[2] and bounds[1] <= lon <= bounds[3]
     if radius_m is not None and not inside:
         raise MapDataError(
             f"point lat={lat:.6f}, lon={lon:.6f} is outside the extract {path.name} "
-            f"(it covers lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
+            f"(its streets and buildings cover lat {bounds[0]:.5f}..{bounds[2]:.5f}, "
             f"lon {bounds[1]:.5f}..{bounds[3]:.5f})"
         )
+    warnings = []
+    if radius_m is not None:
+        edges = _edge_distances_m(lat, lon, bounds)
+        thin = {side: d for side, d in edges.items() if d < radius_m}
+        if thin:
+            sides = ", ".join(f"{d:.0f} m to the {side}" for side, d in thin.items())
+            warnings.append(
+                f"the extract {path.name} ends {sides} of lat={lat:.6f}, lon={lon:.6f}, "
+                f"inside the {radius_m:.0f} m asked for: junctions beyond are missing"
+            )
     if not street_ways:
         raise MapDataError(
             f"no streets within {radius_m:.0f} m of lat={lat:.6f}, lon={lon:.6f} in {path.name}"
         )
     graph = _graph_from_ways(street_ways)
-    return RawMap(graph=graph, buildings=buildings, bounds=bounds, source=str(path))
+    return RawMap(
+        graph=graph, buildings=buildings, bounds=bounds, source=str(path), warnings=warnings
+    )
+
+
+def _edge_distances_m(
+    lat: float, lon: float, bounds: tuple[float, float, float, float]
+) -> dict[str, float]:
+    """Distance from a point inside a box to each of its sides, metres."""
+    south, west, north, east = bounds
+    out = {}
+    for side, (lon2, lat2) in {
+        "south": (lon, south),
+        "north": (lon, north),
+        "west": (west, lat),
+        "east": (east, lat),
+    }.items():
+        _a, _b, dist = GEOD.inv(lon, lat, lon2, lat2)
+        out[side] = float(dist)
+    return out
 
 
 def _graph_from_ways(
     ways: list[tuple[int, dict[str, str], list[tuple[int, float, float]]]],
 ) -> nx.MultiDiGraph:
-    """Build the simplified osmnx graph from street ways via a temporary OSM XML file."""
-    nodes: dict[int, tuple[float, float]] = {}
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6" generator="camloc_geo">']
-    way_lines: list[str] = []
-    for way_id, tags, refs in ways:
-        way_lines.append(f'<way id="{way_id}">')
-        for ref, y, x in refs:
-            nodes[ref] = (y, x)
-            way_lines.append(f'<nd ref="{ref}"/>')
-        way_lines.extend(f"<tag k={quoteattr(k)} v={quoteattr(v)}/>" for k, v in tags.items())
-        way_lines.append("</way>")
-    lines.extend(f'<node id="{ref}" lat="{y:.7f}" lon="{x:.7f}"/>' for ref, (y, x) in nodes.items())
-    lines.extend(way_lines)
-    lines.append("</osm>")
-    with tempfile.TemporaryDirectory(prefix="camloc_osm_") as tmp:
-        xml_path = Path(tmp) / "streets.osm"
-        xml_path.write_text("\n".join(lines), encoding="utf-8")
-        with osmnx_settings(log_console=False):
-            graph = ox.graph_from_xml(
-                xml_path, bidirectional=False, simplify=False, retain_all=True
-            )
-    return simplify(graph)
+    """The simplified street graph of the ways (osmnx's, built without importing osmnx)."""
+    return simplify(graph_from_ways(ways))
 
 
 SIMPLIFY_EDGE_ATTRS_DIFFER = ("name", "highway", "lanes", "width", "junction")
@@ -317,14 +351,55 @@ each (osmnx would otherwise merge them into lists in arbitrary order)."""
 
 
 def simplify(graph: nx.MultiDiGraph) -> nx.MultiDiGraph:
-    """osmnx simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
-    return ox.simplify_graph(graph, edge_attrs_differ=list(SIMPLIFY_EDGE_ATTRS_DIFFER))
+    """osmnx's simplification keeping nodes where :data:`SIMPLIFY_EDGE_ATTRS_DIFFER` change."""
+    return simplify_graph(graph, edge_attrs_differ=SIMPLIFY_EDGE_ATTRS_DIFFER)
 
 
-def overpass_filter(highways: frozenset[str]) -> str:
-    """The osmnx ``custom_filter`` selecting :data:`STREET_HIGHWAYS` ways."""
+def overpass_filter(
+    highways: frozenset[str], named_highways: frozenset[str] = frozenset()
+) -> list[str]:
+    """The osmnx ``custom_filter`` (a union of filters) selecting the street ways."""
     alternatives = "|".join(sorted(highways))
-    return f'["highway"~"^({alternatives})$"]["area"!~"yes"]'
+    filters = [f'["highway"~"^({alternatives})$"]["area"!~"yes"]']
+    if named_highways:
+        named = "|".join(sorted(named_highways))
+        filters.append(f'["highway"~"^({named})$"]["name"]["area"!~"yes"]')
+    return filters
+
+
+CONNECT_TIMEOUT_S = 5.0
+"""How long to wait for the Overpass server to accept a connection, seconds."""
+
+_OFFLINE_HINT = "give --osm EXTRACT (a local OSM extract) to work without the network"
+
+
+def probe_server(url: str, timeout_s: float) -> str | None:
+    """None when a TCP connection to the URL's host opens within ``timeout_s``.
+
+    Otherwise why not: ``"timeout"``, ``"connection refused"``, ``"unknown host"``...
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(url)
+    host = parts.hostname
+    if not host:
+        return "no host in the URL"
+    try:
+        port = parts.port or (443 if parts.scheme == "https" else 80)
+    except ValueError:
+        return "bad port in the URL"
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            return None
+    except TimeoutError:
+        return "timeout"
+    except socket.gaierror:
+        return "unknown host"
+    except ConnectionRefusedError:
+        return "connection refused"
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
 
 
 def read_overpass(
@@ -337,8 +412,16 @@ def read_overpass(
     overpass_rate_limit: bool = True,
     timeout_s: float = 60.0,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    connect_timeout_s: float = CONNECT_TIMEOUT_S,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> RawMap:
     """Query streets and buildings around a point from Overpass through osmnx.
+
+    The server is first probed with a TCP connection of ``connect_timeout_s``: when it does
+    not answer in time the call fails at once (osmnx would otherwise wait its rate-limit
+    pause, 60 s, then the full HTTP timeout). When the connection is refused or the name
+    does not resolve, osmnx still runs without its rate-limit query, so answers in its HTTP
+    cache are served and anything else fails immediately.
 
     Raises
     ------
@@ -358,6 +441,18 @@ def read_overpass(
     if overpass_url is not None:
         settings["overpass_url"] = overpass_url.rstrip("/")
     where = f"lat={lat:.6f}, lon={lon:.6f}"
+    import requests
+
+    ox = _osmnx()
+    url = overpass_url or ox.settings.overpass_url
+    problem = probe_server(url, connect_timeout_s)
+    if problem == "timeout":
+        raise MapSourceError(
+            f"cannot reach the Overpass server {url} (no answer in {connect_timeout_s:g} s): "
+            f"{_OFFLINE_HINT}"
+        )
+    if problem is not None:
+        settings["overpass_rate_limit"] = False
     try:
         with osmnx_settings(**settings):
             graph = ox.graph_from_point(
@@ -367,7 +462,7 @@ def read_overpass(
                 simplify=False,
                 retain_all=True,
                 truncate_by_edge=True,
-                custom_filter=overpass_filter(highways),
+                custom_filter=overpass_filter(highways, named_highways),
             )
             graph = simplify(graph)
             try:
@@ -388,8 +483,8 @@ def read_overpass(
         raise MapSourceError(f"Overpass server error for {where}: {exc}") from exc
     except requests.exceptions.RequestException as exc:
         raise MapSourceError(
-            f"cannot reach the Overpass server {overpass_url or ox.settings.overpass_url}: "
-            f"{type(exc).__name__}"
+            f"cannot reach the Overpass server {url} ({problem or type(exc).__name__}): "
+            f"{_OFFLINE_HINT}"
         ) from exc
     except ValueError as exc:  # a reply that is not Overpass JSON
         raise MapSourceError(

@@ -12,13 +12,18 @@ from typing import Any, TypeVar
 
 import networkx as nx
 import numpy as np
-import osmnx as ox
 from shapely.geometry import LineString, Point
 
 from camloc_geo._errors import MapDataError
 from camloc_geo.geodesy import LocalFrame
-from camloc_geo.osm._intersections import build_intersections, highway_of, street_label
+from camloc_geo.osm._intersections import (
+    build_intersections,
+    highway_of,
+    initial_bearing_deg,
+    street_label,
+)
 from camloc_geo.osm._load import (
+    NAMED_STREET_HIGHWAYS,
     STREET_HIGHWAYS,
     RawMap,
     cache_get,
@@ -105,7 +110,8 @@ class MapData:
     graph
         The simplified osmnx street graph (lon/lat, unprojected, not consolidated).
     bounds
-        ``(south, west, north, east)`` of the extract, when known.
+        ``(south, west, north, east)`` of the data (an extract's streets and buildings, not
+        its header's declared box), when known.
     source
         The extract path or the Overpass URL.
     """
@@ -124,7 +130,11 @@ class MapData:
         self.graph = raw.graph
         self.bounds = raw.bounds
         self.source = raw.source
+        self.warnings: list[str] = list(raw.warnings)
+        """Notes on the data itself (an extract ending inside the radius asked for)."""
         north_america = in_north_america(lat, lon)
+        self.rejected: dict[int, str] = {}
+        """``{osm node id: reason}`` for junction nodes that gave no intersection."""
         self._intersections = tuple(
             build_intersections(
                 raw.graph,
@@ -132,6 +142,7 @@ class MapData:
                 tolerance_m=tolerance_m,
                 radius_m=radius_m,
                 north_america=north_america,
+                rejected=self.rejected,
             )
         )
         self._streets = tuple(_streets_of(raw.graph, north_america))
@@ -185,6 +196,8 @@ class MapData:
     def building_index(self) -> LocalIndex:
         """Valid building footprints larger than 1 m² (ENU), and their STRtree."""
         return self.cached("building_index", lambda: building_index(self.buildings_enu))
+        self._streets_enu: list[LineString] | None = None
+        self._member_points: tuple[np.ndarray, np.ndarray] | None = None
 
     def __repr__(self) -> str:
         return (
@@ -300,6 +313,158 @@ class MapData:
             f"close matches: {'; '.join(hints)}"
         )
 
+    def distance_to_m(self, inter: Intersection, *, lat: float, lon: float) -> float:
+        """Distance from a point to an intersection: its centre or its nearest member node.
+
+        A grouped intersection (a dual carriageway crossing, a one-way pair) is as near as
+        the nearest of its OSM nodes, so a scene placed at any of them matches it.
+        """
+        frame = LocalFrame(lat=lat, lon=lon)
+        pts = [(inter.lon, inter.lat), *inter.osm_node_lonlat]
+        en = frame.points_enu_from_geographic(pts)
+        return float(np.min(np.hypot(en[:, 0], en[:, 1])))
+
+    def _distances_m(self, lat: float, lon: float) -> np.ndarray:
+        """:meth:`distance_to_m` for every intersection at once (one projection)."""
+        if self._member_points is None:
+            pts: list[tuple[float, float]] = []
+            owner: list[int] = []
+            for i, x in enumerate(self._intersections):
+                for ll in ((x.lon, x.lat), *x.osm_node_lonlat):
+                    pts.append(ll)
+                    owner.append(i)
+            self._member_points = (np.asarray(pts, dtype=float), np.asarray(owner, dtype=int))
+        pts_arr, owner_arr = self._member_points
+        out = np.full(len(self._intersections), np.inf)
+        if len(pts_arr):
+            en = LocalFrame(lat=lat, lon=lon).points_enu_from_geographic(pts_arr)
+            np.minimum.at(out, owner_arr, np.hypot(en[:, 0], en[:, 1]))
+        return out
+
+    def intersections_within(
+        self, *, lat: float, lon: float, radius_m: float
+    ) -> list[tuple[Intersection, float]]:
+        """Every intersection within ``radius_m`` of a point, nearest first, with distances.
+
+        Distances as :meth:`distance_to_m` (centre or nearest member node).
+        """
+        dist = self._distances_m(lat, lon)
+        order = np.argsort(dist, kind="stable")
+        return [(self._intersections[i], float(dist[i])) for i in order if dist[i] <= radius_m]
+
+    def _street_hits(self, wanted: list[str]) -> list[Intersection]:
+        norms = [normalize_name(w) for w in wanted]
+
+        def matches(inter: Intersection, loose: bool) -> bool:
+            sets = [{normalize_name(n) for n in (s.names or (s.name,))} for s in inter.streets]
+            for q in norms:
+                q_tokens = set(q.split())
+                ok = any(q in names for names in sets) or (
+                    loose and any(q_tokens <= set(n.split()) for names in sets for n in names)
+                )
+                if not ok:
+                    return False
+            return True
+
+        for loose in (False, True):
+            hits = [x for x in self._intersections if matches(x, loose)]
+            if hits:
+                return hits
+        return []
+
+    def _describe(self, rows: Sequence[tuple[Intersection, float]], n: int = 3) -> str:
+        return ", ".join(f"{x.id} ({' & '.join(x.street_names)}) at {d:.0f} m" for x, d in rows[:n])
+
+    def match_intersection(
+        self,
+        *,
+        lat: float | None = None,
+        lon: float | None = None,
+        streets: str | Sequence[str] | None = None,
+        max_distance_m: float = 25.0,
+    ) -> tuple[Intersection | None, list[str]]:
+        """The modelled intersection a scene means, or None with the reason; never another.
+
+        Parameters
+        ----------
+        lat, lon
+            Where the scene says the intersection is. It matches an intersection whose
+            centre or one of whose member nodes lies within ``max_distance_m``.
+        streets
+            Street names (``"A & B"`` or a list). With a point too, the named intersection
+            must also lie within ``max_distance_m`` of it; alone, the named intersection
+            nearest to the map's point is taken.
+        max_distance_m
+            How far from the given point a modelled intersection may be, metres.
+
+        Returns
+        -------
+        ``(intersection, warnings)``. When nothing matches, the intersection is None and a
+        warning names the nearest modelled intersections and their distances: the caller
+        decides, nothing moves silently to another junction.
+        """
+        warnings: list[str] = []
+        has_point = lat is not None and lon is not None
+        wanted = split_street_query(streets) if streets else []
+        if not has_point and not wanted:
+            raise MapDataError("match_intersection needs lat/lon or street names")
+        if has_point:
+            assert lat is not None
+            assert lon is not None
+            dist = self._distances_m(lat, lon)
+            rows = [
+                (self._intersections[i], float(dist[i])) for i in np.argsort(dist, kind="stable")
+            ]
+            near = [(x, d) for x, d in rows if d <= max_distance_m]
+            where = f"lat={lat:.6f}, lon={lon:.6f}"
+            if wanted:
+                hits = {x.id for x in self._street_hits(wanted)}
+                named_near = [(x, d) for x, d in near if x.id in hits]
+                if named_near:
+                    return named_near[0][0], warnings
+                named_all = [(x, d) for x, d in rows if x.id in hits]
+                names = " & ".join(repr(w) for w in wanted)
+                if named_all:
+                    warnings.append(
+                        f"the scene's intersection {names} is {named_all[0][1]:.0f} m from its "
+                        f"lat/lon ({where}), more than {max_distance_m:.0f} m: "
+                        f"{self._describe(named_all, 1)}"
+                        + (
+                            f"; modelled junctions near the point: {self._describe(near)}"
+                            if near
+                            else ""
+                        )
+                    )
+                else:
+                    warnings.append(
+                        f"no modelled junction of {names} in the map; "
+                        + (f"near {where}: {self._describe(rows)}" if rows else "no junctions")
+                    )
+                return None, warnings
+            if near:
+                return near[0][0], warnings
+            warnings.append(
+                f"no modelled junction within {max_distance_m:.0f} m of the scene's "
+                f"intersection ({where}); nearest: "
+                + (self._describe(rows) if rows else "none in the map")
+            )
+            return None, warnings
+        named = self._street_hits(wanted)
+        if named:
+            best = min(named, key=lambda x: self._dist_from(None, x.lat, x.lon))
+            return best, warnings
+        all_names = self.street_names()
+        hints = []
+        for w in wanted:
+            close = close_matches(w, all_names)
+            hints.append(f"{w!r}: " + (", ".join(repr(c) for c in close) if close else "no match"))
+        warnings.append(
+            f"no modelled junction of {' & '.join(repr(w) for w in wanted)} within "
+            f"{self.radius_m} m of lat={self.frame.lat0:.6f}, lon={self.frame.lon0:.6f}; "
+            f"close matches: {'; '.join(hints)}"
+        )
+        return None, warnings
+
     def street_bearings(
         self, lat: float, lon: float, radius_m: float = 50.0
     ) -> list[tuple[str, float]]:
@@ -325,7 +490,7 @@ class MapData:
             (lon_a, lon_b), (lat_a, lat_b) = self.frame.geographic_from_enu(
                 np.array([a.x, b.x]), np.array([a.y, b.y])
             )
-            brg = float(ox.bearing.calculate_bearing(lat_a, lon_a, lat_b, lon_b)) % 180.0
+            brg = initial_bearing_deg(lat_a, lon_a, lat_b, lon_b) % 180.0
             rows.append((float(dist), street.name, brg))
         rows.sort()
         out: list[tuple[str, float]] = []
@@ -379,6 +544,7 @@ def load_map(
     timeout_s: float = 60.0,
     tolerance_m: float = DEFAULT_TOLERANCE_M,
     highways: frozenset[str] = STREET_HIGHWAYS,
+    named_highways: frozenset[str] = NAMED_STREET_HIGHWAYS,
 ) -> MapData:
     """Load streets, intersections and buildings around a point.
 
@@ -404,6 +570,9 @@ def load_map(
         Intersection consolidation buffer, metres.
     highways
         ``highway`` values forming the street network.
+    named_highways
+        ``highway`` values that are streets when named (named service streets and alleys,
+        pedestrian segments of named streets).
 
     Returns
     -------
@@ -428,6 +597,7 @@ def load_map(
         radius_m,
         tolerance_m,
         tuple(sorted(highways)),
+        tuple(sorted(named_highways)),
     )
     raw: RawMap
     if source is None:
@@ -446,6 +616,7 @@ def load_map(
             overpass_rate_limit=overpass_rate_limit,
             timeout_s=timeout_s,
             highways=highways,
+            named_highways=named_highways,
         )
     else:
         path = Path(source).expanduser()
@@ -458,7 +629,9 @@ def load_map(
         if cached is not None:
             log.debug("map cache hit for %s", path)
             return cached
-        raw = read_extract(path, lat, lon, radius_m, highways=highways)
+        raw = read_extract(
+            path, lat, lon, radius_m, highways=highways, named_highways=named_highways
+        )
     result = MapData(raw, lat, lon, radius_m, tolerance_m=tolerance_m)
     cache_put(key, result)
     return result

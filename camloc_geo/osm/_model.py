@@ -134,7 +134,9 @@ class Intersection:
     warnings
         Human-readable notes on what was not modelled or assumed.
     osm_nodes
-        The OSM node ids consolidated into this intersection.
+        The OSM node ids grouped into this intersection.
+    osm_node_lonlat
+        ``(lon, lat)`` of each of ``osm_nodes``: a scene's point matches any of them.
     """
 
     id: str
@@ -145,6 +147,7 @@ class Intersection:
     kind: str
     warnings: tuple[str, ...] = ()
     osm_nodes: tuple[int, ...] = ()
+    osm_node_lonlat: tuple[tuple[float, float], ...] = ()
 
     @property
     def street_names(self) -> tuple[str, ...]:

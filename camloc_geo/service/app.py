@@ -5,7 +5,6 @@ Nothing is built at import. Errors from the library become 4xx through one table
 never reach the client.
 """
 
-
 import asyncio
 import csv
 import hmac
@@ -614,19 +613,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
 
 def _merge(scenes: list[dict[str, Any]], base: dict[str, Any]) -> dict[str, Any]:
-    try:
-        from camloc_geo.merge import merge_scenes
-    except ImportError:
-        merge_scenes = None
-    if merge_scenes is not None:
-        merged = dict(merge_scenes(scenes))
-    else:  # until camloc merge lands: concatenate the annotators, names made unique
-        merged = dict(scenes[0])
-        anns: list[dict[str, Any]] = []
-        for i, sc in enumerate(scenes):
-            for ann in sc.get("annotations", []):
-                anns.append({**ann, "annotator": f"{ann.get('annotator', 'a')}#{i + 1}"})
-        merged["annotations"] = anns
+    from camloc_geo.merge import merge_scenes
+
+    merged = dict(merge_scenes(scenes))
     if "prior" in base and "prior" not in merged:
         merged["prior"] = base["prior"]
     return merged

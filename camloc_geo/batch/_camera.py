@@ -1,0 +1,620 @@
+"""One camera of a batch: evidence from its listing and scene, placed on its area's map.
+
+:func:`geocode_camera` is pure library code and never raises for a bad row: every outcome is
+a :class:`CameraResult` with a ``status`` and a ``reason``.
+
+Statuses
+--------
+``located``
+    The scene was located; the point is the best candidate's camera position.
+``title_only``
+    No scene: placed at the junction (or address, landmark) the title names.
+``ambiguous``
+    Two places fit equally well (two junctions, the same title in two extracts, or two
+    located candidates far apart); no point is given, the candidates layer has them all.
+``street_only``
+    The title names one street only: no point invented.
+``not_found``
+    The title's names are not in the map (the reason lists the nearest names).
+``no_candidates``
+    The scene was read but no candidate survived (the reason says why).
+``no_evidence``
+    No title, street pair or scene to place the camera with.
+``no_map``
+    No map covers the camera (outside every extract, network off).
+``scene_error``
+    The scene file is missing or breaks the contract.
+``map_error``
+    The map could not be read or fetched.
+``failed``
+    An unexpected error (the reason names it); retried by a rerun.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from camloc_geo._errors import MapDataError, MapSourceError, SceneError
+
+if TYPE_CHECKING:
+    from camloc_geo.batch._areas import Area, MapPlan
+    from camloc_geo.batch._list import CameraRow
+    from camloc_geo.osm import MapData
+
+__all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
+
+log = logging.getLogger(__name__)
+
+PLACED_STATUSES = frozenset({"located", "title_only"})
+"""Statuses that come with a point."""
+
+RETRY_STATUSES = frozenset({"failed", "map_error"})
+"""Statuses a rerun computes again (the cause may be transient)."""
+
+_CONE_RANGE_M = 60.0
+_TITLE_CONE_HALF_DEG = 30.0
+
+
+@dataclass
+class CameraResult:
+    """What the batch found for one camera (plain data: picklable, JSON-able).
+
+    Attributes
+    ----------
+    row, id, title
+        The list's row (1-based), the camera's id and title.
+    status, reason
+        See the module docstring; ``reason`` is None when nothing needs saying.
+    lat, lon
+        The camera's point (None when not placed).
+    score
+        The best candidate's score (locate: normalised over candidates; title: match score).
+    uncertainty_m
+        Radius of the point's uncertainty, metres (located: 1-sigma of the best candidate;
+        title: the junction's size).
+    tie
+        Two candidates fit equally well.
+    method
+        ``"locate"`` (scene) or ``"title"``.
+    names_read, names_matched, match_status, match_kinds
+        What the title gave: street names read, OSM names matched, the title match's status
+        and how each name matched.
+    view_text, view_bearing_deg
+        Compass words read (title or view column) and their bearing.
+    heading_deg, height_m
+        The located camera's heading and height (scene only).
+    extract
+        File name of the extract used (or ``overpass``).
+    list_lat, list_lon
+        The list's rough point, when it gave one.
+    candidates
+        Every candidate (dicts with ``rank``, ``source``, ``lat``, ``lon``, ``score``...).
+    cones
+        View cones: dicts with ``rank``, ``source``, ``score`` and ``lonlat`` (a ring).
+    errors
+        Problems met on the way: dicts with ``stage`` and ``message``.
+    """
+
+    row: int
+    id: str
+    title: str = ""
+    status: str = "failed"
+    reason: str | None = None
+    lat: float | None = None
+    lon: float | None = None
+    score: float | None = None
+    uncertainty_m: float | None = None
+    tie: bool = False
+    method: str | None = None
+    n_candidates: int = 0
+    names_read: list[str] = field(default_factory=list)
+    names_matched: list[str] = field(default_factory=list)
+    match_status: str | None = None
+    match_kinds: list[str] = field(default_factory=list)
+    view_text: str | None = None
+    view_bearing_deg: float | None = None
+    heading_deg: float | None = None
+    height_m: float | None = None
+    extract: str | None = None
+    list_lat: float | None = None
+    list_lon: float | None = None
+    candidates: list[dict[str, Any]] = field(default_factory=list)
+    cones: list[dict[str, Any]] = field(default_factory=list)
+    errors: list[dict[str, str]] = field(default_factory=list)
+
+    @property
+    def placed(self) -> bool:
+        """True when the camera has a point."""
+        return self.lat is not None and self.lon is not None
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-able dict (the batch journal's record)."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> CameraResult:
+        """Inverse of :meth:`to_dict`."""
+        return cls(**data)
+
+    def fail(self, status: str, reason: str, stage: str) -> CameraResult:
+        """Set a failure status and record it in ``errors``."""
+        self.status = status
+        self.reason = reason
+        self.errors.append({"stage": stage, "message": reason})
+        return self
+
+
+def _finite(x: Any) -> float | None:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def _extract_name(m: MapData | None) -> str | None:
+    if m is None:
+        return None
+    src = str(getattr(m, "source", "") or "")
+    return os.path.basename(src) if src and os.sep in src else (src or None)
+
+
+def _compass(text: str | None) -> float | None:
+    """Bearing (degrees) of a view column: a number or compass words."""
+    if not text:
+        return None
+    v = _finite(text.replace("°", "").strip())
+    if v is not None:
+        return v % 360.0
+    from camloc_geo.scene import parse_compass
+
+    try:
+        b = parse_compass(text)
+    except Exception:  # a parser's bug must not stop the batch
+        b = None
+    if b is not None:
+        return float(b)
+    try:
+        from camloc_geo.geocode import parse_title
+
+        return _finite(parse_title(text).view_bearing_deg)
+    except Exception:
+        return None
+
+
+def _cone(lat: float, lon: float, bearing_deg: float, half_deg: float) -> list[list[float]]:
+    from camloc_geo.geodesy import GEOD
+
+    ring = [[lon, lat]]
+    for k in range(9):
+        az = bearing_deg - half_deg + 2.0 * half_deg * k / 8.0
+        lo, la, _ = GEOD.fwd(lon, lat, az, _CONE_RANGE_M)
+        ring.append([round(float(lo), 8), round(float(la), 8)])
+    ring.append([lon, lat])
+    return ring
+
+
+def _match_candidate(match: Any, rank: int, extract: str | None) -> dict[str, Any]:
+    inter = getattr(match, "intersection", None)
+    return {
+        "rank": rank,
+        "source": "title",
+        "status": match.status,
+        "score": _finite(match.score),
+        "lat": _finite(match.lat),
+        "lon": _finite(match.lon),
+        "uncertainty_m": _finite(match.uncertainty_m),
+        "heading_deg": None,
+        "height_m": None,
+        "method": "title:" + str(match.status),
+        "detail": " & ".join(str(n) for n in (match.names_matched or [])) or None,
+        "intersection": getattr(inter, "id", None),
+        "extract": extract,
+    }
+
+
+def _title_matches(row: CameraRow, m: MapData, res: CameraResult) -> tuple[list[Any], str | None]:
+    """Title matches on a map (best first) and the query used; [] when nothing to match."""
+    from camloc_geo.geocode import geocode_title
+
+    if row.streets:
+        query = " & ".join(row.streets)
+    elif row.title:
+        query = row.title
+    else:
+        return [], None
+    near = (row.lat, row.lon) if row.lat is not None and row.lon is not None else None
+    radius = None
+    if near is not None:
+        radius = (row.radius_m or 150.0) + 150.0
+    matches = list(geocode_title(query, map_data=m, near=near, radius_m=radius))
+    return matches, query
+
+
+def _read_title(row: CameraRow, res: CameraResult) -> None:
+    if not row.title:
+        res.view_text = row.view
+        res.view_bearing_deg = _compass(row.view)
+        return
+    from camloc_geo.geocode import parse_title
+
+    parsed = parse_title(row.title)
+    res.names_read = [str(s) for s in (row.streets or parsed.streets or [])]
+    res.view_text = row.view or parsed.compass_text
+    res.view_bearing_deg = _compass(row.view) if row.view else _finite(parsed.view_bearing_deg)
+
+
+def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> None:
+    """Fill a title-only result from title matches."""
+    best = matches[0]
+    res.method = "title"
+    res.match_status = str(best.status)
+    res.names_matched = [str(n) for n in (best.names_matched or [])]
+    res.match_kinds = [str(k) for k in (best.match_kinds or [])]
+    res.candidates = [_match_candidate(mt, k, extract) for k, mt in enumerate(matches, start=1)]
+    res.n_candidates = len(res.candidates)
+    res.score = _finite(best.score)
+    status = best.status
+    with_point = [mt for mt in matches if _finite(mt.lat) is not None]
+    tie = status == "ambiguous" or (
+        len(with_point) >= 2
+        and _finite(with_point[0].score) is not None
+        and _finite(with_point[0].score) == _finite(with_point[1].score)
+        and status == "junction"
+    )
+    res.tie = bool(tie)
+    if status == "ambiguous" or tie:
+        res.status = "ambiguous"
+        res.reason = best.reason or "two places match the title equally well"
+        return
+    if status in ("junction", "address", "landmark") and _finite(best.lat) is not None:
+        res.status = "title_only"
+        res.lat, res.lon = _finite(best.lat), _finite(best.lon)
+        res.uncertainty_m = _finite(best.uncertainty_m)
+        res.reason = best.reason or None
+        if res.view_bearing_deg is not None and res.lat is not None and res.lon is not None:
+            res.cones.append(
+                {
+                    "rank": 1,
+                    "source": "title",
+                    "score": res.score,
+                    "lonlat": _cone(res.lat, res.lon, res.view_bearing_deg, _TITLE_CONE_HALF_DEG),
+                }
+            )
+        return
+    if status == "street":
+        res.status = "street_only"
+        res.reason = best.reason or "the title names one street only: no point invented"
+        return
+    res.status = "not_found"
+    res.reason = best.reason or "the title's names are not in the map"
+
+
+def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -> Any:
+    """The row's scene, with the title's junction, prior and view hint where it has none."""
+    from camloc_geo.scene import Scene, load_scene, parse_scene
+
+    assert row.scene is not None
+    sc = load_scene(row.scene)
+    data = sc.model_dump(mode="json", exclude={"base_dir"}, exclude_none=True)
+    changed = False
+    junction = getattr(match, "intersection", None) if match is not None else None
+    if match is not None and str(match.status) != "junction":
+        junction = None
+    if sc.intersection is not None and junction is not None:
+        hint = sc.intersection
+        if not hint.streets and hint.lat is None:
+            data["intersection"]["lat"] = float(junction.lat)
+            data["intersection"]["lon"] = float(junction.lon)
+            changed = True
+    if sc.prior is None:
+        if row.has_point:
+            data["prior"] = {
+                "lat": row.lat,
+                "lon": row.lon,
+                "radius_m": min(max(row.radius_m or 150.0, 1.0), 50_000.0),
+            }
+            changed = True
+        elif match is not None and _finite(match.lat) is not None:
+            data["prior"] = {
+                "lat": float(match.lat),
+                "lon": float(match.lon),
+                "radius_m": min(max(_finite(match.uncertainty_m) or 50.0, 30.0) + 50.0, 50_000.0),
+            }
+            changed = True
+    if (
+        res.view_bearing_deg is not None
+        and "view_hint" in Scene.model_fields
+        and getattr(sc, "view_hint", None) is None
+    ):
+        data["view_hint"] = {"bearing_deg": res.view_bearing_deg, "text": res.view_text}
+        changed = True
+    if not changed:
+        return sc
+    return parse_scene(data, base_dir=sc.base_dir)
+
+
+def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | None) -> None:
+    from camloc_geo.absolute._geojson import view_cone as _view_cone
+    from camloc_geo.api import locate_scene
+    from camloc_geo.geodesy import normalize_bearing_deg
+
+    try:
+        sc = _scene_with_evidence(row, res, match)
+    except SceneError as exc:
+        res.fail("scene_error", f"scene {os.path.basename(str(row.scene))}: {exc}", "scene")
+        return
+    try:
+        out = locate_scene(sc, map_source=m, network=False)
+    except MapDataError as exc:
+        res.fail("no_candidates", str(exc), "locate")
+        return
+    except SceneError as exc:
+        res.fail("scene_error", str(exc), "locate")
+        return
+    r = out.result
+    res.method = "locate"
+    res.extract = res.extract or _extract_name(out.map_data)
+    frame = r.frame
+    title_cands = res.candidates
+    res.candidates = []
+    for c in r.candidates:
+        heading = _finite(normalize_bearing_deg(c.camera.angles_deg[0]))
+        res.candidates.append(
+            {
+                "rank": c.rank,
+                "source": "locate",
+                "status": None,
+                "score": _finite(c.score),
+                "lat": _finite(c.lat),
+                "lon": _finite(c.lon),
+                "uncertainty_m": _finite(c.sigma_m),
+                "heading_deg": heading,
+                "height_m": _finite(c.camera.height_m),
+                "method": c.method,
+                "detail": ", ".join(str(f) for f in c.flags) or None,
+                "intersection": getattr(r.intersection, "id", None),
+                "extract": res.extract,
+            }
+        )
+        poly = _view_cone(c.camera, r.image_size, _CONE_RANGE_M)
+        ll = frame.points_geographic_from_enu(poly)
+        res.cones.append(
+            {
+                "rank": c.rank,
+                "source": "locate",
+                "score": _finite(c.score),
+                "lonlat": [[round(float(a), 8), round(float(b), 8)] for a, b in ll],
+            }
+        )
+    # keep the title's matches after the located candidates
+    for k, tc in enumerate(title_cands, start=len(res.candidates) + 1):
+        res.candidates.append({**tc, "rank": k})
+    res.n_candidates = len(r.candidates)
+    warnings = list(r.warnings) + list(r.calibration.warnings)
+    if not r.candidates:
+        res.fail("no_candidates", r.reason or "no candidate survived", "locate")
+        return
+    best = r.candidates[0]
+    res.score = _finite(best.score)
+    res.uncertainty_m = _finite(best.sigma_m)
+    res.heading_deg = res.candidates[0]["heading_deg"]
+    res.height_m = res.candidates[0]["height_m"]
+    # a tie between candidates at the same junction (a symmetric one) keeps the best
+    # candidate's point, flagged; the candidates layer has both
+    res.tie = any(w.startswith("ambiguous") for w in r.warnings)
+    if res.tie:
+        warnings.sort(key=lambda w: not w.startswith("ambiguous"))
+    res.status = "located"
+    res.lat, res.lon = _finite(best.lat), _finite(best.lon)
+    res.reason = "; ".join(warnings[:3]) or None
+
+
+def _with_map(
+    row: CameraRow,
+    res: CameraResult,
+    m: MapData | None,
+    matches: list[Any] | None = None,
+    extract: str | None = None,
+) -> CameraResult:
+    """Place a camera with one map (None: scene evidence only)."""
+    res.extract = extract or _extract_name(m)
+    if matches is None and m is not None and (row.title or row.streets):
+        try:
+            matches, _q = _title_matches(row, m, res)
+        except Exception as exc:
+            res.errors.append({"stage": "title", "message": f"{type(exc).__name__}: {exc}"})
+            matches = []
+    matches = matches or []
+    if matches:
+        _apply_match(res, matches, res.extract)
+    if row.scene:
+        title_status, title_reason = res.status, res.reason
+        best = matches[0] if matches else None
+        res.lat = res.lon = None
+        res.cones = []
+        _locate(row, res, m, best)
+        if res.status in ("no_candidates",) and title_status == "title_only" and best is not None:
+            # the scene failed: fall back to the title's junction, saying so
+            locate_reason = res.reason
+            _apply_match(res, matches, res.extract)
+            res.reason = f"scene not located ({locate_reason}); placed from the title"
+        elif res.status == "scene_error" and title_status not in ("failed",):
+            res.match_status = res.match_status or title_status
+            if title_reason and res.reason:
+                res.reason = f"{res.reason}; title: {title_reason}"
+        return res
+    if not matches:
+        if not (row.title or row.streets):
+            res.status = "no_evidence"
+            res.reason = "no title, street pair or scene to place the camera with" + (
+                " (" + "; ".join(row.problems) + ")" if row.problems else ""
+            )
+            res.errors.append({"stage": "input", "message": res.reason})
+        elif m is None:
+            res.fail("no_map", "no map to place the title on", "map")
+        else:
+            res.fail("not_found", "the title names no street found in the map", "title")
+        return res
+    if res.status not in PLACED_STATUSES:
+        res.errors.append({"stage": "title", "message": res.reason or res.status})
+    return res
+
+
+def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
+    """Say in the reason what was wrong with the row, when the camera was placed anyway."""
+    if row.problems and res.status in PLACED_STATUSES:
+        note = "list row: " + "; ".join(row.problems)
+        res.reason = f"{res.reason}; {note}" if res.reason else note
+    return res
+
+
+def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
+    """A camera without a point: its title searched in every extract."""
+    from camloc_geo.batch._areas import area_map
+
+    if not (row.title or row.streets):
+        res.status = "no_evidence"
+        res.reason = "no point, no title and no street pair: nothing to search the maps with"
+        res.errors.append({"stage": "input", "message": res.reason})
+        return res
+    found: list[tuple[Any, list[Any], str]] = []
+    misses: list[tuple[float, str]] = []
+    for f in files:
+        try:
+            m = area_map(("file", f))
+        except (MapDataError, MapSourceError) as exc:
+            res.errors.append({"stage": "map", "message": str(exc)})
+            continue
+        try:
+            matches, _q = _title_matches(row, m, res)
+        except Exception as exc:
+            res.errors.append({"stage": "title", "message": f"{type(exc).__name__}: {exc}"})
+            continue
+        if matches and matches[0].status not in ("not_found",):
+            found.append((m, matches, os.path.basename(f)))
+        elif matches:
+            misses.append((-(_finite(matches[0].score) or 0.0), matches[0].reason or ""))
+    placed = [
+        (m, mt, name)
+        for m, mt, name in found
+        if mt[0].status in ("junction", "address", "landmark", "ambiguous")
+    ]
+    if len(placed) >= 2:
+        res.method = "title"
+        res.tie = True
+        res.match_status = "ambiguous"
+        names = [name for _m, _mt, name in placed]
+        k = 0
+        for _m, mt, name in placed:
+            for one in mt:
+                k += 1
+                res.candidates.append(_match_candidate(one, k, name))
+        res.n_candidates = len(res.candidates)
+        res.score = _finite(placed[0][1][0].score)
+        return res.fail(
+            "ambiguous", "the title matches in several extracts: " + ", ".join(names), "title"
+        )
+    if placed or found:
+        m, matches, name = (placed or found)[0]
+        return _with_map(row, res, m, matches, extract=name)
+    reason = min(misses)[1] if misses else "the title names no street found in any extract"
+    return res.fail(
+        "not_found", reason or "the title names no street found in any extract", "title"
+    )
+
+
+def geocode_camera(
+    row: CameraRow,
+    *,
+    map_data: MapData | None = None,
+    map_source: str | os.PathLike[str] | None = None,
+    network: bool = False,
+    plan: MapPlan | None = None,
+    area: Area | None = None,
+) -> CameraResult:
+    """Place one camera from its listing (title, point, street pair) and its scene.
+
+    Never raises for a bad row: the result's ``status`` and ``reason`` say what happened
+    (see the module docstring for the statuses).
+
+    Parameters
+    ----------
+    row
+        The camera (:func:`camloc_geo.batch.read_camera_list` or :class:`CameraRow`).
+    map_data
+        The map to use (a loaded :class:`~camloc_geo.osm.MapData`); overrides the others.
+    map_source
+        An extract or a folder of extracts; the one covering the camera's point is used
+        (loaded once per process), a title without point is searched in each.
+    network
+        Without ``map_source``: may the map around the camera's point be fetched from
+        Overpass.
+    plan, area
+        A prepared :func:`~camloc_geo.batch._areas.map_plan` and the camera's area (what
+        :func:`run_batch` passes; computed from ``map_source`` when omitted).
+    """
+    res = CameraResult(row=row.row, id=row.id, title=row.title, list_lat=row.lat, list_lon=row.lon)
+    try:
+        for p in row.problems:
+            res.errors.append({"stage": "input", "message": p})
+        _read_title(row, res)
+        return _note_problems(row, _geocode(row, res, map_data, map_source, network, plan, area))
+    except Exception as exc:  # isolate every camera: the batch goes on
+        log.debug("camera %s failed", row.id, exc_info=True)
+        return res.fail("failed", f"{type(exc).__name__}: {exc}", "internal")
+
+
+def _geocode(
+    row: CameraRow,
+    res: CameraResult,
+    map_data: MapData | None,
+    map_source: str | os.PathLike[str] | None,
+    network: bool,
+    plan: MapPlan | None,
+    area: Area | None,
+) -> CameraResult:
+    if map_data is not None:
+        return _with_map(row, res, map_data)
+    if plan is None:
+        from camloc_geo.batch._areas import map_plan
+
+        plan = (
+            _cached_plan(map_source, network)
+            if map_source is not None
+            else map_plan(None, network=network)
+        )
+    if area is None:
+        area = plan.area_of(row)
+    kind = area[0]
+    if kind == "none":
+        if row.scene and not (row.title or row.streets):
+            # a scene with references may not need a map at all
+            return _with_map(row, res, None)
+        return res.fail("no_map", str(area[1]), "map")
+    if kind == "search":
+        return _search(row, res, tuple(area[1]))
+    from camloc_geo.batch._areas import area_map
+
+    try:
+        m = area_map(area)
+    except (MapDataError, MapSourceError) as exc:
+        return res.fail("map_error", str(exc), "map")
+    name = "overpass" if kind == "net" else os.path.basename(str(area[1]))
+    return _with_map(row, res, m, extract=name)
+
+
+_PLANS: dict[tuple[str, bool], MapPlan] = {}
+
+
+def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
+    from camloc_geo.batch._areas import map_plan
+
+    key = (str(map_source), bool(network))
+    if key not in _PLANS:
+        _PLANS[key] = map_plan(map_source, network=network)
+    return _PLANS[key]

@@ -1,0 +1,122 @@
+"""The batch journal: a SQLite file next to the output recording every finished camera.
+
+Each finished chunk of cameras is written in one transaction (WAL mode), keyed by the
+list's row number, so an interruption at any point (Ctrl-C, ``kill -9``) loses nothing
+finished and a rerun computes each remaining camera exactly once. The GeoPackage is built
+from the journal at the end of every run.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+from camloc_geo._errors import InputError
+
+__all__ = ["Journal", "journal_path"]
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS done (
+    row INTEGER PRIMARY KEY,
+    id TEXT NOT NULL,
+    status TEXT NOT NULL,
+    record TEXT NOT NULL
+);
+"""
+
+
+def journal_path(out_gpkg: str | Path) -> Path:
+    """The journal of an output: ``OUT.gpkg`` -> ``OUT.camloc-batch.sqlite``."""
+    p = Path(out_gpkg)
+    return p.with_name(p.stem + ".camloc-batch.sqlite")
+
+
+class Journal:
+    """Rows done so far, and their results (JSON records)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self.db = sqlite3.connect(str(path), timeout=30.0, isolation_level=None)
+            self.db.execute("PRAGMA journal_mode=WAL")
+            self.db.execute("PRAGMA synchronous=NORMAL")
+            self.db.executescript(_SCHEMA)
+        except sqlite3.DatabaseError as exc:
+            raise InputError(
+                f"cannot use the batch journal {path}: {exc} (delete it to start again)"
+            ) from None
+
+    def close(self) -> None:
+        """Close the database."""
+        self.db.close()
+
+    def check_options(self, options: dict[str, Any], restart: bool) -> None:
+        """Remember the run's options; refuse to resume a run made with other options."""
+        text = json.dumps(options, sort_keys=True)
+        cur = self.db.execute("SELECT value FROM meta WHERE key = 'options'")
+        row = cur.fetchone()
+        if restart:
+            self.db.execute("BEGIN")
+            self.db.execute("DELETE FROM done")
+            self.db.execute("INSERT OR REPLACE INTO meta VALUES ('options', ?)", (text,))
+            self.db.execute("COMMIT")
+            return
+        if row is None:
+            self.db.execute("INSERT INTO meta VALUES ('options', ?)", (text,))
+        elif row[0] != text:
+            raise InputError(
+                f"{self.path.name} holds a run made with other options ({row[0]}); "
+                "rerun with the same options, or --restart to start again"
+            )
+
+    def done_rows(self, retry: Iterable[str] = ()) -> dict[int, str]:
+        """``{row: id}`` of the cameras finished (statuses in ``retry`` excluded)."""
+        retry = tuple(retry)
+        q = "SELECT row, id FROM done"
+        if retry:
+            q += " WHERE status NOT IN (" + ",".join("?" * len(retry)) + ")"
+        return {int(r): str(i) for r, i in self.db.execute(q, retry)}
+
+    def write(self, records: Iterable[dict[str, Any]]) -> int:
+        """Record finished cameras in one transaction; returns how many."""
+        rows = [
+            (int(r["row"]), str(r["id"]), str(r["status"]), json.dumps(r, allow_nan=False))
+            for r in records
+        ]
+        self.db.execute("BEGIN IMMEDIATE")
+        try:
+            self.db.executemany("INSERT OR REPLACE INTO done VALUES (?, ?, ?, ?)", rows)
+            self.db.execute("COMMIT")
+        except BaseException:
+            self.db.execute("ROLLBACK")
+            raise
+        return len(rows)
+
+    def count(self) -> int:
+        """Cameras recorded."""
+        return int(self.db.execute("SELECT COUNT(*) FROM done").fetchone()[0])
+
+    def status_counts(self) -> dict[str, int]:
+        """Cameras per status."""
+        return {
+            str(s): int(n)
+            for s, n in self.db.execute("SELECT status, COUNT(*) FROM done GROUP BY status")
+        }
+
+    def records(self, page: int = 2000) -> Iterator[dict[str, Any]]:
+        """Every record in row order, read a page at a time."""
+        last = -(1 << 62)
+        while True:
+            rows = self.db.execute(
+                "SELECT row, record FROM done WHERE row > ? ORDER BY row LIMIT ?", (last, page)
+            ).fetchall()
+            if not rows:
+                return
+            for _r, rec in rows:
+                yield json.loads(rec)
+            last = rows[-1][0]

@@ -1,0 +1,440 @@
+"""Reading a camera list (CSV or GeoJSON), streamed row by row.
+
+Columns (case-insensitive, first variant present wins; see ``docs/batch.md``):
+
+============  ======================================================================
+field         accepted column names
+============  ======================================================================
+id            id, camera_id, cam_id, cameraid, camera, uid, ident, key
+title         title, name, camera_name, description, desc, label, location
+lat           lat, latitude, y
+lon           lon, lng, long, longitude, x
+radius_m      radius_m, radius, uncertainty_m, uncertainty, accuracy_m, accuracy
+streets       streets, street_pair, intersection, cross_streets, junction
+street pair   street1 + street2, street_a + street_b, street + cross_street,
+              on_street + cross_street
+scene         scene, scene_file, scene_path, annotations
+view          view, direction, facing, heading, bearing (compass words or degrees)
+area          area, city, extract, region (restricts the extracts searched)
+============  ======================================================================
+
+A GeoJSON list is a FeatureCollection (or one Feature per line); a Point geometry gives
+lat/lon and the properties give the other columns. A FeatureCollection is parsed
+incrementally (its ``features`` array feature by feature), so memory does not grow with the
+length of the list.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from camloc_geo._errors import InputError
+
+__all__ = ["COLUMN_VARIANTS", "CameraRow", "count_camera_rows", "read_camera_list"]
+
+COLUMN_VARIANTS: dict[str, tuple[str, ...]] = {
+    "id": ("id", "camera_id", "cam_id", "cameraid", "camera", "uid", "ident", "key"),
+    "title": ("title", "name", "camera_name", "description", "desc", "label", "location"),
+    "lat": ("lat", "latitude", "y"),
+    "lon": ("lon", "lng", "long", "longitude", "x"),
+    "radius_m": ("radius_m", "radius", "uncertainty_m", "uncertainty", "accuracy_m", "accuracy"),
+    "streets": ("streets", "street_pair", "intersection", "cross_streets", "junction"),
+    "scene": ("scene", "scene_file", "scene_path", "annotations"),
+    "view": ("view", "direction", "facing", "heading", "bearing"),
+    "area": ("area", "city", "extract", "region"),
+}
+"""Accepted column names per field, in order of preference (compared case-insensitively)."""
+
+_STREET_PAIRS = (
+    ("street1", "street2"),
+    ("street_1", "street_2"),
+    ("street_a", "street_b"),
+    ("street", "cross_street"),
+    ("on_street", "cross_street"),
+    ("main_street", "cross_street"),
+)
+
+_MAX_FIELD_CHARS = 10_000
+DEFAULT_RADIUS_M = 150.0
+
+
+@dataclass(frozen=True)
+class CameraRow:
+    """One camera of the list, as read (nothing resolved yet).
+
+    Attributes
+    ----------
+    row
+        1-based position in the list (the key of the batch journal).
+    id
+        The camera's id (``row-N`` when the list gives none).
+    title
+        The listing's title ("" when none).
+    lat, lon, radius_m
+        The rough point and its uncertainty (metres), when given.
+    streets
+        An explicit street pair, when given.
+    scene
+        Absolute path of the scene file, when given (relative paths are resolved against the
+        list's folder).
+    view
+        The view column's text (compass words or degrees), when given.
+    area
+        Name restricting the extracts a title without point is searched in.
+    problems
+        What is wrong with the row (bad numbers, missing columns); a row with problems may
+        still be placed from what is usable.
+    """
+
+    row: int
+    id: str
+    title: str = ""
+    lat: float | None = None
+    lon: float | None = None
+    radius_m: float | None = None
+    streets: tuple[str, ...] | None = None
+    scene: str | None = None
+    view: str | None = None
+    area: str | None = None
+    problems: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def has_point(self) -> bool:
+        """True when the row gives a usable rough point."""
+        return self.lat is not None and self.lon is not None
+
+
+def _clean(value: Any) -> str:
+    if value is None:
+        return ""
+    text = value if isinstance(value, str) else str(value)
+    text = "".join(ch if ch.isprintable() else " " for ch in text[:_MAX_FIELD_CHARS]).strip()
+    return text
+
+
+def _number(value: Any, name: str, problems: list[str]) -> float | None:
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    try:
+        num = float(value)
+    except (TypeError, ValueError):
+        problems.append(f"{name} {_clean(value)[:40]!r} is not a number")
+        return None
+    if not math.isfinite(num):
+        problems.append(f"{name} {value!r} is not a finite number")
+        return None
+    return num
+
+
+def _pick(lower: Mapping[str, Any], key: str) -> Any:
+    for name in COLUMN_VARIANTS[key]:
+        if name in lower and lower[name] not in (None, ""):
+            return lower[name]
+    return None
+
+
+def row_from_mapping(
+    values: Mapping[str, Any],
+    row: int,
+    *,
+    base_dir: Path | None = None,
+    point: tuple[float, float] | None = None,
+    list_problems: tuple[str, ...] = (),
+) -> CameraRow:
+    """A :class:`CameraRow` from one record's columns (names matched case-insensitively).
+
+    ``point`` is ``(lat, lon)`` from a geometry, used when the columns give none.
+    """
+    lower = {str(k).strip().lower(): v for k, v in values.items() if k is not None}
+    problems = list(list_problems)
+    ident = _clean(_pick(lower, "id")) or f"row-{row}"
+    title = _clean(_pick(lower, "title"))
+    lat = _number(_pick(lower, "lat"), "lat", problems)
+    lon = _number(_pick(lower, "lon"), "lon", problems)
+    if lat is None and lon is None and point is not None:
+        lat, lon = point
+    if (lat is None) != (lon is None):
+        problems.append("give both lat and lon, or neither")
+        lat = lon = None
+    if lat is not None and lon is not None and not (-90 <= lat <= 90 and -180 <= lon <= 180):
+        problems.append(f"lat={lat}, lon={lon} is not a point on Earth")
+        lat = lon = None
+    radius = _number(_pick(lower, "radius_m"), "radius_m", problems)
+    if radius is not None and radius <= 0:
+        problems.append(f"radius_m {radius} is not positive")
+        radius = None
+    streets: tuple[str, ...] | None = None
+    raw_streets = _clean(_pick(lower, "streets"))
+    if raw_streets:
+        from camloc_geo.osm._names import split_street_query
+
+        parts = [p for p in split_street_query(raw_streets) if p]
+        streets = tuple(parts) if parts else None
+    else:
+        for a, b in _STREET_PAIRS:
+            sa, sb = _clean(lower.get(a)), _clean(lower.get(b))
+            if sa and sb:
+                streets = (sa, sb)
+                break
+    scene_text = _clean(_pick(lower, "scene"))
+    scene: str | None = None
+    if scene_text:
+        p = Path(scene_text).expanduser()
+        if not p.is_absolute() and base_dir is not None:
+            p = base_dir / p
+        scene = str(p)
+    view = _clean(_pick(lower, "view")) or None
+    area = _clean(_pick(lower, "area")) or None
+    return CameraRow(
+        row=row,
+        id=ident,
+        title=title,
+        lat=lat,
+        lon=lon,
+        radius_m=radius,
+        streets=streets,
+        scene=scene,
+        view=view,
+        area=area,
+        problems=tuple(problems),
+    )
+
+
+def _list_kind(path: Path) -> str:
+    name = path.name.lower()
+    if name.endswith((".geojson", ".json", ".geojsonl", ".geojsons", ".ndjson", ".jsonl")):
+        return "geojson"
+    if name.endswith((".csv", ".tsv", ".txt")):
+        return "csv"
+    with open(path, "rb") as fh:
+        head = fh.read(64).lstrip()
+    return "geojson" if head.startswith((b"{", b"[")) else "csv"
+
+
+def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
+    lower = {c.strip().lower() for c in columns if c}
+    problems = []
+    if not any(n in lower for n in COLUMN_VARIANTS["title"]):
+        problems.append(
+            "the list has no title column (" + ", ".join(COLUMN_VARIANTS["title"][:3]) + ", ...)"
+        )
+    if not any(n in lower for n in COLUMN_VARIANTS["id"]):
+        problems.append("the list has no id column; rows are named row-N")
+    return tuple(problems)
+
+
+def _read_csv(path: Path) -> Iterator[CameraRow]:
+    with open(path, encoding="utf-8-sig", newline="") as fh:
+        sample = fh.read(8192)
+        fh.seek(0)
+        delimiter = ","
+        if path.name.lower().endswith(".tsv"):
+            delimiter = "\t"
+        else:
+            try:
+                delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+            except csv.Error:
+                delimiter = ","
+        csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
+        reader = csv.DictReader(fh, delimiter=delimiter)
+        columns = list(reader.fieldnames or [])
+        if not columns:
+            return
+        list_problems = _missing_column_problems(columns)
+        # a missing id column only renames rows: not a problem of the camera
+        list_problems = tuple(p for p in list_problems if "no id column" not in p)
+        base = path.resolve().parent
+        for n, rec in enumerate(reader, start=1):
+            yield row_from_mapping(rec, n, base_dir=base, list_problems=list_problems)
+
+
+def _feature_row(feat: Any, n: int, base: Path) -> CameraRow:
+    if not isinstance(feat, dict):
+        return CameraRow(row=n, id=f"row-{n}", problems=("not a GeoJSON feature",))
+    props = feat.get("properties") or {}
+    if not isinstance(props, dict):
+        props = {}
+    if "id" in feat and not any(k.lower() in COLUMN_VARIANTS["id"] for k in props):
+        props = {**props, "id": feat["id"]}
+    point = None
+    geom = feat.get("geometry")
+    problems: tuple[str, ...] = ()
+    if isinstance(geom, dict) and geom.get("type") == "Point":
+        coords = geom.get("coordinates") or []
+        try:
+            point = (float(coords[1]), float(coords[0]))
+        except (TypeError, ValueError, IndexError):
+            problems = ("the Point geometry has no usable coordinates",)
+    elif geom is not None:
+        problems = (f"geometry {geom.get('type') if isinstance(geom, dict) else geom!r} ignored",)
+    if not any(k.lower() in COLUMN_VARIANTS["title"] for k in props):
+        problems = (*problems, "the feature has no title property")
+    return row_from_mapping(props, n, base_dir=base, point=point, list_problems=problems)
+
+
+def _iter_json_features(fh: TextIO, name: str) -> Iterator[Any]:
+    """Features of a FeatureCollection read incrementally (or of a top-level array)."""
+    dec = json.JSONDecoder()
+    buf = ""
+    pos = 0
+    eof = False
+
+    def fill() -> bool:
+        nonlocal buf, pos, eof
+        if eof:
+            return False
+        chunk = fh.read(1 << 16)
+        if not chunk:
+            eof = True
+            return False
+        buf = buf[pos:] + chunk
+        pos = 0
+        return True
+
+    def skip_ws() -> str:
+        nonlocal pos
+        while True:
+            while pos < len(buf) and buf[pos] in " \t\r\n":
+                pos += 1
+            if pos < len(buf):
+                return buf[pos]
+            if not fill():
+                return ""
+
+    def value() -> Any:
+        nonlocal pos
+        skip_ws()
+        while True:
+            try:
+                obj, end = dec.raw_decode(buf, pos)
+            except json.JSONDecodeError as exc:
+                if fill():
+                    continue
+                raise InputError(f"malformed GeoJSON in {name}: {exc.msg}") from None
+            # a number at the buffer's end may be cut: read on before trusting it
+            if end >= len(buf) and not eof and fill():
+                continue
+            pos = end
+            return obj
+
+    def array_items() -> Iterator[Any]:
+        nonlocal pos
+        pos += 1  # '['
+        if skip_ws() == "]":
+            pos += 1
+            return
+        while True:
+            skip_ws()
+            yield value()
+            c = skip_ws()
+            if c == ",":
+                pos += 1
+            elif c == "]":
+                pos += 1
+                return
+            else:
+                raise InputError(f"malformed GeoJSON in {name}: expected ',' or ']'")
+
+    c = skip_ws()
+    if c == "[":
+        yield from array_items()
+        return
+    if c != "{":
+        raise InputError(f"{name} is neither a CSV list nor GeoJSON")
+    pos += 1
+    found = False
+    while True:
+        c = skip_ws()
+        if c == "}":
+            break
+        key = value()
+        if skip_ws() != ":":
+            raise InputError(f"malformed GeoJSON in {name}: expected ':'")
+        pos += 1
+        if key == "features" and skip_ws() == "[":
+            found = True
+            yield from array_items()
+        else:
+            obj = value()
+            if key == "type" and obj == "Feature":
+                raise _SingleFeatureError
+        c = skip_ws()
+        if c == ",":
+            pos += 1
+    if not found:
+        raise InputError(f"{name} is a JSON object without a 'features' array")
+
+
+class _SingleFeatureError(Exception):
+    pass
+
+
+def _read_geojson(path: Path) -> Iterator[CameraRow]:
+    base = path.resolve().parent
+    with open(path, encoding="utf-8-sig") as fh:
+        head = fh.read(1 << 16)
+        fh.seek(0)
+        lines = head.splitlines()
+        seq = len(lines) > 1 and all(
+            ln.strip().lstrip("\x1e").startswith("{") for ln in lines[:2] if ln.strip()
+        )
+        if seq and lines[0].rstrip().endswith("}"):
+            # GeoJSON text sequence / one feature per line
+            for n, line in enumerate((ln for ln in fh if ln.strip()), start=1):
+                try:
+                    feat = json.loads(line.strip().lstrip("\x1e"))
+                except json.JSONDecodeError as exc:
+                    yield CameraRow(
+                        row=n, id=f"row-{n}", problems=(f"malformed JSON line: {exc.msg}",)
+                    )
+                    continue
+                yield _feature_row(feat, n, base)
+            return
+        try:
+            for n, feat in enumerate(_iter_json_features(fh, path.name), start=1):
+                yield _feature_row(feat, n, base)
+        except _SingleFeatureError:
+            fh.seek(0)
+            yield _feature_row(json.load(fh), 1, base)
+
+
+def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
+    """Stream the cameras of a CSV or GeoJSON list, one :class:`CameraRow` per record.
+
+    Never raises for a bad row: what is wrong goes into :attr:`CameraRow.problems`.
+
+    Raises
+    ------
+    InputError
+        The file does not exist, cannot be read, or is neither CSV nor GeoJSON.
+    """
+    p = Path(path).expanduser()
+    if not p.is_file():
+        raise InputError(f"camera list not found: {p}")
+    try:
+        kind = _list_kind(p)
+        if kind == "geojson":
+            yield from _read_geojson(p)
+        else:
+            yield from _read_csv(p)
+    except UnicodeDecodeError as exc:
+        raise InputError(f"camera list {p.name} is not UTF-8 text: {exc.reason}") from None
+    except csv.Error as exc:
+        raise InputError(f"malformed CSV in {p.name}: {exc}") from None
+    except OSError as exc:
+        raise InputError(f"cannot read camera list {p}: {exc}") from None
+
+
+def count_camera_rows(path: str | os.PathLike[str]) -> int:
+    """How many cameras a list holds (one streaming pass)."""
+    n = 0
+    for _ in read_camera_list(path):
+        n += 1
+    return n

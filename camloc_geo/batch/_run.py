@@ -1,0 +1,663 @@
+"""``run_batch``: a camera list through :func:`geocode_camera`, locally or on Dask.
+
+Work flows as chunks of cameras of one area (same map): the list is streamed, cameras are
+grouped by area in a bounded window, each full chunk goes to a worker (a local process pool
+by default, or a Dask ``Client``), and each finished chunk is written to the journal in one
+transaction. At the end the GeoPackage (``cameras``, ``candidates``, ``view_cones``,
+``errors``) and the optional summary map are built from the journal, in row order, so the
+output does not depend on where or in which order the work ran.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing
+import os
+import sys
+import threading
+import time
+from collections import defaultdict
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor
+from concurrent.futures import wait as cf_wait
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from camloc_geo._errors import InputError
+from camloc_geo.batch._areas import Area, MapPlan, area_map, map_plan
+from camloc_geo.batch._camera import RETRY_STATUSES, CameraResult, geocode_camera
+from camloc_geo.batch._journal import Journal, journal_path
+from camloc_geo.batch._list import CameraRow, read_camera_list
+
+__all__ = ["BatchSummary", "process_chunk", "run_batch"]
+
+log = logging.getLogger(__name__)
+
+DEFAULT_CHUNK_SIZE = 16
+_WINDOW_ROWS = 1024
+
+
+@dataclass
+class BatchSummary:
+    """What a batch run did.
+
+    Attributes
+    ----------
+    total
+        Cameras in the list.
+    computed
+        Cameras computed by this run.
+    skipped
+        Cameras already done by an earlier run (taken from the journal).
+    statuses
+        Cameras per status (all rows of the list).
+    out_gpkg, summary_map, journal
+        Files written.
+    stage_s
+        Seconds per stage: ``read_list``, ``map_load`` and ``geocode`` (summed over
+        workers), ``journal``, ``gpkg``, ``summary_map``.
+    elapsed_s
+        Wall time of the run.
+    """
+
+    total: int
+    computed: int
+    skipped: int
+    statuses: dict[str, int]
+    out_gpkg: Path
+    journal: Path
+    summary_map: Path | None = None
+    stage_s: dict[str, float] = field(default_factory=dict)
+    elapsed_s: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-able summary."""
+        return {
+            "total": self.total,
+            "computed": self.computed,
+            "skipped": self.skipped,
+            "statuses": dict(sorted(self.statuses.items())),
+            "out_gpkg": str(self.out_gpkg),
+            "journal": str(self.journal),
+            "summary_map": str(self.summary_map) if self.summary_map else None,
+            "stage_s": {k: round(v, 3) for k, v in self.stage_s.items()},
+            "elapsed_s": round(self.elapsed_s, 3),
+        }
+
+
+def process_chunk(
+    plan: MapPlan, area: Area, rows: list[CameraRow]
+) -> tuple[list[dict[str, Any]], dict[str, float]]:
+    """Geocode cameras of one area (a worker's task); returns records and stage seconds.
+
+    Never raises for a camera: each gets a record with its status.
+    """
+    t0 = time.perf_counter()
+    if area[0] in ("file", "cell", "net"):
+        try:
+            area_map(area)  # load (or find) the area's map once, timed apart
+        except Exception as exc:  # every camera reports it below
+            log.debug("map of %s failed: %s", area, exc)
+    elif area[0] == "search":
+        for f in area[1]:
+            try:
+                area_map(("file", f))
+            except Exception as exc:
+                log.debug("map of %s failed: %s", f, exc)
+    t1 = time.perf_counter()
+    out = [geocode_camera(r, plan=plan, area=area).to_dict() for r in rows]
+    t2 = time.perf_counter()
+    return out, {"map_load": t1 - t0, "geocode": t2 - t1}
+
+
+class _InlineExecutor(Executor):
+    """Runs each task when submitted (``workers=1``)."""
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future[Any]:
+        fut: Future[Any] = Future()
+        try:
+            fut.set_result(fn(*args, **kwargs))
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt):
+                raise
+            fut.set_exception(exc)
+        return fut
+
+
+def _local_executor(workers: int) -> Executor:
+    if workers <= 1:
+        return _InlineExecutor()
+    methods = multiprocessing.get_all_start_methods()
+    # fork is cheap and shares what the parent imported; only safe without threads
+    method = os.environ.get("CAMLOC_BATCH_START_METHOD", "")
+    if method not in methods:
+        method = "fork" if "fork" in methods and threading.active_count() == 1 else "spawn"
+        if method != "fork" and "forkserver" in methods:
+            method = "forkserver"
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+
+
+class _DaskRunner:
+    def __init__(self, scheduler: Any) -> None:
+        from distributed import Client
+
+        if isinstance(scheduler, str):
+            self.client = Client(scheduler, set_as_default=False)
+            self.own = True
+        else:
+            self.client = scheduler
+            self.own = False
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
+        return self.client.submit(fn, *args, pure=False)
+
+    def wait_one(self, futures: set[Any]) -> set[Any]:
+        from distributed import wait
+
+        done, _ = wait(list(futures), return_when="FIRST_COMPLETED")
+        return set(done)
+
+    def close(self, cancel: bool = False) -> None:
+        if self.own:
+            self.client.close()
+
+
+class _LocalRunner:
+    def __init__(self, workers: int) -> None:
+        self.ex = _local_executor(workers)
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
+        return self.ex.submit(fn, *args)
+
+    def wait_one(self, futures: set[Any]) -> set[Any]:
+        done, _ = cf_wait(futures, return_when=FIRST_COMPLETED)
+        return set(done)
+
+    def close(self, cancel: bool = False) -> None:
+        self.ex.shutdown(wait=not cancel, cancel_futures=cancel)
+
+
+def _chunks(
+    rows: Iterable[CameraRow], plan: MapPlan, chunk_size: int
+) -> Iterator[tuple[Area, list[CameraRow]]]:
+    """Rows grouped by area into chunks, within a bounded window of the list."""
+    pending: dict[Area, list[CameraRow]] = defaultdict(list)
+    held = 0
+    for row in rows:
+        area = plan.area_of(row)
+        group = pending[area]
+        group.append(row)
+        held += 1
+        if len(group) >= chunk_size:
+            yield area, group
+            held -= len(group)
+            pending[area] = []
+        if held >= _WINDOW_ROWS:
+            for a, g in pending.items():
+                if g:
+                    yield a, g
+            pending.clear()
+            held = 0
+    for a, g in pending.items():
+        if g:
+            yield a, g
+
+
+def run_batch(
+    list_path: str | os.PathLike[str],
+    *,
+    out_gpkg: str | os.PathLike[str],
+    map_source: str | os.PathLike[str] | None = None,
+    network: bool = False,
+    scheduler: Any = None,
+    summary_map: str | os.PathLike[str] | None = None,
+    progress: bool = True,
+    workers: int | None = None,
+    area: str | None = None,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    restart: bool = False,
+    offline_map: bool = True,
+    on_chunk: Callable[[int], None] | None = None,
+) -> BatchSummary:
+    """Geocode every camera of a list into a GeoPackage (resumable).
+
+    Parameters
+    ----------
+    list_path
+        CSV or GeoJSON camera list (columns in ``docs/batch.md``).
+    out_gpkg
+        The GeoPackage to write (replaced at the end of each run); the journal
+        ``OUT.camloc-batch.sqlite`` next to it records finished cameras.
+    map_source
+        An OSM extract or a folder of extracts (each camera uses the one covering it).
+    network
+        Without ``map_source``: fetch each area's map from Overpass.
+    scheduler
+        None: this machine, ``workers`` processes. A ``tcp://HOST:PORT`` address or a
+        ``dask.distributed.Client``: the same chunks run on that Dask cluster (its workers
+        must see the extracts at the same paths).
+    summary_map
+        Also write this HTML summary map (clustered markers; self-contained unless
+        ``offline_map`` is False).
+    progress
+        Show a progress bar (tqdm, on stderr) with rate and time left.
+    workers
+        Local processes (default: the machine's cores); 1 runs in this process.
+    area
+        Only search titles without a point in extracts whose file name contains this.
+    chunk_size
+        Cameras per task and per journal transaction.
+    restart
+        Forget the journal and compute every camera again.
+    on_chunk
+        Called with the number of cameras done after each journal write.
+
+    Raises
+    ------
+    InputError
+        Unreadable list, missing extract, a journal from a different run or list.
+    """
+    t_start = time.perf_counter()
+    list_p = Path(list_path).expanduser()
+    out = Path(out_gpkg).expanduser()
+    if not list_p.is_file():
+        raise InputError(f"camera list not found: {list_p}")
+    if chunk_size < 1:
+        raise InputError("chunk_size must be at least 1")
+    plan = map_plan(map_source, network=network, area=area)
+    stage: dict[str, float] = defaultdict(float)
+    journal = Journal(journal_path(out))
+    try:
+        journal.check_options(
+            {
+                "list": str(list_p.resolve()),
+                "map_source": str(Path(map_source).resolve()) if map_source else None,
+                "network": bool(network),
+                "area": area,
+            },
+            restart,
+        )
+        done = journal.done_rows(retry=RETRY_STATUSES)
+        t = time.perf_counter()
+        total = 0
+        skipped = 0
+        for row in read_camera_list(list_p):
+            total += 1
+            if row.row in done:
+                if done[row.row] != row.id:
+                    raise InputError(
+                        f"row {row.row} of {list_p.name} is camera {row.id!r} but the journal "
+                        f"recorded {done[row.row]!r}: the list changed; use --restart"
+                    )
+                skipped += 1
+        stage["read_list"] += time.perf_counter() - t
+        todo = (r for r in read_camera_list(list_p) if r.row not in done)
+        computed = _run_chunks(
+            todo,
+            plan,
+            journal,
+            stage,
+            scheduler=scheduler,
+            workers=workers or os.cpu_count() or 1,
+            chunk_size=chunk_size,
+            progress=progress,
+            total=total,
+            initial=skipped,
+            on_chunk=on_chunk,
+        )
+        t = time.perf_counter()
+        _write_gpkg(journal, out)
+        stage["gpkg"] += time.perf_counter() - t
+        map_path = None
+        if summary_map is not None:
+            t = time.perf_counter()
+            map_path = _write_summary_map(journal, Path(summary_map), offline=offline_map)
+            stage["summary_map"] += time.perf_counter() - t
+        statuses = journal.status_counts()
+    finally:
+        journal.close()
+    return BatchSummary(
+        total=total,
+        computed=computed,
+        skipped=skipped,
+        statuses=statuses,
+        out_gpkg=out,
+        journal=journal.path,
+        summary_map=map_path,
+        stage_s=dict(stage),
+        elapsed_s=time.perf_counter() - t_start,
+    )
+
+
+def _run_chunks(
+    todo: Iterable[CameraRow],
+    plan: MapPlan,
+    journal: Journal,
+    stage: dict[str, float],
+    *,
+    scheduler: Any,
+    workers: int,
+    chunk_size: int,
+    progress: bool,
+    total: int,
+    initial: int,
+    on_chunk: Callable[[int], None] | None,
+) -> int:
+    runner: _LocalRunner | _DaskRunner
+    if scheduler is not None:
+        runner = _DaskRunner(scheduler)
+        n_slots = max(2, len(runner.client.nthreads()) if hasattr(runner.client, "nthreads") else 2)
+    else:
+        runner = _LocalRunner(workers)
+        n_slots = workers
+    max_inflight = 2 * n_slots + 1
+    from tqdm import tqdm
+
+    bar = tqdm(
+        total=total,
+        initial=initial,
+        unit="cam",
+        desc="camloc batch",
+        file=sys.stderr,
+        disable=not progress,
+        dynamic_ncols=True,
+        smoothing=0.1,
+    )
+    computed = 0
+    done_count = initial
+    inflight: set[Any] = set()
+
+    def collect(futs: set[Any]) -> None:
+        nonlocal computed, done_count
+        for fut in futs:
+            records, times = fut.result()
+            for k, v in times.items():
+                stage[k] += v
+            t = time.perf_counter()
+            n = journal.write(records)
+            stage["journal"] += time.perf_counter() - t
+            computed += n
+            done_count += n
+            bar.update(n)
+            if on_chunk is not None:
+                on_chunk(done_count)
+
+    cancel = False
+    try:
+        t_read = time.perf_counter()
+        for area, rows in _chunks(todo, plan, chunk_size):
+            stage["read_list"] += time.perf_counter() - t_read
+            inflight.add(runner.submit(process_chunk, plan, area, rows))
+            while len(inflight) >= max_inflight:
+                finished = runner.wait_one(inflight)
+                inflight -= finished
+                collect(finished)
+            t_read = time.perf_counter()
+        while inflight:
+            finished = runner.wait_one(inflight)
+            inflight -= finished
+            collect(finished)
+    except BaseException:
+        cancel = True
+        raise
+    finally:
+        bar.close()
+        runner.close(cancel=cancel)
+    return computed
+
+
+# ------------------------------------------------------------------------ GeoPackage
+_CAMERA_COLUMNS: dict[str, str] = {
+    "row": "int64",
+    "id": "object",
+    "title": "object",
+    "status": "object",
+    "reason": "object",
+    "lat": "float64",
+    "lon": "float64",
+    "score": "float64",
+    "uncertainty_m": "float64",
+    "tie": "bool",
+    "method": "object",
+    "n_candidates": "int64",
+    "match_status": "object",
+    "names_read": "object",
+    "names_matched": "object",
+    "match_kinds": "object",
+    "view_text": "object",
+    "view_bearing_deg": "float64",
+    "heading_deg": "float64",
+    "height_m": "float64",
+    "extract": "object",
+    "list_lat": "float64",
+    "list_lon": "float64",
+    "n_errors": "int64",
+}
+_CANDIDATE_COLUMNS: dict[str, str] = {
+    "row": "int64",
+    "id": "object",
+    "rank": "int64",
+    "source": "object",
+    "status": "object",
+    "score": "float64",
+    "lat": "float64",
+    "lon": "float64",
+    "uncertainty_m": "float64",
+    "heading_deg": "float64",
+    "height_m": "float64",
+    "method": "object",
+    "detail": "object",
+    "intersection": "object",
+    "extract": "object",
+}
+_CONE_COLUMNS = {
+    "row": "int64",
+    "id": "object",
+    "rank": "int64",
+    "source": "object",
+    "score": "float64",
+}
+_ERROR_COLUMNS = {
+    "row": "int64",
+    "id": "object",
+    "status": "object",
+    "stage": "object",
+    "message": "object",
+}
+
+
+def _frame(rows: list[dict[str, Any]], columns: dict[str, str], geoms: list[Any] | None) -> Any:
+    import geopandas as gpd
+    import pandas as pd
+
+    df = pd.DataFrame({c: [r.get(c) for r in rows] for c in columns})
+    for c, dtype in columns.items():
+        if dtype == "float64":
+            df[c] = pd.to_numeric(df[c], errors="coerce").astype("float64")
+        elif dtype in ("int64", "bool"):
+            df[c] = df[c].fillna(0).astype(dtype)
+        else:
+            df[c] = df[c].astype(object).where(df[c].notna(), None)
+    if geoms is None:
+        return df
+    return gpd.GeoDataFrame(df, geometry=gpd.GeoSeries(geoms, crs="EPSG:4326"), crs="EPSG:4326")
+
+
+def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
+    from shapely.geometry import Point, Polygon
+
+    cams, cam_g, cands, cand_g, cones, cone_g, errs = [], [], [], [], [], [], []
+    for r in records:
+        cam = {k: r.get(k) for k in _CAMERA_COLUMNS}
+        for k in ("names_read", "names_matched", "match_kinds"):
+            cam[k] = " | ".join(r.get(k) or []) or None
+        cam["n_errors"] = len(r.get("errors") or [])
+        cams.append(cam)
+        placed = r.get("lat") is not None and r.get("lon") is not None
+        cam_g.append(Point(r["lon"], r["lat"]) if placed else None)
+        for c in r.get("candidates") or []:
+            cands.append({**c, "row": r["row"], "id": r["id"]})
+            ok = c.get("lat") is not None and c.get("lon") is not None
+            cand_g.append(Point(c["lon"], c["lat"]) if ok else None)
+        for c in r.get("cones") or []:
+            cones.append({**c, "row": r["row"], "id": r["id"]})
+            cone_g.append(Polygon(c["lonlat"]))
+        for e in r.get("errors") or []:
+            errs.append({**e, "row": r["row"], "id": r["id"], "status": r["status"]})
+    return {
+        "cameras": _frame(cams, _CAMERA_COLUMNS, cam_g),
+        "candidates": _frame(cands, _CANDIDATE_COLUMNS, cand_g),
+        "view_cones": _frame(cones, _CONE_COLUMNS, cone_g),
+        "errors": _frame(errs, _ERROR_COLUMNS, None),
+    }
+
+
+_GEOM_TYPES = {"cameras": "Point", "candidates": "Point", "view_cones": "Polygon"}
+
+
+def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
+    """Build the GeoPackage from the journal, a page of cameras at a time, then swap it in."""
+    import pyogrio
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(out.stem + ".part" + (out.suffix or ".gpkg"))
+    if tmp.exists():
+        tmp.unlink()
+    started: set[str] = set()
+    buf: list[dict[str, Any]] = []
+
+    def flush(final: bool) -> None:
+        layers = _layers_of(buf)
+        for name, df in layers.items():
+            if len(df) == 0 and (name in started or not final):
+                continue
+            kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
+            if name in _GEOM_TYPES:
+                kwargs["geometry_type"] = _GEOM_TYPES[name]
+            pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
+            started.add(name)
+        buf.clear()
+
+    for rec in journal.records():
+        buf.append(rec)
+        if len(buf) >= page:
+            flush(False)
+    flush(False)
+    for name in ("cameras", "candidates", "view_cones", "errors"):
+        if name not in started:
+            buf.clear()
+            df = _layers_of([])[name]
+            kwargs = {"driver": "GPKG", "layer": name}
+            if name in _GEOM_TYPES:
+                kwargs["geometry_type"] = _GEOM_TYPES[name]
+            pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
+            started.add(name)
+    os.replace(tmp, out)
+
+
+# ------------------------------------------------------------------------ summary map
+_MAX_MAP_MARKERS = 50_000
+
+
+def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
+    n = 0
+    for r in journal.records():
+        label = f"{r['id']} {r.get('title') or ''}".strip()
+        if r.get("lat") is None or r.get("lon") is None:
+            yield (
+                label,
+                {
+                    "features": [],
+                    "properties": {"reason": f"{r['status']}: {r.get('reason') or ''}"},
+                },
+            )
+            continue
+        n += 1
+        if n > _MAX_MAP_MARKERS:
+            continue
+        heading = r.get("heading_deg")
+        if heading is None:
+            heading = r.get("view_bearing_deg")
+        props = {
+            "kind": "candidate",
+            "rank": 1,
+            "lat": r["lat"],
+            "lon": r["lon"],
+            "score": r.get("score") or 0.0,
+            "method": f"{r.get('method')} ({r['status']})",
+            "heading_deg": heading,
+            "height_m": r.get("height_m"),
+            "sigma_m": r.get("uncertainty_m"),
+            "flags": ([r["status"]] + (["tie"] if r.get("tie") else [])),
+        }
+        yield (
+            label,
+            {
+                "features": [
+                    {
+                        "type": "Feature",
+                        "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
+                        "properties": props,
+                    }
+                ],
+                "properties": {"reason": r.get("reason")},
+            },
+        )
+
+
+def _markercluster_assets() -> tuple[str, str]:
+    import xstatic.pkg.leaflet_markercluster as xmc
+
+    base = Path(xmc.BASE_DIR)
+    js = (base / "leaflet.markercluster.js").read_text(encoding="utf-8")
+    js = js.replace("//# sourceMappingURL=leaflet.markercluster.js.map", "")
+    css = (base / "MarkerCluster.css").read_text(encoding="utf-8") + (
+        base / "MarkerCluster.Default.css"
+    ).read_text(encoding="utf-8")
+    return js, css
+
+
+def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
+    """The summary map: one marker per placed camera, clustered (offline: inlined plug-in)."""
+    import re
+
+    from camloc_geo.maps import build_summary_map, inline_assets
+
+    fmap = build_summary_map(
+        _summary_items(journal), offline=False, tiles=None if offline else "OpenStreetMap"
+    )
+    page = fmap.get_root().render()
+    if offline:
+        js, css = _markercluster_assets()
+        page = re.sub(
+            r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
+            lambda _m: "<!--camloc:markercluster_js-->",
+            page,
+        )
+        page = re.sub(
+            r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
+            lambda _m: "<!--camloc:markercluster_css-->",
+            page,
+        )
+        # without a tile layer the map has no maxZoom, which the cluster plug-in needs
+        page = re.sub(
+            r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
+        )
+        page = inline_assets(page)
+        page = page.replace("<!--camloc:markercluster_css-->", "<style>" + css + "</style>", 1)
+        page = page.replace("<!--camloc:markercluster_css-->", "")
+        page = page.replace("<!--camloc:markercluster_js-->", "<script>" + js + "</script>", 1)
+        page = page.replace("<!--camloc:markercluster_js-->", "")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(page, encoding="utf-8")
+    return path
+
+
+def results_from_journal(out_gpkg: str | os.PathLike[str]) -> list[CameraResult]:
+    """Every camera recorded for an output so far (row order)."""
+    j = Journal(journal_path(Path(out_gpkg)))
+    try:
+        return [CameraResult.from_dict(r) for r in j.records()]
+    finally:
+        j.close()

@@ -1,0 +1,95 @@
+"""``camloc batch LIST -o OUT.gpkg``: geocode a camera list into a GeoPackage (resumable)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from typing import Any
+
+from camloc_geo._errors import InputError
+
+log = logging.getLogger(__name__)
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``batch`` command."""
+    p: argparse.ArgumentParser = subparsers.add_parser(
+        "batch",
+        help="geocode a camera list (CSV/GeoJSON) into a GeoPackage, resumable",
+        description=(
+            "Place every camera of a list from its title's junction and, when it has one, its "
+            "located scene. Writes a GeoPackage (layers cameras, candidates, view_cones, "
+            "errors); OUT.camloc-batch.sqlite next to it records finished cameras, so a "
+            "rerun after an interruption continues where it stopped. Columns: docs/batch.md."
+        ),
+    )
+    p.add_argument("list", help="camera list: CSV or GeoJSON (id, title, lat, lon, scene...)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.gpkg", help="GeoPackage to write")
+    p.add_argument("--map", metavar="SUMMARY.html", help="also write a summary map (clustered)")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument(
+        "--osm",
+        metavar="EXTRACT_OR_FOLDER",
+        help="an OSM extract or a folder of extracts (each camera uses the one covering it)",
+    )
+    src.add_argument(
+        "--network",
+        action="store_true",
+        help="fetch each area's map from Overpass (cameras need lat/lon)",
+    )
+    p.add_argument(
+        "--area",
+        metavar="NAME",
+        help="search titles without a point only in extracts whose file name contains NAME",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="run on this Dask distributed scheduler instead of local processes",
+    )
+    p.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    p.add_argument(
+        "--chunk-size",
+        type=int,
+        default=16,
+        help="cameras per task and per journal transaction (default 16)",
+    )
+    p.add_argument("--restart", action="store_true", help="forget finished cameras, start again")
+    p.add_argument(
+        "--online-map", action="store_true", help="summary map with web tiles (not self-contained)"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the command."""
+    from camloc_geo.batch import run_batch
+
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers must be at least 1")
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise InputError("--scheduler needs an address such as tcp://HOST:8786")
+    summary = run_batch(
+        args.list,
+        out_gpkg=args.output,
+        map_source=args.osm,
+        network=args.network,
+        scheduler=args.scheduler,
+        summary_map=args.map,
+        progress=not args.no_progress and sys.stderr.isatty(),
+        workers=args.workers,
+        area=args.area,
+        chunk_size=args.chunk_size,
+        restart=args.restart,
+        offline_map=not args.online_map,
+    )
+    counts = ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))
+    sys.stderr.write(
+        f"camloc batch: {summary.total} cameras ({summary.computed} computed, "
+        f"{summary.skipped} already done): {counts}; wrote {summary.out_gpkg}"
+        + (f" and {summary.summary_map}" if summary.summary_map else "")
+        + "\n"
+    )
+    return 0

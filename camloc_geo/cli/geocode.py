@@ -1,0 +1,198 @@
+"""``camloc geocode``: place webcam titles at the junctions they name (GeoJSON)."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import IO, Any
+
+__all__ = ["register", "run"]
+
+_TITLE_COLUMNS = ("title", "name", "camera_title", "description", "location")
+_ID_COLUMNS = ("id", "camera_id", "cam_id", "number")
+_LAT_COLUMNS = ("lat", "latitude", "y")
+_LON_COLUMNS = ("lon", "lng", "longitude", "x")
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``geocode`` sub-command."""
+    parser = subparsers.add_parser(
+        "geocode",
+        help="place webcam titles at the junctions they name (GeoJSON)",
+        description=(
+            "Read webcam titles ('625 - Milton & E Biddle St', 'N POTOMAC ST @ E FAYETTE ST', "
+            "'Karl-Liebknecht-Str. / Wadzeckstr.') and write a GeoJSON FeatureCollection with "
+            "one feature per match, best first: status junction | street | address | landmark "
+            "| ambiguous | not_found, the names read and the OSM names matched, how each "
+            "matched, the score and the reason. Map data © OpenStreetMap contributors (ODbL)."
+        ),
+    )
+    parser.add_argument("titles", nargs="*", metavar="TITLE", help="webcam titles")
+    parser.add_argument(
+        "--osm",
+        metavar="EXTRACT_OR_FOLDER",
+        required=True,
+        help="an .osm/.osm.gz/.osm.bz2/.osm.pbf extract, or a folder of them (a title is "
+        "then searched in every extract; placed in two means ambiguous)",
+    )
+    parser.add_argument("--near", metavar="LAT,LON", help="rank by distance from this point")
+    parser.add_argument(
+        "--radius-m", type=float, help="with --near (or --area): keep matches within this radius"
+    )
+    parser.add_argument("--area", help="search around this named place of the map")
+    parser.add_argument(
+        "--list",
+        metavar="LIST.csv",
+        help="CSV of titles (column title or name; optional id, lat, lon), streamed",
+    )
+    parser.add_argument("--best", action="store_true", help="only the best match per title")
+    parser.add_argument("-o", "--output", metavar="OUT.geojson", help="output file (stdout)")
+    parser.set_defaults(func=run)
+
+
+def _parse_near(text: str | None) -> tuple[float, float] | None:
+    from camloc_geo._errors import InputError
+
+    if text is None:
+        return None
+    try:
+        lat_s, lon_s = text.split(",")
+        lat, lon = float(lat_s), float(lon_s)
+    except ValueError:
+        raise InputError(f"--near must be LAT,LON in degrees, got {text!r}") from None
+    if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0):
+        raise InputError(f"--near out of range: {text!r}")
+    return lat, lon
+
+
+def _column(header: list[str], options: tuple[str, ...]) -> str | None:
+    lowered = {h.strip().lower(): h for h in header if h}
+    for o in options:
+        if o in lowered:
+            return lowered[o]
+    return None
+
+
+def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
+    """(row number, id, title, point) of each CSV row, one at a time."""
+    from camloc_geo._errors import InputError
+
+    csv.field_size_limit(1 << 20)
+    try:
+        fh = path.open(newline="", encoding="utf-8-sig", errors="replace")
+    except OSError as exc:
+        raise InputError(f"cannot read the list {path}: {exc.strerror or exc}") from None
+    with fh:
+        reader = csv.reader(fh)
+        try:
+            header = next(reader)
+        except StopIteration:
+            raise InputError(f"the list {path} is empty") from None
+        except csv.Error as exc:
+            raise InputError(f"the list {path} is not CSV: {exc}") from None
+        title_col = _column(header, _TITLE_COLUMNS)
+        if title_col is None:
+            raise InputError(
+                f"the list {path} has no title column (one of {', '.join(_TITLE_COLUMNS)}); "
+                f"its columns: {', '.join(header)}"
+            )
+        idx = {h: i for i, h in enumerate(header)}
+        t_i = idx[title_col]
+        id_col = _column(header, _ID_COLUMNS)
+        lat_col, lon_col = _column(header, _LAT_COLUMNS), _column(header, _LON_COLUMNS)
+        row_no = 1
+        while True:
+            try:
+                row = next(reader)
+            except StopIteration:
+                return
+            except csv.Error as exc:
+                row_no += 1
+                yield row_no, None, "", None
+                sys.stderr.write(f"camloc geocode: row {row_no}: unreadable ({exc})\n")
+                continue
+            row_no += 1
+            if not row:
+                continue
+            title = row[t_i] if t_i < len(row) else ""
+            ident = row[idx[id_col]] if id_col is not None and idx[id_col] < len(row) else None
+            point = None
+            if lat_col is not None and lon_col is not None:
+                try:
+                    lat = float(row[idx[lat_col]])
+                    lon = float(row[idx[lon_col]])
+                    if -90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0:
+                        point = (lat, lon)
+                except (ValueError, IndexError):
+                    point = None
+            yield row_no, ident, title, point
+
+
+@contextmanager
+def _feature_writer(out: str | None) -> Iterator[Any]:
+    fh: IO[str]
+    close = False
+    if out in (None, "-"):
+        fh = sys.stdout
+    else:
+        fh = open(str(out), "w", encoding="utf-8")  # noqa: SIM115
+        close = True
+    first = [True]
+    fh.write('{"type": "FeatureCollection", "features": [\n')
+
+    def write(feature: dict[str, Any]) -> None:
+        if not first[0]:
+            fh.write(",\n")
+        first[0] = False
+        fh.write(json.dumps(feature, allow_nan=False, ensure_ascii=False))
+
+    try:
+        yield write
+    finally:
+        fh.write("\n]}\n")
+        if close:
+            fh.close()
+        else:
+            fh.flush()
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``camloc geocode``."""
+    from camloc_geo._errors import InputError
+    from camloc_geo.geocode import geocode_title_in_maps
+    from camloc_geo.geocode._maps import extract_paths, whole_map
+
+    if not args.titles and not args.list:
+        raise InputError("give one or more titles, or --list LIST.csv")
+    near = _parse_near(args.near)
+    if args.radius_m is not None and not (args.radius_m > 0):
+        raise InputError(f"--radius-m must be positive, got {args.radius_m}")
+    maps = [whole_map(p) for p in extract_paths(args.osm)]
+
+    def matches_of(title: str, point: tuple[float, float] | None) -> list[dict[str, Any]]:
+        found = geocode_title_in_maps(
+            title, maps, near=point or near, radius_m=args.radius_m, area=args.area
+        )
+        if args.best:
+            found = found[:1]
+        return [m.to_feature() for m in found]
+
+    with _feature_writer(args.output) as write:
+        for title in args.titles:
+            for rank, feature in enumerate(matches_of(title, None)):
+                feature["properties"]["rank"] = rank
+                write(feature)
+        if args.list:
+            for row_no, ident, title, point in _rows(Path(args.list)):
+                for rank, feature in enumerate(matches_of(title, point)):
+                    props = feature["properties"]
+                    props["row"] = row_no
+                    props["id"] = ident
+                    props["rank"] = rank
+                    write(feature)
+    return 0

@@ -1,0 +1,199 @@
+"""The street graph of a local extract, built without importing osmnx.
+
+osmnx's :func:`osmnx.graph_from_xml` and :func:`osmnx.simplify_graph` make the same graph,
+but importing osmnx costs half a second (it pulls in geopandas, pandas and matplotlib), more
+than reading and modelling a whole neighbourhood. These functions follow osmnx 2.x step by
+step (same node and edge order, attributes, lengths and simplification rules; osmnx is MIT
+licensed), so that a map read from an extract is the map osmnx would give, and the graph
+that Overpass returns through osmnx is simplified by the same code.
+
+The graph is an unprojected :class:`networkx.MultiDiGraph`: nodes carry ``x`` (longitude)
+and ``y`` (latitude); edges carry ``osmid``, the useful way tags, ``oneway``, ``reversed``,
+``length`` (metres, great circle) and, once simplified, ``geometry`` (lon/lat LineString).
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+from collections.abc import Iterable, Iterator, Sequence
+from typing import Any
+
+import networkx as nx
+from shapely.geometry import LineString
+
+__all__ = ["USEFUL_TAGS_WAY", "graph_from_ways", "simplify_graph"]
+
+log = logging.getLogger(__name__)
+
+USEFUL_TAGS_WAY = (
+    "access",
+    "area",
+    "bridge",
+    "est_width",
+    "highway",
+    "junction",
+    "landuse",
+    "lanes",
+    "maxspeed",
+    "name",
+    "oneway",
+    "ref",
+    "service",
+    "tunnel",
+    "width",
+)
+"""Way tags kept as edge attributes (osmnx's ``settings.useful_tags_way``)."""
+
+_ONEWAY_VALUES = {"yes", "true", "1", "-1", "reverse", "T", "F"}
+_REVERSED_VALUES = {"-1", "reverse", "T"}
+EARTH_RADIUS_M = 6_371_009.0
+
+
+def _great_circle_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Haversine distance (osmnx's ``great_circle``), metres."""
+    y1, y2 = math.radians(lat1), math.radians(lat2)
+    x1, x2 = math.radians(lon1), math.radians(lon2)
+    h = math.sin((y2 - y1) / 2) ** 2 + math.cos(y1) * math.cos(y2) * math.sin((x2 - x1) / 2) ** 2
+    return 2 * math.asin(math.sqrt(h)) * EARTH_RADIUS_M
+
+
+def graph_from_ways(
+    ways: Sequence[tuple[int, dict[str, str], Sequence[tuple[int, float, float]]]],
+) -> nx.MultiDiGraph:
+    """The unsimplified directed street graph of OSM ways.
+
+    What ``osmnx.graph_from_xml(path, bidirectional=False, simplify=False, retain_all=True)``
+    gives for an OSM XML file holding these ways and their nodes (coordinates at the
+    file's 7 decimals).
+
+    Parameters
+    ----------
+    ways
+        ``(way_id, tags, [(node_id, lat, lon), ...])`` in file order.
+    """
+    nodes: dict[int, dict[str, float]] = {}
+    for _way_id, _tags, refs in ways:
+        for ref, lat, lon in refs:
+            nodes[ref] = {"y": float(f"{lat:.7f}"), "x": float(f"{lon:.7f}")}
+    G = nx.MultiDiGraph(created_with="camloc_geo", crs="epsg:4326")
+    G.add_nodes_from(nodes.items())
+    paths: dict[int, tuple[dict[str, Any], list[int]]] = {}
+    for way_id, tags, refs in ways:
+        attrs: dict[str, Any] = {"osmid": way_id}
+        for key in USEFUL_TAGS_WAY:
+            if key in tags:
+                attrs[key] = tags[key]
+        paths[way_id] = (attrs, [k for k, _g in itertools.groupby(r[0] for r in refs)])
+    for attrs, way_nodes in paths.values():
+        one_way = attrs.get("oneway") in _ONEWAY_VALUES or attrs.get("junction") == "roundabout"
+        if one_way and attrs.get("oneway") in _REVERSED_VALUES:
+            way_nodes.reverse()
+        attrs["oneway"] = one_way
+        edges = list(itertools.pairwise(way_nodes))
+        attrs["reversed"] = False
+        G.add_edges_from(edges, **attrs)
+        if not one_way:
+            attrs["reversed"] = True
+            G.add_edges_from([(v, u) for u, v in edges], **attrs)
+    for u, v, data in G.edges(data=True):
+        a, b = G.nodes[u], G.nodes[v]
+        data["length"] = _great_circle_m(a["y"], a["x"], b["y"], b["x"])
+    return G
+
+
+def _is_endpoint(G: nx.MultiDiGraph, node: Any, edge_attrs_differ: Iterable[str]) -> bool:
+    neighbors = set(list(G.predecessors(node)) + list(G.successors(node)))
+    n = len(neighbors)
+    d = G.degree(node)
+    if node in neighbors:  # self-loop
+        return True
+    if G.out_degree(node) == 0 or G.in_degree(node) == 0:  # dead end
+        return True
+    if not (n == 2 and d in {2, 4}):  # not a mid-street node (one-way or two-way)
+        return True
+    for attr in edge_attrs_differ:
+        in_values = {v for _, _, v in G.in_edges(node, data=attr, keys=False)}
+        out_values = {v for _, _, v in G.out_edges(node, data=attr, keys=False)}
+        if len(in_values | out_values) > 1:
+            return True
+    return False
+
+
+def _build_path(
+    G: nx.MultiDiGraph, endpoint: Any, successor0: Any, endpoints: set[Any]
+) -> list[Any]:
+    path = [endpoint, successor0]
+    for this_successor in G.successors(successor0):
+        successor = this_successor
+        if successor not in path:
+            path.append(successor)
+            while successor not in endpoints:
+                successors = [n for n in G.successors(successor) if n not in path]
+                if len(successors) == 1:
+                    successor = successors[0]
+                    path.append(successor)
+                elif len(successors) == 0:
+                    if endpoint in G.successors(successor):  # a ring back to the endpoint
+                        return [*path, endpoint]
+                    log.debug("unexpected simplify pattern near %s", successor)
+                    return path
+                else:  # pragma: no cover - cannot happen for a non-endpoint
+                    raise RuntimeError(f"impossible simplify pattern near {successor}")
+            return path
+    return path
+
+
+def _paths_to_simplify(G: nx.MultiDiGraph, edge_attrs_differ: Sequence[str]) -> Iterator[list[Any]]:
+    endpoints = {n for n in G.nodes if _is_endpoint(G, n, edge_attrs_differ)}
+    for endpoint in endpoints:
+        for successor in G.successors(endpoint):
+            if successor not in endpoints:
+                yield _build_path(G, endpoint, successor, endpoints)
+
+
+def simplify_graph(G: nx.MultiDiGraph, *, edge_attrs_differ: Sequence[str] = ()) -> nx.MultiDiGraph:
+    """Merge each chain of mid-street nodes into one edge with a LineString geometry.
+
+    ``osmnx.simplify_graph(G, edge_attrs_differ=...)`` with its defaults: nodes where an
+    ``edge_attrs_differ`` attribute changes are kept; a merged edge sums ``length`` and keeps
+    one value of every other attribute when all agree, else the list of distinct values;
+    rings without any endpoint are removed.
+    """
+    if G.graph.get("simplified"):
+        raise ValueError("this graph is already simplified")
+    G = G.copy()
+    nodes_to_remove: list[Any] = []
+    edges_to_add: list[tuple[Any, Any, dict[str, Any]]] = []
+    for path in _paths_to_simplify(G, edge_attrs_differ):
+        path_attributes: dict[str, Any] = {}
+        for u, v in itertools.pairwise(path):
+            edge_data = next(iter(G.get_edge_data(u, v).values()))
+            for attr in edge_data:
+                if attr in path_attributes:
+                    path_attributes[attr].append(edge_data[attr])
+                else:
+                    path_attributes[attr] = [edge_data[attr]]
+        for name, values in path_attributes.items():
+            if name in ("length", "travel_time"):
+                path_attributes[name] = sum(values)
+            elif len(set(values)) == 1:
+                path_attributes[name] = values[0]
+            else:
+                path_attributes[name] = list(set(values))
+        path_attributes["geometry"] = LineString(
+            [(G.nodes[node]["x"], G.nodes[node]["y"]) for node in path]
+        )
+        nodes_to_remove.extend(path[1:-1])
+        edges_to_add.append((path[0], path[-1], path_attributes))
+    for u, v, attrs in edges_to_add:
+        G.add_edge(u, v, **attrs)
+    G.remove_nodes_from(set(nodes_to_remove))
+    ring_nodes: set[Any] = set()
+    for wcc in nx.weakly_connected_components(G):
+        if not any(_is_endpoint(G, n, edge_attrs_differ) for n in wcc):
+            ring_nodes.update(wcc)
+    G.remove_nodes_from(ring_nodes)
+    G.graph["simplified"] = True
+    return G

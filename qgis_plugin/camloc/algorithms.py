@@ -1,0 +1,409 @@
+"""The camloc Processing algorithms: thin wrappers over ``camloc_geo`` run out of process."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from qgis.core import (
+    QgsDistanceArea,
+    QgsPointXY,
+    QgsProcessing,
+    QgsProcessingAlgorithm,
+    QgsProcessingContext,
+    QgsProcessingException,
+    QgsProcessingFeedback,
+    QgsProcessingLayerPostProcessorInterface,
+    QgsProcessingParameterBoolean,
+    QgsProcessingParameterExtent,
+    QgsProcessingParameterFeatureSink,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterPoint,
+    QgsProcessingParameterString,
+)
+
+from .layers import apply_style, fields_of, wgs84, wkb_of, write_to_sink
+from .runner import WorkerCanceledError, WorkerError, run_worker
+
+OSM_FILTER = "OSM extracts (*.osm *.pbf *.osm.pbf *.bz2 *.gz);;All files (*.*)"
+SCENE_FILTER = "camloc scenes (*.json);;All files (*.*)"
+
+_post_processors: dict[str, QgsProcessingLayerPostProcessorInterface] = {}
+
+
+class _Styler(QgsProcessingLayerPostProcessorInterface):
+    """Applies a camloc default style to an output layer loaded on completion."""
+
+    def __init__(self, kind: str) -> None:
+        super().__init__()
+        self.kind = kind
+
+    def postProcessLayer(self, layer, context, feedback):
+        apply_style(layer, self.kind)
+
+
+class _CamlocAlgorithm(QgsProcessingAlgorithm):
+    """Shared parts: group, help, the worker call and the typed sinks."""
+
+    _name = ""
+    _display = ""
+    _help = ""
+
+    def name(self) -> str:
+        return self._name
+
+    def displayName(self) -> str:
+        return self._display
+
+    def group(self) -> str:
+        return "Camera location"
+
+    def groupId(self) -> str:
+        return "camloc"
+
+    def shortHelpString(self) -> str:
+        return self._help
+
+    def createInstance(self):
+        return type(self)()
+
+    def _add_map_params(self) -> None:
+        self.addParameter(
+            QgsProcessingParameterFile(
+                "OSM",
+                "OSM extract (.osm, .osm.pbf, .osm.bz2, .osm.gz); empty: Overpass if allowed",
+                behavior=QgsProcessingParameterFile.File,
+                fileFilter=OSM_FILTER,
+                optional=True,
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterBoolean(
+                "NETWORK", "Allow fetching OpenStreetMap data from Overpass", defaultValue=False
+            )
+        )
+
+    def _run(self, job: dict[str, Any], feedback: QgsProcessingFeedback) -> dict[str, Any] | None:
+        def progress(pct: float, message: str) -> None:
+            feedback.setProgress(pct)
+            if message:
+                feedback.setProgressText(message)
+
+        try:
+            res = run_worker(
+                job, progress=progress, canceled=feedback.isCanceled, log=feedback.pushDebugInfo
+            )
+        except WorkerCanceledError:
+            feedback.reportError("canceled", fatalError=False)
+            return None
+        except WorkerError as exc:
+            raise QgsProcessingException(f"camloc: {exc}") from None
+        for w in res.get("warnings") or []:
+            feedback.pushWarning(str(w)) if hasattr(feedback, "pushWarning") else feedback.pushInfo(
+                f"Warning: {w}"
+            )
+        return res
+
+    def _sink(
+        self,
+        parameters: dict[str, Any],
+        name: str,
+        desc: dict[str, Any],
+        kind: str,
+        context: QgsProcessingContext,
+        results: dict[str, Any],
+    ) -> int:
+        fields = fields_of(desc)
+        sink, dest = self.parameterAsSink(parameters, name, context, fields, wkb_of(desc), wgs84())
+        if sink is None:
+            if parameters.get(name) is None:
+                return 0  # optional output skipped
+            raise QgsProcessingException(self.invalidSinkError(parameters, name))
+        n = write_to_sink(sink, desc, fields)
+        del sink
+        if context.willLoadLayerOnCompletion(dest):
+            styler = _post_processors.setdefault(dest, _Styler(kind))
+            context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
+        results[name] = dest
+        return n
+
+    def _osm(self, parameters: dict[str, Any], context: QgsProcessingContext) -> str | None:
+        path = self.parameterAsFile(parameters, "OSM", context)
+        return path or None
+
+
+class LocateAlgorithm(_CamlocAlgorithm):
+    """``camloc:locate``: candidate camera positions from a scene file and an OSM extract."""
+
+    _name = "locate"
+    _display = "Locate camera from a scene"
+    _help = (
+        "Candidate absolute positions of the camera that took a snapshot, from its camloc scene "
+        "file (car annotations, intersection corners, landmarks) and OpenStreetMap. Outputs: "
+        "candidates (best first; rank, score, tie, height, heading...), their view cones, the map "
+        "corners each candidate matched, and the intersection used. Layers are in EPSG:4326. "
+        "Candidates whose score is within 80 % of the best are flagged as ties (drawn as stars)."
+    )
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(
+            QgsProcessingParameterFile(
+                "SCENE", "Scene file (camloc-scene/1 JSON)", fileFilter=SCENE_FILTER
+            )
+        )
+        self._add_map_params()
+        self.addParameter(
+            QgsProcessingParameterNumber(
+                "MAX_CANDIDATES",
+                "At most this many candidates",
+                type=QgsProcessingParameterNumber.Integer,
+                minValue=1,
+                optional=True,
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterNumber(
+                "RADIUS_M",
+                "Map radius around the scene (m; empty: prior radius + 200 m)",
+                type=QgsProcessingParameterNumber.Double,
+                minValue=10,
+                optional=True,
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "CANDIDATES", "Camera candidates", QgsProcessing.TypeVectorPoint
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "VIEW_CONES", "View cones", QgsProcessing.TypeVectorPolygon, optional=True
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "MATCHED_CORNERS",
+                "Matched map corners",
+                QgsProcessing.TypeVectorPoint,
+                optional=True,
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "INTERSECTION",
+                "Intersection and its corners",
+                QgsProcessing.TypeVectorPoint,
+                optional=True,
+            )
+        )
+
+    def processAlgorithm(self, parameters, context, feedback):
+        scene = self.parameterAsFile(parameters, "SCENE", context)
+        if not scene:
+            raise QgsProcessingException("camloc: no scene file given")
+        job: dict[str, Any] = {
+            "task": "locate",
+            "scene": scene,
+            "osm": self._osm(parameters, context),
+            "network": self.parameterAsBool(parameters, "NETWORK", context),
+        }
+        if parameters.get("MAX_CANDIDATES") not in (None, ""):
+            job["max_candidates"] = self.parameterAsInt(parameters, "MAX_CANDIDATES", context)
+        if parameters.get("RADIUS_M") not in (None, ""):
+            job["radius_m"] = self.parameterAsDouble(parameters, "RADIUS_M", context)
+        res = self._run(job, feedback)
+        if res is None:
+            return {}
+        layers = res["layers"]
+        results: dict[str, Any] = {}
+        n = self._sink(
+            parameters, "CANDIDATES", layers["candidates"], "candidates", context, results
+        )
+        self._sink(parameters, "VIEW_CONES", layers["view_cones"], "view_cones", context, results)
+        self._sink(
+            parameters,
+            "MATCHED_CORNERS",
+            layers["matched_corners"],
+            "matched_corners",
+            context,
+            results,
+        )
+        self._sink(
+            parameters, "INTERSECTION", layers["intersection"], "intersection", context, results
+        )
+        info = res.get("info") or {}
+        feedback.pushInfo(f"{n} candidate(s)")
+        if not n and info.get("reason"):
+            feedback.reportError(f"camloc: no candidates: {info['reason']}", fatalError=False)
+        results["N_CANDIDATES"] = n
+        return results
+
+
+class CornersAlgorithm(_CamlocAlgorithm):
+    """``camloc:corners``: intersections and kerb corners around a point or in an extent."""
+
+    _name = "corners"
+    _display = "Intersections and kerb corners"
+    _help = (
+        "Road intersections with their kerb corners (clockwise order from above, starting at 0) "
+        "from OpenStreetMap, around a point (with a radius) or in an extent (for example the "
+        "map canvas extent). Give STREETS ('A & B') to keep only that intersection."
+    )
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(QgsProcessingParameterPoint("POINT", "Around this point", optional=True))
+        self.addParameter(
+            QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True)
+        )
+        self.addParameter(
+            QgsProcessingParameterNumber(
+                "RADIUS_M",
+                "Radius around the point (m)",
+                type=QgsProcessingParameterNumber.Double,
+                defaultValue=150.0,
+                minValue=1.0,
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterString(
+                "STREETS", "Only the intersection of 'A & B'", optional=True
+            )
+        )
+        self._add_map_params()
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "CORNERS", "Intersections and corners", QgsProcessing.TypeVectorPoint
+            )
+        )
+
+    def processAlgorithm(self, parameters, context, feedback):
+        crs = wgs84()
+        if parameters.get("POINT") not in (None, ""):
+            pt = self.parameterAsPoint(parameters, "POINT", context, crs)
+            radius = self.parameterAsDouble(parameters, "RADIUS_M", context)
+        elif parameters.get("EXTENT") not in (None, ""):
+            ext = self.parameterAsExtent(parameters, "EXTENT", context, crs)
+            if ext.isEmpty():
+                raise QgsProcessingException("camloc: the extent is empty")
+            pt = ext.center()
+            da = QgsDistanceArea()
+            da.setEllipsoid("WGS84")
+            radius = 0.5 * da.measureLine(
+                QgsPointXY(ext.xMinimum(), ext.yMinimum()),
+                QgsPointXY(ext.xMaximum(), ext.yMaximum()),
+            )
+            if radius > 5000:
+                raise QgsProcessingException(
+                    f"camloc: the extent is {2 * radius / 1000:.1f} km across; zoom in "
+                    "(at most 10 km) or give a point and a radius"
+                )
+        else:
+            raise QgsProcessingException("camloc: give a point (POINT) or an extent (EXTENT)")
+        job = {
+            "task": "corners",
+            "lat": pt.y(),
+            "lon": pt.x(),
+            "radius_m": radius,
+            "streets": self.parameterAsString(parameters, "STREETS", context) or None,
+            "osm": self._osm(parameters, context),
+            "network": self.parameterAsBool(parameters, "NETWORK", context),
+        }
+        res = self._run(job, feedback)
+        if res is None:
+            return {}
+        results: dict[str, Any] = {}
+        n = self._sink(parameters, "CORNERS", res["layers"]["corners"], "corners", context, results)
+        feedback.pushInfo(f"{n} feature(s)")
+        return results
+
+
+class GeocodeListAlgorithm(_CamlocAlgorithm):
+    """``camloc:geocodelist``: one best location per camera of a webcam list."""
+
+    _name = "geocodelist"
+    _display = "Geocode a webcam list"
+    _help = (
+        "A list of cameras (CSV or GeoJSON: id, title, lat/lon, radius_m, streets, scene) in; "
+        "one point per camera at its best candidate with a status (ok, ambiguous, not_found, "
+        "error) and the reason, and every candidate with its camera id. Uses the batch engine "
+        "camloc_geo.batch when installed, otherwise the library's locate per camera."
+    )
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(
+            QgsProcessingParameterFile(
+                "LIST",
+                "Camera list (CSV or GeoJSON)",
+                fileFilter="Camera lists (*.csv *.geojson *.json);;All files (*.*)",
+            )
+        )
+        self._add_map_params()
+        self.addParameter(
+            QgsProcessingParameterFeatureSink("CAMERAS", "Cameras", QgsProcessing.TypeVectorPoint)
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "CANDIDATES", "All candidates", QgsProcessing.TypeVectorPoint, optional=True
+            )
+        )
+
+    def processAlgorithm(self, parameters, context, feedback):
+        job = {
+            "task": "geocodelist",
+            "list": self.parameterAsFile(parameters, "LIST", context),
+            "osm": self._osm(parameters, context),
+            "network": self.parameterAsBool(parameters, "NETWORK", context),
+        }
+        res = self._run(job, feedback)
+        if res is None:
+            return {}
+        layers = res["layers"]
+        results: dict[str, Any] = {}
+        n = self._sink(parameters, "CAMERAS", layers["cameras"], "cameras", context, results)
+        self._sink(
+            parameters, "CANDIDATES", layers["candidates"], "list_candidates", context, results
+        )
+        feedback.pushInfo(f"{n} camera(s), engine {res.get('info', {}).get('engine')}")
+        return results
+
+
+class MeasureAlgorithm(_CamlocAlgorithm):
+    """``camloc:measure``: ground distances and heights with a calibrated camera."""
+
+    _name = "measure"
+    _display = "Measure distances and heights in a snapshot"
+    _help = (
+        "Ground distances and heights from pixel pairs of a calibrated scene. PAIRS is JSON: "
+        '[{"kind": "distance"|"height", "a": [x, y], "b": [x, y]}, ...].'
+    )
+
+    def initAlgorithm(self, config=None):
+        self.addParameter(
+            QgsProcessingParameterFile("SCENE", "Scene file", fileFilter=SCENE_FILTER)
+        )
+        self.addParameter(
+            QgsProcessingParameterString("PAIRS", "Pixel pairs (JSON)", multiLine=True)
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink(
+                "MEASUREMENTS", "Measurements", QgsProcessing.TypeVector
+            )
+        )
+
+    def processAlgorithm(self, parameters, context, feedback):
+        try:
+            pairs = json.loads(self.parameterAsString(parameters, "PAIRS", context) or "[]")
+        except ValueError as exc:
+            raise QgsProcessingException(f"camloc: PAIRS is not valid JSON: {exc}") from None
+        job = {
+            "task": "measure",
+            "scene": self.parameterAsFile(parameters, "SCENE", context),
+            "pairs": pairs,
+        }
+        res = self._run(job, feedback)
+        if res is None:
+            return {}
+        results: dict[str, Any] = {}
+        self._sink(parameters, "MEASUREMENTS", res["layers"]["measurements"], "", context, results)
+        return results

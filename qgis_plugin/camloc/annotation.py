@@ -1,0 +1,153 @@
+"""The analyst's annotation of one snapshot, as a ``camloc-scene/1`` dict (no Qt, no qgis).
+
+The steps follow the annotation page: the car's ground corner and the ends of its three
+edges, segments parallel to each edge, the visible kerb corners of the intersection in
+clockwise order, and the intersection's position picked on the map. Validation of the
+finished scene is the library's (``camloc_geo.scene`` through the worker).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+SCENE_FORMAT = "camloc-scene/1"
+
+# (key, label, kind): kind "point" (one click, then the next step), "line" (two clicks per
+# segment, any number of segments) or "multi" (any number of points).
+STEPS = [
+    ("origin", "1. Car corner on the ground (origin)", "point"),
+    ("length", "2. End of the car's length edge", "point"),
+    ("width", "3. End of the car's width edge", "point"),
+    ("height", "4. Top of the height edge (roof line)", "point"),
+    ("lines_length", "5. Lines parallel to the length (2 clicks each)", "line"),
+    ("lines_width", "6. Lines parallel to the width (2 clicks each)", "line"),
+    ("lines_height", "7. Vertical lines (2 clicks each)", "line"),
+    ("corners", "8. Intersection kerb corners, clockwise on screen", "multi"),
+]
+STEP_KEYS = [s[0] for s in STEPS]
+AXES = ("origin", "length", "width", "height")
+
+
+def _r(v: float) -> float:
+    return round(float(v), 1)
+
+
+class Annotation:
+    """Clicks of one analyst on one snapshot."""
+
+    def __init__(self, width: int = 0, height: int = 0, scene_id: str = "scene") -> None:
+        self.width = int(width)
+        self.height = int(height)
+        self.scene_id = scene_id
+        self.image_path: str | None = None
+        self.annotator = "qgis"
+        self.preset = "sedan"
+        self.axes: dict[str, list[float]] = {}
+        self.lines: dict[str, list[list[float]]] = {"length": [], "width": [], "height": []}
+        self.corners: list[list[float]] = []
+        self.streets: list[str] = []
+        self.lat: float | None = None
+        self.lon: float | None = None
+        self.radius_m = 150.0
+        self.step = STEP_KEYS[0]
+        self.pending: list[float] | None = None
+
+    # --- editing -------------------------------------------------------------------------
+    def set_step(self, key: str) -> None:
+        """Make ``key`` the current step (drops a half-drawn line)."""
+        if key not in STEP_KEYS:
+            raise ValueError(f"unknown step {key!r}")
+        self.step = key
+        self.pending = None
+
+    def click(self, x: float, y: float) -> str:
+        """Record a click at pixel ``(x, y)`` for the current step; what happened."""
+        if not (0 <= x <= self.width and 0 <= y <= self.height):
+            return "outside the image"
+        kind = {k: t for k, _l, t in STEPS}[self.step]
+        if kind == "point":
+            self.axes[self.step] = [_r(x), _r(y)]
+            done = self.step
+            nxt = STEP_KEYS.index(self.step) + 1
+            self.set_step(STEP_KEYS[nxt])
+            return f"{done} set"
+        if kind == "line":
+            if self.pending is None:
+                self.pending = [_r(x), _r(y)]
+                return "line started"
+            seg = [*self.pending, _r(x), _r(y)]
+            self.pending = None
+            self.lines[self.step.split("_", 1)[1]].append(seg)
+            return "line added"
+        self.corners.append([_r(x), _r(y)])
+        return f"corner {len(self.corners) - 1} added"
+
+    def undo(self) -> None:
+        """Remove the last thing added in the current step."""
+        if self.pending is not None:
+            self.pending = None
+        elif self.step.startswith("lines_"):
+            lst = self.lines[self.step.split("_", 1)[1]]
+            if lst:
+                lst.pop()
+        elif self.step == "corners":
+            if self.corners:
+                self.corners.pop()
+        else:
+            idx = STEP_KEYS.index(self.step)
+            prev = STEP_KEYS[max(idx - 1, 0)]
+            self.axes.pop(prev, None)
+            self.set_step(prev)
+
+    def set_location(self, *, lat: float, lon: float) -> None:
+        """The intersection's position picked on the map (degrees WGS 84)."""
+        self.lat = round(float(lat), 7)
+        self.lon = round(float(lon), 7)
+
+    # --- checks and output ---------------------------------------------------------------
+    def problems(self) -> list[str]:
+        """What is still missing before the scene can be located (empty: ready)."""
+        out = []
+        if not self.width or not self.height:
+            out.append("open a snapshot first")
+        missing = [a for a in AXES if a not in self.axes]
+        if missing:
+            out.append("click the car's " + ", ".join(missing))
+        for axis in ("length", "width"):
+            if len(self.lines[axis]) < 1:
+                out.append(f"draw at least one more line parallel to the {axis}")
+        if self.corners and (self.lat is None and not self.streets):
+            out.append("pick the intersection on the map (or name its streets)")
+        if not self.corners and self.lat is None:
+            out.append("mark the intersection's corners and pick it on the map")
+        return out
+
+    def to_scene(self) -> dict[str, Any]:
+        """The ``camloc-scene/1`` dict of this annotation."""
+        scene: dict[str, Any] = {
+            "format": SCENE_FORMAT,
+            "id": self.scene_id,
+            "image": {"width": self.width, "height": self.height},
+            "object": {"preset": self.preset},
+        }
+        if self.image_path:
+            scene["image"]["path"] = self.image_path
+        if all(a in self.axes for a in AXES):
+            scene["annotations"] = [
+                {
+                    "annotator": self.annotator,
+                    "axes": {a: list(self.axes[a]) for a in AXES},
+                    "vp_lines": {k: [list(s) for s in v] for k, v in self.lines.items() if v},
+                }
+            ]
+        if self.corners:
+            inter: dict[str, Any] = {"corners": [list(c) for c in self.corners]}
+            if self.lat is not None and self.lon is not None:
+                inter["lat"] = self.lat
+                inter["lon"] = self.lon
+            if self.streets:
+                inter["streets"] = list(self.streets)
+            scene["intersection"] = inter
+        if self.lat is not None and self.lon is not None:
+            scene["prior"] = {"lat": self.lat, "lon": self.lon, "radius_m": self.radius_m}
+        return scene

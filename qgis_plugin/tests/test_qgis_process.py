@@ -1,0 +1,118 @@
+"""How a user's QGIS sees the plugin: the built zip in a fresh profile, run by qgis_process."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+
+import pytest
+from conftest import PLUGIN_ROOT, SAMPLE_OSM, SAMPLE_SCENE, metres_between, truth
+
+QGIS_PROCESS = shutil.which("qgis_process.bin") or "/usr/bin/qgis_process.bin"
+
+
+@pytest.fixture(scope="module")
+def profile_home(tmp_path_factory):
+    """HOME with a default profile that has the built camloc.zip installed and enabled."""
+    home = tmp_path_factory.mktemp("home")
+    dist = tmp_path_factory.mktemp("dist")
+    r = subprocess.run(
+        [sys.executable, str(PLUGIN_ROOT / "build_zip.py"), "-o", str(dist)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    archive = r.stdout.strip()
+    assert archive.endswith("camloc.zip")
+    with zipfile.ZipFile(archive) as zf:
+        names = zf.namelist()
+        assert "camloc/metadata.txt" in names
+        assert "camloc/icon.png" in names
+        assert not [n for n in names if "__pycache__" in n or "/tests/" in n]
+        profile = home / ".local/share/QGIS/QGIS3/profiles/default"
+        zf.extractall(profile / "python" / "plugins")
+    (profile / "QGIS").mkdir(parents=True)
+    (profile / "QGIS" / "QGIS3.ini").write_text("[PythonPlugins]\ncamloc=true\n")
+    return home
+
+
+def _env(home) -> dict[str, str]:
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if not k.startswith(("QGIS_", "PYTHON")) and k != "QT_QPA_PLATFORM"
+    }
+    env.update(HOME=str(home), QT_QPA_PLATFORM="offscreen", CAMLOC_PYTHON=sys.executable)
+    return env
+
+
+def test_qgis_process_lists_the_camloc_algorithms(profile_home):
+    r = subprocess.run(
+        [QGIS_PROCESS, "list"], capture_output=True, text=True, env=_env(profile_home), timeout=300
+    )
+    assert r.returncode == 0, r.stderr
+    for alg in ("camloc:locate", "camloc:corners", "camloc:geocodelist"):
+        assert alg in r.stdout
+
+
+def test_qgis_process_runs_locate_on_the_sample(profile_home, tmp_path):
+    out = tmp_path / "candidates.gpkg"
+    r = subprocess.run(
+        [
+            QGIS_PROCESS,
+            "run",
+            "camloc:locate",
+            f"--SCENE={SAMPLE_SCENE}",
+            f"--OSM={SAMPLE_OSM}",
+            f"--CANDIDATES={out}",
+            f"--VIEW_CONES={tmp_path / 'cones.gpkg'}",
+        ],
+        capture_output=True,
+        text=True,
+        env=_env(profile_home),
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "N_CANDIDATES:\t12" in r.stdout
+    from osgeo import ogr
+
+    ds = ogr.Open(str(out))
+    layer = ds.GetLayer(0)
+    assert layer.GetFeatureCount() == 12
+    defn = layer.GetLayerDefn()
+    types = {
+        defn.GetFieldDefn(i).GetName(): defn.GetFieldDefn(i).GetTypeName()
+        for i in range(defn.GetFieldCount())
+    }
+    assert types["rank"] == "Integer"
+    assert types["score"] == "Real"
+    t = truth()
+    best = min(
+        metres_between(f.GetGeometryRef().GetY(), f.GetGeometryRef().GetX(), t["lat"], t["lon"])
+        for f in layer
+    )
+    assert best < 5.0
+
+
+def test_qgis_process_reports_a_bad_scene_as_an_error(profile_home, tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "camloc-scene/9"}')
+    r = subprocess.run(
+        [
+            QGIS_PROCESS,
+            "run",
+            "camloc:locate",
+            f"--SCENE={bad}",
+            f"--OSM={SAMPLE_OSM}",
+            f"--CANDIDATES={tmp_path / 'c.gpkg'}",
+        ],
+        capture_output=True,
+        text=True,
+        env=_env(profile_home),
+        timeout=300,
+    )
+    assert r.returncode != 0
+    assert "unknown format version" in r.stdout + r.stderr

@@ -1,0 +1,389 @@
+"""camloc batch: lists, statuses, GeoPackage layers, local vs Dask, kill -9 and resume."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pyogrio
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+import _geocode_double
+
+from camloc_geo.batch import (
+    CameraRow,
+    geocode_camera,
+    journal_path,
+    read_camera_list,
+    run_batch,
+)
+from camloc_geo.batch._synthetic import BAD_ROWS, make_camera_list
+from camloc_geo.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+BALTIMORE = REPO / "sample_maps" / "baltimore.osm.pbf"
+HELSINKI = REPO / "data" / "osm" / "helsinki.osm.pbf"
+DOUBLE = _geocode_double.install_if_missing()
+LAYERS = ("cameras", "candidates", "view_cones", "errors")
+
+
+@pytest.fixture(scope="module")
+def world(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """A folder with two extracts and a list of 24 synthetic cameras plus bad rows."""
+    base = tmp_path_factory.mktemp("batch")
+    osm = base / "osm"
+    osm.mkdir()
+    (osm / "baltimore.osm.pbf").symlink_to(BALTIMORE)
+    (osm / "helsinki.osm.pbf").symlink_to(HELSINKI)
+    lst = make_camera_list(
+        base / "list",
+        [osm / "baltimore.osm.pbf", osm / "helsinki.osm.pbf"],
+        24,
+        seed=3,
+        scene_fraction=0.4,
+        point_fraction=0.75,
+        bad_rows=BAD_ROWS,
+    )
+    return {"base": base, "osm": osm, "list": lst}
+
+
+def _layers(gpkg: Path) -> dict[str, pd.DataFrame]:
+    out = {}
+    for name in LAYERS:
+        df = pyogrio.read_dataframe(gpkg, layer=name)
+        if "geometry" in df:
+            wkb = [None if g is None else g.wkb_hex for g in df.geometry]
+            df = pd.DataFrame(df.drop(columns="geometry")).assign(wkb=wkb)
+        out[name] = df.reset_index(drop=True)
+    return out
+
+
+def _truth(list_path: Path) -> pd.DataFrame:
+    return pd.read_csv(list_path, dtype={"id": str})
+
+
+@pytest.fixture(scope="module")
+def local_run(world: dict[str, Path]) -> dict[str, Any]:
+    """The local default (two processes) over the world's list."""
+    out = world["base"] / "local" / "out.gpkg"
+    env = os.environ.get("CAMLOC_BATCH_START_METHOD")
+    if DOUBLE:  # the stand-in geocoder lives in this process only: children must fork
+        os.environ["CAMLOC_BATCH_START_METHOD"] = "fork"
+    try:
+        summary = run_batch(
+            world["list"],
+            out_gpkg=out,
+            map_source=world["osm"],
+            summary_map=world["base"] / "local" / "summary.html",
+            progress=False,
+            workers=2,
+            chunk_size=4,
+        )
+    finally:
+        if env is None:
+            os.environ.pop("CAMLOC_BATCH_START_METHOD", None)
+        else:
+            os.environ["CAMLOC_BATCH_START_METHOD"] = env
+    return {"summary": summary, "layers": _layers(out), "out": out}
+
+
+def test_every_row_once_with_status(world: dict[str, Path], local_run: dict[str, Any]) -> None:
+    cams = local_run["layers"]["cameras"]
+    truth = _truth(world["list"])
+    assert local_run["summary"].total == len(truth) == 29
+    assert cams["row"].tolist() == list(range(1, 30))
+    assert cams["id"].tolist() == truth["id"].tolist()
+    assert cams["status"].notna().all()
+    by_id = cams.set_index("id")
+    assert by_id.loc["bad_unknown_streets", "status"] == "not_found"
+    assert "Nowhere Lane" in by_id.loc["bad_unknown_streets", "reason"]
+    assert by_id.loc["bad_missing_scene", "status"] == "scene_error"
+    assert "not found" in by_id.loc["bad_missing_scene", "reason"]
+    assert by_id.loc["bad_far_point", "status"] == "no_map"
+    assert "outside every extract" in by_id.loc["bad_far_point", "reason"]
+    assert by_id.loc["bad_empty_title", "status"] == "no_evidence"
+    # a bad lat is reported, and the title still places the camera
+    assert by_id.loc["bad_bad_lat", "status"] == "title_only"
+    assert "lat 'north-ish' is not a number" in by_id.loc["bad_bad_lat", "reason"]
+    errors = local_run["layers"]["errors"]
+    assert {"bad_unknown_streets", "bad_missing_scene", "bad_far_point"} <= set(errors["id"])
+    # lat/lon columns equal the point geometry
+    placed = cams[cams["status"].isin(["located", "title_only"])]
+    assert len(placed) >= 20
+    assert placed["lat"].notna().all()
+    assert local_run["summary"].statuses["title_only"] >= 10
+
+
+def test_positions_against_truth(world: dict[str, Path], local_run: dict[str, Any]) -> None:
+    cams = local_run["layers"]["cameras"].merge(
+        _truth(world["list"])[["id", "true_lat", "true_lon", "scene"]], on="id"
+    )
+    good = cams[cams["id"].str.startswith("cam")]
+    err = np.hypot(
+        (good["lat"] - good["true_lat"]) * 111_320.0,
+        (good["lon"] - good["true_lon"]) * 111_320.0 * np.cos(np.radians(good["true_lat"])),
+    )
+    title = good["status"] == "title_only"
+    no_scene = good["scene"].isna()
+    # a title-only camera without scene is placed on the junction it watches, within its
+    # size (two streets may meet twice, 25 m apart: then the one nearer the list's point)
+    on_junction = err[title & no_scene] < 30.0
+    assert on_junction.mean() >= 0.9
+    assert (err[title & no_scene] < 60.0).all()
+    located = good["status"] == "located"
+    assert located.sum() >= 4
+    assert float(np.median(err[located])) < 10.0
+    assert (good.loc[title, "uncertainty_m"] > 0).all()
+    # compass words of the title are read
+    compass = good[good["view_text"].notna()]
+    assert len(compass) >= 1
+    assert compass["view_bearing_deg"].notna().all()
+
+
+def test_layers_and_summary_map(world: dict[str, Path], local_run: dict[str, Any]) -> None:
+    layers = local_run["layers"]
+    info = {row[0]: row[1] for row in pyogrio.list_layers(local_run["out"])}
+    assert info == {
+        "cameras": "Point",
+        "candidates": "Point",
+        "view_cones": "Polygon",
+        "errors": None,
+    }
+    cands = layers["candidates"]
+    assert set(cands["row"]) <= set(layers["cameras"]["row"])
+    assert (cands.groupby("row")["rank"].min() == 1).all()
+    assert {"locate", "title"} <= set(cands["source"])
+    assert len(layers["view_cones"]) >= 4
+    page = (world["base"] / "local" / "summary.html").read_text(encoding="utf-8")
+    assert "markerClusterGroup" in page
+    assert "maxZoom: 22" in page  # the cluster plug-in fails on a map without maxZoom
+    assert 'src="http' not in page
+    assert "camera(s) located" in page
+
+
+def test_local_and_dask_give_identical_geopackages(
+    world: dict[str, Path], local_run: dict[str, Any]
+) -> None:
+    from distributed import Client, LocalCluster
+
+    out = world["base"] / "dask" / "out.gpkg"
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as lc,
+        Client(lc) as client,
+    ):
+        summary = run_batch(
+            world["list"],
+            out_gpkg=out,
+            map_source=world["osm"],
+            scheduler=client,
+            progress=False,
+            chunk_size=3,
+        )
+    assert summary.computed == summary.total == 29
+    dask_layers = _layers(out)
+    for name in LAYERS:
+        pd.testing.assert_frame_equal(
+            dask_layers[name], local_run["layers"][name], check_exact=True
+        )
+
+
+def test_kill9_halfway_then_rerun_finishes_each_camera_once(
+    world: dict[str, Path], local_run: dict[str, Any]
+) -> None:
+    out = world["base"] / "killed" / "out.gpkg"
+    out.parent.mkdir()
+    runner = world["base"] / "runner.py"
+    runner.write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+        "import _geocode_double\n"
+        "_geocode_double.install_if_missing()\n"
+        "from camloc_geo.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n",
+        encoding="utf-8",
+    )
+    cmd = [
+        sys.executable,
+        str(runner),
+        "batch",
+        str(world["list"]),
+        "-o",
+        str(out),
+        "--osm",
+        str(world["osm"]),
+        "--workers",
+        "1",
+        "--chunk-size",
+        "1",
+        "--no-progress",
+    ]
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    proc = subprocess.Popen(
+        cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
+    journal = journal_path(out)
+    n_done = 0
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if journal.exists():
+            try:
+                with sqlite3.connect(journal, timeout=1) as db:
+                    n_done = db.execute("SELECT COUNT(*) FROM done").fetchone()[0]
+            except sqlite3.OperationalError:
+                n_done = 0
+            if n_done >= 3:
+                break
+        time.sleep(0.01)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert proc.returncode == -signal.SIGKILL
+    with sqlite3.connect(journal) as db:
+        n_killed = db.execute("SELECT COUNT(*) FROM done").fetchone()[0]
+    assert 3 <= n_killed < 29
+    assert not out.exists()
+    summary = run_batch(
+        world["list"], out_gpkg=out, map_source=world["osm"], progress=False, workers=1
+    )
+    assert summary.skipped == n_killed
+    assert summary.computed == 29 - n_killed
+    layers = _layers(out)
+    assert layers["cameras"]["row"].tolist() == list(range(1, 30))
+    for name in LAYERS:
+        pd.testing.assert_frame_equal(layers[name], local_run["layers"][name], check_exact=True)
+    # a third run computes nothing
+    again = run_batch(
+        world["list"], out_gpkg=out, map_source=world["osm"], progress=False, workers=1
+    )
+    assert (again.computed, again.skipped) == (0, 29)
+
+
+def test_read_camera_list_variants(tmp_path: Path) -> None:
+    p = tmp_path / "cams.csv"
+    p.write_text(
+        "Camera_ID;Name;Latitude;Lng;Accuracy;street1;street2;scene_file;Direction\n"
+        "7;Main St & 5th Ave looking north;39.28;-76.59;80;Main St;5th Ave;s/7.json;NB\n"
+        "8;Side St;abc;-76.5;;;;;\n",
+        encoding="utf-8",
+    )
+    rows = list(read_camera_list(p))
+    assert rows[0] == CameraRow(
+        row=1,
+        id="7",
+        title="Main St & 5th Ave looking north",
+        lat=39.28,
+        lon=-76.59,
+        radius_m=80.0,
+        streets=("Main St", "5th Ave"),
+        scene=str(tmp_path / "s" / "7.json"),
+        view="NB",
+    )
+    assert rows[1].lat is None
+    assert rows[1].problems == ("lat 'abc' is not a number", "give both lat and lon, or neither")
+    only = tmp_path / "only.csv"
+    only.write_text("id,title\na,Eastern Ave & S Broadway\n", encoding="utf-8")
+    assert [(r.id, r.title, r.has_point) for r in read_camera_list(only)] == [
+        ("a", "Eastern Ave & S Broadway", False)
+    ]
+    no_title = tmp_path / "no_title.csv"
+    no_title.write_text("id,lat,lon\nx,39.28,-76.59\n", encoding="utf-8")
+    (row,) = read_camera_list(no_title)
+    assert row.problems
+    assert "no title column" in row.problems[0]
+
+
+def test_geojson_list_streamed(tmp_path: Path) -> None:
+    feats = [
+        {
+            "type": "Feature",
+            "id": f"f{i}",
+            "geometry": {"type": "Point", "coordinates": [-76.59 + i * 1e-5, 39.28]},
+            "properties": {"title": f"A St & B Ave {'x' * (i % 50)}", "radius": 40 + i},
+        }
+        for i in range(3000)
+    ]
+    p = tmp_path / "cams.geojson"
+    p.write_text(
+        json.dumps({"type": "FeatureCollection", "name": "c", "features": feats}),
+        encoding="utf-8",
+    )
+    rows = list(read_camera_list(p))
+    assert len(rows) == 3000
+    assert rows[2999].id == "f2999"
+    assert rows[2999].lon == pytest.approx(-76.59 + 2999e-5)
+    assert rows[1234].radius_m == 1274.0
+    seq = tmp_path / "cams.geojsonl"
+    seq.write_text("\n".join(json.dumps(f) for f in feats[:3]) + "\n", encoding="utf-8")
+    assert [r.id for r in read_camera_list(seq)] == ["f0", "f1", "f2"]
+
+
+def test_geocode_camera_never_raises(world: dict[str, Path]) -> None:
+    from camloc_geo.batch._areas import area_map
+
+    m = area_map(("file", str((world["osm"] / "helsinki.osm.pbf").absolute())))
+    for title in ("", "x" * 10_000, "&&&///", "\x00\x01\x02", "Unioninkatu & Kaisaniemenkatu"):
+        res = geocode_camera(CameraRow(row=1, id="t", title=title), map_data=m)
+        assert res.status in {"title_only", "not_found", "street_only", "no_evidence"}
+        assert res.status == "title_only" or res.reason
+    res = geocode_camera(
+        CameraRow(row=2, id="s", title="", scene=str(world["base"] / "nope.json")), map_data=m
+    )
+    assert res.status == "scene_error"
+    assert "nope.json" in (res.reason or "")
+
+
+def test_title_in_two_extracts_is_ambiguous(tmp_path: Path) -> None:
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "baltimore_a.osm.pbf").symlink_to(BALTIMORE)
+    (osm / "baltimore_b.osm.pbf").symlink_to(REPO / "data" / "osm" / "baltimore.osm.pbf")
+    (osm / "helsinki.osm.pbf").symlink_to(HELSINKI)
+    lst = tmp_path / "l.csv"
+    with open(lst, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["id", "title", "area"])
+        w.writerow(["1", "Eastern Avenue & South Broadway", ""])
+        w.writerow(["2", "Eastern Avenue & South Broadway", "baltimore_b"])
+        w.writerow(["3", "Unioninkatu & Kaisaniemenkatu", ""])
+    summary = run_batch(
+        lst, out_gpkg=tmp_path / "o.gpkg", map_source=osm, progress=False, workers=1
+    )
+    cams = pyogrio.read_dataframe(tmp_path / "o.gpkg", layer="cameras").set_index("id")
+    assert cams.loc["1", "status"] == "ambiguous"
+    assert bool(cams.loc["1", "tie"])
+    assert "baltimore_a.osm.pbf" in cams.loc["1", "reason"]
+    assert "baltimore_b.osm.pbf" in cams.loc["1", "reason"]
+    assert cams.loc["2", "status"] == "title_only"
+    assert cams.loc["2", "extract"] == "baltimore_b.osm.pbf"
+    assert cams.loc["3", "status"] == "title_only"
+    assert math.isclose(cams.loc["3", "lat"], cams.loc["3", "geometry"].y)
+    assert math.isclose(cams.loc["3", "lon"], cams.loc["3", "geometry"].x)
+    assert summary.statuses == {"ambiguous": 1, "title_only": 2}
+
+
+def test_cli_batch_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["batch", str(tmp_path / "missing.csv"), "-o", str(tmp_path / "o.gpkg")]) == 2
+    assert "camera list not found" in capsys.readouterr().err
+    lst = tmp_path / "l.csv"
+    lst.write_text("id,title\n1,A & B\n", encoding="utf-8")
+    code = main(["batch", str(lst), "-o", str(tmp_path / "o.gpkg"), "--osm", str(tmp_path / "x")])
+    assert code == 2
+    assert "not found" in capsys.readouterr().err
+    # no map at all: every row gets a status, the run succeeds
+    assert main(["batch", str(lst), "-o", str(tmp_path / "o.gpkg"), "--workers", "1"]) == 0
+    cams = pyogrio.read_dataframe(tmp_path / "o.gpkg", layer="cameras")
+    assert cams["status"].tolist() == ["no_map"]
+    assert "give --osm" in capsys.readouterr().err or True

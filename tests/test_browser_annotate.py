@@ -1,0 +1,449 @@
+"""The annotation page in a real browser: headless Debian Chromium driven by Playwright.
+
+A synthetic snapshot of a known camera at a Baltimore junction is clicked the way a person
+would (the exact pixels of the synthetic scene), saved, and fed to ``camloc calibrate`` and
+``camloc locate``. Every request leaving ``file:``/``data:`` is aborted and counted.
+Screenshots of each step go to ``tests/artifacts/annotate/`` for a person to look at.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from annotate_synthetic import BALTIMORE, located_case, render_snapshot
+
+from camloc_geo.cli import main
+from camloc_geo.geodesy import distance_m
+from camloc_geo.scene import parse_scene
+from camloc_geo.synthetic import NoiseModel, make_scene, random_camera
+from camloc_geo.vanishing import estimate_intrinsics, fit_vanishing_point
+
+CHROMIUM = Path("/usr/bin/chromium")
+ARTIFACTS = Path(__file__).parent / "artifacts" / "annotate"
+LAUNCH_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
+]
+
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(not CHROMIUM.exists(), reason="Debian chromium is not installed"),
+]
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=str(CHROMIUM), args=LAUNCH_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """The snapshot, its truth scene and pages made with the command line."""
+    out = tmp_path_factory.mktemp("annotate")
+    ls = located_case()
+    snap = out / "snapshot.jpg"
+    snap.write_bytes(render_snapshot(ls))
+    truth = dict(ls.scene)
+    truth["image"] = {**truth["image"], "path": "snapshot.jpg"}
+    truth_path = out / "truth.json"
+    truth_path.write_text(json.dumps(truth, indent=1))
+    prior = ls.scene["prior"]
+    page = out / "page.html"
+    args = ["annotate", str(snap), "-o", str(page), "--osm", str(BALTIMORE)]
+    args += ["--lat", str(prior["lat"]), "--lon", str(prior["lon"])]
+    assert main(args) == 0
+    review = out / "review.html"
+    assert main(["annotate", str(snap), "-o", str(review), "--scene", str(truth_path)]) == 0
+    return {
+        "dir": out,
+        "ls": ls,
+        "snap": snap,
+        "truth": truth,
+        "truth_path": truth_path,
+        "page": page,
+        "review": review,
+    }
+
+
+class Tab:
+    """A page with every request leaving ``file:``/``data:`` aborted and recorded."""
+
+    def __init__(self, browser: Any, tmp: Path) -> None:
+        self.context = browser.new_context(
+            viewport={"width": 1400, "height": 900}, accept_downloads=True
+        )
+        self.page = self.context.new_page()
+        self.requests: list[str] = []
+        self.errors: list[str] = []
+        self.tmp = tmp
+        self.page.route("**/*", self._route)
+        self.page.on("pageerror", lambda exc: self.errors.append(f"pageerror: {exc}"))
+        self.page.on(
+            "console",
+            lambda m: self.errors.append(f"console: {m.text}") if m.type == "error" else None,
+        )
+
+    def _route(self, route: Any) -> None:
+        url = route.request.url
+        if url.startswith("data:"):
+            route.continue_()
+            return
+        self.requests.append(url)
+        if url.startswith("file:"):
+            route.continue_()
+        else:
+            route.abort()
+
+    def open(self, path: Path) -> float:
+        t0 = time.perf_counter()
+        self.page.goto(path.resolve().as_uri(), wait_until="load")
+        self.page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        return time.perf_counter() - t0
+
+    def screen(self, x: float, y: float) -> tuple[float, float]:
+        sx, sy = self.page.evaluate(f"camloc.screenFromImage({float(x)!r}, {float(y)!r})")
+        return float(sx), float(sy)
+
+    def click_image(self, x: float, y: float) -> None:
+        self.page.mouse.click(*self.screen(x, y))
+
+    def wait_js(self, expression: str, timeout_s: float = 5.0) -> None:
+        """Poll a JS expression until it is true (wait_for_function evaluates strings, which
+        the page's Content Security Policy forbids)."""
+        deadline = time.monotonic() + timeout_s
+        while not self.page.evaluate(expression):
+            assert time.monotonic() < deadline, f"timed out waiting for {expression}"
+            self.page.wait_for_timeout(50)
+
+    def state(self) -> dict[str, Any]:
+        return dict(self.page.evaluate("camloc.state()"))
+
+    def shot(self, name: str) -> None:
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        self.page.screenshot(path=str(ARTIFACTS / f"{name}.png"))
+
+    def save(self) -> dict[str, Any]:
+        with self.page.expect_download() as info:
+            self.page.click("#btn-save")
+        path = self.tmp / info.value.suggested_filename
+        info.value.save_as(path)
+        self.saved = path
+        return dict(json.loads(path.read_text()))
+
+    def page_requests(self) -> list[str]:
+        """Requests other than the page file itself."""
+        return [u for u in self.requests if not u.endswith(".html")]
+
+    def close(self) -> None:
+        self.context.close()
+
+
+@pytest.fixture
+def tab(browser: Any, tmp_path: Path) -> Iterator[Tab]:
+    t = Tab(browser, tmp_path)
+    yield t
+    assert t.errors == []
+    assert t.page_requests() == [], "a request left the page"
+    t.close()
+
+
+def zoom_on(tab: Tab, x: float, y: float, clicks: int = 3) -> None:
+    tab.page.mouse.move(*tab.screen(x, y))
+    for _ in range(clicks):
+        tab.page.mouse.wheel(0, -300)
+    tab.page.wait_for_timeout(50)
+
+
+def test_click_through_save_calibrate_locate(
+    tab: Tab, files: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    ls, truth = files["ls"], files["truth"]
+    ann = truth["annotations"][0]
+    seconds = tab.open(files["page"])
+    (ARTIFACTS).mkdir(parents=True, exist_ok=True)
+    (ARTIFACTS / "open_seconds.txt").write_text(f"{seconds:.3f}\n")
+    page = tab.page
+    assert page.locator("#map .corner-label").count() >= 2
+    tab.shot("01_start")
+    # Step 1: the car, zoomed in on it.
+    box = np.array([ann["axes"][k] for k in ("origin", "length", "width", "height")])
+    zoom_on(tab, *box.mean(axis=0))
+    for k in ("origin", "length", "width", "height"):
+        tab.click_image(*ann["axes"][k])
+    assert page.evaluate("camloc.step()") == 1  # moved on by itself
+    tab.shot("02_car")
+    page.click("#btn-fit")
+    # Steps 2-4: lines along each axis.
+    for i, axis in enumerate(("length", "width", "height")):
+        assert page.evaluate("camloc.step()") == i + 1
+        for seg in ann["vp_lines"][axis]:
+            tab.click_image(seg[0], seg[1])
+            tab.click_image(seg[2], seg[3])
+        tab.shot(f"0{3 + i}_{axis}_lines")
+        page.click("#btn-next")
+    checks = page.inner_text("#checks-body")
+    assert "Focal length" in checks
+    assert "Wrong corner" not in checks
+    # Step 5: kerb corners, clockwise.
+    assert page.evaluate("camloc.step()") == 4
+    for c in truth["intersection"]["corners"]:
+        tab.click_image(*c)
+    tab.shot("06_corners")
+    page.click("#btn-next")
+    tab.shot("07_known_places")
+    page.click("#btn-next")
+    page.fill("#annotator", "tester")
+    tab.shot("08_save")
+    scene = tab.save()
+    tab.shot("09_saved")
+    parse_scene(scene)
+    assert scene["annotations"][0]["annotator"] == "tester"
+    got = scene["annotations"][0]
+    for k in ("origin", "length", "width", "height"):
+        assert np.allclose(got["axes"][k], ann["axes"][k], atol=0.01)
+    for axis in ("length", "width", "height"):
+        assert np.allclose(got["vp_lines"][axis], ann["vp_lines"][axis], atol=0.01)
+    assert np.allclose(
+        scene["intersection"]["corners"], truth["intersection"]["corners"], atol=0.01
+    )
+    assert scene["intersection"]["lat"] == pytest.approx(truth["intersection"]["lat"], abs=1e-7)
+    assert scene["prior"]["lat"] == pytest.approx(truth["prior"]["lat"])
+    # The live check agrees with the Python core on this scene.
+    intr = page.evaluate("camloc.analysis().intrinsics")
+    assert intr["focal"] == pytest.approx(ls.camera_world.focal_px, rel=1e-3)
+
+    assert main(["calibrate", str(tab.saved)]) == 0
+    cal = json.loads(capsys.readouterr().out)
+    assert np.allclose(cal["camera_in_world"], ls.camera_world.center_in_world, atol=0.02)
+    assert cal["focal_px"] == pytest.approx(ls.camera_world.focal_px, rel=1e-3)
+    assert main(["locate", str(tab.saved), "--osm", str(BALTIMORE), "--offline"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    cands = [f for f in doc["features"] if f["properties"]["kind"] == "candidate"]
+    errs = [distance_m(*f["geometry"]["coordinates"], ls.lon, ls.lat) for f in cands]
+    assert min(errs) < 0.1
+
+
+def test_undo_redo_move_and_delete(tab: Tab, files: dict[str, Any]) -> None:
+    tab.open(files["page"])
+    page = tab.page
+    tab.click_image(500.25, 600.5)
+    tab.click_image(900.75, 610.25)
+    assert tab.state()["axes"]["length"] == pytest.approx([900.75, 610.25], abs=1e-3)
+    page.keyboard.press("Control+z")
+    assert tab.state()["axes"]["length"] is None
+    page.keyboard.press("Control+y")
+    assert tab.state()["axes"]["length"] == pytest.approx([900.75, 610.25], abs=1e-3)
+    page.click("#btn-undo")
+    assert tab.state()["axes"]["length"] is None
+    page.click("#btn-redo")
+    # Move the origin by dragging it.
+    page.mouse.move(*tab.screen(500.25, 600.5))
+    page.mouse.down()
+    page.mouse.move(*tab.screen(530, 640), steps=5)
+    page.mouse.up()
+    assert tab.state()["axes"]["origin"] == pytest.approx([530, 640], abs=1e-3)
+    tab.shot("10_moved_point")
+    page.keyboard.press("Control+z")
+    assert tab.state()["axes"]["origin"] == pytest.approx([500.25, 600.5], abs=1e-3)
+    # Delete the length end: point at it, press Delete.
+    page.mouse.move(*tab.screen(900.75, 610.25))
+    page.keyboard.press("Delete")
+    assert tab.state()["axes"]["length"] is None
+    assert "Next click (2 of 4)" in page.inner_text("#step-missing")
+    # Dragging the photo pans, it places nothing.
+    page.mouse.move(*tab.screen(1200, 300))
+    page.mouse.down()
+    page.mouse.move(*tab.screen(1100, 350), steps=5)
+    page.mouse.up()
+    assert tab.state()["axes"]["length"] is None
+    # A line: two clicks; Esc drops a half-drawn one.
+    page.keyboard.press("2")
+    tab.click_image(100, 800)
+    page.keyboard.press("Escape")
+    tab.click_image(100, 800)
+    tab.click_image(400, 700)
+    assert tab.state()["lines"]["length"] == [pytest.approx([100, 800, 400, 700], abs=1e-3)]
+
+
+def test_existing_scene_saves_unchanged(tab: Tab, files: dict[str, Any]) -> None:
+    tab.open(files["review"])
+    assert tab.page.evaluate("camloc.step()") == 6  # everything there: straight to saving
+    tab.shot("11_review_scene")
+    assert tab.save() == files["truth"]
+    # The same through "Open scene..." on a fresh page.
+    tab.open(files["page"])
+    tab.page.set_input_files("#scene-file", str(files["truth_path"]))
+    tab.wait_js("camloc.state().axes.origin !== null")
+    assert tab.save() == files["truth"]
+
+
+def test_bad_scene_files_say_what_is_wrong(tab: Tab, files: dict[str, Any]) -> None:
+    tab.open(files["page"])
+    other = dict(files["truth"])
+    other["image"] = {"width": 640, "height": 480}
+    bad_size = files["dir"] / "other_size.json"
+    bad_size.write_text(json.dumps(other))
+    tab.page.set_input_files("#scene-file", str(bad_size))
+    banner = tab.page.locator("#banner")
+    banner.wait_for(state="visible")
+    assert "is for a 640x480 image" in banner.inner_text()
+    assert "1920x1080" in banner.inner_text()
+    tab.shot("12_bad_scene")
+    broken = files["dir"] / "broken.json"
+    broken.write_text("{not json")
+    tab.page.set_input_files("#scene-file", str(broken))
+    tab.wait_js("document.getElementById('banner').textContent.includes('JSON')")
+    wrong = dict(files["truth"])
+    wrong["format"] = "camloc-scene/0"
+    bad_format = files["dir"] / "bad_format.json"
+    bad_format.write_text(json.dumps(wrong))
+    tab.page.set_input_files("#scene-file", str(bad_format))
+    tab.wait_js("document.getElementById('banner').textContent.includes('format')")
+    assert tab.state()["axes"]["origin"] is None  # nothing loaded
+
+
+def test_wrong_corner_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> None:
+    ls = files["ls"]
+    scene = json.loads(json.dumps(files["truth"]))
+    size = scene["object"]
+    L, W, H = size["length_m"], size["width_m"], size["height_m"]
+    cam = ls.camera_world
+    ws = 1.0
+    wend = np.array(scene["annotations"][0]["axes"]["width"])
+    if np.linalg.norm(cam.project([0, W, 0]) - wend) > 1e-3:
+        ws = -1.0
+    # The far end of the length edge as origin, with the edges that start there.
+    pts = cam.project(np.array([[L, 0, 0], [0, 0, 0], [L, ws * W, 0], [L, 0, H]], float))
+    scene["annotations"][0]["axes"] = dict(
+        zip(("origin", "length", "width", "height"), pts.tolist(), strict=True)
+    )
+    path = tmp_path / "wrong.json"
+    path.write_text(json.dumps(scene))
+    page = tmp_path / "wrong.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(page), "--scene", str(path)]) == 0
+    tab.open(page)
+    assert "Wrong corner" in tab.page.inner_text("#checks-body")
+    tab.page.keyboard.press("1")
+    tab.shot("13_wrong_corner")
+    # The right corner clears it.
+    tab.open(files["review"])
+    assert "Wrong corner" not in tab.page.inner_text("#checks-body")
+
+
+def test_page_geometry_matches_python(tab: Tab, files: dict[str, Any]) -> None:
+    """The page's vanishing points and focal length equal camloc_geo.vanishing's."""
+    tab.open(files["page"])
+    rng = np.random.default_rng(7)
+    size = (1920, 1080)
+    diag = math.hypot(*size)
+    checked = 0
+    for _ in range(12):
+        cam = random_camera(rng, image_size=size)
+        syn = make_scene(cam, rng, noise=NoiseModel(point_px=1.0, line_px=1.5), n_annotators=1)
+        lines = syn.scene["annotations"][0]["vp_lines"]
+        if any(len(lines[k]) < 2 for k in lines):
+            continue
+        js = tab.page.evaluate(
+            """([lines, diag]) => {
+                const g = window.camlocGeometry, out = {}, hv = {};
+                for (const k of ["length", "width", "height"]) {
+                    const vp = g.fitVanishingPoint(lines[k], diag);
+                    out[k] = vp; hv[k] = vp.homogeneous;
+                }
+                out.intrinsics = g.estimateIntrinsics(hv, 1920, 1080, {});
+                return out;
+            }""",
+            [lines, diag],
+        )
+        hv = {}
+        for k in ("length", "width", "height"):
+            vp = fit_vanishing_point(lines[k], scale_px=diag)
+            h_js = np.array(js[k]["homogeneous"])
+            sign = 1.0 if float(h_js @ vp.homogeneous) >= 0 else -1.0
+            assert np.allclose(sign * h_js, vp.homogeneous, atol=1e-6), k
+            assert js[k]["finite"] == vp.finite
+            assert np.allclose(js[k]["residuals"], vp.residuals_px, atol=1e-4)
+            hv[k] = vp.homogeneous
+        est = estimate_intrinsics(hv, size)
+        assert js["intrinsics"]["method"] == est.method
+        assert js["intrinsics"]["focal"] == pytest.approx(est.focal_px, rel=1e-6)
+        assert np.allclose(js["intrinsics"]["principalPoint"], est.principal_point, atol=1e-3)
+        checked += 1
+    assert checked >= 8
+
+
+def test_crowd_mode_submits(browser: Any, files: dict[str, Any], tmp_path: Path) -> None:
+    from camloc_geo.web import annotation_page_html
+
+    page_path = tmp_path / "crowd.html"
+    page_path.write_text(
+        annotation_page_html(
+            files["snap"],
+            scene=files["truth_path"],
+            mode="crowd",
+            submit_url="https://crowd.invalid/submit",
+        )
+    )
+    tab = Tab(browser, tmp_path)
+    posted: list[dict[str, Any]] = []
+
+    def submit(route: Any) -> None:
+        posted.append(json.loads(route.request.post_data))
+        route.fulfill(status=200, body="ok")
+
+    tab.page.route("https://crowd.invalid/submit", submit)
+    try:
+        tab.open(page_path)
+        assert tab.page.inner_text("#btn-save") == "Submit"
+        tab.page.click("#btn-save")
+        tab.wait_js("document.getElementById('save-status').textContent.includes('Submitted')")
+        tab.shot("14_crowd_submitted")
+        assert posted == [files["truth"]]
+    finally:
+        tab.close()
+
+
+def test_live_warnings_for_lines(tab: Tab, files: dict[str, Any]) -> None:
+    """Lines of one axis that do not meet, and an implausible focal length, are flagged."""
+    tab.open(files["page"])
+    page = tab.page
+    page.keyboard.press("2")
+    vp = np.array([3000.0, 500.0])
+    for start in ([200.0, 900.0], [300.0, 700.0]):
+        a = np.array(start)
+        b = a + 0.4 * (vp - a)
+        tab.click_image(*a)
+        tab.click_image(*b)
+    assert "Length lines meet at (3,000, 500)" in page.inner_text("#checks-body")
+    tab.click_image(200.0, 300.0)  # a third line, far from parallel to the others
+    tab.click_image(700.0, 600.0)
+    checks = page.inner_text("#checks-body")
+    assert "do not meet in one point" in checks
+    assert "line L3" in checks
+    assert "do not meet" in page.inner_text("#alerts")
+    tab.shot("15_lines_do_not_meet")
+    page.keyboard.press("Control+z")
+    # Width lines meeting on the same side as the length lines: no real focal length.
+    page.keyboard.press("3")
+    for start in ([1000.0, 1000.0], [1400.0, 1000.0]):
+        a = np.array(start)
+        b = a + 0.3 * (np.array([2600.0, 520.0]) - a)
+        tab.click_image(*a)
+        tab.click_image(*b)
+    checks = page.inner_text("#checks-body")
+    assert "No focal length" in checks or "implausible" in checks

@@ -1,0 +1,218 @@
+"""``camloc geocode``: titles, lists, folders, bad input; the library's bad-input paths."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import tracemalloc
+from pathlib import Path
+
+import pytest
+
+from camloc_geo.cli import main
+from camloc_geo.geocode import geocode_title, geocode_title_in_maps, index_for, whole_map
+
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
+BERLIN = OSM / "berlin_alexanderplatz.osm.pbf"
+PARIS = OSM / "paris_bss.osm.pbf"
+
+
+@pytest.fixture(scope="module")
+def berlin():  # type: ignore[no-untyped-def]
+    return whole_map(BERLIN)
+
+
+def test_cli_titles_to_file(tmp_path: Path) -> None:
+    out = tmp_path / "out.geojson"
+    code = main(
+        [
+            "geocode",
+            "Karl-Liebknecht-Str. / Wadzeckstr.",
+            "Alexanderstraße",
+            "Nowhere Street & Missing Road",
+            "--osm",
+            str(BERLIN),
+            "--best",
+            "-o",
+            str(out),
+        ]
+    )
+    assert code == 0
+    features = json.loads(out.read_text())["features"]
+    statuses = [f["properties"]["status"] for f in features]
+    assert statuses == ["junction", "street", "not_found"]
+    j = features[0]
+    assert j["properties"]["names_matched"] == ["Karl-Liebknecht-Straße", "Wadzeckstraße"]
+    assert j["properties"]["match_kinds"] == ["abbreviation", "abbreviation"]
+    lon, lat = j["geometry"]["coordinates"]
+    assert abs(lat - 52.5259) < 0.0005
+    assert abs(lon - 13.4146) < 0.0005
+    assert features[1]["geometry"]["type"] in ("LineString", "MultiLineString")
+    assert features[2]["geometry"] is None
+    assert "Nowhere Street" in features[2]["properties"]["reason"]
+
+
+def test_cli_folder_ambiguous_and_near(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    folder = tmp_path / "maps"
+    folder.mkdir()
+    shutil.copy(BERLIN, folder / BERLIN.name)
+    shutil.copy(PARIS, folder / PARIS.name)
+    maps = [whole_map(p) for p in sorted(folder.iterdir())]
+    # a Paris junction is found in the Paris extract only
+    found = geocode_title_in_maps("Av. de la Republique x R. Saint-Maur", maps)
+    assert found[0].status == "junction"
+    assert Path(found[0].source).name == PARIS.name
+    # names in neither extract
+    both = geocode_title_in_maps("Street A & Street B", maps)
+    assert both[0].status == "not_found"
+    code = main(
+        ["geocode", "Grunerstr. x Alexanderstr.", "--osm", str(folder), "--near", "52.52,13.41"]
+    )
+    assert code == 0
+    features = json.loads(capsys.readouterr().out)["features"]
+    assert features[0]["properties"]["status"] == "junction"
+    assert Path(features[0]["properties"]["source"]).name == BERLIN.name
+
+
+def test_two_extracts_one_title_is_ambiguous(tmp_path: Path) -> None:
+    a = tmp_path / "a.osm.pbf"
+    b = tmp_path / "b.osm.pbf"
+    shutil.copy(BERLIN, a)
+    shutil.copy(BERLIN, b)
+    found = geocode_title_in_maps("Grunerstr. x Alexanderstr.", [whole_map(a), whole_map(b)])
+    assert [m.status for m in found] == ["ambiguous", "ambiguous"]
+    assert "placed in 2 extracts" in found[0].reason
+
+
+def test_cli_list_streams(tmp_path: Path) -> None:
+    rows = tmp_path / "list.csv"
+    rows.write_text(
+        "id,title,lat,lon\n"
+        "c1,Karl-Liebknecht-Str. / Wadzeckstr.,,\n"
+        'c2,"Grunerstr. x Alexanderstr.",52.52,13.415\n'
+        "c3,,,\n"
+        "c4,!!!,,\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out.geojson"
+    assert (
+        main(["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]) == 0
+    )
+    features = json.loads(out.read_text())["features"]
+    assert [f["properties"]["id"] for f in features] == ["c1", "c2", "c3", "c4"]
+    assert [f["properties"]["status"] for f in features] == [
+        "junction",
+        "junction",
+        "not_found",
+        "not_found",
+    ]
+
+
+def test_list_memory_does_not_grow(tmp_path: Path, berlin) -> None:  # type: ignore[no-untyped-def]
+    from camloc_geo.cli.geocode import _rows
+
+    rows = tmp_path / "big.csv"
+    with rows.open("w", encoding="utf-8") as fh:
+        fh.write("id,title\n")
+        for i in range(200_000):
+            fh.write(f"{i},{i} - Street {i} & Road {i % 97}\n")
+    index_for(berlin)
+    tracemalloc.start()
+    n = 0
+    for _row, _ident, title, _point in _rows(rows):
+        n += 1
+        if n == 1_000:
+            base = tracemalloc.get_traced_memory()[0]
+        if n % 20_000 == 0:
+            geocode_title(title, map_data=berlin)
+    peak_growth = tracemalloc.get_traced_memory()[0] - base
+    tracemalloc.stop()
+    assert n == 200_000
+    assert peak_growth < 5_000_000  # bytes: the rows are not kept
+
+
+@pytest.mark.parametrize(
+    "title",
+    ["", "   ", ";;; --- ///", "\x00\x07\x1b", "a" * 10_000, "& " * 5_000, "12345", "(north)"],
+)
+def test_bad_titles_get_a_status(berlin, title: str) -> None:  # type: ignore[no-untyped-def]
+    found = geocode_title(title, map_data=berlin)
+    assert found
+    assert found[0].status in ("not_found", "street", "landmark")
+    assert found[0].reason
+    json.dumps(found[0].to_feature(), allow_nan=False)
+
+
+def test_not_found_names_the_missing_name(berlin) -> None:  # type: ignore[no-untyped-def]
+    best = geocode_title("Karl-Liebknecht-Str. & Quxbazstraße", map_data=berlin)[0]
+    assert best.status == "not_found"
+    assert "'Quxbazstraße' is not a street name" in best.reason
+    assert best.suggestions["Quxbazstraße"]
+
+
+def test_never_meet_and_single_street(berlin) -> None:  # type: ignore[no-untyped-def]
+    best = geocode_title("Wadzeckstraße & Spandauer Straße", map_data=berlin)[0]
+    assert best.status == "not_found"
+    assert "do not meet" in best.reason
+    street = geocode_title("Karl-Liebknecht-Str.", map_data=berlin)[0]
+    assert street.status == "street"
+    assert street.lat is None
+    assert street.geometry is not None
+
+
+def test_radius_filters(berlin) -> None:  # type: ignore[no-untyped-def]
+    far = geocode_title(
+        "Grunerstr. x Alexanderstr.", map_data=berlin, near=(52.5255, 13.4060), radius_m=50.0
+    )
+    assert far[0].status == "not_found"
+    with pytest.raises(ValueError, match="radius_m"):
+        geocode_title("a & b", map_data=berlin, radius_m=-1.0)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["geocode", "--osm", "/nonexistent/x.osm.pbf", "A & B"], "not found"),
+        (["geocode", "--osm", str(BERLIN)], "give one or more titles"),
+        (["geocode", "--osm", str(BERLIN), "--near", "abc", "A & B"], "--near"),
+        (["geocode", "--osm", str(BERLIN), "--list", "/nonexistent.csv"], "cannot read the list"),
+    ],
+)
+def test_cli_bad_input_exit_2(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_cli_list_without_title_column(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rows = tmp_path / "bad.csv"
+    rows.write_text("foo,bar\n1,2\n", encoding="utf-8")
+    assert main(["geocode", "--osm", str(BERLIN), "--list", str(rows)]) == 2
+    assert "no title column" in capsys.readouterr().err
+
+
+def test_cli_subprocess(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "camloc_geo.cli",
+            "geocode",
+            "Otto-Braun-Str und Mollstr.",
+            "--osm",
+            str(BERLIN),
+            "--best",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    feature = json.loads(proc.stdout)["features"][0]
+    assert feature["properties"]["names_matched"] == ["Otto-Braun-Straße", "Mollstraße"]
