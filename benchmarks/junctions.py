@@ -368,7 +368,10 @@ def kerbs(name: str) -> dict[str, Any] | None:
         if not x.corners:
             continue
         naive_pts = _naive_corners(x, frame)
-        pts = [np.asarray(frame.enu_from_geographic(c.lon, c.lat), dtype=float) for c in x.corners]
+        pts = [
+            np.asarray(frame.enu_from_geographic(lat=c.lat, lon=c.lon), dtype=float)
+            for c in x.corners
+        ]
         d_ours = _nearest(tree, lines, pts)
         d_naive = _nearest(tree, lines, naive_pts)
         if not d_ours or max(d_ours) > KERB_EVIDENCE_M or not d_naive:

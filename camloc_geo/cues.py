@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from camloc_geo.absolute._model import Flag, FlagKind
+
 if TYPE_CHECKING:
     from camloc_geo.geodesy import LocalFrame
     from camloc_geo.osm import MapData
@@ -255,8 +257,8 @@ def apply_cues(
             frame=result.frame,
         )
         logs.append(cue.log_factor)
-        c.flags = [f for f in c.flags if not f.startswith("cue: ")] + [
-            f"cue: {n}" for n in cue.notes
+        c.flags = [f for f in c.flags if f.kind is not FlagKind.CUE] + [
+            Flag(FlagKind.CUE, f" {n}") for n in cue.notes
         ]
     w = np.array([max(c.score, 1e-300) for c in cands]) * np.exp(np.array(logs) - max(logs))
     w /= w.sum()

@@ -234,7 +234,15 @@ def test_click_through_save_calibrate_locate(
     assert main(["locate", str(tab.saved), "--osm", str(BALTIMORE), "--offline"]) == 0
     doc = json.loads(capsys.readouterr().out)
     cands = [f for f in doc["features"] if f["properties"]["kind"] == "candidate"]
-    errs = [distance_m(*f["geometry"]["coordinates"], ls.lon, ls.lat) for f in cands]
+    errs = [
+        distance_m(
+            lon1=f["geometry"]["coordinates"][0],
+            lat1=f["geometry"]["coordinates"][1],
+            lon2=ls.lon,
+            lat2=ls.lat,
+        )
+        for f in cands
+    ]
     assert min(errs) < 0.1
 
 

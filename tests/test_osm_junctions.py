@@ -25,7 +25,7 @@ def _load(name: str, lat: float, lon: float, radius_m: float = 80.0) -> MapData:
 
 def _offset_m(x: Intersection, lon: float, lat: float, bearing: float) -> float:
     """Signed distance of a point from the line through the centre with this bearing."""
-    e, n = LocalFrame(x.lat, x.lon).enu_from_geographic(lon, lat)
+    e, n = LocalFrame(lat=x.lat, lon=x.lon).enu_from_geographic(lat=lat, lon=lon)
     t = math.radians(bearing)
     return float(e * math.cos(t) - n * math.sin(t))
 
@@ -45,7 +45,8 @@ def _assert_corners_on_kerbs(x: Intersection) -> None:
         corner = min(
             (c for c in x.corners if c.streets == (a.name, b.name)),
             key=lambda c: abs(
-                (bearing_deg(x.lon, x.lat, c.lon, c.lat) - mid + 180.0) % 360.0 - 180.0
+                (bearing_deg(lat1=x.lat, lon1=x.lon, lat2=c.lat, lon2=c.lon) - mid + 180.0) % 360.0
+                - 180.0
             ),
         )
         assert abs(_offset_m(x, corner.lon, corner.lat, a.bearing_deg)) == pytest.approx(
@@ -55,7 +56,9 @@ def _assert_corners_on_kerbs(x: Intersection) -> None:
             b.width_m / 2.0, abs=0.3
         )
         if a.width_m == b.width_m:  # on the bisector, w/2 / sin(gap/2) from the centre
-            e, n = LocalFrame(x.lat, x.lon).enu_from_geographic(corner.lon, corner.lat)
+            e, n = LocalFrame(lat=x.lat, lon=x.lon).enu_from_geographic(
+                lat=corner.lat, lon=corner.lon
+            )
             d = math.hypot(e, n)
             assert d == pytest.approx(a.width_m / 2.0 / math.sin(math.radians(gap / 2)), abs=0.5)
 
@@ -183,9 +186,12 @@ def test_dual_carriageway_grouped_with_member_nodes_fremantle() -> None:
     assert grouped
     for x in grouped:
         assert len(x.osm_node_lonlat) == len(x.osm_nodes)
-        frame = LocalFrame(x.lat, x.lon)
+        frame = LocalFrame(lat=x.lat, lon=x.lon)
         span = max(
-            math.dist(frame.enu_from_geographic(*p), frame.enu_from_geographic(*q))
+            math.dist(
+                frame.enu_from_geographic(lon=p[0], lat=p[1]),
+                frame.enu_from_geographic(lon=q[0], lat=q[1]),
+            )
             for p in x.osm_node_lonlat
             for q in x.osm_node_lonlat
         )
@@ -202,7 +208,7 @@ def test_dual_carriageway_grouped_with_member_nodes_fremantle() -> None:
 def test_no_junction_near_the_point_warns_and_names_the_nearest() -> None:
     m = _load("kotka.osm.pbf", 60.5233823, 26.9485972, 150)
     # 60 m north of the T junction, along Kosselinkatu: no junction within 25 m
-    lon, lat = LocalFrame(60.5233823, 26.9485972).geographic_from_enu(-30.0, 55.0)
+    lon, lat = LocalFrame(lat=60.5233823, lon=26.9485972).geographic_from_enu(-30.0, 55.0)
     x, warnings = m.match_intersection(lat=float(lat), lon=float(lon))
     assert x is None
     assert len(warnings) == 1

@@ -190,6 +190,8 @@ class FlagKind(str, Enum):
     WORST_REFERENCE = "worst_reference"
     POOR_FIT = "poor_fit"
     UNMATCHED = "unmatched"
+    CUE = "cue"
+    """A tie-breaking cue's note (``cue: view_hint ...``), see :mod:`camloc_geo.cues`."""
 
 
 @dataclass(frozen=True)

@@ -149,6 +149,7 @@ class MapData:
         self._buildings = tuple(raw.buildings)
         self._cache: dict[str, Any] = {}
         self._cache_lock = threading.RLock()
+        self._member_points: tuple[np.ndarray, np.ndarray] | None = None
 
     def __getstate__(self) -> dict[str, Any]:
         state = self.__dict__.copy()
@@ -196,8 +197,6 @@ class MapData:
     def building_index(self) -> LocalIndex:
         """Valid building footprints larger than 1 m² (ENU), and their STRtree."""
         return self.cached("building_index", lambda: building_index(self.buildings_enu))
-        self._streets_enu: list[LineString] | None = None
-        self._member_points: tuple[np.ndarray, np.ndarray] | None = None
 
     def __repr__(self) -> str:
         return (
