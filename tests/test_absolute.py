@@ -589,3 +589,18 @@ def test_evidence_above_the_calibrated_horizon_is_explained(maps: dict[str, MapD
     assert result.candidates == []
     assert result.reason is not None
     assert "above the calibrated camera's horizon" in result.reason
+
+
+def test_intersection_point_matching_no_junction_is_refused_naming_the_nearest() -> None:
+    """A scene's intersection 150 m from any modelled junction never moves to another one."""
+    import json
+
+    from camloc_geo.api import locate_scene
+
+    root = Path(__file__).resolve().parents[1] / "sample_maps"
+    scene = json.loads((root / "sample_scene.json").read_text())
+    scene["intersection"]["lat"] = 39.28698  # 42 m from Bank Street & South Broadway
+    scene["intersection"]["lon"] = -76.59348
+    scene["intersection"].pop("streets", None)
+    with pytest.raises(MapDataError, match=r"no modelled junction matches.*nearest"):
+        locate_scene(scene, map_source=root / "baltimore.osm.pbf")

@@ -160,14 +160,30 @@ def _check_distinct_corners(scene: Scene) -> None:
 
 
 def choose_intersection(scene: Scene, map_data: MapData, frame: LocalFrame) -> Intersection:
-    """The map intersection the scene's corners belong to."""
+    """The map intersection the scene's corners belong to.
+
+    A stated lat/lon must match a modelled junction (its centre or one of its member nodes)
+    within 25 m, with the stated street names if any: otherwise a :class:`MapDataError`
+    names the nearest junctions and their distances. Nothing moves silently to another one.
+    """
     hint = scene.intersection
     assert hint is not None
     near = (scene.prior.lat, scene.prior.lon) if scene.prior is not None else None
+    if hint.lat is not None and hint.lon is not None:
+        inter, warnings = map_data.match_intersection(
+            lat=hint.lat, lon=hint.lon, streets=list(hint.streets or []) or None
+        )
+        if inter is None:
+            raise MapDataError(
+                "intersection: no modelled junction matches the scene's intersection "
+                f"(lat={hint.lat:.6f}, lon={hint.lon:.6f}"
+                + (f", streets {' & '.join(hint.streets)}" if hint.streets else "")
+                + "): "
+                + "; ".join(warnings)
+            )
+        return inter
     if hint.streets:
         return map_data.find_intersection(list(hint.streets), near=near)
-    if hint.lat is not None and hint.lon is not None:
-        return map_data.nearest_intersection(lat=hint.lat, lon=hint.lon)
     if scene.prior is not None:
         return map_data.nearest_intersection(lat=scene.prior.lat, lon=scene.prior.lon)
     return map_data.nearest_intersection(lat=frame.lat0, lon=frame.lon0)
