@@ -437,6 +437,19 @@ def _batch_module() -> Any | None:
     return batch
 
 
+_BATCH_STATUS = {
+    "located": "ok",
+    "title_only": "ok",
+    "ambiguous": "ambiguous",
+    "not_found": "not_found",
+    "no_candidates": "not_found",
+    "street_only": "not_found",
+    "no_evidence": "not_found",
+}
+"""The batch engine's statuses as the plugin's (``ok``, ``ambiguous``, ``not_found``, else
+``error``); the engine's own status leads the ``reason`` where it says more."""
+
+
 def _batch_result(
     result: Any,
 ) -> tuple[dict[str, Any], list[tuple[dict[str, Any], dict[str, Any]]]]:
@@ -470,11 +483,18 @@ def _batch_result(
         for g, r in candidate_rows({"features": [f for f in feats if f]})
     ]
     best = _best_of(rows)
+    batch_status = str(get("status", "located"))
+    status = _BATCH_STATUS.get(batch_status, "error")
+    if status == "ok" and get("tie", False):
+        status = "ambiguous"
+    reason = get("reason", None)
+    if batch_status not in ("located", status):
+        reason = f"{batch_status}: {reason}" if reason else batch_status
     props = {
         "camera_id": cam_id,
         "title": get("title", None),
-        "status": str(get("status", "ok")),
-        "reason": get("reason", None),
+        "status": status,
+        "reason": reason,
         "n_candidates": len(rows),
         **best,
     }

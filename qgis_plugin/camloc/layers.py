@@ -65,7 +65,10 @@ def _geometry(geom: dict[str, Any] | None) -> QgsGeometry | None:
     if not geom:
         return None
     if geom["type"] == "Point":
-        x, y = geom["coordinates"][:2]
+        coords = geom.get("coordinates") or []
+        if len(coords) < 2 or coords[0] is None or coords[1] is None:
+            return None  # a camera that could not be placed: a row without geometry
+        x, y = coords[:2]
         return QgsGeometry.fromPointXY(QgsPointXY(float(x), float(y)))
     if geom["type"] == "Polygon":
         rings = [
