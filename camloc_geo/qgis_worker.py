@@ -438,6 +438,7 @@ def _batch_module() -> Any | None:
 
 
 _BATCH_STATUS = {
+    "ok": "ok",
     "located": "ok",
     "title_only": "ok",
     "ambiguous": "ambiguous",
