@@ -23,7 +23,7 @@ that venv with ``python -m venv benchmarks/.venv && benchmarks/.venv/bin/pip ins
 lu-vp-detect 'opencv-contrib-python<5'``.
 
 Writes ``benchmarks/out/vp_yud.json`` and PNG plots next to it. The York Urban DB is used
-for testing only (see ``shared/data/yud/SOURCES.md``); nothing of it is copied.
+for testing only; nothing of it is copied (set ``CAMLOC_YUD_DIR`` to its folder).
 """
 
 from __future__ import annotations

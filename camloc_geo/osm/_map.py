@@ -281,26 +281,9 @@ class MapData:
         wanted = split_street_query(streets)
         if len(wanted) < 2:
             raise MapDataError(f"give at least two street names, got {streets!r}")
-        norms = [normalize_name(w) for w in wanted]
-
-        def street_norms(inter: Intersection) -> list[set[str]]:
-            return [{normalize_name(n) for n in (s.names or (s.name,))} for s in inter.streets]
-
-        def matches(inter: Intersection, loose: bool) -> bool:
-            sets = street_norms(inter)
-            for q in norms:
-                q_tokens = set(q.split())
-                ok = any(q in names for names in sets) or (
-                    loose and any(q_tokens <= set(n.split()) for names in sets for n in names)
-                )
-                if not ok:
-                    return False
-            return True
-
-        for loose in (False, True):
-            hits = [x for x in self._intersections if matches(x, loose)]
-            if hits:
-                return min(hits, key=lambda x: self._dist_from(near, x.lat, x.lon))
+        hits = self._street_hits(wanted)
+        if hits:
+            return min(hits, key=lambda x: self._dist_from(near, x.lat, x.lon))
         all_names = self.street_names()
         hints = []
         for w in wanted:

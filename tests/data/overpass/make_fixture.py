@@ -3,7 +3,7 @@
 The responses mimic what Overpass returns (``[out:json]``) for osmnx's street query
 (``baltimore_streets.json``) and building query (``baltimore_buildings.json``) around
 Eastern Avenue & South Bond Street, Baltimore. Data © OpenStreetMap contributors, ODbL 1.0
-(from ``shared/data/osm/baltimore.osm.pbf``, see its SOURCES.md).
+(from ``data/osm/baltimore.osm.pbf``, see its SOURCES.md).
 
     python tests/data/overpass/make_fixture.py
 """
