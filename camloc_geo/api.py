@@ -271,9 +271,6 @@ def locate_scene(
             raise SceneError("max_candidates must be at least 1", "max_candidates")
         settings = replace(settings, max_candidates=max_candidates)
     result = locate(sc, map_data, calibration=calibration, settings=settings)
-    from camloc_geo.cues import apply_cues
-
-    apply_cues(result, sc, map_data, merge_distance_m=settings.merge_distance_m)
     return LocateOutput(scene=sc, result=result, map_data=map_data)
 
 

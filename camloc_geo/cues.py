@@ -227,6 +227,10 @@ def apply_cues(
 ) -> Any:
     """Re-rank a :class:`~camloc_geo.absolute.LocateResult` by the scene's cues, in place.
 
+    :func:`camloc_geo.absolute.locate` scores every hypothesis with the cues itself (before
+    merging, refinement and ranking), and its result says so (``cues_applied``): then this
+    does nothing. It remains for results computed without them.
+
     Each candidate's score (a posterior weight) is multiplied by its cue factor
     (:func:`cue_log_likelihood`) and the scores renormalised; the ranks follow. Notes go to the
     candidate's ``flags`` (``cue: ...``), and the ambiguity warning is recomputed with the rule
@@ -234,6 +238,8 @@ def apply_cues(
     and apart). A scene without cues leaves the result unchanged.
     """
     cands = list(getattr(result, "candidates", []) or [])
+    if getattr(result, "cues_applied", False):
+        return result  # locate() already ranked with them
     has_cue = scene.view_hint is not None or scene.object.street or scene.object.front
     if not cands or not has_cue:
         return result

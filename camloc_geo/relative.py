@@ -137,6 +137,43 @@ class AnnotatorSolution:
         return out
 
 
+@dataclass(frozen=True)
+class JointState:
+    """The joint fit's problem at its solution, for fits that add more evidence.
+
+    :mod:`camloc_geo.absolute`'s bundle adjustment re-fits the camera with the annotations
+    and the matched map points together; it needs the annotations' residuals in the fit's
+    internal frame. A world point ``p`` of the calibration's output frame is
+    ``internal_from_output @ p + internal_origin`` in that frame.
+
+    Attributes
+    ----------
+    problem
+        The stacked annotation residuals (``_JointProblem``).
+    x
+        The solution's parameter vector.
+    rotation0
+        Reference rotation of the rotation-vector parameterisation.
+    principal_point
+        The fixed principal point, or None when it is a parameter.
+    focal_px
+        The given focal length, or None when it is a parameter.
+    weights
+        The annotators' final robust weights.
+    internal_from_output, internal_origin
+        The output frame (origin at the chosen corner) in the internal frame.
+    """
+
+    problem: Any
+    x: FloatArray
+    rotation0: FloatArray
+    principal_point: tuple[float, float] | None
+    focal_px: float | None
+    weights: FloatArray
+    internal_from_output: FloatArray
+    internal_origin: FloatArray
+
+
 @dataclass
 class CalibrationResult:
     """Everything :func:`calibrate` found.
@@ -191,6 +228,7 @@ class CalibrationResult:
     clamped_clicks: int = 0
     annotator_influence_m: list[float | None] = field(default_factory=list)
     position_sigma_fit_m: FloatArray | None = None
+    joint_state: JointState | None = field(default=None, repr=False, compare=False)
 
     @property
     def height_m(self) -> float:
@@ -1753,6 +1791,16 @@ def _joint(
     if sigma_c is not None and not _size_given(scene):
         sigma_c = np.sqrt(sigma_c**2 + (settings.size_sigma_rel * np.abs(C)) ** 2)
     weights = [float(w) for w in prob.weights]
+    state = JointState(
+        prob,
+        np.asarray(res.x, dtype=float).copy(),
+        R0,
+        pp_model,
+        f_fixed,
+        np.asarray(prob.weights, dtype=float).copy(),
+        np.asarray(M, dtype=float),
+        np.asarray(origin, dtype=float),
+    )
     outliers = [
         scene.annotations[i].annotator for i, w in enumerate(weights) if w < settings.outlier_weight
     ]
@@ -1796,6 +1844,7 @@ def _joint(
         width_signs=width_signs,
         annotator_corners=corner_names,
         width_sign=ws_out,
+        joint_state=state,
     )
     if len(chosen_corners) > 1:
         result.warnings.append(

@@ -39,6 +39,18 @@ class Evidence:
     streets: LocalIndex | None = None  # the map's centre lines (ENU), half widths, STRtree
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
+    intersection: Intersection | None = None  # the junction whose corners these are
+    scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
+    map_data: MapData | None = None
+    frame: LocalFrame | None = None
+
+    @property
+    def has_cues(self) -> bool:
+        """The scene carries a tie-breaking cue (:mod:`camloc_geo.cues`)."""
+        sc = self.scene
+        return sc is not None and bool(
+            sc.view_hint is not None or sc.object.street or sc.object.front
+        )
 
     @property
     def buildings_tree(self) -> Any:
@@ -358,6 +370,8 @@ def gather_evidence(
         landmarks,
         unique_bearings(bearings),
     )
+    ev.intersection = ce.intersection
+    ev.scene, ev.map_data, ev.frame = scene, map_data, frame
     _add_map_context(ev, scene, map_data, frame, settings)
     size = scene.object_size
     ws = 1.0 if sum(result.calibration.width_signs or [1.0]) >= 0 else -1.0
@@ -383,3 +397,59 @@ def _add_map_context(
         ev.prior_radius_m = scene.prior.radius_m
     if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
         ev.streets = map_data.street_index
+
+
+MAX_PRIOR_JUNCTIONS = 24
+"""At most this many junctions (nearest the prior first) are hypotheses of a prior-only scene."""
+
+
+def other_junctions(scene: Scene, map_data: MapData | None, ev: Evidence) -> list[Intersection]:
+    """The junctions besides ``ev.intersection`` whose corners the scene's corners may be.
+
+    A scene that names its intersection by lat/lon is taken at its word. One that gives only
+    a prior (or street names that meet at several junctions) keeps every such junction with
+    kerb corners within ``prior.radius_m`` of the prior (at most :data:`MAX_PRIOR_JUNCTIONS`,
+    nearest first): the corners' geometry, the prior's density and the map's plausibility
+    rank them, instead of the nearest one being assumed.
+    """
+    hint = scene.intersection
+    if map_data is None or hint is None or not ev.corners or scene.prior is None:
+        return []
+    if hint.lat is not None and hint.lon is not None:
+        return []
+    near = map_data.intersections_within(
+        lat=scene.prior.lat, lon=scene.prior.lon, radius_m=scene.prior.radius_m
+    )
+    pool = [x for x, _d in near if x.corners]
+    if hint.streets:
+        named = {x.id for x in map_data.street_junctions(list(hint.streets))}
+        pool = [x for x in pool if x.id in named]
+    current = ev.intersection.id if ev.intersection is not None else None
+    return [x for x in pool if x.id != current][: MAX_PRIOR_JUNCTIONS - 1]
+
+
+def evidence_at(
+    ev: Evidence,
+    inter: Intersection,
+    map_data: MapData,
+    frame: LocalFrame,
+    settings: LocateSettings,
+) -> Evidence:
+    """``ev`` with another junction's kerb corners and the street bearings around it."""
+    from dataclasses import replace
+
+    corners = np.array(
+        [frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in inter.corners], dtype=float
+    )
+    bearings = [st.bearing_deg for st in inter.streets]
+    for _name, brg in map_data.street_bearings(
+        lat=inter.lat, lon=inter.lon, radius_m=settings.street_search_m
+    ):
+        bearings.append(brg)
+    return replace(
+        ev,
+        map_corners=corners,
+        map_corner_ids=[f"{inter.id}:{c.order}" for c in inter.corners],
+        street_bearings=unique_bearings(bearings),
+        intersection=inter,
+    )

@@ -94,7 +94,8 @@ def _gen_bearing_point(
     return out
 
 
-def _gen_corners(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+def corner_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    """The kerb-corner hypotheses: visible corners assigned to the map's, in order."""
     k, n = len(ev.corners), len(ev.map_corners)
     if k == 0 or n == 0:
         return []
@@ -190,7 +191,7 @@ def generate_hypotheses(
     if scene.intersection is not None:
         tried.append("corners")
         _warn_corner_counts(ev, result)
-        hyps += _gen_corners(ev, settings)
+        hyps += corner_hypotheses(ev, settings)
     if scene.landmarks:
         tried.append("landmark")
         if len(ev.landmarks) == 1 and not ev.street_bearings:

@@ -67,6 +67,9 @@ class LocateSettings:
     prior_gate_radii
         Hypotheses farther than this many ``prior.radius_m`` from the prior are dropped;
         when all are, none is returned (the evidence contradicts the prior).
+    bundle_adjust
+        Re-fit the leading candidates' cameras to the annotations and their matched map
+        points together (:mod:`camloc_geo.absolute._bundle`); their rank and score stay.
     """
 
     sigma_pixel_rel: float = 0.0015
@@ -88,6 +91,7 @@ class LocateSettings:
     view_cone_range_m: float = 60.0
     fit_gate: float = 16.0
     prior_gate_radii: float = 3.0
+    bundle_adjust: bool = True
 
 
 @dataclass(frozen=True)
@@ -250,6 +254,8 @@ class Candidate:
     merged: int = 1
     corner_assignment: tuple[int, ...] | None = None  # map corner per visible corner, -1 = none
     ambiguous_with: list[int] = field(default_factory=list)
+    intersection_id: str | None = None  # the junction a corners hypothesis stands at
+    evidence: Any = field(default=None, repr=False, compare=False)  # what it was scored on
 
     @property
     def theta_rad(self) -> float:
@@ -292,3 +298,4 @@ class LocateResult:
     scene_id: str = "scene"
     image_size: tuple[int, int] = (0, 0)
     view_cone_range_m: float = 60.0  # LocateSettings.view_cone_range_m of the run
+    cues_applied: bool = False  # the scene's cues (camloc_geo.cues) are in the scores

@@ -1,6 +1,6 @@
 """The :func:`locate` pipeline.
 
-evidence → hypotheses → scores → prior gate → refinement → ranking.
+evidence → hypotheses → scores → prior gate → refinement → ranking → bundle adjustment.
 """
 
 from __future__ import annotations
@@ -12,9 +12,21 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from camloc_geo.absolute._evidence import Evidence, frame_anchor, gather_evidence
-from camloc_geo.absolute._hypotheses import Hypothesis, NoCandidatesError, generate_hypotheses
-from camloc_geo.absolute._model import Candidate, FlagKind, LocateResult, LocateSettings
+from camloc_geo.absolute._bundle import bundle_adjust
+from camloc_geo.absolute._evidence import (
+    Evidence,
+    evidence_at,
+    frame_anchor,
+    gather_evidence,
+    other_junctions,
+)
+from camloc_geo.absolute._hypotheses import (
+    Hypothesis,
+    NoCandidatesError,
+    corner_hypotheses,
+    generate_hypotheses,
+)
+from camloc_geo.absolute._model import Candidate, Flag, FlagKind, LocateResult, LocateSettings
 from camloc_geo.absolute._refine import refine
 from camloc_geo.absolute._scoring import plausibility, score, unmatched_flags
 from camloc_geo.camera import Camera
@@ -24,7 +36,14 @@ from camloc_geo.scene import Scene
 if TYPE_CHECKING:
     from camloc_geo.osm import MapData
 
-__all__ = ["locate", "normalise_and_merge", "prior_gate", "rank", "refine_leaders"]
+__all__ = [
+    "bundle_leaders",
+    "locate",
+    "normalise_and_merge",
+    "prior_gate",
+    "rank",
+    "refine_leaders",
+]
 
 
 def locate(
@@ -77,28 +96,68 @@ def locate(
     )
     world_cam = cal.camera
     ev = gather_evidence(scene, map_data, world_cam, settings, result)
+    result.cues_applied = ev.has_cues
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
         cands = [score_hypothesis(h, world_cam, ev, settings) for h in hyps]
+        cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
         cands = refine_leaders(cands, world_cam, ev, settings)
-        result.candidates = rank(cands, settings, result)
+        cands = rank(cands, settings, result)
+        result.candidates = bundle_leaders(cands, cal, ev, settings, result)
+        top_ev = result.candidates[0].evidence if result.candidates else None
+        if top_ev is not None and top_ev.intersection is not None:
+            result.intersection = top_ev.intersection
     except NoCandidatesError as exc:
         result.reason = str(exc)
     return result
+
+
+def _other_junction_candidates(
+    scene: Scene,
+    map_data: MapData | None,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+) -> list[Candidate]:
+    """Corner hypotheses at the other junctions a prior-only scene may show, scored."""
+    others = other_junctions(scene, map_data, ev)
+    if not others:
+        return []
+    assert map_data is not None
+    assert scene.prior is not None
+    out = []
+    for inter in others:
+        ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
+        out += [
+            score_hypothesis(h, world_cam, ev_j, settings)
+            for h in corner_hypotheses(ev_j, settings)
+        ]
+    result.warnings.append(
+        f"corners: no intersection lat/lon in the scene, so the corners were matched at the "
+        f"{len(others) + 1} junctions with kerb corners within {scene.prior.radius_m:g} m of "
+        "the prior; give intersection.lat/lon (or street names) to fix the junction"
+    )
+    return out
 
 
 def _rescore(
     cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings, log_prior: float
 ) -> Candidate:
     """The candidate with its likelihood, plausibility, matches and flags (re)computed."""
+    ev = cand.evidence if cand.evidence is not None else ev
     fit = score(cand.enu_from_world, ev, settings, cand.corner_assignment)
     plaus, flags = plausibility(cand.camera, cand.enu_from_world, ev, settings, fit.matches)
     flags += unmatched_flags(ev, fit.corner_assignment)
+    cue_log = 0.0
+    if ev.has_cues:
+        cue_log, cue_flags = _cues(cand, ev)
+        flags += cue_flags
     return replace(
         cand,
-        log_likelihood=fit.log_likelihood + log_prior,
+        log_likelihood=fit.log_likelihood + log_prior + cue_log,
         prior=plaus,
         residual_m=fit.residual_m,
         matches=fit.matches,
@@ -107,12 +166,39 @@ def _rescore(
     )
 
 
+def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:
+    """The scene's tie-breaking cues for one candidate: log factor and ``cue`` flags."""
+    from camloc_geo.cues import cue_log_likelihood
+
+    assert ev.scene is not None
+    cue = cue_log_likelihood(
+        ev.scene,
+        heading_deg=float(cand.heading_deg),
+        theta_rad=float(cand.theta_rad),
+        translation_en=np.asarray(cand.translation_en, float),
+        scale=float(cand.scale),
+        car_center_world=ev.car_center_world,
+        map_data=ev.map_data,
+        frame=ev.frame,
+    )
+    return cue.log_factor, [Flag(FlagKind.CUE, f" {n}") for n in cue.notes]
+
+
 def score_hypothesis(
     h: Hypothesis, world_cam: Camera, ev: Evidence, settings: LocateSettings
 ) -> Candidate:
     """Stage 3: a hypothesis scored against all the evidence, as a candidate."""
     cam = h.enu_from_world.camera(world_cam)
-    cand = Candidate(h.method, h.enu_from_world, cam, corner_assignment=h.corner_assignment)
+    cand = Candidate(
+        h.method,
+        h.enu_from_world,
+        cam,
+        corner_assignment=h.corner_assignment,
+        intersection_id=(
+            ev.intersection.id if h.method == "corners" and ev.intersection is not None else None
+        ),
+        evidence=ev,
+    )
     return _rescore(cand, world_cam, ev, settings, h.log_prior)
 
 
@@ -154,7 +240,7 @@ def refine_leaders(
     """Stage 5: refine the ``refine_top`` leading candidates, then score them again."""
     cands = list(cands)
     for i in range(min(settings.refine_top, len(cands))):
-        c = refine(cands[i], world_cam, ev, settings)
+        c = refine(cands[i], world_cam, cands[i].evidence or ev, settings)
         cands[i] = _rescore(c, world_cam, ev, settings, 0.0)
     return cands
 
@@ -240,6 +326,37 @@ def _mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateR
             result.warnings.append(
                 f"ambiguous: candidates 1 and 2 fit the evidence equally well (scores "
                 f"{cands[0].score:.2f} and {cands[1].score:.2f}) but stand {gap:.0f} m apart; "
-                "a symmetric junction cannot tell them apart: more evidence (a reference pixel, "
-                "a landmark, another corner) or a tighter prior decides"
+                + (
+                    "even with the scene's cues"
+                    if result.cues_applied
+                    else "a symmetric junction cannot tell them apart: more evidence (a reference "
+                    "pixel, a landmark, another corner), a viewing-direction hint (view_hint) or "
+                    "a tighter prior decides"
+                )
             )
+
+
+def bundle_leaders(
+    cands: list[Candidate],
+    calibration: CalibrationResult,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+) -> list[Candidate]:
+    """Stage 7: the ``refine_top`` leaders' cameras re-fitted with the annotations and the map.
+
+    Ranks and scores stay (they compare hypotheses on the same evidence); the position,
+    camera and ``sigma_m`` become the bundle's (:mod:`camloc_geo.absolute._bundle`).
+    """
+    if not settings.bundle_adjust:
+        return cands
+    out = list(cands)
+    for i in range(min(settings.refine_top, len(out))):
+        c = bundle_adjust(out[i], calibration, out[i].evidence or ev, settings, result.image_size)
+        if c is out[i]:
+            continue
+        C = c.camera.center_in_world
+        lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
+        c.lon, c.lat = float(lon), float(lat)
+        out[i] = c
+    return out

@@ -334,6 +334,11 @@ class MapData:
         order = np.argsort(dist, kind="stable")
         return [(self._intersections[i], float(dist[i])) for i in order if dist[i] <= radius_m]
 
+    def street_junctions(self, streets: str | Sequence[str]) -> list[Intersection]:
+        """Every intersection where all the named streets meet (names as
+        :meth:`find_intersection`); empty when they meet nowhere on this map."""
+        return self._street_hits(split_street_query(streets))
+
     def _street_hits(self, wanted: list[str]) -> list[Intersection]:
         norms = [normalize_name(w) for w in wanted]
 

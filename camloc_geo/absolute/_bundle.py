@@ -1,0 +1,224 @@
+"""Stage 7, bundle adjustment: the camera re-fitted with the annotations and the map together.
+
+The relative pose (:func:`camloc_geo.relative.calibrate`) is fitted to the annotations
+alone, and :func:`~camloc_geo.absolute._refine.refine` then fits only the car-to-map
+similarity ``enu_from_world``, keeping that pose. When the vanishing lines determine the
+focal length poorly (a vanishing point near infinity), a focal length off by 20-50 %
+distorts every ground point, and no similarity can undo it.
+
+Here, for each leading candidate, one robust least-squares problem holds
+
+- every annotator's vanishing-line and car-corner residuals of the joint fit (with the
+  annotators' final robust weights), and
+- every map point the candidate matched (references, kerb corners, landmarks) as a pixel
+  residual: the map point, carried into the car's world frame by ``enu_from_world``'s
+  inverse, projected with the camera, against the clicked pixel; its sigma is the click
+  noise and the map's uncertainty seen at the point's depth,
+- the scale prior of ``enu_from_world`` and, when the car stands along a street, the
+  street-bearing prior of the refinement,
+
+over the focal length (unless given), the camera's rotation and centre, and the
+similarity. It is :func:`scipy.optimize.least_squares` with a soft-L1 loss. The candidate
+keeps its rank and score (those compare hypotheses on the same evidence); its camera,
+position and ``sigma_m`` become the bundle's. A bundle that does not converge, or moves the
+annotations' fit by more than a chi-square jump of :data:`MAX_ANNOTATION_COST_RISE` while
+explaining the map no better, is dropped and the candidate kept as it was.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+from scipy.optimize import least_squares
+
+from camloc_geo.absolute._evidence import Evidence
+from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
+from camloc_geo.absolute._refine import _matched_points, _street_bearing_prior
+from camloc_geo.absolute._similarity import Similarity2D, rot2
+from camloc_geo.camera import Camera
+
+if TYPE_CHECKING:
+    from camloc_geo.relative import CalibrationResult, JointState
+
+__all__ = ["MAX_ANNOTATION_COST_RISE", "bundle_adjust"]
+
+FloatArray = npt.NDArray[np.float64]
+
+MAX_ANNOTATION_COST_RISE = 30.0
+"""Largest rise of the annotations' chi-square the map may force (in squared sigmas)."""
+
+_F_SCALE = 2.5
+
+
+def _cam_parts(
+    state: JointState, x_cam: FloatArray
+) -> tuple[float, tuple[float, float], FloatArray, FloatArray]:
+    """Focal length, principal point, rotation and centre in the calibration's output frame."""
+    f, pp, R, C = state.problem.unpack(
+        x_cam, state.rotation0, state.principal_point, state.focal_px
+    )
+    M, origin = state.internal_from_output, state.internal_origin
+    return f, pp, R @ M, M.T @ (C - origin)
+
+
+def bundle_adjust(
+    cand: Candidate,
+    calibration: CalibrationResult,
+    ev: Evidence,
+    settings: LocateSettings,
+    image_size: tuple[int, int],
+) -> Candidate:
+    """The candidate with its camera re-fitted to the annotations and its matched map points.
+
+    Parameters
+    ----------
+    cand
+        A scored (and refined) candidate; its matches say which map point each pixel is.
+    calibration
+        The relative pose; without its joint fit's state (``joint_state``) nothing changes.
+    ev
+        The evidence the candidate was scored on.
+    settings
+        The noise model (click noise, scale prior, bearing prior).
+    image_size
+        ``(width, height)``, pixels.
+
+    Returns
+    -------
+    Candidate
+        A copy with ``camera``, ``enu_from_world`` and ``sigma_m`` from the bundle, or
+        ``cand`` itself when there is no joint state, fewer than two matched map points, or
+        the bundle is not trustworthy.
+    """
+    state = calibration.joint_state
+    if state is None:
+        return cand
+    obs_q = _matched_points(cand, ev)
+    if len(obs_q) < 2:
+        return cand
+    prob = state.problem
+    saved_weights = prob.weights
+    prob.weights = state.weights
+    try:
+        return _bundle(cand, state, obs_q, ev, settings, image_size)
+    except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+        return cand
+    finally:
+        prob.weights = saved_weights
+
+
+def _bundle(
+    cand: Candidate,
+    state: JointState,
+    obs_q: list[tuple[Observation, FloatArray]],
+    ev: Evidence,
+    settings: LocateSettings,
+    image_size: tuple[int, int],
+) -> Candidate:
+    prob = state.problem
+    pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
+    q_en = np.array([q for _o, q in obs_q], dtype=float)
+    sigma_map = np.array([o.sigma_map_m for o, _q in obs_q], dtype=float)
+    sigma_click = settings.sigma_pixel_rel * math.hypot(*image_size)
+    s_sigma = max(settings.scale_sigma_rel, 1e-6)
+    street_brg = _street_bearing_prior(cand, ev, settings)
+    n_cam = len(state.x)
+    M, origin = state.internal_from_output, state.internal_origin
+
+    def map_residuals(z: FloatArray) -> FloatArray:
+        x_cam = z[:n_cam]
+        theta, tx, ty, ls = z[n_cam:]
+        f, (cx, cy), R, C = prob.unpack(
+            x_cam, state.rotation0, state.principal_point, state.focal_px
+        )
+        s = math.exp(ls)
+        p_xy = (q_en - np.array([tx, ty])) @ rot2(theta) / s  # rot2(θ)ᵀ applied to each row
+        p_out = np.column_stack([p_xy, np.zeros(len(p_xy))])
+        p_int = p_out @ M.T + origin
+        pc = (p_int - C) @ R.T
+        depth = np.maximum(pc[:, 2], 0.05)
+        u = pc[:, 0] / depth * f + cx
+        v = pc[:, 1] / depth * f + cy
+        sig = np.sqrt(sigma_click**2 + (f * sigma_map / depth) ** 2)
+        r = np.concatenate([(u - pixels[:, 0]) / sig, (v - pixels[:, 1]) / sig, [ls / s_sigma]])
+        if street_brg is not None:
+            car_brg = (90.0 - math.degrees(theta)) % 180.0
+            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
+            r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
+        return r
+
+    def annotation_residuals(z: FloatArray) -> FloatArray:
+        return np.asarray(
+            prob.residuals(z[:n_cam], state.rotation0, state.principal_point, state.focal_px)
+        )
+
+    def residuals(z: FloatArray) -> FloatArray:
+        return np.concatenate([annotation_residuals(z), map_residuals(z)])
+
+    # The similarity is expressed from the calibration's output frame; the start is the
+    # candidate's (refined) one.
+    sim0 = cand.enu_from_world
+    z0 = np.concatenate(
+        [state.x, [sim0.rotation_rad, *np.asarray(sim0.translation_m), math.log(sim0.scale)]]
+    )
+    res = least_squares(
+        residuals, z0, loss="soft_l1", f_scale=_F_SCALE, x_scale="jac", max_nfev=200
+    )
+    if not res.success or not np.all(np.isfinite(res.x)):
+        return cand
+
+    def robust(r: FloatArray) -> float:
+        return float(np.sum(2.0 * (np.sqrt(1.0 + (r / _F_SCALE) ** 2) - 1.0)) * _F_SCALE**2)
+
+    ann0, ann1 = robust(annotation_residuals(z0)), robust(annotation_residuals(res.x))
+    map0, map1 = robust(map_residuals(z0)), robust(map_residuals(res.x))
+    if ann1 - ann0 > MAX_ANNOTATION_COST_RISE and map0 - map1 < ann1 - ann0:
+        return cand
+    lo, hi = prob.f_bounds
+    f, pp, R_out, C_out = _cam_parts(state, res.x[:n_cam])
+    if not lo * 1.001 < f < hi / 1.001 or C_out[2] <= 0.0:
+        return cand
+    theta, tx, ty, ls = res.x[n_cam:]
+    sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(float(ls)))
+    world_cam = Camera.from_center(f, pp, R_out, C_out)
+    camera = sim.camera(world_cam)
+    return replace(
+        cand,
+        enu_from_world=sim,
+        camera=camera,
+        sigma_m=_position_sigma(res, state, n_cam),
+        refined=True,
+    )
+
+
+def _position_sigma(res: object, state: JointState, n_cam: int) -> float | None:
+    """1-sigma horizontal position uncertainty (m) from the bundle's covariance."""
+    J = np.asarray(res.jac)  # type: ignore[attr-defined]
+    fun = np.asarray(res.fun)  # type: ignore[attr-defined]
+    z = np.asarray(res.x)  # type: ignore[attr-defined]
+    dof = max(len(fun) - len(z), 1)
+    s2 = max(float(fun @ fun) / dof, 1.0)
+    try:
+        cov = np.linalg.pinv(J.T @ J) * s2
+    except np.linalg.LinAlgError:
+        return None
+
+    def position(zz: FloatArray) -> FloatArray:
+        _f, _pp, _R, C = _cam_parts(state, zz[:n_cam])
+        theta, tx, ty, ls = zz[n_cam:]
+        return np.asarray(math.exp(ls) * rot2(theta) @ C[:2] + np.array([tx, ty]))
+
+    p0 = position(z)
+    Jp = np.empty((2, len(z)))
+    for k in range(len(z)):
+        h = 1e-6 * max(1.0, abs(z[k]))
+        dz = z.copy()
+        dz[k] += h
+        Jp[:, k] = (position(dz) - p0) / h
+    cov_p = Jp @ cov @ Jp.T
+    tr = float(np.trace(cov_p))
+    return math.sqrt(tr) if math.isfinite(tr) and tr >= 0.0 else None
