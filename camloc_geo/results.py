@@ -131,6 +131,7 @@ class CandidateProperties:
     scene: str
     matches: list[MatchProperties]
     ambiguous_with: list[int] = field(default_factory=list)
+    intersection: str | None = field(default=None, metadata=_OMIT_NONE)
 
 
 @dataclass(kw_only=True)

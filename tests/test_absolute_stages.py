@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camloc_geo.absolute import LocateSettings, locate
+from camloc_geo.absolute import LocateSettings, candidates_geojson, locate
 from camloc_geo.cues import apply_cues
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
@@ -67,6 +67,9 @@ def test_prior_only_keeps_every_junction_within_the_prior(baltimore: MapData) ->
     assert any("junctions with kerb corners within 150 m" in w for w in result.warnings)
     assert result.intersection is not None
     assert result.intersection.id == result.candidates[0].intersection_id
+    gj = candidates_geojson(result)
+    cand_props = [f["properties"] for f in gj["features"] if f["properties"]["kind"] == "candidate"]
+    assert {p["intersection"] for p in cand_props} == ids
 
 
 def test_stated_intersection_point_is_the_only_junction(baltimore: MapData) -> None:

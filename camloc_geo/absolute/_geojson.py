@@ -96,6 +96,7 @@ def _candidate_feature(c: Candidate, result: LocateResult) -> Feature:
         scene=result.scene_id,
         matches=[_match_properties(m, result.frame) for m in c.matches],
         ambiguous_with=list(c.ambiguous_with),
+        intersection=c.intersection_id,
     )
     return Feature(geometry=point(c.lon, c.lat), properties=props)
 
