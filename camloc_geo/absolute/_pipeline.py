@@ -255,20 +255,25 @@ def normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> lis
     for c, wi in zip(cands, w, strict=True):
         c.score = float(wi)
     cands.sort(key=lambda c: -c.score)
+    # Vectorised over the kept ones: landmark scenes have thousands of hypotheses.
+    en = np.array([c.east_north for c in cands], dtype=float)
+    heading = np.array([c.heading_deg for c in cands], dtype=float)
     kept: list[Candidate] = []
-    kept_heading: list[float] = []
-    for c in cands:
-        h = c.heading_deg
-        for k, hk in zip(kept, kept_heading, strict=True):
-            close = np.linalg.norm(c.east_north - k.east_north) < settings.merge_distance_m
-            dh = abs((h - hk + 180.0) % 360.0 - 180.0)
-            if close and dh < settings.merge_heading_deg:
+    kept_rows: list[int] = []
+    for i, c in enumerate(cands):
+        if kept_rows:
+            d = np.linalg.norm(en[kept_rows] - en[i], axis=1)
+            dh = np.abs((heading[i] - heading[kept_rows] + 180.0) % 360.0 - 180.0)
+            hit = np.flatnonzero(
+                (d < settings.merge_distance_m) & (dh < settings.merge_heading_deg)
+            )
+            if hit.size:
+                k = kept[int(hit[0])]
                 k.score += c.score
                 k.merged += c.merged
-                break
-        else:
-            kept.append(c)
-            kept_heading.append(h)
+                continue
+        kept.append(c)
+        kept_rows.append(i)
     kept.sort(key=lambda c: -c.score)
     return kept
 
