@@ -265,6 +265,8 @@ _PAGE_CSS = """
 .camloc-tied::before { content: ""; position: absolute; inset: -6px; border-radius: 50%;
   border: 2.5px dashed #111; background: rgba(255,255,255,0.55); }
 .camloc-tied .camloc-dot { position: relative; }
+.camloc-tied-arrow { position: relative; width: 100%; height: 100%; }
+.camloc-tied-arrow svg { display: block; }
 .camloc-badge { position: absolute; top: -11px; right: -11px; width: 16px; height: 16px;
   border-radius: 50%; background: #fff; color: #111; border: 1.5px solid #111;
   font: bold 13px/14px sans-serif; text-align: center; box-sizing: border-box; }
@@ -1260,21 +1262,27 @@ def _arrow_icon(
     else:
         shape = f'<path transform="rotate({heading:.1f})" d="M0,-11 L6,6 L0,2 L-6,6 Z" />'
     ring = ""
+    size = 26
     if tied:
+        size = 36
         ring = (
-            f'<circle r="12" fill="rgba(255,255,255,0.6)" stroke="{TIE_RING}" '
-            'stroke-width="2.5" stroke-dasharray="4 3" />'
+            f'<circle r="16" fill="rgba(255,255,255,0.7)" stroke="{TIE_RING}" '
+            'stroke-width="2.5" stroke-dasharray="5 3" />'
         )
+    h = size // 2
     svg = (
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="26" height="26" viewBox="-13 -13 26 26"'
-        f' overflow="visible">{ring}'
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" '
+        f'viewBox="-{h} -{h} {size} {size}">{ring}'
         f'<g fill="{fill}" stroke="#111" stroke-width="1.5">{shape}</g></svg>'
     )
     if tied:
         svg = (
-            f'<div class="camloc-tied" data-tied="1">{svg}<span class="camloc-badge">≈</span></div>'
+            f'<div class="camloc-tied-arrow" data-tied="1">{svg}'
+            '<span class="camloc-badge">≈</span></div>'
         )
-    return folium.DivIcon(html=svg, icon_size=(26, 26), icon_anchor=(13, 13), class_name=css_class)
+    return folium.DivIcon(
+        html=svg, icon_size=(size, size), icon_anchor=(h, h), class_name=css_class
+    )
 
 
 def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
