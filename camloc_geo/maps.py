@@ -492,7 +492,8 @@ def _tie_hints(group: Sequence[int], by_rank: Mapping[int, Any], scene: Scene | 
     items = []
     given = []
     if scene is None or scene.view_hint is None:
-        which = f": does it look {' or '.join(looks)}?" if len(set(looks)) >= 2 else ""
+        sectors = list({c.split(" ", 1)[0]: c for c in reversed(looks)}.values())[::-1]
+        which = f": does it look {' or '.join(sectors)}?" if len(sectors) >= 2 else ""
         items.append(f"<code>view_hint</code> (the camera's direction{html.escape(which)})")
     else:
         given.append("view_hint")
