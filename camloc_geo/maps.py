@@ -2,18 +2,28 @@
 
 A reviewer decides from the candidate map which candidate position is right:
 
-- candidates are numbered by rank, coloured by score on one sequential scale (dark red =
-  most of the weight, pale yellow = almost none) and sized by rank, the best drawn on top
-  with a heavy outline; their popups list every property of the candidate GeoJSON
-  (:func:`camloc_geo.absolute.candidates_geojson`) and show the image overlay
-  (:mod:`camloc_geo.overlay`) of the leading candidates;
-- view cones (60 m) of the three best candidates are shown, the others' in a hidden layer;
+- candidates are numbered by rank and each rank has its own colour (:data:`RANK_PALETTE`,
+  Okabe–Ito, colour-blind safe: rank 1 blue, 2 orange, 3 green...), sized by rank, the best
+  drawn on top with a heavy outline; their popups list every property of the candidate
+  GeoJSON (:func:`camloc_geo.absolute.candidates_geojson`) and show the image overlay
+  (:mod:`camloc_geo.overlay`) of the leading candidates; the legend lists each rank's colour
+  and score;
+- candidates that tie (non-empty ``ambiguous_with``) wear a dashed ring and an "≈" badge;
+  a banner at the top of the page says which candidates tie, how close their scores are,
+  why (the result's ``ambiguous`` warning, their flags) and what evidence would decide;
+  each tied candidate's popup names the ranks it ties with;
+- view cones (60 m) of the three best candidates are shown in their candidate's colour, the
+  others' in a hidden layer;
 - the intersection's kerb corners are shown with their map order (``m0``, ``m1``... clockwise
   from above); for each leading candidate a layer numbers the map corners with the index of
   the scene corner matched to them (``intersection.corners[i]``) and joins them to the
   camera position;
 - the streets (centre lines and modelled carriageways) and buildings near the scene are
   vector layers; a layer control, a legend and a scale bar complete the page.
+
+The summary map colours each camera's best candidate by score (:data:`SCORE_SCALE`); a camera
+whose best candidate is tied gets a dashed ring and an "≈" badge, and its popup says which
+candidate it is tied with.
 
 Offline pages (``offline=True``) are one self-contained HTML file: Leaflet's JS and CSS
 and jQuery (which folium's popups use) are inlined from the ``xstatic-leaflet`` and
@@ -52,11 +62,14 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_PAGE_BYTES",
+    "RANK_OTHER",
+    "RANK_PALETTE",
     "SCORE_SCALE",
     "build_candidates_map",
     "build_summary_map",
     "candidates_map",
     "inline_assets",
+    "rank_colour",
     "rank_style",
     "score_colour",
     "summary_map",
@@ -76,6 +89,26 @@ SCORE_SCALE: tuple[tuple[float, str, str], ...] = (
 )
 """Score bins (lower bound, fill colour, legend text), best first (ColorBrewer YlOrRd)."""
 
+RANK_PALETTE: tuple[str, ...] = (
+    "#0072B2",  # blue
+    "#E69F00",  # orange
+    "#009E73",  # bluish green
+    "#CC79A7",  # reddish purple
+    "#56B4E9",  # sky blue
+    "#D55E00",  # vermillion
+    "#F0E442",  # yellow
+    "#000000",  # black
+)
+"""Colour of candidate ranks 1, 2, ... 8 on the one-scene page: the Okabe–Ito palette
+(Okabe & Ito 2008, "Color Universal Design"), told apart under the common colour-vision
+deficiencies. Neighbouring ranks never share a colour."""
+
+RANK_OTHER = "#999999"
+"""Colour of ranks beyond :data:`RANK_PALETTE` (grey)."""
+
+TIE_RING = "#111111"
+"""Colour of the dashed ring and the "≈" badge of a tied candidate."""
+
 OSM_ATTRIBUTION = ATTRIBUTION
 _OSM_TILES_ATTR = (
     '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors'
@@ -92,6 +125,8 @@ _STYLE: dict[str, Any] = {
 _OVERLAY_TOP = 5
 _MATCH_LAYERS = 5
 _CONES_SHOWN = 3
+_BANNER_PX = 150  # about the height of the tie banner: the candidates are fitted below it
+_BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
 
 
 # ----------------------------------------------------------------------------- styling
@@ -102,6 +137,12 @@ def score_colour(score: float) -> str:
         if s >= lower:
             return colour
     return SCORE_SCALE[-1][1]
+
+
+def rank_colour(rank: int) -> str:
+    """Colour of a candidate rank on the one-scene page (:data:`RANK_PALETTE`)."""
+    r = int(rank)
+    return RANK_PALETTE[r - 1] if 1 <= r <= len(RANK_PALETTE) else RANK_OTHER
 
 
 def rank_style(rank: int) -> tuple[int, float, int]:
@@ -164,6 +205,34 @@ var {{ this.get_name() }} = L.control({position: {{ this.position|tojson }}});
         self.css = css
 
 
+class _Banner(MacroElement):
+    """A box at the top centre of the map (over the tiles, under nothing)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    var div = L.DomUtil.create(
+        "div", {{ this.css_class|tojson }}, {{ this._parent.get_name() }}.getContainer());
+    div.innerHTML = {{ this.html|tojson }};
+    L.DomEvent.disableClickPropagation(div);
+    L.DomEvent.disableScrollPropagation(div);
+    // an open popup would be under the banner: fold it to its headline meanwhile
+    var map = {{ this._parent.get_name() }};
+    map.on("popupopen", function () { L.DomUtil.addClass(div, "folded"); });
+    map.on("popupclose", function () { L.DomUtil.removeClass(div, "folded"); });
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, html_text: str, *, css_class: str) -> None:
+        super().__init__()
+        self._name = "CamlocBanner"
+        self.html = html_text
+        self.css_class = css_class
+
+
 _PAGE_CSS = """
 .camloc-legend, .camloc-title { background: rgba(255,255,255,0.93); padding: 6px 9px;
   border-radius: 5px; box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif;
@@ -192,24 +261,92 @@ _PAGE_CSS = """
   vertical-align: top; }
 .camloc-popup img { display: block; width: 460px; margin-top: 6px;
   border: 1px solid #999; }
+.camloc-tied { position: relative; width: 100%; height: 100%; }
+.camloc-tied::before { content: ""; position: absolute; inset: -6px; border-radius: 50%;
+  border: 2.5px dashed #111; background: rgba(255,255,255,0.55); }
+.camloc-tied .camloc-dot { position: relative; }
+.camloc-tied-arrow { position: relative; width: 100%; height: 100%; }
+.camloc-tied-arrow svg { display: block; }
+.camloc-badge { position: absolute; top: -11px; right: -11px; width: 16px; height: 16px;
+  border-radius: 50%; background: #fff; color: #111; border: 1.5px solid #111;
+  font: bold 13px/14px sans-serif; text-align: center; box-sizing: border-box; }
+.camloc-banner { position: absolute; top: 10px; left: 50%; transform: translateX(-50%);
+  z-index: 1000; max-width: min(640px, calc(100% - 640px)); min-width: 320px;
+  background: #fff8e1; border: 2px solid #b26a00; border-radius: 6px; padding: 7px 11px;
+  box-shadow: 0 2px 7px rgba(0,0,0,0.45); font: 12.5px/1.4 sans-serif; color: #222; }
+.camloc-banner.folded .camloc-banner-body { display: none; }
+.camloc-banner.folded h4 { margin: 0; }
+.camloc-banner.minor { background: rgba(255,255,255,0.93); border-color: #777; }
+.camloc-banner h4 { margin: 0 0 3px; font-size: 14px; color: #7a3e00; }
+.camloc-banner.minor h4 { color: #333; font-size: 12.5px; }
+.camloc-banner ul { margin: 3px 0 0; padding-left: 18px; }
+.camloc-banner code, .camloc-popup code { background: #eee; padding: 0 2px; }
+.camloc-tie { background: #fff8e1; border-left: 3px solid #b26a00; padding: 3px 6px;
+  margin: 3px 0 5px; }
 """
 
 
-def _legend_html(*, scene_id: str | None, has_corners: bool, has_prior: bool, summary: bool) -> str:
+def _tie_swatch(fill: str) -> str:
+    """A legend swatch of a tied marker: dashed ring and "≈"."""
+    return (
+        f'<span class="sw" style="background:{fill};border:2px dashed {TIE_RING};'
+        'text-align:center;font:bold 10px/10px sans-serif">≈</span>'
+    )
+
+
+def _legend_html(
+    *,
+    scene_id: str | None,
+    has_corners: bool,
+    has_prior: bool,
+    summary: bool,
+    cands: Sequence[Mapping[str, Any]] = (),
+    any_tie: bool = False,
+) -> str:
     rows = []
     title = "Camera positions" if summary else "Candidate camera positions"
     rows.append(f"<h4>{html.escape(title)}</h4>")
     if summary:
         rows.append("<small>best candidate per camera; arrow = heading</small><br>")
+        rows.append("<b>score</b><br>")
+        for _lower, colour, text in SCORE_SCALE:
+            rows.append(
+                f'<span class="sw" style="background:{colour}"></span>{html.escape(text)}<br>'
+            )
+        if any_tie:
+            rows.append(
+                _tie_swatch("#fff") + "best candidate tied with another (see its popup)<br>"
+            )
     else:
-        rows.append("<small>number = rank (1 = most likely); larger = better</small><br>")
-    rows.append("<b>score</b><br>")
-    for _lower, colour, text in SCORE_SCALE:
-        rows.append(f'<span class="sw" style="background:{colour}"></span>{html.escape(text)}<br>')
-    if not summary:
         rows.append(
-            f'<span class="bx" style="background:{score_colour(0.6)};opacity:.45"></span>'
-            "view cone (60 m)<br>"
+            "<small>number = rank (1 = most likely); larger = better; "
+            "colour = rank (Okabe–Ito)</small><br>"
+        )
+        rows.append("<b>rank: score</b><br>")
+        shown = [p for p in cands if isinstance(p.get("rank"), int)][: len(RANK_PALETTE)]
+        for p in shown:
+            rank = int(p["rank"])
+            ties = _ties_of(p)
+            swatch = (
+                _tie_swatch(rank_colour(rank))
+                if ties
+                else f'<span class="sw" style="background:{rank_colour(rank)}"></span>'
+            )
+            tie = f" ≈ tied with {_and(ties)}" if ties else ""
+            rows.append(
+                f'{swatch}<span data-legend-rank="{rank}">{rank}: '
+                f"{_fmt(p.get('score'), digits=3)}{html.escape(tie)}</span><br>"
+            )
+        if len(cands) > len(RANK_PALETTE):
+            rows.append(
+                f'<span class="sw" style="background:{RANK_OTHER}"></span>'
+                f"ranks {len(RANK_PALETTE) + 1}–{len(cands)}<br>"
+            )
+        if any_tie:
+            rows.append(_tie_swatch("#fff") + "dashed ring, ≈: tied (see the banner)<br>")
+        rows.append(
+            f'<span class="bx" style="background:{rank_colour(1)};opacity:.45"></span>'
+            "view cone (60 m), in its candidate's colour<br>"
         )
         if has_corners:
             rows.append(
@@ -239,6 +376,221 @@ def _legend_html(*, scene_id: str | None, has_corners: bool, has_prior: bool, su
             )
     rows.append(f"<small>{html.escape(OSM_ATTRIBUTION)}</small>")
     return "".join(rows)
+
+
+# -------------------------------------------------------------------------------- ties
+_TIE_RULE = (
+    "the weaker scores at least 0.8 of the stronger, yet they stand more than 4 m apart: the "
+    "evidence cannot tell them apart (typically a symmetric junction seen with two corners)"
+)
+_COMPASS: tuple[str, ...] = ("N", "NNE", "NE", "ENE", "E", "ESE", "SE", "SSE")
+_COMPASS += ("S", "SSW", "SW", "WSW", "W", "WNW", "NW", "NNW")
+
+
+def _compass(bearing_deg: Any) -> str | None:
+    """``"NNW (335°)"`` for a bearing; None when there is none."""
+    if not isinstance(bearing_deg, (int, float)) or not math.isfinite(bearing_deg):
+        return None
+    b = float(bearing_deg) % 360.0
+    return f"{_COMPASS[int((b + 11.25) // 22.5) % 16]} ({b:.0f}°)"
+
+
+def _distance_m(a: Mapping[str, Any], b: Mapping[str, Any]) -> float:
+    """Ground distance between two candidates' lat/lon (equirectangular; metres apart)."""
+    lat0 = math.radians((float(a["lat"]) + float(b["lat"])) / 2.0)
+    dn = math.radians(float(a["lat"]) - float(b["lat"])) * 6_371_008.8
+    de = math.radians(float(a["lon"]) - float(b["lon"])) * 6_371_008.8 * math.cos(lat0)
+    return math.hypot(dn, de)
+
+
+def _ties_of(props: Mapping[str, Any]) -> list[int]:
+    """The ranks a candidate ties with (its ``ambiguous_with``; tolerant of odd input)."""
+    raw = props.get("ambiguous_with") or []
+    if isinstance(raw, (int, str)):
+        raw = [raw]
+    out = []
+    for r in raw if isinstance(raw, (list, tuple)) else []:
+        try:
+            out.append(int(r))
+        except (TypeError, ValueError):
+            continue
+    return sorted(set(out) - {props.get("rank")})
+
+
+def _tie_groups(cands: Sequence[Mapping[str, Any]]) -> list[list[int]]:
+    """Ranks that tie, as connected groups of two or more, ordered by their best rank."""
+    ranks = {int(p["rank"]) for p in cands if isinstance(p.get("rank"), int)}
+    parent = {r: r for r in ranks}
+
+    def root(r: int) -> int:
+        while parent[r] != r:
+            r = parent[r]
+        return r
+
+    for p in cands:
+        if not isinstance(p.get("rank"), int):
+            continue
+        for other in _ties_of(p):
+            if other in parent:
+                a, b = root(int(p["rank"])), root(other)
+                parent[max(a, b)] = min(a, b)
+    groups: dict[int, list[int]] = {}
+    for r in sorted(ranks):
+        groups.setdefault(root(r), []).append(r)
+    return sorted((g for g in groups.values() if len(g) >= 2), key=lambda g: g[0])
+
+
+def _and(items: Sequence[Any]) -> str:
+    """``"1 and 2"``, ``"1, 2 and 3"``."""
+    words = [str(i) for i in items]
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def _ambiguity_reasons(collection: Mapping[str, Any]) -> list[str]:
+    """The result's own words on ties: ``ambiguous...`` warnings and an ``ambiguous`` property."""
+    out = [
+        str(w)
+        for w in collection.get("warnings") or []
+        if isinstance(w, str) and w.lower().startswith("ambiguous")
+    ]
+    extra = collection.get("ambiguous")
+    if isinstance(extra, str):
+        out.append(extra)
+    elif isinstance(extra, (list, tuple)):
+        out.extend(str(e) for e in extra if isinstance(e, str))
+    return list(dict.fromkeys(out))
+
+
+def _tie_reason(group: Sequence[int], collection: Mapping[str, Any], *, short: bool = False) -> str:
+    """Why these ranks tie: the result's warning naming them, else the rule (escaped HTML).
+
+    ``short``: only the warning's explanation (after its first ``;``), without the
+    ``ambiguous: candidates 1 and 2 ...`` lead the banner already says.
+    """
+    for w in _ambiguity_reasons(collection):
+        named = {int(n) for n in re.findall(r"\b(\d+)\b", w.split("(", 1)[0])}
+        if set(group[:2]) <= named:
+            text = re.sub(r"^ambiguous:\s*", "", w, flags=re.IGNORECASE)
+            if short and ";" in text:
+                text = text.split(";", 1)[1].strip()
+            return html.escape(text.rstrip(". "))
+    return html.escape(_TIE_RULE)
+
+
+def _flags_text(group: Sequence[int], by_rank: Mapping[int, Mapping[str, Any]]) -> str:
+    flagged = [(r, list(by_rank[r].get("flags") or [])) for r in group]
+    if not any(f for _r, f in flagged):
+        return "none (the map finds nothing implausible about any of them)"
+    return "; ".join(
+        f"{r}: {html.escape(', '.join(str(x) for x in f)) if f else 'none'}" for r, f in flagged
+    )
+
+
+def _tie_hints(group: Sequence[int], by_rank: Mapping[int, Any], scene: Scene | None) -> str:
+    """What evidence would break a tie, one HTML sentence (cues the scene lacks first)."""
+    looks = [c for c in (_compass(by_rank[r].get("heading_deg")) for r in group) if c]
+    items = []
+    given = []
+    if scene is None or scene.view_hint is None:
+        sectors = list({c.split(" ", 1)[0]: c for c in reversed(looks)}.values())[::-1]
+        which = f": does it look {' or '.join(sectors)}?" if len(sectors) >= 2 else ""
+        items.append(f"<code>view_hint</code> (the camera's direction{html.escape(which)})")
+    else:
+        given.append("view_hint")
+    if scene is None or scene.object.street is None:
+        items.append("<code>object.street</code> (the car's street)")
+    else:
+        given.append("object.street")
+    if scene is None or scene.object.front is None:
+        items.append("<code>object.front</code> (the car's front; decides on a one-way street)")
+    else:
+        given.append("object.front")
+    items.append(
+        "a reference pixel with its lat/lon, a landmark, another kerb corner or a tighter "
+        "<code>prior</code>"
+    )
+    head = "<b>To break the tie</b>, add to the scene "
+    if given:
+        head = (
+            f"The scene's {html.escape(_and(given))} did not decide. <b>To break the tie</b>, add "
+        )
+    return head + ", ".join(items[:-1]) + (", or " if len(items) > 1 else "") + items[-1] + "."
+
+
+def _tie_banner(
+    collection: Mapping[str, Any], cands: Sequence[Mapping[str, Any]], scene: Scene | None
+) -> tuple[str, str] | None:
+    """``(html, css_class)`` of the page's tie banner; None when no candidates tie."""
+    groups = _tie_groups(cands)
+    if not groups:
+        return None
+    by_rank = {int(p["rank"]): p for p in cands if isinstance(p.get("rank"), int)}
+    main = groups[0] if groups[0][0] == 1 else None
+    rest = [g for g in groups if g is not main]
+    parts = []
+    if main is not None:
+        scores = [float(by_rank[r].get("score") or 0.0) for r in main]
+        ratio = min(scores) / max(scores) if max(scores) > 0 else 1.0
+        gap = max(_distance_m(by_rank[a], by_rank[b]) for a in main for b in main if a < b)
+        looks = [c for c in (_compass(by_rank[r].get("heading_deg")) for r in main) if c]
+        parts.append(
+            f"<h4>≈ Ambiguous: candidates {_and(main)} fit equally well "
+            f"(score ratio {ratio:.2f})</h4>"
+            f"Scores {' vs '.join(f'{x:.3f}' for x in scores)}, {gap:.0f} m apart"
+            + (f", looking {html.escape(' vs '.join(looks))}" if looks else "")
+            + f". Flags: {_flags_text(main, by_rank)}. Check "
+            + ("them all" if len(main) > 2 else "both")
+            + " before choosing rank 1.<br>"
+            f"<b>Why:</b> {_tie_reason(main, collection, short=True)}.<br>"
+            + _tie_hints(main, by_rank, scene)
+        )
+        css = "camloc-banner"
+    else:
+        parts.append(
+            f"<h4>≈ Candidates {_and(rest[0])} tie with each other</h4>"
+            f"The best candidate (rank 1) is not tied. <b>Why:</b> {html.escape(_TIE_RULE)}."
+        )
+        rest = rest[1:]
+        css = "camloc-banner minor"
+    if rest:
+        shown = ", ".join(" ≈ ".join(str(r) for r in g) for g in rest[:6])
+        top = max(float(by_rank[r].get("score") or 0.0) for g in rest for r in g)
+        parts.append(
+            f"<br><small>Also tied: {shown}{' …' if len(rest) > 6 else ''} "
+            f"(scores at most {top:.3f}).</small>"
+        )
+    head, body = "".join(parts).split("</h4>", 1)
+    return f'{head}</h4><div class="camloc-banner-body">{body}</div>', css
+
+
+def _tie_note(
+    props: Mapping[str, Any],
+    by_rank: Mapping[int, Mapping[str, Any]],
+    collection: Mapping[str, Any],
+) -> str:
+    """The popup's line on a tied candidate: whom it ties with and why (empty if untied)."""
+    others = [r for r in _ties_of(props) if r in by_rank]
+    if not others:
+        return ""
+    rank = int(props.get("rank", 0))
+    score = float(props.get("score") or 0.0)
+    bits = []
+    for r in others:
+        o = by_rank[r]
+        s = float(o.get("score") or 0.0)
+        ratio = min(s, score) / max(s, score) if max(s, score) > 0 else 1.0
+        look = _compass(o.get("heading_deg"))
+        bits.append(
+            f"<b>{r}</b> (score {s:.3f}, ratio {ratio:.2f}, {_distance_m(props, o):.0f} m away"
+            + (f", looking {look}" if look else "")
+            + ")"
+        )
+    word = "candidate" if len(others) == 1 else "candidates"
+    return (
+        f'<div class="camloc-tie">≈ <b>Tied with {word}</b> {_and(bits)}.'
+        f"<br>Why: {_tie_reason(sorted([rank, *others]), collection)}."
+        "</div>"
+    )
 
 
 # ---------------------------------------------------------------------------- geometry
@@ -376,7 +728,7 @@ def _map_layers(
 
 
 def _candidate_popup(
-    props: Mapping[str, Any], image_src: str | None, image_link: str | None
+    props: Mapping[str, Any], image_src: str | None, image_link: str | None, tie_note: str = ""
 ) -> str:
     rows = [
         ("rank", _fmt(props.get("rank"))),
@@ -392,6 +744,7 @@ def _candidate_popup(
         ("residual_m", _fmt(props.get("residual_m"), " m")),
         ("sigma_m", _fmt(props.get("sigma_m"), " m")),
         ("flags", html.escape(_fmt(list(props.get("flags") or [])))),
+        ("ambiguous_with", html.escape(_fmt(_ties_of(props)))),
     ]
     shown = {
         "kind",
@@ -409,6 +762,7 @@ def _candidate_popup(
         "sigma_m",
         "flags",
         "matches",
+        "ambiguous_with",
     }
     for key, value in props.items():
         if key not in shown:
@@ -417,6 +771,7 @@ def _candidate_popup(
     body = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows)
     parts = [
         f'<div class="camloc-popup"><b>Candidate {int(props.get("rank", 0))}</b>',
+        tie_note,
         f"<table>{body}</table>",
     ]
     matches = props.get("matches") or []
@@ -438,12 +793,27 @@ def _candidate_popup(
     return "".join(parts)
 
 
-def _dot_icon(label: str, fill: str, size: int, outline: float, css_class: str) -> folium.DivIcon:
+def _dot_icon(
+    label: str,
+    fill: str,
+    size: int,
+    outline: float,
+    css_class: str,
+    tied_with: Sequence[int] = (),
+) -> folium.DivIcon:
+    """A numbered disc; a tied one sits in a dashed ring with an "≈" badge."""
     text = _text_colour(fill)
     inner = (
-        f'<div class="camloc-dot" data-rank="{html.escape(label)}" style="background:{fill};'
-        f'color:{text};border-width:{outline}px">{html.escape(label)}</div>'
+        f'<div class="camloc-dot" data-rank="{html.escape(label)}" data-fill="{fill}" '
+        f'style="background:{fill};color:{text};border-width:{outline}px">'
+        f"{html.escape(label)}</div>"
     )
+    if tied_with:
+        ties = ",".join(str(int(r)) for r in tied_with)
+        inner = (
+            f'<div class="camloc-tied" data-tied-with="{ties}">{inner}'
+            '<span class="camloc-badge">≈</span></div>'
+        )
     return folium.DivIcon(
         html=inner, icon_size=(size, size), icon_anchor=(size // 2, size // 2), class_name=css_class
     )
@@ -561,7 +931,7 @@ def build_candidates_map(
     for cone in sorted(cones, key=lambda f: -f["properties"]["rank"]):
         rank = int(cone["properties"]["rank"])
         score = float(cone["properties"]["score"])
-        colour = score_colour(score)
+        colour = rank_colour(rank)
         style = {
             "color": colour,
             "weight": 2.5 if rank == 1 else 1.0,
@@ -646,18 +1016,33 @@ def build_candidates_map(
 
     # Candidates last (on top), best drawn above the others.
     fg_cands = folium.FeatureGroup(name="Candidates", show=True)
+    collection = gj["properties"]
+    cand_props = [f["properties"] for f in cands]
+    by_rank = {int(p["rank"]): p for p in cand_props}
+    banner = _tie_banner(collection, cand_props, scene)
     for f in sorted(cands, key=lambda f: -f["properties"]["rank"]):
         p = f["properties"]
         rank = int(p["rank"])
         size, outline, z = rank_style(rank)
         img = (overlay_images or {}).get(rank)
         link = (overlay_links or {}).get(rank)
-        popup = folium.Popup(_candidate_popup(p, img, link), max_width=500 if img else 360)
+        ties = [r for r in _ties_of(p) if r in by_rank]
+        note = _tie_note(p, by_rank, collection)
+        popup = folium.Popup(
+            _candidate_popup(p, img, link, note),
+            max_width=500 if img else 360,
+            auto_pan_padding_top_left=[10, 10 if banner is None else _BANNER_FOLDED_PX],
+        )
+        tip = f"#{rank} score {p['score']:.3f} ({html.escape(str(p['method']))})"
+        if ties:
+            tip += f" ≈ tied with {_and(ties)}"
         folium.Marker(
             [p["lat"], p["lon"]],
-            icon=_dot_icon(str(rank), score_colour(p["score"]), size, outline, "camloc-candidate"),
+            icon=_dot_icon(
+                str(rank), rank_colour(rank), size, outline, "camloc-candidate", tied_with=ties
+            ),
             popup=popup,
-            tooltip=f"#{rank} score {p['score']:.3f} ({html.escape(str(p['method']))})",
+            tooltip=tip,
             z_index_offset=z,
         ).add_to(fg_cands)
     fg_cands.add_to(fmap)
@@ -669,10 +1054,14 @@ def build_candidates_map(
             has_corners=bool(corners),
             has_prior=scene is not None and scene.prior is not None,
             summary=False,
+            cands=cand_props,
+            any_tie=bool(_tie_groups(cand_props)),
         ),
         position="bottomleft",
         css_class="camloc-legend",
     ).add_to(fmap)
+    if banner is not None:
+        _Banner(banner[0], css_class=banner[1]).add_to(fmap)
     cal = gj["properties"]["calibration"]
     title = (
         f"<h4>{html.escape(str(result.scene_id))}</h4>"
@@ -690,7 +1079,11 @@ def build_candidates_map(
         pts.append([f["geometry"]["coordinates"][1], f["geometry"]["coordinates"][0]])
     if len(pts) >= 2:
         arr = np.asarray(pts)
-        fmap.fit_bounds([arr.min(axis=0).tolist(), arr.max(axis=0).tolist()], padding=(40, 40))
+        fmap.fit_bounds(
+            [arr.min(axis=0).tolist(), arr.max(axis=0).tolist()],
+            padding_top_left=(40, 40 if banner is None else _BANNER_PX + 20),
+            padding_bottom_right=(40, 40),
+        )
     return fmap
 
 
@@ -861,16 +1254,47 @@ def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
     return min(cands, key=lambda f: f["properties"].get("rank", 1 << 30)), reason
 
 
-def _arrow_icon(heading: float | None, fill: str, css_class: str) -> folium.DivIcon:
+def _arrow_icon(
+    heading: float | None, fill: str, css_class: str, tied: bool = False
+) -> folium.DivIcon:
+    """A heading arrow (a dot without heading); a tied camera's in a dashed ring with "≈"."""
     if heading is None or not math.isfinite(heading):
         shape = '<circle r="6" />'
     else:
         shape = f'<path transform="rotate({heading:.1f})" d="M0,-11 L6,6 L0,2 L-6,6 Z" />'
+    ring = ""
+    size = 26
+    if tied:
+        size = 36
+        ring = (
+            f'<circle r="16" fill="rgba(255,255,255,0.7)" stroke="{TIE_RING}" '
+            'stroke-width="2.5" stroke-dasharray="5 3" />'
+        )
+    h = size // 2
     svg = (
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="26" height="26" viewBox="-13 -13 26 26">'
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{size}" '
+        f'viewBox="-{h} -{h} {size} {size}">{ring}'
         f'<g fill="{fill}" stroke="#111" stroke-width="1.5">{shape}</g></svg>'
     )
-    return folium.DivIcon(html=svg, icon_size=(26, 26), icon_anchor=(13, 13), class_name=css_class)
+    if tied:
+        svg = (
+            f'<div class="camloc-tied-arrow" data-tied="1">{svg}'
+            '<span class="camloc-badge">≈</span></div>'
+        )
+    return folium.DivIcon(
+        html=svg, icon_size=(size, size), icon_anchor=(h, h), class_name=css_class
+    )
+
+
+def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
+    """How a camera's best candidate is tied, for its popup; None when it is not."""
+    others = _ties_of(props)
+    if others:
+        word = "candidate" if len(others) == 1 else "candidates"
+        return f"tied with {word} {_and(others)}"
+    if "tie" in [str(f) for f in props.get("flags") or []]:
+        return "tied with another candidate" + (f": {reason}" if reason else "")
+    return None
 
 
 def build_summary_map(
@@ -898,14 +1322,17 @@ def build_summary_map(
         A map to draw under the cameras (its streets and buildings within 500 m of its
         centre): the only context an offline page has.
     """
-    rows = []
+    rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
+    reasons: dict[int, str | None] = {}
     for scene_id, item in items:
         best, reason = _best_feature(item)
         if best is None:
             missing.append((scene_id, reason))
         else:
+            reasons[len(rows)] = reason
             rows.append((scene_id, best))
+    ties = {i: _summary_tie(f["properties"], reasons[i]) for i, (_s, f) in enumerate(rows)}
     if rows:
         lats = np.array([f["properties"]["lat"] for _s, f in rows])
         lons = np.array([f["properties"]["lon"] for _s, f in rows])
@@ -923,8 +1350,11 @@ def build_summary_map(
         parent = MarkerCluster(name="Cameras (best candidate)")
     else:
         parent = folium.FeatureGroup(name="Cameras (best candidate)")
-    for scene_id, f in sorted(rows, key=lambda r: r[1]["properties"].get("score", 0.0)):
+    order = sorted(range(len(rows)), key=lambda i: rows[i][1]["properties"].get("score", 0.0))
+    for i in order:
+        scene_id, f = rows[i]
         p = f["properties"]
+        tie = ties[i]
         body = "".join(
             f"<tr><th>{k}</th><td>{v}</td></tr>"
             for k, v in (
@@ -941,8 +1371,14 @@ def build_summary_map(
                 ("flags", html.escape(_fmt(list(p.get("flags") or [])))),
             )
         )
+        note = ""
+        if tie:
+            note = (
+                f'<div class="camloc-tie">≈ <b>{html.escape(tie)}</b>: the best candidate '
+                "is not more likely than that one; see the camera's review page</div>"
+            )
         popup = folium.Popup(
-            f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>'
+            f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>{note}'
             f"<table>{body}</table></div>",
             max_width=320,
         )
@@ -950,18 +1386,31 @@ def build_summary_map(
             [p["lat"], p["lon"]],
             popup=popup,
             icon=_arrow_icon(
-                p.get("heading_deg"), score_colour(p.get("score", 0.0)), "camloc-summary-marker"
+                p.get("heading_deg"),
+                score_colour(p.get("score", 0.0)),
+                "camloc-summary-marker",
+                tied=tie is not None,
             ),
-            tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})",
+            tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})"
+            + (f" ≈ {html.escape(tie)}" if tie else ""),
         ).add_to(parent)
     parent.add_to(fmap)
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _Control(
-        _legend_html(scene_id=None, has_corners=False, has_prior=False, summary=True),
+        _legend_html(
+            scene_id=None,
+            has_corners=False,
+            has_prior=False,
+            summary=True,
+            any_tie=any(t is not None for t in ties.values()),
+        ),
         position="bottomleft",
         css_class="camloc-legend",
     ).add_to(fmap)
     title = f"<h4>{len(rows)} camera(s) located</h4>"
+    n_tied = sum(t is not None for t in ties.values())
+    if n_tied:
+        title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
         title += (
             f"{len(missing)} without candidates: "

@@ -48,10 +48,24 @@ def pages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     scene, res = located(md, 0)
     _s2, res2 = located(md, 2)
     cand = maps.candidates_map(res, md, out / "candidates.html", offline=True, scene=scene)
+    from camloc_geo.api import locate_scene
+
+    samples = Path(__file__).resolve().parents[1] / "sample_maps"
+    tie = locate_scene(samples / "sample_scene.json", map_source=samples / "baltimore.osm.pbf")
+    assert tie.result.candidates[0].ambiguous_with == [2]
+    tied = maps.candidates_map(
+        tie.result, tie.map_data, out / "tied.html", offline=True, scene=tie.scene
+    )
     summary = maps.summary_map(
         [(res.scene_id, res), ("other", res2)], out / "summary.html", offline=True, map_data=md
     )
-    return {"candidates": cand, "summary": summary, "result": res}
+    return {
+        "candidates": cand,
+        "summary": summary,
+        "result": res,
+        "tied": tied,
+        "tied_result": tie.result,
+    }
 
 
 class _Page:
@@ -154,5 +168,94 @@ def test_summary_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> None:
     assert "method" in text
     assert "camera" in text
     page.screenshot(path=str(ARTIFACTS / "summary_map.png"))
+    assert tab.blocked == []
+    assert tab.errors == []
+
+
+def _box(page: Any, selector: str) -> dict[str, float]:
+    box = page.locator(selector).first.bounding_box()
+    assert box is not None, selector
+    return dict(box)
+
+
+def _overlap(a: dict[str, float], b: dict[str, float]) -> bool:
+    return (
+        a["x"] < b["x"] + b["width"]
+        and b["x"] < a["x"] + a["width"]
+        and a["y"] < b["y"] + b["height"]
+        and b["y"] < a["y"] + a["height"]
+    )
+
+
+def test_tied_candidates_are_marked_and_explained(
+    tab: _Page, pages: dict[str, Any], tmp_path: Path
+) -> None:
+    res = pages["tied_result"]
+    tab.open(pages["tied"], ".camloc-candidate")
+    page = tab.page
+    banner = page.locator(".camloc-banner")
+    assert banner.count() == 1
+    assert banner.is_visible()
+    text = banner.inner_text()
+    assert "Ambiguous: candidates 1 and 2 fit equally well" in text
+    assert "symmetric junction" in text
+    assert "view_hint" in text
+    # the two tied markers: different fill colours, both in the dashed ring with the badge
+    fills = page.evaluate(
+        """() => [1, 2, 3].map(r => getComputedStyle(
+            document.querySelector(`.camloc-candidate [data-rank="${r}"]`)).backgroundColor)"""
+    )
+    assert fills[0] == "rgb(0, 114, 178)"  # Okabe-Ito blue
+    assert fills[1] == "rgb(230, 159, 0)"  # Okabe-Ito orange
+    assert len(set(fills)) == 3
+    for rank in (1, 2):
+        ring = page.locator(f'.camloc-tied:has([data-rank="{rank}"])')
+        assert ring.count() == 1
+        assert ring.locator(".camloc-badge").is_visible()
+        style = page.evaluate(
+            """r => getComputedStyle(document.querySelector(
+                `.camloc-tied:has([data-rank="${r}"])`), "::before").borderTopStyle""",
+            rank,
+        )
+        assert style == "dashed"
+        # the page is fitted so that the banner hides neither tied candidate
+        assert not _overlap(_box(page, f'[data-rank="{rank}"]'), _box(page, ".camloc-banner"))
+    assert page.locator('.camloc-tied:has([data-rank="3"])').count() == 0
+    ARTIFACTS.mkdir(exist_ok=True)
+    shot = tmp_path / "tied_map.png"
+    page.screenshot(path=str(shot))
+    page.screenshot(path=str(ARTIFACTS / "tied_map.png"))
+    assert shot.stat().st_size > 10_000
+    # a tied candidate's popup names the other and why; the banner folds to its headline
+    page.locator('.camloc-candidate [data-rank="2"]').click()
+    popup = tab.popup_text()
+    assert "Tied with candidate 1 (score" in popup
+    assert f"{res.candidates[0].score:.3f}" in popup
+    assert "symmetric junction" in popup
+    assert banner.locator("h4").is_visible()
+    assert not banner.locator(".camloc-banner-body").is_visible()
+    page.screenshot(path=str(ARTIFACTS / "tied_map_popup.png"))
+    page.locator(".leaflet-popup-close-button").click()
+    page.wait_for_function(
+        "!document.querySelector('.camloc-banner').classList.contains('folded')", timeout=3000
+    )
+    assert banner.locator(".camloc-banner-body").is_visible()
+    assert tab.blocked == []
+    assert tab.errors == []
+
+
+def test_summary_map_rings_a_tied_camera(tab: _Page, pages: dict[str, Any], tmp_path: Path) -> None:
+    tie = pages["tied_result"]
+    out = maps.summary_map(
+        [("tied-cam", tie), ("clear-cam", pages["result"])], tmp_path / "s.html", offline=True
+    )
+    tab.open(out, ".camloc-summary-marker")
+    page = tab.page
+    assert page.locator(".camloc-summary-marker").count() == 2
+    assert page.locator(".camloc-summary-marker .camloc-tied-arrow").count() == 1
+    page.locator(".camloc-summary-marker .camloc-tied-arrow").click()
+    text = tab.popup_text()
+    assert "tied with candidate 2" in text
+    assert "tied-cam" in text
     assert tab.blocked == []
     assert tab.errors == []

@@ -314,3 +314,203 @@ def test_page_without_candidates_says_why(
     assert div_icons(text, "camloc-candidate") == []
     assert "no candidates" in text
     assert "every candidate misfits" in text
+
+
+# ------------------------------------------------------------------------------- ties
+BALTIMORE_SCENE = SAMPLES / "sample_scene.json"  # a symmetric junction seen with 3 corners
+
+
+@pytest.fixture(scope="module")
+def tied() -> Any:
+    """The sample scene at Eastern Ave × S Broadway: candidates 1 and 2 tie, 60 m apart."""
+    from camloc_geo.api import locate_scene
+
+    out = locate_scene(BALTIMORE_SCENE, map_source=SAMPLES / "baltimore.osm.pbf")
+    res = out.result
+    assert res.candidates[0].ambiguous_with == [2]
+    assert res.candidates[1].ambiguous_with == [1]
+    assert any(w.startswith("ambiguous: candidates 1 and 2") for w in res.warnings)
+    return out
+
+
+@pytest.fixture(scope="module")
+def tied_page(tmp_path_factory: pytest.TempPathFactory, tied: Any) -> str:
+    out = tmp_path_factory.mktemp("ties") / "tie.html"
+    maps.candidates_map(tied.result, tied.map_data, out, offline=True, scene=tied.scene)
+    return out.read_text(encoding="utf-8")
+
+
+def candidate_icon(page: str, rank: int) -> str:
+    """The DivIcon HTML of the candidate marker labelled ``rank``."""
+    found = [h for h in div_icons(page, "camloc-candidate") if f'data-rank="{rank}"' in h]
+    assert len(found) == 1, rank
+    return found[0]
+
+
+def banner_html(page: str) -> str | None:
+    """The tie banner's HTML (the JSON string the page's script puts into it), if any."""
+    m = re.search(
+        r'L\.DomUtil\.create\(\s*"div",\s*"(camloc-banner[^"]*)",'
+        r'.*?div\.innerHTML = ("(?:[^"\\]|\\.)*");',
+        page,
+        flags=re.DOTALL,
+    )
+    return None if m is None else f"{m.group(1)}|{json.loads(m.group(2))}"
+
+
+def popup_of(page: str, rank: int) -> str:
+    """The popup HTML of candidate ``rank`` (folium puts it in a div of its own)."""
+    starts = [m.start() for m in re.finditer(r"<b>Candidate \d+</b>", page)]
+    for s in starts:
+        if page.startswith(f"<b>Candidate {rank}</b>", s):
+            end = page.find("</table>", s)
+            return page[s:end]
+    raise AssertionError(f"no popup of candidate {rank}")
+
+
+def test_rank_colours_are_distinct_okabe_ito() -> None:
+    colours = [maps.rank_colour(r) for r in range(1, 9)]
+    assert len(set(colours)) == 8
+    assert colours[0] == "#0072B2"  # blue
+    assert colours[1] == "#E69F00"  # orange
+    assert maps.rank_colour(9) == maps.rank_colour(40) == maps.RANK_OTHER
+    assert maps.RANK_OTHER not in colours
+
+
+def test_tied_candidates_differ_in_colour_and_wear_the_tie_ring(tied_page: str, tied: Any) -> None:
+    one, two, three = (candidate_icon(tied_page, r) for r in (1, 2, 3))
+    assert f"background:{maps.rank_colour(1)}" in one
+    assert f"background:{maps.rank_colour(2)}" in two
+    assert maps.rank_colour(1) != maps.rank_colour(2)
+    assert 'class="camloc-tied" data-tied-with="2"' in one
+    assert 'class="camloc-tied" data-tied-with="1"' in two
+    assert "camloc-badge" in one
+    assert "camloc-badge" in two
+    assert tied.result.candidates[2].ambiguous_with == []
+    assert "camloc-tied" not in three
+    assert "camloc-badge" not in three
+    # the view cones of ranks 1 and 2 are drawn in their candidate's colour
+    for rank in (1, 2):
+        colour = maps.rank_colour(rank)
+        assert f'return {{"color": "{colour}", "fillColor": "{colour}"' in tied_page, rank
+    assert remote_references(tied_page) == []
+
+
+def test_tie_banner_says_which_why_and_what_decides(tied_page: str, tied: Any) -> None:
+    banner = banner_html(tied_page)
+    assert banner is not None
+    css, text = banner.split("|", 1)
+    assert css == "camloc-banner"
+    assert "Ambiguous: candidates 1 and 2 fit equally well" in text
+    c1, c2 = tied.result.candidates[:2]
+    assert f"score ratio {min(c1.score, c2.score) / max(c1.score, c2.score):.2f}" in text
+    assert f"{c1.score:.3f} vs {c2.score:.3f}" in text
+    # why: the engine's own warning, and the candidates' (empty) flags
+    assert "a symmetric junction cannot tell them apart" in text
+    assert "Flags: none" in text
+    # the sample scene has no view hint, street or front: each is suggested, with the two
+    # viewing directions the hint would have to choose between
+    scene = tied.scene
+    assert scene.view_hint is None
+    assert scene.object.street is None
+    assert "<code>view_hint</code>" in text
+    assert "<code>object.street</code>" in text
+    assert "<code>object.front</code>" in text
+    assert "NNW (335°) or SSE (155°)" in text
+    # the lower-ranked pairs that tie (all at a score near 0) are listed, not headlined
+    assert "Also tied: 5 ≈ 6, 7 ≈ 8" in text
+
+
+def test_tied_popups_name_the_ranks_and_why(tied_page: str) -> None:
+    two = popup_of(tied_page, 2)
+    assert "Tied with candidate</b> <b>1</b> (score 0.37" in two
+    assert "60 m away, looking NNW (335°)" in two
+    assert "a symmetric junction cannot tell them apart" in two
+    assert "<tr><th>ambiguous_with</th><td>1</td></tr>" in two
+    three = popup_of(tied_page, 3)
+    assert "Tied with" not in three
+    assert "<tr><th>ambiguous_with</th><td>none</td></tr>" in three
+
+
+def test_banner_exactly_when_candidates_tie(tied: Any, offline_page: str) -> None:
+    import copy
+
+    res = copy.deepcopy(tied.result)
+    # only lower ranks tie: a quieter banner that says the best is not tied
+    res.candidates[0].ambiguous_with = []
+    res.candidates[1].ambiguous_with = []
+    res.warnings = []
+    page = maps.build_candidates_map(res, None, offline=True).get_root().render()
+    banner = banner_html(page)
+    assert banner is not None
+    assert banner.startswith("camloc-banner minor|")
+    assert "Candidates 5 and 6 tie with each other" in banner
+    assert "The best candidate (rank 1) is not tied" in banner
+    assert "camloc-tied" not in candidate_icon(page, 1)
+    # no tie at all: no banner, no ring
+    for c in res.candidates:
+        c.ambiguous_with = []
+    page = maps.build_candidates_map(res, None, offline=True).get_root().render()
+    assert banner_html(page) is None
+    assert not any("camloc-tied" in h for h in div_icons(page, "camloc-candidate"))
+    # and the Fremantle page has a banner exactly when its result has ties
+    assert (banner_html(offline_page) is not None) == bool(
+        re.search(r'data-tied-with="\d', offline_page)
+    )
+
+
+def test_banner_hints_follow_the_scene_cues(tied: Any) -> None:
+    from camloc_geo.scene import ViewHint
+
+    scene = tied.scene.model_copy(
+        update={
+            "view_hint": ViewHint(bearing_deg=90.0, tolerance_deg=20.0),
+            "object": tied.scene.object.model_copy(update={"street": "Eastern Avenue"}),
+        }
+    )
+    page = maps.build_candidates_map(tied.result, None, scene=scene, offline=True)
+    text = banner_html(page.get_root().render())
+    assert text is not None
+    assert "The scene's view_hint and object.street did not decide" in text
+    assert "<code>view_hint</code>" not in text
+    assert "<code>object.front</code>" in text
+
+
+def test_summary_map_marks_a_tied_best_candidate(tmp_path: Path, tied: Any) -> None:
+    import copy
+
+    gj = candidates_geojson(tied.result)
+    clear = copy.deepcopy(gj)
+    for f in clear["features"]:
+        if f["properties"].get("kind") == "candidate":
+            f["properties"]["ambiguous_with"] = []
+    batch_row = {  # a batch journal row: a tie flag, no ambiguous_with
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": 1,
+                    "lat": 39.28,
+                    "lon": -76.59,
+                    "score": 0.5,
+                    "method": "title (ambiguous)",
+                    "flags": ["ambiguous", "tie"],
+                },
+            }
+        ],
+        "properties": {"reason": "two places match the title equally well"},
+    }
+    items = [("cam-tied", gj), ("cam-clear", clear), ("cam-title", batch_row)]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert remote_references(page) == []
+    icons = div_icons(page, "camloc-summary-marker")
+    assert len(icons) == 3
+    assert sum("camloc-tied-arrow" in h and "stroke-dasharray" in h for h in icons) == 2
+    assert "≈ <b>tied with candidate 2</b>" in page
+    assert "tied with another candidate: two places match the title equally well" in page
+    assert "cam-tied (0.37) ≈ tied with candidate 2" in page  # tooltip
+    assert "2 with a tied best candidate" in page
+    assert "cam-clear (0.37)" in page
+    assert "cam-clear (0.37) ≈" not in page

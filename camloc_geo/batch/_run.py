@@ -590,6 +590,8 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
             "height_m": r.get("height_m"),
             "sigma_m": r.get("uncertainty_m"),
             "flags": ([r["status"]] + (["tie"] if r.get("tie") else [])),
+            # a located camera's tie is always its candidates 1 and 2 (the engine's warning)
+            "ambiguous_with": [2] if r.get("tie") and r["status"] == "located" else [],
         }
         yield (
             label,
