@@ -81,6 +81,13 @@ class CalibrationSettings:
         Annotation noise, as fractions of the image diagonal.
     size_sigma_rel
         Relative error of a preset object size (added to the uncertainty).
+    focal_prior_width, focal_prior_sigma_log
+        A weak log-normal prior on the focal length: median ``focal_prior_width`` image
+        widths (0.75: a 67° horizontal field of view), ``focal_prior_sigma_log`` its spread
+        in natural log units (0.5: a factor 1.65 at one sigma, so 35-110° lie within one
+        sigma). It is used only where the annotations alone leave the focal length loose
+        (its 1-sigma relative uncertainty above ``focal_prior_when_sigma_log``, 10 %: a
+        vanishing point near infinity), so well-determined fits are unbiased; 0 turns it off.
     cluster_threshold_rel, cluster_threshold_min_m
         Candidates closer than ``max(min_m, rel × median camera distance)`` are linked.
     outlier_weight
@@ -91,6 +98,9 @@ class CalibrationSettings:
     sigma_point_rel: float = 0.0015
     sigma_line_rel: float = 0.0010
     size_sigma_rel: float = 0.05
+    focal_prior_width: float = 0.75
+    focal_prior_sigma_log: float = 0.5
+    focal_prior_when_sigma_log: float = 0.1
     cluster_threshold_rel: float = 0.15
     cluster_threshold_min_m: float = 1.5
     outlier_weight: float = 0.3
@@ -580,6 +590,9 @@ class _JointProblem:
         self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
         self.weights = np.ones(self.n_annotators)
         self.f_bounds = (0.15 * width, 15.0 * width)
+        # A weak log-normal prior on the focal length (settings.focal_prior_sigma_log; 0 = none).
+        self.log_f_prior = math.log(settings.focal_prior_width * width)
+        self.log_f_prior_sigma = 0.0  # switched on by _joint where the data leave f loose
         self.log_f_bounds = (math.log(self.f_bounds[0]), math.log(self.f_bounds[1]))
         self.image_wh = (float(width), float(height))
 
@@ -701,6 +714,9 @@ class _JointProblem:
         wpt = self._w_pt / self._sigma_pt_each
         u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * wpt
         v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * wpt
+        if f_fixed is None and self.log_f_prior_sigma > 0.0:
+            r_f = (np.log(f) - self.log_f_prior)[:, None] / self.log_f_prior_sigma
+            return np.concatenate([r_seg, u, v, r_f], axis=1)
         return np.concatenate([r_seg, u, v], axis=1)
 
     @property
@@ -726,7 +742,7 @@ class _JointProblem:
         self.weights = saved
         n_seg, n_pt = len(self.segments), len(self.pt_pix)
         sq_seg = r[:n_seg] ** 2
-        sq_pt = r[n_seg : n_seg + n_pt] ** 2 + r[n_seg + n_pt :] ** 2
+        sq_pt = r[n_seg : n_seg + n_pt] ** 2 + r[n_seg + n_pt : n_seg + 2 * n_pt] ** 2
         num = np.bincount(self.seg_ann, sq_seg, self.n_annotators) + np.bincount(
             self.pt_ann, sq_pt, self.n_annotators
         )
@@ -1733,6 +1749,13 @@ def _joint(
     if settings.reassign_corners:
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed)
+    if f_fixed is None and settings.focal_prior_sigma_log > 0.0:
+        # Where the lines leave the focal length loose (a vanishing point near infinity),
+        # the weak prior decides; where they fix it, it is not used (no bias).
+        sig_log_f = _param_sigma(res, slice(0, 1))
+        if sig_log_f is None or sig_log_f > settings.focal_prior_when_sigma_log:
+            prob.log_f_prior_sigma = settings.focal_prior_sigma_log
+            res = _fit(prob, res.x, R0, pp_fixed, f_fixed)
     chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
     free_pp = settings.free_principal_point
     n_res = len(res.fun)
@@ -1808,7 +1831,7 @@ def _joint(
     r = prob.residuals(res.x, R0, pp_model, f_fixed)
     n_seg = len(prob.segments)
     rms_seg = float(np.sqrt(np.mean(r[:n_seg] ** 2))) * prob.sigma_line
-    rms_pt = float(np.sqrt(np.mean(r[n_seg:] ** 2))) * prob.sigma_pt
+    rms_pt = float(np.sqrt(np.mean(r[n_seg : n_seg + 2 * len(prob.pt_pix)] ** 2))) * prob.sigma_pt
     if pp_model is None:
         method, reason = (
             "joint_fit_free_principal_point",
