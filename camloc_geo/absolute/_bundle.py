@@ -44,12 +44,17 @@ from camloc_geo.camera import Camera
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult, JointState
 
-__all__ = ["MAX_ANNOTATION_COST_RISE", "bundle_adjust"]
+__all__ = ["MAX_ANNOTATION_COST_RISE", "MIN_MATCHED_POINTS", "bundle_adjust"]
 
 FloatArray = npt.NDArray[np.float64]
 
 MAX_ANNOTATION_COST_RISE = 30.0
 """Largest rise of the annotations' chi-square the map may force (in squared sigmas)."""
+
+MIN_MATCHED_POINTS = 3
+"""Fewer matched map points add no redundancy beyond the similarity's four parameters: two
+points fit any camera exactly, and the bundle would only wander along the flat valley of
+the similarity's rotation (measured: it moved two-corner candidates by up to 8 m)."""
 
 _F_SCALE = 2.5
 
@@ -91,14 +96,14 @@ def bundle_adjust(
     -------
     Candidate
         A copy with ``camera``, ``enu_from_world`` and ``sigma_m`` from the bundle, or
-        ``cand`` itself when there is no joint state, fewer than two matched map points, or
-        the bundle is not trustworthy.
+        ``cand`` itself when there is no joint state, fewer than :data:`MIN_MATCHED_POINTS`
+        matched map points, or the bundle is not trustworthy.
     """
     state = calibration.joint_state
     if state is None:
         return cand
     obs_q = _matched_points(cand, ev)
-    if len(obs_q) < 2:
+    if len(obs_q) < MIN_MATCHED_POINTS:
         return cand
     prob = state.problem
     saved_weights = prob.weights
