@@ -88,6 +88,10 @@ class CalibrationSettings:
         sigma). It is used only where the annotations alone leave the focal length loose
         (its 1-sigma relative uncertainty above ``focal_prior_when_sigma_log``, 10 %: a
         vanishing point near infinity), so well-determined fits are unbiased; 0 turns it off.
+    focal_prior_when_sigma_log, focal_prior_basin_widths
+        When the prior is used: the focal length's relative 1-sigma above the first, or a
+        focal length above the second (image widths) that a fit started at the prior's
+        focal length beats in a MAP comparison (see ``_focal_prior``).
     cluster_threshold_rel, cluster_threshold_min_m
         Candidates closer than ``max(min_m, rel × median camera distance)`` are linked.
     outlier_weight
@@ -101,6 +105,7 @@ class CalibrationSettings:
     focal_prior_width: float = 0.75
     focal_prior_sigma_log: float = 0.5
     focal_prior_when_sigma_log: float = 0.1
+    focal_prior_basin_widths: float = 4.0
     cluster_threshold_rel: float = 0.15
     cluster_threshold_min_m: float = 1.5
     outlier_weight: float = 0.3
@@ -1687,6 +1692,62 @@ def _param_sigma(res: Any, sl: slice) -> float | None:
     return float(np.sqrt(np.max(np.clip(np.diag(cov)[sl], 0, None))))
 
 
+def _weighted_cost(
+    prob: _JointProblem, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None
+) -> float:
+    """Soft-L1 cost of the residuals as fitted (annotator weights and prior as set)."""
+    r = prob.residuals(x, R0, pp_fixed, None)
+    z = (r / _F_SCALE) ** 2
+    return float(np.sum(2.0 * (np.sqrt(1.0 + z) - 1.0)))
+
+
+def _focal_prior(
+    prob: _JointProblem,
+    res: Any,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float],
+    settings: CalibrationSettings,
+) -> Any:
+    """The fit with the weak focal-length prior where the annotations need it.
+
+    Two cases, both leaving a well-determined fit untouched (no bias):
+
+    - the annotations leave the focal length loose (1-sigma above
+      ``focal_prior_when_sigma_log``): refit with the prior;
+    - a second basin: a telephoto camera far away and a normal lens nearby can explain a car
+      seen almost side-on equally well (one vanishing point near infinity), and the fit may
+      sit tightly in the wrong one (measured: 14x the true focal length, "1 %" sigma). When
+      the fit's focal length exceeds ``focal_prior_basin_widths`` image widths (a field of
+      view under 14°), a fit started at the prior's focal length (the camera moved in
+      proportion) is kept if it lands more than 20 % away and its cost with the prior (a
+      MAP comparison) is lower.
+    """
+    sigma = settings.focal_prior_sigma_log
+    sig_log_f = _param_sigma(res, slice(0, 1))
+    if sig_log_f is None or sig_log_f > settings.focal_prior_when_sigma_log:
+        prob.log_f_prior_sigma = sigma
+        return _fit(prob, res.x, R0, pp_fixed, None)
+    if float(res.x[0]) < math.log(settings.focal_prior_basin_widths * prob.image_wh[0]):
+        return res  # an ordinary lens, well determined: the data alone
+    prob.log_f_prior_sigma = sigma
+    cost_data_basin = _weighted_cost(prob, res.x, R0, pp_fixed)
+    x_b = np.asarray(res.x, dtype=float).copy()
+    x_b[0] = prob.log_f_prior
+    x_b[-3:] *= math.exp(prob.log_f_prior - float(res.x[0]))
+    try:
+        res_b = _fit(prob, x_b, R0, pp_fixed, None)
+    except (np.linalg.LinAlgError, ValueError):
+        res_b = None
+    if (
+        res_b is not None
+        and abs(float(res_b.x[0]) - float(res.x[0])) > 0.2
+        and _weighted_cost(prob, res_b.x, R0, pp_fixed) < cost_data_basin
+    ):
+        return res_b
+    prob.log_f_prior_sigma = 0.0
+    return res
+
+
 def _cauchy_weights(rms: FloatArray) -> FloatArray:
     scale = max(1.0, float(np.median(rms)))
     w = 1.0 / (1.0 + (rms / (2.0 * scale)) ** 2)
@@ -1750,12 +1811,7 @@ def _joint(
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed)
     if f_fixed is None and settings.focal_prior_sigma_log > 0.0:
-        # Where the lines leave the focal length loose (a vanishing point near infinity),
-        # the weak prior decides; where they fix it, it is not used (no bias).
-        sig_log_f = _param_sigma(res, slice(0, 1))
-        if sig_log_f is None or sig_log_f > settings.focal_prior_when_sigma_log:
-            prob.log_f_prior_sigma = settings.focal_prior_sigma_log
-            res = _fit(prob, res.x, R0, pp_fixed, f_fixed)
+        res = _focal_prior(prob, res, R0, pp_fixed, settings)
     chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
     free_pp = settings.free_principal_point
     n_res = len(res.fun)
