@@ -5,10 +5,13 @@ into the repository: a random pole camera (height 5-10 m, 14-24 m from the refer
 horizontal field of view 55-80°), ``--size`` frames (default 1280×720) at 25 or 30 fps with
 2 px sensor noise and MJPG compression, a textured road, the scene's parked car, and two
 vehicles (random speed 20-100 km/h, along the road either way or along the cross street)
-passing about 2.5 s apart. The scene is the camera's noise-free annotation, so the
+passing about 2.5 s apart, each a car, a small car, an SUV, a van or a truck (the radar's
+cuboid prior is the car). The scene is the camera's noise-free annotation, so the
 calibration is exact and the errors are the radar's own.
 
-Three runs per video, all with ``cv2.setNumThreads(1)`` (one core):
+Three runs per video, all with ``cv2.setNumThreads(1)`` (one core; frames per second are
+counted on the process's CPU time, which other sessions sharing the machine do not inflate,
+and also on the wall clock):
 
 - ``detection``: background subtraction finds the vehicles;
 - ``tracks``: the exact boxes given (a perfect detector/tracker);
@@ -54,6 +57,13 @@ PAPER_REL = 0.15
 BEST_PUBLISHED_MEAN_KMH = {"Sochor et al. 2017 (BrnoCompSpeed)": 1.10, "Kocur 2020": 0.75}
 PERCENTILES = (50, 80, 90, 95)
 COLOURS = [(40, 40, 180), (160, 60, 30), (40, 160, 40), (30, 160, 200), (120, 40, 120)]
+SIZES_M = {  # length, width, height: the radar's cuboid prior is the first one
+    "car": (4.5, 1.8, 1.5),
+    "small": (3.7, 1.65, 1.45),
+    "suv": (4.8, 1.95, 1.75),
+    "van": (5.3, 2.0, 2.4),
+    "truck": (9.0, 2.5, 3.3),
+}
 
 
 def _video(rng: np.random.Generator, i: int, size: tuple[int, int], folder: Path) -> SyntheticVideo:
@@ -70,12 +80,14 @@ def _video(rng: np.random.Generator, i: int, size: tuple[int, int], folder: Path
     for k in range(2):
         kind = rng.integers(3)
         direction, centre = [(0.0, (4.0, -4.0)), (180.0, (6.0, -8.0)), (90.0, (14.0, -6.0))][kind]
+        kind_name = list(SIZES_M)[int(rng.integers(len(SIZES_M)))]
         vehicles.append(
             SyntheticVehicle(
                 centre,
                 direction,
                 float(rng.uniform(20.0, 100.0)),
                 start_s=1.2 + 2.5 * k,
+                size_m=SIZES_M[kind_name],
                 colour=COLOURS[int(rng.integers(len(COLOURS)))],
             )
         )
@@ -107,6 +119,7 @@ def _match(video: SyntheticVideo, result: RadarResult, mode: str, i: int) -> lis
                 "mode": mode,
                 "vehicle": k,
                 "true_kmh": true,
+                "size_m": list(video.vehicles[k].size_m),
                 "speed_kmh": v.speed_kmh,
                 "sigma_kmh": v.sigma_kmh,
                 "error_kmh": v.speed_kmh - true,
@@ -152,6 +165,8 @@ def main(argv: list[str] | None = None) -> int:
     rows: list[dict[str, Any]] = []
     recall: dict[str, list[bool]] = {"detection": [], "tracks": [], "tracks_noisy": []}
     speed: dict[str, list[float]] = {"detection": [], "tracks": [], "tracks_noisy": []}
+    wall: dict[str, list[float]] = {"detection": [], "tracks": [], "tracks_noisy": []}
+    realtime: dict[str, list[float]] = {"detection": [], "tracks": [], "tracks_noisy": []}
     frames_total = 0
     with tempfile.TemporaryDirectory(prefix="camloc-radar-") as tmp:
         for i in range(args.n):
@@ -165,9 +180,11 @@ def main(argv: list[str] | None = None) -> int:
             }
             runs = {"detection": None, "tracks": video.boxes, "tracks_noisy": noisy}
             for mode, tracks in runs.items():
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 res = measure_speeds(cal, video.path, tracks=tracks, image_size=(w, h))
-                speed[mode].append(video.n_frames / (time.perf_counter() - t0))
+                wall[mode].append(video.n_frames / (time.perf_counter() - t0))
+                speed[mode].append(video.n_frames / (time.process_time() - c0))
+                realtime[mode].append(speed[mode][-1] / video.fps)
                 got = _match(video, res, mode, i)
                 rows.extend(got)
                 for k, per in video.boxes.items():
@@ -191,9 +208,11 @@ def main(argv: list[str] | None = None) -> int:
         summary[mode] = {
             **_stats(sel),
             "recall": round(float(np.mean(recall[mode])), 3) if recall[mode] else None,
-            "processing_fps_median": round(float(np.median(speed[mode])), 1),
-            "processing_fps_min": round(float(np.min(speed[mode])), 1),
-            "faster_than_real_time": bool(np.min(speed[mode]) > 30.0),
+            "cpu_fps_median": round(float(np.median(speed[mode])), 1),
+            "cpu_fps_min": round(float(np.min(speed[mode])), 1),
+            "wall_fps_median": round(float(np.median(wall[mode])), 1),
+            "times_real_time_min": round(float(np.min(realtime[mode])), 2),
+            "faster_than_real_time": bool(np.min(realtime[mode]) > 1.0),
         }
     OUT_DIR.mkdir(exist_ok=True)
     (OUT_DIR / "radar.json").write_text(

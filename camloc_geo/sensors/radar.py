@@ -5,7 +5,7 @@ ground plane ``z = 0`` turns a pixel where a vehicle touches the ground into met
 radar (see ``docs/radar.md``):
 
 1. **Vehicles.** Background subtraction at reduced resolution, in colour (a car may have
-   the road's grey level): the background starts as the median of 15 frames sampled over
+   the road's grey level): the background starts as the median of 9 frames sampled over
    the video and is updated (running average) where no vehicle is; pixels more than 30
    levels away in some channel are foreground; morphology and connected components give
    blobs; blobs are associated frame to frame by IoU with the track's
@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import json
 import logging
 import math
@@ -104,10 +105,12 @@ CSV_COLUMNS = (
 _SEED = 20261123
 _MAX_BLOBS = 64  # largest blobs kept per frame (bounds the work per frame)
 _MAX_MISSED = 3  # frames a detected track may go unseen before it is closed
+_MAX_COAST_S = 1.5  # longest a track may stay hidden in a merged blob
 _MIN_DETECTED_FRAMES = 3  # shorter detections are noise, not vehicles
 _MAX_FEATURES = 40
 _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foreground
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
+_BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
 
 
 # --------------------------------------------------------------------------- results
@@ -489,12 +492,12 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
 
 
 def _background_init(cap: Any, n_frames: int, scale: float, max_frames: int) -> Any:
-    """Median of up to 15 frames sampled over the video (reduced, grey), or None."""
+    """Median of frames sampled over the video (reduced, colour), or None."""
     import cv2
 
     if n_frames < 10:
         return None
-    idx = np.unique(np.linspace(0, min(n_frames, max_frames) - 1, 15).astype(int))
+    idx = np.unique(np.linspace(0, min(n_frames, max_frames) - 1, _BG_SAMPLES).astype(int))
     frames = []
     for i in idx:
         if not cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)):
@@ -526,6 +529,7 @@ class _Track:
     box: Box
     velocity: tuple[float, float] = (0.0, 0.0)
     missed: int = 0
+    coasting: int = 0
     frames: list[int] = field(default_factory=list)
     boxes: list[Box] = field(default_factory=list)
     contacts: list[tuple[float, float]] = field(default_factory=list)
@@ -561,21 +565,42 @@ def _blobs(fg: Any, scale: float, min_area: int) -> list[Box]:
     return out
 
 
-def _associate(tracks: list[_Track], blobs: list[Box]) -> tuple[dict[int, int], list[int]]:
-    """Track index -> blob index, and the unmatched blob indices (Hungarian on 1 - IoU)."""
+def _associate(
+    tracks: list[_Track], blobs: list[Box]
+) -> tuple[dict[int, int], list[int], set[int]]:
+    """Match tracks to blobs (Hungarian on 1 - IoU with the predicted boxes).
+
+    Returns track index -> blob index, the blobs that start new tracks, and the tracks hidden
+    in a merged blob (one blob covering at least 30 % of two or more established tracks'
+    predicted boxes: vehicles passing each other). Those coast on their prediction and the
+    merged blob is used by none.
+    """
     from scipy.optimize import linear_sum_assignment
 
     if not tracks or not blobs:
-        return {}, list(range(len(blobs)))
+        return {}, list(range(len(blobs))), set()
+    preds = [t.predicted() for t in tracks]
+    cover = np.zeros((len(tracks), len(blobs)))
     cost = np.ones((len(tracks), len(blobs)))
-    for i, t in enumerate(tracks):
-        pred = t.predicted()
+    for i, pred in enumerate(preds):
+        area = max(1e-9, (pred[2] - pred[0]) * (pred[3] - pred[1]))
         for j, b in enumerate(blobs):
+            ix = max(0.0, min(pred[2], b[2]) - max(pred[0], b[0]))
+            iy = max(0.0, min(pred[3], b[3]) - max(pred[1], b[1]))
+            cover[i, j] = ix * iy / area
             cost[i, j] = 1.0 - _iou(pred, b)
+    established = np.array([len(t.frames) >= _MIN_DETECTED_FRAMES for t in tracks])
+    covering = (cover > 0.3) & established[:, None]
+    merged_blobs = {j for j in range(len(blobs)) if covering[:, j].sum() >= 2}
+    hidden = {i for j in merged_blobs for i in np.flatnonzero(covering[:, j]).tolist()}
+    cost[list(hidden), :] = 1.0
+    cost[:, list(merged_blobs)] = 1.0
     rows, cols = linear_sum_assignment(cost)
     match = {int(r): int(c) for r, c in zip(rows, cols, strict=True) if cost[r, c] < 0.9}
-    used = set(match.values())
-    return match, [j for j in range(len(blobs)) if j not in used]
+    used = set(match.values()) | merged_blobs
+    for i in hidden:  # a hidden track overlapping the merged blob only: keep it coasting
+        match.pop(i, None)
+    return match, [j for j in range(len(blobs)) if j not in used], hidden
 
 
 def _contact(
@@ -839,10 +864,15 @@ def _fit_track(
 
 
 _CAR_DIMS_M = np.array([4.5, 1.8, 1.5])
+_MARGIN_PRIOR_PX = 5.0
 
 
 def _cuboid_boxes(cam: Any, params: FloatArray, times: FloatArray) -> FloatArray:
-    """Image boxes ``(N, 4)`` of a cuboid ``(x0, y0, vx, vy, log L, log W, log H)``."""
+    """Image boxes ``(N, 4)`` of a cuboid ``(x0, y0, vx, vy, log L, log W, log H[, margin])``.
+
+    ``margin`` (pixels) widens the box on every side: detectors' and masks' boxes are
+    looser or tighter than the object by a roughly constant number of pixels.
+    """
     x0, y0, vx, vy = params[:4]
     length, width, height = np.exp(params[4:7])
     speed = math.hypot(vx, vy) or 1e-9
@@ -865,7 +895,8 @@ def _cuboid_boxes(cam: Any, params: FloatArray, times: FloatArray) -> FloatArray
         axis=1,
     ).reshape(-1, 3)
     px = cam.project(pts).reshape(n, 8, 2)
-    return np.concatenate([px.min(axis=1), px.max(axis=1)], axis=1)
+    margin = params[7] if len(params) > 7 else 0.0
+    return np.concatenate([px.min(axis=1) - margin, px.max(axis=1) + margin], axis=1)
 
 
 def _cuboid_fit(
@@ -892,15 +923,13 @@ def _cuboid_fit(
     coef = solve @ ground
     seg0 = sorted(set(labels))
     mid = coef[1 : 1 + len(seg0)].mean(axis=0)
-    fwd = vel / speed
-    # the contact is a near bottom corner: start the centre half a car ahead along travel
-    start = np.concatenate([mid - fwd * 0.0, vel, np.log(_CAR_DIMS_M)])
+    start = np.concatenate([mid, vel, np.log(_CAR_DIMS_M), [0.0]])
     span = float(np.median(boxes[:, 3] - boxes[:, 1])) + 1.0
 
     def resid(p: FloatArray) -> FloatArray:
         pred = _cuboid_boxes(cam, p, tc)
         r = ((pred - boxes) / span * 20.0).ravel()
-        prior = (p[4:7] - np.log(_CAR_DIMS_M)) / 0.7
+        prior = np.append((p[4:7] - np.log(_CAR_DIMS_M)) / 0.7, p[7] / _MARGIN_PRIOR_PX)
         out = np.concatenate([r, prior])
         return np.where(np.isfinite(out), out, 1e3)
 
@@ -1048,6 +1077,11 @@ def measure_speeds(
         )
     elif not any(v.measured for v in vehicles):
         warnings.append("vehicles were found but none could be measured (see their reasons)")
+    if max_frames is None and n_done >= MAX_VIDEO_FRAMES:
+        warnings.append(
+            f"stopped after {MAX_VIDEO_FRAMES} frames (the limit); the rest of the video is "
+            "not measured"
+        )
     return RadarResult(
         info,
         vehicles,
@@ -1082,6 +1116,8 @@ def _run(
     min_area = max(12, int(4e-4 * sw * sh))
     bg_init = _background_init(cap, n_file, scale, limit)
     background = None if bg_init is None else bg_init.astype(np.float32)
+    max_coast = max(5, round(_MAX_COAST_S * fps))
+    hidden: set[int] = set()
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     kernel_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
     active: list[_Track] = []
@@ -1106,14 +1142,23 @@ def _run(
             if background is None:
                 background = small.astype(np.float32)
             diff = cv2.absdiff(small, background.astype(np.uint8))
-            level = diff.max(axis=2) if diff.ndim == 3 else diff
+            if diff.ndim == 3:  # largest channel difference (cv2: numpy's max is slow here)
+                b, g, r = cv2.split(diff)
+                level = cv2.max(cv2.max(b, g), r)
+            else:
+                level = diff
             fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
             cv2.accumulateWeighted(small, background, _BG_RATE, mask=cv2.bitwise_not(fg))
             fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
             fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
             if given is None:
                 blobs = _blobs(fg, scale, min_area)
-                match, fresh = _associate(active, blobs)
+                match, fresh, hidden = _associate(active, blobs)
+                for k in hidden:  # coast on the prediction while merged with another
+                    t = active[k]
+                    t.box = t.predicted()
+                    t.coasting += 1
+                    t.points = None
                 current: dict[int, Box] = {k: blobs[j] for k, j in match.items()}
                 for j in fresh:
                     t = _Track(next_id, blobs[j])
@@ -1134,15 +1179,18 @@ def _run(
             fg_full = None
             for k, t in enumerate(active):
                 if k not in current:
-                    t.missed += 1
+                    if given is not None or k not in hidden:
+                        t.missed += 1
                     t.points = None
                     continue
+                t.coasting = 0
                 box = current[k]
                 if t.frames:
                     gap = max(1, i - t.frames[-1])
+                    last = t.boxes[-1]
                     t.velocity = (
-                        ((box[0] + box[2]) - (t.box[0] + t.box[2])) / 2 / gap,
-                        ((box[1] + box[3]) - (t.box[1] + t.box[3])) / 2 / gap,
+                        ((box[0] + box[2]) - (last[0] + last[2])) / 2 / gap,
+                        ((box[1] + box[3]) - (last[1] + last[3])) / 2 / gap,
                     )
                 t.box = box
                 t.missed = 0
@@ -1169,7 +1217,7 @@ def _run(
                     t.points = _seed_features(grey, fg_full, box)
             still = []
             for t in active:
-                if given is None and t.missed > _MAX_MISSED:
+                if given is None and (t.missed > _MAX_MISSED or t.coasting > max_coast):
                     done.append(t)
                 else:
                     still.append(t)
@@ -1189,6 +1237,8 @@ def _run(
     else:
         noise = sum(1 for t in done if len(t.frames) < _MIN_DETECTED_FRAMES)
         done = [t for t in done if len(t.frames) >= _MIN_DETECTED_FRAMES]
+    if given is None:
+        done = [piece for t in done for piece in _split_reversals(t)]
     done.sort(key=lambda t: (t.frames[0], t.vid))
     if given is None:  # number detected vehicles 1, 2, ... in order of appearance
         for k, t in enumerate(done):
@@ -1197,6 +1247,45 @@ def _run(
         _fit_track(t, calibration, fps, width, height, min_track_s, n_samples, seed) for t in done
     ]
     return i, vehicles, noise
+
+
+def _split_reversals(t: _Track) -> list[_Track]:
+    """Split a detected track where one vehicle left the frame and another came in.
+
+    The blob of a vehicle leaving through an image border and the blob of one entering at
+    the same place can be one track. Between two stretches wholly inside the image with a
+    border-touching stretch between them, the track is cut when the image motion reverses.
+    """
+    runs: list[tuple[int, int]] = []
+    start = None
+    for i, b in enumerate([*t.border, True]):
+        if not b and start is None:
+            start = i
+        elif b and start is not None:
+            runs.append((start, i))
+            start = None
+    cuts = []
+    for (a0, a1), (b0, b1) in itertools.pairwise(runs):
+        if a1 - a0 < 2 or b1 - b0 < 2:
+            continue
+        va = np.subtract(_centre(t.boxes[a1 - 1]), _centre(t.boxes[a0]))
+        vb = np.subtract(_centre(t.boxes[b1 - 1]), _centre(t.boxes[b0]))
+        if float(va @ vb) < 0:
+            cuts.append((a1 + b0) // 2)
+    if not cuts:
+        return [t]
+    pieces = []
+    for lo, hi in zip([0, *cuts], [*cuts, len(t.frames)], strict=True):
+        piece = _Track(t.vid, t.boxes[hi - 1])
+        piece.frames, piece.boxes = t.frames[lo:hi], t.boxes[lo:hi]
+        piece.contacts, piece.kinds = t.contacts[lo:hi], t.kinds[lo:hi]
+        piece.klt, piece.border = t.klt[lo:hi], t.border[lo:hi]
+        pieces.append(piece)
+    return pieces
+
+
+def _centre(box: Box) -> tuple[float, float]:
+    return ((box[0] + box[2]) / 2.0, (box[1] + box[3]) / 2.0)
 
 
 def _clip(box: Box, width: int, height: int) -> Box:
