@@ -7,7 +7,8 @@ origin, and vehicles (cuboids with windows and wheels, shaded per face) driving 
 straight lines at constant known speeds. Frames get Gaussian sensor noise and are written
 with :class:`cv2.VideoWriter` (MJPG in ``.avi`` by default).
 
-Shortcuts: no shadows, no lighting changes, no lens distortion, rigid boxes.
+Optionally, hard shadows on the ground (``shadow=``). Shortcuts: no lighting changes, no
+lens distortion, rigid boxes.
 Used by ``tests/test_radar.py`` and ``benchmarks/radar.py``; videos go to temporary
 directories, never into the repository.
 """
@@ -175,6 +176,28 @@ def _background(
     return np.asarray(img, np.uint8)
 
 
+def _draw_shadow(
+    img: npt.NDArray[np.uint8], camera: Camera, corners: FloatArray, shadow: tuple[float, float]
+) -> None:
+    """Darken the ground under a cuboid's shadow (sun direction: ``shadow`` m per m height)."""
+    import cv2
+
+    top = corners[4:]
+    cast = top[:, :2] + np.outer(top[:, 2], shadow)
+    ground = np.vstack([corners[:4, :2], cast])
+    px = camera.project(np.column_stack([ground, np.zeros(len(ground))]))
+    if not np.all(np.isfinite(px)):
+        return
+    hull = cv2.convexHull(np.round(px * 16).astype(np.int32))
+    mask = np.zeros(img.shape[:2], np.uint8)
+    cv2.fillConvexPoly(mask, hull, 255, cv2.LINE_AA, 4)
+    x, y, w, h = cv2.boundingRect(mask)
+    if w and h:
+        roi = img[y : y + h, x : x + w]
+        a = mask[y : y + h, x : x + w, None].astype(np.float32) / 255.0
+        roi[:] = (roi * (1.0 - 0.5 * a)).astype(np.uint8)
+
+
 def _draw_vehicle(
     img: npt.NDArray[np.uint8], camera: Camera, corners: FloatArray, colour: tuple[int, int, int]
 ) -> bool:
@@ -258,6 +281,7 @@ def render_video(
     noise_sigma: float = 2.0,
     fourcc: str = "MJPG",
     parked_car: bool = True,
+    shadow: tuple[float, float] | None = None,
 ) -> SyntheticVideo:
     """Render and write a synthetic traffic video; returns its truth and the scene.
 
@@ -279,6 +303,9 @@ def render_video(
         Codec; MJPG is available in every OpenCV build.
     parked_car
         Draw the scene's reference car (the preset sedan at the world origin).
+    shadow
+        Cast hard shadows on the ground (50 % darker): the horizontal displacement of a
+        point's shadow per metre of its height, ``(dx, dy)`` in the world frame. None: no sun.
 
     Raises
     ------
@@ -306,6 +333,8 @@ def render_video(
             size_m=(sedan.length_m, sedan.width_m, sedan.height_m),
             colour=(150, 150, 150),
         )
+        if shadow is not None:
+            _draw_shadow(background, camera, parked.corners_at(0.0), shadow)
         _draw_vehicle(background, camera, parked.corners_at(0.0), parked.colour)
     n_frames = round(duration_s * fps)
     path = Path(path)
@@ -322,6 +351,9 @@ def render_video(
                 range(len(vehicles)),
                 key=lambda k: -float(np.linalg.norm(vehicles[k].centre_at(t_s) - eye)),
             )
+            if shadow is not None:
+                for k in order:
+                    _draw_shadow(frame, camera, vehicles[k].corners_at(t_s), shadow)
             for k in order:
                 _draw_vehicle(frame, camera, vehicles[k].corners_at(t_s), vehicles[k].colour)
             if noise_sigma > 0:

@@ -30,10 +30,10 @@ from camloc_geo.synthetic_video import (
 )
 
 SIZE = (640, 360)
-CASES = [  # direction (deg from +x), speed km/h, centre when in view, fps
-    (0.0, 30.0, (4.0, -4.0), 25.0),
-    (180.0, 60.0, (6.0, -8.0), 30.0),
-    (90.0, 45.0, (14.0, -6.0), 25.0),
+CASES = [  # direction (deg from +x), speed km/h, centre when in view, fps, size (L, W, H) m
+    (0.0, 30.0, (4.0, -4.0), 25.0, (4.5, 1.8, 1.5)),
+    (180.0, 60.0, (6.0, -8.0), 30.0, (3.7, 1.65, 1.45)),
+    (90.0, 45.0, (14.0, -6.0), 25.0, (5.3, 2.0, 2.4)),  # a van: not the cuboid prior
 ]
 
 
@@ -46,8 +46,8 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def videos(folder: Path) -> list[SyntheticVideo]:
     cam = traffic_camera(image_size=SIZE)
     out = []
-    for k, (direction, speed, centre, fps) in enumerate(CASES):
-        veh = SyntheticVehicle(centre, direction, speed, start_s=1.5)
+    for k, (direction, speed, centre, fps, size) in enumerate(CASES):
+        veh = SyntheticVehicle(centre, direction, speed, start_s=1.5, size_m=size)
         out.append(
             render_video(
                 folder / f"v{k}.avi", cam, [veh], image_size=SIZE, fps=fps, duration_s=3.0, seed=k
@@ -98,7 +98,7 @@ def test_detection_speeds_within_bound(
         assert v.measured or v.reason
 
 
-@pytest.mark.parametrize("case", [0, 1])
+@pytest.mark.parametrize("case", [0, 2])
 def test_given_tracks(
     videos: list[SyntheticVideo], calibration: CalibrationResult, case: int
 ) -> None:
@@ -119,10 +119,15 @@ def test_given_tracks(
 
 
 def test_given_fps_scales_speed(
-    videos: list[SyntheticVideo], calibration: CalibrationResult
+    videos: list[SyntheticVideo],
+    calibration: CalibrationResult,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
     video = videos[0]
-    res = measure_speeds(calibration, video.path, tracks=video.boxes, fps=2 * video.fps)
+    res = measure_speeds(
+        calibration, video.path, tracks=video.boxes, fps=2 * video.fps, progress=True
+    )
+    assert "frame" in capsys.readouterr().err  # the tqdm bar, asked for
     assert res.video.fps_source == "given"
     assert res.video.fps_in_file == pytest.approx(video.fps)
     (v,) = res.measured
@@ -191,6 +196,7 @@ def test_radar_scene_api(videos: list[SyntheticVideo], scene_file: Path) -> None
     res = radar_scene(scene_file, videos[1].path, tracks=videos[1].boxes)
     (v,) = res.measured
     assert v.speed_kmh == pytest.approx(60.0, rel=0.01)
+    assert v.heading_deg == pytest.approx(270.0, abs=1.0)
     d = res.to_dict()
     json.dumps(d, allow_nan=False)
     assert d["n_measured"] == 1

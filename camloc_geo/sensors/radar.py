@@ -7,8 +7,9 @@ radar (see ``docs/radar.md``):
 1. **Vehicles.** Background subtraction at reduced resolution, in colour (a car may have
    the road's grey level): the background starts as the median of 9 frames sampled over
    the video and is updated (running average) where no vehicle is; pixels more than 30
-   levels away in some channel are foreground; morphology and connected components give
-   blobs; blobs are associated frame to frame by IoU with the track's
+   levels away in some channel are foreground, except cast shadows (the background dimmed
+   by the same ratio, 0.35-0.9, in every channel); morphology and connected components
+   give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
 2. **Ground contact.** In each frame, the lowest vertex of the convex hull of the vehicle's
@@ -110,6 +111,8 @@ _MIN_DETECTED_FRAMES = 3  # shorter detections are noise, not vehicles
 _MAX_FEATURES = 40
 _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foreground
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
+_SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
+_SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
 
 
@@ -1149,6 +1152,8 @@ def _run(
                 level = diff
             fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
             cv2.accumulateWeighted(small, background, _BG_RATE, mask=cv2.bitwise_not(fg))
+            if small.ndim == 3:
+                fg = cv2.bitwise_and(fg, cv2.bitwise_not(_shadows(small, background)))
             fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
             fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
             if given is None:
@@ -1282,6 +1287,24 @@ def _split_reversals(t: _Track) -> list[_Track]:
         piece.klt, piece.border = t.klt[lo:hi], t.border[lo:hi]
         pieces.append(piece)
     return pieces
+
+
+def _shadows(frame: Any, background: Any) -> Any:
+    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio.
+
+    A shadow keeps the road's colour and dims it (ratio ``_SHADOW_RATIO``, spread below
+    ``_SHADOW_SPREAD`` between channels); a vehicle changes the colour or is much darker.
+    """
+    import cv2
+
+    ratio = cv2.divide(frame.astype(np.float32), background + 1.0)
+    b, g, r = cv2.split(ratio)
+    lo = cv2.min(cv2.min(b, g), r)
+    hi = cv2.max(cv2.max(b, g), r)
+    dim = cv2.inRange(lo, _SHADOW_RATIO[0], _SHADOW_RATIO[1])
+    grey = cv2.inRange(hi - lo, 0.0, _SHADOW_SPREAD)
+    bright = cv2.inRange(hi, 0.0, _SHADOW_RATIO[1])
+    return cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
 
 
 def _centre(box: Box) -> tuple[float, float]:
