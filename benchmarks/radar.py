@@ -10,8 +10,9 @@ cuboid prior is the car). The scene is the camera's noise-free annotation, so th
 calibration is exact and the errors are the radar's own (except in the crowd run below).
 
 Three runs per video, all with ``cv2.setNumThreads(1)`` (one core; frames per second are
-counted on the process's CPU time, which other sessions sharing the machine do not inflate,
-and also on the wall clock):
+counted on the process's CPU time, summed over all its threads (numpy's too), so a lower
+bound on what one core does, and which other jobs sharing the machine do not slow down; and
+also on the wall clock):
 
 - ``detection``: background subtraction finds the vehicles;
 - ``tracks``: the exact boxes given (a perfect detector/tracker);
