@@ -20,15 +20,18 @@ radar (see ``docs/radar.md``):
 3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
    :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
    motion; where the measured contact jumps away from it (another corner became the lowest,
-   two vehicles merged, an occlusion) the track is split into segments. Features are never
-   cast onto the ground themselves: their height is unknown.
+   two vehicles merged, an occlusion) the track is split into segments. The same motion
+   predicts the vehicle's box in the next frame (association, coasting through merged
+   blobs). Features are never cast onto the ground themselves: their height is unknown.
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
    least squares, with one velocity shared by all segments and one offset per segment
    (constant velocity over the track). Speed = |velocity| in km/h.
 
 Step 4 is then refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant
 velocity along the fitted direction is fitted (soft-L1) so that its projected image box
-matches the vehicle's box in every frame; its velocity is the reported one.
+(plus a constant margin in pixels) matches the vehicle's box in every frame; its velocity
+is the reported one. Each track is fitted as soon as it ends, so a long video holds only
+the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the cuboid fit's standard error (from
 its residuals); half the difference between the contact-point and the cuboid speeds (model
@@ -52,7 +55,7 @@ import os
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -1124,7 +1127,21 @@ def _run(
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     kernel_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
     active: list[_Track] = []
-    done: list[_Track] = []
+    vehicles: list[VehicleSpeed] = []
+    noise = [0]
+    last_given = {vid: max(per) for vid, per in given.items() if per} if given is not None else {}
+
+    def finish(t: _Track) -> None:
+        if given is None and len(t.frames) < _MIN_DETECTED_FRAMES:
+            noise[0] += 1  # a flicker, not a vehicle
+            return
+        if not t.frames:
+            return
+        for piece in _split_reversals(t) if given is None else [t]:
+            vehicles.append(
+                _fit_track(piece, calibration, fps, width, height, min_track_s, n_samples, seed)
+            )
+
     by_id: dict[int, _Track] = {}
     next_id = 1
     prev_grey = None
@@ -1190,7 +1207,9 @@ def _run(
                     continue
                 t.coasting = 0
                 box = current[k]
-                if t.frames:
+                if k in shifts:  # the features' motion: robust to a blob that merges or splits
+                    t.velocity = shifts[k]
+                elif t.frames:
                     gap = max(1, i - t.frames[-1])
                     last = t.boxes[-1]
                     t.velocity = (
@@ -1222,8 +1241,12 @@ def _run(
                     t.points = _seed_features(grey, fg_full, box)
             still = []
             for t in active:
-                if given is None and (t.missed > _MAX_MISSED or t.coasting > max_coast):
-                    done.append(t)
+                if given is None:
+                    over = t.missed > _MAX_MISSED or t.coasting > max_coast
+                else:
+                    over = i >= last_given[t.vid]
+                if over:
+                    finish(t)  # fitted now: a long video keeps only the active tracks
                 else:
                     still.append(t)
             if len(still) != len(active):
@@ -1235,23 +1258,12 @@ def _run(
             bar.update(1)
     finally:
         bar.close()
-    done.extend(active)
-    if given is not None:
-        done = [t for t in done if t.frames]
-        noise = 0
-    else:
-        noise = sum(1 for t in done if len(t.frames) < _MIN_DETECTED_FRAMES)
-        done = [t for t in done if len(t.frames) >= _MIN_DETECTED_FRAMES]
-    if given is None:
-        done = [piece for t in done for piece in _split_reversals(t)]
-    done.sort(key=lambda t: (t.frames[0], t.vid))
+    for t in active:
+        finish(t)
+    vehicles.sort(key=lambda v: (v.first_frame, v.vehicle_id))
     if given is None:  # number detected vehicles 1, 2, ... in order of appearance
-        for k, t in enumerate(done):
-            t.vid = k + 1
-    vehicles = [
-        _fit_track(t, calibration, fps, width, height, min_track_s, n_samples, seed) for t in done
-    ]
-    return i, vehicles, noise
+        vehicles = [replace(v, vehicle_id=k + 1) for k, v in enumerate(vehicles)]
+    return i, vehicles, noise[0]
 
 
 def _split_reversals(t: _Track) -> list[_Track]:
