@@ -164,6 +164,16 @@ def test_given_fps_scales_speed(
     assert v.speed_kmh == pytest.approx(2 * video.vehicles[0].speed_kmh, rel=0.01)
 
 
+def test_max_frames(videos: list[SyntheticVideo], calibration: CalibrationResult) -> None:
+    video = videos[0]
+    res = measure_speeds(calibration, video.path, tracks=video.boxes, max_frames=40)
+    assert res.video.n_frames == 40
+    for v in res.vehicles:
+        assert v.last_frame < 40
+    with pytest.raises(InputError, match="max_frames"):
+        measure_speeds(calibration, video.path, max_frames=0)
+
+
 def test_short_track_is_skipped_with_reason(
     videos: list[SyntheticVideo], calibration: CalibrationResult
 ) -> None:
