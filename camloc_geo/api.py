@@ -461,16 +461,20 @@ def radar_scene(
         The scene does not calibrate, the video is unreadable or not the scene's size, no
         frame rate, malformed tracks (each a one-line message).
     """
-    from camloc_geo.sensors.radar import measure_speeds
+    from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
     sc = scene_from(scene)
+    size = (sc.image.width, sc.image.height)
+    probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
+    if isinstance(tracks, (str, os.PathLike)):
+        tracks = read_tracks(tracks)
     calibration = calibrate_scene(sc)
     return measure_speeds(
         calibration,
         video,
         fps=fps,
         tracks=tracks,
-        image_size=(sc.image.width, sc.image.height),
+        image_size=size,
         min_track_s=min_track_s,
         max_frames=max_frames,
         progress=progress,

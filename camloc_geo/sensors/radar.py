@@ -80,6 +80,7 @@ __all__ = [
     "VehicleSpeed",
     "VideoInfo",
     "measure_speeds",
+    "probe_video",
     "read_tracks",
 ]
 
@@ -495,6 +496,37 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
             f"{MAX_VIDEO_PIXELS / 1e6:.1f} megapixels (4K UHD)"
         )
     return cap, w, h, (fps if math.isfinite(fps) and 0.5 <= fps <= 1000.0 else None), max(n, 0)
+
+
+def probe_video(
+    video_path: str | os.PathLike[str], *, image_size: tuple[int, int] | None = None
+) -> tuple[int, int, float | None, int]:
+    """Width, height, stated frame rate (None: none usable) and frame count of a video.
+
+    Cheap (reads the header only): front ends call it before calibrating, to refuse a bad
+    video at once.
+
+    Raises
+    ------
+    InputError
+        Missing or unreadable video, too large frames, or (with ``image_size``) frames of
+        another size than the scene's image.
+    """
+    cap, w, h, fps, n = _open_video(video_path)
+    cap.release()
+    if image_size is not None:
+        _check_size(video_path, (w, h), image_size)
+    return w, h, fps, n
+
+
+def _check_size(
+    video_path: str | os.PathLike[str], size: tuple[int, int], image_size: tuple[int, int]
+) -> None:
+    if tuple(size) != tuple(image_size):
+        raise InputError(
+            f"video {video_path} is {size[0]}x{size[1]} but the scene's image is "
+            f"{image_size[0]}x{image_size[1]}: annotate a frame of this video"
+        )
 
 
 def _background_init(cap: Any, n_frames: int, scale: float, max_frames: int) -> Any:
@@ -1026,11 +1058,8 @@ def measure_speeds(
         )
     cap, width, height, fps_file, n_file = _open_video(video_path)
     try:
-        if image_size is not None and (width, height) != tuple(image_size):
-            raise InputError(
-                f"video {video_path} is {width}x{height} but the scene's image is "
-                f"{image_size[0]}x{image_size[1]}: annotate a frame of this video"
-            )
+        if image_size is not None:
+            _check_size(video_path, (width, height), image_size)
         if fps is None and fps_file is None:
             raise InputError(f"video {video_path} states no frame rate: give it (--fps)")
         rate = float(fps if fps is not None else fps_file)  # type: ignore[arg-type]
