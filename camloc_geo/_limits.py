@@ -20,6 +20,10 @@ __all__ = [
     "MAX_LINES_PER_AXIS",
     "MAX_REFERENCES",
     "MAX_SCENE_BYTES",
+    "MAX_TRACKS_BYTES",
+    "MAX_TRACK_BOXES",
+    "MAX_VIDEO_FRAMES",
+    "MAX_VIDEO_PIXELS",
     "MAX_WEIGHT",
     "MIN_WEIGHT",
     "check_image_file",
@@ -47,6 +51,18 @@ MAX_WEIGHT = 1e6
 
 MAX_IMAGE_PIXELS = 50_000_000
 """Largest image decoded (width × height), checked from the file header before decoding."""
+
+MAX_VIDEO_PIXELS = 3840 * 2160
+"""Largest video frame processed by the radar (width × height): 4K UHD."""
+
+MAX_VIDEO_FRAMES = 180_000
+"""Most frames the radar processes in one run (2 h at 25 fps); longer videos are refused."""
+
+MAX_TRACKS_BYTES = 200_000_000
+"""Largest ``--tracks`` file read (bytes)."""
+
+MAX_TRACK_BOXES = 2_000_000
+"""Most boxes in one ``--tracks`` file."""
 
 
 def check_regular_file(path: str | os.PathLike[str], what: str = "file") -> Path:

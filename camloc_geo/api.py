@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from camloc_geo.osm import MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
+    from camloc_geo.sensors.radar import RadarResult
 
 __all__ = [
     "DEFAULT_MIN_RADIUS_M",
@@ -40,6 +41,7 @@ __all__ = [
     "locate_scene",
     "map_around",
     "map_for_scene",
+    "radar_scene",
     "scene_from",
     "streets_near",
     "vanishing_points",
@@ -432,3 +434,45 @@ def map_around(
     lon = sum(p[1] for p in points) / len(points)
     radius = max(distance_m(lat1=lat, lon1=lon, lat2=q[0], lon2=q[1]) for q in points)
     return load_map(map_source, lat, lon, radius_m=min(radius + margin_m, max_radius_m))
+
+
+def radar_scene(
+    scene: SceneLike,
+    video: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    tracks: str | os.PathLike[str] | dict[int, dict[int, Any]] | None = None,
+    min_track_s: float = 0.5,
+    max_frames: int | None = None,
+    progress: bool = False,
+) -> RadarResult:
+    """Virtual radar: calibrate the scene, then measure the vehicles' speeds in a video.
+
+    The video must come from the scene's camera, with the same framing and frame size as
+    the scene's image. See :func:`camloc_geo.sensors.radar.measure_speeds` for the options
+    and ``docs/radar.md`` for the method.
+
+    Raises
+    ------
+    InputError
+        The scene does not calibrate, the video is unreadable or not the scene's size, no
+        frame rate, malformed tracks (each a one-line message).
+    """
+    from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
+
+    sc = scene_from(scene)
+    size = (sc.image.width, sc.image.height)
+    probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
+    if isinstance(tracks, (str, os.PathLike)):
+        tracks = read_tracks(tracks)
+    calibration = calibrate_scene(sc)
+    return measure_speeds(
+        calibration,
+        video,
+        fps=fps,
+        tracks=tracks,
+        image_size=size,
+        min_track_s=min_track_s,
+        max_frames=max_frames,
+        progress=progress,
+    )

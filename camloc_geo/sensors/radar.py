@@ -1,0 +1,1357 @@
+"""Virtual radar: vehicle speeds from a video of a calibrated camera.
+
+The camera is calibrated once from a snapshot (:func:`camloc_geo.relative.calibrate`); its
+ground plane ``z = 0`` turns a pixel where a vehicle touches the ground into metres. The
+radar (see ``docs/radar.md``):
+
+1. **Vehicles.** Background subtraction at reduced resolution, in colour (a car may have
+   the road's grey level): the background starts as the median of 9 frames sampled over
+   the video and is updated (running average) where no vehicle is; pixels more than 30
+   levels away in some channel are foreground, except cast shadows (the background dimmed
+   by the same ratio, 0.35-0.9, in every channel); morphology and connected components
+   give blobs; blobs are associated frame to frame by IoU with the track's
+   predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
+   With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
+2. **Ground contact.** In each frame, the lowest vertex of the convex hull of the vehicle's
+   foreground silhouette: for a vehicle on the ground seen from above, that pixel is a
+   bottom corner, *on the ground*, so it casts onto ``z = 0`` without any assumption on
+   heights. Without a usable silhouette (given boxes with no foreground), the bottom-centre
+   of the box is used (biased by 1-5 % under perspective; see the docs).
+3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
+   :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
+   motion; where the measured contact jumps away from it (another corner became the lowest,
+   two vehicles merged, an occlusion) the track is split into segments. The same motion
+   predicts the vehicle's box in the next frame (association, coasting through merged
+   blobs). Features are never cast onto the ground themselves: their height is unknown.
+4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
+   least squares, with one velocity shared by all segments and one offset per segment
+   (constant velocity over the track). Speed = |velocity| in km/h.
+
+Step 4 is then refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant
+velocity along the fitted direction is fitted (soft-L1) so that its projected image box
+(plus a constant margin in pixels) matches the vehicle's box in every frame; its velocity
+is the reported one. Each track is fitted as soon as it ends, so a long video holds only
+the active tracks in memory.
+
+Uncertainty (``sigma_kmh``), combined in quadrature: the cuboid fit's standard error (from
+its residuals); half the difference between the contact-point and the cuboid speeds (model
+error); the calibration's part: the contact pixels are recast and refitted with
+``n_samples`` cameras drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length
+perturbed by the calibration's sigmas; rotation fixed), and the spread of the speeds taken.
+
+Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
+blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import itertools
+import json
+import logging
+import math
+import os
+import sys
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from camloc_geo._errors import InputError
+from camloc_geo._limits import (
+    MAX_TRACK_BOXES,
+    MAX_TRACKS_BYTES,
+    MAX_VIDEO_FRAMES,
+    MAX_VIDEO_PIXELS,
+    check_regular_file,
+)
+from camloc_geo.sensors import _draws, _ground, _rays
+
+if TYPE_CHECKING:
+    from camloc_geo.relative import CalibrationResult
+
+__all__ = [
+    "CSV_COLUMNS",
+    "RadarResult",
+    "VehicleSpeed",
+    "VideoInfo",
+    "measure_speeds",
+    "probe_video",
+    "read_tracks",
+]
+
+log = logging.getLogger(__name__)
+
+FloatArray = npt.NDArray[np.float64]
+Box = tuple[float, float, float, float]
+TrackBoxes = dict[int, dict[int, Box]]
+"""Given tracks: ``{vehicle id: {frame index (0-based): (x1, y1, x2, y2)}}``, pixels."""
+
+CSV_COLUMNS = (
+    "vehicle_id",
+    "status",
+    "speed_kmh",
+    "sigma_kmh",
+    "first_frame",
+    "last_frame",
+    "n_frames",
+    "duration_s",
+    "distance_m",
+    "heading_deg",
+    "contact",
+    "reason",
+)
+"""Columns of :meth:`RadarResult.to_csv`, one row per vehicle."""
+
+_SEED = 20261123
+_MAX_BLOBS = 64  # largest blobs kept per frame (bounds the work per frame)
+_MAX_MISSED = 3  # frames a detected track may go unseen before it is closed
+_MAX_COAST_S = 1.5  # longest a track may stay hidden in a merged blob
+_MIN_DETECTED_FRAMES = 3  # shorter detections are noise, not vehicles
+_MAX_FEATURES = 40
+_FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foreground
+_BG_RATE = 0.02  # background update rate per frame, where no foreground
+_SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
+_SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
+_BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class VideoInfo:
+    """The video as read.
+
+    Attributes
+    ----------
+    path
+        The file.
+    width, height
+        Frame size, pixels.
+    fps
+        Frame rate used for the speeds.
+    fps_source
+        ``"file"`` (from the container) or ``"given"``.
+    fps_in_file
+        What the file states (None when it states nothing usable).
+    n_frames
+        Frames processed.
+    """
+
+    path: str
+    width: int
+    height: int
+    fps: float
+    fps_source: str
+    fps_in_file: float | None
+    n_frames: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {
+            "path": self.path,
+            "width": self.width,
+            "height": self.height,
+            "fps": self.fps,
+            "fps_source": self.fps_source,
+            "fps_in_file": self.fps_in_file,
+            "n_frames": self.n_frames,
+        }
+
+
+@dataclass(frozen=True)
+class VehicleSpeed:
+    """One vehicle's speed, or why it has none.
+
+    Attributes
+    ----------
+    vehicle_id
+        Track id (the given id with ``tracks``).
+    status
+        ``"measured"`` or ``"skipped"``.
+    speed_kmh, sigma_kmh
+        Speed over the track and its 1-sigma uncertainty (NaN when skipped).
+    first_frame, last_frame, n_frames
+        0-based frame range of the track and the number of frames used in the fit.
+    duration_s
+        Time spanned by the frames used.
+    distance_m
+        Ground distance covered over ``duration_s`` at the fitted velocity.
+    heading_deg
+        Direction of travel in the scene's world frame, clockwise from +y (NaN when skipped).
+    contact
+        How the ground contact was found: ``"silhouette"``, ``"box"`` or ``"mixed"``.
+    n_segments
+        Pieces the track was split into (contact jumps), each with its own offset.
+    reason
+        Why the vehicle was skipped (None when measured).
+    track_world_m
+        ``(frame, x, y)`` of the ground contact in each frame used (metres, world frame).
+    """
+
+    vehicle_id: int
+    status: str
+    speed_kmh: float
+    sigma_kmh: float
+    first_frame: int
+    last_frame: int
+    n_frames: int
+    duration_s: float
+    distance_m: float
+    heading_deg: float
+    contact: str
+    n_segments: int = 0
+    reason: str | None = None
+    track_world_m: list[tuple[int, float, float]] = field(default_factory=list)
+
+    @property
+    def measured(self) -> bool:
+        """True when the speed was measured."""
+        return self.status == "measured"
+
+    def to_dict(self, *, track: bool = True) -> dict[str, Any]:
+        """JSON-ready (NaN becomes None); ``track=False`` leaves out ``track_world_m``."""
+        out: dict[str, Any] = {
+            "vehicle_id": self.vehicle_id,
+            "status": self.status,
+            "speed_kmh": _num(self.speed_kmh),
+            "sigma_kmh": _num(self.sigma_kmh),
+            "first_frame": self.first_frame,
+            "last_frame": self.last_frame,
+            "n_frames": self.n_frames,
+            "duration_s": _num(self.duration_s),
+            "distance_m": _num(self.distance_m),
+            "heading_deg": _num(self.heading_deg),
+            "contact": self.contact,
+            "n_segments": self.n_segments,
+            "reason": self.reason,
+        }
+        if track:
+            out["track_world_m"] = [[f, round(x, 4), round(y, 4)] for f, x, y in self.track_world_m]
+        return out
+
+    def csv_row(self) -> dict[str, Any]:
+        """One row of :data:`CSV_COLUMNS` (empty cells for missing values)."""
+        d = self.to_dict(track=False)
+        return {k: "" if d[k] is None else d[k] for k in CSV_COLUMNS}
+
+
+@dataclass(frozen=True)
+class RadarResult:
+    """Everything the radar found.
+
+    Attributes
+    ----------
+    video
+        The video as read.
+    vehicles
+        Every vehicle, measured or skipped, in order of first appearance.
+    source
+        ``"detection"`` (background subtraction) or ``"tracks"`` (given boxes).
+    processing_s
+        Wall time of the video pass and the fits.
+    noise_blobs
+        Detected blobs seen in fewer than 3 frames, dropped as noise (not vehicles).
+    warnings
+        Things the caller should know (e.g. no vehicle found).
+    """
+
+    video: VideoInfo
+    vehicles: list[VehicleSpeed]
+    source: str
+    processing_s: float
+    noise_blobs: int = 0
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def measured(self) -> list[VehicleSpeed]:
+        """The vehicles with a speed."""
+        return [v for v in self.vehicles if v.measured]
+
+    @property
+    def frames_per_second(self) -> float:
+        """Processing speed, video frames per wall-clock second."""
+        return self.video.n_frames / self.processing_s if self.processing_s > 0 else math.inf
+
+    def to_dict(self, *, tracks: bool = True) -> dict[str, Any]:
+        """JSON-ready: video, counts, warnings and one entry per vehicle."""
+        return {
+            "video": self.video.to_dict(),
+            "source": self.source,
+            "n_vehicles": len(self.vehicles),
+            "n_measured": len(self.measured),
+            "noise_blobs": self.noise_blobs,
+            "processing_s": round(self.processing_s, 3),
+            "processing_fps": round(self.frames_per_second, 1),
+            "warnings": list(self.warnings),
+            "vehicles": [v.to_dict(track=tracks) for v in self.vehicles],
+        }
+
+    def to_csv(self) -> str:
+        """CSV text with a header and one row per vehicle (:data:`CSV_COLUMNS`)."""
+        buf = io.StringIO()
+        writer = csv.DictWriter(buf, fieldnames=list(CSV_COLUMNS), lineterminator="\n")
+        writer.writeheader()
+        for v in self.vehicles:
+            writer.writerow(v.csv_row())
+        return buf.getvalue()
+
+
+def _num(x: float) -> float | None:
+    return round(float(x), 4) if math.isfinite(x) else None
+
+
+# --------------------------------------------------------------------------- tracks input
+def _box(values: Any, where: str) -> Box:
+    try:
+        x1, y1, x2, y2 = (float(v) for v in values)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: a box is four numbers x1, y1, x2, y2") from None
+    if not all(math.isfinite(v) for v in (x1, y1, x2, y2)):
+        raise InputError(f"{where}: box coordinates must be finite")
+    if x2 <= x1 or y2 <= y1:
+        raise InputError(f"{where}: box needs x2 > x1 and y2 > y1, got {[x1, y1, x2, y2]}")
+    return (x1, y1, x2, y2)
+
+
+def _int(value: Any, what: str, where: str) -> int:
+    try:
+        f = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: {what} must be an integer, not {value!r}") from None
+    if not math.isfinite(f) or f != int(f):
+        raise InputError(f"{where}: {what} must be an integer, not {value!r}")
+    return int(f)
+
+
+def _add(out: TrackBoxes, vid: int, frame: int, box: Box, where: str, count: list[int]) -> None:
+    if frame < 0:
+        raise InputError(f"{where}: frame must be >= 0 (frames count from 0), got {frame}")
+    per = out.setdefault(vid, {})
+    if frame in per:
+        raise InputError(f"{where}: vehicle {vid} has two boxes in frame {frame}")
+    per[frame] = box
+    count[0] += 1
+    if count[0] > MAX_TRACK_BOXES:
+        raise InputError(f"tracks: more than {MAX_TRACK_BOXES} boxes; split the file")
+
+
+def _tracks_json(data: Any, name: str) -> TrackBoxes:
+    rows = data.get("detections") if isinstance(data, dict) else data
+    if not isinstance(rows, list):
+        raise InputError(
+            f"tracks {name}: JSON must be a list of detections "
+            '{"frame", "id", "box": [x1, y1, x2, y2]} (or {"detections": [...]})'
+        )
+    out: TrackBoxes = {}
+    count = [0]
+    for i, row in enumerate(rows):
+        where = f"tracks {name}: detection {i}"
+        if not isinstance(row, dict):
+            raise InputError(f"{where}: must be an object with frame, id and box")
+        missing = [k for k in ("frame", "id") if k not in row]
+        if "box" not in row and not all(k in row for k in ("x1", "y1", "x2", "y2")):
+            missing.append("box")
+        if missing:
+            raise InputError(f"{where}: missing {', '.join(missing)}")
+        raw = row["box"] if "box" in row else [row[k] for k in ("x1", "y1", "x2", "y2")]
+        _add(
+            out,
+            _int(row["id"], "id", where),
+            _int(row["frame"], "frame", where),
+            _box(raw, where),
+            where,
+            count,
+        )
+    return out
+
+
+def _tracks_csv(text: str, name: str) -> TrackBoxes:
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(f"tracks {name}: the file has no rows")
+    first = [c.strip().lower() for c in next(csv.reader([lines[0]]))]
+    out: TrackBoxes = {}
+    count = [0]
+    if first and first[0] and not _is_number(first[0]):
+        cols = {c: i for i, c in enumerate(first)}
+        if {"x1", "y1", "x2", "y2"} <= set(cols):
+            form = "corners"
+        elif {"x", "y", "w", "h"} <= set(cols):
+            form = "xywh"
+        else:
+            raise InputError(
+                f"tracks {name}: CSV header needs frame, id and x1, y1, x2, y2 "
+                f"(or x, y, w, h), got {', '.join(first)}"
+            )
+        for need in ("frame", "id"):
+            if need not in cols:
+                raise InputError(f"tracks {name}: CSV header has no {need!r} column")
+        body, offset, mot = lines[1:], 2, False
+    else:  # MOTChallenge: frame (1-based), id, left, top, width, height, ...
+        cols = {"frame": 0, "id": 1, "x": 2, "y": 3, "w": 4, "h": 5}
+        form, body, offset, mot = "xywh", lines, 1, True
+    for k, row in enumerate(csv.reader(body)):
+        where = f"tracks {name}: line {k + offset}"
+        try:
+            vals = [row[cols[c]] for c in ("frame", "id")]
+            if form == "corners":
+                box = _box([row[cols[c]] for c in ("x1", "y1", "x2", "y2")], where)
+            else:
+                x, y, w, h = (float(row[cols[c]]) for c in ("x", "y", "w", "h"))
+                box = _box([x, y, x + w, y + h], where)
+        except IndexError:
+            raise InputError(f"{where}: too few columns") from None
+        except InputError:
+            raise
+        except ValueError:
+            raise InputError(f"{where}: box values must be numbers") from None
+        frame = _int(vals[0], "frame", where) - (1 if mot else 0)
+        _add(out, _int(vals[1], "id", where), frame, box, where, count)
+    return out
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def read_tracks(path: str | os.PathLike[str]) -> TrackBoxes:
+    """Read vehicle boxes given by another detector / tracker.
+
+    Formats (see ``docs/radar.md``):
+
+    - JSON: a list of ``{"frame": 0, "id": 3, "box": [x1, y1, x2, y2]}`` (or the object
+      ``{"detections": [...]}``; ``x1, y1, x2, y2`` may be given as keys instead of ``box``);
+    - CSV with a header naming ``frame, id, x1, y1, x2, y2`` or ``frame, id, x, y, w, h``;
+    - CSV without header in the MOTChallenge layout ``frame, id, left, top, width, height,
+      ...`` (frames counted from 1 there, from 0 everywhere else).
+
+    Returns
+    -------
+    ``{id: {frame: (x1, y1, x2, y2)}}``, frames counted from 0, pixels.
+
+    Raises
+    ------
+    InputError
+        Missing, too large or malformed file (the message names the line or detection).
+    """
+    p = check_regular_file(path, "tracks file")
+    size = p.stat().st_size
+    if size > MAX_TRACKS_BYTES:
+        raise InputError(f"tracks file {p} is {size} bytes; the limit is {MAX_TRACKS_BYTES}")
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read tracks file {p}: {exc}") from None
+    if p.suffix.lower() == ".json" or text.lstrip()[:1] in ("[", "{"):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(f"tracks {p.name}: not valid JSON ({exc})") from None
+        out = _tracks_json(data, p.name)
+    else:
+        out = _tracks_csv(text, p.name)
+    if not out:
+        raise InputError(f"tracks {p.name}: no boxes in the file")
+    return out
+
+
+def _check_tracks(tracks: Mapping[int, Mapping[int, Any]]) -> TrackBoxes:
+    out: TrackBoxes = {}
+    for vid, per in tracks.items():
+        out[int(vid)] = {
+            int(f): _box(b, f"tracks: vehicle {vid} frame {f}") for f, b in per.items()
+        }
+    if not any(out.values()):
+        raise InputError("tracks: no boxes given")
+    return out
+
+
+# --------------------------------------------------------------------------- video
+def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | None, int]:
+    import cv2
+
+    p = check_regular_file(path, "video")
+    cap = cv2.VideoCapture(str(p))
+    if not cap.isOpened():
+        raise InputError(f"cannot open video {p}: not a video file OpenCV can read")
+    w = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH))
+    h = int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+    fps = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+    n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
+    if w <= 0 or h <= 0:
+        cap.release()
+        raise InputError(f"cannot read video {p}: it states no frame size")
+    if w * h > MAX_VIDEO_PIXELS:
+        cap.release()
+        raise InputError(
+            f"video {p} frames are {w}x{h}; the supported limit is "
+            f"{MAX_VIDEO_PIXELS / 1e6:.1f} megapixels (4K UHD)"
+        )
+    return cap, w, h, (fps if math.isfinite(fps) and 0.5 <= fps <= 1000.0 else None), max(n, 0)
+
+
+def probe_video(
+    video_path: str | os.PathLike[str], *, image_size: tuple[int, int] | None = None
+) -> tuple[int, int, float | None, int]:
+    """Width, height, stated frame rate (None: none usable) and frame count of a video.
+
+    Cheap (reads the header only): front ends call it before calibrating, to refuse a bad
+    video at once.
+
+    Raises
+    ------
+    InputError
+        Missing or unreadable video, too large frames, or (with ``image_size``) frames of
+        another size than the scene's image.
+    """
+    cap, w, h, fps, n = _open_video(video_path)
+    cap.release()
+    if image_size is not None:
+        _check_size(video_path, (w, h), image_size)
+    return w, h, fps, n
+
+
+def _check_size(
+    video_path: str | os.PathLike[str], size: tuple[int, int], image_size: tuple[int, int]
+) -> None:
+    if tuple(size) != tuple(image_size):
+        raise InputError(
+            f"video {video_path} is {size[0]}x{size[1]} but the scene's image is "
+            f"{image_size[0]}x{image_size[1]}: annotate a frame of this video"
+        )
+
+
+def _background_init(cap: Any, n_frames: int, scale: float, max_frames: int) -> Any:
+    """Median of frames sampled over the video (reduced, colour), or None."""
+    import cv2
+
+    if n_frames < 10:
+        return None
+    idx = np.unique(np.linspace(0, min(n_frames, max_frames) - 1, _BG_SAMPLES).astype(int))
+    frames = []
+    for i in idx:
+        if not cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)):
+            break
+        ok, frame = cap.read()
+        if not ok:
+            break
+        frames.append(_reduce(frame, scale))
+    cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
+    if len(frames) < 5:
+        return None
+    return np.median(np.stack(frames), axis=0).astype(np.uint8)
+
+
+def _reduce(frame: Any, scale: float) -> Any:
+    """The frame (colour: a car may have the road's grey level) reduced by ``scale``."""
+    import cv2
+
+    if scale == 1.0:
+        return frame
+    h, w = frame.shape[:2]
+    return cv2.resize(frame, (round(w * scale), round(h * scale)), interpolation=cv2.INTER_AREA)
+
+
+# --------------------------------------------------------------------------- tracking
+@dataclass
+class _Track:
+    vid: int
+    box: Box
+    velocity: tuple[float, float] = (0.0, 0.0)
+    missed: int = 0
+    coasting: int = 0
+    frames: list[int] = field(default_factory=list)
+    boxes: list[Box] = field(default_factory=list)
+    contacts: list[tuple[float, float]] = field(default_factory=list)
+    kinds: list[str] = field(default_factory=list)
+    klt: list[tuple[float, float]] = field(default_factory=list)
+    border: list[bool] = field(default_factory=list)
+    points: Any = None  # KLT features (N, 1, 2) float32 in the previous frame
+
+    def predicted(self) -> Box:
+        dx, dy = self.velocity
+        x1, y1, x2, y2 = self.box
+        return (x1 + dx, y1 + dy, x2 + dx, y2 + dy)
+
+
+def _iou(a: Box, b: Box) -> float:
+    ix = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    iy = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    inter = ix * iy
+    union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
+    return inter / union if union > 0 else 0.0
+
+
+def _blobs(fg: Any, scale: float, min_area: int) -> list[Box]:
+    import cv2
+
+    n, _labels, stats, _ = cv2.connectedComponentsWithStats(fg, connectivity=8)
+    keep = [i for i in range(1, n) if stats[i, cv2.CC_STAT_AREA] >= min_area]
+    keep.sort(key=lambda i: -int(stats[i, cv2.CC_STAT_AREA]))
+    out = []
+    for i in keep[:_MAX_BLOBS]:
+        x, y, w, h = (int(v) for v in stats[i, :4])
+        out.append((x / scale, y / scale, (x + w) / scale, (y + h) / scale))
+    return out
+
+
+def _associate(
+    tracks: list[_Track], blobs: list[Box]
+) -> tuple[dict[int, int], list[int], set[int]]:
+    """Match tracks to blobs (Hungarian on 1 - IoU with the predicted boxes).
+
+    Returns track index -> blob index, the blobs that start new tracks, and the tracks hidden
+    in a merged blob (one blob covering at least 30 % of two or more established tracks'
+    predicted boxes: vehicles passing each other). Those coast on their prediction and the
+    merged blob is used by none.
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    if not tracks or not blobs:
+        return {}, list(range(len(blobs))), set()
+    preds = [t.predicted() for t in tracks]
+    cover = np.zeros((len(tracks), len(blobs)))
+    cost = np.ones((len(tracks), len(blobs)))
+    for i, pred in enumerate(preds):
+        area = max(1e-9, (pred[2] - pred[0]) * (pred[3] - pred[1]))
+        for j, b in enumerate(blobs):
+            ix = max(0.0, min(pred[2], b[2]) - max(pred[0], b[0]))
+            iy = max(0.0, min(pred[3], b[3]) - max(pred[1], b[1]))
+            cover[i, j] = ix * iy / area
+            cost[i, j] = 1.0 - _iou(pred, b)
+    established = np.array([len(t.frames) >= _MIN_DETECTED_FRAMES for t in tracks])
+    covering = (cover > 0.3) & established[:, None]
+    merged_blobs = {j for j in range(len(blobs)) if covering[:, j].sum() >= 2}
+    hidden = {i for j in merged_blobs for i in np.flatnonzero(covering[:, j]).tolist()}
+    cost[list(hidden), :] = 1.0
+    cost[:, list(merged_blobs)] = 1.0
+    rows, cols = linear_sum_assignment(cost)
+    match = {int(r): int(c) for r, c in zip(rows, cols, strict=True) if cost[r, c] < 0.9}
+    used = set(match.values()) | merged_blobs
+    for i in hidden:  # a hidden track overlapping the merged blob only: keep it coasting
+        match.pop(i, None)
+    return match, [j for j in range(len(blobs)) if j not in used], hidden
+
+
+def _contact(
+    fg: Any, box: Box, scale: float, prev_u: float | None
+) -> tuple[tuple[float, float], str]:
+    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette hull vertex or box."""
+    import cv2
+
+    x1, y1, x2, y2 = box
+    bottom_centre = ((x1 + x2) / 2.0, y2)
+    if fg is not None:
+        h, w = fg.shape
+        c0, r0 = max(0, int(x1 * scale)), max(0, int(y1 * scale))
+        c1, r1 = min(w, math.ceil(x2 * scale)), min(h, math.ceil(y2 * scale))
+        if c1 - c0 >= 2 and r1 - r0 >= 2:
+            roi = fg[r0:r1, c0:c1]
+            contours, _ = cv2.findContours(roi, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
+            if contours:
+                big = max(contours, key=cv2.contourArea)
+                area = cv2.contourArea(big)
+                hull = cv2.convexHull(big).reshape(-1, 2)
+                low = hull[:, 1].max()
+                # the silhouette must fill the box reasonably and reach its bottom
+                if area >= 0.25 * roi.size and low >= 0.85 * (r1 - r0) - 1:
+                    cand = hull[hull[:, 1] >= low - 1]
+                    if prev_u is None or len(cand) == 1:
+                        # the lowest vertex; on a near-horizontal bottom edge, its left end
+                        u = float(cand[np.lexsort((cand[:, 0], -cand[:, 1]))[0], 0])
+                    else:
+                        us = (cand[:, 0] + c0 + 0.5) / scale
+                        u = float(cand[int(np.argmin(np.abs(us - prev_u))), 0])
+                    return ((u + c0 + 0.5) / scale, (low + r0 + 1.0) / scale), "silhouette"
+    return bottom_centre, "box"
+
+
+def _klt_step(
+    prev: Any, grey: Any, tracks: list[_Track], boxes: dict[int, Box]
+) -> dict[int, tuple[float, float]]:
+    """Track every vehicle's features from ``prev`` to ``grey``; median lower-half motion."""
+    import cv2
+
+    pts, owners = [], []
+    guess = []
+    for k, t in enumerate(tracks):
+        if t.points is not None and len(t.points) and k in boxes:
+            pts.append(t.points)
+            owners.extend([k] * len(t.points))
+            guess.append(t.points + np.asarray(t.velocity, np.float32))
+    if not pts:
+        return {}
+    p0 = np.concatenate(pts).astype(np.float32)
+    p1, status, _err = cv2.calcOpticalFlowPyrLK(
+        prev,
+        grey,
+        p0,
+        np.concatenate(guess).astype(np.float32),
+        winSize=(15, 15),
+        maxLevel=3,
+        flags=cv2.OPTFLOW_USE_INITIAL_FLOW,
+        criteria=(cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 20, 0.03),
+    )
+    own = np.asarray(owners)
+    ok = status.ravel() == 1
+    out: dict[int, tuple[float, float]] = {}
+    for k in set(owners):
+        sel = (own == k) & ok
+        a, b = p0[sel, 0], p1[sel, 0]
+        x1, y1, x2, y2 = boxes[k]
+        inside = (
+            (b[:, 0] >= x1 - 2) & (b[:, 0] <= x2 + 2) & (b[:, 1] >= y1 - 2) & (b[:, 1] <= y2 + 2)
+        )
+        a, b = a[inside], b[inside]
+        tracks[k].points = b.reshape(-1, 1, 2) if len(b) else None
+        if len(a) >= 3:
+            d = b - a
+            lower = a[:, 1] >= np.median(a[:, 1])
+            use = d[lower] if lower.sum() >= 3 else d
+            out[k] = (float(np.median(use[:, 0])), float(np.median(use[:, 1])))
+    return out
+
+
+def _seed_features(grey: Any, fg_full: Any, box: Box) -> Any:
+    import cv2
+
+    h, w = grey.shape
+    x1, y1, x2, y2 = box
+    mx, my = 0.1 * (x2 - x1), 0.1 * (y2 - y1)
+    c0, r0 = max(0, int(x1 + mx)), max(0, int(y1 + my))
+    c1, r1 = min(w, int(x2 - mx)), min(h, int(y2 - my))
+    if c1 - c0 < 6 or r1 - r0 < 6:
+        return None
+    mask = None if fg_full is None else fg_full[r0:r1, c0:c1]
+    if mask is not None and cv2.countNonZero(mask) < 0.1 * mask.size:
+        mask = None  # no foreground here (given boxes on a background-less frame)
+    pts = cv2.goodFeaturesToTrack(
+        grey[r0:r1, c0:c1], _MAX_FEATURES, 0.01, 3, mask=mask, blockSize=5
+    )
+    if pts is None:
+        return None
+    return (pts + np.asarray([c0, r0], np.float32)).astype(np.float32)
+
+
+# --------------------------------------------------------------------------- fitting
+def _segments(t: _Track, fps: float, width: int, height: int) -> tuple[list[int], list[int]]:
+    """Indices of the records used and their segment labels (split where the contact jumps)."""
+    use, labels = [], []
+    seg = -1
+    prev: int | None = None
+    for i in range(len(t.frames)):
+        if t.border[i]:
+            prev = None
+            continue
+        if prev is None or t.frames[i] - t.frames[prev] > _MAX_MISSED + 1:
+            seg += 1
+        else:
+            x1, y1, x2, y2 = t.boxes[i]
+            thr = max(4.0, 0.15 * (y2 - y1), 0.08 * (x2 - x1))
+            dm = np.subtract(t.contacts[i], t.contacts[prev])
+            k = t.klt[i]
+            if t.kinds[i] != t.kinds[prev]:
+                seg += 1
+            elif math.isfinite(k[0]) and t.frames[i] - t.frames[prev] == 1:
+                if math.hypot(dm[0] - k[0], dm[1] - k[1]) > thr:
+                    seg += 1
+            elif math.hypot(*dm) > 3 * thr * (t.frames[i] - t.frames[prev]):
+                seg += 1
+        use.append(i)
+        labels.append(seg)
+        prev = i
+    # segments shorter than 3 frames carry no velocity: drop them
+    counts = {s: labels.count(s) for s in set(labels)}
+    keep = [j for j, s in enumerate(labels) if counts[s] >= 3]
+    return [use[j] for j in keep], [labels[j] for j in keep]
+
+
+def _design(times: FloatArray, labels: list[int]) -> FloatArray:
+    segs = sorted(set(labels))
+    a = np.zeros((len(times), 1 + len(segs)))
+    a[:, 0] = times - times.mean()
+    for j, s in enumerate(labels):
+        a[j, 1 + segs.index(s)] = 1.0
+    return a
+
+
+def _irls(a: FloatArray, g: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Huber IRLS of ``g ≈ a @ coef``; returns the solve matrix, weights and residuals."""
+    w = np.ones(len(g))
+    for _ in range(4):
+        sw = np.sqrt(w)[:, None]
+        solve = np.linalg.pinv(a * sw) * sw.T
+        res = g - a @ (solve @ g)
+        r = np.linalg.norm(res, axis=1)
+        s = 1.4826 * float(np.median(r)) + 1e-6
+        w = np.where(r <= 2.0 * s, 1.0, 2.0 * s / np.maximum(r, 1e-12))
+    sw = np.sqrt(w)[:, None]
+    solve = np.linalg.pinv(a * sw) * sw.T
+    res = g - a @ (solve @ g)
+    return np.asarray(solve, np.float64), np.asarray(w, np.float64), res
+
+
+def _fit_track(
+    t: _Track,
+    calibration: CalibrationResult,
+    fps: float,
+    width: int,
+    height: int,
+    min_track_s: float,
+    n_samples: int,
+    seed: int,
+) -> VehicleSpeed:
+    first, last = t.frames[0], t.frames[-1]
+    kinds = set(t.kinds)
+    contact = kinds.pop() if len(kinds) == 1 else "mixed"
+
+    def skipped(reason: str, n: int = 0, dur: float = math.nan) -> VehicleSpeed:
+        nan = math.nan
+        return VehicleSpeed(
+            t.vid, "skipped", nan, nan, first, last, n, dur, nan, nan, contact, 0, reason
+        )
+
+    span_s = (last - first) / fps
+    if span_s < min_track_s:
+        return skipped(f"tracked for only {span_s:.2f} s (< {min_track_s:g} s)", len(t.frames))
+    if all(t.border):
+        return skipped("never wholly inside the frame (its box touches the image border)")
+    use, labels = _segments(t, fps, width, height)
+    if not use:
+        return skipped("its ground contact jumps in every frame (occlusions or merged vehicles)")
+    pixels = np.array([t.contacts[i] for i in use], dtype=np.float64)
+    frames = np.array([t.frames[i] for i in use])
+    cam = calibration.camera
+    centres, focals, px = _draws(calibration, pixels, n_samples, 0.0, seed)
+    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    ground = _ground(centres, rays)[..., :2]
+    ok = np.all(np.isfinite(ground[0]), axis=1)
+    if ok.sum() < 3:
+        return skipped("its ground contact is at or above the horizon")
+    ground, frames = ground[:, ok], frames[ok]
+    labels = [s for s, k in zip(labels, ok, strict=True) if k]
+    counts = {s: labels.count(s) for s in set(labels)}
+    keep = np.array([counts[s] >= 3 for s in labels])
+    ground, frames = ground[:, keep], frames[keep]
+    labels = [s for s, k in zip(labels, keep, strict=True) if k]
+    times = frames / fps
+    dur = float(times.max() - times.min()) if len(times) else 0.0
+    if len(times) < 3 or dur < min_track_s:
+        return skipped(
+            f"only {dur:.2f} s of usable frames wholly inside the image (< {min_track_s:g} s)",
+            len(times),
+            dur,
+        )
+    a = _design(times, labels)
+    solve, weights, res = _irls(a, ground[0])
+    coef = solve @ ground[0]
+    vel = coef[0]
+    speed = float(np.linalg.norm(vel))
+    if speed * dur < 1.0:
+        return skipped(f"stationary (moved {speed * dur:.2f} m in {dur:.1f} s)", len(times), dur)
+    # fit standard error along the direction of travel
+    dof = max(1, len(times) - a.shape[1])
+    unit = vel / speed
+    s2 = float(np.sum(weights * (res @ unit) ** 2) / dof)
+    sigma_fit = math.sqrt(s2 * float(solve[0] @ solve[0]))
+    # calibration: refit with every drawn camera
+    draws = np.einsum("n,snd->sd", solve[0], ground[1:])
+    sp = np.linalg.norm(draws, axis=1)
+    sp = sp[np.isfinite(sp)]
+    sigma_cal = float(np.std(sp, ddof=1)) if len(sp) >= 2 else 0.0
+    sigma = math.hypot(sigma_fit, sigma_cal)
+    # refine with a cuboid moving at constant velocity whose image box matches the boxes
+    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
+    refined = _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
+    if refined is not None:
+        vel_c, sigma_c = refined
+        speed_c = float(np.linalg.norm(vel_c))
+        if speed_c * dur >= 1.0:
+            sigma_cal *= speed_c / speed
+            # the two estimates (ground contact, cuboid) disagree by the model's error
+            sigma_model = abs(speed_c - speed) / 2.0
+            vel, speed, sigma_fit = vel_c, speed_c, sigma_c
+            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2)
+    heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
+    heading = 0.0 if heading >= 359.99995 else heading
+    world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
+    return VehicleSpeed(
+        t.vid,
+        "measured",
+        speed * 3.6,
+        sigma * 3.6,
+        first,
+        last,
+        len(times),
+        dur,
+        speed * dur,
+        heading,
+        contact,
+        len(set(labels)),
+        None,
+        world,
+    )
+
+
+_CAR_DIMS_M = np.array([4.5, 1.8, 1.5])
+_MARGIN_PRIOR_PX = 5.0
+
+
+def _cuboid_boxes(cam: Any, params: FloatArray, times: FloatArray) -> FloatArray:
+    """Image boxes ``(N, 4)`` of a cuboid ``(x0, y0, vx, vy, log L, log W, log H[, margin])``.
+
+    ``margin`` (pixels) widens the box on every side: detectors' and masks' boxes are
+    looser or tighter than the object by a roughly constant number of pixels.
+    """
+    x0, y0, vx, vy = params[:4]
+    length, width, height = np.exp(params[4:7])
+    speed = math.hypot(vx, vy) or 1e-9
+    fwd = np.array([vx, vy]) / speed
+    left = np.array([-fwd[1], fwd[0]])
+    centres = np.array([x0, y0]) + np.outer(times, [vx, vy])
+    offs = np.array(
+        [
+            s * length / 2 * fwd + q * width / 2 * left
+            for s, q in ((1, -1), (1, 1), (-1, 1), (-1, -1))
+        ]
+    )
+    foot = centres[:, None, :] + offs[None]
+    n = len(times)
+    pts = np.concatenate(
+        [
+            np.concatenate([foot, np.zeros((n, 4, 1))], axis=2),
+            np.concatenate([foot, np.full((n, 4, 1), height)], axis=2),
+        ],
+        axis=1,
+    ).reshape(-1, 3)
+    px = cam.project(pts).reshape(n, 8, 2)
+    margin = params[7] if len(params) > 7 else 0.0
+    return np.concatenate([px.min(axis=1) - margin, px.max(axis=1) + margin], axis=1)
+
+
+def _cuboid_fit(
+    cam: Any,
+    boxes: FloatArray,
+    times: FloatArray,
+    ground: FloatArray,
+    labels: list[int],
+    solve: FloatArray,
+    vel: FloatArray,
+) -> tuple[FloatArray, float] | None:
+    """Velocity and its sigma (m/s) of a constant-velocity cuboid fitted to the boxes.
+
+    The contact-point fit gives the start (direction, speed, position); the cuboid's centre,
+    velocity and dimensions (weak prior: a car, 4.5 × 1.8 × 1.5 m) are then fitted (soft-L1)
+    to every frame's box. Returns None when the fit fails or is implausible.
+    """
+    from scipy.optimize import least_squares
+
+    speed = float(np.linalg.norm(vel))
+    if len(times) < 6 or speed <= 0:
+        return None
+    tc = times - times.mean()
+    coef = solve @ ground
+    seg0 = sorted(set(labels))
+    mid = coef[1 : 1 + len(seg0)].mean(axis=0)
+    start = np.concatenate([mid, vel, np.log(_CAR_DIMS_M), [0.0]])
+    span = float(np.median(boxes[:, 3] - boxes[:, 1])) + 1.0
+
+    def resid(p: FloatArray) -> FloatArray:
+        pred = _cuboid_boxes(cam, p, tc)
+        r = ((pred - boxes) / span * 20.0).ravel()
+        prior = np.append((p[4:7] - np.log(_CAR_DIMS_M)) / 0.7, p[7] / _MARGIN_PRIOR_PX)
+        out = np.concatenate([r, prior])
+        return np.where(np.isfinite(out), out, 1e3)
+
+    try:
+        res = least_squares(resid, start, loss="soft_l1", f_scale=1.0, max_nfev=200)
+    except (ValueError, np.linalg.LinAlgError):
+        return None
+    if not res.success:
+        return None
+    v = res.x[2:4]
+    sp = float(np.linalg.norm(v))
+    if not (0.5 * speed < sp < 2.0 * speed):
+        return None
+    try:
+        jac = res.jac
+        dof = max(1, len(res.fun) - len(res.x))
+        s2 = 2.0 * res.cost / dof
+        cov = np.linalg.pinv(jac.T @ jac) * s2
+        u = v / sp
+        var = float(u @ cov[2:4, 2:4] @ u)
+    except np.linalg.LinAlgError:
+        return None
+    return v, math.sqrt(max(var, 0.0))
+
+
+# --------------------------------------------------------------------------- main entry
+def measure_speeds(
+    calibration: CalibrationResult,
+    video_path: str | os.PathLike[str],
+    *,
+    fps: float | None = None,
+    tracks: str | os.PathLike[str] | Mapping[int, Mapping[int, Any]] | None = None,
+    image_size: tuple[int, int] | None = None,
+    min_track_s: float = 0.5,
+    max_frames: int | None = None,
+    detect_width_px: int = 640,
+    n_samples: int = 200,
+    seed: int = _SEED,
+    progress: bool = False,
+) -> RadarResult:
+    """Speeds of the vehicles in a video from a calibrated camera (the virtual radar).
+
+    Parameters
+    ----------
+    calibration
+        The calibrated camera (:class:`camloc_geo.relative.CalibrationResult`) of the scene.
+    video_path
+        A video OpenCV can read, from the same camera, same framing and size as the scene.
+    fps
+        Frame rate; default: the one the file states (refused when it states none).
+    tracks
+        Boxes per frame from any detector: a file (:func:`read_tracks`) or
+        ``{id: {frame: (x1, y1, x2, y2)}}``. Default: background subtraction finds vehicles.
+    image_size
+        ``(width, height)`` of the scene's image; the video's frames must be that size.
+    min_track_s
+        Shorter tracks are skipped (reported with the reason).
+    max_frames
+        Process only the first frames (default: all, up to :data:`MAX_VIDEO_FRAMES`).
+    detect_width_px
+        Background subtraction runs on frames reduced to at most this width.
+    n_samples, seed
+        Monte Carlo cameras for the calibration part of ``sigma_kmh``.
+    progress
+        Show a tqdm progress bar on stderr.
+
+    Returns
+    -------
+    RadarResult
+        Every vehicle with its speed (or why it has none). No vehicle at all is not an error:
+        the result is empty with a warning (the CLI turns it into exit 2).
+
+    Raises
+    ------
+    InputError
+        Unreadable video, no usable frame rate, frame size different from the scene's image,
+        too long or too large a video, malformed tracks.
+    """
+    t0 = time.perf_counter()
+    if fps is not None and not (math.isfinite(fps) and 0.5 <= fps <= 1000.0):
+        raise InputError(f"fps must be between 0.5 and 1000, not {fps}")
+    if not (math.isfinite(min_track_s) and min_track_s > 0):
+        raise InputError(f"min_track_s must be > 0, not {min_track_s}")
+    given: TrackBoxes | None = None
+    if tracks is not None:
+        given = (
+            read_tracks(tracks) if isinstance(tracks, (str, os.PathLike)) else _check_tracks(tracks)
+        )
+    cap, width, height, fps_file, n_file = _open_video(video_path)
+    try:
+        if image_size is not None:
+            _check_size(video_path, (width, height), image_size)
+        if fps is None and fps_file is None:
+            raise InputError(f"video {video_path} states no frame rate: give it (--fps)")
+        rate = float(fps if fps is not None else fps_file)  # type: ignore[arg-type]
+        limit = MAX_VIDEO_FRAMES if max_frames is None else min(max_frames, MAX_VIDEO_FRAMES)
+        if max_frames is not None and max_frames < 1:
+            raise InputError(f"max_frames must be >= 1, not {max_frames}")
+        if max_frames is None and n_file > MAX_VIDEO_FRAMES:
+            raise InputError(
+                f"video {video_path} has {n_file} frames; the limit is {MAX_VIDEO_FRAMES} "
+                "(cut it, or process the first frames only with max_frames / --max-frames)"
+            )
+        result = _run(
+            cap,
+            calibration,
+            width,
+            height,
+            rate,
+            n_file,
+            limit,
+            given,
+            detect_width_px,
+            min_track_s,
+            n_samples,
+            seed,
+            progress,
+            str(video_path),
+        )
+    finally:
+        cap.release()
+    n_done, vehicles, noise = result
+    if n_done == 0:
+        raise InputError(f"cannot decode any frame of video {video_path}")
+    if given is not None and n_done < limit and max(max(p) for p in given.values() if p) >= n_done:
+        log.warning("some track boxes are after the video's last frame (%d)", n_done - 1)
+    info = VideoInfo(
+        str(video_path),
+        width,
+        height,
+        rate,
+        "file" if fps is None else "given",
+        fps_file,
+        n_done,
+    )
+    warnings: list[str] = []
+    if not vehicles:
+        warnings.append(
+            "no vehicle found in the video"
+            if given is None
+            else "no given track box falls within the video's frames"
+        )
+    elif not any(v.measured for v in vehicles):
+        warnings.append("vehicles were found but none could be measured (see their reasons)")
+    if max_frames is None and n_done >= MAX_VIDEO_FRAMES:
+        warnings.append(
+            f"stopped after {MAX_VIDEO_FRAMES} frames (the limit); the rest of the video is "
+            "not measured"
+        )
+    return RadarResult(
+        info,
+        vehicles,
+        "detection" if given is None else "tracks",
+        time.perf_counter() - t0,
+        noise,
+        warnings,
+    )
+
+
+def _run(
+    cap: Any,
+    calibration: CalibrationResult,
+    width: int,
+    height: int,
+    fps: float,
+    n_file: int,
+    limit: int,
+    given: TrackBoxes | None,
+    detect_width_px: int,
+    min_track_s: float,
+    n_samples: int,
+    seed: int,
+    progress: bool,
+    name: str,
+) -> tuple[int, list[VehicleSpeed], int]:
+    import cv2
+    from tqdm import tqdm
+
+    scale = min(1.0, detect_width_px / width)
+    sw, sh = round(width * scale), round(height * scale)
+    min_area = max(12, int(4e-4 * sw * sh))
+    bg_init = _background_init(cap, n_file, scale, limit)
+    background = None if bg_init is None else bg_init.astype(np.float32)
+    max_coast = max(5, round(_MAX_COAST_S * fps))
+    hidden: set[int] = set()
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    kernel_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
+    active: list[_Track] = []
+    vehicles: list[VehicleSpeed] = []
+    noise = [0]
+    last_given = {vid: max(per) for vid, per in given.items() if per} if given is not None else {}
+
+    def finish(t: _Track) -> None:
+        if given is None and len(t.frames) < _MIN_DETECTED_FRAMES:
+            noise[0] += 1  # a flicker, not a vehicle
+            return
+        if not t.frames:
+            return
+        for piece in _split_reversals(t) if given is None else [t]:
+            vehicles.append(
+                _fit_track(piece, calibration, fps, width, height, min_track_s, n_samples, seed)
+            )
+
+    by_id: dict[int, _Track] = {}
+    next_id = 1
+    prev_grey = None
+    total = min(n_file, limit) if n_file else None
+    bar = tqdm(total=total, disable=not progress, file=sys.stderr, unit="frame", desc="radar")
+    i = 0
+    try:
+        while i < limit:
+            ok, frame = cap.read()
+            if not ok:
+                break
+            if frame.shape[1] != width or frame.shape[0] != height:
+                raise InputError(f"video {name}: frame {i} is not {width}x{height}")
+            grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+            small = (
+                frame if scale == 1.0 else cv2.resize(frame, (sw, sh), interpolation=cv2.INTER_AREA)
+            )
+            if background is None:
+                background = small.astype(np.float32)
+            diff = cv2.absdiff(small, background.astype(np.uint8))
+            if diff.ndim == 3:  # largest channel difference (cv2: numpy's max is slow here)
+                b, g, r = cv2.split(diff)
+                level = cv2.max(cv2.max(b, g), r)
+            else:
+                level = diff
+            fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
+            cv2.accumulateWeighted(small, background, _BG_RATE, mask=cv2.bitwise_not(fg))
+            if small.ndim == 3:
+                fg = cv2.bitwise_and(fg, cv2.bitwise_not(_shadows(small, background)))
+            fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
+            fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
+            if given is None:
+                blobs = _blobs(fg, scale, min_area)
+                match, fresh, hidden = _associate(active, blobs)
+                for k in hidden:  # coast on the prediction while merged with another
+                    t = active[k]
+                    t.box = t.predicted()
+                    t.coasting += 1
+                    t.points = None
+                current: dict[int, Box] = {k: blobs[j] for k, j in match.items()}
+                for j in fresh:
+                    t = _Track(next_id, blobs[j])
+                    next_id += 1
+                    active.append(t)
+                    current[len(active) - 1] = blobs[j]
+            else:
+                current = {}
+                for vid, per in given.items():
+                    if i in per:
+                        if vid not in by_id:
+                            by_id[vid] = _Track(vid, per[i])
+                            active.append(by_id[vid])
+                        current[active.index(by_id[vid])] = _clip(per[i], width, height)
+            shifts: dict[int, tuple[float, float]] = (
+                _klt_step(prev_grey, grey, active, current) if prev_grey is not None else {}
+            )
+            fg_full = None
+            for k, t in enumerate(active):
+                if k not in current:
+                    if given is not None or k not in hidden:
+                        t.missed += 1
+                    t.points = None
+                    continue
+                t.coasting = 0
+                box = current[k]
+                if k in shifts:  # the features' motion: robust to a blob that merges or splits
+                    t.velocity = shifts[k]
+                elif t.frames:
+                    gap = max(1, i - t.frames[-1])
+                    last = t.boxes[-1]
+                    t.velocity = (
+                        ((box[0] + box[2]) - (last[0] + last[2])) / 2 / gap,
+                        ((box[1] + box[3]) - (last[1] + last[3])) / 2 / gap,
+                    )
+                t.box = box
+                t.missed = 0
+                prev_u = t.contacts[-1][0] if t.contacts else None
+                c, kind = _contact(fg, box, scale, prev_u)
+                t.frames.append(i)
+                t.boxes.append(box)
+                t.contacts.append(c)
+                t.kinds.append(kind)
+                t.klt.append(shifts.get(k, (math.nan, math.nan)))
+                t.border.append(
+                    box[0] <= 1.0
+                    or box[1] <= 1.0
+                    or box[2] >= width - 1.0
+                    or box[3] >= height - 1.0
+                )
+                if t.points is None or len(t.points) < 8 or len(t.frames) % 10 == 0:
+                    if fg_full is None:
+                        fg_full = (
+                            fg
+                            if scale == 1.0
+                            else cv2.resize(fg, (width, height), interpolation=cv2.INTER_NEAREST)
+                        )
+                    t.points = _seed_features(grey, fg_full, box)
+            still = []
+            for t in active:
+                if given is None:
+                    over = t.missed > _MAX_MISSED or t.coasting > max_coast
+                else:
+                    over = i >= last_given[t.vid]
+                if over:
+                    finish(t)  # fitted now: a long video keeps only the active tracks
+                else:
+                    still.append(t)
+            if len(still) != len(active):
+                active = still
+                if given is not None:
+                    by_id = {t.vid: t for t in active}
+            prev_grey = grey
+            i += 1
+            bar.update(1)
+    finally:
+        bar.close()
+    for t in active:
+        finish(t)
+    vehicles.sort(key=lambda v: (v.first_frame, v.vehicle_id))
+    if given is None:  # number detected vehicles 1, 2, ... in order of appearance
+        vehicles = [replace(v, vehicle_id=k + 1) for k, v in enumerate(vehicles)]
+    return i, vehicles, noise[0]
+
+
+def _split_reversals(t: _Track) -> list[_Track]:
+    """Split a detected track where one vehicle left the frame and another came in.
+
+    The blob of a vehicle leaving through an image border and the blob of one entering at
+    the same place can be one track. Between two stretches wholly inside the image with a
+    border-touching stretch between them, the track is cut when the image motion reverses.
+    """
+    runs: list[tuple[int, int]] = []
+    start = None
+    for i, b in enumerate([*t.border, True]):
+        if not b and start is None:
+            start = i
+        elif b and start is not None:
+            runs.append((start, i))
+            start = None
+    cuts = []
+    for (a0, a1), (b0, b1) in itertools.pairwise(runs):
+        if a1 - a0 < 2 or b1 - b0 < 2:
+            continue
+        va = np.subtract(_centre(t.boxes[a1 - 1]), _centre(t.boxes[a0]))
+        vb = np.subtract(_centre(t.boxes[b1 - 1]), _centre(t.boxes[b0]))
+        if float(va @ vb) < 0:
+            cuts.append((a1 + b0) // 2)
+    if not cuts:
+        return [t]
+    pieces = []
+    for lo, hi in zip([0, *cuts], [*cuts, len(t.frames)], strict=True):
+        piece = _Track(t.vid, t.boxes[hi - 1])
+        piece.frames, piece.boxes = t.frames[lo:hi], t.boxes[lo:hi]
+        piece.contacts, piece.kinds = t.contacts[lo:hi], t.kinds[lo:hi]
+        piece.klt, piece.border = t.klt[lo:hi], t.border[lo:hi]
+        pieces.append(piece)
+    return pieces
+
+
+def _shadows(frame: Any, background: Any) -> Any:
+    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio.
+
+    A shadow keeps the road's colour and dims it (ratio ``_SHADOW_RATIO``, spread below
+    ``_SHADOW_SPREAD`` between channels); a vehicle changes the colour or is much darker.
+    """
+    import cv2
+
+    ratio = cv2.divide(frame.astype(np.float32), background + 1.0)
+    b, g, r = cv2.split(ratio)
+    lo = cv2.min(cv2.min(b, g), r)
+    hi = cv2.max(cv2.max(b, g), r)
+    dim = cv2.inRange(lo, _SHADOW_RATIO[0], _SHADOW_RATIO[1])
+    grey = cv2.inRange(hi - lo, 0.0, _SHADOW_SPREAD)
+    bright = cv2.inRange(hi, 0.0, _SHADOW_RATIO[1])
+    return cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
+
+
+def _centre(box: Box) -> tuple[float, float]:
+    return ((box[0] + box[2]) / 2.0, (box[1] + box[3]) / 2.0)
+
+
+def _clip(box: Box, width: int, height: int) -> Box:
+    x1, y1, x2, y2 = box
+    return (max(0.0, x1), max(0.0, y1), min(float(width), x2), min(float(height), y2))
