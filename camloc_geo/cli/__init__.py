@@ -75,6 +75,7 @@ _COMMAND_MODULES = (
     "batch",
     "serve",
     "measure",
+    "guide",
 )
 
 log = logging.getLogger("camloc_geo.cli")
