@@ -18,14 +18,16 @@ Two modes
 Noise model and scores
 ----------------------
 Everything is resampled on a common time grid (``step_s``). At each grid time where both a
-ground track ``p`` and a trace ``g`` exist, ``z² = |p - g|² / s²`` with
-``s² = gps_sigma_m² + projection sigma²`` (per axis; the projection sigma is the Monte Carlo
-spread of the ground point over the calibration's uncertainty and ``click_sigma_px``). A
-sample adds ``w · (gate - ρ(z²)) / 2`` to the pair's score, ``ρ`` Huber (quadratic up to
-``z = 2``, linear after), ``gate`` the 99 % quantile of χ²(2) and
+ground track ``p`` and a trace ``g`` exist, ``d = |p - g|`` and ``s² = gps_sigma_m² +``
+projection sigma² (per axis; the projection sigma is the Monte Carlo spread of the ground
+point over the calibration's uncertainty and ``click_sigma_px``). The sample's
+log-likelihood ratio between "this trace is this person's" (``d`` Gaussian with ``s``,
+robustified: Huber ``ρ`` on ``z = d / s``, quadratic up to 2, linear after) and "it is
+somebody else's nearby" (``d`` Gaussian with ``S² = s² + crowd_spread_m²``, the spread of
+people around each other) is ``log(S²/s²) - ρ(z²)/2 + d²/(2 S²)``; it is weighted by
 ``w = min(1, step_s / gps_correlation_s)`` (GPS errors are correlated in time, so samples
-closer than that are not independent). The score is a log-likelihood ratio against "this
-person carries none of the traces" (score 0).
+closer than that are not independent) and summed into the pair's score. A score is thus a
+log-likelihood ratio against "this person carries none of the traces" (score 0).
 
 The assignment maximises the total score (``scipy.optimize.linear_sum_assignment``; one
 "no match" column per track; a final match with less than ``min_overlap_s`` of common time
@@ -79,7 +81,6 @@ __all__ = [
 
 FloatArray = npt.NDArray[np.float64]
 
-_CHI2_2_99 = 9.2103
 _HUBER_Z = 2.0
 _BIG = 1e9
 _SEED = 20261124
@@ -530,6 +531,9 @@ class GuideSettings:
         GPS error per axis, metres.
     gps_correlation_s
         Time over which GPS errors stay correlated; samples closer count as one.
+    crowd_spread_m
+        How far apart, per axis, unrelated people and traces typically are (the
+        alternative hypothesis of the scores).
     click_sigma_px
         Error of a foot pixel (a detector's box bottom), pixels per coordinate.
     step_s
@@ -549,7 +553,8 @@ class GuideSettings:
     """
 
     gps_sigma_m: float = 4.0
-    gps_correlation_s: float = 3.0
+    gps_correlation_s: float = 10.0
+    crowd_spread_m: float = 15.0
     click_sigma_px: float = 3.0
     step_s: float = 1.0
     min_overlap_s: float = 3.0
@@ -562,7 +567,7 @@ class GuideSettings:
 
     def check(self) -> None:
         """Raise :class:`InputError` on a meaningless value."""
-        for name in ("gps_sigma_m", "step_s", "gps_correlation_s"):
+        for name in ("gps_sigma_m", "step_s", "gps_correlation_s", "crowd_spread_m"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"{name} must be positive, not {v}")
@@ -650,6 +655,7 @@ class GuideResult:
             "settings": {
                 "gps_sigma_m": s.gps_sigma_m,
                 "gps_correlation_s": s.gps_correlation_s,
+                "crowd_spread_m": s.crowd_spread_m,
                 "click_sigma_px": s.click_sigma_px,
                 "step_s": s.step_s,
                 "min_overlap_s": s.min_overlap_s,
@@ -842,7 +848,10 @@ def _scores(grid: _Grid, sim: Similarity2D, settings: GuideSettings) -> tuple[Fl
     valid = np.isfinite(D)
     with np.errstate(invalid="ignore"):
         rho = _huber(np.where(valid, D**2 / s2, 0.0))
-    per = np.where(valid, 0.5 * grid.w * (_CHI2_2_99 - rho), 0.0)
+    big2 = s2 + settings.crowd_spread_m**2
+    with np.errstate(invalid="ignore"):
+        llr = np.log(big2 / s2) - 0.5 * rho + 0.5 * np.where(valid, D**2, 0.0) / big2
+    per = np.where(valid, grid.w * llr, 0.0)
     return per, valid, D
 
 
