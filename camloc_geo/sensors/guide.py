@@ -59,7 +59,7 @@ import numpy.typing as npt
 from camloc_geo._errors import InputError
 from camloc_geo.absolute._similarity import Similarity2D, rot2
 from camloc_geo.geodesy import LocalFrame
-from camloc_geo.sensors import _draws, _ground, _pixels, _rays
+from camloc_geo.sensors import _draws_posed, _ground, _pixels, _rays
 
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult
@@ -734,10 +734,10 @@ def _project_track(
     """Ground points ``(N, 2)`` in the car's world frame and their sigma ``(N,)``, metres."""
     pixels = _pixels(track.foot_px, f"track {track.id}")
     cam = calibration.camera
-    centres, focals, px = _draws(
+    centres, focals, rotations, px = _draws_posed(
         calibration, pixels, settings.n_samples, settings.click_sigma_px, seed
     )
-    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    rays = _rays(px, focals, cam.principal_point, rotations)
     pts = _ground(centres, rays)
     bad = ~np.all(np.isfinite(pts[0]), axis=-1)
     if np.any(bad):
