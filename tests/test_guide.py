@@ -420,3 +420,26 @@ def test_cli_located_scene_geojson(tmp_path: Path, capsys: pytest.CaptureFixture
     assert abs(lat - ls.lat) < 0.001
     assert abs(lon - ls.lon) < 0.001
     assert gj["properties"]["mode"] == "absolute"
+    # The same pose rebuilt from the candidate GeoJSON camloc locate writes: no map needed.
+    cands = tmp_path / "cands.geojson"
+    assert main(["locate", str(tmp_path / "scene.json"), "--osm", str(osm), "-o", str(cands)]) == 0
+    out2 = tmp_path / "guide2.geojson"
+    rc = main(
+        [
+            *_guide(tmp_path),
+            "--gps",
+            str(tmp_path / "traces.csv"),
+            "--candidates",
+            str(cands),
+            "--no-network",
+            "-o",
+            str(out2),
+        ]
+    )
+    assert rc == 0, capsys.readouterr().err
+    gj2 = json.loads(out2.read_text(encoding="utf-8"))
+    tracks2 = [f for f in gj2["features"] if f["properties"]["kind"] == "person_track"]
+    assert {f["properties"]["track"]: f["properties"]["gps"] for f in tracks2} == data.truth
+    a = np.asarray(tracks[0]["geometry"]["coordinates"])
+    b = np.asarray(tracks2[0]["geometry"]["coordinates"])
+    assert np.abs(a - b).max() < 2e-6  # the same ground track within ~0.2 m
