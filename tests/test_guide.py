@@ -129,6 +129,8 @@ def test_absolute_assignment_and_timing(absolute: GuideResult, data: GuideData) 
         assert m.certain_after_s is not None
         # certain within the walk (60 s), after several seconds of common data
         assert 5.0 <= m.certain_after_s <= 45.0
+        assert m.stable_after_s is not None
+        assert m.stable_after_s <= m.certain_after_s
         assert m.median_distance_m is not None
         assert m.median_distance_m < 10.0
     no_phone = absolute.match_of("person4")

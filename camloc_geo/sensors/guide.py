@@ -37,7 +37,8 @@ best total score and ``S₂`` the best total score with that outcome forbidden (
 mode, the best over the top transform proposals). It is evaluated on the data up to each of
 up to ``max_evaluations`` times; ``certain_after_s`` is the time, counted from the track's
 first sample, from which the track's outcome equals the final one and its certainty stays at
-or above ``certainty``.
+or above ``certainty``; ``stable_after_s`` the time from which the outcome equals the final
+one, whatever its certainty (the paper's "bootstrapping time").
 """
 
 from __future__ import annotations
@@ -591,6 +592,7 @@ class GuideMatch:
     median_distance_m: float | None
     score: float
     reason: str | None = None
+    stable_after_s: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -600,6 +602,7 @@ class GuideMatch:
             "certainty": round(self.certainty, 6),
             "certain_after_s": self.certain_after_s,
             "certain_at": None if self.certain_at_s is None else format_time(self.certain_at_s),
+            "stable_after_s": self.stable_after_s,
             "overlap_s": self.overlap_s,
             "mean_distance_m": self.mean_distance_m,
             "median_distance_m": self.median_distance_m,
@@ -1022,6 +1025,16 @@ def match_people(
                 since = k
             else:
                 break
+        stable: int | None = None
+        for k, a, _c in reversed(history):
+            if a[i] != j:
+                break
+            stable = k
+        stable_after = (
+            None
+            if stable is None
+            else round(max(0.0, float(times[stable]) - float(tr.times_s[0])), 3)
+        )
         certain_at = None if since is None else float(times[since])
         after = (
             None if certain_at is None else round(max(0.0, certain_at - float(tr.times_s[0])), 3)
@@ -1040,6 +1053,7 @@ def match_people(
                     0.0,
                     f"its best trace {traces[j].id} overlaps it for only "
                     f"{overlap_cum[i, j, -1]:g} s (< {settings.min_overlap_s:g} s)",
+                    stable_after,
                 )
             )
         elif j >= 0 and D_f is not None and per_f is not None:
@@ -1055,6 +1069,8 @@ def match_people(
                     round(float(np.mean(d)), 3),
                     round(float(np.median(d)), 3),
                     float(per_f[i, j].sum()),
+                    None,
+                    stable_after,
                 )
             )
         else:
@@ -1065,7 +1081,17 @@ def match_people(
                 reason = "no GPS trace stays close enough to it"
             matches.append(
                 GuideMatch(
-                    tr.id, None, final_certs[i], after, certain_at, 0.0, None, None, 0.0, reason
+                    tr.id,
+                    None,
+                    final_certs[i],
+                    after,
+                    certain_at,
+                    0.0,
+                    None,
+                    None,
+                    0.0,
+                    reason,
+                    stable_after,
                 )
             )
     taken = {m.gps for m in matches if m.gps is not None}
