@@ -445,3 +445,8 @@ def test_cli_located_scene_geojson(tmp_path: Path, capsys: pytest.CaptureFixture
     a = np.asarray(tracks[0]["geometry"]["coordinates"])
     b = np.asarray(tracks2[0]["geometry"]["coordinates"])
     assert np.abs(a - b).max() < 2e-6  # the same ground track within ~0.2 m
+
+
+def test_too_fine_a_grid_is_refused(calibration: CalibrationResult, data: GuideData) -> None:
+    with pytest.raises(InputError, match="use a larger step"):
+        match_people(calibration, data.tracks, data.traces, settings=GuideSettings(step_s=1e-4))

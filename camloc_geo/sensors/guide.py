@@ -47,6 +47,7 @@ import csv
 import io
 import json
 import math
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -86,6 +87,9 @@ _HUBER_Z = 2.0
 _BIG = 1e9
 _SEED = 20261124
 _MAX_GRID = 200_000
+_MAX_CELLS = 20_000_000  # tracks x traces x grid steps held at once
+_MAX_PROPOSALS = 40
+_CHUNK = 2000  # pixels projected at once
 _UNIX_MIN_S = 1e8  # numbers above this are UNIX times (1973 onwards), below: video seconds
 
 
@@ -737,25 +741,32 @@ def _project_track(
     """Ground points ``(N, 2)`` in the car's world frame and their sigma ``(N,)``, metres."""
     pixels = _pixels(track.foot_px, f"track {track.id}")
     cam = calibration.camera
-    centres, focals, rotations, px = _draws_posed(
-        calibration, pixels, settings.n_samples, settings.click_sigma_px, seed
-    )
-    rays = _rays(px, focals, cam.principal_point, rotations)
-    pts = _ground(centres, rays)
-    bad = ~np.all(np.isfinite(pts[0]), axis=-1)
-    if np.any(bad):
-        k = int(np.argmax(bad))
-        u, v = pixels[k]
-        raise InputError(
-            f"track {track.id}: foot pixel ({u:g}, {v:g}) at {format_time(track.times_s[k])} is "
-            "at or above the horizon: its ray never meets the ground"
+    xy = np.empty((len(pixels), 2))
+    sigma = np.zeros(len(pixels))
+    for c0 in range(0, len(pixels), _CHUNK):
+        chunk = pixels[c0 : c0 + _CHUNK]
+        centres, focals, rotations, px = _draws_posed(
+            calibration, chunk, settings.n_samples, settings.click_sigma_px, seed + c0
         )
-    draws = pts[1:, :, :2]
-    with np.errstate(invalid="ignore"):
-        var = np.nanvar(draws, axis=0, ddof=1).mean(axis=-1) if len(draws) > 1 else None
-    sigma = np.zeros(len(pixels)) if var is None else np.sqrt(np.nan_to_num(var, nan=1e6))
-    # Far points whose draws often miss the ground: their sigma is huge, as it should be.
-    return np.asarray(pts[0, :, :2]), np.minimum(sigma, 1e3)
+        pts = _ground(centres, _rays(px, focals, cam.principal_point, rotations))
+        bad = ~np.all(np.isfinite(pts[0]), axis=-1)
+        if np.any(bad):
+            k = c0 + int(np.argmax(bad))
+            u, v = pixels[k]
+            raise InputError(
+                f"track {track.id}: foot pixel ({u:g}, {v:g}) at "
+                f"{format_time(track.times_s[k])} is at or above the horizon: its ray never "
+                "meets the ground"
+            )
+        xy[c0 : c0 + len(chunk)] = pts[0, :, :2]
+        draws = pts[1:, :, :2]
+        if len(draws) > 1:
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                var = np.nanvar(draws, axis=0, ddof=1).mean(axis=-1)
+            # Far points whose draws often miss the ground: a huge sigma, as it should be.
+            sigma[c0 : c0 + len(chunk)] = np.sqrt(np.nan_to_num(var, nan=1e6))
+    return xy, np.minimum(sigma, 1e3)
 
 
 def _resample(
@@ -843,11 +854,18 @@ class _Grid:
     w: float
 
 
-def _scores(grid: _Grid, sim: Similarity2D, settings: GuideSettings) -> tuple[FloatArray, ...]:
-    """Per-sample pair scores ``(n, m, K)``, validity and distances under ``sim``."""
-    Q = sim.apply(grid.P.reshape(-1, 2)).reshape(grid.P.shape)
-    D = np.linalg.norm(Q[:, None] - grid.G[None], axis=-1)  # (n, m, K)
-    s2 = settings.gps_sigma_m**2 + (sim.scale * grid.SP[:, None, :]) ** 2
+def _scores(
+    grid: _Grid, sim: Similarity2D, settings: GuideSettings, upto: int | None = None
+) -> tuple[FloatArray, ...]:
+    """Per-sample pair scores ``(n, m, K)``, validity and distances under ``sim``.
+
+    ``upto``: only the grid times ``0..upto`` (the arrays are then that long).
+    """
+    end = None if upto is None else upto + 1
+    P, SP, G = grid.P[:, :end], grid.SP[:, :end], grid.G[:, :end]
+    Q = sim.apply(P.reshape(-1, 2)).reshape(P.shape)
+    D = np.linalg.norm(Q[:, None] - G[None], axis=-1)  # (n, m, K)
+    s2 = settings.gps_sigma_m**2 + (sim.scale * SP[:, None, :]) ** 2
     valid = np.isfinite(D)
     with np.errstate(invalid="ignore"):
         rho = _huber(np.where(valid, D**2 / s2, 0.0))
@@ -909,6 +927,11 @@ def match_people(
             f"the tracks span {t_hi - t_lo:.0f} s: more than {_MAX_GRID} steps of "
             f"{settings.step_s:g} s; use a larger step"
         )
+    if len(tracks) * len(traces) * n_grid > _MAX_CELLS:
+        raise InputError(
+            f"too much to match at once: {len(tracks)} tracks x {len(traces)} traces x "
+            f"{n_grid} steps of {settings.step_s:g} s; use a larger step or split the video"
+        )
     times: FloatArray = t_lo + settings.step_s * np.arange(n_grid, dtype=np.float64)
     # Ground tracks in the car's world frame.
     P = np.full((len(tracks), n_grid, 2), np.nan)
@@ -951,6 +974,8 @@ def match_people(
     if pose is not None:
         abs_cum = np.cumsum(_scores(grid, pose.enu_from_world, settings)[0], axis=-1)
 
+    previous: list[Similarity2D] = []
+
     def solve_at(k: int) -> tuple[Similarity2D | None, list[tuple[float, list[int], FloatArray]]]:
         """Transform(s) and their (total, assignment, W) at grid index k, best first."""
         allowed = overlap_cum[..., k] > 0
@@ -958,25 +983,26 @@ def match_people(
             W = abs_cum[..., k]
             total, assign = _assign(W, allowed)
             return pose.enu_from_world, [(total, assign, W)]
-        sims = _proposals(grid, both, k, allowed, scale)
+        sims = _proposals(grid, both, k, overlap_cum[..., k], _MAX_PROPOSALS, scale)
+        if previous:
+            sims.append(previous[0])  # the last evaluation's answer, refitted on more data
         scored: list[tuple[float, list[int], FloatArray, Similarity2D]] = []
         for sim in sims:
             for _it in range(2):
-                per, _valid, _D = _scores(grid, sim, settings)
-                W = per[..., : k + 1].sum(axis=-1)
+                W = _scores(grid, sim, settings, k)[0].sum(axis=-1)
                 total, assign = _assign(W, allowed)
                 refit = _refit(grid, both, k, assign, scale)
                 if refit is None:
                     break
                 sim = refit
-            per, _valid, _D = _scores(grid, sim, settings)
-            W = per[..., : k + 1].sum(axis=-1)
+            W = _scores(grid, sim, settings, k)[0].sum(axis=-1)
             total, assign = _assign(W, allowed)
             scored.append((total, assign, W, sim))
         scored.sort(key=lambda s: -s[0])
         top = scored[: settings.proposals]
         if not top:
             return None, []
+        previous[:] = [top[0][3]]
         return top[0][3], [(s[0], s[1], s[2]) for s in top]
 
     timeline: list[dict[str, Any]] = []
@@ -1141,23 +1167,23 @@ def _proposals(
     grid: _Grid,
     both: npt.NDArray[np.bool_],
     k: int,
-    allowed: npt.NDArray[np.bool_],
+    overlap_s: FloatArray,
+    most: int,
     scale: float,
 ) -> list[Similarity2D]:
-    """Relative mode: one rigid transform per allowed (track, trace) pair, from data ≤ k."""
+    """Relative mode: one rigid transform per (track, trace) pair with common time up to k
+    (at most ``most``, the longest common times first), each from their data ≤ k."""
     sims = []
-    n, m = allowed.shape
-    for i in range(n):
-        for j in range(m):
-            if not allowed[i, j]:
-                continue
-            sel = both[i, j, : k + 1]
-            src = grid.P[i, : k + 1][sel]
-            if len(src) < 2 or np.ptp(src, axis=0).max() < 1e-6:
-                continue
-            dst = grid.G[j, : k + 1][sel]
-            w = 1.0 / (1.0 + grid.SP[i, : k + 1][sel] ** 2)
-            sims.append(_rigid_fit(src, dst, w, scale))
+    pairs = np.argwhere(overlap_s > 0)
+    order = np.argsort(-overlap_s[overlap_s > 0], kind="stable")
+    for i, j in pairs[order][:most]:
+        sel = both[i, j, : k + 1]
+        src = grid.P[i, : k + 1][sel]
+        if len(src) < 2 or np.ptp(src, axis=0).max() < 1e-6:
+            continue
+        dst = grid.G[j, : k + 1][sel]
+        w = 1.0 / (1.0 + grid.SP[i, : k + 1][sel] ** 2)
+        sims.append(_rigid_fit(src, dst, w, scale))
     return sims
 
 
