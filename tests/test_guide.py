@@ -450,3 +450,17 @@ def test_cli_located_scene_geojson(tmp_path: Path, capsys: pytest.CaptureFixture
 def test_too_fine_a_grid_is_refused(calibration: CalibrationResult, data: GuideData) -> None:
     with pytest.raises(InputError, match="use a larger step"):
         match_people(calibration, data.tracks, data.traces, settings=GuideSettings(step_s=1e-4))
+
+
+def test_traces_far_from_everybody(calibration: CalibrationResult, data: GuideData) -> None:
+    """Traces ~700 m east of the view: nobody matched, each with its reason."""
+    shift = np.array([0.01, 0.0])
+    far = [GpsTrace(g.id, g.times_s, g.lonlat + shift) for g in data.traces]
+    pose = AbsolutePose(data.enu_from_world, data.frame)
+    res = match_people(calibration, data.tracks, far, pose=pose)
+    assert all(m.gps is None for m in res.matches)
+    assert all(m.reason == "no GPS trace stays close enough to it" for m in res.matches)
+    assert all(m.certainty > 0.99 for m in res.matches)
+    assert {u["gps"] for u in res.unmatched_gps} == {g.id for g in data.traces}
+    kinds = [f["properties"]["kind"] for f in res.to_geojson()["features"]]
+    assert kinds.count("person_track") == 4

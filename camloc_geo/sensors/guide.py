@@ -21,10 +21,10 @@ Everything is resampled on a common time grid (``step_s``). At each grid time wh
 ground track ``p`` and a trace ``g`` exist, ``d = |p - g|`` and ``s² = gps_sigma_m² +``
 projection sigma² (per axis; the projection sigma is the Monte Carlo spread of the ground
 point over the calibration's uncertainty and ``click_sigma_px``). The sample's
-log-likelihood ratio between "this trace is this person's" (``d`` Gaussian with ``s``,
-robustified: Huber ``ρ`` on ``z = d / s``, quadratic up to 2, linear after) and "it is
-somebody else's nearby" (``d`` Gaussian with ``S² = s² + crowd_spread_m²``, the spread of
-people around each other) is ``log(S²/s²) - ρ(z²)/2 + d²/(2 S²)``; it is weighted by
+log-likelihood ratio between "this trace is this person's" (``d`` Gaussian with ``s`` per
+axis) and "it is somebody else's nearby" (Gaussian with ``S² = s² + crowd_spread_m²``, the
+spread of people around each other) is ``log(S²/s²) - d² (1/s² - 1/S²) / 2``, floored at -4
+(robust: a GPS jump or a wrong detection costs at most that); it is weighted by
 ``w = min(1, step_s / gps_correlation_s)`` (GPS errors are correlated in time, so samples
 closer than that are not independent) and summed into the pair's score. A score is thus a
 log-likelihood ratio against "this person carries none of the traces" (score 0).
@@ -83,7 +83,7 @@ __all__ = [
 
 FloatArray = npt.NDArray[np.float64]
 
-_HUBER_Z = 2.0
+_LLR_FLOOR = -4.0
 _BIG = 1e9
 _SEED = 20261124
 _MAX_GRID = 200_000
@@ -789,12 +789,6 @@ def _resample(
     return out
 
 
-def _huber(z2: FloatArray) -> FloatArray:
-    z = np.sqrt(z2)
-    c = _HUBER_Z
-    return np.where(z <= c, z2, 2.0 * c * z - c * c)
-
-
 def _assign(W: FloatArray, allowed: npt.NDArray[np.bool_]) -> tuple[float, list[int]]:
     """Best total score and, per track, its trace index or -1 (no match)."""
     from scipy.optimize import linear_sum_assignment
@@ -867,12 +861,12 @@ def _scores(
     D = np.linalg.norm(Q[:, None] - G[None], axis=-1)  # (n, m, K)
     s2 = settings.gps_sigma_m**2 + (sim.scale * SP[:, None, :]) ** 2
     valid = np.isfinite(D)
-    with np.errstate(invalid="ignore"):
-        rho = _huber(np.where(valid, D**2 / s2, 0.0))
+    d2 = np.where(valid, D, 0.0) ** 2
     big2 = s2 + settings.crowd_spread_m**2
     with np.errstate(invalid="ignore"):
-        llr = np.log(big2 / s2) - 0.5 * rho + 0.5 * np.where(valid, D**2, 0.0) / big2
-    per = np.where(valid, grid.w * llr, 0.0)
+        llr = np.log(big2 / s2) - 0.5 * d2 * (1.0 / s2 - 1.0 / big2)
+    # Robust: one sample (a GPS jump, a detector's wrong box) costs at most _LLR_FLOOR.
+    per = np.where(valid, grid.w * np.maximum(llr, _LLR_FLOOR), 0.0)
     return per, valid, D
 
 
@@ -1154,6 +1148,8 @@ def match_people(
             result.warnings.append(
                 "no track matched: the camera's transform to the GPS frame is not determined"
             )
+            result.enu_from_world = None  # nothing places the ground tracks
+            result.ground_tracks_en = {}
     return result
 
 
