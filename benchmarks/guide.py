@@ -2,8 +2,8 @@
 
 Each trial draws a noisy scene (same camera and annotation-noise model as
 ``benchmarks/relative.py``), calibrates it, and lets people walk in the true camera's view
-for 40 s (:func:`camloc_geo.synthetic_guide.make_guide_data`: foot pixels with 2 px noise at
-5 Hz; phones log at 1 Hz with time-correlated noise, correlation 10 s, per-axis sigma
+for 40 s or 120 s (:func:`camloc_geo.synthetic_guide.make_guide_data`: foot pixels with 2 px
+noise at 5 Hz; phones log at 1 Hz with time-correlated noise, correlation 10 s, per-axis sigma
 ``gps_sigma_m``; with 4 or more people one has no phone; two distractor phones walk 15-60 m
 away, unseen). The guide runs with the calibrated camera
 
@@ -11,7 +11,8 @@ away, unseen). The guide runs with the calibrated camera
   error remains);
 - **relative**: no pose, the transform solved from the traces.
 
-Per configuration (GPS sigma 2/4/6/8 m with 4 people; 2/4/8 people with 4 m): assignment
+Per configuration (40 s walks: GPS sigma 2/4/6/8 m with 4 people, 2/4/8 people with 4 m;
+and 120 s walks, 4 people, 4 m): assignment
 accuracy (tracks whose final outcome, trace or none, is right), fraction certain, fraction
 *certain and wrong*, time to certain (from the person's first appearance) of the right
 certain matches, time after which the right match no longer changes whatever its certainty
@@ -50,7 +51,16 @@ from relative import draw_scene
 from camloc_geo.synthetic import NoiseModel
 
 OUT_DIR = Path(__file__).parent / "out"
-CONFIGS = [(2.0, 4), (4.0, 4), (6.0, 4), (8.0, 4), (4.0, 2), (4.0, 8)]
+CONFIGS = [
+    (2.0, 4, 40.0),
+    (4.0, 4, 40.0),
+    (6.0, 4, 40.0),
+    (8.0, 4, 40.0),
+    (4.0, 2, 40.0),
+    (4.0, 8, 40.0),
+    (4.0, 4, 120.0),
+]
+"""(GPS sigma per axis in metres, people, seconds of walking)."""
 
 
 def _pct(values: list[float], p: float) -> float | None:
@@ -58,7 +68,12 @@ def _pct(values: list[float], p: float) -> float | None:
 
 
 def _trial(
-    rng: np.random.Generator, index: int, gps_sigma_m: float, n_people: int, modes: list[str]
+    rng: np.random.Generator,
+    index: int,
+    gps_sigma_m: float,
+    n_people: int,
+    duration_s: float,
+    modes: list[str],
 ) -> list[dict[str, Any]]:
     syn, size, _n_ann = draw_scene(rng, index, NoiseModel())
     try:
@@ -73,6 +88,7 @@ def _trial(
         n_distractors=2,
         gps_sigma_m=gps_sigma_m,
         image_size=size,
+        duration_s=duration_s,
     )
     settings = GuideSettings(gps_sigma_m=gps_sigma_m)
     rows = []
@@ -156,7 +172,11 @@ def _plot(results: list[dict[str, Any]]) -> None:
         return
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for mode, style, colour in (("absolute", "o-", "C0"), ("relative", "s--", "C1")):
-        sel = [r for r in results if r["mode"] == mode and r["n_people"] == 4]
+        sel = [
+            r
+            for r in results
+            if r["mode"] == mode and r["n_people"] == 4 and r.get("duration_s", 40.0) == 40.0
+        ]
         if not sel:
             continue
         xs = [r["gps_sigma_m"] for r in sel]
@@ -199,15 +219,21 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     modes = args.modes.split(",")
     results: list[dict[str, Any]] = []
-    for c, (gps_sigma, n_people) in enumerate(CONFIGS):
+    for c, (gps_sigma, n_people, duration) in enumerate(CONFIGS):
         rng = np.random.default_rng(args.seed * 1000 + c)
         rows: list[dict[str, Any]] = []
         for i in range(args.n):
-            rows += _trial(rng, i, gps_sigma, n_people, modes)
+            rows += _trial(rng, i, gps_sigma, n_people, duration, modes)
         for mode in modes:
             summary = _summarise([r for r in rows if r["mode"] == mode])
             results.append(
-                {"mode": mode, "gps_sigma_m": gps_sigma, "n_people": n_people, **summary}
+                {
+                    "mode": mode,
+                    "gps_sigma_m": gps_sigma,
+                    "n_people": n_people,
+                    "duration_s": duration,
+                    **summary,
+                }
             )
             print(json.dumps(results[-1]), flush=True)
     OUT_DIR.mkdir(exist_ok=True)
