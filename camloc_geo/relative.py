@@ -167,7 +167,11 @@ class CalibrationResult:
         1-sigma uncertainty of the orientation, degrees: small-angle rotations about the
         **camera's** x (right), y (down) and z (optical) axes, i.e. the perturbed rotation is
         ``exp([ε]×) · cam_from_world_rotation`` with ``ε ~ N(0, diag(σ²))``. Like
-        ``position_sigma_m``: the fit's covariance plus the jackknife spread.
+        ``position_sigma_m``: the fit's covariance plus the jackknife spread. It is the
+        uncertainty *given the principal point model*: a principal point assumed at the
+        image centre but really off by ``δ`` pixels turns the fitted orientation by about
+        ``δ / f`` about x and y while the pixels' rays barely move (the two compensate), so
+        that part is not included (it would inflate the sensors' ``sigma_m`` for nothing).
     rotation_sigma_fit_deg
         The fit's covariance part alone (when the jackknife was added).
     excluded_annotators
