@@ -10,6 +10,9 @@ calibrates each, and measures with the calibrated camera:
 - clinometer: a ground point and the point ``3-25 m`` above it (a building's roof edge), both
   visible, clicked with the same noise; error = |measured - true| / true.
 
+The calibration's orientation error about the camera's axes is compared with its
+``rotation_sigma_deg`` (fraction within 2 sigma per axis).
+
 Writes ``benchmarks/out/sensors.json`` (percentiles, fraction within 2 sigma, the paper's
 targets: scale < 20 %, building height < 25 % at p90) and ``sensors.png`` (CDFs) when
 matplotlib is available. A scene whose calibration fails counts as an infinite error.
@@ -29,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from camloc_geo import InputError
 from camloc_geo.camera import Camera
@@ -120,6 +124,14 @@ def main(argv: list[str] | None = None) -> int:
             distance_within_2sigma=abs(d.value_m - dist) <= 2 * d.sigma_m,
             height_within_2sigma=abs(hm.value_m - height) <= 2 * hm.sigma_m,
         )
+        if cal.rotation_sigma_deg is not None:
+            # Orientation error about the camera's axes: rotvec(R_cal · R_trueᵀ), degrees.
+            turn = Rotation.from_matrix(
+                cal.camera.cam_from_world_rotation @ cam.cam_from_world_rotation.T
+            ).as_rotvec()
+            if np.linalg.norm(turn) < math.radians(30.0):  # else another frame
+                row["rotation_error_deg"] = np.degrees(turn).tolist()
+                row["rotation_sigma_deg"] = cal.rotation_sigma_deg.tolist()
         rows.append(row)
     ok = [r for r in rows if "error" not in r]
     summary: dict[str, Any] = {"n_scenes": len(rows), "n_failures": len(rows) - len(ok)}
@@ -138,6 +150,15 @@ def main(argv: list[str] | None = None) -> int:
             "meets_target": p90 is not None and p90 < PAPER_P90[key],
             "fraction_within_2sigma": float(np.mean([r[cover] for r in ok])) if ok else None,
         }
+    rot = [r for r in ok if "rotation_error_deg" in r]
+    if rot:
+        z = np.abs([r["rotation_error_deg"] for r in rot]) / np.array(
+            [r["rotation_sigma_deg"] for r in rot]
+        )
+        summary["rotation_within_2sigma_xyz"] = (z <= 2.0).mean(axis=0).tolist()
+        summary["rotation_error_deg_p90_xyz"] = np.percentile(
+            np.abs([r["rotation_error_deg"] for r in rot]), 90, axis=0
+        ).tolist()
     OUT_DIR.mkdir(exist_ok=True)
     for r in rows:
         for k, v in r.items():

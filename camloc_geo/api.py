@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from camloc_geo.osm import MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
+    from camloc_geo.sensors.guide import GuideResult, GuideSettings
     from camloc_geo.sensors.radar import RadarResult
 
 __all__ = [
@@ -38,6 +39,7 @@ __all__ = [
     "SceneLike",
     "calibrate_scene",
     "corners_near",
+    "guide_scene",
     "locate_scene",
     "map_around",
     "map_for_scene",
@@ -476,3 +478,135 @@ def radar_scene(
         max_frames=max_frames,
         progress=progress,
     )
+
+
+def guide_scene(
+    scene: SceneLike,
+    tracks: Any,
+    gps: Any,
+    *,
+    video_start: Any = None,
+    fps: float | None = None,
+    pose: str = "auto",
+    candidates: str | os.PathLike[str] | dict[str, Any] | None = None,
+    candidate: int = 1,
+    map_source: MapSource = None,
+    network: bool = True,
+    radius_m: float | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+    settings: GuideSettings | None = None,
+) -> GuideResult:
+    """Virtual guide: match people tracked in the camera's video to GPS traces.
+
+    Parameters
+    ----------
+    scene
+        Path, dict or model; calibrated with :func:`calibrate_scene`.
+    tracks
+        People's pixel tracks: a ``.json``/``.csv`` path, parsed JSON, or a list of
+        :class:`~camloc_geo.sensors.guide.PixelTrack` (format in ``docs/guide.md``).
+    gps
+        GPS traces: a ``.gpx``/``.csv`` path or a list of
+        :class:`~camloc_geo.sensors.guide.GpsTrace`.
+    video_start, fps
+        Time of the video's first frame (ISO 8601 or UNIX seconds) when the tracks' times are
+        seconds since it; frame rate when they give frame numbers.
+    pose
+        ``"absolute"``: the camera's absolute pose is needed (from ``candidates`` or by
+        locating the scene, which must carry references, kerb corners or landmarks);
+        ``"relative"``: solve the transform to the GPS frame jointly with the matching;
+        ``"auto"`` (default): absolute when ``candidates`` is given or the scene can be
+        located (a scene that locate cannot place falls back to relative, with a warning).
+    candidates, candidate
+        A candidate GeoJSON written by ``camloc locate`` (path or dict) and the rank to use
+        (default 1, the best). Without it the scene is located here.
+    map_source, network, radius_m, cache_folder, overpass_url
+        Where the map comes from when the scene is located (see :func:`locate_scene`).
+    settings
+        Noise model and knobs (:class:`~camloc_geo.sensors.guide.GuideSettings`).
+
+    Raises
+    ------
+    InputError
+        Unreadable tracks or traces, pixels above the horizon, traces with no overlap in time,
+        an absolute pose asked for a scene that cannot be located; each in one line.
+    """
+    from camloc_geo._errors import InputError
+    from camloc_geo.sensors.guide import (
+        AbsolutePose,
+        GpsTrace,
+        PixelTrack,
+        match_people,
+        pose_from_candidates_geojson,
+        read_gps,
+        read_tracks,
+    )
+
+    if pose not in ("auto", "absolute", "relative"):
+        raise InputError(f"pose must be auto, absolute or relative, not {pose!r}")
+    if candidate < 1:
+        raise InputError(f"candidate rank must be at least 1, not {candidate}")
+    if candidates is not None and pose == "relative":
+        raise InputError("a candidates file gives an absolute pose: do not ask for relative")
+    sc = scene_from(scene)
+    if isinstance(tracks, list) and all(isinstance(t, PixelTrack) for t in tracks) and tracks:
+        pixel_tracks = list(tracks)
+    else:
+        pixel_tracks = read_tracks(tracks, video_start=video_start, fps=fps)
+    if isinstance(gps, list) and all(isinstance(g, GpsTrace) for g in gps) and gps:
+        traces = list(gps)
+    else:
+        traces = read_gps(gps)
+    warnings: list[str] = []
+    abs_pose: AbsolutePose | None = None
+    if candidates is not None:
+        calibration = calibrate_scene(sc)
+        if isinstance(candidates, dict):
+            doc, name = candidates, "candidates"
+        else:
+            from camloc_geo._io import read_json_file
+
+            doc, name = read_json_file(candidates), Path(candidates).name
+        abs_pose = pose_from_candidates_geojson(doc, calibration, rank=candidate, name=name)
+    elif pose != "relative" and (sc.references or sc.intersection or sc.landmarks):
+        out = locate_scene(
+            sc,
+            map_source=map_source,
+            network=network,
+            radius_m=radius_m,
+            cache_folder=cache_folder,
+            overpass_url=overpass_url,
+        )
+        calibration = out.calibration
+        cands = out.result.candidates
+        if len(cands) >= candidate:
+            c = cands[candidate - 1]
+            abs_pose = AbsolutePose(
+                c.enu_from_world,
+                out.result.frame,
+                f"locate candidate {c.rank} of {len(cands)} (score {c.score:.2f})",
+                c.enu_from_world.inverse().camera(c.camera),
+            )
+            if c.ambiguous_with:
+                warnings.append(
+                    f"candidate {c.rank} ties with candidates {c.ambiguous_with}: the ground "
+                    "tracks may be placed at the wrong one"
+                )
+        else:
+            why = f"locate found {len(cands)} candidate(s), not a rank {candidate}" + (
+                f" ({out.result.reason})" if out.result.reason else ""
+            )
+            if pose == "absolute":
+                raise InputError(f"no absolute pose: {why}")
+            warnings.append(f"{why}: matched in the relative frame")
+    else:
+        if pose == "absolute":
+            raise InputError(
+                "no absolute pose: the scene has no references, intersection corners or "
+                "landmarks to locate it; give a candidates file or use the relative pose"
+            )
+        calibration = calibrate_scene(sc)
+    result = match_people(calibration, pixel_tracks, traces, pose=abs_pose, settings=settings)
+    result.warnings[:0] = warnings + list(calibration.warnings)
+    return result

@@ -215,6 +215,17 @@ class CalibrationResult:
         covariance and, with 2-12 annotators, their jackknife spread.
     position_sigma_fit_m
         The fit's covariance part alone (when the jackknife was added).
+    rotation_sigma_deg
+        1-sigma uncertainty of the orientation, degrees: small-angle rotations about the
+        **camera's** x (right), y (down) and z (optical) axes, i.e. the perturbed rotation is
+        ``exp([ε]×) · cam_from_world_rotation`` with ``ε ~ N(0, diag(σ²))``. Like
+        ``position_sigma_m``: the fit's covariance plus the jackknife spread. It is the
+        uncertainty *given the principal point model*: a principal point assumed at the
+        image centre but really off by ``δ`` pixels turns the fitted orientation by about
+        ``δ / f`` about x and y while the pixels' rays barely move (the two compensate), so
+        that part is not included (it would inflate the sensors' ``sigma_m`` for nothing).
+    rotation_sigma_fit_deg
+        The fit's covariance part alone (when the jackknife was added).
     excluded_annotators
         ``{annotator, index, reason}`` of each annotator left out.
     clamped_clicks
@@ -243,6 +254,8 @@ class CalibrationResult:
     clamped_clicks: int = 0
     annotator_influence_m: list[float | None] = field(default_factory=list)
     position_sigma_fit_m: FloatArray | None = None
+    rotation_sigma_deg: FloatArray | None = None
+    rotation_sigma_fit_deg: FloatArray | None = None
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -288,6 +301,8 @@ class CalibrationResult:
             out["height_sigma_m"] = float(self.position_sigma_m[2])
         if self.focal_sigma_px is not None:
             out["focal_sigma_px"] = self.focal_sigma_px
+        if self.rotation_sigma_deg is not None:
+            out["rotation_sigma_deg"] = self.rotation_sigma_deg.tolist()
         if self.rms_residual_px is not None:
             out["rms_residual_px"] = self.rms_residual_px
         out["width_sign"] = self.width_sign
@@ -1322,8 +1337,9 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     The Gauss-Newton covariance trusts every click's noise model; crowd annotators also differ
     in ways the model does not know (a long line drawn a little off). The jackknife variance
     ``(n-1)/n Σ (C₋ᵢ - C̄)²`` of the camera centre over the refits without each annotator
-    measures that, and is added to ``position_sigma_m``; each annotator's influence (how far
-    the camera moves without them) goes to ``annotator_influence_m``.
+    measures that, and is added to ``position_sigma_m`` (and, for the rotation turned onto the
+    main fit's, ``ε = rotvec(R₋ᵢ · Rᵀ)``, to ``rotation_sigma_deg``); each annotator's
+    influence (how far the camera moves without them) goes to ``annotator_influence_m``.
     """
     n = len(scene.annotations)
     c = result.camera.center_in_world
@@ -1339,6 +1355,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
         reassign_corners=settings.reassign_corners and bool(result.corner_mistakes),
     )
     centres: list[FloatArray] = []
+    turns: list[FloatArray] = []
+    R = result.camera.cam_from_world_rotation
     influence: list[float | None] = []
     for j in range(n):
         sub = scene.model_copy(
@@ -1353,6 +1371,9 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             influence.append(None)  # another frame, or no answer without them
             continue
         centres.append(res.camera.center_in_world)
+        turn = Rotation.from_matrix(res.camera.cam_from_world_rotation @ R.T).as_rotvec()
+        if np.linalg.norm(turn) < math.radians(30.0):  # else another frame: not a spread
+            turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
     result.annotator_influence_m = influence
     if len(centres) < 2:
@@ -1363,6 +1384,26 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     base = result.position_sigma_m if result.position_sigma_m is not None else np.zeros(3)
     result.position_sigma_fit_m = base
     result.position_sigma_m = np.sqrt(base**2 + sigma_jack**2)
+    if len(turns) < 2:
+        return
+    rot = np.asarray(turns)
+    m_r = len(rot)
+    rot_jack = np.degrees(np.sqrt((m_r - 1) / m_r * ((rot - rot.mean(axis=0)) ** 2).sum(axis=0)))
+    base_r = result.rotation_sigma_deg if result.rotation_sigma_deg is not None else np.zeros(3)
+    result.rotation_sigma_fit_deg = base_r
+    result.rotation_sigma_deg = np.sqrt(base_r**2 + rot_jack**2)
+
+
+def _so3_left_jacobian(rotvec: FloatArray) -> FloatArray:
+    """Left Jacobian of SO(3): ``exp(ω + dω) ≈ exp(J_l(ω)·dω)·exp(ω)``."""
+    w = np.asarray(rotvec, dtype=float)
+    theta = float(np.linalg.norm(w))
+    K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    if theta < 1e-6:
+        return np.asarray(np.eye(3) + 0.5 * K, dtype=float)
+    a = (1.0 - math.cos(theta)) / theta**2
+    b = (theta - math.sin(theta)) / theta**3
+    return np.asarray(np.eye(3) + a * K + b * (K @ K), dtype=float)
 
 
 def _no_usable_annotator(excluded: list[dict[str, Any]]) -> InputError:
@@ -1860,9 +1901,15 @@ def _joint(
     s2 = max(2.0 * res.cost / dof, 1e-12)
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
+    sigma_r: FloatArray | None = None
     try:
         cov = np.linalg.pinv(J.T @ J) * s2
         sigma_c = np.sqrt(np.clip(np.diag(cov)[-3:], 0, None))
+        # The rotation vector ω of R = exp(ω)·R0: a change dω turns R by J_l(ω)·dω on the
+        # left (camera axes); the frame change R·M below keeps left perturbations.
+        jl = _so3_left_jacobian(res.x[-6:-3])
+        cov_r = jl @ cov[-6:-3, -6:-3] @ jl.T
+        sigma_r = np.degrees(np.sqrt(np.clip(np.diag(cov_r), 0, None)))
         if f_fixed is None:
             sigma_f = float(f * math.sqrt(max(cov[0, 0], 0.0)))
     except np.linalg.LinAlgError:
@@ -1919,6 +1966,7 @@ def _joint(
         outliers,
         position_sigma_m=sigma_c,
         focal_sigma_px=sigma_f,
+        rotation_sigma_deg=sigma_r,
         rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
         width_signs=width_signs,
         annotator_corners=corner_names,

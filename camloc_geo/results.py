@@ -289,6 +289,7 @@ class CalibrationOutput:
     camera_in_world_sigma_m: list[float] | None = field(default=None, metadata=_OMIT_NONE)
     height_sigma_m: float | None = field(default=None, metadata=_OMIT_NONE)
     focal_sigma_px: float | None = field(default=None, metadata=_OMIT_NONE)
+    rotation_sigma_deg: list[float] | None = field(default=None, metadata=_OMIT_NONE)
     rms_residual_px: float | None = field(default=None, metadata=_OMIT_NONE)
     width_sign: float = 1.0
     annotator_weights: list[float] = field(default_factory=list)
@@ -324,6 +325,9 @@ def calibration_output(cal: CalibrationResult) -> CalibrationOutput:
         camera_in_world_sigma_m=None if sigma is None else sigma.tolist(),
         height_sigma_m=None if sigma is None else float(sigma[2]),
         focal_sigma_px=cal.focal_sigma_px,
+        rotation_sigma_deg=(
+            None if cal.rotation_sigma_deg is None else cal.rotation_sigma_deg.tolist()
+        ),
         rms_residual_px=cal.rms_residual_px,
         width_sign=cal.width_sign,
         annotator_weights=cal.annotator_weights,

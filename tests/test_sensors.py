@@ -154,3 +154,30 @@ def test_cli_bad_pixels_exit_2(
 def test_cli_missing_scene_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["measure", str(tmp_path / "nope.json"), "--ground", "1,2", "3,4"]) == 2
     assert "Traceback" not in capsys.readouterr().err
+
+
+def test_rotation_sigma_reported_and_propagated() -> None:
+    """The calibration reports its orientation's uncertainty; the sensors draw rotations."""
+    from dataclasses import replace
+
+    from camloc_geo.results import calibration_output
+
+    cam = camera_aimed_at_car(7.0, 22.0, azimuth_deg=215.0)
+    noise = NoiseModel(wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0)
+    syn = make_scene(cam, np.random.default_rng(11), noise=noise, n_annotators=5)
+    cal = calibrate_scene(syn.scene)
+    sig = cal.rotation_sigma_deg
+    assert sig is not None
+    assert sig.shape == (3,)
+    assert np.all(sig > 0.0)
+    assert np.all(sig < 5.0)
+    assert cal.rotation_sigma_fit_deg is not None
+    assert np.all(cal.rotation_sigma_fit_deg <= sig + 1e-12)  # the jackknife only adds
+    assert cal.to_dict()["rotation_sigma_deg"] == sig.tolist()
+    assert calibration_output(cal).rotation_sigma_deg == sig.tolist()
+    px = cam.project(GROUND_PTS)
+    with_rot = ground_distance(cal, px).sigma_m
+    without = ground_distance(replace(cal, rotation_sigma_deg=None), px).sigma_m
+    assert with_rot > without
+    bigger = ground_distance(replace(cal, rotation_sigma_deg=sig * 10.0), px).sigma_m
+    assert bigger > 2.0 * with_rot

@@ -76,6 +76,7 @@ _COMMAND_MODULES = (
     "serve",
     "measure",
     "radar",
+    "guide",
 )
 
 log = logging.getLogger("camloc_geo.cli")

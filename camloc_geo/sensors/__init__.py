@@ -11,14 +11,17 @@ Uncertainty model (``sigma_m``)
 Monte Carlo with a fixed seed (reproducible): ``n_samples`` draws of
 
 - the camera centre, perturbed independently per axis by ``calibration.position_sigma_m``
-  (zero when the calibration has none), the rotation kept fixed;
+  (zero when the calibration has none);
+- the orientation, turned by a small random rotation ``exp([ε]×)`` on the left of
+  ``cam_from_world_rotation``, ``ε`` drawn per camera axis (x right, y down, z optical) with
+  ``calibration.rotation_sigma_deg`` (none when the calibration has none);
 - the focal length, perturbed by ``calibration.focal_sigma_px`` when known;
 - every clicked pixel, perturbed by ``click_sigma_px`` (default 1.5 px) per coordinate.
 
-``sigma_m`` is the standard deviation of the measurement over the draws. The rotation's
-uncertainty is not propagated (the calibration does not report it), so ``sigma_m`` is a lower
-bound when the orientation is poorly determined. Draws in which a pixel's ray misses the
-ground are dropped; if more than half are dropped the measurement is refused.
+``sigma_m`` is the standard deviation of the measurement over the draws. The draws are
+independent per parameter (the fit's correlations between position, rotation and focal
+length are not kept). Draws in which a pixel's ray misses the ground are dropped; if more
+than half are dropped the measurement is refused.
 
 Radar (vehicle speeds from video) and guide (matching people to GPS traces) are not built.
 """
@@ -91,12 +94,17 @@ def _pixels(pixels_px: npt.ArrayLike, what: str) -> FloatArray:
 def _rays(
     pixels: FloatArray, focal: FloatArray, pp: tuple[float, float], R: FloatArray
 ) -> FloatArray:
-    """World viewing directions (not normalised) of pixels ``(S, N, 2)`` for focals ``(S,)``."""
+    """World viewing directions (not normalised) of pixels ``(S, N, 2)`` for focals ``(S,)``.
+
+    ``R`` is one ``cam_from_world`` rotation ``(3, 3)`` or one per draw ``(S, 3, 3)``.
+    """
     f = focal[:, None]
     d_cam = np.stack(
         [(pixels[..., 0] - pp[0]) / f, (pixels[..., 1] - pp[1]) / f, np.ones(pixels.shape[:2])],
         axis=-1,
     )
+    if R.ndim == 3:
+        return np.asarray(np.einsum("snj,sjk->snk", d_cam, R), dtype=np.float64)
     return np.asarray(d_cam @ R, dtype=np.float64)  # Rᵀ applied to each row
 
 
@@ -117,7 +125,27 @@ def _draws(
     click_sigma_px: float,
     seed: int,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Centres ``(S+1, 3)``, focals ``(S+1,)`` and pixels ``(S+1, N, 2)``; row 0 nominal."""
+    """Centres ``(S+1, 3)``, focals ``(S+1,)`` and pixels ``(S+1, N, 2)``; row 0 nominal.
+
+    The rotation is not drawn: see :func:`_draws_posed`.
+    """
+    centres, focals, _rotations, px = _draws_posed(
+        calibration, pixels, n_samples, click_sigma_px, seed
+    )
+    return centres, focals, px
+
+
+def _draws_posed(
+    calibration: CalibrationResult,
+    pixels: FloatArray,
+    n_samples: int,
+    click_sigma_px: float,
+    seed: int,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Centres ``(S+1, 3)``, focals ``(S+1,)``, ``cam_from_world`` rotations ``(S+1, 3, 3)``
+    and pixels ``(S+1, N, 2)``; row 0 nominal (model in the module docstring)."""
+    from scipy.spatial.transform import Rotation
+
     cam = calibration.camera
     rng = np.random.default_rng(seed)
     sig_c = calibration.position_sigma_m
@@ -128,9 +156,17 @@ def _draws(
     focals = cam.focal_px + rng.normal(0.0, sig_f, n_samples)
     focals = np.clip(focals, 0.1 * cam.focal_px, None)
     px = pixels[None] + rng.normal(0.0, click_sigma_px, (n_samples, *pixels.shape))
+    R = cam.cam_from_world_rotation
+    sig_r = getattr(calibration, "rotation_sigma_deg", None)
+    rotations = np.broadcast_to(R, (n_samples + 1, 3, 3)).copy()
+    if sig_r is not None:
+        sig_rad = np.radians(np.nan_to_num(np.asarray(sig_r, float).reshape(3)))
+        eps = rng.normal(0.0, 1.0, (n_samples, 3)) * sig_rad
+        rotations[1:] = Rotation.from_rotvec(eps).as_matrix() @ R
     return (
         np.vstack([cam.center_in_world[None], centres]),
         np.concatenate([[cam.focal_px], focals]),
+        rotations,
         np.concatenate([pixels[None], px]),
     )
 
@@ -191,8 +227,10 @@ def ground_distance(
     if len(pixels) < 2:
         raise InputError("ground: give at least two pixels")
     cam = calibration.camera
-    centres, focals, px = _draws(calibration, pixels, n_samples, click_sigma_px, seed)
-    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    centres, focals, rotations, px = _draws_posed(
+        calibration, pixels, n_samples, click_sigma_px, seed
+    )
+    rays = _rays(px, focals, cam.principal_point, rotations)
     points = _ground(centres, rays)
     _check_ground(points[0], pixels)
     lengths = np.linalg.norm(np.diff(points[..., :2], axis=1), axis=-1).sum(axis=1)
@@ -240,8 +278,10 @@ def point_height(
         raise InputError("height: give one base pixel and one top pixel")
     pixels = np.vstack([base, top])
     cam = calibration.camera
-    centres, focals, px = _draws(calibration, pixels, n_samples, click_sigma_px, seed)
-    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    centres, focals, rotations, px = _draws_posed(
+        calibration, pixels, n_samples, click_sigma_px, seed
+    )
+    rays = _rays(px, focals, cam.principal_point, rotations)
     foot = _ground(centres, rays[:, :1])[:, 0]
     _check_ground(foot[:1], base)
     d = rays[:, 1]
