@@ -1,4 +1,4 @@
-"""Virtual sensors on a calibrated camera: the scale and the clinometer.
+"""Virtual sensors on a calibrated camera: the scale and the clinometer (radar, guide below).
 
 Once :func:`camloc_geo.relative.calibrate` has found the camera in the car's metric world
 frame (ground plane ``z = 0``), pixels on the ground become points in metres:
@@ -23,7 +23,9 @@ independent per parameter (the fit's correlations between position, rotation and
 length are not kept). Draws in which a pixel's ray misses the ground are dropped; if more
 than half are dropped the measurement is refused.
 
-Radar (vehicle speeds from video) and guide (matching people to GPS traces) are not built.
+The virtual radar (vehicle speeds from video) is :mod:`camloc_geo.sensors.radar`; the
+virtual guide (people seen by the camera matched to GPS traces) is
+:mod:`camloc_geo.sensors.guide`.
 """
 
 from __future__ import annotations
