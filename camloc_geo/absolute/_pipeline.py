@@ -306,18 +306,22 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
     return cands
 
 
+TIE_MIN_SCORE = 0.01
+"""Candidates scoring less than this tie with nobody (a tie of two negligible ones says nothing)."""
+
+
 def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
     lo, hi = sorted((a.score, b.score))
     gap = float(np.linalg.norm(a.east_north - b.east_north))
-    return lo >= 0.8 * hi and gap > 2.0 * settings.merge_distance_m
+    return lo >= 0.8 * hi and lo >= TIE_MIN_SCORE and gap > 2.0 * settings.merge_distance_m
 
 
 def _mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
     """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
 
-    Two candidates tie when the weaker scores at least 0.8 of the stronger yet they stand
-    more than ``2 * merge_distance_m`` apart (a symmetric junction: the evidence cannot tell
-    them apart).
+    Two candidates tie when the weaker scores at least 0.8 of the stronger (and at least
+    :data:`TIE_MIN_SCORE`) yet they stand more than ``2 * merge_distance_m`` apart (a
+    symmetric junction: the evidence cannot tell them apart).
     """
     for a, b in itertools.combinations(cands, 2):
         if _tie(a, b, settings):
