@@ -18,7 +18,9 @@ Here, for each leading candidate, one robust least-squares problem holds
   street-bearing prior of the refinement,
 
 over the focal length (unless given), the camera's rotation and centre, and the
-similarity. It is :func:`scipy.optimize.least_squares` with a soft-L1 loss. The candidate
+similarity: a soft-L1 Levenberg-Marquardt fit (the joint fit's own optimiser,
+:func:`camloc_geo._optimize.soft_l1_least_squares`, which keeps ``scipy.optimize``'s
+import out of ``locate``). The candidate
 keeps its rank and score (those compare hypotheses on the same evidence); its camera,
 position and ``sigma_m`` become the bundle's. A bundle that does not converge, or moves the
 annotations' fit by more than a chi-square jump of :data:`MAX_ANNOTATION_COST_RISE` while
@@ -33,7 +35,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-from scipy.optimize import least_squares
 
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
@@ -170,9 +171,20 @@ def _bundle(
     z0 = np.concatenate(
         [state.x, [sim0.rotation_rad, *np.asarray(sim0.translation_m), math.log(sim0.scale)]]
     )
-    res = least_squares(
-        residuals, z0, loss="soft_l1", f_scale=_F_SCALE, x_scale="jac", max_nfev=200
-    )
+
+    def jacobian(z: FloatArray) -> FloatArray:
+        h = 1e-6 * np.maximum(1.0, np.abs(z))
+        r0 = residuals(z)
+        J = np.empty((len(r0), len(z)))
+        for k in range(len(z)):
+            dz = z.copy()
+            dz[k] += h[k]
+            J[:, k] = (residuals(dz) - r0) / h[k]
+        return J
+
+    from camloc_geo._optimize import soft_l1_least_squares
+
+    res = soft_l1_least_squares(residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200)
     if not res.success or not np.all(np.isfinite(res.x)):
         return cand
 
