@@ -507,7 +507,8 @@ def plot(rows: list[dict[str, Any]], summary: dict[str, Any], path: Path) -> Non
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, grid = plt.subplots(2, 3, figsize=(16, 9.5))
+    n_rows = (len(METHODS) + 1 + 2) // 3  # one panel per method, then the candidate counts
+    fig, grid = plt.subplots(n_rows, 3, figsize=(16, 4.75 * n_rows))
     axes = list(grid.ravel())
     for ax, method in zip(axes, METHODS, strict=False):
         entries = [r["methods"][method] for r in rows if method in r.get("methods", {})]
@@ -549,7 +550,9 @@ def plot(rows: list[dict[str, Any]], summary: dict[str, Any], path: Path) -> Non
         ax.set_ylabel("fraction of scenes")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
-    ax = axes[-1]
+    for spare in axes[len(METHODS) + 1 :]:
+        spare.set_visible(False)
+    ax = axes[len(METHODS)]
     for method in METHODS:
         ns = [
             r["methods"][method]["n"] for r in rows if r.get("methods", {}).get(method, {}).get("n")
@@ -557,6 +560,7 @@ def plot(rows: list[dict[str, Any]], summary: dict[str, Any], path: Path) -> Non
         if ns:
             bins = np.arange(0.5, max(ns) + 1.5)
             ax.hist(ns, bins=bins, histtype="step", label=method)
+    ax.set_xscale("log")
     ax.set_xlabel("number of candidates")
     ax.set_ylabel("scenes")
     ax.set_title("candidates per scene", fontsize=9)
