@@ -37,6 +37,7 @@ import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
+from camloc_geo._optimize import soft_l1_cost
 from camloc_geo.camera import Camera
 from camloc_geo.objects import ObjectSize
 from camloc_geo.scene import Annotation, Scene, pixel_problem
@@ -1666,8 +1667,7 @@ def _robust_cost(
     prob.weights = np.ones(prob.n_annotators)
     r = prob.residuals(x, R0, pp_fixed, f_fixed)
     prob.weights = saved
-    z = (r / _F_SCALE) ** 2
-    return float(np.sum(2.0 * (np.sqrt(1.0 + z) - 1.0)))
+    return soft_l1_cost(r, _F_SCALE)
 
 
 def _reassign_corners(
@@ -1737,9 +1737,7 @@ def _weighted_cost(
     prob: _JointProblem, x: FloatArray, R0: FloatArray, pp_fixed: tuple[float, float] | None
 ) -> float:
     """Soft-L1 cost of the residuals as fitted (annotator weights and prior as set)."""
-    r = prob.residuals(x, R0, pp_fixed, None)
-    z = (r / _F_SCALE) ** 2
-    return float(np.sum(2.0 * (np.sqrt(1.0 + z) - 1.0)))
+    return soft_l1_cost(prob.residuals(x, R0, pp_fixed, None), _F_SCALE)
 
 
 def _focal_prior(

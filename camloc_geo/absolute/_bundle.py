@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from camloc_geo._optimize import soft_l1_cost, soft_l1_least_squares
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
 from camloc_geo.absolute._refine import _matched_points, _street_bearing_prior
@@ -182,14 +183,12 @@ def _bundle(
             J[:, k] = (residuals(dz) - r0) / h[k]
         return J
 
-    from camloc_geo._optimize import soft_l1_least_squares
-
     res = soft_l1_least_squares(residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200)
     if not res.success or not np.all(np.isfinite(res.x)):
         return cand
 
-    def robust(r: FloatArray) -> float:
-        return float(np.sum(2.0 * (np.sqrt(1.0 + (r / _F_SCALE) ** 2) - 1.0)) * _F_SCALE**2)
+    def robust(r: FloatArray) -> float:  # in squared sigmas, like a chi-square
+        return 2.0 * soft_l1_cost(r, _F_SCALE)
 
     ann0, ann1 = robust(annotation_residuals(z0)), robust(annotation_residuals(res.x))
     map0, map1 = robust(map_residuals(z0)), robust(map_residuals(res.x))
