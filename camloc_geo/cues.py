@@ -240,8 +240,7 @@ def apply_cues(
     cands = list(getattr(result, "candidates", []) or [])
     if getattr(result, "cues_applied", False):
         return result  # locate() already ranked with them
-    has_cue = scene.view_hint is not None or scene.object.street or scene.object.front
-    if not cands or not has_cue:
+    if not cands or not scene.has_cues:
         return result
     if merge_distance_m is None:
         from camloc_geo.absolute import LocateSettings

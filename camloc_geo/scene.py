@@ -465,6 +465,12 @@ class Scene(_Model):
         return self.object.size()
 
     @property
+    def has_cues(self) -> bool:
+        """The scene carries a tie-breaking cue: ``view_hint``, ``object.street`` or
+        ``object.front`` (:mod:`camloc_geo.cues`)."""
+        return bool(self.view_hint is not None or self.object.street or self.object.front)
+
+    @property
     def image_size(self) -> tuple[int, int]:
         """``(width, height)`` in pixels."""
         return self.image.width, self.image.height

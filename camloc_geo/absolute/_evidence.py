@@ -47,10 +47,7 @@ class Evidence:
     @property
     def has_cues(self) -> bool:
         """The scene carries a tie-breaking cue (:mod:`camloc_geo.cues`)."""
-        sc = self.scene
-        return sc is not None and bool(
-            sc.view_hint is not None or sc.object.street or sc.object.front
-        )
+        return self.scene is not None and self.scene.has_cues
 
     @property
     def buildings_tree(self) -> Any:
