@@ -194,6 +194,9 @@ def _entry(res: LocateResult, ls: LocatedScene) -> dict[str, Any]:
             top_sigma_m=res.candidates[0].sigma_m,
             top_residual_m=round(res.candidates[0].residual_m, 3),
             top_tied=bool(res.candidates[0].ambiguous_with),
+            # Every candidate's error and score (to study ties and ranking offline).
+            errors_m=[round(e, 2) for e in errs],
+            scores=[round(c.score, 5) for c in res.candidates],
         )
     else:
         entry["reason"] = res.reason
@@ -352,6 +355,15 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         s["top_wrong_but_a_candidate_right"] = len(wrong_top)
         s["of_those_named_tied"] = (
             sum(bool(e.get("top_tied")) for e in wrong_top) / len(wrong_top) if wrong_top else None
+        )
+        # the price: right top candidates that are named tied all the same
+        right_top = [e for e in found if e["top"] < 10.0]
+        s["right_top_named_tied"] = (
+            sum(bool(e.get("top_tied")) for e in right_top) / len(right_top) if right_top else None
+        )
+        wrong_any = [e for e in found if e["top"] >= 10.0]
+        s["wrong_top_named_tied"] = (
+            sum(bool(e.get("top_tied")) for e in wrong_any) / len(wrong_any) if wrong_any else None
         )
         if method == "corners":
             s["by_visible_corners"] = {}

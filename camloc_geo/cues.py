@@ -234,17 +234,17 @@ def apply_cues(
     Each candidate's score (a posterior weight) is multiplied by its cue factor
     (:func:`cue_log_likelihood`) and the scores renormalised; the ranks follow. Notes go to the
     candidate's ``flags`` (``cue: ...``), and the ambiguity warning is recomputed with the rule
-    of :func:`camloc_geo.absolute.locate` (candidates 1 and 2 within 0.8 of each other's score
-    and apart). A scene without cues leaves the result unchanged.
+    of :func:`camloc_geo.absolute.locate` (:func:`camloc_geo.absolute.mark_ties`). A scene
+    without cues leaves the result unchanged.
     """
     cands = list(getattr(result, "candidates", []) or [])
     if getattr(result, "cues_applied", False):
         return result  # locate() already ranked with them
     if not cands or not scene.has_cues:
         return result
-    if merge_distance_m is None:
-        from camloc_geo.absolute import LocateSettings
+    from camloc_geo.absolute import LocateSettings, mark_ties
 
+    if merge_distance_m is None:
         merge_distance_m = LocateSettings().merge_distance_m
     size = scene.object_size
     ws = float(getattr(result.calibration, "width_sign", 1.0) or 1.0)
@@ -273,13 +273,6 @@ def apply_cues(
     for rank, c in enumerate(cands, start=1):
         c.rank = rank
     result.candidates = cands
-    result.warnings = [x for x in result.warnings if not x.startswith("ambiguous:")]
-    if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
-        gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
-        if gap > 2.0 * merge_distance_m:
-            result.warnings.append(
-                f"ambiguous: candidates 1 and 2 fit the evidence equally well (scores "
-                f"{cands[0].score:.2f} and {cands[1].score:.2f}) but stand {gap:.0f} m apart, "
-                "even with the scene's cues"
-            )
+    result.cues_applied = True
+    mark_ties(cands, LocateSettings(merge_distance_m=merge_distance_m), result)
     return result

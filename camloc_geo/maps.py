@@ -52,7 +52,7 @@ from jinja2 import Template
 from shapely.geometry import LineString, Point, Polygon
 
 from camloc_geo import overlay as _overlay
-from camloc_geo.results import ATTRIBUTION
+from camloc_geo.results import ATTRIBUTION, TIE_DISTANCE_M, TIE_SCORE_RATIO
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult
@@ -380,8 +380,10 @@ def _legend_html(
 
 # -------------------------------------------------------------------------------- ties
 _TIE_RULE = (
-    "the weaker scores at least 0.8 of the stronger, yet they stand more than 4 m apart: the "
-    "evidence cannot tell them apart (typically a symmetric junction seen with two corners)"
+    f"the weaker scores at least {TIE_SCORE_RATIO:g} of the stronger (the evidence favours one "
+    f"by less than {1 / TIE_SCORE_RATIO:g} to 1), yet they stand more than {TIE_DISTANCE_M:g} m "
+    "apart: the "
+    "evidence cannot tell them apart firmly (typically a symmetric junction seen with two corners)"
 )
 _COMPASS: tuple[str, ...] = ("N", "NNE", "NE", "ENE", "E", "ESE", "SE", "SSE")
 _COMPASS += ("S", "SSW", "SW", "WSW", "W", "WNW", "NW", "NNW")
@@ -534,7 +536,7 @@ def _tie_banner(
         gap = max(_distance_m(by_rank[a], by_rank[b]) for a in main for b in main if a < b)
         looks = [c for c in (_compass(by_rank[r].get("heading_deg")) for r in main) if c]
         parts.append(
-            f"<h4>≈ Ambiguous: candidates {_and(main)} fit equally well "
+            f"<h4>≈ Ambiguous: candidates {_and(main)} fit almost equally well "
             f"(score ratio {ratio:.2f})</h4>"
             f"Scores {' vs '.join(f'{x:.3f}' for x in scores)}, {gap:.0f} m apart"
             + (f", looking {html.escape(' vs '.join(looks))}" if looks else "")
@@ -1374,8 +1376,9 @@ def build_summary_map(
         note = ""
         if tie:
             note = (
-                f'<div class="camloc-tie">≈ <b>{html.escape(tie)}</b>: the best candidate '
-                "is not more likely than that one; see the camera's review page</div>"
+                f'<div class="camloc-tie">≈ <b>{html.escape(tie)}</b>: the evidence does not '
+                "favour the best candidate firmly (odds under "
+                f"{1 / TIE_SCORE_RATIO:g} to 1); see the camera's review page</div>"
             )
         popup = folium.Popup(
             f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>{note}'

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from camloc_geo._errors import InputError
+from camloc_geo.results import TIE_SCORE_RATIO  # the library's tie rule (stdlib-only module)
 
 __all__ = [
     "CANDIDATE_FIELDS",
@@ -42,9 +43,6 @@ __all__ = [
     "run_job",
 ]
 
-TIE_SCORE_RATIO = 0.8
-"""A candidate ties with the best when its score is at least this fraction of the best score
-(the ratio the library's ``ambiguous`` warning uses)."""
 
 Field = tuple[str, str]
 

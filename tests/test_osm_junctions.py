@@ -37,7 +37,7 @@ def _assert_corners_on_kerbs(x: Intersection) -> None:
     for i, a in enumerate(streets):
         b = streets[(i + 1) % len(streets)]
         gap = (b.bearing_deg - a.bearing_deg) % 360.0
-        if gap < 160.0:
+        if 15.0 <= gap < 160.0:  # a sharper fork has no corner (its gore)
             expected.append((a, b, gap))
     assert len(x.corners) == len(expected)
     for a, b, gap in expected:
@@ -266,3 +266,46 @@ def test_thin_map_warns_point_outside_data_refused() -> None:
     assert inside.warnings == []
     with pytest.raises(MapDataError, match="outside the extract"):
         _load("kotka.osm.pbf", 60.60, 26.95, 100)
+
+
+def test_median_opening_has_the_median_noses_moscow() -> None:
+    """A gap in the median of a dual carriageway (Ogorodny proezd): four median-nose corners.
+
+    osmnx's graph counts both carriageway nodes as junctions; a camera there sees the two
+    ends of the median island either side of the gap, on the carriageways' inner kerbs.
+    """
+    m = _load("moscow_ostankino.osm.gz", 55.8146, 37.60083)
+    x, warnings = m.match_intersection(lat=55.8146, lon=37.60083)
+    assert warnings == []
+    assert x is not None
+    assert x.kind == "junction"
+    assert len(x.osm_nodes) == 2
+    assert [(s.name, s.carriageways) for s in x.streets] == [("Огородный проезд", 2)] * 2
+    assert any("median opening" in w for w in x.warnings)
+    assert len(x.corners) == 4
+    road = x.streets[0]
+    frame = LocalFrame(lat=x.lat, lon=x.lon)
+    t = math.radians(road.bearing_deg)
+    along = []
+    for c in x.corners:
+        # inside the road (between its outer kerbs), off its centre line: on the median
+        lateral = _offset_m(x, c.lon, c.lat, road.bearing_deg)
+        assert 0.2 < abs(lateral) < road.width_m / 2.0 - 2.0
+        e, n = frame.enu_from_geographic(lat=c.lat, lon=c.lon)
+        along.append(float(e * math.sin(t) + n * math.cos(t)))
+    # two corners at each end of the gap, the ends a connector's width (5-12 m) apart
+    along.sort()
+    assert along[1] - along[0] < 1.0
+    assert along[3] - along[2] < 1.0
+    assert 5.0 < along[2] - along[1] < 12.0
+
+
+def test_sharp_fork_keeps_the_other_corners_monaco() -> None:
+    """Two streets leaving 14° apart have no corner between them; the others stay."""
+    m = _load("monaco.osm.pbf", 43.7398998, 7.423849)
+    x, _ = m.match_intersection(lat=43.7398998, lon=7.423849)
+    assert x is not None
+    assert x.kind == "junction"
+    assert any("fork's gore" in w for w in x.warnings)
+    assert len(x.corners) == 2
+    _assert_corners_on_kerbs(x)

@@ -11,7 +11,7 @@ import jsonschema
 import numpy as np
 import pytest
 
-from camloc_geo.absolute import LocateSettings, candidates_geojson
+from camloc_geo.absolute import TIE_SCORE_RATIO, LocateSettings, candidates_geojson
 from camloc_geo.api import calibrate_scene, locate_scene, map_for_scene
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, intersections_geojson
@@ -129,7 +129,7 @@ def test_ambiguous_with_names_the_ties(located: Any) -> None:
         for other in p["ambiguous_with"]:
             assert p["rank"] in by_rank[other]["ambiguous_with"]  # symmetric
             lo, hi = sorted((p["score"], by_rank[other]["score"]))
-            assert lo >= 0.8 * hi
+            assert lo >= TIE_SCORE_RATIO * hi
     warned = any(
         w.startswith("ambiguous: candidates 1 and 2") for w in doc["properties"]["warnings"]
     )

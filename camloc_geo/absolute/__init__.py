@@ -63,6 +63,7 @@ from __future__ import annotations
 
 from camloc_geo.absolute._geojson import candidates_geojson
 from camloc_geo.absolute._model import (
+    TIE_SCORE_RATIO,
     Candidate,
     Flag,
     FlagKind,
@@ -71,10 +72,11 @@ from camloc_geo.absolute._model import (
     Match,
     Observation,
 )
-from camloc_geo.absolute._pipeline import locate
+from camloc_geo.absolute._pipeline import locate, mark_ties
 from camloc_geo.absolute._similarity import Similarity2D
 
 __all__ = [
+    "TIE_SCORE_RATIO",
     "Candidate",
     "Flag",
     "FlagKind",
@@ -85,4 +87,5 @@ __all__ = [
     "Similarity2D",
     "candidates_geojson",
     "locate",
+    "mark_ties",
 ]

@@ -14,11 +14,13 @@ from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.relative import CalibrationResult
+from camloc_geo.results import TIE_DISTANCE_M, TIE_SCORE_RATIO
 
 if TYPE_CHECKING:
     from camloc_geo.osm import Intersection
 
 __all__ = [
+    "TIE_SCORE_RATIO",
     "Candidate",
     "Flag",
     "FlagKind",
@@ -70,6 +72,11 @@ class LocateSettings:
     bundle_adjust
         Re-fit the leading candidates' cameras to the annotations and their matched map
         points together (:mod:`camloc_geo.absolute._bundle`); their rank and score stay.
+    tie_score_ratio, tie_distance_m
+        Candidates tie (``ambiguous_with``) when the weaker scores at least
+        ``tie_score_ratio`` of the stronger (:data:`~camloc_geo.results.TIE_SCORE_RATIO`) and
+        they stand more than ``tie_distance_m`` apart (closer ones are one answer at the
+        accuracy the tool aims at: 10 m).
     """
 
     sigma_pixel_rel: float = 0.0015
@@ -92,6 +99,8 @@ class LocateSettings:
     fit_gate: float = 16.0
     prior_gate_radii: float = 3.0
     bundle_adjust: bool = True
+    tie_score_ratio: float = TIE_SCORE_RATIO
+    tie_distance_m: float = TIE_DISTANCE_M
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
 __all__ = [
     "bundle_leaders",
     "locate",
+    "mark_ties",
     "normalise_and_merge",
     "prior_gate",
     "rank",
@@ -106,6 +107,7 @@ def locate(
         cands = refine_leaders(cands, world_cam, ev, settings)
         cands = rank(cands, settings, result)
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
+        mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -302,7 +304,7 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
         C = c.camera.center_in_world
         lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
         c.lon, c.lat = float(lon), float(lat)
-    _mark_ties(cands, settings, result)
+    mark_ties(cands, settings, result)
     return cands
 
 
@@ -313,36 +315,46 @@ TIE_MIN_SCORE = 0.01
 def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
     lo, hi = sorted((a.score, b.score))
     gap = float(np.linalg.norm(a.east_north - b.east_north))
-    return lo >= 0.8 * hi and lo >= TIE_MIN_SCORE and gap > 2.0 * settings.merge_distance_m
+    return (
+        lo >= settings.tie_score_ratio * hi
+        and lo >= TIE_MIN_SCORE
+        and gap > max(settings.tie_distance_m, 2.0 * settings.merge_distance_m)
+    )
 
 
-def _mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
+def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
     """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
 
-    Two candidates tie when the weaker scores at least 0.8 of the stronger (and at least
-    :data:`TIE_MIN_SCORE`) yet they stand more than ``2 * merge_distance_m`` apart (a
-    symmetric junction: the evidence cannot tell them apart).
+    Two candidates tie when the weaker scores at least ``settings.tie_score_ratio`` of the
+    stronger (:data:`~camloc_geo.absolute._model.TIE_SCORE_RATIO`: the evidence favours the
+    stronger by less than 10 to 1) and at least :data:`TIE_MIN_SCORE`, yet they stand more
+    than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot tell them apart).
+    Earlier marks and the earlier warning are replaced.
     """
+    for c in cands:
+        c.ambiguous_with = []
     for a, b in itertools.combinations(cands, 2):
         if _tie(a, b, settings):
             a.ambiguous_with.append(b.rank)
             b.ambiguous_with.append(a.rank)
     for c in cands:
         c.ambiguous_with.sort()
-    if len(cands) >= 2 and cands[1].score >= 0.8 * cands[0].score:
+    result.warnings = [w for w in result.warnings if not w.startswith("ambiguous:")]
+    if len(cands) >= 2 and _tie(cands[0], cands[1], settings):
         gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
-        if gap > 2.0 * settings.merge_distance_m:
-            result.warnings.append(
-                f"ambiguous: candidates 1 and 2 fit the evidence equally well (scores "
-                f"{cands[0].score:.2f} and {cands[1].score:.2f}) but stand {gap:.0f} m apart; "
-                + (
-                    "even with the scene's cues"
-                    if result.cues_applied
-                    else "a symmetric junction cannot tell them apart: more evidence (a reference "
-                    "pixel, a landmark, another corner), a viewing-direction hint (view_hint) or "
-                    "a tighter prior decides"
-                )
+        odds = cands[0].score / max(cands[1].score, 1e-300)
+        result.warnings.append(
+            f"ambiguous: candidates 1 and 2 fit the evidence almost equally well (scores "
+            f"{cands[0].score:.2f} and {cands[1].score:.2f}: odds of {odds:.1f} to 1, under "
+            f"{1.0 / settings.tie_score_ratio:g} to 1) but stand {gap:.0f} m apart; "
+            + (
+                "even with the scene's cues"
+                if result.cues_applied
+                else "a symmetric junction cannot tell them apart: more evidence (a reference "
+                "pixel, a landmark, another corner), a viewing-direction hint (view_hint) or "
+                "a tighter prior decides"
             )
+        )
 
 
 def bundle_leaders(

@@ -35,6 +35,17 @@ def _junctions(map_data: Any) -> list[Any]:
     return out
 
 
+_COMPASS_8 = ("north", "NE", "east", "SE", "south", "SW", "west", "NW")
+
+
+def _true_compass(title: str, heading_deg: float) -> str:
+    """The title with its compass words (if any) replaced by the camera's true heading's."""
+    for word in _COMPASS[:3]:
+        if title.endswith(" " + word):
+            return f"{title[: -len(word)]}looking {_COMPASS_8[round(heading_deg / 45.0) % 8]}"
+    return title
+
+
 def _title(names: Sequence[str], style: int, rng: np.random.Generator) -> str:
     a, b = names[0], names[1]
     if style == 0:
@@ -126,6 +137,10 @@ def make_camera_list(
                 rel = f"scenes/{cam_id}.json"
                 (out / rel).write_text(json.dumps(scene), encoding="utf-8")
                 row["scene"] = rel
+                # a listing's compass words describe the camera it lists
+                row["title"] = _true_compass(
+                    row["title"], float(ls.camera_enu.angles_deg[0]) % 360.0
+                )
                 row["true_lat"] = f"{ls.lat:.7f}"
                 row["true_lon"] = f"{ls.lon:.7f}"
         rows.append(row)

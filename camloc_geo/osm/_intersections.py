@@ -26,10 +26,17 @@ Which gaps get a corner (consistency matters more than anything for sequence mat
 - a gap between adjacent streets of :data:`MAX_CORNER_GAP_DEG` or more has no corner: the
   kerb runs on (nearly) straight, so the side of a T junction opposite the stem has no
   corner. A T has 2 corners, a crossing 4, a Y 3, a five-way junction 5;
-- a gap under :data:`MIN_CORNER_GAP_DEG` (two streets leaving almost together), parallel
-  kerb lines, a corner farther than :data:`MAX_CORNER_DISTANCE_M` from the centre, or more
-  than :data:`MAX_STREETS` streets make the junction ``"unmodelled"``: no corners at all,
-  and a warning saying why;
+- a gap under :data:`MIN_CORNER_GAP_DEG` (two streets leaving almost together: a fork's
+  gore, a tunnel under a street, a slip road peeling off) has no corner either: the kerbs
+  meet far out in a thin wedge nobody would click. The junction's other corners stay (a
+  warning names the pair);
+- parallel kerb lines, a corner farther than :data:`MAX_CORNER_DISTANCE_M` from the
+  centre, more than :data:`MAX_STREETS` streets, or no corner left at all make the junction
+  ``"unmodelled"``: no corners at all, and a warning saying why;
+- a median opening (a dual carriageway whose two carriageways are joined by a short
+  connector inside the junction, no side street) has the four corners of the median noses:
+  where each carriageway's inner kerb meets the connector's kerbs
+  (:func:`_median_opening_corners`);
 - roundabouts (``junction=roundabout|circular`` on a street at the cluster) are
   ``"roundabout"``, without corners. Mini-roundabouts (a node tag) are ordinary junctions.
 - Nodes joining fewer than three streets (after merging carriageways and dropping slip
@@ -82,7 +89,9 @@ ARM_SAMPLE_M = 20.0
 DUAL_MAX_ANGLE_DEG = 35.0
 """Two opposite one-way carriageways of one name closer than this in bearing are one street."""
 MIN_CORNER_GAP_DEG = 15.0
-"""Adjacent streets closer than this in bearing make the junction unmodelled."""
+"""Adjacent streets closer than this in bearing have no kerb corner between them."""
+MIN_MEDIAN_M = 0.5
+"""A median opening's corners need a median at least this wide between the carriageways."""
 MAX_CORNER_GAP_DEG = 160.0
 """Adjacent streets this far apart or more have no kerb corner between them."""
 MAX_CORNER_DISTANCE_M = 40.0
@@ -655,12 +664,17 @@ def _is_roundabout(G: nx.MultiDiGraph, osm_nodes: list[Any]) -> bool:
 
 
 def _model_corners(
-    streets: list[_Street], centre: np.ndarray
+    streets: list[_Street], centre: np.ndarray, notes: list[str] | None = None
 ) -> tuple[list[tuple[np.ndarray, _Street, _Street]], str | None]:
-    """Kerb corners between adjacent streets, or the reason the junction is unmodelled."""
+    """Kerb corners between adjacent streets, or the reason the junction is unmodelled.
+
+    ``notes`` (if given) receives one line per pair of streets too close in bearing to have
+    a corner between them.
+    """
     if len(streets) > MAX_STREETS:
         return [], f"{len(streets)} streets meet (more than {MAX_STREETS})"
     corners: list[tuple[np.ndarray, _Street, _Street]] = []
+    sharp: list[str] = []
     n = len(streets)
     for i in range(n):
         a, b = streets[i], streets[(i + 1) % n]
@@ -668,7 +682,8 @@ def _model_corners(
         if gap >= MAX_CORNER_GAP_DEG:
             continue
         if gap < MIN_CORNER_GAP_DEG:
-            return [], f"{a.name!r} and {b.name!r} leave only {gap:.0f}° apart"
+            sharp.append(f"{a.name!r} and {b.name!r} (only {gap:.0f}° apart")
+            continue
         point = _kerb_corner(a, b)
         if point is None:
             return [], f"the kerbs of {a.name!r} and {b.name!r} do not meet"
@@ -676,7 +691,109 @@ def _model_corners(
         if dist > MAX_CORNER_DISTANCE_M:
             return [], f"the kerbs of {a.name!r} and {b.name!r} meet {dist:.0f} m from the centre"
         corners.append((point, a, b))
+    if not corners:
+        return [], (
+            "; ".join(f"{pair})" for pair in sharp) if sharp else "no two streets meet at an angle"
+        )
+    if notes is not None:
+        notes += [f"no kerb corner between {pair}: a fork's gore)" for pair in sharp]
     return corners, None
+
+
+def _median_opening_corners(
+    Gp: nx.MultiDiGraph,
+    members: list[Any],
+    arms: list[_Arm],
+    streets: list[_Street],
+    north_america: bool,
+) -> list[tuple[np.ndarray, _Street, _Street]]:
+    """The median noses of a median opening, or ``[]`` if the group is not one.
+
+    A median opening is a group of nodes whose arms make one straight dual carriageway
+    (two opposite streets, at least one of them of two carriageways) joined by connector
+    pieces inside the group. Its kerb corners are where the inner kerb of each carriageway
+    (the median's edge) meets either kerb of a connector: four per connector, the corners a
+    camera sees at the two ends of the gap in the median.
+    """
+    if len(streets) != 2 or max(s.carriageways for s in streets) < 2:
+        return []
+    a, b = streets
+    if _angle_diff(a.bearing, (b.bearing + 180.0) % 360.0) > DUAL_MAX_ANGLE_DEG:
+        return []
+    d = a.direction
+    r = _right_normal(d)
+    # the carriageways: arms of either side, as lateral offsets (in a's frame) and widths
+    lanes = sorted(
+        (float((arm.origin - a.origin) @ r), arm.width_m)
+        for arm in arms
+        if min(_angle_diff(arm.bearing, a.bearing), _angle_diff(arm.bearing, b.bearing))
+        <= DUAL_MAX_ANGLE_DEG
+    )
+    carriageways: list[tuple[float, float]] = []
+    for off, width in lanes:  # the arms of one carriageway on both sides: one entry
+        if carriageways and abs(off - carriageways[-1][0]) < 1.0:
+            continue
+        carriageways.append((off, width))
+    if len(carriageways) != 2:
+        return []
+    (o1, w1), (o2, w2) = carriageways
+    s1, s2 = o1 + w1 / 2.0, o2 - w2 / 2.0  # the median's two edges
+    if s2 - s1 < MIN_MEDIAN_M:
+        return []
+    inside = set(members)
+    seen: set[frozenset[Any]] = set()
+    out: list[tuple[np.ndarray, _Street, _Street]] = []
+    for u in members:
+        for _u, v, data in Gp.out_edges(u, data=True):
+            if v not in inside or v == u or frozenset((u, v)) in seen:
+                continue
+            seen.add(frozenset((u, v)))
+            pu = np.array([Gp.nodes[u]["x"], Gp.nodes[u]["y"]], dtype=float)
+            pv = np.array([Gp.nodes[v]["x"], Gp.nodes[v]["y"]], dtype=float)
+            along = pv - pu
+            if float(np.hypot(*along)) < 1.0:
+                continue
+            c = along / float(np.hypot(*along))
+            if abs(float(c @ d)) > math.cos(math.radians(MIN_CORNER_GAP_DEG)):
+                continue  # a piece along the carriageway, not across the median
+            name, names = street_label(data)
+            highway = highway_of(data)
+            width, source = resolve_width_m(
+                width=data.get("width"),
+                lanes=data.get("lanes"),
+                highway=highway,
+                oneway=_is_oneway(data),
+                north_america=north_america,
+            )
+            mid = (pu + pv) / 2.0
+            conn = _Street(
+                name=name,
+                names=names,
+                highway=highway,
+                oneway=_is_oneway(data),
+                lanes=parse_lanes(data.get("lanes")),
+                width_m=width,
+                width_source=source,
+                carriageways=1,
+                origin=mid,
+                direction=c,
+                s_left=-width / 2.0,
+                s_right=width / 2.0,
+                bearing=0.0,
+                edge=(int(u), int(v)),
+            )
+            rc = _right_normal(c)
+            for s_med in (s1, s2):
+                base = a.origin + s_med * r
+                for s_conn in (conn.s_left, conn.s_right):
+                    q = mid + s_conn * rc
+                    # base + t d = q + k c
+                    det = float(-d[0] * c[1] + d[1] * c[0])
+                    rx, ry = float(q[0] - base[0]), float(q[1] - base[1])
+                    t = (-rx * float(c[1]) + ry * float(c[0])) / det
+                    side = a if t >= 0.0 else b
+                    out.append((np.asarray(base + t * d, dtype=float), side, conn))
+    return out
 
 
 def build_intersections(
@@ -751,7 +868,17 @@ def build_intersections(
             kind = "roundabout"
             warnings.append("roundabout: kerb corners not modelled")
         else:
-            modelled, reason = _model_corners(streets, centre)
+            modelled, reason = _model_corners(streets, centre, warnings)
+            if reason and len(members) > 1:
+                road = _group_streets(plain, frame)
+                modelled = _median_opening_corners(Gp, members, arms, road, north_america)
+                if modelled:
+                    reason = None
+                    streets = road  # one road of two carriageways each way
+                    warnings.append(
+                        "median opening: the corners are the noses of the median either side "
+                        "of the gap"
+                    )
             if reason:
                 kind = "unmodelled"
                 warnings.append(f"unmodelled junction: {reason}")
