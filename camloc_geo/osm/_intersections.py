@@ -90,6 +90,10 @@ DUAL_MAX_ANGLE_DEG = 35.0
 """Two opposite one-way carriageways of one name closer than this in bearing are one street."""
 MIN_CORNER_GAP_DEG = 15.0
 """Adjacent streets closer than this in bearing have no kerb corner between them."""
+MAX_RING_NODES = 200
+"""A roundabout's ring is followed through at most this many nodes."""
+MAX_RING_RADIUS_M = 60.0
+"""Rings wider than this (gyratories, squares around a park) get no corners."""
 MIN_MEDIAN_M = 0.5
 """A median opening's corners need a median at least this wide between the carriageways."""
 MAX_CORNER_GAP_DEG = 160.0
@@ -700,6 +704,107 @@ def _model_corners(
     return corners, None
 
 
+def _is_ring_edge(data: dict[str, Any]) -> bool:
+    junction = data.get("junction")
+    values = junction if isinstance(junction, list) else [junction]
+    return any(str(j) in _ROUNDABOUT for j in values if j)
+
+
+def _roundabout_corners(
+    Gp: nx.MultiDiGraph, members: list[Any], arms: list[_Arm], north_america: bool
+) -> tuple[list[tuple[np.ndarray, _Street, _Street]], str | None]:
+    """Kerb corners of a roundabout: where each approach's kerbs meet the ring's outer kerb.
+
+    The ring is followed from the group's nodes along ``junction=roundabout|circular``
+    edges; a circle fitted to its geometry (algebraic least squares) gives the centre and
+    the radius of its centre line, and half the ring's carriageway width (one-way) gives
+    the outer kerb. Each approach (an arm that is not part of the ring) has two kerb lines,
+    straight along its first metres; each meets the outer kerb circle where the approach
+    flares into the ring. Returns the corners, or ``[]`` and the reason.
+    """
+    ring_data: dict[str, Any] | None = None
+    seen: set[Any] = set()
+    todo = [n for n in members if n in Gp]
+    points: list[tuple[float, float]] = []
+    while todo and len(seen) < MAX_RING_NODES:
+        n = todo.pop()
+        if n in seen:
+            continue
+        seen.add(n)
+        for u, v, data in list(Gp.out_edges(n, data=True)) + list(Gp.in_edges(n, data=True)):
+            if not _is_ring_edge(data):
+                continue
+            ring_data = ring_data or data
+            points += [tuple(p) for p in _edge_coords(Gp, u, v, data)]
+            todo += [w for w in (u, v) if w not in seen]
+    if ring_data is None or len(points) < 4:
+        return [], "no ring geometry"
+    xy = np.unique(np.asarray(points, dtype=float), axis=0)
+    if len(xy) < 4:
+        return [], "no ring geometry"
+    # Kasa circle fit: x^2 + y^2 + D x + E y + F = 0
+    A = np.column_stack([xy[:, 0], xy[:, 1], np.ones(len(xy))])
+    b = -(xy[:, 0] ** 2 + xy[:, 1] ** 2)
+    (D, E, F), *_ = np.linalg.lstsq(A, b, rcond=None)
+    centre = np.array([-D / 2.0, -E / 2.0])
+    radius_sq = float(centre @ centre - F)
+    if radius_sq <= 0.0:
+        return [], "the ring is not a circle"
+    radius = math.sqrt(radius_sq)
+    spread = np.abs(np.hypot(*(xy - centre).T) - radius)
+    if radius > MAX_RING_RADIUS_M or float(np.median(spread)) > 0.25 * radius + 2.0:
+        return [], f"a ring of {radius:.0f} m radius (or no circle)"
+    ring_name, ring_names = street_label(ring_data)
+    ring_width, ring_source = resolve_width_m(
+        width=ring_data.get("width"),
+        lanes=ring_data.get("lanes"),
+        highway=highway_of(ring_data),
+        oneway=True,
+        north_america=north_america,
+    )
+    outer = radius + ring_width / 2.0
+    ring = _Street(
+        name=ring_name,
+        names=ring_names,
+        highway=highway_of(ring_data),
+        oneway=True,
+        lanes=parse_lanes(ring_data.get("lanes")),
+        width_m=ring_width,
+        width_source=ring_source,
+        carriageways=1,
+        origin=centre,
+        direction=np.array([1.0, 0.0]),
+        s_left=-ring_width / 2.0,
+        s_right=ring_width / 2.0,
+        bearing=0.0,
+        edge=(0, 0),
+    )
+    out: list[tuple[np.ndarray, _Street, _Street]] = []
+    for arm in arms:
+        if _is_ring_edge(arm.data):
+            continue
+        street = _single_street(arm)
+        r = _right_normal(arm.direction)
+        for s_kerb, pair in (
+            (arm.width_m / 2.0, (street, ring)),
+            (-arm.width_m / 2.0, (ring, street)),
+        ):
+            p = arm.origin + s_kerb * r - centre
+            # |p + t d| = outer, the root nearest the arm's start (t >= 0 leaves the ring)
+            pd = float(p @ arm.direction)
+            disc = pd * pd - float(p @ p) + outer * outer
+            if disc < 0.0:
+                continue
+            roots = [-pd + math.sqrt(disc), -pd - math.sqrt(disc)]
+            t = min(roots, key=abs)
+            if abs(t) > outer + MAX_CORNER_DISTANCE_M:
+                continue
+            out.append((np.asarray(centre + p + t * arm.direction, dtype=float), *pair))
+    if not out:
+        return [], "no approach meets the ring"
+    return out, None
+
+
 def _median_opening_corners(
     Gp: nx.MultiDiGraph,
     members: list[Any],
@@ -866,7 +971,13 @@ def build_intersections(
         modelled: list[tuple[np.ndarray, _Street, _Street]] = []
         if _is_roundabout(Gp, osm_nodes):
             kind = "roundabout"
-            warnings.append("roundabout: kerb corners not modelled")
+            modelled, reason = _roundabout_corners(Gp, members, arms, north_america)
+            warnings.append(
+                f"roundabout: kerb corners not modelled ({reason})"
+                if reason
+                else "roundabout: the corners are where each approach's kerbs meet the ring's "
+                "outer kerb"
+            )
         else:
             modelled, reason = _model_corners(streets, centre, warnings)
             if reason and len(members) > 1:
