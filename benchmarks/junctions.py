@@ -76,7 +76,8 @@ COVER_M = 15.0
 NAIVE_OFFSET_M = 5.0
 """The naive baseline's corner distance from the centre-line crossing, metres."""
 KERB_EVIDENCE_M = 15.0
-"""A corner counts in the kerb comparison when kerb evidence lies within this distance."""
+"""A junction counts in the kerb comparison when kerb evidence lies within this distance of
+every naive corner (chosen on the map's kerb mapping, never on camloc's own answer)."""
 EXTRACTS = sorted(
     p.name
     for p in OSM.iterdir()
@@ -364,6 +365,7 @@ def kerbs(name: str) -> dict[str, Any] | None:
     camloc = load_map(path, lat, lon, None)
     ours: list[float] = []
     naive: list[float] = []
+    by_kind: dict[str, list[float]] = {}
     for x in camloc.intersections:
         if not x.corners:
             continue
@@ -374,10 +376,16 @@ def kerbs(name: str) -> dict[str, Any] | None:
         ]
         d_ours = _nearest(tree, lines, pts)
         d_naive = _nearest(tree, lines, naive_pts)
-        if not d_ours or max(d_ours) > KERB_EVIDENCE_M or not d_naive:
+        if not d_ours or not d_naive or max(d_naive) > KERB_EVIDENCE_M:
             continue  # no kerb mapped around this junction
         ours.extend(d_ours)
         naive.extend(d_naive)
+        kind = x.kind
+        if any("median opening" in w for w in x.warnings):
+            kind = "median_opening"
+        elif any("fork's gore" in w for w in x.warnings):
+            kind = "sharp_fork"
+        by_kind.setdefault(kind, []).extend(d_ours)
     if not ours:
         return None
     kinds: dict[str, int] = {}
@@ -392,6 +400,14 @@ def kerbs(name: str) -> dict[str, Any] | None:
         "naive_corners": len(naive),
         "naive_median_m": float(np.median(naive)),
         "naive_p90_m": float(np.percentile(naive, 90)),
+        "camloc_by_kind": {
+            k: {
+                "corners": len(v),
+                "median_m": float(np.median(v)),
+                "p90_m": float(np.percentile(v, 90)),
+            }
+            for k, v in sorted(by_kind.items())
+        },
     }
 
 

@@ -309,3 +309,35 @@ def test_sharp_fork_keeps_the_other_corners_monaco() -> None:
     assert any("fork's gore" in w for w in x.warnings)
     assert len(x.corners) == 2
     _assert_corners_on_kerbs(x)
+
+
+def test_roundabout_corners_on_the_ring_paris() -> None:
+    """Place Olympe de Gouges: each approach's two kerbs meet the ring's outer kerb.
+
+    The corners lie on one circle (the outer kerb) and come in pairs, one pair per approach;
+    approaches that curve into each other near the ring (Rue de Franche-Comté and Rue
+    Béranger here) are left out rather than given interleaved corners.
+    """
+    import numpy as np
+
+    m = _load("paris_bss.osm.pbf", 48.864697, 2.3646324)
+    x, _ = m.match_intersection(lat=48.864697, lon=2.3646324)
+    assert x is not None
+    assert x.kind == "roundabout"
+    assert any("outer kerb" in w for w in x.warnings)
+    assert len(x.corners) == 6
+    frame = LocalFrame(lat=x.lat, lon=x.lon)
+    xy = np.array([frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in x.corners], float)
+    a = np.column_stack([xy[:, 0], xy[:, 1], np.ones(len(xy))])
+    (d, e, f), *_ = np.linalg.lstsq(a, -(xy**2).sum(axis=1), rcond=None)
+    centre = np.array([-d / 2.0, -e / 2.0])
+    radius = float(np.sqrt(centre @ centre - f))
+    assert 5.0 < radius < 15.0
+    assert np.abs(np.hypot(*(xy - centre).T) - radius).max() < 0.5
+    # one pair per approach, the ring's name on the other side of each corner
+    approaches = [next(n for n in c.streets if n != "Place Olympe de Gouges") for c in x.corners]
+    assert (
+        approaches
+        == ["Rue Charlot", "Rue Charlot", "Rue de Turenne", "Rue de Turenne"] + ["Rue Charlot"] * 2
+    )
+    assert all("Place Olympe de Gouges" in c.streets for c in x.corners)

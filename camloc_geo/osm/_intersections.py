@@ -38,7 +38,9 @@ Which gaps get a corner (consistency matters more than anything for sequence mat
   where each carriageway's inner kerb meets the connector's kerbs
   (:func:`_median_opening_corners`);
 - roundabouts (``junction=roundabout|circular`` on a street at the cluster) are
-  ``"roundabout"``, without corners. Mini-roundabouts (a node tag) are ordinary junctions.
+  ``"roundabout"``; their corners are where each approach's two kerbs meet the ring's outer
+  kerb (:func:`_roundabout_corners`; none for rings over :data:`MAX_RING_RADIUS_M`).
+  Mini-roundabouts (a node tag) are ordinary junctions.
 - Nodes joining fewer than three streets (after merging carriageways and dropping slip
   roads) are not intersections.
 
@@ -780,7 +782,8 @@ def _roundabout_corners(
         edge=(0, 0),
     )
     out: list[tuple[np.ndarray, _Street, _Street]] = []
-    for arm in arms:
+    owner: list[int] = []
+    for k, arm in enumerate(arms):
         if _is_ring_edge(arm.data):
             continue
         street = _single_street(arm)
@@ -800,6 +803,19 @@ def _roundabout_corners(
             if abs(t) > outer + MAX_CORNER_DISTANCE_M:
                 continue
             out.append((np.asarray(centre + p + t * arm.direction, dtype=float), *pair))
+            owner.append(k)
+    # Around the ring, an approach's two corners are neighbours; approaches whose corners
+    # interleave (arms that curve into each other near the ring) are left out.
+    angles = [math.atan2(float(q[1] - centre[1]), float(q[0] - centre[0])) for q, _a, _b in out]
+    order = sorted(range(len(out)), key=lambda i: angles[i])
+    seq = [owner[i] for i in order]
+    bad = {
+        k
+        for k in set(seq)
+        if seq.count(k) == 2
+        and (j := [i for i, o in enumerate(seq) if o == k])[1] - j[0] not in (1, len(seq) - 1)
+    }
+    out = [c for c, k in zip(out, owner, strict=True) if k not in bad]
     if not out:
         return [], "no approach meets the ring"
     return out, None

@@ -128,7 +128,8 @@ class Intersection:
     streets
         Incident streets, sorted clockwise by outward bearing.
     corners
-        Kerb corners, clockwise from above. Empty unless ``kind == "junction"``.
+        Kerb corners, clockwise from above. Empty for ``"unmodelled"`` junctions (and
+        roundabouts whose ring is too wide or not a circle).
     kind
         ``"junction"`` (modelled), ``"roundabout"`` or ``"unmodelled"`` (see ``warnings``).
     warnings
