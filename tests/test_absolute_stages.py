@@ -134,3 +134,23 @@ def test_bundle_adjustment_helps_where_the_relative_pose_is_off(baltimore: MapDa
                 assert res.candidates[0].sigma_m > 0.0
     assert np.mean(bundled) < 0.9 * np.mean(plain), (plain, bundled)
     assert max(bundled) < max(plain), (plain, bundled)
+
+
+def test_two_corners_also_try_the_car_along_a_street() -> None:
+    """Two corners close together fix the rotation poorly: street-aligned alternatives
+    within 30° of the fitted rotation are proposed too (none for far-off streets)."""
+    import math
+
+    from camloc_geo.absolute._hypotheses import _street_aligned
+    from camloc_geo.absolute._similarity import Similarity2D, theta_for_bearing
+
+    world = np.array([[0.0, 0.0], [6.0, 0.0]])
+    fitted = Similarity2D(theta_for_bearing(100.0), np.zeros(2), 1.0)
+    enu = fitted.apply(world)
+    hyps = _street_aligned(world, enu, fitted, [90.0, 10.0], 0.0, (0, 1))
+    assert len(hyps) == 1  # 90° (10° off) kept, 270° and 10°/190° too far
+    h = hyps[0]
+    assert math.isclose(h.enu_from_world.heading_deg, 90.0, abs_tol=1e-9)
+    # the corners' centroid is matched exactly
+    assert np.allclose(h.enu_from_world.apply(world).mean(axis=0), enu.mean(axis=0))
+    assert h.corner_assignment == (0, 1)

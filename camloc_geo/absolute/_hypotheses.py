@@ -122,6 +122,31 @@ def corner_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis
         sim = similarity_fit(world[used], enu, wts[used], settings.scale_sigma_rel)
         lp = 0.0 if consecutive else math.log(settings.non_consecutive_prior)
         out.append(Hypothesis("corners", sim, lp, tuple(assign)))
+        if len(used) == 2:
+            # Two corners fix the rotation poorly when they are close together and far
+            # away: also try the car along each street, the corners' centroid matched.
+            out += _street_aligned(world[used], enu, sim, ev.street_bearings, lp, tuple(assign))
+    return out
+
+
+def _street_aligned(
+    world: FloatArray,
+    enu: FloatArray,
+    sim: Similarity2D,
+    bearings: Sequence[float],
+    log_prior: float,
+    assign: tuple[int, ...],
+) -> list[Hypothesis]:
+    """Hypotheses with the car's axis along a street near the fitted rotation (within 30°)."""
+    out = []
+    for b in bearings:
+        for flip in (0.0, 180.0):
+            theta = theta_for_bearing(b + flip)
+            d = (theta - sim.rotation_rad + math.pi) % (2 * math.pi) - math.pi
+            if abs(d) > math.radians(30.0) or abs(d) < math.radians(1.0):
+                continue
+            T = enu.mean(axis=0) - rot2(theta) @ world.mean(axis=0)
+            out.append(Hypothesis("corners", Similarity2D(theta, T, 1.0), log_prior, assign))
     return out
 
 
