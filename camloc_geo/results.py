@@ -71,7 +71,7 @@ TIE_SCORE_RATIO = 0.1
 
 The scores are posterior weights, so their ratio is the odds the evidence gives one over the
 other: under 10 to 1 is no strong evidence (Jeffreys' scale). On the absolute benchmark a
-top candidate that is wrong while another is right names that one as tied in 98 % of the
+top candidate that is wrong while another is right names that one as tied in 96 % of the
 scenes at 0.1 (87 % at 0.8: noise often favours a symmetric junction's mirror by 2-30 to 1).
 """
 TIE_DISTANCE_M = 10.0
