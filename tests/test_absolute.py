@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from camloc_geo._errors import InputError, MapDataError, SceneError
-from camloc_geo.absolute import LocateResult, candidates_geojson, locate
+from camloc_geo.absolute import LocateResult, LocateSettings, candidates_geojson, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
@@ -116,10 +116,15 @@ def test_exact_corners_found_at_real_intersections(maps: dict[str, MapData], pla
         assert true.camera.height_m == pytest.approx(ls.camera_enu.height_m, abs=0.05)
         top = result.candidates[0]
         if errs[0] > EXACT:
-            # Only an exact symmetric twin may outrank the truth: it fits as well and its
-            # score differs only through the map plausibility factors.
-            assert top.residual_m < 0.05, (inter.id, errs[0], top.residual_m)
-            assert true.score > 0.5 * top.score, (inter.id, true.score, top.score)
+            # Only an exact symmetric twin may outrank the truth (it fits as well and its
+            # score differs only through the map plausibility factors), or a street-aligned
+            # pose that misfits within the corners' noise: either way rank 1 names the truth
+            # as tied.
+            assert true.rank in top.ambiguous_with, (inter.id, errs[0], top.ambiguous_with)
+            if top.residual_m >= 0.05:
+                assert top.residual_m < LocateSettings().sigma_corner_m, (inter.id, top.residual_m)
+            else:
+                assert true.score > 0.5 * top.score, (inter.id, true.score, top.score)
 
 
 @pytest.mark.parametrize(
