@@ -1,6 +1,6 @@
 """The :func:`locate` pipeline.
 
-evidence → hypotheses → scores → prior gate → refinement → ranking → bundle adjustment.
+evidence → hypotheses → scores → prior gate → refinement → ranking → bundle adjustment → ties.
 """
 
 from __future__ import annotations
@@ -281,7 +281,9 @@ def normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> lis
 
 
 def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> list[Candidate]:
-    """Stage 6: merged, cut to ``max_candidates``, ranked, placed on the map; ties named.
+    """Stage 6: merged, cut to ``max_candidates``, ranked and placed on the map.
+
+    Ties are named after stage 7 (:func:`mark_ties`), on the leaders' adjusted positions.
 
     Raises
     ------
@@ -304,7 +306,6 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
         C = c.camera.center_in_world
         lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
         c.lon, c.lat = float(lon), float(lat)
-    mark_ties(cands, settings, result)
     return cands
 
 

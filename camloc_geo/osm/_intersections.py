@@ -662,9 +662,7 @@ def _is_roundabout(G: nx.MultiDiGraph, osm_nodes: list[Any]) -> bool:
         if n not in G:
             continue
         for _u, _v, data in list(G.out_edges(n, data=True)) + list(G.in_edges(n, data=True)):
-            junction = data.get("junction")
-            values = junction if isinstance(junction, list) else [junction]
-            if any(str(j) in _ROUNDABOUT for j in values if j):
+            if _is_ring_edge(data):
                 return True
     return False
 
