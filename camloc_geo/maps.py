@@ -536,8 +536,9 @@ def _tie_banner(
         gap = max(_distance_m(by_rank[a], by_rank[b]) for a in main for b in main if a < b)
         looks = [c for c in (_compass(by_rank[r].get("heading_deg")) for r in main) if c]
         parts.append(
-            f"<h4>≈ Ambiguous: candidates {_and(main)} fit almost equally well "
-            f"(score ratio {ratio:.2f})</h4>"
+            f"<h4>≈ Ambiguous: candidates {_and(main)} "
+            f"{'all' if len(main) > 2 else 'both'} fit the evidence "
+            f"(score ratio {ratio:.2f}; tied: odds under {1 / TIE_SCORE_RATIO:g} to 1)</h4>"
             f"Scores {' vs '.join(f'{x:.3f}' for x in scores)}, {gap:.0f} m apart"
             + (f", looking {html.escape(' vs '.join(looks))}" if looks else "")
             + f". Flags: {_flags_text(main, by_rank)}. Check "

@@ -197,7 +197,7 @@ def test_tied_candidates_are_marked_and_explained(
     assert banner.count() == 1
     assert banner.is_visible()
     text = banner.inner_text()
-    assert "Ambiguous: candidates 1, 2, 3 and 4 fit almost equally well" in text
+    assert "Ambiguous: candidates 1, 2, 3 and 4 all fit the evidence" in text
     assert "symmetric junction" in text
     assert "view_hint" in text
     # the two tied markers: different fill colours, both in the dashed ring with the badge

@@ -403,7 +403,7 @@ def test_tie_banner_says_which_why_and_what_decides(tied_page: str, tied: Any) -
     css, text = banner.split("|", 1)
     assert css == "camloc-banner"
     # 1 and 2 across the junction, each with a near twin (3 beside 1, 4 beside 2): one group
-    assert "Ambiguous: candidates 1, 2, 3 and 4 fit almost equally well" in text
+    assert "Ambiguous: candidates 1, 2, 3 and 4 all fit the evidence" in text
     scores = [c.score for c in tied.result.candidates[:4]]
     assert f"score ratio {min(scores) / max(scores):.2f}" in text
     assert " vs ".join(f"{s:.3f}" for s in scores) in text
