@@ -276,13 +276,10 @@ def test_y_junction_and_roundabout_krems() -> None:
     # corners where each approach's two kerbs meet the ring's outer kerb: pairs, on a circle
     assert len(r.corners) >= 4
     assert any("outer kerb" in w for w in r.warnings)
-    frame = LocalFrame(lat=r.lat, lon=r.lon)
-    xy = np.array([frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in r.corners], float)
-    a = np.column_stack([xy[:, 0], xy[:, 1], np.ones(len(xy))])
-    (d, e, f), *_ = np.linalg.lstsq(a, -(xy**2).sum(axis=1), rcond=None)
-    centre = np.array([-d / 2.0, -e / 2.0])
-    radius = float(np.sqrt(centre @ centre - f))
-    assert np.abs(np.hypot(*(xy - centre).T) - radius).max() < 0.5
+    from test_osm_junctions import ring_of_corners
+
+    _radius, misfit = ring_of_corners(r)
+    assert misfit < 0.5
 
 
 def test_five_way_paris() -> None:

@@ -63,6 +63,20 @@ def _assert_corners_on_kerbs(x: Intersection) -> None:
             assert d == pytest.approx(a.width_m / 2.0 / math.sin(math.radians(gap / 2)), abs=0.5)
 
 
+def ring_of_corners(x: Intersection) -> tuple[float, float]:
+    """The circle through an intersection's corners (algebraic least squares, in metres):
+    its radius and the largest corner's distance off it."""
+    import numpy as np
+
+    frame = LocalFrame(lat=x.lat, lon=x.lon)
+    xy = np.array([frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in x.corners], float)
+    a = np.column_stack([xy[:, 0], xy[:, 1], np.ones(len(xy))])
+    (d, e, f), *_ = np.linalg.lstsq(a, -(xy**2).sum(axis=1), rcond=None)
+    centre = np.array([-d / 2.0, -e / 2.0])
+    radius = float(np.sqrt(centre @ centre - f))
+    return radius, float(np.abs(np.hypot(*(xy - centre).T) - radius).max())
+
+
 def _names(x: Intersection) -> list[str]:
     return [s.name for s in x.streets]
 
@@ -318,22 +332,15 @@ def test_roundabout_corners_on_the_ring_paris() -> None:
     approaches that curve into each other near the ring (Rue de Franche-Comté and Rue
     Béranger here) are left out rather than given interleaved corners.
     """
-    import numpy as np
-
     m = _load("paris_bss.osm.pbf", 48.864697, 2.3646324)
     x, _ = m.match_intersection(lat=48.864697, lon=2.3646324)
     assert x is not None
     assert x.kind == "roundabout"
     assert any("outer kerb" in w for w in x.warnings)
     assert len(x.corners) == 6
-    frame = LocalFrame(lat=x.lat, lon=x.lon)
-    xy = np.array([frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in x.corners], float)
-    a = np.column_stack([xy[:, 0], xy[:, 1], np.ones(len(xy))])
-    (d, e, f), *_ = np.linalg.lstsq(a, -(xy**2).sum(axis=1), rcond=None)
-    centre = np.array([-d / 2.0, -e / 2.0])
-    radius = float(np.sqrt(centre @ centre - f))
+    radius, misfit = ring_of_corners(x)
     assert 5.0 < radius < 15.0
-    assert np.abs(np.hypot(*(xy - centre).T) - radius).max() < 0.5
+    assert misfit < 0.5
     # one pair per approach, the ring's name on the other side of each corner
     approaches = [next(n for n in c.streets if n != "Place Olympe de Gouges") for c in x.corners]
     assert (

@@ -645,16 +645,22 @@ def _kerb_corner(a: _Street, b: _Street) -> np.ndarray | None:
     """
     ra, rb = _right_normal(a.direction), _right_normal(b.direction)
     pa = a.origin + a.s_right * ra
-    pb = b.origin + b.s_left * rb
-    # solve pa + t da = pb + u db (Cramer's rule on the 2 x 2 system)
-    dax, day = float(a.direction[0]), float(a.direction[1])
-    dbx, dby = float(b.direction[0]), float(b.direction[1])
+    t = _line_meet(pa, a.direction, b.origin + b.s_left * rb, b.direction)
+    return None if t is None else np.asarray(pa + t * a.direction, dtype=float)
+
+
+def _line_meet(pa: np.ndarray, da: np.ndarray, pb: np.ndarray, db: np.ndarray) -> float | None:
+    """``t`` where the line ``pa + t da`` meets ``pb + u db``; None if they are parallel.
+
+    Cramer's rule on the 2 x 2 system.
+    """
+    dax, day = float(da[0]), float(da[1])
+    dbx, dby = float(db[0]), float(db[1])
     det = -dax * dby + day * dbx
     if abs(det) < 1e-9:
         return None
     rx, ry = float(pb[0] - pa[0]), float(pb[1] - pa[1])
-    t = (-rx * dby + ry * dbx) / det
-    return np.asarray(pa + t * a.direction, dtype=float)
+    return (-rx * dby + ry * dbx) / det
 
 
 def _is_roundabout(G: nx.MultiDiGraph, osm_nodes: list[Any]) -> bool:
@@ -905,11 +911,9 @@ def _median_opening_corners(
             for s_med in (s1, s2):
                 base = a.origin + s_med * r
                 for s_conn in (conn.s_left, conn.s_right):
-                    q = mid + s_conn * rc
-                    # base + t d = q + k c
-                    det = float(-d[0] * c[1] + d[1] * c[0])
-                    rx, ry = float(q[0] - base[0]), float(q[1] - base[1])
-                    t = (-rx * float(c[1]) + ry * float(c[0])) / det
+                    t = _line_meet(base, d, mid + s_conn * rc, c)
+                    if t is None:  # never: the connector crosses d by MIN_CORNER_GAP_DEG or more
+                        continue
                     side = a if t >= 0.0 else b
                     out.append((np.asarray(base + t * d, dtype=float), side, conn))
     return out
