@@ -138,7 +138,8 @@ def test_bundle_adjustment_helps_where_the_relative_pose_is_off(baltimore: MapDa
 
 def test_two_corners_also_try_the_car_along_a_street() -> None:
     """Two corners close together fix the rotation poorly: street-aligned alternatives
-    within 30° of the fitted rotation are proposed too (none for far-off streets)."""
+    within the rotation's window of the fitted rotation are proposed too (none for
+    far-off streets)."""
     import math
 
     from camloc_geo.absolute._hypotheses import _street_aligned
@@ -147,10 +148,30 @@ def test_two_corners_also_try_the_car_along_a_street() -> None:
     world = np.array([[0.0, 0.0], [6.0, 0.0]])
     fitted = Similarity2D(theta_for_bearing(100.0), np.zeros(2), 1.0)
     enu = fitted.apply(world)
-    hyps = _street_aligned(world, enu, fitted, [90.0, 10.0], 0.0, (0, 1))
+    hyps = _street_aligned(world, enu, fitted, [90.0, 10.0], 0.0, (0, 1), math.radians(30.0))
     assert len(hyps) == 1  # 90° (10° off) kept, 270° and 10°/190° too far
+    # A loose rotation (a 100° window) also tries 10° and 190° (90° off) but not 270°.
+    loose = _street_aligned(world, enu, fitted, [90.0, 10.0], 0.0, (0, 1), math.radians(100.0))
+    assert sorted(round(h.enu_from_world.heading_deg) % 360 for h in loose) == [10, 90, 190]
     h = hyps[0]
     assert math.isclose(h.enu_from_world.heading_deg, 90.0, abs_tol=1e-9)
     # the corners' centroid is matched exactly
     assert np.allclose(h.enu_from_world.apply(world).mean(axis=0), enu.mean(axis=0))
     assert h.corner_assignment == (0, 1)
+
+
+def test_two_corner_rotation_window_widens_with_a_short_baseline() -> None:
+    """Three sigmas of the two-corner rotation, never under 30°: corners a narrow side
+    street apart (5 m, each uncertain by 2 m) leave it loose by nearly 90°; corners 20 m
+    apart known to 0.5 m keep the 30° floor."""
+    import math
+
+    from camloc_geo.absolute._hypotheses import _rotation_window_rad
+
+    narrow = _rotation_window_rad(np.array([[0.0, 0.0], [5.0, 0.0]]), np.array([0.25, 0.25]))
+    assert math.degrees(narrow) == pytest.approx(3 * math.degrees(math.atan2(math.sqrt(8), 5)))
+    assert math.degrees(narrow) > 85.0
+    wide = _rotation_window_rad(np.array([[0.0, 0.0], [20.0, 0.0]]), np.array([4.0, 4.0]))
+    assert math.degrees(wide) == pytest.approx(30.0)
+    same = _rotation_window_rad(np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, 1.0]))
+    assert same == pytest.approx(math.pi)

@@ -125,8 +125,26 @@ def corner_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis
         if len(used) == 2:
             # Two corners fix the rotation poorly when they are close together and far
             # away: also try the car along each street, the corners' centroid matched.
-            out += _street_aligned(world[used], enu, sim, ev.street_bearings, lp, tuple(assign))
+            window = _rotation_window_rad(enu, wts[used])
+            out += _street_aligned(
+                world[used], enu, sim, ev.street_bearings, lp, tuple(assign), window
+            )
     return out
+
+
+def _rotation_window_rad(enu: FloatArray, weights: FloatArray) -> float:
+    """How far a two-corner fit's rotation may be off: three sigmas, at least 30°.
+
+    Each corner's position is uncertain by ``1 / sqrt(weight)`` metres (its click noise seen
+    on the ground plus the map's error); across a baseline of ``L`` metres that turns the
+    rotation by about ``sqrt(σ1² + σ2²) / L`` radians. Corners a narrow side street apart
+    (5 m), seen from 40 m, leave the rotation loose by 30° or more.
+    """
+    baseline = float(np.linalg.norm(enu[1] - enu[0]))
+    sigma = math.sqrt(float(np.sum(1.0 / weights)))
+    if baseline <= 0.0:
+        return math.pi
+    return min(math.pi, max(math.radians(30.0), 3.0 * math.atan2(sigma, baseline)))
 
 
 def _street_aligned(
@@ -136,14 +154,16 @@ def _street_aligned(
     bearings: Sequence[float],
     log_prior: float,
     assign: tuple[int, ...],
+    window_rad: float,
 ) -> list[Hypothesis]:
-    """Hypotheses with the car's axis along a street near the fitted rotation (within 30°)."""
+    """Hypotheses with the car's axis along a street within ``window_rad`` of the fitted
+    rotation (the corners' centroid matched)."""
     out = []
     for b in bearings:
         for flip in (0.0, 180.0):
             theta = theta_for_bearing(b + flip)
             d = (theta - sim.rotation_rad + math.pi) % (2 * math.pi) - math.pi
-            if abs(d) > math.radians(30.0) or abs(d) < math.radians(1.0):
+            if abs(d) > window_rad or abs(d) < math.radians(1.0):
                 continue
             T = enu.mean(axis=0) - rot2(theta) @ world.mean(axis=0)
             out.append(Hypothesis("corners", Similarity2D(theta, T, 1.0), log_prior, assign))
