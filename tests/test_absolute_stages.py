@@ -175,3 +175,50 @@ def test_two_corner_rotation_window_widens_with_a_short_baseline() -> None:
     assert math.degrees(wide) == pytest.approx(30.0)
     same = _rotation_window_rad(np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([1.0, 1.0]))
     assert same == pytest.approx(math.pi)
+
+
+def test_plausibility_is_averaged_over_the_position_uncertainty(baltimore: MapData) -> None:
+    """A candidate put 2.5+ m inside a building is penalised at its estimate; with a
+    position sigma of 15 m the averaged plausibility is far milder (much of the Gaussian
+    stands outside the footprint), and with a negligible sigma it is the estimate's."""
+    from dataclasses import replace
+
+    from shapely.geometry import Point
+
+    from camloc_geo.absolute._model import FlagKind
+    from camloc_geo.absolute._pipeline import _expected_plausibility
+    from camloc_geo.absolute._scoring import plausibility
+
+    js = _junctions(baltimore)
+    ls = make_located_scene(
+        baltimore, js[0], np.random.default_rng(3), noise=NoiseModel.exact(), corner_sigma_m=0.0
+    )
+    assert ls is not None
+    sc = parse_scene(ls.scene)
+    cal = calibrate(sc)
+    res = locate(sc, baltimore, calibration=cal)
+    cand = res.candidates[0]
+    ev = cand.evidence
+    assert ev is not None
+    assert ev.buildings is not None
+    centre = cand.camera.center_in_world[:2]
+    # The nearest footprint with a point more than 2.5 m from its outline.
+    inner = None
+    for poly in sorted(ev.buildings.geometries, key=lambda p: p.distance(Point(*centre))):
+        p = poly.representative_point()
+        if poly.exterior.distance(p) > 2.5:
+            inner = np.array([p.x, p.y])
+            break
+    assert inner is not None
+    sim = cand.enu_from_world
+    moved = replace(sim, translation_m=np.asarray(sim.translation_m) + (inner - centre))
+    cam = moved.camera(cal.camera)
+    assert np.allclose(cam.center_in_world[:2], inner)
+    settings = LocateSettings()
+    p0, flags = plausibility(cam, moved, ev, settings, cand.matches)
+    assert FlagKind.INSIDE_BUILDING in {f.kind for f in flags}
+    inside = replace(cand, enu_from_world=moved, camera=cam)
+    tiny = _expected_plausibility(p0, inside, 1e-3, cal.camera, ev, settings, cand.matches)
+    assert tiny == pytest.approx(p0, rel=1e-6)
+    wide = _expected_plausibility(p0, inside, 15.0, cal.camera, ev, settings, cand.matches)
+    assert 2.0 * p0 < wide <= 1.0

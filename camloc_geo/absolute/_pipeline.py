@@ -26,8 +26,15 @@ from camloc_geo.absolute._hypotheses import (
     corner_hypotheses,
     generate_hypotheses,
 )
-from camloc_geo.absolute._model import Candidate, Flag, FlagKind, LocateResult, LocateSettings
-from camloc_geo.absolute._refine import refine
+from camloc_geo.absolute._model import (
+    Candidate,
+    Flag,
+    FlagKind,
+    LocateResult,
+    LocateSettings,
+    Match,
+)
+from camloc_geo.absolute._refine import position_sigma_m, refine
 from camloc_geo.absolute._scoring import plausibility, score, unmatched_flags
 from camloc_geo.camera import Camera
 from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
@@ -104,6 +111,7 @@ def locate(
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
+        cands = expected_plausibility(cands, world_cam, ev, settings)
         cands = refine_leaders(cands, world_cam, ev, settings)
         cands = rank(cands, settings, result)
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
@@ -146,12 +154,29 @@ def _other_junction_candidates(
 
 
 def _rescore(
-    cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings, log_prior: float
+    cand: Candidate,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    log_prior: float,
+    *,
+    expected: bool = False,
 ) -> Candidate:
-    """The candidate with its likelihood, plausibility, matches and flags (re)computed."""
+    """The candidate with its likelihood, plausibility, matches and flags (re)computed.
+
+    With ``expected``, the plausibility is averaged over the candidate's position
+    uncertainty (:func:`_expected_plausibility`; its ``sigma_m``, else the fit's covariance
+    at the candidate).
+    """
     ev = cand.evidence if cand.evidence is not None else ev
     fit = score(cand.enu_from_world, ev, settings, cand.corner_assignment)
     plaus, flags = plausibility(cand.camera, cand.enu_from_world, ev, settings, fit.matches)
+    if expected:
+        sigma = cand.sigma_m
+        if sigma is None:
+            sigma = position_sigma_m(replace(cand, matches=fit.matches), world_cam, ev, settings)
+        if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
+            plaus = _expected_plausibility(plaus, cand, sigma, world_cam, ev, settings, fit.matches)
     flags += unmatched_flags(ev, fit.corner_assignment)
     cue_log = 0.0
     if ev.has_cues:
@@ -166,6 +191,40 @@ def _rescore(
         flags=flags,
         corner_assignment=fit.corner_assignment,
     )
+
+
+SIGMA_POINT_CAP_M = 25.0
+"""The spread of the sigma points of :func:`_expected_plausibility` is capped at this."""
+
+
+def _expected_plausibility(
+    plaus_centre: float,
+    cand: Candidate,
+    sigma_m: float,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    matches: list[Match],
+) -> float:
+    """The map plausibility averaged over the candidate's position uncertainty.
+
+    A candidate a few metres off with a position sigma of 10 m may stand inside a building,
+    see its corners through one and put its car beside the street, where the truth it
+    stands for does none of that. The plausibility tests are step functions of the
+    position, so their value at the estimate alone over-penalises uncertain candidates:
+    this is their expectation over an isotropic Gaussian of ``sigma_m`` (per axis
+    ``sigma_m / √2``, capped at :data:`SIGMA_POINT_CAP_M`), by the unscented transform's
+    five points (the centre, weight 1/3, and ``±√3`` per-axis sigmas east and north, 1/6
+    each). The camera and its car move together (the similarity's translation).
+    """
+    step = math.sqrt(3.0) * min(sigma_m, SIGMA_POINT_CAP_M) / math.sqrt(2.0)
+    total = plaus_centre / 3.0
+    sim = cand.enu_from_world
+    for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
+        moved = replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
+        f, _flags = plausibility(moved.camera(world_cam), moved, ev, settings, matches)
+        total += f / 6.0
+    return total
 
 
 def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:
@@ -236,14 +295,55 @@ def prior_gate(
     return kept_near
 
 
+PLAUSIBILITY_MARGIN = 10.0
+"""Candidates whose likelihood alone trails the best score by more than this (in log units:
+22,000 to 1) keep the plausibility at their estimate; averaging it could not bring them
+near the leaders (a plausibility is at most 1)."""
+
+
+def expected_plausibility(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Stage 5a: the plausibility of the leading merged candidates averaged over their
+    position uncertainty (:func:`_expected_plausibility`), so that a candidate a few metres
+    off is not ruled out by a building or a kerb that the truth it stands for is clear of.
+
+    It runs on merged candidates (sorted by score, as :func:`normalise_and_merge` leaves
+    them): near-duplicates share one place, so they must share one plausibility (five sigma
+    points of step functions would otherwise pick among them at random). Bounded work: the
+    first ``max_candidates`` whose likelihood alone is within :data:`PLAUSIBILITY_MARGIN`
+    of the best score. Scores are re-normalised and re-sorted.
+    """
+    if not cands:
+        return cands
+    best = max(c.score for c in cands)
+    floor = best * math.exp(-PLAUSIBILITY_MARGIN)
+    out = []
+    for i, c in enumerate(cands):
+        upper = c.score / max(c.prior, 1e-300)  # the score with a plausibility of 1
+        if i < settings.max_candidates and upper >= floor:
+            c_ev = c.evidence or ev
+            sigma = position_sigma_m(c, world_cam, c_ev, settings)
+            if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
+                p = _expected_plausibility(c.prior, c, sigma, world_cam, c_ev, settings, c.matches)
+                c = replace(c, prior=p, score=upper * p)
+        out.append(c)
+    total = sum(c.score for c in out) or 1.0
+    for c in out:
+        c.score = c.score / total
+    out.sort(key=lambda c: -c.score)
+    return out
+
+
 def refine_leaders(
     cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
 ) -> list[Candidate]:
-    """Stage 5: refine the ``refine_top`` leading candidates, then score them again."""
+    """Stage 5: refine the ``refine_top`` leading candidates, then score them again (the
+    plausibility averaged over their refined uncertainty)."""
     cands = list(cands)
     for i in range(min(settings.refine_top, len(cands))):
         c = refine(cands[i], world_cam, cands[i].evidence or ev, settings)
-        cands[i] = _rescore(c, world_cam, ev, settings, 0.0)
+        cands[i] = _rescore(c, world_cam, ev, settings, 0.0, expected=True)
     return cands
 
 

@@ -117,6 +117,22 @@ def _position_sigma_m(
         return None
 
 
+def position_sigma_m(
+    cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> float | None:
+    """1-sigma position uncertainty of a candidate as it stands (no refinement): the
+    covariance of the least-squares fit of ``enu_from_world`` to its matched evidence,
+    linearised at the candidate's own similarity."""
+    obs_q = _matched_points(cand, ev)
+    if not obs_q:
+        return None
+    street_brg = _street_bearing_prior(cand, ev, settings)
+    resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
+    x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    _r, J = resid_jac(x0)
+    return _position_sigma_m(J, cand.enu_from_world, world_cam)
+
+
 def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings) -> Candidate:
     """Refine ``enu_from_world`` and so the camera's position against all matched evidence.
 
