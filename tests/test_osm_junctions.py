@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from camloc_geo import MapDataError
-from camloc_geo.geodesy import LocalFrame, bearing_deg
+from camloc_geo.geodesy import LocalFrame, bearing_deg, distance_m
 from camloc_geo.osm import Intersection, MapData, load_map
 
 OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
@@ -37,9 +37,10 @@ def _assert_corners_on_kerbs(x: Intersection) -> None:
     for i, a in enumerate(streets):
         b = streets[(i + 1) % len(streets)]
         gap = (b.bearing_deg - a.bearing_deg) % 360.0
-        if 15.0 <= gap < 160.0:  # a sharper fork has no corner (its gore)
+        if 15.0 <= gap < 160.0:  # a sharper fork's corner is its gore's nose, far out
             expected.append((a, b, gap))
-    assert len(x.corners) == len(expected)
+    noses = sum("gore's nose" in w for w in x.warnings)
+    assert len(x.corners) == len(expected) + noses
     for a, b, gap in expected:
         mid = (a.bearing_deg + gap / 2.0) % 360.0
         corner = min(
@@ -315,14 +316,56 @@ def test_median_opening_has_the_median_noses_moscow() -> None:
 
 
 def test_sharp_fork_keeps_the_other_corners_monaco() -> None:
-    """Two streets leaving 14° apart have no corner between them; the others stay."""
+    """Two streets leaving 14° apart have no corner at the node: their corner is the nose of
+    the gore between them, 37 m out where their facing kerbs meet; the others stay."""
     m = _load("monaco.osm.pbf", 43.7398998, 7.423849)
     x, _ = m.match_intersection(lat=43.7398998, lon=7.423849)
     assert x is not None
     assert x.kind == "junction"
-    assert any("fork's gore" in w for w in x.warnings)
-    assert len(x.corners) == 2
+    assert any("gore's nose" in w for w in x.warnings)
+    assert len(x.corners) == 3
     _assert_corners_on_kerbs(x)
+    nose = next(
+        c
+        for c in x.corners
+        if c.streets == ("Boulevard Princesse Charlotte", "Avenue Saint-Michel")
+    )
+    assert 30.0 < distance_m(lat1=x.lat, lon1=x.lon, lat2=nose.lat, lon2=nose.lon) < 45.0
+    assert 52.0 < bearing_deg(lat1=x.lat, lon1=x.lon, lat2=nose.lat, lon2=nose.lon) < 66.0
+
+
+@pytest.mark.parametrize(
+    ("name", "lat", "lon", "a", "b", "out_m"),
+    [
+        # a two-way street splitting into two one-way carriageways 10° apart
+        ("kotka.osm.pbf", 60.5332685, 26.9542466, 0, 1, (35.0, 47.0)),
+        # a slip road leaving a motorway 6° apart
+        ("kotka.osm.pbf", 60.528707, 26.9565551, 0, 1, (50.0, 65.0)),
+    ],
+)
+def test_a_carriageway_split_or_diverge_has_its_gore_nose(
+    name: str, lat: float, lon: float, a: int, b: int, out_m: tuple[float, float]
+) -> None:
+    """Streets forking a few degrees apart meet at no corner by the node; the one corner such
+    a junction has is the nose of the gore, where a's right kerb meets b's left kerb (half a
+    carriageway right of a, tens of metres out between the two)."""
+    m = _load(name, lat, lon)
+    x, _ = m.match_intersection(lat=lat, lon=lon)
+    assert x is not None
+    assert x.kind == "junction"
+    assert len(x.corners) == 1
+    assert any("gore's nose" in w for w in x.warnings)
+    sa, sb = x.streets[a], x.streets[b]
+    nose = x.corners[0]
+    assert nose.streets == (sa.name, sb.name)
+    d = distance_m(lat1=x.lat, lon1=x.lon, lat2=nose.lat, lon2=nose.lon)
+    assert out_m[0] < d < out_m[1]
+    brg = bearing_deg(lat1=x.lat, lon1=x.lon, lat2=nose.lat, lon2=nose.lon)
+    assert sa.bearing_deg - 2.0 < brg < sb.bearing_deg + 2.0
+    assert _offset_m(x, nose.lon, nose.lat, sa.bearing_deg) == pytest.approx(
+        sa.width_m / 2.0, abs=0.3
+    )
+    assert _offset_m(x, nose.lon, nose.lat, sb.bearing_deg) < 0.0  # left of b
 
 
 def test_roundabout_corners_on_the_ring_paris() -> None:

@@ -102,6 +102,9 @@ MAX_CORNER_GAP_DEG = 160.0
 """Adjacent streets this far apart or more have no kerb corner between them."""
 MAX_CORNER_DISTANCE_M = 40.0
 """A kerb corner farther than this from the centre means the junction is unmodelled."""
+MAX_GORE_DISTANCE_M = 80.0
+"""A gore's nose (where the facing kerbs of two streets forking less than
+:data:`MIN_CORNER_GAP_DEG` apart meet) farther than this along them is not modelled."""
 MAX_STREETS = 6
 """Junctions with more streets are unmodelled."""
 
@@ -182,6 +185,7 @@ class _Street:
     s_right: float  # right kerb (positive)
     bearing: float
     edge: tuple[int, int]
+    coords: np.ndarray | None = None  # (N, 2) ENU centre line outward (single carriageways)
 
 
 def _right_normal(d: np.ndarray) -> np.ndarray:
@@ -566,6 +570,7 @@ def _single_street(arm: _Arm) -> _Street:
         s_right=half,
         bearing=arm.bearing,
         edge=arm.edge,
+        coords=arm.coords,
     )
 
 
@@ -685,6 +690,7 @@ def _model_corners(
         return [], f"{len(streets)} streets meet (more than {MAX_STREETS})"
     corners: list[tuple[np.ndarray, _Street, _Street]] = []
     sharp: list[str] = []
+    noses: list[str] = []
     n = len(streets)
     for i in range(n):
         a, b = streets[i], streets[(i + 1) % n]
@@ -692,7 +698,15 @@ def _model_corners(
         if gap >= MAX_CORNER_GAP_DEG:
             continue
         if gap < MIN_CORNER_GAP_DEG:
-            sharp.append(f"{a.name!r} and {b.name!r} (only {gap:.0f}° apart")
+            nose = _gore_nose(a, b)
+            if nose is None:
+                sharp.append(f"{a.name!r} and {b.name!r} (only {gap:.0f}° apart")
+            else:
+                corners.append((nose, a, b))
+                noses.append(
+                    f"the corner between {a.name!r} and {b.name!r} (only {gap:.0f}° apart) is "
+                    f"their gore's nose, {float(np.hypot(*(nose - centre))):.0f} m out"
+                )
             continue
         point = _kerb_corner(a, b)
         if point is None:
@@ -707,7 +721,37 @@ def _model_corners(
         )
     if notes is not None:
         notes += [f"no kerb corner between {pair}: a fork's gore)" for pair in sharp]
+        notes += noses
     return corners, None
+
+
+def _gore_nose(a: _Street, b: _Street) -> np.ndarray | None:
+    """The nose of the gore between two streets forking at a sharp angle, or None.
+
+    Streets leaving a node a few degrees apart (a carriageway splitting, a slip road
+    leaving a motorway) have no corner at the node: their facing kerbs (a's right, b's left)
+    run side by side and meet only where the carriageways have drawn apart by their half
+    widths, tens of metres out, at the tip of the island or the painted gore. The kerbs
+    are the centre lines' offset curves along their real geometry (a straight extension
+    of the first bearing would put a curving slip road's nose far off); the meeting
+    nearest the node, within :data:`MAX_GORE_DISTANCE_M`, is the nose.
+    """
+    if a.coords is None or b.coords is None or len(a.coords) < 2 or len(b.coords) < 2:
+        return None
+    from shapely.geometry import LineString, Point
+
+    kerb_a = LineString(a.coords).offset_curve(-a.s_right)  # shapely: positive is left
+    kerb_b = LineString(b.coords).offset_curve(-b.s_left)
+    meet = kerb_a.intersection(kerb_b)
+    if meet.is_empty:
+        return None
+    points = [g for g in getattr(meet, "geoms", [meet]) if isinstance(g, Point)]
+    origin = Point(float(a.coords[0][0]), float(a.coords[0][1]))
+    points = [p for p in points if p.distance(origin) <= MAX_GORE_DISTANCE_M]
+    if not points:
+        return None
+    nearest = min(points, key=origin.distance)
+    return np.array([nearest.x, nearest.y], dtype=float)
 
 
 def _is_ring_edge(data: dict[str, Any]) -> bool:
