@@ -117,18 +117,30 @@ def _position_sigma_m(
         return None
 
 
-def position_sigma_m(
-    cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings
-) -> float | None:
-    """1-sigma position uncertainty of a candidate as it stands (no refinement): the
-    covariance of the least-squares fit of ``enu_from_world`` to its matched evidence,
-    linearised at the candidate's own similarity."""
+def _similarity_problem(
+    cand: Candidate, ev: Evidence, settings: LocateSettings
+) -> tuple[ResidualJacobian, FloatArray] | None:
+    """The least-squares problem of ``enu_from_world`` for a candidate's matched evidence
+    (residuals and Jacobian in ``(θ, tx, ty, ln s)``) and its start, None with no match."""
     obs_q = _matched_points(cand, ev)
     if not obs_q:
         return None
     street_brg = _street_bearing_prior(cand, ev, settings)
     resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
     x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    return resid_jac, x0
+
+
+def position_sigma_m(
+    cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> float | None:
+    """1-sigma position uncertainty of a candidate as it stands (no refinement): the
+    covariance of the least-squares fit of ``enu_from_world`` to its matched evidence,
+    linearised at the candidate's own similarity."""
+    problem = _similarity_problem(cand, ev, settings)
+    if problem is None:
+        return None
+    resid_jac, x0 = problem
     _r, J = resid_jac(x0)
     return _position_sigma_m(J, cand.enu_from_world, world_cam)
 
@@ -141,12 +153,10 @@ def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSet
     least squares on the Mahalanobis residuals of every matched point plus the scale prior,
     and its covariance is propagated to the camera position.
     """
-    obs_q = _matched_points(cand, ev)
-    if not obs_q:
+    problem = _similarity_problem(cand, ev, settings)
+    if problem is None:
         return cand
-    street_brg = _street_bearing_prior(cand, ev, settings)
-    resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
-    x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+    resid_jac, x0 = problem
     x, J = gauss_newton(resid_jac, x0)
     theta, tx, ty, ls = x
     sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
