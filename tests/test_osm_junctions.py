@@ -23,6 +23,13 @@ def _load(name: str, lat: float, lon: float, radius_m: float = 80.0) -> MapData:
     return load_map(OSM / name, lat, lon, radius_m)
 
 
+def _junction_at(name: str, lat: float, lon: float) -> Intersection:
+    """The intersection an extract's map (80 m around the point) matches at the point."""
+    x, _ = _load(name, lat, lon).match_intersection(lat=lat, lon=lon)
+    assert x is not None
+    return x
+
+
 def _offset_m(x: Intersection, lon: float, lat: float, bearing: float) -> float:
     """Signed distance of a point from the line through the centre with this bearing."""
     e, n = LocalFrame(lat=x.lat, lon=x.lon).enu_from_geographic(lat=lat, lon=lon)
@@ -177,18 +184,14 @@ def test_same_name_fork_kotka() -> None:
 
 def test_named_service_street_is_an_arm_krems() -> None:
     """A named highway=service street is a junction arm (issue 18)."""
-    m = _load("krems.osm.gz", 48.403791, 15.655438)
-    x, _ = m.match_intersection(lat=48.403791, lon=15.655438)
-    assert x is not None
+    x = _junction_at("krems.osm.gz", 48.403791, 15.655438)
     assert ("An der Schütt", "service") in {(s.name, s.highway) for s in x.streets}
     assert len(x.corners) == 4
 
 
 def test_pedestrian_segments_are_arms_heidelberg() -> None:
     """Pedestrian segments of named streets meet in junctions (Marktplatz)."""
-    m = _load("heidelberg_altstadt.osm.pbf", 49.4122891, 8.710133)
-    x, _ = m.match_intersection(lat=49.4122891, lon=8.710133)
-    assert x is not None
+    x = _junction_at("heidelberg_altstadt.osm.pbf", 49.4122891, 8.710133)
     assert x.id == "n324700898"
     assert [s.highway for s in x.streets] == ["pedestrian"] * 3
     assert len(x.corners) == 2
@@ -318,9 +321,7 @@ def test_median_opening_has_the_median_noses_moscow() -> None:
 def test_sharp_fork_keeps_the_other_corners_monaco() -> None:
     """Two streets leaving 14° apart have no corner at the node: their corner is the nose of
     the gore between them, 37 m out where their facing kerbs meet; the others stay."""
-    m = _load("monaco.osm.pbf", 43.7398998, 7.423849)
-    x, _ = m.match_intersection(lat=43.7398998, lon=7.423849)
-    assert x is not None
+    x = _junction_at("monaco.osm.pbf", 43.7398998, 7.423849)
     assert x.kind == "junction"
     assert any("gore's nose" in w for w in x.warnings)
     assert len(x.corners) == 3
@@ -349,9 +350,7 @@ def test_a_carriageway_split_or_diverge_has_its_gore_nose(
     """Streets forking a few degrees apart meet at no corner by the node; the one corner such
     a junction has is the nose of the gore, where a's right kerb meets b's left kerb (half a
     carriageway right of a, tens of metres out between the two)."""
-    m = _load(name, lat, lon)
-    x, _ = m.match_intersection(lat=lat, lon=lon)
-    assert x is not None
+    x = _junction_at(name, lat, lon)
     assert x.kind == "junction"
     assert len(x.corners) == 1
     assert any("gore's nose" in w for w in x.warnings)
@@ -375,9 +374,7 @@ def test_roundabout_corners_on_the_ring_paris() -> None:
     approaches that curve into each other near the ring (Rue de Franche-Comté and Rue
     Béranger here) are left out rather than given interleaved corners.
     """
-    m = _load("paris_bss.osm.pbf", 48.864697, 2.3646324)
-    x, _ = m.match_intersection(lat=48.864697, lon=2.3646324)
-    assert x is not None
+    x = _junction_at("paris_bss.osm.pbf", 48.864697, 2.3646324)
     assert x.kind == "roundabout"
     assert any("outer kerb" in w for w in x.warnings)
     assert len(x.corners) == 6
