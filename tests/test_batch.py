@@ -194,7 +194,7 @@ def test_local_and_dask_give_identical_geopackages(
     out = world["base"] / "dask" / "out.gpkg"
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=":0"
         ) as lc,
         Client(lc) as client,
     ):
