@@ -29,8 +29,8 @@ from camloc_geo.batch import (
     read_camera_list,
     run_batch,
 )
-from camloc_geo.batch._synthetic import BAD_ROWS, make_camera_list
 from camloc_geo.cli import main
+from camloc_geo.testing.camera_list import BAD_ROWS, make_camera_list
 
 REPO = Path(__file__).resolve().parents[1]
 BALTIMORE = REPO / "sample_maps" / "baltimore.osm.pbf"

@@ -3,7 +3,7 @@
 Each camera watches a real junction of an extract: its title is written from OSM's own
 street names in one of the listing styles ("A & B", "12 - A / B looking north", "A at B",
 upper case), it may carry a rough point near the junction and a synthetic annotated scene
-(:func:`camloc_geo.synthetic.make_located_scene`). The truth goes into extra columns
+(:func:`camloc_geo.testing.synthetic.make_located_scene`). The truth goes into extra columns
 (``true_lat``, ``true_lon``, ``true_junction``) that the batch reader ignores.
 """
 
@@ -87,7 +87,7 @@ def make_camera_list(
     """
     from camloc_geo.batch._areas import _bounds
     from camloc_geo.osm import load_map
-    from camloc_geo.synthetic import make_located_scene
+    from camloc_geo.testing.synthetic import make_located_scene
 
     rng = np.random.default_rng(seed)
     out = Path(folder)
