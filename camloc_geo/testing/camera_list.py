@@ -85,8 +85,8 @@ def make_camera_list(
     strip_scene_junction
         Share of scenes whose intersection hint loses its lat/lon (the title must give it).
     """
-    from camloc_geo.batch._areas import _bounds
     from camloc_geo.osm import load_map
+    from camloc_geo.osm._catalogue import _bounds
     from camloc_geo.testing.synthetic import make_located_scene
 
     rng = np.random.default_rng(seed)

@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 from camloc_geo._errors import InputError, MapDataError
 
 if TYPE_CHECKING:
-    from camloc_geo.batch._list import CameraRow
+    from camloc_geo.cameras._list import CameraRow
     from camloc_geo.osm import MapData
 
 __all__ = ["CELL_M", "WHOLE_EXTRACT_MAX_BYTES", "Area", "MapPlan", "area_map", "map_plan"]

@@ -41,9 +41,9 @@ from typing import TYPE_CHECKING, Any
 from camloc_geo._errors import MapDataError, MapSourceError, SceneError
 
 if TYPE_CHECKING:
-    from camloc_geo.batch._areas import Area, MapPlan
-    from camloc_geo.batch._list import CameraRow
+    from camloc_geo.cameras._list import CameraRow
     from camloc_geo.osm import MapData
+    from camloc_geo.osm._catalogue import Area, MapPlan
 
 __all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
 
@@ -475,7 +475,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.batch._areas import area_map
+    from camloc_geo.osm._catalogue import area_map
 
     if not (row.title or row.streets):
         res.status = "no_evidence"
@@ -555,7 +555,7 @@ def geocode_camera(
         Without ``map_source``: may the map around the camera's point be fetched from
         Overpass.
     plan, area
-        A prepared :func:`~camloc_geo.batch._areas.map_plan` and the camera's area (what
+        A prepared :func:`~camloc_geo.osm._catalogue.map_plan` and the camera's area (what
         :func:`run_batch` passes; computed from ``map_source`` when omitted).
     """
     res = CameraResult(row=row.row, id=row.id, title=row.title, list_lat=row.lat, list_lon=row.lon)
@@ -581,7 +581,7 @@ def _geocode(
     if map_data is not None:
         return _with_map(row, res, map_data)
     if plan is None:
-        from camloc_geo.batch._areas import map_plan
+        from camloc_geo.osm._catalogue import map_plan
 
         plan = (
             _cached_plan(map_source, network)
@@ -598,7 +598,7 @@ def _geocode(
         return res.fail("no_map", str(area[1]), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
-    from camloc_geo.batch._areas import area_map
+    from camloc_geo.osm._catalogue import area_map
 
     try:
         m = area_map(area)
@@ -612,7 +612,7 @@ _PLANS: dict[tuple[str, bool], MapPlan] = {}
 
 
 def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
-    from camloc_geo.batch._areas import map_plan
+    from camloc_geo.osm._catalogue import map_plan
 
     key = (str(map_source), bool(network))
     if key not in _PLANS:
