@@ -298,8 +298,11 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
     """The row's scene, with the title's junction, prior and view hint where it has none."""
     from camloc_geo.scene import Scene, load_scene, parse_scene
 
-    assert row.scene is not None
-    sc = load_scene(row.scene)
+    if row.scene_data is not None:
+        sc = parse_scene(row.scene_data)
+    else:
+        assert row.scene is not None
+        sc = load_scene(row.scene)
     data = sc.model_dump(mode="json", exclude={"base_dir"}, exclude_none=True)
     changed = False
     junction = getattr(match, "intersection", None) if match is not None else None
@@ -346,7 +349,10 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
     try:
         sc = _scene_with_evidence(row, res, match)
     except SceneError as exc:
-        res.fail("scene_error", f"scene {os.path.basename(str(row.scene))}: {exc}", "scene")
+        where = "scene"
+        if row.scene_data is None:
+            where = f"scene {os.path.basename(str(row.scene))}"
+        res.fail("scene_error", f"{where}: {exc}", "scene")
         return
     try:
         out = locate_scene(sc, map_source=m, network=False)
@@ -432,7 +438,7 @@ def _with_map(
     matches = matches or []
     if matches:
         _apply_match(res, matches, res.extract)
-    if row.scene:
+    if row.has_scene:
         title_status, title_reason = res.status, res.reason
         best = matches[0] if matches else None
         res.lat = res.lon = None
@@ -592,7 +598,7 @@ def _geocode(
         area = plan.area_of(row)
     kind = area[0]
     if kind == "none":
-        if row.scene and not (row.title or row.streets):
+        if row.has_scene and not (row.title or row.streets):
             # a scene with references may not need a map at all
             return _with_map(row, res, None)
         return res.fail("no_map", str(area[1]), "map")

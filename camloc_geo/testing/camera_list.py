@@ -85,8 +85,7 @@ def make_camera_list(
     strip_scene_junction
         Share of scenes whose intersection hint loses its lat/lon (the title must give it).
     """
-    from camloc_geo.osm import load_map
-    from camloc_geo.osm._catalogue import _bounds
+    from camloc_geo.osm import extract_bounds, load_map
     from camloc_geo.testing.synthetic import make_located_scene
 
     rng = np.random.default_rng(seed)
@@ -95,7 +94,7 @@ def make_camera_list(
     maps = []
     for e in extracts:
         path = str(Path(e).absolute())
-        s, w, nn, ee = _bounds(path)
+        s, w, nn, ee = extract_bounds(path)
         m = load_map(path, (s + nn) / 2, (w + ee) / 2, radius_m=None)
         maps.append((m, _junctions(m)))
     rows: list[dict[str, Any]] = []
