@@ -5,10 +5,15 @@ options, and returns typed results. Domain decisions (where to anchor the map, h
 load it, whether a map is needed, when the network may be used) live here and nowhere in the
 front ends.
 
-Network policy (one rule for every command): an extract given as ``map_source`` is always
-used and the network never is; without one, Overpass is queried through osmnx (cached) when
-``network`` is true, and a scene that needs a map fails with a :class:`MapDataError` naming
-``--osm EXTRACT`` when it is false.
+Map sources (the same for every front end): ``map_source`` is an extract, a folder of
+extracts, a :class:`~camloc_geo.osm.MapCatalogue` or an already loaded map. A folder or a
+catalogue chooses the map for a point by the catalogue's one rule (the smallest extract
+covering it, loaded whole or by cells; Overpass cells when the catalogue allows the network).
+
+Network policy (one rule for every command): an extract or folder given as ``map_source`` is
+always used and the network never is; without one, Overpass is queried through osmnx (cached)
+when ``network`` is true, and a scene that needs a map fails with a :class:`MapDataError`
+naming ``--osm EXTRACT`` when it is false.
 
 Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 """
@@ -16,7 +21,7 @@ Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -26,7 +31,8 @@ from camloc_geo._errors import MapDataError, SceneError
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
     from camloc_geo.autovp import AutoVPResult
-    from camloc_geo.osm import MapData
+    from camloc_geo.cameras import CameraResult, CameraRow
+    from camloc_geo.osm import MapCatalogue, MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
     from camloc_geo.sensors.guide import GuideResult, GuideSettings
@@ -40,10 +46,12 @@ __all__ = [
     "calibrate_scene",
     "corners_near",
     "guide_scene",
+    "locate_camera",
     "locate_scene",
     "map_around",
     "map_for_scene",
     "radar_scene",
+    "read_camera_list",
     "scene_from",
     "streets_near",
     "vanishing_points",
@@ -52,8 +60,9 @@ __all__ = [
 SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
 """A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
 
-MapSource = Union[str, os.PathLike, "MapData", None]
-"""A map: an extract path, an already loaded :class:`~camloc_geo.osm.MapData`, or None."""
+MapSource = Union[str, os.PathLike, "MapData", "MapCatalogue", None]
+"""A map: an extract or folder path, a :class:`~camloc_geo.osm.MapCatalogue`, an already
+loaded :class:`~camloc_geo.osm.MapData`, or None."""
 
 DEFAULT_MIN_RADIUS_M = 300.0
 """The smallest map radius loaded around a scene (metres)."""
@@ -147,6 +156,20 @@ def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
     )
 
 
+def _catalogue_of(map_source: MapSource) -> MapCatalogue | None:
+    """The catalogue a map source chooses through: a catalogue itself, or a folder's."""
+    if map_source is None:
+        return None
+    is_path = isinstance(map_source, (str, os.PathLike))
+    if is_path and not Path(map_source).expanduser().is_dir():  # type: ignore[arg-type]
+        return None
+    from camloc_geo.osm import MapCatalogue
+
+    if is_path:
+        return MapCatalogue.from_source(map_source)  # type: ignore[arg-type]
+    return map_source if isinstance(map_source, MapCatalogue) else None
+
+
 def map_for_scene(
     scene: SceneLike,
     *,
@@ -162,9 +185,12 @@ def map_for_scene(
     Parameters
     ----------
     map_source
-        Extract path or a loaded map; None: Overpass when ``network`` allows it.
+        Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map;
+        None: Overpass when ``network`` allows it. A folder or catalogue gives the map
+        covering the scene's anchor, or None when none covers it and the scene needs none.
     network
-        May Overpass be queried (only when no ``map_source`` is given).
+        May Overpass be queried (only when no ``map_source`` is given; a catalogue says
+        itself whether it may).
     radius_m
         Map radius around the scene's anchor (default :func:`scene_map_radius_m`).
     required
@@ -172,12 +198,28 @@ def map_for_scene(
         or the scene needs one.
     """
     sc = scene_from(scene)
-    if map_source is not None and not isinstance(map_source, (str, os.PathLike)):
-        return map_source  # an already loaded MapData
+    catalogue = _catalogue_of(map_source)
+    loaded = catalogue is None and map_source is not None
+    if loaded and not isinstance(map_source, (str, os.PathLike)):
+        return map_source  # type: ignore[return-value]  # an already loaded MapData
     need = scene_needs_map(sc) if required is None else required
     if map_source is None and not need:
         return None
     centre = scene_anchor(sc)
+    if catalogue is not None:
+        if centre is None:
+            if not need:
+                return None
+        else:
+            area = catalogue.area_for_point(centre[0], centre[1])
+            if area[0] != "none":
+                return catalogue.map_for_area(area)
+            if not need:
+                return None
+            raise MapDataError(
+                "this scene needs a map (intersection corners, landmarks or street bearings) "
+                f"and no map serves it: {area[1]}"
+            )
     if centre is None:
         raise SceneError(
             "no location to load the map around: give prior (lat/lon), intersection lat/lon "
@@ -193,7 +235,7 @@ def map_for_scene(
     from camloc_geo.osm import load_map
 
     if map_source is not None:
-        return load_map(map_source, centre[0], centre[1], radius_m=radius)
+        return load_map(map_source, centre[0], centre[1], radius_m=radius)  # type: ignore[arg-type]
     return load_map(
         None,
         centre[0],
@@ -278,6 +320,61 @@ def locate_scene(
     return LocateOutput(scene=sc, result=result, map_data=map_data)
 
 
+def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
+    """The cameras of a list (CSV or GeoJSON, column variants in ``docs/batch.md``), streamed.
+
+    Raises
+    ------
+    InputError
+        The list is missing or unreadable (a bad row is a :class:`CameraRow` with problems).
+    """
+    from camloc_geo.cameras import read_camera_list as _read
+
+    return _read(path)
+
+
+def locate_camera(
+    camera: CameraRow | Mapping[str, Any],
+    *,
+    map_source: MapSource = None,
+    network: bool = False,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> CameraResult:
+    """Place one camera of a list: the camera-list engine every front end calls.
+
+    Its title's junction, its rough point (a prior), its scene (a file or inline) and the
+    view words, on the map the catalogue chooses for its point (a title without a point is
+    searched in every extract). ``camloc batch``, the service's jobs and QGIS's
+    ``camloc:geocodelist`` all call this, so one camera gets one answer.
+
+    Parameters
+    ----------
+    camera
+        A :class:`~camloc_geo.cameras.CameraRow` or a mapping with a list's columns (``id``,
+        ``title``, ``lat``, ``lon``, ``radius_m``, ``scene`` and their aliases).
+    map_source
+        An extract, a folder of extracts, a :class:`~camloc_geo.osm.MapCatalogue` or a loaded
+        map; None: Overpass when ``network`` allows it.
+
+    Returns
+    -------
+    A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
+    ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
+    """
+    from camloc_geo.cameras import CameraRow, geocode_camera
+    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.osm import MapCatalogue, MapData
+
+    row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)
+    if isinstance(map_source, MapData):
+        return geocode_camera(row, map_data=map_source)
+    catalogue = MapCatalogue.from_source(
+        map_source, network=network, cache_folder=cache_folder, overpass_url=overpass_url
+    )
+    return geocode_camera(row, plan=catalogue)
+
+
 def _require_source(map_source: MapSource, network: bool) -> None:
     """Fail at once (before any heavy import) when no map can be had."""
     if map_source is None and not network:
@@ -340,12 +437,20 @@ def streets_near(
         Overpass could not be reached (within a few seconds) or failed.
     """
     _require_source(map_source, network)
+    catalogue = _catalogue_of(map_source)
+    if catalogue is not None:
+        return catalogue.map_for_point(lat=lat, lon=lon)
     from camloc_geo.osm import MapData, load_map
 
     if isinstance(map_source, MapData):
         return map_source
     return load_map(
-        map_source, lat, lon, radius_m, cache_folder=cache_folder, overpass_url=overpass_url
+        map_source,  # type: ignore[arg-type]  # an extract path or None here
+        lat,
+        lon,
+        radius_m,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
     )
 
 
@@ -434,8 +539,12 @@ def map_around(
         return map_source
     lat = sum(p[0] for p in points) / len(points)
     lon = sum(p[1] for p in points) / len(points)
+    catalogue = _catalogue_of(map_source)
+    if catalogue is not None:
+        return catalogue.map_for_point(lat=lat, lon=lon)
     radius = max(distance_m(lat1=lat, lon1=lon, lat2=q[0], lon2=q[1]) for q in points)
-    return load_map(map_source, lat, lon, radius_m=min(radius + margin_m, max_radius_m))
+    radius_m = min(radius + margin_m, max_radius_m)
+    return load_map(map_source, lat, lon, radius_m=radius_m)  # type: ignore[arg-type]
 
 
 def radar_scene(

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
+    from camloc_geo.cameras import CameraResult
     from camloc_geo.osm import Intersection
     from camloc_geo.relative import CalibrationResult
 
@@ -56,6 +57,7 @@ __all__ = [
     "PolygonGeometry",
     "ViewConeProperties",
     "calibration_output",
+    "camera_job_result",
     "corners_collection",
     "intersection_features",
     "output_json_schema",
@@ -457,3 +459,48 @@ def output_json_schema(kind: OutputKind) -> dict[str, Any]:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = f"camloc {kind} output"
     return schema
+
+
+# ------------------------------------------------------------------------- camera lists
+_JOB_FIELDS = (
+    "id",
+    "title",
+    "status",
+    "reason",
+    "lat",
+    "lon",
+    "score",
+    "uncertainty_m",
+    "method",
+    "match_status",
+    "heading_deg",
+    "height_m",
+    "extract",
+    "n_candidates",
+)
+
+
+def camera_job_result(result: CameraResult) -> dict[str, Any]:
+    """One camera of an HTTP job, from the camera-list engine's result.
+
+    The camera's fields (``status`` in the engine's vocabulary, ``docs/contract.md``), the
+    tie as ``ambiguous`` (the engine's ``tie``), and ``candidates`` as GeoJSON point features
+    (``kind: "candidate"``, best first) for the job's GeoJSON and GeoPackage.
+    """
+    out: dict[str, Any] = {k: getattr(result, k, None) for k in _JOB_FIELDS}
+    out["ambiguous"] = bool(result.tie)
+    feats = []
+    for c in result.candidates:
+        if c.get("lat") is None or c.get("lon") is None:
+            continue
+        props = {k: v for k, v in c.items() if v is not None}
+        props["kind"] = "candidate"
+        feats.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [c["lon"], c["lat"]]},
+                "properties": props,
+            }
+        )
+    out["candidates"] = feats
+    return out

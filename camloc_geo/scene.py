@@ -467,7 +467,7 @@ class Scene(_Model):
     @property
     def has_cues(self) -> bool:
         """The scene carries a tie-breaking cue: ``view_hint``, ``object.street`` or
-        ``object.front`` (:mod:`camloc_geo.cues`)."""
+        ``object.front`` (:mod:`camloc_geo.absolute._cues`)."""
         return bool(self.view_hint is not None or self.object.street or self.object.front)
 
     @property

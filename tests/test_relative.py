@@ -16,7 +16,7 @@ from camloc_geo.camera import Camera
 from camloc_geo.objects import ObjectSize
 from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 EXACT = 1e-6
 CLUSTER = CalibrationSettings(joint_fit=False)

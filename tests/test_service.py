@@ -278,7 +278,7 @@ def test_job_geojson_and_geopackage(client: httpx.Client, tmp_path: Path) -> Non
     assert cams_out["good"]["properties"]["status"] == "located"
     good = cams_out["good"]["properties"]
     assert _dist_m(good["lat"], good["lon"], TRUTH["lat"], TRUTH["lon"]) < 10.0
-    assert cams_out["bad"]["properties"]["status"] == "failed"
+    assert cams_out["bad"]["properties"]["status"] == "scene_error"  # docs/contract.md: statuses
     assert "image" in cams_out["bad"]["properties"]["reason"]
     assert cams_out["nothing"]["properties"]["status"] == "no_evidence"
     gpkg = client.get(f"/v1/jobs/{job['id']}/result", params={"format": "gpkg"})

@@ -51,6 +51,7 @@ __all__ = [
     "STREET_HIGHWAYS",
     "RawMap",
     "clear_cache",
+    "header_box",
     "osmnx_settings",
     "read_extract",
     "read_overpass",
@@ -175,7 +176,7 @@ def _check_extract_path(path: Path) -> None:
         raise MapDataError(f"OSM extract is empty: {path}")
 
 
-def _header_box(path: Path) -> tuple[float, float, float, float] | None:
+def header_box(path: Path) -> tuple[float, float, float, float] | None:
     """``(south, west, north, east)`` declared in the extract's header, or None.
 
     Only a hint (clipped extracts hold data beyond it): choosing which extract of a folder
