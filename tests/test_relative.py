@@ -553,3 +553,41 @@ def test_a_left_out_line_that_agrees_with_the_joint_fit_is_re_admitted(
     np.testing.assert_allclose(
         result.camera.center_in_world, reference.camera.center_in_world, atol=1e-6
     )
+
+
+# ------------------------------------------- uncertainty without refits (issue 26, item 1)
+def _crowd_scene(seed: int, n_annotators: int = 5) -> dict[str, Any]:
+    from camloc_geo.synthetic import random_camera
+
+    rng = np.random.default_rng(seed)
+    cam = random_camera(rng, image_size=(1920, 1080), pp_offset_px=19.0)
+    syn = make_scene(cam, rng, noise=NoiseModel(), n_annotators=n_annotators)
+    syn.scene["object"] = {"preset": "sedan"}
+    return syn.scene
+
+
+def _flagged(influence: list[float | None]) -> set[int]:
+    """Annotators who move the camera more than three times the median annotator."""
+    vals = np.array([np.nan if v is None else v for v in influence])
+    med = float(np.nanmedian(vals))
+    return {i for i, v in enumerate(vals) if np.isfinite(v) and v > 3.0 * med}
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 5])
+def test_one_step_jackknife_matches_the_refits(seed: int) -> None:
+    scene = parse_scene(_crowd_scene(seed))
+    fast = calibrate(scene)
+    slow = calibrate(scene, CalibrationSettings(jackknife_method="refit"))
+    assert fast.position_sigma_m is not None
+    assert slow.position_sigma_m is not None
+    assert fast.rotation_sigma_deg is not None
+    assert slow.rotation_sigma_deg is not None
+    np.testing.assert_allclose(fast.position_sigma_m, slow.position_sigma_m, rtol=0.10)
+    np.testing.assert_allclose(fast.rotation_sigma_deg, slow.rotation_sigma_deg, rtol=0.10)
+    # The jackknife part is really there (the sigmas grew past the fit's covariance).
+    assert fast.position_sigma_fit_m is not None
+    assert np.all(fast.position_sigma_m > fast.position_sigma_fit_m)
+    assert _flagged(fast.annotator_influence_m) == _flagged(slow.annotator_influence_m)
+    for a, b in zip(fast.annotator_influence_m, slow.annotator_influence_m, strict=True):
+        if a is not None and b is not None:
+            assert a == pytest.approx(b, rel=0.15, abs=0.05)
