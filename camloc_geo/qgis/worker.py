@@ -1,13 +1,14 @@
-"""Out-of-process worker for the QGIS plugin: ``python -m camloc_geo.qgis_worker JOB.json``.
+"""Out-of-process worker for the QGIS plugin: ``python -m camloc_geo.qgis.worker JOB.json``.
 
 QGIS loads the system GEOS and PROJ into its process, and the shapely/pyproj wheels crash
 there (``docs/qgis.md``). The plugin therefore runs every computation in a separate Python
 that can import ``camloc_geo``: it writes a job file, starts this module, reads progress from
-its standard output and loads the layers it writes. This module imports no qgis and no Qt.
+its standard output and loads the layers it writes. This module imports no qgis and no Qt,
+and only the library's public API.
 
 Job file (JSON object): ``task`` (``locate``, ``corners``, ``geocodelist``, ``measure``,
-``check_scene``, ``probe``), ``out_dir`` (folder for the output layers) and the task's
-parameters (see the ``_task_*`` functions).
+``check_scene``, ``annotation_page``, ``probe``), ``out_dir`` (folder for the output layers)
+and the task's parameters (see the ``_task_*`` functions).
 
 Standard output: one JSON object per line,
 
@@ -19,28 +20,35 @@ Standard output: one JSON object per line,
 
 Output layers are GeoJSON FeatureCollections in EPSG:4326 with flat, typed properties (no nested
 objects): field types are ``int``, ``double``, ``string`` and ``bool``.
+
+Ties are the library's, carried as data: a candidate's ``ambiguous_with`` (the ranks it ties
+with, decided by :data:`camloc_geo.results.TIE_SCORE_RATIO` and
+:data:`camloc_geo.results.TIE_DISTANCE_M`); nothing here reads warning text or compares scores.
 """
 
 from __future__ import annotations
 
-import csv
 import json
 import math
+import re
 import sys
 import traceback
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from camloc_geo._errors import InputError
-from camloc_geo.results import TIE_SCORE_RATIO  # the library's tie rule (stdlib-only module)
+from camloc_geo import InputError
+from camloc_geo.results import TIE_DISTANCE_M, TIE_SCORE_RATIO
 
 __all__ = [
     "CANDIDATE_FIELDS",
+    "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "candidate_rows",
     "main",
     "run_job",
+    "score_text",
+    "user_words",
 ]
 
 
@@ -49,6 +57,7 @@ Field = tuple[str, str]
 CANDIDATE_FIELDS: list[Field] = [
     ("rank", "int"),
     ("score", "double"),
+    ("score_text", "string"),
     ("tie", "bool"),
     ("ambiguous_with", "string"),
     ("lat", "double"),
@@ -68,10 +77,17 @@ CANDIDATE_FIELDS: list[Field] = [
     ("flags", "string"),
     ("scene", "string"),
 ]
-CONE_FIELDS: list[Field] = [("rank", "int"), ("score", "double"), ("tie", "bool")]
+CONE_FIELDS: list[Field] = [
+    ("rank", "int"),
+    ("score", "double"),
+    ("score_text", "string"),
+    ("tie", "bool"),
+    ("leading", "bool"),
+]
 MATCH_FIELDS: list[Field] = [
     ("rank", "int"),
     ("label", "string"),
+    ("what", "string"),
     ("match_kind", "string"),
     ("pixel_x", "double"),
     ("pixel_y", "double"),
@@ -93,13 +109,48 @@ CAMERA_FIELDS: list[Field] = [
     ("lat", "double"),
     ("lon", "double"),
     ("score", "double"),
+    ("score_text", "string"),
     ("sigma_m", "double"),
     ("tie", "bool"),
     ("n_candidates", "int"),
     ("height_m", "double"),
     ("heading_deg", "double"),
+    ("method", "string"),
+    ("names_matched", "string"),
+    ("extract", "string"),
 ]
-LIST_CANDIDATE_FIELDS: list[Field] = [("camera_id", "string"), *CANDIDATE_FIELDS]
+LIST_CANDIDATE_FIELDS: list[Field] = [
+    ("camera_id", "string"),
+    ("rank", "int"),
+    ("score", "double"),
+    ("score_text", "string"),
+    ("tie", "bool"),
+    ("ambiguous_with", "string"),
+    ("lat", "double"),
+    ("lon", "double"),
+    ("height_m", "double"),
+    ("heading_deg", "double"),
+    ("method", "string"),
+    ("sigma_m", "double"),
+    ("flags", "string"),
+    ("source", "string"),
+    ("extract", "string"),
+]
+STREET_FIELDS: list[Field] = [
+    ("name", "string"),
+    ("highway", "string"),
+    ("width_m", "double"),
+    ("oneway", "bool"),
+]
+BUILDING_FIELDS: list[Field] = [
+    ("building_id", "string"),
+    ("name", "string"),
+    ("building", "string"),
+    ("height_m", "double"),
+]
+LEADING_MIN_SCORE = 0.05
+"""A candidate is *leading* (its view cone drawn at full strength) when it is the best, ties
+with another, or scores at least this (candidate scores sum to 1 over a scene)."""
 
 
 def _emit(obj: dict[str, Any]) -> None:
@@ -116,6 +167,41 @@ def _num(value: Any) -> float | None:
         return None
     v = float(value)
     return None if math.isnan(v) else v
+
+
+def score_text(score: float | None) -> str | None:
+    """A score as people read it: ``0.37``, ``0.0021``, ``1.2e-15`` (never cut to digits)."""
+    if score is None or not math.isfinite(score):
+        return None
+    if score == 0.0:
+        return "0"
+    if abs(score) >= 0.01:
+        return f"{score:.2f}"
+    if abs(score) >= 1e-4:
+        return f"{score:.2g}"
+    return f"{score:.1e}"
+
+
+_LABEL_WORDS = [
+    (re.compile(r"^intersection\.corners\[(\d+)\]$"), "your kerb corner {0}"),
+    (re.compile(r"^references\[(\d+)\]$"), "your reference point {0}"),
+    (re.compile(r"^landmarks\[(\d+)\]$"), "your landmark {0}"),
+]
+
+
+def user_words(label: str | None) -> str | None:
+    """A scene label in the analyst's words (``intersection.corners[0]``: kerb corner 0)."""
+    if not label:
+        return label
+    prefix = ""
+    if ":" in label:
+        prefix, label = label.split(":", 1)
+        prefix = prefix + " "
+    for pattern, words in _LABEL_WORDS:
+        m = pattern.match(label)
+        if m:
+            return prefix + words.format(*m.groups())
+    return prefix + label
 
 
 def _write_layer(
@@ -142,25 +228,14 @@ def _write_layer(
 
 
 def _ties(features: list[dict[str, Any]]) -> dict[int, list[int]]:
-    """Rank -> the other ranks it ties with (score within :data:`TIE_SCORE_RATIO` of the best)."""
-    if not features:
-        return {}
-    given = {
-        int(f["properties"]["rank"]): list(f["properties"]["ambiguous_with"])
-        for f in features
-        if isinstance(f["properties"].get("ambiguous_with"), list)
-    }
-    if given:
-        return given
-    best = max(float(f["properties"]["score"]) for f in features)
-    tied = [
-        int(f["properties"]["rank"])
-        for f in features
-        if float(f["properties"]["score"]) >= TIE_SCORE_RATIO * best
-    ]
-    if len(tied) < 2:
-        return {}
-    return {r: [o for o in tied if o != r] for r in tied}
+    """Rank -> the other ranks it ties with: the library's ``ambiguous_with``, nothing else."""
+    out: dict[int, list[int]] = {}
+    for f in features:
+        p = f["properties"]
+        given = p.get("ambiguous_with")
+        if isinstance(given, list) and given:
+            out[int(p["rank"])] = [int(o) for o in given]
+    return out
 
 
 def candidate_rows(gj: dict[str, Any]) -> list[tuple[dict[str, Any], dict[str, Any]]]:
@@ -172,12 +247,14 @@ def candidate_rows(gj: dict[str, Any]) -> list[tuple[dict[str, Any], dict[str, A
         p = f["properties"]
         rank = int(p["rank"])
         others = ties.get(rank, [])
+        score = _num(p.get("score"))
         rows.append(
             (
                 f["geometry"],
                 {
                     "rank": rank,
-                    "score": _num(p.get("score")),
+                    "score": score,
+                    "score_text": score_text(score),
                     "tie": bool(others),
                     "ambiguous_with": ",".join(str(o) for o in others) or None,
                     "lat": _num(p.get("lat")),
@@ -202,22 +279,32 @@ def candidate_rows(gj: dict[str, Any]) -> list[tuple[dict[str, Any], dict[str, A
     return rows
 
 
+def _leading(props: dict[str, Any]) -> bool:
+    return bool(props["rank"] == 1 or props["tie"] or (props["score"] or 0.0) >= LEADING_MIN_SCORE)
+
+
 def _locate_layers(gj: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     rows = candidate_rows(gj)
-    tie_by_rank = {props["rank"]: props["tie"] for _g, props in rows}
+    by_rank = {props["rank"]: props for _g, props in rows}
     feats = gj["features"]
-    cones = [
-        (
-            f["geometry"],
-            {
-                "rank": f["properties"]["rank"],
-                "score": _num(f["properties"].get("score")),
-                "tie": tie_by_rank.get(f["properties"]["rank"], False),
-            },
+    cones = []
+    for f in feats:
+        if f["properties"].get("kind") != "view_cone":
+            continue
+        cand = by_rank.get(f["properties"]["rank"])
+        score = _num(f["properties"].get("score"))
+        cones.append(
+            (
+                f["geometry"],
+                {
+                    "rank": f["properties"]["rank"],
+                    "score": score,
+                    "score_text": score_text(score),
+                    "tie": bool(cand and cand["tie"]),
+                    "leading": bool(cand and _leading(cand)),
+                },
+            )
         )
-        for f in feats
-        if f["properties"].get("kind") == "view_cone"
-    ]
     matches = []
     for f in feats:
         p = f["properties"]
@@ -230,6 +317,7 @@ def _locate_layers(gj: dict[str, Any], out_dir: Path) -> dict[str, Any]:
                 {
                     "rank": p.get("rank"),
                     "label": p.get("label"),
+                    "what": user_words(p.get("label")),
                     "match_kind": p.get("match_kind"),
                     "pixel_x": _num(pixel[0]),
                     "pixel_y": _num(pixel[1]),
@@ -283,13 +371,52 @@ def _intersection_rows(feats: list[dict[str, Any]]) -> list[tuple[dict[str, Any]
     return rows
 
 
+def _context_layers(map_data: Any, out_dir: Path) -> dict[str, Any]:
+    """The map model's streets and buildings (what locate matched against), for context."""
+    from shapely.geometry import mapping
+
+    streets = [
+        (
+            dict(mapping(s.geometry)),
+            {
+                "name": s.name or None,
+                "highway": s.highway,
+                "width_m": s.width_m,
+                "oneway": s.oneway,
+            },
+        )
+        for s in map_data.streets
+    ]
+    buildings = [
+        (
+            dict(mapping(b.footprint)),
+            {
+                "building_id": b.id,
+                "name": b.name,
+                "building": b.building,
+                "height_m": _num(b.height_m),
+            },
+        )
+        for b in map_data.buildings
+    ]
+    return {
+        "context_streets": _write_layer(
+            out_dir, "context_streets", "LineString", STREET_FIELDS, streets
+        ),
+        "context_buildings": _write_layer(
+            out_dir, "context_buildings", "Polygon", BUILDING_FIELDS, buildings
+        ),
+    }
+
+
 def _opt_float(job: dict[str, Any], key: str) -> float | None:
     v = job.get(key)
     return None if v in (None, "") else float(v)
 
 
 def _task_locate(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
-    """``scene`` (path), ``osm`` (path or null), ``network``, ``radius_m``, ``max_candidates``."""
+    """``scene`` (path or dict), ``osm`` (path or null), ``network``, ``radius_m``,
+    ``max_candidates``, ``context`` (also the map model's streets and buildings)."""
     from camloc_geo.api import locate_scene
 
     _progress(5, "reading the scene and the map")
@@ -304,8 +431,11 @@ def _task_locate(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     _progress(80, "writing the layers")
     gj = out.to_geojson()
     props = gj.get("properties", {})
+    layers = _locate_layers(gj, out_dir)
+    if job.get("context") and out.map_data is not None:
+        layers.update(_context_layers(out.map_data, out_dir))
     return {
-        "layers": _locate_layers(gj, out_dir),
+        "layers": layers,
         "warnings": list(props.get("warnings") or []),
         "info": {"n_candidates": props.get("n_candidates"), "reason": props.get("reason")},
     }
@@ -331,221 +461,111 @@ def _task_corners(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     return {"layers": {"corners": layer}, "warnings": [], "info": {"count": layer["count"]}}
 
 
-# --- webcam lists ------------------------------------------------------------------------------
-
-_ALIASES = {
-    "id": ("id", "camera_id", "camera", "name"),
-    "title": ("title", "description", "label"),
-    "lat": ("lat", "latitude", "y"),
-    "lon": ("lon", "lng", "long", "longitude", "x"),
-    "radius_m": ("radius_m", "uncertainty_m", "radius"),
-    "streets": ("streets", "street_pair", "intersection"),
-    "scene": ("scene", "scene_file", "scene_path"),
-}
+# --- webcam lists: the library's camera-list engine (camloc_geo.batch) ----------------------
 
 
-def _pick(row: dict[str, Any], key: str) -> Any:
-    low = {str(k).strip().lower(): v for k, v in row.items()}
-    for alias in _ALIASES[key]:
-        v = low.get(alias)
-        if v not in (None, ""):
-            return v
-    return None
-
-
-def _read_list(path: Path) -> list[dict[str, Any]]:
-    """Rows of a camera list (CSV or GeoJSON) as plain dicts."""
-    if not path.is_file():
-        raise InputError(f"camera list not found: {path}")
-    if path.suffix.lower() in (".geojson", ".json"):
-        try:
-            data = json.loads(path.read_text(encoding="utf-8"))
-        except ValueError as exc:
-            raise InputError(f"camera list {path.name} is not valid JSON: {exc}") from exc
-        rows = []
-        for f in data.get("features", []):
-            row = dict(f.get("properties") or {})
-            geom = f.get("geometry") or {}
-            if geom.get("type") == "Point":
-                row.setdefault("lon", geom["coordinates"][0])
-                row.setdefault("lat", geom["coordinates"][1])
-            rows.append(row)
-        return rows
-    with path.open(newline="", encoding="utf-8-sig") as fh:
-        return list(csv.DictReader(fh))
-
-
-def _best_of(rows: list[tuple[dict[str, Any], dict[str, Any]]]) -> dict[str, Any]:
-    if not rows:
-        return {}
-    p = rows[0][1]
-    return {k: p[k] for k in ("lat", "lon", "score", "sigma_m", "tie", "height_m", "heading_deg")}
-
-
-def _geocode_row(
-    row: dict[str, Any], base: Path, job: dict[str, Any]
-) -> tuple[dict[str, Any], list[tuple[dict[str, Any], dict[str, Any]]]]:
-    """One camera with the library's ``locate_scene``: (camera properties, candidate rows)."""
-    from camloc_geo.api import locate_scene, scene_from
-
-    cam_id = str(_pick(row, "id") or "")
-    props: dict[str, Any] = {"camera_id": cam_id, "title": _pick(row, "title")}
-    scene_path = _pick(row, "scene")
-    if not scene_path:
-        return {**props, "status": "error", "reason": "no scene file in the row"}, []
-    p = Path(str(scene_path))
-    if not p.is_absolute():
-        p = base / p
-    try:
-        sc = scene_from(p)
-        data = sc.model_dump(mode="json", exclude_none=True)
-        lat, lon = _pick(row, "lat"), _pick(row, "lon")
-        if "prior" not in data and lat is not None and lon is not None:
-            data["prior"] = {
-                "lat": float(lat),
-                "lon": float(lon),
-                "radius_m": float(_pick(row, "radius_m") or 150.0),
-            }
-        streets = _pick(row, "streets")
-        if streets and "intersection" in data and not data["intersection"].get("streets"):
-            data["intersection"]["streets"] = [
-                s.strip() for s in str(streets).replace("/", "&").split("&") if s.strip()
-            ]
-        out = locate_scene(
-            data, map_source=job.get("osm") or None, network=bool(job.get("network", False))
+def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any], dict[str, Any]]]]:
+    """The cameras-layer properties and candidate rows of one ``CameraResult`` of the batch."""
+    cam_id = str(result.id)
+    rows: list[tuple[dict[str, Any], dict[str, Any]]] = []
+    for c in result.candidates:
+        lat, lon = _num(c.get("lat")), _num(c.get("lon"))
+        if lat is None or lon is None:
+            continue  # a title match without a point (a street, a name not found)
+        others = [int(o) for o in c.get("ambiguous_with") or []]
+        score = _num(c.get("score"))
+        rows.append(
+            (
+                {"type": "Point", "coordinates": [lon, lat]},
+                {
+                    "camera_id": cam_id,
+                    "rank": int(c.get("rank") or len(rows) + 1),
+                    "score": score,
+                    "score_text": score_text(score),
+                    "tie": bool(others),
+                    "ambiguous_with": ",".join(str(o) for o in others) or None,
+                    "lat": lat,
+                    "lon": lon,
+                    "height_m": _num(c.get("height_m")),
+                    "heading_deg": _num(c.get("heading_deg")),
+                    "method": c.get("method"),
+                    "sigma_m": _num(c.get("uncertainty_m")),
+                    "flags": c.get("detail"),
+                    "source": c.get("source"),
+                    "extract": c.get("extract"),
+                },
+            )
         )
-    except InputError as exc:
-        return {**props, "status": "error", "reason": str(exc)}, []
-    rows = [(g, {"camera_id": cam_id, **r}) for g, r in candidate_rows(out.to_geojson())]
-    if not rows:
-        reason = out.result.reason or "no candidates"
-        return {**props, "status": "not_found", "reason": reason}, []
-    best = _best_of(rows)
-    status = "ambiguous" if best["tie"] else "ok"
-    return {**props, **best, "status": status, "reason": None, "n_candidates": len(rows)}, rows
-
-
-def _batch_module() -> Any | None:
-    try:
-        import camloc_geo.batch as batch  # type: ignore[import-not-found,unused-ignore]
-    except ImportError:
-        return None
-    if not hasattr(batch, "geocode_camera") or not hasattr(batch, "read_camera_list"):
-        return None
-    return batch
-
-
-_BATCH_STATUS = {
-    "ok": "ok",
-    "located": "ok",
-    "title_only": "ok",
-    "ambiguous": "ambiguous",
-    "not_found": "not_found",
-    "no_candidates": "not_found",
-    "street_only": "not_found",
-    "no_evidence": "not_found",
-}
-"""The batch engine's statuses as the plugin's (``ok``, ``ambiguous``, ``not_found``, else
-``error``); the engine's own status leads the ``reason`` where it says more."""
-
-
-def _batch_result(
-    result: Any,
-) -> tuple[dict[str, Any], list[tuple[dict[str, Any], dict[str, Any]]]]:
-    """Camera properties and candidate rows from the batch engine's ``CameraResult``."""
-
-    def get(key: str, default: Any = None) -> Any:
-        if isinstance(result, dict):
-            return result.get(key, default)
-        return getattr(result, key, default)
-
-    cam_id = str(get("id", None) or get("camera_id", "") or "")
-    cands_gj = get("candidates", None) or []
-    if hasattr(cands_gj, "to_geojson"):
-        cands_gj = cands_gj.to_geojson()
-    feats: list[dict[str, Any]] = []
-    if isinstance(cands_gj, dict):
-        feats = cands_gj.get("features", [])
-    elif isinstance(cands_gj, list):
-        feats = [
-            f
-            if isinstance(f, dict) and "properties" in f
-            else {
-                "type": "Feature",
-                "geometry": {"type": "Point", "coordinates": [f["lon"], f["lat"]]},
-                "properties": {"kind": "candidate", **f},
-            }
-            for f in (c if isinstance(c, dict) else c.__dict__ for c in cands_gj)
-        ]
-    rows = [
-        (g, {"camera_id": cam_id, **r})
-        for g, r in candidate_rows({"features": [f for f in feats if f]})
-    ]
-    best = _best_of(rows)
-    batch_status = str(get("status", "located"))
-    status = _BATCH_STATUS.get(batch_status, "error")
-    if status == "ok" and get("tie", False):
-        status = "ambiguous"
-    reason = get("reason", None)
-    if batch_status not in ("located", status):
-        reason = f"{batch_status}: {reason}" if reason else batch_status
+    score = _num(result.score)
     props = {
         "camera_id": cam_id,
-        "title": get("title", None),
-        "status": status,
-        "reason": reason,
+        "title": result.title or None,
+        "status": result.status,
+        "reason": result.reason,
+        "lat": _num(result.lat),
+        "lon": _num(result.lon),
+        "score": score,
+        "score_text": score_text(score),
+        "sigma_m": _num(result.uncertainty_m),
+        "tie": bool(result.tie),
         "n_candidates": len(rows),
-        **best,
+        "height_m": _num(result.height_m),
+        "heading_deg": _num(result.heading_deg),
+        "method": result.method,
+        "names_matched": " & ".join(result.names_matched) or None,
+        "extract": result.extract,
     }
-    for key in ("lat", "lon", "score", "sigma_m"):
-        if props.get(key) is None and get(key, None) is not None:
-            props[key] = _num(get(key, None))
-    if props.get("tie") is None and get("tie", None) is not None:
-        props["tie"] = bool(get("tie", None))
     return props, rows
 
 
 def _task_geocodelist(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
-    """``list`` (CSV or GeoJSON camera list), ``osm``, ``network``, ``engine`` (auto|library)."""
+    """``list`` (CSV or GeoJSON camera list), ``osm`` (an extract or a folder), ``network``.
+
+    The list runs through :func:`camloc_geo.batch.run_batch`, the engine of ``camloc batch``,
+    in this process: the same rows, statuses and answers as the command line.
+    """
+    from camloc_geo.batch import read_camera_list, results_from_journal, run_batch
+
     path = Path(job["list"])
-    batch = _batch_module() if job.get("engine", "auto") == "auto" else None
+    if not path.is_file():
+        raise InputError(f"camera list not found: {path}")
+    osm = job.get("osm") or None
+    if osm and not Path(osm).exists():
+        raise InputError(f"OSM extract or folder not found: {osm}")
+    n = sum(1 for _row in read_camera_list(path))
+    _progress(2, f"{n} camera(s) in {path.name}")
+    work = out_dir / "batch"
+    work.mkdir(parents=True, exist_ok=True)
+    out_gpkg = work / "cameras.gpkg"
+
+    def on_chunk(done: int) -> None:
+        _progress(5 + 90.0 * done / max(n, 1), f"camera {done}/{n}")
+
+    run_batch(
+        path,
+        out_gpkg=out_gpkg,
+        map_source=osm,
+        network=bool(job.get("network", False)),
+        progress=False,
+        workers=1,
+        chunk_size=max(1, min(50, n // 20 or 1)),
+        restart=True,
+        on_chunk=on_chunk,
+    )
     cameras: list[tuple[dict[str, Any] | None, dict[str, Any]]] = []
     candidates: list[tuple[dict[str, Any], dict[str, Any]]] = []
-    if batch is not None:
-        items: list[Any] = list(batch.read_camera_list(path))
-        engine = "camloc_geo.batch"
-
-        def one(item: Any) -> tuple[dict[str, Any], list[Any]]:
-            try:
-                return _batch_result(
-                    batch.geocode_camera(
-                        item, map_source=job.get("osm") or None, network=job.get("network", False)
-                    )
-                )
-            except InputError as exc:
-                return {
-                    "camera_id": str(getattr(item, "id", "")),
-                    "status": "error",
-                    "reason": str(exc),
-                }, []
-    else:
-        items = _read_list(path)
-        engine = "camloc_geo.api.locate_scene"
-
-        def one(item: Any) -> tuple[dict[str, Any], list[Any]]:
-            return _geocode_row(item, path.parent, job)
-
-    n = len(items)
-    for i, item in enumerate(items):
-        props, rows = one(item)
+    for result in results_from_journal(out_gpkg):
+        props, rows = _camera_rows(result)
         geom = (
             {"type": "Point", "coordinates": [props["lon"], props["lat"]]}
-            if props.get("lat") is not None and props.get("lon") is not None
+            if props["lat"] is not None and props["lon"] is not None
             else None
         )
         cameras.append((geom, props))
         candidates.extend(rows)
-        _progress(100.0 * (i + 1) / max(n, 1), f"camera {i + 1}/{n}: {props.get('status')}")
+    statuses: dict[str, int] = {}
+    for _g, p in cameras:
+        statuses[p["status"]] = statuses.get(p["status"], 0) + 1
     return {
         "layers": {
             "cameras": _write_layer(out_dir, "cameras", "Point", CAMERA_FIELDS, cameras),
@@ -554,7 +574,7 @@ def _task_geocodelist(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
             ),
         },
         "warnings": [],
-        "info": {"engine": engine, "n_cameras": n},
+        "info": {"engine": "camloc_geo.batch", "n_cameras": len(cameras), "statuses": statuses},
     }
 
 
@@ -613,6 +633,46 @@ def _task_check_scene(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     return {"layers": {}, "warnings": [], "info": {"scene": data}}
 
 
+def _task_annotation_page(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
+    """``image``; ``submit_url``; optional ``scene`` (to correct), ``lat``/``lon``, ``osm``,
+    ``radius_m``, ``streets``: the annotation page (crowd mode: Submit posts the scene to
+    ``submit_url``) as ``info.html``."""
+    from camloc_geo.web import annotation_page_html
+
+    lat, lon = _opt_float(job, "lat"), _opt_float(job, "lon")
+    corners = None
+    notes: list[str] = []
+    if job.get("osm") and lat is not None and lon is not None:
+        from camloc_geo.cli.annotate import junction_geojson
+
+        try:
+            corners = junction_geojson(
+                lat=lat,
+                lon=lon,
+                map_source=job["osm"],
+                radius_m=_opt_float(job, "radius_m") or 150.0,
+                streets=job.get("streets") or None,
+            )
+        except InputError as exc:  # no junction there: the page works without its map
+            notes.append(f"no junction map on the page: {exc}")
+    page = annotation_page_html(
+        job["image"],
+        scene=job.get("scene") or None,
+        mode="crowd",
+        submit_url=job["submit_url"],
+        corners_geojson=corners,
+        prior=(lat, lon) if lat is not None and lon is not None else None,
+        title=job.get("title") or None,
+    )
+    return {"layers": {}, "warnings": notes, "info": {"html": page}}
+
+
+def _presets() -> list[str]:
+    from camloc_geo.objects import DEFAULT_PRESET, PRESETS
+
+    return [DEFAULT_PRESET, *sorted(k for k in PRESETS if k != DEFAULT_PRESET)]
+
+
 def _task_probe(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     """What this interpreter offers: version and optional engines."""
     import camloc_geo
@@ -629,7 +689,10 @@ def _task_probe(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
         "info": {
             "version": getattr(camloc_geo, "__version__", None),
             "python": sys.executable,
-            "batch": _batch_module() is not None,
+            "batch": True,
+            "presets": _presets(),
+            "tie_score_ratio": TIE_SCORE_RATIO,
+            "tie_distance_m": TIE_DISTANCE_M,
             "sensors": has_sensors,
         },
     }
@@ -641,6 +704,7 @@ _TASKS: dict[str, Callable[[dict[str, Any], Path], dict[str, Any]]] = {
     "geocodelist": _task_geocodelist,
     "measure": _task_measure,
     "check_scene": _task_check_scene,
+    "annotation_page": _task_annotation_page,
     "probe": _task_probe,
 }
 
@@ -656,10 +720,10 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: ``python -m camloc_geo.qgis_worker JOB.json`` (``-`` reads standard input)."""
+    """Entry point: ``python -m camloc_geo.qgis.worker JOB.json`` (``-`` reads standard input)."""
     args = sys.argv[1:] if argv is None else argv
     if len(args) != 1:
-        _emit({"ok": False, "error": "usage: python -m camloc_geo.qgis_worker JOB.json"})
+        _emit({"ok": False, "error": "usage: python -m camloc_geo.qgis.worker JOB.json"})
         return 2
     try:
         text = sys.stdin.read() if args[0] == "-" else Path(args[0]).read_text(encoding="utf-8")
