@@ -11,7 +11,13 @@ from __future__ import annotations
 
 from camloc_geo.batch._camera import PLACED_STATUSES, CameraResult, geocode_camera
 from camloc_geo.batch._journal import journal_path
-from camloc_geo.batch._list import COLUMN_VARIANTS, CameraRow, read_camera_list
+from camloc_geo.batch._list import (
+    COLUMN_VARIANTS,
+    CameraRow,
+    read_camera_csv,
+    read_camera_list,
+    row_from_mapping,
+)
 from camloc_geo.batch._run import BatchSummary, results_from_journal, run_batch
 
 __all__ = [
@@ -22,7 +28,9 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "journal_path",
+    "read_camera_csv",
     "read_camera_list",
     "results_from_journal",
+    "row_from_mapping",
     "run_batch",
 ]
