@@ -19,6 +19,7 @@ from camloc_geo.cameras import (
     geocode_camera,
     read_camera_list,
 )
+from camloc_geo.cameras._list import read_camera_csv, row_from_mapping
 
 __all__ = [
     "COLUMN_VARIANTS",
@@ -28,7 +29,9 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "journal_path",
+    "read_camera_csv",
     "read_camera_list",
     "results_from_journal",
+    "row_from_mapping",
     "run_batch",
 ]
