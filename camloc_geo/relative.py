@@ -34,7 +34,6 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo._optimize import soft_l1_cost
@@ -692,6 +691,8 @@ class _JointProblem:
             k += 2
         else:
             pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         R = Rotation.from_rotvec(X[:, k : k + 3]).as_matrix() @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
@@ -843,6 +844,8 @@ def _score_test(
     """
     f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
     x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
     x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
     r = prob.residuals(x1, R0, None, f_fixed)
     J = prob.jacobian(x1, R0, None, f_fixed)
@@ -1523,6 +1526,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             influence.append(None)  # another frame, or no answer without them
             continue
         centres.append(res.camera.center_in_world)
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         turn = Rotation.from_matrix(res.camera.cam_from_world_rotation @ R.T).as_rotvec()
         if np.linalg.norm(turn) < math.radians(30.0):  # else another frame: not a spread
             turns.append(turn)
@@ -2115,6 +2120,8 @@ def _joint(
     if pp_given is None and free_pp is not False and worth_trying:
         f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
         x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
         res_free = _fit(prob, x1, R0, None, f_fixed)
         cost_fixed, cost_free = 2.0 * res.cost, 2.0 * res_free.cost
