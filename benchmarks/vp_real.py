@@ -174,16 +174,11 @@ def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
         t0 = time.perf_counter()
         row: dict[str, Any] = {"set": t["set"], "name": t["name"], "f_true": t["f"]}
         try:
-            kw: dict[str, Any] = {"seed": 0}
-            if use_exif:
-                kw["use_exif"] = True
-            res = detect_vanishing_points(t["path"], **kw)
+            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif)
         except NotEnoughStructureError as exc:
             row.update(error=str(exc), time_s=time.perf_counter() - t0)
             rows.append(row)
             continue
-        except TypeError:  # an older camloc_geo without use_exif
-            res = detect_vanishing_points(t["path"], seed=0)
         row.update(
             time_s=time.perf_counter() - t0,
             f=res.focal_px,
