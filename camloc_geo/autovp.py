@@ -61,7 +61,7 @@ import numpy.typing as npt
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from camloc_geo._errors import InputError, NotEnoughStructureError
+from camloc_geo._errors import DegenerateGeometryError, InputError, NotEnoughStructureError
 
 __all__ = [
     "AutoVPResult",
@@ -833,6 +833,7 @@ def detect_vanishing_points(
     focal_prior_source: str = "prior-given",
     use_exif: bool = False,
     bias_deg: float | None = None,
+    distortion_k1: float | None = None,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -889,6 +890,12 @@ def detect_vanishing_points(
         Systematic bias of segment directions (degrees) propagated into the focal
         length's standard deviation (see ``_systematic_logf_std``); default
         :data:`BIAS_DEG`, calibrated on real photos (``benchmarks/vp_real.py``).
+    distortion_k1
+        Known radial distortion of the photo (division model,
+        :class:`camloc_geo.camera.RadialDistortion`, radius in half image diagonals):
+        the segment end points are undistorted before the fit, so the vanishing points,
+        focal length and horizon are those of the pinhole camera; ``segments`` in the
+        result stay in the photo's pixels. Not estimated from the photo.
 
     Returns
     -------
@@ -953,6 +960,18 @@ def detect_vanishing_points(
         )
     pp = np.array(principal_point if principal_point is not None else (w / 2.0, h / 2.0), float)
     scale = float(max(w, h))
+    segs_photo = segs_px
+    if distortion_k1:
+        from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+        try:
+            dist = RadialDistortion.for_image(distortion_k1, w, h)
+        except DegenerateGeometryError as exc:
+            raise InputError(f"distortion_k1: {exc}") from exc
+        pp_t = (float(pp[0]), float(pp[1]))
+        und = undistort_points_px(segs_px.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
+        ok = np.all(np.isfinite(und), axis=1)
+        segs_px, segs_photo = und[ok], segs_px[ok]
     hints = _prepare_hints(axes_hint, pp, scale)
     if axes_hint:
         # An annotated axis is a straight line of the image too: fit it with the segments
@@ -1078,7 +1097,7 @@ def detect_vanishing_points(
             best, s, tau, f_prior, f_bounds, prior_w, BIAS_DEG if bias_deg is None else bias_deg
         )
         best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2)
-    return _finish(
+    result = _finish(
         best,
         s,
         segs_px,
@@ -1091,6 +1110,11 @@ def detect_vanishing_points(
         prior_source=focal_prior_source if has_prior else None,
         prior_sigma=prior_sigma if has_prior else None,
     )
+    if distortion_k1:
+        n_ax = len(segs_px) - len(segs_photo)  # annotated axes are not distorted pixels
+        result.segments = np.vstack([segs_px[:n_ax], segs_photo]) if n_ax else segs_photo
+        result.distortion = float(distortion_k1)
+    return result
 
 
 def _prepare_hints(

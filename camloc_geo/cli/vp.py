@@ -59,6 +59,16 @@ def register(subparsers: Any) -> None:
         ),
     )
     p.add_argument(
+        "--distortion",
+        type=float,
+        default=None,
+        metavar="K1",
+        help=(
+            "known radial lens distortion, division model k1 with radii in half image"
+            " diagonals (negative: barrel, wide-angle); segments are undistorted before the fit"
+        ),
+    )
+    p.add_argument(
         "--no-exif",
         action="store_true",
         help=(
@@ -88,6 +98,8 @@ def run(args: argparse.Namespace) -> int:
     if draw_path is not None and draw_path.suffix.lower() not in _IMAGE_SUFFIXES:
         raise InputError(f"--draw {draw_path}: give a .png or .jpg file name")
     options: dict[str, Any] = {}
+    if args.distortion is not None:
+        options["distortion_k1"] = args.distortion
     if args.focal_px is None and not args.no_exif:
         from camloc_geo.exif import focal_from_exif
 
