@@ -466,6 +466,7 @@ def vanishing_points(
     axes_px: Sequence[Sequence[float]] = (),
     estimate_principal_point: bool = False,
     seed: int = 0,
+    **options: Any,
 ) -> AutoVPResult:
     """Three orthogonal vanishing points, focal length, horizon, pitch and roll of a photo.
 
@@ -481,6 +482,9 @@ def vanishing_points(
         ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
     estimate_principal_point
         Also refine the principal point around the image centre.
+    **options
+        Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
+        ``focal_prior_px``, ``distortion``, ...).
 
     Raises
     ------
@@ -516,6 +520,7 @@ def vanishing_points(
         mask=mask,
         estimate_principal_point=estimate_principal_point,
         axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+        **options,
     )
 
 
