@@ -1624,6 +1624,8 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     Each annotator's leave-out camera comes from :func:`_leave_one_out_steps` on the joint
     fit's state; the spread and the influences are then as in :func:`_jackknife`.
     """
+    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
     state = result.joint_state
     assert state is not None
     prob = state.problem
