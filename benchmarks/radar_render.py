@@ -41,10 +41,10 @@ from typing import Any
 
 import cv2
 import numpy as np
-from camloc_geo.synthetic import NoiseModel, make_scene
 
 from camloc_geo.api import calibrate_scene
 from camloc_geo.sensors.radar import RadarResult, measure_speeds
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 from camloc_geo.testing.traffic_render import RenderedVideo, random_street, render_street
 
 OUT_DIR = Path(__file__).parent / "out"

@@ -557,7 +557,7 @@ def test_a_left_out_line_that_agrees_with_the_joint_fit_is_re_admitted(
 
 # ------------------------------------------- uncertainty without refits (issue 26, item 1)
 def _crowd_scene(seed: int, n_annotators: int = 5) -> dict[str, Any]:
-    from camloc_geo.synthetic import random_camera
+    from camloc_geo.testing.synthetic import random_camera
 
     rng = np.random.default_rng(seed)
     cam = random_camera(rng, image_size=(1920, 1080), pp_offset_px=19.0)

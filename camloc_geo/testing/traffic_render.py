@@ -36,7 +36,7 @@ import numpy.typing as npt
 
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import PRESETS
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 __all__ = [
     "COLOURS",
