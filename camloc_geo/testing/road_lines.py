@@ -42,7 +42,8 @@ def road_line_scene(
         ``(width, height)`` pixels.
     n_annotators
         Annotators, each with 2-3 short car edges and one long lane line for the length axis
-        (their width and height lines and clicks as :func:`camloc_geo.testing.synthetic.make_scene`).
+        (their width and height lines and clicks as
+        :func:`camloc_geo.testing.synthetic.make_scene`).
     line_px
         Endpoint noise of the lane lines and of the other axes' lines, pixels.
     edge_px
