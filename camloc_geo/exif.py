@@ -158,6 +158,8 @@ def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) 
     except ImportError:  # pragma: no cover - Pillow is a dependency
         log.debug("Pillow missing: EXIF not read")
         return None
+    if not Path(path).is_file():  # a FIFO or a device would block; the reader names it
+        return None
     try:
         with Image.open(path) as im:
             width, height = im.size
