@@ -692,7 +692,7 @@ class _JointProblem:
             k += 2
         else:
             pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
-        R = Rotation.from_rotvec(X[:, k : k + 3]).as_matrix() @ R0
+        R = _rotvec_matrices(X[:, k : k + 3]) @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
 
@@ -792,6 +792,29 @@ class _JointProblem:
 
 
 _F_SCALE = 2.5  # soft-L1 scale of the normalised residuals (in sigmas)
+
+
+def _rotvec_matrices(rotvecs: FloatArray) -> FloatArray:
+    """Rotation matrices ``(P, 3, 3)`` of rotation vectors ``(P, 3)`` (Rodrigues, vectorised).
+
+    The joint fit evaluates a batch of nearby parameter vectors per Jacobian; scipy's
+    ``Rotation.from_rotvec`` costs more in its per-call checks than the formula itself.
+    """
+    w = np.asarray(rotvecs, dtype=float)
+    theta2 = np.einsum("pi,pi->p", w, w)
+    theta = np.sqrt(theta2)
+    small = theta2 < 1e-12
+    safe = np.where(small, 1.0, theta)
+    # sin θ / θ and (1 - cos θ) / θ², with their Taylor series near zero.
+    a = np.where(small, 1.0 - theta2 / 6.0, np.sin(safe) / safe)
+    b = np.where(small, 0.5 - theta2 / 24.0, (1.0 - np.cos(safe)) / (safe * safe))
+    K = np.zeros((len(w), 3, 3))
+    K[:, 0, 1], K[:, 0, 2] = -w[:, 2], w[:, 1]
+    K[:, 1, 0], K[:, 1, 2] = w[:, 2], -w[:, 0]
+    K[:, 2, 0], K[:, 2, 1] = -w[:, 1], w[:, 0]
+    return np.asarray(
+        np.eye(3)[None] + a[:, None, None] * K + b[:, None, None] * (K @ K), dtype=np.float64
+    )
 
 
 def _fit(
@@ -1571,7 +1594,6 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
         args = (state.rotation0, state.principal_point, state.focal_px)
         n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
         owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
-        out: list[FloatArray | None] = []
         x0 = np.asarray(state.x, dtype=float)
         r = prob.residuals(x0, *args)
         J = prob.jacobian(x0, *args)
@@ -1585,21 +1607,28 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
         g_all = Jw.T @ r
         H_a = np.einsum("am,mi,mj->aij", onehot.astype(float), J, Jw)
         g_a = onehot.astype(float) @ (Jw * r[:, None])
-        for a in range(n_ann):
-            H = H_all - H_a[a]
-            g = g_all - g_a[a]
-            x = _newton_step(H, g, x0)
-            for _ in range(steps - 1):
-                if x is None:
-                    break
-                r_k = prob.residuals(x, *args)
-                J_k = prob.jacobian(x, *args)
+        xs: list[FloatArray | None] = [
+            _newton_step(H_all - H_a[a], g_all - g_a[a], x0) for a in range(n_ann)
+        ]
+        n = len(x0)
+        h = 1e-7 * np.maximum(1.0, np.abs(x0))
+        for _ in range(steps - 1):
+            # Every annotator's next step from one batched evaluation: each point and its
+            # forward differences, (n_ann × (n + 1)) parameter vectors at once.
+            live = [a for a in range(n_ann) if xs[a] is not None]
+            if not live:
+                break
+            pts = np.array([xs[a] for a in live])
+            X = (pts[:, None, :] + np.vstack([np.zeros(n), np.diag(h)])[None, :, :]).reshape(-1, n)
+            Rb = prob.residuals_batch(X, *args).reshape(len(live), n + 1, -1)
+            for k, a in enumerate(live):
                 keep = ~onehot[a]
-                w_k = 1.0 / np.sqrt(1.0 + (r_k[keep] / _F_SCALE) ** 2)
-                Jw_k = J_k[keep] * w_k[:, None]
-                x = _newton_step(J_k[keep].T @ Jw_k, Jw_k.T @ r_k[keep], x)
-            out.append(x)
-        return out
+                r_k = Rb[k, 0, keep]
+                J_k = ((Rb[k, 1:][:, keep] - r_k[None, :]) / h[:, None]).T
+                w_k = 1.0 / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
+                Jw_k = J_k * w_k[:, None]
+                xs[a] = _newton_step(J_k.T @ Jw_k, Jw_k.T @ r_k, pts[k])
+        return xs
     finally:
         prob.weights = saved
 
