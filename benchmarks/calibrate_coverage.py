@@ -46,6 +46,7 @@ from camloc_geo.synthetic import NoiseModel
 OUT_DIR = Path(__file__).parent / "out"
 SETS = {"noise_free": NoiseModel.exact(), "crowd": NoiseModel()}
 QUANTITIES = ("focal", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
+WITH_PP = True  # --plain: the plain sigmas (without the principal point's uncertainty)
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
 
 
@@ -70,13 +71,22 @@ def scene_errors(syn: Any) -> dict[str, Any] | None:
     for k, name in enumerate(("rot_x", "rot_y", "rot_z")):
         err[name] = math.degrees(float(turn[k]))
     sig: dict[str, float | None] = {"focal": res.focal_sigma_px, "height": None}
-    if res.position_sigma_m is not None:
+    pos_sigma, rot_sigma = res.position_sigma_m, res.rotation_sigma_deg
+    if WITH_PP:
+        # The sigmas with the principal point's own uncertainty, where reported.
+        if res.focal_sigma_with_principal_point_px is not None:
+            sig["focal"] = res.focal_sigma_with_principal_point_px
+        if res.position_sigma_with_principal_point_m is not None:
+            pos_sigma = res.position_sigma_with_principal_point_m
+        if res.rotation_sigma_with_principal_point_deg is not None:
+            rot_sigma = res.rotation_sigma_with_principal_point_deg
+    if pos_sigma is not None:
         for k, name in enumerate("xyz"):
-            sig[name] = float(res.position_sigma_m[k])
-        sig["height"] = float(res.position_sigma_m[2])
-    if res.rotation_sigma_deg is not None:
+            sig[name] = float(pos_sigma[k])
+        sig["height"] = float(pos_sigma[2])
+    if rot_sigma is not None:
         for k, name in enumerate(("rot_x", "rot_y", "rot_z")):
-            sig[name] = float(res.rotation_sigma_deg[k])
+            sig[name] = float(rot_sigma[k])
     out["error"] = {k: float(v) for k, v in err.items()}
     out["sigma"] = sig
     pp_err = np.subtract(cam.principal_point, truth.principal_point)
@@ -154,7 +164,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--n", type=int, default=60, help="scenes per set (default 60)")
     parser.add_argument("--seed", type=int, default=20261125, help="random seed")
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
+    parser.add_argument(
+        "--plain",
+        action="store_true",
+        help="judge the plain sigmas (focal_sigma_px, camera_in_world_sigma_m, "
+        "rotation_sigma_deg) instead of the *_with_principal_point ones",
+    )
     args = parser.parse_args(argv)
+    global WITH_PP
+    WITH_PP = not args.plain
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -181,6 +199,7 @@ def main(argv: list[str] | None = None) -> int:
         "seed": args.seed,
         "n_per_set": args.n,
         "want": WANT,
+        "sigmas": "with_principal_point" if WITH_PP else "plain",
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),

@@ -97,6 +97,11 @@ class CalibrationSettings:
         Candidates closer than ``max(min_m, rel × median camera distance)`` are linked.
     outlier_weight
         Annotators whose final weight falls below this are reported as outliers.
+    principal_point_sigma_rel
+        How far a real camera's principal point may lie from the image centre (1-sigma per
+        axis, fraction of the diagonal; 0.7 %: 15 px at 1080p). Where the fit assumes the
+        centre, this uncertainty is propagated into the ``*_with_principal_point`` sigmas
+        of :class:`CalibrationResult`; 0 turns it off.
     jackknife, jackknife_method
         Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators).
         ``one_step``: one Gauss-Newton step per left-out annotator from the joint solution,
@@ -123,6 +128,7 @@ class CalibrationSettings:
     outlier_weight: float = 0.3
     free_principal_point: bool | None = None  # None = decided by BIC
     principal_point_prior_sigma_rel: float = 0.03
+    principal_point_sigma_rel: float = 0.007
     reassign_corners: bool = True
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
@@ -240,6 +246,17 @@ class CalibrationResult:
         that part is not included (it would inflate the sensors' ``sigma_m`` for nothing).
     rotation_sigma_fit_deg
         The fit's covariance part alone (when the jackknife was added).
+    rotation_sigma_with_principal_point_deg, position_sigma_with_principal_point_m
+        See ``focal_sigma_with_principal_point_px``.
+    focal_sigma_with_principal_point_px
+        ``rotation_sigma_deg``, ``position_sigma_m`` and ``focal_sigma_px`` with the
+        principal point's own uncertainty included where the fit assumed it at the image
+        centre (``CalibrationSettings.principal_point_sigma_rel``): how far the answer may
+        be from the truth (``benchmarks/calibrate_coverage.py``). The plain fields leave it
+        out, as the pixels recast through the same principal point compensate.
+    principal_point_sigma_px
+        1-sigma of the principal point (x, y): from the fit when fitted, the assumed spread
+        when held at the image centre; None when given in the scene.
     excluded_annotators
         ``{annotator, index, reason}`` of each annotator left out.
     clamped_clicks
@@ -270,6 +287,10 @@ class CalibrationResult:
     position_sigma_fit_m: FloatArray | None = None
     rotation_sigma_deg: FloatArray | None = None
     rotation_sigma_fit_deg: FloatArray | None = None
+    rotation_sigma_with_principal_point_deg: FloatArray | None = None
+    position_sigma_with_principal_point_m: FloatArray | None = None
+    focal_sigma_with_principal_point_px: float | None = None
+    principal_point_sigma_px: list[float] | None = None
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
 
     @property
@@ -317,6 +338,18 @@ class CalibrationResult:
             out["focal_sigma_px"] = self.focal_sigma_px
         if self.rotation_sigma_deg is not None:
             out["rotation_sigma_deg"] = self.rotation_sigma_deg.tolist()
+        if self.focal_sigma_with_principal_point_px is not None:
+            out["focal_sigma_with_principal_point_px"] = self.focal_sigma_with_principal_point_px
+        if self.position_sigma_with_principal_point_m is not None:
+            out["camera_in_world_sigma_with_principal_point_m"] = (
+                self.position_sigma_with_principal_point_m.tolist()
+            )
+        if self.rotation_sigma_with_principal_point_deg is not None:
+            out["rotation_sigma_with_principal_point_deg"] = (
+                self.rotation_sigma_with_principal_point_deg.tolist()
+            )
+        if self.principal_point_sigma_px is not None:
+            out["principal_point_sigma_px"] = list(self.principal_point_sigma_px)
         if self.rms_residual_px is not None:
             out["rms_residual_px"] = self.rms_residual_px
         out["width_sign"] = self.width_sign
@@ -1566,6 +1599,9 @@ def _add_jackknife_spread(
     base = result.position_sigma_m if result.position_sigma_m is not None else np.zeros(3)
     result.position_sigma_fit_m = base
     result.position_sigma_m = np.sqrt(base**2 + sigma_jack**2)
+    if result.position_sigma_with_principal_point_m is not None:
+        with_pp_c = result.position_sigma_with_principal_point_m
+        result.position_sigma_with_principal_point_m = np.sqrt(with_pp_c**2 + sigma_jack**2)
     if len(turns) < 2:
         return
     rot = np.asarray(turns)
@@ -1574,6 +1610,9 @@ def _add_jackknife_spread(
     base_r = result.rotation_sigma_deg if result.rotation_sigma_deg is not None else np.zeros(3)
     result.rotation_sigma_fit_deg = base_r
     result.rotation_sigma_deg = np.sqrt(base_r**2 + rot_jack**2)
+    if result.rotation_sigma_with_principal_point_deg is not None:
+        with_pp = result.rotation_sigma_with_principal_point_deg
+        result.rotation_sigma_with_principal_point_deg = np.sqrt(with_pp**2 + rot_jack**2)
 
 
 def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray | None]:
@@ -2181,6 +2220,10 @@ def _joint(
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
     sigma_r: FloatArray | None = None
+    sigma_r_pp: FloatArray | None = None
+    sigma_c_pp: FloatArray | None = None
+    sigma_f_pp: float | None = None
+    sigma_pp: list[float] | None = None
     try:
         cov = np.linalg.pinv(J.T @ J) * s2
         sigma_c = np.sqrt(np.clip(np.diag(cov)[-3:], 0, None))
@@ -2191,10 +2234,30 @@ def _joint(
         sigma_r = np.degrees(np.sqrt(np.clip(np.diag(cov_r), 0, None)))
         if f_fixed is None:
             sigma_f = float(f * math.sqrt(max(cov[0, 0], 0.0)))
+        k_pp = int(f_fixed is None)
+        cov_pp = cov
+        if pp_model is None:
+            sigma_pp = np.sqrt(np.clip(np.diag(cov)[k_pp : k_pp + 2], 0, None)).tolist()
+        elif pp_given is None and settings.principal_point_sigma_rel > 0.0:
+            # The principal point is assumed at the image centre, not known there: its
+            # uncertainty flows into the rest (a consider covariance, see _pinned_pp_cov).
+            sig_pp = settings.principal_point_sigma_rel * math.hypot(width, height)
+            extra = _pinned_pp_cov(prob, res.x, R0, pp_model, f_fixed, sig_pp)
+            if extra is not None:
+                cov_pp = cov + extra
+                sigma_pp = [sig_pp, sig_pp]
+        sigma_c_pp = np.sqrt(np.clip(np.diag(cov_pp)[-3:], 0, None))
+        sigma_r_pp = np.degrees(
+            np.sqrt(np.clip(np.diag(jl @ cov_pp[-6:-3, -6:-3] @ jl.T), 0, None))
+        )
+        if f_fixed is None:
+            sigma_f_pp = float(f * math.sqrt(max(cov_pp[0, 0], 0.0)))
     except np.linalg.LinAlgError:
         pass
     if sigma_c is not None and not _size_given(scene):
         sigma_c = np.sqrt(sigma_c**2 + (settings.size_sigma_rel * np.abs(C)) ** 2)
+    if sigma_c_pp is not None and not _size_given(scene):
+        sigma_c_pp = np.sqrt(sigma_c_pp**2 + (settings.size_sigma_rel * np.abs(C)) ** 2)
     weights = [float(w) for w in prob.weights]
     state = JointState(
         prob,
@@ -2246,6 +2309,10 @@ def _joint(
         position_sigma_m=sigma_c,
         focal_sigma_px=sigma_f,
         rotation_sigma_deg=sigma_r,
+        rotation_sigma_with_principal_point_deg=sigma_r_pp,
+        position_sigma_with_principal_point_m=sigma_c_pp,
+        focal_sigma_with_principal_point_px=sigma_f_pp,
+        principal_point_sigma_px=sigma_pp,
         rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
         width_signs=width_signs,
         annotator_corners=corner_names,
@@ -2267,6 +2334,44 @@ def _joint(
             "the lines do not determine it and the position is unreliable; give camera.focal_px"
         )
     return result
+
+
+def _pinned_pp_cov(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp: tuple[float, float],
+    f_fixed: float | None,
+    sigma_pp_px: float,
+) -> FloatArray | None:
+    """Covariance the pinned principal point's own uncertainty adds to the fitted parameters.
+
+    The fit holds the principal point at ``pp``; were it really ``pp + δ``, the fitted
+    parameters ``θ`` would move by ``S δ`` with ``S = −H_θθ⁻¹ H_θp`` (the robust
+    Gauss-Newton Hessian of the model with the principal point free, at the solution). With
+    ``δ ~ N(0, σ² I)`` the added covariance is ``σ² S Sᵀ`` (a "consider" covariance), in the
+    order of ``x``. None when the Hessian is singular.
+    """
+    k = int(f_fixed is None)
+    x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
+    saved = prob.pp_prior_sigma
+    prob.pp_prior_sigma = 0.0  # the data's information alone; the prior is σ here
+    try:
+        r = prob.residuals(x1, R0, None, f_fixed)
+        J = prob.jacobian(x1, R0, None, f_fixed)
+    finally:
+        prob.pp_prior_sigma = saved
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    H = J.T @ (J * w[:, None])
+    pp_idx = [k, k + 1]
+    rest = [i for i in range(len(x1)) if i not in pp_idx]
+    try:
+        S = -np.linalg.solve(H[np.ix_(rest, rest)], H[np.ix_(rest, pp_idx)])
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(S)):
+        return None
+    return np.asarray(sigma_pp_px**2 * (S @ S.T), dtype=np.float64)
 
 
 def _size_given(scene: Scene) -> bool:
