@@ -662,6 +662,9 @@ class _JointProblem:
         seg = self.segments
         self._a = np.column_stack([seg[:, 0:2], np.ones(len(seg))])
         self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
+        # segment_residuals_px's numerator is V · n for a vanishing point V = (x, y, w).
+        x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
+        self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
         self.weights = np.ones(self.n_annotators)
         self.f_bounds = (0.15 * width, 15.0 * width)
         # A weak log-normal prior on the focal length (settings.focal_prior_sigma_log; 0 = none).
@@ -771,26 +774,25 @@ class _JointProblem:
         f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
         cx, cy = pp[:, 0:1], pp[:, 1:2]
         fc = f[:, None]
-        # Vanishing point of world axis i: K R e_i, i.e. column i of K R.
-        vx = fc * R[:, 0, :] + cx * R[:, 2, :]
-        vy = fc * R[:, 1, :] + cy * R[:, 2, :]
-        vw = R[:, 2, :]
-        ax = self.seg_axis
-        px, py, pw = vx[:, ax], vy[:, ax], vw[:, ax]
+        # Vanishing point of world axis i: K R e_i, i.e. column i of K R: V[p, i] = (x, y, w).
+        V = np.empty((len(X), 3, 3))
+        V[:, :, 0] = fc * R[:, 0, :] + cx * R[:, 2, :]
+        V[:, :, 1] = fc * R[:, 1, :] + cy * R[:, 2, :]
+        V[:, :, 2] = R[:, 2, :]
+        Vs = V[:, self.seg_axis, :]  # (P, n_seg, 3)
+        px, py, pw = Vs[..., 0], Vs[..., 1], Vs[..., 2]
         mx, my = self._mid[:, 0], self._mid[:, 1]
-        # Line through the midpoint (mx, my, 1) and the vanishing point (px, py, pw).
+        # Line through the midpoint (mx, my, 1) and the vanishing point; the first endpoint's
+        # distance from it: its numerator is linear in the point, V · n (n precomputed).
         la = my * pw - py
         lb = px - mx * pw
-        lc = mx * py - my * px
         norm = np.sqrt(la * la + lb * lb)
-        r_seg = (la * self._a[:, 0] + lb * self._a[:, 1] + lc) / np.maximum(norm, 1e-300)
-        r_seg = r_seg * (self._w_seg / self.sigma_line)
-        d = self.pt_world[None, :, :] - C[:, None, :]
-        pc = np.einsum("pij,pnj->pni", R, d)
+        num = np.einsum("psk,sk->ps", Vs, self._seg_n)
+        r_seg = num / np.maximum(norm, 1e-300) * self._seg_scale
+        pc = np.einsum("pij,pnj->pni", R, self.pt_world[None, :, :] - C[:, None, :])
         z = np.maximum(pc[:, :, 2], self._z_min)
-        wpt = self._w_pt / self._sigma_pt_each
-        u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * wpt
-        v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * wpt
+        u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * self._pt_scale
+        v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * self._pt_scale
         parts = [r_seg, u, v]
         if f_fixed is None and self.log_f_prior_sigma > 0.0:
             parts.append((np.log(f) - self.log_f_prior)[:, None] / self.log_f_prior_sigma)
@@ -807,6 +809,8 @@ class _JointProblem:
         self._weights = np.asarray(value, dtype=float)
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
+        self._seg_scale = self._w_seg / self.sigma_line
+        self._pt_scale = self._w_pt / self._sigma_pt_each
 
     def per_annotator_rms(
         self,
