@@ -837,6 +837,7 @@ class _JointProblem:
 
 
 _F_SCALE = 2.5  # soft-L1 scale of the normalised residuals (in sigmas)
+_GOOD_SEED_SCORE = 1.0  # median annotator RMS (in sigmas) at which a seed's fit is good
 
 
 def _rotvec_matrices(rotvecs: FloatArray) -> FloatArray:
@@ -2157,6 +2158,8 @@ def _joint(
         log.info("pooled seed unavailable: %s", exc)
     best: tuple[float, _JointProblem, Any, FloatArray, list[float]] | None = None
     for cam0 in seeds:
+        if best is not None and best[0] <= _GOOD_SEED_SCORE:
+            break  # the pooled seed already explains every annotator within the noise
         width_signs = [_width_sign_for(scene, i, cam0) for i in indices]
         prob = _JointProblem(
             scene,
