@@ -1458,11 +1458,14 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     clean = screening.scene
     excluded = list(screening.excluded)
     kept = list(screening.kept)
-    result = _calibrate_usable(clean, settings)
-    if screening.dropped and result.method == "joint_fit":
-        result, clean = _readmit_agreeing(result, clean, screening, settings)
-    for msg in screening.warnings[len(scene.input_warnings) :]:
-        log.warning("%s", msg)  # the scene's own were logged when it was read
+    try:
+        result = _calibrate_usable(clean, settings)
+        if screening.dropped and result.method == "joint_fit":
+            result, clean = _readmit_agreeing(result, clean, screening, settings)
+    finally:
+        # After the re-admission (its withdrawn warnings are not logged); before any error.
+        for msg in screening.warnings[len(scene.input_warnings) :]:
+            log.warning("%s", msg)  # the scene's own were logged when it was read
     problem = implausibility(result, scene.image_size)
     if problem is not None:
         result, dropped = _leave_one_out(clean, settings, result, problem)
