@@ -584,10 +584,53 @@ def test_one_step_jackknife_matches_the_refits(seed: int) -> None:
     assert slow.rotation_sigma_deg is not None
     np.testing.assert_allclose(fast.position_sigma_m, slow.position_sigma_m, rtol=0.10)
     np.testing.assert_allclose(fast.rotation_sigma_deg, slow.rotation_sigma_deg, rtol=0.10)
-    # The jackknife part is really there (the sigmas grew past the fit's covariance).
-    assert fast.position_sigma_fit_m is not None
-    assert np.all(fast.position_sigma_m > fast.position_sigma_fit_m)
+    # The annotators' spread itself, not only the sigma it may be hidden in.
+    assert fast.position_sigma_jackknife_m is not None
+    assert slow.position_sigma_jackknife_m is not None
+    assert np.all(fast.position_sigma_jackknife_m > 0.0)
+    np.testing.assert_allclose(
+        fast.position_sigma_jackknife_m, slow.position_sigma_jackknife_m, rtol=0.10
+    )
+    assert fast.rotation_sigma_fit_deg is not None
+    assert np.all(fast.rotation_sigma_deg > fast.rotation_sigma_fit_deg)
     assert _flagged(fast.annotator_influence_m) == _flagged(slow.annotator_influence_m)
     for a, b in zip(fast.annotator_influence_m, slow.annotator_influence_m, strict=True):
         if a is not None and b is not None:
             assert a == pytest.approx(b, rel=0.15, abs=0.05)
+
+
+# ------------------------------- the pinned principal point's uncertainty (issue 24, item 4)
+@pytest.mark.parametrize("pp", [(952.0, 531.0), (965.0, 530.0)])
+def test_a_pinned_principal_point_flows_into_the_sigmas(pp: tuple[float, float]) -> None:
+    cam = camera_aimed_at_car(height_m=6.0, distance_m=20.0, roll_deg=2.0, principal_point=pp)
+    result = calibrate(parse_scene(exact_scene(cam)))
+    assert result.intrinsics_method == "joint_fit_centre_principal_point"
+    err_f = abs(result.camera.focal_px - cam.focal_px)
+    assert result.focal_sigma_px is not None
+    assert result.focal_sigma_with_principal_point_px is not None
+    # The fit's own sigma knows nothing of the pinning (the error is many of them) ...
+    assert err_f > 3.0 * result.focal_sigma_px
+    # ... the sigma with the principal point's uncertainty covers it.
+    assert err_f < 2.0 * result.focal_sigma_with_principal_point_px
+    assert result.principal_point_sigma_px == pytest.approx([0.007 * math.hypot(1920, 1080)] * 2)
+    turn = result.camera.cam_from_world_rotation @ cam.cam_from_world_rotation.T
+    err_rot = np.degrees(np.abs([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0]]) / 2.0)
+    assert result.rotation_sigma_with_principal_point_deg is not None
+    assert np.all(err_rot < 2.0 * result.rotation_sigma_with_principal_point_deg[:2])
+    out = result.to_dict()
+    for key in (
+        "focal_sigma_with_principal_point_px",
+        "camera_in_world_sigma_with_principal_point_m",
+        "rotation_sigma_with_principal_point_deg",
+        "principal_point_sigma_px",
+    ):
+        assert key in out
+    # The plain fields keep their meaning.
+    assert out["focal_sigma_px"] == result.focal_sigma_px
+
+
+def test_a_given_principal_point_has_no_principal_point_sigma() -> None:
+    cam = camera_aimed_at_car(height_m=6.0, distance_m=20.0, principal_point=(950.0, 530.0))
+    result = calibrate(parse_scene(exact_scene(cam, principal_point=[950.0, 530.0])))
+    assert result.principal_point_sigma_px is None
+    assert result.focal_sigma_with_principal_point_px == pytest.approx(result.focal_sigma_px)
