@@ -42,6 +42,21 @@ def _port() -> int:
         return int(s.getsockname()[1])
 
 
+def _server_cpu_s(pid: int) -> float:
+    """User + system CPU seconds of the server process and its workers so far."""
+    import psutil
+
+    total = 0.0
+    root = psutil.Process(pid)
+    for p in [root, *root.children(recursive=True)]:
+        try:
+            t = p.cpu_times()
+        except psutil.NoSuchProcess:
+            continue
+        total += t.user + t.system
+    return total
+
+
 def _jitter(value: Any, rng: np.random.Generator) -> Any:
     if isinstance(value, list) and value and all(isinstance(v, float) for v in value):
         return [round(v + float(rng.uniform(-1.0, 1.0)), 2) for v in value]
@@ -175,11 +190,13 @@ def main() -> int:
                 headers={"content-type": "application/json"},
                 timeout=120,
             )
+        cpu0 = _server_cpu_s(proc.pid)
         t0 = time.perf_counter()
         lat, errors, answers = asyncio.run(
             _load(url, bodies, args.requests, args.concurrency, args.max_seconds)
         )
         wall = time.perf_counter() - t0
+        server_cpu_s = _server_cpu_s(proc.pid) - cpu0
     finally:
         proc.terminate()
         proc.wait(timeout=20)
@@ -194,6 +211,11 @@ def main() -> int:
         "errors": errors,
         "seconds": round(wall, 3),
         "requests_per_s": round(len(lat) / wall, 1),
+        # CPU the server spent per request: robust to other load on the machine; the rate two
+        # idle cores could serve is 2 / this
+        "server_cpu_ms_per_request": round(server_cpu_s / max(len(lat), 1) * 1000.0, 1),
+        "capacity_2_cores_per_s": round(2.0 / max(server_cpu_s / max(len(lat), 1), 1e-9), 1),
+        "load_average_1min": round(os.getloadavg()[0], 2),
         "p50_ms": round(float(np.percentile(ms, 50)), 1),
         "p90_ms": round(float(np.percentile(ms, 90)), 1),
         "p99_ms": round(float(np.percentile(ms, 99)), 1),

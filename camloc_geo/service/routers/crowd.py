@@ -39,8 +39,7 @@ _UPLOAD_DOC = {
     "requestBody": {
         "required": True,
         "content": {
-            media: {"schema": {"type": "string", "format": "binary"}}
-            for media in IMAGE_MEDIA_TYPES
+            media: {"schema": {"type": "string", "format": "binary"}} for media in IMAGE_MEDIA_TYPES
         },
     }
 }

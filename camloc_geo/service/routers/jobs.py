@@ -14,7 +14,7 @@ from dataclasses import asdict
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import Response
 from pydantic import ValidationError
 
 from camloc_geo import SceneError
@@ -135,7 +135,7 @@ async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
 @router.get("/v1/jobs/{job_id}/result", response_model=None)
 async def job_result(
     request: Request, job_id: JobId, q: Annotated[ResultQuery, Query()], store: ServiceStore
-) -> Response:
+) -> Response | dict[str, Any]:
     """The finished cameras: GeoJSON (best location per camera, then all candidates) or
     GeoPackage (layers ``cameras`` and ``candidates``)."""
     from camloc_geo.results import job_result_geojson, job_result_geopackage
@@ -144,7 +144,7 @@ async def job_result(
         raise NotFoundError(f"no job {job_id}")
     gj = job_result_geojson(job_id, store.job_results(job_id))
     if q.format == "geojson":
-        return JSONResponse(gj)
+        return gj
     data = await run_cpu(request, lambda: job_result_geopackage(gj))
     return Response(
         data,

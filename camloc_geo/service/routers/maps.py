@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import JSONResponse
 
 from camloc_geo.service.deps import Maps, ServiceSettings, run_cpu
 from camloc_geo.service.errors import QueryError
@@ -27,7 +26,7 @@ def _check_radius(q: PointQuery, settings: ServiceSettings) -> None:
 @router.get("/v1/corners")
 async def corners(
     request: Request, q: Annotated[CornersQuery, Query()], maps: Maps, settings: ServiceSettings
-) -> JSONResponse:
+) -> dict[str, Any]:
     """Intersections and their kerb corners around a point (GeoJSON)."""
     _check_radius(q, settings)
 
@@ -39,13 +38,13 @@ async def corners(
             lat=q.lat, lon=q.lon, radius_m=q.radius_m, map_source=m, streets=q.streets
         )
 
-    return JSONResponse(await run_cpu(request, work))
+    return await run_cpu(request, work)
 
 
 @router.get("/v1/streets")
 async def streets(
     request: Request, q: Annotated[PointQuery, Query()], maps: Maps, settings: ServiceSettings
-) -> JSONResponse:
+) -> dict[str, Any]:
     """Streets near a point with their bearings."""
     _check_radius(q, settings)
 
@@ -55,4 +54,4 @@ async def streets(
         m = maps.map_for_point(lat=q.lat, lon=q.lon)
         return streets_within(lat=q.lat, lon=q.lon, radius_m=q.radius_m, map_source=m)
 
-    return JSONResponse(await run_cpu(request, work))
+    return await run_cpu(request, work)

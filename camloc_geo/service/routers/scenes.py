@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Annotated, Any, cast
 
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import HTMLResponse, JSONResponse
+from fastapi.responses import HTMLResponse
 
 from camloc_geo.service.deps import ApiKey, Maps, SceneBody, run_cpu
 from camloc_geo.service.models import LocateQuery
@@ -33,27 +33,27 @@ SCENE_BODY = scene_body_doc("a camloc-scene/1 scene (no image.path)")
 
 
 @router.post("/v1/calibrate", openapi_extra=SCENE_BODY)
-async def calibrate(request: Request, body: SceneBody) -> JSONResponse:
+async def calibrate(request: Request, body: SceneBody) -> dict[str, Any]:
     """Relative pose (focal length, rotation, camera position in the car's frame)."""
     from camloc_geo.api import calibrate_scene
 
     def work() -> dict[str, Any]:
         return {"scene": body.scene.id, **calibrate_scene(body.scene).to_dict()}
 
-    return JSONResponse(await run_cpu(request, work))
+    return await run_cpu(request, work)
 
 
 @router.post("/v1/locate", openapi_extra=SCENE_BODY)
 async def locate(
     request: Request, body: SceneBody, maps: Maps, q: Annotated[LocateQuery, Query()]
-) -> JSONResponse:
+) -> dict[str, Any]:
     """Candidate camera positions as the candidate GeoJSON, best first."""
 
     def work() -> dict[str, Any]:
         out, _m = locate_body(cast(Any, body.scene), maps, max_candidates=q.max_candidates)
         return dict(out.to_geojson())
 
-    return JSONResponse(await run_cpu(request, work))
+    return await run_cpu(request, work)
 
 
 @router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
