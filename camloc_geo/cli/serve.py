@@ -14,8 +14,9 @@ def register(subparsers: Any) -> None:
         description=(
             "Serve the camloc HTTP API. Configuration comes from environment variables: "
             "CAMLOC_MAP_DIR (folder of OSM extracts), CAMLOC_API_KEY (key for write endpoints), "
-            "CAMLOC_DATA_DIR (jobs and tasks database), CAMLOC_NETWORK (allow Overpass), "
-            "and the limits documented in docs/service.md."
+            "CAMLOC_DATA_DIR (jobs and tasks database; default: the user's data folder, e.g. "
+            "~/.local/share/camloc/service), CAMLOC_NETWORK (allow Overpass), and the limits "
+            "documented in docs/service.md. Interactive API docs at /docs (offline)."
         ),
     )
     p.add_argument("--host", default="127.0.0.1", help="address to listen on (127.0.0.1)")

@@ -133,8 +133,13 @@ class ParsedScene:
 async def _scene_body(request: Request, settings: ServiceSettings) -> ParsedScene:
     from camloc_geo.api import scene_from
 
-    data = check_scene_body(await json_body(request), settings)
-    return ParsedScene(data=data, scene=scene_from(data))
+    raw = await raw_body(request, JSON_TYPES)
+
+    def parse() -> ParsedScene:  # up to 2 MB of JSON: off the event loop
+        data = check_scene_body(parse_json(raw), settings)
+        return ParsedScene(data=data, scene=scene_from(data))
+
+    return await run_cpu(request, parse)
 
 
 SceneBody = Annotated[ParsedScene, Depends(_scene_body)]
