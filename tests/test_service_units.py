@@ -126,3 +126,38 @@ def test_data_dir_defaults_to_the_users_data_folder(
     assert data_dir == tmp_path / "xdg" / "camloc" / "service"
     monkeypatch.setenv("CAMLOC_DATA_DIR", str(tmp_path / "mine"))
     assert Settings().data_dir == tmp_path / "mine"
+
+
+def test_worker_processes_answer_like_threads(tmp_path: Path) -> None:
+    import asyncio
+    import shutil
+
+    from camloc_geo import MapDataError
+    from camloc_geo.service.compute import Compute
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.models import PointQuery
+    from camloc_geo.service.routers.crowd import servable_work
+    from camloc_geo.service.routers.maps import streets_work
+    from camloc_geo.service.settings import Settings
+
+    (tmp_path / "maps").mkdir()
+    shutil.copy(SAMPLES / "baltimore.osm.pbf", tmp_path / "maps")
+    q = PointQuery(lat=39.28558, lon=-76.59348, radius_m=100)
+    answers = {}
+    for workers in (0, 1):
+        settings = Settings(
+            map_dir=tmp_path / "maps",
+            data_dir=tmp_path / "d",
+            workers=workers,
+            request_timeout_s=600.0,  # a busy machine: starting the worker and loading the map
+        )
+        compute = Compute(settings, MapStore(settings))
+        compute.start()
+        try:
+            answers[workers] = asyncio.run(compute.run(streets_work, q))
+            with pytest.raises(MapDataError, match=r"lat=48\.850000"):
+                asyncio.run(compute.run(servable_work, False, (48.85, 2.35)))
+        finally:
+            compute.shutdown()
+    assert answers[1] == answers[0]
+    assert "Eastern Avenue" in {n["name"] for n in answers[1]["near"]}

@@ -21,7 +21,15 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--host", default="127.0.0.1", help="address to listen on (127.0.0.1)")
     p.add_argument("--port", type=int, default=8000, help="port (8000)")
-    p.add_argument("--workers", type=int, default=1, help="worker processes (1)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help=(
+            "worker processes for the CPU work (1); one process serves HTTP and hands every "
+            "request to a free worker (sets CAMLOC_WORKERS)"
+        ),
+    )
     p.add_argument("--log-level", default="info", help="uvicorn log level")
     p.set_defaults(func=run)
 
@@ -40,8 +48,11 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--port must be 1-65535, not {args.port}")
     if args.workers < 1:
         raise InputError("--workers must be at least 1")
+    import os
+
     from camloc_geo.service.settings import Settings
 
+    os.environ["CAMLOC_WORKERS"] = str(args.workers)
     try:
         Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
@@ -51,7 +62,6 @@ def run(args: argparse.Namespace) -> int:
         factory=True,
         host=args.host,
         port=args.port,
-        workers=args.workers,
         log_level=args.log_level,
     )
     return 0

@@ -2,7 +2,8 @@
 
 Bodies are parsed once: JSON with NaN/Infinity refused, a scene checked against the server's
 limits and validated into a :class:`~camloc_geo.scene.Scene` that the library takes as it is.
-CPU work runs in a thread pool under the request time limit, never on the event loop.
+CPU work runs in worker processes or threads (:mod:`camloc_geo.service.compute`) under the
+request time limit, never on the event loop.
 """
 
 from __future__ import annotations
@@ -11,13 +12,13 @@ import asyncio
 import hmac
 import json
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, Any, TypeVar
 
 from fastapi import Depends, Header, Request
 
 from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import TimeLimitError, UnauthorizedError, UnsupportedMediaError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.settings import Settings
@@ -33,6 +34,7 @@ __all__ = [
     "SceneBody",
     "ServiceSettings",
     "ServiceStore",
+    "Workers",
     "json_body",
     "raw_body",
     "run_cpu",
@@ -59,9 +61,16 @@ def _store(request: Request) -> Store:
     return store
 
 
+def _compute(request: Request) -> Compute:
+    compute: Compute = request.app.state.compute
+    return compute
+
+
 ServiceSettings = Annotated[Settings, Depends(_settings)]
 Maps = Annotated[MapStore, Depends(_maps)]
 ServiceStore = Annotated[Store, Depends(_store)]
+Workers = Annotated[Compute, Depends(_compute)]
+"""The CPU pool: ``await workers.run(fn, *args)`` runs ``fn(maps, *args)`` on a worker."""
 
 
 def _require_key(
@@ -148,14 +157,14 @@ scene_body = _scene_body
 
 
 async def run_cpu(request: Request, fn: Callable[[], T]) -> T:
-    """Run ``fn`` in the app's thread pool under the request time limit.
+    """Run ``fn`` in the app's thread pool under the request time limit (work needing no map).
 
     Raises
     ------
     TimeLimitError
         ``fn`` took longer than ``CAMLOC_REQUEST_TIMEOUT_S`` (HTTP 503).
     """
-    executor: ThreadPoolExecutor = request.app.state.executor
+    executor = _compute(request).executor()
     limit_s = _settings(request).request_timeout_s
     loop = asyncio.get_running_loop()
     try:

@@ -18,6 +18,7 @@ from fastapi.responses import Response
 from pydantic import ValidationError
 
 from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
 from camloc_geo.service.deps import (
     ApiKey,
     ServiceSettings,
@@ -153,11 +154,16 @@ async def job_result(
     )
 
 
+def camera_work(maps: MapStore, camera: Any, settings: Settings) -> dict[str, Any]:
+    """One camera of a job; never raises (runs on a worker)."""
+    return process_camera(camera, maps, settings)
+
+
 class JobRunner:
     """The thread that claims queued cameras one at a time and commits their results."""
 
-    def __init__(self, store: Store, maps: MapStore, settings: Settings) -> None:
-        self.store, self.maps, self.settings = store, maps, settings
+    def __init__(self, store: Store, compute: Compute, settings: Settings) -> None:
+        self.store, self.compute, self.settings = store, compute, settings
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -185,5 +191,15 @@ class JobRunner:
                 self._stop.wait(0.2)
                 continue
             job_id, idx, camera = claimed
-            result = process_camera(camera, self.maps, self.settings)
+            try:
+                result = self.compute.submit(camera_work, camera, self.settings).result()
+            except Exception as exc:  # a worker died or the pool is shutting down
+                if self._stop.is_set():
+                    return  # the claim goes back to pending at the next start
+                log.exception("camera %d of job %s failed", idx, job_id)
+                result = {
+                    "id": str(camera.get("id", "")) if isinstance(camera, dict) else "",
+                    "status": "failed",
+                    "reason": f"internal error ({type(exc).__name__})",
+                }
             self.store.finish_camera(job_id, idx, result)
