@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from camloc_geo import SceneError
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import MapData
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_maps"
@@ -18,13 +22,13 @@ pytest.importorskip("fastapi")
 
 
 @pytest.fixture(scope="module")
-def whole_map():  # the whole extract, as the service loads it
+def whole_map() -> MapData:  # the whole extract, as the service loads it
     from camloc_geo.osm import load_map
 
     return load_map(SAMPLES / "baltimore.osm.pbf", 39.2856, -76.5935, radius_m=None)
 
 
-def test_corners_within_keeps_only_the_radius(whole_map) -> None:
+def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
     from camloc_geo.api import corners_near, corners_within
     from camloc_geo.geodesy import distance_m
 
@@ -42,7 +46,7 @@ def test_corners_within_keeps_only_the_radius(whole_map) -> None:
     assert all(f["properties"]["intersection"] in kept for f in corners)
 
 
-def test_streets_within_lists_only_near_streets(whole_map) -> None:
+def test_streets_within_lists_only_near_streets(whole_map: MapData) -> None:
     from camloc_geo.api import streets_within
 
     out = streets_within(lat=39.28558, lon=-76.59348, radius_m=100, map_source=whole_map)
