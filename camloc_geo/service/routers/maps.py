@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Annotated, Any
 
 from fastapi import APIRouter, Query
+from fastapi.responses import Response
 
 from camloc_geo.service.deps import ServiceSettings, Workers
 from camloc_geo.service.errors import QueryError
@@ -44,19 +45,19 @@ def streets_work(maps: MapStore, q: PointQuery) -> dict[str, Any]:
     return streets_within(lat=q.lat, lon=q.lon, radius_m=q.radius_m, map_source=m)
 
 
-@router.get("/v1/corners")
+@router.get("/v1/corners", response_model=dict[str, Any])
 async def corners(
     q: Annotated[CornersQuery, Query()], workers: Workers, settings: ServiceSettings
-) -> dict[str, Any]:
+) -> Response:
     """Intersections and their kerb corners around a point (GeoJSON)."""
     _check_radius(q, settings)
-    return await workers.run(corners_work, q)
+    return await workers.run_json(corners_work, q)
 
 
-@router.get("/v1/streets")
+@router.get("/v1/streets", response_model=dict[str, Any])
 async def streets(
     q: Annotated[PointQuery, Query()], workers: Workers, settings: ServiceSettings
-) -> dict[str, Any]:
+) -> Response:
     """Streets near a point with their bearings."""
     _check_radius(q, settings)
-    return await workers.run(streets_work, q)
+    return await workers.run_json(streets_work, q)

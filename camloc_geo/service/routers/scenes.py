@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, cast
 
 from fastapi import APIRouter, Query
-from fastapi.responses import HTMLResponse
+from fastapi.responses import HTMLResponse, Response
 
 from camloc_geo.service.deps import ApiKey, SceneBody, Workers
 from camloc_geo.service.models import LocateQuery
@@ -60,18 +60,16 @@ def review_work(maps: MapStore, scene: Scene) -> str:
         return path.read_text(encoding="utf-8")
 
 
-@router.post("/v1/calibrate", openapi_extra=SCENE_BODY)
-async def calibrate(body: SceneBody, workers: Workers) -> dict[str, Any]:
+@router.post("/v1/calibrate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
+async def calibrate(body: SceneBody, workers: Workers) -> Response:
     """Relative pose (focal length, rotation, camera position in the car's frame)."""
-    return await workers.run(calibrate_work, body.scene)
+    return await workers.run_json(calibrate_work, body.scene)
 
 
-@router.post("/v1/locate", openapi_extra=SCENE_BODY)
-async def locate(
-    body: SceneBody, workers: Workers, q: Annotated[LocateQuery, Query()]
-) -> dict[str, Any]:
+@router.post("/v1/locate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
+async def locate(body: SceneBody, workers: Workers, q: Annotated[LocateQuery, Query()]) -> Response:
     """Candidate camera positions as the candidate GeoJSON, best first."""
-    return await workers.run(locate_work, body.scene, q.max_candidates)
+    return await workers.run_json(locate_work, body.scene, q.max_candidates)
 
 
 @router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
