@@ -1,4 +1,4 @@
-"""The service's dependencies: its shared state, the API key, body parsing, the CPU pool.
+"""The service's dependencies: its shared state, the API key, body parsing, the thread pool.
 
 Bodies are parsed once: JSON with NaN/Infinity refused, a scene checked against the server's
 limits and validated into a :class:`~camloc_geo.scene.Scene` that the library takes as it is.
@@ -35,10 +35,10 @@ __all__ = [
     "ServiceSettings",
     "ServiceStore",
     "Workers",
-    "json_body",
+    "content_type",
+    "parse_json",
     "raw_body",
     "run_cpu",
-    "scene_body",
 ]
 
 T = TypeVar("T")
@@ -126,11 +126,6 @@ def parse_json(raw: bytes) -> Any:
         raise SceneError(f"the body is not valid JSON: {exc}", "body") from None
 
 
-async def json_body(request: Request) -> Any:
-    """The parsed JSON body of an ``application/json`` request."""
-    return parse_json(await raw_body(request, JSON_TYPES))
-
-
 @dataclass(frozen=True)
 class ParsedScene:
     """A scene body: the JSON as sent (to store) and the validated model (to compute with)."""
@@ -153,7 +148,6 @@ async def _scene_body(request: Request, settings: ServiceSettings) -> ParsedScen
 
 SceneBody = Annotated[ParsedScene, Depends(_scene_body)]
 """A ``camloc-scene/1`` body within the server's limits, validated once."""
-scene_body = _scene_body
 
 
 async def run_cpu(request: Request, fn: Callable[[], T]) -> T:
