@@ -42,6 +42,21 @@ def _port() -> int:
         return int(s.getsockname()[1])
 
 
+def _server_cpu_s(pid: int) -> dict[int, float]:
+    """User + system CPU seconds so far of the server process and of each of its workers."""
+    import psutil
+
+    out: dict[int, float] = {}
+    root = psutil.Process(pid)
+    for p in [root, *root.children(recursive=True)]:
+        try:
+            t = p.cpu_times()
+        except psutil.NoSuchProcess:
+            continue
+        out[p.pid] = t.user + t.system
+    return out
+
+
 def _jitter(value: Any, rng: np.random.Generator) -> Any:
     if isinstance(value, list) and value and all(isinstance(v, float) for v in value):
         return [round(v + float(rng.uniform(-1.0, 1.0)), 2) for v in value]
@@ -168,18 +183,24 @@ def main() -> int:
             except httpx.HTTPError:
                 time.sleep(0.2)
         bodies = scene_bodies(max(args.requests, 1))
-        for body in bodies[: 4 * args.workers]:  # every worker loads its map
-            httpx.post(
-                url + "/v1/locate",
-                content=body,
-                headers={"content-type": "application/json"},
-                timeout=120,
+        # every worker loads its map: requests at once, so that each worker gets some, until
+        # a round has no error (a map load may outlast the server's time limit)
+        warm_end = time.perf_counter() + 300.0
+        while time.perf_counter() < warm_end:
+            _l, warm_errors, _a = asyncio.run(
+                _load(url, bodies, 4 * args.workers, 2 * args.workers, 120.0)
             )
+            if warm_errors == 0:
+                break
+        cpu0 = _server_cpu_s(proc.pid)
         t0 = time.perf_counter()
         lat, errors, answers = asyncio.run(
             _load(url, bodies, args.requests, args.concurrency, args.max_seconds)
         )
         wall = time.perf_counter() - t0
+        cpu1 = _server_cpu_s(proc.pid)
+        per_process = {k: v - cpu0.get(k, 0.0) for k, v in cpu1.items()}
+        server_cpu_s = sum(per_process.values())
     finally:
         proc.terminate()
         proc.wait(timeout=20)
@@ -194,6 +215,15 @@ def main() -> int:
         "errors": errors,
         "seconds": round(wall, 3),
         "requests_per_s": round(len(lat) / wall, 1),
+        # CPU the server spent per request: robust to other load on the machine; the rate two
+        # idle cores could serve is 2 / this
+        "server_cpu_ms_per_request": round(server_cpu_s / max(len(lat), 1) * 1000.0, 1),
+        "capacity_2_cores_per_s": round(2.0 / max(server_cpu_s / max(len(lat), 1), 1e-9), 1),
+        "load_average_1min": round(os.getloadavg()[0], 2),
+        # how the work fell on the processes (supervisor and workers), share of the CPU
+        "cpu_share_per_process": sorted(
+            (round(v / max(server_cpu_s, 1e-9), 3) for v in per_process.values()), reverse=True
+        ),
         "p50_ms": round(float(np.percentile(ms, 50)), 1),
         "p90_ms": round(float(np.percentile(ms, 90)), 1),
         "p99_ms": round(float(np.percentile(ms, 99)), 1),

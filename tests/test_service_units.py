@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from camloc_geo import SceneError
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import MapData
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_maps"
@@ -18,13 +22,13 @@ pytest.importorskip("fastapi")
 
 
 @pytest.fixture(scope="module")
-def whole_map():  # the whole extract, as the service loads it
+def whole_map() -> MapData:  # the whole extract, as the service loads it
     from camloc_geo.osm import load_map
 
     return load_map(SAMPLES / "baltimore.osm.pbf", 39.2856, -76.5935, radius_m=None)
 
 
-def test_corners_within_keeps_only_the_radius(whole_map) -> None:
+def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
     from camloc_geo.api import corners_near, corners_within
     from camloc_geo.geodesy import distance_m
 
@@ -42,7 +46,7 @@ def test_corners_within_keeps_only_the_radius(whole_map) -> None:
     assert all(f["properties"]["intersection"] in kept for f in corners)
 
 
-def test_streets_within_lists_only_near_streets(whole_map) -> None:
+def test_streets_within_lists_only_near_streets(whole_map: MapData) -> None:
     from camloc_geo.api import streets_within
 
     out = streets_within(lat=39.28558, lon=-76.59348, radius_m=100, map_source=whole_map)
@@ -126,3 +130,38 @@ def test_data_dir_defaults_to_the_users_data_folder(
     assert data_dir == tmp_path / "xdg" / "camloc" / "service"
     monkeypatch.setenv("CAMLOC_DATA_DIR", str(tmp_path / "mine"))
     assert Settings().data_dir == tmp_path / "mine"
+
+
+def test_worker_processes_answer_like_threads(tmp_path: Path) -> None:
+    import asyncio
+    import shutil
+
+    from camloc_geo import MapDataError
+    from camloc_geo.service.compute import Compute
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.models import PointQuery
+    from camloc_geo.service.routers.crowd import servable_work
+    from camloc_geo.service.routers.maps import streets_work
+    from camloc_geo.service.settings import Settings
+
+    (tmp_path / "maps").mkdir()
+    shutil.copy(SAMPLES / "baltimore.osm.pbf", tmp_path / "maps")
+    q = PointQuery(lat=39.28558, lon=-76.59348, radius_m=100)
+    answers = {}
+    for workers in (0, 1):
+        settings = Settings(
+            map_dir=tmp_path / "maps",
+            data_dir=tmp_path / "d",
+            workers=workers,
+            request_timeout_s=600.0,  # a busy machine: starting the worker and loading the map
+        )
+        compute = Compute(settings, MapStore(settings))
+        compute.start()
+        try:
+            answers[workers] = asyncio.run(compute.run(streets_work, q))
+            with pytest.raises(MapDataError, match=r"lat=48\.850000"):
+                asyncio.run(compute.run(servable_work, False, (48.85, 2.35)))
+        finally:
+            compute.shutdown()
+    assert answers[1] == answers[0]
+    assert "Eastern Avenue" in {n["name"] for n in answers[1]["near"]}

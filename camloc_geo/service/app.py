@@ -8,12 +8,12 @@ status table in :mod:`camloc_geo.service.errors`, body parsing and the API key i
 from __future__ import annotations
 
 from collections.abc import AsyncIterator
-from concurrent.futures import ThreadPoolExecutor
 from contextlib import asynccontextmanager
 
 from fastapi import FastAPI
 
 from camloc_geo import __version__
+from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import ERROR_STATUS, install_error_handlers
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.middleware import RequestLimits
@@ -42,17 +42,18 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     """
     settings = settings or Settings()
     maps, store = MapStore(settings), Store(settings.data_dir)
-    runner = JobRunner(store, maps, settings)
-    executor = ThreadPoolExecutor(max_workers=4, thread_name_prefix="camloc")
+    compute = Compute(settings, maps)
+    runner = JobRunner(store, compute, settings)
 
     @asynccontextmanager
     async def lifespan(_app: FastAPI) -> AsyncIterator[None]:
+        compute.start()
         runner.start()
         try:
             yield
         finally:
             runner.stop()
-            executor.shutdown(wait=False, cancel_futures=True)
+            compute.shutdown()
 
     app = FastAPI(
         title="camloc",
@@ -63,7 +64,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         redoc_url=None,
     )
     app.state.settings, app.state.maps, app.state.store = settings, maps, store
-    app.state.executor = executor
+    app.state.compute = compute
     for router in ROUTERS:
         app.include_router(router)
     install_error_handlers(app)

@@ -1,8 +1,9 @@
-"""The service's dependencies: its shared state, the API key, body parsing, the CPU pool.
+"""The service's dependencies: its shared state, the API key, body parsing, the thread pool.
 
 Bodies are parsed once: JSON with NaN/Infinity refused, a scene checked against the server's
 limits and validated into a :class:`~camloc_geo.scene.Scene` that the library takes as it is.
-CPU work runs in a thread pool under the request time limit, never on the event loop.
+CPU work runs in worker processes or threads (:mod:`camloc_geo.service.compute`) under the
+request time limit, never on the event loop.
 """
 
 from __future__ import annotations
@@ -11,13 +12,13 @@ import asyncio
 import hmac
 import json
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Annotated, Any, TypeVar
 
 from fastapi import Depends, Header, Request
 
 from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import TimeLimitError, UnauthorizedError, UnsupportedMediaError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.settings import Settings
@@ -33,10 +34,11 @@ __all__ = [
     "SceneBody",
     "ServiceSettings",
     "ServiceStore",
-    "json_body",
+    "Workers",
+    "content_type",
+    "parse_json",
     "raw_body",
     "run_cpu",
-    "scene_body",
 ]
 
 T = TypeVar("T")
@@ -59,9 +61,16 @@ def _store(request: Request) -> Store:
     return store
 
 
+def _compute(request: Request) -> Compute:
+    compute: Compute = request.app.state.compute
+    return compute
+
+
 ServiceSettings = Annotated[Settings, Depends(_settings)]
 Maps = Annotated[MapStore, Depends(_maps)]
 ServiceStore = Annotated[Store, Depends(_store)]
+Workers = Annotated[Compute, Depends(_compute)]
+"""The CPU pool: ``await workers.run(fn, *args)`` runs ``fn(maps, *args)`` on a worker."""
 
 
 def _require_key(
@@ -117,11 +126,6 @@ def parse_json(raw: bytes) -> Any:
         raise SceneError(f"the body is not valid JSON: {exc}", "body") from None
 
 
-async def json_body(request: Request) -> Any:
-    """The parsed JSON body of an ``application/json`` request."""
-    return parse_json(await raw_body(request, JSON_TYPES))
-
-
 @dataclass(frozen=True)
 class ParsedScene:
     """A scene body: the JSON as sent (to store) and the validated model (to compute with)."""
@@ -133,24 +137,28 @@ class ParsedScene:
 async def _scene_body(request: Request, settings: ServiceSettings) -> ParsedScene:
     from camloc_geo.api import scene_from
 
-    data = check_scene_body(await json_body(request), settings)
-    return ParsedScene(data=data, scene=scene_from(data))
+    raw = await raw_body(request, JSON_TYPES)
+
+    def parse() -> ParsedScene:  # up to 2 MB of JSON: off the event loop
+        data = check_scene_body(parse_json(raw), settings)
+        return ParsedScene(data=data, scene=scene_from(data))
+
+    return await run_cpu(request, parse)
 
 
 SceneBody = Annotated[ParsedScene, Depends(_scene_body)]
 """A ``camloc-scene/1`` body within the server's limits, validated once."""
-scene_body = _scene_body
 
 
 async def run_cpu(request: Request, fn: Callable[[], T]) -> T:
-    """Run ``fn`` in the app's thread pool under the request time limit.
+    """Run ``fn`` in the app's thread pool under the request time limit (work needing no map).
 
     Raises
     ------
     TimeLimitError
         ``fn`` took longer than ``CAMLOC_REQUEST_TIMEOUT_S`` (HTTP 503).
     """
-    executor: ThreadPoolExecutor = request.app.state.executor
+    executor = _compute(request).executor()
     limit_s = _settings(request).request_timeout_s
     loop = asyncio.get_running_loop()
     try:

@@ -62,6 +62,15 @@ class Settings(BaseSettings):
     )
     max_references: int = Field(default=50, ge=1, description="most references in one scene")
     max_cameras_per_job: int = Field(default=10_000, ge=1, description="most cameras in one job")
+    workers: int = Field(
+        default=0,
+        ge=0,
+        le=256,
+        description=(
+            "worker processes for the CPU work, each with its own maps (0: threads of the "
+            "serving process); camloc serve --workers sets it"
+        ),
+    )
     request_timeout_s: float = Field(
         default=20.0, gt=0, description="processing time limit of one request (seconds)"
     )

@@ -15,10 +15,10 @@ from fastapi.responses import HTMLResponse
 from camloc_geo import CamlocError, MapDataError, SceneError
 from camloc_geo.service.deps import (
     ApiKey,
-    Maps,
     SceneBody,
     ServiceSettings,
     ServiceStore,
+    Workers,
     raw_body,
     run_cpu,
 )
@@ -69,8 +69,14 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
     return IMAGE_TYPES[fmt], width, height
 
 
-def _check_servable(maps: MapStore, network: bool, point: tuple[float, float] | None) -> None:
-    """Refuse a task no map can serve, before anyone annotates it (network off)."""
+def servable_work(maps: MapStore, network: bool, point: tuple[float, float] | None) -> None:
+    """Refuse a task no map can serve, before anyone annotates it (runs on a worker).
+
+    Raises
+    ------
+    MapDataError
+        The network is off and no configured extract covers the point (or there is none).
+    """
     if network:
         return
     if point is None:
@@ -92,7 +98,7 @@ async def create_task(
     q: Annotated[TaskQuery, Query()],
     settings: ServiceSettings,
     store: ServiceStore,
-    maps: Maps,
+    workers: Workers,
 ) -> dict[str, Any]:
     """Create a crowd task from a snapshot (the raw image as the body)."""
     raw = await raw_body(request, IMAGE_MEDIA_TYPES)
@@ -100,7 +106,7 @@ async def create_task(
     if (q.lat is None) != (q.lon is None):
         raise SceneError("give both lat and lon, or neither", "lat" if q.lat is None else "lon")
     point = (q.lat, q.lon) if q.lat is not None and q.lon is not None else None
-    await run_cpu(request, lambda: _check_servable(maps, settings.network, point))
+    await workers.run(servable_work, settings.network, point)
     base: dict[str, Any] = {"format": "camloc-scene/1", "image": {"width": width, "height": height}}
     if point is not None:
         base["prior"] = {"lat": point[0], "lon": point[1], "radius_m": q.radius_m}
@@ -141,16 +147,18 @@ async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HT
     return HTMLResponse(await run_cpu(request, work))
 
 
-def _finish(store: Store, maps: MapStore, task_id: str, task: dict[str, Any]) -> None:
+def crowd_work(
+    maps: MapStore, scenes: list[dict[str, Any]], prior: dict[str, Any] | None
+) -> tuple[str, dict[str, Any]]:
+    """Merge a task's scenes and locate them: ``(status, result)`` (runs on a worker)."""
     from camloc_geo.api import crowd_scene
 
     try:
-        merged = crowd_scene(store.annotations(task_id), prior=task["base_scene"].get("prior"))
+        merged = crowd_scene(scenes, prior=prior)
         out, _m = locate_body(merged, maps)
-        result = {"scene": merged, "candidates": out.to_geojson()}
-        store.set_task_result(task_id, "located", result)
     except CamlocError as exc:
-        store.set_task_result(task_id, "failed", {"reason": " ".join(str(exc).split())})
+        return "failed", {"reason": " ".join(str(exc).split())}
+    return "located", {"scene": merged, "candidates": out.to_geojson()}
 
 
 @router.post(
@@ -158,7 +166,7 @@ def _finish(store: Store, maps: MapStore, task_id: str, task: dict[str, Any]) ->
     openapi_extra=scene_body_doc("one annotator's scene for this task's snapshot"),
 )
 async def submit(
-    request: Request, task_id: TaskId, body: SceneBody, store: ServiceStore, maps: Maps
+    task_id: TaskId, body: SceneBody, store: ServiceStore, workers: Workers
 ) -> dict[str, Any]:
     """Collect one annotator's work; the task is merged and located when enough came in.
 
@@ -176,7 +184,9 @@ async def submit(
         raise SceneError("this task has all its annotations already", "task")
     n = store.add_annotation(task_id, body.data)
     if n >= task["needed"]:
-        await run_cpu(request, lambda: _finish(store, maps, task_id, task))
+        prior = task["base_scene"].get("prior")
+        status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        store.set_task_result(task_id, status, result)
     got = cast(dict[str, Any], store.task(task_id))
     return {"annotations": n, "needed": task["needed"], "status": got["status"]}
 

@@ -14,10 +14,11 @@ from dataclasses import asdict
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import JSONResponse, Response
+from fastapi.responses import Response
 from pydantic import ValidationError
 
 from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
 from camloc_geo.service.deps import (
     ApiKey,
     ServiceSettings,
@@ -135,7 +136,7 @@ async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
 @router.get("/v1/jobs/{job_id}/result", response_model=None)
 async def job_result(
     request: Request, job_id: JobId, q: Annotated[ResultQuery, Query()], store: ServiceStore
-) -> Response:
+) -> Response | dict[str, Any]:
     """The finished cameras: GeoJSON (best location per camera, then all candidates) or
     GeoPackage (layers ``cameras`` and ``candidates``)."""
     from camloc_geo.results import job_result_geojson, job_result_geopackage
@@ -144,7 +145,7 @@ async def job_result(
         raise NotFoundError(f"no job {job_id}")
     gj = job_result_geojson(job_id, store.job_results(job_id))
     if q.format == "geojson":
-        return JSONResponse(gj)
+        return gj
     data = await run_cpu(request, lambda: job_result_geopackage(gj))
     return Response(
         data,
@@ -153,11 +154,16 @@ async def job_result(
     )
 
 
+def camera_work(maps: MapStore, camera: Any, settings: Settings) -> dict[str, Any]:
+    """One camera of a job; never raises (runs on a worker)."""
+    return process_camera(camera, maps, settings)
+
+
 class JobRunner:
     """The thread that claims queued cameras one at a time and commits their results."""
 
-    def __init__(self, store: Store, maps: MapStore, settings: Settings) -> None:
-        self.store, self.maps, self.settings = store, maps, settings
+    def __init__(self, store: Store, compute: Compute, settings: Settings) -> None:
+        self.store, self.compute, self.settings = store, compute, settings
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -185,5 +191,15 @@ class JobRunner:
                 self._stop.wait(0.2)
                 continue
             job_id, idx, camera = claimed
-            result = process_camera(camera, self.maps, self.settings)
+            try:
+                result = self.compute.submit(camera_work, camera, self.settings).result()
+            except Exception as exc:  # a worker died or the pool is shutting down
+                if self._stop.is_set():
+                    return  # the claim goes back to pending at the next start
+                log.exception("camera %d of job %s failed", idx, job_id)
+                result = {
+                    "id": str(camera.get("id", "")) if isinstance(camera, dict) else "",
+                    "status": "failed",
+                    "reason": f"internal error ({type(exc).__name__})",
+                }
             self.store.finish_camera(job_id, idx, result)
