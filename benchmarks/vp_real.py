@@ -168,13 +168,13 @@ def horizon_err(
     return max(e) / h
 
 
-def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
+def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict[str, Any]]:
     rows = []
     for t in data:
         t0 = time.perf_counter()
         row: dict[str, Any] = {"set": t["set"], "name": t["name"], "f_true": t["f"]}
         try:
-            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif)
+            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
         except NotEnoughStructureError as exc:
             row.update(error=str(exc), time_s=time.perf_counter() - t0)
             rows.append(row)
@@ -190,6 +190,8 @@ def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
             hz_err=horizon_err(res.up_in_cam, res.focal_px, res.principal_point, t),
             pitch_deg=res.pitch_deg,
             n_lines=list(res.n_lines),
+            k1=res.distortion,
+            k1_std=res.distortion_std,
         )
         rows.append(row)
     return rows
@@ -322,6 +324,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
     ap.add_argument("--sets", default="strecha,sceaux,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
+    ap.add_argument(
+        "--estimate-distortion", action="store_true", help="also fit the lens distortion k1"
+    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -340,10 +345,11 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    runs = {"no EXIF": run(data, use_exif=False)}
+    opts = {"estimate_distortion": True} if args.estimate_distortion else {}
+    runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:
-        runs["EXIF prior"] = run(exif_data, use_exif=True)
+        runs["EXIF prior"] = run(exif_data, use_exif=True, **opts)
     summary: dict[str, Any] = {}
     for tag, rows in runs.items():
         summary[tag] = {"all": summarise(rows)}

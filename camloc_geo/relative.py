@@ -1313,7 +1313,7 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         raise _no_usable_annotator(screening.excluded)
     for msg in screening.warnings[len(scene.input_warnings) :]:
         log.warning("%s", msg)  # the scene's own were logged when it was read
-    clean = screening.scene
+    clean = screening.scene.undistorted()  # camera.distortion: pinhole pixels from here on
     excluded = list(screening.excluded)
     kept = list(screening.kept)
     result = _calibrate_usable(clean, settings)
