@@ -97,8 +97,12 @@ _MIN_SEGMENTS = 6
 _MIN_SUPPORT = 3  # inlier segments needed by each of the two best-supported VPs
 #: Annotated axes may pick a frame whose support is at least this share of the best one.
 _HINT_MIN_SCORE_SHARE = 0.8
+#: Prior standard deviation of the distortion k1 when it is estimated.
+_K1_PRIOR_SIGMA = 0.2
+#: Rounds of the distortion estimate (each refits, relabels and undistorts again).
+_K1_ROUNDS = 3
 #: A direction with fewer distinct lines than this is left out of the final fit.
-_WEAK_LINES = 4
+_WEAK_LINES = 6
 #: Above this relative standard deviation of the focal length a warning is given.
 _LOOSE_FOCAL_STD = 0.10
 #: Systematic bias of segment directions (degrees) put into the focal length's sigma.
@@ -553,6 +557,76 @@ def _refine(
     return R, f, logf_std, delta
 
 
+def _undistorted_segs(s: _Segs, scale: float, k1: float, radius_n: float) -> _Segs:
+    """Segments (normalised coordinates) with their end points undistorted (division model)."""
+    half = 0.5 * s.length_px[:, None] / scale * s.dirn
+    p1, p2 = s.mid - half, s.mid + half
+    p1 = p1 / (1.0 + k1 * np.sum(p1 * p1, axis=1, keepdims=True) / radius_n**2)
+    p2 = p2 / (1.0 + k1 * np.sum(p2 * p2, axis=1, keepdims=True) / radius_n**2)
+    d = p2 - p1
+    length = np.hypot(d[:, 0], d[:, 1])
+    dirn = d / np.maximum(length, 1e-300)[:, None]
+    nrm = np.column_stack([-dirn[:, 1], dirn[:, 0]])
+    mid = 0.5 * (p1 + p2)
+    lines = np.column_stack([nrm, -np.sum(nrm * mid, axis=1)])
+    return _Segs(mid=mid, dirn=dirn, length_px=length * scale, lines=lines, weight=s.weight)
+
+
+def _refine_distortion(
+    m: _Model,
+    s: _Segs,
+    scale: float,
+    radius_n: float,
+    tau_px: float,
+    f_free: bool,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> tuple[float, float, float]:
+    """Fit the division-model ``k1`` with the rotation and the focal length.
+
+    The segments keep their labels; straight lines broken into pieces along a bowed edge
+    then agree on one vanishing point only for the right ``k1``. A Gaussian prior
+    (sigma :data:`_K1_PRIOR_SIGMA`) keeps ``k1`` near 0 where the photo says little.
+
+    Returns
+    -------
+    k1, its standard deviation, and the standard deviation of ``log(focal)`` with ``k1``
+    free.
+    """
+    inl = m.labels >= 0
+    ss = _subset(s, inl)
+    lab = m.labels[inl]
+    cols = np.arange(len(lab))
+    lo, hi = f_bounds
+    w_prior = 0.05 * tau_px if prior_w is None else prior_w
+    n_par = 4 + int(f_free)
+    i_k = n_par - 1
+
+    def fun(x: FloatArray) -> FloatArray:
+        R = Rotation.from_rotvec(x[:3]).as_matrix() @ m.R
+        f = min(max(m.f_n * math.exp(x[3]), lo), hi) if f_free else m.f_n
+        su = _undistorted_segs(ss, scale, float(x[i_k]), radius_n)
+        res = _endpoint_residual(_vps_from_rotation(R, f), su)[lab, cols]
+        extra = [tau_px * float(x[i_k]) / _K1_PRIOR_SIGMA]
+        if f_free:
+            extra.append(w_prior * math.log(f / f_prior))
+        return np.concatenate([res, extra])
+
+    sol = least_squares(
+        fun, np.zeros(n_par), loss="soft_l1", f_scale=tau_px, max_nfev=60, x_scale=1.0
+    )
+    dof = max(1, len(sol.fun) - len(sol.x))
+    sigma2 = max(float(2.0 * sol.cost / dof), 0.3**2)
+    try:
+        cov = np.linalg.inv(sol.jac.T @ sol.jac) * sigma2
+    except np.linalg.LinAlgError:
+        return 0.0, float("inf"), float("inf")
+    k1_std = math.sqrt(max(cov[i_k, i_k], 0.0))
+    logf_std = math.sqrt(max(cov[3, 3], 0.0)) if f_free else float("nan")
+    return float(sol.x[i_k]), k1_std, logf_std
+
+
 def _rotated_groups(s: _Segs, angle_rad: FloatArray) -> _Segs:
     """Segments each turned about its midpoint by its own angle (radians)."""
     c, sn = np.cos(angle_rad), np.sin(angle_rad)
@@ -834,6 +908,7 @@ def detect_vanishing_points(
     use_exif: bool = False,
     bias_deg: float | None = None,
     distortion_k1: float | None = None,
+    estimate_distortion: bool = False,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -895,7 +970,13 @@ def detect_vanishing_points(
         :class:`camloc_geo.camera.RadialDistortion`, radius in half image diagonals):
         the segment end points are undistorted before the fit, so the vanishing points,
         focal length and horizon are those of the pinhole camera; ``segments`` in the
-        result stay in the photo's pixels. Not estimated from the photo.
+        result stay in the photo's pixels.
+    estimate_distortion
+        When ``distortion_k1`` is not given, also fit ``k1`` (division model) with the
+        rotation and the focal length, from the bowing of long edges that LSD breaks
+        into pieces. It is kept when it differs from 0 by more than twice its standard
+        deviation (then the segments are undistorted and the fit redone); the result
+        reports it with its sigma either way (``distortion``, ``distortion_std``).
 
     Returns
     -------
@@ -1077,6 +1158,47 @@ def detect_vanishing_points(
         s = _prepare(segs_px, pp, scale)
         labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         best = _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
+    k1_est, k1_std = 0.0, float("nan")
+    if estimate_distortion and not distortion_k1:
+        from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+        radius_n = 0.5 * diag / scale
+        pp_t = (float(pp[0]), float(pp[1]))
+        segs_orig = segs_px
+        k_total = 0.0
+        for _ in range(_K1_ROUNDS):
+            dk, k1_std, logf_std_k = _refine_distortion(
+                best, s, scale, radius_n, tau, f_fixed is None, f_prior, f_bounds, prior_w
+            )
+            if not abs(dk) > max(0.5 * k1_std, 0.002):
+                break
+            # small division-model corrections compose nearly additively
+            k_try = k_total + dk
+            if not abs(k_try) < 0.9:
+                break
+            dist = RadialDistortion.for_image(k_try, w, h)
+            und = undistort_points_px(segs_orig.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
+            if not np.all(np.isfinite(und)):
+                break
+            k_total = k_try
+            segs_px = und
+            s = _prepare(segs_px, pp, scale)
+            best = _fit(
+                best.R, best.f_n, s, tau, f_fixed is None, f_prior, f_bounds, 2, prior_w=prior_w
+            )
+            if math.isfinite(logf_std_k):
+                best.logf_std = max(best.logf_std, logf_std_k)
+        if abs(k_total) > 2.0 * k1_std:
+            k1_est = k_total
+            segs_photo = segs_orig
+            log.debug("distortion k1 %.4f +/- %.4f applied", k1_est, k1_std)
+        elif k_total:
+            # not significant: back to the photo's segments
+            segs_px = segs_orig
+            s = _prepare(segs_px, pp, scale)
+            best = _fit(
+                best.R, best.f_n, s, tau, f_fixed is None, f_prior, f_bounds, 2, prior_w=prior_w
+            )
     # A direction supported by a few lines only (paving joints, shadows, a roof slope) is
     # left out: it would pull the focal length and the horizon wherever it lies.
     merge_px = max(4.0, 0.01 * diag)
@@ -1110,6 +1232,10 @@ def detect_vanishing_points(
         prior_source=focal_prior_source if has_prior else None,
         prior_sigma=prior_sigma if has_prior else None,
     )
+    result.distortion_std = k1_std
+    if k1_est:
+        result.segments = segs_photo
+        result.distortion = k1_est
     if distortion_k1:
         n_ax = len(segs_px) - len(segs_photo)  # annotated axes are not distorted pixels
         result.segments = np.vstack([segs_px[:n_ax], segs_photo]) if n_ax else segs_photo
