@@ -325,7 +325,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sets", default="strecha,sceaux,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
-        "--estimate-distortion", action="store_true", help="also fit the lens distortion k1"
+        "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
@@ -345,7 +345,7 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    opts = {"estimate_distortion": True} if args.estimate_distortion else {}
+    opts = {"estimate_distortion": False} if args.no_distortion else {}
     runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:

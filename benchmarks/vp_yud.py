@@ -389,7 +389,7 @@ def main(argv: list[str] | None = None) -> int:
     results["ours (focal unknown)"] = run_ours(data, None)
     results["ours (true focal given)"] = run_ours(data, F_TRUE)
     results["ours (f unknown, pp refined)"] = run_ours(data, None, estimate_principal_point=True)
-    results["ours (f unknown, k1 estimated)"] = run_ours(data, None, estimate_distortion=True)
+    results["ours (f unknown, no k1)"] = run_ours(data, None, estimate_distortion=False)
     if not args.no_lu:
         lu = run_lu(data, args.lu_python)
         results["lu-vp-detect (true focal)"] = lu["true"]

@@ -908,7 +908,7 @@ def detect_vanishing_points(
     use_exif: bool = False,
     bias_deg: float | None = None,
     distortion_k1: float | None = None,
-    estimate_distortion: bool = False,
+    estimate_distortion: bool = True,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -972,7 +972,7 @@ def detect_vanishing_points(
         focal length and horizon are those of the pinhole camera; ``segments`` in the
         result stay in the photo's pixels.
     estimate_distortion
-        When ``distortion_k1`` is not given, also fit ``k1`` (division model) with the
+        (Default on.) When ``distortion_k1`` is not given, also fit ``k1`` (division model) with the
         rotation and the focal length, from the bowing of long edges that LSD breaks
         into pieces. It is kept when it differs from 0 by more than twice its standard
         deviation (then the segments are undistorted and the fit redone); the result
@@ -1444,18 +1444,18 @@ def _finish(
     if f_free:
         lo_b, hi_b = f_bounds
         at_bound = not (lo_b * 1.02 < m.f_n < hi_b / 1.02)
+        # How likely the focal length is within 10 %, as the stated sigma says (a default
+        # the photo cannot fix is no likelier to be right than its sigma says).
+        c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2) if math.isfinite(logf_std) else 0.02
         if prior_source is not None:
             focal_source = prior_source
-            c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2) if math.isfinite(logf_std) else 0.5
         elif at_bound:
             focal_source = "bound"
-            c_focal = 0.25
+            c_focal = min(c_focal, 0.25)
         elif not math.isfinite(logf_std) or logf_std > 0.25:
             focal_source = "prior"
-            c_focal = 0.5
         else:
             focal_source = "estimated"
-            c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2)
         if focal_source in ("bound", "prior"):
             warnings.append(
                 "the photo does not fix the focal length: a default was used; give --focal-px "

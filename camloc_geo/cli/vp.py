@@ -101,7 +101,9 @@ def run(args: argparse.Namespace) -> int:
     options: dict[str, Any] = {}
     if args.distortion is None:
         options["estimate_distortion"] = True
-    elif args.distortion != 0.0:
+    elif args.distortion == 0.0:
+        options["estimate_distortion"] = False
+    else:
         options["distortion_k1"] = args.distortion
     if args.focal_px is None and not args.no_exif:
         from camloc_geo.exif import focal_from_exif
