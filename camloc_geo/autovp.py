@@ -466,6 +466,7 @@ class _Model:
     labels: npt.NDArray[np.int64]
     score: float
     logf_std: float = float("nan")
+    tilt_sys_deg: tuple[float, float] = (0.0, 0.0)
 
 
 def _labels(
@@ -494,6 +495,7 @@ def _refine(
     pp_sigma: float | None = None,
     prior_w: float | None = None,
     max_nfev: int = 40,
+    info: dict[str, Any] | None = None,
 ) -> tuple[FloatArray, float, float, FloatArray]:
     inl = labels >= 0
     ss = _Segs(
@@ -558,14 +560,17 @@ def _refine(
     )
     R, f = unpack(sol.x)
     logf_std = float("nan")
-    if f_free:
+    if f_free or info is not None:
         J = sol.jac
         # Covariance of the parameters with the robust loss folded into the Jacobian.
         dof = max(1, len(sol.fun) - len(sol.x))
         sigma2 = max(float(2.0 * sol.cost / dof), (0.3) ** 2)
         try:
             cov = np.linalg.inv(J.T @ J) * sigma2
-            logf_std = float(math.sqrt(max(cov[3, 3], 0.0)))
+            if f_free:
+                logf_std = float(math.sqrt(max(cov[3, 3], 0.0)))
+            if info is not None:
+                info["cov_rot"] = cov[:3, :3]  # rotation vector applied on the left (camera)
         except np.linalg.LinAlgError:
             logf_std = float("inf")
     delta = np.asarray(sol.x[i_pp : i_pp + 2] if pp_sigma else np.zeros(2), dtype=np.float64)
@@ -661,6 +666,7 @@ def _systematic_logf_std(
     f_bounds: tuple[float, float],
     prior_w: float | None,
     bias_deg: float,
+    f_free: bool = True,
 ) -> float:
     """How far a systematic bias of the segments' directions moves ``log(focal)``.
 
@@ -676,6 +682,9 @@ def _systematic_logf_std(
     """
     delta = math.radians(bias_deg)
     total = 0.0
+    kv = int(np.argmin(_vertical_cost(m.R.T)))
+    p0, r0 = pitch_roll_from_up(_up_sign(m.R[:, kv]))
+    tilt2 = np.zeros(2)
     for k in range(3):
         sel = m.labels == k
         if np.count_nonzero(sel) < 2:
@@ -687,20 +696,46 @@ def _systematic_logf_std(
         side = np.sign(rel[:, 0] * mean_dir[1] - rel[:, 1] * mean_dir[0])
         for pattern in (np.ones(len(sel)), side):
             ang = np.where(sel, delta * pattern, 0.0)
-            _, f, _, _ = _refine(
+            R, f, _, _ = _refine(
                 m.R,
                 m.f_n,
                 _rotated_groups(s, ang),
                 m.labels,
                 tau_px,
-                True,
+                f_free,
                 f_prior,
                 f_bounds,
                 prior_w=prior_w,
                 max_nfev=20,
             )
             total += math.log(f / m.f_n) ** 2
+            p1, r1 = pitch_roll_from_up(_up_sign(R[:, kv]))
+            tilt2 += np.array([(p1 - p0) ** 2, (r1 - r0) ** 2])
+    m.tilt_sys_deg = (float(math.sqrt(tilt2[0])), float(math.sqrt(tilt2[1])))
     return math.sqrt(total)
+
+
+def _up_sign(d: FloatArray) -> FloatArray:
+    """The direction pointing image-up (``y < 0``)."""
+    return np.asarray(-d if d[1] > 0 else d, dtype=np.float64)
+
+
+def _tilt_std_deg(m: _Model, cov_rot: FloatArray | None) -> tuple[float, float]:
+    """1-sigma of pitch and roll (degrees): least squares and the systematic part."""
+    kv = int(np.argmin(_vertical_cost(m.R.T)))
+    up = _up_sign(m.R[:, kv])
+    p0, r0 = pitch_roll_from_up(up)
+    var = np.array([m.tilt_sys_deg[0] ** 2, m.tilt_sys_deg[1] ** 2])
+    if cov_rot is not None and np.all(np.isfinite(cov_rot)):
+        eps = 1e-6
+        J = np.zeros((2, 3))
+        for i in range(3):
+            rv = np.zeros(3)
+            rv[i] = eps
+            p1, r1 = pitch_roll_from_up(Rotation.from_rotvec(rv).as_matrix() @ up)
+            J[:, i] = [(p1 - p0) / eps, (r1 - r0) / eps]
+        var = var + np.diag(J @ cov_rot @ J.T)
+    return float(math.sqrt(var[0])), float(math.sqrt(var[1]))
 
 
 # ------------------------------------------------------------------------- result
@@ -772,6 +807,8 @@ class AutoVPResult:
     warnings: list[str] = field(default_factory=list)
     distortion: float = 0.0
     distortion_std: float = float("nan")
+    pitch_std_deg: float = float("nan")
+    roll_std_deg: float = float("nan")
 
     @property
     def street_index(self) -> int:
@@ -845,6 +882,8 @@ class AutoVPResult:
             },
             "pitch_deg": _jsonable_float(self.pitch_deg, 4),
             "roll_deg": _jsonable_float(self.roll_deg, 4),
+            "pitch_std_deg": _jsonable_float(self.pitch_std_deg, 4),
+            "roll_std_deg": _jsonable_float(self.roll_std_deg, 4),
             "confidence": _jsonable_float(self.confidence, 4),
             "vertical_identified": bool(self.vertical_identified),
             "n_segments": len(self.segments),
@@ -1228,12 +1267,28 @@ def detect_vanishing_points(
         U, _, Vt = np.linalg.svd(R)
         best = _Model(R=U @ Vt, f_n=f, labels=labels, score=best.score, logf_std=logf_std)
         log.debug("direction %d left out: %d distinct lines", weak, n_lines[weak])
-    sys_std = 0.0
+    bias = BIAS_DEG if bias_deg is None else bias_deg
     if f_fixed is None and math.isfinite(best.logf_std):
-        sys_std = _systematic_logf_std(
-            best, s, tau, f_prior, f_bounds, prior_w, BIAS_DEG if bias_deg is None else bias_deg
-        )
+        sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
         best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2)
+    elif f_fixed is not None:
+        _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias, f_free=False)
+    info: dict[str, Any] = {}
+    if np.count_nonzero(best.labels >= 0) >= 4:
+        _refine(
+            best.R,
+            best.f_n,
+            s,
+            best.labels,
+            tau,
+            f_fixed is None,
+            f_prior,
+            f_bounds,
+            prior_w=prior_w,
+            max_nfev=1,
+            info=info,
+        )
+    pitch_std, roll_std = _tilt_std_deg(best, info.get("cov_rot"))
     result = _finish(
         best,
         s,
@@ -1248,6 +1303,7 @@ def detect_vanishing_points(
         prior_sigma=prior_sigma if has_prior else None,
     )
     result.distortion_std = k1_std
+    result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
     if k1_est:
         result.segments = segs_photo
         result.distortion = k1_est

@@ -217,3 +217,13 @@ def test_vp_distortion_options(scene_png: Path, capsys: pytest.CaptureFixture[st
     assert given["focal_px"] != off["focal_px"]
     assert main(["vp", str(scene_png), "--distortion", "3"]) == 2
     assert "distortion" in capsys.readouterr().err
+
+
+def test_vp_reports_tilt_sigmas(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert 0.0 < out["pitch_std_deg"] < 2.0
+    assert 0.0 < out["roll_std_deg"] < 2.0
+    # the truth (pitch 8, roll -3) within 3 sigma (rendered lines: a tiny sigma is fine)
+    assert abs(out["pitch_deg"] - 8.0) <= 3 * out["pitch_std_deg"] + 0.2
+    assert abs(out["roll_deg"] + 3.0) <= 3 * out["roll_std_deg"] + 0.2
