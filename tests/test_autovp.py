@@ -581,3 +581,53 @@ def test_level_street_view_states_a_loose_focal() -> None:
     segs0, _ = _street_segments(f, 0.0)
     res0 = detect_vanishing_points(None, segments=segs0, image_size=size)
     assert abs(math.log(res0.focal_px / f)) <= 2.0 * res0.focal_std_rel
+
+
+SCEAUX = Path(os.environ.get("CAMLOC_SCEAUX_DIR", "/nonexistent/sceaux"))
+SCEAUX_MISSING = (
+    "Sceaux castle photos not found: git clone "
+    "https://github.com/openMVG/ImageDataset_SceauxCastle and set CAMLOC_SCEAUX_DIR to its "
+    "images folder"
+)
+STRECHA = Path(os.environ.get("CAMLOC_STRECHA_DIR", "/nonexistent/strecha"))
+STRECHA_MISSING = (
+    "Strecha 2008 photos not found: git clone "
+    "https://github.com/openMVG/SfM_quality_evaluation and set CAMLOC_STRECHA_DIR to its "
+    "Benchmarking_Camera_Calibration_2008 folder"
+)
+
+
+@pytest.mark.skipif(not SCEAUX.exists(), reason=SCEAUX_MISSING)
+def test_real_photo_with_exif_and_barrel_distortion() -> None:
+    """A compact camera's photo (EXIF kept): the EXIF prior puts the focal length within
+    10 % of the published calibration (+6 % here; +12 % without EXIF), and the lens' barrel
+    distortion is found."""
+    f_true = float(np.loadtxt(SCEAUX / "K.txt")[0, 0])
+    res = detect_vanishing_points(str(SCEAUX / "100_7100.JPG"), use_exif=True)
+    assert res.focal_source == "exif-35mm"
+    assert abs(res.focal_px - f_true) / f_true < 0.10
+    assert res.distortion < 0.0
+    assert abs(res.distortion) > 2 * res.distortion_std
+
+
+@pytest.mark.skipif(not STRECHA.exists(), reason=STRECHA_MISSING)
+@pytest.mark.parametrize("name", ["castle-P30/0000", "entry-P10/0000", "Herz-Jesus-P25/0000"])
+def test_real_building_photo_focal_and_pitch(name: str) -> None:
+    """Photos of buildings with a published calibration: focal length within 10 % (or a
+    stated sigma that covers the error), pitch within 2 degrees."""
+    group, stem = name.split("/")
+    vals = [
+        [float(x) for x in ln.split()]
+        for ln in (STRECHA / group / "gt_dense_cameras" / f"{stem}.jpg.camera")
+        .read_text(encoding="ascii")
+        .splitlines()
+        if ln.strip()
+    ]
+    f_true = 0.5 * (vals[0][0] + vals[1][1])
+    up = -np.array(vals[6])
+    up = up if up[1] < 0 else -up
+    pitch_true, _ = pitch_roll_from_up(up)
+    res = detect_vanishing_points(str(STRECHA / group / "images" / f"{stem}.jpg"))
+    err = abs(math.log(res.focal_px / f_true))
+    assert err < 0.10 or err < 2 * res.focal_std_rel
+    assert abs(res.pitch_deg - pitch_true) < 2.0
