@@ -101,6 +101,9 @@ INFINITY_TOL_DEG = 0.05
 _F_PRIOR_REL = 1.0
 _F_PRIOR_SIGMA = 1.0
 _PP_SIGMA_REL = 0.03
+#: Uncertainty of an assumed (image-centre) principal point, relative to the longer side,
+#: put into the pitch sigma (York Urban's lies 2.7 % from the centre, Strecha's 0.6 %).
+_PP_TILT_SIGMA_REL = 0.02
 #: Number of distinct best hypotheses refined.
 _N_REFINED = 3
 #: Inlier distance (px per 800 px of image diagonal) of segment end points.
@@ -720,8 +723,12 @@ def _up_sign(d: FloatArray) -> FloatArray:
     return np.asarray(-d if d[1] > 0 else d, dtype=np.float64)
 
 
-def _tilt_std_deg(m: _Model, cov_rot: FloatArray | None) -> tuple[float, float]:
-    """1-sigma of pitch and roll (degrees): least squares and the systematic part."""
+def _tilt_std_deg(
+    m: _Model, cov_rot: FloatArray | None, pp_sigma_n: float = 0.0
+) -> tuple[float, float]:
+    """1-sigma of pitch and roll (degrees): least squares, the systematic part and, when
+    the principal point is assumed rather than known, its uncertainty (``pp_sigma_n`` in
+    normalised units: pitch is measured from the optical axis through it)."""
     kv = int(np.argmin(_vertical_cost(m.R.T)))
     up = _up_sign(m.R[:, kv])
     p0, r0 = pitch_roll_from_up(up)
@@ -735,6 +742,12 @@ def _tilt_std_deg(m: _Model, cov_rot: FloatArray | None) -> tuple[float, float]:
             p1, r1 = pitch_roll_from_up(Rotation.from_rotvec(rv).as_matrix() @ up)
             J[:, i] = [(p1 - p0) / eps, (r1 - r0) / eps]
         var = var + np.diag(J @ cov_rot @ J.T)
+    if pp_sigma_n > 0:
+        # an offset of the principal point turns the optical axis: by its full angle in
+        # pitch, and about the vertical, which shows as roll in proportion to the pitch
+        pp_deg = math.degrees(math.atan(pp_sigma_n / m.f_n))
+        var[0] += pp_deg**2
+        var[1] += (pp_deg * math.sin(math.radians(p0))) ** 2
     return float(math.sqrt(var[0])), float(math.sqrt(var[1]))
 
 
@@ -1288,7 +1301,8 @@ def detect_vanishing_points(
             max_nfev=1,
             info=info,
         )
-    pitch_std, roll_std = _tilt_std_deg(best, info.get("cov_rot"))
+    pp_sigma_n = 0.0 if principal_point is not None else _PP_TILT_SIGMA_REL
+    pitch_std, roll_std = _tilt_std_deg(best, info.get("cov_rot"), pp_sigma_n)
     result = _finish(
         best,
         s,
