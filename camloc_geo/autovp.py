@@ -103,7 +103,7 @@ _F_PRIOR_SIGMA = 1.0
 _PP_SIGMA_REL = 0.03
 #: Uncertainty of an assumed (image-centre) principal point, relative to the longer side,
 #: put into the pitch sigma (York Urban's lies 2.7 % from the centre, Strecha's 0.6 %).
-_PP_TILT_SIGMA_REL = 0.02
+_PP_TILT_SIGMA_REL = 0.015
 #: Number of distinct best hypotheses refined.
 _N_REFINED = 3
 #: Inlier distance (px per 800 px of image diagonal) of segment end points.
