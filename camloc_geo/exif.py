@@ -151,12 +151,15 @@ def focal_from_tags(
 def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) -> ExifFocal | None:
     """Focal length in pixels from a photo's EXIF, or None (no EXIF, or not enough of it).
 
-    Never raises on a file Pillow cannot read: the EXIF is optional.
+    Never raises on a file Pillow cannot read, and reads only regular files: the EXIF
+    is optional.
     """
     try:
         from PIL import Image, UnidentifiedImageError
     except ImportError:  # pragma: no cover - Pillow is a dependency
         log.debug("Pillow missing: EXIF not read")
+        return None
+    if not Path(path).is_file():  # a FIFO or a device would block the read
         return None
     try:
         with Image.open(path) as im:

@@ -98,3 +98,13 @@ def test_exif_prior_decides_a_loose_focal(tmp_path: Path) -> None:
     assert res.focal_source == "exif-35mm"
     assert res.focal_px == pytest.approx(f_true, rel=0.08)
     assert res.focal_std_rel <= 0.05
+
+
+def test_a_fifo_is_not_read(tmp_path: Path) -> None:
+    import os
+
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs on this system")
+    fifo = tmp_path / "pipe.jpg"
+    os.mkfifo(fifo)
+    assert focal_from_exif(fifo) is None  # returns at once, no blocking read
