@@ -121,6 +121,10 @@ _K1_PRIOR_SIGMA = 0.2
 _K1_ROUNDS = 3
 #: A direction with fewer distinct lines than this is left out of the final fit.
 _WEAK_LINES = 6
+#: Above this focal sigma the photo does not fix the focal length (a default is used).
+_PRIOR_ONLY_STD = 0.25
+#: Largest focal sigma stated for an estimate that rests on a weak direction.
+_MAX_STATED_STD = 1.0
 #: Above this relative standard deviation of the focal length a warning is given.
 _LOOSE_FOCAL_STD = 0.10
 #: Systematic bias of segment directions (degrees) put into the focal length's sigma.
@@ -470,6 +474,7 @@ class _Model:
     score: float
     logf_std: float = float("nan")
     tilt_sys_deg: tuple[float, float] = (0.0, 0.0)
+    weak_only: int = 0  # the focal length rests on a direction with this few lines
 
 
 def _labels(
@@ -1277,9 +1282,20 @@ def detect_vanishing_points(
         R, f, logf_std, _ = _refine(
             best.R, best.f_n, s, labels, tau, f_fixed is None, f_prior, f_bounds, prior_w=prior_w
         )
-        U, _, Vt = np.linalg.svd(R)
-        best = _Model(R=U @ Vt, f_n=f, labels=labels, score=best.score, logf_std=logf_std)
-        log.debug("direction %d left out: %d distinct lines", weak, n_lines[weak])
+        loose = not (math.isfinite(logf_std) and logf_std <= _PRIOR_ONLY_STD)
+        if f_fixed is None and not has_prior and loose:
+            # Without it the photo does not fix the focal length at all: its estimate
+            # beats the default, but it is stated with the sigma of the fit without it.
+            best.logf_std = max(
+                best.logf_std if math.isfinite(best.logf_std) else 0.0,
+                min(logf_std, _MAX_STATED_STD) if math.isfinite(logf_std) else _MAX_STATED_STD,
+            )
+            best.weak_only = n_lines[weak]
+            log.debug("focal length rests on direction %d (%d lines)", weak, n_lines[weak])
+        else:
+            U, _, Vt = np.linalg.svd(R)
+            best = _Model(R=U @ Vt, f_n=f, labels=labels, score=best.score, logf_std=logf_std)
+            log.debug("direction %d left out: %d distinct lines", weak, n_lines[weak])
     bias = BIAS_DEG if bias_deg is None else bias_deg
     if f_fixed is None and math.isfinite(best.logf_std):
         sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
@@ -1537,7 +1553,14 @@ def _finish(
         elif at_bound:
             focal_source = "bound"
             c_focal = min(c_focal, 0.25)
-        elif not math.isfinite(logf_std) or logf_std > 0.25:
+        elif m.weak_only:
+            focal_source = "estimated"
+            warnings.append(
+                f"the focal length rests on a direction of only {m.weak_only} lines (a roof "
+                f"slope, paving or shadows may pose as one): +/- {100 * logf_std:.0f} %; give "
+                "--focal-px if it is known"
+            )
+        elif not math.isfinite(logf_std) or logf_std > _PRIOR_ONLY_STD:
             focal_source = "prior"
         else:
             focal_source = "estimated"
@@ -1546,7 +1569,7 @@ def _finish(
                 "the photo does not fix the focal length: a default was used; give --focal-px "
                 "or a photo with EXIF"
             )
-        elif math.isfinite(logf_std) and logf_std > _LOOSE_FOCAL_STD:
+        elif math.isfinite(logf_std) and logf_std > _LOOSE_FOCAL_STD and not m.weak_only:
             n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
             why = (
                 "only one horizontal vanishing point is finite and the vertical one lies far off"
