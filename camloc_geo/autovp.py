@@ -44,7 +44,7 @@ Measured on the 102 York Urban photos (``benchmarks/vp_yud.py``, focal length no
 given): focal length within 10 % on 92 % of the photos, median vanishing-direction
 error 0.9 degrees against the orthogonalised ground truth, horizon AUC 95 %, about 75 ms
 of CPU per 640x480 photo. On 216 real photos with published calibrations
-(``benchmarks/vp_real.py``): within 10 % on 91 %, the stated focal sigma covers 70 % at
+(``benchmarks/vp_real.py``): within 10 % on 91 %, the stated focal sigma covers 69 % at
 1 sigma and 92 % at 2 sigma.
 
 Conventions (see ``spec/SCENE.md``): image pixels are continuous, origin at the
