@@ -1300,6 +1300,8 @@ def detect_vanishing_points(
     if f_fixed is None and math.isfinite(best.logf_std):
         sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
         best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2)
+        if best.weak_only:
+            best.logf_std = min(best.logf_std, _MAX_STATED_STD)
     elif f_fixed is not None:
         _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias, f_free=False)
     info: dict[str, Any] = {}
