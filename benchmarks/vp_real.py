@@ -63,7 +63,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from vp_yud import horizon_auc, load_yud
 
 from camloc_geo import NotEnoughStructureError
-from camloc_geo.autovp import detect_vanishing_points, horizon_from_up
+from camloc_geo.autovp import detect_vanishing_points, horizon_from_up, pitch_roll_from_up
 
 log = logging.getLogger("vp_real")
 
@@ -168,13 +168,13 @@ def horizon_err(
     return max(e) / h
 
 
-def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
+def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict[str, Any]]:
     rows = []
     for t in data:
         t0 = time.perf_counter()
         row: dict[str, Any] = {"set": t["set"], "name": t["name"], "f_true": t["f"]}
         try:
-            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif)
+            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
         except NotEnoughStructureError as exc:
             row.update(error=str(exc), time_s=time.perf_counter() - t0)
             rows.append(row)
@@ -190,7 +190,14 @@ def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
             hz_err=horizon_err(res.up_in_cam, res.focal_px, res.principal_point, t),
             pitch_deg=res.pitch_deg,
             n_lines=list(res.n_lines),
+            k1=res.distortion,
+            k1_std=res.distortion_std,
+            pitch_std_deg=res.pitch_std_deg,
+            roll_std_deg=res.roll_std_deg,
         )
+        if t["up"] is not None:
+            p_true, r_true = pitch_roll_from_up(t["up"])
+            row.update(pitch_err_deg=res.pitch_deg - p_true, roll_err_deg=res.roll_deg - r_true)
         rows.append(row)
     return rows
 
@@ -202,6 +209,26 @@ def roc_auc(score: np.ndarray, positive: np.ndarray) -> float | None:
         return None
     gt = (pos[:, None] > neg[None, :]).sum() + 0.5 * (pos[:, None] == neg[None, :]).sum()
     return float(gt / (len(pos) * len(neg)))
+
+
+def _tilt_coverage(ok: list[dict[str, Any]]) -> dict[str, Any]:
+    """1/2-sigma coverage and median error/sigma of the stated pitch and roll sigmas."""
+    out: dict[str, Any] = {}
+    for k in ("pitch", "roll"):
+        z = np.array(
+            [
+                abs(r[f"{k}_err_deg"]) / r[f"{k}_std_deg"]
+                for r in ok
+                if f"{k}_err_deg" in r and r.get(f"{k}_std_deg")
+            ]
+        )
+        if len(z):
+            out[f"{k}_sigma_cover_1"] = float(np.mean(z <= 1))
+            out[f"{k}_sigma_cover_2"] = float(np.mean(z <= 2))
+            out[f"{k}_median_err_over_sigma"] = float(np.median(z))
+            errs = [abs(r[f"{k}_err_deg"]) for r in ok if f"{k}_err_deg" in r]
+            out[f"{k}_abs_err_median_deg"] = float(np.median(errs))
+    return out
 
 
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -238,6 +265,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "roc_auc_confidence_vs_err10": roc_auc(1.0 - conf, bad) if len(ok) else None,
         "n_confidently_wrong": int(confidently_wrong.sum()),
         "n_warned": int(warned.sum()),
+        **_tilt_coverage(ok),
         "n_with_horizon_truth": len(hz),
         "horizon_auc_pct": 100.0 * horizon_auc(hz) if hz else None,
         "horizon_err_median": float(np.median(hz)) if hz else None,
@@ -322,6 +350,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
     ap.add_argument("--sets", default="strecha,sceaux,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
+    ap.add_argument(
+        "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
+    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -340,10 +371,11 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    runs = {"no EXIF": run(data, use_exif=False)}
+    opts = {"estimate_distortion": False} if args.no_distortion else {}
+    runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:
-        runs["EXIF prior"] = run(exif_data, use_exif=True)
+        runs["EXIF prior"] = run(exif_data, use_exif=True, **opts)
     summary: dict[str, Any] = {}
     for tag, rows in runs.items():
         summary[tag] = {"all": summarise(rows)}
@@ -367,6 +399,11 @@ def main(argv: list[str] | None = None) -> int:
         ("n_confidently_wrong", "conf.wrong", "{}"),
         ("n_warned", "warned", "{}"),
         ("horizon_auc_pct", "hz AUC %", "{:.1f}"),
+        ("pitch_sigma_cover_1", "pitch 1sig", "{:.2f}"),
+        ("pitch_sigma_cover_2", "pitch 2sig", "{:.2f}"),
+        ("pitch_median_err_over_sigma", "p err/sig", "{:.2f}"),
+        ("roll_sigma_cover_2", "roll 2sig", "{:.2f}"),
+        ("roll_median_err_over_sigma", "r err/sig", "{:.2f}"),
         ("n_refused", "refused", "{}"),
     ]
     lines = [f"{'run / set':32s} " + " ".join(f"{k[1]:>12s}" for k in keys)]

@@ -215,6 +215,15 @@ def summarise(rows: list[dict[str, Any]], with_focal: bool) -> dict[str, Any]:
         out["focal_rel_err_median"] = float(np.median(fe))
         out["share_focal_within_10pct"] = float(np.mean(np.asarray(fe) <= 0.10))
         out["share_focal_within_15pct"] = float(np.mean(np.asarray(fe) <= 0.15))
+        z = [
+            abs(math.log(r["f"] / F_TRUE)) / r["focal_std_rel"]
+            for r in rows
+            if "f" in r and r.get("focal_std_rel")
+        ]
+        if z:
+            out["focal_sigma_cover_1"] = float(np.mean(np.asarray(z) <= 1))
+            out["focal_sigma_cover_2"] = float(np.mean(np.asarray(z) <= 2))
+            out["focal_median_err_over_sigma"] = float(np.median(z))
     return out
 
 
@@ -249,6 +258,7 @@ def run_ours(
                 "f": res.focal_px,
                 "focal_source": res.focal_source,
                 "confidence": res.confidence,
+                "focal_std_rel": res.focal_std_rel,
                 "dir_err": direction_errors(res.directions_in_cam, gt["dirs"]),
                 "hz_err": horizon_error(res.up_in_cam, res.focal_px, res.principal_point, gt, w, h),
                 "hz_err_vertical": horizon_error(
@@ -379,6 +389,7 @@ def main(argv: list[str] | None = None) -> int:
     results["ours (focal unknown)"] = run_ours(data, None)
     results["ours (true focal given)"] = run_ours(data, F_TRUE)
     results["ours (f unknown, pp refined)"] = run_ours(data, None, estimate_principal_point=True)
+    results["ours (f unknown, no k1)"] = run_ours(data, None, estimate_distortion=False)
     if not args.no_lu:
         lu = run_lu(data, args.lu_python)
         results["lu-vp-detect (true focal)"] = lu["true"]
@@ -401,6 +412,9 @@ def main(argv: list[str] | None = None) -> int:
         ("horizon_err_median", "hz med", "{:.4f}"),
         ("share_focal_within_10pct", "f<=10%", "{:.2f}"),
         ("focal_rel_err_median", "f med err", "{:.3f}"),
+        ("focal_sigma_cover_1", "1sig cov", "{:.2f}"),
+        ("focal_sigma_cover_2", "2sig cov", "{:.2f}"),
+        ("focal_median_err_over_sigma", "med err/sig", "{:.2f}"),
         ("time_median_ms", "ms/img", "{:.0f}"),
         ("cpu_time_median_ms", "cpu ms/img", "{:.0f}"),
         ("n_failed", "failed", "{}"),

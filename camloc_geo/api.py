@@ -484,7 +484,7 @@ def vanishing_points(
         Also refine the principal point around the image centre.
     **options
         Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
-        ``focal_prior_px``, ``distortion``, ...).
+        ``focal_prior_px``, ``distortion_k1``, ``estimate_distortion``, ...).
 
     Raises
     ------

@@ -151,7 +151,8 @@ def focal_from_tags(
 def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) -> ExifFocal | None:
     """Focal length in pixels from a photo's EXIF, or None (no EXIF, or not enough of it).
 
-    Never raises on a file Pillow cannot read: the EXIF is optional.
+    Never raises on a file Pillow cannot read, and reads only regular files: the EXIF
+    is optional.
     """
     try:
         from PIL import Image, UnidentifiedImageError

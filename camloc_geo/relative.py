@@ -1456,7 +1456,7 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     screening = _screen_annotations(scene, settings.sigma_line_rel)
     if not screening.kept:
         raise _no_usable_annotator(screening.excluded)
-    clean = screening.scene
+    clean = screening.scene.undistorted()  # camera.distortion: pinhole pixels from here on
     excluded = list(screening.excluded)
     kept = list(screening.kept)
     try:

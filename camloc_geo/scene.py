@@ -463,6 +463,56 @@ class Scene(_Model):
         """References, corners and landmarks clamped or left out when the scene was read."""
         return list(self._input_warnings)
 
+    def undistorted(self) -> Scene:
+        """This scene with every annotated pixel undistorted by ``camera.distortion``.
+
+        Axes, vanishing-line segments, references, landmarks and intersection corners are
+        mapped to the pixels of the pinhole camera
+        (:func:`camloc_geo.camera.undistort_points_px`, about ``camera.principal_point``,
+        else the image centre). Without a distortion the scene itself is returned.
+        """
+        dist = self.camera.distortion
+        if dist is None or dist.k1 == 0.0:
+            return self
+        import numpy as np
+
+        from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+        w, h = self.image_size
+        rd = RadialDistortion.for_image(dist.k1, w, h)
+        pp = self.camera.principal_point or (w / 2.0, h / 2.0)
+
+        def und(values: Any) -> Any:
+            arr = np.asarray(values, dtype=np.float64).reshape(-1, 2)
+            out = undistort_points_px(arr, rd, (float(pp[0]), float(pp[1])))
+            out = np.where(np.isfinite(out), out, arr)  # far outside the model: unchanged
+            return tuple(float(v) for v in out.ravel())
+
+        anns = []
+        for a in self.annotations:
+            axes = a.axes.model_copy(
+                update={k: und(getattr(a.axes, k)) for k in ("origin", "length", "width", "height")}
+            )
+            lines = a.vp_lines.model_copy(
+                update={
+                    k: [und(seg) for seg in getattr(a.vp_lines, k)]
+                    for k in ("length", "width", "height")
+                }
+            )
+            anns.append(a.model_copy(update={"axes": axes, "vp_lines": lines}))
+        update: dict[str, Any] = {
+            "annotations": anns,
+            "references": [r.model_copy(update={"pixel": und(r.pixel)}) for r in self.references],
+            "landmarks": [m.model_copy(update={"pixel": und(m.pixel)}) for m in self.landmarks],
+        }
+        if self.intersection is not None:
+            update["intersection"] = self.intersection.model_copy(
+                update={"corners": [und(c) for c in self.intersection.corners]}
+            )
+        out = self.model_copy(update=update)
+        out._input_warnings = list(self._input_warnings)
+        return out
+
     @property
     def pixel_margin_px(self) -> float:
         """How far outside the image a click is clamped rather than refused (pixels)."""
@@ -554,6 +604,13 @@ def _drop_unusable_evidence(scene: Scene) -> Scene:
     margin = scene.pixel_margin_px
     notes: list[str] = []
     update: dict[str, Any] = {}
+    photo = scene.image_file()
+    if photo is not None and (scene.base_dir or photo.is_absolute()) and not photo.is_file():
+        # Only where the path can be resolved: a scene posted without its file names none.
+        notes.append(
+            f"image.path: {str(photo)!r} does not exist; the photo is not used (no lines "
+            "detected in it, no background for the overlay)"
+        )
 
     def screen(items: list[Any], name: str, attr: str) -> list[Any] | None:
         kept, changed = [], False

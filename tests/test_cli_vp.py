@@ -199,3 +199,31 @@ def test_vp_draw_has_a_legend(scene_png: Path, tmp_path: Path) -> None:
     box = img[6:60, 6:120]
     assert (box.max(axis=2) < 20).mean() > 0.5  # a black legend box
     assert (box.min(axis=2) > 230).sum() > 20  # white text in it
+
+
+def test_vp_distortion_options(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["distortion"]["model"] == "division"
+    assert out["distortion"]["k1_std"] is not None  # estimated by default
+    assert abs(out["distortion"]["k1"]) <= 2.5 * out["distortion"]["k1_std"] + 1e-9
+    assert main(["vp", str(scene_png), "--distortion", "0"]) == 0
+    off = json.loads(capsys.readouterr().out)
+    assert off["distortion"]["k1"] == 0.0
+    assert off["distortion"]["k1_std"] is None
+    assert main(["vp", str(scene_png), "--distortion", "-0.05"]) == 0
+    given = json.loads(capsys.readouterr().out)
+    assert given["distortion"]["k1"] == -0.05
+    assert given["focal_px"] != off["focal_px"]
+    assert main(["vp", str(scene_png), "--distortion", "3"]) == 2
+    assert "distortion" in capsys.readouterr().err
+
+
+def test_vp_reports_tilt_sigmas(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert 0.0 < out["pitch_std_deg"] < 2.0
+    assert 0.0 < out["roll_std_deg"] < 2.0
+    # the truth (pitch 8, roll -3) within 3 sigma (rendered lines: a tiny sigma is fine)
+    assert abs(out["pitch_deg"] - 8.0) <= 3 * out["pitch_std_deg"] + 0.2
+    assert abs(out["roll_deg"] + 3.0) <= 3 * out["roll_std_deg"] + 0.2

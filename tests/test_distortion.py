@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,3 +97,85 @@ def test_vp_fit_with_the_distortion_given_recovers_the_focal() -> None:
     assert given.distortion == -0.15
     assert len(given.segments) == len(segs)  # reported in the photo's pixels
     assert np.array_equal(np.sort(given.segments, axis=0), np.sort(segs, axis=0))
+
+
+def test_missing_photo_is_warned(tmp_path: Path) -> None:
+    """A scene whose image.path does not exist loads with a warning naming it."""
+    import json
+
+    from camloc_geo.scene import load_scene
+
+    scene = {
+        "format": "camloc-scene/1",
+        "image": {"width": 1280, "height": 720, "path": "nowhere.jpg"},
+        "camera": {"distortion": {"k1": -0.05}},
+        "annotations": [
+            {
+                "axes": {
+                    "origin": [600, 500],
+                    "length": [800, 520],
+                    "width": [560, 540],
+                    "height": [600, 420],
+                }
+            }
+        ],
+    }
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene), encoding="utf-8")
+    loaded = load_scene(path)
+    assert any("nowhere.jpg" in w and "does not exist" in w for w in loaded.input_warnings)
+    assert loaded.camera.distortion is not None
+    assert loaded.camera.distortion.k1 == -0.05
+    (tmp_path / "nowhere.jpg").write_bytes(b"x")
+    assert not any("image.path" in w for w in load_scene(path).input_warnings)
+
+
+def test_calibrate_undistorts_the_annotations() -> None:
+    """A scene annotated on a barrel-distorted photo: with camera.distortion the focal
+    length is found as on the pinhole photo; without it, it is off."""
+    from camloc_geo.relative import calibrate
+    from camloc_geo.scene import parse_scene
+    from camloc_geo.synthetic import NoiseModel, make_scene, random_camera
+
+    rng = np.random.default_rng(7)
+    size = (1920, 1080)
+    cam = random_camera(rng, image_size=size, focal_px=(900.0, 900.0), roll_deg=0.0)
+    syn = make_scene(cam, rng, noise=NoiseModel.exact(), n_annotators=3, image_size=size)
+    dist = RadialDistortion.for_image(-0.2, *size)
+    pp = cam.principal_point
+
+    def warp(values: list[float]) -> list[float]:
+        arr = np.asarray(values, float).reshape(-1, 2)
+        return [float(v) for v in distort_points_px(arr, dist, pp).ravel()]
+
+    data = syn.scene
+    for ann in data["annotations"]:
+        for k, v in ann["axes"].items():
+            ann["axes"][k] = warp(v)
+        for k, segs in ann.get("vp_lines", {}).items():
+            ann["vp_lines"][k] = [warp(s) for s in segs]
+    data["camera"] = {"principal_point": list(pp)}
+    plain = calibrate(parse_scene(data))
+    data["camera"]["distortion"] = {"model": "division", "k1": -0.2}
+    fixed = calibrate(parse_scene(data))
+    f_true = cam.focal_px
+    assert abs(fixed.camera.focal_px - f_true) / f_true < 0.02
+    assert abs(fixed.camera.focal_px - f_true) < abs(plain.camera.focal_px - f_true)
+
+
+def test_vp_estimates_the_distortion_from_bowed_lines() -> None:
+    from camloc_geo.autovp import detect_vanishing_points
+
+    f = 800.0
+    segs = _manhattan_segments(f, DIST)
+    segs = segs + np.random.default_rng(0).normal(0.0, 0.3, segs.shape)
+    est = detect_vanishing_points(None, segments=segs, image_size=(W, H), estimate_distortion=True)
+    assert est.distortion == pytest.approx(-0.15, abs=0.03)
+    assert 0.0 < est.distortion_std < 0.05
+    assert abs(est.focal_px - f) / f < 0.06
+    straight = _manhattan_segments(f, None)
+    straight = straight + np.random.default_rng(0).normal(0.0, 0.3, straight.shape)
+    none = detect_vanishing_points(
+        None, segments=straight, image_size=(W, H), estimate_distortion=True
+    )
+    assert abs(none.distortion) <= 2.5 * none.distortion_std

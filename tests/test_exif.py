@@ -98,3 +98,33 @@ def test_exif_prior_decides_a_loose_focal(tmp_path: Path) -> None:
     assert res.focal_source == "exif-35mm"
     assert res.focal_px == pytest.approx(f_true, rel=0.08)
     assert res.focal_std_rel <= 0.05
+
+
+def test_a_fifo_is_not_read(tmp_path: Path) -> None:
+    import os
+
+    if not hasattr(os, "mkfifo"):
+        pytest.skip("no FIFOs on this system")
+    fifo = tmp_path / "pipe.jpg"
+    os.mkfifo(fifo)
+    assert focal_from_exif(fifo) is None  # returns at once, no blocking read
+
+
+def test_focal_resting_on_a_weak_direction_is_flagged() -> None:
+    """A frontal facade whose depth direction has only four lines: the focal length rests
+    on them; it is reported with a large sigma and a warning, not as a confident answer."""
+    from camloc_geo.autovp import detect_vanishing_points
+
+    rng = np.random.default_rng(5)
+    segs = []
+    for x in np.linspace(100, 1100, 14):
+        segs.append([x, 150 + rng.normal(0, 0.2), x + rng.normal(0, 0.2), 650])
+    for y in np.linspace(120, 680, 12):
+        segs.append([80, y, 1120, y + rng.normal(0, 0.2)])
+    for a in np.radians([30, 150, 210, 330]):
+        c, s = math.cos(a), math.sin(a)
+        segs.append([600 + 60 * c, 400 + 60 * s, 600 + 250 * c, 400 + 250 * s])
+    res = detect_vanishing_points(None, segments=np.array(segs, float), image_size=(1200, 800))
+    assert res.focal_std_rel > 0.25
+    assert res.confidence < 0.2
+    assert any("rests on a direction of only" in w or "does not fix" in w for w in res.warnings)

@@ -65,7 +65,8 @@ def register(subparsers: Any) -> None:
         metavar="K1",
         help=(
             "known radial lens distortion, division model k1 with radii in half image"
-            " diagonals (negative: barrel, wide-angle); segments are undistorted before the fit"
+            " diagonals (negative: barrel, wide-angle); segments are undistorted before the fit."
+            " Default: estimated from the photo's bowed edges; 0 turns that off"
         ),
     )
     p.add_argument(
@@ -98,7 +99,11 @@ def run(args: argparse.Namespace) -> int:
     if draw_path is not None and draw_path.suffix.lower() not in _IMAGE_SUFFIXES:
         raise InputError(f"--draw {draw_path}: give a .png or .jpg file name")
     options: dict[str, Any] = {}
-    if args.distortion is not None:
+    if args.distortion is None:
+        options["estimate_distortion"] = True
+    elif args.distortion == 0.0:
+        options["estimate_distortion"] = False
+    else:
         options["distortion_k1"] = args.distortion
     if args.focal_px is None and not args.no_exif:
         from camloc_geo.exif import focal_from_exif
