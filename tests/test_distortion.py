@@ -135,7 +135,7 @@ def test_calibrate_undistorts_the_annotations() -> None:
     length is found as on the pinhole photo; without it, it is off."""
     from camloc_geo.relative import calibrate
     from camloc_geo.scene import parse_scene
-    from camloc_geo.synthetic import NoiseModel, make_scene, random_camera
+    from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
 
     rng = np.random.default_rng(7)
     size = (1920, 1080)
