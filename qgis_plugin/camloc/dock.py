@@ -293,9 +293,11 @@ class CamlocDock(QDockWidget):
         self.browser_button.clicked.connect(self.annotate_in_browser)
         self.load_button = QPushButton("Load scene…")
         self.load_button.clicked.connect(self._load_dialog)
-        for b in (self.open_button, self.browser_button, self.load_button):
-            row.addWidget(b)
+        row.addWidget(self.open_button)
+        row.addWidget(self.load_button)
         lay.addLayout(row)
+        self.browser_button.setText("Annotate in browser (zoom, checks)…")
+        lay.addWidget(self.browser_button)
         self.guidance = QLabel()
         self.guidance.setWordWrap(True)
         self.guidance.setStyleSheet("QLabel { background: #fff8d6; padding: 4px; }")
@@ -397,6 +399,9 @@ class CamlocDock(QDockWidget):
         lay.addWidget(self.status)
         scroll = QScrollArea()
         scroll.setWidgetResizable(True)
+        scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)  # wrap, never cut
+        scroll.setFrameShape(QScrollArea.NoFrame)
+        self.setMinimumWidth(380)
         scroll.setWidget(body)
         self.setWidget(scroll)
 
@@ -851,12 +856,16 @@ class CamlocDock(QDockWidget):
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
-            ext = xform.transformBoundingBox(cands.extent())
-            ext.scale(2.0)
-            if ext.width() < 150 and ext.height() < 150:
-                ext.grow(75)
+            ext84 = cands.extent()
+            ext84.grow(0.0006)  # degrees (the layer is EPSG:4326): about 60 m around them
+            ext = xform.transformBoundingBox(ext84)
             canvas.setExtent(ext)
             canvas.refresh()
+            # the first layers of an empty project make QGIS zoom to their full extent once
+            # the event loop runs: zoom again after that
+            from qgis.PyQt.QtCore import QTimer
+
+            QTimer.singleShot(0, lambda: (canvas.setExtent(ext), canvas.refresh()))
 
     def wait(self, timeout_s: float = 120.0) -> bool:
         """Process events until the run (and the page task) ends; True if it did in time."""
