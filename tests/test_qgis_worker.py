@@ -281,3 +281,46 @@ def test_check_scene_job_rejects_a_bad_scene(tmp_path):
     with pytest.raises(InputError, match="give both lat and lon"):
         run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
     assert not out.exists()
+
+
+def test_annotation_page_job_serves_the_library_page_in_crowd_mode(tmp_path):
+    from PIL import Image
+
+    img = tmp_path / "snap.png"
+    Image.new("RGB", (640, 360), (120, 120, 120)).save(img)
+    res = run_job(
+        {
+            "task": "annotation_page",
+            "image": str(img),
+            "submit_url": "http://127.0.0.1:5/camloc/t/scene",
+            "lat": 39.2856,
+            "lon": -76.5935,
+            "osm": str(OSM),
+            "out_dir": str(tmp_path),
+        }
+    )
+    page = res["info"]["html"]
+    assert '"mode":"crowd"' in page
+    assert "http://127.0.0.1:5" in page  # the page may post to the plugin's server only
+    assert '"prior":{"lat":39.2856' in page
+    assert "Eastern Avenue" in page  # the junction's map from the extract
+    with pytest.raises(InputError):
+        run_job({"task": "annotation_page", "image": str(tmp_path / "no.png"), "submit_url": "x"})
+
+
+def test_locate_context_layers_are_the_map_model(tmp_path):
+    res = run_job(
+        {
+            "task": "locate",
+            "scene": str(SCENE),
+            "osm": str(OSM),
+            "context": True,
+            "out_dir": str(tmp_path),
+        }
+    )
+    streets = _read(res["layers"]["context_streets"])
+    assert {"Eastern Avenue", "South Broadway"} <= {f["properties"]["name"] for f in streets}
+    assert all(f["geometry"]["type"] in ("LineString", "MultiLineString") for f in streets)
+    assert res["layers"]["context_buildings"]["count"] > 0
+    matched = _read(res["layers"]["matched_corners"])
+    assert {f["properties"]["what"] for f in matched} >= {"your kerb corner 0"}
