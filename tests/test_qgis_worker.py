@@ -163,6 +163,7 @@ def test_geocodelist_gives_the_answers_of_camloc_batch(tmp_path):
     for cam_id, r in batch.items():
         p = cams[cam_id]
         assert (p["status"], p["lat"], p["lon"], p["tie"]) == (r.status, r.lat, r.lon, r.tie)
+        assert p["n_candidates"] == r.n_candidates
 
 
 def test_geocodelist_names_a_missing_list_or_map(tmp_path):
