@@ -63,6 +63,15 @@ AXIS_COLOURS = {
 }
 PRESETS = ["sedan", "bus", "hatchback", "minivan", "pickup", "suv", "taxi_ny", "van"]
 """The library's object presets (``camloc_geo.objects.PRESETS``; the worker's probe wins)."""
+LAYER_TITLES = {
+    "candidates": "camera candidates",
+    "matched_corners": "matched map points",
+    "intersection": "intersection and kerb corners",
+    "view_cones": "view cones (leading candidates)",
+    "context_buildings": "map model: buildings",
+    "context_streets": "map model: streets",
+}
+"""The dock's names for its result layers."""
 RESULTS_NAME = "camloc_results.gpkg"
 MARKER_PX = 6.0
 """Click markers' radius on screen (pixels, at any zoom)."""
@@ -270,6 +279,7 @@ class CamlocDock(QDockWidget):
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
         self.task: QgsTask | None = None
+        self._loading = False
         self.page_task: WorkerTask | None = None
         self.page_server: Any = None
         self.inbox = _SceneInbox()
@@ -752,7 +762,7 @@ class CamlocDock(QDockWidget):
 
         Returns the task (None when the scene is not ready or a run is going on).
         """
-        if self.task is not None:
+        if self.task is not None or self._loading:
             self.set_status("A run is going on: wait for it or Cancel it.")
             return None
         problems = self.annotation.problems()
@@ -813,38 +823,39 @@ class CamlocDock(QDockWidget):
         self._load_results(task)
 
     def _load_results(self, task: LocateTask) -> None:
-        project = QgsProject.instance()
-        root = project.layerTreeRoot()
+        """Load the task's layers one per event-loop turn (each turn a few tens of ms, so the
+        GUI never stalls for the whole batch), candidates on top; then report and zoom."""
+        from qgis.PyQt.QtCore import QTimer
+
+        root = QgsProject.instance().layerTreeRoot()
         name = f"camloc: {self.annotation.scene_id}"
         group = root.findGroup(name) or root.insertGroup(0, name)
-        titles = {
-            "candidates": "camera candidates",
-            "matched_corners": "matched map points",
-            "intersection": "intersection and kerb corners",
-            "view_cones": "view cones (leading candidates)",
-            "context_buildings": "map model: buildings",
-            "context_streets": "map model: streets",
-        }
+        todo = [k for k in DRAW_ORDER if k in task.uris]  # top to bottom
         self.result_layers = []
-        for kind in DRAW_ORDER:  # top to bottom: candidates above cones above context
-            uri = task.uris.get(kind)
-            if uri is None:
-                continue
-            layer = QgsVectorLayer(uri, titles.get(kind, kind), "ogr")
-            if not layer.isValid():
-                continue
-            apply_style(layer, kind)
-            project.addMapLayer(layer, False)
-            group.addLayer(layer)
-            self.result_layers.append(layer)
-        cands = next(
-            (
-                lyr
-                for lyr in self.result_layers
-                if lyr.customProperty("camloc/kind") == "candidates"
-            ),
-            None,
-        )
+        self._loading = True
+
+        def next_layer() -> None:
+            if not todo:
+                self._loading = False
+                self._report(task)
+                return
+            kind = todo.pop(0)
+            opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan
+            layer = QgsVectorLayer(task.uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
+            if layer.isValid():
+                apply_style(layer, kind)
+                QgsProject.instance().addMapLayer(layer, False)
+                group.addLayer(layer)
+                self.result_layers.append(layer)
+            QTimer.singleShot(0, next_layer)
+
+        next_layer()
+
+    def _report(self, task: LocateTask) -> None:
+        from qgis.PyQt.QtCore import QTimer
+
+        kinds = {lyr.customProperty("camloc/kind"): lyr for lyr in self.result_layers}
+        cands = kinds.get("candidates")
         n = cands.featureCount() if cands is not None else 0
         tied = cands is not None and any(f["tie"] for f in cands.getFeatures())
         msg = f"{n} candidate(s) in {task.gpkg}; best first."
@@ -855,6 +866,7 @@ class CamlocDock(QDockWidget):
         self.set_status(msg)
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
+            project = QgsProject.instance()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
             ext84 = cands.extent()
             ext84.grow(0.0006)  # degrees (the layer is EPSG:4326): about 60 m around them
@@ -863,8 +875,6 @@ class CamlocDock(QDockWidget):
             canvas.refresh()
             # the first layers of an empty project make QGIS zoom to their full extent once
             # the event loop runs: zoom again after that
-            from qgis.PyQt.QtCore import QTimer
-
             QTimer.singleShot(0, lambda: (canvas.setExtent(ext), canvas.refresh()))
 
     def wait(self, timeout_s: float = 120.0) -> bool:
@@ -874,12 +884,14 @@ class CamlocDock(QDockWidget):
         from qgis.PyQt.QtCore import QCoreApplication
 
         t0 = time.monotonic()
-        while (self.task is not None or self.page_task is not None) and (
-            time.monotonic() - t0 < timeout_s
-        ):
+
+        def busy() -> bool:
+            return self.task is not None or self.page_task is not None or self._loading
+
+        while busy() and time.monotonic() - t0 < timeout_s:
             QCoreApplication.processEvents()
             time.sleep(0.01)
-        return self.task is None and self.page_task is None
+        return not busy()
 
     def _remove_results(self) -> None:
         project = QgsProject.instance()
