@@ -149,18 +149,18 @@ class ImageView(QGraphicsView):
         """Screen pixels per image pixel."""
         return float(self.transform().m11())
 
-    def wheelEvent(self, event):
+    def wheelEvent(self, event: Any) -> None:
         steps = event.angleDelta().y() / 120.0
         if steps:
             self.zoom(1.25**steps)
         event.accept()
 
-    def resizeEvent(self, event):
+    def resizeEvent(self, event: Any) -> None:
         super().resizeEvent(event)
         if self._fitted:
             self.fit()
 
-    def mousePressEvent(self, event):
+    def mousePressEvent(self, event: Any) -> None:
         pan = event.button() in (Qt.RightButton, Qt.MiddleButton) or (
             event.button() == Qt.LeftButton and event.modifiers() & Qt.ControlModifier
         )
@@ -174,7 +174,7 @@ class ImageView(QGraphicsView):
             self.clicked.emit(p.x(), p.y())
         super().mousePressEvent(event)
 
-    def mouseMoveEvent(self, event):
+    def mouseMoveEvent(self, event: Any) -> None:
         if self._pan_from is not None:
             d = event.pos() - self._pan_from
             self._pan_from = event.pos()
@@ -184,7 +184,7 @@ class ImageView(QGraphicsView):
             return
         super().mouseMoveEvent(event)
 
-    def mouseReleaseEvent(self, event):
+    def mouseReleaseEvent(self, event: Any) -> None:
         if self._pan_from is not None:
             self._pan_from = None
             self.unsetCursor()
@@ -290,6 +290,7 @@ class CamlocDock(QDockWidget):
 
     # --- layout ---------------------------------------------------------------------------
     def _build(self) -> None:
+        self.view = ImageView()
         body = QWidget()
         lay = QVBoxLayout(body)
         row = QHBoxLayout()
@@ -335,7 +336,6 @@ class CamlocDock(QDockWidget):
         self.undo_button.clicked.connect(self.undo)
         zoom.addWidget(self.undo_button)
         lay.addLayout(zoom)
-        self.view = ImageView()
         self.view.clicked.connect(self.image_clicked)
         lay.addWidget(self.view, 1)
 
@@ -539,7 +539,7 @@ class CamlocDock(QDockWidget):
         for key, (x, y) in a.axes.items():
             dot(x, y, AXIS_COLOURS[key])
         if a.pending is not None:
-            dot(*a.pending, "#ffff00")
+            dot(a.pending[0], a.pending[1], "#ffff00")
         for i, (x, y) in enumerate(a.corners):
             dot(x, y, AXIS_COLOURS["corners"], MARKER_PX * 1.3)
             t = sc.addSimpleText(str(i))
@@ -916,7 +916,7 @@ class CamlocDock(QDockWidget):
             self.task = None
         self._stop_page()
 
-    def closeEvent(self, event):
+    def closeEvent(self, event: Any) -> None:
         self.pick_button.setChecked(False)
         self._stop_page()
         super().closeEvent(event)
