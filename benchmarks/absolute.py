@@ -13,9 +13,9 @@ the corners against mapped kerbs where they exist).
 
 Synthetic cameras stand at these junctions (several OSM extracts: row-house grid, old
 towns, a hilly principality, a Mexican grid, Moscow, Oakland...), placed by
-:func:`camloc_geo.synthetic.make_located_scene`: 2.5-14 m high, 12-45 m from the junction,
+:func:`camloc_geo.testing.synthetic.make_located_scene`: 2.5-14 m high, 12-45 m from the junction,
 outside buildings, horizontal fields of view 45-95°, a car in a lane of one of the streets.
-Annotations follow :class:`camloc_geo.synthetic.NoiseModel` (defaults: 2 px clicks, 1 px
+Annotations follow :class:`camloc_geo.testing.synthetic.NoiseModel` (defaults: 2 px clicks, 1 px
 segment ends, 10 % wrong-corner and 10 % sloppy annotators, car size off by 5 % per
 dimension, five annotators); the real kerbs differ from the map's corners by 1.5 m (RMS over
 both axes); the references' map positions are off by 0.5 m per axis.
@@ -60,13 +60,12 @@ from typing import Any
 
 import numpy as np
 
-from camloc_geo.absolute import LocateResult, locate
-from camloc_geo.cues import apply_cues
+from camloc_geo.absolute import LocateResult, apply_cues, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent

@@ -35,7 +35,7 @@ def main() -> int:
 
     stand_in = _geocode_double.install_if_missing()
     from camloc_geo.batch import run_batch
-    from camloc_geo.batch._synthetic import make_camera_list
+    from camloc_geo.testing.camera_list import make_camera_list
 
     work = OUT / "batch_work"
     lst = work / f"cameras_{args.n}.csv"

@@ -2,7 +2,7 @@
 
 Each trial draws a noisy scene (same camera and annotation-noise model as
 ``benchmarks/relative.py``), calibrates it, and lets people walk in the true camera's view
-for 40 s or 120 s (:func:`camloc_geo.synthetic_guide.make_guide_data`: foot pixels with 2 px
+for 40 s or 120 s (:func:`camloc_geo.testing.synthetic_guide.make_guide_data`: foot pixels with 2 px
 noise at 5 Hz; phones log at 1 Hz with time-correlated noise, correlation 10 s, per-axis sigma
 ``gps_sigma_m``; with 4 or more people one has no phone; two distractor phones walk 15-60 m
 away, unseen). The guide runs with the calibrated camera
@@ -43,12 +43,12 @@ from camloc_geo import InputError
 from camloc_geo.relative import calibrate
 from camloc_geo.scene import parse_scene
 from camloc_geo.sensors.guide import AbsolutePose, GuideSettings, match_people
-from camloc_geo.synthetic_guide import make_guide_data
+from camloc_geo.testing.synthetic_guide import make_guide_data
 
 sys.path.insert(0, str(Path(__file__).parent))
 from relative import draw_scene
 
-from camloc_geo.synthetic import NoiseModel
+from camloc_geo.testing.synthetic import NoiseModel
 
 OUT_DIR = Path(__file__).parent / "out"
 CONFIGS = [

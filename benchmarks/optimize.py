@@ -24,7 +24,7 @@ from camloc_geo import relative
 from camloc_geo._optimize import soft_l1_least_squares
 from camloc_geo.osm import load_map
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
 HERE = Path(__file__).resolve().parent
 OSM = HERE.parent / "data" / "osm"

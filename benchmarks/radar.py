@@ -1,6 +1,6 @@
 """Benchmark of the virtual radar (``camloc_geo.sensors.radar``) on synthetic traffic videos.
 
-Renders ``--n`` videos (``camloc_geo.synthetic_video``) into a temporary directory, never
+Renders ``--n`` videos (``camloc_geo.testing.synthetic_video``) into a temporary directory, never
 into the repository: a random pole camera (height 5-10 m, 14-24 m from the reference car,
 horizontal field of view 55-80°), ``--size`` frames (default 1280×720) at 25 or 30 fps with
 2 px sensor noise and MJPG compression, a textured road, the scene's parked car, and two
@@ -54,8 +54,8 @@ from camloc_geo import InputError
 from camloc_geo.api import calibrate_scene
 from camloc_geo.relative import CalibrationResult
 from camloc_geo.sensors.radar import RadarResult, measure_speeds
-from camloc_geo.synthetic import NoiseModel, make_scene
-from camloc_geo.synthetic_video import (
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic_video import (
     SyntheticVehicle,
     SyntheticVideo,
     render_video,

@@ -1,6 +1,6 @@
 """Benchmark of the relative pose (``camloc_geo.relative.calibrate``) on synthetic scenes.
 
-Draws ``--n`` synthetic scenes with :mod:`camloc_geo.synthetic` (noise model in
+Draws ``--n`` synthetic scenes with :mod:`camloc_geo.testing.synthetic` (noise model in
 ``benchmarks/README.md``), calibrates each with the joint robust fit (the default) and with
 the paper's cluster baseline (``CalibrationSettings(joint_fit=False)``), and writes
 
@@ -37,7 +37,7 @@ from camloc_geo import InputError
 from camloc_geo.objects import PRESETS
 from camloc_geo.relative import CalibrationSettings, calibrate
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import NoiseModel, make_scene, random_camera
+from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
 
 OUT_DIR = Path(__file__).parent / "out"
 IMAGE_SIZES = ((1280, 720), (1920, 1080))

@@ -43,7 +43,7 @@ from camloc_geo.sensors import ground_distance, point_height
 sys.path.insert(0, str(Path(__file__).parent))
 from relative import draw_scene
 
-from camloc_geo.synthetic import NoiseModel
+from camloc_geo.testing.synthetic import NoiseModel
 
 OUT_DIR = Path(__file__).parent / "out"
 PAPER_P90 = {"scale_rel_error": 0.20, "height_rel_error": 0.25}

@@ -5,10 +5,15 @@ options, and returns typed results. Domain decisions (where to anchor the map, h
 load it, whether a map is needed, when the network may be used) live here and nowhere in the
 front ends.
 
-Network policy (one rule for every command): an extract given as ``map_source`` is always
-used and the network never is; without one, Overpass is queried through osmnx (cached) when
-``network`` is true, and a scene that needs a map fails with a :class:`MapDataError` naming
-``--osm EXTRACT`` when it is false.
+Map sources (the same for every front end): ``map_source`` is an extract, a folder of
+extracts, a :class:`~camloc_geo.osm.MapCatalogue` or an already loaded map. A folder or a
+catalogue chooses the map for a point by the catalogue's one rule (the smallest extract
+covering it, loaded whole or by cells; Overpass cells when the catalogue allows the network).
+
+Network policy (one rule for every command): an extract or folder given as ``map_source`` is
+always used and the network never is; without one, Overpass is queried through osmnx (cached)
+when ``network`` is true, and a scene that needs a map fails with a :class:`MapDataError`
+naming ``--osm EXTRACT`` when it is false.
 
 Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 """
@@ -16,7 +21,7 @@ Coordinates: scalars are keyword-only ``lat=`` / ``lon=`` (degrees WGS 84).
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Union
@@ -26,7 +31,8 @@ from camloc_geo._errors import MapDataError, SceneError
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
     from camloc_geo.autovp import AutoVPResult
-    from camloc_geo.osm import MapData
+    from camloc_geo.cameras import CameraResult, CameraRow
+    from camloc_geo.osm import MapCatalogue, MapData
     from camloc_geo.relative import CalibrationResult, CalibrationSettings
     from camloc_geo.scene import Scene
     from camloc_geo.sensors.guide import GuideResult, GuideSettings
@@ -39,21 +45,27 @@ __all__ = [
     "SceneLike",
     "calibrate_scene",
     "corners_near",
+    "corners_within",
+    "crowd_scene",
     "guide_scene",
+    "locate_camera",
     "locate_scene",
     "map_around",
     "map_for_scene",
     "radar_scene",
+    "read_camera_list",
     "scene_from",
     "streets_near",
+    "streets_within",
     "vanishing_points",
 ]
 
 SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
 """A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
 
-MapSource = Union[str, os.PathLike, "MapData", None]
-"""A map: an extract path, an already loaded :class:`~camloc_geo.osm.MapData`, or None."""
+MapSource = Union[str, os.PathLike, "MapData", "MapCatalogue", None]
+"""A map: an extract or folder path, a :class:`~camloc_geo.osm.MapCatalogue`, an already
+loaded :class:`~camloc_geo.osm.MapData`, or None."""
 
 DEFAULT_MIN_RADIUS_M = 300.0
 """The smallest map radius loaded around a scene (metres)."""
@@ -147,6 +159,20 @@ def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
     )
 
 
+def _catalogue_of(map_source: MapSource) -> MapCatalogue | None:
+    """The catalogue a map source chooses through: a catalogue itself, or a folder's."""
+    if map_source is None:
+        return None
+    is_path = isinstance(map_source, (str, os.PathLike))
+    if is_path and not Path(map_source).expanduser().is_dir():  # type: ignore[arg-type]
+        return None
+    from camloc_geo.osm import MapCatalogue
+
+    if is_path:
+        return MapCatalogue.from_source(map_source)  # type: ignore[arg-type]
+    return map_source if isinstance(map_source, MapCatalogue) else None
+
+
 def map_for_scene(
     scene: SceneLike,
     *,
@@ -162,9 +188,12 @@ def map_for_scene(
     Parameters
     ----------
     map_source
-        Extract path or a loaded map; None: Overpass when ``network`` allows it.
+        Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map;
+        None: Overpass when ``network`` allows it. A folder or catalogue gives the map
+        covering the scene's anchor, or None when none covers it and the scene needs none.
     network
-        May Overpass be queried (only when no ``map_source`` is given).
+        May Overpass be queried (only when no ``map_source`` is given; a catalogue says
+        itself whether it may).
     radius_m
         Map radius around the scene's anchor (default :func:`scene_map_radius_m`).
     required
@@ -172,12 +201,28 @@ def map_for_scene(
         or the scene needs one.
     """
     sc = scene_from(scene)
-    if map_source is not None and not isinstance(map_source, (str, os.PathLike)):
-        return map_source  # an already loaded MapData
+    catalogue = _catalogue_of(map_source)
+    loaded = catalogue is None and map_source is not None
+    if loaded and not isinstance(map_source, (str, os.PathLike)):
+        return map_source  # type: ignore[return-value]  # an already loaded MapData
     need = scene_needs_map(sc) if required is None else required
     if map_source is None and not need:
         return None
     centre = scene_anchor(sc)
+    if catalogue is not None:
+        if centre is None:
+            if not need:
+                return None
+        else:
+            area = catalogue.area_for_point(centre[0], centre[1])
+            if area[0] != "none":
+                return catalogue.map_for_area(area)
+            if not need:
+                return None
+            raise MapDataError(
+                "this scene needs a map (intersection corners, landmarks or street bearings) "
+                f"and no map serves it: {area[1]}"
+            )
     if centre is None:
         raise SceneError(
             "no location to load the map around: give prior (lat/lon), intersection lat/lon "
@@ -193,7 +238,7 @@ def map_for_scene(
     from camloc_geo.osm import load_map
 
     if map_source is not None:
-        return load_map(map_source, centre[0], centre[1], radius_m=radius)
+        return load_map(map_source, centre[0], centre[1], radius_m=radius)  # type: ignore[arg-type]
     return load_map(
         None,
         centre[0],
@@ -278,6 +323,61 @@ def locate_scene(
     return LocateOutput(scene=sc, result=result, map_data=map_data)
 
 
+def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
+    """The cameras of a list (CSV or GeoJSON, column variants in ``docs/batch.md``), streamed.
+
+    Raises
+    ------
+    InputError
+        The list is missing or unreadable (a bad row is a :class:`CameraRow` with problems).
+    """
+    from camloc_geo.cameras import read_camera_list as _read
+
+    return _read(path)
+
+
+def locate_camera(
+    camera: CameraRow | Mapping[str, Any],
+    *,
+    map_source: MapSource = None,
+    network: bool = False,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> CameraResult:
+    """Place one camera of a list: the camera-list engine every front end calls.
+
+    Its title's junction, its rough point (a prior), its scene (a file or inline) and the
+    view words, on the map the catalogue chooses for its point (a title without a point is
+    searched in every extract). ``camloc batch``, the service's jobs and QGIS's
+    ``camloc:geocodelist`` all call this, so one camera gets one answer.
+
+    Parameters
+    ----------
+    camera
+        A :class:`~camloc_geo.cameras.CameraRow` or a mapping with a list's columns (``id``,
+        ``title``, ``lat``, ``lon``, ``radius_m``, ``scene`` and their aliases).
+    map_source
+        An extract, a folder of extracts, a :class:`~camloc_geo.osm.MapCatalogue` or a loaded
+        map; None: Overpass when ``network`` allows it.
+
+    Returns
+    -------
+    A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
+    ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
+    """
+    from camloc_geo.cameras import CameraRow, geocode_camera
+    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.osm import MapCatalogue, MapData
+
+    row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)
+    if isinstance(map_source, MapData):
+        return geocode_camera(row, map_data=map_source)
+    catalogue = MapCatalogue.from_source(
+        map_source, network=network, cache_folder=cache_folder, overpass_url=overpass_url
+    )
+    return geocode_camera(row, plan=catalogue)
+
+
 def _require_source(map_source: MapSource, network: bool) -> None:
     """Fail at once (before any heavy import) when no map can be had."""
     if map_source is None and not network:
@@ -340,12 +440,20 @@ def streets_near(
         Overpass could not be reached (within a few seconds) or failed.
     """
     _require_source(map_source, network)
+    catalogue = _catalogue_of(map_source)
+    if catalogue is not None:
+        return catalogue.map_for_point(lat=lat, lon=lon)
     from camloc_geo.osm import MapData, load_map
 
     if isinstance(map_source, MapData):
         return map_source
     return load_map(
-        map_source, lat, lon, radius_m, cache_folder=cache_folder, overpass_url=overpass_url
+        map_source,  # type: ignore[arg-type]  # an extract path or None here
+        lat,
+        lon,
+        radius_m,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
     )
 
 
@@ -358,6 +466,7 @@ def vanishing_points(
     axes_px: Sequence[Sequence[float]] = (),
     estimate_principal_point: bool = False,
     seed: int = 0,
+    **options: Any,
 ) -> AutoVPResult:
     """Three orthogonal vanishing points, focal length, horizon, pitch and roll of a photo.
 
@@ -373,6 +482,9 @@ def vanishing_points(
         ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
     estimate_principal_point
         Also refine the principal point around the image centre.
+    **options
+        Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
+        ``focal_prior_px``, ``distortion``, ...).
 
     Raises
     ------
@@ -408,6 +520,7 @@ def vanishing_points(
         mask=mask,
         estimate_principal_point=estimate_principal_point,
         axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+        **options,
     )
 
 
@@ -434,8 +547,12 @@ def map_around(
         return map_source
     lat = sum(p[0] for p in points) / len(points)
     lon = sum(p[1] for p in points) / len(points)
+    catalogue = _catalogue_of(map_source)
+    if catalogue is not None:
+        return catalogue.map_for_point(lat=lat, lon=lon)
     radius = max(distance_m(lat1=lat, lon1=lon, lat2=q[0], lon2=q[1]) for q in points)
-    return load_map(map_source, lat, lon, radius_m=min(radius + margin_m, max_radius_m))
+    radius_m = min(radius + margin_m, max_radius_m)
+    return load_map(map_source, lat, lon, radius_m=radius_m)  # type: ignore[arg-type]
 
 
 def radar_scene(
@@ -610,3 +727,103 @@ def guide_scene(
     result = match_people(calibration, pixel_tracks, traces, pose=abs_pose, settings=settings)
     result.warnings[:0] = warnings + list(calibration.warnings)
     return result
+
+
+def corners_within(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+    streets: str | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> dict[str, Any]:
+    """:func:`corners_near` limited to the intersections within ``radius_m`` of the point.
+
+    For a map loaded wider than the radius (a whole extract shared by many requests): only
+    intersections whose node lies within ``radius_m`` (geodesic distance) are kept, with
+    their corners. With ``streets`` the named intersection is returned wherever it is.
+    """
+    gj = corners_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        streets=streets,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    if streets:
+        return gj
+    from camloc_geo.geodesy import distance_m
+
+    inters = [f for f in gj["features"] if f["properties"].get("kind") == "intersection"]
+    keep: set[Any] = set()
+    if inters:
+        lons = [f["geometry"]["coordinates"][0] for f in inters]
+        lats = [f["geometry"]["coordinates"][1] for f in inters]
+        dist = distance_m(lat1=[lat] * len(lats), lon1=[lon] * len(lons), lat2=lats, lon2=lons)
+        keep = {f["properties"]["id"] for f, d in zip(inters, dist, strict=True) if d <= radius_m}
+    gj["features"] = [
+        f
+        for f in gj["features"]
+        if f["properties"].get("id") in keep or f["properties"].get("intersection") in keep
+    ]
+    return gj
+
+
+def streets_within(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> dict[str, Any]:
+    """The streets within ``radius_m`` of a point with their bearings (JSON).
+
+    ``near`` lists each street's name and bearing there; ``streets`` describes only those
+    streets (not every street of the map, which may be a whole extract).
+    """
+    from camloc_geo.osm import streets_json
+
+    m = streets_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    out = streets_json(m, lat, lon, radius_m)
+    names = {n["name"] for n in out["near"]}
+    out["streets"] = [s for s in out["streets"] if s["name"] in names]
+    return out
+
+
+def crowd_scene(
+    scenes: Sequence[SceneLike], *, prior: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """One scene from several annotators' scenes of one snapshot, with the task's prior.
+
+    The scenes are merged (:func:`camloc_geo.merge.merge_scenes`); ``prior`` (``{"lat",
+    "lon", "radius_m"}``, the point the snapshot was taken near) is used when no annotator
+    gave one.
+
+    Raises
+    ------
+    SceneError
+        No scene, a scene that does not validate, or scenes that conflict.
+    """
+    from camloc_geo.merge import merge_scenes
+
+    merged = dict(merge_scenes(list(scenes)))
+    if prior is not None and merged.get("prior") is None:
+        merged["prior"] = dict(prior)
+    return merged

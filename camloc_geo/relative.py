@@ -34,7 +34,6 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo._optimize import soft_l1_cost
@@ -97,6 +96,12 @@ class CalibrationSettings:
         Candidates closer than ``max(min_m, rel × median camera distance)`` are linked.
     outlier_weight
         Annotators whose final weight falls below this are reported as outliers.
+    jackknife, jackknife_method
+        Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators).
+        ``one_step``: one Gauss-Newton step per left-out annotator from the joint solution,
+        on the fit's own residuals and Jacobian (no refits; within 10 % of the refits'
+        sigmas, see ``benchmarks/calibrate_speed.py``); ``refit``: the whole calibration
+        repeated without each annotator (the reference, about 5x the cost of one fit).
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -119,6 +124,7 @@ class CalibrationSettings:
     principal_point_prior_sigma_rel: float = 0.03
     reassign_corners: bool = True
     jackknife: bool = True
+    jackknife_method: Literal["one_step", "refit"] = "one_step"
 
 
 @dataclass
@@ -685,6 +691,8 @@ class _JointProblem:
             k += 2
         else:
             pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         R = Rotation.from_rotvec(X[:, k : k + 3]).as_matrix() @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
@@ -836,6 +844,8 @@ def _score_test(
     """
     f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
     x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
     x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
     r = prob.residuals(x1, R0, None, f_fixed)
     J = prob.jacobian(x1, R0, None, f_fixed)
@@ -967,6 +977,18 @@ class _Screening:
     excluded: list[dict[str, Any]]
     clamped_clicks: int
     warnings: list[str]
+    dropped: list[_DroppedSegment] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _DroppedSegment:
+    """A segment the screen left out: whose (scene index), which axis and position, why."""
+
+    index: int
+    axis: str
+    position: int
+    segment: tuple[float, ...]
+    warning: str
 
 
 def _screen_annotation(
@@ -1014,7 +1036,7 @@ def _screen_annotation(
     return new, None, clamped, notes
 
 
-def _screen_annotations(scene: Scene) -> _Screening:
+def _screen_annotations(scene: Scene, sigma_line_rel: float = 0.001) -> _Screening:
     """Clamp slips onto the image; leave out annotators and hints that cannot be used.
 
     An annotator is left out (with a warning naming them and the reason) when a click is not
@@ -1044,7 +1066,8 @@ def _screen_annotations(scene: Scene) -> _Screening:
         clamped += n
     if clamped:
         log.info("%d click(s) just outside the image clamped onto it", clamped)
-    anns, kept = _screen_segments(scene, anns, kept, excluded, warnings)
+    dropped: list[_DroppedSegment] = []
+    anns, kept = _screen_segments(scene, anns, kept, excluded, warnings, dropped, sigma_line_rel)
     update: dict[str, Any] = {"annotations": anns}
     hints: dict[str, Any] = {}
     w, h = scene.image_size
@@ -1069,17 +1092,57 @@ def _screen_annotations(scene: Scene) -> _Screening:
         warnings.append(msg)
     if hints:
         update["camera"] = scene.camera.model_copy(update=hints)
-    return _Screening(scene.model_copy(update=update), kept, excluded, clamped, warnings)
+    kept_set = set(kept)
+    dropped = [d for d in dropped if d.index in kept_set]
+    return _Screening(scene.model_copy(update=update), kept, excluded, clamped, warnings, dropped)
 
 
-def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
-    """Residuals (px) of segments to their least-median-of-squares vanishing point.
+def _residuals_to_many(segments: FloatArray, V: FloatArray) -> FloatArray:
+    """:func:`segment_residuals_px` of every segment to every vanishing point: ``(P, n)``."""
+    mx = (segments[:, 0] + segments[:, 2]) / 2.0
+    my = (segments[:, 1] + segments[:, 3]) / 2.0
+    px, py, pw = V[:, 0:1], V[:, 1:2], V[:, 2:3]
+    la, lb = my * pw - py, px - mx * pw
+    lc = mx * py - my * px
+    out = (la * segments[:, 0] + lb * segments[:, 1] + lc) / np.maximum(np.hypot(la, lb), 1e-300)
+    return np.asarray(out, dtype=np.float64)
 
-    Candidates are the intersections of pairs of segments (all pairs up to 25 segments, 300
-    seeded random pairs beyond); the one with the smallest median residual is refined by a
-    fit to its inliers. Robust to nearly half the segments being slips, however long.
+
+def _consensus_residuals(
+    segments: FloatArray, diag: float, sigma_px: float
+) -> tuple[FloatArray, float] | None:
+    """Residuals (px) of segments to their consensus vanishing point, and the noise scale.
+
+    Every line is a witness in proportion to its information. A segment of length ``L``
+    whose endpoints are off by ``σ`` misses a vanishing point ``θ`` away from its direction
+    by ``r ≈ L/2 · sin θ``, so its standardised residual ``r / σ`` counts the sigmas of its
+    own angular precision ``σ / L``: a 560 px road line 0.5° off a point is many sigmas out,
+    a 30 px car edge is not, and a point the short edges merely tolerate cannot outvote the
+    long lines. Candidates are the intersections of pairs of segments (all pairs up to 25
+    segments; beyond, 300 seeded random pairs and every pair of the 12 longest). The noise
+    scale is the least-median-of-squares one (at least ``sigma_px``), and each candidate is
+    scored by the truncated cost ``Σ min(rᵢ², T²)`` (MSAC, ``T`` = three noise scales): the
+    best-determined point, the one every line fits within its own noise, wins, not the one
+    most lines happen to tolerate. It is refined by a fit to its inliers, and the inliers
+    re-admitted against the refined point until they settle: a line that agrees with the
+    final fit is not left out.
+
+    Parameters
+    ----------
+    segments
+        ``(n, 4)`` segments, pixels.
+    diag
+        Image diagonal, pixels.
+    sigma_px
+        Endpoint noise of a drawn segment, pixels.
+
+    Returns
+    -------
+    ``(n,)`` absolute residuals and their robust scale (pixels, at least 0.2 % of the
+    diagonal), or None when no pair of segments meets.
     """
     n = len(segments)
+    lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
     ones = np.ones((n, 1))
     lines = np.cross(np.hstack([segments[:, :2], ones]), np.hstack([segments[:, 2:], ones]))
     lines /= np.maximum(np.linalg.norm(lines[:, :2], axis=1), 1e-12)[:, None]
@@ -1087,7 +1150,13 @@ def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
         pairs = np.array([(i, j) for i in range(n) for j in range(i + 1, n)])
     else:
         rng = np.random.default_rng(0)
-        pairs = rng.integers(0, n, (300, 2))
+        longest = np.argsort(-lengths)[:12]
+        pairs = np.vstack(
+            [
+                rng.integers(0, n, (300, 2)),
+                np.array([(a, b) for k, a in enumerate(longest) for b in longest[k + 1 :]]),
+            ]
+        )
         pairs = pairs[pairs[:, 0] != pairs[:, 1]]
     if len(pairs) == 0:
         return None
@@ -1096,25 +1165,28 @@ def _lmeds_residuals(segments: FloatArray, diag: float) -> FloatArray | None:
     if len(V) == 0:
         return None
     V /= np.linalg.norm(V, axis=1)[:, None]
-    # segment_residuals_px for every candidate at once: (P, n).
-    mx = (segments[:, 0] + segments[:, 2]) / 2.0
-    my = (segments[:, 1] + segments[:, 3]) / 2.0
-    px, py, pw = V[:, 0:1], V[:, 1:2], V[:, 2:3]
-    la, lb = my * pw - py, px - mx * pw
-    lc = mx * py - my * px
-    res = (la * segments[:, 0] + lb * segments[:, 1] + lc) / np.maximum(np.hypot(la, lb), 1e-300)
-    med = np.median(np.abs(res), axis=1)
-    best = (float(med.min()), V[int(np.argmin(med))])
-    r = np.abs(segment_residuals_px(segments, best[1]))
-    scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
-    inliers = r <= 3.0 * scale
-    if inliers.sum() >= 2:
+    res = np.abs(_residuals_to_many(segments, V))
+    noise = max(1.4826 * float(np.min(np.median(res, axis=1))), sigma_px)
+    threshold = 3.0 * noise
+    cost = np.sum(np.minimum(res, threshold) ** 2, axis=1)
+    r = res[int(np.argmin(cost))]
+    floor = max(sigma_px, 0.002 * diag)
+    scale = max(noise, floor)
+    inliers = r <= threshold
+    for _ in range(5):
+        if inliers.sum() < 2:
+            break
         try:
             vp = fit_vanishing_point(segments[inliers], scale_px=diag, name="pooled")
-            r = np.abs(segment_residuals_px(segments, vp.homogeneous))
         except (DegenerateGeometryError, np.linalg.LinAlgError):
-            pass
-    return np.asarray(r, dtype=np.float64)
+            break
+        r = np.abs(segment_residuals_px(segments, vp.homogeneous))
+        scale = max(1.4826 * float(np.median(r[inliers])), floor)
+        new_inliers = r <= 3.0 * scale
+        if np.array_equal(new_inliers, inliers):
+            break
+        inliers = new_inliers
+    return np.asarray(r, dtype=np.float64), scale
 
 
 def _screen_segments(
@@ -1123,15 +1195,19 @@ def _screen_segments(
     kept: list[int],
     excluded: list[dict[str, Any]],
     warnings: list[str],
+    dropped: list[_DroppedSegment],
+    sigma_line_rel: float,
 ) -> tuple[list[Annotation], list[int]]:
     """Leave out segments that disagree grossly with everybody's vanishing point of their axis.
 
-    Per axis, the vanishing point of all annotators' segments pooled (with a robust 3 × MAD
-    rejection) is the reference; a segment farther from it than ``max(8 × the robust scale,
-    1 % of the image diagonal)``, or pointing more than 30° away from it and farther than
-    3 × the robust scale, is a slip (an end dragged away, a line drawn for another axis)
-    and is dropped with a warning. An annotator (of three or more) most of whose
-    segments of an axis are such slips drew that axis wrong and is left out.
+    Per axis, the consensus vanishing point of all annotators' segments pooled, each
+    weighted by its information (:func:`_consensus_residuals`), is the reference; a segment
+    farther from it than ``max(8 × the robust scale, 1 % of the image diagonal)``, or
+    pointing more than 30° away from it and farther than 3 × the robust scale, is a slip (an
+    end dragged away, a line drawn for another axis) and is dropped with a warning (and
+    recorded in ``dropped``: :func:`calibrate` re-admits it if it agrees with the final
+    fit). An annotator (of three or more) most of whose segments of an axis are such slips
+    drew that axis wrong and is left out.
     """
     w, h = scene.image_size
     diag = math.hypot(w, h)
@@ -1141,10 +1217,10 @@ def _screen_segments(
         pooled = np.vstack(segs) if segs else np.zeros((0, 4))
         if len(pooled) < 5:  # too few to tell a slip from the others' noise
             continue
-        r = _lmeds_residuals(pooled, diag)
-        if r is None:
+        found = _consensus_residuals(pooled, diag, sigma_line_rel * diag)
+        if found is None:
             continue
-        scale = max(1.4826 * float(np.median(r)), 0.002 * diag)
+        r, scale = found
         half = 0.5 * np.hypot(pooled[:, 2] - pooled[:, 0], pooled[:, 3] - pooled[:, 1])
         angle = np.degrees(np.arcsin(np.clip(r / np.maximum(half, 1e-9), 0.0, 1.0)))
         bad = (r > max(8.0 * scale, 0.01 * diag)) | ((angle > 30.0) & (r > 3.0 * scale))
@@ -1171,10 +1247,12 @@ def _screen_segments(
                 )
                 break
             for j in np.flatnonzero(flags):
-                warnings.append(
+                text = (
                     f"annotations[{i}].vp_lines.{axis}[{j}] ({ann.annotator}): far from "
                     "everybody's vanishing point of that axis; left out"
                 )
+                warnings.append(text)
+                dropped.append(_DroppedSegment(i, axis, int(j), tuple(segs_list[j]), text))
             lines[axis] = [sg for sg, f in zip(segs_list, flags, strict=True) if not f]
         if reason is not None:
             excluded.append(
@@ -1308,15 +1386,17 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     if not scene.annotations:
         raise SceneError("at least one annotation is needed to calibrate", "annotations")
     names = [a.annotator for a in scene.annotations]
-    screening = _screen_annotations(scene)
+    screening = _screen_annotations(scene, settings.sigma_line_rel)
     if not screening.kept:
         raise _no_usable_annotator(screening.excluded)
-    for msg in screening.warnings[len(scene.input_warnings) :]:
-        log.warning("%s", msg)  # the scene's own were logged when it was read
     clean = screening.scene
     excluded = list(screening.excluded)
     kept = list(screening.kept)
     result = _calibrate_usable(clean, settings)
+    if screening.dropped and result.method == "joint_fit":
+        result, clean = _readmit_agreeing(result, clean, screening, settings)
+    for msg in screening.warnings[len(scene.input_warnings) :]:
+        log.warning("%s", msg)  # the scene's own were logged when it was read
     problem = implausibility(result, scene.image_size)
     if problem is not None:
         result, dropped = _leave_one_out(clean, settings, result, problem)
@@ -1332,7 +1412,10 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
             update={"annotations": [a for j, a in enumerate(clean.annotations) if j != dropped]}
         )
     if settings.joint_fit and settings.jackknife and 2 <= len(kept) <= _MAX_JACKKNIFE:
-        _jackknife(result, clean, settings)
+        if settings.jackknife_method == "refit" or result.joint_state is None:
+            _jackknife(result, clean, settings)
+        else:
+            _jackknife_one_step(result, settings)
     result = _remap(result, kept, len(scene.annotations), excluded, names)
     result.excluded_annotators = sorted(excluded, key=lambda e: int(e["index"]))
     result.clamped_clicks = screening.clamped_clicks
@@ -1341,6 +1424,66 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
     )
     return result
+
+
+def _readmit_agreeing(
+    result: CalibrationResult,
+    clean: Scene,
+    screening: _Screening,
+    settings: CalibrationSettings,
+) -> tuple[CalibrationResult, Scene]:
+    """Give back the screened-out segments that agree with the joint fit, and refit.
+
+    The screen judges a segment against a consensus of the lines alone; the joint fit also
+    has the axis clicks and the other axes. A left-out segment whose residual to the fitted
+    camera's vanishing point of its axis is within three times that axis' kept segments'
+    robust residual scale (at least three times the line noise) agrees with the answer and
+    is put back; its warning is withdrawn. The refit replaces the result only if it is
+    plausible.
+    """
+    cam = result.camera
+    K = np.linalg.inv(cam.cam_from_img)
+    R = cam.cam_from_world_rotation
+    w, h = clean.image_size
+    sigma_line = settings.sigma_line_rel * math.hypot(w, h)
+    slot_of = {k: j for j, k in enumerate(screening.kept)}
+    back: list[_DroppedSegment] = []
+    for axis in AXES:
+        vp_h = K @ R[:, _AXIS_INDEX[axis]]
+        kept_segs = [_segments(a, axis) for a in clean.annotations]
+        pooled = np.vstack(kept_segs) if kept_segs else np.zeros((0, 4))
+        r_kept = np.abs(segment_residuals_px(pooled, vp_h)) if len(pooled) else np.zeros(0)
+        scale = max(1.4826 * float(np.median(r_kept)) if len(r_kept) else 0.0, sigma_line)
+        for d in screening.dropped:
+            if d.axis != axis or d.index not in slot_of:
+                continue
+            r = abs(float(segment_residuals_px(np.asarray(d.segment), vp_h)[0]))
+            if r <= 3.0 * scale:
+                back.append(d)
+    if not back:
+        return result, clean
+    anns = list(clean.annotations)
+    for slot in sorted({slot_of[d.index] for d in back}):
+        ann = anns[slot]
+        mine = [d for d in back if slot_of[d.index] == slot]
+        lines = {}
+        for axis in AXES:
+            segs = [tuple(sg) for sg in getattr(ann.vp_lines, axis)]
+            segs += [d.segment for d in mine if d.axis == axis]
+            lines[axis] = segs
+        anns[slot] = ann.model_copy(update={"vp_lines": ann.vp_lines.model_copy(update=lines)})
+    new_clean = clean.model_copy(update={"annotations": anns})
+    try:
+        refit = _calibrate_usable(new_clean, settings)
+    except (InputError, np.linalg.LinAlgError):
+        return result, clean
+    if refit.method != "joint_fit" or implausibility(refit, clean.image_size) is not None:
+        return result, clean
+    gone = {d.warning for d in back}
+    screening.warnings[:] = [wn for wn in screening.warnings if wn not in gone]
+    screening.dropped[:] = [d for d in screening.dropped if d.warning not in gone]
+    log.info("%d screened-out segment(s) agree with the joint fit: re-admitted", len(back))
+    return refit, new_clean
 
 
 def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSettings) -> None:
@@ -1383,11 +1526,20 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             influence.append(None)  # another frame, or no answer without them
             continue
         centres.append(res.camera.center_in_world)
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         turn = Rotation.from_matrix(res.camera.cam_from_world_rotation @ R.T).as_rotvec()
         if np.linalg.norm(turn) < math.radians(30.0):  # else another frame: not a spread
             turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
     result.annotator_influence_m = influence
+    _add_jackknife_spread(result, centres, turns)
+
+
+def _add_jackknife_spread(
+    result: CalibrationResult, centres: list[FloatArray], turns: list[FloatArray]
+) -> None:
+    """Add the jackknife variance of leave-one-out centres and turns (rotvecs) to the sigmas."""
     if len(centres) < 2:
         return
     arr = np.asarray(centres)
@@ -1404,6 +1556,102 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     base_r = result.rotation_sigma_deg if result.rotation_sigma_deg is not None else np.zeros(3)
     result.rotation_sigma_fit_deg = base_r
     result.rotation_sigma_deg = np.sqrt(base_r**2 + rot_jack**2)
+
+
+def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray | None]:
+    """Parameter vectors of the joint fit without each annotator, by Gauss-Newton steps.
+
+    At the joint solution ``x`` the robust (soft-L1, IRLS-weighted) normal equations are
+    ``H = Σₐ Hₐ + H_prior`` and ``g = Σₐ gₐ ≈ 0``, summed over annotators' rows. Leaving
+    annotator ``a`` out, one Newton step from ``x`` gives ``x₋ₐ = x − (H − Hₐ)⁻¹ (g − gₐ)``:
+    the infinitesimal jackknife, warm-started at the answer, with every other annotator's
+    weight, corner and the principal-point model as the joint fit chose them. ``steps > 1``
+    repeats the step on the residuals at ``x₋ₐ``. None where the rest do not determine the
+    camera (``H − Hₐ`` singular).
+    """
+    prob = state.problem
+    saved = prob.weights
+    prob.weights = state.weights
+    try:
+        args = (state.rotation0, state.principal_point, state.focal_px)
+        n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+        owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
+        out: list[FloatArray | None] = []
+        x0 = np.asarray(state.x, dtype=float)
+        r = prob.residuals(x0, *args)
+        J = prob.jacobian(x0, *args)
+        owner = np.concatenate([owner_base, np.full(len(r) - n_seg - 2 * n_pt, -1)])
+        w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+        Jw = J * w[:, None]
+        # Per-annotator blocks of the normal equations, all at once.
+        n_ann = prob.n_annotators
+        onehot = owner[None, :] == np.arange(n_ann)[:, None]  # (n_ann, m)
+        H_all = J.T @ Jw
+        g_all = Jw.T @ r
+        H_a = np.einsum("am,mi,mj->aij", onehot.astype(float), J, Jw)
+        g_a = onehot.astype(float) @ (Jw * r[:, None])
+        for a in range(n_ann):
+            H = H_all - H_a[a]
+            g = g_all - g_a[a]
+            x = _newton_step(H, g, x0)
+            for _ in range(steps - 1):
+                if x is None:
+                    break
+                r_k = prob.residuals(x, *args)
+                J_k = prob.jacobian(x, *args)
+                keep = ~onehot[a]
+                w_k = 1.0 / np.sqrt(1.0 + (r_k[keep] / _F_SCALE) ** 2)
+                Jw_k = J_k[keep] * w_k[:, None]
+                x = _newton_step(J_k[keep].T @ Jw_k, Jw_k.T @ r_k[keep], x)
+            out.append(x)
+        return out
+    finally:
+        prob.weights = saved
+
+
+def _newton_step(H: FloatArray, g: FloatArray, x: FloatArray) -> FloatArray | None:
+    """``x − H⁻¹ g``, or None when ``H`` is (numerically) singular."""
+    d = np.sqrt(np.clip(np.diag(H), 1e-300, None))
+    Hs = H / d[:, None] / d[None, :]
+    if np.linalg.cond(Hs) > 1e10:
+        return None
+    return np.asarray(x - np.linalg.solve(Hs, g / d) / d, dtype=np.float64)
+
+
+def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings) -> None:
+    """The leave-one-annotator-out spread of :func:`_jackknife` without refits.
+
+    Each annotator's leave-out camera comes from :func:`_leave_one_out_steps` on the joint
+    fit's state; the spread and the influences are then as in :func:`_jackknife`.
+    """
+    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
+    state = result.joint_state
+    assert state is not None
+    prob = state.problem
+    args = (state.rotation0, state.principal_point, state.focal_px)
+    c = result.camera.center_in_world
+    R = result.camera.cam_from_world_rotation
+    M, origin = state.internal_from_output, state.internal_origin
+    centres: list[FloatArray] = []
+    turns: list[FloatArray] = []
+    influence: list[float | None] = []
+    for x in _leave_one_out_steps(state, steps=2):
+        if x is None or not np.all(np.isfinite(x)):
+            influence.append(None)
+            continue
+        _f, _pp, R_i, C_i = prob.unpack(x, *args)
+        c_i = M.T @ (C_i - origin)
+        if c_i[2] <= 0.0:
+            influence.append(None)  # no answer without them
+            continue
+        centres.append(c_i)
+        turn = Rotation.from_matrix((R_i @ M) @ R.T).as_rotvec()
+        if np.linalg.norm(turn) < math.radians(30.0):
+            turns.append(turn)
+        influence.append(float(np.linalg.norm(c_i - c)))
+    result.annotator_influence_m = influence
+    _add_jackknife_spread(result, centres, turns)
 
 
 def _so3_left_jacobian(rotvec: FloatArray) -> FloatArray:
@@ -1874,6 +2122,8 @@ def _joint(
     if pp_given is None and free_pp is not False and worth_trying:
         f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
         x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
         x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
         res_free = _fit(prob, x1, R0, None, f_fixed)
         cost_fixed, cost_free = 2.0 * res.cost, 2.0 * res_free.cost

@@ -32,11 +32,13 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
+    from camloc_geo.cameras import CameraResult
     from camloc_geo.osm import Intersection
     from camloc_geo.relative import CalibrationResult
 
 __all__ = [
     "ATTRIBUTION",
+    "JOB_LAYERS",
     "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "CalibrationOutput",
@@ -56,8 +58,11 @@ __all__ = [
     "PolygonGeometry",
     "ViewConeProperties",
     "calibration_output",
+    "camera_job_result",
     "corners_collection",
     "intersection_features",
+    "job_result_geojson",
+    "job_result_geopackage",
     "output_json_schema",
     "point",
     "to_json",
@@ -457,3 +462,116 @@ def output_json_schema(kind: OutputKind) -> dict[str, Any]:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = f"camloc {kind} output"
     return schema
+
+
+# ------------------------------------------------------------------------- camera lists
+_JOB_FIELDS = (
+    "id",
+    "title",
+    "status",
+    "reason",
+    "lat",
+    "lon",
+    "score",
+    "uncertainty_m",
+    "method",
+    "match_status",
+    "heading_deg",
+    "height_m",
+    "extract",
+    "n_candidates",
+)
+
+
+def camera_job_result(result: CameraResult) -> dict[str, Any]:
+    """One camera of an HTTP job, from the camera-list engine's result.
+
+    The camera's fields (``status`` in the engine's vocabulary, ``docs/contract.md``), the
+    tie as ``ambiguous`` (the engine's ``tie``), and ``candidates`` as GeoJSON point features
+    (``kind: "candidate"``, best first) for the job's GeoJSON and GeoPackage.
+    """
+    out: dict[str, Any] = {k: getattr(result, k, None) for k in _JOB_FIELDS}
+    out["ambiguous"] = bool(result.tie)
+    feats = []
+    for c in result.candidates:
+        if c.get("lat") is None or c.get("lon") is None:
+            continue
+        props = {k: v for k, v in c.items() if v is not None}
+        props["kind"] = "candidate"
+        feats.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [c["lon"], c["lat"]]},
+                "properties": props,
+            }
+        )
+    out["candidates"] = feats
+    return out
+
+
+# ------------------------------------------------------------------------- job results
+def job_result_geojson(job_id: str, results: Iterable[dict[str, Any]]) -> dict[str, Any]:
+    """The result of a camera-list job as one GeoJSON FeatureCollection.
+
+    Per camera (in list order) one ``camera`` feature (its status, reason and best position;
+    no geometry when it was not placed), then its ``candidate`` features, each carrying the
+    camera's id as ``camera_id``.
+    """
+    feats: list[dict[str, Any]] = []
+    for r in results:
+        props = {k: v for k, v in r.items() if k != "candidates"}
+        props["kind"] = "camera"
+        geom = (
+            {"type": "Point", "coordinates": [r["lon"], r["lat"]]}
+            if r.get("lat") is not None and r.get("lon") is not None
+            else None
+        )
+        feats.append({"type": "Feature", "geometry": geom, "properties": props})
+        for c in r.get("candidates", []) or []:
+            cp = dict(c["properties"])
+            cp["camera_id"] = r.get("id")
+            feats.append({"type": "Feature", "geometry": c["geometry"], "properties": cp})
+    return {
+        "type": "FeatureCollection",
+        "features": feats,
+        "properties": {"job": job_id, "attribution": ATTRIBUTION},
+    }
+
+
+JOB_LAYERS = (("cameras", "camera"), ("candidates", "candidate"))
+"""GeoPackage layers of a job result: ``(layer name, feature kind)``."""
+
+
+def job_result_geopackage(collection: dict[str, Any]) -> bytes:
+    """A job result (:func:`job_result_geojson`) as GeoPackage bytes, EPSG:4326.
+
+    Layers ``cameras`` and ``candidates`` (a layer without features is left out); list and
+    dict properties are stored as JSON text. Needs geopandas and pyogrio.
+    """
+    import json
+    import tempfile
+    from pathlib import Path
+
+    import geopandas as gpd
+    from shapely.geometry import shape
+
+    with tempfile.TemporaryDirectory(prefix="camloc-job-") as tmp:
+        path = Path(tmp) / "job.gpkg"
+        for layer, kind in JOB_LAYERS:
+            feats = [f for f in collection["features"] if f["properties"].get("kind") == kind]
+            if not feats:
+                continue
+            rows = [
+                {
+                    k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
+                    for k, v in f["properties"].items()
+                }
+                for f in feats
+            ]
+            frame = gpd.GeoDataFrame(
+                rows,
+                geometry=[shape(f["geometry"]) if f["geometry"] else None for f in feats],
+                crs="EPSG:4326",
+            )
+            frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio")
+        return path.read_bytes() if path.exists() else b""

@@ -2,7 +2,7 @@
 
 The scene is synthetic (there is no photograph of it): a camera at Eastern Avenue & South
 Broadway (OSM data of the bundled ``baltimore.osm.pbf``), a sedan in a lane of South
-Broadway, three annotators with the documented noise of :mod:`camloc_geo.synthetic`, three
+Broadway, three annotators with the documented noise of :mod:`camloc_geo.testing.synthetic`, three
 visible kerb corners listed clockwise as a person sees them on screen, the streets named.
 The true camera position is written next to it (``sample_scene.truth.json``) so the
 README's command can be checked against it.
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from camloc_geo.osm import load_map
-from camloc_geo.synthetic import NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
 HERE = Path(__file__).resolve().parent
 

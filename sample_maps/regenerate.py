@@ -4,7 +4,7 @@ Usage (from the repository root)::
 
     python sample_maps/regenerate.py [--out sample_maps] [--online]
 
-Each camera is a synthetic scene (:func:`camloc_geo.synthetic.make_located_scene`, fixed
+Each camera is a synthetic scene (:func:`camloc_geo.testing.synthetic.make_located_scene`, fixed
 seeds, the default annotation noise) at a real intersection of a bundled extract, located with
 :func:`camloc_geo.absolute.locate`; its page is written offline (one self-contained HTML file,
 overlays embedded). The synthetic scenes have no picture, so the overlays are drawn on a blank
@@ -29,7 +29,7 @@ from camloc_geo.absolute import LocateResult, locate
 from camloc_geo.maps import candidates_map, summary_map
 from camloc_geo.osm import load_map
 from camloc_geo.scene import load_scene, parse_scene
-from camloc_geo.synthetic import make_located_scene
+from camloc_geo.testing.synthetic import make_located_scene
 
 log = logging.getLogger("sample_maps")
 

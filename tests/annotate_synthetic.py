@@ -1,8 +1,8 @@
 """A synthetic snapshot for the annotation page: a known camera at a real Baltimore junction.
 
-The picture is drawn with OpenCV from :mod:`camloc_geo.synthetic` geometry: ground and sky split
-at the true horizon, the car's box, the scene lines the synthetic annotator uses and the kerb
-corners. The scene dict holds the exact pixels a careful person would click.
+The picture is drawn with OpenCV from :mod:`camloc_geo.testing.synthetic` geometry: ground and
+sky split at the true horizon, the car's box, the scene lines the synthetic annotator uses and
+the kerb corners. The scene dict holds the exact pixels a careful person would click.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from camloc_geo.osm import load_map
-from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 
 OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 BALTIMORE = OSM / "baltimore.osm.pbf"

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from camloc_geo.camera import Camera, rotation_from_angles
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 SCENES_DIR = Path(__file__).parent / "data" / "scenes"
 

@@ -1,6 +1,7 @@
 """Absolute localisation (:mod:`camloc_geo.absolute`) on real OSM extracts.
 
-Synthetic cameras stand at real intersections (:func:`camloc_geo.synthetic.make_located_scene`);
+Synthetic cameras stand at real intersections
+(:func:`camloc_geo.testing.synthetic.make_located_scene`);
 noise-free annotations must give the true position exactly, and the candidate list must keep
 the contract of ``../docs/contract.md``.
 """
@@ -21,7 +22,7 @@ from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 
 OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 

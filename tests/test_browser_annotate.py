@@ -22,7 +22,7 @@ from annotate_synthetic import BALTIMORE, located_case, render_snapshot
 from camloc_geo.cli import main
 from camloc_geo.geodesy import distance_m
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import NoiseModel, make_scene, random_camera
+from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
 from camloc_geo.vanishing import estimate_intrinsics, fit_vanishing_point
 
 CHROMIUM = Path("/usr/bin/chromium")

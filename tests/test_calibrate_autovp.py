@@ -14,7 +14,7 @@ from camloc_geo import SceneError
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.relative import calibrate
 from camloc_geo.scene import load_scene
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 
 def _camera() -> Camera:

@@ -14,7 +14,7 @@ import pytest
 from camloc_geo.cli import main
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import load_map
-from camloc_geo.synthetic import LocatedScene, NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 
 OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
 BALTIMORE = OSM / "baltimore.osm.pbf"

@@ -18,13 +18,13 @@ from test_absolute import (
     junctions,
 )
 
-from camloc_geo.absolute import locate
-from camloc_geo.cues import (
+from camloc_geo.absolute import (
     CUE_FLOOR,
     OFF_STREET_FACTOR,
     WRONG_WAY_FACTOR,
     apply_cues,
     cue_log_likelihood,
+    locate,
     view_log_factor,
 )
 from camloc_geo.osm import MapData, load_map

@@ -31,7 +31,7 @@ from camloc_geo.sensors.guide import (
     read_gps,
     read_tracks,
 )
-from camloc_geo.synthetic_guide import GuideData, make_guide_data
+from camloc_geo.testing.synthetic_guide import GuideData, make_guide_data
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "osm"
 SETTINGS = GuideSettings(gps_sigma_m=3.0)
@@ -378,7 +378,7 @@ def test_cli_errors(files: Path, capsys: pytest.CaptureFixture[str]) -> None:
 def test_cli_located_scene_geojson(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A scene located on a real extract: ground tracks and traces in lat/lon, right matches."""
     from camloc_geo.osm import load_map
-    from camloc_geo.synthetic import make_located_scene
+    from camloc_geo.testing.synthetic import make_located_scene
 
     osm = DATA / "fremantle.osm"
     m = load_map(osm, -32.036172, 115.755714, radius_m=250)

@@ -16,7 +16,7 @@ from camloc_geo.absolute import LocateResult, candidates_geojson, locate
 from camloc_geo.cli import main
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.scene import Scene, parse_scene
-from camloc_geo.synthetic import NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
 FREMANTLE = (-32.036172, 115.755714)

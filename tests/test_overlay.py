@@ -17,7 +17,7 @@ from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.osm import load_map
 from camloc_geo.scene import parse_scene
-from camloc_geo.synthetic import NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
 SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
 FREMANTLE = (-32.036172, 115.755714)

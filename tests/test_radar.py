@@ -22,7 +22,7 @@ from camloc_geo.api import calibrate_scene, radar_scene
 from camloc_geo.cli import main
 from camloc_geo.relative import CalibrationResult
 from camloc_geo.sensors.radar import CSV_COLUMNS, measure_speeds, read_tracks
-from camloc_geo.synthetic_video import (
+from camloc_geo.testing.synthetic_video import (
     SyntheticVehicle,
     SyntheticVideo,
     render_video,

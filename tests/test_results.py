@@ -141,7 +141,7 @@ def test_symmetric_twins_are_ambiguous_with_each_other() -> None:
     from camloc_geo.absolute import locate
     from camloc_geo.osm import load_map
     from camloc_geo.scene import parse_scene
-    from camloc_geo.synthetic import NoiseModel, make_located_scene
+    from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
     m = load_map(REPO / "data" / "osm" / "baltimore.osm.pbf", 39.2851, -76.5934, radius_m=300)
     found = False

@@ -16,7 +16,7 @@ from camloc_geo.camera import Camera
 from camloc_geo.cli import main
 from camloc_geo.relative import CalibrationResult
 from camloc_geo.sensors import ground_distance, point_height
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 GROUND_PTS = np.array([[3.0, -4.0, 0.0], [10.0, -2.0, 0.0], [12.0, 3.0, 0.0]])
 TRUE_LENGTH = float(np.linalg.norm(np.diff(GROUND_PTS, axis=0), axis=1).sum())

@@ -11,7 +11,7 @@ import numpy as np
 
 from camloc_geo.api import locate_scene, map_for_scene
 from camloc_geo.osm import MapData, clear_cache
-from camloc_geo.synthetic import NoiseModel, make_located_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 
 REPO = Path(__file__).resolve().parents[1]
 EXTRACT = REPO / "sample_maps" / "baltimore.osm.pbf"

@@ -61,6 +61,16 @@ The pipeline, one function per stage (:func:`locate` reads as the list):
 
 from __future__ import annotations
 
+from camloc_geo.absolute._cues import (
+    CUE_FLOOR,
+    OFF_STREET_FACTOR,
+    VIEW_SIGMA_DEG,
+    WRONG_WAY_FACTOR,
+    CueScore,
+    apply_cues,
+    cue_log_likelihood,
+    view_log_factor,
+)
 from camloc_geo.absolute._geojson import candidates_geojson
 from camloc_geo.absolute._model import (
     TIE_SCORE_RATIO,
@@ -76,8 +86,13 @@ from camloc_geo.absolute._pipeline import locate, mark_ties
 from camloc_geo.absolute._similarity import Similarity2D
 
 __all__ = [
+    "CUE_FLOOR",
+    "OFF_STREET_FACTOR",
     "TIE_SCORE_RATIO",
+    "VIEW_SIGMA_DEG",
+    "WRONG_WAY_FACTOR",
     "Candidate",
+    "CueScore",
     "Flag",
     "FlagKind",
     "LocateResult",
@@ -85,7 +100,10 @@ __all__ = [
     "Match",
     "Observation",
     "Similarity2D",
+    "apply_cues",
     "candidates_geojson",
+    "cue_log_likelihood",
     "locate",
     "mark_ties",
+    "view_log_factor",
 ]

@@ -46,7 +46,7 @@ class Evidence:
 
     @property
     def has_cues(self) -> bool:
-        """The scene carries a tie-breaking cue (:mod:`camloc_geo.cues`)."""
+        """The scene carries a tie-breaking cue (:mod:`camloc_geo.absolute._cues`)."""
         return self.scene is not None and self.scene.has_cues
 
     @property

@@ -204,7 +204,7 @@ class FlagKind(str, Enum):
     POOR_FIT = "poor_fit"
     UNMATCHED = "unmatched"
     CUE = "cue"
-    """A tie-breaking cue's note (``cue: view_hint ...``), see :mod:`camloc_geo.cues`."""
+    """A tie-breaking cue's note (``cue: view_hint ...``), see :mod:`camloc_geo.absolute._cues`."""
 
 
 @dataclass(frozen=True)
@@ -307,4 +307,4 @@ class LocateResult:
     scene_id: str = "scene"
     image_size: tuple[int, int] = (0, 0)
     view_cone_range_m: float = 60.0  # LocateSettings.view_cone_range_m of the run
-    cues_applied: bool = False  # the scene's cues (camloc_geo.cues) are in the scores
+    cues_applied: bool = False  # the scene's cues (camloc_geo.absolute._cues) are in the scores

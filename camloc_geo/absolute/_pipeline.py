@@ -234,7 +234,7 @@ def _expected_plausibility(
 
 def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:
     """The scene's tie-breaking cues for one candidate: log factor and ``cue`` flags."""
-    from camloc_geo.cues import cue_log_likelihood
+    from camloc_geo.absolute._cues import cue_log_likelihood
 
     assert ev.scene is not None
     cue = cue_log_likelihood(

@@ -9,10 +9,17 @@ to a resumable journal and then to a GeoPackage (``cameras``, ``candidates``,
 
 from __future__ import annotations
 
-from camloc_geo.batch._camera import PLACED_STATUSES, CameraResult, geocode_camera
 from camloc_geo.batch._journal import journal_path
-from camloc_geo.batch._list import COLUMN_VARIANTS, CameraRow, read_camera_list
 from camloc_geo.batch._run import BatchSummary, results_from_journal, run_batch
+from camloc_geo.cameras import (
+    COLUMN_VARIANTS,
+    PLACED_STATUSES,
+    CameraResult,
+    CameraRow,
+    geocode_camera,
+    read_camera_list,
+)
+from camloc_geo.cameras._list import read_camera_csv, row_from_mapping
 
 __all__ = [
     "COLUMN_VARIANTS",
@@ -22,7 +29,9 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "journal_path",
+    "read_camera_csv",
     "read_camera_list",
     "results_from_journal",
+    "row_from_mapping",
     "run_batch",
 ]

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -25,54 +24,21 @@ def extract_paths(path: str | os.PathLike[str]) -> list[Path]:
     MapDataError
         The path does not exist, or the folder holds no extract.
     """
-    from camloc_geo.osm._load import EXTRACT_SUFFIXES
+    from camloc_geo.osm import extract_files
 
-    p = Path(path).expanduser()
-    if p.is_file():
-        return [p]
-    if not p.is_dir():
-        raise MapDataError(f"OSM extract or folder not found: {p}")
-    found = sorted(
-        f for f in p.iterdir() if f.is_file() and f.name.lower().endswith(EXTRACT_SUFFIXES)
-    )
-    if not found:
-        raise MapDataError(f"no OSM extract (.osm, .osm.gz, .osm.bz2, .osm.pbf) in {p}")
-    return found
-
-
-def _extract_box(path: Path) -> tuple[float, float, float, float]:
-    """(south, west, north, east) from the header, else from the nodes."""
-    import osmium
-
-    from camloc_geo.osm._load import _check_extract_path, _header_box
-
-    _check_extract_path(path)
-    box = _header_box(path)
-    if box is not None:
-        return box
-    s, w, n, e = math.inf, math.inf, -math.inf, -math.inf
-    try:
-        for node in osmium.FileProcessor(str(path), osmium.osm.NODE):
-            if not isinstance(node, osmium.osm.Node):
-                continue
-            loc = node.location
-            if loc.valid():
-                s, n = min(s, loc.lat), max(n, loc.lat)
-                w, e = min(w, loc.lon), max(e, loc.lon)
-    except RuntimeError as exc:
-        raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
-    if not math.isfinite(s):
-        raise MapDataError(f"OSM extract {path.name} holds no located nodes")
-    return s, w, n, e
+    return [Path(f) for f in extract_files(path)]
 
 
 def whole_map(path: str | os.PathLike[str]) -> MapData:
-    """Load a whole extract, anchored at its centre (cached like every :func:`load_map`)."""
-    from camloc_geo.osm import load_map
+    """Load a whole extract, anchored at its centre (the map catalogue's ``file`` area).
 
-    p = Path(path).expanduser()
-    s, w, n, e = _extract_box(p)
-    return load_map(p, (s + n) / 2.0, (w + e) / 2.0, radius_m=None)
+    The same map, anchored at the same point, as every front end gets for a point in this
+    extract (:class:`camloc_geo.osm.MapCatalogue`), loaded once per process.
+    """
+    from camloc_geo.osm._catalogue import area_map
+
+    p = Path(path).expanduser().absolute()
+    return area_map(("file", str(p)))
 
 
 def map_contains(map_data: MapData, lat: float, lon: float) -> bool:

@@ -11,13 +11,21 @@ and :mod:`camloc_geo.osm._widths` for carriageway widths.
 
 from __future__ import annotations
 
+from camloc_geo.osm._catalogue import (
+    CELL_M,
+    WHOLE_EXTRACT_MAX_BYTES,
+    MapCatalogue,
+    MapCatalogueSource,
+    extract_bounds,
+    extract_files,
+)
 from camloc_geo.osm._geojson import intersections_geojson, streets_json
 from camloc_geo.osm._intersections import (
     ARM_SAMPLE_M,
     MAX_CORNER_GAP_DEG,
     MIN_CORNER_GAP_DEG,
 )
-from camloc_geo.osm._load import STREET_HIGHWAYS, clear_cache
+from camloc_geo.osm._load import EXTRACT_SUFFIXES, STREET_HIGHWAYS, clear_cache, header_box
 from camloc_geo.osm._map import DEFAULT_TOLERANCE_M, MapData, load_map
 from camloc_geo.osm._model import Building, Corner, IncidentStreet, Intersection, Street
 from camloc_geo.osm._names import normalize_name
@@ -25,17 +33,25 @@ from camloc_geo.osm._widths import resolve_width_m
 
 __all__ = [
     "ARM_SAMPLE_M",
+    "CELL_M",
     "DEFAULT_TOLERANCE_M",
+    "EXTRACT_SUFFIXES",
     "MAX_CORNER_GAP_DEG",
     "MIN_CORNER_GAP_DEG",
     "STREET_HIGHWAYS",
+    "WHOLE_EXTRACT_MAX_BYTES",
     "Building",
     "Corner",
     "IncidentStreet",
     "Intersection",
+    "MapCatalogue",
+    "MapCatalogueSource",
     "MapData",
     "Street",
     "clear_cache",
+    "extract_bounds",
+    "extract_files",
+    "header_box",
     "intersections_geojson",
     "load_map",
     "normalize_name",

@@ -7,7 +7,14 @@ from pathlib import Path
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-__all__ = ["Settings"]
+__all__ = ["Settings", "default_data_dir"]
+
+
+def default_data_dir() -> Path:
+    """The user's data folder for the service (``~/.local/share/camloc/service`` on Linux)."""
+    from platformdirs import user_data_path
+
+    return user_data_path("camloc", appauthor=False) / "service"
 
 
 class Settings(BaseSettings):
@@ -34,8 +41,11 @@ class Settings(BaseSettings):
         description="when set, write endpoints need the header X-API-Key with this value",
     )
     data_dir: Path = Field(
-        default=Path("camloc-service-data"),
-        description="folder for the job and task database (SQLite) and uploaded snapshots",
+        default_factory=default_data_dir,
+        description=(
+            "folder for the job and task database (SQLite) and uploaded snapshots (default: "
+            "the user's data folder, e.g. ~/.local/share/camloc/service)"
+        ),
     )
     max_request_bytes: int = Field(
         default=2_000_000, ge=1_000, description="largest JSON body accepted"

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
-import math
 from typing import TYPE_CHECKING, Any
 
 from camloc_geo._errors import CamlocError, InputError, SceneError
@@ -70,111 +70,56 @@ def check_scene_body(data: Any, settings: Settings, *, where: str = "body") -> d
     return data
 
 
-def _anchor(scene: Any) -> tuple[float, float] | None:
-    from camloc_geo.api import scene_anchor
-
-    return scene_anchor(scene)
-
-
 def locate_body(
     data: dict[str, Any], maps: MapStore, *, max_candidates: int | None = None
 ) -> tuple[Any, Any]:
-    """Locate a scene dict with the server's maps; returns ``(LocateOutput, map or None)``."""
-    from camloc_geo.api import locate_scene, scene_from, scene_needs_map
+    """Locate a scene dict with the server's maps; returns ``(LocateOutput, map or None)``.
 
-    scene = scene_from(data)
-    map_data = None
-    anchor = _anchor(scene)
-    if anchor is not None:
-        try:
-            map_data = maps.map_for_point(lat=anchor[0], lon=anchor[1])
-        except InputError:
-            if scene_needs_map(scene):
-                raise
-    elif scene_needs_map(scene):
-        raise SceneError(
-            "no location to find the map around: give prior (lat/lon), intersection lat/lon "
-            "or references",
-            "prior",
-        )
-    out = locate_scene(scene, map_source=map_data, network=False, max_candidates=max_candidates)
-    return out, map_data
+    One library call: the server's :class:`~camloc_geo.osm.MapCatalogue` chooses the map
+    for the scene (or none, when the scene needs none and no map covers it).
+    """
+    from camloc_geo.api import locate_scene
 
-
-def _finite(value: Any) -> float | None:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
+    out = locate_scene(
+        data, map_source=maps.catalogue, network=False, max_candidates=max_candidates
+    )
+    return out, out.map_data
 
 
 def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str, Any]:
     """One camera of a job: never raises; the result says ``status`` and ``reason``.
 
-    A camera is ``{"id", "title", "lat", "lon", "radius_m", "scene"}`` (all optional but one
-    piece of evidence). With a scene it is located; with a title only, the title's junction
-    is looked up when title geocoding is available.
+    A camera is ``{"id", "title", "lat", "lon", "radius_m", "scene", ...}`` with the column
+    names and aliases of a camera list (``docs/batch.md``); the scene is inline. It is placed
+    by the library's camera-list engine (:func:`camloc_geo.api.locate_camera`), exactly as
+    ``camloc batch`` places it: title, prior, scene and evidence, on the map the server's
+    catalogue chooses; statuses are the engine's (``docs/contract.md``).
     """
+    from camloc_geo.api import locate_camera
+    from camloc_geo.cameras import CameraResult
+    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.results import camera_job_result
+
     cam_id = str(camera.get("id", "")) if isinstance(camera, dict) else ""
-    out: dict[str, Any] = {"id": cam_id, "status": "failed", "reason": None}
     try:
         if not isinstance(camera, dict):
             raise SceneError("a camera must be a JSON object")
-        lat, lon = _finite(camera.get("lat")), _finite(camera.get("lon"))
         scene = camera.get("scene")
         if scene is not None:
-            scene = check_scene_body(scene, settings, where="scene")
-            if lat is not None and lon is not None and "prior" not in scene:
-                radius = _finite(camera.get("radius_m")) or 150.0
-                scene = {**scene, "prior": {"lat": lat, "lon": lon, "radius_m": radius}}
-            located, _m = locate_body(scene, maps)
-            gj = located.to_geojson()
-            cands = [f for f in gj["features"] if f["properties"].get("kind") == "candidate"]
-            if not cands:
-                out.update(status="no_candidate", reason=gj["properties"].get("reason"))
-            else:
-                best = cands[0]["properties"]
-                out.update(
-                    status="located",
-                    lat=best["lat"],
-                    lon=best["lon"],
-                    score=best["score"],
-                    uncertainty_m=best.get("sigma_m"),
-                    ambiguous=bool(best.get("ambiguous_with")),
-                    candidates=cands,
-                )
-            return out
-        title = camera.get("title")
-        if isinstance(title, str) and title.strip():
-            try:
-                from camloc_geo.geocode import geocode_title
-            except ImportError:
-                out.update(status="no_evidence", reason="title geocoding is not available")
-                return out
-            if lat is None or lon is None:
-                raise SceneError("a title-only camera needs lat/lon on this server", "lat")
-            m = maps.map_for_point(lat=lat, lon=lon)
-            matches = geocode_title(
-                title, map_data=m, near=(lat, lon), radius_m=_finite(camera.get("radius_m"))
-            )
-            if not matches or matches[0].lat is None:
-                reason = matches[0].reason if matches else "nothing matched"
-                out.update(status="not_found", reason=reason)
-            else:
-                best_match = matches[0]
-                out.update(
-                    status="title_only",
-                    lat=best_match.lat,
-                    lon=best_match.lon,
-                    uncertainty_m=best_match.uncertainty_m,
-                    match_status=best_match.status,
-                )
-            return out
-        out.update(status="no_evidence", reason="give a scene or a title")
+            check_scene_body(scene, settings, where="scene")
+        row = row_from_mapping(camera, 1, scene_paths=False)
+        if not cam_id:
+            row = dataclasses.replace(row, id="")
+        res = locate_camera(row, map_source=maps.catalogue)
     except CamlocError as exc:
-        out.update(status="failed", reason=" ".join(str(exc).split()))
+        res = CameraResult(row=1, id=cam_id).fail(
+            "scene_error" if isinstance(exc, SceneError) else "failed",
+            " ".join(str(exc).split()),
+            "input",
+        )
     except Exception as exc:  # one bad camera never sinks the job
         log.exception("camera %r failed", cam_id)
-        out.update(status="failed", reason=f"internal error ({type(exc).__name__})")
-    return out
+        res = CameraResult(row=1, id=cam_id).fail(
+            "failed", f"internal error ({type(exc).__name__})", "internal"
+        )
+    return camera_job_result(res)

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from camloc_geo.camera import Camera, rotation_from_angles
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 HERE = Path(__file__).parent
 

@@ -41,9 +41,9 @@ from typing import TYPE_CHECKING, Any
 from camloc_geo._errors import MapDataError, MapSourceError, SceneError
 
 if TYPE_CHECKING:
-    from camloc_geo.batch._areas import Area, MapPlan
-    from camloc_geo.batch._list import CameraRow
+    from camloc_geo.cameras._list import CameraRow
     from camloc_geo.osm import MapData
+    from camloc_geo.osm._catalogue import Area, MapPlan
 
 __all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
 
@@ -299,8 +299,11 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
     """The row's scene, with the title's junction, prior and view hint where it has none."""
     from camloc_geo.scene import Scene, load_scene, parse_scene
 
-    assert row.scene is not None
-    sc = load_scene(row.scene)
+    if row.scene_data is not None:
+        sc = parse_scene(row.scene_data)
+    else:
+        assert row.scene is not None
+        sc = load_scene(row.scene)
     data = sc.model_dump(mode="json", exclude={"base_dir"}, exclude_none=True)
     changed = False
     junction = getattr(match, "intersection", None) if match is not None else None
@@ -347,7 +350,10 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
     try:
         sc = _scene_with_evidence(row, res, match)
     except SceneError as exc:
-        res.fail("scene_error", f"scene {os.path.basename(str(row.scene))}: {exc}", "scene")
+        where = "scene"
+        if row.scene_data is None:
+            where = f"scene {os.path.basename(str(row.scene))}"
+        res.fail("scene_error", f"{where}: {exc}", "scene")
         return
     try:
         out = locate_scene(sc, map_source=m, network=False)
@@ -433,7 +439,7 @@ def _with_map(
     matches = matches or []
     if matches:
         _apply_match(res, matches, res.extract)
-    if row.scene:
+    if row.has_scene:
         title_status, title_reason = res.status, res.reason
         best = matches[0] if matches else None
         res.lat = res.lon = None
@@ -476,7 +482,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.batch._areas import area_map
+    from camloc_geo.osm._catalogue import area_map
 
     if not (row.title or row.streets):
         res.status = "no_evidence"
@@ -556,7 +562,7 @@ def geocode_camera(
         Without ``map_source``: may the map around the camera's point be fetched from
         Overpass.
     plan, area
-        A prepared :func:`~camloc_geo.batch._areas.map_plan` and the camera's area (what
+        A prepared :func:`~camloc_geo.osm._catalogue.map_plan` and the camera's area (what
         :func:`run_batch` passes; computed from ``map_source`` when omitted).
     """
     res = CameraResult(row=row.row, id=row.id, title=row.title, list_lat=row.lat, list_lon=row.lon)
@@ -582,7 +588,7 @@ def _geocode(
     if map_data is not None:
         return _with_map(row, res, map_data)
     if plan is None:
-        from camloc_geo.batch._areas import map_plan
+        from camloc_geo.osm._catalogue import map_plan
 
         plan = (
             _cached_plan(map_source, network)
@@ -593,13 +599,13 @@ def _geocode(
         area = plan.area_of(row)
     kind = area[0]
     if kind == "none":
-        if row.scene and not (row.title or row.streets):
+        if row.has_scene and not (row.title or row.streets):
             # a scene with references may not need a map at all
             return _with_map(row, res, None)
         return res.fail("no_map", str(area[1]), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
-    from camloc_geo.batch._areas import area_map
+    from camloc_geo.osm._catalogue import area_map
 
     try:
         m = area_map(area)
@@ -613,7 +619,7 @@ _PLANS: dict[tuple[str, bool], MapPlan] = {}
 
 
 def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
-    from camloc_geo.batch._areas import map_plan
+    from camloc_geo.osm._catalogue import map_plan
 
     key = (str(map_source), bool(network))
     if key not in _PLANS:

@@ -1,6 +1,6 @@
 """Synthetic traffic videos for the virtual radar: a textured ground and moving cuboids.
 
-A known camera (the same one whose annotated scene :func:`camloc_geo.synthetic.make_scene`
+A known camera (the same one whose annotated scene :func:`camloc_geo.testing.synthetic.make_scene`
 produces, so the scene calibrates to it) watches a textured ground plane (blurred random
 noise at several scales, lane markings) with the scene's parked reference car at the world
 origin, and vehicles (cuboids with windows and wheels, shaded per face) driving along
@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import PRESETS
-from camloc_geo.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 __all__ = [
     "SyntheticVehicle",

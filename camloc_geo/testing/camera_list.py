@@ -3,7 +3,7 @@
 Each camera watches a real junction of an extract: its title is written from OSM's own
 street names in one of the listing styles ("A & B", "12 - A / B looking north", "A at B",
 upper case), it may carry a rough point near the junction and a synthetic annotated scene
-(:func:`camloc_geo.synthetic.make_located_scene`). The truth goes into extra columns
+(:func:`camloc_geo.testing.synthetic.make_located_scene`). The truth goes into extra columns
 (``true_lat``, ``true_lon``, ``true_junction``) that the batch reader ignores.
 """
 
@@ -85,9 +85,8 @@ def make_camera_list(
     strip_scene_junction
         Share of scenes whose intersection hint loses its lat/lon (the title must give it).
     """
-    from camloc_geo.batch._areas import _bounds
-    from camloc_geo.osm import load_map
-    from camloc_geo.synthetic import make_located_scene
+    from camloc_geo.osm import extract_bounds, load_map
+    from camloc_geo.testing.synthetic import make_located_scene
 
     rng = np.random.default_rng(seed)
     out = Path(folder)
@@ -95,7 +94,7 @@ def make_camera_list(
     maps = []
     for e in extracts:
         path = str(Path(e).absolute())
-        s, w, nn, ee = _bounds(path)
+        s, w, nn, ee = extract_bounds(path)
         m = load_map(path, (s + nn) / 2, (w + ee) / 2, radius_m=None)
         maps.append((m, _junctions(m)))
     rows: list[dict[str, Any]] = []

@@ -242,7 +242,8 @@ def apply_cues(
         return result  # locate() already ranked with them
     if not cands or not scene.has_cues:
         return result
-    from camloc_geo.absolute import LocateSettings, mark_ties
+    from camloc_geo.absolute._model import LocateSettings
+    from camloc_geo.absolute._pipeline import mark_ties
 
     if merge_distance_m is None:
         merge_distance_m = LocateSettings().merge_distance_m

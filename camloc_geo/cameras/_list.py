@@ -37,7 +37,14 @@ from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
 
-__all__ = ["COLUMN_VARIANTS", "CameraRow", "count_camera_rows", "read_camera_list"]
+__all__ = [
+    "COLUMN_VARIANTS",
+    "CameraRow",
+    "count_camera_rows",
+    "read_camera_csv",
+    "read_camera_list",
+    "row_from_mapping",
+]
 
 COLUMN_VARIANTS: dict[str, tuple[str, ...]] = {
     "id": ("id", "camera_id", "cam_id", "cameraid", "camera", "uid", "ident", "key"),
@@ -84,6 +91,9 @@ class CameraRow:
     scene
         Absolute path of the scene file, when given (relative paths are resolved against the
         list's folder).
+    scene_data
+        The scene itself (a ``camloc-scene/1`` dict), when the list holds it inline (a GeoJSON
+        property, an HTTP job); it wins over ``scene``.
     view
         The view column's text (compass words or degrees), when given.
     area
@@ -104,11 +114,17 @@ class CameraRow:
     view: str | None = None
     area: str | None = None
     problems: tuple[str, ...] = field(default_factory=tuple)
+    scene_data: dict[str, Any] | None = field(default=None, hash=False)
 
     @property
     def has_point(self) -> bool:
         """True when the row gives a usable rough point."""
         return self.lat is not None and self.lon is not None
+
+    @property
+    def has_scene(self) -> bool:
+        """True when the row gives a scene (a file or inline)."""
+        return bool(self.scene) or self.scene_data is not None
 
 
 def _clean(value: Any) -> str:
@@ -147,10 +163,13 @@ def row_from_mapping(
     base_dir: Path | None = None,
     point: tuple[float, float] | None = None,
     list_problems: tuple[str, ...] = (),
+    scene_paths: bool = True,
 ) -> CameraRow:
     """A :class:`CameraRow` from one record's columns (names matched case-insensitively).
 
-    ``point`` is ``(lat, lon)`` from a geometry, used when the columns give none.
+    ``point`` is ``(lat, lon)`` from a geometry, used when the columns give none. A scene
+    column holding an object is an inline scene (``scene_data``); with ``scene_paths`` false
+    (a list sent by a stranger) a scene given as a file path is refused as a row problem.
     """
     lower = {str(k).strip().lower(): v for k, v in values.items() if k is not None}
     problems = list(list_problems)
@@ -183,8 +202,13 @@ def row_from_mapping(
             if sa and sb:
                 streets = (sa, sb)
                 break
-    scene_text = _clean(_pick(lower, "scene"))
+    raw_scene = _pick(lower, "scene")
+    scene_data = raw_scene if isinstance(raw_scene, dict) else None
+    scene_text = "" if scene_data is not None else _clean(raw_scene)
     scene: str | None = None
+    if scene_text and not scene_paths:
+        problems.append("a scene must be given inline (a JSON object), not as a file path")
+        scene_text = ""
     if scene_text:
         p = Path(scene_text).expanduser()
         if not p.is_absolute() and base_dir is not None:
@@ -204,6 +228,7 @@ def row_from_mapping(
         view=view,
         area=area,
         problems=tuple(problems),
+        scene_data=scene_data,
     )
 
 
@@ -232,27 +257,39 @@ def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
 
 def _read_csv(path: Path) -> Iterator[CameraRow]:
     with open(path, encoding="utf-8-sig", newline="") as fh:
-        sample = fh.read(8192)
-        fh.seek(0)
-        delimiter = ","
-        if path.name.lower().endswith(".tsv"):
-            delimiter = "\t"
-        else:
-            try:
-                delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
-            except csv.Error:
-                delimiter = ","
-        csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
-        reader = csv.DictReader(fh, delimiter=delimiter)
-        columns = list(reader.fieldnames or [])
-        if not columns:
-            return
-        list_problems = _missing_column_problems(columns)
-        # a missing id column only renames rows: not a problem of the camera
-        list_problems = tuple(p for p in list_problems if "no id column" not in p)
-        base = path.resolve().parent
-        for n, rec in enumerate(reader, start=1):
-            yield row_from_mapping(rec, n, base_dir=base, list_problems=list_problems)
+        yield from read_camera_csv(
+            fh, base_dir=path.resolve().parent, tsv=path.name.lower().endswith(".tsv")
+        )
+
+
+def read_camera_csv(
+    fh: TextIO, *, base_dir: Path | None = None, tsv: bool = False
+) -> Iterator[CameraRow]:
+    """Stream the cameras of CSV text (an open file or :class:`io.StringIO`).
+
+    The in-memory entry point of :func:`read_camera_list` (same columns, delimiter sniffed
+    among ``, ; tab |``). ``base_dir`` resolves relative scene paths (None: left relative).
+    """
+    sample = fh.read(8192)
+    fh.seek(0)
+    delimiter = ","
+    if tsv:
+        delimiter = "\t"
+    else:
+        try:
+            delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+        except csv.Error:
+            delimiter = ","
+    csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
+    reader = csv.DictReader(fh, delimiter=delimiter)
+    columns = list(reader.fieldnames or [])
+    if not columns:
+        return
+    list_problems = _missing_column_problems(columns)
+    # a missing id column only renames rows: not a problem of the camera
+    list_problems = tuple(p for p in list_problems if "no id column" not in p)
+    for n, rec in enumerate(reader, start=1):
+        yield row_from_mapping(rec, n, base_dir=base_dir, list_problems=list_problems)
 
 
 def _feature_row(feat: Any, n: int, base: Path) -> CameraRow:

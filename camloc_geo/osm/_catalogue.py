@@ -1,0 +1,400 @@
+"""The map catalogue: which map serves a point, for every front end.
+
+A :class:`MapCatalogue` knows where maps come from: extract files (one file or a folder,
+each extract's bounds read once, from its header box or one scan of its nodes), Overpass
+through osmnx and its cache (``network=True``), or nothing. One rule chooses the map for a
+point (:meth:`MapCatalogue.area_for_point`):
+
+- the smallest extract whose bounds cover the point;
+  - an extract up to :data:`WHOLE_EXTRACT_MAX_BYTES` is one ``("file", PATH)`` area, its map
+    anchored at the centre of its bounds, shared by every camera it covers;
+  - a larger one is split into squares of :data:`CELL_M` metres, ``("cell", PATH, I, J)``,
+    each map anchored at its cell's centre;
+- no extract covers it and the network is allowed: the Overpass cell ``("net", I, J)``;
+- otherwise ``("none", REASON)``.
+
+Without a point, a title is searched in each (whole) extract: ``("search", PATHS)``
+(:meth:`MapCatalogue.area_for_search`).
+
+Maps are kept in a per-process dictionary (:meth:`MapCatalogue.map_for_area`), so a worker
+parses an area's extract once however many cameras it serves. Areas are pure values: the
+same point gets the same area, and so the same map anchored at the same point, in every
+process and every front end (CLI, batch, service, geocoder, QGIS), which keeps their answers
+identical.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import threading
+from collections import OrderedDict
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from camloc_geo._errors import InputError, MapDataError
+
+if TYPE_CHECKING:
+    from camloc_geo.osm._map import MapData
+
+__all__ = [
+    "CELL_M",
+    "WHOLE_EXTRACT_MAX_BYTES",
+    "Area",
+    "MapCatalogue",
+    "MapPlan",
+    "area_map",
+    "clear_maps",
+    "extract_bounds",
+    "extract_files",
+    "map_plan",
+]
+
+log = logging.getLogger(__name__)
+
+WHOLE_EXTRACT_MAX_BYTES = 48 * 1024 * 1024
+"""Extracts up to this size are loaded whole (one map for every camera they cover)."""
+
+CELL_M = 2000.0
+"""Side of the square cells larger extracts and Overpass are split into (metres)."""
+
+_CELL_MARGIN_M = 400.0
+_MAX_MAPS = 32
+_DEG_LAT_M = 111_320.0
+
+Area = tuple[Any, ...]
+"""A unit of map loading: ``("file", PATH)``, ``("cell", PATH, I, J)``, ``("net", I, J)``,
+``("search", PATHS)`` or ``("none", REASON)``."""
+
+
+def extract_files(source: str | os.PathLike[str]) -> tuple[str, ...]:
+    """The extract itself, or every extract in a folder (absolute paths, sorted by name).
+
+    Raises
+    ------
+    MapDataError
+        The path does not exist, or the folder holds no extract.
+    """
+    from camloc_geo.osm._load import EXTRACT_SUFFIXES
+
+    path = Path(source).expanduser()
+    if path.is_file():
+        return (str(path.absolute()),)
+    if path.is_dir():
+        files = sorted(
+            str(p.absolute())
+            for p in path.iterdir()
+            if p.is_file() and p.name.lower().endswith(EXTRACT_SUFFIXES)
+        )
+        if not files:
+            raise MapDataError(
+                f"no OSM extracts (.osm, .osm.pbf, .osm.gz, .osm.bz2) in the folder {path}"
+            )
+        return tuple(files)
+    raise MapDataError(f"OSM extract or folder not found: {path}")
+
+
+@lru_cache(maxsize=256)
+def _bounds_cached(path: str, mtime_ns: int) -> tuple[float, float, float, float]:
+    import osmium
+
+    from camloc_geo.osm._load import _check_extract_path, header_box
+
+    _check_extract_path(Path(path))
+    box = header_box(Path(path))
+    if box is not None:
+        return box
+    s, w, n, e = math.inf, math.inf, -math.inf, -math.inf
+    try:
+        for node in osmium.FileProcessor(path, osmium.osm.NODE):
+            if not isinstance(node, osmium.osm.Node):
+                continue
+            loc = node.location
+            if loc.valid():
+                s, n = min(s, loc.lat), max(n, loc.lat)
+                w, e = min(w, loc.lon), max(e, loc.lon)
+    except (RuntimeError, OSError, ValueError) as exc:
+        raise MapDataError(f"cannot read OSM extract {Path(path).name}: {exc}") from exc
+    if not math.isfinite(s):
+        raise MapDataError(f"OSM extract {Path(path).name} holds no located nodes")
+    return s, w, n, e
+
+
+def extract_bounds(path: str | os.PathLike[str]) -> tuple[float, float, float, float]:
+    """``(south, west, north, east)`` of an extract: its header box, else one scan of its nodes.
+
+    Read once per file and modification time.
+
+    Raises
+    ------
+    MapDataError
+        The file is missing, unreadable or holds no located node.
+    """
+    p = str(Path(path).expanduser().absolute())
+    try:
+        mtime = os.stat(p).st_mtime_ns
+    except OSError:
+        mtime = 0
+    return _bounds_cached(p, mtime)
+
+
+def _cell_of(lat: float, lon: float) -> tuple[int, int]:
+    d = CELL_M / _DEG_LAT_M
+    return math.floor(lat / d), math.floor(lon / d)
+
+
+def _cell_centre(i: int, j: int) -> tuple[float, float]:
+    d = CELL_M / _DEG_LAT_M
+    return (i + 0.5) * d, (j + 0.5) * d
+
+
+@dataclass(frozen=True)
+class MapCatalogue:
+    """Where maps come from: extract files, Overpass, or nothing (a pure, picklable value).
+
+    Build one with :meth:`from_source`. Attributes
+    ----------
+    files
+        Absolute paths of the extracts (one file, or a folder's extracts).
+    network
+        May Overpass be queried for a point no extract covers.
+    area_filter
+        Only extracts whose file name contains this (a city's name) serve titles without a point.
+    cache_folder, overpass_url
+        osmnx's HTTP cache folder and the Overpass endpoint (online only; default osmnx's).
+    """
+
+    files: tuple[str, ...] = ()
+    network: bool = False
+    area_filter: str | None = None
+    cache_folder: str | None = None
+    overpass_url: str | None = None
+
+    @classmethod
+    def from_source(
+        cls,
+        source: MapCatalogueSource,
+        *,
+        network: bool = False,
+        area: str | None = None,
+        cache_folder: str | os.PathLike[str] | None = None,
+        overpass_url: str | None = None,
+    ) -> MapCatalogue:
+        """The catalogue of an extract, a folder of extracts, or the network.
+
+        Parameters
+        ----------
+        source
+            An extract, a folder of extracts, a catalogue (returned as is) or None (Overpass
+            when ``network``; with an extract or folder the network is never used).
+        area
+            Keep only the extracts whose name contains it (titles without a point).
+
+        Raises
+        ------
+        MapDataError
+            The extract or folder does not exist or holds no extract.
+        InputError
+            No extract's name contains ``area``.
+        """
+        if isinstance(source, MapCatalogue):
+            return source
+        folder = None if cache_folder is None else str(cache_folder)
+        if source is None:
+            return cls(
+                network=bool(network),
+                area_filter=area,
+                cache_folder=folder,
+                overpass_url=overpass_url,
+            )
+        files = extract_files(source)
+        if area and not any(area.strip().lower() in Path(f).name.lower() for f in files):
+            raise InputError(f"--area {area!r}: no extract's name contains it")
+        return cls(files=files, area_filter=area, cache_folder=folder, overpass_url=overpass_url)
+
+    def _whole(self, path: str) -> bool:
+        try:
+            return os.path.getsize(path) <= WHOLE_EXTRACT_MAX_BYTES
+        except OSError:
+            return True
+
+    def _named(self, name: str | None) -> tuple[str, ...]:
+        if not name:
+            return self.files
+        key = name.strip().lower()
+        return tuple(f for f in self.files if key in Path(f).name.lower())
+
+    def covering(self, lat: float, lon: float, *, name: str | None = None) -> list[str]:
+        """The extracts whose bounds cover a point, smallest first (``name`` preferred)."""
+        covering = []
+        for f in self._named(name) or self.files:
+            try:
+                s, w, n, e = extract_bounds(f)
+            except MapDataError as exc:
+                log.warning("%s", exc)
+                continue
+            if s <= lat <= n and w <= lon <= e:
+                covering.append(((n - s) * (e - w), f))
+        return [f for _size, f in sorted(covering)]
+
+    def area_for_point(self, lat: float, lon: float, *, name: str | None = None) -> Area:
+        """The area whose map serves a point (the module's one rule)."""
+        if self.files:
+            covering = self.covering(lat, lon, name=name)
+            if not covering:
+                names = ", ".join(Path(f).name for f in self.files[:5])
+                more = " ..." if len(self.files) > 5 else ""
+                return (
+                    "none",
+                    f"lat={lat:.6f}, lon={lon:.6f} is outside every extract ({names}{more})",
+                )
+            f = covering[0]
+            if self._whole(f):
+                return ("file", f)
+            return ("cell", f, *_cell_of(lat, lon))
+        if self.network:
+            return ("net", *_cell_of(lat, lon))
+        return ("none", "no map: give --osm EXTRACT_OR_FOLDER or allow --network")
+
+    def area_for_search(self, name: str | None = None) -> Area:
+        """The area in which a title without a point is searched (whole extracts only)."""
+        if not self.files:
+            return (
+                "none",
+                "no point to load the map around (no lat/lon) and no extract to search the "
+                "title in: give --osm EXTRACT_OR_FOLDER",
+            )
+        name = name or self.area_filter
+        files = self._named(name)
+        if not files:
+            return ("none", f"no extract's name contains the area {name!r}")
+        whole = tuple(f for f in files if self._whole(f))
+        if not whole:
+            return (
+                "none",
+                "no point given and the extract is too large to search whole: give lat/lon",
+            )
+        if len(whole) == 1:
+            return ("file", whole[0])
+        return ("search", whole)
+
+    def area_of(self, row: Any) -> Area:
+        """The area of a camera (anything with ``lat``, ``lon``, ``has_point`` and ``area``)."""
+        if getattr(row, "has_point", False):
+            return self.area_for_point(float(row.lat), float(row.lon), name=row.area)
+        return self.area_for_search(getattr(row, "area", None))
+
+    def map_for_area(self, area: Area) -> MapData:
+        """The map of an area, loaded once per process (thread-safe).
+
+        Raises
+        ------
+        MapDataError, MapSourceError
+            No map for the area, an unreadable extract, or Overpass failed.
+        """
+        if area[0] == "none":
+            raise MapDataError(str(area[1]))
+        if area[0] == "net":
+            return area_map(area, cache_folder=self.cache_folder, overpass_url=self.overpass_url)
+        return area_map(area)
+
+    def map_for_point(self, *, lat: float, lon: float) -> MapData:
+        """The map serving a point.
+
+        Raises
+        ------
+        MapDataError
+            No extract covers the point and the network is off; an unreadable extract.
+        MapSourceError
+            Overpass failed.
+        """
+        return self.map_for_area(self.area_for_point(lat, lon))
+
+    def source_name(self, area: Area) -> str | None:
+        """What a result names as its map: the extract's file name, ``overpass`` or None."""
+        if area[0] == "net":
+            return "overpass"
+        if area[0] in ("file", "cell"):
+            return os.path.basename(str(area[1]))
+        return None
+
+
+MapCatalogueSource = str | os.PathLike[str] | MapCatalogue | None
+"""What every front end accepts as a map source: an extract, a folder, a catalogue, or None."""
+
+MapPlan = MapCatalogue
+"""The old name of :class:`MapCatalogue` (batch)."""
+
+
+def map_plan(
+    map_source: MapCatalogueSource, *, network: bool = False, area: str | None = None
+) -> MapCatalogue:
+    """The :class:`MapCatalogue` of an extract, a folder of extracts, or the network.
+
+    Raises
+    ------
+    MapDataError
+        The extract or folder does not exist or holds no extract.
+    """
+    return MapCatalogue.from_source(map_source, network=network, area=area)
+
+
+_MAPS: OrderedDict[tuple[Any, ...], Any] = OrderedDict()
+_MAPS_LOCK = threading.Lock()
+_LOAD_LOCKS: dict[tuple[Any, ...], threading.Lock] = {}
+
+
+def area_map(
+    area: Area, *, cache_folder: str | None = None, overpass_url: str | None = None
+) -> MapData:
+    """The map of an area, loaded once per process (thread-safe).
+
+    Raises
+    ------
+    MapDataError, MapSourceError
+        The extract is unreadable or Overpass failed.
+    """
+    key = (*area, cache_folder, overpass_url) if area[0] == "net" else tuple(area)
+    with _MAPS_LOCK:
+        if key in _MAPS:
+            _MAPS.move_to_end(key)
+            return _MAPS[key]
+        lock = _LOAD_LOCKS.setdefault(key, threading.Lock())
+    with lock:
+        with _MAPS_LOCK:
+            if key in _MAPS:
+                return _MAPS[key]
+        m = _load_area(area, cache_folder, overpass_url)
+        with _MAPS_LOCK:
+            _MAPS[key] = m
+            while len(_MAPS) > _MAX_MAPS:
+                _MAPS.popitem(last=False)
+        return m
+
+
+def _load_area(area: Area, cache_folder: str | None, overpass_url: str | None) -> MapData:
+    from camloc_geo.osm._map import load_map
+
+    kind = area[0]
+    radius = CELL_M * math.sqrt(0.5) + _CELL_MARGIN_M
+    if kind == "file":
+        s, w, n, e = extract_bounds(area[1])
+        return load_map(area[1], (s + n) / 2.0, (w + e) / 2.0, radius_m=None)
+    if kind == "cell":
+        lat, lon = _cell_centre(area[2], area[3])
+        return load_map(area[1], lat, lon, radius_m=radius)
+    if kind == "net":
+        lat, lon = _cell_centre(area[1], area[2])
+        return load_map(
+            None, lat, lon, radius_m=radius, cache_folder=cache_folder, overpass_url=overpass_url
+        )
+    raise MapDataError(f"no map for area {area[0]!r}")
+
+
+def clear_maps() -> None:
+    """Forget the maps of this process."""
+    with _MAPS_LOCK:
+        _MAPS.clear()
