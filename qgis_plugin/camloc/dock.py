@@ -46,6 +46,7 @@ from qgis.PyQt.QtWidgets import (
     QProgressBar,
     QPushButton,
     QScrollArea,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
@@ -311,6 +312,8 @@ class CamlocDock(QDockWidget):
         lay.addWidget(self.browser_button)
         self.guidance = QLabel()
         self.guidance.setWordWrap(True)
+        # wrapped labels take the dock's width; a long word (a path, a URL) never widens it
+        self.guidance.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.guidance.setStyleSheet("QLabel { background: #fff8d6; padding: 4px; }")
         lay.addWidget(self.guidance)
         self.steps = QListWidget()
@@ -383,8 +386,8 @@ class CamlocDock(QDockWidget):
         out.addWidget(self.gpkg_edit)
         out.addWidget(gpkg_button)
         form.addRow("Results", out)
-        self.context_check = QCheckBox("also the map model's streets and buildings")
-        form.addRow("", self.context_check)
+        self.context_check = QCheckBox("Also load the map model's streets and buildings")
+        form.addRow(self.context_check)  # its own row: a long label never widens the dock
         lay.addLayout(form)
         row4 = QHBoxLayout()
         self.run_button = QPushButton("Run")
@@ -405,6 +408,7 @@ class CamlocDock(QDockWidget):
             "Open a snapshot, then annotate it here or in the browser (Annotate in browser…)."
         )
         self.status.setWordWrap(True)
+        self.status.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.status.setTextInteractionFlags(Qt.TextSelectableByMouse)
         lay.addWidget(self.status)
         scroll = QScrollArea()
@@ -601,8 +605,9 @@ class CamlocDock(QDockWidget):
         QDesktopServices.openUrl(QUrl(self.page_server.url))
         self.set_status(
             "The annotation page is open in your browser. Annotate there and press Submit: "
-            f"the scene comes back here by itself. (Page: {self.page_server.url})"
+            "the scene comes back here by itself."
         )
+        self.status.setToolTip(self.page_server.url)
 
     def _scene_from_page(self, scene: dict[str, Any]) -> str | None:
         """On the page server's thread: validate with the library, then hand to the GUI."""
