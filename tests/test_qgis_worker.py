@@ -163,6 +163,7 @@ def test_geocodelist_gives_the_answers_of_camloc_batch(tmp_path):
     for cam_id, r in batch.items():
         p = cams[cam_id]
         assert (p["status"], p["lat"], p["lon"], p["tie"]) == (r.status, r.lat, r.lon, r.tie)
+        assert p["n_candidates"] == r.n_candidates
 
 
 def test_geocodelist_names_a_missing_list_or_map(tmp_path):
@@ -281,3 +282,122 @@ def test_check_scene_job_rejects_a_bad_scene(tmp_path):
     with pytest.raises(InputError, match="give both lat and lon"):
         run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
     assert not out.exists()
+
+
+def test_annotation_page_job_serves_the_library_page_in_crowd_mode(tmp_path):
+    from PIL import Image
+
+    img = tmp_path / "snap.png"
+    Image.new("RGB", (640, 360), (120, 120, 120)).save(img)
+    res = run_job(
+        {
+            "task": "annotation_page",
+            "image": str(img),
+            "submit_url": "http://127.0.0.1:5/camloc/t/scene",
+            "lat": 39.2856,
+            "lon": -76.5935,
+            "osm": str(OSM),
+            "out_dir": str(tmp_path),
+        }
+    )
+    page = res["info"]["html"]
+    assert '"mode":"crowd"' in page
+    assert "http://127.0.0.1:5" in page  # the page may post to the plugin's server only
+    assert '"prior":{"lat":39.2856' in page
+    assert "Eastern Avenue" in page  # the junction's map from the extract
+    with pytest.raises(InputError):
+        run_job({"task": "annotation_page", "image": str(tmp_path / "no.png"), "submit_url": "x"})
+
+
+def test_locate_context_layers_are_the_map_model(tmp_path):
+    res = run_job(
+        {
+            "task": "locate",
+            "scene": str(SCENE),
+            "osm": str(OSM),
+            "context": True,
+            "out_dir": str(tmp_path),
+        }
+    )
+    streets = _read(res["layers"]["context_streets"])
+    assert {"Eastern Avenue", "South Broadway"} <= {f["properties"]["name"] for f in streets}
+    assert all(f["geometry"]["type"] in ("LineString", "MultiLineString") for f in streets)
+    assert res["layers"]["context_buildings"]["count"] > 0
+    matched = _read(res["layers"]["matched_corners"])
+    assert {f["properties"]["what"] for f in matched} >= {"your kerb corner 0"}
+
+
+def test_geocodelist_agrees_with_camloc_batch_on_a_multi_city_list(tmp_path):
+    """Issue 25's check for QGIS: a synthetic list over three cities, one folder of extracts,
+    through ``camloc batch`` (the CLI, in its own process) and the worker's geocodelist."""
+    import os
+
+    pyogrio = pytest.importorskip("pyogrio")
+    from camloc_geo.testing.camera_list import make_camera_list
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    osm = REPO / "data" / "osm"
+    for name in ("baltimore.osm.pbf", "helsinki.osm.pbf", "heidelberg_altstadt.osm.pbf"):
+        os.symlink(osm / name, maps / name)
+    lst = make_camera_list(
+        tmp_path / "list",
+        sorted(maps.iterdir()),
+        9,
+        seed=5,
+        scene_fraction=0.5,
+        point_fraction=0.6,
+        bad_rows=("unknown_streets", "far_point"),
+    )
+    out = tmp_path / "batch.gpkg"
+    env = {**os.environ, "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "camloc_geo.cli",
+            "batch",
+            str(lst),
+            "--osm",
+            str(maps),
+            "-o",
+            str(out),
+            "--workers",
+            "1",
+            "--no-progress",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    cli = {
+        str(r["id"]): (r["status"], r["lat"], r["lon"])
+        for _, r in pyogrio.read_dataframe(out, layer="cameras").iterrows()
+    }
+    (tmp_path / "w").mkdir()
+    res = run_job(
+        {"task": "geocodelist", "list": str(lst), "osm": str(maps), "out_dir": str(tmp_path / "w")}
+    )
+    qgis = {
+        f["properties"]["camera_id"]: (
+            f["properties"]["status"],
+            f["properties"]["lat"],
+            f["properties"]["lon"],
+        )
+        for f in _read(res["layers"]["cameras"])
+    }
+    assert set(qgis) == set(cli)
+    assert len(cli) == 11
+    placed = 0
+    for cam_id, (status, lat, lon) in cli.items():
+        q_status, q_lat, q_lon = qgis[cam_id]
+        assert q_status == status, cam_id
+        if lat is None or lat != lat:  # not placed (NaN in the GeoPackage)
+            assert q_lat is None, cam_id
+            continue
+        placed += 1
+        assert abs(q_lat - lat) < 1e-5, cam_id  # about 1 m
+        assert abs(q_lon - lon) < 1e-5, cam_id
+    assert placed >= 6

@@ -256,7 +256,8 @@ def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> 
     res.names_matched = [str(n) for n in (best.names_matched or [])]
     res.match_kinds = [str(k) for k in (best.match_kinds or [])]
     res.candidates = [_match_candidate(mt, k, extract) for k, mt in enumerate(matches, start=1)]
-    res.n_candidates = len(res.candidates)
+    # a not_found match says why nothing was found: it is no candidate
+    res.n_candidates = 0 if best.status == "not_found" else len(res.candidates)
     res.score = _finite(best.score)
     status = best.status
     with_point = [mt for mt in matches if _finite(mt.lat) is not None]

@@ -508,7 +508,7 @@ def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any]
         "score_text": score_text(score),
         "sigma_m": _num(result.uncertainty_m),
         "tie": bool(result.tie),
-        "n_candidates": len(rows),
+        "n_candidates": int(result.n_candidates),  # the engine's count, as camloc batch
         "height_m": _num(result.height_m),
         "heading_deg": _num(result.heading_deg),
         "method": result.method,

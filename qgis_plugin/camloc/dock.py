@@ -46,6 +46,7 @@ from qgis.PyQt.QtWidgets import (
     QProgressBar,
     QPushButton,
     QScrollArea,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
@@ -63,6 +64,15 @@ AXIS_COLOURS = {
 }
 PRESETS = ["sedan", "bus", "hatchback", "minivan", "pickup", "suv", "taxi_ny", "van"]
 """The library's object presets (``camloc_geo.objects.PRESETS``; the worker's probe wins)."""
+LAYER_TITLES = {
+    "candidates": "camera candidates",
+    "matched_corners": "matched map points",
+    "intersection": "intersection and kerb corners",
+    "view_cones": "view cones (leading candidates)",
+    "context_buildings": "map model: buildings",
+    "context_streets": "map model: streets",
+}
+"""The dock's names for its result layers."""
 RESULTS_NAME = "camloc_results.gpkg"
 MARKER_PX = 6.0
 """Click markers' radius on screen (pixels, at any zoom)."""
@@ -140,18 +150,18 @@ class ImageView(QGraphicsView):
         """Screen pixels per image pixel."""
         return float(self.transform().m11())
 
-    def wheelEvent(self, event):
+    def wheelEvent(self, event: Any) -> None:
         steps = event.angleDelta().y() / 120.0
         if steps:
             self.zoom(1.25**steps)
         event.accept()
 
-    def resizeEvent(self, event):
+    def resizeEvent(self, event: Any) -> None:
         super().resizeEvent(event)
         if self._fitted:
             self.fit()
 
-    def mousePressEvent(self, event):
+    def mousePressEvent(self, event: Any) -> None:
         pan = event.button() in (Qt.RightButton, Qt.MiddleButton) or (
             event.button() == Qt.LeftButton and event.modifiers() & Qt.ControlModifier
         )
@@ -165,7 +175,7 @@ class ImageView(QGraphicsView):
             self.clicked.emit(p.x(), p.y())
         super().mousePressEvent(event)
 
-    def mouseMoveEvent(self, event):
+    def mouseMoveEvent(self, event: Any) -> None:
         if self._pan_from is not None:
             d = event.pos() - self._pan_from
             self._pan_from = event.pos()
@@ -175,7 +185,7 @@ class ImageView(QGraphicsView):
             return
         super().mouseMoveEvent(event)
 
-    def mouseReleaseEvent(self, event):
+    def mouseReleaseEvent(self, event: Any) -> None:
         if self._pan_from is not None:
             self._pan_from = None
             self.unsetCursor()
@@ -270,6 +280,7 @@ class CamlocDock(QDockWidget):
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
         self.task: QgsTask | None = None
+        self._loading = False
         self.page_task: WorkerTask | None = None
         self.page_server: Any = None
         self.inbox = _SceneInbox()
@@ -280,6 +291,7 @@ class CamlocDock(QDockWidget):
 
     # --- layout ---------------------------------------------------------------------------
     def _build(self) -> None:
+        self.view = ImageView()
         body = QWidget()
         lay = QVBoxLayout(body)
         row = QHBoxLayout()
@@ -293,11 +305,15 @@ class CamlocDock(QDockWidget):
         self.browser_button.clicked.connect(self.annotate_in_browser)
         self.load_button = QPushButton("Load scene…")
         self.load_button.clicked.connect(self._load_dialog)
-        for b in (self.open_button, self.browser_button, self.load_button):
-            row.addWidget(b)
+        row.addWidget(self.open_button)
+        row.addWidget(self.load_button)
         lay.addLayout(row)
+        self.browser_button.setText("Annotate in browser (zoom, checks)…")
+        lay.addWidget(self.browser_button)
         self.guidance = QLabel()
         self.guidance.setWordWrap(True)
+        # wrapped labels take the dock's width; a long word (a path, a URL) never widens it
+        self.guidance.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.guidance.setStyleSheet("QLabel { background: #fff8d6; padding: 4px; }")
         lay.addWidget(self.guidance)
         self.steps = QListWidget()
@@ -323,7 +339,6 @@ class CamlocDock(QDockWidget):
         self.undo_button.clicked.connect(self.undo)
         zoom.addWidget(self.undo_button)
         lay.addLayout(zoom)
-        self.view = ImageView()
         self.view.clicked.connect(self.image_clicked)
         lay.addWidget(self.view, 1)
 
@@ -371,8 +386,8 @@ class CamlocDock(QDockWidget):
         out.addWidget(self.gpkg_edit)
         out.addWidget(gpkg_button)
         form.addRow("Results", out)
-        self.context_check = QCheckBox("also the map model's streets and buildings")
-        form.addRow("", self.context_check)
+        self.context_check = QCheckBox("Also load the map model's streets and buildings")
+        form.addRow(self.context_check)  # its own row: a long label never widens the dock
         lay.addLayout(form)
         row4 = QHBoxLayout()
         self.run_button = QPushButton("Run")
@@ -393,10 +408,14 @@ class CamlocDock(QDockWidget):
             "Open a snapshot, then annotate it here or in the browser (Annotate in browser…)."
         )
         self.status.setWordWrap(True)
+        self.status.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.status.setTextInteractionFlags(Qt.TextSelectableByMouse)
         lay.addWidget(self.status)
         scroll = QScrollArea()
         scroll.setWidgetResizable(True)
+        scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)  # wrap, never cut
+        scroll.setFrameShape(QScrollArea.NoFrame)
+        self.setMinimumWidth(380)
         scroll.setWidget(body)
         self.setWidget(scroll)
 
@@ -524,7 +543,7 @@ class CamlocDock(QDockWidget):
         for key, (x, y) in a.axes.items():
             dot(x, y, AXIS_COLOURS[key])
         if a.pending is not None:
-            dot(*a.pending, "#ffff00")
+            dot(a.pending[0], a.pending[1], "#ffff00")
         for i, (x, y) in enumerate(a.corners):
             dot(x, y, AXIS_COLOURS["corners"], MARKER_PX * 1.3)
             t = sc.addSimpleText(str(i))
@@ -586,8 +605,9 @@ class CamlocDock(QDockWidget):
         QDesktopServices.openUrl(QUrl(self.page_server.url))
         self.set_status(
             "The annotation page is open in your browser. Annotate there and press Submit: "
-            f"the scene comes back here by itself. (Page: {self.page_server.url})"
+            "the scene comes back here by itself."
         )
+        self.status.setToolTip(self.page_server.url)
 
     def _scene_from_page(self, scene: dict[str, Any]) -> str | None:
         """On the page server's thread: validate with the library, then hand to the GUI."""
@@ -747,7 +767,7 @@ class CamlocDock(QDockWidget):
 
         Returns the task (None when the scene is not ready or a run is going on).
         """
-        if self.task is not None:
+        if self.task is not None or self._loading:
             self.set_status("A run is going on: wait for it or Cancel it.")
             return None
         problems = self.annotation.problems()
@@ -808,38 +828,39 @@ class CamlocDock(QDockWidget):
         self._load_results(task)
 
     def _load_results(self, task: LocateTask) -> None:
-        project = QgsProject.instance()
-        root = project.layerTreeRoot()
+        """Load the task's layers one per event-loop turn (each turn a few tens of ms, so the
+        GUI never stalls for the whole batch), candidates on top; then report and zoom."""
+        from qgis.PyQt.QtCore import QTimer
+
+        root = QgsProject.instance().layerTreeRoot()
         name = f"camloc: {self.annotation.scene_id}"
         group = root.findGroup(name) or root.insertGroup(0, name)
-        titles = {
-            "candidates": "camera candidates",
-            "matched_corners": "matched map points",
-            "intersection": "intersection and kerb corners",
-            "view_cones": "view cones (leading candidates)",
-            "context_buildings": "map model: buildings",
-            "context_streets": "map model: streets",
-        }
+        todo = [k for k in DRAW_ORDER if k in task.uris]  # top to bottom
         self.result_layers = []
-        for kind in DRAW_ORDER:  # top to bottom: candidates above cones above context
-            uri = task.uris.get(kind)
-            if uri is None:
-                continue
-            layer = QgsVectorLayer(uri, titles.get(kind, kind), "ogr")
-            if not layer.isValid():
-                continue
-            apply_style(layer, kind)
-            project.addMapLayer(layer, False)
-            group.addLayer(layer)
-            self.result_layers.append(layer)
-        cands = next(
-            (
-                lyr
-                for lyr in self.result_layers
-                if lyr.customProperty("camloc/kind") == "candidates"
-            ),
-            None,
-        )
+        self._loading = True
+
+        def next_layer() -> None:
+            if not todo:
+                self._loading = False
+                self._report(task)
+                return
+            kind = todo.pop(0)
+            opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan
+            layer = QgsVectorLayer(task.uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
+            if layer.isValid():
+                apply_style(layer, kind)
+                QgsProject.instance().addMapLayer(layer, False)
+                group.addLayer(layer)
+                self.result_layers.append(layer)
+            QTimer.singleShot(0, next_layer)
+
+        next_layer()
+
+    def _report(self, task: LocateTask) -> None:
+        from qgis.PyQt.QtCore import QTimer
+
+        kinds = {lyr.customProperty("camloc/kind"): lyr for lyr in self.result_layers}
+        cands = kinds.get("candidates")
         n = cands.featureCount() if cands is not None else 0
         tied = cands is not None and any(f["tie"] for f in cands.getFeatures())
         msg = f"{n} candidate(s) in {task.gpkg}; best first."
@@ -850,13 +871,16 @@ class CamlocDock(QDockWidget):
         self.set_status(msg)
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
+            project = QgsProject.instance()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
-            ext = xform.transformBoundingBox(cands.extent())
-            ext.scale(2.0)
-            if ext.width() < 150 and ext.height() < 150:
-                ext.grow(75)
+            ext84 = cands.extent()
+            ext84.grow(0.0006)  # degrees (the layer is EPSG:4326): about 60 m around them
+            ext = xform.transformBoundingBox(ext84)
             canvas.setExtent(ext)
             canvas.refresh()
+            # the first layers of an empty project make QGIS zoom to their full extent once
+            # the event loop runs: zoom again after that
+            QTimer.singleShot(0, lambda: (canvas.setExtent(ext), canvas.refresh()))
 
     def wait(self, timeout_s: float = 120.0) -> bool:
         """Process events until the run (and the page task) ends; True if it did in time."""
@@ -865,12 +889,14 @@ class CamlocDock(QDockWidget):
         from qgis.PyQt.QtCore import QCoreApplication
 
         t0 = time.monotonic()
-        while (self.task is not None or self.page_task is not None) and (
-            time.monotonic() - t0 < timeout_s
-        ):
+
+        def busy() -> bool:
+            return self.task is not None or self.page_task is not None or self._loading
+
+        while busy() and time.monotonic() - t0 < timeout_s:
             QCoreApplication.processEvents()
             time.sleep(0.01)
-        return self.task is None and self.page_task is None
+        return not busy()
 
     def _remove_results(self) -> None:
         project = QgsProject.instance()
@@ -895,7 +921,7 @@ class CamlocDock(QDockWidget):
             self.task = None
         self._stop_page()
 
-    def closeEvent(self, event):
+    def closeEvent(self, event: Any) -> None:
         self.pick_button.setChecked(False)
         self._stop_page()
         super().closeEvent(event)

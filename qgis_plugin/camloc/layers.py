@@ -396,10 +396,24 @@ def apply_style(layer: QgsVectorLayer, kind: str) -> None:
     if fn is not None and layer.isValid() and layer.isSpatial():
         fn(layer)
     layer.setCustomProperty(KIND_PROPERTY, kind)
-    for field in ("score", "score_text"):
-        idx = layer.fields().indexOf(field)
-        if idx >= 0 and field == "score_text":
-            layer.setFieldAlias(idx, "score (readable)")
+    _score_columns(layer)
+
+
+def _score_columns(layer: QgsVectorLayer) -> None:
+    """The attribute table shows ``score_text`` next to ``score``, wide enough for 1.2e-15."""
+    fields = layer.fields()
+    if fields.indexOf("score_text") >= 0:
+        layer.setFieldAlias(fields.indexOf("score_text"), "score (readable)")
+    if fields.indexOf("score") < 0:
+        return
+    config = layer.attributeTableConfig()
+    config.update(fields)
+    columns = config.columns()
+    for col in columns:
+        if col.name in ("score", "score_text"):
+            col.width = 190  # the full double, exponent included (the default cut it)
+    config.setColumns(columns)
+    layer.setAttributeTableConfig(config)
 
 
 def order_camloc_layers(group: QgsLayerTreeGroup) -> None:

@@ -76,6 +76,10 @@ class CamlocPlugin:
 
             self.dock = CamlocDock(self.iface, self.iface.mainWindow())
             self.iface.addDockWidget(Qt.RightDockWidgetArea, self.dock)
+            window = self.iface.mainWindow()
+            if hasattr(window, "resizeDocks"):  # room for the snapshot: half the window
+                width = max(480, window.width() // 3)
+                window.resizeDocks([self.dock], [width], Qt.Horizontal)
             self.dock.visibilityChanged.connect(self._dock_visibility)
         if self.dock is not None:
             self.dock.setVisible(on)

@@ -117,6 +117,8 @@ def test_locate_default_style_ties_stars_best_red_unlikely_faded(provider, tmp_p
     expr = layer.labeling().settings().fieldName
     assert '"rank"' in expr
     assert '"score_text"' in expr
+    widths = {c.name: c.width for c in layer.attributeTableConfig().columns()}
+    assert widths["score"] >= 150  # room for 1.17461213e-15, exponent included
     scores = {f["score_text"] for f in layer.getFeatures()}
     assert all(t and len(t) <= 8 for t in scores), scores  # 0.37, 1.2e-15: never cut
 

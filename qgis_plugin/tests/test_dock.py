@@ -137,15 +137,14 @@ def test_dock_refuses_to_save_an_invalid_scene(dock, tmp_path):
     assert not out.exists()
 
 
-def _camloc_tmp() -> set[str]:
+def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
+    dock, qgis_iface, tmp_path, artifacts, monkeypatch
+):
     import tempfile
 
-    return {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("camloc_")}
-
-
-def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
-    dock, qgis_iface, tmp_path, artifacts
-):
+    private_tmp = tmp_path / "tmp"  # the shared /tmp has other people's files
+    private_tmp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(private_tmp))
     assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
     _annotate(dock)
     _pick_on_canvas(dock, qgis_iface)
@@ -153,7 +152,6 @@ def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
     dock.context_check.setChecked(True)
     gpkg = tmp_path / "results.gpkg"
     dock.gpkg_edit.setText(str(gpkg))
-    before = _camloc_tmp()
     task = dock.run()
     assert task is not None
     assert dock.cancel_button.isEnabled()
@@ -170,7 +168,7 @@ def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
         "context_streets",
     ]
     assert all(str(gpkg) in lyr.source() for lyr in layers)  # the analyst's GeoPackage
-    assert _camloc_tmp() <= before  # nothing left in the temporary folder
+    assert os.listdir(private_tmp) == []  # nothing left in the temporary folder
     project = QgsProject.instance()
     group = project.layerTreeRoot().findGroup("camloc: snapshot")
     assert group is not None

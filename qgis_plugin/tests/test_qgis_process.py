@@ -116,3 +116,42 @@ def test_qgis_process_reports_a_bad_scene_as_an_error(profile_home, tmp_path):
     )
     assert r.returncode != 0
     assert "unknown format version" in r.stdout + r.stderr
+
+
+def test_qgis_process_geocodelist_takes_a_folder_of_extracts(profile_home, tmp_path):
+    """As ``camloc batch --osm data/osm/``: a list spanning extracts, made-up titles not placed."""
+    data_osm = PLUGIN_ROOT.parent / "data" / "osm"
+    lst = tmp_path / "cams.csv"
+    lst.write_text(
+        "id,title\n"
+        "foo,Foo St & Bar Ave\n"
+        "milton,N Milton Ave & E Biddle St\n"
+        "main,Main St\n"
+        "berlin,Karl-Liebknecht-Str. / Wadzeckstr.\n"
+    )
+    out = tmp_path / "cams.gpkg"
+    r = subprocess.run(
+        [
+            QGIS_PROCESS,
+            "run",
+            "camloc:geocodelist",
+            "--",
+            f"LIST={lst}",
+            f"OSM={data_osm}/",
+            f"CAMERAS={out}",
+        ],
+        capture_output=True,
+        text=True,
+        env=_env(profile_home),
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stdout + r.stderr
+    from qgis.core import QgsVectorLayer
+
+    layer = QgsVectorLayer(str(out), "cams", "ogr")
+    assert layer.isValid()
+    rows = {f["camera_id"]: (f["status"], f["n_candidates"]) for f in layer.getFeatures()}
+    assert rows["foo"] == ("not_found", 0)
+    assert rows["main"] == ("not_found", 0)
+    assert rows["milton"][0] == "title_only"
+    assert rows["berlin"][0] == "title_only"  # another extract of the folder
