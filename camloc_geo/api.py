@@ -126,10 +126,8 @@ def calibrate_scene(
 
 
 def scene_needs_map(scene: Scene) -> bool:
-    """True when the scene's evidence can only be used with map data."""
-    if scene.intersection is not None or scene.landmarks:
-        return True
-    return len(scene.references) == 1 and scene.street_bearing_deg is None
+    """True when the scene's evidence can only be used with map data (:attr:`Scene.needs_map`)."""
+    return scene.needs_map
 
 
 def scene_anchor(scene: Scene) -> tuple[float, float] | None:
@@ -261,7 +259,7 @@ class LocateOutput:
 
     def to_geojson(self) -> dict[str, Any]:
         """The candidate GeoJSON FeatureCollection (``docs/contract.md``)."""
-        from camloc_geo.absolute import candidates_geojson
+        from camloc_geo.results import candidates_geojson
 
         return candidates_geojson(self.result)
 
@@ -409,7 +407,7 @@ def corners_near(
         cache_folder=cache_folder,
         overpass_url=overpass_url,
     )
-    from camloc_geo.osm import intersections_geojson
+    from camloc_geo.results import intersections_geojson
 
     inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
     return intersections_geojson(inters)

@@ -448,34 +448,18 @@ def _and(items: Sequence[Any]) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
-def _ambiguity_reasons(collection: Mapping[str, Any]) -> list[str]:
-    """The result's own words on ties: ``ambiguous...`` warnings and an ``ambiguous`` property."""
-    out = [
-        str(w)
-        for w in collection.get("warnings") or []
-        if isinstance(w, str) and w.lower().startswith("ambiguous")
-    ]
-    extra = collection.get("ambiguous")
-    if isinstance(extra, str):
-        out.append(extra)
-    elif isinstance(extra, (list, tuple)):
-        out.extend(str(e) for e in extra if isinstance(e, str))
-    return list(dict.fromkeys(out))
-
-
 def _tie_reason(group: Sequence[int], collection: Mapping[str, Any], *, short: bool = False) -> str:
-    """Why these ranks tie: the result's warning naming them, else the rule (escaped HTML).
+    """Why these ranks tie: the result's tie naming them (its ``ties`` data), else the rule.
 
-    ``short``: only the warning's explanation (after its first ``;``), without the
-    ``ambiguous: candidates 1 and 2 ...`` lead the banner already says.
+    ``short``: only the explanation (what would decide), without the odds the banner already
+    says. Escaped HTML.
     """
-    for w in _ambiguity_reasons(collection):
-        named = {int(n) for n in re.findall(r"\b(\d+)\b", w.split("(", 1)[0])}
-        if set(group[:2]) <= named:
-            text = re.sub(r"^ambiguous:\s*", "", w, flags=re.IGNORECASE)
-            if short and ";" in text:
-                text = text.split(";", 1)[1].strip()
-            return html.escape(text.rstrip(". "))
+    for tie in collection.get("ties") or []:
+        ranks = tie.get("ranks") if isinstance(tie, Mapping) else None
+        if isinstance(ranks, list) and set(group[:2]) <= set(ranks):
+            text = str(tie.get("why" if short else "text") or "")
+            if text:
+                return html.escape(text.rstrip(". "))
     return html.escape(_TIE_RULE)
 
 
@@ -900,7 +884,7 @@ def build_candidates_map(
     folium.Map
         With layers, layer control, legend and scale bar.
     """
-    from camloc_geo.absolute import candidates_geojson
+    from camloc_geo.results import candidates_geojson
 
     gj = candidates_geojson(result)
     feats = gj["features"]
@@ -1245,7 +1229,7 @@ def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
     if isinstance(item, Mapping):
         gj = item
     else:
-        from camloc_geo.absolute import candidates_geojson
+        from camloc_geo.results import candidates_geojson
 
         gj = candidates_geojson(item, view_cones=False)
     cands = [

@@ -342,8 +342,8 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
 
 
 def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | None) -> None:
-    from camloc_geo.absolute._geojson import view_cone as _view_cone
-    from camloc_geo.api import locate_scene
+    from camloc_geo.absolute import locate
+    from camloc_geo.absolute import view_cone as _view_cone
     from camloc_geo.geodesy import normalize_bearing_deg
 
     try:
@@ -354,17 +354,24 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
             where = f"scene {os.path.basename(str(row.scene))}"
         res.fail("scene_error", f"{where}: {exc}", "scene")
         return
+    if m is None and sc.needs_map:
+        res.fail(
+            "no_candidates",
+            "this scene needs a map (intersection corners, landmarks or street bearings) and "
+            "no map covers it",
+            "locate",
+        )
+        return
     try:
-        out = locate_scene(sc, map_source=m, network=False)
+        r = locate(sc, m)
     except MapDataError as exc:
         res.fail("no_candidates", str(exc), "locate")
         return
     except SceneError as exc:
         res.fail("scene_error", str(exc), "locate")
         return
-    r = out.result
     res.method = "locate"
-    res.extract = res.extract or _extract_name(out.map_data)
+    res.extract = res.extract or _extract_name(m)
     frame = r.frame
     title_cands = res.candidates
     res.candidates = []
@@ -412,9 +419,10 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
     res.height_m = res.candidates[0]["height_m"]
     # a tie between candidates at the same junction (a symmetric one) keeps the best
     # candidate's point, flagged; the candidates layer has both
-    res.tie = any(w.startswith("ambiguous") for w in r.warnings)
+    res.tie = r.leaders_tie
     if res.tie:
-        warnings.sort(key=lambda w: not w.startswith("ambiguous"))
+        lead = f"ambiguous: {r.ties[0].text}"
+        warnings = [lead] + [w for w in warnings if w != lead]
     res.status = "located"
     res.lat, res.lon = _finite(best.lat), _finite(best.lon)
     res.reason = "; ".join(warnings[:3]) or None

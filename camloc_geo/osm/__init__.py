@@ -11,6 +11,8 @@ and :mod:`camloc_geo.osm._widths` for carriageway widths.
 
 from __future__ import annotations
 
+from typing import Any
+
 from camloc_geo.osm._catalogue import (
     CELL_M,
     WHOLE_EXTRACT_MAX_BYTES,
@@ -19,7 +21,6 @@ from camloc_geo.osm._catalogue import (
     extract_bounds,
     extract_files,
 )
-from camloc_geo.osm._geojson import intersections_geojson, streets_json
 from camloc_geo.osm._intersections import (
     ARM_SAMPLE_M,
     MAX_CORNER_GAP_DEG,
@@ -52,9 +53,22 @@ __all__ = [
     "extract_bounds",
     "extract_files",
     "header_box",
-    "intersections_geojson",
     "load_map",
     "normalize_name",
     "resolve_width_m",
-    "streets_json",
 ]
+
+
+_MOVED_TO_RESULTS = {"intersections_geojson", "streets_json"}
+
+
+def __getattr__(name: str) -> Any:
+    """``intersections_geojson``, ``streets_json``: output shapes, now in :mod:`camloc_geo.results`.
+
+    Kept importable from here (public names); the map layer itself never imports ``results``.
+    """
+    if name in _MOVED_TO_RESULTS:
+        from camloc_geo import results
+
+        return getattr(results, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -383,7 +383,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         """Streets near a point with their bearings."""
 
         def work() -> dict[str, Any]:
-            from camloc_geo.osm._geojson import streets_json
+            from camloc_geo.results import streets_json
 
             m = maps.map_for_point(lat=lat, lon=lon)
             out = streets_json(m, lat, lon, radius_m)
@@ -647,7 +647,7 @@ def _cameras_from(raw: bytes, ctype: str) -> list[Any]:
 
 
 def _job_geojson(job_id: str, results: list[dict[str, Any]]) -> dict[str, Any]:
-    from camloc_geo.osm._geojson import ATTRIBUTION
+    from camloc_geo.results import ATTRIBUTION
 
     feats: list[dict[str, Any]] = []
     for r in results:
