@@ -360,8 +360,7 @@ def locate_camera(
     A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
     ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
     """
-    from camloc_geo.cameras import CameraRow, geocode_camera
-    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.cameras import CameraRow, geocode_camera, row_from_mapping
     from camloc_geo.osm import MapCatalogue, MapData
 
     row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)

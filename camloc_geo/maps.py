@@ -69,6 +69,7 @@ __all__ = [
     "build_summary_map",
     "candidates_map",
     "inline_assets",
+    "leaflet_assets",
     "rank_colour",
     "rank_style",
     "score_colour",
@@ -398,11 +399,14 @@ def _compass(bearing_deg: Any) -> str | None:
 
 
 def _distance_m(a: Mapping[str, Any], b: Mapping[str, Any]) -> float:
-    """Ground distance between two candidates' lat/lon (equirectangular; metres apart)."""
-    lat0 = math.radians((float(a["lat"]) + float(b["lat"])) / 2.0)
-    dn = math.radians(float(a["lat"]) - float(b["lat"])) * 6_371_008.8
-    de = math.radians(float(a["lon"]) - float(b["lon"])) * 6_371_008.8 * math.cos(lat0)
-    return math.hypot(dn, de)
+    """Ground distance between two candidates' lat/lon, metres (:func:`geodesy.distance_m`)."""
+    from camloc_geo.geodesy import distance_m
+
+    return float(
+        distance_m(
+            lat1=float(a["lat"]), lon1=float(a["lon"]), lat2=float(b["lat"]), lon2=float(b["lon"])
+        )
+    )
 
 
 def _ties_of(props: Mapping[str, Any]) -> list[int]:
@@ -1446,7 +1450,7 @@ def summary_map(
 
 # ------------------------------------------------------------------------------ offline
 @lru_cache(maxsize=1)
-def _assets() -> dict[str, str]:
+def leaflet_assets() -> dict[str, str]:
     """Leaflet JS/CSS (images as data URIs) and jQuery from the xstatic packages."""
     import xstatic.pkg.jquery as xjquery
     import xstatic.pkg.leaflet as xleaflet
@@ -1493,7 +1497,7 @@ def inline_assets(page: str) -> str:
     ValueError
         When a remote resource reference is left (a tile layer, an ``<img>`` from the web).
     """
-    assets = _assets()
+    assets = leaflet_assets()
 
     placeholders = {
         "leaflet_js": "<!--camloc:leaflet_js-->",

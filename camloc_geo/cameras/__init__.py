@@ -16,7 +16,12 @@ from camloc_geo.cameras._camera import (
     CameraResult,
     geocode_camera,
 )
-from camloc_geo.cameras._list import COLUMN_VARIANTS, CameraRow, read_camera_list
+from camloc_geo.cameras._list import (
+    COLUMN_VARIANTS,
+    CameraRow,
+    read_camera_list,
+    row_from_mapping,
+)
 
 __all__ = [
     "COLUMN_VARIANTS",
@@ -26,4 +31,5 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "read_camera_list",
+    "row_from_mapping",
 ]

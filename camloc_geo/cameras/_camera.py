@@ -41,9 +41,8 @@ from typing import TYPE_CHECKING, Any
 from camloc_geo._errors import MapDataError, MapSourceError, SceneError
 
 if TYPE_CHECKING:
-    from camloc_geo.cameras._list import CameraRow
-    from camloc_geo.osm import MapData
-    from camloc_geo.osm._catalogue import Area, MapPlan
+    from camloc_geo.cameras import CameraRow
+    from camloc_geo.osm import Area, MapData, MapPlan
 
 __all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
 
@@ -489,7 +488,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     if not (row.title or row.streets):
         res.status = "no_evidence"
@@ -569,7 +568,7 @@ def geocode_camera(
         Without ``map_source``: may the map around the camera's point be fetched from
         Overpass.
     plan, area
-        A prepared :func:`~camloc_geo.osm._catalogue.map_plan` and the camera's area (what
+        A prepared :func:`~camloc_geo.osm.map_plan` and the camera's area (what
         :func:`run_batch` passes; computed from ``map_source`` when omitted).
     """
     res = CameraResult(row=row.row, id=row.id, title=row.title, list_lat=row.lat, list_lon=row.lon)
@@ -595,7 +594,7 @@ def _geocode(
     if map_data is not None:
         return _with_map(row, res, map_data)
     if plan is None:
-        from camloc_geo.osm._catalogue import map_plan
+        from camloc_geo.osm import map_plan
 
         plan = (
             _cached_plan(map_source, network)
@@ -612,7 +611,7 @@ def _geocode(
         return res.fail("no_map", str(area[1]), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     try:
         m = area_map(area)
@@ -626,7 +625,7 @@ _PLANS: dict[tuple[str, bool], MapPlan] = {}
 
 
 def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
-    from camloc_geo.osm._catalogue import map_plan
+    from camloc_geo.osm import map_plan
 
     key = (str(map_source), bool(network))
     if key not in _PLANS:

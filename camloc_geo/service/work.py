@@ -96,8 +96,7 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     catalogue chooses; statuses are the engine's (``docs/contract.md``).
     """
     from camloc_geo.api import locate_camera
-    from camloc_geo.cameras import CameraResult
-    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.cameras import CameraResult, row_from_mapping
     from camloc_geo.results import camera_job_result
 
     cam_id = str(camera.get("id", "")) if isinstance(camera, dict) else ""
