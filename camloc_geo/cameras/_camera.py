@@ -44,7 +44,15 @@ if TYPE_CHECKING:
     from camloc_geo.cameras import CameraRow
     from camloc_geo.osm import Area, MapData, MapPlan
 
-__all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
+__all__ = [
+    "PLACED_STATUSES",
+    "RETRY_STATUSES",
+    "STATUSES",
+    "STATUS_ALIASES",
+    "CameraResult",
+    "geocode_camera",
+    "normalize_status",
+]
 
 log = logging.getLogger(__name__)
 
@@ -53,6 +61,30 @@ PLACED_STATUSES = frozenset({"located", "title_only"})
 
 RETRY_STATUSES = frozenset({"failed", "map_error"})
 """Statuses a rerun computes again (the cause may be transient)."""
+
+STATUSES = (
+    "located",
+    "title_only",
+    "ambiguous",
+    "street_only",
+    "not_found",
+    "no_candidates",
+    "no_evidence",
+    "no_map",
+    "scene_error",
+    "map_error",
+    "failed",
+)
+"""The one status vocabulary of a camera (module docstring, ``docs/contract.md``)."""
+
+STATUS_ALIASES = {"no_candidate": "no_candidates"}
+"""Old status words accepted on input (the service's jobs said ``no_candidate``)."""
+
+
+def normalize_status(status: str) -> str:
+    """The status word of :data:`STATUSES` for an old or current one."""
+    return STATUS_ALIASES.get(status, status)
+
 
 _CONE_RANGE_M = 60.0
 _TITLE_CONE_HALF_DEG = 30.0
@@ -136,7 +168,9 @@ class CameraResult:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CameraResult:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (old status words accepted, :data:`STATUS_ALIASES`)."""
+        if isinstance(data.get("status"), str):
+            data = {**data, "status": normalize_status(data["status"])}
         return cls(**data)
 
     def fail(self, status: str, reason: str, stage: str) -> CameraResult:
