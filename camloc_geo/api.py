@@ -408,7 +408,23 @@ def corners_near(
     )
     from camloc_geo.results import intersections_geojson
 
-    inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
+    if streets:
+        return intersections_geojson([m.find_intersection(streets, near=(lat, lon))])
+    inters = list(m.intersections)
+    if inters and (m.radius_m is None or m.radius_m > radius_m):
+        # a map loaded for more than this point (a whole extract, a catalogue cell, a map
+        # passed in): only the intersections whose centre lies within radius_m
+        import numpy as np
+
+        from camloc_geo.geodesy import distance_m
+
+        far = distance_m(
+            lat1=np.full(len(inters), lat),
+            lon1=np.full(len(inters), lon),
+            lat2=np.array([x.lat for x in inters]),
+            lon2=np.array([x.lon for x in inters]),
+        )
+        inters = [x for x, d in zip(inters, far, strict=True) if d <= radius_m]
     return intersections_geojson(inters)
 
 
