@@ -32,6 +32,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
+
 if TYPE_CHECKING:
     from camloc_geo.absolute import Candidate, LocateResult, Match
     from camloc_geo.cameras import CameraResult
@@ -41,6 +43,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ATTRIBUTION",
+    "TIE_DISTANCE_M",
+    "TIE_SCORE_RATIO",
     "CalibrationOutput",
     "CalibrationSummary",
     "CandidateCollection",
@@ -670,15 +674,3 @@ def camera_job_result(result: CameraResult) -> dict[str, Any]:
         )
     out["candidates"] = feats
     return out
-
-
-_FROM_CORE = {"TIE_SCORE_RATIO", "TIE_DISTANCE_M"}
-
-
-def __getattr__(name: str) -> Any:
-    """``TIE_SCORE_RATIO`` and ``TIE_DISTANCE_M``: the core's tie rule, importable from here."""
-    if name in _FROM_CORE:
-        from camloc_geo.absolute import _model
-
-        return getattr(_model, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
 from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
@@ -30,19 +31,6 @@ __all__ = [
     "Observation",
     "Tie",
 ]
-
-TIE_SCORE_RATIO = 0.1
-"""Two candidates tie when the weaker scores at least this fraction of the stronger.
-
-The scores are posterior weights, so their ratio is the odds the evidence gives one over the
-other: under 10 to 1 is no strong evidence (Jeffreys' scale). On the absolute benchmark a
-top candidate that is wrong while another is right names that one as tied in 96 % of the
-scenes at 0.1 (87 % at 0.8: noise often favours a symmetric junction's mirror by 2-30 to 1).
-"""
-TIE_DISTANCE_M = 10.0
-"""Tied candidates stand more than this far apart, metres (closer ones are one answer at the
-accuracy the tool aims at)."""
-
 
 FloatArray = npt.NDArray[np.float64]
 EvidenceKind = Literal["reference", "corner", "landmark"]

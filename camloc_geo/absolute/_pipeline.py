@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from camloc_geo._ties import is_tie
 from camloc_geo.absolute._bundle import bundle_adjust
 from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
@@ -416,17 +417,14 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
     return cands
 
 
-TIE_MIN_SCORE = 0.01
-"""Candidates scoring less than this tie with nobody (a tie of two negligible ones says nothing)."""
-
-
 def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
-    lo, hi = sorted((a.score, b.score))
-    gap = float(np.linalg.norm(a.east_north - b.east_north))
-    return (
-        lo >= settings.tie_score_ratio * hi
-        and lo >= TIE_MIN_SCORE
-        and gap > max(settings.tie_distance_m, 2.0 * settings.merge_distance_m)
+    return is_tie(
+        a.score,
+        b.score,
+        float(np.linalg.norm(a.east_north - b.east_north)),
+        score_ratio=settings.tie_score_ratio,
+        distance_m=settings.tie_distance_m,
+        merge_distance_m=settings.merge_distance_m,
     )
 
 
@@ -434,9 +432,10 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
 
     Two candidates tie when the weaker scores at least ``settings.tie_score_ratio`` of the
-    stronger (:data:`~camloc_geo.absolute._model.TIE_SCORE_RATIO`: the evidence favours the
-    stronger by less than 10 to 1) and at least :data:`TIE_MIN_SCORE`, yet they stand more
-    than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot tell them apart).
+    stronger (:data:`~camloc_geo._ties.TIE_SCORE_RATIO`: the evidence favours the
+    stronger by less than 10 to 1) and at least :data:`~camloc_geo._ties.TIE_MIN_SCORE`, yet
+    they stand more than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot
+    tell them apart); the rule is :func:`camloc_geo._ties.is_tie`.
     Earlier marks and the earlier warning are replaced.
     """
     for c in cands:
