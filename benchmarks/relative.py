@@ -171,7 +171,7 @@ def run_scene(syn: Any, method: str) -> dict[str, Any]:
 def time_calibrate(seed: int, n_scenes: int = 20, repeats: int = 5) -> dict[str, Any]:
     """Median wall time of ``calibrate`` (joint fit) as a library call, five annotators."""
     rng = np.random.default_rng(seed + 1)
-    scenes = []
+    scenes: list[Any] = []
     while len(scenes) < n_scenes:
         syn, _size, _n = draw_scene(rng, len(scenes), NoiseModel(), n_annotators=5)
         scene = parse_scene(syn.scene)

@@ -45,6 +45,8 @@ __all__ = [
     "SceneLike",
     "calibrate_scene",
     "corners_near",
+    "corners_within",
+    "crowd_scene",
     "guide_scene",
     "locate_camera",
     "locate_scene",
@@ -54,6 +56,7 @@ __all__ = [
     "read_camera_list",
     "scene_from",
     "streets_near",
+    "streets_within",
     "vanishing_points",
 ]
 
@@ -476,6 +479,7 @@ def vanishing_points(
     axes_px: Sequence[Sequence[float]] = (),
     estimate_principal_point: bool = False,
     seed: int = 0,
+    **options: Any,
 ) -> AutoVPResult:
     """Three orthogonal vanishing points, focal length, horizon, pitch and roll of a photo.
 
@@ -491,6 +495,9 @@ def vanishing_points(
         ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
     estimate_principal_point
         Also refine the principal point around the image centre.
+    **options
+        Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
+        ``focal_prior_px``, ``distortion``, ...).
 
     Raises
     ------
@@ -526,6 +533,7 @@ def vanishing_points(
         mask=mask,
         estimate_principal_point=estimate_principal_point,
         axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+        **options,
     )
 
 
@@ -732,3 +740,103 @@ def guide_scene(
     result = match_people(calibration, pixel_tracks, traces, pose=abs_pose, settings=settings)
     result.warnings[:0] = warnings + list(calibration.warnings)
     return result
+
+
+def corners_within(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+    streets: str | None = None,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> dict[str, Any]:
+    """:func:`corners_near` limited to the intersections within ``radius_m`` of the point.
+
+    For a map loaded wider than the radius (a whole extract shared by many requests): only
+    intersections whose node lies within ``radius_m`` (geodesic distance) are kept, with
+    their corners. With ``streets`` the named intersection is returned wherever it is.
+    """
+    gj = corners_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        streets=streets,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    if streets:
+        return gj
+    from camloc_geo.geodesy import distance_m
+
+    inters = [f for f in gj["features"] if f["properties"].get("kind") == "intersection"]
+    keep: set[Any] = set()
+    if inters:
+        lons = [f["geometry"]["coordinates"][0] for f in inters]
+        lats = [f["geometry"]["coordinates"][1] for f in inters]
+        dist = distance_m(lat1=[lat] * len(lats), lon1=[lon] * len(lons), lat2=lats, lon2=lons)
+        keep = {f["properties"]["id"] for f, d in zip(inters, dist, strict=True) if d <= radius_m}
+    gj["features"] = [
+        f
+        for f in gj["features"]
+        if f["properties"].get("id") in keep or f["properties"].get("intersection") in keep
+    ]
+    return gj
+
+
+def streets_within(
+    *,
+    lat: float,
+    lon: float,
+    radius_m: float = 150.0,
+    map_source: MapSource = None,
+    network: bool = True,
+    cache_folder: str | os.PathLike[str] | None = None,
+    overpass_url: str | None = None,
+) -> dict[str, Any]:
+    """The streets within ``radius_m`` of a point with their bearings (JSON).
+
+    ``near`` lists each street's name and bearing there; ``streets`` describes only those
+    streets (not every street of the map, which may be a whole extract).
+    """
+    from camloc_geo.osm import streets_json
+
+    m = streets_near(
+        lat=lat,
+        lon=lon,
+        radius_m=radius_m,
+        map_source=map_source,
+        network=network,
+        cache_folder=cache_folder,
+        overpass_url=overpass_url,
+    )
+    out = streets_json(m, lat, lon, radius_m)
+    names = {n["name"] for n in out["near"]}
+    out["streets"] = [s for s in out["streets"] if s["name"] in names]
+    return out
+
+
+def crowd_scene(
+    scenes: Sequence[SceneLike], *, prior: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """One scene from several annotators' scenes of one snapshot, with the task's prior.
+
+    The scenes are merged (:func:`camloc_geo.merge.merge_scenes`); ``prior`` (``{"lat",
+    "lon", "radius_m"}``, the point the snapshot was taken near) is used when no annotator
+    gave one.
+
+    Raises
+    ------
+    SceneError
+        No scene, a scene that does not validate, or scenes that conflict.
+    """
+    from camloc_geo.merge import merge_scenes
+
+    merged = dict(merge_scenes(list(scenes)))
+    if prior is not None and merged.get("prior") is None:
+        merged["prior"] = dict(prior)
+    return merged

@@ -61,7 +61,7 @@ import numpy.typing as npt
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
-from camloc_geo._errors import InputError, NotEnoughStructureError
+from camloc_geo._errors import DegenerateGeometryError, InputError, NotEnoughStructureError
 
 __all__ = [
     "AutoVPResult",
@@ -95,6 +95,16 @@ _LABEL_TAU = 1.5
 _LABEL_ANGLE_DEG = 3.0
 _MIN_SEGMENTS = 6
 _MIN_SUPPORT = 3  # inlier segments needed by each of the two best-supported VPs
+#: Annotated axes may pick a frame whose support is at least this share of the best one.
+_HINT_MIN_SCORE_SHARE = 0.8
+#: A direction with fewer distinct lines than this is left out of the final fit.
+_WEAK_LINES = 4
+#: Above this relative standard deviation of the focal length a warning is given.
+_LOOSE_FOCAL_STD = 0.10
+#: Systematic bias of segment directions (degrees) put into the focal length's sigma.
+BIAS_DEG = 0.3
+#: Residual noise (in inlier distances) that scales a focal-length prior's weight.
+_PRIOR_NOISE_PX = 0.5
 
 
 # --------------------------------------------------------------------------- images
@@ -463,6 +473,8 @@ def _refine(
     f_prior: float,
     f_bounds: tuple[float, float],
     pp_sigma: float | None = None,
+    prior_w: float | None = None,
+    max_nfev: int = 40,
 ) -> tuple[FloatArray, float, float, FloatArray]:
     inl = labels >= 0
     ss = _Segs(
@@ -478,6 +490,7 @@ def _refine(
     lo, hi = f_bounds
     i_pp = 3 + int(f_free)
     step = 1e-7
+    w_prior = 0.05 * tau_px if prior_w is None else prior_w
 
     def batch(X: FloatArray) -> FloatArray:
         """Residuals ``(k, M)`` for ``k`` parameter vectors."""
@@ -493,7 +506,7 @@ def _refine(
         res = _endpoint_residual(vps, ss)[:, lab, cols]
         if f_free:
             # A weak prior keeps the focal length finite when the image cannot fix it.
-            res = np.hstack([res, (0.05 * tau_px * np.log(fk / f_prior))[:, None]])
+            res = np.hstack([res, (w_prior * np.log(fk / f_prior))[:, None]])
         if pp_sigma:
             res = np.hstack([res, tau_px * X[:, i_pp : i_pp + 2] / pp_sigma])
         return res
@@ -520,7 +533,7 @@ def _refine(
         jac=jac,
         loss="soft_l1",
         f_scale=tau_px,
-        max_nfev=40,
+        max_nfev=max_nfev,
         xtol=1e-7,
         ftol=1e-7,
     )
@@ -538,6 +551,67 @@ def _refine(
             logf_std = float("inf")
     delta = np.asarray(sol.x[i_pp : i_pp + 2] if pp_sigma else np.zeros(2), dtype=np.float64)
     return R, f, logf_std, delta
+
+
+def _rotated_groups(s: _Segs, angle_rad: FloatArray) -> _Segs:
+    """Segments each turned about its midpoint by its own angle (radians)."""
+    c, sn = np.cos(angle_rad), np.sin(angle_rad)
+    d = np.column_stack(
+        [c * s.dirn[:, 0] - sn * s.dirn[:, 1], sn * s.dirn[:, 0] + c * s.dirn[:, 1]]
+    )
+    nrm = np.column_stack([-d[:, 1], d[:, 0]])
+    lines = np.column_stack([nrm, -np.sum(nrm * s.mid, axis=1)])
+    return _Segs(mid=s.mid, dirn=d, length_px=s.length_px, lines=lines, weight=s.weight)
+
+
+def _systematic_logf_std(
+    m: _Model,
+    s: _Segs,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    bias_deg: float,
+) -> float:
+    """How far a systematic bias of the segments' directions moves ``log(focal)``.
+
+    Real photos bend and bias line directions coherently (residual lens distortion,
+    edge detectors on blurred or shaded edges, mislabelled lines): for each vanishing
+    point, all its segments are turned by ``bias_deg`` the same way, then in opposite
+    ways on either side of their centroid (a change of their convergence, e.g. of the
+    lean of the verticals), and the focal length refitted. The root sum of squares of
+    the moves is the systematic part of the focal length's standard deviation: it is
+    large exactly where the geometry leaves the focal length loose, e.g. a level camera
+    looking down a street, where only one horizontal vanishing point is finite and the
+    focal length rests on how far off the vertical one lies.
+    """
+    delta = math.radians(bias_deg)
+    total = 0.0
+    for k in range(3):
+        sel = m.labels == k
+        if np.count_nonzero(sel) < 2:
+            continue
+        signs = np.where(s.dirn[sel] @ s.dirn[sel][0] >= 0, 1.0, -1.0)
+        mean_dir = s.dirn[sel].T @ signs
+        mean_dir = mean_dir / (np.linalg.norm(mean_dir) + 1e-300)
+        rel = s.mid - s.mid[sel].mean(axis=0)
+        side = np.sign(rel[:, 0] * mean_dir[1] - rel[:, 1] * mean_dir[0])
+        for pattern in (np.ones(len(sel)), side):
+            ang = np.where(sel, delta * pattern, 0.0)
+            _, f, _, _ = _refine(
+                m.R,
+                m.f_n,
+                _rotated_groups(s, ang),
+                m.labels,
+                tau_px,
+                True,
+                f_prior,
+                f_bounds,
+                prior_w=prior_w,
+                max_nfev=20,
+            )
+            total += math.log(f / m.f_n) ** 2
+    return math.sqrt(total)
 
 
 # ------------------------------------------------------------------------- result
@@ -606,6 +680,19 @@ class AutoVPResult:
     n_inliers: tuple[int, int, int] = field(default=(0, 0, 0))
     n_lines: tuple[int, int, int] = field(default=(0, 0, 0))
     inlier_share: float = 0.0
+    warnings: list[str] = field(default_factory=list)
+    distortion: float = 0.0
+    distortion_std: float = float("nan")
+
+    @property
+    def street_index(self) -> int:
+        """Index (1 or 2) of the horizontal vanishing point taken for the street.
+
+        The horizontal direction nearer the optical axis: a street camera or a photo taken
+        in a street looks along it more than across it.
+        """
+        d = self.directions_in_cam
+        return 1 if abs(float(d[1, 2])) >= abs(float(d[2, 2])) else 2
 
     @property
     def vanishing_points_px(self) -> list[list[float] | None]:
@@ -643,6 +730,15 @@ class AutoVPResult:
                 for v in vps_px
             ],
             "vanishing_point_roles": ["vertical", "horizontal", "horizontal"],
+            "vanishing_point_names": [
+                "vertical",
+                *(
+                    ["street", "across the street"]
+                    if self.street_index == 1
+                    else ["across the street", "street"]
+                ),
+            ],
+            "street_vanishing_point": self.street_index,
             "vanishing_points_homogeneous": [
                 [float(x) for x in _unit(np.asarray(v, dtype=np.float64))]
                 for v in self.vanishing_points
@@ -666,6 +762,12 @@ class AutoVPResult:
             "n_inliers": [int(n) for n in self.n_inliers],
             "n_lines": [int(n) for n in self.n_lines],
             "inlier_share": _jsonable_float(self.inlier_share, 4),
+            "warnings": list(self.warnings),
+            "distortion": {
+                "model": "division",
+                "k1": _jsonable_float(self.distortion, 6),
+                "k1_std": _jsonable_float(self.distortion_std, 6),
+            },
             "image_size": [int(self.image_size[0]), int(self.image_size[1])],
         }
 
@@ -726,6 +828,12 @@ def detect_vanishing_points(
     mask: npt.NDArray[Any] | None = None,
     min_inlier_share: float = 0.2,
     axes_hint: Sequence[tuple[npt.ArrayLike, npt.ArrayLike]] | None = None,
+    focal_prior_px: float | None = None,
+    focal_prior_sigma_rel: float = 0.05,
+    focal_prior_source: str = "prior-given",
+    use_exif: bool = False,
+    bias_deg: float | None = None,
+    distortion_k1: float | None = None,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -770,6 +878,24 @@ def detect_vanishing_points(
         points these axes point at (within a few degrees) is preferred, so that the
         result is aligned with the annotated object rather than, say, a building at an
         angle to it.
+    focal_prior_px, focal_prior_sigma_rel, focal_prior_source
+        A prior on the focal length (pixels, relative standard deviation, and the name
+        ``focal_source`` reports), e.g. from EXIF. The vanishing points refine it where
+        they fix the focal length better; where they leave it loose, the prior decides.
+    use_exif
+        When ``image`` is a path and neither ``focal_px`` nor ``focal_prior_px`` is
+        given, read the focal length from the photo's EXIF (:mod:`camloc_geo.exif`) and
+        use it as the prior (``focal_source`` then names the EXIF source).
+    bias_deg
+        Systematic bias of segment directions (degrees) propagated into the focal
+        length's standard deviation (see ``_systematic_logf_std``); default
+        :data:`BIAS_DEG`, calibrated on real photos (``benchmarks/vp_real.py``).
+    distortion_k1
+        Known radial distortion of the photo (division model,
+        :class:`camloc_geo.camera.RadialDistortion`, radius in half image diagonals):
+        the segment end points are undistorted before the fit, so the vanishing points,
+        focal length and horizon are those of the pinhole camera; ``segments`` in the
+        result stay in the photo's pixels. Not estimated from the photo.
 
     Returns
     -------
@@ -792,6 +918,28 @@ def detect_vanishing_points(
         raise InputError("give an image, or segments with image_size")
     if focal_px is not None and not (math.isfinite(focal_px) and focal_px > 0):
         raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
+    if focal_prior_px is not None and not (math.isfinite(focal_prior_px) and focal_prior_px > 0):
+        raise InputError(f"focal_prior_px must be a positive number, got {focal_prior_px!r}")
+    if not (math.isfinite(focal_prior_sigma_rel) and focal_prior_sigma_rel > 0):
+        raise InputError(
+            f"focal_prior_sigma_rel must be a positive number, got {focal_prior_sigma_rel!r}"
+        )
+    if (
+        use_exif
+        and focal_px is None
+        and focal_prior_px is None
+        and isinstance(image, (str, os.PathLike))
+    ):
+        from camloc_geo.exif import focal_from_exif
+
+        ex = focal_from_exif(image)
+        if ex is not None:
+            focal_prior_px, focal_prior_sigma_rel, focal_prior_source = (
+                ex.focal_px,
+                ex.sigma_rel,
+                ex.source,
+            )
+            log.info("focal length prior from EXIF (%s): %.1f px", ex.source, ex.focal_px)
     if principal_point is not None and not (
         np.shape(principal_point) == (2,) and np.all(np.isfinite(principal_point))
     ):
@@ -812,12 +960,43 @@ def detect_vanishing_points(
         )
     pp = np.array(principal_point if principal_point is not None else (w / 2.0, h / 2.0), float)
     scale = float(max(w, h))
+    segs_photo = segs_px
+    if distortion_k1:
+        from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+        try:
+            dist = RadialDistortion.for_image(distortion_k1, w, h)
+        except DegenerateGeometryError as exc:
+            raise InputError(f"distortion_k1: {exc}") from exc
+        pp_t = (float(pp[0]), float(pp[1]))
+        und = undistort_points_px(segs_px.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
+        ok = np.all(np.isfinite(und), axis=1)
+        segs_px, segs_photo = und[ok], segs_px[ok]
+    hints = _prepare_hints(axes_hint, pp, scale)
+    if axes_hint:
+        # An annotated axis is a straight line of the image too: fit it with the segments
+        # (first, so that it is among the segments hypotheses are scored on).
+        axis_segs = np.array(
+            [
+                np.r_[np.ravel(np.asarray(o, float)), np.ravel(np.asarray(e, float))]
+                for o, e in axes_hint
+            ]
+        )
+        segs_px = np.vstack([axis_segs, segs_px])
     diag = math.hypot(w, h)
     tau = inlier_px if inlier_px is not None else max(1.0, _TAU_PER_800 * diag / 800.0)
     s = _prepare(segs_px, pp, scale)
     f_bounds = (focal_bounds_rel[0], focal_bounds_rel[1])
     f_fixed = None if focal_px is None else focal_px / scale
     f_prior = _F_PRIOR_REL if f_fixed is None else f_fixed
+    prior_sigma = _F_PRIOR_SIGMA
+    prior_w: float | None = None
+    has_prior = f_fixed is None and focal_prior_px is not None
+    if has_prior:
+        assert focal_prior_px is not None
+        f_prior = focal_prior_px / scale
+        prior_sigma = focal_prior_sigma_rel
+        prior_w = _PRIOR_NOISE_PX * tau / focal_prior_sigma_rel
 
     rng = np.random.default_rng(seed)
     # Score hypotheses on the longest segments (they are sorted longest first).
@@ -829,8 +1008,7 @@ def detect_vanishing_points(
     # on the 150 longest.
     n_sc = len(s_sc.mid)
     sub = np.unique(np.linspace(0, n_sc - 1, min(n_sc, 48)).round().astype(int))
-    prior = _focal_prior(fs, f_prior) if f_fixed is None else np.ones(len(fs))
-    hints = _prepare_hints(axes_hint, pp, scale)
+    prior = _focal_prior(fs, f_prior, 2.0 * prior_sigma) if f_fixed is None else np.ones(len(fs))
     if hints is not None:
         prior = prior * _hint_factor(dirs, fs, hints)
     scores = _score(dirs, fs, _subset(s_sc, sub), tau) * prior
@@ -847,21 +1025,38 @@ def detect_vanishing_points(
             continue
         tried.append(R0)
         # one round each: enough to rank the candidates
-        models.append(_fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds, rounds=1))
+        models.append(
+            _fit(R0, float(fs[i]), s, tau, f_fixed is None, f_prior, f_bounds, 1, prior_w=prior_w)
+        )
         if len(tried) >= _N_REFINED:
             break
 
     def model_weight(m: _Model) -> float:
         wgt = m.score
         if f_fixed is None:
-            wgt *= float(_focal_prior(np.array([m.f_n]), f_prior)[0])
+            wgt *= float(_focal_prior(np.array([m.f_n]), f_prior, 2.0 * prior_sigma)[0])
         if hints is not None:
             wgt *= float(_hint_factor(m.R.T[None], np.array([m.f_n]), hints)[0])
         return wgt
 
     best = max(models, key=model_weight)
+    if hints is not None:
+        # The axes choose among frames the photo supports about as well; they do not
+        # overrule a frame the photo supports clearly better.
+        best_img = max(models, key=lambda m: m.score)
+        if best.score < _HINT_MIN_SCORE_SHARE * best_img.score:
+            best = best_img
     best = _fit(
-        best.R, best.f_n, s, tau, f_fixed is None, f_prior, f_bounds, rounds=2, labels0=best.labels
+        best.R,
+        best.f_n,
+        s,
+        tau,
+        f_fixed is None,
+        f_prior,
+        f_bounds,
+        rounds=2,
+        labels0=best.labels,
+        prior_w=prior_w,
     )
     if estimate_principal_point and principal_point is None:
         # Free the principal point around the image centre (a Gaussian prior), on the
@@ -876,12 +1071,50 @@ def detect_vanishing_points(
             f_prior,
             f_bounds,
             pp_sigma=_PP_SIGMA_REL,
+            prior_w=prior_w,
         )
         pp = pp + delta * scale
         s = _prepare(segs_px, pp, scale)
         labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         best = _Model(R=R, f_n=f, labels=labels, score=score, logf_std=logf_std)
-    return _finish(best, s, segs_px, pp, scale, (w, h), f_fixed is None, f_bounds, min_inlier_share)
+    # A direction supported by a few lines only (paving joints, shadows, a roof slope) is
+    # left out: it would pull the focal length and the horizon wherever it lies.
+    merge_px = max(4.0, 0.01 * diag)
+    n_lines = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
+    weak = int(np.argmin(n_lines))
+    others = sorted(n_lines)[1:]
+    if 0 < n_lines[weak] < _WEAK_LINES and min(others) >= _MIN_SUPPORT:
+        labels = np.where(best.labels == weak, -1, best.labels)
+        R, f, logf_std, _ = _refine(
+            best.R, best.f_n, s, labels, tau, f_fixed is None, f_prior, f_bounds, prior_w=prior_w
+        )
+        U, _, Vt = np.linalg.svd(R)
+        best = _Model(R=U @ Vt, f_n=f, labels=labels, score=best.score, logf_std=logf_std)
+        log.debug("direction %d left out: %d distinct lines", weak, n_lines[weak])
+    sys_std = 0.0
+    if f_fixed is None and math.isfinite(best.logf_std):
+        sys_std = _systematic_logf_std(
+            best, s, tau, f_prior, f_bounds, prior_w, BIAS_DEG if bias_deg is None else bias_deg
+        )
+        best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2)
+    result = _finish(
+        best,
+        s,
+        segs_px,
+        pp,
+        scale,
+        (w, h),
+        f_fixed is None,
+        f_bounds,
+        min_inlier_share,
+        prior_source=focal_prior_source if has_prior else None,
+        prior_sigma=prior_sigma if has_prior else None,
+    )
+    if distortion_k1:
+        n_ax = len(segs_px) - len(segs_photo)  # annotated axes are not distorted pixels
+        result.segments = np.vstack([segs_px[:n_ax], segs_photo]) if n_ax else segs_photo
+        result.distortion = float(distortion_k1)
+    return result
 
 
 def _prepare_hints(
@@ -970,11 +1203,9 @@ def _n_distinct_lines(segs: FloatArray, merge_px: float = 4.0) -> int:
     return n
 
 
-def _focal_prior(f_n: FloatArray, f_prior: float) -> FloatArray:
-    """Mild log-normal preference for usual focal lengths; decides near ties only."""
-    return np.asarray(
-        np.exp(-0.5 * (np.log(f_n / f_prior) / _F_PRIOR_SIGMA) ** 2), dtype=np.float64
-    )
+def _focal_prior(f_n: FloatArray, f_prior: float, sigma: float = _F_PRIOR_SIGMA) -> FloatArray:
+    """Log-normal preference for the prior focal length (mild by default: near ties only)."""
+    return np.asarray(np.exp(-0.5 * (np.log(f_n / f_prior) / sigma) ** 2), dtype=np.float64)
 
 
 def _same_frame(Ra: FloatArray, Rb: FloatArray, tol_deg: float = 3.0) -> bool:
@@ -992,6 +1223,7 @@ def _fit(
     f_bounds: tuple[float, float],
     rounds: int = 3,
     labels0: npt.NDArray[np.int64] | None = None,
+    prior_w: float | None = None,
 ) -> _Model:
     R, f = R0, f0
     logf_std = float("nan")
@@ -1002,7 +1234,9 @@ def _fit(
     for _ in range(rounds):
         if np.count_nonzero(labels >= 0) < 4:
             break
-        R, f, logf_std, _ = _refine(R, f, s, labels, tau, f_free, f_prior, f_bounds)
+        R, f, logf_std, _ = _refine(
+            R, f, s, labels, tau, f_free, f_prior, f_bounds, prior_w=prior_w
+        )
         new_labels, score = _labels(R, f, s, tau * _LABEL_TAU, _LABEL_ANGLE_DEG)
         if np.array_equal(new_labels, labels):
             break
@@ -1023,6 +1257,8 @@ def _finish(
     f_free: bool,
     f_bounds: tuple[float, float],
     min_inlier_share: float,
+    prior_source: str | None = None,
+    prior_sigma: float | None = None,
 ) -> AutoVPResult:
     dirs = m.R.T.copy()  # rows
     support = np.array([s.weight[m.labels == k].sum() for k in range(3)])
@@ -1078,10 +1314,14 @@ def _finish(
     focal_source = "given"
     c_focal = 1.0
     logf_std = m.logf_std
+    warnings: list[str] = []
     if f_free:
         lo_b, hi_b = f_bounds
         at_bound = not (lo_b * 1.02 < m.f_n < hi_b / 1.02)
-        if at_bound:
+        if prior_source is not None:
+            focal_source = prior_source
+            c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2) if math.isfinite(logf_std) else 0.5
+        elif at_bound:
             focal_source = "bound"
             c_focal = 0.25
         elif not math.isfinite(logf_std) or logf_std > 0.25:
@@ -1090,6 +1330,32 @@ def _finish(
         else:
             focal_source = "estimated"
             c_focal = 1.0 / (1.0 + (logf_std / 0.1) ** 2)
+        if focal_source in ("bound", "prior"):
+            warnings.append(
+                "the photo does not fix the focal length: a default was used; give --focal-px "
+                "or a photo with EXIF"
+            )
+        elif math.isfinite(logf_std) and logf_std > _LOOSE_FOCAL_STD:
+            n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
+            why = (
+                "only one horizontal vanishing point is finite and the vertical one lies far off"
+                if n_finite < 2 and abs(float(dirs[0, 2])) < 0.15
+                else "the vanishing points leave it loose"
+            )
+            warnings.append(
+                f"the focal length is uncertain (+/- {100 * logf_std:.0f} %): {why}; give "
+                "--focal-px if it is known"
+            )
+    if distinct[perm[0]] < _MIN_SUPPORT:
+        warnings.append(
+            f"few vertical lines ({int(distinct[perm[0]])}): the vertical direction, pitch and "
+            "roll are weakly supported"
+        )
+    if not vertical_identified:
+        warnings.append(
+            "another vanishing direction could be the vertical one nearly as well: check "
+            "pitch and roll"
+        )
     confidence = float(np.clip(c_support * c_count * c_vert * c_focal, 0.0, 1.0))
     log.debug(
         "confidence parts: explained %.2f distinct %s focal %.2f",
@@ -1124,6 +1390,7 @@ def _finish(
         n_inliers=(int(counts[0]), int(counts[1]), int(counts[2])),
         n_lines=(int(distinct[perm[0]]), int(distinct[perm[1]]), int(distinct[perm[2]])),
         inlier_share=explained,
+        warnings=warnings,
     )
 
 
@@ -1211,7 +1478,8 @@ def draw_segments(
     """Write a PNG of the image with segments coloured by vanishing point.
 
     Red: vertical, green: horizontal-1, blue: horizontal-2, grey: outliers; the horizon
-    is drawn in yellow.
+    is drawn in yellow. A legend in the top-left corner names the colours and which
+    horizontal vanishing point is taken for the street (:attr:`AutoVPResult.street_index`).
     """
     import cv2
 
@@ -1237,6 +1505,35 @@ def draw_segments(
             (round(ep[0][0]), round(ep[0][1])),
             (round(ep[1][0]), round(ep[1][1])),
             (0, 220, 255),
+            1,
+            cv2.LINE_AA,
+        )
+    # Legend: what each colour is, with the role of each horizontal vanishing point.
+    names = {1: "horizontal-1", 2: "horizontal-2"}
+    names[res.street_index] += " (street)"
+    names[3 - res.street_index] += " (across)"
+    entries = [
+        ((0, 0, 255), "vertical"),
+        ((0, 200, 0), names[1]),
+        ((255, 64, 0), names[2]),
+        ((160, 160, 160), "outliers"),
+        ((0, 220, 255), "horizon"),
+    ]
+    h_img = canvas.shape[0]
+    fs = max(0.35, min(1.2, h_img / 1000.0))
+    line_h = round(22 * fs / 0.5)
+    box_w = round(250 * fs / 0.5)
+    cv2.rectangle(canvas, (4, 4), (4 + box_w, 8 + line_h * len(entries)), (0, 0, 0), -1)
+    for i, (col, text) in enumerate(entries):
+        y = 4 + line_h * (i + 1) - line_h // 3
+        cv2.line(canvas, (10, y), (10 + line_h, y), col, 2, cv2.LINE_AA)
+        cv2.putText(
+            canvas,
+            text,
+            (16 + line_h, y + line_h // 4),
+            cv2.FONT_HERSHEY_SIMPLEX,
+            fs,
+            (255, 255, 255),
             1,
             cv2.LINE_AA,
         )

@@ -41,10 +41,13 @@ from camloc_geo._errors import DegenerateGeometryError
 
 __all__ = [
     "Camera",
+    "RadialDistortion",
     "angles_from_rotation",
     "clip_segment_to_image",
+    "distort_points_px",
     "project_to_rotation",
     "rotation_from_angles",
+    "undistort_points_px",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -53,6 +56,94 @@ HorizonPolicy = Literal["nan", "error"]
 _UP = np.array([0.0, 0.0, 1.0])
 # Minimum cosine between a viewing ray and the ground (below the horizon) to count as a ground hit.
 _GROUND_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class RadialDistortion:
+    """One-parameter radial lens distortion, the division model.
+
+    A distorted pixel ``p_d`` (as in the photo) and its undistorted (pinhole) pixel
+    ``p_u`` satisfy::
+
+        p_u = c + (p_d - c) / (1 + k1 * r_d**2),   r_d = |p_d - c| / radius_px
+
+    with ``c`` the principal point and ``radius_px`` half the image diagonal, so that
+    ``k1`` does not depend on the image's size: ``k1 < 0`` is barrel distortion (wide-angle
+    lenses; straight lines bow outwards), ``k1 > 0`` pincushion. ``k1 = -0.1`` moves a
+    corner of the photo outwards by about 11 % of its distance to the centre.
+
+    Attributes
+    ----------
+    k1
+        The coefficient (dimensionless).
+    radius_px
+        Half the image diagonal, pixels.
+    """
+
+    k1: float
+    radius_px: float
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.k1) or abs(self.k1) >= 1.0:
+            raise DegenerateGeometryError(
+                f"distortion k1 must be finite and in (-1, 1), got {self.k1}"
+            )
+        if not (math.isfinite(self.radius_px) and self.radius_px > 0):
+            raise DegenerateGeometryError(
+                f"distortion radius must be positive, got {self.radius_px}"
+            )
+
+    @classmethod
+    def for_image(cls, k1: float, width_px: float, height_px: float) -> RadialDistortion:
+        """The distortion ``k1`` of a ``width_px`` x ``height_px`` image."""
+        return cls(float(k1), 0.5 * math.hypot(width_px, height_px))
+
+
+def undistort_points_px(
+    points_px: npt.ArrayLike,
+    distortion: RadialDistortion | None,
+    principal_point: tuple[float, float],
+) -> FloatArray:
+    """Pinhole pixels of ``(2,)`` or ``(N, 2)`` pixels of a distorted photo.
+
+    ``distortion`` None or ``k1 == 0`` returns the points unchanged (as floats). A point
+    the model maps through infinity (``1 + k1 r**2 <= 0``, far outside the photo) is NaN.
+    """
+    p = np.asarray(points_px, dtype=np.float64)
+    if distortion is None or distortion.k1 == 0.0:
+        return p.copy()
+    c = np.asarray(principal_point, dtype=np.float64)
+    d = p - c
+    r2 = np.sum(d * d, axis=-1, keepdims=True) / distortion.radius_px**2
+    den = 1.0 + distortion.k1 * r2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(den > 0, c + d / den, np.nan)
+    return np.asarray(out, dtype=np.float64)
+
+
+def distort_points_px(
+    points_px: npt.ArrayLike,
+    distortion: RadialDistortion | None,
+    principal_point: tuple[float, float],
+) -> FloatArray:
+    """Pixels in the distorted photo of ``(2,)`` or ``(N, 2)`` pinhole pixels.
+
+    The inverse of :func:`undistort_points_px`: ``r_d`` solves
+    ``k1 r_u r_d**2 - r_d + r_u = 0`` (the root that tends to ``r_u`` as ``k1 -> 0``).
+    Points with no solution (``4 k1 r_u**2 > 1``, far outside a pincushion photo) are NaN.
+    """
+    p = np.asarray(points_px, dtype=np.float64)
+    if distortion is None or distortion.k1 == 0.0:
+        return p.copy()
+    c = np.asarray(principal_point, dtype=np.float64)
+    d = (p - c) / distortion.radius_px
+    ru = np.sqrt(np.sum(d * d, axis=-1, keepdims=True))
+    k = distortion.k1
+    disc = 1.0 - 4.0 * k * ru * ru
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # r_d / r_u = 2 / (1 + sqrt(disc)), stable for small k and r_u = 0
+        ratio = np.where(disc >= 0, 2.0 / (1.0 + np.sqrt(np.maximum(disc, 0.0))), np.nan)
+    return np.asarray(c + (p - c) * ratio, dtype=np.float64)
 
 
 def project_to_rotation(matrix: npt.ArrayLike) -> FloatArray:
@@ -139,12 +230,18 @@ class Camera:
         ``R``, a proper 3×3 rotation.
     cam_from_world_translation
         ``t``, metres: the world origin in the camera frame.
+    distortion
+        Optional radial lens distortion (:class:`RadialDistortion`): :meth:`project`
+        returns pixels of the distorted photo and :meth:`rays_in_world` takes them. The
+        matrices (``img_from_cam``, ``horizon_line``, ...) are those of the pinhole camera:
+        undistort pixels with :func:`undistort_points_px` before using them.
     """
 
     focal_px: float
     principal_point: tuple[float, float]
     cam_from_world_rotation: FloatArray
     cam_from_world_translation: FloatArray
+    distortion: RadialDistortion | None = None
 
     def __post_init__(self) -> None:
         R = np.asarray(self.cam_from_world_rotation, dtype=np.float64).reshape(3, 3)
@@ -165,6 +262,7 @@ class Camera:
             self.focal_px == other.focal_px
             and self.principal_point == other.principal_point
             and bool(np.array_equal(self.cam_from_world_rotation, other.cam_from_world_rotation))
+            and self.distortion == other.distortion
             and bool(
                 np.array_equal(self.cam_from_world_translation, other.cam_from_world_translation)
             )
@@ -267,6 +365,8 @@ class Camera:
             uv = points_in_cam[:, :2] / z[:, None]
         uv = uv * self.focal_px + np.asarray(self.principal_point)
         uv[z <= 1e-12] = np.nan
+        if self.distortion is not None:
+            uv = distort_points_px(uv, self.distortion, self.principal_point)
         return uv[0] if single else uv
 
     def rays_in_world(self, pixels: npt.ArrayLike) -> FloatArray:
@@ -274,6 +374,8 @@ class Camera:
         px = np.asarray(pixels, dtype=float)
         single = px.ndim == 1
         px = px.reshape(-1, 2)
+        if self.distortion is not None:
+            px = undistort_points_px(px, self.distortion, self.principal_point)
         rays_in_cam = np.column_stack([px, np.ones(len(px))]) @ self.cam_from_img.T
         rays = rays_in_cam @ self.cam_from_world_rotation  # Rᵀ applied to each row
         rays /= np.linalg.norm(rays, axis=1, keepdims=True)

@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ATTRIBUTION",
+    "JOB_LAYERS",
     "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "CalibrationOutput",
@@ -69,6 +70,8 @@ __all__ = [
     "corners_collection",
     "intersection_features",
     "intersections_geojson",
+    "job_result_geojson",
+    "job_result_geopackage",
     "output_json_schema",
     "point",
     "streets_json",
@@ -674,3 +677,71 @@ def camera_job_result(result: CameraResult) -> dict[str, Any]:
         )
     out["candidates"] = feats
     return out
+
+
+# ------------------------------------------------------------------------- job results
+def job_result_geojson(job_id: str, results: Iterable[dict[str, Any]]) -> dict[str, Any]:
+    """The result of a camera-list job as one GeoJSON FeatureCollection.
+
+    Per camera (in list order) one ``camera`` feature (its status, reason and best position;
+    no geometry when it was not placed), then its ``candidate`` features, each carrying the
+    camera's id as ``camera_id``.
+    """
+    feats: list[dict[str, Any]] = []
+    for r in results:
+        props = {k: v for k, v in r.items() if k != "candidates"}
+        props["kind"] = "camera"
+        geom = (
+            {"type": "Point", "coordinates": [r["lon"], r["lat"]]}
+            if r.get("lat") is not None and r.get("lon") is not None
+            else None
+        )
+        feats.append({"type": "Feature", "geometry": geom, "properties": props})
+        for c in r.get("candidates", []) or []:
+            cp = dict(c["properties"])
+            cp["camera_id"] = r.get("id")
+            feats.append({"type": "Feature", "geometry": c["geometry"], "properties": cp})
+    return {
+        "type": "FeatureCollection",
+        "features": feats,
+        "properties": {"job": job_id, "attribution": ATTRIBUTION},
+    }
+
+
+JOB_LAYERS = (("cameras", "camera"), ("candidates", "candidate"))
+"""GeoPackage layers of a job result: ``(layer name, feature kind)``."""
+
+
+def job_result_geopackage(collection: dict[str, Any]) -> bytes:
+    """A job result (:func:`job_result_geojson`) as GeoPackage bytes, EPSG:4326.
+
+    Layers ``cameras`` and ``candidates`` (a layer without features is left out); list and
+    dict properties are stored as JSON text. Needs geopandas and pyogrio.
+    """
+    import json
+    import tempfile
+    from pathlib import Path
+
+    import geopandas as gpd
+    from shapely.geometry import shape
+
+    with tempfile.TemporaryDirectory(prefix="camloc-job-") as tmp:
+        path = Path(tmp) / "job.gpkg"
+        for layer, kind in JOB_LAYERS:
+            feats = [f for f in collection["features"] if f["properties"].get("kind") == kind]
+            if not feats:
+                continue
+            rows = [
+                {
+                    k: (json.dumps(v) if isinstance(v, (list, dict)) else v)
+                    for k, v in f["properties"].items()
+                }
+                for f in feats
+            ]
+            frame = gpd.GeoDataFrame(
+                rows,
+                geometry=[shape(f["geometry"]) if f["geometry"] else None for f in feats],
+                crs="EPSG:4326",
+            )
+            frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio")
+        return path.read_bytes() if path.exists() else b""

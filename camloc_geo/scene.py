@@ -188,6 +188,26 @@ class ObjectSpec(_Model):
         )
 
 
+class LensDistortion(_Model):
+    """One-parameter radial lens distortion (extension; see ``docs/scene-format.md``)."""
+
+    model: Literal["division"] = Field(
+        default="division",
+        description=(
+            "the division model: p_u = c + (p_d - c) / (1 + k1 r_d^2), r_d = |p_d - c| / "
+            "(half the image diagonal), c the principal point, p_d a pixel of the photo"
+        ),
+    )
+    k1: float = Field(
+        gt=-1.0,
+        lt=1.0,
+        description="the coefficient; negative for barrel distortion (wide-angle lenses)",
+    )
+    k1_std: float | None = Field(
+        default=None, ge=0, description="its standard deviation, when it was estimated"
+    )
+
+
 class CameraHints(_Model):
     """Known intrinsics, each optional."""
 
@@ -205,6 +225,13 @@ class CameraHints(_Model):
         description=(
             f"known principal point, {_PIXEL_DOC} (absent: the image centre unless the data "
             "justify fitting it; a point outside the image is ignored with a warning)"
+        ),
+    )
+    distortion: LensDistortion | None = Field(
+        default=None,
+        description=(
+            "radial lens distortion of the photo (extension; absent: none). Annotated pixels "
+            "are undistorted with it before any fit, and every projection distorts"
         ),
     )
 

@@ -185,21 +185,32 @@ def fit_vanishing_point(
     phi0 = math.atan2(v0[1], v0[0])
     seg_c = np.column_stack([(seg[:, 0:2] - center) / scale, (seg[:, 2:4] - center) / scale])
 
+    mx_c = (seg_c[:, 0] + seg_c[:, 2]) / 2.0
+    my_c = (seg_c[:, 1] + seg_c[:, 3]) / 2.0
+
+    def fun_many(X: FloatArray) -> FloatArray:
+        # segment_residuals_px of the conditioned segments to the unit points of the rows of
+        # X = (theta, phi), all at once: (P, n).
+        th, ph = X[:, 0:1], X[:, 1:2]
+        px, py, pw = np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)
+        la, lb = my_c * pw - py, px - mx_c * pw
+        lc = mx_c * py - my_c * px
+        norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
+        return np.asarray((la * seg_c[:, 0] + lb * seg_c[:, 1] + lc) / norm * weights)
+
     def fun(x: FloatArray) -> FloatArray:
-        return segment_residuals_px(seg_c, unit(x)) * weights
+        return np.asarray(fun_many(x[None, :])[0])
 
     if len(seg) > 2:
-        # A few damped Gauss-Newton steps (2 parameters: cheaper than a general solver).
+        # A few damped Gauss-Newton steps (2 parameters: cheaper than a general solver); the
+        # forward-difference Jacobian in the same call as the residuals.
         x = np.array([theta0, phi0])
         r = fun(x)
         cost = float(r @ r)
         lam = 1e-6
         for _ in range(10):
-            J = np.empty((len(r), 2))
-            for j in range(2):
-                step = np.zeros(2)
-                step[j] = 1e-7
-                J[:, j] = (fun(x + step) - r) / 1e-7
+            F = fun_many(np.vstack([x, x + 1e-7 * np.eye(2)]))
+            J = ((F[1:] - F[0]) / 1e-7).T
             JtJ, Jtr = J.T @ J, J.T @ r
             try:
                 dx = -np.linalg.solve(JtJ + lam * np.diag(np.diag(JtJ) + 1e-12), Jtr)
@@ -209,11 +220,14 @@ def fit_vanishing_point(
             cost_new = float(r_new @ r_new)
             if cost_new < cost:
                 x, r = x + dx, r_new
-                done = cost - cost_new <= 1e-10 * cost or np.max(np.abs(dx)) < 1e-12
+                done = cost - cost_new <= 1e-12 * cost or np.max(np.abs(dx)) < 1e-10
                 cost, lam = cost_new, lam * 0.3
                 if done:
                     break
             else:
+                # No decrease: at the minimum to rounding when even this step is tiny.
+                if np.max(np.abs(dx)) < 1e-10:
+                    break
                 lam *= 10.0
                 if lam > 1e6:
                     break

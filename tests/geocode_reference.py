@@ -283,6 +283,12 @@ def reference_titles(
             break
     for a, b in far:
         out.append(RefTitle(f"{a} & {b}", "not_found", names=(a, b), style="never meet"))
+    # a real street and a made-up one: one real name does not place the pair
+    for name in rng.sample(names_sorted, min(2, len(names_sorted))):
+        out.append(
+            RefTitle(f"{name} & Qzxwv Ave", "not_found", names=(name,), style="made-up street")
+        )
+    out.append(RefTitle("Plmokn St & Qzxwv Ave", "not_found", style="made-up streets"))
     for name in rng.sample(names_sorted, min(3, len(names_sorted))):
         out.append(RefTitle(name, "street", names=(name,), style="single street"))
     return out

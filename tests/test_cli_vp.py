@@ -150,3 +150,52 @@ def test_vp_axis_hint_option(scene_png: Path, capsys: pytest.CaptureFixture[str]
     assert json.loads(capsys.readouterr().out)["confidence"] > 0.5
     assert main(["vp", str(scene_png), "--axis", "400", "500", "400", "500"]) == 2
     assert "axes_hint[0]" in capsys.readouterr().err
+
+
+def test_vp_exif_prior_named_and_no_exif(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A photo with FocalLengthIn35mmFilm: the prior is used and named; --no-exif drops it."""
+    image_mod = pytest.importorskip("PIL.Image")
+    img = render_scene(cam_from_world(25.0, 8.0, -3.0), 650.0, seed=2)
+    path = tmp_path / "exif.jpg"
+    exif = image_mod.Exif()
+    # 35 mm equivalent of 650 px on an 800 x 600 photo (diagonal 1000 px)
+    exif.get_ifd(0x8769)[0xA405] = round(650.0 * 43.2666 / 1000.0)
+    image_mod.fromarray(img).save(path, exif=exif, quality=95)
+    assert main(["vp", str(path)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["focal_source"] == "exif-35mm"
+    assert out["focal_px"] == pytest.approx(650.0, rel=0.05)
+    assert isinstance(out["warnings"], list)
+    assert out["street_vanishing_point"] in (1, 2)
+    assert out["vanishing_point_names"][0] == "vertical"
+    assert sorted(out["vanishing_point_names"][1:]) == ["across the street", "street"]
+    assert main(["vp", str(path), "--no-exif"]) == 0
+    out2 = json.loads(capsys.readouterr().out)
+    assert out2["focal_source"] == "estimated"
+
+
+def test_vp_axis_changes_the_answer(scene_png: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["vp", str(scene_png)]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    vp = plain["vanishing_points"][1]
+    assert vp is not None
+    # an axis drawn 1.5 degrees off the direction of a vanishing point pulls the fit
+    o = np.array([400.0, 450.0])
+    d = np.array(vp) - o
+    c, s = np.cos(np.radians(1.5)), np.sin(np.radians(1.5))
+    e = o + 0.3 * np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])
+    assert main(["vp", str(scene_png), "--axis", *map(str, [*o, *e])]) == 0
+    hinted = json.loads(capsys.readouterr().out)
+    assert hinted["n_segments"] == plain["n_segments"] + 1
+    assert hinted["vanishing_points_homogeneous"] != plain["vanishing_points_homogeneous"]
+
+
+def test_vp_draw_has_a_legend(scene_png: Path, tmp_path: Path) -> None:
+    drawing = tmp_path / "legend.png"
+    assert main(["vp", str(scene_png), "--draw", str(drawing)]) == 0
+    img = cv2.imread(str(drawing))
+    box = img[6:60, 6:120]
+    assert (box.max(axis=2) < 20).mean() > 0.5  # a black legend box
+    assert (box.min(axis=2) > 230).sum() > 20  # white text in it

@@ -122,3 +122,75 @@ def test_baltimore_issue_titles(baltimore, title: str, expected: tuple[str, str]
     inter = best.intersection
     assert inter is not None
     assert _dist_m(best.lat, best.lon, inter.lat, inter.lon) < 1.0  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    "title",
+    [
+        "Foo St & Bar Ave",  # a bar called "Bar" is not "Bar Avenue"
+        "Bar Ave",
+        "Broadway & Bar St",  # one real street does not make the other real
+        "Fleet St & Pub Ave",
+        "Main St",  # no Main Street in this extract
+        "Eastern Ave & Cafe St",
+        "Qwertzuiop Tower & Plmokn Gate",
+        "Fleet St & Zyxwvut Ave",
+    ],
+)
+def test_baltimore_titles_that_must_not_be_placed(baltimore, title: str) -> None:  # type: ignore[no-untyped-def]
+    found = geocode_title(title, map_data=baltimore)
+    assert [m.status for m in found] == ["not_found"], [(m.status, m.reason) for m in found]
+    assert not found[0].placed
+    assert found[0].score == 0.0
+
+
+def test_a_street_pair_is_placed_where_the_two_streets_meet(baltimore) -> None:  # type: ignore[no-untyped-def]
+    best = geocode_title("N Milton Ave & E Biddle St", map_data=baltimore)[0]
+    assert best.status == "junction"
+    assert best.intersection is not None
+    streets = set(best.intersection.street_names)
+    assert {"North Milton Avenue", "East Biddle Street"} <= streets
+
+
+def test_scores_tell_a_clean_match_from_a_fuzzy_one(baltimore) -> None:  # type: ignore[no-untyped-def]
+    """Exact names > abbreviations > a name without its type > a misspelt name."""
+    titles = [
+        "North Milton Avenue & East Biddle Street",
+        "N Milton Ave & E Biddle St",
+        "Milton & E Biddle St",
+        "N Miltn Ave & E Biddle St",
+    ]
+    found = [geocode_title(t, map_data=baltimore)[0] for t in titles]
+    assert [m.status for m in found] == ["junction"] * 4
+    inter = {m.intersection.id for m in found if m.intersection is not None}
+    assert len(inter) == 1  # the same junction each time
+    scores = [m.score for m in found]
+    assert scores == sorted(scores, reverse=True)
+    assert len(set(scores)) == 4, scores
+    assert scores[0] == 1.0
+    assert scores[-1] < 0.85
+
+
+def test_a_landmark_name_never_stands_in_for_a_street(baltimore) -> None:  # type: ignore[no-untyped-def]
+    """Every one-word named feature, given a street type and paired with a real street."""
+    from camloc_geo.geocode import index_for
+
+    index = index_for(baltimore)
+    words = sorted(
+        {
+            toks[0]
+            for toks in index.landmarks
+            if len(toks) == 1 and toks[0].isalpha() and len(toks[0]) >= 3
+        }
+    )
+    checked = 0
+    for word in words:
+        for typ, full in (("Ave", "avenue"), ("St", "street")):
+            if any(full in t and word in t for t in index.displays):
+                continue  # a real street of that name
+            title = f"Eastern Ave & {word.title()} {typ}"
+            best = geocode_title(title, map_data=baltimore)[0]
+            if best.placed:
+                assert best.status == "junction", (title, best.status, best.reason)
+            checked += 1
+    assert checked >= 10

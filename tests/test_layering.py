@@ -25,6 +25,7 @@ FRONT_ENDS = (
     "camloc_geo.overlay",
     "camloc_geo.web",
     "camloc_geo.qgis_worker",
+    "camloc_geo.qgis",
 )
 """Layer 1: parse input, call the API, present the result."""
 

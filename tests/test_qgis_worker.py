@@ -1,4 +1,4 @@
-"""The QGIS plugin's out-of-process worker (``python -m camloc_geo.qgis_worker``), without QGIS."""
+"""The QGIS plugin's out-of-process worker (``python -m camloc_geo.qgis.worker``), without QGIS."""
 
 from __future__ import annotations
 
@@ -9,8 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from camloc_geo._errors import InputError
-from camloc_geo.qgis_worker import CANDIDATE_FIELDS, candidate_rows, run_job
+from camloc_geo import InputError
+from camloc_geo.qgis.worker import (
+    CANDIDATE_FIELDS,
+    candidate_rows,
+    run_job,
+    score_text,
+    user_words,
+)
 
 REPO = Path(__file__).resolve().parent.parent
 SCENE = REPO / "sample_maps" / "sample_scene.json"
@@ -81,12 +87,15 @@ def test_corners_job(tmp_path):
     assert sum(1 for p in props if p["kind"] == "corner" and p["intersection"] == main[0]) == 4
 
 
-def test_geocodelist_job_isolates_bad_rows(tmp_path):
+def _camera_list(tmp_path: Path) -> Path:
     lst = tmp_path / "cams.geojson"
     rows = [
         {"id": "a", "scene": str(SCENE)},
         {"id": "b", "scene": "nowhere.json"},
         {"id": "c"},
+        {"id": "d", "title": "N Milton Ave & E Biddle St"},
+        {"id": "e", "title": "Foo St & Bar Ave"},
+        {"id": "f", "title": "Main St"},
     ]
     lst.write_text(
         json.dumps(
@@ -95,7 +104,11 @@ def test_geocodelist_job_isolates_bad_rows(tmp_path):
                 "features": [
                     {
                         "type": "Feature",
-                        "geometry": {"type": "Point", "coordinates": [-76.5935, 39.2856]},
+                        "geometry": (
+                            {"type": "Point", "coordinates": [-76.5935, 39.2856]}
+                            if r["id"] in "abc"
+                            else None
+                        ),
                         "properties": r,
                     }
                     for r in rows
@@ -103,23 +116,117 @@ def test_geocodelist_job_isolates_bad_rows(tmp_path):
             }
         )
     )
+    return lst
+
+
+def test_geocodelist_job_isolates_bad_rows(tmp_path):
+    lst = _camera_list(tmp_path)
+    res = run_job(
+        {"task": "geocodelist", "list": str(lst), "osm": str(OSM), "out_dir": str(tmp_path)}
+    )
+    assert res["info"]["engine"] == "camloc_geo.batch"
+    cams = {f["properties"]["camera_id"]: f for f in _read(res["layers"]["cameras"])}
+    assert cams["a"]["properties"]["status"] == "located"
+    assert cams["a"]["properties"]["tie"] is True  # the sample's symmetric junction
+    assert cams["a"]["geometry"]["type"] == "Point"
+    assert cams["b"]["properties"]["status"] == "scene_error"
+    assert "nowhere.json" in cams["b"]["properties"]["reason"]
+    assert cams["c"]["properties"]["status"] == "no_evidence"
+    assert cams["c"]["geometry"] is None
+    assert cams["d"]["properties"]["status"] == "title_only"
+    assert cams["e"]["properties"]["status"] == "not_found"  # no landmark stands in
+    assert cams["e"]["geometry"] is None
+    assert cams["f"]["properties"]["status"] == "not_found"
+    assert cams["f"]["properties"]["n_candidates"] == 0
+    assert cams["a"]["properties"]["n_candidates"] >= 2
+    assert res["layers"]["candidates"]["count"] >= 13
+
+
+def test_geocodelist_gives_the_answers_of_camloc_batch(tmp_path):
+    """The same list through ``camloc_geo.batch.run_batch`` (``camloc batch``) and the worker."""
+    from camloc_geo.batch import results_from_journal, run_batch
+
+    lst = _camera_list(tmp_path)
+    run_batch(lst, out_gpkg=tmp_path / "b.gpkg", map_source=OSM.parent, progress=False, workers=1)
+    batch = {r.id: r for r in results_from_journal(tmp_path / "b.gpkg")}
+    (tmp_path / "w").mkdir()
     res = run_job(
         {
             "task": "geocodelist",
             "list": str(lst),
-            "osm": str(OSM),
-            "engine": "library",
-            "out_dir": str(tmp_path),
+            "osm": str(OSM.parent),  # a folder of extracts, as camloc batch --osm takes
+            "out_dir": str(tmp_path / "w"),
         }
     )
-    cams = {f["properties"]["camera_id"]: f for f in _read(res["layers"]["cameras"])}
-    assert cams["a"]["properties"]["status"] == "ambiguous"  # the sample's symmetric junction
-    assert cams["a"]["geometry"]["type"] == "Point"
-    assert cams["b"]["properties"]["status"] == "error"
-    assert "not found" in cams["b"]["properties"]["reason"]
-    assert cams["c"]["properties"]["reason"] == "no scene file in the row"
-    assert cams["c"]["geometry"] is None
-    assert res["layers"]["candidates"]["count"] == 12
+    cams = {f["properties"]["camera_id"]: f["properties"] for f in _read(res["layers"]["cameras"])}
+    assert set(cams) == set(batch)
+    for cam_id, r in batch.items():
+        p = cams[cam_id]
+        assert (p["status"], p["lat"], p["lon"], p["tie"]) == (r.status, r.lat, r.lon, r.tie)
+
+
+def test_geocodelist_names_a_missing_list_or_map(tmp_path):
+    with pytest.raises(InputError, match="camera list not found"):
+        run_job({"task": "geocodelist", "list": str(tmp_path / "no.csv"), "out_dir": "."})
+    lst = _camera_list(tmp_path)
+    with pytest.raises(InputError, match="OSM extract or folder not found"):
+        run_job({"task": "geocodelist", "list": str(lst), "osm": str(tmp_path / "nope")})
+
+
+def test_scores_and_labels_read_as_people_write_them():
+    assert [score_text(s) for s in (0.3712, 0.045, 0.0021, 1.17461213e-15, 0.0, None)] == [
+        "0.37",
+        "0.04",
+        "0.0021",
+        "1.2e-15",
+        "0",
+        None,
+    ]
+    assert user_words("intersection.corners[0]") == "your kerb corner 0"
+    assert user_words("occluded:references[2]") == "occluded your reference point 2"
+    assert user_words("landmarks[1]") == "your landmark 1"
+
+
+def test_ties_never_come_from_close_scores():
+    """No ``ambiguous_with``, no tie, however close the scores (the rule is the core's)."""
+    gj = {
+        "features": [
+            {
+                "geometry": {"type": "Point", "coordinates": [0, 0]},
+                "properties": {"kind": "candidate", "rank": r, "score": s},
+            }
+            for r, s in ((1, 0.37), (2, 0.36), (3, 0.045))
+        ]
+    }
+    assert [p["tie"] for _g, p in candidate_rows(gj)] == [False, False, False]
+
+
+def test_old_module_path_still_runs(tmp_path):
+    r = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.qgis_worker", "-"],
+        input=json.dumps({"task": "probe", "out_dir": str(tmp_path)}),
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 0, r.stderr
+    info = json.loads(r.stdout.strip().splitlines()[-1])["info"]
+    assert info["tie_score_ratio"] == 0.1
+    assert "sedan" in info["presets"]
+
+
+def test_worker_imports_no_private_core_module():
+    import ast
+
+    src = (REPO / "camloc_geo" / "qgis" / "worker.py").read_text()
+    mods = [
+        n.module if isinstance(n, ast.ImportFrom) else a.name
+        for n in ast.walk(ast.parse(src))
+        if isinstance(n, (ast.Import, ast.ImportFrom))
+        for a in (n.names if isinstance(n, ast.Import) else [n])
+    ]
+    private = [m for m in mods if m and m.startswith("camloc_geo")]
+    assert [m for m in private if any(p.startswith("_") for p in m.split("."))] == []
+    assert "camloc_geo.batch" in private  # the camera-list engine of camloc batch
 
 
 def test_check_scene_job_validates_and_saves_the_scene(tmp_path):
@@ -134,7 +241,7 @@ def test_worker_process_reports_bad_input_in_one_line_without_traceback(tmp_path
     job = tmp_path / "job.json"
     job.write_text(json.dumps({"task": "locate", "scene": str(tmp_path / "nope.json")}))
     r = subprocess.run(
-        [sys.executable, "-m", "camloc_geo.qgis_worker", str(job)],
+        [sys.executable, "-m", "camloc_geo.qgis.worker", str(job)],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -152,7 +259,7 @@ def test_worker_process_reports_bad_input_in_one_line_without_traceback(tmp_path
 )
 def test_worker_names_bad_jobs(tmp_path, job, message):
     r = subprocess.run(
-        [sys.executable, "-m", "camloc_geo.qgis_worker", "-"],
+        [sys.executable, "-m", "camloc_geo.qgis.worker", "-"],
         input=json.dumps({**job, "out_dir": str(tmp_path)}),
         capture_output=True,
         text=True,
@@ -174,29 +281,3 @@ def test_check_scene_job_rejects_a_bad_scene(tmp_path):
     with pytest.raises(InputError, match="give both lat and lon"):
         run_job({"task": "check_scene", "scene": data, "save_to": str(out)})
     assert not out.exists()
-
-
-def test_geocodelist_uses_the_batch_engine_when_present(tmp_path, monkeypatch):
-    import types
-
-    import camloc_geo.qgis_worker as worker
-
-    def geocode_camera(row, *, map_data=None, map_source=None, network=False):
-        if row["id"] == "bad":
-            return types.SimpleNamespace(id="bad", status="error", reason="no scene", candidates=[])
-        cand = {"rank": 1, "score": 1.0, "lat": 39.28, "lon": -76.59, "sigma_m": 3.0}
-        return types.SimpleNamespace(id=row["id"], status="ok", reason=None, candidates=[cand])
-
-    fake = types.SimpleNamespace(
-        read_camera_list=lambda path: iter([{"id": "a"}, {"id": "bad"}]),
-        geocode_camera=geocode_camera,
-    )
-    monkeypatch.setattr(worker, "_batch_module", lambda: fake)
-    res = run_job({"task": "geocodelist", "list": "cams.csv", "out_dir": str(tmp_path)})
-    assert res["info"]["engine"] == "camloc_geo.batch"
-    cams = {f["properties"]["camera_id"]: f for f in _read(res["layers"]["cameras"])}
-    assert cams["a"]["properties"]["status"] == "ok"
-    assert cams["a"]["geometry"]["coordinates"] == [-76.59, 39.28]
-    assert cams["a"]["properties"]["tie"] is False
-    assert cams["bad"]["properties"]["reason"] == "no scene"
-    assert res["layers"]["candidates"]["count"] == 1

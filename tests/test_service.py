@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import socket
@@ -381,6 +382,39 @@ def test_crowd_task_collects_and_locates(client: httpx.Client) -> None:
     )
     late = client.post(f"/v1/tasks/{task['id']}/annotations", json=SCENE)
     assert late.status_code == 422
+
+
+def test_crowd_task_no_map_can_serve_is_refused(client: httpx.Client) -> None:
+    w, h = SCENE["image"]["width"], SCENE["image"]["height"]
+    r = client.post(
+        "/v1/tasks",
+        content=_png(w, h),
+        headers={"content-type": "image/png"},
+        params={"lat": 48.85, "lon": 2.35},
+    )
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["type"] == "map_data"
+    assert "lat=48.850000, lon=2.350000" in err["message"]
+
+
+def test_docs_work_offline(client: httpx.Client) -> None:
+    page = client.get("/docs")
+    assert page.status_code == 200
+    assert "SwaggerUIBundle" in page.text
+    assert "cdn." not in page.text
+    assert "//fonts." not in page.text
+    srcs = re.findall(r'(?:src|href)="([^"]+)"', page.text)
+    assert len(srcs) >= 2
+    assert all(s.startswith("/") for s in srcs), srcs
+    for src in srcs:
+        asset = client.get(src)
+        assert asset.status_code == 200, src
+        assert len(asset.content) > 1_000
+    redoc = client.get("/redoc")
+    assert redoc.status_code == 200
+    assert "cdn." not in redoc.text
+    assert "fonts.googleapis" not in redoc.text
 
 
 def test_task_upload_limits(client: httpx.Client) -> None:

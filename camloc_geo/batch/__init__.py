@@ -17,7 +17,9 @@ from camloc_geo.cameras import (
     CameraResult,
     CameraRow,
     geocode_camera,
+    read_camera_csv,
     read_camera_list,
+    row_from_mapping,
 )
 
 __all__ = [
@@ -28,7 +30,9 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "journal_path",
+    "read_camera_csv",
     "read_camera_list",
     "results_from_journal",
+    "row_from_mapping",
     "run_batch",
 ]

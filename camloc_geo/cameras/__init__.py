@@ -22,6 +22,7 @@ from camloc_geo.cameras._camera import (
 from camloc_geo.cameras._list import (
     COLUMN_VARIANTS,
     CameraRow,
+    read_camera_csv,
     read_camera_list,
     row_from_mapping,
 )
@@ -36,6 +37,7 @@ __all__ = [
     "CameraRow",
     "geocode_camera",
     "normalize_status",
+    "read_camera_csv",
     "read_camera_list",
     "row_from_mapping",
 ]

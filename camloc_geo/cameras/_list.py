@@ -41,6 +41,7 @@ __all__ = [
     "COLUMN_VARIANTS",
     "CameraRow",
     "count_camera_rows",
+    "read_camera_csv",
     "read_camera_list",
     "row_from_mapping",
 ]
@@ -256,27 +257,39 @@ def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
 
 def _read_csv(path: Path) -> Iterator[CameraRow]:
     with open(path, encoding="utf-8-sig", newline="") as fh:
-        sample = fh.read(8192)
-        fh.seek(0)
-        delimiter = ","
-        if path.name.lower().endswith(".tsv"):
-            delimiter = "\t"
-        else:
-            try:
-                delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
-            except csv.Error:
-                delimiter = ","
-        csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
-        reader = csv.DictReader(fh, delimiter=delimiter)
-        columns = list(reader.fieldnames or [])
-        if not columns:
-            return
-        list_problems = _missing_column_problems(columns)
-        # a missing id column only renames rows: not a problem of the camera
-        list_problems = tuple(p for p in list_problems if "no id column" not in p)
-        base = path.resolve().parent
-        for n, rec in enumerate(reader, start=1):
-            yield row_from_mapping(rec, n, base_dir=base, list_problems=list_problems)
+        yield from read_camera_csv(
+            fh, base_dir=path.resolve().parent, tsv=path.name.lower().endswith(".tsv")
+        )
+
+
+def read_camera_csv(
+    fh: TextIO, *, base_dir: Path | None = None, tsv: bool = False
+) -> Iterator[CameraRow]:
+    """Stream the cameras of CSV text (an open file or :class:`io.StringIO`).
+
+    The in-memory entry point of :func:`read_camera_list` (same columns, delimiter sniffed
+    among ``, ; tab |``). ``base_dir`` resolves relative scene paths (None: left relative).
+    """
+    sample = fh.read(8192)
+    fh.seek(0)
+    delimiter = ","
+    if tsv:
+        delimiter = "\t"
+    else:
+        try:
+            delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+        except csv.Error:
+            delimiter = ","
+    csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
+    reader = csv.DictReader(fh, delimiter=delimiter)
+    columns = list(reader.fieldnames or [])
+    if not columns:
+        return
+    list_problems = _missing_column_problems(columns)
+    # a missing id column only renames rows: not a problem of the camera
+    list_problems = tuple(p for p in list_problems if "no id column" not in p)
+    for n, rec in enumerate(reader, start=1):
+        yield row_from_mapping(rec, n, base_dir=base_dir, list_problems=list_problems)
 
 
 def _feature_row(feat: Any, n: int, base: Path) -> CameraRow:

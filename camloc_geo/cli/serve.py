@@ -14,13 +14,22 @@ def register(subparsers: Any) -> None:
         description=(
             "Serve the camloc HTTP API. Configuration comes from environment variables: "
             "CAMLOC_MAP_DIR (folder of OSM extracts), CAMLOC_API_KEY (key for write endpoints), "
-            "CAMLOC_DATA_DIR (jobs and tasks database), CAMLOC_NETWORK (allow Overpass), "
-            "and the limits documented in docs/service.md."
+            "CAMLOC_DATA_DIR (jobs and tasks database; default: the user's data folder, e.g. "
+            "~/.local/share/camloc/service), CAMLOC_NETWORK (allow Overpass), and the limits "
+            "documented in docs/service.md. Interactive API docs at /docs (offline)."
         ),
     )
     p.add_argument("--host", default="127.0.0.1", help="address to listen on (127.0.0.1)")
     p.add_argument("--port", type=int, default=8000, help="port (8000)")
-    p.add_argument("--workers", type=int, default=1, help="worker processes (1)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help=(
+            "worker processes for the CPU work (1); one process serves HTTP and hands every "
+            "request to a free worker (sets CAMLOC_WORKERS)"
+        ),
+    )
     p.add_argument("--log-level", default="info", help="uvicorn log level")
     p.set_defaults(func=run)
 
@@ -39,8 +48,11 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--port must be 1-65535, not {args.port}")
     if args.workers < 1:
         raise InputError("--workers must be at least 1")
+    import os
+
     from camloc_geo.service.settings import Settings
 
+    os.environ["CAMLOC_WORKERS"] = str(args.workers)
     try:
         Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
@@ -50,7 +62,6 @@ def run(args: argparse.Namespace) -> int:
         factory=True,
         host=args.host,
         port=args.port,
-        workers=args.workers,
         log_level=args.log_level,
     )
     return 0

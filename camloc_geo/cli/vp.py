@@ -54,7 +54,26 @@ def register(subparsers: Any) -> None:
         default=None,
         help=(
             "an annotated object axis from origin to end pixel (e.g. a car's length edge);"
-            " prefer the vanishing points it points at; up to 3"
+            " prefer the vanishing points it points at and fit them as a line of the image;"
+            " up to 3"
+        ),
+    )
+    p.add_argument(
+        "--distortion",
+        type=float,
+        default=None,
+        metavar="K1",
+        help=(
+            "known radial lens distortion, division model k1 with radii in half image"
+            " diagonals (negative: barrel, wide-angle); segments are undistorted before the fit"
+        ),
+    )
+    p.add_argument(
+        "--no-exif",
+        action="store_true",
+        help=(
+            "ignore the photo's EXIF focal length (by default FocalLengthIn35mmFilm, or"
+            " FocalLength with the sensor size, is used as a prior when present)"
         ),
     )
     p.add_argument(
@@ -78,6 +97,20 @@ def run(args: argparse.Namespace) -> int:
     draw_path = output_path(args.draw, inputs=[args.image], option="--draw")
     if draw_path is not None and draw_path.suffix.lower() not in _IMAGE_SUFFIXES:
         raise InputError(f"--draw {draw_path}: give a .png or .jpg file name")
+    options: dict[str, Any] = {}
+    if args.distortion is not None:
+        options["distortion_k1"] = args.distortion
+    if args.focal_px is None and not args.no_exif:
+        from camloc_geo.exif import focal_from_exif
+
+        ex = focal_from_exif(args.image)
+        if ex is not None:
+            log.info("focal length prior from EXIF (%s): %.1f px", ex.source, ex.focal_px)
+            options.update(
+                focal_prior_px=ex.focal_px,
+                focal_prior_sigma_rel=ex.sigma_rel,
+                focal_prior_source=ex.source,
+            )
     res = vanishing_points(
         args.image,
         focal_px=args.focal_px,
@@ -86,7 +119,10 @@ def run(args: argparse.Namespace) -> int:
         axes_px=args.axis or (),
         estimate_principal_point=args.estimate_principal_point,
         seed=args.seed,
+        **options,
     )
+    for w in res.warnings:
+        log.warning("%s: %s", args.image, w)
     if draw_path is not None:
         with atomic_output(draw_path) as tmp:
             draw_segments(args.image, res, tmp)

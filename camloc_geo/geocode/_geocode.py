@@ -348,6 +348,12 @@ def suggestions_for(name: str, index: GeocodeIndex, n: int = 5) -> list[str]:
 
 
 def _landmark_hits(name: str, index: GeocodeIndex) -> list[tuple[Landmark, str, float]]:
+    """Named OSM features a name reads as, best first.
+
+    A name with a street type ("Bar Ave", "Foo St") names a street: it matches a feature
+    only by its whole name (a feature called "Bar Avenue"), never by its core, so that a bar
+    called "Bar" never stands in for "Bar Ave".
+    """
     from rapidfuzz import fuzz, process
 
     toks = name_tokens(name)
@@ -358,6 +364,8 @@ def _landmark_hits(name: str, index: GeocodeIndex) -> list[tuple[Landmark, str, 
     for mark in index.landmarks.get(toks, ()):
         kind = "exact" if fold(mark.name) == raw_fold else "abbreviation"
         out.append((mark, kind, _SCORES[kind]))
+    if types_of(toks):
+        return out  # a street's name: the feature's whole name or nothing
     if not out:
         for full in index.landmark_core.get(core_tokens(toks), ()):
             for mark in index.landmarks.get(full, ()):
@@ -758,12 +766,15 @@ def _two_names(
                 )
             )
         return out
-    # no junction: a landmark among the names, or say what failed
+    # no junction: a landmark among the names (next to the other, named street), or say
+    # what failed
     missing = [n for n, h in zip(names, hits, strict=True) if not h]
-    for n in missing:
-        marks = _landmark_hits(n, index)
-        if marks:
-            return _landmark_matches(parsed, title, n, marks, map_data, near, radius_m, index)
+    if len(missing) < len(names):
+        for n in missing:
+            streets = [h for k, h in enumerate(hits) if h and names[k] != n]
+            marks = _landmarks_by_street(_landmark_hits(n, index), streets, index)
+            if marks:
+                return _landmark_matches(parsed, title, n, marks, map_data, near, radius_m, index)
     suggestions = {n: suggestions_for(n, index) for n in missing}
     if missing:
         reason = "; ".join(
@@ -788,6 +799,32 @@ def _two_names(
             suggestions=suggestions,
         )
     ]
+
+
+LANDMARK_STREET_M = 100.0
+"""A title's landmark must lie this close to the street the title names with it."""
+
+
+def _landmarks_by_street(
+    marks: list[tuple[Landmark, str, float]], streets: list[list[NameHit]], index: GeocodeIndex
+) -> list[tuple[Landmark, str, float]]:
+    """The landmarks within :data:`LANDMARK_STREET_M` of a street the title also names.
+
+    "Broadway @ City Hall" is the City Hall on Broadway; a feature that merely shares a name
+    with a word of the title, away from its street, is not the place.
+    """
+    if not marks or not streets:
+        return []
+    out = []
+    for mark, kind, score in marks:
+        point = shapely.Point(mark.lon, mark.lat)
+        kx = _M_PER_DEG * math.cos(math.radians(mark.lat))
+        for hits in streets:
+            geom = _shapes(hits[0].tokens, index)[0]
+            if not geom.is_empty and geom.distance(point) * kx <= LANDMARK_STREET_M:
+                out.append((mark, kind, score * hits[0].score))
+                break
+    return out
 
 
 def _landmark_matches(

@@ -58,8 +58,6 @@ from typing import Any
 import networkx as nx
 import numpy as np
 import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from shapely.geometry import LineString
 
 from camloc_geo.geodesy import LocalFrame, bearing_deg, initial_bearing_deg
@@ -364,6 +362,9 @@ def consolidate_nodes(
     tree = shapely.STRtree(points)
     # overlapping buffers of radius r <=> centres closer than 2 r
     pairs = tree.query(points, predicate="dwithin", distance=2.0 * tolerance_m)
+    from scipy.sparse import coo_matrix  # scipy.sparse: imported on first use
+    from scipy.sparse.csgraph import connected_components
+
     n = len(nodes)
     adj = coo_matrix((np.ones(pairs.shape[1]), (pairs[0], pairs[1])), shape=(n, n))
     _count, labels = connected_components(adj, directed=False)

@@ -2,7 +2,9 @@
 
 Start it with ``camloc serve`` or any ASGI server::
 
-    uvicorn --factory camloc_geo.service:app_from_env
+    CAMLOC_WORKERS=2 uvicorn --factory camloc_geo.service:app_from_env
+
+(``CAMLOC_WORKERS``: worker processes for the CPU work; 0, the default, computes in threads.)
 """
 
 from __future__ import annotations

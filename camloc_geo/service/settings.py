@@ -7,7 +7,14 @@ from pathlib import Path
 from pydantic import Field, SecretStr
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
-__all__ = ["Settings"]
+__all__ = ["Settings", "default_data_dir"]
+
+
+def default_data_dir() -> Path:
+    """The user's data folder for the service (``~/.local/share/camloc/service`` on Linux)."""
+    from platformdirs import user_data_path
+
+    return user_data_path("camloc", appauthor=False) / "service"
 
 
 class Settings(BaseSettings):
@@ -34,8 +41,11 @@ class Settings(BaseSettings):
         description="when set, write endpoints need the header X-API-Key with this value",
     )
     data_dir: Path = Field(
-        default=Path("camloc-service-data"),
-        description="folder for the job and task database (SQLite) and uploaded snapshots",
+        default_factory=default_data_dir,
+        description=(
+            "folder for the job and task database (SQLite) and uploaded snapshots (default: "
+            "the user's data folder, e.g. ~/.local/share/camloc/service)"
+        ),
     )
     max_request_bytes: int = Field(
         default=2_000_000, ge=1_000, description="largest JSON body accepted"
@@ -52,6 +62,15 @@ class Settings(BaseSettings):
     )
     max_references: int = Field(default=50, ge=1, description="most references in one scene")
     max_cameras_per_job: int = Field(default=10_000, ge=1, description="most cameras in one job")
+    workers: int = Field(
+        default=0,
+        ge=0,
+        le=256,
+        description=(
+            "worker processes for the CPU work, each with its own maps (0: threads of the "
+            "serving process); camloc serve --workers sets it"
+        ),
+    )
     request_timeout_s: float = Field(
         default=20.0, gt=0, description="processing time limit of one request (seconds)"
     )

@@ -23,7 +23,15 @@ from qgis.core import (
     QgsProcessingParameterString,
 )
 
-from .layers import apply_style, fields_of, wgs84, wkb_of, write_to_sink
+from .layers import (
+    TIE_WORDS,
+    apply_style,
+    fields_of,
+    order_camloc_layers,
+    wgs84,
+    wkb_of,
+    write_to_sink,
+)
 from .runner import WorkerCanceledError, WorkerError, run_worker
 
 OSM_FILTER = "OSM extracts (*.osm *.pbf *.osm.pbf *.bz2 *.gz);;All files (*.*)"
@@ -41,6 +49,13 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
+        # Processing adds each output on top as it loads it: re-stack the camloc layers so
+        # candidates are drawn above cones whatever the loading order
+        project = context.project()
+        if project is not None:
+            node = project.layerTreeRoot().findLayer(layer.id())
+            if node is not None and node.parent() is not None:
+                order_camloc_layers(node.parent())
 
 
 class _CamlocAlgorithm(QgsProcessingAlgorithm):
@@ -68,16 +83,39 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
     def createInstance(self):
         return type(self)()
 
-    def _add_map_params(self) -> None:
-        self.addParameter(
-            QgsProcessingParameterFile(
-                "OSM",
-                "OSM extract (.osm, .osm.pbf, .osm.bz2, .osm.gz); empty: Overpass if allowed",
-                behavior=QgsProcessingParameterFile.File,
-                fileFilter=OSM_FILTER,
-                optional=True,
+    def _add_map_params(self, folder: bool = False) -> None:
+        if folder:
+            # Processing's File parameter refuses folders (QGIS 3.22) and its Folder parameter
+            # takes files: OSM takes both, as camloc batch --osm does; OSM_FILE is the file
+            # picker for the dialog
+            self.addParameter(
+                QgsProcessingParameterFile(
+                    "OSM",
+                    "Folder of OSM extracts (each camera uses the one covering it), or one "
+                    "extract's path; empty: Overpass if allowed",
+                    behavior=QgsProcessingParameterFile.Folder,
+                    optional=True,
+                )
             )
-        )
+            self.addParameter(
+                QgsProcessingParameterFile(
+                    "OSM_FILE",
+                    "Or one OSM extract file",
+                    behavior=QgsProcessingParameterFile.File,
+                    fileFilter=OSM_FILTER,
+                    optional=True,
+                )
+            )
+        else:
+            self.addParameter(
+                QgsProcessingParameterFile(
+                    "OSM",
+                    "OSM extract (.osm, .osm.pbf, .osm.bz2, .osm.gz); empty: Overpass if allowed",
+                    behavior=QgsProcessingParameterFile.File,
+                    fileFilter=OSM_FILTER,
+                    optional=True,
+                )
+            )
         self.addParameter(
             QgsProcessingParameterBoolean(
                 "NETWORK", "Allow fetching OpenStreetMap data from Overpass", defaultValue=False
@@ -130,7 +168,14 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
 
     def _osm(self, parameters: dict[str, Any], context: QgsProcessingContext) -> str | None:
         path = self.parameterAsFile(parameters, "OSM", context)
-        return path or None
+        other = (
+            self.parameterAsFile(parameters, "OSM_FILE", context)
+            if self.parameterDefinition("OSM_FILE") is not None
+            else ""
+        )
+        if path and other:
+            raise QgsProcessingException("camloc: give OSM or OSM_FILE, not both")
+        return path or other or None
 
 
 class LocateAlgorithm(_CamlocAlgorithm):
@@ -141,9 +186,11 @@ class LocateAlgorithm(_CamlocAlgorithm):
     _help = (
         "Candidate absolute positions of the camera that took a snapshot, from its camloc scene "
         "file (car annotations, intersection corners, landmarks) and OpenStreetMap. Outputs: "
-        "candidates (best first; rank, score, tie, height, heading...), their view cones, the map "
-        "corners each candidate matched, and the intersection used. Layers are in EPSG:4326. "
-        "Candidates whose score is within 80 % of the best are flagged as ties (drawn as stars)."
+        "candidates (best first; rank, score, tie, height, heading...), their view cones (drawn "
+        "for the leading candidates only), the map points each candidate matched, the "
+        "intersection used and, on request, the map model's streets and buildings. Layers are "
+        "in EPSG:4326. A star marks a " + TIE_WORDS + ": the library's rule "
+        "(camloc_geo.results), carried in each candidate's ambiguous_with."
     )
 
     def initAlgorithm(self, config=None):
@@ -172,6 +219,13 @@ class LocateAlgorithm(_CamlocAlgorithm):
             )
         )
         self.addParameter(
+            QgsProcessingParameterBoolean(
+                "CONTEXT",
+                "Also output the map model's streets and buildings (what locate matched)",
+                defaultValue=False,
+            )
+        )
+        self.addParameter(
             QgsProcessingParameterFeatureSink(
                 "CANDIDATES", "Camera candidates", QgsProcessing.TypeVectorPoint
             )
@@ -197,6 +251,15 @@ class LocateAlgorithm(_CamlocAlgorithm):
                 optional=True,
             )
         )
+        for name, title, typ in (
+            ("CONTEXT_STREETS", "Map model: streets", QgsProcessing.TypeVectorLine),
+            ("CONTEXT_BUILDINGS", "Map model: buildings", QgsProcessing.TypeVectorPolygon),
+        ):
+            self.addParameter(
+                QgsProcessingParameterFeatureSink(
+                    name, title, typ, optional=True, createByDefault=False
+                )
+            )
 
     def processAlgorithm(self, parameters, context, feedback):
         scene = self.parameterAsFile(parameters, "SCENE", context)
@@ -207,6 +270,7 @@ class LocateAlgorithm(_CamlocAlgorithm):
             "scene": scene,
             "osm": self._osm(parameters, context),
             "network": self.parameterAsBool(parameters, "NETWORK", context),
+            "context": self.parameterAsBool(parameters, "CONTEXT", context),
         }
         if parameters.get("MAX_CANDIDATES") not in (None, ""):
             job["max_candidates"] = self.parameterAsInt(parameters, "MAX_CANDIDATES", context)
@@ -232,6 +296,12 @@ class LocateAlgorithm(_CamlocAlgorithm):
         self._sink(
             parameters, "INTERSECTION", layers["intersection"], "intersection", context, results
         )
+        for name, kind in (
+            ("CONTEXT_STREETS", "context_streets"),
+            ("CONTEXT_BUILDINGS", "context_buildings"),
+        ):
+            if kind in layers:
+                self._sink(parameters, name, layers[kind], kind, context, results)
         info = res.get("info") or {}
         feedback.pushInfo(f"{n} candidate(s)")
         if not n and info.get("reason"):
@@ -325,9 +395,11 @@ class GeocodeListAlgorithm(_CamlocAlgorithm):
     _display = "Geocode a webcam list"
     _help = (
         "A list of cameras (CSV or GeoJSON: id, title, lat/lon, radius_m, streets, scene) in; "
-        "one point per camera at its best candidate with a status (ok, ambiguous, not_found, "
-        "error) and the reason, and every candidate with its camera id. Uses the batch engine "
-        "camloc_geo.batch when installed, otherwise the library's locate per camera."
+        "one point per camera with the status and reason of camloc batch (located, title_only, "
+        "ambiguous, street_only, not_found, no_candidates, no_evidence, no_map, scene_error, "
+        "map_error, failed), and every candidate with its camera id. The list runs through "
+        "camloc_geo.batch, the engine of camloc batch, so the answers are the same. OSM may be "
+        "one extract or a folder of extracts (as camloc batch --osm takes)."
     )
 
     def initAlgorithm(self, config=None):
@@ -338,7 +410,7 @@ class GeocodeListAlgorithm(_CamlocAlgorithm):
                 fileFilter="Camera lists (*.csv *.geojson *.json);;All files (*.*)",
             )
         )
-        self._add_map_params()
+        self._add_map_params(folder=True)
         self.addParameter(
             QgsProcessingParameterFeatureSink("CAMERAS", "Cameras", QgsProcessing.TypeVectorPoint)
         )

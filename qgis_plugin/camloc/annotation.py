@@ -8,6 +8,7 @@ finished scene is the library's (``camloc_geo.scene`` through the worker).
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 SCENE_FORMAT = "camloc-scene/1"
@@ -25,6 +26,21 @@ STEPS = [
     ("corners", "8. Intersection kerb corners, clockwise on screen", "multi"),
 ]
 STEP_KEYS = [s[0] for s in STEPS]
+GUIDANCE = {
+    "origin": "Click the corner of the car where its length, width and height edges meet, "
+    "on the ground (wheel to zoom, right-drag to pan).",
+    "length": "Click the other end of the car's long edge along the ground.",
+    "width": "Click the other end of the car's short edge along the ground.",
+    "height": "Click straight above the first corner, on the roof line.",
+    "lines_length": "Draw lines parallel to the car's length (kerbs, lane marks): two "
+    "clicks each, as many as you see; at least one.",
+    "lines_width": "Draw lines parallel to the car's width (stop lines, crossings): two "
+    "clicks each; at least one.",
+    "lines_height": "Draw vertical lines (poles, building edges): two clicks each; optional.",
+    "corners": "Click the visible kerb corners of the intersection, clockwise on screen; then "
+    "pick the intersection on the map or name its streets.",
+}
+"""What to do at each step, in words shown above the snapshot."""
 AXES = ("origin", "length", "width", "height")
 
 
@@ -49,8 +65,49 @@ class Annotation:
         self.lat: float | None = None
         self.lon: float | None = None
         self.radius_m = 150.0
+        self.view_hint: str = ""
         self.step = STEP_KEYS[0]
         self.pending: list[float] | None = None
+        self.base: dict[str, Any] | None = None  # a scene from elsewhere (the browser page)
+
+    @classmethod
+    def from_scene(cls, scene: dict[str, Any]) -> Annotation:
+        """An annotation holding a scene made elsewhere (its first annotation editable here).
+
+        Everything the dock does not edit (more annotators, references, landmarks...) is kept
+        as it came and written back by :meth:`to_scene`.
+        """
+        image = scene.get("image") or {}
+        a = cls(
+            int(image.get("width") or 0), int(image.get("height") or 0), scene.get("id") or "scene"
+        )
+        a.base = copy.deepcopy(scene)
+        a.image_path = image.get("path")
+        obj = scene.get("object") or {}
+        a.preset = obj.get("preset") or a.preset
+        anns = scene.get("annotations") or []
+        if anns:
+            first = anns[0]
+            a.annotator = first.get("annotator") or a.annotator
+            a.axes = {k: list(v) for k, v in (first.get("axes") or {}).items() if k in AXES}
+            for k, segs in (first.get("vp_lines") or {}).items():
+                if k in a.lines:
+                    a.lines[k] = [list(seg) for seg in segs]
+        inter = scene.get("intersection") or {}
+        a.corners = [list(c) for c in inter.get("corners") or []]
+        a.streets = list(inter.get("streets") or [])
+        prior = scene.get("prior") or {}
+        lat, lon = inter.get("lat", prior.get("lat")), inter.get("lon", prior.get("lon"))
+        if lat is not None and lon is not None:
+            a.set_location(lat=lat, lon=lon)
+        if prior.get("radius_m"):
+            a.radius_m = float(prior["radius_m"])
+        hint = scene.get("view_hint") or {}
+        if hint.get("bearing_deg") is not None:
+            a.view_hint = f"{hint['bearing_deg']:g}"
+        elif hint.get("text"):
+            a.view_hint = str(hint["text"])
+        return a
 
     # --- editing -------------------------------------------------------------------------
     def set_step(self, key: str) -> None:
@@ -123,31 +180,52 @@ class Annotation:
         return out
 
     def to_scene(self) -> dict[str, Any]:
-        """The ``camloc-scene/1`` dict of this annotation."""
-        scene: dict[str, Any] = {
-            "format": SCENE_FORMAT,
-            "id": self.scene_id,
-            "image": {"width": self.width, "height": self.height},
-            "object": {"preset": self.preset},
-        }
+        """The ``camloc-scene/1`` dict of this annotation (over :attr:`base`, when set)."""
+        scene: dict[str, Any] = copy.deepcopy(self.base) if self.base else {}
+        scene["format"] = SCENE_FORMAT
+        scene["id"] = self.scene_id
+        image = scene.get("image") or {}
+        image.update({"width": self.width, "height": self.height})
         if self.image_path:
-            scene["image"]["path"] = self.image_path
+            image["path"] = self.image_path
+        scene["image"] = image
+        scene["object"] = {**(scene.get("object") or {}), "preset": self.preset}
+        anns = scene.get("annotations") or []
         if all(a in self.axes for a in AXES):
-            scene["annotations"] = [
-                {
-                    "annotator": self.annotator,
-                    "axes": {a: list(self.axes[a]) for a in AXES},
-                    "vp_lines": {k: [list(s) for s in v] for k, v in self.lines.items() if v},
-                }
-            ]
+            mine: dict[str, Any] = {
+                **(anns[0] if anns else {}),
+                "annotator": self.annotator,
+                "axes": {a: list(self.axes[a]) for a in AXES},
+                "vp_lines": {k: [list(s) for s in v] for k, v in self.lines.items() if v},
+            }
+            anns = [mine, *anns[1:]]
+        elif anns:
+            anns = anns[1:]
+        if anns:
+            scene["annotations"] = anns
+        else:
+            scene.pop("annotations", None)
         if self.corners:
-            inter: dict[str, Any] = {"corners": [list(c) for c in self.corners]}
+            inter: dict[str, Any] = {
+                **(scene.get("intersection") or {}),
+                "corners": [list(c) for c in self.corners],
+            }
             if self.lat is not None and self.lon is not None:
                 inter["lat"] = self.lat
                 inter["lon"] = self.lon
             if self.streets:
                 inter["streets"] = list(self.streets)
             scene["intersection"] = inter
+        else:
+            scene.pop("intersection", None)
         if self.lat is not None and self.lon is not None:
             scene["prior"] = {"lat": self.lat, "lon": self.lon, "radius_m": self.radius_m}
+        hint = self.view_hint.strip()
+        if hint:
+            try:
+                scene["view_hint"] = {"bearing_deg": float(hint)}
+            except ValueError:
+                scene["view_hint"] = {"text": hint}
+        else:
+            scene.pop("view_hint", None)
         return scene

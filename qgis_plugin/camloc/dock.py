@@ -1,38 +1,58 @@
-"""The analyst's dock: annotate a snapshot, pick the intersection, run, save the scene."""
+"""The analyst's dock: annotate a snapshot, pick the intersection, run in the background.
+
+Two ways to annotate, one scene:
+
+- **In the browser** (recommended): *Annotate in browser…* opens the library's annotation page
+  (``camloc_geo.web``, the page of ``camloc annotate``: zoom, pan, undo, moving points, guided
+  steps, live focal length) served from QGIS; its *Submit* hands the scene back to the dock.
+- **In the dock**: the same steps, clicked on the snapshot here (wheel zooms, right or middle
+  drag pans, *1:1* shows full resolution).
+
+Preset, search radius and viewing direction are set here for either. *Run* locates the camera
+in a QgsTask (progress, *Cancel*; the GUI stays responsive) and writes the layers into a
+GeoPackage the analyst picks (default: ``camloc_results.gpkg`` beside the project).
+"""
 
 from __future__ import annotations
 
 import json
 import os
-import tempfile
 from typing import Any
 
 from qgis.core import (
+    QgsApplication,
     QgsCoordinateTransform,
     QgsProject,
+    QgsTask,
     QgsVectorLayer,
 )
 from qgis.gui import QgsMapToolEmitPoint
-from qgis.PyQt.QtCore import QPointF, QRectF, Qt, pyqtSignal
-from qgis.PyQt.QtGui import QBrush, QColor, QPainter, QPen, QPixmap
+from qgis.PyQt.QtCore import QObject, QPointF, QRectF, Qt, QUrl, pyqtSignal
+from qgis.PyQt.QtGui import QBrush, QColor, QDesktopServices, QPainter, QPen, QPixmap
 from qgis.PyQt.QtWidgets import (
-    QApplication,
+    QCheckBox,
+    QComboBox,
     QDockWidget,
+    QDoubleSpinBox,
     QFileDialog,
+    QFormLayout,
+    QGraphicsItem,
     QGraphicsScene,
     QGraphicsView,
     QHBoxLayout,
     QLabel,
     QLineEdit,
     QListWidget,
+    QProgressBar,
     QPushButton,
+    QScrollArea,
     QVBoxLayout,
     QWidget,
 )
 
-from .annotation import STEPS, Annotation
-from .layers import apply_style, wgs84
-from .runner import WorkerError, run_worker
+from .annotation import GUIDANCE, STEPS, Annotation
+from .layers import DRAW_ORDER, apply_style, wgs84, write_gpkg_layer
+from .runner import WorkerCanceledError, WorkerError, run_worker
 
 AXIS_COLOURS = {
     "origin": "#ffffff",
@@ -41,10 +61,19 @@ AXIS_COLOURS = {
     "height": "#4daf4a",
     "corners": "#ff7f00",
 }
+PRESETS = ["sedan", "bus", "hatchback", "minivan", "pickup", "suv", "taxi_ny", "van"]
+"""The library's object presets (``camloc_geo.objects.PRESETS``; the worker's probe wins)."""
+RESULTS_NAME = "camloc_results.gpkg"
+MARKER_PX = 6.0
+"""Click markers' radius on screen (pixels, at any zoom)."""
 
 
 class ImageView(QGraphicsView):
-    """The snapshot; emits image pixel coordinates of left clicks."""
+    """The snapshot; emits image pixel coordinates of left clicks; zooms and pans.
+
+    Overlays (click markers) are the view's own items: replacing the image removes them
+    first, so no item is ever removed twice (the crash of issue 27).
+    """
 
     clicked = pyqtSignal(float, float)
 
@@ -52,28 +81,180 @@ class ImageView(QGraphicsView):
         super().__init__(parent)
         self.setScene(QGraphicsScene(self))
         self.setRenderHint(QPainter.Antialiasing)
-        self.setMinimumHeight(220)
-        self._pixmap_item = None
+        self.setRenderHint(QPainter.SmoothPixmapTransform)
+        self.setTransformationAnchor(QGraphicsView.AnchorUnderMouse)
+        self.setMinimumHeight(260)
+        self._pixmap_item: Any = None
+        self._overlays: list[QGraphicsItem] = []
+        self._fitted = True
+        self._pan_from: Any = None
 
+    # --- image and overlays -------------------------------------------------------------
     def set_pixmap(self, pixmap: QPixmap) -> None:
-        self.scene().clear()
+        self.clear_overlays()
+        if self._pixmap_item is not None:
+            self.scene().removeItem(self._pixmap_item)
         self._pixmap_item = self.scene().addPixmap(pixmap)
+        self._pixmap_item.setZValue(-1)
+        self._pixmap_item.setTransformationMode(Qt.SmoothTransformation)
         self.scene().setSceneRect(QRectF(pixmap.rect()))
         self.fit()
 
+    def has_image(self) -> bool:
+        return self._pixmap_item is not None
+
+    def clear_overlays(self) -> None:
+        """Remove the click markers (each once)."""
+        sc = self.scene()
+        for item in self._overlays:
+            if item.scene() is sc:
+                sc.removeItem(item)
+        self._overlays = []
+
+    def add_overlay(self, item: QGraphicsItem) -> QGraphicsItem:
+        self._overlays.append(item)
+        return item
+
+    def overlay_count(self) -> int:
+        return len(self._overlays)
+
+    # --- zoom and pan ---------------------------------------------------------------------
     def fit(self) -> None:
+        """The whole image in the view."""
         if self._pixmap_item is not None:
             self.fitInView(self.scene().sceneRect(), Qt.KeepAspectRatio)
+        self._fitted = True
+
+    def actual_size(self) -> None:
+        """One image pixel per screen pixel (full resolution)."""
+        self.resetTransform()
+        self._fitted = False
+
+    def zoom(self, factor: float) -> None:
+        scale = self.transform().m11() * factor
+        if 0.02 <= scale <= 40.0:
+            self.scale(factor, factor)
+            self._fitted = False
+
+    def zoom_level(self) -> float:
+        """Screen pixels per image pixel."""
+        return float(self.transform().m11())
+
+    def wheelEvent(self, event):
+        steps = event.angleDelta().y() / 120.0
+        if steps:
+            self.zoom(1.25**steps)
+        event.accept()
 
     def resizeEvent(self, event):
         super().resizeEvent(event)
-        self.fit()
+        if self._fitted:
+            self.fit()
 
     def mousePressEvent(self, event):
+        pan = event.button() in (Qt.RightButton, Qt.MiddleButton) or (
+            event.button() == Qt.LeftButton and event.modifiers() & Qt.ControlModifier
+        )
+        if pan:
+            self._pan_from = event.pos()
+            self.setCursor(Qt.ClosedHandCursor)
+            event.accept()
+            return
         if event.button() == Qt.LeftButton and self._pixmap_item is not None:
             p = self.mapToScene(event.pos())
             self.clicked.emit(p.x(), p.y())
         super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event):
+        if self._pan_from is not None:
+            d = event.pos() - self._pan_from
+            self._pan_from = event.pos()
+            self.horizontalScrollBar().setValue(self.horizontalScrollBar().value() - d.x())
+            self.verticalScrollBar().setValue(self.verticalScrollBar().value() - d.y())
+            event.accept()
+            return
+        super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event):
+        if self._pan_from is not None:
+            self._pan_from = None
+            self.unsetCursor()
+            event.accept()
+            return
+        super().mouseReleaseEvent(event)
+
+
+class LocateTask(QgsTask):
+    """Locate a scene in the worker and write its layers into a GeoPackage (off the GUI)."""
+
+    def __init__(self, job: dict[str, Any], gpkg: str, prefix: str) -> None:
+        super().__init__("camloc: locate the camera", QgsTask.CanCancel)
+        self.job = job
+        self.gpkg = gpkg
+        self.prefix = prefix
+        self.uris: dict[str, str] = {}
+        self.error: str | None = None
+        self.warnings: list[str] = []
+        self.info: dict[str, Any] = {}
+        self.message = ""
+        self.on_done: Any = None
+
+    def run(self) -> bool:
+        def progress(pct: float, message: str) -> None:
+            self.message = message
+            self.setProgress(0.9 * pct)
+
+        try:
+            res = run_worker(self.job, progress=progress, canceled=self.isCanceled)
+            for kind in DRAW_ORDER:
+                desc = res["layers"].get(kind)
+                if desc is not None:
+                    self.uris[kind] = write_gpkg_layer(self.gpkg, f"{self.prefix}_{kind}", desc)
+            self.warnings = [str(w) for w in res.get("warnings") or []]
+            self.info = dict(res.get("info") or {})
+        except WorkerCanceledError:
+            self.error = "canceled"
+            return False
+        except (WorkerError, OSError) as exc:
+            self.error = str(exc)
+            return False
+        self.setProgress(100)
+        return True
+
+    def finished(self, ok: bool) -> None:
+        if self.on_done is not None:
+            self.on_done(self, ok)
+
+
+class WorkerTask(QgsTask):
+    """Any worker job in the background; ``on_done(task, ok)`` on the GUI thread."""
+
+    def __init__(self, title: str, job: dict[str, Any]) -> None:
+        super().__init__(title, QgsTask.CanCancel)
+        self.job = job
+        self.result: dict[str, Any] = {}
+        self.error: str | None = None
+        self.on_done: Any = None
+
+    def run(self) -> bool:
+        try:
+            self.result = run_worker(
+                self.job, progress=lambda p, _m: self.setProgress(p), canceled=self.isCanceled
+            )
+        except WorkerError as exc:
+            self.error = str(exc)
+            return False
+        return True
+
+    def finished(self, ok: bool) -> None:
+        if self.on_done is not None:
+            self.on_done(self, ok)
+
+
+class _SceneInbox(QObject):
+    """Carries a scene from the page server's thread to the GUI thread."""
+
+    received = pyqtSignal(dict)
 
 
 class CamlocDock(QDockWidget):
@@ -84,89 +265,187 @@ class CamlocDock(QDockWidget):
         self.setObjectName("CamlocDock")
         self.iface = iface
         self.annotation = Annotation()
-        self.overlays: list[Any] = []
+        self.image_file: str | None = None
         self.result_layers: list[QgsVectorLayer] = []
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
+        self.task: QgsTask | None = None
+        self.page_task: WorkerTask | None = None
+        self.page_server: Any = None
+        self.inbox = _SceneInbox()
+        self.inbox.received.connect(self.receive_scene)
+        self._build()
+        self.steps.setCurrentRow(0)
+        self._show_guidance()
 
-        body = QWidget(self)
+    # --- layout ---------------------------------------------------------------------------
+    def _build(self) -> None:
+        body = QWidget()
         lay = QVBoxLayout(body)
         row = QHBoxLayout()
         self.open_button = QPushButton("Open snapshot…")
         self.open_button.clicked.connect(self._open_dialog)
-        self.undo_button = QPushButton("Undo")
-        self.undo_button.clicked.connect(self.undo)
-        row.addWidget(self.open_button)
-        row.addWidget(self.undo_button)
+        self.browser_button = QPushButton("Annotate in browser…")
+        self.browser_button.setToolTip(
+            "The camloc annotation page (zoom, pan, undo, moving points, live focal length); "
+            "its Submit sends the scene back here"
+        )
+        self.browser_button.clicked.connect(self.annotate_in_browser)
+        self.load_button = QPushButton("Load scene…")
+        self.load_button.clicked.connect(self._load_dialog)
+        for b in (self.open_button, self.browser_button, self.load_button):
+            row.addWidget(b)
         lay.addLayout(row)
+        self.guidance = QLabel()
+        self.guidance.setWordWrap(True)
+        self.guidance.setStyleSheet("QLabel { background: #fff8d6; padding: 4px; }")
+        lay.addWidget(self.guidance)
         self.steps = QListWidget()
+        self.steps.setWordWrap(True)
         for _key, label, _kind in STEPS:
             self.steps.addItem(label)
-        self.steps.setFixedHeight(self.steps.sizeHintForRow(0) * len(STEPS) + 8)
+        self.steps.setMinimumHeight(self.steps.sizeHintForRow(0) * len(STEPS) + 8)
         self.steps.currentRowChanged.connect(self._step_changed)
         lay.addWidget(self.steps)
+        zoom = QHBoxLayout()
+        for text, slot in (
+            ("Fit", lambda: self.view.fit()),
+            ("1:1", lambda: self.view.actual_size()),
+            ("−", lambda: self.view.zoom(1 / 1.25)),
+            ("+", lambda: self.view.zoom(1.25)),
+        ):
+            b = QPushButton(text)
+            b.setMaximumWidth(48)
+            b.clicked.connect(slot)
+            zoom.addWidget(b)
+        zoom.addStretch(1)
+        self.undo_button = QPushButton("Undo")
+        self.undo_button.clicked.connect(self.undo)
+        zoom.addWidget(self.undo_button)
+        lay.addLayout(zoom)
         self.view = ImageView()
         self.view.clicked.connect(self.image_clicked)
         lay.addWidget(self.view, 1)
-        row2 = QHBoxLayout()
-        self.pick_button = QPushButton("Pick intersection on map")
+
+        form = QFormLayout()
+        self.preset_combo = QComboBox()
+        self.preset_combo.addItems(PRESETS)
+        self.preset_combo.setToolTip("the annotated car's size class (camloc_geo.objects)")
+        form.addRow("Car preset", self.preset_combo)
+        self.radius_spin = QDoubleSpinBox()
+        self.radius_spin.setRange(10.0, 5000.0)
+        self.radius_spin.setDecimals(0)
+        self.radius_spin.setSingleStep(50.0)
+        self.radius_spin.setSuffix(" m")
+        self.radius_spin.setValue(150.0)
+        self.radius_spin.setToolTip("how far from the picked point the camera may stand")
+        form.addRow("Search radius", self.radius_spin)
+        self.hint_edit = QLineEdit()
+        self.hint_edit.setPlaceholderText("e.g. looking north, NB, facing SW, or 270 (degrees)")
+        self.hint_edit.setToolTip("the camera's viewing direction: decides between tied places")
+        form.addRow("Viewing direction", self.hint_edit)
+        pick = QHBoxLayout()
+        self.pick_button = QPushButton("Pick on map")
         self.pick_button.setCheckable(True)
         self.pick_button.toggled.connect(self._pick_toggled)
         self.streets_edit = QLineEdit()
-        self.streets_edit.setPlaceholderText("streets (optional): A & B")
-        row2.addWidget(self.pick_button)
-        row2.addWidget(self.streets_edit)
-        lay.addLayout(row2)
-        row3 = QHBoxLayout()
+        self.streets_edit.setPlaceholderText("or its streets: A & B")
+        pick.addWidget(self.pick_button)
+        pick.addWidget(self.streets_edit)
+        form.addRow("Intersection", pick)
+        osm = QHBoxLayout()
         self.osm_edit = QLineEdit()
-        self.osm_edit.setPlaceholderText("OSM extract (empty: Overpass)")
+        self.osm_edit.setPlaceholderText("OSM extract or folder (empty: Overpass)")
         osm_button = QPushButton("…")
         osm_button.setMaximumWidth(30)
         osm_button.clicked.connect(self._osm_dialog)
-        row3.addWidget(self.osm_edit)
-        row3.addWidget(osm_button)
-        lay.addLayout(row3)
+        osm.addWidget(self.osm_edit)
+        osm.addWidget(osm_button)
+        form.addRow("Map", osm)
+        out = QHBoxLayout()
+        self.gpkg_edit = QLineEdit()
+        self.gpkg_edit.setPlaceholderText(f"{RESULTS_NAME} beside the project")
+        gpkg_button = QPushButton("…")
+        gpkg_button.setMaximumWidth(30)
+        gpkg_button.clicked.connect(self._gpkg_dialog)
+        out.addWidget(self.gpkg_edit)
+        out.addWidget(gpkg_button)
+        form.addRow("Results", out)
+        self.context_check = QCheckBox("also the map model's streets and buildings")
+        form.addRow("", self.context_check)
+        lay.addLayout(form)
         row4 = QHBoxLayout()
         self.run_button = QPushButton("Run")
         self.run_button.clicked.connect(self.run)
+        self.cancel_button = QPushButton("Cancel")
+        self.cancel_button.setEnabled(False)
+        self.cancel_button.clicked.connect(self.cancel)
         self.save_button = QPushButton("Save scene…")
         self.save_button.clicked.connect(self._save_dialog)
-        row4.addWidget(self.run_button)
-        row4.addWidget(self.save_button)
+        for b in (self.run_button, self.cancel_button, self.save_button):
+            row4.addWidget(b)
         lay.addLayout(row4)
-        self.status = QLabel("Open a snapshot to start.")
+        self.progress = QProgressBar()
+        self.progress.setRange(0, 100)
+        self.progress.setVisible(False)
+        lay.addWidget(self.progress)
+        self.status = QLabel(
+            "Open a snapshot, then annotate it here or in the browser (Annotate in browser…)."
+        )
         self.status.setWordWrap(True)
+        self.status.setTextInteractionFlags(Qt.TextSelectableByMouse)
         lay.addWidget(self.status)
-        self.setWidget(body)
-        self.steps.setCurrentRow(0)
+        scroll = QScrollArea()
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(body)
+        self.setWidget(scroll)
 
     # --- snapshot and clicks ---------------------------------------------------------------
     def _open_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
-            self, "Open snapshot", "", "Images (*.png *.jpg *.jpeg *.bmp *.tif);;All files (*.*)"
+            self, "Open snapshot", "", "Images (*.png *.jpg *.jpeg *.webp *.bmp *.tif);;All (*.*)"
         )
         if path:
             self.open_snapshot(path)
 
     def open_snapshot(self, path: str) -> bool:
-        """Show the image and start a new annotation for it."""
+        """Show the image and start a new annotation for it (any number of times)."""
         pix = QPixmap(path)
         if pix.isNull():
             self.set_status(f"cannot read the image {path}")
             return False
+        self._stop_page()
         scene_id = os.path.splitext(os.path.basename(path))[0]
         self.annotation = Annotation(pix.width(), pix.height(), scene_id=scene_id)
         self.annotation.image_path = os.path.basename(path)
+        self.image_file = os.path.abspath(path)
         self.view.set_pixmap(pix)
+        self.steps.blockSignals(True)
         self.steps.setCurrentRow(0)
+        self.steps.blockSignals(False)
         self.redraw()
-        self.set_status(f"{pix.width()}×{pix.height()} px. {STEPS[0][1]}")
+        self._show_guidance()
+        self.set_status(
+            f"{pix.width()}×{pix.height()} px. Annotate here, or in the browser with its "
+            "zoom and checks (Annotate in browser…)."
+        )
         return True
 
     def _step_changed(self, row: int) -> None:
         if 0 <= row < len(STEPS):
             self.annotation.set_step(STEPS[row][0])
             self.redraw()
+            self._show_guidance()
+
+    def _show_guidance(self) -> None:
+        if not self.view.has_image():
+            self.guidance.setText(
+                "<b>Start:</b> open a snapshot. The steps below mark the car (its corner and "
+                "edges), lines along its axes and the intersection's kerb corners."
+            )
+            return
+        row = [s[0] for s in STEPS].index(self.annotation.step)
+        self.guidance.setText(f"<b>{STEPS[row][1]}</b><br>{GUIDANCE[self.annotation.step]}")
 
     def set_step(self, key: str) -> None:
         """Select a step by key (``origin``, ``lines_length``, ``corners``...)."""
@@ -174,21 +453,28 @@ class CamlocDock(QDockWidget):
 
     def image_clicked(self, x: float, y: float) -> None:
         """A click on the snapshot at image pixel ``(x, y)``."""
+        if not self.view.has_image():
+            self.set_status("Open a snapshot first.")
+            return
         what = self.annotation.click(x, y)
+        self._sync_step_row()
+        self.redraw()
+        self._show_guidance()
+        row = [s[0] for s in STEPS].index(self.annotation.step)
+        self.set_status(f"{what} at ({x:.1f}, {y:.1f}). Next: {STEPS[row][1]}")
+
+    def _sync_step_row(self) -> None:
         row = [s[0] for s in STEPS].index(self.annotation.step)
         if row != self.steps.currentRow():
             self.steps.blockSignals(True)
             self.steps.setCurrentRow(row)
             self.steps.blockSignals(False)
-        self.redraw()
-        self.set_status(f"{what} at ({x:.1f}, {y:.1f}). {STEPS[row][1]}")
 
     def undo(self) -> None:
         self.annotation.undo()
-        self.steps.blockSignals(True)
-        self.steps.setCurrentRow([s[0] for s in STEPS].index(self.annotation.step))
-        self.steps.blockSignals(False)
+        self._sync_step_row()
         self.redraw()
+        self._show_guidance()
 
     def _update_step_labels(self) -> None:
         a = self.annotation
@@ -203,57 +489,168 @@ class CamlocDock(QDockWidget):
             self.steps.item(row).setText(label + extra)
 
     def redraw(self) -> None:
-        """Draw the annotation over the image."""
+        """Draw the annotation over the image: markers a fixed size on screen at any zoom."""
         self._update_step_labels()
-        sc = self.view.scene()
-        for item in self.overlays:
-            sc.removeItem(item)
-        self.overlays = []
+        view = self.view
+        view.clear_overlays()
+        if not view.has_image():
+            return
+        sc = view.scene()
         a = self.annotation
-        width = max(2.0, a.width / 600.0)
-        r = width * 3
 
-        def pen(colour: str) -> QPen:
+        def pen(colour: str, width: float = 2.5) -> QPen:
             p = QPen(QColor(colour))
             p.setWidthF(width)
+            p.setCosmetic(True)  # screen pixels, whatever the zoom
             return p
+
+        def dot(x: float, y: float, fill: str, r: float = MARKER_PX) -> None:
+            item = sc.addEllipse(-r, -r, 2 * r, 2 * r, pen("#000000", 1.5), QBrush(QColor(fill)))
+            item.setPos(x, y)
+            item.setFlag(QGraphicsItem.ItemIgnoresTransformations)
+            view.add_overlay(item)
 
         if "origin" in a.axes:
             ox, oy = a.axes["origin"]
             for axis in ("length", "width", "height"):
                 if axis in a.axes:
                     x, y = a.axes[axis]
-                    self.overlays.append(sc.addLine(ox, oy, x, y, pen(AXIS_COLOURS[axis])))
-        for key, (x, y) in a.axes.items():
-            self.overlays.append(
-                sc.addEllipse(
-                    x - r, y - r, 2 * r, 2 * r, pen("#000000"), QBrush(QColor(AXIS_COLOURS[key]))
-                )
-            )
+                    view.add_overlay(sc.addLine(ox, oy, x, y, pen(AXIS_COLOURS[axis], 3.0)))
         for axis, segs in a.lines.items():
             p = pen(AXIS_COLOURS[axis])
             p.setStyle(Qt.DashLine)
             for x1, y1, x2, y2 in segs:
-                self.overlays.append(sc.addLine(x1, y1, x2, y2, p))
+                view.add_overlay(sc.addLine(x1, y1, x2, y2, p))
+        for key, (x, y) in a.axes.items():
+            dot(x, y, AXIS_COLOURS[key])
         if a.pending is not None:
-            x, y = a.pending
-            self.overlays.append(sc.addEllipse(x - r, y - r, 2 * r, 2 * r, pen("#ffff00")))
+            dot(*a.pending, "#ffff00")
         for i, (x, y) in enumerate(a.corners):
-            self.overlays.append(
-                sc.addEllipse(
-                    x - 1.5 * r,
-                    y - 1.5 * r,
-                    3 * r,
-                    3 * r,
-                    pen("#000000"),
-                    QBrush(QColor(AXIS_COLOURS["corners"])),
-                )
-            )
+            dot(x, y, AXIS_COLOURS["corners"], MARKER_PX * 1.3)
             t = sc.addSimpleText(str(i))
             t.setBrush(QBrush(QColor("#ffffff")))
-            t.setScale(max(1.0, a.width / 400.0))
-            t.setPos(QPointF(x + 2 * r, y - 4 * r))
-            self.overlays.append(t)
+            t.setPen(pen("#000000", 0.8))
+            f = t.font()
+            f.setPointSize(12)
+            f.setBold(True)
+            t.setFont(f)
+            t.setFlag(QGraphicsItem.ItemIgnoresTransformations)
+            t.setPos(QPointF(x, y))
+            view.add_overlay(t)
+
+    # --- the annotation page in the browser -----------------------------------------------
+    def annotate_in_browser(self) -> bool:
+        """Open the library's annotation page for the snapshot; its Submit comes back here."""
+        if not self.image_file:
+            self.set_status("Open a snapshot first: the page annotates that image.")
+            return False
+        if self.page_task is not None:
+            self.set_status("The annotation page is being prepared…")
+            return False
+        from .browser import PageServer
+
+        self._stop_page()
+        self.page_server = PageServer(self._scene_from_page)
+        a = self.annotation
+        job: dict[str, Any] = {
+            "task": "annotation_page",
+            "image": self.image_file,
+            "submit_url": self.page_server.submit_url,
+            "title": f"camloc: annotate {os.path.basename(self.image_file)}",
+        }
+        if a.lat is not None and a.lon is not None:
+            job.update({"lat": a.lat, "lon": a.lon, "radius_m": self.radius_spin.value()})
+            osm = self.osm_edit.text().strip()
+            if osm and os.path.isfile(osm):
+                job["osm"] = osm
+            if self.streets_edit.text().strip():
+                job["streets"] = self.streets_edit.text().strip()
+        if a.axes or a.corners or a.base:
+            job["scene"] = self.scene()  # continue from what was clicked here
+        task = WorkerTask("camloc: prepare the annotation page", job)
+        task.on_done = self._page_ready
+        self.page_task = task
+        QgsApplication.taskManager().addTask(task)
+        self.set_status("Preparing the annotation page…")
+        return True
+
+    def _page_ready(self, task: WorkerTask, ok: bool) -> None:
+        self.page_task = None
+        if self.page_server is None:
+            return
+        if not ok:
+            self.set_status(f"annotation page: {task.error or 'canceled'}")
+            self._stop_page()
+            return
+        self.page_server.html = task.result["info"]["html"]
+        QDesktopServices.openUrl(QUrl(self.page_server.url))
+        self.set_status(
+            "The annotation page is open in your browser. Annotate there and press Submit: "
+            f"the scene comes back here by itself. (Page: {self.page_server.url})"
+        )
+
+    def _scene_from_page(self, scene: dict[str, Any]) -> str | None:
+        """On the page server's thread: validate with the library, then hand to the GUI."""
+        try:
+            run_worker({"task": "check_scene", "scene": scene})
+        except WorkerError as exc:
+            return str(exc)
+        self.inbox.received.emit(scene)
+        return None
+
+    def receive_scene(self, scene: dict[str, Any]) -> None:
+        """Take a scene (from the page or a file) as the dock's annotation."""
+        self.annotation = Annotation.from_scene(scene)
+        if self.image_file and not self.annotation.image_path:
+            self.annotation.image_path = os.path.basename(self.image_file)
+        self._settings_from_annotation()
+        self._sync_step_row()
+        self.redraw()
+        self._show_guidance()
+        anns = len(scene.get("annotations") or [])
+        corners = len((scene.get("intersection") or {}).get("corners") or [])
+        missing = self.annotation.problems()
+        self.set_status(
+            f"Scene received: {anns} car annotation(s), {corners} kerb corner(s). "
+            + ("Run when ready." if not missing else "Still to do: " + "; ".join(missing))
+        )
+
+    def _settings_from_annotation(self) -> None:
+        a = self.annotation
+        if self.preset_combo.findText(a.preset) < 0:
+            self.preset_combo.addItem(a.preset)
+        self.preset_combo.setCurrentText(a.preset)
+        self.radius_spin.setValue(a.radius_m)
+        self.hint_edit.setText(a.view_hint)
+        self.streets_edit.setText(" & ".join(a.streets))
+
+    def _stop_page(self) -> None:
+        if self.page_server is not None:
+            self.page_server.stop()
+            self.page_server = None
+
+    def _load_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Load scene", "", "camloc scenes (*.json)")
+        if path:
+            self.load_scene(path)
+
+    def load_scene(self, path: str) -> bool:
+        """Load a scene file (for example one saved by the annotation page)."""
+        try:
+            with open(path, encoding="utf-8") as fh:
+                scene = json.load(fh)
+            if not isinstance(scene, dict):
+                raise ValueError("not a JSON object")
+        except (OSError, ValueError) as exc:
+            self.set_status(f"cannot read the scene {path}: {exc}")
+            return False
+        image = (scene.get("image") or {}).get("path")
+        if image and not self.image_file:
+            candidate = os.path.join(os.path.dirname(path), image)
+            if os.path.isfile(candidate):
+                self.open_snapshot(candidate)
+        self.receive_scene(scene)
+        return True
 
     # --- map pick --------------------------------------------------------------------------
     def _pick_toggled(self, on: bool) -> None:
@@ -261,16 +658,19 @@ class CamlocDock(QDockWidget):
             return
         canvas = self.iface.mapCanvas()
         if on:
+            if self.map_tool is not None:
+                return
             self._previous_tool = canvas.mapTool()
             self.map_tool = QgsMapToolEmitPoint(canvas)
             self.map_tool.canvasClicked.connect(self._canvas_clicked)
             canvas.setMapTool(self.map_tool)
             self.set_status("Click the intersection on the map.")
         elif self.map_tool is not None:
-            canvas.unsetMapTool(self.map_tool)
+            tool, self.map_tool = self.map_tool, None
+            canvas.unsetMapTool(tool)
             if self._previous_tool is not None:
                 canvas.setMapTool(self._previous_tool)
-            self.map_tool = None
+            self._previous_tool = None
 
     def _canvas_clicked(self, point: Any, button: Any = None) -> None:
         crs = self.iface.mapCanvas().mapSettings().destinationCrs() if self.iface else None
@@ -288,12 +688,14 @@ class CamlocDock(QDockWidget):
 
     # --- scene, run, save ------------------------------------------------------------------
     def scene(self) -> dict[str, Any]:
-        """The current scene dict (streets from the text box)."""
+        """The current scene dict, with the dock's preset, radius, direction and streets."""
+        a = self.annotation
         text = self.streets_edit.text().strip()
-        self.annotation.streets = [
-            s.strip() for s in text.replace("/", "&").split("&") if s.strip()
-        ]
-        return self.annotation.to_scene()
+        a.streets = [s.strip() for s in text.replace("/", "&").split("&") if s.strip()]
+        a.preset = self.preset_combo.currentText() or a.preset
+        a.radius_m = float(self.radius_spin.value())
+        a.view_hint = self.hint_edit.text().strip()
+        return a.to_scene()
 
     def save_scene(self, path: str) -> bool:
         """Validate the scene with the library and write it; False (status says why) if invalid."""
@@ -319,71 +721,181 @@ class CamlocDock(QDockWidget):
         if path:
             self.osm_edit.setText(path)
 
-    def run(self) -> list[QgsVectorLayer]:
-        """Locate the camera (``camloc:locate``) and add the candidate layers to the project."""
+    def _gpkg_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(
+            self,
+            "Results GeoPackage",
+            self.results_path(),
+            "GeoPackage (*.gpkg)",
+            options=QFileDialog.DontConfirmOverwrite,  # layers are added to an existing file
+        )
+        if path:
+            self.gpkg_edit.setText(path if path.endswith(".gpkg") else path + ".gpkg")
+
+    def results_path(self) -> str:
+        """The GeoPackage results go to: the one chosen, else beside the project (or image)."""
+        chosen = self.gpkg_edit.text().strip()
+        if chosen:
+            return chosen
+        folder = QgsProject.instance().absolutePath()
+        if not folder and self.image_file:
+            folder = os.path.dirname(self.image_file)
+        return os.path.join(folder or os.path.expanduser("~"), RESULTS_NAME)
+
+    def run(self) -> QgsTask | None:
+        """Locate the camera in the background; the layers load when the task ends.
+
+        Returns the task (None when the scene is not ready or a run is going on).
+        """
+        if self.task is not None:
+            self.set_status("A run is going on: wait for it or Cancel it.")
+            return None
         problems = self.annotation.problems()
         if problems:
             self.set_status("Not ready: " + "; ".join(problems))
-            return []
-        import processing
+            return None
+        osm = self.osm_edit.text().strip()
+        gpkg = self.results_path()
+        folder = os.path.dirname(os.path.abspath(gpkg))
+        if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+            self.set_status(f"cannot write results to {gpkg}: pick another GeoPackage")
+            return None
+        self._remove_results()  # their GeoPackage tables are about to be replaced
+        job = {
+            "task": "locate",
+            "scene": self.scene(),
+            "osm": osm or None,
+            "network": not osm,
+            "context": self.context_check.isChecked(),
+        }
+        prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id)
+        task = LocateTask(job, gpkg, prefix or "scene")
+        task.on_done = self._run_done
+        task.progressChanged.connect(self._task_progress)
+        self.task = task
+        self.run_button.setEnabled(False)
+        self.cancel_button.setEnabled(True)
+        self.progress.setValue(0)
+        self.progress.setVisible(True)
+        self.set_status(
+            "Locating the camera…" + ("" if osm else " (downloading the map from Overpass)")
+        )
+        QgsApplication.taskManager().addTask(task)
+        return task
 
-        folder = tempfile.mkdtemp(prefix="camloc_dock_")
-        scene_path = os.path.join(folder, f"{self.annotation.scene_id}.json")
-        with open(scene_path, "w", encoding="utf-8") as fh:
-            json.dump(self.scene(), fh, indent=1)
-        outputs = {
-            "CANDIDATES": os.path.join(folder, "candidates.gpkg"),
-            "VIEW_CONES": os.path.join(folder, "view_cones.gpkg"),
-            "MATCHED_CORNERS": os.path.join(folder, "matched_corners.gpkg"),
-            "INTERSECTION": os.path.join(folder, "intersection.gpkg"),
-        }
-        params = {
-            "SCENE": scene_path,
-            "OSM": self.osm_edit.text().strip() or None,
-            "NETWORK": not self.osm_edit.text().strip(),
-            **outputs,
-        }
-        QApplication.setOverrideCursor(Qt.WaitCursor)
-        try:
-            res = processing.run("camloc:locate", params)
-        except Exception as exc:  # QgsProcessingException: the library's message
-            self.set_status(str(exc).strip().splitlines()[0] if str(exc).strip() else repr(exc))
-            return []
-        finally:
-            QApplication.restoreOverrideCursor()
+    def cancel(self) -> None:
+        """Cancel the run (the worker process is stopped)."""
+        if self.task is not None:
+            self.task.cancel()
+            self.set_status("Canceling…")
+
+    def _task_progress(self, value: float) -> None:
+        self.progress.setValue(int(value))
+        task = self.task
+        if isinstance(task, LocateTask) and task.message:
+            self.status.setText(f"Locating the camera… {task.message}")
+
+    def _run_done(self, task: LocateTask, ok: bool) -> None:
+        self.task = None
+        self.run_button.setEnabled(True)
+        self.cancel_button.setEnabled(False)
+        self.progress.setVisible(False)
+        if not ok:
+            self.set_status(
+                "Canceled." if task.error in (None, "canceled") else f"camloc: {task.error}"
+            )
+            return
+        self._load_results(task)
+
+    def _load_results(self, task: LocateTask) -> None:
         project = QgsProject.instance()
-        for old in self.result_layers:
-            if project.mapLayer(old.id()) is not None:
-                project.removeMapLayer(old.id())
+        root = project.layerTreeRoot()
+        name = f"camloc: {self.annotation.scene_id}"
+        group = root.findGroup(name) or root.insertGroup(0, name)
+        titles = {
+            "candidates": "camera candidates",
+            "matched_corners": "matched map points",
+            "intersection": "intersection and kerb corners",
+            "view_cones": "view cones (leading candidates)",
+            "context_buildings": "map model: buildings",
+            "context_streets": "map model: streets",
+        }
         self.result_layers = []
-        for key, kind, title in (
-            ("VIEW_CONES", "view_cones", "camloc view cones"),
-            ("INTERSECTION", "intersection", "camloc intersection"),
-            ("MATCHED_CORNERS", "matched_corners", "camloc matched corners"),
-            ("CANDIDATES", "candidates", "camloc candidates"),
-        ):
-            if key not in res:
+        for kind in DRAW_ORDER:  # top to bottom: candidates above cones above context
+            uri = task.uris.get(kind)
+            if uri is None:
                 continue
-            layer = QgsVectorLayer(res[key], title, "ogr")
+            layer = QgsVectorLayer(uri, titles.get(kind, kind), "ogr")
             if not layer.isValid():
                 continue
             apply_style(layer, kind)
-            project.addMapLayer(layer)
+            project.addMapLayer(layer, False)
+            group.addLayer(layer)
             self.result_layers.append(layer)
-        n = self.result_layers[-1].featureCount() if self.result_layers else 0
-        self.set_status(f"{n} candidate(s); best first, ties drawn as stars.")
-        if self.iface is not None and self.result_layers:
+        cands = next(
+            (
+                lyr
+                for lyr in self.result_layers
+                if lyr.customProperty("camloc/kind") == "candidates"
+            ),
+            None,
+        )
+        n = cands.featureCount() if cands is not None else 0
+        tied = cands is not None and any(f["tie"] for f in cands.getFeatures())
+        msg = f"{n} candidate(s) in {task.gpkg}; best first."
+        if tied:  # the library's tie, from the data (never from warning text)
+            msg += " ★ marks a tie: add a viewing direction or a landmark to decide."
+        if not n and task.info.get("reason"):
+            msg = f"No candidate: {task.info['reason']}"
+        self.set_status(msg)
+        if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
-            ext = xform.transformBoundingBox(self.result_layers[-1].extent())
+            ext = xform.transformBoundingBox(cands.extent())
             ext.scale(2.0)
+            if ext.width() < 150 and ext.height() < 150:
+                ext.grow(75)
             canvas.setExtent(ext)
             canvas.refresh()
-        return self.result_layers
+
+    def wait(self, timeout_s: float = 120.0) -> bool:
+        """Process events until the run (and the page task) ends; True if it did in time."""
+        import time
+
+        from qgis.PyQt.QtCore import QCoreApplication
+
+        t0 = time.monotonic()
+        while (self.task is not None or self.page_task is not None) and (
+            time.monotonic() - t0 < timeout_s
+        ):
+            QCoreApplication.processEvents()
+            time.sleep(0.01)
+        return self.task is None and self.page_task is None
+
+    def _remove_results(self) -> None:
+        project = QgsProject.instance()
+        for old in self.result_layers:
+            try:
+                layer_id = old.id()
+            except RuntimeError:  # deleted with the project
+                continue
+            if project.mapLayer(layer_id) is not None:
+                project.removeMapLayer(layer_id)
+        self.result_layers = []
 
     def set_status(self, text: str) -> None:
         self.status.setText(text)
 
+    def shutdown(self) -> None:
+        """Stop what runs in the background (the plugin calls this on unload)."""
+        self.pick_button.setChecked(False)
+        if self.task is not None:
+            self.task.on_done = None
+            self.task.cancel()
+            self.task = None
+        self._stop_page()
+
     def closeEvent(self, event):
         self.pick_button.setChecked(False)
+        self._stop_page()
         super().closeEvent(event)

@@ -7,20 +7,23 @@ from typing import Any
 
 from qgis.core import (
     QgsCoordinateReferenceSystem,
+    QgsCoordinateTransformContext,
     QgsFeature,
     QgsFeatureSink,
     QgsField,
     QgsFields,
     QgsGeometry,
-    QgsGraduatedSymbolRenderer,
+    QgsLayerTreeGroup,
+    QgsLayerTreeLayer,
     QgsPalLayerSettings,
     QgsPointXY,
     QgsProperty,
-    QgsRendererRange,
+    QgsRuleBasedRenderer,
     QgsSymbol,
     QgsSymbolLayer,
     QgsTextBufferSettings,
     QgsTextFormat,
+    QgsVectorFileWriter,
     QgsVectorLayer,
     QgsVectorLayerSimpleLabeling,
     QgsWkbTypes,
@@ -38,7 +41,8 @@ _TYPES = {
 }
 _WKB = {
     "Point": QgsWkbTypes.Point,
-    "Polygon": QgsWkbTypes.Polygon,
+    "LineString": QgsWkbTypes.MultiLineString,
+    "Polygon": QgsWkbTypes.MultiPolygon,
     "None": QgsWkbTypes.NoGeometry,
 }
 
@@ -61,32 +65,50 @@ def wkb_of(desc: dict[str, Any]) -> int:
     return _WKB[desc["geometry"]]
 
 
-def _geometry(geom: dict[str, Any] | None) -> QgsGeometry | None:
+def _ring(ring: list[Any]) -> list[QgsPointXY]:
+    return [QgsPointXY(float(p[0]), float(p[1])) for p in ring]
+
+
+def _geometry(geom: dict[str, Any] | None, wkb: int) -> QgsGeometry | None:
     if not geom:
         return None
-    if geom["type"] == "Point":
-        coords = geom.get("coordinates") or []
+    kind = geom["type"]
+    coords = geom.get("coordinates") or []
+    if kind == "Point":
         if len(coords) < 2 or coords[0] is None or coords[1] is None:
             return None  # a camera that could not be placed: a row without geometry
-        x, y = coords[:2]
-        return QgsGeometry.fromPointXY(QgsPointXY(float(x), float(y)))
-    if geom["type"] == "Polygon":
-        rings = [
-            [QgsPointXY(float(p[0]), float(p[1])) for p in ring] for ring in geom["coordinates"]
-        ]
-        return QgsGeometry.fromPolygonXY(rings)
-    raise ValueError(f"unsupported geometry type {geom['type']}")
+        return QgsGeometry.fromPointXY(QgsPointXY(float(coords[0]), float(coords[1])))
+    if kind == "LineString":
+        g = QgsGeometry.fromMultiPolylineXY([_ring(coords)])
+    elif kind == "MultiLineString":
+        g = QgsGeometry.fromMultiPolylineXY([_ring(line) for line in coords])
+    elif kind == "Polygon":
+        g = QgsGeometry.fromPolygonXY([_ring(r) for r in coords])
+        if wkb == QgsWkbTypes.MultiPolygon:
+            g.convertToMultiType()
+    elif kind == "MultiPolygon":
+        g = QgsGeometry.fromMultiPolygonXY([[_ring(r) for r in poly] for poly in coords])
+    else:
+        raise ValueError(f"unsupported geometry type {kind}")
+    return g
+
+
+def _data(desc: dict[str, Any]) -> dict[str, Any]:
+    data = desc.get("data")
+    if data is None:  # a description straight from the worker (its file still there)
+        with open(desc["path"], encoding="utf-8") as fh:
+            data = json.load(fh)
+    return data
 
 
 def features_of(desc: dict[str, Any], fields: QgsFields) -> list[QgsFeature]:
-    """The features of a worker layer file, attributes in field order."""
-    with open(desc["path"], encoding="utf-8") as fh:
-        data = json.load(fh)
+    """The features of a worker layer (inline ``data`` or its file), attributes in field order."""
     names = [f.name() for f in fields]
+    wkb = wkb_of(desc)
     out = []
-    for f in data["features"]:
+    for f in _data(desc)["features"]:
         feat = QgsFeature(fields)
-        g = _geometry(f.get("geometry"))
+        g = _geometry(f.get("geometry"), wkb)
         if g is not None:
             feat.setGeometry(g)
         props = f.get("properties") or {}
@@ -103,86 +125,249 @@ def write_to_sink(sink: QgsFeatureSink, desc: dict[str, Any], fields: QgsFields)
     return len(feats)
 
 
+def write_gpkg_layer(gpkg: str, layer_name: str, desc: dict[str, Any]) -> str:
+    """Write (or replace) one layer of a GeoPackage; its ``path|layername=`` URI.
+
+    Safe off the GUI thread (no project access), so a QgsTask can call it.
+
+    Raises
+    ------
+    OSError
+        The GeoPackage cannot be written (the message names it).
+    """
+    import os
+
+    fields = fields_of(desc)
+    opts = QgsVectorFileWriter.SaveVectorOptions()
+    opts.driverName = "GPKG"
+    opts.layerName = layer_name
+    opts.actionOnExistingFile = (
+        QgsVectorFileWriter.CreateOrOverwriteLayer
+        if os.path.exists(gpkg)
+        else QgsVectorFileWriter.CreateOrOverwriteFile
+    )
+    writer = QgsVectorFileWriter.create(
+        gpkg, fields, wkb_of(desc), wgs84(), QgsCoordinateTransformContext(), opts
+    )
+    if writer.hasError() != QgsVectorFileWriter.NoError:
+        raise OSError(f"cannot write {layer_name} to {gpkg}: {writer.errorMessage()}")
+    for feat in features_of(desc, fields):
+        writer.addFeature(feat, QgsFeatureSink.FastInsert)
+    del writer  # closes the file
+    return f"{gpkg}|layername={layer_name}"
+
+
 # --- default styles -------------------------------------------------------------------------
 
-SCORE_CLASSES = [
-    (0.0, 0.05, "#2c7bb6", "< 0.05"),
-    (0.05, 0.15, "#abd9e9", "0.05 – 0.15"),
-    (0.15, 0.3, "#fdae61", "0.15 – 0.30"),
-    (0.3, 1.0001, "#d7191c", "≥ 0.30"),
-]
-"""Score classes of the candidate style: colour by score (red = most likely)."""
+KIND_PROPERTY = "camloc/kind"
+"""Custom layer property naming a camloc output (``candidates``, ``view_cones``...)."""
 
-TIE_SHAPE_EXPR = "CASE WHEN \"tie\" THEN 'star' ELSE 'circle' END"
-TIE_SIZE_EXPR = 'CASE WHEN "tie" THEN 6.5 ELSE 4 END'
+DRAW_ORDER = [
+    "cameras",
+    "candidates",
+    "list_candidates",
+    "matched_corners",
+    "intersection",
+    "corners",
+    "view_cones",
+    "context_buildings",
+    "context_streets",
+]
+"""Top to bottom: points people read above the areas and lines that give them context."""
+
+TIE_WORDS = (
+    "tie: another candidate fits the evidence nearly as well (odds under 10 to 1) "
+    "more than 10 m away; add a viewing direction or a landmark to decide"
+)
+"""The legend's words for a tie: the core's rule (camloc_geo.results.TIE_SCORE_RATIO,
+TIE_DISTANCE_M), read by the plugin from the ``tie`` field, never from scores."""
+
+LEADING_EXPR = '"rank" = 1 OR "tie" OR coalesce("score", 0) >= 0.05'
+"""A candidate worth a view cone (the worker's ``leading``: best, tied, or score >= 0.05)."""
+
+_NO_TIE = 'NOT coalesce("tie", false)'
+
 RANK_LABEL_EXPR = (
-    "concat('#', \"rank\", "
-    "CASE WHEN \"tie\" THEN ' (tie ' || \"ambiguous_with\" || ')' ELSE '' END)"
+    "concat('#', \"rank\", ' ', coalesce(\"score_text\", ''), "
+    "CASE WHEN \"tie\" THEN ' (tie with #' || replace(\"ambiguous_with\", ',', ', #') || ')' "
+    "ELSE '' END)"
 )
 
 
+def _marker(colour: str, shape: str, size: float, opacity: float = 1.0) -> QgsSymbol:
+    sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PointGeometry)
+    sym.setColor(QColor(colour))
+    sym.setSize(size)
+    sym.setOpacity(opacity)
+    sl = sym.symbolLayer(0)
+    if hasattr(sl, "setShape"):
+        from qgis.core import QgsSimpleMarkerSymbolLayerBase
+
+        sl.setShape(getattr(QgsSimpleMarkerSymbolLayerBase, shape))
+    sl.setStrokeColor(QColor("black"))
+    return sym
+
+
+def _rules(layer: QgsVectorLayer, rules: list[tuple[str, str | None, QgsSymbol]]) -> None:
+    """A rule-based renderer: (legend label, filter or None for else, symbol); the filters
+    must exclude each other (every matching rule draws)."""
+    root = QgsRuleBasedRenderer.Rule(None)
+    for label, expr, sym in rules:
+        rule = QgsRuleBasedRenderer.Rule(sym, 0, 0, expr or "", label)
+        if expr is None:
+            rule.setIsElse(True)
+        root.appendChild(rule)
+    layer.setRenderer(QgsRuleBasedRenderer(root))
+
+
 def style_candidates(layer: QgsVectorLayer) -> None:
-    """Candidates coloured by score, labelled by rank; ties drawn as stars and labelled."""
-    ranges = []
-    for lo, hi, colour, label in SCORE_CLASSES:
-        sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PointGeometry)
-        sym.setColor(QColor(colour))
-        sl = sym.symbolLayer(0)
-        sl.setDataDefinedProperty(
-            QgsSymbolLayer.PropertyName, QgsProperty.fromExpression(TIE_SHAPE_EXPR)
-        )
-        sl.setDataDefinedProperty(
-            QgsSymbolLayer.PropertySize, QgsProperty.fromExpression(TIE_SIZE_EXPR)
-        )
-        sl.setStrokeColor(QColor("black"))
-        ranges.append(QgsRendererRange(lo, hi, sym, label))
-    layer.setRenderer(QgsGraduatedSymbolRenderer("score", ranges))
-    _label(layer, RANK_LABEL_EXPR)
+    """Ties as stars, the best as a large red dot, the rest by score (the unlikely faded)."""
+    _rules(
+        layer,
+        [
+            ("★ " + TIE_WORDS, '"tie"', _marker("#d7191c", "Star", 7.0)),
+            ("best candidate (#1)", _NO_TIE + ' AND "rank" = 1', _marker("#d7191c", "Circle", 5.0)),
+            (
+                "score ≥ 0.30",
+                _NO_TIE + ' AND "rank" > 1 AND "score" >= 0.3',
+                _marker("#fdae61", "Circle", 4.2),
+            ),
+            (
+                "score 0.05 – 0.30",
+                _NO_TIE + ' AND "rank" > 1 AND "score" >= 0.05 AND "score" < 0.3',
+                _marker("#abd9e9", "Circle", 3.6),
+            ),
+            ("score < 0.05 (unlikely)", None, _marker("#2c7bb6", "Circle", 2.6, 0.55)),
+        ],
+    )
+    # labels for the leading candidates only: the unlikely ones stay quiet
+    _label(layer, f"CASE WHEN {LEADING_EXPR} THEN {RANK_LABEL_EXPR} END", priority=8)
+    layer.triggerRepaint()
+
+
+def style_list_candidates(layer: QgsVectorLayer) -> None:
+    """A list's candidates: small, unlabelled but for ties, under the cameras' labels."""
+    _rules(
+        layer,
+        [
+            ("★ " + TIE_WORDS, '"tie"', _marker("#d7191c", "Star", 5.0)),
+            (
+                "a camera's best candidate",
+                _NO_TIE + ' AND "rank" = 1',
+                _marker("#fdae61", "Circle", 3.2),
+            ),
+            ("other candidates", None, _marker("#2c7bb6", "Circle", 2.2, 0.6)),
+        ],
+    )
+    _label(layer, 'CASE WHEN "rank" > 1 OR "tie" THEN concat(\'#\', "rank") END', priority=1)
     layer.triggerRepaint()
 
 
 def style_view_cones(layer: QgsVectorLayer) -> None:
-    """Cones filled by score (the likely ones stand out), ties outlined in red."""
-    from qgis.core import QgsSingleSymbolRenderer
-
+    """Cones of the leading candidates only (best, tied, score >= 0.05), faded by score."""
     sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
-    sym.setColor(QColor(255, 200, 0, 60))
+    sym.setColor(QColor(255, 190, 0, 70))
     sl = sym.symbolLayer(0)
     sl.setStrokeColor(QColor(180, 120, 0))
     sl.setDataDefinedProperty(
         QgsSymbolLayer.PropertyFillColor,
-        QgsProperty.fromExpression('color_rgba(255, 190, 0, 10 + 150 * coalesce("score", 0))'),
+        QgsProperty.fromExpression(
+            'color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce("score", 0) / 0.5))'
+        ),
     )
     sl.setDataDefinedProperty(
         QgsSymbolLayer.PropertyStrokeColor,
         QgsProperty.fromExpression(
-            "CASE WHEN \"tie\" THEN '#d7191c' "
-            'ELSE color_rgba(180, 120, 0, 30 + 200 * coalesce("score", 0)) END'
+            "CASE WHEN \"tie\" THEN '#d7191c' ELSE color_rgba(180, 120, 0, 160) END"
         ),
     )
-    layer.setRenderer(QgsSingleSymbolRenderer(sym))
+    _rules(
+        layer,
+        [("view cone of a leading candidate (faded by score)", LEADING_EXPR, sym)],
+    )
     layer.triggerRepaint()
 
 
-def style_points(layer: QgsVectorLayer, colour: str, label_expr: str | None = None) -> None:
-    """Small points in one colour, optionally labelled."""
+def style_corners(layer: QgsVectorLayer) -> None:
+    """Intersections (large green squares, their streets) apart from kerb corners (orange)."""
+    _rules(
+        layer,
+        [
+            ("intersection", "\"kind\" = 'intersection'", _marker("#008837", "Square", 4.5)),
+            (
+                "kerb corner (clockwise from 0)",
+                "\"kind\" = 'corner'",
+                _marker("#ff7f00", "Circle", 2.4),
+            ),
+        ],
+    )
+    _label(
+        layer,
+        'CASE WHEN "kind" = \'corner\' THEN \'corner \' || "order" ELSE "streets" END',
+        priority=3,
+    )
+    layer.triggerRepaint()
+
+
+def style_matched(layer: QgsVectorLayer) -> None:
+    """Map points the best candidate matched, labelled with the analyst's own words."""
+    _rules(
+        layer,
+        [
+            ("matched by the best candidate", '"rank" = 1', _marker("#7b3294", "Diamond", 3.4)),
+            ("matched by other candidates", None, _marker("#c2a5cf", "Diamond", 2.0, 0.5)),
+        ],
+    )
+    _label(layer, 'CASE WHEN "rank" = 1 THEN coalesce("what", "label") END', priority=4)
+    layer.triggerRepaint()
+
+
+def style_cameras(layer: QgsVectorLayer) -> None:
+    """A list's cameras: their labels win over the candidates' (highest priority)."""
+    _rules(
+        layer,
+        [
+            ("camera placed", None, _marker("#d7191c", "Triangle", 4.5)),
+        ],
+    )
+    _label(layer, '"camera_id" || \' \' || "status"', priority=10, size=10)
+    layer.triggerRepaint()
+
+
+def style_context_streets(layer: QgsVectorLayer) -> None:
+    """The map model's streets, grey, as wide as the model thinks they are."""
+    from qgis.core import QgsSingleSymbolRenderer, QgsUnitTypes
+
+    sym = QgsSymbol.defaultSymbol(QgsWkbTypes.LineGeometry)
+    sym.setColor(QColor(150, 150, 150, 140))
+    sym.setWidthUnit(QgsUnitTypes.RenderMetersInMapUnits)
+    sym.symbolLayer(0).setDataDefinedProperty(
+        QgsSymbolLayer.PropertyStrokeWidth,
+        QgsProperty.fromExpression('coalesce("width_m", 8)'),
+    )
+    layer.setRenderer(QgsSingleSymbolRenderer(sym))
+    _label(layer, '"name"', priority=0, size=8)
+    layer.triggerRepaint()
+
+
+def style_context_buildings(layer: QgsVectorLayer) -> None:
+    """The map model's buildings, light fill."""
     from qgis.core import QgsSingleSymbolRenderer
 
-    sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PointGeometry)
-    sym.setColor(QColor(colour))
-    sym.setSize(2.6)
+    sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
+    sym.setColor(QColor(210, 200, 190, 160))
+    sym.symbolLayer(0).setStrokeColor(QColor(160, 150, 140))
     layer.setRenderer(QgsSingleSymbolRenderer(sym))
-    if label_expr:
-        _label(layer, label_expr)
     layer.triggerRepaint()
 
 
-def _label(layer: QgsVectorLayer, expr: str) -> None:
+def _label(layer: QgsVectorLayer, expr: str, priority: int = 5, size: float = 9) -> None:
     pal = QgsPalLayerSettings()
     pal.fieldName = expr
     pal.isExpression = True
+    pal.priority = priority
     fmt = QgsTextFormat()
-    fmt.setSize(9)
+    fmt.setSize(size)
     buf = QgsTextBufferSettings()
     buf.setEnabled(True)
     buf.setSize(1.0)
@@ -194,22 +379,14 @@ def _label(layer: QgsVectorLayer, expr: str) -> None:
 
 STYLES = {
     "candidates": style_candidates,
-    "list_candidates": style_candidates,
+    "list_candidates": style_list_candidates,
     "view_cones": style_view_cones,
-    "matched_corners": lambda lyr: style_points(
-        lyr, "#7b3294", 'CASE WHEN "rank" = 1 THEN \'matched \' || "label" END'
-    ),
-    "intersection": lambda lyr: style_points(
-        lyr,
-        "#008837",
-        'CASE WHEN "kind" = \'corner\' THEN \'corner \' || "order" ELSE "streets" END',
-    ),
-    "corners": lambda lyr: style_points(
-        lyr,
-        "#008837",
-        'CASE WHEN "kind" = \'corner\' THEN \'corner \' || "order" ELSE "streets" END',
-    ),
-    "cameras": lambda lyr: style_points(lyr, "#d7191c", '"camera_id" || \' \' || "status"'),
+    "matched_corners": style_matched,
+    "intersection": style_corners,
+    "corners": style_corners,
+    "cameras": style_cameras,
+    "context_streets": style_context_streets,
+    "context_buildings": style_context_buildings,
 }
 
 
@@ -218,3 +395,34 @@ def apply_style(layer: QgsVectorLayer, kind: str) -> None:
     fn = STYLES.get(kind)
     if fn is not None and layer.isValid() and layer.isSpatial():
         fn(layer)
+    layer.setCustomProperty(KIND_PROPERTY, kind)
+    for field in ("score", "score_text"):
+        idx = layer.fields().indexOf(field)
+        if idx >= 0 and field == "score_text":
+            layer.setFieldAlias(idx, "score (readable)")
+
+
+def order_camloc_layers(group: QgsLayerTreeGroup) -> None:
+    """Re-stack the camloc layers of a layer-tree group in :data:`DRAW_ORDER`, in place.
+
+    Only camloc layers move: they are gathered, in that order, where the topmost of them
+    was, so a basemap under them stays under them.
+    """
+    slots: list[int] = []  # where camloc layers are now
+    nodes: list[QgsLayerTreeLayer] = []
+    for i, node in enumerate(group.children()):
+        if isinstance(node, QgsLayerTreeLayer) and node.layer() is not None:
+            kind = node.layer().customProperty(KIND_PROPERTY)
+            if kind in DRAW_ORDER:
+                slots.append(i)
+                nodes.append(node)
+    wanted = sorted(nodes, key=lambda n: DRAW_ORDER.index(n.layer().customProperty(KIND_PROPERTY)))
+    if wanted == nodes:
+        return
+    # clones go in before the originals leave: a layer whose last node leaves the tree is
+    # removed from the project by the tree's registry bridge
+    first = slots[0]
+    for k, node in enumerate(wanted):
+        group.insertChildNode(first + k, node.clone())
+    for node in nodes:
+        group.removeChildNode(node)

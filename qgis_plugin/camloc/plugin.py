@@ -39,9 +39,36 @@ class CamlocPlugin:
         self.iface.addPluginToMenu(MENU, self.action)
         self.iface.addToolBarIcon(self.action)
         if runner.find_python() is None:
-            self.iface.messageBar().pushMessage(
-                "camloc", runner.missing_message(), level=Qgis.Warning, duration=0
-            )
+            self._warn_missing()
+
+    def missing_dialog_text(self) -> str:
+        """The whole install recipe, as the dialog behind the message bar shows it."""
+        return runner.missing_message()
+
+    def _warn_missing(self) -> None:
+        """A one-line warning with a button opening the whole recipe (the bar cuts text)."""
+        bar = self.iface.messageBar()
+        text = "the camloc_geo library is missing: the plugin needs a Python that has it."
+        try:
+            from qgis.PyQt.QtWidgets import QPushButton
+
+            widget = bar.createMessage("camloc", text)
+            button = QPushButton("How to install…", widget)
+            button.clicked.connect(self._show_missing)
+            widget.layout().addWidget(button)
+            bar.pushWidget(widget, Qgis.Warning)
+        except (AttributeError, TypeError):  # a stub interface (tests)
+            bar.pushMessage("camloc", text, level=Qgis.Warning, duration=0)
+
+    def _show_missing(self) -> None:
+        from qgis.PyQt.QtWidgets import QMessageBox
+
+        box = QMessageBox(self.iface.mainWindow())
+        box.setWindowTitle("camloc: install camloc_geo")
+        box.setIcon(QMessageBox.Information)
+        box.setText(self.missing_dialog_text())
+        box.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        box.exec_()
 
     def _toggle_dock(self, on: bool) -> None:
         if on and self.dock is None:
@@ -59,7 +86,7 @@ class CamlocPlugin:
 
     def unload(self) -> None:
         if self.dock is not None:
-            self.dock.pick_button.setChecked(False)
+            self.dock.shutdown()
             self.iface.removeDockWidget(self.dock)
             self.dock.deleteLater()
             self.dock = None

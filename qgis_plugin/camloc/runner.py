@@ -1,4 +1,4 @@
-"""Run camloc_geo in a separate Python (``python -m camloc_geo.qgis_worker JOB.json``).
+"""Run camloc_geo in a separate Python (``python -m camloc_geo.qgis.worker JOB.json``).
 
 QGIS loads the system GEOS/PROJ into its own process and the shapely/pyproj wheels that
 camloc_geo needs crash there, so nothing heavy is imported in QGIS: the plugin finds an
@@ -25,11 +25,13 @@ from pathlib import Path
 from typing import Any
 
 SETTING_KEY = "camloc/python"
+WORKER_MODULES = ("camloc_geo.qgis.worker", "camloc_geo.qgis_worker")
+"""The worker's module, then its home before camloc_geo 0.x moved it (older installs)."""
 DEFAULT_VENV = "~/.local/share/camloc-venv"
 """A venv the plugin looks in without configuration (its ``bin/python``)."""
 PIP_PACKAGE = "camloc-geo"
 
-_found: dict[str, str | None] = {}
+_found: dict[str, tuple[str, str] | None] = {}
 
 
 class WorkerError(Exception):
@@ -41,7 +43,7 @@ class WorkerCanceledError(WorkerError):
 
 
 def qgis_python() -> str:
-    """The Python interpreter QGIS runs (for the pip command shown to the user)."""
+    """The Python interpreter QGIS runs (the base of the venv the message suggests)."""
     exe = Path(sys.executable)
     if exe.name.lower().startswith("python"):
         return str(exe)
@@ -57,13 +59,6 @@ def qgis_python() -> str:
     return "python3"
 
 
-def pip_command() -> str:
-    """The command that installs camloc_geo into QGIS's Python."""
-    py = qgis_python()
-    py = f'"{py}"' if " " in py else py
-    return f"{py} -m pip install {PIP_PACKAGE}"
-
-
 def _externally_managed() -> bool:
     """True for a distribution's Python that refuses pip installs (PEP 668, Debian bookworm)."""
     import sysconfig
@@ -72,20 +67,39 @@ def _externally_managed() -> bool:
     return bool(stdlib) and os.path.exists(os.path.join(stdlib, "EXTERNALLY-MANAGED"))
 
 
+def install_commands() -> list[str]:
+    """Shell commands that give the plugin a Python with camloc_geo, one per line.
+
+    A venv in :data:`DEFAULT_VENV` (where the plugin looks without configuration), made from
+    QGIS's own Python with ``--system-site-packages`` and numpy 1.24 (``docs/qgis.md``); on
+    Windows the venv's ``Scripts`` folder. Never ``pip install`` into a distribution's Python
+    (Debian and Ubuntu refuse it, PEP 668).
+    """
+    py = qgis_python()
+    py = f'"{py}"' if " " in py else py
+    if sys.platform.startswith("win"):
+        venv = "%APPDATA%\\camloc-venv"
+        return [
+            f"{py} -m venv --system-site-packages {venv}",
+            f'{venv}\\Scripts\\python -m pip install "numpy<2" {PIP_PACKAGE}',
+            f"setx CAMLOC_PYTHON {venv}\\Scripts\\python.exe",
+        ]
+    return [
+        f"{py} -m venv --system-site-packages {DEFAULT_VENV}",
+        f'{DEFAULT_VENV}/bin/python -m pip install "numpy==1.24.2" {PIP_PACKAGE}',
+    ]
+
+
 def missing_message() -> str:
-    """What to tell the user when no interpreter can import camloc_geo."""
-    msg = (
-        "The camloc plugin needs the camloc_geo library, and no Python found can import it. "
-        f"Install it into QGIS's Python with:  {pip_command()}"
-    )
-    if _externally_managed() or sys.platform.startswith("linux"):
-        msg += (
-            f"  — or, where that Python refuses pip (Debian, Ubuntu):  python3 -m venv "
-            f"{DEFAULT_VENV} && {DEFAULT_VENV}/bin/python -m pip install {PIP_PACKAGE}"
-        )
-    return msg + (
-        "  The plugin also uses the Python named by the environment variable CAMLOC_PYTHON or the "
-        "setting camloc/python. Then restart QGIS."
+    """What to tell the user when no interpreter can import camloc_geo (several lines)."""
+    return (
+        "The camloc plugin needs the camloc_geo library, and no Python it tried can import "
+        "it. Make a Python for it once, in a terminal:\n\n    "
+        + "\n    ".join(install_commands())
+        + "\n\nthen restart QGIS. The plugin looks in "
+        + DEFAULT_VENV
+        + " by itself; a Python elsewhere can be named by the environment variable "
+        "CAMLOC_PYTHON or the setting camloc/python (docs/qgis.md)."
     )
 
 
@@ -123,17 +137,21 @@ def _candidates() -> list[str]:
     return seen
 
 
-def _can_import(python: str) -> bool:
-    try:
-        r = subprocess.run(
-            [python, "-c", "import camloc_geo.qgis_worker"],
-            capture_output=True,
-            timeout=60,
-            env=_worker_env(),
-        )
-    except (OSError, subprocess.SubprocessError):
-        return False
-    return r.returncode == 0
+def _worker_module(python: str) -> str | None:
+    """The worker module ``python`` can import (newest home first), or None."""
+    for module in WORKER_MODULES:
+        try:
+            r = subprocess.run(
+                [python, "-c", f"import {module}"],
+                capture_output=True,
+                timeout=60,
+                env=_worker_env(),
+            )
+        except (OSError, subprocess.SubprocessError):
+            return None
+        if r.returncode == 0:
+            return module
+    return None
 
 
 def _worker_env() -> dict[str, str]:
@@ -146,12 +164,22 @@ def _worker_env() -> dict[str, str]:
     return env
 
 
-def find_python(refresh: bool = False) -> str | None:
-    """The first interpreter that can import camloc_geo (cached), or None."""
+def _find(refresh: bool = False) -> tuple[str, str] | None:
     key = "|".join(_candidates())
     if refresh or key not in _found:
-        _found[key] = next((c for c in _candidates() if _can_import(c)), None)
+        _found[key] = None
+        for c in _candidates():
+            module = _worker_module(c)
+            if module is not None:
+                _found[key] = (c, module)
+                break
     return _found[key]
+
+
+def find_python(refresh: bool = False) -> str | None:
+    """The first interpreter that can import camloc_geo (cached), or None."""
+    found = _find(refresh)
+    return found[0] if found else None
 
 
 def run_worker(
@@ -160,9 +188,12 @@ def run_worker(
     progress: Callable[[float, str], None] | None = None,
     canceled: Callable[[], bool] | None = None,
     log: Callable[[str], None] | None = None,
-    out_dir: str | None = None,
 ) -> dict[str, Any]:
     """Run a job in the worker; its final message (``layers``, ``warnings``, ``info``).
+
+    The job file and the worker's layer files live in a temporary folder removed before this
+    returns: each layer's features come back in its description (``data``), so nothing is
+    left behind in the temporary folder.
 
     Raises
     ------
@@ -171,22 +202,44 @@ def run_worker(
     WorkerCanceledError
         ``canceled()`` became true; the worker process is killed.
     """
-    python = find_python()
-    if python is None:
+    found = _find()
+    if found is None:
         raise WorkerError(missing_message())
-    work = out_dir or tempfile.mkdtemp(prefix="camloc_")
-    job = {**job, "out_dir": job.get("out_dir") or work}
+    with tempfile.TemporaryDirectory(prefix="camloc_") as work:
+        final = _run_in(found, job, work, progress=progress, canceled=canceled, log=log)
+        for desc in (final.get("layers") or {}).values():
+            path = desc.get("path")
+            if path and os.path.isfile(path):
+                with open(path, encoding="utf-8") as fh:
+                    desc["data"] = json.load(fh)
+            desc["path"] = None
+    return final
+
+
+def _run_in(
+    found: tuple[str, str],
+    job: dict[str, Any],
+    work: str,
+    *,
+    progress: Callable[[float, str], None] | None,
+    canceled: Callable[[], bool] | None,
+    log: Callable[[str], None] | None,
+) -> dict[str, Any]:
+    python, module = found
+    job = {**job, "out_dir": work}
     job_path = Path(work) / "job.json"
     job_path.write_text(json.dumps(job), encoding="utf-8")
     proc = subprocess.Popen(
-        [python, "-m", "camloc_geo.qgis_worker", str(job_path)],
+        [python, "-m", module, str(job_path)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         env=_worker_env(),
         text=True,
         encoding="utf-8",
+        cwd=work,
     )
     lines: queue.Queue[str | None] = queue.Queue()
+    errors: list[str] = []
 
     def pump() -> None:
         assert proc.stdout is not None
@@ -194,16 +247,23 @@ def run_worker(
             lines.put(line)
         lines.put(None)
 
-    reader = threading.Thread(target=pump, daemon=True)
-    reader.start()
+    def pump_err() -> None:  # read stderr as it comes: a chatty worker never blocks on it
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            errors.append(line)
+            del errors[:-200]
+
+    readers = [threading.Thread(target=f, daemon=True) for f in (pump, pump_err)]
+    for r in readers:
+        r.start()
     final: dict[str, Any] | None = None
     while True:
         if canceled is not None and canceled():
             proc.kill()
             proc.wait()
-            for stream in (proc.stdout, proc.stderr):
-                if stream is not None:
-                    stream.close()
+            for r in readers:
+                r.join(timeout=5)
+            _close(proc)
             raise WorkerCanceledError("canceled")
         try:
             line = lines.get(timeout=0.1)
@@ -223,10 +283,10 @@ def run_worker(
         elif "ok" in msg:
             final = msg
     rc = proc.wait()
-    stderr = proc.stderr.read() if proc.stderr else ""
-    for stream in (proc.stdout, proc.stderr):
-        if stream is not None:
-            stream.close()
+    for r in readers:
+        r.join(timeout=5)
+    _close(proc)
+    stderr = "".join(errors)
     if final is None:
         tail = stderr.strip().splitlines()[-3:]
         raise WorkerError(
@@ -239,6 +299,12 @@ def run_worker(
         for ln in stderr.strip().splitlines()[-20:]:
             log(ln)
     return final
+
+
+def _close(proc: subprocess.Popen[str]) -> None:
+    for stream in (proc.stdout, proc.stderr):
+        if stream is not None:
+            stream.close()
 
 
 def probe(timeout_s: float = 60.0) -> dict[str, Any]:

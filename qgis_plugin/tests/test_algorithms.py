@@ -96,27 +96,81 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     assert streets == ["Eastern Avenue & South Broadway"]
 
 
-def test_locate_default_style_colours_by_score_labels_rank_marks_ties(provider, tmp_path):
-    from camloc.layers import apply_style
-    from qgis.core import QgsGraduatedSymbolRenderer, QgsSymbolLayer
+def test_locate_default_style_ties_stars_best_red_unlikely_faded(provider, tmp_path):
+    from camloc.layers import TIE_WORDS, apply_style
+    from qgis.core import QgsRuleBasedRenderer
 
     res = _locate(tmp_path, MAX_CANDIDATES=3)
     layer = _layer(res["CANDIDATES"])
     assert layer.featureCount() == 3
     apply_style(layer, "candidates")
     r = layer.renderer()
-    assert isinstance(r, QgsGraduatedSymbolRenderer)
-    assert r.classAttribute() == "score"
-    ranges = r.ranges()  # keep the copies alive while their symbols are read
-    symbols = [rng.symbol() for rng in ranges]
-    colours = {sym.color().name() for sym in symbols}
-    assert len(colours) == len(ranges) >= 3
-    props = symbols[0].symbolLayer(0).dataDefinedProperties()
-    shape = props.property(QgsSymbolLayer.PropertyName).expressionString()
-    assert '"tie"' in shape
-    assert "star" in shape
+    assert isinstance(r, QgsRuleBasedRenderer)
+    rules = r.rootRule().children()
+    assert rules[0].filterExpression() == '"tie"'
+    assert "odds under 10 to 1" in rules[0].label()  # the legend explains a tie
+    assert "10 to 1" in TIE_WORDS
+    assert rules[-1].isElse()
+    assert rules[-1].symbol().opacity() < 1.0  # the unlikely are faded
+    assert len({rule.symbol().color().name() for rule in rules}) >= 4
     assert layer.labelsEnabled()
-    assert '"rank"' in layer.labeling().settings().fieldName
+    expr = layer.labeling().settings().fieldName
+    assert '"rank"' in expr
+    assert '"score_text"' in expr
+    scores = {f["score_text"] for f in layer.getFeatures()}
+    assert all(t and len(t) <= 8 for t in scores), scores  # 0.37, 1.2e-15: never cut
+
+
+def test_locate_help_states_the_core_tie_rule(provider):
+    from qgis.core import QgsApplication
+
+    text = QgsApplication.processingRegistry().algorithmById("camloc:locate").shortHelpString()
+    assert "80 %" not in text
+    assert "odds under 10 to 1" in text
+    assert "ambiguous_with" in text
+
+
+def test_locate_context_layers_of_the_map_model(provider, tmp_path):
+    res = _locate(
+        tmp_path,
+        CONTEXT=True,
+        CONTEXT_STREETS=str(tmp_path / "streets.gpkg"),
+        CONTEXT_BUILDINGS=str(tmp_path / "buildings.gpkg"),
+    )
+    streets = _layer(res["CONTEXT_STREETS"])
+    assert streets.featureCount() > 20
+    names = {f["name"] for f in streets.getFeatures()}
+    assert {"Eastern Avenue", "South Broadway"} <= names
+    assert _layer(res["CONTEXT_BUILDINGS"]).featureCount() > 0
+
+
+def test_run_and_load_results_draws_candidates_above_cones(provider, tmp_path):
+    """``processing.runAndLoadResults``: Processing's own loading, then our post-processors."""
+    import processing
+    from qgis.core import QgsProject
+
+    project = QgsProject.instance()
+    project.clear()
+    processing.runAndLoadResults(
+        "camloc:locate",
+        {
+            "SCENE": str(SAMPLE_SCENE),
+            "OSM": str(SAMPLE_OSM),
+            "CANDIDATES": "TEMPORARY_OUTPUT",
+            "VIEW_CONES": "TEMPORARY_OUTPUT",
+            "MATCHED_CORNERS": "TEMPORARY_OUTPUT",
+            "INTERSECTION": "TEMPORARY_OUTPUT",
+        },
+    )
+    order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
+    names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
+    assert order.index("candidates") < order.index("view_cones"), (order, names)
+    assert order.index("matched_corners") < order.index("view_cones"), order
+    # the map draws the layer tree's order: the candidates last, on top
+    drawn = project.layerTreeRoot().layerOrder()
+    kinds = [lyr.customProperty("camloc/kind") for lyr in drawn]
+    assert kinds.index("candidates") < kinds.index("view_cones")
+    project.clear()
 
 
 def test_locate_bad_scene_is_a_processing_error_naming_the_problem(provider, tmp_path):
@@ -249,26 +303,39 @@ def test_geocodelist_one_row_per_camera_with_status(provider, tmp_path):
         f"cam1,Eastern Ave & S Broadway looking north,39.2856,-76.5935,{SAMPLE_SCENE}\n"
         "cam2,no snapshot,39.2856,-76.5935,missing.json\n"
         "cam3,far away,52.52,13.41,far.json\n"
+        "cam4,Foo St & Bar Ave,,,\n"
+        "cam5,N Milton Ave & E Biddle St,,,\n"
     )
     res = processing.run(
         "camloc:geocodelist",
         {
             "LIST": str(lst),
-            "OSM": str(SAMPLE_OSM),
+            "OSM": str(SAMPLE_OSM.parent),  # a folder of extracts, as camloc batch takes
             "CAMERAS": str(tmp_path / "cameras.gpkg"),
             "CANDIDATES": str(tmp_path / "cands.gpkg"),
         },
     )
     cams = {f["camera_id"]: f for f in _layer(res["CAMERAS"]).getFeatures()}
-    assert set(cams) == {"cam1", "cam2", "cam3"}
-    assert cams["cam1"]["status"] in ("ok", "ambiguous")
+    assert set(cams) == {"cam1", "cam2", "cam3", "cam4", "cam5"}
+    assert cams["cam1"]["status"] == "located"
     t = truth()
     pt = cams["cam1"].geometry().asPoint()
     assert metres_between(pt.y(), pt.x(), t["lat"], t["lon"]) < 5.0
-    assert cams["cam2"]["status"] == "error"
-    assert "not found" in cams["cam2"]["reason"]
-    assert cams["cam3"]["status"] in ("error", "not_found")
+    assert cams["cam2"]["status"] == "scene_error"
+    assert "missing.json" in cams["cam2"]["reason"]
+    assert cams["cam3"]["status"] in ("no_map", "scene_error", "no_candidates")
     assert cams["cam3"]["reason"]
+    assert cams["cam4"]["status"] == "not_found"
+    assert cams["cam4"]["n_candidates"] == 0
+    assert cams["cam4"].geometry().isEmpty()  # not placed (GeoPackage: POINT EMPTY)
+    assert cams["cam5"]["status"] == "title_only"
     cands = _layer(res["CANDIDATES"])
     assert cands.featureCount() >= 1
     assert "cam1" in {f["camera_id"] for f in cands.getFeatures()}
+    # the camera labels win over the candidates' (label priority)
+    from camloc.layers import apply_style
+
+    cam_layer, cand_layer = _layer(res["CAMERAS"]), _layer(res["CANDIDATES"])
+    apply_style(cam_layer, "cameras")
+    apply_style(cand_layer, "list_candidates")
+    assert cam_layer.labeling().settings().priority > cand_layer.labeling().settings().priority

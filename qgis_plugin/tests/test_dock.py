@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -14,7 +15,6 @@ from qgis.core import (
     QgsMapSettings,
     QgsPointXY,
     QgsProject,
-    QgsVectorLayer,
 )
 from qgis.PyQt.QtCore import QPointF, QSize, Qt
 from qgis.PyQt.QtGui import QColor, QImage, QPainter, QPen, QPolygonF
@@ -130,27 +130,53 @@ def test_dock_refuses_to_save_an_invalid_scene(dock, tmp_path):
     assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
     out = tmp_path / "scene.json"
     dock.annotation.set_location(lat=39.2856, lon=-76.5935)
-    dock.annotation.radius_m = 0.0  # the library's check names the field
+    dock.preset_combo.addItem("spaceship")
+    dock.preset_combo.setCurrentText("spaceship")  # the library's check names the field
     assert not dock.save_scene(str(out))
-    assert "prior.radius_m" in dock.status.text()
+    assert "spaceship" in dock.status.text()
     assert not out.exists()
 
 
-def test_dock_run_adds_candidate_layers_in_any_project_crs(dock, qgis_iface, tmp_path, artifacts):
+def _camloc_tmp() -> set[str]:
+    import tempfile
+
+    return {n for n in os.listdir(tempfile.gettempdir()) if n.startswith("camloc_")}
+
+
+def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
+    dock, qgis_iface, tmp_path, artifacts
+):
     assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
     _annotate(dock)
     _pick_on_canvas(dock, qgis_iface)
     dock.osm_edit.setText(str(SAMPLE_OSM))
-    layers = dock.run()
-    assert [lyr.name() for lyr in layers] == [
-        "camloc view cones",
-        "camloc intersection",
-        "camloc matched corners",
-        "camloc candidates",
+    dock.context_check.setChecked(True)
+    gpkg = tmp_path / "results.gpkg"
+    dock.gpkg_edit.setText(str(gpkg))
+    before = _camloc_tmp()
+    task = dock.run()
+    assert task is not None
+    assert dock.cancel_button.isEnabled()
+    assert dock.run() is None  # a second Run while one goes on is refused, not stacked
+    assert dock.wait(), dock.status.text()
+    layers = dock.result_layers
+    kinds = [lyr.customProperty("camloc/kind") for lyr in layers]
+    assert kinds == [
+        "candidates",
+        "matched_corners",
+        "intersection",
+        "view_cones",
+        "context_buildings",
+        "context_streets",
     ]
+    assert all(str(gpkg) in lyr.source() for lyr in layers)  # the analyst's GeoPackage
+    assert _camloc_tmp() <= before  # nothing left in the temporary folder
     project = QgsProject.instance()
-    assert all(project.mapLayer(lyr.id()) is not None for lyr in layers)
-    cands = layers[-1]
+    group = project.layerTreeRoot().findGroup("camloc: snapshot")
+    assert group is not None
+    drawn = [n.layer().customProperty("camloc/kind") for n in group.findLayers()]
+    assert drawn.index("candidates") < drawn.index("view_cones")  # candidates on top
+    cands = layers[0]
     assert cands.crs().authid() == "EPSG:4326"
     assert cands.featureCount() >= 2
     t = truth()
@@ -162,23 +188,169 @@ def test_dock_run_adds_candidate_layers_in_any_project_crs(dock, qgis_iface, tmp
     # scene (the three-annotator sample is within 5 m, see test_algorithms)
     assert best < 20.0
     assert "candidate(s)" in dock.status.text()
-    # the canvas (Web Mercator) shows the candidates with their styles, over the OSM streets
-    streets = QgsVectorLayer(f"{SAMPLE_OSM}|layername=lines", "OSM streets", "ogr")
-    assert streets.isValid()
+    matched = [f["what"] for f in layers[1].getFeatures() if f["rank"] == 1]
+    assert "your kerb corner 0" in matched  # the analyst's words, not intersection.corners[0]
+    # a second run replaces the layers (same GeoPackage tables), no duplicates
+    assert dock.run() is not None
+    assert dock.wait()
+    assert len(group.findLayers()) == 6
+    cands = dock.result_layers[0]
+    # the canvas (Web Mercator) shows the candidates with their styles, over the map model
     settings = QgsMapSettings()
     settings.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:3857"))
     settings.setOutputSize(QSize(1000, 800))
     settings.setBackgroundColor(QColor("white"))
-    settings.setLayers([*reversed(layers), streets])
+    settings.setLayers(dock.result_layers)
     ext = qgis_iface.mapCanvas().extent()  # the dock zoomed the canvas to the candidates
     to_canvas = QgsCoordinateTransform(cands.crs(), settings.destinationCrs(), project)
     assert ext.contains(to_canvas.transform(QgsPointXY(t["lon"], t["lat"])))
-    ext = to_canvas.transformBoundingBox(layers[0].extent())
-    ext.scale(1.3)
+    ext = to_canvas.transformBoundingBox(dock.result_layers[0].extent())
+    ext.scale(2.5)
     settings.setExtent(ext)
     job = QgsMapRendererSequentialJob(settings)
     job.start()
     job.waitForFinished()
-    image = job.renderedImage()
-    assert image.save(str(artifacts / "canvas.png"))
+    assert job.renderedImage().save(str(artifacts / "canvas.png"))
     dock.grab().save(str(artifacts / "dock_after_run.png"))
+
+
+def test_dock_cancel_stops_the_run(dock, qgis_iface, tmp_path):
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    assert dock.run() is not None
+    dock.cancel()
+    dock.cancel()  # twice is harmless
+    assert dock.wait()
+    assert dock.result_layers == []
+    assert dock.run_button.isEnabled()
+    assert "Cancel" in dock.status.text() or "candidate" in dock.status.text()
+
+
+def test_reopening_a_snapshot_after_clicks_does_not_crash(dock, tmp_path):
+    """Issue 27: open, click, open again died in QGraphicsScene::removeItem."""
+    snap = str(_snapshot(tmp_path / "snapshot.png"))
+    for _ in range(3):
+        assert dock.open_snapshot(snap)
+        assert dock.view.overlay_count() == 0
+        dock.view.clicked.emit(100.0, 200.0)
+        dock.view.clicked.emit(300.0, 400.0)
+        assert dock.view.overlay_count() > 0
+        dock.redraw()
+        dock.redraw()
+    assert dock.annotation.axes == {"origin": [100.0, 200.0], "length": [300.0, 400.0]}
+    dock.view.actual_size()
+    assert dock.view.zoom_level() == 1.0  # full resolution
+    dock.view.zoom(1.25)
+    assert dock.open_snapshot(snap)
+    assert dock.view.zoom_level() < 1.0  # fitted again
+
+
+def test_every_dock_action_out_of_order_or_twice(dock, qgis_iface, tmp_path):
+    # before any snapshot
+    dock.undo()
+    dock.undo()
+    dock.redraw()
+    dock.image_clicked(10.0, 10.0)
+    assert "Open a snapshot" in dock.status.text()
+    assert dock.run() is None
+    assert "Not ready" in dock.status.text()
+    assert dock.annotate_in_browser() is False
+    dock.cancel()
+    assert not dock.open_snapshot(str(tmp_path / "missing.png"))
+    dock.pick_button.setChecked(True)
+    dock.pick_button.setChecked(True)
+    dock.pick_button.setChecked(False)
+    dock.pick_button.setChecked(False)
+    assert dock.map_tool is None
+    # with a snapshot: steps out of order, undo past the start, clicks outside
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    dock.set_step("corners")
+    dock.view.clicked.emit(500.0, 600.0)
+    dock.set_step("origin")
+    dock.undo()
+    dock.undo()
+    dock.view.clicked.emit(-5.0, 99999.0)  # outside the image
+    assert dock.annotation.corners == [[500.0, 600.0]]
+    dock.set_step("lines_length")
+    dock.view.clicked.emit(1.0, 1.0)  # half a line, then another step
+    dock.set_step("lines_width")
+    assert dock.annotation.pending is None
+    assert dock.run() is None  # still not ready: says what is missing
+    assert "click the car" in dock.status.text()
+    out = tmp_path / "s.json"
+    assert dock.save_scene(str(out)) or "not saved" in dock.status.text()
+    dock.shutdown()
+    dock.shutdown()
+
+
+def test_preset_radius_and_viewing_direction_go_into_the_scene(dock, qgis_iface, tmp_path):
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.preset_combo.setCurrentText("suv")
+    dock.radius_spin.setValue(300.0)
+    dock.hint_edit.setText("looking north")
+    sc = dock.scene()
+    assert sc["object"] == {"preset": "suv"}
+    assert sc["prior"]["radius_m"] == 300.0
+    assert sc["view_hint"] == {"text": "looking north"}
+    dock.hint_edit.setText("270")
+    assert dock.scene()["view_hint"] == {"bearing_deg": 270.0}
+    out = tmp_path / "s.json"
+    assert dock.save_scene(str(out)), dock.status.text()  # the library accepts it
+
+
+def test_annotation_page_round_trip(dock, qgis_iface, tmp_path, monkeypatch, artifacts):
+    """The browser page is served from QGIS; its Submit lands in the dock by itself."""
+    import urllib.request
+
+    from qgis.PyQt.QtGui import QDesktopServices
+
+    opened: list[str] = []
+    monkeypatch.setattr(QDesktopServices, "openUrl", lambda url: opened.append(url.toString()))
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _pick_on_canvas(dock, qgis_iface)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    assert dock.annotate_in_browser()
+    assert dock.wait(), dock.status.text()
+    assert opened == [dock.page_server.url]
+    page = urllib.request.urlopen(opened[0], timeout=10).read().decode("utf-8")
+    assert "camloc-config" in page
+    assert dock.page_server.submit_url.replace("/", "\\/") in page or (
+        dock.page_server.submit_url in page
+    )
+    # what the page's Submit posts: the sample's scene for this image
+    scene = json.loads(SAMPLE_SCENE.read_text())
+    scene["image"] = {"width": 1920, "height": 1080, "path": "snapshot.png"}
+    scene["id"] = "snapshot"
+    req = urllib.request.Request(
+        dock.page_server.submit_url,
+        data=json.dumps(scene).encode(),
+        headers={"Content-Type": "application/json"},
+        method="POST",
+    )
+    assert urllib.request.urlopen(req, timeout=60).status == 200
+    from qgis.PyQt.QtCore import QCoreApplication
+
+    for _ in range(50):
+        QCoreApplication.processEvents()
+    assert dock.annotation.base is not None
+    assert dock.annotation.corners == scene["intersection"]["corners"]
+    assert "Scene received" in dock.status.text()
+    assert len(dock.scene()["annotations"]) == len(scene["annotations"])
+    # a bad scene is refused with the library's words, on the page
+    bad = dict(scene)
+    bad["prior"] = {"lat": 39.28, "lon": -76.59, "radius_m": 0}
+    req = urllib.request.Request(
+        dock.page_server.submit_url, data=json.dumps(bad).encode(), method="POST"
+    )
+    import urllib.error
+
+    with pytest.raises(urllib.error.HTTPError) as err:
+        urllib.request.urlopen(req, timeout=60)
+    assert "prior.radius_m" in err.value.read().decode()
+    dock.grab().save(str(artifacts / "dock_scene_from_page.png"))
+    dock.shutdown()

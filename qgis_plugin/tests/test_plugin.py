@@ -44,15 +44,20 @@ def test_processing_only_start_does_not_touch_iface(qgis_processing):
         reg.removeProvider(plugin.provider)
 
 
-def test_missing_library_gives_the_pip_command_not_a_traceback(
+def test_missing_library_gives_a_venv_recipe_not_a_traceback(
     qgis_iface, qgis_processing, provider, monkeypatch, tmp_path
 ):
     import processing
     from camloc import runner
 
     monkeypatch.setattr(runner, "find_python", lambda refresh=False: None)
+    monkeypatch.setattr(runner, "_find", lambda refresh=False: None)
     msg = runner.missing_message()
-    assert "-m pip install" in msg
+    lines = runner.install_commands()
+    assert "-m venv --system-site-packages" in lines[0]
+    assert "/bin/python -m pip install" in lines[1]  # into the venv, which Debian allows
+    assert all(ln in msg for ln in lines)  # the whole recipe, one command a line
+    assert "/usr/bin/python3 -m pip install" not in msg
     assert "camloc-geo" in msg
     assert "CAMLOC_PYTHON" in msg
     with pytest.raises(QgsProcessingException) as err:
@@ -60,7 +65,7 @@ def test_missing_library_gives_the_pip_command_not_a_traceback(
             "camloc:locate",
             {"SCENE": str(SAMPLE_SCENE), "CANDIDATES": str(tmp_path / "c.gpkg")},
         )
-    assert "pip install" in str(err.value)
+    assert "-m venv" in str(err.value)
     assert "Traceback" not in str(err.value)
 
     # the GUI start shows the same message in the message bar
@@ -70,12 +75,20 @@ def test_missing_library_gives_the_pip_command_not_a_traceback(
     monkeypatch.setattr(
         qgis_iface.messageBar(), "pushMessage", lambda *a, **k: pushed.append(a), raising=False
     )
+    monkeypatch.setattr(
+        qgis_iface.messageBar(),
+        "pushWidget",
+        lambda w, *a, **k: pushed.append((w.text(),)),
+        raising=False,
+    )
     reg = QgsApplication.processingRegistry()
     reg.removeProvider(reg.providerById("camloc"))
     plugin = camloc.classFactory(qgis_iface)
     plugin.initGui()
     try:
-        assert any("pip install" in " ".join(map(str, a)) for a in pushed)
+        # the bar shows a short line and a button for the whole recipe (never cut)
+        assert any("camloc_geo" in " ".join(map(str, a)) for a in pushed)
+        assert plugin.missing_dialog_text() == msg
     finally:
         plugin.unload()
 

@@ -1,0 +1,385 @@
+"""Benchmark ``camloc vp`` on real photographs with independent truth.
+
+Usage::
+
+    python benchmarks/vp_real.py [--strecha DIR] [--sceaux DIR] [--yud DIR] [--limit N]
+
+The photos (none of them is in this repository; their licences keep them out):
+
+``strecha``
+    Strecha et al., "On benchmarking camera calibration and multi-view stereo for high
+    resolution imagery" (CVPR 2008): 103 outdoor photos of buildings (castle-P19,
+    castle-P30, entry-P10, fountain-P11, Herz-Jesu-P8, Herz-Jesu-P25; 3072x2048,
+    radially undistorted). Truth: the published calibration (``gt_dense_cameras``),
+    focal length and principal point; the zenith from the published rotation (the
+    frame of the laser scan, whose z axis is vertical). A copy is in the public
+    repository ``openMVG/SfM_quality_evaluation``
+    (``git clone https://github.com/openMVG/SfM_quality_evaluation``); point
+    ``CAMLOC_STRECHA_DIR`` (or ``--strecha``) at its ``Benchmarking_Camera_Calibration_2008``
+    folder.
+``sceaux``
+    11 photos of the Chateau de Sceaux (Kodak Z612, 2832x2128, EXIF kept), published
+    calibration ``images/K.txt`` (f = 2905.88 px) in ``openMVG/ImageDataset_SceauxCastle``
+    (``CAMLOC_SCEAUX_DIR`` or ``--sceaux``: the repository's ``images`` folder). These
+    are run with and without their EXIF.
+``yud``
+    The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
+    published calibration, horizon from the ground-truth vanishing points; research use
+    only: ``CAMLOC_YUD_DIR``).
+
+Reported per set and over all photos (focal length not given, EXIF ignored unless the
+row says so):
+
+- the focal-length error distribution (signed, relative; percentiles, share within 10
+  and 20 %);
+- the horizon error (largest vertical distance over the image width / image height) and
+  its AUC up to 0.25, where the truth gives a zenith;
+- how often the stated ``focal_std_rel`` covers the truth at 1 and 2 sigma, and the
+  median |log error| / sigma;
+- the ROC AUC of ``1 - confidence`` as a predictor of a focal error over 10 %;
+- "confidently wrong": off by more than 10 % and more than twice the stated sigma, with
+  no warning and confidence at least 0.5.
+
+Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from vp_yud import horizon_auc, load_yud
+
+from camloc_geo import NotEnoughStructureError
+from camloc_geo.autovp import detect_vanishing_points, horizon_from_up
+
+log = logging.getLogger("vp_real")
+
+HERE = Path(__file__).resolve().parent
+_SHARED = HERE.parents[1] / "shared" / "data"
+DEFAULT_STRECHA = Path(
+    os.environ.get("CAMLOC_STRECHA_DIR", str(_SHARED / "Benchmarking_Camera_Calibration_2008"))
+)
+DEFAULT_SCEAUX = Path(
+    os.environ.get("CAMLOC_SCEAUX_DIR", str(_SHARED / "ImageDataset_SceauxCastle" / "images"))
+)
+DEFAULT_YUD = Path(os.environ.get("CAMLOC_YUD_DIR", str(_SHARED / "yud" / "YorkUrbanDB")))
+
+HOW_TO_GET = (
+    "git clone https://github.com/openMVG/SfM_quality_evaluation and set CAMLOC_STRECHA_DIR "
+    "to its Benchmarking_Camera_Calibration_2008 folder; git clone "
+    "https://github.com/openMVG/ImageDataset_SceauxCastle and set CAMLOC_SCEAUX_DIR to its "
+    "images folder; CAMLOC_YUD_DIR: the York Urban DB (York University)"
+)
+
+
+def load_strecha(root: Path) -> list[dict[str, Any]]:
+    """Photos and truth of the Strecha 2008 sets (``gt_dense_cameras`` files)."""
+    out = []
+    for cam_dir in sorted(root.glob("*/gt_dense_cameras")):
+        for cam in sorted(cam_dir.glob("*.jpg.camera")):
+            rows = [ln.split() for ln in cam.read_text(encoding="ascii").splitlines()]
+            vals = [[float(x) for x in r] for r in rows if r]
+            K = np.array(vals[0:3])
+            R_world_from_cam = np.array(vals[4:7])
+            w, h = (int(v) for v in vals[8])
+            up = -R_world_from_cam[2]  # world z in the camera frame; camera y is down
+            if up[1] > 0:
+                up = -up
+            out.append(
+                {
+                    "set": "strecha",
+                    "name": f"{cam_dir.parent.name}/{cam.name[:-7]}",
+                    "path": str(cam_dir.parent / "images" / cam.name[:-7]),
+                    "f": 0.5 * (K[0, 0] + K[1, 1]),
+                    "pp": (float(K[0, 2]), float(K[1, 2])),
+                    "up": up / np.linalg.norm(up),
+                    "size": (w, h),
+                }
+            )
+    return out
+
+
+def load_sceaux(root: Path) -> list[dict[str, Any]]:
+    """Photos and the published calibration of the Sceaux castle set."""
+    K = np.loadtxt(root / "K.txt")
+    out = []
+    for p in sorted(root.glob("*.JPG")):
+        out.append(
+            {
+                "set": "sceaux",
+                "name": f"sceaux/{p.stem}",
+                "path": str(p),
+                "f": float(K[0, 0]),
+                "pp": (float(K[0, 2]), float(K[1, 2])),
+                "up": None,
+                "size": (2832, 2128),
+                "exif": True,
+            }
+        )
+    return out
+
+
+def load_yud_set(root: Path) -> list[dict[str, Any]]:
+    out = []
+    for g in load_yud(root):
+        d = g["dirs_orth"]
+        k = int(np.argmax(np.abs(d[:, 1])))
+        up = d[k] if d[k, 1] < 0 else -d[k]
+        out.append(
+            {
+                "set": "yud",
+                "name": f"yud/{g['name']}",
+                "path": g["path"],
+                "f": g["f"],
+                "pp": (float(g["pp"][0]), float(g["pp"][1])),
+                "up": up,
+                "size": (640, 480),
+            }
+        )
+    return out
+
+
+def horizon_err(
+    up_est: np.ndarray, f_est: float, pp_est: tuple[float, float], t: dict[str, Any]
+) -> float | None:
+    if t["up"] is None:
+        return None
+    w, h = t["size"]
+    le = horizon_from_up(up_est, f_est, pp_est)
+    lg = horizon_from_up(t["up"], t["f"], t["pp"])
+    if abs(le[1]) < 1e-9 or abs(lg[1]) < 1e-9:
+        return math.inf
+    e = []
+    for x in (0.0, float(w)):
+        e.append(abs(-(le[0] * x + le[2]) / le[1] + (lg[0] * x + lg[2]) / lg[1]))
+    return max(e) / h
+
+
+def run(data: list[dict[str, Any]], use_exif: bool) -> list[dict[str, Any]]:
+    rows = []
+    for t in data:
+        t0 = time.perf_counter()
+        row: dict[str, Any] = {"set": t["set"], "name": t["name"], "f_true": t["f"]}
+        try:
+            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif)
+        except NotEnoughStructureError as exc:
+            row.update(error=str(exc), time_s=time.perf_counter() - t0)
+            rows.append(row)
+            continue
+        row.update(
+            time_s=time.perf_counter() - t0,
+            f=res.focal_px,
+            focal_err=(res.focal_px - t["f"]) / t["f"],
+            focal_std_rel=res.focal_std_rel,
+            focal_source=res.focal_source,
+            confidence=res.confidence,
+            warnings=list(getattr(res, "warnings", [])),
+            hz_err=horizon_err(res.up_in_cam, res.focal_px, res.principal_point, t),
+            pitch_deg=res.pitch_deg,
+            n_lines=list(res.n_lines),
+        )
+        rows.append(row)
+    return rows
+
+
+def roc_auc(score: np.ndarray, positive: np.ndarray) -> float | None:
+    """Area under the ROC curve of ``score`` predicting ``positive`` (Mann-Whitney)."""
+    pos, neg = score[positive], score[~positive]
+    if len(pos) == 0 or len(neg) == 0:
+        return None
+    gt = (pos[:, None] > neg[None, :]).sum() + 0.5 * (pos[:, None] == neg[None, :]).sum()
+    return float(gt / (len(pos) * len(neg)))
+
+
+def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    ok = [r for r in rows if "f" in r]
+    n = len(rows)
+    fe = np.array([r["focal_err"] for r in ok])
+    ale = np.abs(np.log1p(fe)) if len(fe) else np.zeros(0)
+    sig = np.array([r["focal_std_rel"] if r["focal_std_rel"] else math.nan for r in ok])
+    sig = np.where(np.isfinite(sig) & (sig > 0), sig, np.inf)
+    z = ale / sig
+    conf = np.array([r["confidence"] for r in ok])
+    bad = np.abs(fe) > 0.10
+    warned = np.array([bool(r["warnings"]) for r in ok])
+    confidently_wrong = bad & (ale > 2 * sig) & ~warned & (conf >= 0.5)
+    hz = [r["hz_err"] for r in rows if r.get("hz_err") is not None] + [
+        math.inf for r in rows if "f" not in r and r["set"] != "sceaux"
+    ]
+    all_abs = np.concatenate([np.abs(fe), np.full(n - len(ok), np.inf)])
+    out: dict[str, Any] = {
+        "n_images": n,
+        "n_refused": n - len(ok),
+        "share_focal_within_10pct": float(np.mean(all_abs <= 0.10)) if n else None,
+        "share_focal_within_20pct": float(np.mean(all_abs <= 0.20)) if n else None,
+        "focal_err_pct_percentiles_5_25_50_75_95": (
+            [float(100 * np.percentile(fe, q)) for q in (5, 25, 50, 75, 95)] if len(fe) else None
+        ),
+        "focal_abs_err_median_pct": float(100 * np.median(all_abs)) if n else None,
+        "sigma_cover_1": float(np.mean(z <= 1)) if len(z) else None,
+        "sigma_cover_2": float(np.mean(z <= 2)) if len(z) else None,
+        "median_err_over_sigma": float(np.median(z)) if len(z) else None,
+        "median_focal_std_rel": float(np.median(sig[np.isfinite(sig)]))
+        if np.isfinite(sig).any()
+        else None,
+        "roc_auc_confidence_vs_err10": roc_auc(1.0 - conf, bad) if len(ok) else None,
+        "n_confidently_wrong": int(confidently_wrong.sum()),
+        "n_warned": int(warned.sum()),
+        "n_with_horizon_truth": len(hz),
+        "horizon_auc_pct": 100.0 * horizon_auc(hz) if hz else None,
+        "horizon_err_median": float(np.median(hz)) if hz else None,
+        "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
+    }
+    return out
+
+
+def plots(runs: dict[str, list[dict[str, Any]]], out_dir: Path) -> None:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        log.warning("matplotlib missing: no plots")
+        return
+    rows = runs["no EXIF"]
+    sets = sorted({r["set"] for r in rows})
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for s in sets:
+        fe = [100 * r["focal_err"] for r in rows if r["set"] == s and "f" in r]
+        ax.hist(np.clip(fe, -60, 60), bins=48, range=(-60, 60), alpha=0.5, label=s)
+    ax.axvspan(-10, 10, color="g", alpha=0.1)
+    ax.set_xlabel("focal length error (%), focal length not given, EXIF ignored")
+    ax.set_ylabel("photos")
+    ax.set_title("Real photos: focal length error")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "vp_real_focal.png", dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for s in sets:
+        hz = np.sort([r.get("hz_err") or math.inf for r in rows if r["set"] == s])
+        if s == "sceaux" or not len(hz):
+            continue
+        ax.step(
+            np.concatenate([[0], hz]),
+            np.arange(len(hz) + 1) / len(hz),
+            where="post",
+            label=f"{s} (AUC {100 * horizon_auc(list(hz)):.1f} %)",
+        )
+    ax.set_xlim(0, 0.25)
+    ax.set_ylim(0, 1)
+    ax.set_xlabel("horizon error / image height")
+    ax.set_ylabel("share of photos")
+    ax.set_title("Real photos: horizon error")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "vp_real_horizon.png", dpi=120)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ok = [r for r in rows if "f" in r]
+    z = np.sort(
+        [
+            abs(math.log1p(r["focal_err"])) / r["focal_std_rel"] if r["focal_std_rel"] else math.inf
+            for r in ok
+        ]
+    )
+    ax.step(z, np.arange(1, len(z) + 1) / len(z), where="post", label="measured")
+    from scipy.stats import halfnorm
+
+    xs = np.linspace(0, 4, 200)
+    ax.plot(xs, halfnorm.cdf(xs), "k--", label="Gaussian")
+    ax.set_xlim(0, 4)
+    ax.set_xlabel("|log focal error| / stated focal_std_rel")
+    ax.set_ylabel("share of photos")
+    ax.set_title("Real photos: calibration of the stated focal sigma")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_dir / "vp_real_sigma.png", dpi=120)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--strecha", type=Path, default=DEFAULT_STRECHA)
+    ap.add_argument("--sceaux", type=Path, default=DEFAULT_SCEAUX)
+    ap.add_argument("--yud", type=Path, default=DEFAULT_YUD)
+    ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
+    ap.add_argument("--sets", default="strecha,sceaux,yud")
+    ap.add_argument("--out", type=Path, default=HERE / "out")
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    wanted = set(args.sets.split(","))
+    data: list[dict[str, Any]] = []
+    for name, root, loader in (
+        ("strecha", args.strecha, load_strecha),
+        ("sceaux", args.sceaux, load_sceaux),
+        ("yud", args.yud, load_yud_set),
+    ):
+        if name not in wanted:
+            continue
+        if not root.exists():
+            log.warning("%s: not found at %s (%s)", name, root, HOW_TO_GET)
+            continue
+        data.extend(loader(root)[: args.limit])
+    if not data:
+        log.error("no photos found: %s", HOW_TO_GET)
+        return 2
+    runs = {"no EXIF": run(data, use_exif=False)}
+    exif_data = [t for t in data if t.get("exif")]
+    if exif_data:
+        runs["EXIF prior"] = run(exif_data, use_exif=True)
+    summary: dict[str, Any] = {}
+    for tag, rows in runs.items():
+        summary[tag] = {"all": summarise(rows)}
+        for s in sorted({r["set"] for r in rows}):
+            summary[tag][s] = summarise([r for r in rows if r["set"] == s])
+        outdoor = [r for r in rows if r["set"] != "yud"]
+        if outdoor and len(outdoor) != len(rows):
+            summary[tag]["outdoor (strecha+sceaux)"] = summarise(outdoor)
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "vp_real.json", "w", encoding="utf-8") as fh:
+        json.dump({"summary": summary, "per_image": runs}, fh, indent=1, default=float)
+    plots(runs, args.out)
+    keys = [
+        ("n_images", "n", "{}"),
+        ("share_focal_within_10pct", "f<=10%", "{:.2f}"),
+        ("focal_abs_err_median_pct", "|f err| med%", "{:.1f}"),
+        ("sigma_cover_1", "1sig cov", "{:.2f}"),
+        ("sigma_cover_2", "2sig cov", "{:.2f}"),
+        ("median_err_over_sigma", "med err/sig", "{:.2f}"),
+        ("roc_auc_confidence_vs_err10", "ROC AUC", "{:.2f}"),
+        ("n_confidently_wrong", "conf.wrong", "{}"),
+        ("n_warned", "warned", "{}"),
+        ("horizon_auc_pct", "hz AUC %", "{:.1f}"),
+        ("n_refused", "refused", "{}"),
+    ]
+    lines = [f"{'run / set':32s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
+    for tag, per in summary.items():
+        for s, sm in per.items():
+            cells = []
+            for k, _, fmt in keys:
+                v = sm.get(k)
+                cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
+            lines.append(f"{(tag + ' / ' + s):32s} " + " ".join(cells))
+    log.info("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

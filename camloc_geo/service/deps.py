@@ -1,0 +1,167 @@
+"""The service's dependencies: its shared state, the API key, body parsing, the thread pool.
+
+Bodies are parsed once: JSON with NaN/Infinity refused, a scene checked against the server's
+limits and validated into a :class:`~camloc_geo.scene.Scene` that the library takes as it is.
+CPU work runs in worker processes or threads (:mod:`camloc_geo.service.compute`) under the
+request time limit, never on the event loop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import json
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Annotated, Any, TypeVar
+
+from fastapi import Depends, Header, Request
+
+from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
+from camloc_geo.service.errors import TimeLimitError, UnauthorizedError, UnsupportedMediaError
+from camloc_geo.service.mapstore import MapStore
+from camloc_geo.service.settings import Settings
+from camloc_geo.service.store import Store
+from camloc_geo.service.work import check_scene_body
+
+if TYPE_CHECKING:
+    from camloc_geo.scene import Scene
+
+__all__ = [
+    "ApiKey",
+    "Maps",
+    "SceneBody",
+    "ServiceSettings",
+    "ServiceStore",
+    "Workers",
+    "content_type",
+    "parse_json",
+    "raw_body",
+    "run_cpu",
+]
+
+T = TypeVar("T")
+
+JSON_TYPES = ("application/json",)
+
+
+def _settings(request: Request) -> Settings:
+    settings: Settings = request.app.state.settings
+    return settings
+
+
+def _maps(request: Request) -> MapStore:
+    maps: MapStore = request.app.state.maps
+    return maps
+
+
+def _store(request: Request) -> Store:
+    store: Store = request.app.state.store
+    return store
+
+
+def _compute(request: Request) -> Compute:
+    compute: Compute = request.app.state.compute
+    return compute
+
+
+ServiceSettings = Annotated[Settings, Depends(_settings)]
+Maps = Annotated[MapStore, Depends(_maps)]
+ServiceStore = Annotated[Store, Depends(_store)]
+Workers = Annotated[Compute, Depends(_compute)]
+"""The CPU pool: ``await workers.run(fn, *args)`` runs ``fn(maps, *args)`` on a worker."""
+
+
+def _require_key(
+    settings: ServiceSettings,
+    x_api_key: Annotated[
+        str | None, Header(description="the server's key, when it has one")
+    ] = None,
+) -> None:
+    if settings.api_key is None:
+        return
+    expected = settings.api_key.get_secret_value().encode()
+    if x_api_key is None or not hmac.compare_digest(x_api_key.encode(), expected):
+        raise UnauthorizedError("missing or wrong X-API-Key", "X-API-Key")
+
+
+ApiKey = Depends(_require_key)
+"""Guards a write endpoint when ``CAMLOC_API_KEY`` is set (``dependencies=[ApiKey]``)."""
+
+
+def content_type(request: Request) -> str:
+    """The request's media type, lower case, without parameters."""
+    return request.headers.get("content-type", "").split(";")[0].strip().lower()
+
+
+async def raw_body(request: Request, kinds: tuple[str, ...]) -> bytes:
+    """The body, when its content type is one of ``kinds``.
+
+    Raises
+    ------
+    UnsupportedMediaError
+        Another content type (HTTP 415).
+    """
+    ctype = content_type(request)
+    if ctype not in kinds:
+        raise UnsupportedMediaError(
+            f"content type {ctype or 'none'!r} not supported here; send {' or '.join(kinds)}",
+            "content-type",
+        )
+    return await request.body()
+
+
+def _reject_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a number JSON allows")
+
+
+def parse_json(raw: bytes) -> Any:
+    """Parsed JSON; NaN, Infinity, bad UTF-8 and deep nesting are a :class:`SceneError`."""
+    try:
+        return json.loads(raw.decode("utf-8"), parse_constant=_reject_constant)
+    except RecursionError:
+        raise SceneError("the JSON body is nested too deeply", "body") from None
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise SceneError(f"the body is not valid JSON: {exc}", "body") from None
+
+
+@dataclass(frozen=True)
+class ParsedScene:
+    """A scene body: the JSON as sent (to store) and the validated model (to compute with)."""
+
+    data: dict[str, Any]
+    scene: Scene
+
+
+async def _scene_body(request: Request, settings: ServiceSettings) -> ParsedScene:
+    from camloc_geo.api import scene_from
+
+    raw = await raw_body(request, JSON_TYPES)
+
+    def parse() -> ParsedScene:  # up to 2 MB of JSON: off the event loop
+        data = check_scene_body(parse_json(raw), settings)
+        return ParsedScene(data=data, scene=scene_from(data))
+
+    return await run_cpu(request, parse)
+
+
+SceneBody = Annotated[ParsedScene, Depends(_scene_body)]
+"""A ``camloc-scene/1`` body within the server's limits, validated once."""
+
+
+async def run_cpu(request: Request, fn: Callable[[], T]) -> T:
+    """Run ``fn`` in the app's thread pool under the request time limit (work needing no map).
+
+    Raises
+    ------
+    TimeLimitError
+        ``fn`` took longer than ``CAMLOC_REQUEST_TIMEOUT_S`` (HTTP 503).
+    """
+    executor = _compute(request).executor()
+    limit_s = _settings(request).request_timeout_s
+    loop = asyncio.get_running_loop()
+    try:
+        return await asyncio.wait_for(loop.run_in_executor(executor, fn), timeout=limit_s)
+    except asyncio.TimeoutError:
+        raise TimeLimitError(f"processing took longer than {limit_s:g} s") from None

@@ -1,0 +1,104 @@
+"""The service's one middleware (plain ASGI): a request id, and the body size limits.
+
+Plain ASGI rather than ``@app.middleware("http")``: no extra task and no response copy per
+request. A body over its limit is refused from ``Content-Length`` before it is read, and a
+body without one is cut off while it streams in.
+"""
+
+from __future__ import annotations
+
+import json
+import uuid
+from typing import Any
+
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from camloc_geo.service.work import LimitError
+
+__all__ = ["RequestLimits"]
+
+
+class RequestLimits:
+    """Give every request an id (``X-Request-ID``) and refuse bodies over their limit.
+
+    Parameters
+    ----------
+    app
+        The wrapped ASGI app.
+    max_bytes
+        Largest body (bytes).
+    upload_paths, max_upload_bytes
+        Paths that take uploads, and their larger limit.
+    """
+
+    def __init__(
+        self,
+        app: ASGIApp,
+        *,
+        max_bytes: int,
+        upload_paths: tuple[str, ...] = (),
+        max_upload_bytes: int = 0,
+    ) -> None:
+        self.app = app
+        self.max_bytes = max_bytes
+        self.upload_paths = upload_paths
+        self.max_upload_bytes = max_upload_bytes
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        rid = uuid.uuid4().hex[:16]
+        scope.setdefault("state", {})["request_id"] = rid
+        header = (b"x-request-id", rid.encode())
+        limit = self.max_upload_bytes if scope["path"] in self.upload_paths else self.max_bytes
+        length = dict(scope["headers"]).get(b"content-length")
+        if length is not None:
+            try:
+                too_big = int(length) > limit
+            except ValueError:
+                await _answer(send, 400, "bad_request", "invalid Content-Length header", None, rid)
+                return
+            if too_big:
+                msg = f"request body over {limit} bytes"
+                await _answer(send, 413, "limit_exceeded", msg, "body", rid)
+                return
+
+        received = 0
+
+        async def counted() -> Message:
+            nonlocal received
+            message = await receive()
+            if message["type"] == "http.request":
+                received += len(message.get("body", b""))
+                if received > limit:
+                    raise LimitError(f"request body over {limit} bytes", "body")
+            return message
+
+        async def send_with_id(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                message["headers"] = [*message.get("headers", []), header]
+            await send(message)
+
+        await self.app(scope, counted, send_with_id)
+
+
+async def _answer(
+    send: Send, status: int, kind: str, message: str, field: str | None, rid: str
+) -> None:
+    error: dict[str, Any] = {"type": kind, "message": message}
+    if field:
+        error["field"] = field
+    body = json.dumps({"error": error, "request_id": rid}).encode()
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status,
+            "headers": [
+                (b"content-type", b"application/json"),
+                (b"content-length", str(len(body)).encode()),
+                (b"x-request-id", rid.encode()),
+            ],
+        }
+    )
+    await send({"type": "http.response.body", "body": body})

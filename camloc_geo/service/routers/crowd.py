@@ -1,0 +1,205 @@
+"""Crowd endpoints: a task per snapshot, its annotation page, annotators' scenes, its result.
+
+When a task has its annotations, the library merges them (with the task's point as prior)
+and locates the merged scene.
+"""
+
+from __future__ import annotations
+
+import io
+from typing import Annotated, Any, cast
+
+from fastapi import APIRouter, Query, Request
+from fastapi.responses import HTMLResponse
+
+from camloc_geo import CamlocError, MapDataError, SceneError
+from camloc_geo.service.deps import (
+    ApiKey,
+    SceneBody,
+    ServiceSettings,
+    ServiceStore,
+    Workers,
+    raw_body,
+    run_cpu,
+)
+from camloc_geo.service.errors import LimitError, NotFoundError
+from camloc_geo.service.mapstore import MapStore
+from camloc_geo.service.models import TaskId, TaskQuery
+from camloc_geo.service.routers.scenes import scene_body_doc
+from camloc_geo.service.store import Store
+from camloc_geo.service.work import locate_body
+
+__all__ = ["router"]
+
+router = APIRouter(tags=["crowd"])
+
+IMAGE_TYPES = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
+IMAGE_MEDIA_TYPES = tuple(f"image/{kind.lower()}" for kind in IMAGE_TYPES)
+_UPLOAD_DOC = {
+    "requestBody": {
+        "required": True,
+        "content": {
+            media: {"schema": {"type": "string", "format": "binary"}} for media in IMAGE_MEDIA_TYPES
+        },
+    }
+}
+
+
+def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
+    """``(extension, width, height)`` of an uploaded snapshot, from its header only."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(io.BytesIO(raw)) as img:
+            fmt = img.format or ""
+            width, height = img.size
+    except (UnidentifiedImageError, OSError, ValueError):
+        raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
+    except Image.DecompressionBombError:
+        raise LimitError("the snapshot has too many pixels", "body") from None
+    if fmt not in IMAGE_TYPES:
+        raise SceneError(
+            f"snapshot format {fmt or 'unknown'} not supported (JPEG, PNG, WebP)", "body"
+        )
+    if width * height > max_pixels:
+        raise LimitError(
+            f"the snapshot is {width}×{height}; this server accepts at most {max_pixels} pixels",
+            "body",
+        )
+    return IMAGE_TYPES[fmt], width, height
+
+
+def servable_work(maps: MapStore, network: bool, point: tuple[float, float] | None) -> None:
+    """Refuse a task no map can serve, before anyone annotates it (runs on a worker).
+
+    Raises
+    ------
+    MapDataError
+        The network is off and no configured extract covers the point (or there is none).
+    """
+    if network:
+        return
+    if point is None:
+        if not maps.extracts:
+            raise MapDataError(
+                "this server has no map data (no CAMLOC_MAP_DIR, network off): no task can be "
+                "located"
+            )
+        return
+    try:
+        maps.map_for_point(lat=point[0], lon=point[1])
+    except MapDataError as exc:
+        raise MapDataError(f"refused: the task could never be located: {exc}") from None
+
+
+@router.post("/v1/tasks", status_code=201, dependencies=[ApiKey], openapi_extra=_UPLOAD_DOC)
+async def create_task(
+    request: Request,
+    q: Annotated[TaskQuery, Query()],
+    settings: ServiceSettings,
+    store: ServiceStore,
+    workers: Workers,
+) -> dict[str, Any]:
+    """Create a crowd task from a snapshot (the raw image as the body)."""
+    raw = await raw_body(request, IMAGE_MEDIA_TYPES)
+    kind, width, height = image_info(raw, settings.max_upload_pixels)
+    if (q.lat is None) != (q.lon is None):
+        raise SceneError("give both lat and lon, or neither", "lat" if q.lat is None else "lon")
+    point = (q.lat, q.lon) if q.lat is not None and q.lon is not None else None
+    await workers.run(servable_work, settings.network, point)
+    base: dict[str, Any] = {"format": "camloc-scene/1", "image": {"width": width, "height": height}}
+    if point is not None:
+        base["prior"] = {"lat": point[0], "lon": point[1], "radius_m": q.radius_m}
+    needed = q.annotations or settings.annotations_per_task
+    task_id = store.create_task(
+        image=raw, image_type=kind, width=width, height=height, needed=needed, base_scene=base
+    )
+    return {
+        "id": task_id,
+        "annotate_url": f"/annotate/{task_id}",
+        "status_url": f"/v1/tasks/{task_id}",
+        "needed": needed,
+    }
+
+
+def _task(store: Store, task_id: str) -> dict[str, Any]:
+    task = store.task(task_id)
+    if task is None:
+        raise NotFoundError(f"no task {task_id}")
+    return task
+
+
+@router.get("/annotate/{task_id}", response_class=HTMLResponse)
+async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HTMLResponse:
+    """The annotation page in crowd mode: a submit button instead of a download."""
+    task = _task(store, task_id)
+
+    def work() -> str:
+        from camloc_geo.web import annotation_page_html
+
+        return annotation_page_html(
+            store.task_image(task),
+            scene=task["base_scene"],
+            mode="crowd",
+            submit_url=f"/v1/tasks/{task_id}/annotations",
+        )
+
+    return HTMLResponse(await run_cpu(request, work))
+
+
+def crowd_work(
+    maps: MapStore, scenes: list[dict[str, Any]], prior: dict[str, Any] | None
+) -> tuple[str, dict[str, Any]]:
+    """Merge a task's scenes and locate them: ``(status, result)`` (runs on a worker)."""
+    from camloc_geo.api import crowd_scene
+
+    try:
+        merged = crowd_scene(scenes, prior=prior)
+        out, _m = locate_body(merged, maps)
+    except CamlocError as exc:
+        return "failed", {"reason": " ".join(str(exc).split())}
+    return "located", {"scene": merged, "candidates": out.to_geojson()}
+
+
+@router.post(
+    "/v1/tasks/{task_id}/annotations",
+    openapi_extra=scene_body_doc("one annotator's scene for this task's snapshot"),
+)
+async def submit(
+    task_id: TaskId, body: SceneBody, store: ServiceStore, workers: Workers
+) -> dict[str, Any]:
+    """Collect one annotator's work; the task is merged and located when enough came in.
+
+    No API key: the task id is the annotators' capability.
+    """
+    task = _task(store, task_id)
+    image = body.scene.image
+    if (image.width, image.height) != (task["width"], task["height"]):
+        raise SceneError(
+            f"the scene is for a {image.width}×{image.height} image; this "
+            f"task's snapshot is {task['width']}×{task['height']}",
+            "image",
+        )
+    if task["status"] != "collecting":
+        raise SceneError("this task has all its annotations already", "task")
+    n = store.add_annotation(task_id, body.data)
+    if n >= task["needed"]:
+        prior = task["base_scene"].get("prior")
+        status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        store.set_task_result(task_id, status, result)
+    got = cast(dict[str, Any], store.task(task_id))
+    return {"annotations": n, "needed": task["needed"], "status": got["status"]}
+
+
+@router.get("/v1/tasks/{task_id}")
+async def task_status(task_id: TaskId, store: ServiceStore) -> dict[str, Any]:
+    """A task's progress, and its merged scene and candidates once located."""
+    task = _task(store, task_id)
+    return {
+        "id": task_id,
+        "status": task["status"],
+        "annotations": task["annotations"],
+        "needed": task["needed"],
+        "image": {"width": task["width"], "height": task["height"]},
+        "result": task["result"],
+    }

@@ -1,0 +1,205 @@
+"""Job endpoints: queue a webcam list, poll it, fetch its result; and the job runner thread.
+
+A list is read by the batch list reader (:mod:`camloc_geo.batch`: the same columns and
+variants as ``camloc batch``); each camera is processed alone by the runner and committed to
+the store, so a job survives a restart.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import threading
+from dataclasses import asdict
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Query, Request
+from fastapi.responses import Response
+from pydantic import ValidationError
+
+from camloc_geo import SceneError
+from camloc_geo.service.compute import Compute
+from camloc_geo.service.deps import (
+    ApiKey,
+    ServiceSettings,
+    ServiceStore,
+    content_type,
+    parse_json,
+    raw_body,
+    run_cpu,
+)
+from camloc_geo.service.errors import LimitError, NotFoundError
+from camloc_geo.service.mapstore import MapStore
+from camloc_geo.service.models import JobId, JobList, ResultQuery
+from camloc_geo.service.settings import Settings
+from camloc_geo.service.store import Store
+from camloc_geo.service.work import process_camera
+
+__all__ = ["JobRunner", "camera_records", "router"]
+
+log = logging.getLogger(__name__)
+
+router = APIRouter(tags=["jobs"])
+
+_LIST_DOC = {
+    "requestBody": {
+        "required": True,
+        "description": (
+            'A webcam list: JSON {"cameras": [{"id", "title", "lat", "lon", "radius_m", '
+            '"scene"}, ...]} or CSV with columns id,title,lat,lon,radius_m (the column '
+            "variants of camloc batch are accepted)"
+        ),
+        "content": {
+            "application/json": {"schema": JobList.model_json_schema()},
+            "text/csv": {"schema": {"type": "string"}},
+        },
+    }
+}
+_ROW_FIELDS = ("id", "title", "lat", "lon", "radius_m", "streets", "view", "area", "problems")
+
+
+def _record(row: Any, scene: Any = None) -> dict[str, Any]:
+    values = asdict(row)
+    out = {k: values[k] for k in _ROW_FIELDS if values[k] not in (None, "", ())}
+    if scene is not None:
+        out["scene"] = scene
+    return out
+
+
+def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
+    """The cameras of a list body, as the job store keeps them (at most ``max_cameras + 1``).
+
+    Raises
+    ------
+    SceneError
+        Not UTF-8, not ``{"cameras": [...]}``, or a CSV naming scene files.
+    """
+    from camloc_geo.batch import read_camera_csv, row_from_mapping
+
+    if ctype == "text/csv":
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            raise SceneError("the CSV list is not UTF-8 text", "body") from None
+        out: list[Any] = []
+        for row in read_camera_csv(io.StringIO(text)):
+            if row.scene is not None:
+                raise SceneError(
+                    "a list sent over HTTP cannot name scene files: send it as JSON with each "
+                    "camera's scene inline",
+                    "scene",
+                )
+            out.append(_record(row))
+            if len(out) > max_cameras:
+                break
+        return out
+    try:
+        cameras = JobList.model_validate(parse_json(raw)).cameras
+    except ValidationError:
+        raise SceneError('the body must be {"cameras": [...]}', "cameras") from None
+    return [
+        _record(row_from_mapping({k: v for k, v in c.items() if k != "scene"}, n), c.get("scene"))
+        if isinstance(c, dict)
+        else c
+        for n, c in enumerate(cameras[: max_cameras + 1], start=1)
+    ]
+
+
+@router.post("/v1/jobs", status_code=202, dependencies=[ApiKey], openapi_extra=_LIST_DOC)
+async def create_job(
+    request: Request, settings: ServiceSettings, store: ServiceStore
+) -> dict[str, Any]:
+    """Queue a webcam list; poll ``/v1/jobs/{id}``. Jobs survive a server restart."""
+    raw = await raw_body(request, ("application/json", "text/csv"))
+    limit = settings.max_cameras_per_job
+    cameras = await run_cpu(request, lambda: camera_records(raw, content_type(request), limit))
+    if not cameras:
+        raise SceneError("the list holds no camera", "cameras")
+    if len(cameras) > limit:
+        raise LimitError(
+            f"over {limit} cameras; this server accepts at most {limit} per job", "cameras"
+        )
+    job_id = await run_cpu(request, lambda: store.create_job(cameras))
+    return {"id": job_id, "status_url": f"/v1/jobs/{job_id}", "total": len(cameras)}
+
+
+@router.get("/v1/jobs/{job_id}")
+async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
+    """A job's status and progress."""
+    job = store.job(job_id)
+    if job is None:
+        raise NotFoundError(f"no job {job_id}")
+    job["result_url"] = f"/v1/jobs/{job_id}/result"
+    return job
+
+
+@router.get("/v1/jobs/{job_id}/result", response_model=None)
+async def job_result(
+    request: Request, job_id: JobId, q: Annotated[ResultQuery, Query()], store: ServiceStore
+) -> Response | dict[str, Any]:
+    """The finished cameras: GeoJSON (best location per camera, then all candidates) or
+    GeoPackage (layers ``cameras`` and ``candidates``)."""
+    from camloc_geo.results import job_result_geojson, job_result_geopackage
+
+    if store.job(job_id) is None:
+        raise NotFoundError(f"no job {job_id}")
+    gj = job_result_geojson(job_id, store.job_results(job_id))
+    if q.format == "geojson":
+        return gj
+    data = await run_cpu(request, lambda: job_result_geopackage(gj))
+    return Response(
+        data,
+        media_type="application/geopackage+sqlite3",
+        headers={"Content-Disposition": f'attachment; filename="camloc-{job_id}.gpkg"'},
+    )
+
+
+def camera_work(maps: MapStore, camera: Any, settings: Settings) -> dict[str, Any]:
+    """One camera of a job; never raises (runs on a worker)."""
+    return process_camera(camera, maps, settings)
+
+
+class JobRunner:
+    """The thread that claims queued cameras one at a time and commits their results."""
+
+    def __init__(self, store: Store, compute: Compute, settings: Settings) -> None:
+        self.store, self.compute, self.settings = store, compute, settings
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        """Release what a dead process had claimed, then start working."""
+        self.store.release_own_claims()
+        self._thread = threading.Thread(target=self._run, name="camloc-jobs", daemon=True)
+        self._thread.start()
+
+    def stop(self, timeout_s: float = 5.0) -> None:
+        """Stop after the camera in hand."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=timeout_s)
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                claimed = self.store.claim_camera()
+            except Exception:  # database busy or gone: try again later
+                log.exception("job runner could not claim a camera")
+                self._stop.wait(1.0)
+                continue
+            if claimed is None:
+                self._stop.wait(0.2)
+                continue
+            job_id, idx, camera = claimed
+            try:
+                result = self.compute.submit(camera_work, camera, self.settings).result()
+            except Exception as exc:  # a worker died or the pool is shutting down
+                if self._stop.is_set():
+                    return  # the claim goes back to pending at the next start
+                log.exception("camera %d of job %s failed", idx, job_id)
+                result = {
+                    "id": str(camera.get("id", "")) if isinstance(camera, dict) else "",
+                    "status": "failed",
+                    "reason": f"internal error ({type(exc).__name__})",
+                }
+            self.store.finish_camera(job_id, idx, result)

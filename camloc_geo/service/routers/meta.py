@@ -1,0 +1,100 @@
+"""Health, and the API's description: ``/openapi.json`` with the scene schema, and ``/docs``
+and ``/redoc`` whose assets are served by the server itself (they work offline).
+
+Swagger UI and ReDoc come from the ``fastapi-offline`` package; without it the pages fall back
+to FastAPI's (which load their assets from a CDN).
+"""
+
+from __future__ import annotations
+
+import logging
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from fastapi import APIRouter, FastAPI, Request
+from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html
+from fastapi.openapi.utils import get_openapi
+from fastapi.responses import HTMLResponse
+from fastapi.staticfiles import StaticFiles
+
+from camloc_geo import __version__
+from camloc_geo.service.deps import Maps
+
+__all__ = ["install_docs", "router"]
+
+log = logging.getLogger(__name__)
+
+router = APIRouter(tags=["meta"])
+
+ASSETS = "/docs/assets"
+
+
+@router.get("/healthz")
+async def healthz(maps: Maps) -> dict[str, Any]:
+    """Liveness: the version and how many extracts are configured."""
+    return {"status": "ok", "version": __version__, "extracts": len(maps.extracts)}
+
+
+def _assets_dir() -> Path | None:
+    try:
+        folder = Path(str(resources.files("fastapi_offline") / "static"))
+    except ModuleNotFoundError:
+        return None
+    return folder if (folder / "swagger-ui-bundle.js").is_file() else None
+
+
+def _scene_schemas() -> dict[str, Any]:
+    from camloc_geo.scene import Scene
+
+    schema = Scene.model_json_schema(ref_template="#/components/schemas/{model}")
+    defs = schema.pop("$defs", {})
+    schema.get("properties", {}).pop("base_dir", None)
+    defs["Scene"] = schema
+    return dict(defs)
+
+
+def install_docs(app: FastAPI) -> None:
+    """``/openapi.json`` (built once, with the ``Scene`` schema), ``/docs`` and ``/redoc``.
+
+    Build the app with ``docs_url=None, redoc_url=None``.
+    """
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:
+            schema = get_openapi(
+                title=app.title, version=app.version, description=app.description, routes=app.routes
+            )
+            schema.setdefault("components", {}).setdefault("schemas", {}).update(_scene_schemas())
+            app.openapi_schema = schema
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
+    folder = _assets_dir()
+    if folder is None:
+        log.warning("fastapi-offline is not installed: /docs loads Swagger UI from a CDN")
+        swagger: dict[str, Any] = {}
+        redoc: dict[str, Any] = {}
+    else:
+        app.mount(ASSETS, StaticFiles(directory=folder), name="docs-assets")
+        swagger = {
+            "swagger_js_url": f"{ASSETS}/swagger-ui-bundle.js",
+            "swagger_css_url": f"{ASSETS}/swagger-ui.css",
+            "swagger_favicon_url": f"{ASSETS}/favicon.png",
+        }
+        redoc = {
+            "redoc_js_url": f"{ASSETS}/redoc.standalone.js",
+            "redoc_favicon_url": f"{ASSETS}/favicon.png",
+            "with_google_fonts": False,
+        }
+
+    async def docs(request: Request) -> HTMLResponse:
+        return get_swagger_ui_html(
+            openapi_url="/openapi.json", title=f"{app.title} - API", **swagger
+        )
+
+    async def redoc_page(request: Request) -> HTMLResponse:
+        return get_redoc_html(openapi_url="/openapi.json", title=f"{app.title} - API", **redoc)
+
+    app.add_api_route("/docs", docs, include_in_schema=False)
+    app.add_api_route("/redoc", redoc_page, include_in_schema=False)

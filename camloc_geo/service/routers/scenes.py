@@ -1,0 +1,78 @@
+"""Scene endpoints: calibrate, locate, and the review page of a scene's candidates."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, cast
+
+from fastapi import APIRouter, Query
+from fastapi.responses import HTMLResponse, Response
+
+from camloc_geo.service.deps import ApiKey, SceneBody, Workers
+from camloc_geo.service.models import LocateQuery
+from camloc_geo.service.work import locate_body
+
+if TYPE_CHECKING:
+    from camloc_geo.scene import Scene
+    from camloc_geo.service.mapstore import MapStore
+
+__all__ = ["SCENE_BODY", "router"]
+
+router = APIRouter(tags=["scenes"], dependencies=[ApiKey])
+
+
+def scene_body_doc(description: str) -> dict[str, Any]:
+    """OpenAPI of a scene request body (the ``Scene`` schema is added by the app)."""
+    return {
+        "requestBody": {
+            "required": True,
+            "description": description,
+            "content": {"application/json": {"schema": {"$ref": "#/components/schemas/Scene"}}},
+        }
+    }
+
+
+SCENE_BODY = scene_body_doc("a camloc-scene/1 scene (no image.path)")
+
+
+def calibrate_work(_maps: MapStore, scene: Scene) -> dict[str, Any]:
+    """The calibration answer of a validated scene (runs on a worker)."""
+    from camloc_geo.api import calibrate_scene
+
+    return {"scene": scene.id, **calibrate_scene(scene).to_dict()}
+
+
+def locate_work(maps: MapStore, scene: Scene, max_candidates: int | None) -> dict[str, Any]:
+    """The candidate GeoJSON of a validated scene (runs on a worker)."""
+    out, _m = locate_body(cast(Any, scene), maps, max_candidates=max_candidates)
+    return dict(out.to_geojson())
+
+
+def review_work(maps: MapStore, scene: Scene) -> str:
+    """The offline review page of a validated scene (runs on a worker)."""
+    from camloc_geo.maps import candidates_map
+
+    out, m = locate_body(cast(Any, scene), maps)
+    with tempfile.TemporaryDirectory(prefix="camloc-map-") as tmp:
+        path = Path(tmp) / "review.html"
+        candidates_map(out.result, m, path, offline=True, scene=out.scene)
+        return path.read_text(encoding="utf-8")
+
+
+@router.post("/v1/calibrate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
+async def calibrate(body: SceneBody, workers: Workers) -> Response:
+    """Relative pose (focal length, rotation, camera position in the car's frame)."""
+    return await workers.run_json(calibrate_work, body.scene)
+
+
+@router.post("/v1/locate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
+async def locate(body: SceneBody, workers: Workers, q: Annotated[LocateQuery, Query()]) -> Response:
+    """Candidate camera positions as the candidate GeoJSON, best first."""
+    return await workers.run_json(locate_work, body.scene, q.max_candidates)
+
+
+@router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
+async def review_map(body: SceneBody, workers: Workers) -> HTMLResponse:
+    """The review page of a scene's candidates: one self-contained offline HTML file."""
+    return HTMLResponse(await workers.run(review_work, body.scene))

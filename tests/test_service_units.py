@@ -1,0 +1,167 @@
+"""The service's pieces without a server: list bodies, settings, and the library functions
+the service calls (corner and street radius filters, crowd merge, job result shapes)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pytest
+
+from camloc_geo import SceneError
+
+if TYPE_CHECKING:
+    from camloc_geo.osm import MapData
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = ROOT / "sample_maps"
+SCENE = json.loads((SAMPLES / "sample_scene.json").read_text())
+
+pytest.importorskip("fastapi")
+
+
+@pytest.fixture(scope="module")
+def whole_map() -> MapData:  # the whole extract, as the service loads it
+    from camloc_geo.osm import load_map
+
+    return load_map(SAMPLES / "baltimore.osm.pbf", 39.2856, -76.5935, radius_m=None)
+
+
+def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
+    from camloc_geo.api import corners_near, corners_within
+    from camloc_geo.geodesy import distance_m
+
+    lat, lon = 39.28558, -76.59348
+    every = corners_near(lat=lat, lon=lon, radius_m=120, map_source=whole_map)
+    near = corners_within(lat=lat, lon=lon, radius_m=120, map_source=whole_map)
+    inters = [f for f in near["features"] if f["properties"]["kind"] == "intersection"]
+    assert 0 < len(inters) < len(every["features"])
+    kept = {f["properties"]["id"] for f in inters}
+    for f in inters:
+        flon, flat = f["geometry"]["coordinates"]
+        assert distance_m(lat1=lat, lon1=lon, lat2=flat, lon2=flon) <= 120.0
+    corners = [f for f in near["features"] if f["properties"]["kind"] == "corner"]
+    assert corners
+    assert all(f["properties"]["intersection"] in kept for f in corners)
+
+
+def test_streets_within_lists_only_near_streets(whole_map: MapData) -> None:
+    from camloc_geo.api import streets_within
+
+    out = streets_within(lat=39.28558, lon=-76.59348, radius_m=100, map_source=whole_map)
+    near = {n["name"] for n in out["near"]}
+    assert "Eastern Avenue" in near
+    assert {s["name"] for s in out["streets"]} == near
+
+
+def test_crowd_scene_takes_the_task_prior_only_when_none_given() -> None:
+    from camloc_geo.api import crowd_scene
+
+    one, two = ({**SCENE, "annotations": [a]} for a in SCENE["annotations"][:2])
+    no_prior = [{k: v for k, v in s.items() if k != "prior"} for s in (one, two)]
+    prior = {"lat": 39.0, "lon": -76.0, "radius_m": 80.0}
+    merged = crowd_scene(no_prior, prior=prior)
+    assert merged["prior"] == prior
+    assert len(merged["annotations"]) == 2
+    assert crowd_scene([one, two], prior=prior)["prior"]["lat"] == SCENE["prior"]["lat"]
+    with pytest.raises(SceneError):
+        crowd_scene([])
+
+
+def test_job_result_geojson_shapes() -> None:
+    from camloc_geo.results import job_result_geojson
+
+    cand = {
+        "type": "Feature",
+        "geometry": {"type": "Point", "coordinates": [1.0, 2.0]},
+        "properties": {"kind": "candidate", "rank": 1},
+    }
+    gj = job_result_geojson(
+        "j1",
+        [
+            {"id": "a", "status": "located", "lat": 2.0, "lon": 1.0, "candidates": [cand]},
+            {"id": "b", "status": "failed", "reason": "bad"},
+        ],
+    )
+    kinds = [(f["properties"]["kind"], f["properties"].get("id")) for f in gj["features"]]
+    assert kinds == [("camera", "a"), ("candidate", None), ("camera", "b")]
+    assert gj["features"][0]["geometry"]["coordinates"] == [1.0, 2.0]
+    assert gj["features"][1]["properties"]["camera_id"] == "a"
+    assert gj["features"][2]["geometry"] is None
+    assert gj["properties"]["job"] == "j1"
+
+
+def test_camera_records_read_like_camloc_batch() -> None:
+    from camloc_geo.service.routers.jobs import camera_records
+
+    text = "Camera_ID;Name;Latitude;Lng\nc1;Eastern Ave & S Broadway;39.2856;-76.5935\n;x;abc;1\n"
+    rows = camera_records(text.encode(), "text/csv", 10)
+    assert rows[0] == {
+        "id": "c1",
+        "title": "Eastern Ave & S Broadway",
+        "lat": 39.2856,
+        "lon": -76.5935,
+    }
+    assert rows[1]["id"] == "row-2"
+    assert "lat" not in rows[1]
+    assert any("not a number" in p for p in rows[1]["problems"])
+    body = {"cameras": [{"id": "j", "latitude": "39.2", "lon": -76.5, "scene": SCENE}, 5]}
+    got = camera_records(json.dumps(body).encode(), "application/json", 10)
+    assert got[0]["lat"] == 39.2
+    assert got[0]["scene"] == SCENE
+    assert got[1] == 5
+    assert len(camera_records(("id\n" + "x\n" * 50).encode(), "text/csv", 3)) == 4
+    with pytest.raises(SceneError, match="scene"):
+        camera_records(b"id,scene\nc,/etc/passwd\n", "text/csv", 10)
+    with pytest.raises(SceneError, match="cameras"):
+        camera_records(b'{"cams": []}', "application/json", 10)
+
+
+def test_data_dir_defaults_to_the_users_data_folder(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    from camloc_geo.service.settings import Settings
+
+    monkeypatch.delenv("CAMLOC_DATA_DIR", raising=False)
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "xdg"))
+    monkeypatch.chdir(tmp_path)
+    data_dir = Settings().data_dir
+    assert data_dir == tmp_path / "xdg" / "camloc" / "service"
+    monkeypatch.setenv("CAMLOC_DATA_DIR", str(tmp_path / "mine"))
+    assert Settings().data_dir == tmp_path / "mine"
+
+
+def test_worker_processes_answer_like_threads(tmp_path: Path) -> None:
+    import asyncio
+    import shutil
+
+    from camloc_geo import MapDataError
+    from camloc_geo.service.compute import Compute
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.models import PointQuery
+    from camloc_geo.service.routers.crowd import servable_work
+    from camloc_geo.service.routers.maps import streets_work
+    from camloc_geo.service.settings import Settings
+
+    (tmp_path / "maps").mkdir()
+    shutil.copy(SAMPLES / "baltimore.osm.pbf", tmp_path / "maps")
+    q = PointQuery(lat=39.28558, lon=-76.59348, radius_m=100)
+    answers = {}
+    for workers in (0, 1):
+        settings = Settings(
+            map_dir=tmp_path / "maps",
+            data_dir=tmp_path / "d",
+            workers=workers,
+            request_timeout_s=600.0,  # a busy machine: starting the worker and loading the map
+        )
+        compute = Compute(settings, MapStore(settings))
+        compute.start()
+        try:
+            answers[workers] = asyncio.run(compute.run(streets_work, q))
+            with pytest.raises(MapDataError, match=r"lat=48\.850000"):
+                asyncio.run(compute.run(servable_work, False, (48.85, 2.35)))
+        finally:
+            compute.shutdown()
+    assert answers[1] == answers[0]
+    assert "Eastern Avenue" in {n["name"] for n in answers[1]["near"]}
