@@ -753,13 +753,15 @@ def corners_within(
     cache_folder: str | os.PathLike[str] | None = None,
     overpass_url: str | None = None,
 ) -> dict[str, Any]:
-    """:func:`corners_near` limited to the intersections within ``radius_m`` of the point.
+    """:func:`corners_near`, which keeps only the intersections within ``radius_m``.
 
-    For a map loaded wider than the radius (a whole extract shared by many requests): only
-    intersections whose node lies within ``radius_m`` (geodesic distance) are kept, with
-    their corners. With ``streets`` the named intersection is returned wherever it is.
+    For a map loaded wider than the radius (a whole extract shared by many requests, a
+    catalogue cell): only intersections whose centre lies within ``radius_m`` (geodesic
+    distance) are kept, with their corners; :func:`corners_near` applies that rule itself,
+    and this name stays for the service. With ``streets`` the named intersection is returned
+    wherever it is.
     """
-    gj = corners_near(
+    return corners_near(
         lat=lat,
         lon=lon,
         radius_m=radius_m,
@@ -769,23 +771,6 @@ def corners_within(
         cache_folder=cache_folder,
         overpass_url=overpass_url,
     )
-    if streets:
-        return gj
-    from camloc_geo.geodesy import distance_m
-
-    inters = [f for f in gj["features"] if f["properties"].get("kind") == "intersection"]
-    keep: set[Any] = set()
-    if inters:
-        lons = [f["geometry"]["coordinates"][0] for f in inters]
-        lats = [f["geometry"]["coordinates"][1] for f in inters]
-        dist = distance_m(lat1=[lat] * len(lats), lon1=[lon] * len(lons), lat2=lats, lon2=lons)
-        keep = {f["properties"]["id"] for f, d in zip(inters, dist, strict=True) if d <= radius_m}
-    gj["features"] = [
-        f
-        for f in gj["features"]
-        if f["properties"].get("id") in keep or f["properties"].get("intersection") in keep
-    ]
-    return gj
 
 
 def streets_within(
