@@ -742,35 +742,10 @@ def guide_scene(
     return result
 
 
-def corners_within(
-    *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
-    map_source: MapSource = None,
-    network: bool = True,
-    streets: str | None = None,
-    cache_folder: str | os.PathLike[str] | None = None,
-    overpass_url: str | None = None,
-) -> dict[str, Any]:
-    """:func:`corners_near`, which keeps only the intersections within ``radius_m``.
-
-    For a map loaded wider than the radius (a whole extract shared by many requests, a
-    catalogue cell): only intersections whose centre lies within ``radius_m`` (geodesic
-    distance) are kept, with their corners; :func:`corners_near` applies that rule itself,
-    and this name stays for the service. With ``streets`` the named intersection is returned
-    wherever it is.
-    """
-    return corners_near(
-        lat=lat,
-        lon=lon,
-        radius_m=radius_m,
-        map_source=map_source,
-        network=network,
-        streets=streets,
-        cache_folder=cache_folder,
-        overpass_url=overpass_url,
-    )
+corners_within = corners_near
+"""The service's name for :func:`corners_near`, which keeps only the intersections within
+``radius_m`` on a map loaded wider than the radius (a whole extract shared by many requests,
+a catalogue cell): one radius rule, in one function."""
 
 
 def streets_within(
