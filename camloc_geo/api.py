@@ -129,10 +129,8 @@ def calibrate_scene(
 
 
 def scene_needs_map(scene: Scene) -> bool:
-    """True when the scene's evidence can only be used with map data."""
-    if scene.intersection is not None or scene.landmarks:
-        return True
-    return len(scene.references) == 1 and scene.street_bearing_deg is None
+    """True when the scene's evidence can only be used with map data (:attr:`Scene.needs_map`)."""
+    return scene.needs_map
 
 
 def scene_anchor(scene: Scene) -> tuple[float, float] | None:
@@ -264,7 +262,7 @@ class LocateOutput:
 
     def to_geojson(self) -> dict[str, Any]:
         """The candidate GeoJSON FeatureCollection (``docs/contract.md``)."""
-        from camloc_geo.absolute import candidates_geojson
+        from camloc_geo.results import candidates_geojson
 
         return candidates_geojson(self.result)
 
@@ -365,8 +363,7 @@ def locate_camera(
     A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
     ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
     """
-    from camloc_geo.cameras import CameraRow, geocode_camera
-    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.cameras import CameraRow, geocode_camera, row_from_mapping
     from camloc_geo.osm import MapCatalogue, MapData
 
     row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)
@@ -412,9 +409,25 @@ def corners_near(
         cache_folder=cache_folder,
         overpass_url=overpass_url,
     )
-    from camloc_geo.osm import intersections_geojson
+    from camloc_geo.results import intersections_geojson
 
-    inters = [m.find_intersection(streets, near=(lat, lon))] if streets else list(m.intersections)
+    if streets:
+        return intersections_geojson([m.find_intersection(streets, near=(lat, lon))])
+    inters = list(m.intersections)
+    if inters and (m.radius_m is None or m.radius_m > radius_m):
+        # a map loaded for more than this point (a whole extract, a catalogue cell, a map
+        # passed in): only the intersections whose centre lies within radius_m
+        import numpy as np
+
+        from camloc_geo.geodesy import distance_m
+
+        far = distance_m(
+            lat1=np.full(len(inters), lat),
+            lon1=np.full(len(inters), lon),
+            lat2=np.array([x.lat for x in inters]),
+            lon2=np.array([x.lon for x in inters]),
+        )
+        inters = [x for x, d in zip(inters, far, strict=True) if d <= radius_m]
     return intersections_geojson(inters)
 
 
@@ -729,50 +742,10 @@ def guide_scene(
     return result
 
 
-def corners_within(
-    *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
-    map_source: MapSource = None,
-    network: bool = True,
-    streets: str | None = None,
-    cache_folder: str | os.PathLike[str] | None = None,
-    overpass_url: str | None = None,
-) -> dict[str, Any]:
-    """:func:`corners_near` limited to the intersections within ``radius_m`` of the point.
-
-    For a map loaded wider than the radius (a whole extract shared by many requests): only
-    intersections whose node lies within ``radius_m`` (geodesic distance) are kept, with
-    their corners. With ``streets`` the named intersection is returned wherever it is.
-    """
-    gj = corners_near(
-        lat=lat,
-        lon=lon,
-        radius_m=radius_m,
-        map_source=map_source,
-        network=network,
-        streets=streets,
-        cache_folder=cache_folder,
-        overpass_url=overpass_url,
-    )
-    if streets:
-        return gj
-    from camloc_geo.geodesy import distance_m
-
-    inters = [f for f in gj["features"] if f["properties"].get("kind") == "intersection"]
-    keep: set[Any] = set()
-    if inters:
-        lons = [f["geometry"]["coordinates"][0] for f in inters]
-        lats = [f["geometry"]["coordinates"][1] for f in inters]
-        dist = distance_m(lat1=[lat] * len(lats), lon1=[lon] * len(lons), lat2=lats, lon2=lons)
-        keep = {f["properties"]["id"] for f, d in zip(inters, dist, strict=True) if d <= radius_m}
-    gj["features"] = [
-        f
-        for f in gj["features"]
-        if f["properties"].get("id") in keep or f["properties"].get("intersection") in keep
-    ]
-    return gj
+corners_within = corners_near
+"""The service's name for :func:`corners_near`, which keeps only the intersections within
+``radius_m`` on a map loaded wider than the radius (a whole extract shared by many requests,
+a catalogue cell): one radius rule, in one function."""
 
 
 def streets_within(

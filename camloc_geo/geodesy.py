@@ -38,10 +38,13 @@ import numpy.typing as npt
 from pyproj import Geod, Transformer
 
 __all__ = [
+    "EARTH_RADIUS_M",
     "GEOD",
     "LocalFrame",
     "bearing_deg",
     "distance_m",
+    "great_circle_m",
+    "initial_bearing_deg",
     "normalize_bearing_deg",
 ]
 
@@ -78,6 +81,35 @@ def distance_m(*, lat1: Any, lon1: Any, lat2: Any, lon2: Any) -> Any:
     """Geodesic distance on WGS 84, metres (scalars or arrays)."""
     _fwd, _back, dist = GEOD.inv(lon1, lat1, lon2, lat2)
     return dist
+
+
+EARTH_RADIUS_M = 6_371_009.0
+"""The sphere of :func:`great_circle_m` and :func:`initial_bearing_deg` (osmnx's), metres."""
+
+
+def great_circle_m(*, lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Great-circle distance on a sphere (haversine, osmnx's ``great_circle``), metres.
+
+    The street graph's edge lengths and hot loops (title geocoding) use it: the same lengths
+    osmnx gives, at a tenth of a geodesic call's cost; within 0.5 % of :func:`distance_m`.
+    """
+    y1, y2 = math.radians(lat1), math.radians(lat2)
+    x1, x2 = math.radians(lon1), math.radians(lon2)
+    h = math.sin((y2 - y1) / 2) ** 2 + math.cos(y1) * math.cos(y2) * math.sin((x2 - x1) / 2) ** 2
+    return 2 * math.asin(min(1.0, math.sqrt(h))) * EARTH_RADIUS_M
+
+
+def initial_bearing_deg(*, lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Initial great-circle bearing on a sphere (osmnx's ``calculate_bearing``), [0, 360).
+
+    The street bearings of the map layer use it (osmnx's numbers without importing osmnx);
+    within 0.2° of :func:`bearing_deg`.
+    """
+    phi1, phi2 = math.radians(lat1), math.radians(lat2)
+    dlon = math.radians(lon2 - lon1)
+    y = math.sin(dlon) * math.cos(phi2)
+    x = math.cos(phi1) * math.sin(phi2) - math.sin(phi1) * math.cos(phi2) * math.cos(dlon)
+    return math.degrees(math.atan2(y, x)) % 360.0
 
 
 @lru_cache(maxsize=256)

@@ -69,6 +69,7 @@ __all__ = [
     "build_summary_map",
     "candidates_map",
     "inline_assets",
+    "leaflet_assets",
     "rank_colour",
     "rank_style",
     "score_colour",
@@ -398,11 +399,14 @@ def _compass(bearing_deg: Any) -> str | None:
 
 
 def _distance_m(a: Mapping[str, Any], b: Mapping[str, Any]) -> float:
-    """Ground distance between two candidates' lat/lon (equirectangular; metres apart)."""
-    lat0 = math.radians((float(a["lat"]) + float(b["lat"])) / 2.0)
-    dn = math.radians(float(a["lat"]) - float(b["lat"])) * 6_371_008.8
-    de = math.radians(float(a["lon"]) - float(b["lon"])) * 6_371_008.8 * math.cos(lat0)
-    return math.hypot(dn, de)
+    """Ground distance between two candidates' lat/lon, metres (:func:`geodesy.distance_m`)."""
+    from camloc_geo.geodesy import distance_m
+
+    return float(
+        distance_m(
+            lat1=float(a["lat"]), lon1=float(a["lon"]), lat2=float(b["lat"]), lon2=float(b["lon"])
+        )
+    )
 
 
 def _ties_of(props: Mapping[str, Any]) -> list[int]:
@@ -448,34 +452,18 @@ def _and(items: Sequence[Any]) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
-def _ambiguity_reasons(collection: Mapping[str, Any]) -> list[str]:
-    """The result's own words on ties: ``ambiguous...`` warnings and an ``ambiguous`` property."""
-    out = [
-        str(w)
-        for w in collection.get("warnings") or []
-        if isinstance(w, str) and w.lower().startswith("ambiguous")
-    ]
-    extra = collection.get("ambiguous")
-    if isinstance(extra, str):
-        out.append(extra)
-    elif isinstance(extra, (list, tuple)):
-        out.extend(str(e) for e in extra if isinstance(e, str))
-    return list(dict.fromkeys(out))
-
-
 def _tie_reason(group: Sequence[int], collection: Mapping[str, Any], *, short: bool = False) -> str:
-    """Why these ranks tie: the result's warning naming them, else the rule (escaped HTML).
+    """Why these ranks tie: the result's tie naming them (its ``ties`` data), else the rule.
 
-    ``short``: only the warning's explanation (after its first ``;``), without the
-    ``ambiguous: candidates 1 and 2 ...`` lead the banner already says.
+    ``short``: only the explanation (what would decide), without the odds the banner already
+    says. Escaped HTML.
     """
-    for w in _ambiguity_reasons(collection):
-        named = {int(n) for n in re.findall(r"\b(\d+)\b", w.split("(", 1)[0])}
-        if set(group[:2]) <= named:
-            text = re.sub(r"^ambiguous:\s*", "", w, flags=re.IGNORECASE)
-            if short and ";" in text:
-                text = text.split(";", 1)[1].strip()
-            return html.escape(text.rstrip(". "))
+    for tie in collection.get("ties") or []:
+        ranks = tie.get("ranks") if isinstance(tie, Mapping) else None
+        if isinstance(ranks, list) and set(group[:2]) <= set(ranks):
+            text = str(tie.get("why" if short else "text") or "")
+            if text:
+                return html.escape(text.rstrip(". "))
     return html.escape(_TIE_RULE)
 
 
@@ -900,7 +888,7 @@ def build_candidates_map(
     folium.Map
         With layers, layer control, legend and scale bar.
     """
-    from camloc_geo.absolute import candidates_geojson
+    from camloc_geo.results import candidates_geojson
 
     gj = candidates_geojson(result)
     feats = gj["features"]
@@ -1245,7 +1233,7 @@ def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
     if isinstance(item, Mapping):
         gj = item
     else:
-        from camloc_geo.absolute import candidates_geojson
+        from camloc_geo.results import candidates_geojson
 
         gj = candidates_geojson(item, view_cones=False)
     cands = [
@@ -1462,7 +1450,7 @@ def summary_map(
 
 # ------------------------------------------------------------------------------ offline
 @lru_cache(maxsize=1)
-def _assets() -> dict[str, str]:
+def leaflet_assets() -> dict[str, str]:
     """Leaflet JS/CSS (images as data URIs) and jQuery from the xstatic packages."""
     import xstatic.pkg.jquery as xjquery
     import xstatic.pkg.leaflet as xleaflet
@@ -1509,7 +1497,7 @@ def inline_assets(page: str) -> str:
     ValueError
         When a remote resource reference is left (a tile layer, an ``<img>`` from the web).
     """
-    assets = _assets()
+    assets = leaflet_assets()
 
     placeholders = {
         "leaflet_js": "<!--camloc:leaflet_js-->",

@@ -27,13 +27,18 @@ front ends may import it at start-up.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
+from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
+
 if TYPE_CHECKING:
+    from camloc_geo.absolute import Candidate, LocateResult, Match
     from camloc_geo.cameras import CameraResult
-    from camloc_geo.osm import Intersection
+    from camloc_geo.geodesy import LocalFrame
+    from camloc_geo.osm import Intersection, MapData
     from camloc_geo.relative import CalibrationResult
 
 __all__ = [
@@ -56,32 +61,25 @@ __all__ = [
     "OutputKind",
     "PointGeometry",
     "PolygonGeometry",
+    "TieProperties",
     "ViewConeProperties",
     "calibration_output",
     "camera_job_result",
+    "candidates_collection",
+    "candidates_geojson",
     "corners_collection",
     "intersection_features",
+    "intersections_geojson",
     "job_result_geojson",
     "job_result_geopackage",
     "output_json_schema",
     "point",
+    "streets_json",
     "to_json",
 ]
 
 ATTRIBUTION = "Map data © OpenStreetMap contributors, ODbL 1.0"
 """The one attribution string of every output built from OpenStreetMap data."""
-
-TIE_SCORE_RATIO = 0.1
-"""Two candidates tie when the weaker scores at least this fraction of the stronger.
-
-The scores are posterior weights, so their ratio is the odds the evidence gives one over the
-other: under 10 to 1 is no strong evidence (Jeffreys' scale). On the absolute benchmark a
-top candidate that is wrong while another is right names that one as tied in 96 % of the
-scenes at 0.1 (87 % at 0.8: noise often favours a symmetric junction's mirror by 2-30 to 1).
-"""
-TIE_DISTANCE_M = 10.0
-"""Tied candidates stand more than this far apart, metres (closer ones are one answer at the
-accuracy the tool aims at)."""
 
 OutputKind = Literal["candidates", "calibration", "corners"]
 
@@ -253,6 +251,15 @@ class CalibrationSummary:
 
 
 @dataclass(kw_only=True)
+class TieProperties:
+    """Candidates the evidence cannot tell apart (the core's tie rule, as data)."""
+
+    ranks: list[int]
+    text: str
+    why: str
+
+
+@dataclass(kw_only=True)
 class CandidateCollectionProperties:
     """What the candidate list as a whole says."""
 
@@ -262,6 +269,7 @@ class CandidateCollectionProperties:
     reason: str | None
     warnings: list[str]
     calibration: CalibrationSummary
+    ties: list[TieProperties] = field(default_factory=list)
     attribution: str = ATTRIBUTION
 
 
@@ -462,6 +470,168 @@ def output_json_schema(kind: OutputKind) -> dict[str, Any]:
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = f"camloc {kind} output"
     return schema
+
+
+# ------------------------------------------------------------------------- candidates
+def _match_properties(m: Match, frame: LocalFrame) -> MatchProperties:
+    lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
+    return MatchProperties(
+        kind=m.kind,
+        label=m.label,
+        pixel=list(m.pixel),
+        map_corner=m.map_corner,
+        order=m.order,
+        misfit_m=m.misfit_m,
+        mahalanobis2=m.mahalanobis2,
+        map_lonlat=[lon, lat],
+    )
+
+
+def _candidate_feature(c: Candidate, result: LocateResult) -> Feature:
+    from camloc_geo.geodesy import normalize_bearing_deg
+
+    heading, pitch_c, roll_c = c.camera.angles_deg
+    props = CandidateProperties(
+        rank=c.rank,
+        score=c.score,
+        lat=c.lat,
+        lon=c.lon,
+        height_m=c.camera.height_m,
+        heading_deg=float(normalize_bearing_deg(heading)),
+        pitch_deg=pitch_c,
+        roll_deg=roll_c,
+        focal_px=c.camera.focal_px,
+        method=c.method,
+        residual_m=None if math.isnan(c.residual_m) else c.residual_m,
+        sigma_m=c.sigma_m,
+        scale=c.scale,
+        refined=c.refined,
+        merged=c.merged,
+        flags=[str(f) for f in c.flags],
+        scene=result.scene_id,
+        matches=[_match_properties(m, result.frame) for m in c.matches],
+        ambiguous_with=list(c.ambiguous_with),
+        intersection=c.intersection_id,
+    )
+    return Feature(geometry=point(c.lon, c.lat), properties=props)
+
+
+def _view_cone_feature(c: Candidate, result: LocateResult, range_m: float) -> Feature:
+    from camloc_geo.absolute import view_cone
+
+    poly = view_cone(c.camera, result.image_size, range_m)
+    ll = result.frame.points_geographic_from_enu(poly)
+    return Feature(
+        geometry=PolygonGeometry(coordinates=[ll.tolist()]),
+        properties=ViewConeProperties(rank=c.rank, score=c.score),
+    )
+
+
+def _matched_point_feature(c: Candidate, m: Match, frame: LocalFrame) -> Feature:
+    lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
+    props = MatchedPointProperties(
+        rank=c.rank,
+        label=m.label,
+        match_kind=m.kind,
+        pixel=list(m.pixel),
+        misfit_m=m.misfit_m,
+        map_corner=m.map_corner,
+    )
+    return Feature(geometry=point(float(lon), float(lat)), properties=props)
+
+
+def _collection_properties(result: LocateResult) -> CandidateCollectionProperties:
+    cal = result.calibration
+    _h, pitch, roll = cal.camera.angles_deg
+    return CandidateCollectionProperties(
+        scene=result.scene_id,
+        methods_tried=result.methods_tried,
+        n_candidates=len(result.candidates),
+        reason=result.reason,
+        warnings=result.warnings + cal.warnings,
+        ties=[TieProperties(ranks=list(t.ranks), text=t.text, why=t.why) for t in result.ties],
+        calibration=CalibrationSummary(
+            focal_px=cal.camera.focal_px,
+            height_m=cal.camera.height_m,
+            pitch_deg=pitch,
+            roll_deg=roll,
+            method=cal.method,
+            intrinsics_method=cal.intrinsics_method,
+            outlier_annotators=cal.outlier_annotators,
+        ),
+    )
+
+
+def candidates_collection(
+    result: LocateResult, *, view_cones: bool = True, view_cone_range_m: float | None = None
+) -> CandidateCollection:
+    """The typed candidate FeatureCollection (:class:`CandidateCollection`) of a locate result."""
+    cands = result.candidates
+    range_m = result.view_cone_range_m if view_cone_range_m is None else view_cone_range_m
+    feats = [_candidate_feature(c, result) for c in cands]
+    if view_cones:
+        feats += [_view_cone_feature(c, result, range_m) for c in cands]
+    feats += [_matched_point_feature(c, m, result.frame) for c in cands for m in c.matches]
+    if result.intersection is not None:
+        feats += intersection_features(result.intersection, detailed=False)
+    return CandidateCollection(features=feats, properties=_collection_properties(result))
+
+
+def candidates_geojson(
+    result: LocateResult, *, view_cones: bool = True, view_cone_range_m: float | None = None
+) -> dict[str, Any]:
+    """The candidate GeoJSON FeatureCollection of the scene contract (``docs/candidates.md``).
+
+    Candidate Point features (``kind: "candidate"``, best first) carry every property of
+    the contract plus ``sigma_m`` (1-sigma position uncertainty), ``scale``, ``flags``,
+    ``matches``, ``merged`` and ``ambiguous_with``. Extra features: ``view_cone`` polygons
+    (one per candidate, reaching ``view_cone_range_m``, default the result's
+    :attr:`LocateSettings.view_cone_range_m`), ``matched_point`` points (the map points each
+    candidate matched), and the ``intersection`` used, with its ``corner`` points.
+    """
+    doc: dict[str, Any] = to_json(
+        candidates_collection(result, view_cones=view_cones, view_cone_range_m=view_cone_range_m)
+    )
+    return doc
+
+
+# ------------------------------------------------------------------------- map views
+def intersections_geojson(intersections: Iterable[Intersection]) -> dict[str, Any]:
+    """A FeatureCollection of intersections (``kind: "intersection"``) and their corners.
+
+    Intersection properties: ``id``, ``streets`` (names, clockwise), ``kind_detail``
+    (``junction``/``roundabout``/``unmodelled``; also as ``intersection_kind``, the same
+    value), ``warnings``, ``incident_streets`` (bearing, highway, width... per street),
+    ``corner_distances_m``. Corner properties: ``intersection`` (the id), ``order``
+    (clockwise from above, from 0), ``streets`` (the two streets it lies between).
+    Coordinates are ``[lon, lat]``. The typed model is
+    :class:`CornersCollection`.
+    """
+    doc: dict[str, Any] = to_json(corners_collection(intersections))
+    return doc
+
+
+def streets_json(m: MapData, lat: float, lon: float, radius_m: float) -> dict[str, Any]:
+    """Streets near a point with their bearings, and every street segment of the map."""
+    near = [
+        {"name": n, "bearing_deg": round(b, 3)} for n, b in m.street_bearings(lat, lon, radius_m)
+    ]
+    seen: dict[str, dict[str, Any]] = {}
+    for s in m.streets:
+        entry = seen.setdefault(
+            s.name,
+            {"name": s.name, "highway": s.highway, "oneway": s.oneway, "segments": 0, "ways": []},
+        )
+        entry["segments"] += 1
+        entry["ways"] = sorted(set(entry["ways"]) | set(s.way_ids))
+    return {
+        "lat": lat,
+        "lon": lon,
+        "radius_m": radius_m,
+        "near": near,
+        "streets": sorted(seen.values(), key=lambda e: e["name"]),
+        "attribution": ATTRIBUTION,
+    }
 
 
 # ------------------------------------------------------------------------- camera lists

@@ -548,6 +548,14 @@ class Scene(_Model):
         return bool(self.view_hint is not None or self.object.street or self.object.front)
 
     @property
+    def needs_map(self) -> bool:
+        """The scene's evidence can only be used with map data: intersection corners,
+        landmarks, or one reference without a street bearing."""
+        if self.intersection is not None or self.landmarks:
+            return True
+        return len(self.references) == 1 and self.street_bearing_deg is None
+
+    @property
     def image_size(self) -> tuple[int, int]:
         """``(width, height)`` in pixels."""
         return self.image.width, self.image.height

@@ -344,7 +344,7 @@ def test_geojson_list_streamed(tmp_path: Path) -> None:
 
 
 def test_geocode_camera_never_raises(world: dict[str, Path]) -> None:
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     m = area_map(("file", str((world["osm"] / "helsinki.osm.pbf").absolute())))
     for title in ("", "x" * 10_000, "&&&///", "\x00\x01\x02", "Unioninkatu & Kaisaniemenkatu"):

@@ -334,6 +334,17 @@ def tied() -> Any:
     return out
 
 
+def test_ties_are_data_decided_in_the_core(tied: Any) -> None:
+    """The tie is a field of the result and of its GeoJSON, not only words in a warning."""
+    res = tied.result
+    assert res.leaders_tie
+    assert [t.ranks for t in res.ties] == [[1, 2, 3, 4]]
+    assert f"ambiguous: {res.ties[0].text}" in res.warnings
+    doc = tied.to_geojson()
+    assert doc["properties"]["ties"][0]["ranks"] == [1, 2, 3, 4]
+    assert "symmetric junction" in doc["properties"]["ties"][0]["why"]
+
+
 @pytest.fixture(scope="module")
 def tied_page(tmp_path_factory: pytest.TempPathFactory, tied: Any) -> str:
     out = tmp_path_factory.mktemp("ties") / "tie.html"

@@ -139,3 +139,38 @@ def test_batch_and_http_job_give_one_answer(case: dict[str, Any]) -> None:
             assert not math.isnan(b["lat"])
             assert _dist_m(b["lat"], b["lon"], j["lat"], j["lon"]) < 1.0, (cam_id, b, j)
     assert placed >= 8  # the check compares placed cameras, not only failures
+
+
+def test_old_status_words_are_accepted_on_input() -> None:
+    from camloc_geo.cameras import STATUSES, CameraResult, normalize_status
+
+    assert normalize_status("no_candidate") == "no_candidates"
+    assert normalize_status("located") == "located"
+    old = CameraResult(row=1, id="c1", status="no_candidates").to_dict()
+    old["status"] = "no_candidate"  # a journal or job stored before the one vocabulary
+    assert CameraResult.from_dict(old).status == "no_candidates"
+    assert "no_candidate" not in STATUSES
+
+
+def test_a_job_camera_is_a_list_row() -> None:
+    """The service's camera dicts are read with the list's column aliases; scene paths refused."""
+    from camloc_geo.cameras import row_from_mapping
+
+    row = row_from_mapping(
+        {"ID": "c7", "name": "Eastern Ave & S Broadway", "latitude": "39.2856", "lng": -76.5935},
+        1,
+        scene_paths=False,
+    )
+    assert (row.id, row.title, row.lat, row.lon) == (
+        "c7",
+        "Eastern Ave & S Broadway",
+        39.2856,
+        -76.5935,
+    )
+    bad = row_from_mapping({"id": "c8", "scene": "/etc/passwd"}, 1, scene_paths=False)
+    assert bad.scene is None
+    assert not bad.has_scene
+    assert any("inline" in p for p in bad.problems)
+    inline = row_from_mapping({"id": "c9", "scene": {"format": "camloc-scene/1"}}, 1)
+    assert inline.has_scene
+    assert inline.scene_data == {"format": "camloc-scene/1"}

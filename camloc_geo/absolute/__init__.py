@@ -61,18 +61,20 @@ The pipeline, one function per stage (:func:`locate` reads as the list):
 
 from __future__ import annotations
 
+from typing import Any
+
+from camloc_geo.absolute._cone import view_cone
 from camloc_geo.absolute._cues import (
     CUE_FLOOR,
     OFF_STREET_FACTOR,
     VIEW_SIGMA_DEG,
     WRONG_WAY_FACTOR,
     CueScore,
-    apply_cues,
     cue_log_likelihood,
     view_log_factor,
 )
-from camloc_geo.absolute._geojson import candidates_geojson
 from camloc_geo.absolute._model import (
+    TIE_DISTANCE_M,
     TIE_SCORE_RATIO,
     Candidate,
     Flag,
@@ -81,13 +83,15 @@ from camloc_geo.absolute._model import (
     LocateSettings,
     Match,
     Observation,
+    Tie,
 )
-from camloc_geo.absolute._pipeline import locate, mark_ties
+from camloc_geo.absolute._pipeline import apply_cues, locate, mark_ties
 from camloc_geo.absolute._similarity import Similarity2D
 
 __all__ = [
     "CUE_FLOOR",
     "OFF_STREET_FACTOR",
+    "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "VIEW_SIGMA_DEG",
     "WRONG_WAY_FACTOR",
@@ -100,10 +104,23 @@ __all__ = [
     "Match",
     "Observation",
     "Similarity2D",
+    "Tie",
     "apply_cues",
-    "candidates_geojson",
     "cue_log_likelihood",
     "locate",
     "mark_ties",
+    "view_cone",
     "view_log_factor",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """``candidates_geojson``: an output shape, now :func:`camloc_geo.results.candidates_geojson`.
+
+    Kept importable from here (a public name); the core itself never imports ``results``.
+    """
+    if name == "candidates_geojson":
+        from camloc_geo import results
+
+        return results.candidates_geojson
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -23,8 +23,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from camloc_geo.absolute._model import Flag, FlagKind
-
 if TYPE_CHECKING:
     from camloc_geo.geodesy import LocalFrame
     from camloc_geo.osm import MapData
@@ -36,7 +34,6 @@ __all__ = [
     "VIEW_SIGMA_DEG",
     "WRONG_WAY_FACTOR",
     "CueScore",
-    "apply_cues",
     "cue_log_likelihood",
     "view_log_factor",
 ]
@@ -220,60 +217,3 @@ def cue_log_likelihood(
                 else:
                     notes.append(f"object.front: the car drives with one-way {s.label}")
     return CueScore(total, notes)
-
-
-def apply_cues(
-    result: Any, scene: Scene, map_data: MapData | None, *, merge_distance_m: float | None = None
-) -> Any:
-    """Re-rank a :class:`~camloc_geo.absolute.LocateResult` by the scene's cues, in place.
-
-    :func:`camloc_geo.absolute.locate` scores every hypothesis with the cues itself (before
-    merging, refinement and ranking), and its result says so (``cues_applied``): then this
-    does nothing. It remains for results computed without them.
-
-    Each candidate's score (a posterior weight) is multiplied by its cue factor
-    (:func:`cue_log_likelihood`) and the scores renormalised; the ranks follow. Notes go to the
-    candidate's ``flags`` (``cue: ...``), and the ambiguity warning is recomputed with the rule
-    of :func:`camloc_geo.absolute.locate` (:func:`camloc_geo.absolute.mark_ties`). A scene
-    without cues leaves the result unchanged.
-    """
-    cands = list(getattr(result, "candidates", []) or [])
-    if getattr(result, "cues_applied", False):
-        return result  # locate() already ranked with them
-    if not cands or not scene.has_cues:
-        return result
-    from camloc_geo.absolute._model import LocateSettings
-    from camloc_geo.absolute._pipeline import mark_ties
-
-    if merge_distance_m is None:
-        merge_distance_m = LocateSettings().merge_distance_m
-    size = scene.object_size
-    ws = float(getattr(result.calibration, "width_sign", 1.0) or 1.0)
-    centre = np.array([size.length_m / 2.0, ws * size.width_m / 2.0])
-    logs = []
-    for c in cands:
-        cue = cue_log_likelihood(
-            scene,
-            heading_deg=float(c.heading_deg),
-            theta_rad=float(c.theta_rad),
-            translation_en=np.asarray(c.translation_en, float),
-            scale=float(c.scale),
-            car_center_world=centre,
-            map_data=map_data,
-            frame=result.frame,
-        )
-        logs.append(cue.log_factor)
-        c.flags = [f for f in c.flags if f.kind is not FlagKind.CUE] + [
-            Flag(FlagKind.CUE, f" {n}") for n in cue.notes
-        ]
-    w = np.array([max(c.score, 1e-300) for c in cands]) * np.exp(np.array(logs) - max(logs))
-    w /= w.sum()
-    for c, wi in zip(cands, w, strict=True):
-        c.score = float(wi)
-    cands.sort(key=lambda c: -c.score)
-    for rank, c in enumerate(cands, start=1):
-        c.rank = rank
-    result.candidates = cands
-    result.cues_applied = True
-    mark_ties(cands, LocateSettings(merge_distance_m=merge_distance_m), result)
-    return result

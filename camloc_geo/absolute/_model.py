@@ -10,16 +10,17 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
 from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.relative import CalibrationResult
-from camloc_geo.results import TIE_DISTANCE_M, TIE_SCORE_RATIO
 
 if TYPE_CHECKING:
     from camloc_geo.osm import Intersection
 
 __all__ = [
+    "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "Candidate",
     "Flag",
@@ -28,6 +29,7 @@ __all__ = [
     "LocateSettings",
     "Match",
     "Observation",
+    "Tie",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -74,7 +76,7 @@ class LocateSettings:
         points together (:mod:`camloc_geo.absolute._bundle`); their rank and score stay.
     tie_score_ratio, tie_distance_m
         Candidates tie (``ambiguous_with``) when the weaker scores at least
-        ``tie_score_ratio`` of the stronger (:data:`~camloc_geo.results.TIE_SCORE_RATIO`) and
+        ``tie_score_ratio`` of the stronger (:data:`TIE_SCORE_RATIO`) and
         they stand more than ``tie_distance_m`` apart (closer ones are one answer at the
         accuracy the tool aims at: 10 m).
     """
@@ -293,6 +295,25 @@ class Candidate:
 
 
 @dataclass
+class Tie:
+    """Candidates the evidence cannot tell apart, decided by the core's one tie rule.
+
+    Attributes
+    ----------
+    ranks
+        The ranks that tie with each other (a group linked by the rule), ascending.
+    text
+        What the tie means, one sentence (the leaders' tie gives the odds and the distance).
+    why
+        The explanation alone: what would decide it.
+    """
+
+    ranks: list[int]
+    text: str
+    why: str
+
+
+@dataclass
 class LocateResult:
     """Candidates, best first, and how they were found."""
 
@@ -308,3 +329,5 @@ class LocateResult:
     image_size: tuple[int, int] = (0, 0)
     view_cone_range_m: float = 60.0  # LocateSettings.view_cone_range_m of the run
     cues_applied: bool = False  # the scene's cues (camloc_geo.absolute._cues) are in the scores
+    ties: list[Tie] = field(default_factory=list)  # groups of tied candidates (mark_ties)
+    leaders_tie: bool = False  # candidates 1 and 2 tie: the best point is not decided

@@ -8,11 +8,13 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from camloc_geo._ties import is_tie
 from camloc_geo.absolute._bundle import bundle_adjust
+from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
     Evidence,
     evidence_at,
@@ -33,6 +35,7 @@ from camloc_geo.absolute._model import (
     LocateResult,
     LocateSettings,
     Match,
+    Tie,
 )
 from camloc_geo.absolute._refine import position_sigma_m, refine
 from camloc_geo.absolute._scoring import plausibility, score, unmatched_flags
@@ -44,6 +47,7 @@ if TYPE_CHECKING:
     from camloc_geo.osm import MapData
 
 __all__ = [
+    "apply_cues",
     "bundle_leaders",
     "locate",
     "mark_ties",
@@ -234,7 +238,6 @@ def _expected_plausibility(
 
 def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:
     """The scene's tie-breaking cues for one candidate: log factor and ``cue`` flags."""
-    from camloc_geo.absolute._cues import cue_log_likelihood
 
     assert ev.scene is not None
     cue = cue_log_likelihood(
@@ -414,17 +417,14 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
     return cands
 
 
-TIE_MIN_SCORE = 0.01
-"""Candidates scoring less than this tie with nobody (a tie of two negligible ones says nothing)."""
-
-
 def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
-    lo, hi = sorted((a.score, b.score))
-    gap = float(np.linalg.norm(a.east_north - b.east_north))
-    return (
-        lo >= settings.tie_score_ratio * hi
-        and lo >= TIE_MIN_SCORE
-        and gap > max(settings.tie_distance_m, 2.0 * settings.merge_distance_m)
+    return is_tie(
+        a.score,
+        b.score,
+        float(np.linalg.norm(a.east_north - b.east_north)),
+        score_ratio=settings.tie_score_ratio,
+        distance_m=settings.tie_distance_m,
+        merge_distance_m=settings.merge_distance_m,
     )
 
 
@@ -432,9 +432,10 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
 
     Two candidates tie when the weaker scores at least ``settings.tie_score_ratio`` of the
-    stronger (:data:`~camloc_geo.absolute._model.TIE_SCORE_RATIO`: the evidence favours the
-    stronger by less than 10 to 1) and at least :data:`TIE_MIN_SCORE`, yet they stand more
-    than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot tell them apart).
+    stronger (:data:`~camloc_geo._ties.TIE_SCORE_RATIO`: the evidence favours the
+    stronger by less than 10 to 1) and at least :data:`~camloc_geo._ties.TIE_MIN_SCORE`, yet
+    they stand more than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot
+    tell them apart); the rule is :func:`camloc_geo._ties.is_tie`.
     Earlier marks and the earlier warning are replaced.
     """
     for c in cands:
@@ -446,21 +447,52 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     for c in cands:
         c.ambiguous_with.sort()
     result.warnings = [w for w in result.warnings if not w.startswith("ambiguous:")]
-    if len(cands) >= 2 and _tie(cands[0], cands[1], settings):
-        gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
-        odds = cands[0].score / max(cands[1].score, 1e-300)
-        result.warnings.append(
-            f"ambiguous: candidates 1 and 2 both fit the evidence (scores "
-            f"{cands[0].score:.2f} and {cands[1].score:.2f}: odds of {odds:.1f} to 1, under "
-            f"{1.0 / settings.tie_score_ratio:g} to 1) but stand {gap:.0f} m apart; "
-            + (
-                "even with the scene's cues"
-                if result.cues_applied
-                else "a symmetric junction cannot tell them apart: more evidence (a reference "
-                "pixel, a landmark, another corner), a viewing-direction hint (view_hint) or "
-                "a tighter prior decides"
+    result.leaders_tie = len(cands) >= 2 and _tie(cands[0], cands[1], settings)
+    why = (
+        "even with the scene's cues"
+        if result.cues_applied
+        else "a symmetric junction cannot tell them apart: more evidence (a reference "
+        "pixel, a landmark, another corner), a viewing-direction hint (view_hint) or "
+        "a tighter prior decides"
+    )
+    result.ties = []
+    for group in _tie_groups(cands):
+        if result.leaders_tie and group[:2] == [cands[0].rank, cands[1].rank]:
+            gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
+            odds = cands[0].score / max(cands[1].score, 1e-300)
+            text = (
+                f"candidates 1 and 2 both fit the evidence (scores "
+                f"{cands[0].score:.2f} and {cands[1].score:.2f}: odds of {odds:.1f} to 1, under "
+                f"{1.0 / settings.tie_score_ratio:g} to 1) but stand {gap:.0f} m apart; {why}"
             )
-        )
+            result.warnings.append(f"ambiguous: {text}")
+        else:
+            names = ", ".join(str(r) for r in group[:-1]) + f" and {group[-1]}"
+            text = (
+                f"candidates {names} fit the evidence within odds of "
+                f"{1.0 / settings.tie_score_ratio:g} to 1 but stand apart; {why}"
+            )
+        result.ties.append(Tie(ranks=group, text=text, why=why))
+
+
+def _tie_groups(cands: list[Candidate]) -> list[list[int]]:
+    """The groups of ranks linked by ``ambiguous_with`` (two or more each), ascending."""
+    parent = {c.rank: c.rank for c in cands}
+
+    def root(r: int) -> int:
+        while parent[r] != r:
+            parent[r] = parent[parent[r]]
+            r = parent[r]
+        return r
+
+    for c in cands:
+        for other in c.ambiguous_with:
+            if other in parent:
+                parent[root(other)] = root(c.rank)
+    groups: dict[int, list[int]] = {}
+    for r in sorted(parent):
+        groups.setdefault(root(r), []).append(r)
+    return sorted((g for g in groups.values() if len(g) >= 2), key=lambda g: g[0])
 
 
 def bundle_leaders(
@@ -487,3 +519,57 @@ def bundle_leaders(
         c.lon, c.lat = float(lon), float(lat)
         out[i] = c
     return out
+
+
+def apply_cues(
+    result: Any, scene: Scene, map_data: MapData | None, *, merge_distance_m: float | None = None
+) -> Any:
+    """Re-rank a :class:`~camloc_geo.absolute.LocateResult` by the scene's cues, in place.
+
+    :func:`camloc_geo.absolute.locate` scores every hypothesis with the cues itself (before
+    merging, refinement and ranking), and its result says so (``cues_applied``): then this
+    does nothing. It remains for results computed without them.
+
+    Each candidate's score (a posterior weight) is multiplied by its cue factor
+    (:func:`~camloc_geo.absolute._cues.cue_log_likelihood`) and the scores renormalised; the
+    ranks follow. Notes go to the candidate's ``flags`` (``cue: ...``), and the ties are
+    recomputed with the rule of :func:`locate` (:func:`mark_ties`). A scene
+    without cues leaves the result unchanged.
+    """
+    cands = list(getattr(result, "candidates", []) or [])
+    if getattr(result, "cues_applied", False):
+        return result  # locate() already ranked with them
+    if not cands or not scene.has_cues:
+        return result
+    if merge_distance_m is None:
+        merge_distance_m = LocateSettings().merge_distance_m
+    size = scene.object_size
+    ws = float(getattr(result.calibration, "width_sign", 1.0) or 1.0)
+    centre = np.array([size.length_m / 2.0, ws * size.width_m / 2.0])
+    logs = []
+    for c in cands:
+        cue = cue_log_likelihood(
+            scene,
+            heading_deg=float(c.heading_deg),
+            theta_rad=float(c.theta_rad),
+            translation_en=np.asarray(c.translation_en, float),
+            scale=float(c.scale),
+            car_center_world=centre,
+            map_data=map_data,
+            frame=result.frame,
+        )
+        logs.append(cue.log_factor)
+        c.flags = [f for f in c.flags if f.kind is not FlagKind.CUE] + [
+            Flag(FlagKind.CUE, f" {n}") for n in cue.notes
+        ]
+    w = np.array([max(c.score, 1e-300) for c in cands]) * np.exp(np.array(logs) - max(logs))
+    w /= w.sum()
+    for c, wi in zip(cands, w, strict=True):
+        c.score = float(wi)
+    cands.sort(key=lambda c: -c.score)
+    for rank, c in enumerate(cands, start=1):
+        c.rank = rank
+    result.candidates = cands
+    result.cues_applied = True
+    mark_ties(cands, LocateSettings(merge_distance_m=merge_distance_m), result)
+    return result

@@ -17,9 +17,10 @@ from camloc_geo.cameras import (
     CameraResult,
     CameraRow,
     geocode_camera,
+    read_camera_csv,
     read_camera_list,
+    row_from_mapping,
 )
-from camloc_geo.cameras._list import read_camera_csv, row_from_mapping
 
 __all__ = [
     "COLUMN_VARIANTS",

@@ -26,9 +26,14 @@ from typing import Any
 
 from camloc_geo._errors import InputError
 from camloc_geo.batch._journal import Journal, journal_path
-from camloc_geo.cameras._camera import RETRY_STATUSES, CameraResult, geocode_camera
-from camloc_geo.cameras._list import CameraRow, read_camera_list
-from camloc_geo.osm._catalogue import Area, MapPlan, area_map, map_plan
+from camloc_geo.cameras import (
+    RETRY_STATUSES,
+    CameraResult,
+    CameraRow,
+    geocode_camera,
+    read_camera_list,
+)
+from camloc_geo.osm import Area, MapPlan, area_map, map_plan
 
 __all__ = ["BatchSummary", "process_chunk", "run_batch"]
 

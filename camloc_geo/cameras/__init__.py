@@ -13,17 +13,31 @@ from __future__ import annotations
 from camloc_geo.cameras._camera import (
     PLACED_STATUSES,
     RETRY_STATUSES,
+    STATUS_ALIASES,
+    STATUSES,
     CameraResult,
     geocode_camera,
+    normalize_status,
 )
-from camloc_geo.cameras._list import COLUMN_VARIANTS, CameraRow, read_camera_list
+from camloc_geo.cameras._list import (
+    COLUMN_VARIANTS,
+    CameraRow,
+    read_camera_csv,
+    read_camera_list,
+    row_from_mapping,
+)
 
 __all__ = [
     "COLUMN_VARIANTS",
     "PLACED_STATUSES",
     "RETRY_STATUSES",
+    "STATUSES",
+    "STATUS_ALIASES",
     "CameraResult",
     "CameraRow",
     "geocode_camera",
+    "normalize_status",
+    "read_camera_csv",
     "read_camera_list",
+    "row_from_mapping",
 ]

@@ -41,11 +41,18 @@ from typing import TYPE_CHECKING, Any
 from camloc_geo._errors import MapDataError, MapSourceError, SceneError
 
 if TYPE_CHECKING:
-    from camloc_geo.cameras._list import CameraRow
-    from camloc_geo.osm import MapData
-    from camloc_geo.osm._catalogue import Area, MapPlan
+    from camloc_geo.cameras import CameraRow
+    from camloc_geo.osm import Area, MapData, MapPlan
 
-__all__ = ["PLACED_STATUSES", "RETRY_STATUSES", "CameraResult", "geocode_camera"]
+__all__ = [
+    "PLACED_STATUSES",
+    "RETRY_STATUSES",
+    "STATUSES",
+    "STATUS_ALIASES",
+    "CameraResult",
+    "geocode_camera",
+    "normalize_status",
+]
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +61,30 @@ PLACED_STATUSES = frozenset({"located", "title_only"})
 
 RETRY_STATUSES = frozenset({"failed", "map_error"})
 """Statuses a rerun computes again (the cause may be transient)."""
+
+STATUSES = (
+    "located",
+    "title_only",
+    "ambiguous",
+    "street_only",
+    "not_found",
+    "no_candidates",
+    "no_evidence",
+    "no_map",
+    "scene_error",
+    "map_error",
+    "failed",
+)
+"""The one status vocabulary of a camera (module docstring, ``docs/contract.md``)."""
+
+STATUS_ALIASES = {"no_candidate": "no_candidates"}
+"""Old status words accepted on input (the service's jobs said ``no_candidate``)."""
+
+
+def normalize_status(status: str) -> str:
+    """The status word of :data:`STATUSES` for an old or current one."""
+    return STATUS_ALIASES.get(status, status)
+
 
 _CONE_RANGE_M = 60.0
 _TITLE_CONE_HALF_DEG = 30.0
@@ -137,7 +168,9 @@ class CameraResult:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CameraResult:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (old status words accepted, :data:`STATUS_ALIASES`)."""
+        if isinstance(data.get("status"), str):
+            data = {**data, "status": normalize_status(data["status"])}
         return cls(**data)
 
     def fail(self, status: str, reason: str, stage: str) -> CameraResult:
@@ -343,8 +376,8 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
 
 
 def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | None) -> None:
-    from camloc_geo.absolute._geojson import view_cone as _view_cone
-    from camloc_geo.api import locate_scene
+    from camloc_geo.absolute import locate
+    from camloc_geo.absolute import view_cone as _view_cone
     from camloc_geo.geodesy import normalize_bearing_deg
 
     try:
@@ -355,17 +388,24 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
             where = f"scene {os.path.basename(str(row.scene))}"
         res.fail("scene_error", f"{where}: {exc}", "scene")
         return
+    if m is None and sc.needs_map:
+        res.fail(
+            "no_candidates",
+            "this scene needs a map (intersection corners, landmarks or street bearings) and "
+            "no map covers it",
+            "locate",
+        )
+        return
     try:
-        out = locate_scene(sc, map_source=m, network=False)
+        r = locate(sc, m)
     except MapDataError as exc:
         res.fail("no_candidates", str(exc), "locate")
         return
     except SceneError as exc:
         res.fail("scene_error", str(exc), "locate")
         return
-    r = out.result
     res.method = "locate"
-    res.extract = res.extract or _extract_name(out.map_data)
+    res.extract = res.extract or _extract_name(m)
     frame = r.frame
     title_cands = res.candidates
     res.candidates = []
@@ -413,9 +453,10 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
     res.height_m = res.candidates[0]["height_m"]
     # a tie between candidates at the same junction (a symmetric one) keeps the best
     # candidate's point, flagged; the candidates layer has both
-    res.tie = any(w.startswith("ambiguous") for w in r.warnings)
+    res.tie = r.leaders_tie
     if res.tie:
-        warnings.sort(key=lambda w: not w.startswith("ambiguous"))
+        lead = f"ambiguous: {r.ties[0].text}"
+        warnings = [lead] + [w for w in warnings if w != lead]
     res.status = "located"
     res.lat, res.lon = _finite(best.lat), _finite(best.lon)
     res.reason = "; ".join(warnings[:3]) or None
@@ -482,7 +523,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     if not (row.title or row.streets):
         res.status = "no_evidence"
@@ -562,7 +603,7 @@ def geocode_camera(
         Without ``map_source``: may the map around the camera's point be fetched from
         Overpass.
     plan, area
-        A prepared :func:`~camloc_geo.osm._catalogue.map_plan` and the camera's area (what
+        A prepared :func:`~camloc_geo.osm.map_plan` and the camera's area (what
         :func:`run_batch` passes; computed from ``map_source`` when omitted).
     """
     res = CameraResult(row=row.row, id=row.id, title=row.title, list_lat=row.lat, list_lon=row.lon)
@@ -588,7 +629,7 @@ def _geocode(
     if map_data is not None:
         return _with_map(row, res, map_data)
     if plan is None:
-        from camloc_geo.osm._catalogue import map_plan
+        from camloc_geo.osm import map_plan
 
         plan = (
             _cached_plan(map_source, network)
@@ -605,7 +646,7 @@ def _geocode(
         return res.fail("no_map", str(area[1]), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     try:
         m = area_map(area)
@@ -619,7 +660,7 @@ _PLANS: dict[tuple[str, bool], MapPlan] = {}
 
 
 def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
-    from camloc_geo.osm._catalogue import map_plan
+    from camloc_geo.osm import map_plan
 
     key = (str(map_source), bool(network))
     if key not in _PLANS:

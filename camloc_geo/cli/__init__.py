@@ -138,7 +138,10 @@ def add_map_options(
     p.add_argument(
         "--osm",
         metavar="EXTRACT",
-        help="local OSM extract (.osm, .osm.gz, .osm.bz2, .osm.pbf); then no network is used",
+        help=(
+            "local OSM extract (.osm, .osm.gz, .osm.bz2, .osm.pbf) or a folder of them (the one "
+            "covering the point is used); then no network is used"
+        ),
     )
     p.add_argument(
         "--no-network",

@@ -164,8 +164,7 @@ def _feature_writer(out: str | None) -> Iterator[Any]:
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc geocode``."""
     from camloc_geo._errors import InputError
-    from camloc_geo.geocode import geocode_title_in_maps
-    from camloc_geo.geocode._maps import extract_paths, whole_map
+    from camloc_geo.geocode import extract_paths, geocode_title_in_maps, whole_map
 
     if not args.titles and not args.list:
         raise InputError("give one or more titles, or --list LIST.csv")

@@ -74,9 +74,8 @@ def run(args: argparse.Namespace) -> int:
         cache_folder=args.cache_folder,
         overpass_url=args.overpass_url,
     )
-    for warning in out.result.warnings:
-        if warning.startswith("ambiguous"):
-            log.warning("%s", warning)  # a tie is never only in the GeoJSON
+    if out.result.leaders_tie:  # a tie is never only in the GeoJSON
+        log.warning("ambiguous: %s", out.result.ties[0].text)
     write_json(out.to_geojson(), args.output, inputs=inputs)
     if map_path is not None:
         from camloc_geo.maps import candidates_map

@@ -35,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``camloc streets``."""
     from camloc_geo.api import streets_near
     from camloc_geo.cli import output_path
-    from camloc_geo.osm import streets_json
+    from camloc_geo.results import streets_json
 
     output_path(args.output, inputs=[args.osm])
     m = streets_near(

@@ -39,7 +39,10 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--osm",
         metavar="EXTRACT",
-        help="draw this extract's streets and buildings (within 500 m of the cameras' centre)",
+        help=(
+            "draw this extract's (or this folder's covering extract's) streets and buildings "
+            "(within 500 m of the cameras' centre)"
+        ),
     )
     p.add_argument("--no-cluster", action="store_true", help="plain markers on online pages too")
     p.set_defaults(func=run)

@@ -37,6 +37,7 @@ from camloc_geo.geocode._normalize import (
     types_of,
 )
 from camloc_geo.geocode._parse import ParsedTitle, parse_title
+from camloc_geo.geodesy import great_circle_m
 
 if TYPE_CHECKING:
     from camloc_geo.osm import Intersection, MapData
@@ -386,8 +387,7 @@ def _landmark_hits(name: str, index: GeocodeIndex) -> list[tuple[Landmark, str, 
 
 
 def _dist_m(lat0: float, lon0: float, lat: float, lon: float) -> float:
-    kx = _M_PER_DEG * math.cos(math.radians((lat0 + lat) / 2.0))
-    return math.hypot((lon - lon0) * kx, (lat - lat0) * 110_574.0)
+    return great_circle_m(lat1=lat0, lon1=lon0, lat2=lat, lon2=lon)
 
 
 def _junction_size_m(inter: Intersection, map_data: MapData, index: GeocodeIndex) -> float:

@@ -35,7 +35,7 @@ def whole_map(path: str | os.PathLike[str]) -> MapData:
     The same map, anchored at the same point, as every front end gets for a point in this
     extract (:class:`camloc_geo.osm.MapCatalogue`), loaded once per process.
     """
-    from camloc_geo.osm._catalogue import area_map
+    from camloc_geo.osm import area_map
 
     p = Path(path).expanduser().absolute()
     return area_map(("file", str(p)))

@@ -11,25 +11,32 @@ and :mod:`camloc_geo.osm._widths` for carriageway widths.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 from camloc_geo.osm._catalogue import (
     CELL_M,
     WHOLE_EXTRACT_MAX_BYTES,
+    Area,
     MapCatalogue,
     MapCatalogueSource,
+    MapPlan,
+    area_map,
     extract_bounds,
     extract_files,
+    map_plan,
 )
-from camloc_geo.osm._geojson import intersections_geojson, streets_json
-from camloc_geo.osm._intersections import (
-    ARM_SAMPLE_M,
-    MAX_CORNER_GAP_DEG,
-    MIN_CORNER_GAP_DEG,
-)
-from camloc_geo.osm._load import EXTRACT_SUFFIXES, STREET_HIGHWAYS, clear_cache, header_box
-from camloc_geo.osm._map import DEFAULT_TOLERANCE_M, MapData, load_map
-from camloc_geo.osm._model import Building, Corner, IncidentStreet, Intersection, Street
-from camloc_geo.osm._names import normalize_name
-from camloc_geo.osm._widths import resolve_width_m
+
+if TYPE_CHECKING:
+    from camloc_geo.osm._intersections import (
+        ARM_SAMPLE_M,
+        MAX_CORNER_GAP_DEG,
+        MIN_CORNER_GAP_DEG,
+    )
+    from camloc_geo.osm._load import EXTRACT_SUFFIXES, STREET_HIGHWAYS, clear_cache, header_box
+    from camloc_geo.osm._map import DEFAULT_TOLERANCE_M, MapData, load_map
+    from camloc_geo.osm._model import Building, Corner, IncidentStreet, Intersection, Street
+    from camloc_geo.osm._names import normalize_name
+    from camloc_geo.osm._widths import resolve_width_m
 
 __all__ = [
     "ARM_SAMPLE_M",
@@ -40,6 +47,7 @@ __all__ = [
     "MIN_CORNER_GAP_DEG",
     "STREET_HIGHWAYS",
     "WHOLE_EXTRACT_MAX_BYTES",
+    "Area",
     "Building",
     "Corner",
     "IncidentStreet",
@@ -47,14 +55,59 @@ __all__ = [
     "MapCatalogue",
     "MapCatalogueSource",
     "MapData",
+    "MapPlan",
     "Street",
+    "area_map",
     "clear_cache",
     "extract_bounds",
     "extract_files",
     "header_box",
-    "intersections_geojson",
     "load_map",
+    "map_plan",
     "normalize_name",
     "resolve_width_m",
-    "streets_json",
 ]
+
+
+_LAZY = {
+    "ARM_SAMPLE_M": "_intersections",
+    "MAX_CORNER_GAP_DEG": "_intersections",
+    "MIN_CORNER_GAP_DEG": "_intersections",
+    "EXTRACT_SUFFIXES": "_load",
+    "STREET_HIGHWAYS": "_load",
+    "clear_cache": "_load",
+    "header_box": "_load",
+    "DEFAULT_TOLERANCE_M": "_map",
+    "MapData": "_map",
+    "load_map": "_map",
+    "Building": "_model",
+    "Corner": "_model",
+    "IncidentStreet": "_model",
+    "Intersection": "_model",
+    "Street": "_model",
+    "normalize_name": "_names",
+    "resolve_width_m": "_widths",
+}
+"""Names imported on first use (osmium, networkx and scipy load only when a map does)."""
+
+_MOVED_TO_RESULTS = {"intersections_geojson", "streets_json"}
+
+
+def __getattr__(name: str) -> Any:
+    """The map layer's names, imported on first use.
+
+    ``intersections_geojson`` and ``streets_json`` are output shapes, now in
+    :mod:`camloc_geo.results`; they stay importable from here (public names), and the map
+    layer itself never imports ``results``.
+    """
+    import importlib
+
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    if name in _MOVED_TO_RESULTS:
+        from camloc_geo import results
+
+        return getattr(results, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

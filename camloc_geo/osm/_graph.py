@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import itertools
 import logging
-import math
 from collections.abc import Iterable, Iterator, Sequence
 from typing import Any
 
 import networkx as nx
 from shapely.geometry import LineString
+
+from camloc_geo.geodesy import great_circle_m
 
 __all__ = ["USEFUL_TAGS_WAY", "graph_from_ways", "simplify_graph"]
 
@@ -48,15 +49,6 @@ USEFUL_TAGS_WAY = (
 
 _ONEWAY_VALUES = {"yes", "true", "1", "-1", "reverse", "T", "F"}
 _REVERSED_VALUES = {"-1", "reverse", "T"}
-EARTH_RADIUS_M = 6_371_009.0
-
-
-def _great_circle_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
-    """Haversine distance (osmnx's ``great_circle``), metres."""
-    y1, y2 = math.radians(lat1), math.radians(lat2)
-    x1, x2 = math.radians(lon1), math.radians(lon2)
-    h = math.sin((y2 - y1) / 2) ** 2 + math.cos(y1) * math.cos(y2) * math.sin((x2 - x1) / 2) ** 2
-    return 2 * math.asin(math.sqrt(h)) * EARTH_RADIUS_M
 
 
 def graph_from_ways(
@@ -99,7 +91,7 @@ def graph_from_ways(
             G.add_edges_from([(v, u) for u, v in edges], **attrs)
     for u, v, data in G.edges(data=True):
         a, b = G.nodes[u], G.nodes[v]
-        data["length"] = _great_circle_m(a["y"], a["x"], b["y"], b["x"])
+        data["length"] = great_circle_m(lat1=a["y"], lon1=a["x"], lat2=b["y"], lon2=b["x"])
     return G
 
 

@@ -60,7 +60,7 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString
 
-from camloc_geo.geodesy import LocalFrame, bearing_deg
+from camloc_geo.geodesy import LocalFrame, bearing_deg, initial_bearing_deg
 from camloc_geo.osm._model import Corner, IncidentStreet, Intersection
 from camloc_geo.osm._names import normalize_name
 from camloc_geo.osm._widths import _first, parse_lanes, resolve_width_m
@@ -194,20 +194,7 @@ def _bearing_enu(frame: LocalFrame, p0: np.ndarray, p1: np.ndarray) -> float:
     (lon0, lon1), (lat0, lat1) = frame.geographic_from_enu(
         np.array([p0[0], p1[0]]), np.array([p0[1], p1[1]])
     )
-    return initial_bearing_deg(lat0, lon0, lat1, lon1)
-
-
-def initial_bearing_deg(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
-    """Initial great-circle bearing from point 1 to point 2, degrees in [0, 360).
-
-    The formula of :func:`osmnx.bearing.calculate_bearing` (kept here so that a local
-    extract needs no osmnx import for it).
-    """
-    phi1, phi2 = math.radians(lat1), math.radians(lat2)
-    dlon = math.radians(lon2 - lon1)
-    y = math.sin(dlon) * math.cos(phi2)
-    x = math.cos(phi1) * math.sin(phi2) - math.sin(phi1) * math.cos(phi2) * math.cos(dlon)
-    return math.degrees(math.atan2(y, x)) % 360.0
+    return initial_bearing_deg(lat1=lat0, lon1=lon0, lat2=lat1, lon2=lon1)
 
 
 def project_graph_enu(G: nx.MultiDiGraph, frame: LocalFrame) -> nx.MultiDiGraph:

@@ -15,11 +15,10 @@ import numpy as np
 from shapely.geometry import LineString, Point
 
 from camloc_geo._errors import MapDataError
-from camloc_geo.geodesy import LocalFrame
+from camloc_geo.geodesy import LocalFrame, initial_bearing_deg
 from camloc_geo.osm._intersections import (
     build_intersections,
     highway_of,
-    initial_bearing_deg,
     street_label,
 )
 from camloc_geo.osm._load import (
@@ -477,7 +476,7 @@ class MapData:
             (lon_a, lon_b), (lat_a, lat_b) = self.frame.geographic_from_enu(
                 np.array([a.x, b.x]), np.array([a.y, b.y])
             )
-            brg = initial_bearing_deg(lat_a, lon_a, lat_b, lon_b) % 180.0
+            brg = initial_bearing_deg(lat1=lat_a, lon1=lon_a, lat2=lat_b, lon2=lon_b) % 180.0
             rows.append((float(dist), street.name, brg))
         rows.sort()
         out: list[tuple[str, float]] = []

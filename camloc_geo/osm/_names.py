@@ -1,57 +1,24 @@
 """Street and building name normalisation for tolerant look-ups.
 
-Names are compared after :func:`normalize_name`: Unicode case folding, accents kept,
-``ß`` folded to ``ss``, punctuation dropped, and common abbreviations expanded token by
-token (``St``/``Street``, ``Ave``/``Avenue``, ``N``/``North``, ``Str.``/``Straße``...). A
-leading ``St`` is read as *Saint* (``St Paul St`` = ``Saint Paul Street``).
+Names are compared after :func:`normalize_name`, the canonical tokens of the one normaliser
+(:func:`camloc_geo.osm._tokens.name_tokens`, shared with title geocoding): transliterated to
+ASCII and case folded, punctuation dropped, abbreviations expanded by one table (USPS street
+suffixes and directionals, French, Spanish, Portuguese, German, Russian: ``St``/``Street``,
+``Ave``/``Avenue``, ``N``/``North``, ``Str.``/``Straße``...), numbered streets as digits.
+``St`` is *Saint* unless it ends the name (``St Paul St`` = ``Saint Paul Street``). Close
+names are found with rapidfuzz.
 """
 
 from __future__ import annotations
 
-import difflib
 import re
-import unicodedata
 from collections.abc import Iterable, Sequence
+
+from camloc_geo.osm._tokens import name_tokens
 
 __all__ = ["close_matches", "names_match", "normalize_name", "split_street_query"]
 
-_ABBREVIATIONS: dict[str, str] = {
-    "st": "street",
-    "str": "strasse",
-    "ave": "avenue",
-    "av": "avenue",
-    "avn": "avenue",
-    "rd": "road",
-    "blvd": "boulevard",
-    "bd": "boulevard",
-    "bvd": "boulevard",
-    "dr": "drive",
-    "ln": "lane",
-    "pl": "place",
-    "ct": "court",
-    "cir": "circle",
-    "hwy": "highway",
-    "pkwy": "parkway",
-    "sq": "square",
-    "ter": "terrace",
-    "tce": "terrace",
-    "cres": "crescent",
-    "expy": "expressway",
-    "fwy": "freeway",
-    "mt": "mount",
-    "n": "north",
-    "s": "south",
-    "e": "east",
-    "w": "west",
-    "ne": "northeast",
-    "nw": "northwest",
-    "se": "southeast",
-    "sw": "southwest",
-    "r": "rue",
-}
-
 _SPLIT_RE = re.compile(r"\s*(?:&|/|×|\+|\s+and\s+|\s+x\s+|\s+at\s+)\s*", re.IGNORECASE)
-_PUNCT_RE = re.compile(r"[^\w\s]", re.UNICODE)
 
 
 def normalize_name(name: str) -> str:
@@ -75,18 +42,7 @@ def normalize_name(name: str) -> str:
     >>> normalize_name("Hauptstr.") == normalize_name("Hauptstraße")
     True
     """
-    text = unicodedata.normalize("NFKC", name).casefold().replace("ß", "ss")
-    # glued German suffix: "Hauptstr." -> "hauptstrasse"
-    text = re.sub(r"(\w)str\b\.?", r"\1strasse", text)
-    text = _PUNCT_RE.sub(" ", text)
-    tokens = text.split()
-    out: list[str] = []
-    for i, tok in enumerate(tokens):
-        if tok == "st" and i == 0 and len(tokens) > 1:
-            out.append("saint")
-        else:
-            out.append(_ABBREVIATIONS.get(tok, tok))
-    return " ".join(out)
+    return " ".join(name_tokens(name))
 
 
 def names_match(query: str, name: str) -> bool:
@@ -114,7 +70,10 @@ def close_matches(query: str, candidates: Iterable[str], n: int = 5) -> list[str
     for cand in candidates:
         by_norm.setdefault(normalize_name(cand), cand)
     norm_query = normalize_name(query)
-    hits = difflib.get_close_matches(norm_query, list(by_norm), n=n, cutoff=0.6)
+    from rapidfuzz import fuzz, process
+
+    found = process.extract(norm_query, list(by_norm), scorer=fuzz.ratio, limit=n, score_cutoff=60)
+    hits = [name for name, _score, _i in found]
     # also offer names that contain the query's tokens ("Broadway" -> "South Broadway")
     q_tokens = set(norm_query.split())
     for norm, _cand in by_norm.items():

@@ -166,7 +166,13 @@ class Store:
             "SELECT result FROM job_cameras WHERE job_id = ? AND state = 'done' ORDER BY idx",
             (job_id,),
         )
-        return [json.loads(r["result"]) for r in rows]
+        from camloc_geo.cameras import normalize_status
+
+        out = [json.loads(r["result"]) for r in rows]
+        for r in out:  # results stored by an older server: its status words
+            if isinstance(r, dict) and isinstance(r.get("status"), str):
+                r["status"] = normalize_status(r["status"])
+        return out
 
     # --- crowd tasks ---------------------------------------------------------------------
     def create_task(

@@ -96,14 +96,13 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     catalogue chooses; statuses are the engine's (``docs/contract.md``).
     """
     from camloc_geo.api import locate_camera
-    from camloc_geo.cameras import CameraResult
-    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.cameras import CameraResult, row_from_mapping
     from camloc_geo.results import camera_job_result
 
     cam_id = str(camera.get("id", "")) if isinstance(camera, dict) else ""
     try:
         if not isinstance(camera, dict):
-            raise SceneError("a camera must be a JSON object")
+            raise InputError("a camera must be a JSON object")
         scene = camera.get("scene")
         if scene is not None:
             check_scene_body(scene, settings, where="scene")
@@ -113,7 +112,7 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
         res = locate_camera(row, map_source=maps.catalogue)
     except CamlocError as exc:
         res = CameraResult(row=1, id=cam_id).fail(
-            "scene_error" if isinstance(exc, SceneError) else "failed",
+            "scene_error" if isinstance(exc, (SceneError, LimitError)) else "failed",
             " ".join(str(exc).split()),
             "input",
         )

@@ -238,15 +238,15 @@ def annotation_page_html(
     has_map = bool(corners_geojson and corners_geojson.get("features"))
     leaflet = ""
     if has_map:
-        from camloc_geo.maps import _assets
+        from camloc_geo.maps import leaflet_assets
 
-        assets = _assets()
+        assets = leaflet_assets()
         leaflet = (
             "<style>"
             + assets["leaflet_css"]
             + "</style>\n<script>"
             + assets["leaflet_js"]
-            # "</script" cannot occur: maps._assets checked it.
+            # "</script" cannot occur: maps.leaflet_assets checked it.
             + "</script>"
         )
     page = _asset("annotate.html")
