@@ -400,3 +400,21 @@ def test_cli_batch_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     cams = pyogrio.read_dataframe(tmp_path / "o.gpkg", layer="cameras")
     assert cams["status"].tolist() == ["no_map"]
     assert "give --osm" in capsys.readouterr().err or True
+
+
+def test_candidates_carry_the_cores_ties(local_run: dict[str, Any]) -> None:
+    """The candidates layer says which ranks tie, as the core decided (no warning text)."""
+    cams = local_run["layers"]["cameras"].set_index("id")
+    cands = local_run["layers"]["candidates"]
+    located = cands[cands["source"] == "locate"]
+    assert len(located) > 0
+    for cam_id, group in located.groupby("id"):
+        ranks = set(group["rank"])
+        ties = {
+            int(r): {int(o) for o in (t if isinstance(t, str) else "").split(",") if o}
+            for r, t in zip(group["rank"], group["ambiguous_with"], strict=True)
+        }
+        for rank, others in ties.items():
+            assert others <= ranks - {rank}, (cam_id, rank, others)
+            assert all(rank in ties[o] for o in others), (cam_id, rank, others)  # symmetric
+        assert bool(cams.loc[cam_id, "tie"]) == bool(ties.get(1)), cam_id

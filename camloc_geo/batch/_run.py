@@ -455,6 +455,7 @@ _CANDIDATE_COLUMNS: dict[str, str] = {
     "detail": "object",
     "intersection": "object",
     "extract": "object",
+    "ambiguous_with": "object",
 }
 _CONE_COLUMNS = {
     "row": "int64",
@@ -489,6 +490,19 @@ def _frame(rows: list[dict[str, Any]], columns: dict[str, str], geoms: list[Any]
     return gpd.GeoDataFrame(df, geometry=gpd.GeoSeries(geoms, crs="EPSG:4326"), crs="EPSG:4326")
 
 
+def _best_ties(r: dict[str, Any]) -> list[int]:
+    """The ranks the camera's best candidate ties with (journals of older runs: rank 2)."""
+    cands = r.get("candidates") or []
+    if cands and "ambiguous_with" in cands[0]:
+        return [int(o) for o in cands[0].get("ambiguous_with") or []]
+    return [2] if r.get("tie") and r.get("status") == "located" else []
+
+
+def _ranks_text(ranks: list[Any]) -> str | None:
+    """A candidate's tie ranks as GeoPackage text (``"2,4"``), None without a tie."""
+    return ",".join(str(int(o)) for o in ranks) or None
+
+
 def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
     from shapely.geometry import Point, Polygon
 
@@ -502,7 +516,8 @@ def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
         placed = r.get("lat") is not None and r.get("lon") is not None
         cam_g.append(Point(r["lon"], r["lat"]) if placed else None)
         for c in r.get("candidates") or []:
-            cands.append({**c, "row": r["row"], "id": r["id"]})
+            ties = c.get("ambiguous_with") or []
+            cands.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": _ranks_text(ties)})
             ok = c.get("lat") is not None and c.get("lon") is not None
             cand_g.append(Point(c["lon"], c["lat"]) if ok else None)
         for c in r.get("cones") or []:
@@ -595,8 +610,8 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
             "height_m": r.get("height_m"),
             "sigma_m": r.get("uncertainty_m"),
             "flags": ([r["status"]] + (["tie"] if r.get("tie") else [])),
-            # a located camera's tie is always its candidates 1 and 2 (the engine's warning)
-            "ambiguous_with": [2] if r.get("tie") and r["status"] == "located" else [],
+            # the best candidate's ties, as the engine decided them (the core's rule)
+            "ambiguous_with": _best_ties(r),
         }
         yield (
             label,

@@ -426,6 +426,8 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
                 "detail": ", ".join(str(f) for f in c.flags) or None,
                 "intersection": getattr(r.intersection, "id", None),
                 "extract": res.extract,
+                # the core's tie rule, as data: the ranks this candidate ties with
+                "ambiguous_with": [int(o) for o in c.ambiguous_with],
             }
         )
         poly = _view_cone(c.camera, r.image_size, _CONE_RANGE_M)
