@@ -340,9 +340,17 @@ class MapData:
 
     def _street_hits(self, wanted: list[str]) -> list[Intersection]:
         norms = [normalize_name(w) for w in wanted]
+        # every intersection's normalised street names, once per map (30 ms a call on a
+        # city's extract when done per call, twice per locate)
+        table = self.cached(
+            "intersection_street_names",
+            lambda: [
+                [frozenset(normalize_name(n) for n in (s.names or (s.name,))) for s in x.streets]
+                for x in self._intersections
+            ],
+        )
 
-        def matches(inter: Intersection, loose: bool) -> bool:
-            sets = [{normalize_name(n) for n in (s.names or (s.name,))} for s in inter.streets]
+        def matches(sets: list[frozenset[str]], loose: bool) -> bool:
             for q in norms:
                 q_tokens = set(q.split())
                 ok = any(q in names for names in sets) or (
@@ -353,7 +361,11 @@ class MapData:
             return True
 
         for loose in (False, True):
-            hits = [x for x in self._intersections if matches(x, loose)]
+            hits = [
+                x
+                for x, sets in zip(self._intersections, table, strict=True)
+                if matches(sets, loose)
+            ]
             if hits:
                 return hits
         return []
