@@ -158,6 +158,34 @@ def _bundle(
             r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
         return r
 
+    def map_residuals_batch(Z: FloatArray) -> FloatArray:
+        """:func:`map_residuals` of a batch of parameter vectors ``(P, n)`` → ``(P, m)``."""
+        f, pp, R, C = prob._unpack_batch(
+            Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
+        )
+        theta, tx, ty, ls = Z[:, n_cam], Z[:, n_cam + 1], Z[:, n_cam + 2], Z[:, n_cam + 3]
+        s = np.exp(ls)
+        cos_t, sin_t = np.cos(theta), np.sin(theta)
+        dx = q_en[None, :, 0] - tx[:, None]  # (P, n)
+        dy = q_en[None, :, 1] - ty[:, None]
+        # rot2(θ)ᵀ applied to each row, over the scale
+        px = (dx * cos_t[:, None] + dy * sin_t[:, None]) / s[:, None]
+        py = (-dx * sin_t[:, None] + dy * cos_t[:, None]) / s[:, None]
+        p_out = np.stack([px, py, np.zeros_like(px)], axis=2)  # (P, n, 3)
+        p_int = p_out @ M.T + origin
+        pc = np.einsum("pij,pnj->pni", R, p_int - C[:, None, :])
+        depth = np.maximum(pc[:, :, 2], 0.05)
+        fc = f[:, None]
+        u = pc[:, :, 0] / depth * fc + pp[:, 0:1]
+        v = pc[:, :, 1] / depth * fc + pp[:, 1:2]
+        sig = np.sqrt(sigma_click**2 + (fc * sigma_map[None, :] / depth) ** 2)
+        parts = [(u - pixels[:, 0]) / sig, (v - pixels[:, 1]) / sig, (ls / s_sigma)[:, None]]
+        if street_brg is not None:
+            car_brg = (90.0 - np.degrees(theta)) % 180.0
+            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
+            parts.append((diff / settings.bearing_sigma_deg)[:, None])
+        return np.concatenate(parts, axis=1)
+
     def annotation_residuals(z: FloatArray) -> FloatArray:
         return np.asarray(
             prob.residuals(z[:n_cam], state.rotation0, state.principal_point, state.focal_px)
@@ -174,13 +202,15 @@ def _bundle(
     )
 
     def jacobian(z: FloatArray) -> FloatArray:
+        # The annotations depend on the camera only: their block comes from the joint fit's
+        # own batched Jacobian; the few map rows by forward differences.
+        J_ann = prob.jacobian(z[:n_cam], state.rotation0, state.principal_point, state.focal_px)
         h = 1e-6 * np.maximum(1.0, np.abs(z))
-        r0 = residuals(z)
-        J = np.empty((len(r0), len(z)))
-        for k in range(len(z)):
-            dz = z.copy()
-            dz[k] += h[k]
-            J[:, k] = (residuals(dz) - r0) / h[k]
+        Mb = map_residuals_batch(np.vstack([z, z + np.diag(h)]))
+        n_ann = J_ann.shape[0]
+        J = np.zeros((n_ann + Mb.shape[1], len(z)))
+        J[:n_ann, :n_cam] = J_ann
+        J[n_ann:] = ((Mb[1:] - Mb[0]) / h[:, None]).T
         return J
 
     res = soft_l1_least_squares(residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200)
