@@ -102,15 +102,26 @@ def _journal_count(path: Path) -> int:
         return -1
 
 
-_RESUME_OLD = """
-import resource, sys
+_HWM = """
+def _HWM():  # this process's peak RSS, MiB (ru_maxrss would count the parent's, from fork)
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]) / 1024
+"""
+_RESUME_OLD = (
+    _HWM
+    + """
+import sys
 from camloc_geo.batch._journal import Journal
 j = Journal(__import__("pathlib").Path(sys.argv[1]))
 done = j.done_rows(retry=("failed",))
-print(len(done), resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+print(len(done), _HWM())
 """
-_RESUME_NEW = """
-import resource, sys
+)
+_RESUME_NEW = (
+    _HWM
+    + """
+import sys
 from camloc_geo.batch._journal import Journal
 from camloc_geo.batch._run import _RowBits
 j = Journal(__import__("pathlib").Path(sys.argv[1]))
@@ -119,14 +130,17 @@ n = 0
 for row, _id in j.iter_done(retry=("failed",)):
     done.add(row)
     n += 1
-print(n, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+print(n, _HWM())
 """
-_RESUME_BASE = """
-import resource
+)
+_RESUME_BASE = (
+    _HWM
+    + """
 from camloc_geo.batch._journal import Journal
 from camloc_geo.batch._run import _RowBits
-print(0, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+print(0, _HWM())
 """
+)
 
 
 def resume_check_memory(rows: int) -> dict[str, Any]:
@@ -225,7 +239,15 @@ def main(argv: list[str] | None = None) -> int:
         t0 = time.perf_counter()
         stopped = False
         with log_path.open("w") as log_f:
-            child = subprocess.Popen(cmd, env=env, stdout=log_f, stderr=subprocess.STDOUT)
+            child = subprocess.Popen(
+                cmd,
+                env=env,
+                stdout=log_f,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # its own process group: Ctrl-C reaches the workers
+                # a shell's background job ignores SIGINT, and a child would inherit that
+                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+            )
             ps = psutil.Process(child.pid)
             while child.poll() is None:
                 now = time.perf_counter() - t0
@@ -241,13 +263,15 @@ def main(argv: list[str] | None = None) -> int:
                 )
                 if ns.max_s is not None and now > ns.max_s:
                     stopped = True
-                    child.send_signal(signal.SIGINT)
+                    os.killpg(child.pid, signal.SIGINT)  # Ctrl-C: the batch and its workers
                     with contextlib.suppress(subprocess.TimeoutExpired):
                         child.wait(timeout=60)
                     if child.poll() is None:
                         child.kill()
                     break
                 time.sleep(ns.every)
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(child.pid, signal.SIGKILL)  # no worker outlives the run
         wall = time.perf_counter() - t0
         rc = child.wait()
         done = _journal_count(journal)

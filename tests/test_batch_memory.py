@@ -39,8 +39,11 @@ def test_row_bits_membership() -> None:
         bits.add(r)
     for r in range(0, 1100):
         assert (r in bits) == (r in added)
-    assert 999_999 in bits and 999_998 not in bits and 1_000_000 not in bits
-    assert -1 not in bits and "3" not in bits
+    assert 999_999 in bits
+    assert 999_998 not in bits
+    assert 1_000_000 not in bits
+    assert -1 not in bits
+    assert "3" not in bits
 
 
 def test_resume_refuses_a_changed_list(tmp_path: Path) -> None:
