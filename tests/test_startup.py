@@ -137,3 +137,33 @@ def test_a_typo_names_every_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert "invalid choice: 'locat'" in err
     assert "summary-map" in err
     assert "calibrate" in err
+
+
+def test_gc_policy_only_when_main_owns_the_process(tmp_path: Path) -> None:
+    """A short command run as the program collects less often and skips the exit collection;
+    ``batch``/``serve`` keep the default thresholds; a caller passing ``argv`` keeps its own."""
+    out = tmp_path / "cal.json"
+    code = (
+        "import contextlib, gc, io, json, sys\n"
+        "from camloc_geo.cli import main\n"
+        "seen = {'default': gc.get_threshold()}\n"
+        f"assert main(['calibrate', {str(SCENE)!r}, '-o', {str(out)!r}]) == 0\n"
+        "seen['explicit'] = (gc.get_threshold(), gc.isenabled())\n"
+        "sys.argv = ['camloc', 'batch', '--help']\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    main()\n"
+        "seen['batch'] = gc.get_threshold()\n"
+        "gc.enable()\n"
+        f"sys.argv = ['camloc', 'calibrate', {str(SCENE)!r}, '-o', {str(out)!r}]\n"
+        "rc = main()\n"
+        "seen['owned'] = (rc, gc.get_threshold(), gc.isenabled(), gc.get_freeze_count() > 0)\n"
+        "print(json.dumps(seen))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    default = seen["default"]
+    assert seen["explicit"] == [default, True]
+    assert seen["batch"] == default
+    assert seen["owned"] == [0, [10_000, 20, 100], False, True]
