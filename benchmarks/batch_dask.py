@@ -92,6 +92,13 @@ def main(argv: list[str] | None = None) -> int:
         )
     gen_s = time.perf_counter() - t
 
+    from camloc_geo.batch._areas import clear_maps
+    from camloc_geo.osm import clear_cache
+
+    # the list's generation loaded the extracts' maps in this process: forget them, or the
+    # forked local workers would inherit them while the Dask workers load their own
+    clear_maps()
+    clear_cache()
     runs: dict[str, dict[str, Any]] = {}
     t0 = time.perf_counter()
     local = run_batch(
