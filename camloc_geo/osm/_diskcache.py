@@ -10,9 +10,9 @@ later processes.
   (``~/.cache/camloc_geo/maps``); ``CAMLOC_MAP_CACHE=off`` (or ``0``, ``no``, ``false``)
   turns it off. Created private (``0700``).
 - **Key**: the extract's resolved path, modification time and size, the point, radius and
-  options, and a fingerprint of the code that builds maps (this package's ``osm`` modules
-  and ``geodesy``, and the versions of Python, numpy, shapely, networkx and pyosmium), so a
-  changed file, option or code never reads an old map.
+  options, and a fingerprint of the code (every module of ``camloc_geo``, and the versions of
+  Python, numpy, shapely, networkx and pyosmium), so a changed file, option or code never
+  reads an old map.
 - Files are written atomically (a temporary file, then a rename); a file that cannot be read
   is removed and the map is built again. The folder is kept under :data:`MAX_BYTES`, oldest
   files first. Overpass maps are not kept (osmnx has its own HTTP cache).
@@ -49,7 +49,12 @@ def cache_folder() -> Path | None:
         if value.strip().lower() in _OFF or not value.strip():
             return None
         return Path(value).expanduser()
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    base = os.environ.get("XDG_CACHE_HOME")
+    if not base:
+        try:
+            base = str(Path.home() / ".cache")
+        except RuntimeError:  # no home directory: keep nothing
+            return None
     return Path(base) / "camloc_geo" / "maps"
 
 
@@ -62,9 +67,10 @@ def _code_fingerprint() -> str:
     import shapely
 
     h = hashlib.sha256()
-    here = Path(__file__).resolve().parent
-    for path in sorted([*here.glob("*.py"), here.parent / "geodesy.py"]):
-        h.update(path.name.encode())
+    package = Path(__file__).resolve().parents[1]
+    # the whole package (1 MB, 4 ms): whatever module the map model moves to is covered
+    for path in sorted(package.rglob("*.py")):
+        h.update(str(path.relative_to(package)).encode())
         with contextlib.suppress(OSError):
             h.update(path.read_bytes())
     for version in (
