@@ -116,6 +116,7 @@ def test_help_lists_every_command(argv: list[str], capsys: pytest.CaptureFixture
     """Only a named command is registered alone: help and no command list them all."""
     from camloc_geo.cli import main
 
+    rc: object
     try:
         rc = main(argv)
     except SystemExit as exc:
