@@ -18,6 +18,16 @@ from camloc_geo.testing.synthetic import NoiseModel, make_scene
 SCENES_DIR = Path(__file__).parent / "data" / "scenes"
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _private_map_cache(tmp_path_factory: pytest.TempPathFactory) -> None:
+    """Maps kept between processes (``CAMLOC_MAP_CACHE``) go to this run's own folder, never
+    the user's ``~/.cache``; child processes (the CLI, the service) inherit it."""
+    import os
+
+    if "CAMLOC_MAP_CACHE" not in os.environ:
+        os.environ["CAMLOC_MAP_CACHE"] = str(tmp_path_factory.mktemp("map-cache"))
+
+
 def camera_aimed_at_car(
     height_m: float,
     distance_m: float,

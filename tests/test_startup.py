@@ -96,7 +96,8 @@ def test_locate_offline_loads_no_online_or_page_code(tmp_path: Path) -> None:
         f"rc = main(['locate', {str(SCENE)!r}, '--osm', {str(EXTRACT)!r}, "
         f"'-o', {str(out)!r}, '--offline'])\n"
     )
-    got = _loaded(snippet, ("scipy.optimize", *MAP_AND_PAGE))
+    other_commands = ("camloc_geo.cli.batch", "camloc_geo.cli.serve", "camloc_geo.cli.calibrate")
+    got = _loaded(snippet, ("scipy.optimize", *MAP_AND_PAGE, *other_commands))
     assert got == {"rc": 0, "loaded": []}
     assert json.loads(out.read_text())["features"]
 
@@ -108,3 +109,62 @@ def test_library_modules_import_scipy_on_use() -> None:
         ("scipy", "scipy.spatial.transform", "scipy.sparse", *MAP_AND_PAGE),
     )
     assert got["loaded"] == []
+
+
+@pytest.mark.parametrize("argv", [["-h"], ["-v", "--help", "locate"], []])
+def test_help_lists_every_command(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    """Only a named command is registered alone: help and no command list them all."""
+    from camloc_geo.cli import main
+
+    rc: object
+    try:
+        rc = main(argv)
+    except SystemExit as exc:
+        rc = exc.code
+    out = capsys.readouterr()
+    text = out.out + out.err
+    assert rc == (2 if not argv else 0)
+    for command in ("calibrate", "locate", "batch", "summary-map", "serve"):
+        assert command in text
+
+
+def test_a_typo_names_every_command(capsys: pytest.CaptureFixture[str]) -> None:
+    from camloc_geo.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["locat", "scene.json"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "invalid choice: 'locat'" in err
+    assert "summary-map" in err
+    assert "calibrate" in err
+
+
+def test_gc_policy_only_when_main_owns_the_process(tmp_path: Path) -> None:
+    """A short command run as the program collects less often and skips the exit collection;
+    ``batch``/``serve`` keep the default thresholds; a caller passing ``argv`` keeps its own."""
+    out = tmp_path / "cal.json"
+    code = (
+        "import contextlib, gc, io, json, sys\n"
+        "from camloc_geo.cli import main\n"
+        "seen = {'default': gc.get_threshold()}\n"
+        f"assert main(['calibrate', {str(SCENE)!r}, '-o', {str(out)!r}]) == 0\n"
+        "seen['explicit'] = (gc.get_threshold(), gc.isenabled())\n"
+        "sys.argv = ['camloc', 'batch', '--help']\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    main()\n"
+        "seen['batch'] = gc.get_threshold()\n"
+        "gc.enable()\n"
+        f"sys.argv = ['camloc', 'calibrate', {str(SCENE)!r}, '-o', {str(out)!r}]\n"
+        "rc = main()\n"
+        "seen['owned'] = (rc, gc.get_threshold(), gc.isenabled(), gc.get_freeze_count() > 0)\n"
+        "print(json.dumps(seen))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True
+    )
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    default = seen["default"]
+    assert seen["explicit"] == [default, True]
+    assert seen["batch"] == default
+    assert seen["owned"] == [0, [10_000, 20, 100], False, True]

@@ -82,6 +82,26 @@ class Journal:
             q += " WHERE status NOT IN (" + ",".join("?" * len(retry)) + ")"
         return {int(r): str(i) for r, i in self.db.execute(q, retry)}
 
+    def iter_done(self, retry: Iterable[str] = (), page: int = 10_000) -> Iterator[tuple[int, str]]:
+        """``(row, id)`` of the cameras finished, in row order, read a page at a time.
+
+        The streaming form of :meth:`done_rows`: memory stays one page whatever the length of
+        the journal (a million rows as a dict held about 150 MB).
+        """
+        retry = tuple(retry)
+        q = "SELECT row, id FROM done WHERE row > ?"
+        if retry:
+            q += " AND status NOT IN (" + ",".join("?" * len(retry)) + ")"
+        q += " ORDER BY row LIMIT ?"
+        last = -(1 << 62)
+        while True:
+            rows = self.db.execute(q, (last, *retry, page)).fetchall()
+            if not rows:
+                return
+            for r, i in rows:
+                yield int(r), str(i)
+            last = int(rows[-1][0])
+
     def write(self, records: Iterable[dict[str, Any]]) -> int:
         """Record finished cameras in one transaction; returns how many."""
         rows = [

@@ -29,6 +29,7 @@ those inside ``run()``, so ``camloc --help`` starts fast.
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import json
 import logging
@@ -182,7 +183,30 @@ def inline_of(args: argparse.Namespace) -> bool:
     return bool(getattr(args, "inline", False) or args.offline)
 
 
-def _build_parser() -> argparse.ArgumentParser:
+def _named_command(argv: Sequence[str] | None) -> str | None:
+    """The module of the command ``argv`` names exactly, or None (help, a typo, none given).
+
+    Top-level options take no value, so the first argument that is not an option is the
+    command; ``-h`` before it asks for the whole list.
+    """
+    for arg in sys.argv[1:] if argv is None else argv:
+        if arg in ("--", "-h", "--help"):
+            return None
+        if not arg.startswith("-"):
+            module = arg.replace("-", "_")
+            return module if module in _COMMAND_MODULES and "_" not in arg else None
+    return None
+
+
+def _build_parser(
+    argv: Sequence[str] | None = (), *, all_commands: bool = True
+) -> argparse.ArgumentParser:
+    """The ``camloc`` parser, with every command or only the one ``argv`` names.
+
+    With ``all_commands=False`` only the command ``argv`` names exactly is registered, so
+    ``camloc locate`` neither imports nor compiles the other 14 command modules (16 ms);
+    help, a typo or no command still get the whole list.
+    """
     parser = argparse.ArgumentParser(
         prog="camloc",
         description="Find where a street camera stands from one snapshot of it.",
@@ -191,7 +215,8 @@ def _build_parser() -> argparse.ArgumentParser:
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more logging on stderr")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of failures")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in _COMMAND_MODULES:
+    only = None if all_commands else _named_command(argv)
+    for name in _COMMAND_MODULES if only is None else (only,):
         try:
             module = importlib.import_module(f"camloc_geo.cli.{name}")
         except ModuleNotFoundError as exc:
@@ -202,9 +227,43 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_LONG_RUNNING = ("batch", "serve")
+"""Commands that keep the garbage collector's default thresholds (they run for hours)."""
+
+
+def _one_shot_gc(argv: Sequence[str] | None) -> None:
+    """Collect garbage less often in a short command (imports make ~10^6 objects, most for good).
+
+    Only when :func:`main` owns the process (``argv`` is None: the console script or ``python
+    -m camloc_geo.cli``), never for ``batch`` or ``serve``. ``camloc locate`` on the sample:
+    60 ms less CPU.
+    """
+    if argv is None and _named_command(None) not in _LONG_RUNNING:
+        gc.set_threshold(10_000, 20, 100)
+
+
+def _fast_exit(argv: Sequence[str] | None) -> None:
+    """Skip the interpreter's last full collection at exit (0.15-0.2 s after ``locate``).
+
+    The output is written; only this process's own objects are left. Only when :func:`main`
+    owns the process (a library caller or a test keeps its collector as it was).
+    """
+    if argv is None:
+        gc.disable()
+        gc.freeze()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
-    parser = _build_parser()
+    _one_shot_gc(argv)
+    try:
+        return _main(argv)
+    finally:
+        _fast_exit(argv)
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    parser = _build_parser(argv, all_commands=False)
     args = parser.parse_args(argv)
     logging.basicConfig(
         level=logging.WARNING - 10 * min(args.verbose, 2),

@@ -16,6 +16,7 @@ from shapely.geometry import LineString, Point
 
 from camloc_geo._errors import MapDataError
 from camloc_geo.geodesy import LocalFrame, initial_bearing_deg
+from camloc_geo.osm._diskcache import disk_get, disk_put
 from camloc_geo.osm._intersections import (
     build_intersections,
     highway_of,
@@ -627,9 +628,15 @@ def load_map(
         if cached is not None:
             log.debug("map cache hit for %s", path)
             return cached
+        kept = disk_get(key)  # built by an earlier process (camloc_geo.osm._diskcache)
+        if isinstance(kept, MapData):
+            cache_put(key, kept)
+            return kept
         raw = read_extract(
             path, lat, lon, radius_m, highways=highways, named_highways=named_highways
         )
     result = MapData(raw, lat, lon, radius_m, tolerance_m=tolerance_m)
     cache_put(key, result)
+    if source is not None:
+        disk_put(key, result)
     return result
