@@ -341,15 +341,7 @@ class MapData:
 
     def _street_hits(self, wanted: list[str]) -> list[Intersection]:
         norms = [normalize_name(w) for w in wanted]
-        # every intersection's normalised street names, once per map (30 ms a call on a
-        # city's extract when done per call, twice per locate)
-        table = self.cached(
-            "intersection_street_names",
-            lambda: [
-                [frozenset(normalize_name(n) for n in (s.names or (s.name,))) for s in x.streets]
-                for x in self._intersections
-            ],
-        )
+        table, by_token = self.cached("intersection_street_names", self._street_name_table)
 
         def matches(sets: list[frozenset[str]], loose: bool) -> bool:
             for q in norms:
@@ -361,15 +353,33 @@ class MapData:
                     return False
             return True
 
+        # only intersections whose street names hold every query's tokens can match
+        maybe: set[int] | None = None
+        for q in norms:
+            for tok in q.split():
+                hit = by_token.get(tok, set())
+                maybe = set(hit) if maybe is None else maybe & hit
+        order = sorted(maybe) if maybe is not None else range(len(table))
         for loose in (False, True):
-            hits = [
-                x
-                for x, sets in zip(self._intersections, table, strict=True)
-                if matches(sets, loose)
-            ]
+            hits = [self._intersections[i] for i in order if matches(table[i], loose)]
             if hits:
                 return hits
         return []
+
+    def _street_name_table(self) -> tuple[list[list[frozenset[str]]], dict[str, set[int]]]:
+        """Every intersection's normalised street names (per street) and a token index, once
+        per map (normalising them per call cost 30 ms on a city's extract, twice per locate)."""
+        table = [
+            [frozenset(normalize_name(n) for n in (s.names or (s.name,))) for s in x.streets]
+            for x in self._intersections
+        ]
+        by_token: dict[str, set[int]] = {}
+        for i, sets in enumerate(table):
+            for names in sets:
+                for name in names:
+                    for tok in name.split():
+                        by_token.setdefault(tok, set()).add(i)
+        return table, by_token
 
     def _describe(self, rows: Sequence[tuple[Intersection, float]], n: int = 3) -> str:
         return ", ".join(f"{x.id} ({' & '.join(x.street_names)}) at {d:.0f} m" for x, d in rows[:n])
