@@ -425,18 +425,39 @@ def corners_collection(intersections: Iterable[Intersection]) -> CornersCollecti
 
 
 # ------------------------------------------------------------------------ serialiser
+_PLAIN_TYPES = frozenset({str, int, float, bool, type(None)})
+_FIELDS: dict[type, tuple[tuple[str, bool], ...]] = {}
+
+
+def _fields_of(cls: type) -> tuple[tuple[str, bool], ...]:
+    """``(name, omit when None)`` of a dataclass' fields, once per class."""
+    try:
+        return _FIELDS[cls]
+    except KeyError:
+        out = tuple((f.name, bool(f.metadata.get("omit_none"))) for f in dataclasses.fields(cls))
+        _FIELDS[cls] = out
+        return out
+
+
 def to_json(value: Any) -> Any:
     """Plain JSON (dicts, lists, numbers, strings) of an output dataclass tree.
 
     Fields with ``omit_none`` metadata are left out when None; floats are Python floats.
     """
+    t = type(value)
+    if t in _PLAIN_TYPES:
+        return value
+    if t is list or t is tuple:
+        return [to_json(v) for v in value]
+    if t is dict:
+        return {str(k): to_json(v) for k, v in value.items()}
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         out: dict[str, Any] = {}
-        for f in dataclasses.fields(value):
-            v = getattr(value, f.name)
-            if v is None and f.metadata.get("omit_none"):
+        for name, omit_none in _fields_of(t):
+            v = getattr(value, name)
+            if v is None and omit_none:
                 continue
-            out[f.name] = to_json(v)
+            out[name] = to_json(v)
         return out
     if isinstance(value, dict):
         return {str(k): to_json(v) for k, v in value.items()}
