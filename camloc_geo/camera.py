@@ -47,6 +47,8 @@ __all__ = [
     "distort_points_px",
     "project_to_rotation",
     "rotation_from_angles",
+    "rotation_from_rotvec",
+    "rotvec_from_rotation",
     "undistort_points_px",
 ]
 
@@ -164,6 +166,51 @@ def project_to_rotation(matrix: npt.ArrayLike) -> FloatArray:
     u, _s, vt = np.linalg.svd(m)
     d = np.sign(np.linalg.det(u @ vt)) or 1.0
     return np.asarray(u @ np.diag([1.0, 1.0, d]) @ vt, dtype=np.float64)
+
+
+def rotation_from_rotvec(rotvec: npt.ArrayLike) -> FloatArray:
+    """Rotation matrix of a rotation vector (axis times angle in radians), Rodrigues' formula.
+
+    The same as ``scipy.spatial.transform.Rotation.from_rotvec(v).as_matrix()``, without
+    importing scipy.spatial (a quarter of a second) on the calibration's path.
+    """
+    w = np.asarray(rotvec, dtype=float).reshape(3)
+    theta2 = float(w @ w)
+    if theta2 < 1e-12:  # sin θ / θ and (1 - cos θ) / θ² by their Taylor series
+        a, b = 1.0 - theta2 / 6.0, 0.5 - theta2 / 24.0
+    else:
+        theta = math.sqrt(theta2)
+        a, b = math.sin(theta) / theta, (1.0 - math.cos(theta)) / theta2
+    K = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    return np.asarray(np.eye(3) + a * K + b * (K @ K), dtype=np.float64)
+
+
+def rotvec_from_rotation(matrix: npt.ArrayLike) -> FloatArray:
+    """Rotation vector (axis times angle in radians, angle in [0, π]) of a rotation matrix.
+
+    Through the unit quaternion (Shepperd's choice of its largest component, stable at every
+    angle, π included); the same as ``Rotation.from_matrix(R).as_rotvec()``.
+    """
+    R = np.asarray(matrix, dtype=float).reshape(3, 3)
+    tr = R[0, 0] + R[1, 1] + R[2, 2]
+    k = int(np.argmax([tr, R[0, 0], R[1, 1], R[2, 2]]))
+    if k == 0:
+        w = 0.5 * math.sqrt(max(1.0 + tr, 0.0))
+        q = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (4.0 * w)
+    else:
+        i = k - 1
+        j, m = (i + 1) % 3, (i + 2) % 3
+        qi = 0.5 * math.sqrt(max(1.0 + 2.0 * R[i, i] - tr, 0.0))
+        q = np.empty(3)
+        q[i] = qi
+        q[j] = (R[i, j] + R[j, i]) / (4.0 * qi)
+        q[m] = (R[i, m] + R[m, i]) / (4.0 * qi)
+        w = (R[m, j] - R[j, m]) / (4.0 * qi)
+    if w < 0.0:
+        q, w = -q, -w
+    n = float(np.linalg.norm(q))
+    scale = 2.0 * math.atan2(n, w) / n if n > 1e-12 else 2.0 / max(w, 1e-300)
+    return np.asarray(q * scale, dtype=np.float64)
 
 
 def rotation_from_angles(heading_deg: float, pitch_deg: float, roll_deg: float) -> FloatArray:

@@ -37,7 +37,7 @@ import numpy.typing as npt
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo._optimize import soft_l1_cost
-from camloc_geo.camera import Camera
+from camloc_geo.camera import Camera, rotvec_from_rotation
 from camloc_geo.objects import ObjectSize
 from camloc_geo.scene import Annotation, Scene, pixel_problem
 from camloc_geo.vanishing import (
@@ -577,18 +577,39 @@ def _object_points(size: ObjectSize, width_sign: float) -> FloatArray:
     )
 
 
+def _single_linkage_labels(pts: FloatArray, threshold: float) -> npt.NDArray[np.int64]:
+    """Cluster labels (1, 2, ...) of single-linkage clustering cut at ``threshold``.
+
+    The flat clusters of single linkage at a distance are the connected components of the
+    graph joining points at most that far apart (scipy's ``fcluster(linkage(pts, "single"),
+    t, "distance")``, without importing scipy.cluster: over a second on a busy machine).
+    """
+    n = len(pts)
+    parent = np.arange(n)
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = int(parent[i])
+        return i
+
+    d = np.linalg.norm(pts[:, None, :] - pts[None, :, :], axis=2)
+    for i, j in zip(*np.nonzero(np.triu(d <= threshold, k=1)), strict=True):
+        ri, rj = root(int(i)), root(int(j))
+        if ri != rj:
+            parent[max(ri, rj)] = min(ri, rj)
+    roots = np.array([root(i) for i in range(n)])
+    _u, labels = np.unique(roots, return_inverse=True)
+    return np.asarray(labels.reshape(-1) + 1, dtype=np.int64)
+
+
 def _cluster(
     candidates: list[tuple[int, str, FloatArray]], settings: CalibrationSettings
 ) -> dict[str, Any]:
     pts = np.array([c[2] for c in candidates])
     dist_scale = float(np.median(np.linalg.norm(pts, axis=1)))
     threshold = max(settings.cluster_threshold_min_m, settings.cluster_threshold_rel * dist_scale)
-    if len(pts) == 1:
-        labels = np.array([1])
-    else:
-        from scipy.cluster.hierarchy import fcluster, linkage  # 0.25 s to import: only here
-
-        labels = fcluster(linkage(pts, method="single"), t=threshold, criterion="distance")
+    labels = _single_linkage_labels(pts, threshold)
     best_label, best_key = None, None
     for lab in np.unique(labels):
         members = pts[labels == lab]
@@ -911,9 +932,7 @@ def _score_test(
     """
     f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
     x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
-    x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+    x1[-6:-3] = rotvec_from_rotation(R1 @ R0.T)
     r = prob.residuals(x1, R0, None, f_fixed)
     J = prob.jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
@@ -1596,9 +1615,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             influence.append(None)  # another frame, or no answer without them
             continue
         centres.append(res.camera.center_in_world)
-        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
-        turn = Rotation.from_matrix(res.camera.cam_from_world_rotation @ R.T).as_rotvec()
+        turn = rotvec_from_rotation(res.camera.cam_from_world_rotation @ R.T)
         if np.linalg.norm(turn) < math.radians(30.0):  # else another frame: not a spread
             turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
@@ -1712,8 +1729,6 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     within 10 % of the refits'); the spread and the influences are then as in
     :func:`_jackknife`.
     """
-    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
     state = result.joint_state
     assert state is not None
     prob = state.problem
@@ -1734,7 +1749,7 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
             influence.append(None)  # no answer without them
             continue
         centres.append(c_i)
-        turn = Rotation.from_matrix((R_i @ M) @ R.T).as_rotvec()
+        turn = rotvec_from_rotation((R_i @ M) @ R.T)
         if np.linalg.norm(turn) < math.radians(30.0):
             turns.append(turn)
         influence.append(float(np.linalg.norm(c_i - c)))
@@ -2212,9 +2227,7 @@ def _joint(
     if pp_given is None and free_pp is not False and worth_trying:
         f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
         x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
-        x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+        x1[-6:-3] = rotvec_from_rotation(R1 @ R0.T)
         res_free = _fit(prob, x1, R0, None, f_fixed)
         cost_fixed, cost_free = 2.0 * res.cost, 2.0 * res_free.cost
         k_free = len(res_free.x)

@@ -320,3 +320,45 @@ def test_clip_segment_to_image_agrees_with_liang_barsky() -> None:
         else:
             assert got is not None
             np.testing.assert_allclose(got, want, atol=1e-6)
+
+
+def test_rotvec_conversions_match_scipy() -> None:
+    """camera.py's rotation vectors agree with scipy's at every angle, π and 0 included."""
+    from scipy.spatial.transform import Rotation
+
+    from camloc_geo.camera import rotation_from_rotvec, rotvec_from_rotation
+
+    rng = np.random.default_rng(3)
+    angles = np.concatenate(
+        [rng.uniform(0.0, np.pi, 300), np.pi - 10.0 ** rng.uniform(-12, -1, 100), [0.0, 1e-9]]
+    )
+    for angle in angles:
+        axis = rng.normal(size=3)
+        v = axis / np.linalg.norm(axis) * angle
+        R = Rotation.from_rotvec(v).as_matrix()
+        np.testing.assert_allclose(rotation_from_rotvec(v), R, atol=1e-12)
+        got, want = rotvec_from_rotation(R), Rotation.from_matrix(R).as_rotvec()
+        if np.linalg.norm(want) > np.pi - 1e-6:  # at π, v and -v are one rotation
+            assert min(np.linalg.norm(got - want), np.linalg.norm(got + want)) < 1e-7
+        else:
+            np.testing.assert_allclose(got, want, atol=1e-9)
+
+
+def test_single_linkage_is_scipys() -> None:
+    """The calibration's clusters are scipy's single-linkage flat clusters."""
+    from scipy.cluster.hierarchy import fcluster, linkage
+
+    from camloc_geo.relative import _single_linkage_labels
+
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        n = int(rng.integers(1, 30))
+        pts = rng.normal(size=(n, 3)) * rng.uniform(0.5, 5.0)
+        t = float(rng.uniform(0.1, 3.0))
+        ours = _single_linkage_labels(pts, t)
+        theirs = fcluster(linkage(pts, "single"), t=t, criterion="distance") if n > 1 else [1]
+        parts = [
+            {frozenset(np.flatnonzero(np.asarray(lab) == k)) for k in set(lab)}
+            for lab in (ours, theirs)
+        ]
+        assert parts[0] == parts[1]
