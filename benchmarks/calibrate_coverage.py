@@ -46,7 +46,6 @@ from camloc_geo.testing.synthetic import NoiseModel
 OUT_DIR = Path(__file__).parent / "out"
 SETS = {"noise_free": NoiseModel.exact(), "crowd": NoiseModel()}
 QUANTITIES = ("focal", "pp_x", "pp_y", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
-WITH_PP = True  # --plain: the plain sigmas (without the principal point's uncertainty)
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
 
 
@@ -71,15 +70,9 @@ def scene_errors(syn: Any) -> dict[str, Any] | None:
     for k, name in enumerate(("rot_x", "rot_y", "rot_z")):
         err[name] = math.degrees(float(turn[k]))
     sig: dict[str, float | None] = {"focal": res.focal_sigma_px, "height": None}
+    # The main sigmas include the principal point's uncertainty (the *_with_principal_point
+    # fields are their aliases).
     pos_sigma, rot_sigma = res.position_sigma_m, res.rotation_sigma_deg
-    if WITH_PP:
-        # The sigmas with the principal point's own uncertainty, where reported.
-        if res.focal_sigma_with_principal_point_px is not None:
-            sig["focal"] = res.focal_sigma_with_principal_point_px
-        if res.position_sigma_with_principal_point_m is not None:
-            pos_sigma = res.position_sigma_with_principal_point_m
-        if res.rotation_sigma_with_principal_point_deg is not None:
-            rot_sigma = res.rotation_sigma_with_principal_point_deg
     if pos_sigma is not None:
         for k, name in enumerate("xyz"):
             sig[name] = float(pos_sigma[k])
@@ -171,12 +164,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--plain",
         action="store_true",
-        help="judge the plain sigmas (focal_sigma_px, camera_in_world_sigma_m, "
-        "rotation_sigma_deg) instead of the *_with_principal_point ones",
+        help="accepted for old command lines; no effect (the main sigmas now include the "
+        "principal point's uncertainty, the *_with_principal_point fields are aliases)",
     )
     args = parser.parse_args(argv)
-    global WITH_PP
-    WITH_PP = not args.plain
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -203,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
         "seed": args.seed,
         "n_per_set": args.n,
         "want": WANT,
-        "sigmas": "with_principal_point" if WITH_PP else "plain",
+        "sigmas": "main fields (with the principal point's uncertainty)",
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),

@@ -99,8 +99,8 @@ class CalibrationSettings:
     principal_point_sigma_rel
         How far a real camera's principal point may lie from the image centre (1-sigma per
         axis, fraction of the diagonal; 0.7 %: 15 px at 1080p). Where the fit assumes the
-        centre, this uncertainty is propagated into the ``*_with_principal_point`` sigmas
-        of :class:`CalibrationResult`; 0 turns it off.
+        centre, this uncertainty is propagated into every sigma of
+        :class:`CalibrationResult` (and its ``parameter_covariance``); 0 turns it off.
     jackknife, jackknife_method
         Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators).
         ``one_step``: per left-out annotator, the Newton step of the infinitesimal
@@ -243,21 +243,24 @@ class CalibrationResult:
         1-sigma uncertainty of the orientation, degrees: small-angle rotations about the
         **camera's** x (right), y (down) and z (optical) axes, i.e. the perturbed rotation is
         ``exp([ε]×) · cam_from_world_rotation`` with ``ε ~ N(0, diag(σ²))``. Like
-        ``position_sigma_m``: the fit's covariance plus the jackknife spread. It is the
-        uncertainty *given the principal point model*: a principal point assumed at the
-        image centre but really off by ``δ`` pixels turns the fitted orientation by about
-        ``δ / f`` about x and y while the pixels' rays barely move (the two compensate), so
-        that part is not included (it would inflate the sensors' ``sigma_m`` for nothing).
+        ``position_sigma_m``: the fit's covariance plus the jackknife spread.
+    focal_sigma_px
+        1-sigma of the focal length, pixels (None when given in the scene).
     rotation_sigma_fit_deg
         The fit's covariance part alone (when the jackknife was added).
-    rotation_sigma_with_principal_point_deg, position_sigma_with_principal_point_m
-        See ``focal_sigma_with_principal_point_px``.
-    focal_sigma_with_principal_point_px
-        ``rotation_sigma_deg``, ``position_sigma_m`` and ``focal_sigma_px`` with the
-        principal point's own uncertainty included where the fit assumed it at the image
-        centre (``CalibrationSettings.principal_point_sigma_rel``): how far the answer may
-        be from the truth (``benchmarks/calibrate_coverage.py``). The plain fields leave it
-        out, as the pixels recast through the same principal point compensate.
+    parameter_covariance
+        Joint covariance ``(9, 9)`` of the answer before the jackknife: focal length (px),
+        principal point x, y (px), small rotation about the camera's x, y, z axes (rad, as in
+        ``rotation_sigma_deg``), camera centre x, y, z (m). It keeps the correlations the
+        per-axis sigmas lose: a principal point off by ``δ`` pixels turns the fitted
+        orientation by about ``δ / f`` while the pixels' rays barely move, so measurements
+        through the camera (:mod:`camloc_geo.sensors`) draw all of them together.
+    focal_sigma_with_principal_point_px, position_sigma_with_principal_point_m
+        Aliases of ``focal_sigma_px`` and ``position_sigma_m``;
+        ``rotation_sigma_with_principal_point_deg`` of ``rotation_sigma_deg``. Every sigma
+        includes the principal point's own uncertainty where the fit held it at the image
+        centre (``CalibrationSettings.principal_point_sigma_rel``) as a consider covariance:
+        how far the answer may be from the truth (``benchmarks/calibrate_coverage.py``).
     principal_point_sigma_px
         1-sigma of the principal point (x, y): from the fit when fitted, the assumed spread
         when held at the image centre; None when given in the scene.
@@ -291,12 +294,25 @@ class CalibrationResult:
     position_sigma_fit_m: FloatArray | None = None
     rotation_sigma_deg: FloatArray | None = None
     rotation_sigma_fit_deg: FloatArray | None = None
-    rotation_sigma_with_principal_point_deg: FloatArray | None = None
-    position_sigma_with_principal_point_m: FloatArray | None = None
     position_sigma_jackknife_m: FloatArray | None = None
-    focal_sigma_with_principal_point_px: float | None = None
     principal_point_sigma_px: list[float] | None = None
+    parameter_covariance: FloatArray | None = field(default=None, repr=False, compare=False)
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def focal_sigma_with_principal_point_px(self) -> float | None:
+        """Alias of ``focal_sigma_px`` (which now includes the principal point's uncertainty)."""
+        return self.focal_sigma_px
+
+    @property
+    def position_sigma_with_principal_point_m(self) -> FloatArray | None:
+        """Alias of ``position_sigma_m`` (which now includes the principal point's)."""
+        return self.position_sigma_m
+
+    @property
+    def rotation_sigma_with_principal_point_deg(self) -> FloatArray | None:
+        """Alias of ``rotation_sigma_deg`` (which now includes the principal point's)."""
+        return self.rotation_sigma_deg
 
     @property
     def height_m(self) -> float:
@@ -1622,9 +1638,6 @@ def _add_jackknife_spread(
     # measured on the annotators instead of modelled: the larger of the two, not their sum
     # (which counted the spread twice).
     result.position_sigma_m = np.maximum(base, sigma_jack)
-    if result.position_sigma_with_principal_point_m is not None:
-        with_pp_c = result.position_sigma_with_principal_point_m
-        result.position_sigma_with_principal_point_m = np.maximum(with_pp_c, sigma_jack)
     if len(turns) < 2:
         return
     rot = np.asarray(turns)
@@ -1633,9 +1646,6 @@ def _add_jackknife_spread(
     base_r = result.rotation_sigma_deg if result.rotation_sigma_deg is not None else np.zeros(3)
     result.rotation_sigma_fit_deg = base_r
     result.rotation_sigma_deg = np.sqrt(base_r**2 + rot_jack**2)
-    if result.rotation_sigma_with_principal_point_deg is not None:
-        with_pp = result.rotation_sigma_with_principal_point_deg
-        result.rotation_sigma_with_principal_point_deg = np.sqrt(with_pp**2 + rot_jack**2)
 
 
 def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray | None]:
@@ -2244,58 +2254,32 @@ def _joint(
     R, C = R @ M, M.T @ (C - origin)
     camera = Camera.from_center(f, pp, R, C)
     corner_names = [_CORNER_NAMES[_relabel_corner(int(c), out_corner)] for c in prob.corners]
-    # Uncertainty from the Gauss-Newton covariance, scaled by the residual variance.
-    J = res.jac
-    dof = max(len(res.fun) - len(res.x), 1)
-    s2 = max(2.0 * res.cost / dof, 1e-12)
+    # Uncertainty from the Gauss-Newton covariance, scaled by the residual variance, with
+    # the principal point's own uncertainty where it was held at the image centre.
+    sigma_pp_assumed = (
+        settings.principal_point_sigma_rel * math.hypot(width, height)
+        if pp_model is not None and pp_given is None
+        else 0.0
+    )
+    size_rel = 0.0 if _size_given(scene) else settings.size_sigma_rel / math.sqrt(3.0)
+    # A preset's length, width and height are each off by size_sigma_rel, independently; the
+    # camera's distance scales with all three edges at once (the translation is solved from
+    # the length, width and height ends together), so with their average: size_sigma_rel /
+    # √3. (The full 5 % over-stated it: crowd position sigmas covered 88-90 % at 1 sigma,
+    # median error/sigma 0.34-0.40, benchmarks/calibrate_coverage.py.)
+    cov_out = _output_covariance(
+        prob, res, R0, pp_model, f_fixed, f, M, M.T @ (C - origin), sigma_pp_assumed, size_rel
+    )
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
     sigma_r: FloatArray | None = None
-    sigma_r_pp: FloatArray | None = None
-    sigma_c_pp: FloatArray | None = None
-    sigma_f_pp: float | None = None
     sigma_pp: list[float] | None = None
-    try:
-        cov = np.linalg.pinv(J.T @ J) * s2
-        sigma_c = np.sqrt(np.clip(np.diag(cov)[-3:], 0, None))
-        # The rotation vector ω of R = exp(ω)·R0: a change dω turns R by J_l(ω)·dω on the
-        # left (camera axes); the frame change R·M below keeps left perturbations.
-        jl = _so3_left_jacobian(res.x[-6:-3])
-        cov_r = jl @ cov[-6:-3, -6:-3] @ jl.T
-        sigma_r = np.degrees(np.sqrt(np.clip(np.diag(cov_r), 0, None)))
-        if f_fixed is None:
-            sigma_f = float(f * math.sqrt(max(cov[0, 0], 0.0)))
-        k_pp = int(f_fixed is None)
-        cov_pp = cov
-        if pp_model is None:
-            sigma_pp = np.sqrt(np.clip(np.diag(cov)[k_pp : k_pp + 2], 0, None)).tolist()
-        elif pp_given is None and settings.principal_point_sigma_rel > 0.0:
-            # The principal point is assumed at the image centre, not known there: its
-            # uncertainty flows into the rest (a consider covariance, see _pinned_pp_cov).
-            sig_pp = settings.principal_point_sigma_rel * math.hypot(width, height)
-            extra = _pinned_pp_cov(prob, res.x, R0, pp_model, f_fixed, sig_pp)
-            if extra is not None:
-                cov_pp = cov + extra
-                sigma_pp = [sig_pp, sig_pp]
-        sigma_c_pp = np.sqrt(np.clip(np.diag(cov_pp)[-3:], 0, None))
-        sigma_r_pp = np.degrees(
-            np.sqrt(np.clip(np.diag(jl @ cov_pp[-6:-3, -6:-3] @ jl.T), 0, None))
-        )
-        if f_fixed is None:
-            sigma_f_pp = float(f * math.sqrt(max(cov_pp[0, 0], 0.0)))
-    except np.linalg.LinAlgError:
-        pass
-    if not _size_given(scene):
-        # A preset's length, width and height are each off by size_sigma_rel, independently;
-        # the camera's distance scales with all three edges at once (the translation is
-        # solved from the length, width and height ends together), so with their average:
-        # size_sigma_rel / √3. (The full 5 % over-stated it: crowd position sigmas covered
-        # 88-90 % at 1 sigma, median error/sigma 0.34-0.40, benchmarks/calibrate_coverage.py.)
-        size_sigma = settings.size_sigma_rel / math.sqrt(3.0) * np.abs(C)
-        if sigma_c is not None:
-            sigma_c = np.sqrt(sigma_c**2 + size_sigma**2)
-        if sigma_c_pp is not None:
-            sigma_c_pp = np.sqrt(sigma_c_pp**2 + size_sigma**2)
+    if cov_out is not None:
+        sd = np.sqrt(np.clip(np.diag(cov_out), 0.0, None))
+        sigma_f = float(sd[0]) if f_fixed is None else None
+        sigma_pp = sd[1:3].tolist() if pp_given is None else None
+        sigma_r = np.degrees(sd[3:6])
+        sigma_c = sd[6:9]
     weights = [float(w) for w in prob.weights]
     state = JointState(
         prob,
@@ -2347,10 +2331,8 @@ def _joint(
         position_sigma_m=sigma_c,
         focal_sigma_px=sigma_f,
         rotation_sigma_deg=sigma_r,
-        rotation_sigma_with_principal_point_deg=sigma_r_pp,
-        position_sigma_with_principal_point_m=sigma_c_pp,
-        focal_sigma_with_principal_point_px=sigma_f_pp,
         principal_point_sigma_px=sigma_pp,
+        parameter_covariance=cov_out,
         rms_residual_px=float(math.hypot(rms_seg, rms_pt) / math.sqrt(2.0)),
         width_signs=width_signs,
         annotator_corners=corner_names,
@@ -2374,21 +2356,20 @@ def _joint(
     return result
 
 
-def _pinned_pp_cov(
+def _pinned_pp_sensitivity(
     prob: _JointProblem,
     x: FloatArray,
     R0: FloatArray,
     pp: tuple[float, float],
     f_fixed: float | None,
-    sigma_pp_px: float,
 ) -> FloatArray | None:
-    """Covariance the pinned principal point's own uncertainty adds to the fitted parameters.
+    """How the fitted parameters move with a pinned principal point: ``S`` ``(len(x), 2)``.
 
     The fit holds the principal point at ``pp``; were it really ``pp + δ``, the fitted
     parameters ``θ`` would move by ``S δ`` with ``S = −H_θθ⁻¹ H_θp`` (the robust
     Gauss-Newton Hessian of the model with the principal point free, at the solution). With
-    ``δ ~ N(0, σ² I)`` the added covariance is ``σ² S Sᵀ`` (a "consider" covariance), in the
-    order of ``x``. None when the Hessian is singular.
+    ``δ ~ N(0, σ² I)`` the added covariance is ``σ² S Sᵀ`` (a "consider" covariance) and
+    ``cov(θ, δ) = σ² S``. None when the Hessian is singular.
     """
     k = int(f_fixed is None)
     x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
@@ -2409,7 +2390,68 @@ def _pinned_pp_cov(
         return None
     if not np.all(np.isfinite(S)):
         return None
-    return np.asarray(sigma_pp_px**2 * (S @ S.T), dtype=np.float64)
+    return np.asarray(S, dtype=np.float64)
+
+
+def _output_covariance(
+    prob: _JointProblem,
+    res: Any,
+    R0: FloatArray,
+    pp_model: tuple[float, float] | None,
+    f_fixed: float | None,
+    f: float,
+    M: FloatArray,
+    c_out: FloatArray,
+    sigma_pp_px: float,
+    size_rel: float,
+) -> FloatArray | None:
+    """Joint covariance ``(9, 9)`` of the answer, see ``CalibrationResult.parameter_covariance``.
+
+    The Gauss-Newton covariance of the fitted parameters (scaled by the residual variance);
+    where the principal point was held at ``pp_model`` with an assumed spread
+    ``sigma_pp_px``, its consider covariance (:func:`_pinned_pp_sensitivity`) and its
+    correlation with the rest; a preset's size error (``size_rel`` of the distance, along
+    the camera's position vector ``c_out``). Order: focal length (px), principal point x, y
+    (px), small rotation about the camera's x, y, z axes (rad, on the left of
+    ``cam_from_world_rotation``), camera centre x, y, z (m, output frame). None when the
+    normal equations are singular.
+    """
+    J = res.jac
+    x = np.asarray(res.x, dtype=float)
+    n_x = len(x)
+    dof = max(len(res.fun) - n_x, 1)
+    s2 = max(2.0 * res.cost / dof, 1e-12)
+    try:
+        cov = np.linalg.pinv(J.T @ J) * s2
+    except np.linalg.LinAlgError:
+        return None
+    # Positions of x's entries in z = (log f, pp x, pp y, ω, C).
+    z_of_x = ([0] if f_fixed is None else []) + ([1, 2] if pp_model is None else [])
+    z_of_x += [3, 4, 5, 6, 7, 8]
+    A = np.zeros((9, 9))
+    A[np.ix_(z_of_x, z_of_x)] = cov
+    if pp_model is not None and sigma_pp_px > 0.0:
+        S = _pinned_pp_sensitivity(prob, x, R0, pp_model, f_fixed)
+        if S is not None:
+            s2_pp = sigma_pp_px**2
+            A[np.ix_(z_of_x, z_of_x)] += s2_pp * (S @ S.T)
+            A[np.ix_(z_of_x, [1, 2])] = s2_pp * S
+            A[np.ix_([1, 2], z_of_x)] = s2_pp * S.T
+            A[1, 1] = A[2, 2] = s2_pp
+    # The rotation vector ω of R = exp(ω)·R0: a change dω turns R by J_l(ω)·dω on the left
+    # (camera axes); the frame change R·M keeps left perturbations, C_out = Mᵀ (C - origin).
+    T = np.zeros((9, 9))
+    T[0, 0] = f
+    T[1, 1] = T[2, 2] = 1.0
+    T[3:6, 3:6] = _so3_left_jacobian(x[-6:-3])
+    T[6:9, 6:9] = M.T
+    out = T @ A @ T.T
+    if size_rel > 0.0:
+        out[6:9, 6:9] += size_rel**2 * np.outer(c_out, c_out)
+    out = 0.5 * (out + out.T)
+    if not np.all(np.isfinite(out)):
+        return None
+    return np.asarray(out, dtype=np.float64)
 
 
 def _size_given(scene: Scene) -> bool:

@@ -607,16 +607,20 @@ def test_a_pinned_principal_point_flows_into_the_sigmas(pp: tuple[float, float])
     assert result.intrinsics_method == "joint_fit_centre_principal_point"
     err_f = abs(result.camera.focal_px - cam.focal_px)
     assert result.focal_sigma_px is not None
-    assert result.focal_sigma_with_principal_point_px is not None
-    # The fit's own sigma knows nothing of the pinning (the error is many of them) ...
-    assert err_f > 3.0 * result.focal_sigma_px
-    # ... the sigma with the principal point's uncertainty covers it.
-    assert err_f < 2.0 * result.focal_sigma_with_principal_point_px
+    # Without the principal point's uncertainty the fit's sigma knows nothing of the
+    # pinning (the error is many of them) ...
+    pinned = calibrate(
+        parse_scene(exact_scene(cam)), CalibrationSettings(principal_point_sigma_rel=0.0)
+    )
+    assert pinned.focal_sigma_px is not None
+    assert err_f > 3.0 * pinned.focal_sigma_px
+    # ... the main sigma, with it, covers the error.
+    assert err_f < 2.0 * result.focal_sigma_px
     assert result.principal_point_sigma_px == pytest.approx([0.007 * math.hypot(1920, 1080)] * 2)
     turn = result.camera.cam_from_world_rotation @ cam.cam_from_world_rotation.T
     err_rot = np.degrees(np.abs([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0]]) / 2.0)
-    assert result.rotation_sigma_with_principal_point_deg is not None
-    assert np.all(err_rot < 2.0 * result.rotation_sigma_with_principal_point_deg[:2])
+    assert result.rotation_sigma_deg is not None
+    assert np.all(err_rot < 2.0 * result.rotation_sigma_deg[:2])
     out = result.to_dict()
     for key in (
         "focal_sigma_with_principal_point_px",
@@ -625,8 +629,15 @@ def test_a_pinned_principal_point_flows_into_the_sigmas(pp: tuple[float, float])
         "principal_point_sigma_px",
     ):
         assert key in out
-    # The plain fields keep their meaning.
-    assert out["focal_sigma_px"] == result.focal_sigma_px
+    # The *_with_principal_point fields are aliases of the main ones.
+    assert out["focal_sigma_with_principal_point_px"] == out["focal_sigma_px"]
+    assert out["rotation_sigma_with_principal_point_deg"] == out["rotation_sigma_deg"]
+    cov = result.parameter_covariance
+    assert cov is not None
+    assert cov.shape == (9, 9)
+    assert math.sqrt(cov[1, 1]) == pytest.approx(0.007 * math.hypot(1920, 1080))
+    # The principal point and the tilt it trades against are strongly correlated.
+    assert abs(cov[2, 3]) / math.sqrt(cov[2, 2] * cov[3, 3]) > 0.5
 
 
 def test_a_given_principal_point_has_no_principal_point_sigma() -> None:
