@@ -1596,6 +1596,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
         reassign_corners=settings.reassign_corners and bool(result.corner_mistakes),
     )
     centres: list[FloatArray] = []
+    focals: list[float] = []
     turns: list[FloatArray] = []
     R = result.camera.cam_from_world_rotation
     influence: list[float | None] = []
@@ -1612,6 +1613,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             influence.append(None)  # another frame, or no answer without them
             continue
         centres.append(res.camera.center_in_world)
+        focals.append(res.camera.focal_px)
         from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
 
         turn = Rotation.from_matrix(res.camera.cam_from_world_rotation @ R.T).as_rotvec()
@@ -1619,15 +1621,25 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
     result.annotator_influence_m = influence
-    _add_jackknife_spread(result, centres, turns)
+    _add_jackknife_spread(result, centres, turns, focals)
 
 
 def _add_jackknife_spread(
-    result: CalibrationResult, centres: list[FloatArray], turns: list[FloatArray]
+    result: CalibrationResult,
+    centres: list[FloatArray],
+    turns: list[FloatArray],
+    focals: list[float] | None = None,
 ) -> None:
-    """Add the jackknife variance of leave-one-out centres and turns (rotvecs) to the sigmas."""
+    """Add the jackknife variance of leave-one-out centres, turns (rotvecs) and focal lengths
+    to the sigmas."""
     if len(centres) < 2:
         return
+    if focals is not None and len(focals) >= 2 and result.focal_sigma_px is not None:
+        f_arr = np.asarray(focals, dtype=float)
+        m_f = len(f_arr)
+        sigma_f_jack = math.sqrt((m_f - 1) / m_f * float(np.sum((f_arr - f_arr.mean()) ** 2)))
+        # As for the position: the larger of the fit's and the annotators' spread.
+        result.focal_sigma_px = max(result.focal_sigma_px, sigma_f_jack)
     arr = np.asarray(centres)
     m = len(arr)
     sigma_jack = np.sqrt((m - 1) / m * ((arr - arr.mean(axis=0)) ** 2).sum(axis=0))
@@ -1732,24 +1744,26 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     R = result.camera.cam_from_world_rotation
     M, origin = state.internal_from_output, state.internal_origin
     centres: list[FloatArray] = []
+    focals: list[float] = []
     turns: list[FloatArray] = []
     influence: list[float | None] = []
     for x in _leave_one_out_steps(state, steps=2):
         if x is None or not np.all(np.isfinite(x)):
             influence.append(None)
             continue
-        _f, _pp, R_i, C_i = prob.unpack(x, *args)
+        f_i, _pp, R_i, C_i = prob.unpack(x, *args)
         c_i = M.T @ (C_i - origin)
         if c_i[2] <= 0.0:
             influence.append(None)  # no answer without them
             continue
         centres.append(c_i)
+        focals.append(f_i)
         turn = Rotation.from_matrix((R_i @ M) @ R.T).as_rotvec()
         if np.linalg.norm(turn) < math.radians(30.0):
             turns.append(turn)
         influence.append(float(np.linalg.norm(c_i - c)))
     result.annotator_influence_m = influence
-    _add_jackknife_spread(result, centres, turns)
+    _add_jackknife_spread(result, centres, turns, focals)
 
 
 def _so3_left_jacobian(rotvec: FloatArray) -> FloatArray:

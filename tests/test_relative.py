@@ -619,7 +619,8 @@ def test_a_pinned_principal_point_flows_into_the_sigmas(pp: tuple[float, float])
     # Without the principal point's uncertainty the fit's sigma knows nothing of the
     # pinning (the error is many of them) ...
     pinned = calibrate(
-        parse_scene(exact_scene(cam)), CalibrationSettings(principal_point_sigma_rel=0.0)
+        parse_scene(exact_scene(cam)),
+        CalibrationSettings(principal_point_sigma_rel=0.0, jackknife=False),
     )
     assert pinned.focal_sigma_px is not None
     assert err_f > 3.0 * pinned.focal_sigma_px
@@ -654,3 +655,18 @@ def test_a_given_principal_point_has_no_principal_point_sigma() -> None:
     result = calibrate(parse_scene(exact_scene(cam, principal_point=[950.0, 530.0])))
     assert result.principal_point_sigma_px is None
     assert result.focal_sigma_with_principal_point_px == pytest.approx(result.focal_sigma_px)
+
+
+def test_the_jackknife_widens_the_focal_sigma() -> None:
+    """The annotators' leave-one-out spread of the focal length enters focal_sigma_px."""
+    cam = camera_aimed_at_car(height_m=6.0, distance_m=20.0, roll_deg=2.0)
+    widened = 0
+    for seed in range(3):
+        scene = parse_scene(make_scene(cam, np.random.default_rng(seed), noise=NoiseModel()).scene)
+        with_jack = calibrate(scene)
+        without = calibrate(scene, CalibrationSettings(jackknife=False))
+        assert with_jack.focal_sigma_px is not None
+        assert without.focal_sigma_px is not None
+        assert with_jack.focal_sigma_px >= without.focal_sigma_px - 1e-9
+        widened += with_jack.focal_sigma_px > 1.01 * without.focal_sigma_px
+    assert widened >= 1
