@@ -773,11 +773,23 @@ class _JointProblem:
         f_fixed: float | None,
     ) -> FloatArray:
         """Forward-difference Jacobian from one batched evaluation."""
+        return self.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)[1]
+
+    def residuals_and_jacobian(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> tuple[FloatArray, FloatArray]:
+        """The residuals and their forward-difference Jacobian from one batched evaluation."""
+        x = np.asarray(x, dtype=float)
         n = len(x)
         h = 1e-7 * np.maximum(1.0, np.abs(x))
         X = np.vstack([x, x + np.diag(h)])
         Rb = self.residuals_batch(X, R0, pp_fixed, f_fixed)
-        return np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
+        J = np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
+        return np.asarray(Rb[0], dtype=np.float64), J
 
     def residuals_batch(
         self,
@@ -909,6 +921,7 @@ def _fit(
         method=method,
         tol=tol,
         max_nfev=max_nfev,
+        fun_and_jac=lambda x: prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed),
     )
 
 
