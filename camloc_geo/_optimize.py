@@ -87,6 +87,7 @@ def soft_l1_least_squares(
     tol: float = 1e-10,
     max_nfev: int = 200,
     fun_and_jac: ResidualsAndJacobian | None = None,
+    damping: float = 1e-3,
 ) -> LeastSquaresResult:
     """Minimise the soft-L1 cost of ``fun(x)`` from ``x0``.
 
@@ -108,6 +109,9 @@ def soft_l1_least_squares(
         trial step is then evaluated with its Jacobian at once (worth it where a batched
         finite-difference Jacobian costs little more than the residuals alone: most steps
         are accepted, and an accepted step then needs no second call).
+    damping
+        ``lm``: the initial Levenberg-Marquardt damping (relative to the normal equations'
+        diagonal); smaller suits a start already near the minimum.
     """
     x = np.asarray(x0, dtype=np.float64).copy()
     if project is not None:
@@ -123,6 +127,7 @@ def soft_l1_least_squares(
         tol=tol,
         max_nfev=max_nfev,
         fun_and_jac=fun_and_jac,
+        damping=damping,
     )
 
 
@@ -164,6 +169,7 @@ def _lm_soft_l1(
     tol: float,
     max_nfev: int,
     fun_and_jac: ResidualsAndJacobian | None = None,
+    damping: float = 1e-3,
 ) -> LeastSquaresResult:
     """Levenberg-Marquardt on soft-L1 reweighted residuals (IRLS weights per step)."""
     c2 = f_scale**2
@@ -173,7 +179,7 @@ def _lm_soft_l1(
         r = fun(x)
         J = jac(x)
     cost = soft_l1_cost(r, f_scale)
-    lam = 1e-3
+    lam = damping
     nfev = 1
     success = False
     while nfev < max_nfev:
