@@ -947,8 +947,7 @@ def _score_test(
     from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
 
     x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
-    r = prob.residuals(x1, R0, None, f_fixed)
-    J = prob.jacobian(x1, R0, None, f_fixed)
+    r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
     w = 1.0 / np.sqrt(1.0 + z)
@@ -1696,8 +1695,7 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
         n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
         owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
         x0 = np.asarray(state.x, dtype=float)
-        r = prob.residuals(x0, *args)
-        J = prob.jacobian(x0, *args)
+        r, J = prob.residuals_and_jacobian(x0, *args)
         owner = np.concatenate([owner_base, np.full(len(r) - n_seg - 2 * n_pt, -1)])
         w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
         Jw = J * w[:, None]
@@ -2451,8 +2449,7 @@ def _pinned_pp_sensitivity(
     saved = prob.pp_prior_sigma
     prob.pp_prior_sigma = 0.0  # the data's information alone; the prior is σ here
     try:
-        r = prob.residuals(x1, R0, None, f_fixed)
-        J = prob.jacobian(x1, R0, None, f_fixed)
+        r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     finally:
         prob.pp_prior_sigma = saved
     w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
