@@ -2232,7 +2232,7 @@ def _joint(
         x0 = _pack(cam0.focal_px, pp_fixed, cam0.center_in_world, f_fixed is None, False)
         prob.set_corners([0 if w == prob.ws_common else 2 for w in width_signs])
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
-        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=60)
+        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60)
         score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
         if best is None or score < best[0]:
             best = (score, prob, res, R0, width_signs)
