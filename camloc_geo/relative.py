@@ -112,7 +112,9 @@ class CalibrationSettings:
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
         (3 %: 66 px at 1080p; cameras crop little, and a freed principal point otherwise
-        trades off against the focal length); 0 turns it off.
+        trades off against the focal length); 0 turns it off. Where the lines fit better
+        than the noise model (residual variance factor ``s² < 1``) the prior is widened by
+        ``1/s``, as the posterior weighs such data more.
     """
 
     joint_fit: bool = True
