@@ -892,6 +892,26 @@ def _rotvec_matrices(rotvecs: FloatArray) -> FloatArray:
     )
 
 
+def _small_rotvec(R: FloatArray) -> FloatArray:
+    """Rotation vector of a rotation matrix turned by less than ~170° (the log map).
+
+    For the small turns between nearby fits; scipy's ``Rotation.from_matrix`` costs ~50 µs
+    a call in its checks. Near 180° (never met here) the axis is ill-conditioned, so scipy
+    takes over there.
+    """
+    R = np.asarray(R, dtype=float)
+    cos_t = float(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
+    theta = math.acos(cos_t)
+    v = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if theta < 1e-6:
+        return np.asarray(0.5 * v, dtype=np.float64)  # sin θ ≈ θ
+    if theta > math.radians(170.0):
+        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
+
+        return np.asarray(Rotation.from_matrix(R).as_rotvec(), dtype=np.float64)
+    return np.asarray(theta / (2.0 * math.sin(theta)) * v, dtype=np.float64)
+
+
 def _fit(
     prob: _JointProblem,
     x0: FloatArray,
@@ -946,9 +966,7 @@ def _score_test(
     """
     f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
     x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
-    x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+    x1[-6:-3] = _small_rotvec(R1 @ R0.T)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
@@ -1751,8 +1769,6 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     within 10 % of the refits'); the spread and the influences are then as in
     :func:`_jackknife`.
     """
-    from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
     state = result.joint_state
     assert state is not None
     prob = state.problem
@@ -1775,7 +1791,7 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
             continue
         centres.append(c_i)
         focals.append(f_i)
-        turn = Rotation.from_matrix((R_i @ M) @ R.T).as_rotvec()
+        turn = _small_rotvec((R_i @ M) @ R.T)
         if np.linalg.norm(turn) < math.radians(30.0):
             turns.append(turn)
         influence.append(float(np.linalg.norm(c_i - c)))
@@ -2264,9 +2280,7 @@ def _joint(
     if pp_given is None and free_pp is not False and worth_trying:
         f0, _pp, R1, C1 = prob.unpack(res.x, R0, pp_fixed, f_fixed)
         x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-        from scipy.spatial.transform import Rotation  # scipy.spatial: 0.25 s to import
-
-        x1[-6:-3] = Rotation.from_matrix(R1 @ R0.T).as_rotvec()
+        x1[-6:-3] = _small_rotvec(R1 @ R0.T)
         res_free = _fit(prob, x1, R0, None, f_fixed)
         cost_fixed, cost_free = 2.0 * res.cost, 2.0 * res_free.cost
         k_free = len(res_free.x)

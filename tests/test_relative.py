@@ -670,3 +670,17 @@ def test_the_jackknife_widens_the_focal_sigma() -> None:
         assert with_jack.focal_sigma_px >= without.focal_sigma_px - 1e-9
         widened += with_jack.focal_sigma_px > 1.01 * without.focal_sigma_px
     assert widened >= 1
+
+
+def test_small_rotvec_matches_scipy() -> None:
+    """The jackknife's log map of a rotation agrees with scipy's, small turns to near 180°."""
+    from scipy.spatial.transform import Rotation
+
+    from camloc_geo.relative import _small_rotvec
+
+    rng = np.random.default_rng(3)
+    for angle in (0.0, 1e-8, 1e-3, 0.4, 2.0, 3.1):
+        axis = rng.normal(size=3)
+        w = axis / np.linalg.norm(axis) * angle
+        got = _small_rotvec(Rotation.from_rotvec(w).as_matrix())
+        assert got == pytest.approx(w, abs=1e-9)
