@@ -86,6 +86,8 @@ def soft_l1_least_squares(
     method: Literal["lm", "scipy"] = "lm",
     tol: float = 1e-10,
     max_nfev: int = 200,
+    fun_and_jac: ResidualsAndJacobian | None = None,
+    damping: float = 1e-3,
 ) -> LeastSquaresResult:
     """Minimise the soft-L1 cost of ``fun(x)`` from ``x0``.
 
@@ -102,13 +104,31 @@ def soft_l1_least_squares(
         ``lm``: the Levenberg-Marquardt loop; ``scipy``: ``least_squares(loss="soft_l1")``.
     tol, max_nfev
         Relative tolerance on the gradient, step and cost decrease; evaluation budget.
+    fun_and_jac
+        Optional (``lm`` only): the residuals and the Jacobian at ``x`` from one call. Each
+        trial step is then evaluated with its Jacobian at once (worth it where a batched
+        finite-difference Jacobian costs little more than the residuals alone: most steps
+        are accepted, and an accepted step then needs no second call).
+    damping
+        ``lm``: the initial Levenberg-Marquardt damping (relative to the normal equations'
+        diagonal); smaller suits a start already near the minimum.
     """
     x = np.asarray(x0, dtype=np.float64).copy()
     if project is not None:
         x = project(x)
     if method == "scipy":
         return _scipy_soft_l1(fun, jac, x, f_scale=f_scale, tol=tol, max_nfev=max_nfev)
-    return _lm_soft_l1(fun, jac, x, f_scale=f_scale, project=project, tol=tol, max_nfev=max_nfev)
+    return _lm_soft_l1(
+        fun,
+        jac,
+        x,
+        f_scale=f_scale,
+        project=project,
+        tol=tol,
+        max_nfev=max_nfev,
+        fun_and_jac=fun_and_jac,
+        damping=damping,
+    )
 
 
 def _scipy_soft_l1(
@@ -148,15 +168,20 @@ def _lm_soft_l1(
     project: Callable[[FloatArray], FloatArray] | None,
     tol: float,
     max_nfev: int,
+    fun_and_jac: ResidualsAndJacobian | None = None,
+    damping: float = 1e-3,
 ) -> LeastSquaresResult:
     """Levenberg-Marquardt on soft-L1 reweighted residuals (IRLS weights per step)."""
     c2 = f_scale**2
-    r = fun(x)
+    if fun_and_jac is not None:
+        r, J = fun_and_jac(x)
+    else:
+        r = fun(x)
+        J = jac(x)
     cost = soft_l1_cost(r, f_scale)
-    lam = 1e-3
+    lam = damping
     nfev = 1
     success = False
-    J = jac(x)
     while nfev < max_nfev:
         w = 1.0 / np.sqrt(1.0 + r * r / c2)  # soft-L1 IRLS weights
         Jw = J * w[:, None]
@@ -177,7 +202,11 @@ def _lm_soft_l1(
         x_new = x + dx
         if project is not None:
             x_new = project(x_new)
-        r_new = fun(x_new)
+        J_new: FloatArray | None = None
+        if fun_and_jac is not None:
+            r_new, J_new = fun_and_jac(x_new)
+        else:
+            r_new = fun(x_new)
         nfev += 1
         cost_new = soft_l1_cost(r_new, f_scale)
         if cost_new <= cost:
@@ -185,7 +214,7 @@ def _lm_soft_l1(
             gain_small = cost - cost_new <= tol * max(cost, 1e-300)
             x, r, cost = x_new, r_new, cost_new
             lam = max(lam * 0.3, 1e-12)
-            J = jac(x)
+            J = J_new if J_new is not None else jac(x)
             if step_small or gain_small:
                 success = True
                 break

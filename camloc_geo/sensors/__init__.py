@@ -10,18 +10,21 @@ Uncertainty model (``sigma_m``)
 -------------------------------
 Monte Carlo with a fixed seed (reproducible): ``n_samples`` draws of
 
-- the camera centre, perturbed independently per axis by ``calibration.position_sigma_m``
-  (zero when the calibration has none);
+- the camera centre, perturbed per axis by ``calibration.position_sigma_m`` (zero when the
+  calibration has none);
 - the orientation, turned by a small random rotation ``exp([ε]×)`` on the left of
   ``cam_from_world_rotation``, ``ε`` drawn per camera axis (x right, y down, z optical) with
   ``calibration.rotation_sigma_deg`` (none when the calibration has none);
 - the focal length, perturbed by ``calibration.focal_sigma_px`` when known;
+- the principal point, perturbed by ``calibration.principal_point_sigma_px`` when known;
 - every clicked pixel, perturbed by ``click_sigma_px`` (default 1.5 px) per coordinate.
 
-``sigma_m`` is the standard deviation of the measurement over the draws. The draws are
-independent per parameter (the fit's correlations between position, rotation and focal
-length are not kept). Draws in which a pixel's ray misses the ground are dropped; if more
-than half are dropped the measurement is refused.
+The camera's parameters are drawn together, with the correlations of the calibration's
+``parameter_covariance`` at the reported sigmas: a principal point off centre and the tilt
+it trades against nearly cancel on the ground, as they do in the fit. Without a covariance
+they are drawn independently. ``sigma_m`` is the standard deviation of the measurement over
+the draws. Draws in which a pixel's ray misses the ground are dropped; if more than half
+are dropped the measurement is refused.
 
 The virtual radar (vehicle speeds from video) is :mod:`camloc_geo.sensors.radar`; the
 virtual guide (people seen by the camera matched to GPS traces) is
@@ -132,7 +135,7 @@ def _draws(
     The rotation is not drawn: see :func:`_draws_posed`.
     """
     centres, focals, _rotations, px = _draws_posed(
-        calibration, pixels, n_samples, click_sigma_px, seed
+        calibration, pixels, n_samples, click_sigma_px, seed, principal_point=False
     )
     return centres, focals, px
 
@@ -143,9 +146,15 @@ def _draws_posed(
     n_samples: int,
     click_sigma_px: float,
     seed: int,
+    principal_point: bool = True,
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Centres ``(S+1, 3)``, focals ``(S+1,)``, ``cam_from_world`` rotations ``(S+1, 3, 3)``
-    and pixels ``(S+1, N, 2)``; row 0 nominal (model in the module docstring)."""
+    and pixels ``(S+1, N, 2)``; row 0 nominal (model in the module docstring).
+
+    A drawn principal point ``pp + δ`` is applied as the pixels moved by ``−δ`` (the rays
+    through ``u − pp − δ`` are the same), so callers keep casting through the camera's
+    principal point; ``principal_point=False`` leaves it out.
+    """
     from scipy.spatial.transform import Rotation
 
     cam = calibration.camera
@@ -154,16 +163,41 @@ def _draws_posed(
     sig_c = np.zeros(3) if sig_c is None else np.nan_to_num(np.asarray(sig_c, float).reshape(3))
     sig_f = calibration.focal_sigma_px
     sig_f = 0.0 if sig_f is None or not np.isfinite(sig_f) else float(sig_f)
-    centres = cam.center_in_world + rng.normal(0.0, 1.0, (n_samples, 3)) * sig_c
-    focals = cam.focal_px + rng.normal(0.0, sig_f, n_samples)
-    focals = np.clip(focals, 0.1 * cam.focal_px, None)
-    px = pixels[None] + rng.normal(0.0, click_sigma_px, (n_samples, *pixels.shape))
-    R = cam.cam_from_world_rotation
     sig_r = getattr(calibration, "rotation_sigma_deg", None)
+    sig_rad = (
+        np.zeros(3)
+        if sig_r is None
+        else np.radians(np.nan_to_num(np.asarray(sig_r, float).reshape(3)))
+    )
+    sig_pp_in = getattr(calibration, "principal_point_sigma_px", None)
+    sig_pp = (
+        np.zeros(2)
+        if sig_pp_in is None or not principal_point
+        else np.nan_to_num(np.asarray(sig_pp_in, float).reshape(2))
+    )
+    corr = _correlation(getattr(calibration, "parameter_covariance", None))
+    R = cam.cam_from_world_rotation
     rotations = np.broadcast_to(R, (n_samples + 1, 3, 3)).copy()
-    if sig_r is not None:
-        sig_rad = np.radians(np.nan_to_num(np.asarray(sig_r, float).reshape(3)))
-        eps = rng.normal(0.0, 1.0, (n_samples, 3)) * sig_rad
+    d_pp = np.zeros((n_samples, 2))
+    if corr is not None:
+        # Drawn together: the fit's correlations (e.g. a principal point off centre against
+        # the tilt it trades with) at the reported sigmas (which include the jackknife).
+        z = rng.normal(0.0, 1.0, (n_samples, 9)) @ corr.T
+        scale = np.concatenate([[sig_f], sig_pp, sig_rad, sig_c])
+        d = z * scale
+        centres = cam.center_in_world + d[:, 6:9]
+        focals = cam.focal_px + d[:, 0]
+        d_pp = d[:, 1:3]
+        eps = d[:, 3:6]
+        px = pixels[None] + rng.normal(0.0, click_sigma_px, (n_samples, *pixels.shape))
+    else:
+        centres = cam.center_in_world + rng.normal(0.0, 1.0, (n_samples, 3)) * sig_c
+        focals = cam.focal_px + rng.normal(0.0, sig_f, n_samples)
+        px = pixels[None] + rng.normal(0.0, click_sigma_px, (n_samples, *pixels.shape))
+        eps = rng.normal(0.0, 1.0, (n_samples, 3)) * sig_rad if sig_r is not None else None
+    focals = np.clip(focals, 0.1 * cam.focal_px, None)
+    px = px - d_pp[:, None, :]
+    if eps is not None:
         rotations[1:] = Rotation.from_rotvec(eps).as_matrix() @ R
     return (
         np.vstack([cam.center_in_world[None], centres]),
@@ -171,6 +205,28 @@ def _draws_posed(
         rotations,
         np.concatenate([pixels[None], px]),
     )
+
+
+def _correlation(cov: Any) -> FloatArray | None:
+    """A square root ``L`` (``L Lᵀ`` = the correlation matrix) of a ``(9, 9)`` covariance.
+
+    Entries of zero variance get an uncorrelated unit draw (scaled to zero by their sigma).
+    None when there is no usable covariance.
+    """
+    if cov is None:
+        return None
+    c = np.asarray(cov, dtype=np.float64)
+    if c.shape != (9, 9) or not np.all(np.isfinite(c)):
+        return None
+    sd = np.sqrt(np.clip(np.diag(c), 0.0, None))
+    ok = sd > 0.0
+    inv = np.where(ok, 1.0 / np.where(ok, sd, 1.0), 0.0)
+    rho = c * inv[:, None] * inv[None, :]
+    rho[~ok, :] = 0.0
+    rho[:, ~ok] = 0.0
+    rho[np.diag_indices(9)] = 1.0
+    vals, vecs = np.linalg.eigh(0.5 * (rho + rho.T))
+    return np.asarray(vecs * np.sqrt(np.clip(vals, 0.0, None)), dtype=np.float64)
 
 
 def _check_ground(points: FloatArray, pixels: FloatArray) -> None:
