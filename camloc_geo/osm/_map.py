@@ -96,6 +96,13 @@ def _streets_of(G: nx.MultiDiGraph, north_america: bool) -> list[Street]:
     return streets
 
 
+def _strtree(geometries: Sequence[Any]) -> Any:
+    """A :class:`shapely.STRtree` over ``geometries`` (indices aligned with them)."""
+    from shapely import STRtree
+
+    return STRtree(list(geometries))
+
+
 class MapData:
     """Streets, intersections and buildings around a point.
 
@@ -489,7 +496,11 @@ class MapData:
         e, n = self.frame.enu_from_geographic(lat=lat, lon=lon)
         pt = Point(float(e), float(n))
         rows: list[tuple[float, str, float]] = []
-        for street, line in zip(self._streets, self.streets_enu, strict=True):
+        lines = self.streets_enu
+        tree = self.cached("streets_enu_tree", lambda: _strtree(lines))
+        near = sorted(int(i) for i in tree.query(pt, predicate="dwithin", distance=radius_m))
+        for i in near:
+            street, line = self._streets[i], lines[i]
             dist = line.distance(pt)
             if dist > radius_m or line.length < 0.5:
                 continue
