@@ -12,11 +12,14 @@ radar (see ``docs/radar.md``):
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
-2. **Ground contact.** In each frame, the lowest vertex of the convex hull of the vehicle's
-   foreground silhouette: for a vehicle on the ground seen from above, that pixel is a
-   bottom corner, *on the ground*, so it casts onto ``z = 0`` without any assumption on
-   heights. Without a usable silhouette (given boxes with no foreground), the bottom-centre
-   of the box is used (biased by 1-5 % under perspective; see the docs).
+2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
+   silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
+   lines meeting at a corner (on a shallow outline, far away, many pixels share the lowest
+   row, and taking one of them slides the contact along the vehicle). For a vehicle seen
+   from above, that corner is a tyre on the road or a bottom corner of the body, up to its
+   ground clearance above it (unknown: it is in ``sigma_kmh``, not corrected). Without a
+   usable silhouette (given boxes with no foreground), the bottom-centre of the box is
+   used (see step 4).
 3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
    :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
    motion; where the measured contact jumps away from it (another corner became the lowest,
@@ -27,17 +30,21 @@ radar (see ``docs/radar.md``):
    least squares, with one velocity shared by all segments and one offset per segment
    (constant velocity over the track). Speed = |velocity| in km/h.
 
-Step 4 is then refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant
-velocity along the fitted direction is fitted (soft-L1) so that its projected image box
-(plus a constant margin in pixels) matches the vehicle's box in every frame; its velocity
-is the reported one. Each track is fitted as soon as it ends, so a long video holds only
-the active tracks in memory.
+Without a silhouette in most frames (boxes given for a video whose background shows no
+foreground) step 4 is refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
+constant velocity along the fitted direction is fitted (soft-L1) so that its projected
+image box (plus a constant margin in pixels) matches the vehicle's box in every frame; its
+velocity is the reported one. (A cuboid is not a car: on two-box cars with ground
+clearance it reads 2-5 % fast, which is why the silhouette's corner comes first.) Each
+track is fitted as soon as it ends, so a long video holds only the active tracks in memory.
 
-Uncertainty (``sigma_kmh``), combined in quadrature: the cuboid fit's standard error (from
-its residuals); half the difference between the contact-point and the cuboid speeds (model
-error); the calibration's part: the contact pixels are recast and refitted with
-``n_samples`` cameras drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length
-perturbed by the calibration's sigmas; rotation fixed), and the spread of the speeds taken.
+Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
+residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
+0.12 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.12 / H``); with the
+cuboid, half the difference between the contact-point and the cuboid speeds (model error);
+the calibration's part: the contact pixels are recast and refitted with ``n_samples``
+cameras drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by
+the calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
 blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
@@ -118,6 +125,7 @@ _BG_RATE = 0.02  # background update rate per frame, where no foreground
 _SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
 _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
+_CONTACT_HEIGHT_SIGMA_M = 0.12  # the lowest silhouette point: a tyre (0) or a body's edge
 
 
 # --------------------------------------------------------------------------- results
@@ -641,10 +649,8 @@ def _associate(
     return match, [j for j in range(len(blobs)) if j not in used], hidden
 
 
-def _contact(
-    fg: Any, box: Box, scale: float, prev_u: float | None
-) -> tuple[tuple[float, float], str]:
-    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette hull vertex or box."""
+def _contact(fg: Any, box: Box, scale: float) -> tuple[tuple[float, float], str]:
+    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette corner or box."""
     import cv2
 
     x1, y1, x2, y2 = box
@@ -659,19 +665,53 @@ def _contact(
             if contours:
                 big = max(contours, key=cv2.contourArea)
                 area = cv2.contourArea(big)
-                hull = cv2.convexHull(big).reshape(-1, 2)
-                low = hull[:, 1].max()
+                low = big[:, 0, 1].max()
                 # the silhouette must fill the box reasonably and reach its bottom
                 if area >= 0.25 * roi.size and low >= 0.85 * (r1 - r0) - 1:
-                    cand = hull[hull[:, 1] >= low - 1]
-                    if prev_u is None or len(cand) == 1:
-                        # the lowest vertex; on a near-horizontal bottom edge, its left end
-                        u = float(cand[np.lexsort((cand[:, 0], -cand[:, 1]))[0], 0])
-                    else:
-                        us = (cand[:, 0] + c0 + 0.5) / scale
-                        u = float(cand[int(np.argmin(np.abs(us - prev_u))), 0])
-                    return ((u + c0 + 0.5) / scale, (low + r0 + 1.0) / scale), "silhouette"
+                    one = np.zeros_like(roi)
+                    cv2.drawContours(one, [big], 0, 255, -1)
+                    corner = _lowest_corner(one)
+                    if corner is not None:
+                        u, v = corner
+                        return ((u + c0) / scale, (v + r0) / scale), "silhouette"
     return bottom_centre, "box"
+
+
+def _lowest_corner(mask: Any) -> tuple[float, float] | None:
+    """Sub-pixel lowest corner ``(u, v)`` of a silhouette (binary mask, one component).
+
+    On a shallow bottom outline (two nearly collinear bottom edges, far away) many pixels
+    share the lowest row: taking any one of them slides the contact along the vehicle by
+    up to metres and biases the speed. The outline's lowest part is instead fitted with two
+    lines meeting at a corner (a hinge: least squares over the bottom profile of the
+    columns, the corner's column searched), and the corner is their meeting point.
+    """
+    cols = np.flatnonzero(mask.any(axis=0))
+    if len(cols) < 3:
+        return None
+    h = mask.shape[0]
+    bottom = h - np.argmax(mask[::-1, cols] > 0, axis=0).astype(np.float64)  # lower edges
+    low = float(bottom.max())
+    band = max(3.0, 0.2 * float(h))
+    k = int(np.argmax(bottom))
+    lo, hi = k, k
+    while lo > 0 and bottom[lo - 1] >= low - band:
+        lo -= 1
+    while hi < len(cols) - 1 and bottom[hi + 1] >= low - band:
+        hi += 1
+    x = cols[lo : hi + 1].astype(np.float64) + 0.5
+    y = bottom[lo : hi + 1]
+    if len(x) < 5:
+        return float(cols[k]) + 0.5, low
+    best: tuple[float, float, float] | None = None
+    for x0 in np.linspace(x[0], x[-1], min(len(x), 80)):
+        a = np.column_stack([np.ones_like(x), np.minimum(x - x0, 0.0), np.maximum(x - x0, 0.0)])
+        coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+        sse = float(np.sum((a @ coef - y) ** 2))
+        if best is None or sse < best[0]:
+            best = (sse, float(x0), float(coef[0]))
+    assert best is not None
+    return best[1], min(best[2], low)
 
 
 def _klt_step(
@@ -867,10 +907,22 @@ def _fit_track(
     sp = np.linalg.norm(draws, axis=1)
     sp = sp[np.isfinite(sp)]
     sigma_cal = float(np.std(sp, ddof=1)) if len(sp) >= 2 else 0.0
-    sigma = math.hypot(sigma_fit, sigma_cal)
-    # refine with a cuboid moving at constant velocity whose image box matches the boxes
+    # the contact's height is unknown between the road (a tyre) and the body's lower edge:
+    # a point h up casts onto the ground H / (H - h) farther from the camera's foot, and so
+    # does its velocity (H: the camera's height)
+    height_m = max(1.0, float(cam.center_in_world[2]))
+    sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
+    sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
+    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
+    on_silhouette = float(np.mean(kinds_used == "silhouette"))
+    # without a silhouette (given boxes only), refine with a cuboid moving at constant
+    # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
     boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
-    refined = _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
+    refined = (
+        None
+        if on_silhouette >= 0.5
+        else _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
+    )
     if refined is not None:
         vel_c, sigma_c = refined
         speed_c = float(np.linalg.norm(vel_c))
@@ -878,8 +930,9 @@ def _fit_track(
             sigma_cal *= speed_c / speed
             # the two estimates (ground contact, cuboid) disagree by the model's error
             sigma_model = abs(speed_c - speed) / 2.0
+            sigma_contact *= speed_c / speed
             vel, speed, sigma_fit = vel_c, speed_c, sigma_c
-            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2)
+            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2 + sigma_contact**2)
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
     world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
@@ -1247,8 +1300,7 @@ def _run(
                     )
                 t.box = box
                 t.missed = 0
-                prev_u = t.contacts[-1][0] if t.contacts else None
-                c, kind = _contact(fg, box, scale, prev_u)
+                c, kind = _contact(fg, box, scale)
                 t.frames.append(i)
                 t.boxes.append(box)
                 t.contacts.append(c)

@@ -522,7 +522,7 @@ def random_street(
         image_size=image_size,
         hfov_deg=float(rng.uniform(55.0, 70.0)),
         setback_m=float(rng.uniform(14.0, 19.0)),
-        along_m=float(rng.uniform(-12.0, -4.0)),
+        along_m=float(rng.uniform(-14.0, -7.0)),
         aim_xy_m=(float(rng.uniform(5.0, 11.0)), -6.0),
         roll_deg=float(rng.uniform(-1.5, 1.5)),
     )
