@@ -124,8 +124,10 @@ _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foregro
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
 _SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
 _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
+_TEXTURE_MIN = 4.0  # grey levels: local deviation of a background with texture
+_SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and background
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
-_CONTACT_HEIGHT_SIGMA_M = 0.12  # the lowest silhouette point: a tyre (0) or a body's edge
+_CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
 
 
 # --------------------------------------------------------------------------- results
@@ -582,6 +584,7 @@ class _Track:
     kinds: list[str] = field(default_factory=list)
     klt: list[tuple[float, float]] = field(default_factory=list)
     border: list[bool] = field(default_factory=list)
+    occluded: list[bool] = field(default_factory=list)
     points: Any = None  # KLT features (N, 1, 2) float32 in the previous frame
 
     def predicted(self) -> Box:
@@ -596,6 +599,14 @@ def _iou(a: Box, b: Box) -> float:
     inter = ix * iy
     union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
     return inter / union if union > 0 else 0.0
+
+
+def _overlap(a: Box, b: Box) -> float:
+    """Area of the intersection of two boxes over the area of the first."""
+    ix = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    iy = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    area = (a[2] - a[0]) * (a[3] - a[1])
+    return ix * iy / area if area > 0 else 0.0
 
 
 def _blobs(fg: Any, scale: float, min_area: int) -> list[Box]:
@@ -788,7 +799,7 @@ def _segments(t: _Track, fps: float, width: int, height: int) -> tuple[list[int]
     seg = -1
     prev: int | None = None
     for i in range(len(t.frames)):
-        if t.border[i]:
+        if t.border[i] or t.occluded[i]:
             prev = None
             continue
         if prev is None or t.frames[i] - t.frames[prev] > _MAX_MISSED + 1:
@@ -823,16 +834,23 @@ def _design(times: FloatArray, labels: list[int]) -> FloatArray:
     return a
 
 
-def _irls(a: FloatArray, g: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Huber IRLS of ``g ≈ a @ coef``; returns the solve matrix, weights and residuals."""
-    w = np.ones(len(g))
+def _irls(
+    a: FloatArray, g: FloatArray, prior: FloatArray | None = None
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Huber IRLS of ``g ≈ a @ coef``; returns the solve matrix, weights and residuals.
+
+    ``prior``: each row's weight (inverse variance, any scale) before the Huber down-weighting;
+    the residuals are compared in units of each row's own sigma.
+    """
+    p = np.ones(len(g)) if prior is None else np.asarray(prior, np.float64)
+    w = p.copy()
     for _ in range(4):
         sw = np.sqrt(w)[:, None]
         solve = np.linalg.pinv(a * sw) * sw.T
         res = g - a @ (solve @ g)
-        r = np.linalg.norm(res, axis=1)
-        s = 1.4826 * float(np.median(r)) + 1e-6
-        w = np.where(r <= 2.0 * s, 1.0, 2.0 * s / np.maximum(r, 1e-12))
+        r = np.linalg.norm(res, axis=1) * np.sqrt(p)
+        s = 1.4826 * float(np.median(r)) + 1e-9
+        w = p * np.where(r <= 2.0 * s, 1.0, 2.0 * s / np.maximum(r, 1e-12))
     sw = np.sqrt(w)[:, None]
     solve = np.linalg.pinv(a * sw) * sw.T
     res = g - a @ (solve @ g)
@@ -864,6 +882,8 @@ def _fit_track(
         return skipped(f"tracked for only {span_s:.2f} s (< {min_track_s:g} s)", len(t.frames))
     if all(t.border):
         return skipped("never wholly inside the frame (its box touches the image border)")
+    if all(b or o for b, o in zip(t.border, t.occluded, strict=True)):
+        return skipped("never clear of other vehicles' boxes while wholly inside the frame")
     use, labels = _segments(t, fps, width, height)
     if not use:
         return skipped("its ground contact jumps in every frame (occlusions or merged vehicles)")
@@ -901,7 +921,7 @@ def _fit_track(
     dof = max(1, len(times) - a.shape[1])
     unit = vel / speed
     s2 = float(np.sum(weights * (res @ unit) ** 2) / dof)
-    sigma_fit = math.sqrt(s2 * float(solve[0] @ solve[0]))
+    sigma_fit = math.sqrt(s2 * float(np.sum(solve[0] ** 2 / np.maximum(weights, 1e-12))))
     # calibration: refit with every drawn camera
     draws = np.einsum("n,snd->sd", solve[0], ground[1:])
     sp = np.linalg.norm(draws, axis=1)
@@ -1312,6 +1332,12 @@ def _run(
                     or box[2] >= width - 1.0
                     or box[3] >= height - 1.0
                 )
+                # a given box overlapping another one's: the silhouette in it may be both
+                # vehicles' (detected tracks are kept apart by the association instead)
+                t.occluded.append(
+                    given is not None
+                    and any(_overlap(box, b) > 0.02 for j, b in current.items() if j != k)
+                )
                 if t.points is None or len(t.points) < 8 or len(t.frames) % 10 == 0:
                     if fg_full is None:
                         fg_full = (
@@ -1378,15 +1404,21 @@ def _split_reversals(t: _Track) -> list[_Track]:
         piece.frames, piece.boxes = t.frames[lo:hi], t.boxes[lo:hi]
         piece.contacts, piece.kinds = t.contacts[lo:hi], t.kinds[lo:hi]
         piece.klt, piece.border = t.klt[lo:hi], t.border[lo:hi]
+        piece.occluded = t.occluded[lo:hi]
         pieces.append(piece)
     return pieces
 
 
 def _shadows(frame: Any, background: Any) -> Any:
-    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio.
+    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio,
+    its texture kept.
 
     A shadow keeps the road's colour and dims it (ratio ``_SHADOW_RATIO``, spread below
     ``_SHADOW_SPREAD`` between channels); a vehicle changes the colour or is much darker.
+    A grey vehicle on a grey road passes that test too: but a shadow keeps the road's
+    texture (the frame correlates with the background, locally), a vehicle's panels hide
+    it. Where the background has texture (local deviation above ``_TEXTURE_MIN``) a shadow
+    must also correlate with it (normalised cross-correlation above ``_SHADOW_NCC``).
     """
     import cv2
 
@@ -1397,7 +1429,18 @@ def _shadows(frame: Any, background: Any) -> Any:
     dim = cv2.inRange(lo, _SHADOW_RATIO[0], _SHADOW_RATIO[1])
     grey = cv2.inRange(hi - lo, 0.0, _SHADOW_SPREAD)
     bright = cv2.inRange(hi, 0.0, _SHADOW_RATIO[1])
-    return cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
+    shadow = cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
+    f = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY).astype(np.float32)
+    bg = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY)
+    win = (5, 5)
+    mf, mb = cv2.blur(f, win), cv2.blur(bg, win)
+    cov = cv2.blur(f * bg, win) - mf * mb
+    var_f = cv2.blur(f * f, win) - mf * mf
+    var_b = cv2.blur(bg * bg, win) - mb * mb
+    ncc = cov / np.sqrt(np.maximum(var_f * var_b, 1e-6))
+    textured = var_b > _TEXTURE_MIN**2
+    hidden = (textured & (ncc < _SHADOW_NCC)).astype(np.uint8) * 255
+    return cv2.bitwise_and(shadow, cv2.bitwise_not(hidden))
 
 
 def _centre(box: Box) -> tuple[float, float]:

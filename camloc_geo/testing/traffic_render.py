@@ -517,15 +517,24 @@ def random_street(
     alternating directions, lanes at ``y = -3, -5.5`` eastbound and ``-8.5, -11``
     westbound); each passes ``x = 8`` (the middle of the view) at its time.
     """
-    cam = street_camera(
-        float(rng.uniform(6.0, 9.0)),
-        image_size=image_size,
-        hfov_deg=float(rng.uniform(55.0, 70.0)),
-        setback_m=float(rng.uniform(14.0, 19.0)),
-        along_m=float(rng.uniform(-14.0, -7.0)),
-        aim_xy_m=(float(rng.uniform(5.0, 11.0)), -6.0),
-        roll_deg=float(rng.uniform(-1.5, 1.5)),
+    ref = PRESETS["sedan"]
+    car = np.array(
+        [[x, y, z] for x in (0.0, ref.length_m) for y in (0.0, ref.width_m) for z in (0.0, 1.4)]
     )
+    w, h = image_size
+    for _ in range(200):  # the annotated reference car must be in view, off the borders
+        cam = street_camera(
+            float(rng.uniform(6.0, 9.0)),
+            image_size=image_size,
+            hfov_deg=float(rng.uniform(55.0, 70.0)),
+            setback_m=float(rng.uniform(14.0, 19.0)),
+            along_m=float(rng.uniform(-14.0, -7.0)),
+            aim_xy_m=(float(rng.uniform(5.0, 11.0)), -6.0),
+            roll_deg=float(rng.uniform(-1.5, 1.5)),
+        )
+        px = cam.project(car)
+        if px[:, 0].min() > 0.05 * w and px[:, 1].max() < 0.95 * h:
+            break
     vehicles = []
     for k in range(n_vehicles):
         east = k % 2 == 0
