@@ -294,11 +294,13 @@ def _texture(rng: np.random.Generator, m_per_px: float) -> tuple[Any, FloatArray
     return np.asarray(bgr, np.uint8), world_from_tex
 
 
-def _background(camera: Camera, image_size: tuple[int, int], rng: np.random.Generator) -> Any:
+def _background(
+    camera: Camera, image_size: tuple[int, int], rng: np.random.Generator, m_per_px: float
+) -> Any:
     import cv2
 
     w, h = image_size
-    tex, world_from_tex = _texture(rng, 0.025)
+    tex, world_from_tex = _texture(rng, m_per_px)
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     img_from_ground = camera.img_from_cam @ np.column_stack([R[:, 0], R[:, 1], t])
     img = cv2.warpPerspective(
@@ -424,6 +426,7 @@ def render_street(
     sun: bool = True,
     annotation_px: float = 1.0,
     fourcc: str = "MJPG",
+    texture_m_per_px: float = 0.025,
 ) -> RenderedVideo:
     """Render a street video (MJPG ``.avi``) and return it with its truth and annotated scene.
 
@@ -445,6 +448,10 @@ def render_street(
         Cast hard shadows (besides the contact shadows, always drawn).
     annotation_px
         Click noise of the scene's 3 annotators (1 px by default; 0: exact).
+    fourcc
+        Codec; MJPG is available in every OpenCV build.
+    texture_m_per_px
+        Resolution of the asphalt texture (coarser: faster, for small test videos).
 
     Raises
     ------
@@ -467,7 +474,7 @@ def render_street(
     scene = make_scene(
         camera, np.random.default_rng(seed + 7), noise=noise, n_annotators=3, image_size=size
     ).scene
-    background = _background(camera, size, rng)
+    background = _background(camera, size, rng, texture_m_per_px)
     ref = PRESETS["sedan"]
     parked = StreetVehicle(
         (ref.length_m / 2, ref.width_m / 2),
