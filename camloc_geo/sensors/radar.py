@@ -857,6 +857,38 @@ def _irls(
     return np.asarray(solve, np.float64), np.asarray(w, np.float64), res
 
 
+def _consistent(
+    times: FloatArray, ground: FloatArray, labels: list[int], vel: FloatArray
+) -> npt.NDArray[np.bool_]:
+    """Rows of the segments whose own velocity agrees with the track's joint one.
+
+    A segment of at least 8 frames over 0.4 s is fitted alone (a line per axis); it
+    disagrees when its velocity is off the joint one by more than 3 of its standard errors
+    plus 8 % of the speed (a contact that followed another vehicle after a merge, or a
+    merged blob's corner). If that would leave less than half the track's time span, or
+    fewer than 3 frames, nothing is left out.
+    """
+    keep = np.ones(len(times), bool)
+    speed = float(np.linalg.norm(vel))
+    labels_arr = np.asarray(labels)
+    for seg in set(labels):
+        rows = labels_arr == seg
+        t = times[rows]
+        if rows.sum() < 8 or float(np.ptp(t)) < 0.4:
+            continue
+        tc = t - t.mean()
+        sxx = float(tc @ tc)
+        g = ground[rows]
+        v = tc @ (g - g.mean(axis=0)) / sxx
+        res = g - g.mean(axis=0) - np.outer(tc, v)
+        se = math.sqrt(float(np.sum(res**2)) / max(1, 2 * (len(t) - 2)) / sxx)
+        if float(np.linalg.norm(v - vel)) > 3.0 * se + 0.08 * speed:
+            keep[rows] = False
+    if keep.sum() < 3 or float(np.ptp(times[keep])) < 0.5 * float(np.ptp(times)):
+        return np.ones(len(times), bool)
+    return keep
+
+
 def _fit_track(
     t: _Track,
     calibration: CalibrationResult,
@@ -914,6 +946,15 @@ def _fit_track(
     solve, weights, res = _irls(a, ground[0])
     coef = solve @ ground[0]
     vel = coef[0]
+    cons = _consistent(times, ground[0], labels, vel)
+    if not cons.all():  # segments that follow another vehicle (after a merge): left out
+        ground, frames, times = ground[:, cons], frames[cons], times[cons]
+        labels = [s for s, c in zip(labels, cons, strict=True) if c]
+        dur = float(times.max() - times.min())
+        a = _design(times, labels)
+        solve, weights, res = _irls(a, ground[0])
+        coef = solve @ ground[0]
+        vel = coef[0]
     speed = float(np.linalg.norm(vel))
     if speed * dur < 1.0:
         return skipped(f"stationary (moved {speed * dur:.2f} m in {dur:.1f} s)", len(times), dur)
@@ -933,11 +974,11 @@ def _fit_track(
     height_m = max(1.0, float(cam.center_in_world[2]))
     sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
     sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
-    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
+    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep][cons]
     on_silhouette = float(np.mean(kinds_used == "silhouette"))
     # without a silhouette (given boxes only), refine with a cuboid moving at constant
     # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
-    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
+    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep][cons]
     refined = (
         None
         if on_silhouette >= 0.5
