@@ -147,6 +147,7 @@ def _stats(rows: list[dict[str, Any]], n_true: int) -> dict[str, Any]:
         "rel_p90": round(float(np.percentile(np.abs(rel), 90)), 4),
         "rel_max": round(float(np.max(np.abs(rel))), 4),
         "mean_signed_rel": round(float(np.mean(rel)), 4),
+        "median_signed_rel": round(float(np.median(rel)), 4),
         "abs_error_kmh_median": round(float(np.median(np.abs(err))), 3),
         "abs_error_kmh_mean": round(float(np.mean(np.abs(err))), 3),
         "coverage_2sigma": round(float(np.mean(cover)), 3),
