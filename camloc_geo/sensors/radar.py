@@ -30,21 +30,23 @@ radar (see ``docs/radar.md``):
    least squares, with one velocity shared by all segments and one offset per segment
    (constant velocity over the track). Speed = |velocity| in km/h.
 
-Without a silhouette in most frames (boxes given for a video whose background shows no
-foreground) step 4 is refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
+A second, independent estimate: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
 constant velocity along the fitted direction is fitted (soft-L1) so that its projected
-image box (plus a constant margin in pixels) matches the vehicle's box in every frame; its
-velocity is the reported one. (A cuboid is not a car: on two-box cars with ground
-clearance it reads 2-5 % fast, which is why the silhouette's corner comes first.) Each
-track is fitted as soon as it ends, so a long video holds only the active tracks in memory.
+image box (plus a constant margin in pixels) matches the vehicle's box in every frame.
+Without a silhouette in most frames (boxes given for a video whose background shows no
+foreground) its velocity is the reported one; otherwise the contact's is (a cuboid is not a
+car: on two-box cars with ground clearance it reads 2-5 % fast) and the cuboid only widens
+the uncertainty. Each track is fitted as soon as it ends, so a long video holds only the
+active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
 residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
-0.12 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.12 / H``); with the
-cuboid, half the difference between the contact-point and the cuboid speeds (model error);
-the calibration's part: the contact pixels are recast and refitted with ``n_samples``
-cameras drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by
-the calibration's sigmas; rotation fixed), and the spread of the speeds taken.
+0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``); half the
+difference between the contact-point and the cuboid speeds (model error: where the contact
+slid along the vehicle or followed another one through a merge, the two disagree); the
+calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
+drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by the
+calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
 blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
@@ -857,38 +859,6 @@ def _irls(
     return np.asarray(solve, np.float64), np.asarray(w, np.float64), res
 
 
-def _consistent(
-    times: FloatArray, ground: FloatArray, labels: list[int], vel: FloatArray
-) -> npt.NDArray[np.bool_]:
-    """Rows of the segments whose own velocity agrees with the track's joint one.
-
-    A segment of at least 8 frames over 0.4 s is fitted alone (a line per axis); it
-    disagrees when its velocity is off the joint one by more than 3 of its standard errors
-    plus 8 % of the speed (a contact that followed another vehicle after a merge, or a
-    merged blob's corner). If that would leave less than half the track's time span, or
-    fewer than 3 frames, nothing is left out.
-    """
-    keep = np.ones(len(times), bool)
-    speed = float(np.linalg.norm(vel))
-    labels_arr = np.asarray(labels)
-    for seg in set(labels):
-        rows = labels_arr == seg
-        t = times[rows]
-        if rows.sum() < 8 or float(np.ptp(t)) < 0.4:
-            continue
-        tc = t - t.mean()
-        sxx = float(tc @ tc)
-        g = ground[rows]
-        v = tc @ (g - g.mean(axis=0)) / sxx
-        res = g - g.mean(axis=0) - np.outer(tc, v)
-        se = math.sqrt(float(np.sum(res**2)) / max(1, 2 * (len(t) - 2)) / sxx)
-        if float(np.linalg.norm(v - vel)) > 3.0 * se + 0.08 * speed:
-            keep[rows] = False
-    if keep.sum() < 3 or float(np.ptp(times[keep])) < 0.5 * float(np.ptp(times)):
-        return np.ones(len(times), bool)
-    return keep
-
-
 def _fit_track(
     t: _Track,
     calibration: CalibrationResult,
@@ -946,15 +916,6 @@ def _fit_track(
     solve, weights, res = _irls(a, ground[0])
     coef = solve @ ground[0]
     vel = coef[0]
-    cons = _consistent(times, ground[0], labels, vel)
-    if not cons.all():  # segments that follow another vehicle (after a merge): left out
-        ground, frames, times = ground[:, cons], frames[cons], times[cons]
-        labels = [s for s, c in zip(labels, cons, strict=True) if c]
-        dur = float(times.max() - times.min())
-        a = _design(times, labels)
-        solve, weights, res = _irls(a, ground[0])
-        coef = solve @ ground[0]
-        vel = coef[0]
     speed = float(np.linalg.norm(vel))
     if speed * dur < 1.0:
         return skipped(f"stationary (moved {speed * dur:.2f} m in {dur:.1f} s)", len(times), dur)
@@ -974,25 +935,22 @@ def _fit_track(
     height_m = max(1.0, float(cam.center_in_world[2]))
     sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
     sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
-    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep][cons]
+    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
     on_silhouette = float(np.mean(kinds_used == "silhouette"))
     # without a silhouette (given boxes only), refine with a cuboid moving at constant
     # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
-    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep][cons]
-    refined = (
-        None
-        if on_silhouette >= 0.5
-        else _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
-    )
+    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
+    refined = _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
     if refined is not None:
         vel_c, sigma_c = refined
         speed_c = float(np.linalg.norm(vel_c))
         if speed_c * dur >= 1.0:
-            sigma_cal *= speed_c / speed
             # the two estimates (ground contact, cuboid) disagree by the model's error
             sigma_model = abs(speed_c - speed) / 2.0
-            sigma_contact *= speed_c / speed
-            vel, speed, sigma_fit = vel_c, speed_c, sigma_c
+            if on_silhouette < 0.5:  # no silhouette: the cuboid's speed is reported
+                sigma_cal *= speed_c / speed
+                sigma_contact *= speed_c / speed
+                vel, speed, sigma_fit = vel_c, speed_c, sigma_c
             sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2 + sigma_contact**2)
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
