@@ -12,11 +12,14 @@ radar (see ``docs/radar.md``):
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
-2. **Ground contact.** In each frame, the lowest vertex of the convex hull of the vehicle's
-   foreground silhouette: for a vehicle on the ground seen from above, that pixel is a
-   bottom corner, *on the ground*, so it casts onto ``z = 0`` without any assumption on
-   heights. Without a usable silhouette (given boxes with no foreground), the bottom-centre
-   of the box is used (biased by 1-5 % under perspective; see the docs).
+2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
+   silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
+   lines meeting at a corner (on a shallow outline, far away, many pixels share the lowest
+   row, and taking one of them slides the contact along the vehicle). For a vehicle seen
+   from above, that corner is a tyre on the road or a bottom corner of the body, up to its
+   ground clearance above it (unknown: it is in ``sigma_kmh``, not corrected). Without a
+   usable silhouette (given boxes with no foreground), the bottom-centre of the box is
+   used (see step 4).
 3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
    :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
    motion; where the measured contact jumps away from it (another corner became the lowest,
@@ -27,17 +30,23 @@ radar (see ``docs/radar.md``):
    least squares, with one velocity shared by all segments and one offset per segment
    (constant velocity over the track). Speed = |velocity| in km/h.
 
-Step 4 is then refined: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant
-velocity along the fitted direction is fitted (soft-L1) so that its projected image box
-(plus a constant margin in pixels) matches the vehicle's box in every frame; its velocity
-is the reported one. Each track is fitted as soon as it ends, so a long video holds only
-the active tracks in memory.
+A second, independent estimate: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
+constant velocity along the fitted direction is fitted (soft-L1) so that its projected
+image box (plus a constant margin in pixels) matches the vehicle's box in every frame.
+Without a silhouette in most frames (boxes given for a video whose background shows no
+foreground) its velocity is the reported one; otherwise the contact's is (a cuboid is not a
+car: on two-box cars with ground clearance it reads 2-5 % fast) and the cuboid only widens
+the uncertainty. Each track is fitted as soon as it ends, so a long video holds only the
+active tracks in memory.
 
-Uncertainty (``sigma_kmh``), combined in quadrature: the cuboid fit's standard error (from
-its residuals); half the difference between the contact-point and the cuboid speeds (model
-error); the calibration's part: the contact pixels are recast and refitted with
-``n_samples`` cameras drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length
-perturbed by the calibration's sigmas; rotation fixed), and the spread of the speeds taken.
+Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
+residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
+0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``); half the
+difference between the contact-point and the cuboid speeds (model error: where the contact
+slid along the vehicle or followed another one through a merge, the two disagree); the
+calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
+drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by the
+calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
 blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
@@ -117,7 +126,10 @@ _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foregro
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
 _SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
 _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
+_TEXTURE_MIN = 4.0  # grey levels: local deviation of a background with texture
+_SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and background
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
+_CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
 
 
 # --------------------------------------------------------------------------- results
@@ -574,6 +586,7 @@ class _Track:
     kinds: list[str] = field(default_factory=list)
     klt: list[tuple[float, float]] = field(default_factory=list)
     border: list[bool] = field(default_factory=list)
+    occluded: list[bool] = field(default_factory=list)
     points: Any = None  # KLT features (N, 1, 2) float32 in the previous frame
 
     def predicted(self) -> Box:
@@ -588,6 +601,14 @@ def _iou(a: Box, b: Box) -> float:
     inter = ix * iy
     union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter
     return inter / union if union > 0 else 0.0
+
+
+def _overlap(a: Box, b: Box) -> float:
+    """Area of the intersection of two boxes over the area of the first."""
+    ix = max(0.0, min(a[2], b[2]) - max(a[0], b[0]))
+    iy = max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+    area = (a[2] - a[0]) * (a[3] - a[1])
+    return ix * iy / area if area > 0 else 0.0
 
 
 def _blobs(fg: Any, scale: float, min_area: int) -> list[Box]:
@@ -641,10 +662,8 @@ def _associate(
     return match, [j for j in range(len(blobs)) if j not in used], hidden
 
 
-def _contact(
-    fg: Any, box: Box, scale: float, prev_u: float | None
-) -> tuple[tuple[float, float], str]:
-    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette hull vertex or box."""
+def _contact(fg: Any, box: Box, scale: float) -> tuple[tuple[float, float], str]:
+    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette corner or box."""
     import cv2
 
     x1, y1, x2, y2 = box
@@ -659,19 +678,53 @@ def _contact(
             if contours:
                 big = max(contours, key=cv2.contourArea)
                 area = cv2.contourArea(big)
-                hull = cv2.convexHull(big).reshape(-1, 2)
-                low = hull[:, 1].max()
+                low = big[:, 0, 1].max()
                 # the silhouette must fill the box reasonably and reach its bottom
                 if area >= 0.25 * roi.size and low >= 0.85 * (r1 - r0) - 1:
-                    cand = hull[hull[:, 1] >= low - 1]
-                    if prev_u is None or len(cand) == 1:
-                        # the lowest vertex; on a near-horizontal bottom edge, its left end
-                        u = float(cand[np.lexsort((cand[:, 0], -cand[:, 1]))[0], 0])
-                    else:
-                        us = (cand[:, 0] + c0 + 0.5) / scale
-                        u = float(cand[int(np.argmin(np.abs(us - prev_u))), 0])
-                    return ((u + c0 + 0.5) / scale, (low + r0 + 1.0) / scale), "silhouette"
+                    one = np.zeros_like(roi)
+                    cv2.drawContours(one, [big], 0, 255, -1)
+                    corner = _lowest_corner(one)
+                    if corner is not None:
+                        u, v = corner
+                        return ((u + c0) / scale, (v + r0) / scale), "silhouette"
     return bottom_centre, "box"
+
+
+def _lowest_corner(mask: Any) -> tuple[float, float] | None:
+    """Sub-pixel lowest corner ``(u, v)`` of a silhouette (binary mask, one component).
+
+    On a shallow bottom outline (two nearly collinear bottom edges, far away) many pixels
+    share the lowest row: taking any one of them slides the contact along the vehicle by
+    up to metres and biases the speed. The outline's lowest part is instead fitted with two
+    lines meeting at a corner (a hinge: least squares over the bottom profile of the
+    columns, the corner's column searched), and the corner is their meeting point.
+    """
+    cols = np.flatnonzero(mask.any(axis=0))
+    if len(cols) < 3:
+        return None
+    h = mask.shape[0]
+    bottom = h - np.argmax(mask[::-1, cols] > 0, axis=0).astype(np.float64)  # lower edges
+    low = float(bottom.max())
+    band = max(3.0, 0.2 * float(h))
+    k = int(np.argmax(bottom))
+    lo, hi = k, k
+    while lo > 0 and bottom[lo - 1] >= low - band:
+        lo -= 1
+    while hi < len(cols) - 1 and bottom[hi + 1] >= low - band:
+        hi += 1
+    x = cols[lo : hi + 1].astype(np.float64) + 0.5
+    y = bottom[lo : hi + 1]
+    if len(x) < 5:
+        return float(cols[k]) + 0.5, low
+    best: tuple[float, float, float] | None = None
+    for x0 in np.linspace(x[0], x[-1], min(len(x), 80)):
+        a = np.column_stack([np.ones_like(x), np.minimum(x - x0, 0.0), np.maximum(x - x0, 0.0)])
+        coef, *_ = np.linalg.lstsq(a, y, rcond=None)
+        sse = float(np.sum((a @ coef - y) ** 2))
+        if best is None or sse < best[0]:
+            best = (sse, float(x0), float(coef[0]))
+    assert best is not None
+    return best[1], min(best[2], low)
 
 
 def _klt_step(
@@ -748,7 +801,7 @@ def _segments(t: _Track, fps: float, width: int, height: int) -> tuple[list[int]
     seg = -1
     prev: int | None = None
     for i in range(len(t.frames)):
-        if t.border[i]:
+        if t.border[i] or t.occluded[i]:
             prev = None
             continue
         if prev is None or t.frames[i] - t.frames[prev] > _MAX_MISSED + 1:
@@ -783,16 +836,23 @@ def _design(times: FloatArray, labels: list[int]) -> FloatArray:
     return a
 
 
-def _irls(a: FloatArray, g: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Huber IRLS of ``g ≈ a @ coef``; returns the solve matrix, weights and residuals."""
-    w = np.ones(len(g))
+def _irls(
+    a: FloatArray, g: FloatArray, prior: FloatArray | None = None
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Huber IRLS of ``g ≈ a @ coef``; returns the solve matrix, weights and residuals.
+
+    ``prior``: each row's weight (inverse variance, any scale) before the Huber down-weighting;
+    the residuals are compared in units of each row's own sigma.
+    """
+    p = np.ones(len(g)) if prior is None else np.asarray(prior, np.float64)
+    w = p.copy()
     for _ in range(4):
         sw = np.sqrt(w)[:, None]
         solve = np.linalg.pinv(a * sw) * sw.T
         res = g - a @ (solve @ g)
-        r = np.linalg.norm(res, axis=1)
-        s = 1.4826 * float(np.median(r)) + 1e-6
-        w = np.where(r <= 2.0 * s, 1.0, 2.0 * s / np.maximum(r, 1e-12))
+        r = np.linalg.norm(res, axis=1) * np.sqrt(p)
+        s = 1.4826 * float(np.median(r)) + 1e-9
+        w = p * np.where(r <= 2.0 * s, 1.0, 2.0 * s / np.maximum(r, 1e-12))
     sw = np.sqrt(w)[:, None]
     solve = np.linalg.pinv(a * sw) * sw.T
     res = g - a @ (solve @ g)
@@ -824,6 +884,8 @@ def _fit_track(
         return skipped(f"tracked for only {span_s:.2f} s (< {min_track_s:g} s)", len(t.frames))
     if all(t.border):
         return skipped("never wholly inside the frame (its box touches the image border)")
+    if all(b or o for b, o in zip(t.border, t.occluded, strict=True)):
+        return skipped("never clear of other vehicles' boxes while wholly inside the frame")
     use, labels = _segments(t, fps, width, height)
     if not use:
         return skipped("its ground contact jumps in every frame (occlusions or merged vehicles)")
@@ -861,25 +923,35 @@ def _fit_track(
     dof = max(1, len(times) - a.shape[1])
     unit = vel / speed
     s2 = float(np.sum(weights * (res @ unit) ** 2) / dof)
-    sigma_fit = math.sqrt(s2 * float(solve[0] @ solve[0]))
+    sigma_fit = math.sqrt(s2 * float(np.sum(solve[0] ** 2 / np.maximum(weights, 1e-12))))
     # calibration: refit with every drawn camera
     draws = np.einsum("n,snd->sd", solve[0], ground[1:])
     sp = np.linalg.norm(draws, axis=1)
     sp = sp[np.isfinite(sp)]
     sigma_cal = float(np.std(sp, ddof=1)) if len(sp) >= 2 else 0.0
-    sigma = math.hypot(sigma_fit, sigma_cal)
-    # refine with a cuboid moving at constant velocity whose image box matches the boxes
+    # the contact's height is unknown between the road (a tyre) and the body's lower edge:
+    # a point h up casts onto the ground H / (H - h) farther from the camera's foot, and so
+    # does its velocity (H: the camera's height)
+    height_m = max(1.0, float(cam.center_in_world[2]))
+    sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
+    sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
+    kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
+    on_silhouette = float(np.mean(kinds_used == "silhouette"))
+    # without a silhouette (given boxes only), refine with a cuboid moving at constant
+    # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
     boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
     refined = _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
     if refined is not None:
         vel_c, sigma_c = refined
         speed_c = float(np.linalg.norm(vel_c))
         if speed_c * dur >= 1.0:
-            sigma_cal *= speed_c / speed
             # the two estimates (ground contact, cuboid) disagree by the model's error
             sigma_model = abs(speed_c - speed) / 2.0
-            vel, speed, sigma_fit = vel_c, speed_c, sigma_c
-            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2)
+            if on_silhouette < 0.5:  # no silhouette: the cuboid's speed is reported
+                sigma_cal *= speed_c / speed
+                sigma_contact *= speed_c / speed
+                vel, speed, sigma_fit = vel_c, speed_c, sigma_c
+            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2 + sigma_contact**2)
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
     world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
@@ -1247,8 +1319,7 @@ def _run(
                     )
                 t.box = box
                 t.missed = 0
-                prev_u = t.contacts[-1][0] if t.contacts else None
-                c, kind = _contact(fg, box, scale, prev_u)
+                c, kind = _contact(fg, box, scale)
                 t.frames.append(i)
                 t.boxes.append(box)
                 t.contacts.append(c)
@@ -1259,6 +1330,12 @@ def _run(
                     or box[1] <= 1.0
                     or box[2] >= width - 1.0
                     or box[3] >= height - 1.0
+                )
+                # a given box overlapping another one's: the silhouette in it may be both
+                # vehicles' (detected tracks are kept apart by the association instead)
+                t.occluded.append(
+                    given is not None
+                    and any(_overlap(box, b) > 0.02 for j, b in current.items() if j != k)
                 )
                 if t.points is None or len(t.points) < 8 or len(t.frames) % 10 == 0:
                     if fg_full is None:
@@ -1326,15 +1403,21 @@ def _split_reversals(t: _Track) -> list[_Track]:
         piece.frames, piece.boxes = t.frames[lo:hi], t.boxes[lo:hi]
         piece.contacts, piece.kinds = t.contacts[lo:hi], t.kinds[lo:hi]
         piece.klt, piece.border = t.klt[lo:hi], t.border[lo:hi]
+        piece.occluded = t.occluded[lo:hi]
         pieces.append(piece)
     return pieces
 
 
 def _shadows(frame: Any, background: Any) -> Any:
-    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio.
+    """Mask (255) of cast shadows: the background darkened, every channel by the same ratio,
+    its texture kept.
 
     A shadow keeps the road's colour and dims it (ratio ``_SHADOW_RATIO``, spread below
     ``_SHADOW_SPREAD`` between channels); a vehicle changes the colour or is much darker.
+    A grey vehicle on a grey road passes that test too: but a shadow keeps the road's
+    texture (the frame correlates with the background, locally), a vehicle's panels hide
+    it. Where the background has texture (local deviation above ``_TEXTURE_MIN``) a shadow
+    must also correlate with it (normalised cross-correlation above ``_SHADOW_NCC``).
     """
     import cv2
 
@@ -1345,7 +1428,18 @@ def _shadows(frame: Any, background: Any) -> Any:
     dim = cv2.inRange(lo, _SHADOW_RATIO[0], _SHADOW_RATIO[1])
     grey = cv2.inRange(hi - lo, 0.0, _SHADOW_SPREAD)
     bright = cv2.inRange(hi, 0.0, _SHADOW_RATIO[1])
-    return cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
+    shadow = cv2.bitwise_and(cv2.bitwise_and(dim, grey), bright)
+    f = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY).astype(np.float32)
+    bg = cv2.cvtColor(background, cv2.COLOR_BGR2GRAY)
+    win = (5, 5)
+    mf, mb = cv2.blur(f, win), cv2.blur(bg, win)
+    cov = cv2.blur(f * bg, win) - mf * mb
+    var_f = cv2.blur(f * f, win) - mf * mf
+    var_b = cv2.blur(bg * bg, win) - mb * mb
+    ncc = cov / np.sqrt(np.maximum(var_f * var_b, 1e-6))
+    textured = var_b > _TEXTURE_MIN**2
+    hidden = (textured & (ncc < _SHADOW_NCC)).astype(np.uint8) * 255
+    return cv2.bitwise_and(shadow, cv2.bitwise_not(hidden))
 
 
 def _centre(box: Box) -> tuple[float, float]:

@@ -294,11 +294,13 @@ def _texture(rng: np.random.Generator, m_per_px: float) -> tuple[Any, FloatArray
     return np.asarray(bgr, np.uint8), world_from_tex
 
 
-def _background(camera: Camera, image_size: tuple[int, int], rng: np.random.Generator) -> Any:
+def _background(
+    camera: Camera, image_size: tuple[int, int], rng: np.random.Generator, m_per_px: float
+) -> Any:
     import cv2
 
     w, h = image_size
-    tex, world_from_tex = _texture(rng, 0.025)
+    tex, world_from_tex = _texture(rng, m_per_px)
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     img_from_ground = camera.img_from_cam @ np.column_stack([R[:, 0], R[:, 1], t])
     img = cv2.warpPerspective(
@@ -424,6 +426,7 @@ def render_street(
     sun: bool = True,
     annotation_px: float = 1.0,
     fourcc: str = "MJPG",
+    texture_m_per_px: float = 0.025,
 ) -> RenderedVideo:
     """Render a street video (MJPG ``.avi``) and return it with its truth and annotated scene.
 
@@ -445,6 +448,10 @@ def render_street(
         Cast hard shadows (besides the contact shadows, always drawn).
     annotation_px
         Click noise of the scene's 3 annotators (1 px by default; 0: exact).
+    fourcc
+        Codec; MJPG is available in every OpenCV build.
+    texture_m_per_px
+        Resolution of the asphalt texture (coarser: faster, for small test videos).
 
     Raises
     ------
@@ -467,7 +474,7 @@ def render_street(
     scene = make_scene(
         camera, np.random.default_rng(seed + 7), noise=noise, n_annotators=3, image_size=size
     ).scene
-    background = _background(camera, size, rng)
+    background = _background(camera, size, rng, texture_m_per_px)
     ref = PRESETS["sedan"]
     parked = StreetVehicle(
         (ref.length_m / 2, ref.width_m / 2),
@@ -517,15 +524,24 @@ def random_street(
     alternating directions, lanes at ``y = -3, -5.5`` eastbound and ``-8.5, -11``
     westbound); each passes ``x = 8`` (the middle of the view) at its time.
     """
-    cam = street_camera(
-        float(rng.uniform(6.0, 9.0)),
-        image_size=image_size,
-        hfov_deg=float(rng.uniform(55.0, 70.0)),
-        setback_m=float(rng.uniform(14.0, 19.0)),
-        along_m=float(rng.uniform(-12.0, -4.0)),
-        aim_xy_m=(float(rng.uniform(5.0, 11.0)), -6.0),
-        roll_deg=float(rng.uniform(-1.5, 1.5)),
+    ref = PRESETS["sedan"]
+    car = np.array(
+        [[x, y, z] for x in (0.0, ref.length_m) for y in (0.0, ref.width_m) for z in (0.0, 1.4)]
     )
+    w, h = image_size
+    for _ in range(200):  # the annotated reference car must be in view, off the borders
+        cam = street_camera(
+            float(rng.uniform(6.0, 9.0)),
+            image_size=image_size,
+            hfov_deg=float(rng.uniform(55.0, 70.0)),
+            setback_m=float(rng.uniform(14.0, 19.0)),
+            along_m=float(rng.uniform(-14.0, -7.0)),
+            aim_xy_m=(float(rng.uniform(5.0, 11.0)), -6.0),
+            roll_deg=float(rng.uniform(-1.5, 1.5)),
+        )
+        px = cam.project(car)
+        if px[:, 0].min() > 0.05 * w and px[:, 1].max() < 0.95 * h:
+            break
     vehicles = []
     for k in range(n_vehicles):
         east = k % 2 == 0
