@@ -763,7 +763,7 @@ def streets_within(
     ``near`` lists each street's name and bearing there; ``streets`` describes only those
     streets (not every street of the map, which may be a whole extract).
     """
-    from camloc_geo.osm import streets_json
+    from camloc_geo.results import streets_json
 
     m = streets_near(
         lat=lat,

@@ -5,7 +5,7 @@ A reviewer decides from the candidate map which candidate position is right:
 - candidates are numbered by rank and each rank has its own colour (:data:`RANK_PALETTE`,
   Okabe–Ito, colour-blind safe: rank 1 blue, 2 orange, 3 green...), sized by rank, the best
   drawn on top with a heavy outline; their popups list every property of the candidate
-  GeoJSON (:func:`camloc_geo.absolute.candidates_geojson`) and show the image overlay
+  GeoJSON (:func:`camloc_geo.results.candidates_geojson`) and show the image overlay
   (:mod:`camloc_geo.overlay`) of the leading candidates; the legend lists each rank's colour
   and score;
 - candidates that tie (non-empty ``ambiguous_with``) wear a dashed ring and an "≈" badge;
@@ -1302,7 +1302,7 @@ def build_summary_map(
     ----------
     items
         ``(scene_id, candidates)`` pairs; ``candidates`` is a candidate GeoJSON dict
-        (:func:`camloc_geo.absolute.candidates_geojson`) or a ``LocateResult``.
+        (:func:`camloc_geo.results.candidates_geojson`) or a ``LocateResult``.
     offline
         No tiles and no clustering plugin (its script would come from a CDN): plain markers.
     tiles

@@ -17,10 +17,11 @@ import numpy as np
 import pytest
 
 from camloc_geo._errors import InputError, MapDataError, SceneError
-from camloc_geo.absolute import LocateResult, LocateSettings, candidates_geojson, locate
+from camloc_geo.absolute import LocateResult, LocateSettings, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
+from camloc_geo.results import candidates_geojson
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 

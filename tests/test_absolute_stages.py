@@ -10,10 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from camloc_geo.absolute import LocateSettings, apply_cues, candidates_geojson, locate
+from camloc_geo.absolute import LocateSettings, apply_cues, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
 from camloc_geo.relative import calibrate
+from camloc_geo.results import candidates_geojson
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 

@@ -1,10 +1,9 @@
 """The package's layers (``docs/architecture.md``): no import cycle, nothing imports upwards.
 
 Imports are read with :mod:`ast` from every module of ``camloc_geo`` (module level and inside
-functions alike; ``if TYPE_CHECKING:`` blocks are left out: they never run). A package's
-module-level ``__getattr__`` is left out too: it is the one door through which a public name
-that moved up a layer (``camloc_geo.absolute.candidates_geojson`` now lives in ``results``)
-stays importable from its old place, and it runs only when a caller asks for that name.
+functions alike, a module's ``__getattr__`` included; ``if TYPE_CHECKING:`` blocks are left
+out: they never run). Output shapes that moved up a layer (``candidates_geojson``,
+``intersections_geojson``, ``streets_json``) are imported from ``camloc_geo.results`` only.
 """
 
 from __future__ import annotations
@@ -80,8 +79,6 @@ def _walk(nodes: list[ast.stmt], top: bool) -> Iterator[ast.AST]:
         if isinstance(node, ast.If) and _is_type_checking(node):
             yield from _walk(node.orelse, top)
             continue
-        if top and isinstance(node, ast.FunctionDef) and node.name == "__getattr__":
-            continue  # a moved public name's door (module docstring)
         yield node
         for field in ("body", "orelse", "finalbody", "handlers"):
             children = getattr(node, field, None)

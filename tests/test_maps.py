@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from camloc_geo import maps
-from camloc_geo.absolute import LocateResult, candidates_geojson, locate
+from camloc_geo.absolute import LocateResult, locate
 from camloc_geo.cli import main
 from camloc_geo.osm import MapData, load_map
+from camloc_geo.results import candidates_geojson
 from camloc_geo.scene import Scene, parse_scene
 from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
 

@@ -11,11 +11,16 @@ import jsonschema
 import numpy as np
 import pytest
 
-from camloc_geo.absolute import TIE_SCORE_RATIO, LocateSettings, candidates_geojson
+from camloc_geo.absolute import TIE_SCORE_RATIO, LocateSettings
 from camloc_geo.api import calibrate_scene, locate_scene, map_for_scene
 from camloc_geo.geodesy import distance_m
-from camloc_geo.osm import MapData, intersections_geojson
-from camloc_geo.results import ATTRIBUTION, output_json_schema
+from camloc_geo.osm import MapData
+from camloc_geo.results import (
+    ATTRIBUTION,
+    candidates_geojson,
+    intersections_geojson,
+    output_json_schema,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 EXTRACT = REPO / "sample_maps" / "baltimore.osm.pbf"

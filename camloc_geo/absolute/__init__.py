@@ -61,8 +61,6 @@ The pipeline, one function per stage (:func:`locate` reads as the list):
 
 from __future__ import annotations
 
-from typing import Any
-
 from camloc_geo.absolute._cone import view_cone
 from camloc_geo.absolute._cues import (
     CUE_FLOOR,
@@ -112,15 +110,3 @@ __all__ = [
     "view_cone",
     "view_log_factor",
 ]
-
-
-def __getattr__(name: str) -> Any:
-    """``candidates_geojson``: an output shape, now :func:`camloc_geo.results.candidates_geojson`.
-
-    Kept importable from here (a public name); the core itself never imports ``results``.
-    """
-    if name == "candidates_geojson":
-        from camloc_geo import results
-
-        return results.candidates_geojson
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -90,15 +90,12 @@ _LAZY = {
 }
 """Names imported on first use (osmium, networkx and scipy load only when a map does)."""
 
-_MOVED_TO_RESULTS = {"intersections_geojson", "streets_json"}
-
 
 def __getattr__(name: str) -> Any:
     """The map layer's names, imported on first use.
 
-    ``intersections_geojson`` and ``streets_json`` are output shapes, now in
-    :mod:`camloc_geo.results`; they stay importable from here (public names), and the map
-    layer itself never imports ``results``.
+    ``intersections_geojson`` and ``streets_json`` are output shapes: they live in
+    :mod:`camloc_geo.results` (the map layer never imports it).
     """
     import importlib
 
@@ -106,8 +103,4 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
         globals()[name] = value
         return value
-    if name in _MOVED_TO_RESULTS:
-        from camloc_geo import results
-
-        return getattr(results, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
