@@ -2274,9 +2274,13 @@ def _joint(
     # the same answers (4 scenes moved by <= 2 cm), -3 ms per calibrate.
     seeds: list[Any] = [cluster_camera, pooled]
     best: tuple[float, _JointProblem, Any, FloatArray, list[float]] | None = None
+    best_key: tuple[bool, float] | None = None
     for seed_or_maker in seeds:
-        if best is not None and best[0] <= _GOOD_SEED_SCORE:
-            break  # the first seed already explains every annotator within the noise
+        if best_key is not None and not best_key[0] and best_key[1] <= _GOOD_SEED_SCORE:
+            # the first seed already explains every annotator within the noise, with the
+            # camera above the ground (a fit below it may be a mirror minimum of the cluster
+            # seed: the pooled seed then gets its chance, as it always did before)
+            break
         cam0 = seed_or_maker() if callable(seed_or_maker) else seed_or_maker
         if cam0 is None:
             continue
@@ -2296,8 +2300,9 @@ def _joint(
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
         res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60)
         score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
-        if best is None or score < best[0]:
-            best = (score, prob, res, R0, width_signs)
+        below_ground = bool(prob.unpack(res.x, R0, pp_fixed, f_fixed)[3][2] <= 0.0)
+        if best_key is None or score < best_key[1]:
+            best, best_key = (score, prob, res, R0, width_signs), (below_ground, score)
     assert best is not None
     _score, prob, res, R0, width_signs = best
     x0 = res.x
