@@ -1,0 +1,218 @@
+"""``calibrate``'s focal length on the street scenes of the second video generator (issue 28).
+
+Each scene is what :func:`camloc_geo.testing.traffic_render.render_street` annotates for a
+:func:`~camloc_geo.testing.traffic_render.random_street` camera (960x540, 6-9 m up, the
+parked reference sedan annotated by 3 annotators with 1 px click and line noise); no
+video is rendered (the scene does not depend on the frames). Three sets per seed:
+
+- ``traffic``: that scene, the annotators' noise drawn as ``render_street`` draws it;
+- ``traffic_draws``: the same camera with ``--draws`` more noise draws (the spread of the
+  focal error per camera: bias vs scatter);
+- ``noise_free``: the same camera annotated without noise (the method's own bias);
+- ``road_lines``: :func:`camloc_geo.testing.road_lines.road_line_scene` (a street camera
+  6-9 m up whose annotators also drew one long lane line each).
+
+Per scene: the focal error ``f / f_true - 1``, the stated ``focal_sigma_px`` and ``z`` =
+error / sigma. Writes ``benchmarks/out/calibrate_traffic.json`` and
+``benchmarks/out/calibrate_traffic.png`` (focal error per seed with the stated 2-sigma).
+
+Usage: ``python benchmarks/calibrate_traffic.py [--first-seed 300] [--seeds 20] [--draws 5]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from camloc_geo import InputError
+from camloc_geo.api import calibrate_scene
+from camloc_geo.camera import Camera
+from camloc_geo.testing.road_lines import road_line_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.traffic_render import random_street
+
+OUT_DIR = Path(__file__).parent / "out"
+IMAGE_SIZE = (960, 540)
+
+
+def street_noise(click_px: float = 1.0) -> NoiseModel:
+    """The annotators' noise of :func:`~camloc_geo.testing.traffic_render.render_street`."""
+    return NoiseModel(
+        point_px=click_px,
+        line_px=click_px,
+        wrong_corner_prob=0.0,
+        sloppy_prob=0.0,
+        size_rel=0.0,
+        car_yaw_deg=0.0,
+    )
+
+
+def traffic_scene(seed: int, *, noise_seed: int | None = None, click_px: float = 1.0) -> Any:
+    """The camera and annotated scene ``render_street`` makes for ``random_street(seed)``.
+
+    Parameters
+    ----------
+    seed
+        The video's seed (camera from ``default_rng(seed)``, as ``benchmarks/radar_render.py``).
+    noise_seed
+        Seed of the annotators' noise (default ``seed + 7``, as ``render_street``).
+    click_px
+        Click and line-endpoint noise, pixels (0: exact).
+
+    Returns
+    -------
+    SyntheticScene
+        Its ``camera`` is the true camera, ``scene`` the annotated scene dict.
+    """
+    cam, _ = random_street(np.random.default_rng(seed), n_vehicles=10, duration_s=20.0)
+    rng = np.random.default_rng(seed + 7 if noise_seed is None else noise_seed)
+    return make_scene(cam, rng, noise=street_noise(click_px), n_annotators=3, image_size=IMAGE_SIZE)
+
+
+def focal_row(scene: dict[str, Any], truth: Camera) -> dict[str, Any] | None:
+    """Focal error, stated sigma and z of one scene, or None when ``calibrate`` refuses it."""
+    try:
+        res = calibrate_scene(scene)
+    except InputError:
+        return None
+    f_true = truth.focal_px
+    err = res.camera.focal_px / f_true - 1.0
+    sigma = (res.focal_sigma_px or float("nan")) / f_true
+    return {
+        "focal_error": round(float(err), 5),
+        "focal_sigma_rel": round(float(sigma), 5),
+        "z": round(float(err / sigma), 3) if sigma > 0 else None,
+        "height_m": round(float(truth.center_in_world[2]), 2),
+        "warnings": len(res.warnings),
+    }
+
+
+def summary(rows: list[dict[str, Any] | None]) -> dict[str, Any]:
+    """Median, mean, spread and tails of the focal errors of a set."""
+    ok = [r for r in rows if r is not None]
+    e = np.array([r["focal_error"] for r in ok])
+    z = np.array([r["z"] for r in ok if r["z"] is not None])
+    if e.size == 0:
+        return {"n": 0, "failed": len(rows)}
+    return {
+        "n": int(e.size),
+        "failed": len(rows) - len(ok),
+        "median_signed": round(float(np.median(e)), 4),
+        "mean_signed": round(float(e.mean()), 4),
+        "sd": round(float(e.std()), 4),
+        "median_abs": round(float(np.median(np.abs(e))), 4),
+        "max_abs": round(float(np.abs(e).max()), 4),
+        "within_3pct": round(float(np.mean(np.abs(e) < 0.03)), 3),
+        "within_6pct": round(float(np.mean(np.abs(e) < 0.06)), 3),
+        "median_sigma_rel": round(float(np.median([r["focal_sigma_rel"] for r in ok])), 4),
+        "cover_2sigma": round(float(np.mean(np.abs(z) < 2.0)), 3) if z.size else None,
+        "lines_left_out": int(sum(r["warnings"] for r in ok)),
+    }
+
+
+def plot(result: dict[str, Any], path: Path) -> None:
+    """Focal error per seed with the stated 2-sigma, per set."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    styles = {"traffic": ("C0", 0.0), "noise_free": ("C2", 0.15), "road_lines": ("C1", 0.3)}
+    for name, (colour, dx) in styles.items():
+        rows = result["scenes"][name]
+        seeds = [r["seed"] for r in rows if r["focal_error"] is not None]
+        err = [100 * r["focal_error"] for r in rows if r["focal_error"] is not None]
+        sig = [200 * r["focal_sigma_rel"] for r in rows if r["focal_error"] is not None]
+        ax.errorbar(
+            np.array(seeds) + dx,
+            err,
+            yerr=sig,
+            fmt="o",
+            ms=4,
+            color=colour,
+            capsize=2,
+            label=f"{name} (median |err| {100 * result['summary'][name]['median_abs']:.1f} %)",
+        )
+    ax.axhspan(-3, 3, color="0.9", zorder=0, label="±3 %")
+    ax.axhline(0, color="0.5", lw=0.8)
+    ax.set_xlabel("seed")
+    ax.set_ylabel("focal error, % (bars: stated 2σ)")
+    ax.set_title("calibrate on street scenes, 960x540, 3 annotators, 1 px")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--first-seed", type=int, default=300)
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--draws", type=int, default=5, help="extra noise draws per camera")
+    ap.add_argument("--out", type=Path, default=OUT_DIR)
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    scenes: dict[str, list[dict[str, Any]]] = {
+        "traffic": [],
+        "traffic_draws": [],
+        "noise_free": [],
+        "road_lines": [],
+    }
+    empty = {"focal_error": None, "focal_sigma_rel": None, "z": None}
+    for seed in range(args.first_seed, args.first_seed + args.seeds):
+        syn = traffic_scene(seed)
+        scenes["traffic"].append({"seed": seed, **(focal_row(syn.scene, syn.camera) or empty)})
+        exact = traffic_scene(seed, click_px=0.0)
+        scenes["noise_free"].append(
+            {"seed": seed, **(focal_row(exact.scene, exact.camera) or empty)}
+        )
+        for k in range(args.draws):
+            draw = traffic_scene(seed, noise_seed=10_000 * seed + k)
+            scenes["traffic_draws"].append(
+                {"seed": seed, "draw": k, **(focal_row(draw.scene, draw.camera) or empty)}
+            )
+        road = road_line_scene(seed)
+        scenes["road_lines"].append({"seed": seed, **(focal_row(road.scene, road.camera) or empty)})
+    result: dict[str, Any] = {
+        "seeds": [args.first_seed, args.first_seed + args.seeds - 1],
+        "draws": args.draws,
+        "summary": {
+            name: summary([None if r["focal_error"] is None else r for r in rows])
+            for name, rows in scenes.items()
+        },
+        "scenes": scenes,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "calibrate_traffic.json").write_text(json.dumps(result, indent=1))
+    plot(result, args.out / "calibrate_traffic.png")
+    print(f"calibrate on street scenes, seeds {result['seeds']}, {result['seconds']} s")
+    print(
+        f"{'set':14s} {'n':>4s} {'median':>7s} {'mean':>7s} {'sd':>6s} {'med|e|':>7s} "
+        f"{'max|e|':>7s} {'<3%':>5s} {'<6%':>5s} {'sigma':>6s} {'2σcov':>6s} {'drop':>4s}"
+    )
+    for name, s in result["summary"].items():
+        if not s["n"]:
+            print(f"{name:14s} all failed")
+            continue
+        print(
+            f"{name:14s} {s['n']:4d} {100 * s['median_signed']:+6.2f}% "
+            f"{100 * s['mean_signed']:+6.2f}% "
+            f"{100 * s['sd']:5.2f}% {100 * s['median_abs']:6.2f}% {100 * s['max_abs']:6.2f}% "
+            f"{100 * s['within_3pct']:4.0f}% {100 * s['within_6pct']:4.0f}% "
+            f"{100 * s['median_sigma_rel']:5.2f}% {100 * (s['cover_2sigma'] or 0):5.0f}% "
+            f"{s['lines_left_out']:4d}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
