@@ -1627,7 +1627,73 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     result.outlier_annotators = list(
         dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
     )
+    for msg in _photo_disagreement(scene, result):
+        log.warning("%s", msg)
+        result.warnings.append(msg)
     return result
+
+
+PHOTO_AXIS_TOL_DEG = 4.0  # a photo's direction this far from the fit's axis disagrees
+PHOTO_AXIS_NEAR_DEG = 30.0  # ... when it is the photo's nearest direction to that axis
+PHOTO_MIN_SEGMENTS = 6  # a detected direction needs this many segments to count
+
+
+def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
+    """Warnings where the scene's photo and the annotators' fit clearly disagree.
+
+    The photo's vanishing points (``autovp``, cached per file) are turned into directions
+    with the fit's own intrinsics and compared, axis by axis, with the fit's world axes
+    (length, width, up). A detected direction with at least ``PHOTO_MIN_SEGMENTS`` segments
+    that is the nearest one to an axis, within ``PHOTO_AXIS_NEAR_DEG`` of it but more than
+    ``PHOTO_AXIS_TOL_DEG`` off, is reported with the angle; so is an estimated photo focal
+    length more than 10 % and three combined sigmas off the fit's. No photo, or no lines in
+    it: nothing (``image.path``'s own warnings say so). Lens distortion is not undone here.
+    """
+    path = scene.image_file()
+    if path is None or not path.is_file() or result.camera is None:
+        return []
+    stat = path.stat()
+    try:
+        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except (InputError, ValueError) as exc:
+        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+        return []
+    cam = result.camera
+    R = np.asarray(cam.cam_from_world_rotation, dtype=float)
+    K_inv = np.linalg.inv(np.asarray(cam.img_from_cam, dtype=float))
+    support = np.bincount(np.asarray(res.labels)[np.asarray(res.labels) >= 0], minlength=3)
+    dirs = []
+    for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
+        if support[k] < PHOTO_MIN_SEGMENTS:
+            continue
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if n > 0.0 and np.isfinite(n):
+            dirs.append(d / n)
+    out = []
+    for i, axis in enumerate(AXES):
+        if not dirs:
+            break
+        a = R[:, i] / np.linalg.norm(R[:, i])
+        angles = [math.degrees(math.acos(min(1.0, abs(float(a @ d))))) for d in dirs]
+        best = min(angles)
+        if PHOTO_AXIS_TOL_DEG < best <= PHOTO_AXIS_NEAR_DEG:
+            out.append(
+                f"image.path: the photo's lines disagree with the annotators' fit: its "
+                f"{axis} vanishing direction is {best:.1f} degrees from the fit's "
+                f"(the annotators' lines or the photo's detected lines are off)"
+            )
+    f_photo = float(res.focal_px)
+    if res.focal_source == "estimated" and result.focal_sigma_px is not None:
+        rel = math.log(f_photo / cam.focal_px)
+        sd = math.hypot(float(res.focal_std_rel or 0.0), result.focal_sigma_px / cam.focal_px)
+        if abs(rel) > math.log(1.1) and abs(rel) > 3.0 * sd:
+            out.append(
+                f"image.path: the photo's lines give a focal length of {f_photo:.0f} px, "
+                f"{100.0 * (math.exp(rel) - 1.0):+.0f} % from the annotators' fit "
+                f"({cam.focal_px:.0f} ± {result.focal_sigma_px:.0f} px)"
+            )
+    return out
 
 
 def _readmit_agreeing(
