@@ -108,6 +108,14 @@ class CalibrationSettings:
         residuals and Jacobian (no refits; ~2 ms; within 10 % of the refits' sigmas in
         80-95 % of crowd scenes, ``benchmarks/calibrate_speed.py``); ``refit``: the whole
         calibration repeated without each annotator (the reference, ~5x one fit).
+    ground_corner_sigma_rel
+        Where on a rounded body the car's clicks fall: the ground corner is the ground under
+        the body's corner (bumper), but annotators also click the tyre contact, 0.5-1 m
+        inside. Each of the car's four clicks gets this 1-sigma (a fraction of the car's
+        length along its length edge and of its width along its width edge; 2.5 %: 11 cm and
+        4.5 cm for a sedan), in pixels that fraction of the clicked edges; the parameters'
+        move under it enters the stated sigmas as a consider covariance
+        (:func:`_ground_corner_sensitivity`); 0 turns it off.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -132,6 +140,7 @@ class CalibrationSettings:
     principal_point_prior_sigma_rel: float = 0.03
     principal_point_sigma_rel: float = 0.007
     reassign_corners: bool = True
+    ground_corner_sigma_rel: float = 0.025
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
 
@@ -648,6 +657,59 @@ def _cluster(
 
 
 # ----------------------------------------------------------------------------- joint fit
+def _ground_corner_sensitivity(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+) -> FloatArray | None:
+    """How the fitted parameters move with the ground-corner ambiguity: ``D`` ``(len(x), k)``.
+
+    A rounded car has no corner on the ground: the click meant is the ground under the
+    body's corner, but it may land anywhere from there to the tyre contact. Each of an
+    annotator's four clicks is taken as off, independently, along the car's length edge by
+    ``prob.ground_corner_sigma_rel`` of the clicked length edge (pixels) and along its width
+    edge by that fraction of the width edge. A click moved by ``δ`` changes its residuals by
+    ``−scale·δ``; the fit's parameters then move by ``−H⁻¹ Jᵀ W dr`` (robust Gauss-Newton at
+    the solution). Each column is one such 1-sigma move, so the consider covariance is
+    ``D Dᵀ`` (not scaled by the residual variance: a systematic offset the residuals of one
+    fit do not show). None when off or the Hessian is singular.
+    """
+    rel = prob.ground_corner_sigma_rel
+    if rel <= 0.0:
+        return None
+    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    JW = J * w[:, None]
+    H = J.T @ JW
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    scale = prob._pt_scale
+    cols = []
+    for a in range(len(clicks)):
+        for end in (1, 2):
+            edge = clicks[a, end] - clicks[a, 0]
+            norm = float(np.linalg.norm(edge))
+            if norm <= 0.0:
+                continue
+            step = rel * edge  # 1-sigma move of a click along this ground axis, pixels
+            for j in range(4 * a, 4 * a + 4):
+                dr = np.zeros(len(r))
+                dr[n_seg + j] = -scale[j] * step[0]
+                dr[n_seg + n_pt + j] = -scale[j] * step[1]
+                cols.append(JW.T @ dr)
+    if not cols:
+        return None
+    try:
+        D = -np.linalg.solve(H, np.column_stack(cols))
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(D)):
+        return None
+    return np.asarray(D, dtype=np.float64)
+
+
 class _JointProblem:
     """Stacked residuals of all annotators for one pose + intrinsics."""
 
@@ -696,6 +758,7 @@ class _JointProblem:
                 self.pt_pix[j + 1 : j + 4] - self.pt_pix[j], axis=1
             )
         self._sigma_pt_each = np.sqrt(self.sigma_pt**2 + (size_sigma_rel * edge_px) ** 2)
+        self.ground_corner_sigma_rel = settings.ground_corner_sigma_rel
         self.n_annotators = len(indices)
         self._z_min = 0.05
         seg = self.segments
@@ -1564,7 +1627,73 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     result.outlier_annotators = list(
         dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
     )
+    for msg in _photo_disagreement(scene, result):
+        log.warning("%s", msg)
+        result.warnings.append(msg)
     return result
+
+
+PHOTO_AXIS_TOL_DEG = 4.0  # a photo's direction this far from the fit's axis disagrees
+PHOTO_AXIS_NEAR_DEG = 30.0  # ... when it is the photo's nearest direction to that axis
+PHOTO_MIN_SEGMENTS = 6  # a detected direction needs this many segments to count
+
+
+def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
+    """Warnings where the scene's photo and the annotators' fit clearly disagree.
+
+    The photo's vanishing points (``autovp``, cached per file) are turned into directions
+    with the fit's own intrinsics and compared, axis by axis, with the fit's world axes
+    (length, width, up). A detected direction with at least ``PHOTO_MIN_SEGMENTS`` segments
+    that is the nearest one to an axis, within ``PHOTO_AXIS_NEAR_DEG`` of it but more than
+    ``PHOTO_AXIS_TOL_DEG`` off, is reported with the angle; so is an estimated photo focal
+    length more than 10 % and three combined sigmas off the fit's. No photo, or no lines in
+    it: nothing (``image.path``'s own warnings say so). Lens distortion is not undone here.
+    """
+    path = scene.image_file()
+    if path is None or not path.is_file() or result.camera is None:
+        return []
+    stat = path.stat()
+    try:
+        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except (InputError, ValueError) as exc:
+        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+        return []
+    cam = result.camera
+    R = np.asarray(cam.cam_from_world_rotation, dtype=float)
+    K_inv = np.linalg.inv(np.asarray(cam.img_from_cam, dtype=float))
+    support = np.bincount(np.asarray(res.labels)[np.asarray(res.labels) >= 0], minlength=3)
+    dirs = []
+    for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
+        if support[k] < PHOTO_MIN_SEGMENTS:
+            continue
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if n > 0.0 and np.isfinite(n):
+            dirs.append(d / n)
+    out = []
+    for i, axis in enumerate(AXES):
+        if not dirs:
+            break
+        a = R[:, i] / np.linalg.norm(R[:, i])
+        angles = [math.degrees(math.acos(min(1.0, abs(float(a @ d))))) for d in dirs]
+        best = min(angles)
+        if PHOTO_AXIS_TOL_DEG < best <= PHOTO_AXIS_NEAR_DEG:
+            out.append(
+                f"image.path: the photo's lines disagree with the annotators' fit: its "
+                f"{axis} vanishing direction is {best:.1f} degrees from the fit's "
+                f"(the annotators' lines or the photo's detected lines are off)"
+            )
+    f_photo = float(res.focal_px)
+    if res.focal_source == "estimated" and result.focal_sigma_px is not None:
+        rel = math.log(f_photo / cam.focal_px)
+        sd = math.hypot(float(res.focal_std_rel or 0.0), result.focal_sigma_px / cam.focal_px)
+        if abs(rel) > math.log(1.1) and abs(rel) > 3.0 * sd:
+            out.append(
+                f"image.path: the photo's lines give a focal length of {f_photo:.0f} px, "
+                f"{100.0 * (math.exp(rel) - 1.0):+.0f} % from the annotators' fit "
+                f"({cam.focal_px:.0f} ± {result.focal_sigma_px:.0f} px)"
+            )
+    return out
 
 
 def _readmit_agreeing(
@@ -2567,6 +2696,9 @@ def _output_covariance(
     z_of_x += [3, 4, 5, 6, 7, 8]
     A = np.zeros((9, 9))
     A[np.ix_(z_of_x, z_of_x)] = cov
+    D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
+    if D is not None:
+        A[np.ix_(z_of_x, z_of_x)] += D @ D.T
     if pp_model is not None and sigma_pp_px > 0.0:
         S = _pinned_pp_sensitivity(prob, x, R0, pp_model, f_fixed)
         if S is not None:

@@ -203,3 +203,17 @@ def test_web_assets_are_package_data() -> None:
         text = (root / "camloc_geo" / "web" / name).read_text()
         assert "</script" not in text.lower() or name == "annotate.html"
         assert not re.search(r"""(?:src|href)=["']?(?:https?:)?//""", text)
+
+
+def test_ground_corner_drawing_is_the_docs_drawing_and_inlined(snapshot: Path) -> None:
+    """The page inlines web/ground-corner.svg, the same file as docs/ground-corner.svg."""
+    from camloc_geo.web import _asset
+
+    root = Path(__file__).parents[1]
+    doc = (root / "docs" / "ground-corner.svg").read_text(encoding="utf-8")
+    assert _asset("ground-corner.svg") == doc
+    page = annotation_page_html(snapshot)
+    assert '<template id="ground-corner-drawing"><svg' in page
+    assert doc.strip() in page
+    assert "ground-corner.svg" in (root / "docs" / "annotate.md").read_text(encoding="utf-8")
+    assert "ground-corner.svg" in (root / "docs" / "scene-format.md").read_text(encoding="utf-8")

@@ -455,3 +455,26 @@ def test_live_warnings_for_lines(tab: Tab, files: dict[str, Any]) -> None:
         tab.click_image(*b)
     checks = page.inner_text("#checks-body")
     assert "No focal length" in checks or "implausible" in checks
+
+
+def test_step_one_shows_the_ground_corner_drawing(tab: Tab, files: dict[str, Any]) -> None:
+    """Step 1 says which point is the car's ground corner, with the drawing inline."""
+    tab.open(files["page"])
+    assert tab.page.evaluate("camloc.step()") == 0
+    text = tab.page.inner_text("#step-text")
+    assert "straight under the corner of the body" in text
+    assert "not" in text
+    assert "tyre touches the road" in text
+    fig = tab.page.query_selector("#step-text figure#ground-corner svg")
+    assert fig is not None, "the ground-corner drawing is missing from step 1"
+    box = fig.bounding_box()
+    assert box is not None
+    assert box["width"] > 200
+    assert box["height"] > 80
+    # The drawing marks the meant point and the tyre contact (the same file as the docs').
+    svg = tab.page.inner_html("#step-text figure#ground-corner")
+    doc_svg = (Path(__file__).parents[1] / "docs" / "ground-corner.svg").read_text()
+    assert "bumper" in svg
+    assert "tyre contact" in svg
+    assert svg.count("<circle") == doc_svg.count("<circle") >= 5
+    tab.shot("00_step1_ground_corner")

@@ -86,3 +86,44 @@ def test_missing_lines_without_image_is_a_clear_error(tmp_path: Path) -> None:
     path.write_text(json.dumps(syn.scene))
     with pytest.raises(SceneError, match=r"annotations\[0\]\.vp_lines\.height.*at least 2"):
         calibrate(load_scene(path))
+
+
+def _scene_with_photo(tmp_path: Path, photo_cam: Camera) -> Path:
+    """The annotators' exact scene of ``_camera()``, with a photo rendered by ``photo_cam``."""
+    cam = _camera()
+    size = (1280, 720)
+    syn = make_scene(
+        cam, np.random.default_rng(0), noise=NoiseModel.exact(), n_annotators=1, image_size=size
+    )
+    cv2.imwrite(str(tmp_path / "snap.png"), _render(photo_cam, size))
+    syn.scene["image"]["path"] = "snap.png"
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(syn.scene))
+    return path
+
+
+def _photo_warnings(result: object) -> list[str]:
+    return [w for w in result.warnings if "photo's" in w]  # type: ignore[attr-defined]
+
+
+def test_a_photo_that_agrees_gives_no_warning(tmp_path: Path) -> None:
+    result = calibrate(load_scene(_scene_with_photo(tmp_path, _camera())))
+    assert _photo_warnings(result) == []
+
+
+def test_a_photo_that_disagrees_is_reported(tmp_path: Path) -> None:
+    """The photo seen by a camera turned 10 degrees about the vertical: the horizontal axes
+    disagree by about 10 degrees, the vertical agrees."""
+    cam = _camera()
+    t = math.radians(10.0)
+    turn = np.array([[math.cos(t), -math.sin(t), 0.0], [math.sin(t), math.cos(t), 0.0], [0, 0, 1]])
+    R = cam.cam_from_world_rotation @ turn
+    photo_cam = Camera.from_center(cam.focal_px, cam.principal_point, R, cam.center_in_world)
+    result = calibrate(load_scene(_scene_with_photo(tmp_path, photo_cam)))
+    warnings = _photo_warnings(result)
+    axes = {a for w in warnings for a in ("length", "width", "height") if f" {a} vanish" in w}
+    assert axes & {"length", "width"}
+    assert "height" not in axes
+    angles = [float(w.split(" is ")[1].split(" degrees")[0]) for w in warnings if " is " in w]
+    assert angles
+    assert all(5.0 < a < 15.0 for a in angles)

@@ -270,6 +270,7 @@ def annotation_page_html(
             '<script id="camloc-image" type="text/plain">' + info.data_uri() + "</script>"
         ),
         "<!--camloc:js-->": "<script>" + _asset("annotate.js") + "</script>",
+        "<!--camloc:ground-corner-->": _asset("ground-corner.svg"),
     }
     for key, value in replacements.items():
         page = page.replace(key, value, 1)

@@ -523,7 +523,7 @@
   function missing(key) {
     var m = [];
     if (key === "car") {
-      var words = { origin: "the ground corner nearest the camera", length: "the far end of the length edge",
+      var words = { origin: "the ground under the body's corner nearest the camera", length: "the far end of the length edge",
         width: "the far end of the width edge", height: "the top of the height edge" };
       AXIS_POINTS.forEach(function (k) { if (!S.axes[k]) m.push(words[k]); });
     } else if (AXES.indexOf(key) >= 0) {
@@ -794,17 +794,24 @@
   }
 
   // ------------------------------------------------------------------ the side panel
+  /* The drawing of which point is the car's ground corner (web/ground-corner.svg, inlined). */
+  function groundCornerDrawing() {
+    var t = document.getElementById("ground-corner-drawing");
+    return t ? "<figure id='ground-corner' class='drawing'>" + t.innerHTML + "</figure>" : "";
+  }
   var STEP_TEXT = {
     car: function () {
       return "<p>Pick <b>the most visible car</b>: one whose length, width and height you can all see, " +
         "ideally parked or stopped near the middle of the photo. Then click four points on it, in this order:</p>" +
-        "<ol><li><b>its ground corner nearest the camera</b> (where a tyre-side corner of the body meets the road, " +
-        "on the corner closest to you);</li>" +
+        groundCornerDrawing() +
+        "<ol><li><b>its ground corner nearest the camera</b>: the point on the road <b>straight under the corner of the body</b> " +
+        "(the bumper's corner), on the corner closest to you. A rounded car has no corner on the road: " +
+        "imagine the box around the body; <b>not</b> where the tyre touches the road;</li>" +
         "<li>the far end of its <span class='swatch' style='background:" + COLOURS.length + "'></span><b>length</b> edge " +
-        "(the ground corner at the other end of the same side);</li>" +
+        "(the ground under the body's corner at the other end of the same side);</li>" +
         "<li>the far end of its <span class='swatch' style='background:" + COLOURS.width + "'></span><b>width</b> edge " +
-        "(the ground corner across the car's front or back);</li>" +
-        "<li>the <span class='swatch' style='background:" + COLOURS.height + "'></span><b>top</b> of the car straight above the first corner (its roof line).</li></ol>" +
+        "(the ground under the body's corner across the car's front or back);</li>" +
+        "<li>the <span class='swatch' style='background:" + COLOURS.height + "'></span><b>top</b> of the car straight above the first corner (at its roof's height).</li></ol>" +
         "<p class='muted small'>Hidden corners: click where they would be. The car is assumed to be a sedan; change it in the last step.</p>";
     },
     length: function () { return lineText("length", "parallel to the car's length: the car's own sides, lane markings, kerbs, road edges along the street"); },
