@@ -68,16 +68,25 @@ from camloc_geo.autovp import detect_vanishing_points, horizon_from_up, pitch_ro
 log = logging.getLogger("vp_real")
 
 HERE = Path(__file__).resolve().parent
-_SHARED = HERE.parents[1] / "shared" / "data"
+# Photos kept out of the repository by their licence: benchmarks/fetch_real_photos.sh clones
+# openMVG's public sets here; York Urban (research use only) is looked for beside the checkout.
+PHOTOS = Path(
+    os.environ.get("CAMLOC_PHOTOS_DIR", str(Path.home() / ".cache" / "camloc_geo" / "photos"))
+)
 DEFAULT_STRECHA = Path(
-    os.environ.get("CAMLOC_STRECHA_DIR", str(_SHARED / "Benchmarking_Camera_Calibration_2008"))
+    os.environ.get(
+        "CAMLOC_STRECHA_DIR",
+        str(PHOTOS / "SfM_quality_evaluation" / "Benchmarking_Camera_Calibration_2008"),
+    )
 )
 DEFAULT_SCEAUX = Path(
-    os.environ.get("CAMLOC_SCEAUX_DIR", str(_SHARED / "ImageDataset_SceauxCastle" / "images"))
+    os.environ.get("CAMLOC_SCEAUX_DIR", str(PHOTOS / "ImageDataset_SceauxCastle" / "images"))
 )
-DEFAULT_YUD = Path(os.environ.get("CAMLOC_YUD_DIR", str(_SHARED / "yud" / "YorkUrbanDB")))
+_YORK_URBAN_BESIDE = HERE.parents[1] / "shared" / "data" / "yud" / "YorkUrbanDB"
+DEFAULT_YUD = Path(os.environ.get("CAMLOC_YUD_DIR", str(_YORK_URBAN_BESIDE)))
 
 HOW_TO_GET = (
+    "benchmarks/fetch_real_photos.sh, or: "
     "git clone https://github.com/openMVG/SfM_quality_evaluation and set CAMLOC_STRECHA_DIR "
     "to its Benchmarking_Camera_Calibration_2008 folder; git clone "
     "https://github.com/openMVG/ImageDataset_SceauxCastle and set CAMLOC_SCEAUX_DIR to its "
