@@ -25,6 +25,7 @@ import numpy.typing as npt
 
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import PRESETS
+from camloc_geo.testing._video import write_video
 from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 __all__ = [
@@ -312,7 +313,6 @@ def render_video(
     RuntimeError
         OpenCV cannot open a writer for ``path`` with ``fourcc``.
     """
-    import cv2
 
     rng = np.random.default_rng(seed)
     w, h = image_size
@@ -338,29 +338,29 @@ def render_video(
         _draw_vehicle(background, camera, parked.corners_at(0.0), parked.colour)
     n_frames = round(duration_s * fps)
     path = Path(path)
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*fourcc), fps, (w, h))
-    if not writer.isOpened():
-        raise RuntimeError(f"OpenCV cannot write {fourcc} video to {path}")
-    noise = np.empty((h, w, 3), np.float32)
     eye = camera.center_in_world[:2]
-    try:
-        for i in range(n_frames):
-            t_s = i / fps
-            frame = background.copy()
-            order = sorted(
-                range(len(vehicles)),
-                key=lambda k: -float(np.linalg.norm(vehicles[k].centre_at(t_s) - eye)),
-            )
-            if shadow is not None:
-                for k in order:
-                    _draw_shadow(frame, camera, vehicles[k].corners_at(t_s), shadow)
+
+    def frame_at(t_s: float) -> npt.NDArray[np.uint8]:
+        frame = background.copy()
+        order = sorted(
+            range(len(vehicles)),
+            key=lambda k: -float(np.linalg.norm(vehicles[k].centre_at(t_s) - eye)),
+        )
+        if shadow is not None:
             for k in order:
-                _draw_vehicle(frame, camera, vehicles[k].corners_at(t_s), vehicles[k].colour)
-            if noise_sigma > 0:
-                cv2.randn(noise, 0.0, float(noise_sigma))  # type: ignore[call-overload]
-                frame = np.clip(frame + noise, 0, 255).astype(np.uint8)
-            writer.write(frame)
-    finally:
-        writer.release()
+                _draw_shadow(frame, camera, vehicles[k].corners_at(t_s), shadow)
+        for k in order:
+            _draw_vehicle(frame, camera, vehicles[k].corners_at(t_s), vehicles[k].colour)
+        return frame
+
+    write_video(
+        path,
+        frame_at,
+        fps=fps,
+        n_frames=n_frames,
+        size=(w, h),
+        fourcc=fourcc,
+        noise_sigma=noise_sigma,
+    )
     boxes = vehicle_boxes(camera, vehicles, fps, n_frames, image_size)
     return SyntheticVideo(path, camera, syn.scene, fps, n_frames, image_size, vehicles, boxes)

@@ -36,6 +36,7 @@ import numpy.typing as npt
 
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import PRESETS
+from camloc_geo.testing._video import write_video
 from camloc_geo.testing.synthetic import NoiseModel, make_scene
 
 __all__ = [
@@ -458,7 +459,6 @@ def render_street(
     RuntimeError
         OpenCV cannot open a writer for ``path``.
     """
-    import cv2
 
     size = (round(2 * camera.principal_point[0]), round(2 * camera.principal_point[1]))
     w, h = size
@@ -486,24 +486,24 @@ def render_street(
     _draw(background, camera, parked, 0.0, sun)
     n_frames = round(duration_s * fps)
     path = Path(path)
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*fourcc), fps, (w, h))
-    if not writer.isOpened():
-        raise RuntimeError(f"OpenCV cannot write {fourcc} video to {path}")
-    buf = np.empty((h, w, 3), np.float32)
     eye = camera.center_in_world[:2]
-    try:
-        for i in range(n_frames):
-            t_s = i / fps
-            frame = background.copy()
-            order = sorted(vehicles, key=lambda v: -float(np.linalg.norm(v.centre_at(t_s) - eye)))
-            for veh in order:
-                _draw(frame, camera, veh, t_s, sun)
-            if noise_sigma > 0:
-                cv2.randn(buf, 0.0, float(noise_sigma))  # type: ignore[call-overload]
-                frame = np.clip(frame + buf, 0, 255).astype(np.uint8)
-            writer.write(frame)
-    finally:
-        writer.release()
+
+    def frame_at(t_s: float) -> npt.NDArray[np.uint8]:
+        frame = background.copy()
+        order = sorted(vehicles, key=lambda v: -float(np.linalg.norm(v.centre_at(t_s) - eye)))
+        for veh in order:
+            _draw(frame, camera, veh, t_s, sun)
+        return frame
+
+    write_video(
+        path,
+        frame_at,
+        fps=fps,
+        n_frames=n_frames,
+        size=(w, h),
+        fourcc=fourcc,
+        noise_sigma=noise_sigma,
+    )
     boxes, contacts = _truth(camera, vehicles, fps, n_frames, size)
     return RenderedVideo(path, camera, scene, fps, n_frames, size, vehicles, boxes, contacts)
 
