@@ -695,10 +695,8 @@ def _ground_corner_sensitivity(
                 continue
             step = rel * edge  # 1-sigma move of a click along this ground axis, pixels
             for j in range(4 * a, 4 * a + 4):
-                dr = np.zeros(len(r))
-                dr[n_seg + j] = -scale[j] * step[0]
-                dr[n_seg + n_pt + j] = -scale[j] * step[1]
-                cols.append(JW.T @ dr)
+                # Jᵀ W dr, dr nonzero only at the click's u and v rows
+                cols.append(-scale[j] * (step[0] * JW[n_seg + j] + step[1] * JW[n_seg + n_pt + j]))
     if not cols:
         return None
     try:
