@@ -40,7 +40,7 @@ from camloc_geo._optimize import soft_l1_cost, soft_l1_least_squares
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
 from camloc_geo.absolute._refine import _matched_points, _street_bearing_prior
-from camloc_geo.absolute._similarity import Similarity2D, rot2
+from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 
 if TYPE_CHECKING:
@@ -136,30 +136,10 @@ def _bundle(
     n_cam = len(state.x)
     M, origin = state.internal_from_output, state.internal_origin
 
-    def map_residuals(z: FloatArray) -> FloatArray:
-        x_cam = z[:n_cam]
-        theta, tx, ty, ls = z[n_cam:]
-        f, (cx, cy), R, C = prob.unpack(
-            x_cam, state.rotation0, state.principal_point, state.focal_px
-        )
-        s = math.exp(ls)
-        p_xy = (q_en - np.array([tx, ty])) @ rot2(theta) / s  # rot2(θ)ᵀ applied to each row
-        p_out = np.column_stack([p_xy, np.zeros(len(p_xy))])
-        p_int = p_out @ M.T + origin
-        pc = (p_int - C) @ R.T
-        depth = np.maximum(pc[:, 2], 0.05)
-        u = pc[:, 0] / depth * f + cx
-        v = pc[:, 1] / depth * f + cy
-        sig = np.sqrt(sigma_click**2 + (f * sigma_map / depth) ** 2)
-        r = np.concatenate([(u - pixels[:, 0]) / sig, (v - pixels[:, 1]) / sig, [ls / s_sigma]])
-        if street_brg is not None:
-            car_brg = (90.0 - math.degrees(theta)) % 180.0
-            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
-            r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
-        return r
-
     def map_residuals_batch(Z: FloatArray) -> FloatArray:
-        """:func:`map_residuals` of a batch of parameter vectors ``(P, n)`` → ``(P, m)``."""
+        """The map rows of a batch of parameter vectors ``(P, n)`` → ``(P, m)``: each matched
+        map point's pixel residual (u then v, over its sigma), the scale prior, then the
+        street-bearing prior when there is one."""
         f, pp, R, C = prob._unpack_batch(
             Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
         )
@@ -186,13 +166,20 @@ def _bundle(
             parts.append((diff / settings.bearing_sigma_deg)[:, None])
         return np.concatenate(parts, axis=1)
 
-    def annotation_residuals(z: FloatArray) -> FloatArray:
-        return np.asarray(
-            prob.residuals(z[:n_cam], state.rotation0, state.principal_point, state.focal_px)
+    def residuals_and_jacobian(z: FloatArray) -> tuple[FloatArray, FloatArray]:
+        # One batched evaluation each: the annotations depend on the camera only, so their
+        # rows come from the joint fit's own batched residuals and Jacobian; the few map rows
+        # from one batch of forward differences whose first row is the residual itself.
+        r_ann, J_ann = prob.residuals_and_jacobian(
+            z[:n_cam], state.rotation0, state.principal_point, state.focal_px
         )
-
-    def residuals(z: FloatArray) -> FloatArray:
-        return np.concatenate([annotation_residuals(z), map_residuals(z)])
+        h = 1e-6 * np.maximum(1.0, np.abs(z))
+        Mb = map_residuals_batch(np.vstack([z, z + np.diag(h)]))
+        n_ann = J_ann.shape[0]
+        J = np.zeros((n_ann + Mb.shape[1], len(z)))
+        J[:n_ann, :n_cam] = J_ann
+        J[n_ann:] = ((Mb[1:] - Mb[0]) / h[:, None]).T
+        return np.concatenate([r_ann, Mb[0]]), J
 
     # The similarity is expressed from the calibration's output frame; the start is the
     # candidate's (refined) one.
@@ -200,28 +187,34 @@ def _bundle(
     z0 = np.concatenate(
         [state.x, [sim0.rotation_rad, *np.asarray(sim0.translation_m), math.log(sim0.scale)]]
     )
+    r0, J0 = residuals_and_jacobian(z0)  # its costs are needed after the fit too
+    start = [(r0, J0)]
+
+    def fun_and_jac(z: FloatArray) -> tuple[FloatArray, FloatArray]:
+        if start and np.array_equal(z, z0):
+            return start.pop()  # the fit's first evaluation, at the start
+        return residuals_and_jacobian(z)
+
+    def residuals(z: FloatArray) -> FloatArray:
+        return residuals_and_jacobian(z)[0]
 
     def jacobian(z: FloatArray) -> FloatArray:
-        # The annotations depend on the camera only: their block comes from the joint fit's
-        # own batched Jacobian; the few map rows by forward differences.
-        J_ann = prob.jacobian(z[:n_cam], state.rotation0, state.principal_point, state.focal_px)
-        h = 1e-6 * np.maximum(1.0, np.abs(z))
-        Mb = map_residuals_batch(np.vstack([z, z + np.diag(h)]))
-        n_ann = J_ann.shape[0]
-        J = np.zeros((n_ann + Mb.shape[1], len(z)))
-        J[:n_ann, :n_cam] = J_ann
-        J[n_ann:] = ((Mb[1:] - Mb[0]) / h[:, None]).T
-        return J
+        return residuals_and_jacobian(z)[1]
 
-    res = soft_l1_least_squares(residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200)
+    # Every trial step is evaluated with its Jacobian (one batched call: most steps are
+    # accepted, and an accepted one then needs no second call).
+    res = soft_l1_least_squares(
+        residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200, fun_and_jac=fun_and_jac
+    )
     if not res.success or not np.all(np.isfinite(res.x)):
         return cand
 
     def robust(r: FloatArray) -> float:  # in squared sigmas, like a chi-square
         return 2.0 * soft_l1_cost(r, _F_SCALE)
 
-    ann0, ann1 = robust(annotation_residuals(z0)), robust(annotation_residuals(res.x))
-    map0, map1 = robust(map_residuals(z0)), robust(map_residuals(res.x))
+    n_ann = len(r0) - (2 * len(pixels) + 1 + (street_brg is not None))
+    ann0, ann1 = robust(r0[:n_ann]), robust(res.fun[:n_ann])
+    map0, map1 = robust(r0[n_ann:]), robust(res.fun[n_ann:])
     if ann1 - ann0 > MAX_ANNOTATION_COST_RISE and map0 - map1 < ann1 - ann0:
         return cand
     lo, hi = prob.f_bounds
@@ -253,18 +246,20 @@ def _position_sigma(res: object, state: JointState, n_cam: int) -> float | None:
     except np.linalg.LinAlgError:
         return None
 
-    def position(zz: FloatArray) -> FloatArray:
-        _f, _pp, _R, C = _cam_parts(state, zz[:n_cam])
-        theta, tx, ty, ls = zz[n_cam:]
-        return np.asarray(math.exp(ls) * rot2(theta) @ C[:2] + np.array([tx, ty]))
-
-    p0 = position(z)
-    Jp = np.empty((2, len(z)))
-    for k in range(len(z)):
-        h = 1e-6 * max(1.0, abs(z[k]))
-        dz = z.copy()
-        dz[k] += h
-        Jp[:, k] = (position(dz) - p0) / h
+    # The position (east, north) at z and at z moved along each parameter, in one batch:
+    # s · rot2(θ) · C_out[:2] + t, with C_out the camera centre in the output frame.
+    h = 1e-6 * np.maximum(1.0, np.abs(z))
+    Z = np.vstack([z, z + np.diag(h)])
+    prob = state.problem
+    _f, _pp, _R, C = prob._unpack_batch(
+        Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
+    )
+    C_out = (C - state.internal_origin) @ state.internal_from_output
+    theta, tx, ty, s = Z[:, n_cam], Z[:, n_cam + 1], Z[:, n_cam + 2], np.exp(Z[:, n_cam + 3])
+    cos_t, sin_t = np.cos(theta), np.sin(theta)
+    east = s * (cos_t * C_out[:, 0] - sin_t * C_out[:, 1]) + tx
+    north = s * (sin_t * C_out[:, 0] + cos_t * C_out[:, 1]) + ty
+    Jp = np.stack([(east[1:] - east[0]) / h, (north[1:] - north[0]) / h])
     cov_p = Jp @ cov @ Jp.T
     tr = float(np.trace(cov_p))
     return math.sqrt(tr) if math.isfinite(tr) and tr >= 0.0 else None

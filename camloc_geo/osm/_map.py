@@ -313,8 +313,8 @@ class MapData:
         en = frame.points_enu_from_geographic(pts)
         return float(np.min(np.hypot(en[:, 0], en[:, 1])))
 
-    def _distances_m(self, lat: float, lon: float) -> np.ndarray:
-        """:meth:`distance_to_m` for every intersection at once (one projection)."""
+    def _member_lonlat(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every intersection's centre and member nodes (lon/lat) and the intersection of each."""
         if self._member_points is None:
             pts: list[tuple[float, float]] = []
             owner: list[int] = []
@@ -322,12 +322,37 @@ class MapData:
                 for ll in ((x.lon, x.lat), *x.osm_node_lonlat):
                     pts.append(ll)
                     owner.append(i)
-            self._member_points = (np.asarray(pts, dtype=float), np.asarray(owner, dtype=int))
-        pts_arr, owner_arr = self._member_points
+            self._member_points = (
+                np.asarray(pts, dtype=float).reshape(-1, 2),
+                np.asarray(owner, dtype=int),
+            )
+        return self._member_points
+
+    def _distances_m(self, lat: float, lon: float, within_m: float | None = None) -> np.ndarray:
+        """:meth:`distance_to_m` for every intersection at once (one projection).
+
+        With ``within_m``, only the intersections that may lie that near are measured (the
+        others are ``inf``): the map frame's planar distances, projected once per map, pick
+        them with a margin far above that frame's distortion (under 1e-4 within 100 km of
+        its anchor), so the distances within ``within_m`` are exactly those of a full run.
+        """
+        pts_arr, owner_arr = self._member_lonlat()
         out = np.full(len(self._intersections), np.inf)
-        if len(pts_arr):
-            en = LocalFrame(lat=lat, lon=lon).points_enu_from_geographic(pts_arr)
-            np.minimum.at(out, owner_arr, np.hypot(en[:, 0], en[:, 1]))
+        if not len(pts_arr):
+            return out
+        if within_m is not None:
+            pts_en = self.cached(
+                "intersection_members_enu", lambda: self.frame.points_enu_from_geographic(pts_arr)
+            )
+            e0, n0 = self.frame.enu_from_geographic(lat=lat, lon=lon)
+            rough = np.hypot(pts_en[:, 0] - e0, pts_en[:, 1] - n0)
+            near = rough <= 1.01 * within_m + 10.0
+            if not near.all():
+                pts_arr, owner_arr = pts_arr[near], owner_arr[near]
+                if not len(pts_arr):
+                    return out
+        en = LocalFrame(lat=lat, lon=lon).points_enu_from_geographic(pts_arr)
+        np.minimum.at(out, owner_arr, np.hypot(en[:, 0], en[:, 1]))
         return out
 
     def intersections_within(
@@ -337,7 +362,7 @@ class MapData:
 
         Distances as :meth:`distance_to_m` (centre or nearest member node).
         """
-        dist = self._distances_m(lat, lon)
+        dist = self._distances_m(lat, lon, within_m=radius_m)
         order = np.argsort(dist, kind="stable")
         return [(self._intersections[i], float(dist[i])) for i in order if dist[i] <= radius_m]
 
