@@ -37,7 +37,6 @@ from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
 if TYPE_CHECKING:
     from camloc_geo.absolute import Candidate, LocateResult, Match
     from camloc_geo.cameras import CameraResult
-    from camloc_geo.geodesy import LocalFrame
     from camloc_geo.osm import Intersection, MapData
     from camloc_geo.relative import CalibrationResult
 
@@ -494,8 +493,7 @@ def output_json_schema(kind: OutputKind) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------------- candidates
-def _match_properties(m: Match, frame: LocalFrame) -> MatchProperties:
-    lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
+def _match_properties(m: Match, lonlat: list[float]) -> MatchProperties:
     return MatchProperties(
         kind=m.kind,
         label=m.label,
@@ -504,11 +502,13 @@ def _match_properties(m: Match, frame: LocalFrame) -> MatchProperties:
         order=m.order,
         misfit_m=m.misfit_m,
         mahalanobis2=m.mahalanobis2,
-        map_lonlat=[lon, lat],
+        map_lonlat=lonlat,
     )
 
 
-def _candidate_feature(c: Candidate, result: LocateResult) -> Feature:
+def _candidate_feature(
+    c: Candidate, result: LocateResult, match_lonlat: list[list[float]]
+) -> Feature:
     from camloc_geo.geodesy import normalize_bearing_deg
 
     heading, pitch_c, roll_c = c.camera.angles_deg
@@ -530,26 +530,21 @@ def _candidate_feature(c: Candidate, result: LocateResult) -> Feature:
         merged=c.merged,
         flags=[str(f) for f in c.flags],
         scene=result.scene_id,
-        matches=[_match_properties(m, result.frame) for m in c.matches],
+        matches=[_match_properties(m, ll) for m, ll in zip(c.matches, match_lonlat, strict=True)],
         ambiguous_with=list(c.ambiguous_with),
         intersection=c.intersection_id,
     )
     return Feature(geometry=point(c.lon, c.lat), properties=props)
 
 
-def _view_cone_feature(c: Candidate, result: LocateResult, range_m: float) -> Feature:
-    from camloc_geo.absolute import view_cone
-
-    poly = view_cone(c.camera, result.image_size, range_m)
-    ll = result.frame.points_geographic_from_enu(poly)
+def _view_cone_feature(c: Candidate, ring_lonlat: list[list[float]]) -> Feature:
     return Feature(
-        geometry=PolygonGeometry(coordinates=[ll.tolist()]),
+        geometry=PolygonGeometry(coordinates=[ring_lonlat]),
         properties=ViewConeProperties(rank=c.rank, score=c.score),
     )
 
 
-def _matched_point_feature(c: Candidate, m: Match, frame: LocalFrame) -> Feature:
-    lon, lat = frame.geographic_from_enu(*m.map_en.tolist())
+def _matched_point_feature(c: Candidate, m: Match, lonlat: list[float]) -> Feature:
     props = MatchedPointProperties(
         rank=c.rank,
         label=m.label,
@@ -558,7 +553,33 @@ def _matched_point_feature(c: Candidate, m: Match, frame: LocalFrame) -> Feature
         misfit_m=m.misfit_m,
         map_corner=m.map_corner,
     )
-    return Feature(geometry=point(float(lon), float(lat)), properties=props)
+    return Feature(geometry=point(lonlat[0], lonlat[1]), properties=props)
+
+
+def _lonlat_of_points(
+    result: LocateResult, range_m: float, view_cones: bool
+) -> tuple[list[list[list[float]]], list[list[list[float]]]]:
+    """Every candidate's matched map points and view-cone ring as ``[lon, lat]`` lists.
+
+    One projection for the whole answer (the same numbers as one call per point).
+    """
+    import numpy as np
+
+    from camloc_geo.absolute import view_cone
+
+    cands = result.candidates
+    parts = [np.asarray([m.map_en for m in c.matches], dtype=float).reshape(-1, 2) for c in cands]
+    if view_cones:
+        parts += [view_cone(c.camera, result.image_size, range_m) for c in cands]
+    if not parts:
+        return [], []
+    ll = result.frame.points_geographic_from_enu(np.vstack(parts)).tolist()
+    out: list[list[list[float]]] = []
+    start = 0
+    for part in parts:
+        out.append(ll[start : start + len(part)])
+        start += len(part)
+    return out[: len(cands)], out[len(cands) :]
 
 
 def _collection_properties(result: LocateResult) -> CandidateCollectionProperties:
@@ -589,10 +610,15 @@ def candidates_collection(
     """The typed candidate FeatureCollection (:class:`CandidateCollection`) of a locate result."""
     cands = result.candidates
     range_m = result.view_cone_range_m if view_cone_range_m is None else view_cone_range_m
-    feats = [_candidate_feature(c, result) for c in cands]
+    match_ll, cone_ll = _lonlat_of_points(result, range_m, view_cones)
+    feats = [_candidate_feature(c, result, ll) for c, ll in zip(cands, match_ll, strict=True)]
     if view_cones:
-        feats += [_view_cone_feature(c, result, range_m) for c in cands]
-    feats += [_matched_point_feature(c, m, result.frame) for c in cands for m in c.matches]
+        feats += [_view_cone_feature(c, ring) for c, ring in zip(cands, cone_ll, strict=True)]
+    feats += [
+        _matched_point_feature(c, m, lonlat)
+        for c, lls in zip(cands, match_ll, strict=True)
+        for m, lonlat in zip(c.matches, lls, strict=True)
+    ]
     if result.intersection is not None:
         feats += intersection_features(result.intersection, detailed=False)
     return CandidateCollection(features=feats, properties=_collection_properties(result))

@@ -14,12 +14,10 @@ __all__ = ["view_cone"]
 FloatArray = npt.NDArray[np.float64]
 
 
-def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
-    """Ground footprint of the view, clipped at ``range_m`` horizontally (ENU polygon)."""
+def _border_px(size: tuple[int, int], n: int) -> FloatArray:
+    """The image border, clockwise from the bottom-left corner, ``n`` steps per side."""
     w, h = size
-    C = cam.center_in_world
     border: list[tuple[float, float]] = []
-    n = 12
     for i in range(n + 1):
         border.append((w * i / n, h))
     for i in range(n + 1):
@@ -28,18 +26,24 @@ def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
         border.append((w * (1 - i / n), 0.0))
     for i in range(n + 1):
         border.append((0.0, h * i / n))
-    rays = cam.rays_in_world(np.asarray(border, dtype=float))
-    pts = [C[:2].copy()]
-    for r in rays:
-        horiz = math.hypot(r[0], r[1])
-        if horiz < 1e-9:
-            continue
-        if r[2] < -1e-9:
-            lam = -C[2] / r[2]
-            dist = lam * horiz
-        else:
-            dist = math.inf
-        dist = min(dist, range_m)
-        pts.append(C[:2] + dist * r[:2] / horiz)
-    pts.append(C[:2].copy())
-    return np.asarray(pts, dtype=np.float64)
+    return np.asarray(border, dtype=float)
+
+
+def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
+    """Ground footprint of the view, clipped at ``range_m`` horizontally (ENU polygon).
+
+    The camera centre, then where each ray through the image border (12 steps per side)
+    meets the ground, or the point ``range_m`` away along it (a ray above the horizon, or a
+    ground point farther), then the centre again.
+    """
+    C = cam.center_in_world
+    rays = cam.rays_in_world(_border_px(size, 12))
+    horiz = np.array([math.hypot(x, y) for x, y in rays[:, :2].tolist()])
+    keep = horiz >= 1e-9  # rays straight down or up have no direction on the ground
+    rays, horiz = rays[keep], horiz[keep]
+    down = rays[:, 2] < -1e-9
+    dist = np.full(len(rays), math.inf)
+    dist[down] = -C[2] / rays[down, 2] * horiz[down]
+    dist = np.minimum(dist, range_m)
+    pts = C[:2] + dist[:, None] * rays[:, :2] / horiz[:, None]
+    return np.asarray(np.vstack([C[:2], pts, C[:2]]), dtype=np.float64)

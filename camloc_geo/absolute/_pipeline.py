@@ -411,10 +411,19 @@ def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult)
     for i, c in enumerate(cands, start=1):
         c.score = c.score / total
         c.rank = i
-        C = c.camera.center_in_world
-        lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
-        c.lon, c.lat = float(lon), float(lat)
+    _place(cands, result)
     return cands
+
+
+def _place(cands: list[Candidate], result: LocateResult) -> None:
+    """Each candidate's ``lon`` and ``lat`` from its camera centre (one projection for all)."""
+    if not cands:
+        return
+    en = np.array([c.camera.center_in_world[:2] for c in cands], dtype=float)
+    for c, (lon, lat) in zip(
+        cands, result.frame.points_geographic_from_enu(en).tolist(), strict=True
+    ):
+        c.lon, c.lat = lon, lat
 
 
 def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
@@ -510,14 +519,13 @@ def bundle_leaders(
     if not settings.bundle_adjust:
         return cands
     out = list(cands)
+    moved = []
     for i in range(min(settings.refine_top, len(out))):
         c = bundle_adjust(out[i], calibration, out[i].evidence or ev, settings, result.image_size)
-        if c is out[i]:
-            continue
-        C = c.camera.center_in_world
-        lon, lat = result.frame.geographic_from_enu(float(C[0]), float(C[1]))
-        c.lon, c.lat = float(lon), float(lat)
-        out[i] = c
+        if c is not out[i]:
+            out[i] = c
+            moved.append(c)
+    _place(moved, result)
     return out
 
 
