@@ -166,3 +166,23 @@ def test_worker_processes_answer_like_threads(tmp_path: Path) -> None:
             compute.shutdown()
     assert answers[1] == answers[0]
     assert "Eastern Avenue" in {n["name"] for n in answers[1]["near"]}
+
+
+def test_a_worker_freezes_its_maps_once_per_map_change(monkeypatch: pytest.MonkeyPatch) -> None:
+    import gc
+
+    from camloc_geo.osm import _catalogue
+    from camloc_geo.service import compute
+
+    calls: list[str] = []
+    monkeypatch.setattr(gc, "freeze", lambda: calls.append("freeze"))
+    monkeypatch.setattr(gc, "unfreeze", lambda: calls.append("unfreeze"))
+    monkeypatch.setattr(gc, "collect", lambda *a: calls.append("collect") or 0)
+    monkeypatch.setattr(compute, "_frozen_at_loads", -1)
+    compute._freeze_maps()
+    assert calls == ["unfreeze", "collect", "freeze"]
+    compute._freeze_maps()  # no map loaded since: nothing to do
+    assert calls == ["unfreeze", "collect", "freeze"]
+    monkeypatch.setattr(_catalogue, "_LOADS", [_catalogue._LOADS[0] + 1])  # a map loaded
+    compute._freeze_maps()
+    assert calls == ["unfreeze", "collect", "freeze"] * 2

@@ -23,6 +23,7 @@ from camloc_geo.osm._catalogue import (
     area_map,
     extract_bounds,
     extract_files,
+    map_loads,
     map_plan,
 )
 
@@ -63,6 +64,7 @@ __all__ = [
     "extract_files",
     "header_box",
     "load_map",
+    "map_loads",
     "map_plan",
     "normalize_name",
     "resolve_width_m",

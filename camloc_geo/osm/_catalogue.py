@@ -50,6 +50,7 @@ __all__ = [
     "clear_maps",
     "extract_bounds",
     "extract_files",
+    "map_loads",
     "map_plan",
 ]
 
@@ -345,6 +346,16 @@ def map_plan(
 _MAPS: OrderedDict[tuple[Any, ...], Any] = OrderedDict()
 _MAPS_LOCK = threading.Lock()
 _LOAD_LOCKS: dict[tuple[Any, ...], threading.Lock] = {}
+_LOADS = [0]
+
+
+def map_loads() -> int:
+    """How many maps :func:`area_map` has loaded in this process so far (or forgotten).
+
+    A long-running process (the service's workers) compares it between requests to learn
+    that its set of maps changed, e.g. to move them out of the garbage collector's way.
+    """
+    return _LOADS[0]
 
 
 def area_map(
@@ -370,6 +381,7 @@ def area_map(
         m = _load_area(area, cache_folder, overpass_url)
         with _MAPS_LOCK:
             _MAPS[key] = m
+            _LOADS[0] += 1
             while len(_MAPS) > _MAX_MAPS:
                 _MAPS.popitem(last=False)
         return m
@@ -398,3 +410,4 @@ def clear_maps() -> None:
     """Forget the maps of this process."""
     with _MAPS_LOCK:
         _MAPS.clear()
+        _LOADS[0] += 1
