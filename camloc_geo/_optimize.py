@@ -34,11 +34,15 @@ __all__ = [
     "gauss_newton",
     "soft_l1_cost",
     "soft_l1_least_squares",
+    "soft_l1_least_squares_many",
 ]
 
 FloatArray = npt.NDArray[np.float64]
 Residuals = Callable[[FloatArray], FloatArray]
 ResidualsAndJacobian = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
+ManyResidualsAndJacobians = Callable[
+    [list[int], list[FloatArray]], list[tuple[FloatArray, FloatArray]]
+]
 
 
 @dataclass(frozen=True)
@@ -227,6 +231,102 @@ def _lm_soft_l1(
     return LeastSquaresResult(
         x=x, cost=cost, fun=r, jac=J * np.sqrt(w)[:, None], success=success, nfev=nfev
     )
+
+
+def soft_l1_least_squares_many(
+    fun_and_jac_many: ManyResidualsAndJacobians,
+    x0s: list[FloatArray],
+    *,
+    f_scale: float,
+    tol: float = 1e-10,
+    max_nfev: int = 200,
+    damping: float = 1e-3,
+) -> list[LeastSquaresResult]:
+    """Several independent problems through the ``lm`` loop of :func:`soft_l1_least_squares`
+    in lockstep, their trial steps evaluated together.
+
+    Each problem takes exactly the steps, the damping and the stopping decisions it would
+    take alone (``soft_l1_least_squares(..., fun_and_jac=...)``, unprojected); only the
+    evaluations are shared: ``fun_and_jac_many(ids, xs)`` gives the residuals and the
+    Jacobian of problem ``ids[k]`` at ``xs[k]`` for every ``k`` in one call, so that a caller
+    can batch its finite differences over all of them (small problems cost mostly per call).
+    The first call holds every problem at its start.
+    """
+    xs = [np.asarray(x0, dtype=np.float64).copy() for x0 in x0s]
+    n = len(xs)
+    c2 = f_scale**2
+    first = fun_and_jac_many(list(range(n)), xs)
+    rs = [r for r, _J in first]
+    Js = [J for _r, J in first]
+    costs = [soft_l1_cost(r, f_scale) for r in rs]
+    lams = [damping] * n
+    nfevs = [1] * n
+    successes = [False] * n
+    active = list(range(n))
+    while active:
+        trial_ids: list[int] = []
+        trial_xs: list[FloatArray] = []
+        trial_dxs: list[FloatArray] = []
+        still: list[int] = []
+        for i in active:
+            if nfevs[i] >= max_nfev:
+                continue
+            r, J, x = rs[i], Js[i], xs[i]
+            w = 1.0 / np.sqrt(1.0 + r * r / c2)  # soft-L1 IRLS weights
+            Jw = J * w[:, None]
+            A = J.T @ Jw
+            g = Jw.T @ r
+            if np.max(np.abs(g)) * max(1.0, float(np.max(np.abs(x)))) < tol * max(costs[i], 1e-300):
+                successes[i] = True
+                continue
+            diag = np.diag(A).copy()
+            diag[diag <= 0] = 1e-12
+            try:
+                dx = np.asarray(-np.linalg.solve(A + lams[i] * np.diag(diag), g), np.float64)
+            except np.linalg.LinAlgError:
+                lams[i] *= 10.0
+                if lams[i] <= 1e12:
+                    still.append(i)  # retried next round with the same residuals
+                continue
+            trial_ids.append(i)
+            trial_xs.append(x + dx)
+            trial_dxs.append(dx)
+        evaluated = fun_and_jac_many(trial_ids, trial_xs) if trial_ids else []
+        for i, x_new, dx, (r_new, J_new) in zip(
+            trial_ids, trial_xs, trial_dxs, evaluated, strict=True
+        ):
+            nfevs[i] += 1
+            cost_new = soft_l1_cost(r_new, f_scale)
+            if cost_new <= costs[i]:
+                x = xs[i]
+                step_small = np.max(np.abs(dx)) <= tol * (1e-3 + float(np.max(np.abs(x))))
+                gain_small = costs[i] - cost_new <= tol * max(costs[i], 1e-300)
+                xs[i], rs[i], costs[i], Js[i] = x_new, r_new, cost_new, J_new
+                lams[i] = max(lams[i] * 0.3, 1e-12)
+                if step_small or gain_small:
+                    successes[i] = True
+                    continue
+            else:
+                lams[i] *= 10.0
+                if lams[i] > 1e12:
+                    successes[i] = True  # no descent direction left: at a (local) minimum
+                    continue
+            still.append(i)
+        active = sorted(still)
+    out = []
+    for i in range(n):
+        w = 1.0 / np.sqrt(1.0 + rs[i] * rs[i] / c2)
+        out.append(
+            LeastSquaresResult(
+                x=xs[i],
+                cost=costs[i],
+                fun=rs[i],
+                jac=Js[i] * np.sqrt(w)[:, None],
+                success=successes[i],
+                nfev=nfevs[i],
+            )
+        )
+    return out
 
 
 def gauss_newton(

@@ -11,7 +11,12 @@ import pytest
 from scipy.optimize import least_squares
 
 from camloc_geo import relative
-from camloc_geo._optimize import gauss_newton, soft_l1_cost, soft_l1_least_squares
+from camloc_geo._optimize import (
+    gauss_newton,
+    soft_l1_cost,
+    soft_l1_least_squares,
+    soft_l1_least_squares_many,
+)
 from camloc_geo.absolute._similarity import rot2
 from camloc_geo.scene import load_scene
 
@@ -48,6 +53,31 @@ def test_lm_soft_l1_matches_scipy_on_a_curve_with_outliers(seed: int) -> None:
     np.testing.assert_allclose(ours.x, [2.0, -1.3, 0.5], atol=0.05)  # outliers ignored
     via = soft_l1_least_squares(fun, jac, x0, f_scale=2.5, method="scipy")
     assert via.cost == pytest.approx(ref.cost, rel=1e-6)
+
+
+def test_lockstep_problems_take_the_steps_they_take_alone() -> None:
+    problems = [_curve_problem(seed) for seed in range(4)]
+    starts = [x0 + 0.3 * k for k, (_f, _j, x0) in enumerate(problems)]
+    starts[3] = np.array([50.0, 8.0, -40.0])  # far off: many rejected steps
+    batches: list[list[int]] = []
+
+    def many(ids: list[int], xs: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+        batches.append(list(ids))
+        return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
+
+    together = soft_l1_least_squares_many(many, starts, f_scale=2.5, max_nfev=60)
+    for (fun, jac, _x0), x0, res in zip(problems, starts, together, strict=True):
+        alone = soft_l1_least_squares(
+            fun, jac, x0, f_scale=2.5, max_nfev=60, fun_and_jac=lambda x, f=fun, j=jac: (f(x), j(x))
+        )
+        assert res.nfev == alone.nfev
+        assert res.success == alone.success
+        np.testing.assert_array_equal(res.x, alone.x)
+        np.testing.assert_array_equal(res.jac, alone.jac)
+        assert res.cost == alone.cost
+    assert batches[0] == [0, 1, 2, 3]  # the starts, in one call
+    assert max(len(b) for b in batches[1:]) > 1  # trial steps shared
+    assert sum(len(b) for b in batches) == sum(r.nfev for r in together)
 
 
 def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:

@@ -30,13 +30,17 @@ explaining the map no better, is dropped and the candidate kept as it was.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
-from camloc_geo._optimize import soft_l1_cost, soft_l1_least_squares
+from camloc_geo._optimize import (
+    LeastSquaresResult,
+    soft_l1_cost,
+    soft_l1_least_squares_many,
+)
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
 from camloc_geo.absolute._refine import _matched_points, _street_bearing_prior
@@ -46,7 +50,12 @@ from camloc_geo.camera import Camera
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult, JointState
 
-__all__ = ["MAX_ANNOTATION_COST_RISE", "MIN_MATCHED_POINTS", "bundle_adjust"]
+__all__ = [
+    "MAX_ANNOTATION_COST_RISE",
+    "MIN_MATCHED_POINTS",
+    "bundle_adjust",
+    "bundle_adjust_many",
+]
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -101,53 +110,137 @@ def bundle_adjust(
         ``cand`` itself when there is no joint state, fewer than :data:`MIN_MATCHED_POINTS`
         matched map points, or the bundle is not trustworthy.
     """
+    return bundle_adjust_many([cand], calibration, [ev], settings, image_size)[0]
+
+
+def bundle_adjust_many(
+    cands: list[Candidate],
+    calibration: CalibrationResult,
+    evs: list[Evidence],
+    settings: LocateSettings,
+    image_size: tuple[int, int],
+) -> list[Candidate]:
+    """:func:`bundle_adjust` of several candidates (each with its evidence), fitted together.
+
+    Each candidate's fit is its own (the same steps and answer as alone,
+    :func:`camloc_geo._optimize.soft_l1_least_squares_many`); their residuals and
+    finite-difference Jacobians are evaluated in one batch per step, which costs about what
+    one candidate's did.
+    """
+    out = list(cands)
     state = calibration.joint_state
     if state is None:
-        return cand
-    obs_q = _matched_points(cand, ev)
-    if len(obs_q) < MIN_MATCHED_POINTS:
-        return cand
+        return out
+    problems: list[_Problem] = []
+    for i, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        obs_q = _matched_points(cand, ev)
+        if len(obs_q) >= MIN_MATCHED_POINTS:
+            problems.append(_Problem.of(i, cand, ev, obs_q, settings, state))
+    if not problems:
+        return out
     prob = state.problem
     saved_weights = prob.weights
     prob.weights = state.weights
     try:
-        return _bundle(cand, state, obs_q, ev, settings, image_size)
-    except (ValueError, np.linalg.LinAlgError, FloatingPointError):
-        return cand
+        try:
+            fitted = _bundle_many(problems, state, settings, image_size)
+        except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+            fitted = []
+            for p in problems:  # one at a time: a failing candidate keeps its place
+                try:
+                    fitted += _bundle_many([p], state, settings, image_size)
+                except (ValueError, np.linalg.LinAlgError, FloatingPointError):
+                    fitted.append(p.cand)
     finally:
         prob.weights = saved_weights
+    for p, c in zip(problems, fitted, strict=True):
+        out[p.index] = c
+    return out
 
 
-def _bundle(
-    cand: Candidate,
+@dataclass(frozen=True)
+class _Problem:
+    """One candidate's bundle: its matched pixels and map points, priors and start."""
+
+    index: int
+    cand: Candidate
+    pixels: FloatArray  # (n, 2)
+    q_en: FloatArray  # (n, 2) matched map points, local east/north
+    sigma_map: FloatArray  # (n,)
+    street_brg: float | None
+    z0: FloatArray
+
+    @classmethod
+    def of(
+        cls,
+        index: int,
+        cand: Candidate,
+        ev: Evidence,
+        obs_q: list[tuple[Observation, FloatArray]],
+        settings: LocateSettings,
+        state: JointState,
+    ) -> _Problem:
+        # The similarity is expressed from the calibration's output frame; the start is the
+        # candidate's (refined) one.
+        sim0 = cand.enu_from_world
+        return cls(
+            index=index,
+            cand=cand,
+            pixels=np.array([o.pixel for o, _q in obs_q], dtype=float),
+            q_en=np.array([q for _o, q in obs_q], dtype=float),
+            sigma_map=np.array([o.sigma_map_m for o, _q in obs_q], dtype=float),
+            street_brg=_street_bearing_prior(cand, ev, settings),
+            z0=np.concatenate(
+                [
+                    state.x,
+                    [sim0.rotation_rad, *np.asarray(sim0.translation_m), math.log(sim0.scale)],
+                ]
+            ),
+        )
+
+    @property
+    def n_map_rows(self) -> int:
+        """Pixel rows (u, then v, per point), the scale prior, the bearing prior if any."""
+        return 2 * len(self.pixels) + 1 + (self.street_brg is not None)
+
+
+def _bundle_many(
+    problems: list[_Problem],
     state: JointState,
-    obs_q: list[tuple[Observation, FloatArray]],
-    ev: Evidence,
     settings: LocateSettings,
     image_size: tuple[int, int],
-) -> Candidate:
+) -> list[Candidate]:
     prob = state.problem
-    pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
-    q_en = np.array([q for _o, q in obs_q], dtype=float)
-    sigma_map = np.array([o.sigma_map_m for o, _q in obs_q], dtype=float)
     sigma_click = settings.sigma_pixel_rel * math.hypot(*image_size)
     s_sigma = max(settings.scale_sigma_rel, 1e-6)
-    street_brg = _street_bearing_prior(cand, ev, settings)
     n_cam = len(state.x)
     M, origin = state.internal_from_output, state.internal_origin
+    # The problems' map points padded to one length, so that all rows go in one batch.
+    n_max = max(len(p.pixels) for p in problems)
+    Q = np.zeros((len(problems), n_max, 2))
+    PX = np.zeros((len(problems), n_max, 2))
+    SM = np.zeros((len(problems), n_max))
+    BRG = np.zeros(len(problems))  # no bearing prior: a column left out (columns())
+    for k, p in enumerate(problems):
+        n = len(p.pixels)
+        Q[k, :n], PX[k, :n], SM[k, :n] = p.q_en, p.pixels, p.sigma_map
+        if p.street_brg is not None:
+            BRG[k] = p.street_brg
 
-    def map_residuals_batch(Z: FloatArray) -> FloatArray:
-        """The map rows of a batch of parameter vectors ``(P, n)`` → ``(P, m)``: each matched
-        map point's pixel residual (u then v, over its sigma), the scale prior, then the
-        street-bearing prior when there is one."""
+    def map_rows(Z: FloatArray, owner: npt.NDArray[np.int64]) -> FloatArray:
+        """The map rows of parameter vectors ``Z`` ``(P, n)``, row ``p`` of problem
+        ``owner[p]``: each matched map point's pixel residual over its sigma (u, padded to
+        ``n_max``, then v), the scale prior, then the street-bearing prior (a column left
+        unused by a problem without one)."""
         f, pp, R, C = prob._unpack_batch(
             Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
         )
         theta, tx, ty, ls = Z[:, n_cam], Z[:, n_cam + 1], Z[:, n_cam + 2], Z[:, n_cam + 3]
+        q_en, pixels, sigma_map = Q[owner], PX[owner], SM[owner]
         s = np.exp(ls)
         cos_t, sin_t = np.cos(theta), np.sin(theta)
-        dx = q_en[None, :, 0] - tx[:, None]  # (P, n)
-        dy = q_en[None, :, 1] - ty[:, None]
+        dx = q_en[:, :, 0] - tx[:, None]  # (P, n)
+        dy = q_en[:, :, 1] - ty[:, None]
         # rot2(θ)ᵀ applied to each row, over the scale
         px = (dx * cos_t[:, None] + dy * sin_t[:, None]) / s[:, None]
         py = (-dx * sin_t[:, None] + dy * cos_t[:, None]) / s[:, None]
@@ -158,66 +251,90 @@ def _bundle(
         fc = f[:, None]
         u = pc[:, :, 0] / depth * fc + pp[:, 0:1]
         v = pc[:, :, 1] / depth * fc + pp[:, 1:2]
-        sig = np.sqrt(sigma_click**2 + (fc * sigma_map[None, :] / depth) ** 2)
-        parts = [(u - pixels[:, 0]) / sig, (v - pixels[:, 1]) / sig, (ls / s_sigma)[:, None]]
-        if street_brg is not None:
-            car_brg = (90.0 - np.degrees(theta)) % 180.0
-            diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
-            parts.append((diff / settings.bearing_sigma_deg)[:, None])
+        sig = np.sqrt(sigma_click**2 + (fc * sigma_map / depth) ** 2)
+        car_brg = (90.0 - np.degrees(theta)) % 180.0
+        diff = (car_brg - BRG[owner] + 90.0) % 180.0 - 90.0
+        parts = [
+            (u - pixels[:, :, 0]) / sig,
+            (v - pixels[:, :, 1]) / sig,
+            (ls / s_sigma)[:, None],
+            (diff / settings.bearing_sigma_deg)[:, None],
+        ]
         return np.concatenate(parts, axis=1)
 
-    def residuals_and_jacobian(z: FloatArray) -> tuple[FloatArray, FloatArray]:
-        # One batched evaluation each: the annotations depend on the camera only, so their
-        # rows come from the joint fit's own batched residuals and Jacobian; the few map rows
-        # from one batch of forward differences whose first row is the residual itself.
-        r_ann, J_ann = prob.residuals_and_jacobian(
-            z[:n_cam], state.rotation0, state.principal_point, state.focal_px
+    def columns(p: _Problem) -> npt.NDArray[np.int64]:
+        n = len(p.pixels)
+        cols = [*range(n), *range(n_max, n_max + n), 2 * n_max]
+        if p.street_brg is not None:
+            cols.append(2 * n_max + 1)
+        return np.asarray(cols, dtype=np.int64)
+
+    cols = [columns(p) for p in problems]
+    n_z = n_cam + 4
+
+    def fun_and_jac_many(
+        ids: list[int], zs: list[FloatArray]
+    ) -> list[tuple[FloatArray, FloatArray]]:
+        # The annotations depend on the camera only: their rows and forward-difference
+        # Jacobian as the joint fit's own (steps of 1e-7 relative), every problem in one
+        # batch; the map rows likewise (steps of 1e-6), one batch whose first row per problem
+        # is the residual itself.
+        h_ann = [1e-7 * np.maximum(1.0, np.abs(z[:n_cam])) for z in zs]
+        X = np.vstack(
+            [np.vstack([z[:n_cam], z[:n_cam] + np.diag(h)]) for z, h in zip(zs, h_ann, strict=True)]
         )
-        h = 1e-6 * np.maximum(1.0, np.abs(z))
-        Mb = map_residuals_batch(np.vstack([z, z + np.diag(h)]))
-        n_ann = J_ann.shape[0]
-        J = np.zeros((n_ann + Mb.shape[1], len(z)))
-        J[:n_ann, :n_cam] = J_ann
-        J[n_ann:] = ((Mb[1:] - Mb[0]) / h[:, None]).T
-        return np.concatenate([r_ann, Mb[0]]), J
+        Rb = prob.residuals_batch(X, state.rotation0, state.principal_point, state.focal_px)
+        h_map = [1e-6 * np.maximum(1.0, np.abs(z)) for z in zs]
+        Z = np.vstack([np.vstack([z, z + np.diag(h)]) for z, h in zip(zs, h_map, strict=True)])
+        owner = np.repeat(np.asarray(ids, dtype=np.int64), n_z + 1)
+        Mb_all = map_rows(Z, owner)
+        out = []
+        for k, i in enumerate(ids):
+            ra = Rb[k * (n_cam + 1) : (k + 1) * (n_cam + 1)]
+            r_ann = np.asarray(ra[0], dtype=np.float64)
+            J_ann = np.asarray(((ra[1:] - ra[0]) / h_ann[k][:, None]).T, dtype=np.float64)
+            Mb = Mb_all[k * (n_z + 1) : (k + 1) * (n_z + 1)][:, cols[i]]
+            n_ann = J_ann.shape[0]
+            J = np.zeros((n_ann + Mb.shape[1], n_z))
+            J[:n_ann, :n_cam] = J_ann
+            J[n_ann:] = ((Mb[1:] - Mb[0]) / h_map[k][:, None]).T
+            out.append((np.concatenate([r_ann, Mb[0]]), J))
+        return out
 
-    # The similarity is expressed from the calibration's output frame; the start is the
-    # candidate's (refined) one.
-    sim0 = cand.enu_from_world
-    z0 = np.concatenate(
-        [state.x, [sim0.rotation_rad, *np.asarray(sim0.translation_m), math.log(sim0.scale)]]
+    starts: list[FloatArray] = []
+
+    def recorded(ids: list[int], zs: list[FloatArray]) -> list[tuple[FloatArray, FloatArray]]:
+        got = fun_and_jac_many(ids, zs)
+        if not starts:  # the first call: every problem at its start; kept for the costs
+            starts.extend(r for r, _J in got)
+        return got
+
+    results = soft_l1_least_squares_many(
+        recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200
     )
-    r0, J0 = residuals_and_jacobian(z0)  # its costs are needed after the fit too
-    start = [(r0, J0)]
+    return [
+        _accept(p, res, r0, state, n_cam)
+        for p, res, r0 in zip(problems, results, starts, strict=True)
+    ]
 
-    def fun_and_jac(z: FloatArray) -> tuple[FloatArray, FloatArray]:
-        if start and np.array_equal(z, z0):
-            return start.pop()  # the fit's first evaluation, at the start
-        return residuals_and_jacobian(z)
 
-    def residuals(z: FloatArray) -> FloatArray:
-        return residuals_and_jacobian(z)[0]
-
-    def jacobian(z: FloatArray) -> FloatArray:
-        return residuals_and_jacobian(z)[1]
-
-    # Every trial step is evaluated with its Jacobian (one batched call: most steps are
-    # accepted, and an accepted one then needs no second call).
-    res = soft_l1_least_squares(
-        residuals, jacobian, z0, f_scale=_F_SCALE, max_nfev=200, fun_and_jac=fun_and_jac
-    )
+def _accept(
+    p: _Problem, res: LeastSquaresResult, r0: FloatArray, state: JointState, n_cam: int
+) -> Candidate:
+    """The candidate as the bundle left it, or as it was when the bundle is not trustworthy."""
+    cand = p.cand
     if not res.success or not np.all(np.isfinite(res.x)):
         return cand
 
     def robust(r: FloatArray) -> float:  # in squared sigmas, like a chi-square
         return 2.0 * soft_l1_cost(r, _F_SCALE)
 
-    n_ann = len(r0) - (2 * len(pixels) + 1 + (street_brg is not None))
+    n_ann = len(r0) - p.n_map_rows
     ann0, ann1 = robust(r0[:n_ann]), robust(res.fun[:n_ann])
     map0, map1 = robust(r0[n_ann:]), robust(res.fun[n_ann:])
     if ann1 - ann0 > MAX_ANNOTATION_COST_RISE and map0 - map1 < ann1 - ann0:
         return cand
-    lo, hi = prob.f_bounds
+    lo, hi = state.problem.f_bounds
     f, pp, R_out, C_out = _cam_parts(state, res.x[:n_cam])
     if not lo * 1.001 < f < hi / 1.001 or C_out[2] <= 0.0:
         return cand

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from camloc_geo._ties import is_tie
-from camloc_geo.absolute._bundle import bundle_adjust
+from camloc_geo.absolute._bundle import bundle_adjust_many
 from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
     Evidence,
@@ -514,19 +514,16 @@ def bundle_leaders(
     """Stage 7: the ``refine_top`` leaders' cameras re-fitted with the annotations and the map.
 
     Ranks and scores stay (they compare hypotheses on the same evidence); the position,
-    camera and ``sigma_m`` become the bundle's (:mod:`camloc_geo.absolute._bundle`).
+    camera and ``sigma_m`` become the bundle's (:mod:`camloc_geo.absolute._bundle`). The
+    leaders are fitted together (each its own fit, evaluated in one batch per step).
     """
     if not settings.bundle_adjust:
         return cands
-    out = list(cands)
-    moved = []
-    for i in range(min(settings.refine_top, len(out))):
-        c = bundle_adjust(out[i], calibration, out[i].evidence or ev, settings, result.image_size)
-        if c is not out[i]:
-            out[i] = c
-            moved.append(c)
-    _place(moved, result)
-    return out
+    top = cands[: settings.refine_top]
+    evs = [c.evidence or ev for c in top]
+    adjusted = bundle_adjust_many(top, calibration, evs, settings, result.image_size)
+    _place([a for a, c in zip(adjusted, top, strict=True) if a is not c], result)
+    return adjusted + cands[settings.refine_top :]
 
 
 def apply_cues(
