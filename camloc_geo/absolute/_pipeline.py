@@ -38,7 +38,12 @@ from camloc_geo.absolute._model import (
     Tie,
 )
 from camloc_geo.absolute._refine import position_sigma_m, refine
-from camloc_geo.absolute._scoring import plausibility, score, unmatched_flags
+from camloc_geo.absolute._scoring import (
+    plausibility,
+    plausibility_many,
+    score,
+    unmatched_flags,
+)
 from camloc_geo.camera import Camera
 from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
 from camloc_geo.scene import Scene
@@ -229,9 +234,12 @@ def _expected_plausibility(
     step = math.sqrt(3.0) * min(sigma_m, SIGMA_POINT_CAP_M) / math.sqrt(2.0)
     total = plaus_centre / 3.0
     sim = cand.enu_from_world
-    for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
-        moved = replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
-        f, _flags = plausibility(moved.camera(world_cam), moved, ev, settings, matches)
+    moved = [
+        replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
+        for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step))
+    ]
+    cams = [m.camera(world_cam) for m in moved]
+    for f, _flags in plausibility_many(cams, moved, ev, settings, matches):
         total += f / 6.0
     return total
 

@@ -191,26 +191,50 @@ def street_angle_under_car(enu_from_world: Similarity2D, ev: Evidence) -> float 
     half the street's width + 2.5 m from every centre line); else the smallest angle among the
     streets it stands on.
     """
-    from shapely.geometry import Point, box
+    return street_angles_under_car([enu_from_world], ev)[0]
 
-    car_bearing = car_bearing_deg(enu_from_world)
-    car = enu_from_world.apply(ev.car_center_world)
-    x, y = float(car[0]), float(car[1])
-    pt = Point(x, y)
-    best: float | None = None
-    # A box, not a buffered disc: the tree only tests envelopes, and buffering is costly.
+
+def street_angles_under_car(sims: Sequence[Similarity2D], ev: Evidence) -> list[float | None]:
+    """:func:`street_angle_under_car` of several placements of the car, in one pass.
+
+    Each street within a 50 m box of the car (a box, not a buffered disc: the tree only
+    tests envelopes) whose centre line passes within its half width + 2.5 m of the car
+    gives the bearing of its chord from 5 m before to 5 m after the car's projection; the
+    smallest angle to the car's axis wins (the first of equals, in the tree's order). The
+    geometry is GEOS's (distance, project, interpolate), over arrays of every car and near
+    street at once: one call each instead of several per street and car.
+    """
+    import shapely
+
     assert ev.streets is not None
-    for idx in ev.street_tree.query(box(x - 25.0, y - 25.0, x + 25.0, y + 25.0)):
-        line, half_w = ev.streets.geometries[int(idx)], ev.streets.values[int(idx)]
-        if line.distance(pt) > half_w + 2.5:
-            continue
-        sproj = line.project(pt)
-        a = line.interpolate(max(0.0, sproj - 5.0))
-        b = line.interpolate(min(line.length, sproj + 5.0))
-        brg = math.degrees(math.atan2(b.x - a.x, b.y - a.y)) % 180.0
-        diff = (car_bearing - brg + 90.0) % 180.0 - 90.0
-        if best is None or abs(diff) < abs(best):
-            best = diff
+    cars = [sim.apply(ev.car_center_world) for sim in sims]
+    xy = np.array([[float(c[0]), float(c[1])] for c in cars])
+    boxes = shapely.box(xy[:, 0] - 25.0, xy[:, 1] - 25.0, xy[:, 0] + 25.0, xy[:, 1] + 25.0)
+    car_i, line_i = ev.street_tree.query(boxes)
+    best: list[float | None] = [None] * len(sims)
+    if not len(car_i):
+        return best
+    lines = ev.street_tree.geometries[line_i]
+    pts = shapely.points(xy[car_i])
+    half_w = ev.streets.values_array[line_i]
+    on = ~(shapely.distance(lines, pts) > half_w + 2.5)
+    if not on.any():
+        return best
+    car_i, lines, pts = car_i[on], lines[on], pts[on]
+    sproj = shapely.line_locate_point(lines, pts)
+    a = shapely.get_coordinates(
+        shapely.line_interpolate_point(lines, np.maximum(0.0, sproj - 5.0))
+    ).tolist()
+    b = shapely.get_coordinates(
+        shapely.line_interpolate_point(lines, np.minimum(shapely.length(lines), sproj + 5.0))
+    ).tolist()
+    car_bearings = [car_bearing_deg(sim) for sim in sims]
+    for k, (ax, ay), (bx, by) in zip(car_i.tolist(), a, b, strict=True):
+        brg = math.degrees(math.atan2(bx - ax, by - ay)) % 180.0
+        diff = (car_bearings[k] - brg + 90.0) % 180.0 - 90.0
+        prev = best[k]
+        if prev is None or abs(diff) < abs(prev):
+            best[k] = diff
     return best
 
 
@@ -218,39 +242,92 @@ def _building_factor(
     C: FloatArray, ev: Evidence, settings: LocateSettings, matches: list[Match]
 ) -> tuple[float, list[Flag]]:
     """The camera is not deep inside a building; the corners it sees are not hidden."""
-    from shapely.geometry import LineString, Point
+    return _building_factors(np.asarray(C, dtype=float)[None, :2], ev, settings, matches)[0]
 
-    factor = 1.0
-    flags: list[Flag] = []
+
+def _building_factors(
+    centres: FloatArray, ev: Evidence, settings: LocateSettings, matches: list[Match]
+) -> list[tuple[float, list[Flag]]]:
+    """:func:`_building_factor` of several camera positions ``(P, 2)`` with the same matches.
+
+    The tests are GEOS's, as one call per geometry would make them, over arrays: the
+    footprints containing each position (its "home": deep inside one is suspect), and for
+    each position and matched corner, the footprints other than its home that the sight
+    line crosses for more than a metre.
+    """
+    import shapely
+
     assert ev.buildings is not None
-    polys = ev.buildings.geometries
-    pt = Point(float(C[0]), float(C[1]))
-    around = [polys[int(i)] for i in ev.buildings_tree.query(pt)]
-    home = [poly for poly in around if poly.contains(pt)]
-    if any(poly.exterior.distance(pt) > 2.0 for poly in home):
-        factor *= settings.inside_building_factor
-        flags.append(Flag(FlagKind.INSIDE_BUILDING))
-    for m in matches:
-        if m.kind != "corner":
-            continue
-        line = LineString([(C[0], C[1]), tuple(m.map_en.tolist())])
-        for i in ev.buildings_tree.query(line):
-            poly = polys[int(i)]
-            if poly in home:
-                continue
-            if line.crosses(poly) and line.intersection(poly).length > 1.0:
+    tree = ev.buildings_tree
+    polys = tree.geometries
+    pts = shapely.points(centres)
+    n_pts = len(pts)
+    pt_i, poly_i = tree.query(pts, predicate="within")  # the footprints containing each
+    home: list[set[int]] = [set() for _ in range(n_pts)]
+    for p, j in zip(pt_i.tolist(), poly_i.tolist(), strict=True):
+        home[p].add(j)
+    inside = [False] * n_pts
+    if len(pt_i):
+        deep = shapely.distance(shapely.get_exterior_ring(polys[poly_i]), pts[pt_i]) > 2.0
+        for p in pt_i[deep].tolist():
+            inside[p] = True
+    corners = [m for m in matches if m.kind == "corner"]
+    occluded = np.zeros((n_pts, len(corners)), dtype=bool)
+    if corners:
+        ends = np.array([m.map_en for m in corners], dtype=float)
+        coords = np.empty((n_pts, len(corners), 2, 2))
+        coords[:, :, 0, :] = centres[:, None, :]
+        coords[:, :, 1, :] = ends[None, :, :]
+        lines = shapely.linestrings(coords.reshape(-1, 2, 2))
+        line_i, poly_j = tree.query(lines, predicate="crosses")
+        if len(line_i):
+            not_home = np.array(
+                [
+                    j not in home[i // len(corners)]
+                    for i, j in zip(line_i.tolist(), poly_j.tolist(), strict=True)
+                ],
+                dtype=bool,
+            )
+            line_i, poly_j = line_i[not_home], poly_j[not_home]
+        if len(line_i):
+            cut = shapely.length(shapely.intersection(lines[line_i], polys[poly_j])) > 1.0
+            occluded.reshape(-1)[line_i[cut]] = True
+    out = []
+    for p in range(n_pts):
+        factor = 1.0
+        flags: list[Flag] = []
+        if inside[p]:
+            factor *= settings.inside_building_factor
+            flags.append(Flag(FlagKind.INSIDE_BUILDING))
+        for k, m in enumerate(corners):
+            if occluded[p, k]:
                 factor *= settings.occluded_corner_factor
                 flags.append(Flag(FlagKind.OCCLUDED, m.label))
-                break
-    return factor, flags
+        out.append((factor, flags))
+    return out
+
+
+class _Unknown:
+    """Not computed yet."""
+
+
+_UNKNOWN = _Unknown()
 
 
 def _parallel_factor(
-    enu_from_world: Similarity2D, ev: Evidence, settings: LocateSettings
+    enu_from_world: Similarity2D,
+    ev: Evidence,
+    settings: LocateSettings,
+    street_angle: float | _Unknown | None = _UNKNOWN,
 ) -> tuple[float, list[Flag]]:
-    """The car's length axis is parallel to a street (the one under it, when streets are known)."""
+    """The car's length axis is parallel to a street (the one under it, when streets are known).
+
+    ``street_angle``: :func:`street_angle_under_car` when computed already.
+    """
     if ev.street_tree is not None:
-        signed = street_angle_under_car(enu_from_world, ev)
+        if isinstance(street_angle, _Unknown):
+            street_angle = street_angle_under_car(enu_from_world, ev)
+        signed = street_angle
         if signed is None:
             return settings.parallel_floor, [Flag(FlagKind.CAR_OFF_STREET)]
         diff = abs(signed)
@@ -276,26 +353,53 @@ def plausibility(
     matches: list[Match],
 ) -> tuple[float, list[Flag]]:
     """The map plausibility factor of a hypothesis (buildings, prior, streets) and its flags."""
-    factor = 1.0
-    flags: list[Flag] = []
-    C = cam.center_in_world
+    return plausibility_many([cam], [enu_from_world], ev, settings, matches)[0]
+
+
+def plausibility_many(
+    cams: Sequence[Camera],
+    sims: Sequence[Similarity2D],
+    ev: Evidence,
+    settings: LocateSettings,
+    matches: list[Match],
+) -> list[tuple[float, list[Flag]]]:
+    """:func:`plausibility` of several placements (camera and ``enu_from_world`` each) with
+    the same matches; the building tests of all of them in one pass."""
+    centres = [cam.center_in_world for cam in cams]
     if ev.buildings_tree is not None:
-        f, fl = _building_factor(C, ev, settings, matches)
-        factor *= f
-        flags += fl
-    if ev.prior_en is not None and ev.prior_radius_m:
-        # A soft prior: a Gaussian of the listed radius (0.61 at the radius, 0.14 at twice).
-        d = float(np.linalg.norm(C[:2] - ev.prior_en))
-        factor *= math.exp(-0.5 * (d / ev.prior_radius_m) ** 2)
-        if d > ev.prior_radius_m:
-            flags.append(Flag(FlagKind.OUTSIDE_PRIOR))
-    f, fl = _parallel_factor(enu_from_world, ev, settings)
-    factor *= f
-    flags += fl
+        building = _building_factors(
+            np.array([C[:2] for C in centres], dtype=float), ev, settings, matches
+        )
+    else:
+        building = [(1.0, [])] * len(cams)
     if ev.worst_reference is not None:
-        flags.append(Flag(FlagKind.WORST_REFERENCE, ev.worst_reference))
+        worst = [Flag(FlagKind.WORST_REFERENCE, ev.worst_reference)]
+    else:
+        worst = []
     # The flagged worst reference is reported, not held against the whole fit.
     m2 = [m.mahalanobis2 for m in matches if m.label != ev.worst_reference]
-    if m2 and sum(m2) / len(m2) > settings.fit_gate:
-        flags.append(Flag(FlagKind.POOR_FIT))
-    return factor, flags
+    poor = bool(m2) and sum(m2) / len(m2) > settings.fit_gate
+    angles: list[float | None] = [None] * len(sims)
+    if ev.street_tree is not None:
+        angles = street_angles_under_car(sims, ev)
+    out = []
+    for C, sim, (f_b, fl_b), angle in zip(centres, sims, building, angles, strict=True):
+        factor = 1.0
+        flags: list[Flag] = []
+        if ev.buildings_tree is not None:
+            factor *= f_b
+            flags += fl_b
+        if ev.prior_en is not None and ev.prior_radius_m:
+            # A soft prior: a Gaussian of the listed radius (0.61 at the radius, 0.14 at twice).
+            d = float(np.linalg.norm(C[:2] - ev.prior_en))
+            factor *= math.exp(-0.5 * (d / ev.prior_radius_m) ** 2)
+            if d > ev.prior_radius_m:
+                flags.append(Flag(FlagKind.OUTSIDE_PRIOR))
+        f, fl = _parallel_factor(sim, ev, settings, angle)
+        factor *= f
+        flags += fl
+        flags += worst
+        if poor:
+            flags.append(Flag(FlagKind.POOR_FIT))
+        out.append((factor, flags))
+    return out

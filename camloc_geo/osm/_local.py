@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from camloc_geo.geodesy import LocalFrame
 
@@ -38,6 +39,16 @@ class LocalIndex:
     geometries: tuple[Any, ...]
     values: tuple[float, ...]
     tree: Any
+
+    @property
+    def values_array(self) -> npt.NDArray[np.float64]:
+        """:attr:`values` as an array (built once), to index with the tree's answers."""
+        try:
+            out: npt.NDArray[np.float64] = self.__dict__["_values_array"]
+        except KeyError:
+            out = np.asarray(self.values, dtype=np.float64)
+            self.__dict__["_values_array"] = out  # a cache, not state (frozen dataclass)
+        return out
 
     def __len__(self) -> int:
         return len(self.geometries)
