@@ -39,11 +39,11 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import position_sigma_m, refine
 from camloc_geo.absolute._scoring import (
-    plausibility,
     plausibility_many,
     score,
     unmatched_flags,
 )
+from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.relative import CalibrationResult, CalibrationSettings, calibrate
 from camloc_geo.scene import Scene
@@ -116,7 +116,7 @@ def locate(
     result.cues_applied = ev.has_cues
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
-        cands = [score_hypothesis(h, world_cam, ev, settings) for h in hyps]
+        cands = score_hypotheses(hyps, world_cam, ev, settings)
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
@@ -150,10 +150,7 @@ def _other_junction_candidates(
     out = []
     for inter in others:
         ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
-        out += [
-            score_hypothesis(h, world_cam, ev_j, settings)
-            for h in corner_hypotheses(ev_j, settings)
-        ]
+        out += score_hypotheses(corner_hypotheses(ev_j, settings), world_cam, ev_j, settings)
     result.warnings.append(
         f"corners: no intersection lat/lon in the scene, so the corners were matched at the "
         f"{len(others) + 1} junctions with kerb corners within {scene.prior.radius_m:g} m of "
@@ -177,29 +174,77 @@ def _rescore(
     uncertainty (:func:`_expected_plausibility`; its ``sigma_m``, else the fit's covariance
     at the candidate).
     """
-    ev = cand.evidence if cand.evidence is not None else ev
-    fit = score(cand.enu_from_world, ev, settings, cand.corner_assignment)
-    plaus, flags = plausibility(cand.camera, cand.enu_from_world, ev, settings, fit.matches)
-    if expected:
-        sigma = cand.sigma_m
-        if sigma is None:
-            sigma = position_sigma_m(replace(cand, matches=fit.matches), world_cam, ev, settings)
-        if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
-            plaus = _expected_plausibility(plaus, cand, sigma, world_cam, ev, settings, fit.matches)
-    flags += unmatched_flags(ev, fit.corner_assignment)
-    cue_log = 0.0
-    if ev.has_cues:
-        cue_log, cue_flags = _cues(cand, ev)
-        flags += cue_flags
-    return replace(
-        cand,
-        log_likelihood=fit.log_likelihood + log_prior + cue_log,
-        prior=plaus,
-        residual_m=fit.residual_m,
-        matches=fit.matches,
-        flags=flags,
-        corner_assignment=fit.corner_assignment,
-    )
+    return _rescore_many([cand], world_cam, ev, settings, [log_prior], expected=expected)[0]
+
+
+def _rescore_many(
+    cands: list[Candidate],
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    log_priors: list[float],
+    *,
+    expected: bool = False,
+) -> list[Candidate]:
+    """:func:`_rescore` of several candidates: the plausibility tests of all the candidates
+    on one evidence (and of their sigma points, with ``expected``) in one pass."""
+    evs = [c.evidence if c.evidence is not None else ev for c in cands]
+    fits = [
+        score(c.enu_from_world, e, settings, c.corner_assignment)
+        for c, e in zip(cands, evs, strict=True)
+    ]
+    # Each candidate's placements: itself, then (expected) its four sigma points.
+    places: list[list[tuple[Camera, Similarity2D]]] = []
+    for c, e, fit in zip(cands, evs, fits, strict=True):
+        here = [(c.camera, c.enu_from_world)]
+        if expected:
+            sigma = c.sigma_m
+            if sigma is None:
+                sigma = position_sigma_m(replace(c, matches=fit.matches), world_cam, e, settings)
+            if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
+                here += _sigma_points(c.enu_from_world, sigma, world_cam)
+        places.append(here)
+    tests: list[list[tuple[float, list[Flag]]]] = [[] for _ in cands]
+    for e_id in dict.fromkeys(id(e) for e in evs):  # one pass per evidence, in order
+        mine = [i for i, e in enumerate(evs) if id(e) == e_id]
+        got = iter(
+            plausibility_many(
+                [cam for i in mine for cam, _sim in places[i]],
+                [sim for i in mine for _cam, sim in places[i]],
+                evs[mine[0]],
+                settings,
+                [fits[i].matches for i in mine for _place in places[i]],
+            )
+        )
+        for i in mine:
+            tests[i] = [next(got) for _place in places[i]]
+    out = []
+    for c, e, fit, log_prior, (centre, *spread) in zip(
+        cands, evs, fits, log_priors, tests, strict=True
+    ):
+        plaus, flags = centre
+        if spread:
+            total = plaus / 3.0
+            for f, _flags in spread:
+                total += f / 6.0
+            plaus = total
+        flags += unmatched_flags(e, fit.corner_assignment)
+        cue_log = 0.0
+        if e.has_cues:
+            cue_log, cue_flags = _cues(c, e)
+            flags += cue_flags
+        out.append(
+            replace(
+                c,
+                log_likelihood=fit.log_likelihood + log_prior + cue_log,
+                prior=plaus,
+                residual_m=fit.residual_m,
+                matches=fit.matches,
+                flags=flags,
+                corner_assignment=fit.corner_assignment,
+            )
+        )
+    return out
 
 
 SIGMA_POINT_CAP_M = 8.0
@@ -231,17 +276,25 @@ def _expected_plausibility(
     five points (the centre, weight 1/3, and ``±√3`` per-axis sigmas east and north, 1/6
     each). The camera and its car move together (the similarity's translation).
     """
-    step = math.sqrt(3.0) * min(sigma_m, SIGMA_POINT_CAP_M) / math.sqrt(2.0)
     total = plaus_centre / 3.0
-    sim = cand.enu_from_world
-    moved = [
-        replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
-        for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step))
-    ]
-    cams = [m.camera(world_cam) for m in moved]
-    for f, _flags in plausibility_many(cams, moved, ev, settings, matches):
+    points = _sigma_points(cand.enu_from_world, sigma_m, world_cam)
+    cams, sims = [cam for cam, _s in points], [sim for _c, sim in points]
+    for f, _flags in plausibility_many(cams, sims, ev, settings, [matches] * len(points)):
         total += f / 6.0
     return total
+
+
+def _sigma_points(
+    sim: Similarity2D, sigma_m: float, world_cam: Camera
+) -> list[tuple[Camera, Similarity2D]]:
+    """The four outer sigma points of :func:`_expected_plausibility`: the placement moved
+    ``±√3`` per-axis sigmas east and north (camera and car together)."""
+    step = math.sqrt(3.0) * min(sigma_m, SIGMA_POINT_CAP_M) / math.sqrt(2.0)
+    out = []
+    for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
+        moved = replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
+        out.append((moved.camera(world_cam), moved))
+    return out
 
 
 def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:
@@ -265,18 +318,29 @@ def score_hypothesis(
     h: Hypothesis, world_cam: Camera, ev: Evidence, settings: LocateSettings
 ) -> Candidate:
     """Stage 3: a hypothesis scored against all the evidence, as a candidate."""
-    cam = h.enu_from_world.camera(world_cam)
-    cand = Candidate(
-        h.method,
-        h.enu_from_world,
-        cam,
-        corner_assignment=h.corner_assignment,
-        intersection_id=(
-            ev.intersection.id if h.method == "corners" and ev.intersection is not None else None
-        ),
-        evidence=ev,
-    )
-    return _rescore(cand, world_cam, ev, settings, h.log_prior)
+    return score_hypotheses([h], world_cam, ev, settings)[0]
+
+
+def score_hypotheses(
+    hyps: list[Hypothesis], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """:func:`score_hypothesis` of each hypothesis (their map tests in one pass)."""
+    cands = [
+        Candidate(
+            h.method,
+            h.enu_from_world,
+            h.enu_from_world.camera(world_cam),
+            corner_assignment=h.corner_assignment,
+            intersection_id=(
+                ev.intersection.id
+                if h.method == "corners" and ev.intersection is not None
+                else None
+            ),
+            evidence=ev,
+        )
+        for h in hyps
+    ]
+    return _rescore_many(cands, world_cam, ev, settings, [h.log_prior for h in hyps])
 
 
 def prior_gate(
@@ -334,16 +398,34 @@ def expected_plausibility(
         return cands
     best = max(c.score for c in cands)
     floor = best * math.exp(-PLAUSIBILITY_MARGIN)
-    out = []
+    out = list(cands)
+    # (index, score with a plausibility of 1, evidence, sigma points) of each one averaged
+    todo: list[tuple[int, float, Evidence, list[tuple[Camera, Similarity2D]]]] = []
     for i, c in enumerate(cands):
         upper = c.score / max(c.prior, 1e-300)  # the score with a plausibility of 1
         if i < settings.max_candidates and upper >= floor:
             c_ev = c.evidence or ev
             sigma = position_sigma_m(c, world_cam, c_ev, settings)
             if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
-                p = _expected_plausibility(c.prior, c, sigma, world_cam, c_ev, settings, c.matches)
-                c = replace(c, prior=p, score=upper * p)
-        out.append(c)
+                todo.append((i, upper, c_ev, _sigma_points(c.enu_from_world, sigma, world_cam)))
+    # The sigma points of every candidate on one evidence: one pass of the map tests.
+    for e_id in dict.fromkeys(id(e) for _i, _u, e, _pts in todo):
+        mine = [t for t in todo if id(t[2]) == e_id]
+        got = iter(
+            plausibility_many(
+                [cam for *_x, pts in mine for cam, _sim in pts],
+                [sim for *_x, pts in mine for _cam, sim in pts],
+                mine[0][2],
+                settings,
+                [cands[i].matches for i, _u, _e, pts in mine for _p in pts],
+            )
+        )
+        for i, upper, _e, pts in mine:
+            c = cands[i]
+            p = c.prior / 3.0  # the centre's weight; each sigma point's 1/6
+            for _p in pts:
+                p += next(got)[0] / 6.0
+            out[i] = replace(c, prior=p, score=upper * p)
     total = sum(c.score for c in out) or 1.0
     for c in out:
         c.score = c.score / total
@@ -356,11 +438,9 @@ def refine_leaders(
 ) -> list[Candidate]:
     """Stage 5: refine the ``refine_top`` leading candidates, then score them again (the
     plausibility averaged over their refined uncertainty)."""
-    cands = list(cands)
-    for i in range(min(settings.refine_top, len(cands))):
-        c = refine(cands[i], world_cam, cands[i].evidence or ev, settings)
-        cands[i] = _rescore(c, world_cam, ev, settings, 0.0, expected=True)
-    return cands
+    top = [refine(c, world_cam, c.evidence or ev, settings) for c in cands[: settings.refine_top]]
+    top = _rescore_many(top, world_cam, ev, settings, [0.0] * len(top), expected=True)
+    return top + cands[settings.refine_top :]
 
 
 def normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> list[Candidate]:

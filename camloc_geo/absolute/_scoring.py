@@ -242,13 +242,16 @@ def _building_factor(
     C: FloatArray, ev: Evidence, settings: LocateSettings, matches: list[Match]
 ) -> tuple[float, list[Flag]]:
     """The camera is not deep inside a building; the corners it sees are not hidden."""
-    return _building_factors(np.asarray(C, dtype=float)[None, :2], ev, settings, matches)[0]
+    return _building_factors(np.asarray(C, dtype=float)[None, :2], ev, settings, [matches])[0]
 
 
 def _building_factors(
-    centres: FloatArray, ev: Evidence, settings: LocateSettings, matches: list[Match]
+    centres: FloatArray,
+    ev: Evidence,
+    settings: LocateSettings,
+    matches: Sequence[list[Match]],
 ) -> list[tuple[float, list[Flag]]]:
-    """:func:`_building_factor` of several camera positions ``(P, 2)`` with the same matches.
+    """:func:`_building_factor` of several camera positions ``(P, 2)``, each with its matches.
 
     The tests are GEOS's, as one call per geometry would make them, over arrays: the
     footprints containing each position (its "home": deep inside one is suspect), and for
@@ -271,19 +274,19 @@ def _building_factors(
         deep = shapely.distance(shapely.get_exterior_ring(polys[poly_i]), pts[pt_i]) > 2.0
         for p in pt_i[deep].tolist():
             inside[p] = True
-    corners = [m for m in matches if m.kind == "corner"]
-    occluded = np.zeros((n_pts, len(corners)), dtype=bool)
-    if corners:
-        ends = np.array([m.map_en for m in corners], dtype=float)
-        coords = np.empty((n_pts, len(corners), 2, 2))
-        coords[:, :, 0, :] = centres[:, None, :]
-        coords[:, :, 1, :] = ends[None, :, :]
-        lines = shapely.linestrings(coords.reshape(-1, 2, 2))
+    corners = [[m for m in ms if m.kind == "corner"] for ms in matches]
+    owner = [p for p, cs in enumerate(corners) for _m in cs]  # the position of each sight line
+    occluded = np.zeros(len(owner), dtype=bool)
+    if owner:
+        coords = np.empty((len(owner), 2, 2))
+        coords[:, 0, :] = centres[owner]
+        coords[:, 1, :] = [m.map_en for cs in corners for m in cs]
+        lines = shapely.linestrings(coords)
         line_i, poly_j = tree.query(lines, predicate="crosses")
         if len(line_i):
             not_home = np.array(
                 [
-                    j not in home[i // len(corners)]
+                    j not in home[owner[i]]
                     for i, j in zip(line_i.tolist(), poly_j.tolist(), strict=True)
                 ],
                 dtype=bool,
@@ -291,18 +294,21 @@ def _building_factors(
             line_i, poly_j = line_i[not_home], poly_j[not_home]
         if len(line_i):
             cut = shapely.length(shapely.intersection(lines[line_i], polys[poly_j])) > 1.0
-            occluded.reshape(-1)[line_i[cut]] = True
+            occluded[line_i[cut]] = True
+    hidden = occluded.tolist()
     out = []
+    line = 0
     for p in range(n_pts):
         factor = 1.0
         flags: list[Flag] = []
         if inside[p]:
             factor *= settings.inside_building_factor
             flags.append(Flag(FlagKind.INSIDE_BUILDING))
-        for k, m in enumerate(corners):
-            if occluded[p, k]:
+        for m in corners[p]:
+            if hidden[line]:
                 factor *= settings.occluded_corner_factor
                 flags.append(Flag(FlagKind.OCCLUDED, m.label))
+            line += 1
         out.append((factor, flags))
     return out
 
@@ -353,7 +359,7 @@ def plausibility(
     matches: list[Match],
 ) -> tuple[float, list[Flag]]:
     """The map plausibility factor of a hypothesis (buildings, prior, streets) and its flags."""
-    return plausibility_many([cam], [enu_from_world], ev, settings, matches)[0]
+    return plausibility_many([cam], [enu_from_world], ev, settings, [matches])[0]
 
 
 def plausibility_many(
@@ -361,29 +367,24 @@ def plausibility_many(
     sims: Sequence[Similarity2D],
     ev: Evidence,
     settings: LocateSettings,
-    matches: list[Match],
+    matches: Sequence[list[Match]],
 ) -> list[tuple[float, list[Flag]]]:
-    """:func:`plausibility` of several placements (camera and ``enu_from_world`` each) with
-    the same matches; the building tests of all of them in one pass."""
+    """:func:`plausibility` of several placements (camera, ``enu_from_world`` and matches
+    each) on the same evidence; the building and street tests of all of them in one pass."""
     centres = [cam.center_in_world for cam in cams]
     if ev.buildings_tree is not None:
         building = _building_factors(
-            np.array([C[:2] for C in centres], dtype=float), ev, settings, matches
+            np.array([C[:2] for C in centres], dtype=float).reshape(-1, 2), ev, settings, matches
         )
     else:
         building = [(1.0, [])] * len(cams)
-    if ev.worst_reference is not None:
-        worst = [Flag(FlagKind.WORST_REFERENCE, ev.worst_reference)]
-    else:
-        worst = []
-    # The flagged worst reference is reported, not held against the whole fit.
-    m2 = [m.mahalanobis2 for m in matches if m.label != ev.worst_reference]
-    poor = bool(m2) and sum(m2) / len(m2) > settings.fit_gate
     angles: list[float | None] = [None] * len(sims)
     if ev.street_tree is not None:
         angles = street_angles_under_car(sims, ev)
     out = []
-    for C, sim, (f_b, fl_b), angle in zip(centres, sims, building, angles, strict=True):
+    for C, sim, ms, (f_b, fl_b), angle in zip(
+        centres, sims, matches, building, angles, strict=True
+    ):
         factor = 1.0
         flags: list[Flag] = []
         if ev.buildings_tree is not None:
@@ -398,8 +399,11 @@ def plausibility_many(
         f, fl = _parallel_factor(sim, ev, settings, angle)
         factor *= f
         flags += fl
-        flags += worst
-        if poor:
+        if ev.worst_reference is not None:
+            flags.append(Flag(FlagKind.WORST_REFERENCE, ev.worst_reference))
+        # The flagged worst reference is reported, not held against the whole fit.
+        m2 = [m.mahalanobis2 for m in ms if m.label != ev.worst_reference]
+        if m2 and sum(m2) / len(m2) > settings.fit_gate:
             flags.append(Flag(FlagKind.POOR_FIT))
         out.append((factor, flags))
     return out
