@@ -290,8 +290,14 @@ class Candidate:
 
     @property
     def heading_deg(self) -> float:
-        """Camera heading, degrees clockwise from north (grid north of the local frame)."""
-        return self.camera.angles_deg[0]
+        """Camera heading, degrees clockwise from north (grid north of the local frame).
+
+        ``camera.angles_deg[0]`` (the same numbers), without the pitch and roll.
+        """
+        forward = np.asarray(self.camera.cam_from_world_rotation, dtype=float).reshape(3, 3)[2]
+        if math.hypot(forward[0], forward[1]) < 1e-12:
+            return 0.0  # looking straight down or up: no heading
+        return math.degrees(math.atan2(forward[0], forward[1])) % 360.0
 
 
 @dataclass

@@ -11,6 +11,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from camloc_geo._ties import is_tie
 from camloc_geo.absolute._bundle import bundle_adjust_many
@@ -50,6 +51,8 @@ from camloc_geo.scene import Scene
 
 if TYPE_CHECKING:
     from camloc_geo.osm import MapData
+
+FloatArray = npt.NDArray[np.float64]
 
 __all__ = [
     "apply_cues",
@@ -514,11 +517,19 @@ def _place(cands: list[Candidate], result: LocateResult) -> None:
         c.lon, c.lat = lon, lat
 
 
-def _tie(a: Candidate, b: Candidate, settings: LocateSettings) -> bool:
+def _tie(
+    a: Candidate,
+    b: Candidate,
+    settings: LocateSettings,
+    positions: dict[int, FloatArray] | None = None,
+) -> bool:
+    """The tie rule for two candidates (``positions``: their ``east_north`` by ``id``)."""
+    ea = a.east_north if positions is None else positions[id(a)]
+    eb = b.east_north if positions is None else positions[id(b)]
     return is_tie(
         a.score,
         b.score,
-        float(np.linalg.norm(a.east_north - b.east_north)),
+        float(np.linalg.norm(ea - eb)),
         score_ratio=settings.tie_score_ratio,
         distance_m=settings.tie_distance_m,
         merge_distance_m=settings.merge_distance_m,
@@ -535,16 +546,17 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     tell them apart); the rule is :func:`camloc_geo._ties.is_tie`.
     Earlier marks and the earlier warning are replaced.
     """
+    positions = {id(c): c.east_north for c in cands}
     for c in cands:
         c.ambiguous_with = []
     for a, b in itertools.combinations(cands, 2):
-        if _tie(a, b, settings):
+        if _tie(a, b, settings, positions):
             a.ambiguous_with.append(b.rank)
             b.ambiguous_with.append(a.rank)
     for c in cands:
         c.ambiguous_with.sort()
     result.warnings = [w for w in result.warnings if not w.startswith("ambiguous:")]
-    result.leaders_tie = len(cands) >= 2 and _tie(cands[0], cands[1], settings)
+    result.leaders_tie = len(cands) >= 2 and _tie(cands[0], cands[1], settings, positions)
     why = (
         "even with the scene's cues"
         if result.cues_applied
