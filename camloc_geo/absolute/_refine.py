@@ -70,6 +70,17 @@ def _residuals(
     Q = np.array([q for _o, q in obs_q])
     s_sigma = max(settings.scale_sigma_rel, 1e-6)
 
+    n = len(obs_q)
+    m = 2 * n + 1 + (street_brg is not None)
+    # The translation's columns do not change: whitened once.
+    J_t = np.einsum("nji,cnj->cni", L, np.broadcast_to(np.eye(2)[:, None, :], (2, n, 2)))
+    J_const = np.zeros((m, 4))
+    J_const[: 2 * n, 1] = J_t[0].ravel()
+    J_const[: 2 * n, 2] = J_t[1].ravel()
+    J_const[2 * n] = [0.0, 0.0, 0.0, 1.0 / s_sigma]
+    if street_brg is not None:
+        J_const[2 * n + 1] = [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]
+
     def resid_jac(x: FloatArray) -> tuple[FloatArray, FloatArray]:
         theta, tx, ty, ls = x
         s = math.exp(ls)
@@ -77,23 +88,20 @@ def _residuals(
         dR2 = np.array([[-R2[1, 0], -R2[0, 0]], [R2[0, 0], -R2[1, 0]]])
         sp = s * P @ R2.T
         d = sp + np.array([tx, ty]) - Q
-        r = np.einsum("nji,nj->ni", L, d).ravel()
-        cols = [
-            s * P @ dR2.T,
-            np.broadcast_to([1.0, 0.0], P.shape),
-            np.broadcast_to([0.0, 1.0], P.shape),
-            sp,
-        ]
-        J = np.column_stack([np.einsum("nji,nj->ni", L, c).ravel() for c in cols])
-        r = np.concatenate([r, [ls / s_sigma]])
-        J = np.vstack([J, [0.0, 0.0, 0.0, 1.0 / s_sigma]])
+        # Whitened residuals, and the rotation's and the log scale's columns, in one go.
+        w = np.einsum("nji,cnj->cni", L, np.stack([d, s * P @ dR2.T, sp]))
+        r = np.empty(m)
+        r[: 2 * n] = w[0].ravel()
+        r[2 * n] = ls / s_sigma
+        J = J_const.copy()
+        J[: 2 * n, 0] = w[1].ravel()
+        J[: 2 * n, 3] = w[2].ravel()
         if street_brg is not None:
             # The car is parallel to the street it stands on, within bearing_sigma_deg (the
             # street found under the car at the start; the refinement moves it little).
             car_brg = (90.0 - math.degrees(theta)) % 180.0
             diff = (car_brg - street_brg + 90.0) % 180.0 - 90.0
-            r = np.concatenate([r, [diff / settings.bearing_sigma_deg]])
-            J = np.vstack([J, [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]])
+            r[2 * n + 1] = diff / settings.bearing_sigma_deg
         return r, J
 
     return resid_jac
