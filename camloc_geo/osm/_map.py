@@ -12,6 +12,7 @@ from typing import Any, TypeVar
 
 import networkx as nx
 import numpy as np
+import shapely
 from shapely.geometry import LineString, Point
 
 from camloc_geo._errors import MapDataError
@@ -523,20 +524,30 @@ class MapData:
         rows: list[tuple[float, str, float]] = []
         lines = self.streets_enu
         tree = self.cached("streets_enu_tree", lambda: _strtree(lines))
-        near = sorted(int(i) for i in tree.query(pt, predicate="dwithin", distance=radius_m))
-        for i in near:
-            street, line = self._streets[i], lines[i]
-            dist = line.distance(pt)
-            if dist > radius_m or line.length < 0.5:
-                continue
-            s = line.project(pt)
-            a = line.interpolate(max(0.0, s - 10.0))
-            b = line.interpolate(min(line.length, s + 10.0))
-            (lon_a, lon_b), (lat_a, lat_b) = self.frame.geographic_from_enu(
-                np.array([a.x, b.x]), np.array([a.y, b.y])
+        near = np.sort(tree.query(pt, predicate="dwithin", distance=radius_m))
+        if len(near):
+            # Every near street at once (GEOS's distance, project and interpolate over
+            # arrays, one projection back to lon/lat): the numbers of one call per street.
+            geoms = tree.geometries[near]
+            dist = shapely.distance(geoms, pt)
+            length = shapely.length(geoms)
+            keep = ~((dist > radius_m) | (length < 0.5))
+            near, geoms, dist, length = near[keep], geoms[keep], dist[keep], length[keep]
+        if len(near):
+            s = shapely.line_locate_point(geoms, pt)
+            a = shapely.get_coordinates(
+                shapely.line_interpolate_point(geoms, np.maximum(0.0, s - 10.0))
             )
-            brg = initial_bearing_deg(lat1=lat_a, lon1=lon_a, lat2=lat_b, lon2=lon_b) % 180.0
-            rows.append((float(dist), street.name, brg))
+            b = shapely.get_coordinates(
+                shapely.line_interpolate_point(geoms, np.minimum(length, s + 10.0))
+            )
+            ll_a = self.frame.points_geographic_from_enu(a).tolist()
+            ll_b = self.frame.points_geographic_from_enu(b).tolist()
+            for i, d, (lon_a, lat_a), (lon_b, lat_b) in zip(
+                near.tolist(), dist.tolist(), ll_a, ll_b, strict=True
+            ):
+                brg = initial_bearing_deg(lat1=lat_a, lon1=lon_a, lat2=lat_b, lon2=lon_b) % 180.0
+                rows.append((d, self._streets[i].name, brg))
         rows.sort()
         out: list[tuple[str, float]] = []
         for _d, name, brg in rows:
