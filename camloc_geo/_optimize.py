@@ -276,10 +276,12 @@ def soft_l1_least_squares_many(
             Jw = J * w[:, None]
             A = J.T @ Jw
             g = Jw.T @ r
-            if np.max(np.abs(g)) * max(1.0, float(np.max(np.abs(x)))) < tol * max(costs[i], 1e-300):
+            if float(np.abs(g).max()) * max(1.0, float(np.abs(x).max())) < tol * max(
+                costs[i], 1e-300
+            ):
                 successes[i] = True
                 continue
-            diag = np.diag(A).copy()
+            diag = A.diagonal().copy()
             diag[diag <= 0] = 1e-12
             try:
                 dx = np.asarray(-np.linalg.solve(A + lams[i] * np.diag(diag), g), np.float64)
@@ -299,7 +301,7 @@ def soft_l1_least_squares_many(
             cost_new = soft_l1_cost(r_new, f_scale)
             if cost_new <= costs[i]:
                 x = xs[i]
-                step_small = np.max(np.abs(dx)) <= tol * (1e-3 + float(np.max(np.abs(x))))
+                step_small = float(np.abs(dx).max()) <= tol * (1e-3 + float(np.abs(x).max()))
                 gain_small = costs[i] - cost_new <= tol * max(costs[i], 1e-300)
                 xs[i], rs[i], costs[i], Js[i] = x_new, r_new, cost_new, J_new
                 lams[i] = max(lams[i] * 0.3, 1e-12)
