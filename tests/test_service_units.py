@@ -47,6 +47,25 @@ def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
     assert all(f["properties"]["intersection"] in kept for f in corners)
 
 
+def test_intersections_within_measures_exactly_what_a_full_scan_does(whole_map: MapData) -> None:
+    # intersections_within measures only the nodes near the point (picked in the map's
+    # frame); every intersection within the radius, and its distance, as a scan of all.
+    import numpy as np
+
+    xs = whole_map.intersections
+    for k, radius in ((0, 150.0), (len(xs) // 2, 400.0), (len(xs) - 1, 60.0)):
+        lat, lon = xs[k].lat + 3e-4, xs[k].lon - 2e-4
+        got = whole_map.intersections_within(lat=lat, lon=lon, radius_m=radius)
+        every = whole_map._distances_m(lat, lon)  # every node projected: the full scan
+        want = [(xs[i], float(every[i])) for i in np.argsort(every, kind="stable")]
+        want = [(x, d) for x, d in want if d <= radius]
+        assert [x.id for x, _d in got] == [x.id for x, _d in want]
+        assert [d for _x, d in got] == [d for _x, d in want]
+        assert len(got) >= 1
+        near = got[0][0]
+        assert got[0][1] == pytest.approx(whole_map.distance_to_m(near, lat=lat, lon=lon))
+
+
 def test_streets_within_lists_only_near_streets(whole_map: MapData) -> None:
     from camloc_geo.api import streets_within
 
