@@ -453,17 +453,27 @@ class MapData:
         if has_point:
             assert lat is not None
             assert lon is not None
+            # The usual case first: only the nodes that may lie within max_distance_m are
+            # measured (the same distances); every junction only to describe a miss.
+            dist = self._distances_m(lat, lon, within_m=max_distance_m)
+            near = [
+                (self._intersections[i], float(dist[i]))
+                for i in np.argsort(dist, kind="stable")
+                if dist[i] <= max_distance_m
+            ]
+            hits = {x.id for x in self._street_hits(wanted)} if wanted else set()
+            if wanted:
+                named_near = [(x, d) for x, d in near if x.id in hits]
+                if named_near:
+                    return named_near[0][0], warnings
+            elif near:
+                return near[0][0], warnings
             dist = self._distances_m(lat, lon)
             rows = [
                 (self._intersections[i], float(dist[i])) for i in np.argsort(dist, kind="stable")
             ]
-            near = [(x, d) for x, d in rows if d <= max_distance_m]
             where = f"lat={lat:.6f}, lon={lon:.6f}"
             if wanted:
-                hits = {x.id for x in self._street_hits(wanted)}
-                named_near = [(x, d) for x, d in near if x.id in hits]
-                if named_near:
-                    return named_near[0][0], warnings
                 named_all = [(x, d) for x, d in rows if x.id in hits]
                 names = " & ".join(repr(w) for w in wanted)
                 if named_all:
@@ -483,8 +493,6 @@ class MapData:
                         + (f"near {where}: {self._describe(rows)}" if rows else "no junctions")
                     )
                 return None, warnings
-            if near:
-                return near[0][0], warnings
             warnings.append(
                 f"no modelled junction within {max_distance_m:.0f} m of the scene's "
                 f"intersection ({where}); nearest: "
