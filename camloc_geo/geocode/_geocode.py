@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import shapely
+import shapely.ops
 from shapely.geometry import LineString, MultiLineString, mapping
 
 from camloc_geo._errors import InputError
