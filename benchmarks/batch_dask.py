@@ -92,9 +92,8 @@ def main(argv: list[str] | None = None) -> int:
         )
     gen_s = time.perf_counter() - t
 
-    from camloc_geo.batch._areas import clear_maps
-
     from camloc_geo.osm import clear_cache
+    from camloc_geo.osm._catalogue import clear_maps
 
     # the list's generation loaded the extracts' maps in this process: forget them, or the
     # forked local workers would inherit them while the Dask workers load their own

@@ -47,9 +47,8 @@ PAPER_S_PER_IMAGE = 0.41
 
 def _junction_names(extracts: tuple[Path, ...]) -> list[tuple[str, str]]:
     """Street-name pairs of real junctions of the extracts (whole-extract maps)."""
-    from camloc_geo.batch._areas import _bounds
-
     from camloc_geo.osm import load_map
+    from camloc_geo.osm._catalogue import extract_bounds as _bounds
     from camloc_geo.testing.camera_list import _junctions
 
     pairs: list[tuple[str, str]] = []
