@@ -299,8 +299,16 @@ def _chunks(
     """Rows grouped by area into chunks, within a bounded window of the list."""
     pending: dict[Area, list[CameraRow]] = defaultdict(list)
     held = 0
+    # a row without a point is searched in the extracts its area names: the same area for
+    # every such row of an area name (area_of stats each extract's size per call)
+    search_areas: dict[str | None, Area] = {}
     for row in rows:
-        area = plan.area_of(row)
+        if row.has_point:
+            area = plan.area_of(row)
+        else:
+            area = search_areas.get(row.area) or search_areas.setdefault(
+                row.area, plan.area_of(row)
+            )
         group = pending[area]
         group.append(row)
         held += 1
@@ -636,28 +644,42 @@ def _ranks_text(ranks: list[Any]) -> str | None:
     return ",".join(str(int(o)) for o in ranks) or None
 
 
-def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
-    from shapely.geometry import Point, Polygon
+def _points(lonlat: list[tuple[Any, Any]]) -> Any:
+    """Point geometries of ``(lon, lat)`` pairs in one vectorised call; None where missing."""
+    import numpy as np
+    import shapely
 
-    cams, cam_g, cands, cand_g, cones, cone_g, errs = [], [], [], [], [], [], []
+    if not lonlat:
+        return np.empty(0, dtype=object)
+    xy = np.array([(np.nan, np.nan) if x is None or y is None else (x, y) for x, y in lonlat])
+    geoms = shapely.points(xy)
+    geoms[np.isnan(xy).any(axis=1)] = None
+    return geoms
+
+
+def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
+    from shapely.geometry import Polygon
+
+    cams, cands, cones, cone_g, errs = [], [], [], [], []
+    cam_xy: list[tuple[Any, Any]] = []
+    cand_xy: list[tuple[Any, Any]] = []
     for r in records:
         cam = {k: r.get(k) for k in _CAMERA_COLUMNS}
         for k in ("names_read", "names_matched", "match_kinds"):
             cam[k] = " | ".join(r.get(k) or []) or None
         cam["n_errors"] = len(r.get("errors") or [])
         cams.append(cam)
-        placed = r.get("lat") is not None and r.get("lon") is not None
-        cam_g.append(Point(r["lon"], r["lat"]) if placed else None)
+        cam_xy.append((r.get("lon"), r.get("lat")))
         for c in r.get("candidates") or []:
             ties = c.get("ambiguous_with") or []
             cands.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": _ranks_text(ties)})
-            ok = c.get("lat") is not None and c.get("lon") is not None
-            cand_g.append(Point(c["lon"], c["lat"]) if ok else None)
+            cand_xy.append((c.get("lon"), c.get("lat")))
         for c in r.get("cones") or []:
             cones.append({**c, "row": r["row"], "id": r["id"]})
             cone_g.append(Polygon(c["lonlat"]))
         for e in r.get("errors") or []:
             errs.append({**e, "row": r["row"], "id": r["id"], "status": r["status"]})
+    cam_g, cand_g = _points(cam_xy), _points(cand_xy)
     return {
         "cameras": _frame(cams, _CAMERA_COLUMNS, cam_g),
         "candidates": _frame(cands, _CANDIDATE_COLUMNS, cand_g),
