@@ -130,6 +130,8 @@ _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehic
 _TEXTURE_MIN = 4.0  # grey levels: local deviation of a background with texture
 _SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and background
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
+_CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
+_CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
 _CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
 
 
@@ -1033,8 +1035,20 @@ def _fit_track(
             len(times),
             dur,
         )
+    # a contact pixel far away covers metres of road, near by centimetres: each frame is
+    # weighted by the inverse of its ground position's variance (a pixel's footprint on
+    # the road, _CONTACT_PX pixels of noise, plus a floor for the contact's own wander)
+    base = px[0][ok][keep]
+    rot = cam.cam_from_world_rotation
+    foot = np.zeros(len(base))
+    for step in ((1.0, 0.0), (0.0, 1.0)):
+        moved = _ground(
+            centres[:1], _rays((base + step)[None], focals[:1], cam.principal_point, rot)
+        )
+        foot += np.sum((moved[0, :, :2] - ground[0]) ** 2, axis=1)
+    var_m2 = _CONTACT_PX**2 * np.where(np.isfinite(foot), foot, np.inf) + _CONTACT_FLOOR_M**2
     a = _design(times, labels)
-    solve, weights, res = _irls(a, ground[0])
+    solve, weights, res = _irls(a, ground[0], 1.0 / var_m2)
     coef = solve @ ground[0]
     vel = coef[0]
     speed = float(np.linalg.norm(vel))
