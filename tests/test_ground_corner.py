@@ -3,10 +3,19 @@
 from __future__ import annotations
 
 import copy
+import math
+from typing import Any
 
 import numpy as np
+import pytest
 
-from camloc_geo.relative import CalibrationSettings, calibrate
+from camloc_geo import relative
+from camloc_geo.relative import (
+    GROUND_CORNER_FLOOR,
+    CalibrationSettings,
+    _ground_corner_evidence,
+    calibrate,
+)
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
 
@@ -51,3 +60,53 @@ def test_tyre_contact_click_is_inside_the_stated_focal_sigma() -> None:
     assert np.median(sig_ratio) > 1.05
     # Modest: the sigma grows, it is not blown up.
     assert max(sig_ratio) < 5.0
+
+
+def _exact_scenes(n: int) -> list[Any]:
+    scenes = []
+    for seed in range(n):
+        rng = np.random.default_rng(100 + seed)
+        syn = make_scene(random_camera(rng), rng, noise=NoiseModel.exact(), n_annotators=3)
+        scenes.append(parse_scene(syn.scene))
+    return scenes
+
+
+def _focal_sigma(scene: Any) -> float:
+    sigma = calibrate(scene).focal_sigma_px
+    assert sigma is not None
+    return sigma
+
+
+def test_the_term_scales_with_the_clicks_residuals() -> None:
+    """``s`` of the point residuals, clipped to [floor, 1]: exact clicks keep the floor,
+    scatter at the noise model's level or above keeps the whole term."""
+    scene = _exact_scenes(1)[0]
+    prob = calibrate(scene).joint_state.problem  # type: ignore[union-attr]
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    r = np.zeros(n_seg + 2 * n_pt)
+    assert _ground_corner_evidence(prob, r) == GROUND_CORNER_FLOOR == 0.1
+    dof = 2 * n_pt - 3
+    r[n_seg:] = math.sqrt(0.25 * dof / (2 * n_pt))  # s² = 0.25
+    assert _ground_corner_evidence(prob, r) == pytest.approx(0.5)
+    r[n_seg:] = 3.0
+    assert _ground_corner_evidence(prob, r) == 1.0
+
+
+def test_exact_clicks_leave_only_the_floor_of_the_term(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Noise-free clicks show no ground-corner offset: the term adds little to the focal
+    sigma, where at full strength it would (calibrate_coverage's noise-free set: focal
+    median error/sigma 0.17 with the full term, 0.52 with the evidence scaling)."""
+    off = CalibrationSettings(ground_corner_sigma_rel=0.0)
+    scaled, full = [], []
+    for scene in _exact_scenes(6):
+        base = calibrate(scene, off).focal_sigma_px
+        assert base is not None
+        assert base > 0
+        scaled.append(_focal_sigma(scene) / base)
+        with monkeypatch.context() as m:
+            m.setattr(relative, "GROUND_CORNER_FLOOR", 1.0)
+            full.append(_focal_sigma(scene) / base)
+    assert min(scaled) >= 1.0 - 1e-9
+    # Measured on these six: scaled 1.01-1.74 (median 1.04), full 1.6-14 (median 2.8).
+    assert np.median(scaled) < 1.1
+    assert np.median(full) > 2.0 * np.median(scaled)
