@@ -802,6 +802,34 @@ class _JointProblem:
         # A Gaussian prior on a fitted principal point, at the image centre.
         self.pp_prior = np.array([width / 2.0, height / 2.0])
         self.pp_prior_sigma = settings.principal_point_prior_sigma_rel * math.hypot(width, height)
+        # The last few evaluations: the covariance, the score test, the jackknife and the
+        # annotators' RMS all look again at points the fits have just evaluated.
+        self._memo: dict[tuple[Any, ...], tuple[FloatArray, FloatArray | None]] = {}
+
+    def _memo_key(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+        weights: FloatArray | None = None,
+    ) -> tuple[Any, ...]:
+        w = self._weights if weights is None else weights
+        return (
+            np.asarray(x, dtype=float).tobytes(),
+            np.asarray(R0, dtype=float).tobytes(),
+            pp_fixed,
+            f_fixed,
+            w.tobytes(),
+            self.corners.tobytes(),
+            self.log_f_prior_sigma,
+            self.pp_prior_sigma,
+        )
+
+    def _remember(self, key: tuple[Any, ...], r: FloatArray, J: FloatArray | None) -> None:
+        if len(self._memo) >= _MEMO_SIZE:
+            self._memo.pop(next(iter(self._memo)))
+        self._memo[key] = (r, J)
 
     def set_corners(self, corners: npt.ArrayLike) -> None:
         """Which ground corner of the car each annotator marked as the origin.
@@ -861,7 +889,7 @@ class _JointProblem:
             pp = X[:, k : k + 2]
             k += 2
         else:
-            pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
+            pp = np.array([pp_fixed], dtype=float)  # (1, 2): broadcasts over the batch
         R = _rotvec_matrices(X[:, k : k + 3]) @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
@@ -874,7 +902,39 @@ class _JointProblem:
         f_fixed: float | None,
     ) -> FloatArray:
         """Normalised residuals (segments, then point u, then point v)."""
-        return self.residuals_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)[0]
+        x = np.asarray(x, dtype=float)
+        key = self._memo_key(x, R0, pp_fixed, f_fixed)
+        hit = self._memo.get(key)
+        if hit is not None:
+            return hit[0]
+        r = np.asarray(self.residuals_batch(x[None, :], R0, pp_fixed, f_fixed)[0], dtype=float)
+        self._remember(key, r, None)
+        return r
+
+    def unweighted_residuals(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> FloatArray:
+        """The annotation residuals (segments, point u, point v) with every weight 1.
+
+        From a remembered evaluation at the current weights where there is one (the rows
+        divided by their annotator's √weight), else evaluated.
+        """
+        n_rows = len(self.segments) + 2 * len(self.pt_pix)
+        x = np.asarray(x, dtype=float)
+        hit = self._memo.get(self._memo_key(x, R0, pp_fixed, f_fixed))
+        if hit is not None and np.all(self._weights > 0.0):
+            scale = np.concatenate([self._w_seg, self._w_pt, self._w_pt])
+            return np.asarray(hit[0][:n_rows] / scale, dtype=np.float64)
+        saved = self.weights
+        self.weights = np.ones(self.n_annotators)
+        try:
+            return self.residuals(x, R0, pp_fixed, f_fixed)[:n_rows]
+        finally:
+            self.weights = saved
 
     def jacobian(
         self,
@@ -895,12 +955,20 @@ class _JointProblem:
     ) -> tuple[FloatArray, FloatArray]:
         """The residuals and their forward-difference Jacobian from one batched evaluation."""
         x = np.asarray(x, dtype=float)
+        key = self._memo_key(x, R0, pp_fixed, f_fixed)
+        hit = self._memo.get(key)
+        if hit is not None and hit[1] is not None:
+            return hit[0], hit[1]
         n = len(x)
         h = 1e-7 * np.maximum(1.0, np.abs(x))
-        X = np.vstack([x, x + np.diag(h)])
+        X = np.empty((n + 1, n))
+        X[:] = x
+        X[1:] += np.diag(h)
         Rb = self.residuals_batch(X, R0, pp_fixed, f_fixed)
         J = np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
-        return np.asarray(Rb[0], dtype=np.float64), J
+        r = np.asarray(Rb[0], dtype=np.float64)
+        self._remember(key, r, J)
+        return r, J
 
     def residuals_batch(
         self,
@@ -928,7 +996,7 @@ class _JointProblem:
         norm = np.sqrt(la * la + lb * lb)
         num = np.einsum("psk,sk->ps", Vs, self._seg_n)
         r_seg = num / np.maximum(norm, 1e-300) * self._seg_scale
-        pc = np.einsum("pij,pnj->pni", R, self.pt_world[None, :, :] - C[:, None, :])
+        pc = (self.pt_world[None, :, :] - C[:, None, :]) @ np.swapaxes(R, 1, 2)
         z = np.maximum(pc[:, :, 2], self._z_min)
         u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * self._pt_scale
         v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * self._pt_scale
@@ -958,10 +1026,7 @@ class _JointProblem:
         pp_fixed: tuple[float, float] | None,
         f_fixed: float | None,
     ) -> FloatArray:
-        saved = self.weights
-        self.weights = np.ones(self.n_annotators)
-        r = self.residuals(x, R0, pp_fixed, f_fixed)
-        self.weights = saved
+        r = self.unweighted_residuals(x, R0, pp_fixed, f_fixed)
         n_seg, n_pt = len(self.segments), len(self.pt_pix)
         sq_seg = r[:n_seg] ** 2
         sq_pt = r[n_seg : n_seg + n_pt] ** 2 + r[n_seg + n_pt : n_seg + 2 * n_pt] ** 2
@@ -974,6 +1039,7 @@ class _JointProblem:
         return np.asarray(np.sqrt(num / np.maximum(den, 1)), dtype=np.float64)
 
 
+_MEMO_SIZE = 8  # evaluations a _JointProblem remembers
 _F_SCALE = 2.5  # soft-L1 scale of the normalised residuals (in sigmas)
 _GOOD_SEED_SCORE = 1.0  # median annotator RMS (in sigmas) at which a seed's fit is good
 
@@ -1019,6 +1085,11 @@ def _small_rotvec(R: FloatArray) -> FloatArray:
     return np.asarray(theta / (2.0 * math.sin(theta)) * v, dtype=np.float64)
 
 
+# Every fit stops once its next Gauss-Newton step would move the answer by less than this
+# fraction of its own 1-sigma (the Newton decrement, soft_l1_least_squares's sigma_tol).
+_SIGMA_TOL = 0.01
+
+
 def _fit(
     prob: _JointProblem,
     x0: FloatArray,
@@ -1029,6 +1100,7 @@ def _fit(
     tol: float = 1e-10,
     max_nfev: int = 200,
     method: Literal["lm", "scipy"] = "lm",
+    sigma_tol: float | None = _SIGMA_TOL,
 ) -> LeastSquaresResult:
     """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`.
 
@@ -1055,6 +1127,7 @@ def _fit(
         # light initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations,
         # the reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
         damping=1e-4,
+        sigma_tol=sigma_tol,
     )
 
 
@@ -1071,9 +1144,9 @@ def _score_test(
     Gauss-Newton Hessian of the full model, ``gᵀ H⁻¹ g`` approximates how much the cost
     would fall, at the price of one Jacobian.
     """
-    f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
-    x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-    x1[-6:-3] = _small_rotvec(R1 @ R0.T)
+    # The parameters with the principal point inserted, as _pinned_pp_sensitivity builds
+    # them (the same evaluation serves both).
+    x1 = np.insert(np.asarray(x_fixed, dtype=float), int(f_fixed is None), pp_fixed)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
@@ -2311,9 +2384,9 @@ def _reassign_corners(
         saved_corners, saved_w = prob.corners.copy(), prob.weights.copy()
         prob.set_corners(proposal)
         prob.weights = np.ones(prob.n_annotators)
-        x_new = _fit(prob, x, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x_new = _fit(prob, x, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=0.1).x
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x_new, R0, pp_fixed, f_fixed))
-        x_new = _fit(prob, x_new, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x_new = _fit(prob, x_new, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=0.1).x
         after = _robust_cost(prob, x_new, R0, pp_fixed, f_fixed)
         if after < before:
             x = x_new
@@ -2452,7 +2525,7 @@ def _joint(
         x0 = _pack(cam0.focal_px, pp_fixed, cam0.center_in_world, f_fixed is None, False)
         prob.set_corners([0 if w == prob.ws_common else 2 for w in width_signs])
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
-        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60)
+        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60, sigma_tol=0.3)
         score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
         below_ground = bool(prob.unpack(res.x, R0, pp_fixed, f_fixed)[3][2] <= 0.0)
         if best_key is None or score < best_key[1]:
@@ -2465,7 +2538,7 @@ def _joint(
         if np.allclose(new_w, prob.weights, atol=0.02):
             break
         prob.weights = new_w
-        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=0.1).x
     if settings.reassign_corners:
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-8)
@@ -2553,8 +2626,8 @@ def _joint(
     outliers = [
         scene.annotations[i].annotator for i, w in enumerate(weights) if w < settings.outlier_weight
     ]
+    r = prob.unweighted_residuals(res.x, R0, pp_model, f_fixed)
     prob.weights = np.ones(prob.n_annotators)
-    r = prob.residuals(res.x, R0, pp_model, f_fixed)
     n_seg = len(prob.segments)
     rms_seg = float(np.sqrt(np.mean(r[:n_seg] ** 2))) * prob.sigma_line
     rms_pt = float(np.sqrt(np.mean(r[n_seg : n_seg + 2 * len(prob.pt_pix)] ** 2))) * prob.sigma_pt
@@ -2665,12 +2738,10 @@ def _pinned_pp_sensitivity(
     """
     k = int(f_fixed is None)
     x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
-    saved = prob.pp_prior_sigma
-    prob.pp_prior_sigma = 0.0  # the data's information alone; the prior is σ here
-    try:
-        r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
-    finally:
-        prob.pp_prior_sigma = saved
+    r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
+    if prob.pp_prior_sigma > 0.0:
+        # the data's information alone (the prior's two rows come last); the prior is σ here
+        r, J = r[:-2], J[:-2]
     w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
     H = J.T @ (J * w[:, None])
     pp_idx = [k, k + 1]
