@@ -718,21 +718,39 @@ def _ground_corner_evidence(prob: _JointProblem, r: FloatArray) -> float:
     """How much of the ground-corner term the clicks' residuals support, in ``[floor, 1]``.
 
     A click off the ground corner (the tyre contact, a bumper's overhang) does not fit the
-    car's box as the lines place it: the axis clicks' residuals grow with such offsets. Their
-    a posteriori variance factor ``s² = Σ r² / (2 n − 3)`` (the normalised, robustly
-    weighted point residuals; three dof for the camera's position) is 1 where the clicks
-    scatter as the noise model says and ~0 where they fit exactly. The term's sigma is scaled
-    by ``s``, clipped to ``[GROUND_CORNER_FLOOR, 1]``: clicks that fit the box far better
-    than the noise model leave little room for a ground-corner offset (on noise-free scenes
-    the full term over-covered: focal median error/σ 0.16, now 0.52, 0.67 without any term),
-    while scatter at the noise model's level or above keeps the whole term. The floor keeps
-    a tenth of it for offsets the residuals cannot show (an annotator who clicks every
-    corner the same way, absorbed by the preset's size uncertainty).
+    car's box as the lines place it, so the axis clicks scatter more than the annotators'
+    own precision. That precision is measured on their lines: a segment's residual is half
+    the difference of its two ends' offsets, so ``2 × mean(d²)`` estimates an end's
+    variance per axis. The clicks' excess over it (their pixel residuals' mean square per
+    coordinate minus that variance) is compared with the term's own mean square per
+    coordinate (``(rel·|length edge|)² + (rel·|width edge|)²`` over two): the term's sigma
+    is scaled by ``√(excess / term)``, clipped to ``[GROUND_CORNER_FLOOR, 1]``. Annotators'
+    weights weigh both means. Clicks as precise as the lines (noise-free scenes; the street
+    scenes' 1 px clicks and lines) keep the floor; clicks off by a size mismatch or a tyre
+    contact keep the whole term. The floor keeps a tenth of it for offsets the residuals
+    cannot show (an annotator who clicks every corner the same way, absorbed by the
+    preset's size uncertainty).
     """
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
-    r_pt = r[n_seg : n_seg + 2 * n_pt]
-    s2 = float(np.sum(r_pt**2)) / max(2 * n_pt - 3, 1)
-    return float(np.clip(math.sqrt(max(s2, 0.0)), GROUND_CORNER_FLOOR, 1.0))
+    w_seg, w_pt = prob._w_seg, prob._w_pt
+    if not (np.all(w_seg > 0.0) and np.all(w_pt > 0.0)):
+        return 1.0
+    # pixel residuals, the annotators' weights taken out (they weigh the means below)
+    d_seg = r[:n_seg] / w_seg * prob.sigma_line
+    d_u = r[n_seg : n_seg + n_pt] / w_pt * prob._sigma_pt_each
+    d_v = r[n_seg + n_pt : n_seg + 2 * n_pt] / w_pt * prob._sigma_pt_each
+    a_seg, a_pt = w_seg**2, w_pt**2  # the annotators' weights per row
+    line_end_var = 2.0 * float(a_seg @ d_seg**2) / max(float(a_seg.sum()) - 6.0, 1.0)
+    click_var = float(a_pt @ (d_u**2 + d_v**2)) / max(2.0 * float(a_pt.sum()) - 3.0, 1.0)
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    edge_sq = np.sum((clicks[:, 1] - clicks[:, 0]) ** 2, axis=1) + np.sum(
+        (clicks[:, 2] - clicks[:, 0]) ** 2, axis=1
+    )  # per annotator: |length edge|² + |width edge|², pixels²
+    term_var = prob.ground_corner_sigma_rel**2 * float(np.average(edge_sq, weights=a_pt[::4])) / 2.0
+    if term_var <= 0.0:
+        return 1.0
+    excess = max(click_var - line_end_var, 0.0)
+    return float(np.clip(math.sqrt(excess / term_var), GROUND_CORNER_FLOOR, 1.0))
 
 
 class _JointProblem:

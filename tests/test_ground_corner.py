@@ -77,19 +77,32 @@ def _focal_sigma(scene: Any) -> float:
     return sigma
 
 
-def test_the_term_scales_with_the_clicks_residuals() -> None:
-    """``s`` of the point residuals, clipped to [floor, 1]: exact clicks keep the floor,
-    scatter at the noise model's level or above keeps the whole term."""
+def test_the_term_scales_with_the_clicks_excess_over_the_lines_precision() -> None:
+    """The clicks' scatter beyond the annotators' own line precision decides: none (exact,
+    or clicks as precise as line ends) keeps the floor, a large excess the whole term."""
     scene = _exact_scenes(1)[0]
     prob = calibrate(scene).joint_state.problem  # type: ignore[union-attr]
+    prob.weights = np.ones(prob.n_annotators)
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
-    r = np.zeros(n_seg + 2 * n_pt)
-    assert _ground_corner_evidence(prob, r) == GROUND_CORNER_FLOOR == 0.1
-    dof = 2 * n_pt - 3
-    r[n_seg:] = math.sqrt(0.25 * dof / (2 * n_pt))  # s² = 0.25
-    assert _ground_corner_evidence(prob, r) == pytest.approx(0.5)
-    r[n_seg:] = 3.0
-    assert _ground_corner_evidence(prob, r) == 1.0
+    assert GROUND_CORNER_FLOOR == 0.1
+
+    def evidence(end_px: float, click_px: float) -> float:
+        r = np.zeros(n_seg + 2 * n_pt)
+        # a segment's residual is half the difference of its ends' offsets
+        r[:n_seg] = end_px / math.sqrt(2.0) / prob.sigma_line
+        r[n_seg:] = click_px / np.tile(prob._sigma_pt_each, 2)
+        return _ground_corner_evidence(prob, r)
+
+    assert evidence(0.0, 0.0) == GROUND_CORNER_FLOOR
+    assert evidence(1.0, 1.0) == GROUND_CORNER_FLOOR  # clicks as precise as the lines
+    assert evidence(0.0, 1000.0) == 1.0
+    # an excess of half the term's sigma: about half the term
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    edge_sq = np.sum((clicks[:, 1:3] - clicks[:, :1]) ** 2, axis=(1, 2))
+    term_sd = 0.025 * math.sqrt(float(np.mean(edge_sq)) / 2.0)
+    half = evidence(1.0, math.hypot(1.0, 0.5 * term_sd))
+    assert half == pytest.approx(0.5, abs=0.1)
+    assert evidence(1.0, math.hypot(1.0, 0.25 * term_sd)) < half
 
 
 def test_exact_clicks_leave_only_the_floor_of_the_term(monkeypatch: pytest.MonkeyPatch) -> None:
