@@ -115,9 +115,9 @@ class CalibrationSettings:
         length along its length edge and of its width along its width edge; 2.5 %: 11 cm and
         4.5 cm for a sedan), in pixels that fraction of the clicked edges; the parameters'
         move under it enters the stated sigmas as a consider covariance
-        (:func:`_ground_corner_sensitivity`), scaled by the evidence for it in the clicks'
-        residuals (their a posteriori sigma factor, clipped to ``[0.1, 1]``,
-        :func:`_ground_corner_evidence`); 0 turns it off.
+        (:func:`_ground_corner_sensitivity`), scaled by the evidence for it: the clicks'
+        scatter beyond the annotators' own precision on their lines, clipped to
+        ``[0.1, 1]`` of the term (:func:`_ground_corner_evidence`); 0 turns it off.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
