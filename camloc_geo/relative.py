@@ -118,6 +118,14 @@ class CalibrationSettings:
         (:func:`_ground_corner_sensitivity`), scaled by the evidence for it: the clicks'
         scatter beyond the annotators' own precision on their lines, clipped to
         ``[0.1, 1]`` of the term (:func:`_ground_corner_evidence`); 0 turns it off.
+    photo_lines
+        Where the scene carries its photo (``image.path``), segments detected in it
+        (:mod:`camloc_geo.autovp`) that agree with the annotators' fit (within
+        ``PHOTO_SEGMENT_TOL`` line sigmas of one axis' vanishing point, and clearly off the
+        others) join the final fit with a small weight: each at ``PHOTO_SEGMENT_SIGMA``
+        line sigmas, per axis at most as much as the annotators' average lines of that axis
+        count, under the fit's robust loss (:func:`_add_photo_segments`). Lines that
+        disagree are not used (a clear disagreement is a warning); False: never.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -145,6 +153,7 @@ class CalibrationSettings:
     ground_corner_sigma_rel: float = 0.025
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
+    photo_lines: bool = True
 
 
 @dataclass
@@ -284,6 +293,9 @@ class CalibrationResult:
     annotator_influence_m
         Per annotation, how far the camera moves when it is left out (None: not computed, or
         no comparable answer without it).
+    photo_segments
+        Segments detected in the scene's photo that joined the fit, per axis
+        (``CalibrationSettings.photo_lines``); empty when none did.
     """
 
     camera: Camera
@@ -311,6 +323,7 @@ class CalibrationResult:
     principal_point_sigma_px: list[float] | None = None
     parameter_covariance: FloatArray | None = field(default=None, repr=False, compare=False)
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
+    photo_segments: dict[str, int] = field(default_factory=dict)
 
     @property
     def focal_sigma_with_principal_point_px(self) -> float | None:
@@ -403,6 +416,8 @@ class CalibrationResult:
             out["camera_in_world_sigma_fit_m"] = self.position_sigma_fit_m.tolist()
         if self.position_sigma_jackknife_m is not None:
             out["camera_in_world_sigma_jackknife_m"] = self.position_sigma_jackknife_m.tolist()
+        if self.photo_segments:
+            out["photo_segments"] = dict(self.photo_segments)
         out["cluster"] = self.cluster
         out["annotators"] = [a.to_dict() for a in self.annotators]
         if self.warnings:
@@ -810,6 +825,12 @@ class _JointProblem:
         # segment_residuals_px's numerator is V · n for a vanishing point V = (x, y, w).
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        # Segments detected in the scene's photo (set_photo_segments): their rows follow the
+        # clicks' (owned by no annotator, like the priors), with their own fixed sigma.
+        self._seg_axis_all = self.seg_axis
+        self._photo_scale = np.zeros(0)
+        self.photo_segments = np.zeros((0, 4))
+        self.photo_axis = np.zeros(0, dtype=int)
         self.weights = np.ones(self.n_annotators)
         self.f_bounds = (0.15 * width, 15.0 * width)
         # A weak log-normal prior on the focal length (settings.focal_prior_sigma_log; 0 = none).
@@ -848,6 +869,22 @@ class _JointProblem:
         if len(self._memo) >= _MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
         self._memo[key] = (r, J)
+
+    def set_photo_segments(
+        self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
+    ) -> None:
+        """Add segments detected in the photo: ``(k, 4)``, their axis index, 1-sigma (px)."""
+        photo = np.asarray(segments, dtype=float).reshape(-1, 4)
+        self.photo_segments = photo
+        self.photo_axis = np.asarray(axes, dtype=int).reshape(-1)
+        self._photo_scale = 1.0 / np.broadcast_to(np.asarray(sigma_px, float), (len(photo),))
+        seg = np.vstack([self.segments, photo])
+        self._seg_axis_all = np.concatenate([self.seg_axis, self.photo_axis])
+        self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
+        x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
+        self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self.weights = self._weights  # the scales of all segment rows
+        self._memo.clear()
 
     def set_corners(self, corners: npt.ArrayLike) -> None:
         """Which ground corner of the car each annotator marked as the origin.
@@ -1004,7 +1041,7 @@ class _JointProblem:
         V[:, :, 0] = fc * R[:, 0, :] + cx * R[:, 2, :]
         V[:, :, 1] = fc * R[:, 1, :] + cy * R[:, 2, :]
         V[:, :, 2] = R[:, 2, :]
-        Vs = V[:, self.seg_axis, :]  # (P, n_seg, 3)
+        Vs = V[:, self._seg_axis_all, :]  # (P, n_seg + n_photo, 3)
         px, py, pw = Vs[..., 0], Vs[..., 1], Vs[..., 2]
         mx, my = self._mid[:, 0], self._mid[:, 1]
         # Line through the midpoint (mx, my, 1) and the vanishing point; the first endpoint's
@@ -1013,12 +1050,16 @@ class _JointProblem:
         lb = px - mx * pw
         norm = np.sqrt(la * la + lb * lb)
         num = np.einsum("psk,sk->ps", Vs, self._seg_n)
-        r_seg = num / np.maximum(norm, 1e-300) * self._seg_scale
+        r_all = num / np.maximum(norm, 1e-300) * self._seg_scale
+        n_seg = len(self.segments)
+        r_seg = r_all[:, :n_seg]
         pc = (self.pt_world[None, :, :] - C[:, None, :]) @ np.swapaxes(R, 1, 2)
         z = np.maximum(pc[:, :, 2], self._z_min)
         u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * self._pt_scale
         v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * self._pt_scale
         parts = [r_seg, u, v]
+        if len(self.photo_segments):
+            parts.append(r_all[:, n_seg:])
         if f_fixed is None and self.log_f_prior_sigma > 0.0:
             parts.append((np.log(f) - self.log_f_prior)[:, None] / self.log_f_prior_sigma)
         if pp_fixed is None and self.pp_prior_sigma > 0.0:
@@ -1034,7 +1075,7 @@ class _JointProblem:
         self._weights = np.asarray(value, dtype=float)
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
-        self._seg_scale = self._w_seg / self.sigma_line
+        self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
         self._pt_scale = self._w_pt / self._sigma_pt_each
 
     def per_annotator_rms(
@@ -1754,6 +1795,96 @@ PHOTO_AXIS_NEAR_DEG = 30.0  # ... when it is the photo's nearest direction to th
 PHOTO_MIN_SEGMENTS = 6  # a detected direction needs this many segments to count
 
 
+PHOTO_SEGMENT_TOL = 2.0  # a photo segment within this many line sigmas of an axis' VP agrees
+PHOTO_SEGMENT_SIGMA = 2.0  # ... and joins the fit at this many line sigmas
+PHOTO_SEGMENT_MIN_REL = 0.02  # ... if at least this long (fraction of the image diagonal)
+
+
+def _photo_result(scene: Scene) -> Any | None:
+    """The scene photo's detected vanishing points and segments (cached), or None."""
+    path = scene.image_file()
+    if path is None or not path.is_file():  # is_file: a FIFO or a device would block
+        return None
+    stat = path.stat()
+    try:
+        return _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except (InputError, ValueError) as exc:
+        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+        return None
+
+
+def _add_photo_segments(
+    scene: Scene,
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+) -> dict[str, int]:
+    """Give ``prob`` the photo's segments that agree with the fit at ``x``; count per axis.
+
+    A segment detected in the photo (:mod:`camloc_geo.autovp`, at least
+    ``PHOTO_SEGMENT_MIN_REL`` of the diagonal long) agrees with an axis when its residual
+    to that axis' vanishing point of the fit is within ``PHOTO_SEGMENT_TOL`` line sigmas
+    (``sigma_line_rel``) and its residuals to the other two are beyond three times that.
+    Each joins at ``PHOTO_SEGMENT_SIGMA`` line sigmas, widened where an axis has more of
+    them than the annotators drew on average for it (their total weight then equals that
+    many such segments): a small weight, under the fit's soft-L1 loss. Lines that disagree
+    with the fit are never added (a clear disagreement is :func:`_photo_disagreement`'s
+    warning). Nothing without a photo, with a lens distortion (the detector's pixels are
+    not undistorted here) or when the photo's size is not the scene's.
+    """
+    if scene.camera.distortion is not None:
+        return {}
+    res = _photo_result(scene)
+    if res is None or tuple(res.image_size) != tuple(scene.image_size):
+        return {}
+    segs = np.asarray(res.segments, dtype=float).reshape(-1, 4)
+    labels = np.asarray(res.labels, dtype=int).reshape(-1)
+    diag = math.hypot(*prob.image_wh)
+    long_enough = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
+    keep = (long_enough >= PHOTO_SEGMENT_MIN_REL * diag) & (labels >= 0)
+    segs, labels = segs[keep], labels[keep]
+    if len(segs) == 0:
+        return {}
+    f, (cx, cy), R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    K_inv = np.linalg.inv(np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]))
+    # Each of the photo's vanishing points (its own clustering: no choice by the fit) that
+    # is within PHOTO_AXIS_TOL_DEG of one of the fit's axes, and the nearest to it, lends
+    # that axis its segments.
+    cluster_axis = {}
+    for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if not (n > 0.0 and np.isfinite(n)) or np.count_nonzero(labels == k) < PHOTO_MIN_SEGMENTS:
+            continue
+        cosines = np.abs(R.T @ (d / n))  # against the fit's world axes in the camera frame
+        i = int(np.argmax(cosines))
+        if math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG:
+            cluster_axis[k] = i
+    if len(set(cluster_axis.values())) < len(cluster_axis):
+        return {}  # two of the photo's directions on one axis: ambiguous
+    take = np.isin(labels, list(cluster_axis))
+    if not np.any(take):
+        return {}
+    segs = segs[take]
+    axis = np.array([cluster_axis[int(k)] for k in labels[take]], dtype=int)
+    sigma = np.full(len(segs), PHOTO_SEGMENT_SIGMA * prob.sigma_line)
+    used: dict[str, int] = {}
+    for name, i in _AXIS_INDEX.items():
+        mine = axis == i
+        k = int(mine.sum())
+        if k == 0:
+            continue
+        per_annotator = max(float(np.sum(prob.seg_axis == i)) / prob.n_annotators, 2.0)
+        if k > per_annotator:
+            sigma[mine] *= math.sqrt(k / per_annotator)
+        used[name] = k
+    prob.set_photo_segments(segs, axis, sigma)
+    log.info("image.path: %s photo segments agree with the annotators' fit", used)
+    return used
+
+
 def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     """Warnings where the scene's photo and the annotators' fit clearly disagree.
 
@@ -1765,14 +1896,8 @@ def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     length more than 10 % and three combined sigmas off the fit's. No photo, or no lines in
     it: nothing (``image.path``'s own warnings say so). Lens distortion is not undone here.
     """
-    path = scene.image_file()
-    if path is None or not path.is_file() or result.camera is None:
-        return []
-    stat = path.stat()
-    try:
-        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
-    except (InputError, ValueError) as exc:
-        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+    res = _photo_result(scene) if result.camera is not None else None
+    if res is None:
         return []
     cam = result.camera
     R = np.asarray(cam.cam_from_world_rotation, dtype=float)
@@ -2560,6 +2685,11 @@ def _joint(
     if settings.reassign_corners:
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-8)
+    photo_used: dict[str, int] = {}
+    if settings.photo_lines:
+        photo_used = _add_photo_segments(scene, prob, res.x, R0, pp_fixed, f_fixed)
+        if photo_used:
+            res = _fit(prob, res.x, R0, pp_fixed, f_fixed, tol=1e-8)
     if f_fixed is None and settings.focal_prior_sigma_log > 0.0:
         res = _focal_prior(prob, res, R0, pp_fixed, settings)
     chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
@@ -2688,6 +2818,7 @@ def _joint(
         annotator_corners=corner_names,
         width_sign=ws_out,
         joint_state=state,
+        photo_segments=photo_used,
     )
     if len(chosen_corners) > 1:
         result.warnings.append(
@@ -2799,8 +2930,15 @@ def _output_covariance(
     J = res.jac
     x = np.asarray(res.x, dtype=float)
     n_x = len(x)
-    dof = max(len(res.fun) - n_x, 1)
-    s2 = max(2.0 * res.cost / dof, 1e-12)
+    # The residual variance factor of the annotations (and priors) alone: the photo's
+    # segments join at a deliberately wide sigma, and their small residuals would shrink it.
+    fun = np.asarray(res.fun, dtype=float)
+    n_photo = len(prob.photo_segments)
+    if n_photo:
+        start = len(prob.segments) + 2 * len(prob.pt_pix)
+        fun = np.concatenate([fun[:start], fun[start + n_photo :]])
+    dof = max(len(fun) - n_x, 1)
+    s2 = max(2.0 * soft_l1_cost(fun, _F_SCALE) / dof, 1e-12)
     try:
         cov = np.linalg.pinv(J.T @ J) * s2
     except np.linalg.LinAlgError:
