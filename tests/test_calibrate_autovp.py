@@ -152,8 +152,8 @@ def test_the_photos_agreeing_lines_strengthen_the_fit(tmp_path: Path) -> None:
     shrink (measured: mean |error| 4.9 -> 4.2 %, median sigma 7.4 -> 6.7 %), and the sigma
     stays honest (median error/sigma 0.50)."""
     f_true = _camera().focal_px
-    err = {True: [], False: []}
-    sig = {True: [], False: []}
+    err: dict[bool, list[float]] = {True: [], False: []}
+    sig: dict[bool, list[float]] = {True: [], False: []}
     for seed in range(12):
         for photo in (True, False):
             result = calibrate(load_scene(_noisy_scene_with_photo(tmp_path, seed, photo)))
