@@ -1216,9 +1216,25 @@ def _score_test(
     Jw = J * np.sqrt(w)[:, None]
     g = Jw.T @ (r * np.sqrt(w))
     try:
-        return float(g @ np.linalg.pinv(Jw.T @ Jw) @ g)
+        return float(g @ _sym_inverse(Jw.T @ Jw) @ g)
     except np.linalg.LinAlgError:
         return 0.0
+
+
+def _sym_inverse(A: FloatArray) -> FloatArray:
+    """Inverse of a symmetric positive semi-definite matrix: Cholesky where it is well
+    conditioned (~4x cheaper than an SVD on these 7-9 parameter problems), else the
+    pseudo-inverse (a singular direction gets no variance, as before)."""
+    d = np.sqrt(np.clip(np.diag(A), 1e-300, None))
+    As = A / d[:, None] / d[None, :]
+    try:
+        L = np.linalg.cholesky(As)
+    except np.linalg.LinAlgError:
+        return np.asarray(np.linalg.pinv(A), dtype=np.float64)
+    if float(np.min(np.diag(L))) ** 2 < 1e-10:  # nearly singular: as the pseudo-inverse
+        return np.asarray(np.linalg.pinv(A), dtype=np.float64)
+    L_inv = np.linalg.inv(L)
+    return np.asarray((L_inv.T @ L_inv) / d[:, None] / d[None, :], dtype=np.float64)
 
 
 def _pack(
@@ -2114,8 +2130,9 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
         onehot = owner[None, :] == np.arange(n_ann)[:, None]  # (n_ann, m)
         H_all = J.T @ Jw
         g_all = Jw.T @ r
-        H_a = np.einsum("am,mi,mj->aij", onehot.astype(float), J, Jw)
-        g_a = onehot.astype(float) @ (Jw * r[:, None])
+        mask = onehot.astype(float)
+        H_a = np.swapaxes(mask[:, :, None] * J[None], 1, 2) @ Jw  # (n_ann, n, n), batched BLAS
+        g_a = mask @ (Jw * r[:, None])
         xs = _newton_steps(
             H_all[None] - H_a, g_all[None] - g_a, np.broadcast_to(x0, (n_ann, len(x0)))
         )
@@ -2130,16 +2147,14 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
             pts = np.array([xs[a] for a in live])
             X = (pts[:, None, :] + np.vstack([np.zeros(n), np.diag(h)])[None, :, :]).reshape(-1, n)
             Rb = prob.residuals_batch(X, *args).reshape(len(live), n + 1, -1)
-            Hs, gs = [], []
-            for k, a in enumerate(live):
-                keep = ~onehot[a]
-                r_k = Rb[k, 0, keep]
-                J_k = ((Rb[k, 1:][:, keep] - r_k[None, :]) / h[:, None]).T
-                w_k = 1.0 / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
-                Jw_k = J_k * w_k[:, None]
-                Hs.append(J_k.T @ Jw_k)
-                gs.append(Jw_k.T @ r_k)
-            for a, x_a in zip(live, _newton_steps(np.array(Hs), np.array(gs), pts), strict=True):
+            # All live annotators at once: their own rows get zero weight (left out).
+            r_k = Rb[:, 0, :]  # (L, m)
+            J_k = np.swapaxes((Rb[:, 1:, :] - r_k[:, None, :]) / h[None, :, None], 1, 2)
+            w_k = (1.0 - mask[live]) / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
+            Jw_k = J_k * w_k[:, :, None]  # (L, m, n)
+            Hs = np.swapaxes(J_k, 1, 2) @ Jw_k
+            gs = (np.swapaxes(Jw_k, 1, 2) @ r_k[:, :, None])[:, :, 0]
+            for a, x_a in zip(live, _newton_steps(Hs, gs, pts), strict=True):
                 xs[a] = x_a
         return xs
     finally:
@@ -2552,7 +2567,7 @@ def _param_sigma(res: Any, sl: slice) -> float | None:
     dof = max(len(res.fun) - len(res.x), 1)
     s2 = max(2.0 * res.cost / dof, 1e-12)
     try:
-        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
+        cov = _sym_inverse(res.jac.T @ res.jac) * s2
     except np.linalg.LinAlgError:
         return None
     return float(np.sqrt(np.max(np.clip(np.diag(cov)[sl], 0, None))))
@@ -2951,7 +2966,7 @@ def _output_covariance(
     dof = max(len(fun) - n_x, 1)
     s2 = max(2.0 * soft_l1_cost(fun, _F_SCALE) / dof, 1e-12)
     try:
-        cov = np.linalg.pinv(J.T @ J) * s2
+        cov = _sym_inverse(J.T @ J) * s2
     except np.linalg.LinAlgError:
         return None
     # Positions of x's entries in z = (log f, pp x, pp y, ω, C).
