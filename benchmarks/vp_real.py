@@ -442,7 +442,7 @@ def main(argv: list[str] | None = None) -> int:
         action="append",
         default=[
             Path(d) for d in os.environ.get("CAMLOC_EXIF_PHOTO_DIRS", "").split(os.pathsep) if d
-        ],  # noqa: E501
+        ],
         help="a folder of outdoor photos whose EXIF gives the focal length (repeatable)",
     )
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")

@@ -1,0 +1,105 @@
+"""Failure modes of automatic vanishing points on real photos (issue 24), on synthetic
+segments: a photo looking up steeply at a building, roof slopes and paving joints posing
+as a principal direction, a lens' barrel distortion."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camloc_geo.autovp import detect_vanishing_points, pitch_roll_from_up
+
+
+def cam_from_world(yaw_deg: float, pitch_deg: float) -> np.ndarray:
+    """Rows: camera right, down, forward in a z-up world; pitch positive looking down."""
+    ps, th = math.radians(yaw_deg), math.radians(pitch_deg)
+    fwd = np.array([math.cos(ps) * math.cos(th), math.sin(ps) * math.cos(th), -math.sin(th)])
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    return np.array([right, np.cross(fwd, right), fwd])
+
+
+def facade_segments(
+    pitch_deg: float,
+    *,
+    f_px: float = 800.0,
+    size: tuple[int, int] = (1024, 768),
+    n_vertical: int = 60,
+    n_rows: int = 50,
+    n_side: int = 6,
+    facade_yaw_deg: float = 25.0,
+    seed: int = 0,
+    noise_px: float = 0.3,
+    camera_height_m: float = 1.6,
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """Segments of a tall facade 18 m off, seen from a camera ``camera_height_m`` up.
+
+    Its vertical edges (``n_vertical``) and window rows (``n_rows``) are many; the third
+    direction, the courses of a side wall running away from the camera, has ``n_side``.
+    """
+    rng = np.random.default_rng(seed)
+    w, h = size
+    R = cam_from_world(0.0, pitch_deg)
+    a = math.radians(facade_yaw_deg)
+    along = np.array([math.sin(a), -math.cos(a), 0.0])  # the facade's horizontal
+    normal = np.array([math.cos(a), math.sin(a), 0.0])  # towards the side wall's depth
+    up = np.array([0.0, 0.0, 1.0])
+    origin = np.array([18.0, 0.0, -camera_height_m])  # a point of the facade, street level
+    segs: list[list[float]] = []
+
+    def add(p: np.ndarray, q: np.ndarray) -> None:
+        pc, qc = R @ p, R @ q
+        if pc[2] < 0.5 or qc[2] < 0.5:
+            return
+        a_px = f_px * pc[:2] / pc[2] + (w / 2, h / 2)
+        b_px = f_px * qc[:2] / qc[2] + (w / 2, h / 2)
+        ok = all(0 <= v[0] <= w and 0 <= v[1] <= h for v in (a_px, b_px))
+        if ok and np.hypot(*(b_px - a_px)) > 25:
+            segs.append([*a_px, *b_px])
+
+    tries = 0
+    while len(segs) < n_vertical and tries < 20000:
+        tries += 1
+        p = origin + along * rng.uniform(-25, 25) + up * rng.uniform(0, 60)
+        add(p, p + up * rng.uniform(2, 10))
+    n0, tries = len(segs), 0
+    while len(segs) < n0 + n_rows and tries < 20000:
+        tries += 1
+        p = origin + along * rng.uniform(-25, 20) + up * rng.uniform(0, 60)
+        add(p, p + along * rng.uniform(2, 8))
+    n0, tries = len(segs), 0
+    while len(segs) < n0 + n_side and tries < 20000:
+        tries += 1
+        p = origin + along * 22.0 + up * rng.uniform(0, 60) + normal * rng.uniform(0, 10)
+        add(p, p + normal * rng.uniform(2, 6))
+    out = np.array(segs)
+    return out + rng.normal(0.0, noise_px, out.shape), (w, h)
+
+
+@pytest.mark.parametrize("pitch_deg", [-40.0, -50.0, -60.0])
+def test_photo_looking_up_steeply_at_a_building_is_not_read_as_looking_down(
+    pitch_deg: float,
+) -> None:
+    """Looking up 40-60 degrees at a facade sees the same Manhattan frame as looking down
+    50-30 degrees. The building's many vertical edges decide (the other reading would rest
+    on a side wall's 6 courses), and the ambiguity is stated."""
+    segs, size = facade_segments(pitch_deg)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(pitch_deg, abs=1.0)
+    assert abs(res.focal_px / 800.0 - 1.0) < 0.05
+    assert not res.vertical_identified
+    assert any("looks up" in w and "or down" in w for w in res.warnings)
+
+
+def test_mast_camera_looking_down_steeply_stays_looking_down() -> None:
+    """A camera looking down 50 degrees at a facade with as many courses running away as
+    vertical edges: the likelier reading (looking down) is kept."""
+    segs, size = facade_segments(
+        50.0, n_vertical=40, n_rows=40, n_side=40, camera_height_m=40.0, facade_yaw_deg=40.0
+    )
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(50.0, abs=1.0)
+    up_true = cam_from_world(0.0, 50.0) @ np.array([0.0, 0.0, 1.0])
+    assert pitch_roll_from_up(up_true)[0] == pytest.approx(50.0)
