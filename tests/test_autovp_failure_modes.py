@@ -103,3 +103,83 @@ def test_mast_camera_looking_down_steeply_stays_looking_down() -> None:
     assert res.pitch_deg == pytest.approx(50.0, abs=1.0)
     up_true = cam_from_world(0.0, 50.0) @ np.array([0.0, 0.0, 1.0])
     assert pitch_roll_from_up(up_true)[0] == pytest.approx(50.0)
+
+
+def street_segments(
+    *,
+    n_vertical: int = 30,
+    n_joints: int = 0,
+    joint_deg: float = 90.0,
+    n_roof: int = 0,
+    roof_deg: float = 60.0,
+    f_px: float = 800.0,
+    seed: int = 0,
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """A level camera (1.6 m up, pitch 2 degrees) looking down a street (along +x).
+
+    Buildings line both sides (``n_vertical`` edges and 16 window rows each); paving
+    joints (``n_joints``, short, on the ground) run ``joint_deg`` off the street, 90
+    being square to it; roof slopes (``n_roof``) rise ``roof_deg`` along the facades.
+    """
+    rng = np.random.default_rng(seed)
+    w, h = 1024, 768
+    R = cam_from_world(8.0, 2.0)
+    centre = np.array([0.0, 0.0, 1.6])
+    segs: list[list[float]] = []
+
+    def add(p: np.ndarray, q: np.ndarray) -> None:
+        pc, qc = R @ (p - centre), R @ (q - centre)
+        if pc[2] < 0.5 or qc[2] < 0.5:
+            return
+        a_px = f_px * pc[:2] / pc[2] + (w / 2, h / 2)
+        b_px = f_px * qc[:2] / qc[2] + (w / 2, h / 2)
+        ok = all(0 <= v[0] <= w and 0 <= v[1] <= h for v in (a_px, b_px))
+        if ok and np.hypot(*(b_px - a_px)) > 20:
+            segs.append([*a_px, *b_px])
+
+    for side in (-8.0, 8.0):
+        for x in rng.uniform(8, 90, n_vertical):
+            add(np.array([x, side, 0.5]), np.array([x, side, rng.uniform(5, 14)]))
+        for z in rng.uniform(0.5, 12, 16):
+            x0 = rng.uniform(8, 40)
+            add(np.array([x0, side, z]), np.array([x0 + rng.uniform(8, 40), side, z]))
+    a = math.radians(joint_deg)
+    for _ in range(n_joints):
+        p = np.array([rng.uniform(6, 20), rng.uniform(-5, 5), 0.0])
+        add(p, p + np.array([math.cos(a), math.sin(a), 0.0]) * rng.uniform(1.5, 4))
+    r = math.radians(roof_deg)
+    for i in range(n_roof):
+        p = np.array([rng.uniform(15, 60), 8.0 if i % 2 else -8.0, 14.0])
+        add(p, p + np.array([math.cos(r), 0.0, math.sin(r)]) * rng.uniform(3, 6))
+    out = np.array(segs)
+    return out + rng.normal(0.0, 0.3, out.shape), (w, h)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_paving_joints_off_square_do_not_make_a_confident_focal_length(seed: int) -> None:
+    """A level camera looking down a street: the across-street direction comes only from
+    10 short paving joints laid 6 degrees off square. The focal length then rests on them
+    (it is 23-26 % off): the result must say so (a warning, confidence under 0.5) with a
+    sigma that covers the error within 3 sigma, not state a few per cent."""
+    segs, size = street_segments(n_joints=10, joint_deg=84.0, seed=seed)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    err = abs(math.log(res.focal_px / 800.0))
+    assert res.warnings
+    assert res.confidence < 0.5
+    assert err <= 3.0 * res.focal_std_rel
+    # the tilt does not rest on them
+    assert res.pitch_deg == pytest.approx(2.0, abs=1.0)
+    assert abs(res.roll_deg) < 0.5
+
+
+@pytest.mark.parametrize("roof_deg", [55.0, 70.0])
+def test_roof_slopes_do_not_pose_as_the_vertical(roof_deg: float) -> None:
+    """Few building edges (3 a side, trees stand for the rest) and 10 steep roof slopes:
+    the vertical stays the buildings', pitch and roll within half a degree."""
+    segs, size = street_segments(n_vertical=3, n_roof=10, roof_deg=roof_deg, seed=1)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(2.0, abs=0.5)
+    assert abs(res.roll_deg) < 0.5
+    assert abs(res.directions_in_cam[0] @ (cam_from_world(8.0, 2.0) @ [0, 0, 1.0])) > math.cos(
+        math.radians(1.0)
+    )
