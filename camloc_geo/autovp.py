@@ -739,6 +739,53 @@ def _systematic_logf_std(
     return math.sqrt(total)
 
 
+def _split_horizon_logf_std(
+    m: _Model,
+    s: _Segs,
+    segs_px: FloatArray,
+    merge_px: float,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> float:
+    """How much ``log(focal)`` disagrees between the two sides of the horizon.
+
+    A horizontal direction's lines above the horizon (facades) and below it (kerbs,
+    paving, steps, a lawn's paths) should meet at one vanishing point; paving joints,
+    paths or shadows that are not quite parallel to the buildings pull it, the focal
+    length with it, and the least-squares sigma cannot see it. For each horizontal
+    direction with at least :data:`_MIN_SUPPORT` distinct lines on both sides, each side
+    is left out in turn and the focal length refitted; the result is half the root sum
+    of squares of the moves (a grouped jackknife over the two halves would take
+    ``1/sqrt(2)``; each half also carries its own noise, already in the sigma).
+
+    On 216 real photos this took the 1 / 2 sigma coverage of the stated focal sigma from
+    69 / 92 % to 76 / 96 % (median error/sigma 0.60 -> 0.54) and the photos confidently
+    wrong from 6 to 4 (``benchmarks/vp_real.py``).
+    """
+    kv = _vertical_index(m.R.T, m.n_lines)[0]
+    up = _up_sign(m.R[:, kv])
+    ray = np.column_stack([s.mid, np.full(len(s.mid), m.f_n)])
+    above = ray @ up > 0.0
+    total = 0.0
+    for k in range(3):
+        if k == kv:
+            continue
+        sel = m.labels == k
+        n_up = _n_distinct_lines(segs_px[sel & above], merge_px)
+        n_down = _n_distinct_lines(segs_px[sel & ~above], merge_px)
+        if min(n_up, n_down) < _MIN_SUPPORT:
+            continue
+        for side in (above, ~above):
+            labels = np.where(sel & side, -1, m.labels)
+            _, f, _, _ = _refine(
+                m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
+            )
+            total += math.log(f / m.f_n) ** 2
+    return 0.5 * math.sqrt(total)
+
+
 def _up_sign(d: FloatArray) -> FloatArray:
     """The direction pointing image-up (``y < 0``)."""
     return np.asarray(-d if d[1] > 0 else d, dtype=np.float64)
@@ -1322,7 +1369,10 @@ def detect_vanishing_points(
     bias = BIAS_DEG if bias_deg is None else bias_deg
     if f_fixed is None and math.isfinite(best.logf_std):
         sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
-        best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2)
+        split_std = _split_horizon_logf_std(
+            best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
+        )
+        best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2 + split_std**2)
         if best.weak_only:
             best.logf_std = min(best.logf_std, _MAX_STATED_STD)
     elif f_fixed is not None:
