@@ -37,7 +37,10 @@ Pipeline
    the final fit; ``focal_std_rel`` adds to the least-squares sigma how far the focal
    length moves when each direction's segments are turned by :data:`BIAS_DEG` (a
    systematic bias: residual distortion, edge detection), which is large where the
-   geometry leaves the focal length loose (a level camera looking down a street). An EXIF
+   geometry leaves the focal length loose (a level camera looking down a street), and
+   how far it moves when a horizontal direction's lines on either side of the horizon are
+   left out (``_split_horizon_logf_std``: paths or paving not parallel to the facades).
+   An EXIF
    focal length (or any ``focal_prior_px``) is a prior in the fit. ``warnings`` say when
    the focal length is loose, the vertical is weakly supported or ambiguous.
 
@@ -45,8 +48,8 @@ Measured on the 102 York Urban photos (``benchmarks/vp_yud.py``, focal length no
 given): focal length within 10 % on 92 % of the photos, median vanishing-direction
 error 0.9 degrees against the orthogonalised ground truth, horizon AUC 95 %, about 75 ms
 of CPU per 640x480 photo. On 216 real photos with published calibrations
-(``benchmarks/vp_real.py``): within 10 % on 91 %, the stated focal sigma covers 69 % at
-1 sigma and 92 % at 2 sigma, ROC AUC of the confidence for a focal error over 10 % 0.88.
+(``benchmarks/vp_real.py``): within 10 % on 91 %, the stated focal sigma covers 76 % at
+1 sigma and 96 % at 2 sigma, ROC AUC of the confidence for a focal error over 10 % 0.90.
 
 Conventions (see ``spec/SCENE.md``): image pixels are continuous, origin at the
 top-left corner, x right, y down, the centre of the top-left pixel is ``(0.5, 0.5)``;
@@ -861,7 +864,7 @@ class AutoVPResult:
         the Manhattan frame is the photo's (falling with fewer than about 60 distinct
         lines), times the structure's support (explained share of the segments' length,
         lines per direction). On 216 real photos its ROC AUC for an error over 10 % is
-        0.88 (``benchmarks/vp_real.py``).
+        0.90 (``benchmarks/vp_real.py``).
     vertical_identified
         False when another direction could be the vertical one nearly as well (e.g. a
         camera pitched 60 degrees down and one pitched 30 degrees up see the same frame).
