@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 import time
@@ -92,9 +93,8 @@ def main(argv: list[str] | None = None) -> int:
         )
     gen_s = time.perf_counter() - t
 
-    from camloc_geo.batch._areas import clear_maps
-
     from camloc_geo.osm import clear_cache
+    from camloc_geo.osm._catalogue import clear_maps
 
     # the list's generation loaded the extracts' maps in this process: forget them, or the
     # forked local workers would inherit them while the Dask workers load their own
@@ -102,6 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     clear_cache()
     runs: dict[str, dict[str, Any]] = {}
     t0 = time.perf_counter()
+    load_start = os.getloadavg()[0]
     local = run_batch(
         lst,
         out_gpkg=work / "local" / "out.gpkg",
@@ -111,9 +112,14 @@ def main(argv: list[str] | None = None) -> int:
         chunk_size=ns.chunk_size,
         restart=True,
     )
-    runs["local"] = {"wall_s": time.perf_counter() - t0, "summary": local.to_dict()}
+    runs["local"] = {
+        "wall_s": time.perf_counter() - t0,
+        "load1_start_end": [load_start, os.getloadavg()[0]],
+        "summary": local.to_dict(),
+    }
 
     t0 = time.perf_counter()
+    load_start = os.getloadavg()[0]
     with (
         LocalCluster(
             n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
@@ -133,6 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     runs["dask"] = {
         "wall_s": time.perf_counter() - t0,
         "cluster_start_s": t_up,
+        "load1_start_end": [load_start, os.getloadavg()[0]],
         "summary": dask.to_dict(),
     }
 
@@ -151,6 +158,10 @@ def main(argv: list[str] | None = None) -> int:
         r["wall_s"] = round(r["wall_s"], 1)
         r["cameras_per_s"] = round(n / r["wall_s"], 1)
         r["s_per_camera"] = round(r["wall_s"] / n, 4)
+        # the workers' CPU per camera: what the work costs, which a shared machine's load
+        # (the wall time's main term here) does not stretch
+        cpu = r["summary"]["stage_s"].get("geocode_cpu")
+        r["worker_cpu_ms_per_camera"] = round(1000 * cpu / n, 1) if cpu is not None else None
     result = {
         "cameras": local.total,
         "scene_fraction": ns.scene_fraction,

@@ -47,9 +47,8 @@ PAPER_S_PER_IMAGE = 0.41
 
 def _junction_names(extracts: tuple[Path, ...]) -> list[tuple[str, str]]:
     """Street-name pairs of real junctions of the extracts (whole-extract maps)."""
-    from camloc_geo.batch._areas import _bounds
-
     from camloc_geo.osm import load_map
+    from camloc_geo.osm._catalogue import extract_bounds as _bounds
     from camloc_geo.testing.camera_list import _junctions
 
     pairs: list[tuple[str, str]] = []
@@ -75,8 +74,12 @@ def write_title_list(path: Path, rows: int, pairs: list[tuple[str, str]]) -> Non
             w.writerow([f"cam{i + 1:07d}", title])
 
 
-def _tree_rss_mb(proc: Any) -> tuple[float, float, int]:
-    """RSS of a process and its children (MiB): total, the largest one, and how many."""
+_CPU_SEEN: dict[int, float] = {}
+
+
+def _tree_rss_mb(proc: Any) -> tuple[float, float, int, float]:
+    """RSS of a process and its children (MiB): total, the largest one, how many; and the
+    CPU seconds the tree has used so far (workers that ended keep their last reading)."""
     import psutil
 
     total, largest, n = 0, 0, 0
@@ -87,7 +90,9 @@ def _tree_rss_mb(proc: Any) -> tuple[float, float, int]:
                 total += rss
                 largest = max(largest, rss)
                 n += 1
-    return total / 2**20, largest / 2**20, n
+                t = p.cpu_times()
+                _CPU_SEEN[p.pid] = t.user + t.system
+    return total / 2**20, largest / 2**20, n, sum(_CPU_SEEN.values())
 
 
 def _journal_count(path: Path) -> int:
@@ -252,7 +257,7 @@ def main(argv: list[str] | None = None) -> int:
             ps = psutil.Process(child.pid)
             while child.poll() is None:
                 now = time.perf_counter() - t0
-                total, largest, n = _tree_rss_mb(ps)
+                total, largest, n, cpu_s = _tree_rss_mb(ps)
                 samples.append(
                     {
                         "t_s": round(now, 2),
@@ -260,6 +265,8 @@ def main(argv: list[str] | None = None) -> int:
                         "largest_mb": round(largest, 1),
                         "procs": n,
                         "done": _journal_count(journal),
+                        "cpu_s": round(cpu_s, 1),
+                        "load1": round(os.getloadavg()[0], 2),
                     }
                 )
                 if ns.max_s is not None and now > ns.max_s:
@@ -295,6 +302,19 @@ def main(argv: list[str] | None = None) -> int:
     slope = None
     if len(half) >= 2 and half[-1]["done"] > half[0]["done"]:
         slope = (half[-1]["rss_mb"] - half[0]["rss_mb"]) / (half[-1]["done"] - half[0]["done"])
+    # CPU per camera while computing (a shared machine's load stretches the wall time, not
+    # this), and the machine's load meanwhile
+    cpu_per_cam_ms = None
+    if len(computing) >= 2 and computing[-1]["done"] > computing[0]["done"]:
+        cpu_per_cam_ms = (
+            1000
+            * (computing[-1]["cpu_s"] - computing[0]["cpu_s"])
+            / (computing[-1]["done"] - computing[0]["done"])
+        )
+    loads = sorted(s["load1"] for s in samples)
+    gpkg_s = None
+    if computing and samples and not stopped:
+        gpkg_s = round(samples[-1]["t_s"] - computing[-1]["t_s"], 1)
     result: dict[str, Any] = {
         "label": ns.label,
         "rows": ns.rows,
@@ -310,6 +330,11 @@ def main(argv: list[str] | None = None) -> int:
         "cameras_done": done,
         "wall_s": round(wall, 1),
         "cameras_per_s": round(rate, 1),
+        "cpu_ms_per_camera_all_processes": (
+            round(cpu_per_cam_ms, 3) if cpu_per_cam_ms is not None else None
+        ),
+        "load1_median": loads[len(loads) // 2] if loads else None,
+        "after_last_camera_s": gpkg_s,
         "extrapolated_wall_s_all_rows": round(ns.rows / rate, 0) if rate else None,
         "extrapolated_wall_s_million": round(1e6 / rate, 0) if rate else None,
         "paper_s_per_image": PAPER_S_PER_IMAGE,

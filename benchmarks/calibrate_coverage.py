@@ -4,6 +4,8 @@ Draws ``--n`` synthetic scenes per set (``benchmarks/relative.py``'s scene distr
 principal point up to 1 % of the width off centre) and calibrates each with the defaults:
 
 - ``noise_free``: ``NoiseModel.exact()`` (no click, line or size noise);
+- ``noise_free_size_given``: the same scenes stating the car's true size (the preset's
+  5 % size term, a user's ignorance of the car that no click shows, is then off);
 - ``crowd``: ``NoiseModel()``, the crowd noise model of ``benchmarks/README.md``.
 
 For each stated sigma (focal length; the principal point, ``principal_point_sigma_px``;
@@ -44,7 +46,14 @@ from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import NoiseModel
 
 OUT_DIR = Path(__file__).parent / "out"
-SETS = {"noise_free": NoiseModel.exact(), "crowd": NoiseModel()}
+SETS = {
+    "noise_free": NoiseModel.exact(),
+    "noise_free_size_given": NoiseModel.exact(),
+    "crowd": NoiseModel(),
+}
+# Sets whose scenes state the car's true size (length, width, height) instead of the preset's
+# name: the preset's size term (a user's ignorance of the car, which no click shows) is off.
+SIZE_GIVEN = {"noise_free_size_given"}
 QUANTITIES = ("focal", "pp_x", "pp_y", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
 
@@ -186,6 +195,13 @@ def main(argv: list[str] | None = None) -> int:
             syn, _size, _n = draw_scene(rng, i, noise)
             while not _has_lines(syn.scene):
                 syn, _size, _n = draw_scene(rng, i, noise)
+            if name in SIZE_GIVEN:
+                true = syn.true_size
+                syn.scene["object"] = {
+                    "length_m": true.length_m,
+                    "width_m": true.width_m,
+                    "height_m": true.height_m,
+                }
             row = scene_errors(syn)
             if row is None:
                 refused[name] += 1

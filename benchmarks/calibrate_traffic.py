@@ -2,10 +2,14 @@
 
 Each scene is what :func:`camloc_geo.testing.traffic_render.render_street` annotates for a
 :func:`~camloc_geo.testing.traffic_render.random_street` camera (960x540, 6-9 m up, the
-parked reference sedan annotated by 3 annotators with 1 px click and line noise); no
-video is rendered (the scene does not depend on the frames). Three sets per seed:
+parked reference sedan annotated by 3 annotators with 1 px click and line noise, each also
+drawing one or two of the street's painted lane lines,
+:func:`camloc_geo.testing.road_lines.street_scene`); no video is rendered (the scene does
+not depend on the frames). The sets per seed:
 
 - ``traffic``: that scene, the annotators' noise drawn as ``render_street`` draws it;
+- ``car_only``: the same annotation without the lane lines (``render_street``'s scene
+  before issue 28: the car alone);
 - ``traffic_draws``: the same camera with ``--draws`` more noise draws (the spread of the
   focal error per camera: bias vs scatter);
 - ``noise_free``: the same camera annotated without noise (the method's own bias);
@@ -33,27 +37,17 @@ import numpy as np
 from camloc_geo import InputError
 from camloc_geo.api import calibrate_scene
 from camloc_geo.camera import Camera
-from camloc_geo.testing.road_lines import road_line_scene
-from camloc_geo.testing.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.road_lines import road_line_scene, street_noise, street_scene
+from camloc_geo.testing.synthetic import make_scene
 from camloc_geo.testing.traffic_render import random_street
 
 OUT_DIR = Path(__file__).parent / "out"
 IMAGE_SIZE = (960, 540)
 
 
-def street_noise(click_px: float = 1.0) -> NoiseModel:
-    """The annotators' noise of :func:`~camloc_geo.testing.traffic_render.render_street`."""
-    return NoiseModel(
-        point_px=click_px,
-        line_px=click_px,
-        wrong_corner_prob=0.0,
-        sloppy_prob=0.0,
-        size_rel=0.0,
-        car_yaw_deg=0.0,
-    )
-
-
-def traffic_scene(seed: int, *, noise_seed: int | None = None, click_px: float = 1.0) -> Any:
+def traffic_scene(
+    seed: int, *, noise_seed: int | None = None, click_px: float = 1.0, lane_lines: bool = True
+) -> Any:
     """The camera and annotated scene ``render_street`` makes for ``random_street(seed)``.
 
     Parameters
@@ -61,9 +55,12 @@ def traffic_scene(seed: int, *, noise_seed: int | None = None, click_px: float =
     seed
         The video's seed (camera from ``default_rng(seed)``, as ``benchmarks/radar_render.py``).
     noise_seed
-        Seed of the annotators' noise (default ``seed + 7``, as ``render_street``).
+        Seed of the annotators' noise (default ``seed``: ``render_street``'s own draw).
     click_px
         Click and line-endpoint noise, pixels (0: exact).
+    lane_lines
+        The annotators also draw the painted lane lines (as ``render_street``); False: the
+        car alone.
 
     Returns
     -------
@@ -71,7 +68,10 @@ def traffic_scene(seed: int, *, noise_seed: int | None = None, click_px: float =
         Its ``camera`` is the true camera, ``scene`` the annotated scene dict.
     """
     cam, _ = random_street(np.random.default_rng(seed), n_vehicles=10, duration_s=20.0)
-    rng = np.random.default_rng(seed + 7 if noise_seed is None else noise_seed)
+    base = seed if noise_seed is None else noise_seed
+    if lane_lines:
+        return street_scene(cam, base, click_px=click_px, image_size=IMAGE_SIZE)
+    rng = np.random.default_rng(base + 7)
     return make_scene(cam, rng, noise=street_noise(click_px), n_annotators=3, image_size=IMAGE_SIZE)
 
 
@@ -124,7 +124,12 @@ def plot(result: dict[str, Any], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(9, 4.5))
-    styles = {"traffic": ("C0", 0.0), "noise_free": ("C2", 0.15), "road_lines": ("C1", 0.3)}
+    styles = {
+        "traffic": ("C0", 0.0),
+        "car_only": ("C3", -0.15),
+        "noise_free": ("C2", 0.15),
+        "road_lines": ("C1", 0.3),
+    }
     for name, (colour, dx) in styles.items():
         rows = result["scenes"][name]
         seeds = [r["seed"] for r in rows if r["focal_error"] is not None]
@@ -162,6 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     scenes: dict[str, list[dict[str, Any]]] = {
         "traffic": [],
+        "car_only": [],
         "traffic_draws": [],
         "noise_free": [],
         "road_lines": [],
@@ -170,6 +176,8 @@ def main(argv: list[str] | None = None) -> int:
     for seed in range(args.first_seed, args.first_seed + args.seeds):
         syn = traffic_scene(seed)
         scenes["traffic"].append({"seed": seed, **(focal_row(syn.scene, syn.camera) or empty)})
+        car = traffic_scene(seed, lane_lines=False)
+        scenes["car_only"].append({"seed": seed, **(focal_row(car.scene, car.camera) or empty)})
         exact = traffic_scene(seed, click_px=0.0)
         scenes["noise_free"].append(
             {"seed": seed, **(focal_row(exact.scene, exact.camera) or empty)}

@@ -22,6 +22,21 @@ The photos (none of them is in this repository; their licences keep them out):
     calibration ``images/K.txt`` (f = 2905.88 px) in ``openMVG/ImageDataset_SceauxCastle``
     (``CAMLOC_SCEAUX_DIR`` or ``--sceaux``: the repository's ``images`` folder). These
     are run with and without their EXIF.
+``perrot``
+    ``rperrot/ReconstructionDataSet`` (R. Perrot, the openMVG image list's "HIGH-RES"
+    sets; ``git clone https://github.com/rperrot/ReconstructionDataSet``, a few GB; or
+    ``CAMLOC_PERROT_DIR`` / ``--perrot``): about 530 outdoor photos of churches, doors,
+    facades and a statue on a facade, taken with a Canon DSLR, EXIF kept. Truth: the focal
+    length from EXIF (``FocalLength`` with the focal-plane resolution, or a sensor table
+    through ``CAMLOC_SENSOR_DB``; ``FocalLengthIn35mmFilm`` last), so it is as good as the
+    camera's rounding of the focal length to whole millimetres (about 2-3 %). No gravity
+    or horizon truth. Run with and without the EXIF.
+``exif``
+    Any further folders of outdoor photos whose EXIF gives the focal length
+    (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
+    separated): each is a set named by its folder, truth from EXIF as for ``perrot``,
+    run with and without it. Photos without a usable EXIF focal length are skipped
+    (counted in the log).
 ``yud``
     The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
     published calibration, horizon from the ground-truth vanishing points; research use
@@ -38,7 +53,11 @@ row says so):
   median |log error| / sigma;
 - the ROC AUC of ``1 - confidence`` as a predictor of a focal error over 10 %;
 - "confidently wrong": off by more than 10 % and more than twice the stated sigma, with
-  no warning and confidence at least 0.5.
+  no warning and confidence at least 0.5;
+- the share of photos with the pitch within 5 degrees, where the truth gives gravity,
+  and the same figures for the outdoor photos looking up by more than 5 degrees (the
+  Strecha photos: looking up 5 to 15 degrees; none of the sets looks up steeply, so the
+  steep case is checked on synthetic facades only, ``tests/test_autovp_failure_modes.py``).
 
 Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 """
@@ -82,15 +101,20 @@ DEFAULT_STRECHA = Path(
 DEFAULT_SCEAUX = Path(
     os.environ.get("CAMLOC_SCEAUX_DIR", str(PHOTOS / "ImageDataset_SceauxCastle" / "images"))
 )
+DEFAULT_PERROT = Path(os.environ.get("CAMLOC_PERROT_DIR", str(PHOTOS / "ReconstructionDataSet")))
 _YORK_URBAN_BESIDE = HERE.parents[1] / "shared" / "data" / "yud" / "YorkUrbanDB"
 DEFAULT_YUD = Path(os.environ.get("CAMLOC_YUD_DIR", str(_YORK_URBAN_BESIDE)))
+
+#: Photos whose true pitch looks up by more than this (degrees) are also summarised apart.
+LOOKING_UP_DEG = 5.0
 
 HOW_TO_GET = (
     "benchmarks/fetch_real_photos.sh, or: "
     "git clone https://github.com/openMVG/SfM_quality_evaluation and set CAMLOC_STRECHA_DIR "
     "to its Benchmarking_Camera_Calibration_2008 folder; git clone "
     "https://github.com/openMVG/ImageDataset_SceauxCastle and set CAMLOC_SCEAUX_DIR to its "
-    "images folder; CAMLOC_YUD_DIR: the York Urban DB (York University)"
+    "images folder; git clone https://github.com/rperrot/ReconstructionDataSet and set "
+    "CAMLOC_PERROT_DIR to it; CAMLOC_YUD_DIR: the York Urban DB (York University)"
 )
 
 
@@ -141,6 +165,61 @@ def load_sceaux(root: Path) -> list[dict[str, Any]]:
     return out
 
 
+_PHOTO_SUFFIXES = {".jpg", ".jpeg"}
+
+
+def load_exif_folder(root: Path, set_name: str) -> list[dict[str, Any]]:
+    """Photos under ``root`` (recursively) whose EXIF gives the focal length: the truth.
+
+    The focal length from the focal-plane resolution or a sensor table is preferred to
+    ``FocalLengthIn35mmFilm`` (a whole number of millimetres, and the crop it assumes).
+    """
+    from PIL import Image
+
+    from camloc_geo.exif import focal_from_exif, focal_from_tags
+
+    out = []
+    skipped = 0
+    for p in sorted(q for q in root.rglob("*") if q.suffix.lower() in _PHOTO_SUFFIXES):
+        if any(part.startswith(".") for part in p.relative_to(root).parts):
+            continue
+        try:
+            with Image.open(p) as im:
+                w, h = im.size
+                exif = im.getexif()
+                tags: dict[int, Any] = dict(exif)
+                tags.update(exif.get_ifd(0x8769))
+        except (OSError, ValueError, SyntaxError):
+            skipped += 1
+            continue
+        no35 = {k: v for k, v in tags.items() if k != 0xA405}
+        ex = focal_from_tags(no35, w, h) or focal_from_exif(p)
+        if ex is None:
+            skipped += 1
+            continue
+        out.append(
+            {
+                "set": set_name,
+                "name": f"{set_name}/{p.relative_to(root).as_posix()}",
+                "path": str(p),
+                "f": ex.focal_px,
+                "f_source": ex.source,
+                "pp": (w / 2.0, h / 2.0),
+                "up": None,
+                "size": (w, h),
+                "exif": True,
+            }
+        )
+    if skipped:
+        log.info("%s: %d photos without a usable EXIF focal length skipped", set_name, skipped)
+    return out
+
+
+def load_perrot(root: Path) -> list[dict[str, Any]]:
+    """The ReconstructionDataSet photos, truth from their EXIF."""
+    return load_exif_folder(root, "perrot")
+
+
 def load_yud_set(root: Path) -> list[dict[str, Any]]:
     out = []
     for g in load_yud(root):
@@ -181,7 +260,14 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
     rows = []
     for t in data:
         t0 = time.perf_counter()
-        row: dict[str, Any] = {"set": t["set"], "name": t["name"], "f_true": t["f"]}
+        row: dict[str, Any] = {
+            "set": t["set"],
+            "name": t["name"],
+            "f_true": t["f"],
+            "has_horizon_truth": t["up"] is not None,
+        }
+        if t["up"] is not None:
+            row["pitch_true_deg"] = pitch_roll_from_up(t["up"])[0]
         try:
             res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
         except NotEnoughStructureError as exc:
@@ -253,8 +339,9 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     warned = np.array([bool(r["warnings"]) for r in ok])
     confidently_wrong = bad & (ale > 2 * sig) & ~warned & (conf >= 0.5)
     hz = [r["hz_err"] for r in rows if r.get("hz_err") is not None] + [
-        math.inf for r in rows if "f" not in r and r["set"] != "sceaux"
+        math.inf for r in rows if "f" not in r and r["has_horizon_truth"]
     ]
+    with_up = [r for r in rows if "pitch_true_deg" in r]
     all_abs = np.concatenate([np.abs(fe), np.full(n - len(ok), np.inf)])
     out: dict[str, Any] = {
         "n_images": n,
@@ -278,6 +365,11 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "n_with_horizon_truth": len(hz),
         "horizon_auc_pct": 100.0 * horizon_auc(hz) if hz else None,
         "horizon_err_median": float(np.median(hz)) if hz else None,
+        "share_pitch_within_5deg": (
+            float(np.mean([abs(r.get("pitch_err_deg", math.inf)) <= 5.0 for r in with_up]))
+            if with_up
+            else None
+        ),
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
     }
     return out
@@ -309,8 +401,10 @@ def plots(runs: dict[str, list[dict[str, Any]]], out_dir: Path) -> None:
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for s in sets:
-        hz = np.sort([r.get("hz_err") or math.inf for r in rows if r["set"] == s])
-        if s == "sceaux" or not len(hz):
+        hz = np.sort(
+            [r.get("hz_err") or math.inf for r in rows if r["set"] == s and r["has_horizon_truth"]]
+        )
+        if not len(hz):
             continue
         ax.step(
             np.concatenate([[0], hz]),
@@ -356,8 +450,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--strecha", type=Path, default=DEFAULT_STRECHA)
     ap.add_argument("--sceaux", type=Path, default=DEFAULT_SCEAUX)
     ap.add_argument("--yud", type=Path, default=DEFAULT_YUD)
+    ap.add_argument("--perrot", type=Path, default=DEFAULT_PERROT)
+    ap.add_argument(
+        "--exif-dir",
+        type=Path,
+        action="append",
+        default=[
+            Path(d) for d in os.environ.get("CAMLOC_EXIF_PHOTO_DIRS", "").split(os.pathsep) if d
+        ],
+        help="a folder of outdoor photos whose EXIF gives the focal length (repeatable)",
+    )
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
-    ap.add_argument("--sets", default="strecha,sceaux,yud")
+    ap.add_argument("--sets", default="strecha,sceaux,perrot,exif,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
@@ -369,6 +473,7 @@ def main(argv: list[str] | None = None) -> int:
     for name, root, loader in (
         ("strecha", args.strecha, load_strecha),
         ("sceaux", args.sceaux, load_sceaux),
+        ("perrot", args.perrot, load_perrot),
         ("yud", args.yud, load_yud_set),
     ):
         if name not in wanted:
@@ -377,6 +482,11 @@ def main(argv: list[str] | None = None) -> int:
             log.warning("%s: not found at %s (%s)", name, root, HOW_TO_GET)
             continue
         data.extend(loader(root)[: args.limit])
+    for d in args.exif_dir if "exif" in wanted else []:
+        if not d.is_dir():
+            log.warning("--exif-dir %s: not a folder", d)
+            continue
+        data.extend(load_exif_folder(d, d.name)[: args.limit])
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
@@ -392,7 +502,11 @@ def main(argv: list[str] | None = None) -> int:
             summary[tag][s] = summarise([r for r in rows if r["set"] == s])
         outdoor = [r for r in rows if r["set"] != "yud"]
         if outdoor and len(outdoor) != len(rows):
-            summary[tag]["outdoor (strecha+sceaux)"] = summarise(outdoor)
+            summary[tag]["outdoor (all but yud)"] = summarise(outdoor)
+        # photos looking up at a building, where the truth gives gravity
+        up = [r for r in outdoor if r.get("pitch_true_deg", 0.0) < -LOOKING_UP_DEG]
+        if up:
+            summary[tag][f"outdoor looking up > {LOOKING_UP_DEG:.0f} deg"] = summarise(up)
     args.out.mkdir(parents=True, exist_ok=True)
     with open(args.out / "vp_real.json", "w", encoding="utf-8") as fh:
         json.dump({"summary": summary, "per_image": runs}, fh, indent=1, default=float)
@@ -408,6 +522,7 @@ def main(argv: list[str] | None = None) -> int:
         ("n_confidently_wrong", "conf.wrong", "{}"),
         ("n_warned", "warned", "{}"),
         ("horizon_auc_pct", "hz AUC %", "{:.1f}"),
+        ("share_pitch_within_5deg", "pitch<=5deg", "{:.2f}"),
         ("pitch_sigma_cover_1", "pitch 1sig", "{:.2f}"),
         ("pitch_sigma_cover_2", "pitch 2sig", "{:.2f}"),
         ("pitch_median_err_over_sigma", "p err/sig", "{:.2f}"),
@@ -415,14 +530,14 @@ def main(argv: list[str] | None = None) -> int:
         ("roll_median_err_over_sigma", "r err/sig", "{:.2f}"),
         ("n_refused", "refused", "{}"),
     ]
-    lines = [f"{'run / set':32s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
+    lines = [f"{'run / set':40s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
     for tag, per in summary.items():
         for s, sm in per.items():
             cells = []
             for k, _, fmt in keys:
                 v = sm.get(k)
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
-            lines.append(f"{(tag + ' / ' + s):32s} " + " ".join(cells))
+            lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
     log.info("\n".join(lines))
     return 0
 

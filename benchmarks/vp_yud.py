@@ -235,6 +235,8 @@ def run_ours(
     rows = []
     for gt in data:
         img = cv2.imread(gt["path"], cv2.IMREAD_COLOR)
+        if img is None:
+            raise SystemExit(f"{gt['path']}: cannot read the photo")
         h, w = img.shape[:2]
         t0, c0 = time.perf_counter(), time.process_time()
         try:

@@ -92,6 +92,7 @@ def soft_l1_least_squares(
     max_nfev: int = 200,
     fun_and_jac: ResidualsAndJacobian | None = None,
     damping: float = 1e-3,
+    sigma_tol: float | None = None,
 ) -> LeastSquaresResult:
     """Minimise the soft-L1 cost of ``fun(x)`` from ``x0``.
 
@@ -116,6 +117,13 @@ def soft_l1_least_squares(
     damping
         ``lm``: the initial Levenberg-Marquardt damping (relative to the normal equations'
         diagonal); smaller suits a start already near the minimum.
+    sigma_tol
+        ``lm``: also stop once the fit no longer moves the answer: when the undamped
+        Gauss-Newton step from ``x`` is shorter than ``sigma_tol`` of the parameters' own
+        1-sigma (its Newton decrement ``gᵀ A⁻¹ g`` below ``sigma_tol² s²``, ``s²`` the
+        residual variance factor ``2 cost / (m − n)``, at least 1e-12). ``x`` is returned
+        as it is (with its residuals and Jacobian, no further evaluation): within
+        ``sigma_tol`` sigma of the minimum. None: the tolerances alone.
     """
     x = np.asarray(x0, dtype=np.float64).copy()
     if project is not None:
@@ -132,6 +140,7 @@ def soft_l1_least_squares(
         max_nfev=max_nfev,
         fun_and_jac=fun_and_jac,
         damping=damping,
+        sigma_tol=sigma_tol,
     )
 
 
@@ -174,6 +183,7 @@ def _lm_soft_l1(
     max_nfev: int,
     fun_and_jac: ResidualsAndJacobian | None = None,
     damping: float = 1e-3,
+    sigma_tol: float | None = None,
 ) -> LeastSquaresResult:
     """Levenberg-Marquardt on soft-L1 reweighted residuals (IRLS weights per step)."""
     c2 = f_scale**2
@@ -197,7 +207,17 @@ def _lm_soft_l1(
         diag = np.diag(A).copy()
         diag[diag <= 0] = 1e-12
         try:
-            dx = -np.linalg.solve(A + lam * np.diag(diag), g)
+            if sigma_tol is None:
+                dx = -np.linalg.solve(A + lam * np.diag(diag), g)
+            else:
+                # The damped step and the undamped Gauss-Newton step in one call.
+                both = np.linalg.solve(
+                    np.stack([A + lam * np.diag(diag), A]), np.stack([g, g])[:, :, None]
+                )[:, :, 0]
+                if _within_sigma(float(g @ both[1]), cost, len(r), len(g), sigma_tol):
+                    success = True
+                    break
+                dx = -both[0]
         except np.linalg.LinAlgError:
             lam *= 10.0
             if lam > 1e12:
@@ -329,6 +349,13 @@ def soft_l1_least_squares_many(
             )
         )
     return out
+
+
+def _within_sigma(decrement: float, cost: float, m: int, n: int, sigma_tol: float) -> bool:
+    """A Gauss-Newton step of Newton decrement ``gᵀ A⁻¹ g`` is under ``sigma_tol`` of the
+    parameters' 1-sigma (``A⁻¹ s²``, ``s² = 2 cost / (m − n)``, at least 1e-12)."""
+    s2 = max(2.0 * cost / max(m - n, 1), 1e-12)
+    return bool(np.isfinite(decrement) and 0.0 <= decrement <= sigma_tol * sigma_tol * s2)
 
 
 def gauss_newton(

@@ -115,7 +115,17 @@ class CalibrationSettings:
         length along its length edge and of its width along its width edge; 2.5 %: 11 cm and
         4.5 cm for a sedan), in pixels that fraction of the clicked edges; the parameters'
         move under it enters the stated sigmas as a consider covariance
-        (:func:`_ground_corner_sensitivity`); 0 turns it off.
+        (:func:`_ground_corner_sensitivity`), scaled by the evidence for it: the clicks'
+        scatter beyond the annotators' own precision on their lines, clipped to
+        ``[0.1, 1]`` of the term (:func:`_ground_corner_evidence`); 0 turns it off.
+    photo_lines
+        Where the scene carries its photo (``image.path``), segments detected in it
+        (:mod:`camloc_geo.autovp`) that agree with the annotators' fit (within
+        ``PHOTO_SEGMENT_TOL`` line sigmas of one axis' vanishing point, and clearly off the
+        others) join the final fit with a small weight: each at ``PHOTO_SEGMENT_SIGMA``
+        line sigmas, per axis at most as much as the annotators' average lines of that axis
+        count, under the fit's robust loss (:func:`_add_photo_segments`). Lines that
+        disagree are not used (a clear disagreement is a warning); False: never.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -143,6 +153,7 @@ class CalibrationSettings:
     ground_corner_sigma_rel: float = 0.025
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
+    photo_lines: bool = True
 
 
 @dataclass
@@ -282,6 +293,9 @@ class CalibrationResult:
     annotator_influence_m
         Per annotation, how far the camera moves when it is left out (None: not computed, or
         no comparable answer without it).
+    photo_segments
+        Segments detected in the scene's photo that joined the fit, per axis
+        (``CalibrationSettings.photo_lines``); empty when none did.
     """
 
     camera: Camera
@@ -309,6 +323,7 @@ class CalibrationResult:
     principal_point_sigma_px: list[float] | None = None
     parameter_covariance: FloatArray | None = field(default=None, repr=False, compare=False)
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
+    photo_segments: dict[str, int] = field(default_factory=dict)
 
     @property
     def focal_sigma_with_principal_point_px(self) -> float | None:
@@ -401,6 +416,8 @@ class CalibrationResult:
             out["camera_in_world_sigma_fit_m"] = self.position_sigma_fit_m.tolist()
         if self.position_sigma_jackknife_m is not None:
             out["camera_in_world_sigma_jackknife_m"] = self.position_sigma_jackknife_m.tolist()
+        if self.photo_segments:
+            out["photo_segments"] = dict(self.photo_segments)
         out["cluster"] = self.cluster
         out["annotators"] = [a.to_dict() for a in self.annotators]
         if self.warnings:
@@ -685,27 +702,68 @@ def _ground_corner_sensitivity(
     H = J.T @ JW
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
     clicks = prob.pt_pix.reshape(-1, 4, 2)
-    scale = prob._pt_scale
-    cols = []
-    for a in range(len(clicks)):
-        for end in (1, 2):
-            edge = clicks[a, end] - clicks[a, 0]
-            norm = float(np.linalg.norm(edge))
-            if norm <= 0.0:
-                continue
-            step = rel * edge  # 1-sigma move of a click along this ground axis, pixels
-            for j in range(4 * a, 4 * a + 4):
-                # Jᵀ W dr, dr nonzero only at the click's u and v rows
-                cols.append(-scale[j] * (step[0] * JW[n_seg + j] + step[1] * JW[n_seg + n_pt + j]))
-    if not cols:
+    # 1-sigma moves of each click along its annotator's length and width edges, pixels:
+    # steps[j, e] for click j, edge e (a zero edge gives no column)
+    edges = np.stack([clicks[:, 1] - clicks[:, 0], clicks[:, 2] - clicks[:, 0]], axis=1)
+    steps = np.repeat(rel * edges, 4, axis=0)  # (n_pt, 2, 2)
+    live = np.repeat(np.linalg.norm(edges, axis=2) > 0.0, 4, axis=0)  # (n_pt, 2)
+    if not np.any(live):
         return None
+    # Jᵀ W dr, dr nonzero only at the click's u and v rows: one column per (click, edge)
+    ju = JW[n_seg : n_seg + n_pt] * prob._pt_scale[:, None]  # (n_pt, n)
+    jv = JW[n_seg + n_pt : n_seg + 2 * n_pt] * prob._pt_scale[:, None]
+    cols = -(steps[:, :, 0:1] * ju[:, None, :] + steps[:, :, 1:2] * jv[:, None, :])
+    cols = cols[live]  # (k, n)
+    factor = _ground_corner_evidence(prob, r)
     try:
-        D = -np.linalg.solve(H, np.column_stack(cols))
+        D = -factor * np.linalg.solve(H, cols.T)
     except np.linalg.LinAlgError:
         return None
     if not np.all(np.isfinite(D)):
         return None
     return np.asarray(D, dtype=np.float64)
+
+
+GROUND_CORNER_FLOOR = 0.1  # the ground-corner term's least share (of its 1-sigma)
+
+
+def _ground_corner_evidence(prob: _JointProblem, r: FloatArray) -> float:
+    """How much of the ground-corner term the clicks' residuals support, in ``[floor, 1]``.
+
+    A click off the ground corner (the tyre contact, a bumper's overhang) does not fit the
+    car's box as the lines place it, so the axis clicks scatter more than the annotators'
+    own precision. That precision is measured on their lines: a segment's residual is half
+    the difference of its two ends' offsets, so ``2 × mean(d²)`` estimates an end's
+    variance per axis. The clicks' excess over it (their pixel residuals' mean square per
+    coordinate minus that variance) is compared with the term's own mean square per
+    coordinate (``(rel·|length edge|)² + (rel·|width edge|)²`` over two): the term's sigma
+    is scaled by ``√(excess / term)``, clipped to ``[GROUND_CORNER_FLOOR, 1]``. Annotators'
+    weights weigh both means. Clicks as precise as the lines (noise-free scenes; the street
+    scenes' 1 px clicks and lines) keep the floor; clicks off by a size mismatch or a tyre
+    contact keep the whole term. The floor keeps a tenth of it for offsets the residuals
+    cannot show (an annotator who clicks every corner the same way, absorbed by the
+    preset's size uncertainty).
+    """
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    w_seg, w_pt = prob._w_seg, prob._w_pt
+    if not (np.all(w_seg > 0.0) and np.all(w_pt > 0.0)):
+        return 1.0
+    # pixel residuals, the annotators' weights taken out (they weigh the means below)
+    d_seg = r[:n_seg] / w_seg * prob.sigma_line
+    d_u = r[n_seg : n_seg + n_pt] / w_pt * prob._sigma_pt_each
+    d_v = r[n_seg + n_pt : n_seg + 2 * n_pt] / w_pt * prob._sigma_pt_each
+    a_seg, a_pt = w_seg**2, w_pt**2  # the annotators' weights per row
+    line_end_var = 2.0 * float(a_seg @ d_seg**2) / max(float(a_seg.sum()) - 6.0, 1.0)
+    click_var = float(a_pt @ (d_u**2 + d_v**2)) / max(2.0 * float(a_pt.sum()) - 3.0, 1.0)
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    edge_sq = np.sum((clicks[:, 1] - clicks[:, 0]) ** 2, axis=1) + np.sum(
+        (clicks[:, 2] - clicks[:, 0]) ** 2, axis=1
+    )  # per annotator: |length edge|² + |width edge|², pixels²
+    term_var = prob.ground_corner_sigma_rel**2 * float(np.average(edge_sq, weights=a_pt[::4])) / 2.0
+    if term_var <= 0.0:
+        return 1.0
+    excess = max(click_var - line_end_var, 0.0)
+    return float(np.clip(math.sqrt(excess / term_var), GROUND_CORNER_FLOOR, 1.0))
 
 
 class _JointProblem:
@@ -765,6 +823,12 @@ class _JointProblem:
         # segment_residuals_px's numerator is V · n for a vanishing point V = (x, y, w).
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        # Segments detected in the scene's photo (set_photo_segments): their rows follow the
+        # clicks' (owned by no annotator, like the priors), with their own fixed sigma.
+        self._seg_axis_all = self.seg_axis
+        self._photo_scale = np.zeros(0)
+        self.photo_segments = np.zeros((0, 4))
+        self.photo_axis = np.zeros(0, dtype=int)
         self.weights = np.ones(self.n_annotators)
         self.f_bounds = (0.15 * width, 15.0 * width)
         # A weak log-normal prior on the focal length (settings.focal_prior_sigma_log; 0 = none).
@@ -775,6 +839,50 @@ class _JointProblem:
         # A Gaussian prior on a fitted principal point, at the image centre.
         self.pp_prior = np.array([width / 2.0, height / 2.0])
         self.pp_prior_sigma = settings.principal_point_prior_sigma_rel * math.hypot(width, height)
+        # The last few evaluations: the covariance, the score test, the jackknife and the
+        # annotators' RMS all look again at points the fits have just evaluated.
+        self._memo: dict[tuple[Any, ...], tuple[FloatArray, FloatArray | None]] = {}
+
+    def _memo_key(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+        weights: FloatArray | None = None,
+    ) -> tuple[Any, ...]:
+        w = self._weights if weights is None else weights
+        return (
+            np.asarray(x, dtype=float).tobytes(),
+            np.asarray(R0, dtype=float).tobytes(),
+            pp_fixed,
+            f_fixed,
+            w.tobytes(),
+            self.corners.tobytes(),
+            self.log_f_prior_sigma,
+            self.pp_prior_sigma,
+        )
+
+    def _remember(self, key: tuple[Any, ...], r: FloatArray, J: FloatArray | None) -> None:
+        if len(self._memo) >= _MEMO_SIZE:
+            self._memo.pop(next(iter(self._memo)))
+        self._memo[key] = (r, J)
+
+    def set_photo_segments(
+        self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
+    ) -> None:
+        """Add segments detected in the photo: ``(k, 4)``, their axis index, 1-sigma (px)."""
+        photo = np.asarray(segments, dtype=float).reshape(-1, 4)
+        self.photo_segments = photo
+        self.photo_axis = np.asarray(axes, dtype=int).reshape(-1)
+        self._photo_scale = 1.0 / np.broadcast_to(np.asarray(sigma_px, float), (len(photo),))
+        seg = np.vstack([self.segments, photo])
+        self._seg_axis_all = np.concatenate([self.seg_axis, self.photo_axis])
+        self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
+        x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
+        self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self.weights = self._weights  # the scales of all segment rows
+        self._memo.clear()
 
     def set_corners(self, corners: npt.ArrayLike) -> None:
         """Which ground corner of the car each annotator marked as the origin.
@@ -834,7 +942,7 @@ class _JointProblem:
             pp = X[:, k : k + 2]
             k += 2
         else:
-            pp = np.broadcast_to(np.asarray(pp_fixed, float), (P, 2))
+            pp = np.array([pp_fixed], dtype=float)  # (1, 2): broadcasts over the batch
         R = _rotvec_matrices(X[:, k : k + 3]) @ R0
         C = X[:, k + 3 : k + 6]
         return f, pp, R, C
@@ -847,7 +955,39 @@ class _JointProblem:
         f_fixed: float | None,
     ) -> FloatArray:
         """Normalised residuals (segments, then point u, then point v)."""
-        return self.residuals_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)[0]
+        x = np.asarray(x, dtype=float)
+        key = self._memo_key(x, R0, pp_fixed, f_fixed)
+        hit = self._memo.get(key)
+        if hit is not None:
+            return hit[0]
+        r = np.asarray(self.residuals_batch(x[None, :], R0, pp_fixed, f_fixed)[0], dtype=float)
+        self._remember(key, r, None)
+        return r
+
+    def unweighted_residuals(
+        self,
+        x: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> FloatArray:
+        """The annotation residuals (segments, point u, point v) with every weight 1.
+
+        From a remembered evaluation at the current weights where there is one (the rows
+        divided by their annotator's √weight), else evaluated.
+        """
+        n_rows = len(self.segments) + 2 * len(self.pt_pix)
+        x = np.asarray(x, dtype=float)
+        hit = self._memo.get(self._memo_key(x, R0, pp_fixed, f_fixed))
+        if hit is not None and np.all(self._weights > 0.0):
+            scale = np.concatenate([self._w_seg, self._w_pt, self._w_pt])
+            return np.asarray(hit[0][:n_rows] / scale, dtype=np.float64)
+        saved = self.weights
+        self.weights = np.ones(self.n_annotators)
+        try:
+            return self.residuals(x, R0, pp_fixed, f_fixed)[:n_rows]
+        finally:
+            self.weights = saved
 
     def jacobian(
         self,
@@ -868,12 +1008,20 @@ class _JointProblem:
     ) -> tuple[FloatArray, FloatArray]:
         """The residuals and their forward-difference Jacobian from one batched evaluation."""
         x = np.asarray(x, dtype=float)
+        key = self._memo_key(x, R0, pp_fixed, f_fixed)
+        hit = self._memo.get(key)
+        if hit is not None and hit[1] is not None:
+            return hit[0], hit[1]
         n = len(x)
         h = 1e-7 * np.maximum(1.0, np.abs(x))
-        X = np.vstack([x, x + np.diag(h)])
+        X = np.empty((n + 1, n))
+        X[:] = x
+        X[1:] += np.diag(h)
         Rb = self.residuals_batch(X, R0, pp_fixed, f_fixed)
         J = np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
-        return np.asarray(Rb[0], dtype=np.float64), J
+        r = np.asarray(Rb[0], dtype=np.float64)
+        self._remember(key, r, J)
+        return r, J
 
     def residuals_batch(
         self,
@@ -891,7 +1039,7 @@ class _JointProblem:
         V[:, :, 0] = fc * R[:, 0, :] + cx * R[:, 2, :]
         V[:, :, 1] = fc * R[:, 1, :] + cy * R[:, 2, :]
         V[:, :, 2] = R[:, 2, :]
-        Vs = V[:, self.seg_axis, :]  # (P, n_seg, 3)
+        Vs = V[:, self._seg_axis_all, :]  # (P, n_seg + n_photo, 3)
         px, py, pw = Vs[..., 0], Vs[..., 1], Vs[..., 2]
         mx, my = self._mid[:, 0], self._mid[:, 1]
         # Line through the midpoint (mx, my, 1) and the vanishing point; the first endpoint's
@@ -900,12 +1048,16 @@ class _JointProblem:
         lb = px - mx * pw
         norm = np.sqrt(la * la + lb * lb)
         num = np.einsum("psk,sk->ps", Vs, self._seg_n)
-        r_seg = num / np.maximum(norm, 1e-300) * self._seg_scale
-        pc = np.einsum("pij,pnj->pni", R, self.pt_world[None, :, :] - C[:, None, :])
+        r_all = num / np.maximum(norm, 1e-300) * self._seg_scale
+        n_seg = len(self.segments)
+        r_seg = r_all[:, :n_seg]
+        pc = (self.pt_world[None, :, :] - C[:, None, :]) @ np.swapaxes(R, 1, 2)
         z = np.maximum(pc[:, :, 2], self._z_min)
         u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * self._pt_scale
         v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * self._pt_scale
         parts = [r_seg, u, v]
+        if len(self.photo_segments):
+            parts.append(r_all[:, n_seg:])
         if f_fixed is None and self.log_f_prior_sigma > 0.0:
             parts.append((np.log(f) - self.log_f_prior)[:, None] / self.log_f_prior_sigma)
         if pp_fixed is None and self.pp_prior_sigma > 0.0:
@@ -921,7 +1073,7 @@ class _JointProblem:
         self._weights = np.asarray(value, dtype=float)
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
-        self._seg_scale = self._w_seg / self.sigma_line
+        self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
         self._pt_scale = self._w_pt / self._sigma_pt_each
 
     def per_annotator_rms(
@@ -931,10 +1083,7 @@ class _JointProblem:
         pp_fixed: tuple[float, float] | None,
         f_fixed: float | None,
     ) -> FloatArray:
-        saved = self.weights
-        self.weights = np.ones(self.n_annotators)
-        r = self.residuals(x, R0, pp_fixed, f_fixed)
-        self.weights = saved
+        r = self.unweighted_residuals(x, R0, pp_fixed, f_fixed)
         n_seg, n_pt = len(self.segments), len(self.pt_pix)
         sq_seg = r[:n_seg] ** 2
         sq_pt = r[n_seg : n_seg + n_pt] ** 2 + r[n_seg + n_pt : n_seg + 2 * n_pt] ** 2
@@ -947,6 +1096,7 @@ class _JointProblem:
         return np.asarray(np.sqrt(num / np.maximum(den, 1)), dtype=np.float64)
 
 
+_MEMO_SIZE = 8  # evaluations a _JointProblem remembers
 _F_SCALE = 2.5  # soft-L1 scale of the normalised residuals (in sigmas)
 _GOOD_SEED_SCORE = 1.0  # median annotator RMS (in sigmas) at which a seed's fit is good
 
@@ -992,6 +1142,16 @@ def _small_rotvec(R: FloatArray) -> FloatArray:
     return np.asarray(theta / (2.0 * math.sin(theta)) * v, dtype=np.float64)
 
 
+# Every fit stops once its next Gauss-Newton step would move the answer by less than this
+# fraction of its own 1-sigma (the Newton decrement, soft_l1_least_squares's sigma_tol).
+_SIGMA_TOL = 0.01
+# The seeds' fits only rank the seeds and start the reweighting: a sigma is close enough
+# (0.3 -> 1.0: evaluations 6.8 -> 4.2 a seed; relative.py --n 100 the same figures, every
+# camera within 0.16 of its sigma of the fits to the tolerances alone, 99 % within 0.023).
+_SEED_SIGMA_TOL = 1.0
+_RW_SIGMA_TOL = 0.1  # the reweighting and corner refits
+
+
 def _fit(
     prob: _JointProblem,
     x0: FloatArray,
@@ -1002,6 +1162,7 @@ def _fit(
     tol: float = 1e-10,
     max_nfev: int = 200,
     method: Literal["lm", "scipy"] = "lm",
+    sigma_tol: float | None = _SIGMA_TOL,
 ) -> LeastSquaresResult:
     """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`.
 
@@ -1028,6 +1189,7 @@ def _fit(
         # light initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations,
         # the reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
         damping=1e-4,
+        sigma_tol=sigma_tol,
     )
 
 
@@ -1044,9 +1206,9 @@ def _score_test(
     Gauss-Newton Hessian of the full model, ``gᵀ H⁻¹ g`` approximates how much the cost
     would fall, at the price of one Jacobian.
     """
-    f0, _pp, R1, C1 = prob.unpack(x_fixed, R0, pp_fixed, f_fixed)
-    x1 = _pack(f0, pp_fixed, C1, f_fixed is None, True)
-    x1[-6:-3] = _small_rotvec(R1 @ R0.T)
+    # The parameters with the principal point inserted, as _pinned_pp_sensitivity builds
+    # them (the same evaluation serves both).
+    x1 = np.insert(np.asarray(x_fixed, dtype=float), int(f_fixed is None), pp_fixed)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
@@ -1054,9 +1216,25 @@ def _score_test(
     Jw = J * np.sqrt(w)[:, None]
     g = Jw.T @ (r * np.sqrt(w))
     try:
-        return float(g @ np.linalg.pinv(Jw.T @ Jw) @ g)
+        return float(g @ _sym_inverse(Jw.T @ Jw) @ g)
     except np.linalg.LinAlgError:
         return 0.0
+
+
+def _sym_inverse(A: FloatArray) -> FloatArray:
+    """Inverse of a symmetric positive semi-definite matrix: Cholesky where it is well
+    conditioned (~4x cheaper than an SVD on these 7-9 parameter problems), else the
+    pseudo-inverse (a singular direction gets no variance, as before)."""
+    d = np.sqrt(np.clip(np.diag(A), 1e-300, None))
+    As = A / d[:, None] / d[None, :]
+    try:
+        L = np.linalg.cholesky(As)
+    except np.linalg.LinAlgError:
+        return np.asarray(np.linalg.pinv(A), dtype=np.float64)
+    if float(np.min(np.diag(L))) ** 2 < 1e-10:  # nearly singular: as the pseudo-inverse
+        return np.asarray(np.linalg.pinv(A), dtype=np.float64)
+    L_inv = np.linalg.inv(L)
+    return np.asarray((L_inv.T @ L_inv) / d[:, None] / d[None, :], dtype=np.float64)
 
 
 def _pack(
@@ -1636,6 +1814,96 @@ PHOTO_AXIS_NEAR_DEG = 30.0  # ... when it is the photo's nearest direction to th
 PHOTO_MIN_SEGMENTS = 6  # a detected direction needs this many segments to count
 
 
+PHOTO_SEGMENT_TOL = 2.0  # a photo segment within this many line sigmas of an axis' VP agrees
+PHOTO_SEGMENT_SIGMA = 2.0  # ... and joins the fit at this many line sigmas
+PHOTO_SEGMENT_MIN_REL = 0.02  # ... if at least this long (fraction of the image diagonal)
+
+
+def _photo_result(scene: Scene) -> Any | None:
+    """The scene photo's detected vanishing points and segments (cached), or None."""
+    path = scene.image_file()
+    if path is None or not path.is_file():  # is_file: a FIFO or a device would block
+        return None
+    stat = path.stat()
+    try:
+        return _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except (InputError, ValueError) as exc:
+        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+        return None
+
+
+def _add_photo_segments(
+    scene: Scene,
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+) -> dict[str, int]:
+    """Give ``prob`` the photo's segments that agree with the fit at ``x``; count per axis.
+
+    A segment detected in the photo (:mod:`camloc_geo.autovp`, at least
+    ``PHOTO_SEGMENT_MIN_REL`` of the diagonal long) agrees with an axis when its residual
+    to that axis' vanishing point of the fit is within ``PHOTO_SEGMENT_TOL`` line sigmas
+    (``sigma_line_rel``) and its residuals to the other two are beyond three times that.
+    Each joins at ``PHOTO_SEGMENT_SIGMA`` line sigmas, widened where an axis has more of
+    them than the annotators drew on average for it (their total weight then equals that
+    many such segments): a small weight, under the fit's soft-L1 loss. Lines that disagree
+    with the fit are never added (a clear disagreement is :func:`_photo_disagreement`'s
+    warning). Nothing without a photo, with a lens distortion (the detector's pixels are
+    not undistorted here) or when the photo's size is not the scene's.
+    """
+    if scene.camera.distortion is not None:
+        return {}
+    res = _photo_result(scene)
+    if res is None or tuple(res.image_size) != tuple(scene.image_size):
+        return {}
+    segs = np.asarray(res.segments, dtype=float).reshape(-1, 4)
+    labels = np.asarray(res.labels, dtype=int).reshape(-1)
+    diag = math.hypot(*prob.image_wh)
+    long_enough = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
+    keep = (long_enough >= PHOTO_SEGMENT_MIN_REL * diag) & (labels >= 0)
+    segs, labels = segs[keep], labels[keep]
+    if len(segs) == 0:
+        return {}
+    f, (cx, cy), R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    K_inv = np.linalg.inv(np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]))
+    # Each of the photo's vanishing points (its own clustering: no choice by the fit) that
+    # is within PHOTO_AXIS_TOL_DEG of one of the fit's axes, and the nearest to it, lends
+    # that axis its segments.
+    cluster_axis = {}
+    for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if not (n > 0.0 and np.isfinite(n)) or np.count_nonzero(labels == k) < PHOTO_MIN_SEGMENTS:
+            continue
+        cosines = np.abs(R.T @ (d / n))  # against the fit's world axes in the camera frame
+        i = int(np.argmax(cosines))
+        if math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG:
+            cluster_axis[k] = i
+    if len(set(cluster_axis.values())) < len(cluster_axis):
+        return {}  # two of the photo's directions on one axis: ambiguous
+    take = np.isin(labels, list(cluster_axis))
+    if not np.any(take):
+        return {}
+    segs = segs[take]
+    axis = np.array([cluster_axis[int(k)] for k in labels[take]], dtype=int)
+    sigma = np.full(len(segs), PHOTO_SEGMENT_SIGMA * prob.sigma_line)
+    used: dict[str, int] = {}
+    for name, i in _AXIS_INDEX.items():
+        mine = axis == i
+        k = int(mine.sum())
+        if k == 0:
+            continue
+        per_annotator = max(float(np.sum(prob.seg_axis == i)) / prob.n_annotators, 2.0)
+        if k > per_annotator:
+            sigma[mine] *= math.sqrt(k / per_annotator)
+        used[name] = k
+    prob.set_photo_segments(segs, axis, sigma)
+    log.info("image.path: %s photo segments agree with the annotators' fit", used)
+    return used
+
+
 def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     """Warnings where the scene's photo and the annotators' fit clearly disagree.
 
@@ -1647,14 +1915,8 @@ def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     length more than 10 % and three combined sigmas off the fit's. No photo, or no lines in
     it: nothing (``image.path``'s own warnings say so). Lens distortion is not undone here.
     """
-    path = scene.image_file()
-    if path is None or not path.is_file() or result.camera is None:
-        return []
-    stat = path.stat()
-    try:
-        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
-    except (InputError, ValueError) as exc:
-        log.info("image.path: no vanishing points detected in %s: %s", path, exc)
+    res = _photo_result(scene) if result.camera is not None else None
+    if res is None:
         return []
     cam = result.camera
     R = np.asarray(cam.cam_from_world_rotation, dtype=float)
@@ -1868,8 +2130,9 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
         onehot = owner[None, :] == np.arange(n_ann)[:, None]  # (n_ann, m)
         H_all = J.T @ Jw
         g_all = Jw.T @ r
-        H_a = np.einsum("am,mi,mj->aij", onehot.astype(float), J, Jw)
-        g_a = onehot.astype(float) @ (Jw * r[:, None])
+        mask = onehot.astype(float)
+        H_a = np.swapaxes(mask[:, :, None] * J[None], 1, 2) @ Jw  # (n_ann, n, n), batched BLAS
+        g_a = mask @ (Jw * r[:, None])
         xs = _newton_steps(
             H_all[None] - H_a, g_all[None] - g_a, np.broadcast_to(x0, (n_ann, len(x0)))
         )
@@ -1884,16 +2147,14 @@ def _leave_one_out_steps(state: JointState, steps: int = 1) -> list[FloatArray |
             pts = np.array([xs[a] for a in live])
             X = (pts[:, None, :] + np.vstack([np.zeros(n), np.diag(h)])[None, :, :]).reshape(-1, n)
             Rb = prob.residuals_batch(X, *args).reshape(len(live), n + 1, -1)
-            Hs, gs = [], []
-            for k, a in enumerate(live):
-                keep = ~onehot[a]
-                r_k = Rb[k, 0, keep]
-                J_k = ((Rb[k, 1:][:, keep] - r_k[None, :]) / h[:, None]).T
-                w_k = 1.0 / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
-                Jw_k = J_k * w_k[:, None]
-                Hs.append(J_k.T @ Jw_k)
-                gs.append(Jw_k.T @ r_k)
-            for a, x_a in zip(live, _newton_steps(np.array(Hs), np.array(gs), pts), strict=True):
+            # All live annotators at once: their own rows get zero weight (left out).
+            r_k = Rb[:, 0, :]  # (L, m)
+            J_k = np.swapaxes((Rb[:, 1:, :] - r_k[:, None, :]) / h[None, :, None], 1, 2)
+            w_k = (1.0 - mask[live]) / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
+            Jw_k = J_k * w_k[:, :, None]  # (L, m, n)
+            Hs = np.swapaxes(J_k, 1, 2) @ Jw_k
+            gs = (np.swapaxes(Jw_k, 1, 2) @ r_k[:, :, None])[:, :, 0]
+            for a, x_a in zip(live, _newton_steps(Hs, gs, pts), strict=True):
                 xs[a] = x_a
         return xs
     finally:
@@ -2284,9 +2545,13 @@ def _reassign_corners(
         saved_corners, saved_w = prob.corners.copy(), prob.weights.copy()
         prob.set_corners(proposal)
         prob.weights = np.ones(prob.n_annotators)
-        x_new = _fit(prob, x, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x_new = _fit(
+            prob, x, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=_RW_SIGMA_TOL
+        ).x
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x_new, R0, pp_fixed, f_fixed))
-        x_new = _fit(prob, x_new, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x_new = _fit(
+            prob, x_new, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=_RW_SIGMA_TOL
+        ).x
         after = _robust_cost(prob, x_new, R0, pp_fixed, f_fixed)
         if after < before:
             x = x_new
@@ -2302,7 +2567,7 @@ def _param_sigma(res: Any, sl: slice) -> float | None:
     dof = max(len(res.fun) - len(res.x), 1)
     s2 = max(2.0 * res.cost / dof, 1e-12)
     try:
-        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
+        cov = _sym_inverse(res.jac.T @ res.jac) * s2
     except np.linalg.LinAlgError:
         return None
     return float(np.sqrt(np.max(np.clip(np.diag(cov)[sl], 0, None))))
@@ -2425,7 +2690,9 @@ def _joint(
         x0 = _pack(cam0.focal_px, pp_fixed, cam0.center_in_world, f_fixed is None, False)
         prob.set_corners([0 if w == prob.ws_common else 2 for w in width_signs])
         prob.weights = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
-        res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60)
+        res = _fit(
+            prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60, sigma_tol=_SEED_SIGMA_TOL
+        )
         score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
         below_ground = bool(prob.unpack(res.x, R0, pp_fixed, f_fixed)[3][2] <= 0.0)
         if best_key is None or score < best_key[1]:
@@ -2438,10 +2705,17 @@ def _joint(
         if np.allclose(new_w, prob.weights, atol=0.02):
             break
         prob.weights = new_w
-        x0 = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100).x
+        x0 = _fit(
+            prob, x0, R0, pp_fixed, f_fixed, tol=1e-6, max_nfev=100, sigma_tol=_RW_SIGMA_TOL
+        ).x
     if settings.reassign_corners:
         x0 = _reassign_corners(prob, x0, R0, pp_fixed, f_fixed)
     res = _fit(prob, x0, R0, pp_fixed, f_fixed, tol=1e-8)
+    photo_used: dict[str, int] = {}
+    if settings.photo_lines:
+        photo_used = _add_photo_segments(scene, prob, res.x, R0, pp_fixed, f_fixed)
+        if photo_used:
+            res = _fit(prob, res.x, R0, pp_fixed, f_fixed, tol=1e-8)
     if f_fixed is None and settings.focal_prior_sigma_log > 0.0:
         res = _focal_prior(prob, res, R0, pp_fixed, settings)
     chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
@@ -2526,8 +2800,8 @@ def _joint(
     outliers = [
         scene.annotations[i].annotator for i, w in enumerate(weights) if w < settings.outlier_weight
     ]
+    r = prob.unweighted_residuals(res.x, R0, pp_model, f_fixed)
     prob.weights = np.ones(prob.n_annotators)
-    r = prob.residuals(res.x, R0, pp_model, f_fixed)
     n_seg = len(prob.segments)
     rms_seg = float(np.sqrt(np.mean(r[:n_seg] ** 2))) * prob.sigma_line
     rms_pt = float(np.sqrt(np.mean(r[n_seg : n_seg + 2 * len(prob.pt_pix)] ** 2))) * prob.sigma_pt
@@ -2570,6 +2844,7 @@ def _joint(
         annotator_corners=corner_names,
         width_sign=ws_out,
         joint_state=state,
+        photo_segments=photo_used,
     )
     if len(chosen_corners) > 1:
         result.warnings.append(
@@ -2638,12 +2913,10 @@ def _pinned_pp_sensitivity(
     """
     k = int(f_fixed is None)
     x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
-    saved = prob.pp_prior_sigma
-    prob.pp_prior_sigma = 0.0  # the data's information alone; the prior is σ here
-    try:
-        r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
-    finally:
-        prob.pp_prior_sigma = saved
+    r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
+    if prob.pp_prior_sigma > 0.0:
+        # the data's information alone (the prior's two rows come last); the prior is σ here
+        r, J = r[:-2], J[:-2]
     w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
     H = J.T @ (J * w[:, None])
     pp_idx = [k, k + 1]
@@ -2683,10 +2956,17 @@ def _output_covariance(
     J = res.jac
     x = np.asarray(res.x, dtype=float)
     n_x = len(x)
-    dof = max(len(res.fun) - n_x, 1)
-    s2 = max(2.0 * res.cost / dof, 1e-12)
+    # The residual variance factor of the annotations (and priors) alone: the photo's
+    # segments join at a deliberately wide sigma, and their small residuals would shrink it.
+    fun = np.asarray(res.fun, dtype=float)
+    n_photo = len(prob.photo_segments)
+    if n_photo:
+        start = len(prob.segments) + 2 * len(prob.pt_pix)
+        fun = np.concatenate([fun[:start], fun[start + n_photo :]])
+    dof = max(len(fun) - n_x, 1)
+    s2 = max(2.0 * soft_l1_cost(fun, _F_SCALE) / dof, 1e-12)
     try:
-        cov = np.linalg.pinv(J.T @ J) * s2
+        cov = _sym_inverse(J.T @ J) * s2
     except np.linalg.LinAlgError:
         return None
     # Positions of x's entries in z = (log f, pp x, pp y, ω, C).

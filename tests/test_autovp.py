@@ -583,15 +583,26 @@ def test_level_street_view_states_a_loose_focal() -> None:
     assert abs(math.log(res0.focal_px / f)) <= 2.0 * res0.focal_std_rel
 
 
-SCEAUX = Path(os.environ.get("CAMLOC_SCEAUX_DIR", "/nonexistent/sceaux"))
+# Where benchmarks/fetch_real_photos.sh puts the photos (never in the repository).
+PHOTOS = Path(
+    os.environ.get("CAMLOC_PHOTOS_DIR", str(Path.home() / ".cache" / "camloc_geo" / "photos"))
+)
+SCEAUX = Path(
+    os.environ.get("CAMLOC_SCEAUX_DIR", str(PHOTOS / "ImageDataset_SceauxCastle" / "images"))
+)
 SCEAUX_MISSING = (
-    "Sceaux castle photos not found: git clone "
+    "Sceaux castle photos not found: run benchmarks/fetch_real_photos.sh, or git clone "
     "https://github.com/openMVG/ImageDataset_SceauxCastle and set CAMLOC_SCEAUX_DIR to its "
     "images folder"
 )
-STRECHA = Path(os.environ.get("CAMLOC_STRECHA_DIR", "/nonexistent/strecha"))
+STRECHA = Path(
+    os.environ.get(
+        "CAMLOC_STRECHA_DIR",
+        str(PHOTOS / "SfM_quality_evaluation" / "Benchmarking_Camera_Calibration_2008"),
+    )
+)
 STRECHA_MISSING = (
-    "Strecha 2008 photos not found: git clone "
+    "Strecha 2008 photos not found: run benchmarks/fetch_real_photos.sh, or git clone "
     "https://github.com/openMVG/SfM_quality_evaluation and set CAMLOC_STRECHA_DIR to its "
     "Benchmarking_Camera_Calibration_2008 folder"
 )

@@ -80,13 +80,37 @@ def test_lockstep_problems_take_the_steps_they_take_alone() -> None:
     assert sum(len(b) for b in batches) == sum(r.nfev for r in together)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_sigma_tol_stops_within_that_fraction_of_a_sigma(seed: int) -> None:
+    """``sigma_tol`` stops once the next Gauss-Newton step is under that fraction of the
+    parameters' 1-sigma: fewer evaluations, the answer within it of the full minimum."""
+    fun, jac, x0 = _curve_problem(seed)
+    full = soft_l1_least_squares(fun, jac, x0, f_scale=2.5, tol=1e-12)
+    early = soft_l1_least_squares(fun, jac, x0, f_scale=2.5, tol=1e-12, sigma_tol=0.05)
+    assert early.success
+    assert early.nfev < full.nfev
+    # The minimum's covariance, as the fits state it: (JᵀJ)⁻¹ s² of the weighted Jacobian.
+    s2 = 2.0 * full.cost / (len(full.fun) - len(full.x))
+    cov = np.linalg.inv(full.jac.T @ full.jac) * s2
+    d = early.x - full.x
+    assert float(d @ np.linalg.solve(cov, d)) <= (2 * 0.05) ** 2
+    assert float(d @ np.linalg.solve(cov, d)) > 0.0
+    # The stop's residuals and Jacobian are those of the returned x (no step after them).
+    np.testing.assert_allclose(early.fun, fun(early.x))
+
+
 def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:
     recorded: list[tuple[Any, ...]] = []
     original = relative._fit
 
     def spy(prob: Any, x0: Any, R0: Any, pp: Any, f: Any, **kw: Any) -> Any:
         res = original(prob, x0, R0, pp, f, **kw)
-        recorded.append((prob, np.array(x0, float), R0, pp, f, prob.weights.copy(), res))
+        # The same fit to the tolerances alone (no stop at a fraction of a sigma).
+        full = original(prob, x0, R0, pp, f, **{**kw, "sigma_tol": None})
+        sigma_tol = kw.get("sigma_tol", relative._SIGMA_TOL)
+        recorded.append(
+            (prob, np.array(x0, float), R0, pp, f, prob.weights.copy(), res, full, sigma_tol)
+        )
         return res
 
     relative._fit = spy  # type: ignore[assignment]
@@ -95,7 +119,8 @@ def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:
     finally:
         relative._fit = original  # type: ignore[assignment]
     assert recorded
-    for prob, x0, R0, pp, f, weights, ours in recorded:
+    assert any(rec[-1] is not None for rec in recorded)
+    for prob, x0, R0, pp, f, weights, ours, full, sigma_tol in recorded:
         prob.weights = weights
         clamp = None
         if f is None:
@@ -114,7 +139,12 @@ def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:
             method="scipy",
         )
         # The home-made loop reaches scipy's minimum (or a lower one), never a worse one.
-        assert ours.cost <= ref.cost * (1 + 1e-4) + 1e-9
+        assert full.cost <= ref.cost * (1 + 1e-4) + 1e-9
+        # Stopped once the next step moves the answer by less than sigma_tol of its sigma:
+        # within about half sigma_tol² of the residual variance of the minimum's cost.
+        if sigma_tol is not None:
+            s2 = 2.0 * ref.cost / max(len(ref.fun) - len(ref.x), 1)
+            assert ours.cost <= ref.cost + sigma_tol**2 * s2 + 1e-9
 
 
 def test_gauss_newton_matches_scipy_on_a_similarity_fit() -> None:

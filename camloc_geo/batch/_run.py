@@ -16,7 +16,7 @@ import os
 import sys
 import threading
 import time
-from collections import defaultdict
+from collections import OrderedDict, defaultdict
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor
 from concurrent.futures import wait as cf_wait
@@ -33,6 +33,7 @@ from camloc_geo.cameras import (
     geocode_camera,
     read_camera_list,
 )
+from camloc_geo.cameras._list import count_camera_rows
 from camloc_geo.osm import Area, MapPlan, area_map, map_plan
 
 __all__ = ["BatchSummary", "process_chunk", "run_batch"]
@@ -61,9 +62,13 @@ class BatchSummary:
         Files written.
     stage_s
         Seconds per stage: ``read_list``, ``map_load`` and ``geocode`` (summed over
-        workers), ``journal``, ``gpkg``, ``summary_map``.
+        workers; ``geocode_cpu`` is the workers' CPU time in it, which a busy machine does
+        not inflate), ``journal``, ``gpkg``, ``summary_map``.
     elapsed_s
         Wall time of the run.
+    repeats
+        Cameras computed by this run whose listing (no scene) a worker had already geocoded:
+        its answer was reused.
     """
 
     total: int
@@ -75,6 +80,7 @@ class BatchSummary:
     summary_map: Path | None = None
     stage_s: dict[str, float] = field(default_factory=dict)
     elapsed_s: float = 0.0
+    repeats: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able summary."""
@@ -88,6 +94,7 @@ class BatchSummary:
             "summary_map": str(self.summary_map) if self.summary_map else None,
             "stage_s": {k: round(v, 3) for k, v in self.stage_s.items()},
             "elapsed_s": round(self.elapsed_s, 3),
+            "repeats": self.repeats,
         }
 
 
@@ -111,9 +118,58 @@ def process_chunk(
             except Exception as exc:
                 log.debug("map of %s failed: %s", f, exc)
     t1 = time.perf_counter()
-    out = [geocode_camera(r, plan=plan, area=area).to_dict() for r in rows]
+    c1 = time.process_time()
+    out = []
+    hits = 0
+    for r in rows:
+        key = _memo_key(plan, area, r)
+        rec = _MEMO.get(key) if key is not None else None
+        if key is not None and rec is not None:
+            _MEMO.move_to_end(key)
+            out.append({**rec, "row": r.row, "id": r.id})
+            hits += 1
+            continue
+        rec = geocode_camera(r, plan=plan, area=area).to_dict()
+        out.append(rec)
+        if key is not None and _memoizable(rec):
+            _MEMO[key] = rec
+            if len(_MEMO) > _MEMO_SIZE:
+                _MEMO.popitem(last=False)
     t2 = time.perf_counter()
-    return out, {"map_load": t1 - t0, "geocode": t2 - t1}
+    times = {"map_load": t1 - t0, "geocode": t2 - t1, "geocode_cpu": time.process_time() - c1}
+    return out, {**times, "repeats": float(hits)}
+
+
+# A camera without a scene is a pure function of its listing (title, street pair, point,
+# radius, view, area, the row's problems) and its area's map: a list that repeats a listing
+# (the same junction's cameras, a city's list re-checked) is geocoded once per worker.
+_MEMO: OrderedDict[tuple[Any, ...], dict[str, Any]] = OrderedDict()
+_MEMO_SIZE = 8192
+
+
+def _memo_key(plan: MapPlan, area: Area, row: CameraRow) -> tuple[Any, ...] | None:
+    """The key of a camera's answer in the memo; None for a camera that is not memoized."""
+    if row.has_scene:
+        return None  # a scene file may change under the same path; a scene's cost is locate
+    return (
+        plan,
+        area,
+        row.title,
+        row.streets,
+        row.lat,
+        row.lon,
+        row.radius_m,
+        row.view,
+        row.area,
+        row.problems,
+    )
+
+
+def _memoizable(rec: dict[str, Any]) -> bool:
+    """False for answers a rerun computes again (a map that failed may load next time)."""
+    if rec.get("status") in RETRY_STATUSES:
+        return False
+    return not any(e.get("stage") in ("map", "internal") for e in rec.get("errors") or ())
 
 
 class _InlineExecutor(Executor):
@@ -183,6 +239,41 @@ class _LocalRunner:
         self.ex.shutdown(wait=not cancel, cancel_futures=cancel)
 
 
+class _Counted:
+    """An iterable of rows that counts what it hands out."""
+
+    def __init__(self, rows: Iterable[CameraRow]) -> None:
+        self.rows = rows
+        self.n = 0
+
+    def __iter__(self) -> Iterator[CameraRow]:
+        for row in self.rows:
+            self.n += 1
+            yield row
+
+
+def _count_rows(path: Path) -> int:
+    """Rows of a list for the progress bar: CSV records counted by the csv module alone."""
+    import csv
+
+    if path.suffix.lower() not in (".csv", ".tsv", ".txt"):
+        return count_camera_rows(path)
+    csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
+    with open(path, encoding="utf-8-sig", newline="") as fh:
+        sample = fh.read(8192)
+        fh.seek(0)
+        delimiter = "\t" if path.suffix.lower() == ".tsv" else ","
+        if delimiter == ",":
+            try:
+                delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+            except csv.Error:
+                delimiter = ","
+        reader = csv.reader(fh, delimiter=delimiter)
+        if next(reader, None) is None:
+            return 0
+        return sum(1 for rec in reader if rec)
+
+
 class _RowBits:
     """A set of non-negative row numbers as a bit array (one bit per row up to the largest)."""
 
@@ -208,8 +299,16 @@ def _chunks(
     """Rows grouped by area into chunks, within a bounded window of the list."""
     pending: dict[Area, list[CameraRow]] = defaultdict(list)
     held = 0
+    # a row without a point is searched in the extracts its area names: the same area for
+    # every such row of an area name (area_of stats each extract's size per call)
+    search_areas: dict[str | None, Area] = {}
     for row in rows:
-        area = plan.area_of(row)
+        if row.has_point:
+            area = plan.area_of(row)
+        else:
+            area = search_areas.get(row.area) or search_areas.setdefault(
+                row.area, plan.area_of(row)
+            )
         group = pending[area]
         group.append(row)
         held += 1
@@ -291,6 +390,7 @@ def run_batch(
         raise InputError("chunk_size must be at least 1")
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
+    counts: dict[str, int] = defaultdict(int)
     journal = Journal(journal_path(out))
     try:
         journal.check_options(
@@ -310,7 +410,12 @@ def run_batch(
         done = _RowBits()
         recorded = journal.iter_done(retry=RETRY_STATUSES)
         nxt = next(recorded, None)
-        for row in read_camera_list(list_p):
+        # nothing to resume: no first pass over the list (the rows are counted as they are
+        # computed; the progress bar alone needs the count up front, and counts lines)
+        first_pass = nxt is not None
+        if not first_pass and progress:
+            total = _count_rows(list_p)
+        for row in read_camera_list(list_p) if first_pass else ():
             total += 1
             while nxt is not None and nxt[0] < row.row:
                 nxt = next(recorded, None)
@@ -325,11 +430,13 @@ def run_batch(
         del recorded
         stage["read_list"] += time.perf_counter() - t
         todo = (r for r in read_camera_list(list_p) if r.row not in done)
+        counted = _Counted(todo)
         computed = _run_chunks(
-            todo,
+            counted,
             plan,
             journal,
             stage,
+            counts=counts,
             scheduler=scheduler,
             workers=workers or os.cpu_count() or 1,
             chunk_size=chunk_size,
@@ -338,6 +445,8 @@ def run_batch(
             initial=skipped,
             on_chunk=on_chunk,
         )
+        if not first_pass:
+            total = counted.n
         t = time.perf_counter()
         _write_gpkg(journal, out)
         stage["gpkg"] += time.perf_counter() - t
@@ -359,6 +468,7 @@ def run_batch(
         summary_map=map_path,
         stage_s=dict(stage),
         elapsed_s=time.perf_counter() - t_start,
+        repeats=counts["repeats"],
     )
 
 
@@ -368,6 +478,7 @@ def _run_chunks(
     journal: Journal,
     stage: dict[str, float],
     *,
+    counts: dict[str, int],
     scheduler: Any,
     workers: int,
     chunk_size: int,
@@ -405,7 +516,10 @@ def _run_chunks(
         for fut in futs:
             records, times = fut.result()
             for k, v in times.items():
-                stage[k] += v
+                if k == "repeats":
+                    counts["repeats"] += int(v)
+                else:
+                    stage[k] += v
             t = time.perf_counter()
             n = journal.write(records)
             stage["journal"] += time.perf_counter() - t
@@ -530,28 +644,42 @@ def _ranks_text(ranks: list[Any]) -> str | None:
     return ",".join(str(int(o)) for o in ranks) or None
 
 
-def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
-    from shapely.geometry import Point, Polygon
+def _points(lonlat: list[tuple[Any, Any]]) -> Any:
+    """Point geometries of ``(lon, lat)`` pairs in one vectorised call; None where missing."""
+    import numpy as np
+    import shapely
 
-    cams, cam_g, cands, cand_g, cones, cone_g, errs = [], [], [], [], [], [], []
+    if not lonlat:
+        return np.empty(0, dtype=object)
+    xy = np.array([(np.nan, np.nan) if x is None or y is None else (x, y) for x, y in lonlat])
+    geoms = shapely.points(xy)
+    geoms[np.isnan(xy).any(axis=1)] = None
+    return geoms
+
+
+def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
+    from shapely.geometry import Polygon
+
+    cams, cands, cones, cone_g, errs = [], [], [], [], []
+    cam_xy: list[tuple[Any, Any]] = []
+    cand_xy: list[tuple[Any, Any]] = []
     for r in records:
         cam = {k: r.get(k) for k in _CAMERA_COLUMNS}
         for k in ("names_read", "names_matched", "match_kinds"):
             cam[k] = " | ".join(r.get(k) or []) or None
         cam["n_errors"] = len(r.get("errors") or [])
         cams.append(cam)
-        placed = r.get("lat") is not None and r.get("lon") is not None
-        cam_g.append(Point(r["lon"], r["lat"]) if placed else None)
+        cam_xy.append((r.get("lon"), r.get("lat")))
         for c in r.get("candidates") or []:
             ties = c.get("ambiguous_with") or []
             cands.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": _ranks_text(ties)})
-            ok = c.get("lat") is not None and c.get("lon") is not None
-            cand_g.append(Point(c["lon"], c["lat"]) if ok else None)
+            cand_xy.append((c.get("lon"), c.get("lat")))
         for c in r.get("cones") or []:
             cones.append({**c, "row": r["row"], "id": r["id"]})
             cone_g.append(Polygon(c["lonlat"]))
         for e in r.get("errors") or []:
             errs.append({**e, "row": r["row"], "id": r["id"], "status": r["status"]})
+    cam_g, cand_g = _points(cam_xy), _points(cand_xy)
     return {
         "cameras": _frame(cams, _CAMERA_COLUMNS, cam_g),
         "candidates": _frame(cands, _CANDIDATE_COLUMNS, cand_g),

@@ -35,7 +35,7 @@ from __future__ import annotations
 import logging
 import math
 import os
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
 from camloc_geo._errors import MapDataError, MapSourceError, SceneError
@@ -163,8 +163,20 @@ class CameraResult:
         return self.lat is not None and self.lon is not None
 
     def to_dict(self) -> dict[str, Any]:
-        """A JSON-able dict (the batch journal's record)."""
-        return asdict(self)
+        """A JSON-able dict (the batch journal's record).
+
+        The same dict as :func:`dataclasses.asdict`, built without its recursive deep copy
+        (0.4 ms a camera, most of a title-only camera's cost): the lists and their dicts
+        are copied one level down, the values in them are numbers, strings and rings of
+        coordinates that nothing mutates.
+        """
+        out: dict[str, Any] = {}
+        for name in _FIELD_NAMES:
+            v = getattr(self, name)
+            if isinstance(v, list):
+                v = [dict(x) if isinstance(x, dict) else x for x in v]
+            out[name] = v
+        return out
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> CameraResult:
@@ -179,6 +191,9 @@ class CameraResult:
         self.reason = reason
         self.errors.append({"stage": stage, "message": reason})
         return self
+
+
+_FIELD_NAMES = tuple(f.name for f in fields(CameraResult))
 
 
 def _finite(x: Any) -> float | None:

@@ -130,9 +130,10 @@ class CameraRow:
 def _clean(value: Any) -> str:
     if value is None:
         return ""
-    text = value if isinstance(value, str) else str(value)
-    text = "".join(ch if ch.isprintable() else " " for ch in text[:_MAX_FIELD_CHARS]).strip()
-    return text
+    text = (value if isinstance(value, str) else str(value))[:_MAX_FIELD_CHARS]
+    if text.isprintable():  # nearly every field: no character-by-character rewrite
+        return text.strip()
+    return "".join(ch if ch.isprintable() else " " for ch in text).strip()
 
 
 def _number(value: Any, name: str, problems: list[str]) -> float | None:

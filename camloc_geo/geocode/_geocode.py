@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import shapely
+import shapely.ops
 from shapely.geometry import LineString, MultiLineString, mapping
 
 from camloc_geo._errors import InputError
@@ -337,14 +338,27 @@ def _fuzzy(toks: tuple[str, ...], name: str, index: GeocodeIndex) -> list[NameHi
 
 
 def suggestions_for(name: str, index: GeocodeIndex, n: int = 5) -> list[str]:
-    """The map's names closest in spelling to a name (for ``not_found`` messages)."""
+    """The map's names closest in spelling to a name (for ``not_found`` messages).
+
+    Kept in the index's cache: a batch asks again for every title naming the street, in
+    every extract that lacks it.
+    """
     from rapidfuzz import fuzz, process
 
     query = " ".join(name_tokens(name))
     if not query or not index.full_choices:
         return []
+    key = ("suggest", query, n)
+    cached = index.cache.get(key)
+    if cached is not None:
+        return list(cached)
     found = process.extract(query, index.full_choices, scorer=fuzz.WRatio, limit=n)
-    return [index.display(tuple(str(c).split())) for c, _s, _i in found]
+    out = [index.display(tuple(str(c).split())) for c, _s, _i in found]
+    with index.lock:
+        if len(index.cache) > 200_000:
+            index.cache.clear()
+        index.cache[key] = tuple(out)
+    return out
 
 
 def _landmark_hits(name: str, index: GeocodeIndex) -> list[tuple[Landmark, str, float]]:

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import re
 import unicodedata
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
 from typing import Any
 
 from anyascii import anyascii
@@ -266,6 +267,15 @@ def parse_title(title: str) -> ParsedTitle:
     """
     if not isinstance(title, str):
         title = "" if title is None else str(title)
+    # a batch reads the same titles again and again (each camera's title is parsed for the
+    # listing and once per extract searched): parse each once, hand out copies
+    cached = _parse_title_cached(title)
+    return replace(cached, streets=list(cached.streets), notes=list(cached.notes))
+
+
+@lru_cache(maxsize=8192)
+def _parse_title_cached(title: str) -> ParsedTitle:
+    """:func:`parse_title` itself (the cached original; callers get copies)."""
     notes: list[str] = []
     parsed = ParsedTitle(raw=title, notes=notes)
     text = _clean(title, notes)

@@ -122,6 +122,7 @@ _MAX_MISSED = 3  # frames a detected track may go unseen before it is closed
 _MAX_COAST_S = 1.5  # longest a track may stay hidden in a merged blob
 _MIN_DETECTED_FRAMES = 3  # shorter detections are noise, not vehicles
 _MAX_FEATURES = 40
+_MIN_PIECE_PX = 6  # reduced pixels: smaller foreground pieces are noise, never joined
 _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foreground
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
 _SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
@@ -129,6 +130,8 @@ _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehic
 _TEXTURE_MIN = 4.0  # grey levels: local deviation of a background with texture
 _SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and background
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
+_CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
+_CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
 _CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
 
 
@@ -588,6 +591,7 @@ class _Track:
     border: list[bool] = field(default_factory=list)
     occluded: list[bool] = field(default_factory=list)
     points: Any = None  # KLT features (N, 1, 2) float32 in the previous frame
+    absorbed: bool = False  # a fragment of another track's vehicle, joined to it
 
     def predicted(self) -> Box:
         dx, dy = self.velocity
@@ -611,17 +615,123 @@ def _overlap(a: Box, b: Box) -> float:
     return ix * iy / area if area > 0 else 0.0
 
 
-def _blobs(fg: Any, scale: float, min_area: int) -> list[Box]:
+def _blobs(
+    fg: Any, scale: float, min_area: int
+) -> tuple[list[Box], list[list[int]], Any, list[Box], list[int]]:
+    """Connected components of the foreground.
+
+    Returns the boxes (full-resolution pixels) of the ``_MAX_BLOBS`` largest, at least
+    ``min_area`` reduced pixels large, their labels (one each), the label image, and the
+    boxes and labels of the smaller pieces (``_MIN_PIECE_PX`` and up: a wheel or a panel of
+    a vehicle whose colour is the road's, joined by :func:`_join_fragments` to the vehicle
+    whose predicted box holds it).
+    """
     import cv2
 
-    n, _labels, stats, _ = cv2.connectedComponentsWithStats(fg, connectivity=8)
-    keep = [i for i in range(1, n) if stats[i, cv2.CC_STAT_AREA] >= min_area]
-    keep.sort(key=lambda i: -int(stats[i, cv2.CC_STAT_AREA]))
-    out = []
-    for i in keep[:_MAX_BLOBS]:
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(fg, connectivity=8)
+    areas = stats[:, cv2.CC_STAT_AREA]
+    keep = [i for i in range(1, n) if areas[i] >= min_area]
+    keep.sort(key=lambda i: -int(areas[i]))
+    keep = keep[:_MAX_BLOBS]
+    small = [i for i in range(1, n) if _MIN_PIECE_PX <= areas[i] < min_area][: 4 * _MAX_BLOBS]
+
+    def box(i: int) -> Box:
         x, y, w, h = (int(v) for v in stats[i, :4])
-        out.append((x / scale, y / scale, (x + w) / scale, (y + h) / scale))
-    return out
+        return (x / scale, y / scale, (x + w) / scale, (y + h) / scale)
+
+    return [box(i) for i in keep], [[i] for i in keep], labels, [box(i) for i in small], small
+
+
+def _part_of(piece: _Track, whole: _Track) -> bool:
+    """True when ``piece`` is a fragment of ``whole``: its predicted box lies inside the
+    other's (80 %), it is smaller, and it moves the same way (image velocities within 30 %
+    of the vehicle's + 1 px a frame)."""
+    a, b = piece.predicted(), whole.predicted()
+    if _overlap(a, b) < 0.8 or (a[2] - a[0]) * (a[3] - a[1]) >= (b[2] - b[0]) * (b[3] - b[1]):
+        return False
+    dv = math.hypot(piece.velocity[0] - whole.velocity[0], piece.velocity[1] - whole.velocity[1])
+    return dv <= 0.3 * math.hypot(*whole.velocity) + 1.0
+
+
+def _join_fragments(
+    tracks: list[_Track],
+    blobs: list[Box],
+    ids: list[list[int]],
+    small: list[Box],
+    small_ids: list[int],
+) -> tuple[list[Box], list[list[int]]]:
+    """Join the pieces of one vehicle (a road-grey car's cabin, lower body and wheels fall
+    apart under the foreground threshold) by its motion.
+
+    An established track's box moved by its motion (KLT) is the prediction; the blobs and
+    small pieces lying mostly (80 %) inside it, grown by 15 % on every side, and inside no
+    other track's, are one vehicle: their boxes are united and their labels kept together
+    (the contact is the lowest corner of the union). The union may not outgrow the
+    prediction by more than half its area (that would be another vehicle beside it).
+    """
+    if not tracks or not (blobs or small):
+        return blobs, ids
+    pieces = [*blobs, *small]
+    piece_ids = [*ids, *[[i] for i in small_ids]]
+    grown: list[Box | None] = []
+    for t in tracks:
+        if len(t.frames) < _MIN_DETECTED_FRAMES or t.missed:
+            grown.append(None)
+            continue
+        x1, y1, x2, y2 = t.predicted()
+        gx, gy = 0.15 * (x2 - x1), 0.15 * (y2 - y1)
+        grown.append((x1 - gx, y1 - gy, x2 + gx, y2 + gy))
+    inside = np.zeros((len(tracks), len(pieces)), dtype=bool)
+    for k, g in enumerate(grown):
+        if g is not None:
+            inside[k] = [_overlap(b, g) >= 0.8 for b in pieces]
+    taken: set[int] = set()
+    joined: list[tuple[Box, list[int]]] = []
+    for k in range(len(tracks)):
+        if grown[k] is None:
+            continue
+        parts = [m for m in range(len(tracks)) if m != k and _part_of(tracks[m], tracks[k])]
+        if any(_part_of(tracks[k], other) for other in tracks if other is not tracks[k]):
+            continue  # itself a fragment: its vehicle joins it
+        rivals = [m for m in range(len(tracks)) if m != k and m not in parts]
+        mine = [j for j in np.flatnonzero(inside[k]) if not inside[rivals, j].any()]
+        if len(mine) < 2 or not any(j < len(blobs) for j in mine):
+            continue
+        pred = tracks[k].predicted()
+        mine.sort(key=lambda j: -(pieces[j][2] - pieces[j][0]) * (pieces[j][3] - pieces[j][1]))
+        u: Box = pieces[mine[0]]
+        # no faster growth than a vehicle coming nearer (or than its largest piece)
+        max_w = max(1.1 * (pred[2] - pred[0]) + 3.0, u[2] - u[0])
+        max_h = max(1.1 * (pred[3] - pred[1]) + 3.0, u[3] - u[1])
+        chosen = [mine[0]]
+        for j in mine[1:]:  # largest first; a piece that would outgrow the vehicle stays out
+            b = pieces[j]
+            v = (min(u[0], b[0]), min(u[1], b[1]), max(u[2], b[2]), max(u[3], b[3]))
+            if v[2] - v[0] <= max_w and v[3] - v[1] <= max_h:
+                u = v
+                chosen.append(j)
+        mine = chosen
+        if len(mine) < 2 or mine[0] >= len(blobs):
+            continue
+        big = pieces[mine[0]]
+        if (big[2] - big[0]) * (big[3] - big[1]) < 0.3 * (u[2] - u[0]) * (u[3] - u[1]):
+            continue  # a vehicle is one main piece and its loose parts, not a crowd
+        if any(
+            _overlap(pieces[j], other.predicted()) > 0.2
+            for j in mine
+            for m, other in enumerate(tracks)
+            if m != k and not _part_of(other, tracks[k])
+        ):
+            continue  # a piece another vehicle may own
+        taken.update(int(j) for j in mine)
+        for m in parts:  # a fragment's own track ends here: its vehicle's track goes on
+            tracks[m].absorbed = True
+        joined.append((u, [i for j in mine for i in piece_ids[j]]))
+    if not joined:
+        return blobs, ids
+    out = [b for j, b in enumerate(blobs) if j not in taken]
+    out_ids = [i for j, i in enumerate(ids) if j not in taken]
+    return out + [b for b, _ in joined], out_ids + [i for _, i in joined]
 
 
 def _associate(
@@ -662,8 +772,15 @@ def _associate(
     return match, [j for j in range(len(blobs)) if j not in used], hidden
 
 
-def _contact(fg: Any, box: Box, scale: float) -> tuple[tuple[float, float], str]:
-    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette corner or box."""
+def _contact(
+    fg: Any, box: Box, scale: float, labels: Any = None, own: list[int] | None = None
+) -> tuple[tuple[float, float], str]:
+    """Ground-contact pixel of a vehicle in ``box``: lowest silhouette corner or box.
+
+    ``labels`` and ``own``: the label image of the foreground and the vehicle's own labels
+    (a detected vehicle, perhaps in pieces); all of them make its silhouette. Without
+    them (given boxes) the silhouette is the box's largest foreground region.
+    """
     import cv2
 
     x1, y1, x2, y2 = box
@@ -674,15 +791,21 @@ def _contact(fg: Any, box: Box, scale: float) -> tuple[tuple[float, float], str]
         c1, r1 = min(w, math.ceil(x2 * scale)), min(h, math.ceil(y2 * scale))
         if c1 - c0 >= 2 and r1 - r0 >= 2:
             roi = fg[r0:r1, c0:c1]
+            if labels is not None and own:
+                roi = np.where(np.isin(labels[r0:r1, c0:c1], own), 255, 0).astype(np.uint8)
             contours, _ = cv2.findContours(roi, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_SIMPLE)
             if contours:
-                big = max(contours, key=cv2.contourArea)
-                area = cv2.contourArea(big)
-                low = big[:, 0, 1].max()
+                parts = (
+                    list(contours)
+                    if labels is not None and own
+                    else [max(contours, key=cv2.contourArea)]
+                )
+                area = sum(cv2.contourArea(c) for c in parts)
+                low = max(c[:, 0, 1].max() for c in parts)
                 # the silhouette must fill the box reasonably and reach its bottom
                 if area >= 0.25 * roi.size and low >= 0.85 * (r1 - r0) - 1:
                     one = np.zeros_like(roi)
-                    cv2.drawContours(one, [big], 0, 255, -1)
+                    cv2.drawContours(one, parts, -1, 255, -1)
                     corner = _lowest_corner(one)
                     if corner is not None:
                         u, v = corner
@@ -912,8 +1035,20 @@ def _fit_track(
             len(times),
             dur,
         )
+    # a contact pixel far away covers metres of road, near by centimetres: each frame is
+    # weighted by the inverse of its ground position's variance (a pixel's footprint on
+    # the road, _CONTACT_PX pixels of noise, plus a floor for the contact's own wander)
+    base = px[0][ok][keep]
+    rot = cam.cam_from_world_rotation
+    foot = np.zeros(len(base))
+    for step in ((1.0, 0.0), (0.0, 1.0)):
+        moved = _ground(
+            centres[:1], _rays((base + step)[None], focals[:1], cam.principal_point, rot)
+        )
+        foot += np.sum((moved[0, :, :2] - ground[0]) ** 2, axis=1)
+    var_m2 = _CONTACT_PX**2 * np.where(np.isfinite(foot), foot, np.inf) + _CONTACT_FLOOR_M**2
     a = _design(times, labels)
-    solve, weights, res = _irls(a, ground[0])
+    solve, weights, res = _irls(a, ground[0], 1.0 / var_m2)
     coef = solve @ ground[0]
     vel = coef[0]
     speed = float(np.linalg.norm(vel))
@@ -1233,6 +1368,8 @@ def _run(
     last_given = {vid: max(per) for vid, per in given.items() if per} if given is not None else {}
 
     def finish(t: _Track) -> None:
+        if t.absorbed:
+            return  # a piece of a vehicle measured by its own track
         if given is None and len(t.frames) < _MIN_DETECTED_FRAMES:
             noise[0] += 1  # a flicker, not a vehicle
             return
@@ -1275,7 +1412,8 @@ def _run(
             fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
             fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
             if given is None:
-                blobs = _blobs(fg, scale, min_area)
+                blobs, blob_ids, labels, small, small_ids = _blobs(fg, scale, min_area)
+                blobs, blob_ids = _join_fragments(active, blobs, blob_ids, small, small_ids)
                 match, fresh, hidden = _associate(active, blobs)
                 for k in hidden:  # coast on the prediction while merged with another
                     t = active[k]
@@ -1283,13 +1421,15 @@ def _run(
                     t.coasting += 1
                     t.points = None
                 current: dict[int, Box] = {k: blobs[j] for k, j in match.items()}
+                own = {k: blob_ids[j] for k, j in match.items()}
                 for j in fresh:
                     t = _Track(next_id, blobs[j])
                     next_id += 1
                     active.append(t)
                     current[len(active) - 1] = blobs[j]
+                    own[len(active) - 1] = blob_ids[j]
             else:
-                current = {}
+                current, own, labels = {}, {}, None
                 for vid, per in given.items():
                     if i in per:
                         if vid not in by_id:
@@ -1319,7 +1459,7 @@ def _run(
                     )
                 t.box = box
                 t.missed = 0
-                c, kind = _contact(fg, box, scale)
+                c, kind = _contact(fg, box, scale, labels, own.get(k))
                 t.frames.append(i)
                 t.boxes.append(box)
                 t.contacts.append(c)
@@ -1378,6 +1518,7 @@ def _split_reversals(t: _Track) -> list[_Track]:
     The blob of a vehicle leaving through an image border and the blob of one entering at
     the same place can be one track. Between two stretches wholly inside the image with a
     border-touching stretch between them, the track is cut when the image motion reverses.
+    It is also cut where its features' motion turns back (:func:`_identity_switches`).
     """
     runs: list[tuple[int, int]] = []
     start = None
@@ -1395,6 +1536,8 @@ def _split_reversals(t: _Track) -> list[_Track]:
         vb = np.subtract(_centre(t.boxes[b1 - 1]), _centre(t.boxes[b0]))
         if float(va @ vb) < 0:
             cuts.append((a1 + b0) // 2)
+    cuts.extend(_identity_switches(t))
+    cuts = sorted(set(cuts))
     if not cuts:
         return [t]
     pieces = []
@@ -1406,6 +1549,25 @@ def _split_reversals(t: _Track) -> list[_Track]:
         piece.occluded = t.occluded[lo:hi]
         pieces.append(piece)
     return pieces
+
+
+def _identity_switches(t: _Track) -> list[int]:
+    """Record indices where a detected track's features turn back: it now follows another
+    vehicle (two vehicles passed each other in one blob and the track came out on the one
+    driving the other way). The features' median image motion (KLT) of a vehicle changes
+    smoothly; consecutive motions (at least 0.5 px a frame) at more than 120 degrees apart
+    mark a switch."""
+    cuts = []
+    last: tuple[float, float] | None = None
+    for i, (dx, dy) in enumerate(t.klt):
+        if not (math.isfinite(dx) and math.isfinite(dy)) or math.hypot(dx, dy) < 0.5:
+            continue
+        if last is not None:
+            cos = (dx * last[0] + dy * last[1]) / (math.hypot(dx, dy) * math.hypot(*last))
+            if cos < -0.5:
+                cuts.append(i)
+        last = (dx, dy)
+    return cuts
 
 
 def _shadows(frame: Any, background: Any) -> Any:

@@ -5,6 +5,12 @@ Issue 28's case: on a 960×540 street video each annotator drew one long lane li
 car's own edges (20-90 px, same noise). The long lines pin the street's vanishing point;
 the short edges barely constrain it, and a screen that trusts every line alike takes its
 reference from them and leaves the long lines out.
+
+:func:`street_scene` is the annotated scene of
+:func:`camloc_geo.testing.traffic_render.render_street`: the parked reference car as
+:func:`~camloc_geo.testing.synthetic.make_scene` annotates it, and the painted lane lines
+of the rendered street (:data:`LANE_MARKINGS_Y`) that each annotator also draws
+(:func:`add_lane_lines`).
 """
 
 from __future__ import annotations
@@ -13,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from camloc_geo.camera import Camera
 from camloc_geo.testing.synthetic import (
     NoiseModel,
     SyntheticScene,
@@ -21,7 +28,97 @@ from camloc_geo.testing.synthetic import (
     random_camera,
 )
 
-__all__ = ["long_line_lengths", "road_line_scene"]
+__all__ = [
+    "LANE_MARKINGS_Y",
+    "add_lane_lines",
+    "long_line_lengths",
+    "road_line_scene",
+    "street_noise",
+    "street_scene",
+]
+
+# The painted lines along the street that traffic_render's asphalt texture draws (world y,
+# metres; the street runs along x): the solid edge lines at -1.8 and -12.2 and the dashed
+# lane lines between them. They run from x = -90 to 110 m.
+LANE_MARKINGS_Y = (-1.8, -4.25, -7.0, -9.75, -12.2)
+_MARKINGS_X = (-90.0, 110.0)
+_MIN_LANE_LINE_PX = 200.0  # shorter visible stretches are not drawn
+
+
+def street_noise(click_px: float = 1.0) -> NoiseModel:
+    """The annotators' noise of the street scenes: ``click_px`` for clicks and line ends."""
+    return NoiseModel(
+        point_px=click_px,
+        line_px=click_px,
+        wrong_corner_prob=0.0,
+        sloppy_prob=0.0,
+        size_rel=0.0,
+        car_yaw_deg=0.0,
+    )
+
+
+def add_lane_lines(
+    scene: dict[str, Any],
+    camera: Camera,
+    rng: np.random.Generator,
+    *,
+    line_px: float = 1.0,
+    per_annotator: tuple[int, int] = (1, 2),
+    extent: float = 0.6,
+) -> None:
+    """Add to each annotator's length lines the painted lane lines they draw (in place).
+
+    Each annotator draws ``per_annotator`` (inclusive range) of the painted lines
+    (:data:`LANE_MARKINGS_Y`) whose visible stretch is at least 200 px long, each along a
+    random part of at least ``extent`` of that stretch (annotators rarely draw a line to the
+    image border), with ``line_px`` Gaussian noise on each end.
+    """
+    size = (int(scene["image"]["width"]), int(scene["image"]["height"]))
+    visible = []
+    for y in LANE_MARKINGS_Y:
+        a = np.array([_MARKINGS_X[0], y, 0.0])
+        b = np.array([_MARKINGS_X[1], y, 0.0])
+        seg = _visible_segment(camera, a, b, size)
+        if seg is not None and float(np.hypot(*(seg[2:] - seg[:2]))) >= _MIN_LANE_LINE_PX:
+            visible.append(seg)
+    if not visible:
+        return
+    for ann in scene["annotations"]:
+        k = min(int(rng.integers(per_annotator[0], per_annotator[1] + 1)), len(visible))
+        for i in rng.choice(len(visible), k, replace=False):
+            seg = visible[int(i)]
+            start = float(rng.uniform(0.0, 1.0 - extent))
+            stop = float(rng.uniform(start + extent, 1.0))
+            ends = np.r_[
+                seg[:2] + start * (seg[2:] - seg[:2]), seg[:2] + stop * (seg[2:] - seg[:2])
+            ]
+            ann["vp_lines"]["length"].append([float(v) for v in ends + rng.normal(0, line_px, 4)])
+
+
+def street_scene(
+    camera: Camera,
+    seed: int,
+    *,
+    click_px: float = 1.0,
+    image_size: tuple[int, int] = (960, 540),
+) -> SyntheticScene:
+    """The annotated scene of :func:`~camloc_geo.testing.traffic_render.render_street`.
+
+    Three annotators click the parked reference sedan at the origin
+    (:func:`~camloc_geo.testing.synthetic.make_scene`, noise ``default_rng(seed + 7)``, as
+    before the lane lines) and each draws one or two of the street's painted lane lines
+    (:func:`add_lane_lines`, ``default_rng(seed + 11)``), all with ``click_px`` noise (0:
+    exact).
+    """
+    syn = make_scene(
+        camera,
+        np.random.default_rng(seed + 7),
+        noise=street_noise(click_px),
+        n_annotators=3,
+        image_size=image_size,
+    )
+    add_lane_lines(syn.scene, camera, np.random.default_rng(seed + 11), line_px=click_px)
+    return syn
 
 
 def road_line_scene(

@@ -17,7 +17,9 @@ Faces are shaded by a sun (Lambert plus ambient light), colours vary (white, bla
 red, blue, and a grey as dark as the road: the hard case for background subtraction).
 A pole camera 6-9 m up watches a straight street (lanes along world x, the annotated
 reference car parked at the origin); the scene is that camera's annotation by 3
-annotators with 1 px clicks, so it calibrates to the camera up to that noise.
+annotators with 1 px clicks, each also drawing one or two of the painted lane lines
+(:func:`camloc_geo.testing.road_lines.street_scene`), so it calibrates to the camera up to
+that noise.
 
 Truth per frame: the image box of each vehicle wholly in view, and the world positions of
 its wheel contacts. Shortcuts: painter's algorithm per vehicle (no mutual occlusion of
@@ -37,7 +39,7 @@ import numpy.typing as npt
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.objects import PRESETS
 from camloc_geo.testing._video import write_video
-from camloc_geo.testing.synthetic import NoiseModel, make_scene
+from camloc_geo.testing.road_lines import street_scene
 
 __all__ = [
     "COLOURS",
@@ -463,17 +465,8 @@ def render_street(
     size = (round(2 * camera.principal_point[0]), round(2 * camera.principal_point[1]))
     w, h = size
     rng = np.random.default_rng(seed)
-    noise = NoiseModel(
-        point_px=annotation_px,
-        line_px=annotation_px,
-        wrong_corner_prob=0.0,
-        sloppy_prob=0.0,
-        size_rel=0.0,
-        car_yaw_deg=0.0,
-    )
-    scene = make_scene(
-        camera, np.random.default_rng(seed + 7), noise=noise, n_annotators=3, image_size=size
-    ).scene
+    # The parked car's clicks and the painted lane lines, as 3 annotators draw them.
+    scene = street_scene(camera, seed, click_px=annotation_px, image_size=size).scene
     background = _background(camera, size, rng, texture_m_per_px)
     ref = PRESETS["sedan"]
     parked = StreetVehicle(

@@ -1,0 +1,244 @@
+"""Failure modes of automatic vanishing points on real photos (issue 24), on synthetic
+segments: a photo looking up steeply at a building, roof slopes and paving joints posing
+as a principal direction, a lens' barrel distortion."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camloc_geo.autovp import detect_vanishing_points, pitch_roll_from_up
+
+
+def cam_from_world(yaw_deg: float, pitch_deg: float) -> np.ndarray:
+    """Rows: camera right, down, forward in a z-up world; pitch positive looking down."""
+    ps, th = math.radians(yaw_deg), math.radians(pitch_deg)
+    fwd = np.array([math.cos(ps) * math.cos(th), math.sin(ps) * math.cos(th), -math.sin(th)])
+    right = np.cross(fwd, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    return np.array([right, np.cross(fwd, right), fwd])
+
+
+def facade_segments(
+    pitch_deg: float,
+    *,
+    f_px: float = 800.0,
+    size: tuple[int, int] = (1024, 768),
+    n_vertical: int = 60,
+    n_rows: int = 50,
+    n_side: int = 6,
+    facade_yaw_deg: float = 25.0,
+    seed: int = 0,
+    noise_px: float = 0.3,
+    camera_height_m: float = 1.6,
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """Segments of a tall facade 18 m off, seen from a camera ``camera_height_m`` up.
+
+    Its vertical edges (``n_vertical``) and window rows (``n_rows``) are many; the third
+    direction, the courses of a side wall running away from the camera, has ``n_side``.
+    """
+    rng = np.random.default_rng(seed)
+    w, h = size
+    R = cam_from_world(0.0, pitch_deg)
+    a = math.radians(facade_yaw_deg)
+    along = np.array([math.sin(a), -math.cos(a), 0.0])  # the facade's horizontal
+    normal = np.array([math.cos(a), math.sin(a), 0.0])  # towards the side wall's depth
+    up = np.array([0.0, 0.0, 1.0])
+    origin = np.array([18.0, 0.0, -camera_height_m])  # a point of the facade, street level
+    segs: list[list[float]] = []
+
+    def add(p: np.ndarray, q: np.ndarray) -> None:
+        pc, qc = R @ p, R @ q
+        if pc[2] < 0.5 or qc[2] < 0.5:
+            return
+        a_px = f_px * pc[:2] / pc[2] + (w / 2, h / 2)
+        b_px = f_px * qc[:2] / qc[2] + (w / 2, h / 2)
+        ok = all(0 <= v[0] <= w and 0 <= v[1] <= h for v in (a_px, b_px))
+        if ok and np.hypot(*(b_px - a_px)) > 25:
+            segs.append([*a_px, *b_px])
+
+    tries = 0
+    while len(segs) < n_vertical and tries < 20000:
+        tries += 1
+        p = origin + along * rng.uniform(-25, 25) + up * rng.uniform(0, 60)
+        add(p, p + up * rng.uniform(2, 10))
+    n0, tries = len(segs), 0
+    while len(segs) < n0 + n_rows and tries < 20000:
+        tries += 1
+        p = origin + along * rng.uniform(-25, 20) + up * rng.uniform(0, 60)
+        add(p, p + along * rng.uniform(2, 8))
+    n0, tries = len(segs), 0
+    while len(segs) < n0 + n_side and tries < 20000:
+        tries += 1
+        p = origin + along * 22.0 + up * rng.uniform(0, 60) + normal * rng.uniform(0, 10)
+        add(p, p + normal * rng.uniform(2, 6))
+    out = np.array(segs)
+    return out + rng.normal(0.0, noise_px, out.shape), (w, h)
+
+
+@pytest.mark.parametrize("pitch_deg", [-40.0, -50.0, -60.0])
+def test_photo_looking_up_steeply_at_a_building_is_not_read_as_looking_down(
+    pitch_deg: float,
+) -> None:
+    """Looking up 40-60 degrees at a facade sees the same Manhattan frame as looking down
+    50-30 degrees. The building's many vertical edges decide (the other reading would rest
+    on a side wall's 6 courses), and the ambiguity is stated."""
+    segs, size = facade_segments(pitch_deg)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(pitch_deg, abs=1.0)
+    assert abs(res.focal_px / 800.0 - 1.0) < 0.05
+    assert not res.vertical_identified
+    assert any("looks up" in w and "or down" in w for w in res.warnings)
+
+
+def test_mast_camera_looking_down_steeply_stays_looking_down() -> None:
+    """A camera looking down 50 degrees at a facade with as many courses running away as
+    vertical edges: the likelier reading (looking down) is kept."""
+    segs, size = facade_segments(
+        50.0, n_vertical=40, n_rows=40, n_side=40, camera_height_m=40.0, facade_yaw_deg=40.0
+    )
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(50.0, abs=1.0)
+    up_true = cam_from_world(0.0, 50.0) @ np.array([0.0, 0.0, 1.0])
+    assert pitch_roll_from_up(up_true)[0] == pytest.approx(50.0)
+
+
+def street_segments(
+    *,
+    n_vertical: int = 30,
+    n_joints: int = 0,
+    joint_deg: float = 90.0,
+    n_roof: int = 0,
+    roof_deg: float = 60.0,
+    f_px: float = 800.0,
+    seed: int = 0,
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """A level camera (1.6 m up, pitch 2 degrees) looking down a street (along +x).
+
+    Buildings line both sides (``n_vertical`` edges and 16 window rows each); paving
+    joints (``n_joints``, short, on the ground) run ``joint_deg`` off the street, 90
+    being square to it; roof slopes (``n_roof``) rise ``roof_deg`` along the facades.
+    """
+    rng = np.random.default_rng(seed)
+    w, h = 1024, 768
+    R = cam_from_world(8.0, 2.0)
+    centre = np.array([0.0, 0.0, 1.6])
+    segs: list[list[float]] = []
+
+    def add(p: np.ndarray, q: np.ndarray) -> None:
+        pc, qc = R @ (p - centre), R @ (q - centre)
+        if pc[2] < 0.5 or qc[2] < 0.5:
+            return
+        a_px = f_px * pc[:2] / pc[2] + (w / 2, h / 2)
+        b_px = f_px * qc[:2] / qc[2] + (w / 2, h / 2)
+        ok = all(0 <= v[0] <= w and 0 <= v[1] <= h for v in (a_px, b_px))
+        if ok and np.hypot(*(b_px - a_px)) > 20:
+            segs.append([*a_px, *b_px])
+
+    for side in (-8.0, 8.0):
+        for x in rng.uniform(8, 90, n_vertical):
+            add(np.array([x, side, 0.5]), np.array([x, side, rng.uniform(5, 14)]))
+        for z in rng.uniform(0.5, 12, 16):
+            x0 = rng.uniform(8, 40)
+            add(np.array([x0, side, z]), np.array([x0 + rng.uniform(8, 40), side, z]))
+    a = math.radians(joint_deg)
+    for _ in range(n_joints):
+        p = np.array([rng.uniform(6, 20), rng.uniform(-5, 5), 0.0])
+        add(p, p + np.array([math.cos(a), math.sin(a), 0.0]) * rng.uniform(1.5, 4))
+    r = math.radians(roof_deg)
+    for i in range(n_roof):
+        p = np.array([rng.uniform(15, 60), 8.0 if i % 2 else -8.0, 14.0])
+        add(p, p + np.array([math.cos(r), 0.0, math.sin(r)]) * rng.uniform(3, 6))
+    out = np.array(segs)
+    return out + rng.normal(0.0, 0.3, out.shape), (w, h)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_paving_joints_off_square_do_not_make_a_confident_focal_length(seed: int) -> None:
+    """A level camera looking down a street: the across-street direction comes only from
+    10 short paving joints laid 6 degrees off square. The focal length then rests on them
+    (it is 23-26 % off): the result must say so (a warning, confidence under 0.5) with a
+    sigma that covers the error within 3 sigma, not state a few per cent."""
+    segs, size = street_segments(n_joints=10, joint_deg=84.0, seed=seed)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    err = abs(math.log(res.focal_px / 800.0))
+    assert res.warnings
+    assert res.confidence < 0.5
+    assert err <= 3.0 * res.focal_std_rel
+    # the tilt does not rest on them
+    assert res.pitch_deg == pytest.approx(2.0, abs=1.0)
+    assert abs(res.roll_deg) < 0.5
+
+
+@pytest.mark.parametrize("roof_deg", [55.0, 70.0])
+def test_roof_slopes_do_not_pose_as_the_vertical(roof_deg: float) -> None:
+    """Few building edges (3 a side, trees stand for the rest) and 10 steep roof slopes:
+    the vertical stays the buildings', pitch and roll within half a degree."""
+    segs, size = street_segments(n_vertical=3, n_roof=10, roof_deg=roof_deg, seed=1)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    assert res.pitch_deg == pytest.approx(2.0, abs=0.5)
+    assert abs(res.roll_deg) < 0.5
+    assert abs(res.directions_in_cam[0] @ (cam_from_world(8.0, 2.0) @ [0, 0, 1.0])) > math.cos(
+        math.radians(1.0)
+    )
+
+
+def corner_segments(
+    n_paths: int, path_deg: float, seed: int = 0, f_px: float = 700.0
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """A building corner 20 m off seen level (yaw 45, pitch 3 degrees, 1.6 m up), and
+    ``n_paths`` long straight paths on the lawn below the horizon, ``path_deg`` off the
+    first facade's direction (as on York Urban's campus)."""
+    rng = np.random.default_rng(seed)
+    w, h = 1024, 768
+    R = cam_from_world(45.0, 3.0)
+    centre = np.array([0.0, 0.0, 1.6])
+    segs: list[list[float]] = []
+
+    def add(p: list[float] | np.ndarray, q: list[float] | np.ndarray) -> None:
+        pc, qc = R @ (np.asarray(p) - centre), R @ (np.asarray(q) - centre)
+        if pc[2] < 0.5 or qc[2] < 0.5:
+            return
+        a_px = f_px * pc[:2] / pc[2] + (w / 2, h / 2)
+        b_px = f_px * qc[:2] / qc[2] + (w / 2, h / 2)
+        ok = all(0 <= v[0] <= w and 0 <= v[1] <= h for v in (a_px, b_px))
+        if ok and np.hypot(*(b_px - a_px)) > 20:
+            segs.append([*a_px, *b_px])
+
+    d = 20.0
+    for _ in range(25):
+        x, y = rng.uniform(5, 30, 2)
+        add([x, d, 0.0], [x, d, rng.uniform(3, 15)])
+        add([d, y, 0.0], [d, y, rng.uniform(3, 15)])
+        z, x0 = rng.uniform(2, 15), rng.uniform(5, 25)
+        add([x0, d, z], [x0 + rng.uniform(5, 12), d, z])
+        z, y0 = rng.uniform(2, 15), rng.uniform(5, 25)
+        add([d, y0, z], [d, y0 + rng.uniform(5, 12), z])
+    a = math.radians(path_deg)
+    for _ in range(n_paths):
+        p = np.array([rng.uniform(3, 15), rng.uniform(3, 20), 0.0])
+        add(p, p + np.array([math.cos(a), math.sin(a), 0.0]) * rng.uniform(4, 10))
+    out = np.array(segs)
+    return out + rng.normal(0.0, 0.3, out.shape), (w, h)
+
+
+@pytest.mark.parametrize("seed", [0, 2, 3])
+def test_paths_below_the_horizon_that_disagree_with_the_facades_widen_the_sigma(
+    seed: int,
+) -> None:
+    """Paths on a lawn 6 degrees off a facade's direction pull its vanishing point (focal
+    length 3-5 % low). Leaving out either side of the horizon moves the focal length, so
+    the stated sigma grows to cover the error (2.2-2.6 % were stated without that check,
+    the error 1.4-1.9 sigma); with the same paths parallel to the facade it stays small."""
+    segs, size = corner_segments(12, 6.0, seed)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    err = abs(math.log(res.focal_px / 700.0))
+    assert 0.02 < err < 0.06
+    assert res.focal_std_rel > 0.035
+    assert err <= 1.3 * res.focal_std_rel
+    aligned, _ = corner_segments(12, 0.0, seed)
+    res0 = detect_vanishing_points(None, segments=aligned, image_size=size)
+    assert abs(math.log(res0.focal_px / 700.0)) < 0.01
+    assert res0.focal_std_rel < 0.03
