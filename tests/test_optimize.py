@@ -67,9 +67,11 @@ def test_lockstep_problems_take_the_steps_they_take_alone() -> None:
 
     together = soft_l1_least_squares_many(many, starts, f_scale=2.5, max_nfev=60)
     for (fun, jac, _x0), x0, res in zip(problems, starts, together, strict=True):
-        alone = soft_l1_least_squares(
-            fun, jac, x0, f_scale=2.5, max_nfev=60, fun_and_jac=lambda x, f=fun, j=jac: (f(x), j(x))
-        )
+
+        def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
+            return f(x), j(x)
+
+        alone = soft_l1_least_squares(fun, jac, x0, f_scale=2.5, max_nfev=60, fun_and_jac=both)
         assert res.nfev == alone.nfev
         assert res.success == alone.success
         np.testing.assert_array_equal(res.x, alone.x)

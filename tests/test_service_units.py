@@ -194,9 +194,14 @@ def test_a_worker_freezes_its_maps_once_per_map_change(monkeypatch: pytest.Monke
     from camloc_geo.service import compute
 
     calls: list[str] = []
+
+    def collect(*_a: object) -> int:
+        calls.append("collect")
+        return 0
+
     monkeypatch.setattr(gc, "freeze", lambda: calls.append("freeze"))
     monkeypatch.setattr(gc, "unfreeze", lambda: calls.append("unfreeze"))
-    monkeypatch.setattr(gc, "collect", lambda *a: calls.append("collect") or 0)
+    monkeypatch.setattr(gc, "collect", collect)
     monkeypatch.setattr(compute, "_frozen_at_loads", -1)
     compute._freeze_maps()
     assert calls == ["unfreeze", "collect", "freeze"]
