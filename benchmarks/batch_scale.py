@@ -61,16 +61,26 @@ def _junction_names(extracts: tuple[Path, ...]) -> list[tuple[str, str]]:
     return pairs
 
 
-def write_title_list(path: Path, rows: int, pairs: list[tuple[str, str]]) -> None:
-    """``rows`` title-only cameras, written one row at a time (never held in memory)."""
+def write_title_list(
+    path: Path, rows: int, pairs: list[tuple[str, str]], *, distinct: bool = False
+) -> None:
+    """``rows`` title-only cameras, written one row at a time (never held in memory).
+
+    The titles cycle through the junctions and four listing styles, so a title comes back
+    every ``4 × len(pairs)`` rows (as a city's cameras share junctions); ``distinct`` puts
+    the camera's own number first (``"123456 - A & B"``), so no two rows share a title and
+    no answer is reused (the worst case for the batch).
+    """
     styles = ("{a} & {b}", "{n} - {a} / {b} looking north", "{a} at {b}", "{A} @ {B}")
+    if distinct:
+        styles = ("{i} - {a} & {b}", "{i} - {a} / {b} looking north", "{i} - {a} at {b}")
     with path.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["id", "title"])
         for i in range(rows):
             a, b = pairs[i % len(pairs)]
             style = styles[(i // len(pairs)) % len(styles)]
-            title = style.format(a=a, b=b, A=a.upper(), B=b.upper(), n=100 + i % 900)
+            title = style.format(a=a, b=b, A=a.upper(), B=b.upper(), n=100 + i % 900, i=i + 1)
             w.writerow([f"cam{i + 1:07d}", title])
 
 
@@ -201,6 +211,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--max-s", type=float, default=None, help="stop the run after this long")
     ap.add_argument("--label", default="", help="a note kept in the JSON")
     ap.add_argument(
+        "--distinct-titles",
+        action="store_true",
+        help="every row its own title (a camera number first): no answer reused",
+    )
+    ap.add_argument(
         "--resume-rows",
         type=int,
         default=1_000_000,
@@ -219,7 +234,7 @@ def main(argv: list[str] | None = None) -> int:
         t = time.perf_counter()
         pairs = _junction_names(EXTRACTS)
         lst = tmp / "titles.csv"
-        write_title_list(lst, ns.rows, pairs)
+        write_title_list(lst, ns.rows, pairs, distinct=ns.distinct_titles)
         gen_s = time.perf_counter() - t
         out = tmp / "out.gpkg"
         journal = out.with_name(out.stem + ".camloc-batch.sqlite")
@@ -287,17 +302,22 @@ def main(argv: list[str] | None = None) -> int:
         list_mb = lst.stat().st_size / 2**20
     samples = [s for s in samples if s["done"] >= 0]
     working = [s for s in samples if s["done"] > 0]
+    # the rate while cameras are computed: the GeoPackage is built after the last one (the
+    # batch alone, without workers) and counts apart, in after_last_camera_s
+    computing = [s for s in working if s["procs"] > 1]
+    rate_span = computing if len(computing) >= 2 else working
     rate = 0.0
-    if len(working) >= 2 and working[-1]["t_s"] > working[0]["t_s"]:
-        rate = (working[-1]["done"] - working[0]["done"]) / (working[-1]["t_s"] - working[0]["t_s"])
+    if len(rate_span) >= 2 and rate_span[-1]["t_s"] > rate_span[0]["t_s"]:
+        rate = (rate_span[-1]["done"] - rate_span[0]["done"]) / (
+            rate_span[-1]["t_s"] - rate_span[0]["t_s"]
+        )
     deciles = []
     for q in range(1, 11):
         want = done * q / 10
         hit = next((s for s in samples if s["done"] >= want), None)
         if hit is not None:
             deciles.append({"done": hit["done"], "rss_mb": hit["rss_mb"], "t_s": hit["t_s"]})
-    # the slope while cameras are computed (the GeoPackage is built after the last one)
-    computing = [s for s in working if s["procs"] > 1]
+    # the slope while cameras are computed
     half = [s for s in computing if s["done"] >= computing[-1]["done"] / 2] if computing else []
     slope = None
     if len(half) >= 2 and half[-1]["done"] > half[0]["done"]:
@@ -321,6 +341,7 @@ def main(argv: list[str] | None = None) -> int:
         "workers": ns.workers,
         "chunk_size": ns.chunk_size,
         "title_only": True,
+        "distinct_titles": ns.distinct_titles,
         "extracts": [e.name for e in EXTRACTS],
         "junction_titles": len(pairs),
         "list_generation_s": round(gen_s, 1),
@@ -335,8 +356,8 @@ def main(argv: list[str] | None = None) -> int:
         ),
         "load1_median": loads[len(loads) // 2] if loads else None,
         "after_last_camera_s": gpkg_s,
-        "extrapolated_wall_s_all_rows": round(ns.rows / rate, 0) if rate else None,
-        "extrapolated_wall_s_million": round(1e6 / rate, 0) if rate else None,
+        "extrapolated_compute_s_all_rows": round(ns.rows / rate, 0) if rate else None,
+        "extrapolated_compute_s_million": round(1e6 / rate, 0) if rate else None,
         "paper_s_per_image": PAPER_S_PER_IMAGE,
         "peak_rss_mb": max((s["rss_mb"] for s in samples), default=None),
         "rss_mb_by_decile_of_done": deciles,
