@@ -11,6 +11,9 @@ radar (see ``docs/radar.md``):
    by the same ratio, 0.35-0.9, in every channel); morphology and connected components
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
+   The pieces of one vehicle (a road-grey car falls apart under the threshold) inside its
+   track's predicted box are joined by that motion (:func:`_join_fragments`); a track is
+   cut where its features' motion turns back (it came out of a merge on another vehicle).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
 2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
    silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
@@ -27,23 +30,24 @@ radar (see ``docs/radar.md``):
    predicts the vehicle's box in the next frame (association, coasting through merged
    blobs). Features are never cast onto the ground themselves: their height is unknown.
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
-   least squares, with one velocity shared by all segments and one offset per segment
-   (constant velocity over the track). Speed = |velocity| in km/h.
+   least squares weighted by each frame's ground variance (a pixel's footprint on the
+   road), with one velocity shared by all segments and one offset per segment (constant
+   velocity over the track). Speed = |velocity| in km/h.
 
-A second, independent estimate: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
-constant velocity along the fitted direction is fitted (soft-L1) so that its projected
-image box (plus a constant margin in pixels) matches the vehicle's box in every frame.
 Without a silhouette in most frames (boxes given for a video whose background shows no
-foreground) its velocity is the reported one; otherwise the contact's is (a cuboid is not a
-car: on two-box cars with ground clearance it reads 2-5 % fast) and the cuboid only widens
-the uncertainty. Each track is fitted as soon as it ends, so a long video holds only the
-active tracks in memory.
+foreground) a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant velocity
+along the fitted direction is fitted (soft-L1) so that its projected image box (plus a
+constant margin in pixels) matches the vehicle's box in every frame, and its velocity is
+the reported one (a cuboid is not a car: on two-box cars with ground clearance it reads
+2-5 % fast, so it is not used where the contact is seen). Each track is fitted as soon as
+it ends, so a long video holds only the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
 residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
-0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``); half the
-difference between the contact-point and the cuboid speeds (model error: where the contact
-slid along the vehicle or followed another one through a merge, the two disagree); the
+0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``; 0.6 m for
+a silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
+of the track's two halves in time beyond their noise (a contact that followed another
+vehicle through a merge, a corner sliding along the body); the
 calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
 drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by the
 calibration's sigmas; rotation fixed), and the spread of the speeds taken.
