@@ -11,6 +11,9 @@ radar (see ``docs/radar.md``):
    by the same ratio, 0.35-0.9, in every channel); morphology and connected components
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
+   The pieces of one vehicle (a road-grey car falls apart under the threshold) inside its
+   track's predicted box are joined by that motion (:func:`_join_fragments`); a track is
+   cut where its features' motion turns back (it came out of a merge on another vehicle).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
 2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
    silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
@@ -27,23 +30,24 @@ radar (see ``docs/radar.md``):
    predicts the vehicle's box in the next frame (association, coasting through merged
    blobs). Features are never cast onto the ground themselves: their height is unknown.
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
-   least squares, with one velocity shared by all segments and one offset per segment
-   (constant velocity over the track). Speed = |velocity| in km/h.
+   least squares weighted by each frame's ground variance (a pixel's footprint on the
+   road), with one velocity shared by all segments and one offset per segment (constant
+   velocity over the track). Speed = |velocity| in km/h.
 
-A second, independent estimate: a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at
-constant velocity along the fitted direction is fitted (soft-L1) so that its projected
-image box (plus a constant margin in pixels) matches the vehicle's box in every frame.
 Without a silhouette in most frames (boxes given for a video whose background shows no
-foreground) its velocity is the reported one; otherwise the contact's is (a cuboid is not a
-car: on two-box cars with ground clearance it reads 2-5 % fast) and the cuboid only widens
-the uncertainty. Each track is fitted as soon as it ends, so a long video holds only the
-active tracks in memory.
+foreground) a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant velocity
+along the fitted direction is fitted (soft-L1) so that its projected image box (plus a
+constant margin in pixels) matches the vehicle's box in every frame, and its velocity is
+the reported one (a cuboid is not a car: on two-box cars with ground clearance it reads
+2-5 % fast, so it is not used where the contact is seen). Each track is fitted as soon as
+it ends, so a long video holds only the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
 residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
-0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``); half the
-difference between the contact-point and the cuboid speeds (model error: where the contact
-slid along the vehicle or followed another one through a merge, the two disagree); the
+0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``; 0.6 m for
+a silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
+of the track's two halves in time beyond their noise (a contact that followed another
+vehicle through a merge, a corner sliding along the body); the
 calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
 drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed by the
 calibration's sigmas; rotation fixed), and the spread of the speeds taken.
@@ -133,6 +137,8 @@ _BG_SAMPLES = 9  # frames sampled over the video for the initial background (med
 _CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
 _CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
 _CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
+_MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is a piece
+_PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
 
 
 # --------------------------------------------------------------------------- results
@@ -1069,24 +1075,45 @@ def _fit_track(
     # does its velocity (H: the camera's height)
     height_m = max(1.0, float(cam.center_in_world[2]))
     sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
+    # a silhouette lower than any vehicle standing on its contact is a piece of one (a
+    # road-grey car's cabin and roof): its lowest corner may be the body's top edge, up
+    # to a metre above the road
+    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
+    tall_m = _apparent_height_m(cam, ground[0], base, boxes)
+    if tall_m < _MIN_VEHICLE_HEIGHT_M:
+        sigma_contact = speed * _PIECE_CONTACT_SIGMA_M / height_m
     sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
     kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
     on_silhouette = float(np.mean(kinds_used == "silhouette"))
+    # the track's own consistency: its two halves in time, fitted apart, must agree within
+    # their noise; what they disagree by beyond it (a contact that followed another vehicle
+    # through a merge, a corner sliding along the body) is model error
+    sigma_model = _halves_disagreement(times, labels, ground[0], weights, unit)
     # without a silhouette (given boxes only), refine with a cuboid moving at constant
     # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
-    boxes = np.array([t.boxes[i] for i in use], dtype=np.float64)[ok][keep]
-    refined = _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
+    refined = (
+        _cuboid_fit(cam, boxes, times, ground[0], labels, solve, vel)
+        if on_silhouette < 0.5
+        else None
+    )
     if refined is not None:
         vel_c, sigma_c = refined
         speed_c = float(np.linalg.norm(vel_c))
-        if speed_c * dur >= 1.0:
-            # the two estimates (ground contact, cuboid) disagree by the model's error
-            sigma_model = abs(speed_c - speed) / 2.0
-            if on_silhouette < 0.5:  # no silhouette: the cuboid's speed is reported
-                sigma_cal *= speed_c / speed
-                sigma_contact *= speed_c / speed
-                vel, speed, sigma_fit = vel_c, speed_c, sigma_c
-            sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2 + sigma_contact**2)
+        if speed_c * dur >= 1.0:  # the cuboid's speed is reported; the two disagree by
+            sigma_model = max(sigma_model, abs(speed_c - speed) / 2.0)  # the model's error
+            sigma_cal *= speed_c / speed
+            sigma_contact *= speed_c / speed
+            vel, speed, sigma_fit = vel_c, speed_c, sigma_c
+    sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_model**2 + sigma_contact**2)
+    log.debug(
+        "vehicle %d: %.2f m/s; sigma fit %.3f, calibration %.3f, contact %.3f, model %.3f",
+        t.vid,
+        speed,
+        sigma_fit,
+        sigma_cal,
+        sigma_contact,
+        sigma_model,
+    )
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
     world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
@@ -1106,6 +1133,46 @@ def _fit_track(
         None,
         world,
     )
+
+
+def _apparent_height_m(
+    cam: Any, ground: FloatArray, contacts_px: FloatArray, boxes: FloatArray
+) -> float:
+    """Median height (metres) of a track's boxes above their contacts: box top to contact
+    pixel over the image length of a metre standing on the contact's ground point."""
+    n = len(ground)
+    up = cam.project(np.column_stack([ground, np.ones(n)]))[:, 1]
+    metre_px = contacts_px[:, 1] - up
+    tall = (contacts_px[:, 1] - boxes[:, 1]) / np.where(metre_px > 0.5, metre_px, np.nan)
+    tall = tall[np.isfinite(tall)]
+    return float(np.median(tall)) if len(tall) else math.nan
+
+
+def _halves_disagreement(
+    times: FloatArray, labels: list[int], ground: FloatArray, weights: FloatArray, unit: FloatArray
+) -> float:
+    """Half the speed difference (m/s) of a track's first and second halves in time, fitted
+    apart (same weights), beyond 2 standard errors of that difference; 0 when a half has too
+    few frames or too short a time to fit."""
+    mid = float(np.median(times))
+    fits = []
+    for sel in (times <= mid, times > mid):
+        if sel.sum() < 4:
+            return 0.0
+        lab = [s for s, k in zip(labels, sel, strict=True) if k]
+        tt, w, g = times[sel], weights[sel], ground[sel]
+        a = _design(tt, lab)
+        if a.shape[0] <= a.shape[1] or float(np.ptp(tt)) <= 0:
+            return 0.0
+        sw = np.sqrt(w)[:, None]
+        solve = np.linalg.pinv(a * sw) * sw.T
+        res = g - a @ (solve @ g)
+        dof = max(1, len(tt) - a.shape[1])
+        s2 = float(np.sum(w * (res @ unit) ** 2) / dof)
+        se2 = s2 * float(np.sum(solve[0] ** 2 / np.maximum(w, 1e-12)))
+        fits.append((float((solve[0] @ g) @ unit), se2))
+    (v1, e1), (v2, e2) = fits
+    return max(0.0, abs(v1 - v2) - 2.0 * math.sqrt(e1 + e2)) / 2.0
 
 
 _CAR_DIMS_M = np.array([4.5, 1.8, 1.5])

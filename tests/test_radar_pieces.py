@@ -1,0 +1,114 @@
+"""The radar's track repairs, on hand-made tracks and blobs (no video).
+
+- a vehicle falling apart into pieces under the foreground threshold is joined by its motion,
+  a neighbour is not;
+- a track that comes out of a merge on a vehicle driving the other way is cut there;
+- the model term of ``sigma_kmh``: a track whose halves disagree beyond their noise;
+- a silhouette too low for a vehicle standing on its contact is recognised as a piece.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from camloc_geo.camera import Camera, rotation_from_angles
+from camloc_geo.sensors.radar import (
+    _apparent_height_m,
+    _halves_disagreement,
+    _identity_switches,
+    _join_fragments,
+    _Track,
+)
+
+
+def _track(box: tuple[float, float, float, float], velocity: tuple[float, float]) -> _Track:
+    t = _Track(1, box, velocity=velocity)
+    t.frames = [0, 1, 2, 3, 4]
+    return t
+
+
+def test_pieces_of_one_vehicle_are_joined() -> None:
+    # last frame's box moved by (-10, 5): the cabin and the lower body fall inside
+    car = _track((110.0, 195.0, 230.0, 295.0), (-10.0, 5.0))
+    cabin, lower, wheel = (
+        (130.0, 200.0, 210.0, 240.0),
+        (100.0, 240.0, 222.0, 300.0),
+        (96.0, 280.0, 104.0, 290.0),
+    )
+    far = (600.0, 50.0, 640.0, 80.0)
+    blobs, ids = _join_fragments([car], [lower, cabin, far], [[1], [2], [3]], [wheel], [4])
+    assert far in blobs
+    assert ids[blobs.index(far)] == [3]
+    joined = [b for b in blobs if b != far]
+    assert len(joined) == 1
+    assert joined[0] == (96.0, 200.0, 222.0, 300.0)
+    assert sorted(ids[blobs.index(joined[0])]) == [1, 2, 4]
+
+
+def test_neighbour_is_not_joined() -> None:
+    a = _track((100.0, 200.0, 200.0, 260.0), (5.0, 0.0))
+    b = _track((210.0, 200.0, 300.0, 260.0), (-5.0, 0.0))
+    blobs_in = [(105.0, 200.0, 205.0, 260.0), (205.0, 200.0, 295.0, 260.0)]
+    blobs, ids = _join_fragments([a, b], blobs_in, [[1], [2]], [], [])
+    assert blobs == blobs_in
+    assert ids == [[1], [2]]
+
+
+def test_union_may_not_outgrow_a_vehicle() -> None:
+    # a second vehicle just below: joined, the box would be 60 % taller than predicted
+    car = _track((100.0, 100.0, 200.0, 150.0), (0.0, 0.0))
+    blobs_in = [(100.0, 100.0, 200.0, 150.0), (110.0, 148.0, 190.0, 160.0)]
+    blobs, _ = _join_fragments([car], blobs_in, [[1], [2]], [], [])
+    assert blobs == blobs_in
+
+
+def test_fragment_track_is_absorbed() -> None:
+    car = _track((100.0, 200.0, 220.0, 300.0), (-8.0, 4.0))
+    cabin_track = _track((130.0, 200.0, 200.0, 240.0), (-8.5, 4.2))
+    cabin_track.vid = 2
+    blobs_in = [(92.0, 244.0, 212.0, 304.0), (122.0, 204.0, 192.0, 244.0)]
+    blobs, ids = _join_fragments([car, cabin_track], blobs_in, [[1], [2]], [], [])
+    assert len(blobs) == 1
+    assert sorted(ids[0]) == [1, 2]
+    assert cabin_track.absorbed
+    assert not car.absorbed
+
+
+def test_identity_switch_cut_where_motion_turns_back() -> None:
+    t = _track((0.0, 0.0, 10.0, 10.0), (0.0, 0.0))
+    nan = (math.nan, math.nan)
+    t.klt = [nan, (-1.1, 0.8), (-1.0, 0.7), nan, nan, (0.1, 0.0), (0.6, -0.2), (1.2, -0.5)]
+    assert _identity_switches(t) == [6]
+    t.klt = [(-1.0, 0.5), (-1.2, 0.4), (-0.9, 0.6)]
+    assert _identity_switches(t) == []
+
+
+def test_halves_disagreement() -> None:
+    rng = np.random.default_rng(3)
+    times = np.arange(40) / 20.0
+    labels = [0] * 40
+    unit = np.array([1.0, 0.0])
+    w = np.ones(40)
+    steady = np.column_stack([10.0 * times, np.zeros(40)]) + rng.normal(0, 0.05, (40, 2))
+    assert _halves_disagreement(times, labels, steady, w, unit) < 0.3
+    # the second half follows a vehicle at 6 m/s: 2 m/s of model error, at least
+    turn = steady.copy()
+    turn[20:, 0] = turn[19, 0] + 6.0 * (times[20:] - times[19])
+    assert _halves_disagreement(times, labels, turn, w, unit) > 1.5
+
+
+def test_apparent_height_tells_a_piece() -> None:
+    cam = Camera.from_center(
+        800.0, (480.0, 270.0), rotation_from_angles(0.0, 25.0, 0.0), np.array([0.0, -20.0, 7.0])
+    )
+    ground = np.array([[0.0, 0.0], [1.0, 0.5]])
+    contacts = cam.project(np.column_stack([ground, np.zeros(2)]))
+    tops = cam.project(np.column_stack([ground, np.full(2, 1.45)]))
+    whole = np.column_stack([contacts[:, 0] - 40, tops[:, 1], contacts[:, 0] + 40, contacts[:, 1]])
+    assert abs(_apparent_height_m(cam, ground, contacts, whole) - 1.45) < 0.05
+    mids = cam.project(np.column_stack([ground, np.full(2, 0.6)]))
+    piece = whole.copy()
+    piece[:, 1] = mids[:, 1]
+    assert abs(_apparent_height_m(cam, ground, contacts, piece) - 0.6) < 0.05
