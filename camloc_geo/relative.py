@@ -2882,6 +2882,8 @@ def _without_pp_prior(prob: _JointProblem, res: Any, R0: FloatArray, f_fixed: fl
     n_x = len(res.x)
     for _ in range(4):
         r = np.asarray(res.fun, dtype=float)[:-2]  # the prior's two rows come last
+        if len(prob.photo_segments):  # the annotations' variance alone (as the covariance)
+            r = r[: len(prob.segments) + 2 * len(prob.pt_pix)]
         s2 = float(np.sum(r**2)) / max(len(r) - n_x, 1)
         widened = base / math.sqrt(min(max(s2, 1e-10), 1.0))
         if widened <= prob.pp_prior_sigma * 1.1:

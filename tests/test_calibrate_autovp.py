@@ -36,12 +36,12 @@ def _render(cam: Camera, size: tuple[int, int]) -> np.ndarray:
         x0, y0 = rng.uniform(-10, 30), rng.uniform(6, 30)
         dx, dy, hz = rng.uniform(3, 10), rng.uniform(3, 8), rng.uniform(4, 15)
         corners = [(x0, y0), (x0 + dx, y0), (x0 + dx, y0 + dy), (x0, y0 + dy)]
-        edges = []
+        edges: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
         for i in range(4):
             a, b = corners[i], corners[(i + 1) % 4]
             edges += [((*a, 0.0), (*b, 0.0)), ((*a, hz), (*b, hz)), ((*a, 0.0), (*a, hz))]
-        for a, b in edges:
-            pa, pb = cam.project(np.array(a)), cam.project(np.array(b))
+        for p3, q3 in edges:
+            pa, pb = cam.project(np.array(p3)), cam.project(np.array(q3))
             if np.all(np.isfinite(pa)) and np.all(np.isfinite(pb)):
                 cv2.line(
                     img,

@@ -119,7 +119,7 @@ def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:
     try:
         relative.calibrate(load_scene(SCENE))
     finally:
-        relative._fit = original  # type: ignore[assignment]
+        relative._fit = original
     assert recorded
     assert any(rec[-1] is not None for rec in recorded)
     for prob, x0, R0, pp, f, weights, ours, full, sigma_tol in recorded:
@@ -132,9 +132,15 @@ def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:
                 x[0] = float(np.clip(x[0], *prob.log_f_bounds))
                 return x
 
+        def res_fun(x: np.ndarray, prob: Any = prob, R0: Any = R0, pp: Any = pp, f: Any = f) -> Any:
+            return prob.residuals(x, R0, pp, f)
+
+        def jac_fun(x: np.ndarray, prob: Any = prob, R0: Any = R0, pp: Any = pp, f: Any = f) -> Any:
+            return prob.jacobian(x, R0, pp, f)
+
         ref = soft_l1_least_squares(
-            lambda x, prob=prob, R0=R0, pp=pp, f=f: prob.residuals(x, R0, pp, f),
-            lambda x, prob=prob, R0=R0, pp=pp, f=f: prob.jacobian(x, R0, pp, f),
+            res_fun,
+            jac_fun,
             x0,
             f_scale=relative._F_SCALE,
             project=clamp,

@@ -1,0 +1,104 @@
+"""The joint problem's remembered evaluations and vectorised sensitivities (issue 26)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from camloc_geo.relative import (
+    _F_SCALE,
+    _ground_corner_evidence,
+    _ground_corner_sensitivity,
+    calibrate,
+)
+from camloc_geo.scene import parse_scene
+from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
+
+
+def _state(seed: int = 4) -> Any:
+    rng = np.random.default_rng(seed)
+    syn = make_scene(random_camera(rng), rng, noise=NoiseModel(), n_annotators=4)
+    state = calibrate(parse_scene(syn.scene)).joint_state
+    assert state is not None
+    return state
+
+
+def _fresh(prob: Any, x: np.ndarray, args: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray]:
+    prob._memo.clear()
+    r, J = prob.residuals_and_jacobian(x, *args)
+    return r.copy(), J.copy()
+
+
+def test_remembered_evaluations_match_fresh_ones_and_follow_the_state() -> None:
+    state = _state()
+    prob = state.problem
+    args = (state.rotation0, state.principal_point, state.focal_px)
+    x = np.asarray(state.x, dtype=float)
+    prob.weights = state.weights
+    r1, J1 = prob.residuals_and_jacobian(x, *args)
+    r2, J2 = prob.residuals_and_jacobian(x.copy(), *args)
+    assert r2 is r1  # remembered
+    assert J2 is J1
+    np.testing.assert_array_equal(prob.residuals(x, *args), r1)
+    fresh_r, fresh_J = _fresh(prob, x, args)
+    np.testing.assert_array_equal(fresh_r, r1)
+    np.testing.assert_array_equal(fresh_J, J1)
+    # other weights, another point, other corners: not the remembered answer
+    prob.weights = np.ones(prob.n_annotators) * 0.5
+    r3 = prob.residuals(x, *args)
+    assert not np.allclose(r3, r1)
+    np.testing.assert_allclose(r3, _fresh(prob, x, args)[0])
+    x_moved = x + 1e-3
+    assert not np.allclose(prob.residuals(x_moved, *args), r3)
+    saved = prob.corners.copy()
+    prob.set_corners((saved + 1) % 4)
+    assert not np.allclose(prob.residuals(x, *args), r3)
+    prob.set_corners(saved)
+    prob.weights = state.weights
+
+
+def test_unweighted_residuals_are_the_residuals_at_weight_one() -> None:
+    state = _state(5)
+    prob = state.problem
+    args = (state.rotation0, state.principal_point, state.focal_px)
+    x = np.asarray(state.x, dtype=float)
+    prob.weights = np.array([1.0, 0.3, 0.8, 0.05])[: prob.n_annotators]
+    prob.residuals_and_jacobian(x, *args)  # remembered at these weights
+    from_memory = prob.unweighted_residuals(x, *args)
+    saved = prob.weights
+    prob.weights = np.ones(prob.n_annotators)
+    prob._memo.clear()
+    n_rows = len(prob.segments) + 2 * len(prob.pt_pix)
+    direct = prob.residuals(x, *args)[:n_rows]
+    prob.weights = saved
+    np.testing.assert_allclose(from_memory, direct, rtol=1e-12, atol=1e-12)
+
+
+def test_the_vectorised_ground_corner_columns_equal_the_loop() -> None:
+    state = _state(6)
+    prob = state.problem
+    args = (state.rotation0, state.principal_point, state.focal_px)
+    x = np.asarray(state.x, dtype=float)
+    prob.weights = state.weights
+    D = _ground_corner_sensitivity(prob, x, *args)
+    assert D is not None
+    # the loop it replaced: per annotator, per edge, per click one column of -H⁻¹ Jᵀ W dr
+    r, J = _fresh(prob, x, args)
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    JW = J * w[:, None]
+    H = J.T @ JW
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    cols = []
+    for a in range(len(clicks)):
+        for end in (1, 2):
+            step = prob.ground_corner_sigma_rel * (clicks[a, end] - clicks[a, 0])
+            for j in range(4 * a, 4 * a + 4):
+                ju, jv = JW[n_seg + j], JW[n_seg + n_pt + j]
+                cols.append(-prob._pt_scale[j] * (step[0] * ju + step[1] * jv))
+    ref = -_ground_corner_evidence(prob, r) * np.linalg.solve(H, np.column_stack(cols))
+    # the same columns in another order: the consider covariance D Dᵀ is the same
+    assert D.shape == ref.shape == (len(x), 8 * len(clicks))
+    scale = float(np.abs(ref @ ref.T).max())
+    np.testing.assert_allclose(D @ D.T, ref @ ref.T, rtol=1e-9, atol=1e-9 * scale)
