@@ -63,9 +63,10 @@ interpretations in which the camera looks up steeply (see ``_vertical_cost``): s
 cameras and photos are seldom rolled by more than 45 degrees, and a camera that looks
 down steeply is likelier than one that looks up steeply. That prior gives way to the
 lines (``_vertical_index``): a rival direction within 65 degrees of the image's vertical
-axis with twice the distinct lines is the vertical (a photo looking up 50 degrees at a
-building is otherwise read as looking down 40 degrees, resting on a few courses of a side
-wall), and a comparably supported rival is named in a warning.
+axis with twice the distinct lines, tilting the camera by at most 15 degrees more, is the
+vertical (a photo looking up 50 degrees at a building is otherwise read as looking down 40
+degrees, resting on a few courses of a side wall), and a comparably supported rival is
+named in a warning.
 """
 
 from __future__ import annotations
@@ -142,8 +143,11 @@ BIAS_DEG = 0.3
 _VERTICAL_MARGIN_DEG = 25.0
 #: A direction this close (degrees) to the image's vertical axis may be the vertical ...
 _VERTICAL_CANDIDATE_DEG = 65.0
-#: ... and is taken when it has this many times the distinct lines of the likeliest one.
+#: ... and is taken when it has this many times the distinct lines of the likeliest one
+#: and tilts the camera by at most this much more (degrees); a street camera looking down
+#: 30 degrees at lane markings (many) and a few poles is not read as looking up 60.
 _VERTICAL_SUPPORT_RATIO = 2.0
+_VERTICAL_RIVAL_TILT_DEG = 15.0
 #: Distinct lines (all directions) at which the chance of a wrong Manhattan frame is 1:
 #: it falls as the cube of this over the number of lines (see ``_finish``).
 _MODEL_ERROR_LINES = 25.0
@@ -1493,12 +1497,15 @@ def _vertical_index(
 
     The likeliest by :func:`_vertical_cost` (a prior: near the image's vertical axis, and
     rather looking down than up steeply). But where another direction could be the
-    vertical too (within :data:`_VERTICAL_CANDIDATE_DEG` of the image's vertical axis:
-    looking up 50 degrees at a building and looking down 40 degrees see the same frame),
-    the one supported by at least :data:`_VERTICAL_SUPPORT_RATIO` times as many distinct
-    lines wins: a building's edges are many, while the other reading would rest on a few
-    roof slopes, paving joints or a side wall's courses. That is then not a clear
-    identification.
+    vertical too (within :data:`_VERTICAL_CANDIDATE_DEG` of the image's vertical axis, and
+    tilting the camera by at most :data:`_VERTICAL_RIVAL_TILT_DEG` more: looking up 50
+    degrees at a building and looking down 40 degrees see the same frame), the one
+    supported by at least :data:`_VERTICAL_SUPPORT_RATIO` times as many distinct lines
+    wins: a building's edges are many, while the other reading would rest on a few roof
+    slopes, paving joints or a side wall's courses. That is then not a clear
+    identification. Beyond that tilt (looking up 55-60 degrees, read as looking down
+    30-35) the prior stands, unless its vertical has fewer than :data:`_MIN_SUPPORT`
+    distinct lines, and the ambiguity is only stated.
 
     Returns
     -------
@@ -1517,6 +1524,8 @@ def _vertical_index(
         if k != kv
         and angle[k] < _VERTICAL_CANDIDATE_DEG
         and n_lines[k] >= _VERTICAL_SUPPORT_RATIO * max(1, n_lines[kv])
+        # a vertical with hardly any lines of its own does not hold against them
+        and (angle[k] < angle[kv] + _VERTICAL_RIVAL_TILT_DEG or n_lines[kv] < _MIN_SUPPORT)
     ]
     if rivals:
         k_new = max(rivals, key=lambda k: n_lines[k])
