@@ -7,13 +7,13 @@
 #                                    (Canon DSLR, EXIF kept: the focal length truth), a few GB
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
-# Each repository is cloned from a local mirror when one is there (CAMLOC_MIRROR_DIR, by
-# default /work/.mirror, laid out as owner+name/repo, a bare git directory), else from GitHub.
+# Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
+# owner+name/repo, a bare git directory), else from GitHub.
 # A mirror that lacks the photo blobs (large files left out) is skipped for GitHub.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
-mirror="${CAMLOC_MIRROR_DIR:-/work/.mirror}"
+mirror="${CAMLOC_MIRROR_DIR:-}"
 sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet}"
 mkdir -p "$dest"
 for full in $sets; do
@@ -23,7 +23,7 @@ for full in $sets; do
     continue
   fi
   local_git="$mirror/${full%%/*}+$name/repo"
-  if [ -d "$local_git" ] && git -C "$local_git" rev-parse -q --verify HEAD >/dev/null \
+  if [ -n "$mirror" ] && [ -d "$local_git" ] && git -C "$local_git" rev-parse -q --verify HEAD >/dev/null \
     && git --git-dir="$local_git" fsck --connectivity-only HEAD >/dev/null 2>&1; then
     git clone -q "$local_git" "$dest/$name" && echo "$name: cloned from $local_git" && continue
   fi
