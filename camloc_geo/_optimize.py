@@ -12,6 +12,10 @@ Two problems, two solvers, both typed and tested against
     (``benchmarks/optimize.py``) it reaches the same minimum (median relative cost
     difference 3e-10) 1.35x faster per fit (median) and 2.3x faster in total, with no
     trust-region bookkeeping on a 7-9 parameter problem.
+:func:`soft_l1_least_squares_many`
+    The ``lm`` loop for several independent problems in lockstep (the absolute bundle
+    adjustment of the leading candidates): each takes exactly the steps it takes alone
+    (tested bit for bit), their evaluations are made in one call per round.
 :func:`gauss_newton`
     Plain Gauss-Newton for nearly linear problems with an analytic Jacobian (the absolute
     refinement of ``enu_from_world``): a handful of steps, stopping when the cost stops
