@@ -6,6 +6,10 @@ principal point up to 1 % of the width off centre) and calibrates each with the 
 - ``noise_free``: ``NoiseModel.exact()`` (no click, line or size noise);
 - ``noise_free_size_given``: the same scenes stating the car's true size (the preset's
   5 % size term, a user's ignorance of the car that no click shows, is then off);
+- ``noise_free_pp_prior``: noise-free, the principal point drawn from the Gaussian that
+  ``calibrate`` assumes (``CalibrationSettings.principal_point_sigma_rel`` of the diagonal
+  per axis) instead of the uniform box: noise-free errors come from the principal point
+  (and the preset's size), so this set tells the sigmas' propagation from the box's shape;
 - ``crowd``: ``NoiseModel()``, the crowd noise model of ``benchmarks/README.md``.
 
 For each stated sigma (focal length; the principal point, ``principal_point_sigma_px``;
@@ -14,7 +18,8 @@ the fraction of scenes whose error is within 1σ and 2σ and the median error/σ
 sigma covers 68 % and 95 %, median error/σ 0.67; issue 24 asks for 55-80 % at 1σ, 90-98 %
 at 2σ, median 0.5-1.0. Writes ``benchmarks/out/calibrate_coverage.json`` and
 ``benchmarks/out/calibrate_coverage.png`` (the CDF of error/σ per quantity and set, the
-Gaussian's for reference).
+Gaussian's for reference) and ``benchmarks/out/calibrate_coverage_hist.png`` (histograms of
+error/σ of the scenes not exact, per set, against the half-normal density).
 
 Usage::
 
@@ -41,7 +46,7 @@ from relative import _has_lines, draw_scene
 from scipy.spatial.transform import Rotation
 
 from camloc_geo import InputError
-from camloc_geo.relative import calibrate
+from camloc_geo.relative import CalibrationSettings, calibrate
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import NoiseModel
 
@@ -49,8 +54,12 @@ OUT_DIR = Path(__file__).parent / "out"
 SETS = {
     "noise_free": NoiseModel.exact(),
     "noise_free_size_given": NoiseModel.exact(),
+    "noise_free_pp_prior": NoiseModel.exact(),
     "crowd": NoiseModel(),
 }
+# Sets whose principal point is drawn from calibrate's own Gaussian prior (per axis, a
+# fraction of the diagonal) rather than uniformly within ±1 % of the width.
+PP_PRIOR = {"noise_free_pp_prior": CalibrationSettings().principal_point_sigma_rel}
 # Sets whose scenes state the car's true size (length, width, height) instead of the preset's
 # name: the preset's size term (a user's ignorance of the car, which no click shows) is off.
 SIZE_GIVEN = {"noise_free_size_given"}
@@ -169,6 +178,48 @@ def plot(by_set: dict[str, list[dict[str, Any]]], path: Path) -> None:
     plt.close(fig)
 
 
+HIST_QUANTITIES = ("focal", "pp_x", "rot_x", "rot_z", "height")
+
+
+def plot_hist(by_set: dict[str, list[dict[str, Any]]], path: Path) -> None:
+    """Histograms of |error| / σ (scenes not exact), one row per set, the half-normal's line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from scipy.stats import norm
+
+    n_q = len(HIST_QUANTITIES)
+    fig, axes = plt.subplots(
+        len(by_set), n_q, figsize=(3.2 * n_q, 2.4 * len(by_set)), squeeze=False
+    )
+    bins = np.arange(0.0, 4.01, 0.25)
+    xs = np.linspace(0, 4, 200)
+    for row, (name, rows) in zip(axes, by_set.items(), strict=True):
+        rows = [r for r in rows if not is_exact(r)]
+        for ax, q in zip(row, HIST_QUANTITIES, strict=True):
+            z = np.array(
+                [
+                    abs(r["error"][q]) / r["sigma"][q]
+                    for r in rows
+                    if r["sigma"].get(q) is not None and r["sigma"][q] > 0
+                ]
+            )
+            if len(z):
+                ax.hist(np.clip(z, 0, 3.99), bins=bins, density=True, color="tab:blue")
+            ax.plot(xs, 2 * norm.pdf(xs), "k--", lw=1)
+            ax.set_xlim(0, 4)
+            ax.axvline(1, color="grey", lw=0.5)
+            ax.axvline(2, color="grey", lw=0.5)
+            ax.set_title(f"{name}: {q} ({len(z)})", fontsize=8)
+            ax.tick_params(labelsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("|error| / stated sigma (last bin: >= 3.75)", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -191,10 +242,11 @@ def main(argv: list[str] | None = None) -> int:
         rng = np.random.default_rng(args.seed)
         rows: list[dict[str, Any]] = []
         refused[name] = 0
+        pp_sigma = PP_PRIOR.get(name)
         for i in range(args.n):
-            syn, _size, _n = draw_scene(rng, i, noise)
+            syn, _size, _n = draw_scene(rng, i, noise, pp_sigma_rel=pp_sigma)
             while not _has_lines(syn.scene):
-                syn, _size, _n = draw_scene(rng, i, noise)
+                syn, _size, _n = draw_scene(rng, i, noise, pp_sigma_rel=pp_sigma)
             if name in SIZE_GIVEN:
                 true = syn.true_size
                 syn.scene["object"] = {
@@ -230,6 +282,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     (args.out / "calibrate_coverage.json").write_text(json.dumps(result, indent=1))
     plot(by_set, args.out / "calibrate_coverage.png")
+    plot_hist(by_set, args.out / "calibrate_coverage_hist.png")
     for name, cov in summary.items():
         print(
             f"{name}: {len(by_set[name])} scenes, {refused[name]} refused, "

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from camloc_geo import InputError
+from camloc_geo.camera import Camera
 from camloc_geo.objects import PRESETS
 from camloc_geo.relative import CalibrationSettings, calibrate
 from camloc_geo.scene import parse_scene
@@ -50,9 +51,17 @@ PERCENTILES = (50, 80, 90, 95, 99)
 
 
 def draw_scene(
-    rng: np.random.Generator, index: int, noise: NoiseModel, n_annotators: int | None = None
+    rng: np.random.Generator,
+    index: int,
+    noise: NoiseModel,
+    n_annotators: int | None = None,
+    pp_sigma_rel: float | None = None,
 ) -> Any:
-    """One synthetic scene: image size, annotator count, side of the width edge, camera."""
+    """One synthetic scene: image size, annotator count, side of the width edge, camera.
+
+    The principal point lies uniformly within ±1 % of the width off centre per axis; with
+    ``pp_sigma_rel``, Gaussian instead, that fraction of the diagonal per axis.
+    """
     size = IMAGE_SIZES[int(rng.integers(len(IMAGE_SIZES)))]
     n_ann = int(rng.integers(3, 8)) if n_annotators is None else n_annotators
     ws = 1.0 if rng.random() < 0.5 else -1.0
@@ -65,6 +74,10 @@ def draw_scene(
         pp_offset_px=0.01 * size[0],
         width_sign=ws,
     )
+    if pp_sigma_rel is not None:
+        offset = rng.normal(0.0, pp_sigma_rel * math.hypot(*size), 2)
+        pp = (size[0] / 2.0 + float(offset[0]), size[1] / 2.0 + float(offset[1]))
+        cam = Camera.from_center(cam.focal_px, pp, cam.cam_from_world_rotation, cam.center_in_world)
     syn = make_scene(
         cam,
         rng,

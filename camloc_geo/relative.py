@@ -52,6 +52,8 @@ from camloc_geo.vanishing import (
 )
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from camloc_geo._optimize import LeastSquaresResult
 
 __all__ = [
@@ -1297,11 +1299,60 @@ def _check_segment_counts(
 
 
 @functools.lru_cache(maxsize=4)
-def _detect_vps(path: str, _mtime_ns: int, _size: int) -> Any:
-    """The image's detected vanishing points, cached per file version (thread-safe)."""
+def _detect_vps(
+    path: str,
+    _mtime_ns: int,
+    _size: int,
+    distortion_k1: float | None = None,
+    principal_point: tuple[float, float] | None = None,
+) -> Any:
+    """The image's detected vanishing points, cached per file version (thread-safe).
+
+    With a ``distortion_k1`` (the scene's ``camera.distortion``) the detector undistorts
+    its segments about ``principal_point`` (the image centre when None) before the fit:
+    the vanishing points are the pinhole camera's, the segments stay in the photo's pixels
+    (:func:`_photo_segments_px` maps them).
+    """
     from camloc_geo import autovp
 
-    return autovp.detect_vanishing_points(path)
+    return autovp.detect_vanishing_points(
+        path, distortion_k1=distortion_k1, principal_point=principal_point
+    )
+
+
+def _scene_lens(scene: Scene) -> tuple[float | None, tuple[float, float] | None]:
+    """The scene's distortion ``k1`` (None without one) and the point it is centred on."""
+    dist = scene.camera.distortion
+    if dist is None or dist.k1 == 0.0:
+        return None, None
+    pp = scene.camera.principal_point
+    return float(dist.k1), (None if pp is None else (float(pp[0]), float(pp[1])))
+
+
+def _detect_scene_vps(scene: Scene, path: Path) -> Any:
+    """:func:`_detect_vps` of ``path`` (an existing file) with ``scene``'s lens."""
+    stat = path.stat()
+    k1, pp = _scene_lens(scene)
+    return _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size, k1, pp)
+
+
+def _photo_segments_px(scene: Scene, segments: npt.ArrayLike) -> FloatArray:
+    """The photo's ``(N, 4)`` segments in the scene's pinhole pixels (``camera.distortion``).
+
+    The same mapping as :meth:`camloc_geo.scene.Scene.undistorted` (about
+    ``camera.principal_point``, else the image centre); a segment the model maps through
+    infinity is NaN. Without a distortion the segments themselves.
+    """
+    segs = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
+    k1, pp = _scene_lens(scene)
+    if k1 is None or len(segs) == 0:
+        return segs
+    from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+    w, h = scene.image_size
+    centre = pp if pp is not None else (w / 2.0, h / 2.0)
+    und = undistort_points_px(segs.reshape(-1, 2), RadialDistortion.for_image(k1, w, h), centre)
+    return np.asarray(und.reshape(-1, 4), dtype=np.float64)
 
 
 def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
@@ -1313,9 +1364,8 @@ def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, Float
         from camloc_geo import autovp
     except ImportError:  # pragma: no cover - autovp ships with the package
         return {}
-    stat = path.stat()
     try:
-        res = _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+        res = _detect_scene_vps(scene, path)
     except InputError as exc:
         log.warning("image.path: no lines detected in %s: %s", path, exc)
         return {}
@@ -1323,9 +1373,10 @@ def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, Float
     out = {}
     for axis in axes:
         try:
-            out[axis] = np.asarray(
-                autovp.segments_for_axis(res, ann.axes.origin, getattr(ann.axes, axis)), float
-            ).reshape(-1, 4)
+            segs = _photo_segments_px(
+                scene, autovp.segments_for_axis(res, ann.axes.origin, getattr(ann.axes, axis))
+            )
+            out[axis] = segs[np.all(np.isfinite(segs), axis=1)]
             log.info("annotations[%d]: %s segments detected in the image", index, axis)
         except InputError as exc:
             log.info("annotations[%d]: no %s segments in the image: %s", index, axis, exc)
@@ -1824,9 +1875,8 @@ def _photo_result(scene: Scene) -> Any | None:
     path = scene.image_file()
     if path is None or not path.is_file():  # is_file: a FIFO or a device would block
         return None
-    stat = path.stat()
     try:
-        return _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+        return _detect_scene_vps(scene, path)
     except (InputError, ValueError) as exc:
         log.info("image.path: no vanishing points detected in %s: %s", path, exc)
         return None
@@ -1850,16 +1900,20 @@ def _add_photo_segments(
     them than the annotators drew on average for it (their total weight then equals that
     many such segments): a small weight, under the fit's soft-L1 loss. Lines that disagree
     with the fit are never added (a clear disagreement is :func:`_photo_disagreement`'s
-    warning). Nothing without a photo, with a lens distortion (the detector's pixels are
-    not undistorted here) or when the photo's size is not the scene's.
+    warning). With a lens distortion (``camera.distortion``) the detector fits the pinhole
+    camera's vanishing points and its segments are undistorted as the annotations are.
+    Nothing without a photo or when the photo's size is not the scene's.
     """
-    if scene.camera.distortion is not None:
-        return {}
     res = _photo_result(scene)
     if res is None or tuple(res.image_size) != tuple(scene.image_size):
         return {}
     segs = np.asarray(res.segments, dtype=float).reshape(-1, 4)
     labels = np.asarray(res.labels, dtype=int).reshape(-1)
+    if len(segs) != len(labels):
+        return {}
+    segs = _photo_segments_px(scene, segs)  # camera.distortion: the annotations' pixels
+    finite = np.all(np.isfinite(segs), axis=1)
+    segs, labels = segs[finite], labels[finite]
     diag = math.hypot(*prob.image_wh)
     long_enough = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
     keep = (long_enough >= PHOTO_SEGMENT_MIN_REL * diag) & (labels >= 0)
@@ -1913,7 +1967,8 @@ def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     that is the nearest one to an axis, within ``PHOTO_AXIS_NEAR_DEG`` of it but more than
     ``PHOTO_AXIS_TOL_DEG`` off, is reported with the angle; so is an estimated photo focal
     length more than 10 % and three combined sigmas off the fit's. No photo, or no lines in
-    it: nothing (``image.path``'s own warnings say so). Lens distortion is not undone here.
+    it: nothing (``image.path``'s own warnings say so). With a lens distortion
+    (``camera.distortion``) the photo's vanishing points are the pinhole camera's.
     """
     res = _photo_result(scene) if result.camera is not None else None
     if res is None:
