@@ -136,3 +136,29 @@ def test_geocode_finds_shapely_ops_in_a_fresh_process() -> None:
     code = "import camloc_geo.geocode._geocode as g; print(g.shapely.ops.nearest_points.__name__)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "nearest_points"
+
+
+def test_degenerate_scene_is_no_candidate_not_a_failure(
+    repeated_list: dict[str, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scene whose geometry is degenerate is the scene's answer, not an internal failure
+    (``failed`` is computed again by every rerun); the title's junction is the fallback."""
+    import camloc_geo.absolute
+    from camloc_geo._errors import DegenerateGeometryError
+
+    row = next(r for r in read_camera_list(repeated_list["list"]) if r.has_scene)
+    good = geocode_camera(row, map_source=repeated_list["osm"])
+    assert good.status == "located"
+
+    def degenerate(*_a: object, **_k: object) -> None:
+        raise DegenerateGeometryError("the length and width vanishing directions are 16.8° apart")
+
+    monkeypatch.setattr(camloc_geo.absolute, "locate", degenerate)
+    res = geocode_camera(row, map_source=repeated_list["osm"])
+    assert res.status in ("no_candidates", "title_only")
+    assert res.status != "failed"
+    assert [e["stage"] for e in res.errors] == ["locate"]
+    assert "16.8°" in (res.reason or "")
+    if res.status == "title_only":
+        assert str(res.reason).startswith("scene not located")
+        assert res.lat is not None

@@ -17,7 +17,8 @@ Statuses
 ``not_found``
     The title's names are not in the map (the reason lists the nearest names).
 ``no_candidates``
-    The scene was read but no candidate survived (the reason says why).
+    The scene was read but no candidate survived, or its geometry is degenerate (the
+    reason says why).
 ``no_evidence``
     No title, street pair or scene to place the camera with.
 ``no_map``
@@ -38,7 +39,13 @@ import os
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
-from camloc_geo._errors import MapDataError, MapSourceError, SceneError
+from camloc_geo._errors import (
+    DegenerateGeometryError,
+    MapDataError,
+    MapSourceError,
+    NotEnoughStructureError,
+    SceneError,
+)
 
 if TYPE_CHECKING:
     from camloc_geo.cameras import CameraRow
@@ -413,7 +420,10 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
         return
     try:
         r = locate(sc, m)
-    except MapDataError as exc:
+    except (MapDataError, DegenerateGeometryError, NotEnoughStructureError) as exc:
+        # the scene's own geometry (vanishing directions not orthogonal, the camera under
+        # the ground): as final as no candidate surviving, never an internal failure that
+        # every rerun would compute again
         res.fail("no_candidates", str(exc), "locate")
         return
     except SceneError as exc:
