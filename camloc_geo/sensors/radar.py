@@ -26,8 +26,7 @@ radar (see ``docs/radar.md``):
 3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
    :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
    motion; where the measured contact jumps away from it (another corner became the lowest,
-   two vehicles merged, an occlusion) the track is split into segments; a segment whose
-   contact moves unlike the features is left out. The same motion
+   two vehicles merged, an occlusion) the track is split into segments. The same motion
    predicts the vehicle's box in the next frame (association, coasting through merged
    blobs). Features are never cast onto the ground themselves: their height is unknown.
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
