@@ -112,15 +112,3 @@ def test_apparent_height_tells_a_piece() -> None:
     piece = whole.copy()
     piece[:, 1] = mids[:, 1]
     assert abs(_apparent_height_m(cam, ground, contacts, piece) - 0.6) < 0.05
-
-
-def test_contact_off_the_features_is_dropped() -> None:
-    from camloc_geo.sensors.radar import _off_features
-
-    t = _track((0.0, 0.0, 10.0, 10.0), (0.0, 0.0))
-    t.frames = list(range(8))
-    t.klt = [(1.8, -0.9)] * 8
-    t.contacts = [(698.0, 118.0)] * 8  # held still while the vehicle's features move
-    assert _off_features(t, list(range(8)), [0] * 8, 0)
-    t.contacts = [(698.0 + 1.7 * f, 118.0 - 0.8 * f) for f in t.frames]
-    assert not _off_features(t, list(range(8)), [0] * 8, 0)

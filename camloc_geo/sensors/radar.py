@@ -26,8 +26,7 @@ radar (see ``docs/radar.md``):
 3. **KLT.** Features (:func:`cv2.goodFeaturesToTrack`) inside each vehicle are tracked with
    :func:`cv2.calcOpticalFlowPyrLK`. Their median image motion predicts the contact pixel's
    motion; where the measured contact jumps away from it (another corner became the lowest,
-   two vehicles merged, an occlusion) the track is split into segments; a segment whose
-   contact moves unlike the features is left out. The same motion
+   two vehicles merged, an occlusion) the track is split into segments. The same motion
    predicts the vehicle's box in the next frame (association, coasting through merged
    blobs). Features are never cast onto the ground themselves: their height is unknown.
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
@@ -951,32 +950,10 @@ def _segments(t: _Track, fps: float, width: int, height: int) -> tuple[list[int]
         use.append(i)
         labels.append(seg)
         prev = i
-    # segments shorter than 3 frames carry no velocity, and a segment whose contact does
-    # not move with the vehicle's features (a blob stuck on the background, a contact
-    # held by another vehicle) measures something else: drop them
+    # segments shorter than 3 frames carry no velocity: drop them
     counts = {s: labels.count(s) for s in set(labels)}
-    stuck = {s for s in counts if counts[s] >= 3 and _off_features(t, use, labels, s)}
-    keep = [j for j, s in enumerate(labels) if counts[s] >= 3 and s not in stuck]
+    keep = [j for j, s in enumerate(labels) if counts[s] >= 3]
     return [use[j] for j in keep], [labels[j] for j in keep]
-
-
-def _off_features(t: _Track, use: list[int], labels: list[int], seg: int) -> bool:
-    """True when segment ``seg``'s contact moves unlike the vehicle's features: its image
-    velocity (a line through the contact pixels) off the features' median motion by more
-    than half of it + 0.5 px a frame (needs features in 3 of its frames)."""
-    idx = [i for i, s in zip(use, labels, strict=True) if s == seg]
-    klt = np.array([t.klt[i] for i in idx])
-    fine = np.isfinite(klt[:, 0])
-    if fine.sum() < 3:
-        return False
-    frames = np.array([t.frames[i] for i in idx], dtype=np.float64)
-    if np.ptp(frames) <= 0:
-        return False
-    pix = np.array([t.contacts[i] for i in idx])
-    v_contact = np.polyfit(frames - frames.mean(), pix, 1)[0]
-    v_features = np.median(klt[fine], axis=0)
-    gap = float(np.hypot(*(v_contact - v_features)))
-    return gap > 0.5 * float(np.hypot(*v_features)) + 0.5
 
 
 def _design(times: FloatArray, labels: list[int]) -> FloatArray:
