@@ -265,6 +265,7 @@ def soft_l1_least_squares_many(
     tol: float = 1e-10,
     max_nfev: int = 200,
     damping: float = 1e-3,
+    sigma_tol: float | None = None,
 ) -> list[LeastSquaresResult]:
     """Several independent problems through the ``lm`` loop of :func:`soft_l1_least_squares`
     in lockstep, their trial steps evaluated together.
@@ -274,7 +275,9 @@ def soft_l1_least_squares_many(
     evaluations are shared: ``fun_and_jac_many(ids, xs)`` gives the residuals and the
     Jacobian of problem ``ids[k]`` at ``xs[k]`` for every ``k`` in one call, so that a caller
     can batch its finite differences over all of them (small problems cost mostly per call).
-    The first call holds every problem at its start.
+    The first call holds every problem at its start. ``sigma_tol``: each problem stops as
+    :func:`soft_l1_least_squares` with the same ``sigma_tol`` would (within that fraction of
+    its own 1-sigma of the minimum); None (the default): the tolerances alone.
     """
     xs = [np.asarray(x0, dtype=np.float64).copy() for x0 in x0s]
     n = len(xs)
@@ -308,7 +311,17 @@ def soft_l1_least_squares_many(
             diag = A.diagonal().copy()
             diag[diag <= 0] = 1e-12
             try:
-                dx = np.asarray(-np.linalg.solve(A + lams[i] * np.diag(diag), g), np.float64)
+                if sigma_tol is None:
+                    dx = np.asarray(-np.linalg.solve(A + lams[i] * np.diag(diag), g), np.float64)
+                else:
+                    # The damped step and the undamped Gauss-Newton step in one call.
+                    both = np.linalg.solve(
+                        np.stack([A + lams[i] * np.diag(diag), A]), np.stack([g, g])[:, :, None]
+                    )[:, :, 0]
+                    if _within_sigma(float(g @ both[1]), costs[i], len(r), len(g), sigma_tol):
+                        successes[i] = True
+                        continue
+                    dx = np.asarray(-both[0], np.float64)
             except np.linalg.LinAlgError:
                 lams[i] *= 10.0
                 if lams[i] <= 1e12:

@@ -234,3 +234,37 @@ def test_plausibility_is_averaged_over_the_position_uncertainty(baltimore: MapDa
     assert tiny == pytest.approx(p0, rel=1e-6)
     wide = _expected_plausibility(p0, inside, 15.0, cal.camera, ev, settings, cand.matches)
     assert 1.5 * p0 < wide <= 1.0
+
+
+def test_bundle_stopped_within_a_tenth_sigma_keeps_the_full_fits_answer(
+    baltimore: MapData, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The bundle's ``sigma_tol`` stop (3 % of a sigma) moves no leader by more than a
+    tenth of its sigma from the fully converged bundle, and keeps the ranking."""
+    from camloc_geo.absolute import _bundle
+
+    js = _junctions(baltimore)
+    for seed in range(6):
+        ls = make_located_scene(
+            baltimore,
+            js[seed % len(js)],
+            np.random.default_rng(100 + seed),
+            noise=NoiseModel(),
+            corner_sigma_m=0.0,
+            n_references=4,
+            min_corners=3,
+            max_corners=4,
+        )
+        assert ls is not None
+        scene = json.loads(json.dumps(ls.scene))
+        scene.pop("intersection", None)
+        sc = parse_scene(scene)
+        cal = calibrate(sc)
+        early = locate(sc, baltimore, calibration=cal).candidates
+        monkeypatch.setattr(_bundle, "_SIGMA_TOL", None)
+        full = locate(sc, baltimore, calibration=cal).candidates
+        monkeypatch.undo()
+        assert [c.intersection_id for c in early] == [c.intersection_id for c in full]
+        for a, b in zip(early[:3], full[:3], strict=True):
+            moved = float(distance_m(lat1=a.lat, lon1=a.lon, lat2=b.lat, lon2=b.lon))
+            assert b.sigma_m is None or moved <= 0.1 * b.sigma_m, (seed, moved, b.sigma_m)

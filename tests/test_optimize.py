@@ -55,7 +55,8 @@ def test_lm_soft_l1_matches_scipy_on_a_curve_with_outliers(seed: int) -> None:
     assert via.cost == pytest.approx(ref.cost, rel=1e-6)
 
 
-def test_lockstep_problems_take_the_steps_they_take_alone() -> None:
+@pytest.mark.parametrize("sigma_tol", [None, 0.1])
+def test_lockstep_problems_take_the_steps_they_take_alone(sigma_tol: float | None) -> None:
     problems = [_curve_problem(seed) for seed in range(4)]
     starts = [x0 + 0.3 * k for k, (_f, _j, x0) in enumerate(problems)]
     starts[3] = np.array([50.0, 8.0, -40.0])  # far off: many rejected steps
@@ -65,13 +66,17 @@ def test_lockstep_problems_take_the_steps_they_take_alone() -> None:
         batches.append(list(ids))
         return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
 
-    together = soft_l1_least_squares_many(many, starts, f_scale=2.5, max_nfev=60)
+    together = soft_l1_least_squares_many(
+        many, starts, f_scale=2.5, max_nfev=60, sigma_tol=sigma_tol
+    )
     for (fun, jac, _x0), x0, res in zip(problems, starts, together, strict=True):
 
         def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
             return f(x), j(x)
 
-        alone = soft_l1_least_squares(fun, jac, x0, f_scale=2.5, max_nfev=60, fun_and_jac=both)
+        alone = soft_l1_least_squares(
+            fun, jac, x0, f_scale=2.5, max_nfev=60, fun_and_jac=both, sigma_tol=sigma_tol
+        )
         assert res.nfev == alone.nfev
         assert res.success == alone.success
         np.testing.assert_array_equal(res.x, alone.x)

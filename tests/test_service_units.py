@@ -210,3 +210,45 @@ def test_a_worker_freezes_its_maps_once_per_map_change(monkeypatch: pytest.Monke
     monkeypatch.setattr(_catalogue, "_LOADS", [_catalogue._LOADS[0] + 1])  # a map loaded
     compute._freeze_maps()
     assert calls == ["unfreeze", "collect", "freeze"] * 2
+
+
+@pytest.mark.parametrize(
+    ("body", "kind", "field"),
+    [
+        (b'{"format": "camloc-scene/1", "image": {"width": NaN}}', "SceneError", "body"),
+        (
+            json.dumps({**SCENE, "image": {**SCENE["image"], "path": "/x"}}).encode(),
+            "SceneError",
+            "image.path",
+        ),
+        (
+            json.dumps({**SCENE, "annotations": SCENE["annotations"] * 30}).encode(),
+            "LimitError",
+            "annotations",
+        ),
+    ],
+    ids=["nan", "path", "oversized"],
+)
+def test_raw_scene_errors_cross_to_the_serving_process(body: bytes, kind: str, field: str) -> None:
+    # a worker parses the raw body; its error is pickled back and must keep type and field
+    import pickle
+
+    from camloc_geo import InputError
+    from camloc_geo.service.deps import scene_from_raw
+    from camloc_geo.service.settings import Settings
+
+    with pytest.raises(InputError) as info:
+        scene_from_raw(body, Settings())
+    back = pickle.loads(pickle.dumps(info.value))
+    assert type(back).__name__ == kind
+    assert back.field == field
+    assert str(back) == str(info.value)
+
+
+def test_raw_scene_is_the_scene_parsed_in_process() -> None:
+    from camloc_geo.scene import parse_scene
+    from camloc_geo.service.deps import scene_from_raw
+    from camloc_geo.service.settings import Settings
+
+    raw = json.dumps(SCENE).encode()
+    assert scene_from_raw(raw, Settings()) == parse_scene(SCENE)

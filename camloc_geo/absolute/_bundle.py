@@ -69,6 +69,13 @@ the similarity's rotation (measured: it moved two-corner candidates by up to 8 m
 
 _F_SCALE = 2.5
 
+_SIGMA_TOL = 0.03
+"""The bundle stops once its next Gauss-Newton step is under this fraction of the fit's own
+1-sigma (``soft_l1_least_squares``'s ``sigma_tol``). Measured on ``benchmarks/absolute.py
+--n 40`` against the fully converged bundle: the top candidates move by at most 6 cm (0.012
+sigma), every hit rate and rank is the same and the medians within 5 mm; 0.1 saved another
+0.5 ms but moved medians by up to 6 cm."""
+
 
 def _cam_parts(
     state: JointState, x_cam: FloatArray
@@ -310,7 +317,7 @@ def _bundle_many(
         return got
 
     results = soft_l1_least_squares_many(
-        recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200
+        recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200, sigma_tol=_SIGMA_TOL
     )
     return [
         _accept(p, res, r0, state, n_cam)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -14,8 +15,12 @@ __all__ = ["view_cone"]
 FloatArray = npt.NDArray[np.float64]
 
 
+@functools.lru_cache(maxsize=64)
 def _border_px(size: tuple[int, int], n: int) -> FloatArray:
-    """The image border, clockwise from the bottom-left corner, ``n`` steps per side."""
+    """The image border, clockwise from the bottom-left corner, ``n`` steps per side.
+
+    Cached per image size (every candidate of a scene draws the same border); read-only.
+    """
     w, h = size
     border: list[tuple[float, float]] = []
     for i in range(n + 1):
@@ -26,7 +31,9 @@ def _border_px(size: tuple[int, int], n: int) -> FloatArray:
         border.append((w * (1 - i / n), 0.0))
     for i in range(n + 1):
         border.append((0.0, h * i / n))
-    return np.asarray(border, dtype=float)
+    out = np.asarray(border, dtype=float)
+    out.flags.writeable = False
+    return out
 
 
 def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
@@ -37,7 +44,7 @@ def view_cone(cam: Camera, size: tuple[int, int], range_m: float) -> FloatArray:
     ground point farther), then the centre again.
     """
     C = cam.center_in_world
-    rays = cam.rays_in_world(_border_px(size, 12))
+    rays = cam.rays_in_world(_border_px((size[0], size[1]), 12))
     horiz = np.array([math.hypot(x, y) for x, y in rays[:, :2].tolist()])
     keep = horiz >= 1e-9  # rays straight down or up have no direction on the ground
     rays, horiz = rays[keep], horiz[keep]

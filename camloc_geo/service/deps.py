@@ -2,6 +2,8 @@
 
 Bodies are parsed once: JSON with NaN/Infinity refused, a scene checked against the server's
 limits and validated into a :class:`~camloc_geo.scene.Scene` that the library takes as it is.
+The scene endpoints that only compute (``/v1/locate``, ``/v1/calibrate``, ``/v1/maps``) send
+the body's bytes to the worker, which parses and validates it there (:class:`RawScene`).
 CPU work runs in worker processes or threads (:mod:`camloc_geo.service.compute`) under the
 request time limit, never on the event loop.
 """
@@ -31,7 +33,9 @@ if TYPE_CHECKING:
 __all__ = [
     "ApiKey",
     "Maps",
+    "RawScene",
     "SceneBody",
+    "SceneBytes",
     "ServiceSettings",
     "ServiceStore",
     "Workers",
@@ -39,6 +43,7 @@ __all__ = [
     "parse_json",
     "raw_body",
     "run_cpu",
+    "scene_from_raw",
 ]
 
 T = TypeVar("T")
@@ -148,6 +153,42 @@ async def _scene_body(request: Request, settings: ServiceSettings) -> ParsedScen
 
 SceneBody = Annotated[ParsedScene, Depends(_scene_body)]
 """A ``camloc-scene/1`` body within the server's limits, validated once."""
+
+
+@dataclass(frozen=True)
+class RawScene:
+    """A scene body as it came (JSON bytes), for a worker to parse and validate once.
+
+    The serving process only checks the content type: the JSON parsing, the server's limits
+    and the validation all happen on the worker (:func:`scene_from_raw`), so a request's
+    scene is validated once, and one ``bytes`` object is what crosses to the worker
+    process (not a model of thousands of small objects to pickle and unpickle).
+    """
+
+    raw: bytes
+
+
+def scene_from_raw(raw: bytes, settings: Settings) -> Scene:
+    """The validated scene of a raw JSON body, within the server's limits.
+
+    Raises
+    ------
+    SceneError
+        Not JSON, NaN/Infinity, not an object, ``image.path`` given, or not a valid scene.
+    LimitError
+        Too many annotators, lines or references.
+    """
+    from camloc_geo.api import scene_from
+
+    return scene_from(check_scene_body(parse_json(raw), settings))
+
+
+async def _raw_scene(request: Request) -> RawScene:
+    return RawScene(await raw_body(request, JSON_TYPES))
+
+
+SceneBytes = Annotated[RawScene, Depends(_raw_scene)]
+"""A JSON body meant as a ``camloc-scene/1`` scene, not yet parsed (see :class:`RawScene`)."""
 
 
 async def run_cpu(request: Request, fn: Callable[[], T]) -> T:

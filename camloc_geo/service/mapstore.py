@@ -43,6 +43,11 @@ class MapStore:
         )
         self.extracts: list[Path] = [Path(f) for f in files]
 
+    @property
+    def settings(self) -> Settings:
+        """The server's settings (a worker checks a raw scene body against their limits)."""
+        return self._settings
+
     def map_for_point(self, *, lat: float, lon: float) -> MapData:
         """The map serving a point (the catalogue's rule).
 

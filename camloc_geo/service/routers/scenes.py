@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Any, cast
 from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse, Response
 
-from camloc_geo.service.deps import ApiKey, SceneBody, Workers
+from camloc_geo.service.deps import ApiKey, SceneBytes, Workers, scene_from_raw
 from camloc_geo.service.models import LocateQuery
 from camloc_geo.service.work import locate_body
 
@@ -36,24 +36,32 @@ def scene_body_doc(description: str) -> dict[str, Any]:
 SCENE_BODY = scene_body_doc("a camloc-scene/1 scene (no image.path)")
 
 
-def calibrate_work(_maps: MapStore, scene: Scene) -> dict[str, Any]:
-    """The calibration answer of a validated scene (runs on a worker)."""
+def _scene(maps: MapStore, scene: Scene | bytes) -> Scene:
+    """A validated scene: as it is, or parsed and validated from a raw body (on the worker)."""
+    if isinstance(scene, bytes):
+        return scene_from_raw(scene, maps.settings)
+    return scene
+
+
+def calibrate_work(maps: MapStore, scene: Scene | bytes) -> dict[str, Any]:
+    """The calibration answer of a scene or a raw scene body (runs on a worker)."""
     from camloc_geo.api import calibrate_scene
 
-    return {"scene": scene.id, **calibrate_scene(scene).to_dict()}
+    sc = _scene(maps, scene)
+    return {"scene": sc.id, **calibrate_scene(sc).to_dict()}
 
 
-def locate_work(maps: MapStore, scene: Scene, max_candidates: int | None) -> dict[str, Any]:
-    """The candidate GeoJSON of a validated scene (runs on a worker)."""
-    out, _m = locate_body(cast(Any, scene), maps, max_candidates=max_candidates)
+def locate_work(maps: MapStore, scene: Scene | bytes, max_candidates: int | None) -> dict[str, Any]:
+    """The candidate GeoJSON of a scene or a raw scene body (runs on a worker)."""
+    out, _m = locate_body(cast(Any, _scene(maps, scene)), maps, max_candidates=max_candidates)
     return dict(out.to_geojson())
 
 
-def review_work(maps: MapStore, scene: Scene) -> str:
-    """The offline review page of a validated scene (runs on a worker)."""
+def review_work(maps: MapStore, scene: Scene | bytes) -> str:
+    """The offline review page of a scene or a raw scene body (runs on a worker)."""
     from camloc_geo.maps import candidates_map
 
-    out, m = locate_body(cast(Any, scene), maps)
+    out, m = locate_body(cast(Any, _scene(maps, scene)), maps)
     with tempfile.TemporaryDirectory(prefix="camloc-map-") as tmp:
         path = Path(tmp) / "review.html"
         candidates_map(out.result, m, path, offline=True, scene=out.scene)
@@ -61,18 +69,20 @@ def review_work(maps: MapStore, scene: Scene) -> str:
 
 
 @router.post("/v1/calibrate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
-async def calibrate(body: SceneBody, workers: Workers) -> Response:
+async def calibrate(body: SceneBytes, workers: Workers) -> Response:
     """Relative pose (focal length, rotation, camera position in the car's frame)."""
-    return await workers.run_json(calibrate_work, body.scene)
+    return await workers.run_json(calibrate_work, body.raw)
 
 
 @router.post("/v1/locate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
-async def locate(body: SceneBody, workers: Workers, q: Annotated[LocateQuery, Query()]) -> Response:
+async def locate(
+    body: SceneBytes, workers: Workers, q: Annotated[LocateQuery, Query()]
+) -> Response:
     """Candidate camera positions as the candidate GeoJSON, best first."""
-    return await workers.run_json(locate_work, body.scene, q.max_candidates)
+    return await workers.run_json(locate_work, body.raw, q.max_candidates)
 
 
 @router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
-async def review_map(body: SceneBody, workers: Workers) -> HTMLResponse:
+async def review_map(body: SceneBytes, workers: Workers) -> HTMLResponse:
     """The review page of a scene's candidates: one self-contained offline HTML file."""
-    return HTMLResponse(await workers.run(review_work, body.scene))
+    return HTMLResponse(await workers.run(review_work, body.raw))
