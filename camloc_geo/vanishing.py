@@ -154,91 +154,118 @@ def fit_vanishing_point(
     center = pts.mean(axis=0)
     spread = float(np.max(np.abs(pts - center))) or 1.0
     scale = float(scale_px) if scale_px else spread
-    # Conditioned homogeneous lines through each segment, normalised to unit normals.
-    p1 = np.column_stack([(seg[:, 0:2] - center) / scale, np.ones(len(seg))])
-    p2 = np.column_stack([(seg[:, 2:4] - center) / scale, np.ones(len(seg))])
-    lines = np.cross(p1, p2)
-    lines /= np.linalg.norm(lines[:, :2], axis=1, keepdims=True)
+    # Conditioned segments and the homogeneous line through each, normalised to unit normals:
+    # the cross product of (x1, y1, 1) and (x2, y2, 1), written out (the same rounding as
+    # np.cross, without its per-call cost on these tiny arrays).
+    seg_c = (seg - np.tile(center, 2)) / scale
+    x1, y1, x2, y2 = seg_c.T
+    lines = np.stack([y1 - y2, x2 - x1, x1 * y2 - y1 * x2], axis=1)
+    lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
     weights = np.sqrt(lengths / lengths.mean())
-    _u, s, vt = np.linalg.svd(lines * weights[:, None])
+    v0 = _linear_estimate(lines * weights[:, None], name)
+
+    # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
+    if v0[2] < 0:
+        v0 = -v0
+    v0x, v0y, v0w = (float(c) for c in v0)
+    if len(seg) > 2:
+        theta0 = math.acos(min(max(v0w, -1.0), 1.0))
+        phi0 = math.atan2(v0y, v0x)
+        th, ph = _refine_on_sphere(seg_c, weights, theta0, phi0)
+        vcx, vcy, vcw = math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)
+    else:
+        vcx, vcy, vcw = v0x, v0y, v0w  # two segments: the linear solution is exact
+    # Conditioned homogeneous point back to pixel homogeneous coordinates, unit length.
+    cx, cy = float(center[0]), float(center[1])
+    hx, hy, hw = vcx * scale + cx * vcw, vcy * scale + cy * vcw, vcw
+    norm = math.sqrt(hx * hx + hy * hy + hw * hw)
+    vp_h = np.array([hx / norm, hy / norm, hw / norm])
+    residuals = segment_residuals_px(seg, vp_h)
+    diag = float(scale_px) if scale_px else 2.0 * spread
+    return VanishingPoint(vp_h, residuals, _is_finite(vp_h, diag))
+
+
+def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:
+    """Smallest right singular vector of the ``(n, 3)`` weighted line matrix.
+
+    (An eigen-decomposition of the 3x3 normal matrix is cheaper, but its different rounding
+    moves the Gauss-Newton start and so the loosely converged answer by up to 1e-8.)
+
+    Raises
+    ------
+    DegenerateGeometryError
+        When the second singular value is below 1e-9 of the first (all lines one line).
+    """
+    _u, s, vt = np.linalg.svd(weighted_lines)
     # s[1], not s[-2]: with two segments there are only two singular values.
     if s[1] < 1e-9 * max(s[0], 1e-300):
         raise DegenerateGeometryError(
             f"{name}: all segments lie on one line, so they do not define a vanishing point"
         )
-    v0 = vt[-1]
+    return np.asarray(vt[-1], dtype=np.float64)
 
-    def to_pixels(vc: FloatArray) -> FloatArray:
-        # Conditioned homogeneous point back to pixel homogeneous coordinates.
-        return np.array(
-            [vc[0] * scale + center[0] * vc[2], vc[1] * scale + center[1] * vc[2], vc[2]]
-        )
 
-    def unit(theta_phi: FloatArray) -> FloatArray:
-        th, ph = theta_phi
-        return np.array([math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)])
+_FD_STEP = 1e-7  # forward-difference step of the Jacobian, radians
 
-    # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
-    if v0[2] < 0:
-        v0 = -v0
-    theta0 = math.acos(float(np.clip(v0[2], -1.0, 1.0)))
-    phi0 = math.atan2(v0[1], v0[0])
-    seg_c = np.column_stack([(seg[:, 0:2] - center) / scale, (seg[:, 2:4] - center) / scale])
 
+def _refine_on_sphere(
+    seg_c: FloatArray, weights: FloatArray, theta0: float, phi0: float
+) -> tuple[float, float]:
+    """Damped Gauss-Newton on (theta, phi) of the weighted, conditioned segment residuals.
+
+    Two parameters; the residuals and the forward-difference Jacobian come from one
+    evaluation at three points, built from Python floats rather than stacked arrays.
+    """
+    sx, sy = seg_c[:, 0], seg_c[:, 1]
     mx_c = (seg_c[:, 0] + seg_c[:, 2]) / 2.0
     my_c = (seg_c[:, 1] + seg_c[:, 3]) / 2.0
+    h = _FD_STEP
 
-    def fun_many(X: FloatArray) -> FloatArray:
-        # segment_residuals_px of the conditioned segments to the unit points of the rows of
-        # X = (theta, phi), all at once: (P, n).
-        th, ph = X[:, 0:1], X[:, 1:2]
-        px, py, pw = np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)
+    def fun_many(points: list[tuple[float, float]]) -> FloatArray:
+        # segment_residuals_px of the conditioned segments to the unit points (theta, phi),
+        # all at once: (P, n).
+        px = np.array([[math.sin(t) * math.cos(p)] for t, p in points])
+        py = np.array([[math.sin(t) * math.sin(p)] for t, p in points])
+        pw = np.array([[math.cos(t)] for t, _p in points])
         la, lb = my_c * pw - py, px - mx_c * pw
         lc = mx_c * py - my_c * px
         norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
-        return np.asarray((la * seg_c[:, 0] + lb * seg_c[:, 1] + lc) / norm * weights)
+        return np.asarray((la * sx + lb * sy + lc) / norm * weights)
 
-    def fun(x: FloatArray) -> FloatArray:
-        return np.asarray(fun_many(x[None, :])[0])
-
-    if len(seg) > 2:
-        # A few damped Gauss-Newton steps (2 parameters: cheaper than a general solver); the
-        # forward-difference Jacobian in the same call as the residuals.
-        x = np.array([theta0, phi0])
-        r = fun(x)
-        cost = float(r @ r)
-        lam = 1e-6
-        for _ in range(10):
-            F = fun_many(np.vstack([x, x + 1e-7 * np.eye(2)]))
-            J = ((F[1:] - F[0]) / 1e-7).T
-            JtJ, Jtr = J.T @ J, J.T @ r
-            try:
-                dx = -np.linalg.solve(JtJ + lam * np.diag(np.diag(JtJ) + 1e-12), Jtr)
-            except np.linalg.LinAlgError:
+    th, ph = theta0, phi0
+    r = fun_many([(th, ph)])[0]
+    cost = float(r @ r)
+    lam = 1e-6
+    for _ in range(10):
+        F = fun_many([(th, ph), (th + h, ph), (th, ph + h)])
+        J = (F[1:] - F[0]) / h  # (2, n): the Jacobian, transposed
+        JtJ = J @ J.T
+        a, b, c = float(JtJ[0, 0]), float(JtJ[0, 1]), float(JtJ[1, 1])
+        # JtJ + lam diag(diag(JtJ) + 1e-12), built from floats with the same roundings.
+        A = np.array([[a + lam * (a + 1e-12), b], [float(JtJ[1, 0]), c + lam * (c + 1e-12)]])
+        try:
+            # np.linalg.solve, not Cramer's rule: its rounding is what the answers were
+            # frozen with (the stopping rule leaves them converged only to ~1e-8).
+            dth, dph = (-np.linalg.solve(A, J @ r)).tolist()
+        except np.linalg.LinAlgError:
+            break
+        r_new = fun_many([(th + dth, ph + dph)])[0]
+        cost_new = float(r_new @ r_new)
+        step = max(abs(dth), abs(dph))
+        if cost_new < cost:
+            th, ph, r = th + dth, ph + dph, r_new
+            done = cost - cost_new <= 1e-12 * cost or step < 1e-10
+            cost, lam = cost_new, lam * 0.3
+            if done:
                 break
-            r_new = fun(x + dx)
-            cost_new = float(r_new @ r_new)
-            if cost_new < cost:
-                x, r = x + dx, r_new
-                done = cost - cost_new <= 1e-12 * cost or np.max(np.abs(dx)) < 1e-10
-                cost, lam = cost_new, lam * 0.3
-                if done:
-                    break
-            else:
-                # No decrease: at the minimum to rounding when even this step is tiny.
-                if np.max(np.abs(dx)) < 1e-10:
-                    break
-                lam *= 10.0
-                if lam > 1e6:
-                    break
-        vc = unit(x)
-    else:
-        vc = v0  # two segments: the linear solution is exact
-    vp_h = to_pixels(vc)
-    vp_h = vp_h / np.linalg.norm(vp_h)
-    residuals = segment_residuals_px(seg, vp_h)
-    diag = float(scale_px) if scale_px else 2.0 * spread
-    return VanishingPoint(vp_h.astype(np.float64), residuals, _is_finite(vp_h, diag))
+        else:
+            # No decrease: at the minimum to rounding when even this step is tiny.
+            if step < 1e-10:
+                break
+            lam *= 10.0
+            if lam > 1e6:
+                break
+    return th, ph
 
 
 def principal_point_from_orthocentre(
