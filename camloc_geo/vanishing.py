@@ -224,9 +224,10 @@ def _refine_on_sphere(
     def fun_many(points: list[tuple[float, float]]) -> FloatArray:
         # segment_residuals_px of the conditioned segments to the unit points (theta, phi),
         # all at once: (P, n).
-        px = np.array([[math.sin(t) * math.cos(p)] for t, p in points])
-        py = np.array([[math.sin(t) * math.sin(p)] for t, p in points])
-        pw = np.array([[math.cos(t)] for t, _p in points])
+        unit_pts = np.array(
+            [[math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)] for t, p in points]
+        )
+        px, py, pw = unit_pts[:, 0:1], unit_pts[:, 1:2], unit_pts[:, 2:3]
         la, lb = my_c * pw - py, px - mx_c * pw
         lc = mx_c * py - my_c * px
         norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
