@@ -151,17 +151,18 @@ def fit_vanishing_point(
         i = int(np.argmin(lengths))
         raise DegenerateGeometryError(f"{name}[{i}]: segment has zero length")
     pts = seg.reshape(-1, 2)
-    center = pts.mean(axis=0)
+    center = np.add.reduce(pts, axis=0) / len(pts)  # pts.mean(axis=0), cheaper
     spread = float(np.max(np.abs(pts - center))) or 1.0
     scale = float(scale_px) if scale_px else spread
     # Conditioned segments and the homogeneous line through each, normalised to unit normals:
     # the cross product of (x1, y1, 1) and (x2, y2, 1), written out (the same rounding as
     # np.cross, without its per-call cost on these tiny arrays).
-    seg_c = (seg - np.tile(center, 2)) / scale
+    seg_c = (seg - center[[0, 1, 0, 1]]) / scale
     x1, y1, x2, y2 = seg_c.T
-    lines = np.stack([y1 - y2, x2 - x1, x1 * y2 - y1 * x2], axis=1)
+    lines = np.empty((len(seg), 3))
+    lines[:, 0], lines[:, 1], lines[:, 2] = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
     lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
-    weights = np.sqrt(lengths / lengths.mean())
+    weights = np.sqrt(lengths / (float(np.add.reduce(lengths)) / len(lengths)))
     v0 = _linear_estimate(lines * weights[:, None], name)
 
     # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
