@@ -376,12 +376,31 @@ def _within_sigma(decrement: float, cost: float, m: int, n: int, sigma_tol: floa
 
 
 def gauss_newton(
-    resid_jac: ResidualsAndJacobian, x0: npt.ArrayLike, *, max_iter: int = 8
+    resid_jac: ResidualsAndJacobian,
+    x0: npt.ArrayLike,
+    *,
+    max_iter: int = 8,
+    sigma_tol: float | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Gauss-Newton from ``x0``; the solution and the Jacobian there.
 
     For nearly linear problems: each step solves the linearised problem by least squares
     and is taken only if the squared residual does not grow; stops on a step below 1e-10.
+
+    Parameters
+    ----------
+    resid_jac
+        Residuals ``(m,)`` and their Jacobian ``(m, n)`` at ``x``.
+    x0
+        The start.
+    max_iter
+        Most steps taken.
+    sigma_tol
+        For whitened residuals (unit variance): also stop after a step whose length in the
+        parameters' own 1-sigma (``‖J dx‖``, the Newton decrement's root) is under
+        ``sigma_tol``; the next step would be smaller still (Gauss-Newton converges at
+        least linearly here), so ``x`` is within about ``sigma_tol`` sigma of the minimum.
+        None (the default): the 1e-10 step rule alone.
     """
     x = np.asarray(x0, dtype=np.float64)
     r, J = resid_jac(x)
@@ -394,7 +413,8 @@ def gauss_newton(
         r_new, J_new = resid_jac(x_new)
         if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
             break
+        small = sigma_tol is not None and float(np.linalg.norm(J @ dx)) < sigma_tol
         x, r, J = x_new, r_new, J_new
-        if np.max(np.abs(dx)) < 1e-10:
+        if np.max(np.abs(dx)) < 1e-10 or small:
             break
     return x, J

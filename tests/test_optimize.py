@@ -182,3 +182,19 @@ def test_gauss_newton_matches_scipy_on_a_similarity_fit() -> None:
     ref = least_squares(resid, x0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
     np.testing.assert_allclose(x, ref.x, atol=1e-8)
     assert J.shape == (16, 4)
+
+    # The sigma stop: fewer evaluations, within sigma_tol of the minimum in the parameters'
+    # own 1-sigma (whitened residuals: a noise of 0.05 is one sigma here).
+    def whitened(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(1)
+        r, J = resid_jac(x)
+        return r / 0.05, J / 0.05
+
+    calls: list[int] = []
+    x_full, _J = gauss_newton(whitened, x0)
+    n_full = len(calls)
+    calls.clear()
+    x_fast, J_fast = gauss_newton(whitened, x0, sigma_tol=1e-3)
+    assert len(calls) < n_full
+    assert float(np.linalg.norm(J_fast @ (x_fast - x_full))) < 1e-3
+    np.testing.assert_allclose(x_full, ref.x, atol=1e-8)
