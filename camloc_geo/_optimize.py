@@ -295,6 +295,9 @@ def soft_l1_least_squares_many(
         trial_xs: list[FloatArray] = []
         trial_dxs: list[FloatArray] = []
         still: list[int] = []
+        # The normal equations of every problem still going, then all their solves in one
+        # batched call (LAPACK solves each matrix on its own: the same bits as one by one).
+        pending: list[tuple[int, FloatArray, FloatArray, FloatArray]] = []
         for i in active:
             if nfevs[i] >= max_nfev:
                 continue
@@ -310,25 +313,22 @@ def soft_l1_least_squares_many(
                 continue
             diag = A.diagonal().copy()
             diag[diag <= 0] = 1e-12
-            try:
-                if sigma_tol is None:
-                    dx = np.asarray(-np.linalg.solve(A + lams[i] * np.diag(diag), g), np.float64)
-                else:
-                    # The damped step and the undamped Gauss-Newton step in one call.
-                    both = np.linalg.solve(
-                        np.stack([A + lams[i] * np.diag(diag), A]), np.stack([g, g])[:, :, None]
-                    )[:, :, 0]
-                    if _within_sigma(float(g @ both[1]), costs[i], len(r), len(g), sigma_tol):
-                        successes[i] = True
-                        continue
-                    dx = np.asarray(-both[0], np.float64)
-            except np.linalg.LinAlgError:
+            pending.append((i, A + lams[i] * np.diag(diag), A, g))
+        solved = _solve_many(pending, with_gauss_newton=sigma_tol is not None)
+        for (i, _A_damped, _A, g), sol in zip(pending, solved, strict=True):
+            if sol is None:
                 lams[i] *= 10.0
                 if lams[i] <= 1e12:
                     still.append(i)  # retried next round with the same residuals
                 continue
+            if sigma_tol is not None and _within_sigma(
+                float(g @ sol[1]), costs[i], len(rs[i]), len(g), sigma_tol
+            ):
+                successes[i] = True
+                continue
+            dx = np.asarray(-sol[0], np.float64)
             trial_ids.append(i)
-            trial_xs.append(x + dx)
+            trial_xs.append(xs[i] + dx)
             trial_dxs.append(dx)
         evaluated = fun_and_jac_many(trial_ids, trial_xs) if trial_ids else []
         for i, x_new, dx, (r_new, J_new) in zip(
@@ -368,6 +368,39 @@ def soft_l1_least_squares_many(
     return out
 
 
+def _solve_many(
+    pending: list[tuple[int, FloatArray, FloatArray, FloatArray]], *, with_gauss_newton: bool
+) -> list[FloatArray | None]:
+    """For each ``(i, A_damped, A, g)``: ``A_damped⁻¹ g`` (and ``A⁻¹ g`` with
+    ``with_gauss_newton``) stacked, or None where a matrix is singular; one batched solve
+    when every system has the same size and none is singular."""
+    if not pending:
+        return []
+
+    def one(A_damped: FloatArray, A: FloatArray, g: FloatArray) -> FloatArray | None:
+        try:
+            if not with_gauss_newton:
+                return np.asarray(np.linalg.solve(A_damped, g)[None, :], np.float64)
+            both = np.linalg.solve(np.stack([A_damped, A]), np.stack([g, g])[:, :, None])
+            return np.asarray(both[:, :, 0], np.float64)
+        except np.linalg.LinAlgError:
+            return None
+
+    if len({g.shape for _i, _Ad, _A, g in pending}) == 1:
+        mats = [m for _i, Ad, A, _g in pending for m in ((Ad, A) if with_gauss_newton else (Ad,))]
+        k = 2 if with_gauss_newton else 1
+        rhs = [g for _i, _Ad, _A, g in pending for _ in range(k)]
+        try:
+            sols = np.asarray(
+                np.linalg.solve(np.stack(mats), np.stack(rhs)[:, :, None])[:, :, 0], np.float64
+            )
+        except np.linalg.LinAlgError:
+            pass  # some system is singular: one by one, to tell which
+        else:
+            return [sols[j * k : (j + 1) * k] for j in range(len(pending))]
+    return [one(Ad, A, g) for _i, Ad, A, g in pending]
+
+
 def _within_sigma(decrement: float, cost: float, m: int, n: int, sigma_tol: float) -> bool:
     """A Gauss-Newton step of Newton decrement ``gᵀ A⁻¹ g`` is under ``sigma_tol`` of the
     parameters' 1-sigma (``A⁻¹ s²``, ``s² = 2 cost / (m − n)``, at least 1e-12)."""
@@ -376,12 +409,31 @@ def _within_sigma(decrement: float, cost: float, m: int, n: int, sigma_tol: floa
 
 
 def gauss_newton(
-    resid_jac: ResidualsAndJacobian, x0: npt.ArrayLike, *, max_iter: int = 8
+    resid_jac: ResidualsAndJacobian,
+    x0: npt.ArrayLike,
+    *,
+    max_iter: int = 8,
+    sigma_tol: float | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Gauss-Newton from ``x0``; the solution and the Jacobian there.
 
     For nearly linear problems: each step solves the linearised problem by least squares
     and is taken only if the squared residual does not grow; stops on a step below 1e-10.
+
+    Parameters
+    ----------
+    resid_jac
+        Residuals ``(m,)`` and their Jacobian ``(m, n)`` at ``x``.
+    x0
+        The start.
+    max_iter
+        Most steps taken.
+    sigma_tol
+        For whitened residuals (unit variance): also stop after a step whose length in the
+        parameters' own 1-sigma (``‖J dx‖``, the Newton decrement's root) is under
+        ``sigma_tol``; the next step would be smaller still (Gauss-Newton converges at
+        least linearly here), so ``x`` is within about ``sigma_tol`` sigma of the minimum.
+        None (the default): the 1e-10 step rule alone.
     """
     x = np.asarray(x0, dtype=np.float64)
     r, J = resid_jac(x)
@@ -394,7 +446,8 @@ def gauss_newton(
         r_new, J_new = resid_jac(x_new)
         if float(r_new @ r_new) > float(r @ r) * (1 + 1e-12):
             break
+        small = sigma_tol is not None and float(np.linalg.norm(J @ dx)) < sigma_tol
         x, r, J = x_new, r_new, J_new
-        if np.max(np.abs(dx)) < 1e-10:
+        if np.max(np.abs(dx)) < 1e-10 or small:
             break
     return x, J

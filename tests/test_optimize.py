@@ -87,6 +87,36 @@ def test_lockstep_problems_take_the_steps_they_take_alone(sigma_tol: float | Non
     assert sum(len(b) for b in batches) == sum(r.nfev for r in together)
 
 
+def test_lockstep_with_a_singular_problem_matches_alone() -> None:
+    # Problem 1 has a dead parameter (a zero Jacobian column): its undamped normal matrix
+    # is singular, so the batched solve falls back to one system at a time.
+    fun0, jac0, x0 = _curve_problem(0)
+
+    def jac_dead(x: np.ndarray) -> np.ndarray:
+        J = jac0(x)
+        J[:, 2] = 0.0
+        return np.asarray(J)
+
+    problems = [(fun0, jac0), (fun0, jac_dead)]
+
+    def many(ids: list[int], xs: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+        return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
+
+    together = soft_l1_least_squares_many(many, [x0, x0], f_scale=2.5, max_nfev=40, sigma_tol=0.1)
+    for (fun, jac), res in zip(problems, together, strict=True):
+
+        def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
+            return f(x), j(x)
+
+        alone = soft_l1_least_squares(
+            fun, jac, x0, f_scale=2.5, max_nfev=40, fun_and_jac=both, sigma_tol=0.1
+        )
+        assert res.nfev == alone.nfev
+        np.testing.assert_array_equal(res.x, alone.x)
+    assert together[0].success
+    assert np.all(np.isfinite(together[1].x))
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_sigma_tol_stops_within_that_fraction_of_a_sigma(seed: int) -> None:
     """``sigma_tol`` stops once the next Gauss-Newton step is under that fraction of the
@@ -182,3 +212,19 @@ def test_gauss_newton_matches_scipy_on_a_similarity_fit() -> None:
     ref = least_squares(resid, x0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
     np.testing.assert_allclose(x, ref.x, atol=1e-8)
     assert J.shape == (16, 4)
+
+    # The sigma stop: fewer evaluations, within sigma_tol of the minimum in the parameters'
+    # own 1-sigma (whitened residuals: a noise of 0.05 is one sigma here).
+    def whitened(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(1)
+        r, J = resid_jac(x)
+        return r / 0.05, J / 0.05
+
+    calls: list[int] = []
+    x_full, _J = gauss_newton(whitened, x0)
+    n_full = len(calls)
+    calls.clear()
+    x_fast, J_fast = gauss_newton(whitened, x0, sigma_tol=1e-3)
+    assert len(calls) < n_full
+    assert float(np.linalg.norm(J_fast @ (x_fast - x_full))) < 1e-3
+    np.testing.assert_allclose(x_full, ref.x, atol=1e-8)
