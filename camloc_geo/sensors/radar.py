@@ -1061,10 +1061,8 @@ def _fit_track(
     if speed * dur < 1.0:
         return skipped(f"stationary (moved {speed * dur:.2f} m in {dur:.1f} s)", len(times), dur)
     # fit standard error along the direction of travel
-    dof = max(1, len(times) - a.shape[1])
     unit = vel / speed
-    s2 = float(np.sum(weights * (res @ unit) ** 2) / dof)
-    sigma_fit = math.sqrt(s2 * float(np.sum(solve[0] ** 2 / np.maximum(weights, 1e-12))))
+    sigma_fit = math.sqrt(_along_track_var(solve, weights, res, unit))
     # calibration: refit with every drawn camera
     draws = np.einsum("n,snd->sd", solve[0], ground[1:])
     sp = np.linalg.norm(draws, axis=1)
@@ -1082,7 +1080,6 @@ def _fit_track(
     tall_m = _apparent_height_m(cam, ground[0], base, boxes)
     if tall_m < _MIN_VEHICLE_HEIGHT_M:
         sigma_contact = speed * _PIECE_CONTACT_SIGMA_M / height_m
-    sigma = math.sqrt(sigma_fit**2 + sigma_cal**2 + sigma_contact**2)
     kinds_used = np.array([t.kinds[i] for i in use])[ok][keep]
     on_silhouette = float(np.mean(kinds_used == "silhouette"))
     # the track's own consistency: its two halves in time, fitted apart, must agree within
@@ -1148,6 +1145,16 @@ def _apparent_height_m(
     return float(np.median(tall)) if len(tall) else math.nan
 
 
+def _along_track_var(
+    solve: FloatArray, weights: FloatArray, res: FloatArray, unit: FloatArray
+) -> float:
+    """Variance (m²/s²) of a weighted track fit's velocity along ``unit``: the residuals'
+    weighted variance along it times the velocity row of the solve matrix (``solve[0]``)."""
+    dof = max(1, len(res) - solve.shape[0])
+    s2 = float(np.sum(weights * (res @ unit) ** 2) / dof)
+    return s2 * float(np.sum(solve[0] ** 2 / np.maximum(weights, 1e-12)))
+
+
 def _halves_disagreement(
     times: FloatArray, labels: list[int], ground: FloatArray, weights: FloatArray, unit: FloatArray
 ) -> float:
@@ -1165,12 +1172,9 @@ def _halves_disagreement(
         if a.shape[0] <= a.shape[1] or float(np.ptp(tt)) <= 0:
             return 0.0
         sw = np.sqrt(w)[:, None]
-        solve = np.linalg.pinv(a * sw) * sw.T
+        solve = np.asarray(np.linalg.pinv(a * sw) * sw.T, np.float64)
         res = g - a @ (solve @ g)
-        dof = max(1, len(tt) - a.shape[1])
-        s2 = float(np.sum(w * (res @ unit) ** 2) / dof)
-        se2 = s2 * float(np.sum(solve[0] ** 2 / np.maximum(w, 1e-12)))
-        fits.append((float((solve[0] @ g) @ unit), se2))
+        fits.append((float((solve[0] @ g) @ unit), _along_track_var(solve, w, res, unit)))
     (v1, e1), (v2, e2) = fits
     return max(0.0, abs(v1 - v2) - 2.0 * math.sqrt(e1 + e2)) / 2.0
 
