@@ -12,6 +12,7 @@ import numpy.typing as npt
 
 from camloc_geo._errors import MapDataError, SceneError
 from camloc_geo.absolute._model import EvidenceKind, LocateResult, LocateSettings, Observation
+from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.osm._local import LocalIndex
@@ -43,6 +44,11 @@ class Evidence:
     scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
     map_data: MapData | None = None
     frame: LocalFrame | None = None
+    # street_angles_under_car's answers by placement (the same placement is tested when
+    # scored, averaged, refined and bundled); a copy (dataclasses.replace) starts empty.
+    street_angle_memo: dict[Similarity2D, float | None] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def has_cues(self) -> bool:

@@ -40,7 +40,7 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import position_sigma_m, refine
 from camloc_geo.absolute._scoring import (
-    plausibility_many,
+    plausibility_at,
     score,
     unmatched_flags,
 )
@@ -196,10 +196,11 @@ def _rescore_many(
         score(c.enu_from_world, e, settings, c.corner_assignment)
         for c, e in zip(cands, evs, strict=True)
     ]
-    # Each candidate's placements: itself, then (expected) its four sigma points.
-    places: list[list[tuple[Camera, Similarity2D]]] = []
+    # Each candidate's placements (camera centre, similarity): itself, then (expected) its
+    # four sigma points.
+    places: list[list[tuple[FloatArray, Similarity2D]]] = []
     for c, e, fit in zip(cands, evs, fits, strict=True):
-        here = [(c.camera, c.enu_from_world)]
+        here = [(c.camera.center_in_world, c.enu_from_world)]
         if expected:
             sigma = c.sigma_m
             if sigma is None:
@@ -211,9 +212,9 @@ def _rescore_many(
     for e_id in dict.fromkeys(id(e) for e in evs):  # one pass per evidence, in order
         mine = [i for i, e in enumerate(evs) if id(e) == e_id]
         got = iter(
-            plausibility_many(
-                [cam for i in mine for cam, _sim in places[i]],
-                [sim for i in mine for _cam, sim in places[i]],
+            plausibility_at(
+                [centre for i in mine for centre, _sim in places[i]],
+                [sim for i in mine for _centre, sim in places[i]],
                 evs[mine[0]],
                 settings,
                 [fits[i].matches for i in mine for _place in places[i]],
@@ -281,22 +282,33 @@ def _expected_plausibility(
     """
     total = plaus_centre / 3.0
     points = _sigma_points(cand.enu_from_world, sigma_m, world_cam)
-    cams, sims = [cam for cam, _s in points], [sim for _c, sim in points]
-    for f, _flags in plausibility_many(cams, sims, ev, settings, [matches] * len(points)):
+    centres, sims = [centre for centre, _s in points], [sim for _c, sim in points]
+    for f, _flags in plausibility_at(centres, sims, ev, settings, [matches] * len(points)):
         total += f / 6.0
     return total
 
 
 def _sigma_points(
     sim: Similarity2D, sigma_m: float, world_cam: Camera
-) -> list[tuple[Camera, Similarity2D]]:
+) -> list[tuple[FloatArray, Similarity2D]]:
     """The four outer sigma points of :func:`_expected_plausibility`: the placement moved
-    ``±√3`` per-axis sigmas east and north (camera and car together)."""
+    ``±√3`` per-axis sigmas east and north (camera and car together), as (camera centre in
+    the local frame, similarity).
+
+    The centre is ``moved.camera(world_cam).center_in_world`` without building the camera
+    (the plausibility tests need the centre only): the same products, without the camera's
+    ``-Rᵀ(-R c)`` round trip, so equal to within 1e-14 m.
+    """
     step = math.sqrt(3.0) * min(sigma_m, SIGMA_POINT_CAP_M) / math.sqrt(2.0)
+    Rz = np.eye(3)
+    Rz[:2, :2] = sim.rotation
+    # Similarity2D.camera's centre: scale · Rz · C + (T, 0); Rz · C is the same for all.
+    scaled = sim.scale * Rz @ world_cam.center_in_world
     out = []
     for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
         moved = replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
-        out.append((moved.camera(world_cam), moved))
+        T = moved.translation_m
+        out.append((scaled + np.array([T[0], T[1], 0.0]), moved))
     return out
 
 
@@ -403,7 +415,7 @@ def expected_plausibility(
     floor = best * math.exp(-PLAUSIBILITY_MARGIN)
     out = list(cands)
     # (index, score with a plausibility of 1, evidence, sigma points) of each one averaged
-    todo: list[tuple[int, float, Evidence, list[tuple[Camera, Similarity2D]]]] = []
+    todo: list[tuple[int, float, Evidence, list[tuple[FloatArray, Similarity2D]]]] = []
     for i, c in enumerate(cands):
         upper = c.score / max(c.prior, 1e-300)  # the score with a plausibility of 1
         if i < settings.max_candidates and upper >= floor:
@@ -415,9 +427,9 @@ def expected_plausibility(
     for e_id in dict.fromkeys(id(e) for _i, _u, e, _pts in todo):
         mine = [t for t in todo if id(t[2]) == e_id]
         got = iter(
-            plausibility_many(
-                [cam for *_x, pts in mine for cam, _sim in pts],
-                [sim for *_x, pts in mine for _cam, sim in pts],
+            plausibility_at(
+                [centre for *_x, pts in mine for centre, _sim in pts],
+                [sim for *_x, pts in mine for _centre, sim in pts],
                 mine[0][2],
                 settings,
                 [cands[i].matches for i, _u, _e, pts in mine for _p in pts],

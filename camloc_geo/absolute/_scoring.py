@@ -33,6 +33,29 @@ def mahal(obs: Observation, q: FloatArray, enu_from_world: Similarity2D) -> floa
     return float(r @ obs_precision(obs, enu_from_world.rotation, enu_from_world.scale) @ r)
 
 
+class _Carried:
+    """The observations of one placement carried to ENU, each with its precision, computed
+    once per observation (a hypothesis tests one observation against several map points:
+    every corner assignment, every landmark corner). The same products as :func:`mahal`."""
+
+    __slots__ = ("_done", "_rotation", "_sim")
+
+    def __init__(self, enu_from_world: Similarity2D) -> None:
+        self._sim = enu_from_world
+        self._rotation = enu_from_world.rotation
+        self._done: dict[int, tuple[FloatArray, FloatArray]] = {}
+
+    def misfit(self, obs: Observation, q: FloatArray) -> tuple[FloatArray, float]:
+        """``(r, m2)``: the ENU misfit to map point ``q`` and its squared Mahalanobis norm."""
+        got = self._done.get(id(obs))
+        if got is None:
+            sim = self._sim
+            got = (sim.apply(obs.world_xy), obs_precision(obs, self._rotation, sim.scale))
+            self._done[id(obs)] = got
+        r = got[0] - q
+        return r, float(r @ got[1] @ r)
+
+
 @dataclass
 class Fit:
     """How a hypothesis fits the evidence."""
@@ -55,10 +78,14 @@ class Fit:
         m2: float,
         enu_from_world: Similarity2D,
         corner: tuple[str, int] | None = None,
+        misfit: FloatArray | None = None,
     ) -> None:
-        """Count one matched point (its misfit capped at the outlier cost)."""
+        """Count one matched point (its misfit capped at the outlier cost).
+
+        ``misfit``: the carried observation minus ``q``, when computed already.
+        """
         self.log_likelihood -= 0.5 * min(m2, OUTLIER_M2)  # robust: one outlier costs at most 25
-        d = enu_from_world.apply(obs.world_xy) - q
+        d = enu_from_world.apply(obs.world_xy) - q if misfit is None else misfit
         self.sq_misfits_m2.append(float(d @ d))
         self.matches.append(
             Match(
@@ -85,16 +112,18 @@ def score(
     ``-1`` in a corner assignment leaves that image corner unmatched.
     """
     fit = Fit()
+    carried = _Carried(enu_from_world)
     for obs, q in ev.refs:
-        fit.add(obs, q, mahal(obs, q, enu_from_world), enu_from_world)
+        r, m2 = carried.misfit(obs, q)
+        fit.add(obs, q, m2, enu_from_world, misfit=r)
     if ev.corners and len(ev.map_corners):
         if corner_assignment is None:
-            corner_assignment = best_assignment(enu_from_world, ev)
-        _score_corners(fit, enu_from_world, ev, corner_assignment)
+            corner_assignment = best_assignment(enu_from_world, ev, carried)
+        _score_corners(fit, enu_from_world, ev, corner_assignment, carried)
     for obs, pts in ev.landmarks:
-        m2s = [mahal(obs, q, enu_from_world) for q in pts]
-        k = int(np.argmin(m2s))
-        fit.add(obs, pts[k], m2s[k], enu_from_world)
+        tried = [carried.misfit(obs, q) for q in pts]
+        k = int(np.argmin([m2 for _r, m2 in tried]))
+        fit.add(obs, pts[k], tried[k][1], enu_from_world, misfit=tried[k][0])
     s = enu_from_world.scale
     fit.log_likelihood -= 0.5 * ((s - 1.0) / max(settings.scale_sigma_rel, 1e-6)) ** 2
     if corner_assignment is not None:
@@ -103,8 +132,13 @@ def score(
 
 
 def _score_corners(
-    fit: Fit, enu_from_world: Similarity2D, ev: Evidence, assignment: Sequence[int]
+    fit: Fit,
+    enu_from_world: Similarity2D,
+    ev: Evidence,
+    assignment: Sequence[int],
+    carried: _Carried | None = None,
 ) -> None:
+    carried = carried or _Carried(enu_from_world)
     for obs, j in zip(ev.corners, assignment, strict=True):
         if j < 0:
             # A visible corner the map's junction has no counterpart for (more corners
@@ -112,8 +146,8 @@ def _score_corners(
             fit.log_likelihood -= 0.5 * OUTLIER_M2
             continue
         q = ev.map_corners[j]
-        m2 = mahal(obs, q, enu_from_world)
-        fit.add(obs, q, m2, enu_from_world, corner=(ev.map_corner_ids[j], int(j)))
+        r, m2 = carried.misfit(obs, q)
+        fit.add(obs, q, m2, enu_from_world, corner=(ev.map_corner_ids[j], int(j)), misfit=r)
 
 
 def unmatched_flags(ev: Evidence, assignment: tuple[int, ...] | None) -> list[Flag]:
@@ -127,12 +161,15 @@ def unmatched_flags(ev: Evidence, assignment: tuple[int, ...] | None) -> list[Fl
     ]
 
 
-def best_assignment(enu_from_world: Similarity2D, ev: Evidence) -> list[int]:
+def best_assignment(
+    enu_from_world: Similarity2D, ev: Evidence, carried: _Carried | None = None
+) -> list[int]:
     """The cyclic, order-preserving assignment of image corners to map corners that fits best."""
+    carried = carried or _Carried(enu_from_world)
     best: tuple[float, list[int]] | None = None
     for assign, _prior in assignments(len(ev.corners), len(ev.map_corners)):
         cost = sum(
-            mahal(o, ev.map_corners[j], enu_from_world) if j >= 0 else OUTLIER_M2
+            carried.misfit(o, ev.map_corners[j])[1] if j >= 0 else OUTLIER_M2
             for o, j in zip(ev.corners, assign, strict=True)
         )
         if best is None or cost < best[0]:
@@ -202,8 +239,19 @@ def street_angles_under_car(sims: Sequence[Similarity2D], ev: Evidence) -> list[
     gives the bearing of its chord from 5 m before to 5 m after the car's projection; the
     smallest angle to the car's axis wins (the first of equals, in the tree's order). The
     geometry is GEOS's (distance, project, interpolate), over arrays of every car and near
-    street at once: one call each instead of several per street and car.
+    street at once: one call each instead of several per street and car. Answers are
+    remembered on the evidence (``street_angle_memo``): a placement is tested when scored,
+    averaged over its uncertainty, refined and bundled.
     """
+    memo = ev.street_angle_memo
+    todo = list(dict.fromkeys(sim for sim in sims if sim not in memo))
+    if todo:
+        memo.update(zip(todo, _street_angles(todo, ev), strict=True))
+    return [memo[sim] for sim in sims]
+
+
+def _street_angles(sims: Sequence[Similarity2D], ev: Evidence) -> list[float | None]:
+    """:func:`street_angles_under_car`, computed."""
     import shapely
 
     assert ev.streets is not None
@@ -371,13 +419,26 @@ def plausibility_many(
 ) -> list[tuple[float, list[Flag]]]:
     """:func:`plausibility` of several placements (camera, ``enu_from_world`` and matches
     each) on the same evidence; the building and street tests of all of them in one pass."""
-    centres = [cam.center_in_world for cam in cams]
+    return plausibility_at([cam.center_in_world for cam in cams], sims, ev, settings, matches)
+
+
+def plausibility_at(
+    centres: Sequence[FloatArray],
+    sims: Sequence[Similarity2D],
+    ev: Evidence,
+    settings: LocateSettings,
+    matches: Sequence[list[Match]],
+) -> list[tuple[float, list[Flag]]]:
+    """:func:`plausibility_many` of placements given by their camera centres (``(3,)`` or
+    ``(2,)`` each, metres in the local frame) instead of cameras: the tests use the centre
+    only, and building a :class:`~camloc_geo.camera.Camera` per sigma point costs more than
+    they do."""
     if ev.buildings_tree is not None:
         building = _building_factors(
             np.array([C[:2] for C in centres], dtype=float).reshape(-1, 2), ev, settings, matches
         )
     else:
-        building = [(1.0, [])] * len(cams)
+        building = [(1.0, [])] * len(centres)
     angles: list[float | None] = [None] * len(sims)
     if ev.street_tree is not None:
         angles = street_angles_under_car(sims, ev)
