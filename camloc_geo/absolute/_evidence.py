@@ -12,7 +12,6 @@ import numpy.typing as npt
 
 from camloc_geo._errors import MapDataError, SceneError
 from camloc_geo.absolute._model import EvidenceKind, LocateResult, LocateSettings, Observation
-from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.osm._local import LocalIndex
@@ -44,9 +43,11 @@ class Evidence:
     scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
     map_data: MapData | None = None
     frame: LocalFrame | None = None
-    # street_angles_under_car's answers by placement (the same placement is tested when
-    # scored, averaged, refined and bundled); a copy (dataclasses.replace) starts empty.
-    street_angle_memo: dict[Similarity2D, float | None] = field(
+    # What was computed for a placement on this evidence, by id of its Similarity2D
+    # (_scoring.placement: the observations carried and their precisions, the street under
+    # the car); a placement is tested when scored, averaged, refined and bundled. A copy
+    # (dataclasses.replace) starts empty.
+    placement_memo: dict[int, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
 
@@ -71,6 +72,9 @@ class Evidence:
         return [o for o, _ in self.refs] + self.corners + [o for o, _ in self.landmarks]
 
 
+_HALF_PIXEL_STEPS = np.array([[0.0, 0.0], [0.5, 0.0], [-0.5, 0.0], [0.0, 0.5], [0.0, -0.5]])
+
+
 def ground_observation(
     camera: Camera,
     pixel: Sequence[float],
@@ -82,7 +86,10 @@ def ground_observation(
 ) -> Observation:
     """A ground pixel's world position and its covariance (click noise, scale error)."""
     px = np.asarray(pixel, dtype=float)
-    g = camera.ground_from_pixels(px)
+    # The pixel and its central-difference neighbours (half a pixel along u, then v), cast
+    # in one call: row by row the same products as one call each.
+    ground = camera.ground_from_pixels(px + _HALF_PIXEL_STEPS)
+    g = ground[0]
     if not np.all(np.isfinite(g)):
         raise SceneError(
             f"pixel {px.tolist()} is at or above the horizon of the calibrated camera, so it "
@@ -92,11 +99,7 @@ def ground_observation(
     # Jacobian of the ground point w.r.t. the pixel (central differences).
     J = np.empty((2, 2))
     for j in range(2):
-        d = np.zeros(2)
-        d[j] = 0.5
-        gp = camera.ground_from_pixels(px + d)
-        gm = camera.ground_from_pixels(px - d)
-        J[:, j] = (gp[:2] - gm[:2]) / 1.0
+        J[:, j] = (ground[1 + 2 * j, :2] - ground[2 + 2 * j, :2]) / 1.0
     sig_px = settings.sigma_pixel_rel * diag
     cov = sig_px**2 * (J @ J.T)
     foot = camera.center_in_world[:2]

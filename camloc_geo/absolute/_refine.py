@@ -12,7 +12,12 @@ import numpy.typing as npt
 from camloc_geo._optimize import gauss_newton
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
-from camloc_geo.absolute._scoring import OUTLIER_M2, obs_precision, street_angle_under_car
+from camloc_geo.absolute._scoring import (
+    OUTLIER_M2,
+    obs_precision,
+    placement,
+    street_angle_under_car,
+)
 from camloc_geo.absolute._similarity import Similarity2D, rot2
 from camloc_geo.camera import Camera
 
@@ -68,11 +73,21 @@ def _residuals(
     start: Similarity2D,
     settings: LocateSettings,
     street_brg: float | None,
+    ev: Evidence | None = None,
 ) -> ResidualJacobian:
-    """Whitened residuals and Jacobian in x = (θ, tx, ty, ln s)."""
+    """Whitened residuals and Jacobian in x = (θ, tx, ty, ln s).
+
+    ``ev``: the evidence the observations come from, whose memo of the start
+    (:func:`~camloc_geo.absolute._scoring.placement`) has their precisions there.
+    """
     # Whitening at the starting similarity (the rotation and scale change little here).
-    R20 = start.rotation
-    L = np.stack([np.linalg.cholesky(obs_precision(o, R20, start.scale)) for o, _q in obs_q])
+    if ev is None:
+        R20 = start.rotation
+        precisions = [obs_precision(o, R20, start.scale) for o, _q in obs_q]
+    else:
+        here = placement(ev, start)
+        precisions = [here.carried(o)[1] for o, _q in obs_q]
+    L = np.linalg.cholesky(np.stack(precisions))  # each matrix's own factor
     P = np.array([o.world_xy for o, _q in obs_q])
     Q = np.array([q for _o, q in obs_q])
     s_sigma = max(settings.scale_sigma_rel, 1e-6)
@@ -141,7 +156,7 @@ def _similarity_problem(
     if not obs_q:
         return None
     street_brg = _street_bearing_prior(cand, ev, settings)
-    resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg)
+    resid_jac = _residuals(obs_q, cand.enu_from_world, settings, street_brg, ev)
     x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
     return resid_jac, x0
 

@@ -33,27 +33,53 @@ def mahal(obs: Observation, q: FloatArray, enu_from_world: Similarity2D) -> floa
     return float(r @ obs_precision(obs, enu_from_world.rotation, enu_from_world.scale) @ r)
 
 
-class _Carried:
-    """The observations of one placement carried to ENU, each with its precision, computed
-    once per observation (a hypothesis tests one observation against several map points:
-    every corner assignment, every landmark corner). The same products as :func:`mahal`."""
+class _Unknown:
+    """Not computed yet."""
 
-    __slots__ = ("_done", "_rotation", "_sim")
+
+_UNKNOWN = _Unknown()
+
+
+class _Placement:
+    """What one placement (an ``enu_from_world``) gives on one evidence, each computed once:
+    the observations carried to ENU with their precisions (a hypothesis tests one
+    observation against several map points: every corner assignment, every landmark
+    corner; the refinement whitens with the same precisions) and the street under the car.
+    The same products as :func:`mahal` and :func:`obs_precision`."""
+
+    __slots__ = ("_done", "rotation", "sim", "street_angle")
 
     def __init__(self, enu_from_world: Similarity2D) -> None:
-        self._sim = enu_from_world
-        self._rotation = enu_from_world.rotation
+        self.sim = enu_from_world
+        self.rotation = enu_from_world.rotation
+        self.street_angle: float | _Unknown | None = _UNKNOWN
         self._done: dict[int, tuple[FloatArray, FloatArray]] = {}
+
+    def carried(self, obs: Observation) -> tuple[FloatArray, FloatArray]:
+        """The observation in ENU and its precision there (:func:`obs_precision`)."""
+        got = self._done.get(id(obs))
+        if got is None:
+            sim = self.sim
+            got = (sim.apply(obs.world_xy), obs_precision(obs, self.rotation, sim.scale))
+            self._done[id(obs)] = got
+        return got
 
     def misfit(self, obs: Observation, q: FloatArray) -> tuple[FloatArray, float]:
         """``(r, m2)``: the ENU misfit to map point ``q`` and its squared Mahalanobis norm."""
-        got = self._done.get(id(obs))
-        if got is None:
-            sim = self._sim
-            got = (sim.apply(obs.world_xy), obs_precision(obs, self._rotation, sim.scale))
-            self._done[id(obs)] = got
-        r = got[0] - q
-        return r, float(r @ got[1] @ r)
+        p, prec = self.carried(obs)
+        r = p - q
+        return r, float(r @ prec @ r)
+
+
+def placement(ev: Evidence, enu_from_world: Similarity2D) -> _Placement:
+    """The placement's memo on the evidence (``Evidence.placement_memo``, by id; the memo
+    holds the similarity, so the id cannot be reused while it is there)."""
+    memo = ev.placement_memo
+    got = memo.get(id(enu_from_world))
+    if got is None or got.sim is not enu_from_world:
+        got = _Placement(enu_from_world)
+        memo[id(enu_from_world)] = got
+    return got
 
 
 @dataclass
@@ -112,7 +138,7 @@ def score(
     ``-1`` in a corner assignment leaves that image corner unmatched.
     """
     fit = Fit()
-    carried = _Carried(enu_from_world)
+    carried = placement(ev, enu_from_world)
     for obs, q in ev.refs:
         r, m2 = carried.misfit(obs, q)
         fit.add(obs, q, m2, enu_from_world, misfit=r)
@@ -136,9 +162,9 @@ def _score_corners(
     enu_from_world: Similarity2D,
     ev: Evidence,
     assignment: Sequence[int],
-    carried: _Carried | None = None,
+    carried: _Placement | None = None,
 ) -> None:
-    carried = carried or _Carried(enu_from_world)
+    carried = carried or placement(ev, enu_from_world)
     for obs, j in zip(ev.corners, assignment, strict=True):
         if j < 0:
             # A visible corner the map's junction has no counterpart for (more corners
@@ -162,10 +188,10 @@ def unmatched_flags(ev: Evidence, assignment: tuple[int, ...] | None) -> list[Fl
 
 
 def best_assignment(
-    enu_from_world: Similarity2D, ev: Evidence, carried: _Carried | None = None
+    enu_from_world: Similarity2D, ev: Evidence, carried: _Placement | None = None
 ) -> list[int]:
     """The cyclic, order-preserving assignment of image corners to map corners that fits best."""
-    carried = carried or _Carried(enu_from_world)
+    carried = carried or placement(ev, enu_from_world)
     best: tuple[float, list[int]] | None = None
     for assign, _prior in assignments(len(ev.corners), len(ev.map_corners)):
         cost = sum(
@@ -240,14 +266,15 @@ def street_angles_under_car(sims: Sequence[Similarity2D], ev: Evidence) -> list[
     smallest angle to the car's axis wins (the first of equals, in the tree's order). The
     geometry is GEOS's (distance, project, interpolate), over arrays of every car and near
     street at once: one call each instead of several per street and car. Answers are
-    remembered on the evidence (``street_angle_memo``): a placement is tested when scored,
+    remembered on the evidence (:func:`placement`): a placement is tested when scored,
     averaged over its uncertainty, refined and bundled.
     """
-    memo = ev.street_angle_memo
-    todo = list(dict.fromkeys(sim for sim in sims if sim not in memo))
+    places = [placement(ev, sim) for sim in sims]
+    todo = list({id(p): p for p in places if isinstance(p.street_angle, _Unknown)}.values())
     if todo:
-        memo.update(zip(todo, _street_angles(todo, ev), strict=True))
-    return [memo[sim] for sim in sims]
+        for p, angle in zip(todo, _street_angles([p.sim for p in todo], ev), strict=True):
+            p.street_angle = angle
+    return [p.street_angle for p in places]  # type: ignore[misc]
 
 
 def _street_angles(sims: Sequence[Similarity2D], ev: Evidence) -> list[float | None]:
@@ -359,13 +386,6 @@ def _building_factors(
             line += 1
         out.append((factor, flags))
     return out
-
-
-class _Unknown:
-    """Not computed yet."""
-
-
-_UNKNOWN = _Unknown()
 
 
 def _parallel_factor(
