@@ -38,7 +38,7 @@ from camloc_geo.absolute._model import (
     Match,
     Tie,
 )
-from camloc_geo.absolute._refine import position_sigma_m, refine
+from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine
 from camloc_geo.absolute._scoring import (
     plausibility_at,
     score,
@@ -306,8 +306,8 @@ def _sigma_points(
     scaled = sim.scale * Rz @ world_cam.center_in_world
     out = []
     for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
-        moved = replace(sim, translation_m=np.asarray(sim.translation_m) + np.array(shift))
-        T = moved.translation_m
+        T = np.asarray(sim.translation_m) + np.array(shift)
+        moved = Similarity2D(sim.rotation_rad, T, sim.scale)
         out.append((scaled + np.array([T[0], T[1], 0.0]), moved))
     return out
 
@@ -414,15 +414,20 @@ def expected_plausibility(
     best = max(c.score for c in cands)
     floor = best * math.exp(-PLAUSIBILITY_MARGIN)
     out = list(cands)
-    # (index, score with a plausibility of 1, evidence, sigma points) of each one averaged
-    todo: list[tuple[int, float, Evidence, list[tuple[FloatArray, Similarity2D]]]] = []
+    # The candidates averaged: (index, score with a plausibility of 1, evidence).
+    chosen: list[tuple[int, float, Evidence]] = []
     for i, c in enumerate(cands):
         upper = c.score / max(c.prior, 1e-300)  # the score with a plausibility of 1
         if i < settings.max_candidates and upper >= floor:
-            c_ev = c.evidence or ev
-            sigma = position_sigma_m(c, world_cam, c_ev, settings)
-            if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
-                todo.append((i, upper, c_ev, _sigma_points(c.enu_from_world, sigma, world_cam)))
+            chosen.append((i, upper, c.evidence or ev))
+    sigmas = position_sigmas_m(
+        [cands[i] for i, _u, _e in chosen], world_cam, [e for _i, _u, e in chosen], settings
+    )
+    # (index, score with a plausibility of 1, evidence, sigma points) of each one averaged
+    todo: list[tuple[int, float, Evidence, list[tuple[FloatArray, Similarity2D]]]] = []
+    for (i, upper, c_ev), sigma in zip(chosen, sigmas, strict=True):
+        if sigma is not None and math.isfinite(sigma) and sigma > 0.0:
+            todo.append((i, upper, c_ev, _sigma_points(cands[i].enu_from_world, sigma, world_cam)))
     # The sigma points of every candidate on one evidence: one pass of the map tests.
     for e_id in dict.fromkeys(id(e) for _i, _u, e, _pts in todo):
         mine = [t for t in todo if id(t[2]) == e_id]
@@ -538,10 +543,11 @@ def _tie(
     """The tie rule for two candidates (``positions``: their ``east_north`` by ``id``)."""
     ea = a.east_north if positions is None else positions[id(a)]
     eb = b.east_north if positions is None else positions[id(b)]
+    gap = ea - eb
     return is_tie(
         a.score,
         b.score,
-        float(np.linalg.norm(ea - eb)),
+        math.sqrt(float(gap @ gap)),  # np.linalg.norm's own products
         score_ratio=settings.tie_score_ratio,
         distance_m=settings.tie_distance_m,
         merge_distance_m=settings.merge_distance_m,

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -133,18 +133,9 @@ def _position_sigma_m(
     J: FloatArray, enu_from_world: Similarity2D, world_cam: Camera
 ) -> float | None:
     """1-sigma position uncertainty of the camera, propagated from the fit's covariance."""
-    try:
-        cov = np.linalg.pinv(J.T @ J)
-        # Jacobian of the camera's ENU position w.r.t. (θ, tx, ty, ln s).
-        theta, s = enu_from_world.rotation_rad, enu_from_world.scale
-        Cw = world_cam.center_in_world[:2]
-        R2 = rot2(theta)
-        dR = np.array([[-math.sin(theta), -math.cos(theta)], [math.cos(theta), -math.sin(theta)]])
-        Jp = np.column_stack([s * dR @ Cw, [1.0, 0.0], [0.0, 1.0], s * R2 @ Cw])
-        cov_p = Jp @ cov @ Jp.T
-        return float(math.sqrt(max(np.trace(cov_p), 0.0)))
-    except np.linalg.LinAlgError:
-        return None
+    return _propagated_sigma(
+        J.T @ J, _position_jacobian(enu_from_world, world_cam.center_in_world[:2])
+    )
 
 
 def _similarity_problem(
@@ -173,6 +164,59 @@ def position_sigma_m(
     resid_jac, x0 = problem
     _r, J = resid_jac(x0)
     return _position_sigma_m(J, cand.enu_from_world, world_cam)
+
+
+def position_sigmas_m(
+    cands: Sequence[Candidate],
+    world_cam: Camera,
+    evs: Sequence[Evidence],
+    settings: LocateSettings,
+) -> list[float | None]:
+    """:func:`position_sigma_m` of several candidates (each on its evidence): the
+    covariances' pseudo-inverses and their propagation in one batched call each (LAPACK
+    and the matrix products per matrix: the same bits as one at a time)."""
+    out: list[float | None] = [None] * len(cands)
+    rows: list[tuple[int, FloatArray, FloatArray]] = []  # (index, JᵀJ, Jp)
+    Cw = world_cam.center_in_world[:2]
+    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        problem = _similarity_problem(cand, ev, settings)
+        if problem is None:
+            continue
+        resid_jac, x0 = problem
+        _r, J = resid_jac(x0)
+        rows.append((k, J.T @ J, _position_jacobian(cand.enu_from_world, Cw)))
+    if not rows:
+        return out
+    try:
+        cov = np.linalg.pinv(np.stack([JtJ for _k, JtJ, _Jp in rows]))
+    except np.linalg.LinAlgError:  # one at a time: a failing candidate gets None
+        for k, JtJ, Jp in rows:
+            out[k] = _propagated_sigma(JtJ, Jp)
+        return out
+    Jp = np.stack([Jp for _k, _JtJ, Jp in rows])
+    cov_p = Jp @ cov @ Jp.transpose(0, 2, 1)
+    for (k, _JtJ, _Jp), tr in zip(rows, (cov_p[:, 0, 0] + cov_p[:, 1, 1]).tolist(), strict=True):
+        out[k] = float(math.sqrt(max(tr, 0.0)))
+    return out
+
+
+def _position_jacobian(enu_from_world: Similarity2D, Cw: FloatArray) -> FloatArray:
+    """Jacobian ``(2, 4)`` of the camera's ENU position w.r.t. (θ, tx, ty, ln s), with
+    ``Cw`` the camera centre's (x, y) in the world frame."""
+    theta, s = enu_from_world.rotation_rad, enu_from_world.scale
+    R2 = rot2(theta)
+    dR = np.array([[-math.sin(theta), -math.cos(theta)], [math.cos(theta), -math.sin(theta)]])
+    return np.column_stack([s * dR @ Cw, [1.0, 0.0], [0.0, 1.0], s * R2 @ Cw])
+
+
+def _propagated_sigma(JtJ: FloatArray, Jp: FloatArray) -> float | None:
+    """The position sigma from the normal matrix and the position's Jacobian."""
+    try:
+        cov = np.linalg.pinv(JtJ)
+    except np.linalg.LinAlgError:
+        return None
+    cov_p = Jp @ cov @ Jp.T
+    return float(math.sqrt(max(np.trace(cov_p), 0.0)))
 
 
 def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSettings) -> Candidate:

@@ -112,14 +112,15 @@ class Fit:
         """
         self.log_likelihood -= 0.5 * min(m2, OUTLIER_M2)  # robust: one outlier costs at most 25
         d = enu_from_world.apply(obs.world_xy) - q if misfit is None else misfit
-        self.sq_misfits_m2.append(float(d @ d))
+        dd = float(d @ d)
+        self.sq_misfits_m2.append(dd)
         self.matches.append(
             Match(
                 obs.kind,
                 obs.label,
                 obs.pixel,
                 np.asarray(q, dtype=np.float64).copy(),
-                float(np.linalg.norm(d)),
+                math.sqrt(dd),  # np.linalg.norm(d): the same dot product and square root
                 float(m2),
                 None if corner is None else corner[0],
                 None if corner is None else corner[1],
@@ -473,7 +474,8 @@ def plausibility_at(
             flags += fl_b
         if ev.prior_en is not None and ev.prior_radius_m:
             # A soft prior: a Gaussian of the listed radius (0.61 at the radius, 0.14 at twice).
-            d = float(np.linalg.norm(C[:2] - ev.prior_en))
+            away = C[:2] - ev.prior_en
+            d = math.sqrt(float(away @ away))  # np.linalg.norm's own products
             factor *= math.exp(-0.5 * (d / ev.prior_radius_m) ** 2)
             if d > ev.prior_radius_m:
                 flags.append(Flag(FlagKind.OUTSIDE_PRIOR))
