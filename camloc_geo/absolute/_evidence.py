@@ -50,6 +50,9 @@ class Evidence:
     placement_memo: dict[int, Any] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+    # The observations stacked for the placements (_scoring._ObservationTable), made on
+    # first use; a copy starts without.
+    observation_table: Any = field(default=None, init=False, repr=False, compare=False)
 
     @property
     def has_cues(self) -> bool:
