@@ -328,31 +328,44 @@ def _street_angles(sims: Sequence[Similarity2D], ev: Evidence) -> list[float | N
     import shapely
 
     assert ev.streets is not None
-    cars = [sim.apply(ev.car_center_world) for sim in sims]
-    xy = np.array([[float(c[0]), float(c[1])] for c in cars])
+    # The cars' centres and bearings, all placements at once (Similarity2D.apply's and
+    # car_bearing_deg's arithmetic, elementwise).
+    theta = np.array([sim.rotation_rad for sim in sims], dtype=np.float64)
+    scale = np.array([sim.scale for sim in sims], dtype=np.float64)
+    shift = np.array([sim.translation_m for sim in sims], dtype=np.float64).reshape(-1, 2)
+    cx, cy = (float(v) for v in ev.car_center_world)
+    cos_t, sin_t = np.cos(theta), np.sin(theta)
+    xy = np.empty((len(sims), 2))
+    xy[:, 0] = (scale * cos_t) * cx + (scale * -sin_t) * cy + shift[:, 0]
+    xy[:, 1] = (scale * sin_t) * cx + (scale * cos_t) * cy + shift[:, 1]
     boxes = shapely.box(xy[:, 0] - 25.0, xy[:, 1] - 25.0, xy[:, 0] + 25.0, xy[:, 1] + 25.0)
     car_i, line_i = ev.street_tree.query(boxes)
     best: list[float | None] = [None] * len(sims)
     if not len(car_i):
         return best
     lines = ev.street_tree.geometries[line_i]
-    pts = shapely.points(xy[car_i])
+    pts = shapely.points(xy)[car_i]
     half_w = ev.streets.values_array[line_i]
     on = ~(shapely.distance(lines, pts) > half_w + 2.5)
     if not on.any():
         return best
     car_i, lines, pts = car_i[on], lines[on], pts[on]
     sproj = shapely.line_locate_point(lines, pts)
-    a = shapely.get_coordinates(
-        shapely.line_interpolate_point(lines, np.maximum(0.0, sproj - 5.0))
-    ).tolist()
-    b = shapely.get_coordinates(
-        shapely.line_interpolate_point(lines, np.minimum(shapely.length(lines), sproj + 5.0))
-    ).tolist()
-    car_bearings = [car_bearing_deg(sim) for sim in sims]
-    for k, (ax, ay), (bx, by) in zip(car_i.tolist(), a, b, strict=True):
-        brg = math.degrees(math.atan2(bx - ax, by - ay)) % 180.0
-        diff = (car_bearings[k] - brg + 90.0) % 180.0 - 90.0
+    # The chord's ends 5 m before and after the projection, in one call.
+    ends = shapely.get_coordinates(
+        shapely.line_interpolate_point(
+            np.concatenate([lines, lines]),
+            np.concatenate(
+                [np.maximum(0.0, sproj - 5.0), np.minimum(shapely.length(lines), sproj + 5.0)]
+            ),
+        )
+    )
+    n_on = len(lines)
+    a, b = ends[:n_on], ends[n_on:]
+    brg = np.degrees(np.arctan2(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])) % 180.0
+    car_brg = (90.0 - np.degrees(theta)) % 180.0
+    diffs = ((car_brg[car_i] - brg + 90.0) % 180.0 - 90.0).tolist()
+    for k, diff in zip(car_i.tolist(), diffs, strict=True):
         prev = best[k]
         if prev is None or abs(diff) < abs(prev):
             best[k] = diff
