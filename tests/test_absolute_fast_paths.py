@@ -156,3 +156,44 @@ def test_ground_observation_matches_one_cast_per_pixel(
         rng = float(np.linalg.norm(g[:2] - foot)) + float(np.linalg.norm(foot))
         cov = cov + (settings.scale_sigma_rel * 0.5 * rng) ** 2 * np.eye(2)
         np.testing.assert_allclose(obs.cov_world, cov, rtol=1e-12, atol=0.0)
+
+
+def _plain_residuals(obs_q: list[Any], L: np.ndarray, x: np.ndarray, s_sigma: float) -> np.ndarray:
+    """The refinement's whitened point and scale residuals, written out plainly."""
+    theta, tx, ty, ls = x
+    s = math.exp(ls)
+    R = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+    rows = []
+    for (o, q), Lk in zip(obs_q, L, strict=True):
+        rows.append(Lk.T @ (s * R @ o.world_xy + np.array([tx, ty]) - q))
+    return np.concatenate([np.ravel(rows), [ls / s_sigma]])
+
+
+def test_refinement_residuals_and_jacobian(
+    located: list[tuple[Scene, CalibrationResult]], baltimore: MapData
+) -> None:
+    settings = LocateSettings()
+    for scene, cal in located:
+        result = _pipeline.locate(scene, baltimore, calibration=cal)
+        cand = result.candidates[0]
+        ev = cand.evidence
+        assert ev is not None
+        obs_q = _refine._matched_points(cand, ev)
+        brg = _refine._street_bearing_prior(cand, ev, settings)
+        resid_jac = _refine._residuals(obs_q, cand.enu_from_world, settings, brg, ev)
+        here = _scoring.placement(ev, cand.enu_from_world)
+        L = np.linalg.cholesky(np.stack([here.carried(o)[1] for o, _q in obs_q]))
+        x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+        for dx in (np.zeros(4), np.array([0.05, 2.0, -1.0, 0.03])):
+            x = x0 + dx
+            r, J = resid_jac(x)
+            n_pts = 2 * len(obs_q) + 1
+            want = _plain_residuals(obs_q, L, x, max(settings.scale_sigma_rel, 1e-6))
+            np.testing.assert_allclose(r[:n_pts], want, rtol=1e-9, atol=1e-9)
+            assert len(r) == n_pts + (brg is not None)
+            # the Jacobian against central differences
+            for j in range(4):
+                h = np.zeros(4)
+                h[j] = 1e-6
+                fd = (resid_jac(x + h)[0] - resid_jac(x - h)[0]) / 2e-6
+                np.testing.assert_allclose(J[:, j], fd, rtol=1e-5, atol=1e-6)

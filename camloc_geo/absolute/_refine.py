@@ -88,36 +88,38 @@ def _residuals(
         here = placement(ev, start)
         precisions = [here.carried(o)[1] for o, _q in obs_q]
     L = np.linalg.cholesky(np.stack(precisions))  # each matrix's own factor
-    P = np.array([o.world_xy for o, _q in obs_q])
-    Q = np.array([q for _o, q in obs_q])
+    P = np.array([o.world_xy for o, _q in obs_q], dtype=np.float64)
+    Q = np.array([q for _o, q in obs_q], dtype=np.float64)
     s_sigma = max(settings.scale_sigma_rel, 1e-6)
 
     n = len(obs_q)
     m = 2 * n + 1 + (street_brg is not None)
-    # The translation's columns do not change: whitened once.
-    J_t = np.einsum("nji,cnj->cni", L, np.broadcast_to(np.eye(2)[:, None, :], (2, n, 2)))
+    # The residual of point k is L_kᵀ (s R(θ) p_k + t − q_k), with R(θ) p = cos θ p + sin θ p⊥
+    # (p⊥ = p turned by 90°): whitened once, every term is a fixed vector times a scalar of
+    # x, flattened (u, v per point) like the residuals.
+    P_perp = np.stack([-P[:, 1], P[:, 0]], axis=1)
+    U = np.einsum("nji,nj->ni", L, P).ravel()  # L_kᵀ p_k
+    V = np.einsum("nji,nj->ni", L, P_perp).ravel()  # L_kᵀ p⊥_k
+    W = np.einsum("nji,nj->ni", L, Q).ravel()  # L_kᵀ q_k
+    T_east, T_north = L[:, 0, :].ravel(), L[:, 1, :].ravel()  # L_kᵀ e_x, L_kᵀ e_y
     J_const = np.zeros((m, 4))
-    J_const[: 2 * n, 1] = J_t[0].ravel()
-    J_const[: 2 * n, 2] = J_t[1].ravel()
+    J_const[: 2 * n, 1] = T_east  # the translation's columns do not change
+    J_const[: 2 * n, 2] = T_north
     J_const[2 * n] = [0.0, 0.0, 0.0, 1.0 / s_sigma]
     if street_brg is not None:
         J_const[2 * n + 1] = [-math.degrees(1.0) / settings.bearing_sigma_deg, 0, 0, 0]
 
     def resid_jac(x: FloatArray) -> tuple[FloatArray, FloatArray]:
-        theta, tx, ty, ls = x
+        theta, tx, ty, ls = (float(v) for v in x)
         s = math.exp(ls)
-        R2 = rot2(theta)
-        dR2 = np.array([[-R2[1, 0], -R2[0, 0]], [R2[0, 0], -R2[1, 0]]])
-        sp = s * P @ R2.T
-        d = sp + np.array([tx, ty]) - Q
-        # Whitened residuals, and the rotation's and the log scale's columns, in one go.
-        w = np.einsum("nji,cnj->cni", L, np.stack([d, s * P @ dR2.T, sp]))
+        a, b = s * math.cos(theta), s * math.sin(theta)
+        turned = a * U + b * V  # L_kᵀ s R(θ) p_k: also the log scale's column
         r = np.empty(m)
-        r[: 2 * n] = w[0].ravel()
+        r[: 2 * n] = turned + tx * T_east + ty * T_north - W
         r[2 * n] = ls / s_sigma
         J = J_const.copy()
-        J[: 2 * n, 0] = w[1].ravel()
-        J[: 2 * n, 3] = w[2].ravel()
+        J[: 2 * n, 0] = a * V - b * U  # ∂/∂θ
+        J[: 2 * n, 3] = turned
         if street_brg is not None:
             # The car is parallel to the street it stands on, within bearing_sigma_deg (the
             # street found under the car at the start; the refinement moves it little).
