@@ -197,3 +197,16 @@ def test_refinement_residuals_and_jacobian(
                 h[j] = 1e-6
                 fd = (resid_jac(x + h)[0] - resid_jac(x - h)[0]) / 2e-6
                 np.testing.assert_allclose(J[:, j], fd, rtol=1e-5, atol=1e-6)
+
+
+def test_candidate_angles_are_the_cameras_to_the_bit() -> None:
+    from camloc_geo.camera import rotation_from_rotvec
+    from camloc_geo.results import _angles_deg
+
+    rng = np.random.default_rng(2)
+    rotations = [rotation_from_rotvec(v) for v in rng.normal(0.0, 1.5, (500, 3))]
+    rotations.append(np.diag([1.0, -1.0, -1.0]))  # looking straight down: no heading
+    rotations.append(np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]]))  # level, north
+    for R in rotations:
+        cam = Camera(1000.0, (640.0, 360.0), R, np.array([0.0, 0.0, -5.0]))
+        assert _angles_deg(cam) == cam.angles_deg
