@@ -210,3 +210,57 @@ def test_candidate_angles_are_the_cameras_to_the_bit() -> None:
     for R in rotations:
         cam = Camera(1000.0, (640.0, 360.0), R, np.array([0.0, 0.0, -5.0]))
         assert _angles_deg(cam) == cam.angles_deg
+
+
+def test_merge_on_floats_is_the_merge_on_arrays(
+    located: list[tuple[Scene, CalibrationResult]],
+    baltimore: MapData,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import copy
+    from dataclasses import replace
+
+    scene, cal = located[0]
+    base = _pipeline.locate(scene, baltimore, calibration=cal).candidates[0]
+    rng = np.random.default_rng(8)
+    cands = []
+    for k in range(60):
+        sim = Similarity2D(
+            base.enu_from_world.rotation_rad + float(rng.choice([0.0, 0.05, 1.0, 3.0])),
+            np.asarray(base.translation_en) + rng.normal(0.0, 6.0, 2),
+            base.scale,
+        )
+        c = replace(base, enu_from_world=sim, camera=sim.camera(cal.camera), merged=1)
+        c.log_likelihood = float(rng.normal(0.0, 3.0)) - 0.01 * k
+        cands.append(c)
+    settings = LocateSettings()
+    on_floats = _pipeline.normalise_and_merge(copy.deepcopy(cands), settings)
+    monkeypatch.setattr(_pipeline, "_MERGE_LOOP_MAX", -1)
+    on_arrays = _pipeline.normalise_and_merge(copy.deepcopy(cands), settings)
+    assert 3 < len(on_floats) < len(cands)
+    assert [(c.score, c.merged, c.log_likelihood) for c in on_floats] == [
+        (c.score, c.merged, c.log_likelihood) for c in on_arrays
+    ]
+
+
+def test_bundle_position_sigmas_batched_are_the_single_ones(
+    located: list[tuple[Scene, CalibrationResult]],
+    baltimore: MapData,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from camloc_geo.absolute import _bundle
+
+    seen: list[tuple[list[float | None], list[float | None]]] = []
+    batched = _bundle._position_sigmas
+
+    def both(results: Any, state: Any, n_cam: int) -> list[float | None]:
+        got = batched(results, state, n_cam)
+        seen.append((got, [_bundle._position_sigma(r, state, n_cam) for r in results]))
+        return got
+
+    monkeypatch.setattr(_bundle, "_position_sigmas", both)
+    for scene, cal in located:
+        _pipeline.locate(scene, baltimore, calibration=cal)
+    assert any(len(got) >= 2 for got, _one in seen)
+    for got, one in seen:
+        assert got == one

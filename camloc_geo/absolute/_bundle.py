@@ -319,14 +319,20 @@ def _bundle_many(
     results = soft_l1_least_squares_many(
         recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200, sigma_tol=_SIGMA_TOL
     )
+    sigmas = _position_sigmas(results, state, n_cam)
     return [
-        _accept(p, res, r0, state, n_cam)
-        for p, res, r0 in zip(problems, results, starts, strict=True)
+        _accept(p, res, r0, state, n_cam, sigma)
+        for p, res, r0, sigma in zip(problems, results, starts, sigmas, strict=True)
     ]
 
 
 def _accept(
-    p: _Problem, res: LeastSquaresResult, r0: FloatArray, state: JointState, n_cam: int
+    p: _Problem,
+    res: LeastSquaresResult,
+    r0: FloatArray,
+    state: JointState,
+    n_cam: int,
+    sigma_m: float | None,
 ) -> Candidate:
     """The candidate as the bundle left it, or as it was when the bundle is not trustworthy."""
     cand = p.cand
@@ -353,9 +359,58 @@ def _accept(
         cand,
         enu_from_world=sim,
         camera=camera,
-        sigma_m=_position_sigma(res, state, n_cam),
+        sigma_m=sigma_m,
         refined=True,
     )
+
+
+def _position_sigmas(
+    results: list[LeastSquaresResult], state: JointState, n_cam: int
+) -> list[float | None]:
+    """:func:`_position_sigma` of each fit, the covariances' pseudo-inverses in one batched
+    call and the position's finite differences in one evaluation (LAPACK per matrix; the
+    position depends on the camera centre and the similarity only, elementwise): the same
+    bits as one fit at a time."""
+    if len(results) < 2 or len({np.shape(r.jac) for r in results}) != 1:
+        return [_position_sigma(r, state, n_cam) for r in results]
+    s2s = []
+    for res in results:
+        fun, z = np.asarray(res.fun), np.asarray(res.x)
+        dof = max(len(fun) - len(z), 1)
+        s2s.append(max(float(fun @ fun) / dof, 1.0))
+    try:
+        covs = np.linalg.pinv(np.stack([r.jac.T @ r.jac for r in results]))
+    except np.linalg.LinAlgError:
+        return [_position_sigma(r, state, n_cam) for r in results]
+    Jps = _position_jacobians([np.asarray(r.x) for r in results], state, n_cam)
+    out: list[float | None] = []
+    for cov, s2, Jp in zip(covs, s2s, Jps, strict=True):
+        cov_p = Jp @ (cov * s2) @ Jp.T
+        tr = float(np.trace(cov_p))
+        out.append(math.sqrt(tr) if math.isfinite(tr) and tr >= 0.0 else None)
+    return out
+
+
+def _position_jacobians(zs: list[FloatArray], state: JointState, n_cam: int) -> list[FloatArray]:
+    """The finite-difference Jacobians ``(2, n)`` of the camera's (east, north) at each
+    parameter vector (steps of 1e-6 relative), all in one evaluation."""
+    hs = [1e-6 * np.maximum(1.0, np.abs(z)) for z in zs]
+    Z = np.vstack([np.vstack([z, z + np.diag(h)]) for z, h in zip(zs, hs, strict=True)])
+    prob = state.problem
+    _f, _pp, _R, C = prob._unpack_batch(
+        Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
+    )
+    C_out = (C - state.internal_origin) @ state.internal_from_output
+    theta, tx, ty, s = Z[:, n_cam], Z[:, n_cam + 1], Z[:, n_cam + 2], np.exp(Z[:, n_cam + 3])
+    cos_t, sin_t = np.cos(theta), np.sin(theta)
+    east = s * (cos_t * C_out[:, 0] - sin_t * C_out[:, 1]) + tx
+    north = s * (sin_t * C_out[:, 0] + cos_t * C_out[:, 1]) + ty
+    out = []
+    n_z = len(zs[0]) + 1
+    for k, h in enumerate(hs):
+        e, n = east[k * n_z : (k + 1) * n_z], north[k * n_z : (k + 1) * n_z]
+        out.append(np.stack([(e[1:] - e[0]) / h, (n[1:] - n[0]) / h]))
+    return out
 
 
 def _position_sigma(res: object, state: JointState, n_cam: int) -> float | None:

@@ -473,27 +473,58 @@ def normalise_and_merge(cands: list[Candidate], settings: LocateSettings) -> lis
     for c, wi in zip(cands, w, strict=True):
         c.score = float(wi)
     cands.sort(key=lambda c: -c.score)
-    # Vectorised over the kept ones: landmark scenes have thousands of hypotheses.
+    # Vectorised over the kept ones (landmark scenes have thousands of hypotheses) once
+    # there are many; the same arithmetic on floats while there are few.
     en = np.array([c.east_north for c in cands], dtype=float)
     heading = np.array([c.heading_deg for c in cands], dtype=float)
+    en_l, heading_l = en.tolist(), heading.tolist()
     kept: list[Candidate] = []
     kept_rows: list[int] = []
     for i, c in enumerate(cands):
-        if kept_rows:
+        if len(kept_rows) > _MERGE_LOOP_MAX:
             d = np.linalg.norm(en[kept_rows] - en[i], axis=1)
             dh = np.abs((heading[i] - heading[kept_rows] + 180.0) % 360.0 - 180.0)
             hit = np.flatnonzero(
                 (d < settings.merge_distance_m) & (dh < settings.merge_heading_deg)
             )
-            if hit.size:
-                k = kept[int(hit[0])]
-                k.score += c.score
-                k.merged += c.merged
-                continue
+            first = int(hit[0]) if hit.size else None
+        else:
+            first = _first_near(en_l, heading_l, kept_rows, i, settings)
+        if first is not None:
+            k = kept[first]
+            k.score += c.score
+            k.merged += c.merged
+            continue
         kept.append(c)
         kept_rows.append(i)
     kept.sort(key=lambda c: -c.score)
     return kept
+
+
+_MERGE_LOOP_MAX = 32
+"""Up to this many kept candidates, :func:`normalise_and_merge` compares on floats (numpy's
+per-call overhead outweighs the arithmetic); beyond, on arrays."""
+
+
+def _first_near(
+    en: list[list[float]],
+    heading: list[float],
+    kept_rows: list[int],
+    i: int,
+    settings: LocateSettings,
+) -> int | None:
+    """The first kept candidate (its position in ``kept_rows``) within the merge distance
+    and heading of candidate ``i``: :func:`normalise_and_merge`'s array test on floats
+    (the same products, sums and remainders)."""
+    x, y = en[i]
+    h = heading[i]
+    for pos, j in enumerate(kept_rows):
+        dx, dy = en[j][0] - x, en[j][1] - y
+        if math.sqrt(dx * dx + dy * dy) < settings.merge_distance_m and (
+            abs((h - heading[j] + 180.0) % 360.0 - 180.0) < settings.merge_heading_deg
+        ):
+            return pos
+    return None
 
 
 def rank(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> list[Candidate]:
