@@ -240,12 +240,17 @@ def _corners(
             f"intersection {inter.id} is a {inter.kind}: " + "; ".join(inter.warnings)
         )
     if inter.corners:
-        out.map_corners = np.array(
-            [frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in inter.corners], dtype=float
-        )
+        out.map_corners = _corners_enu(inter, frame)
         out.map_corner_ids = [f"{inter.id}:{c.order}" for c in inter.corners]
     out.bearings = [st.bearing_deg for st in inter.streets]
     return out
+
+
+def _corners_enu(inter: Intersection, frame: LocalFrame) -> FloatArray:
+    """The junction's kerb corners ``(n, 2)`` in the local frame, in one projection (the
+    same numbers as one call per corner)."""
+    lonlat = np.array([[c.lon, c.lat] for c in inter.corners], dtype=float).reshape(-1, 2)
+    return frame.points_enu_from_geographic(lonlat)
 
 
 def _landmarks(
@@ -447,9 +452,7 @@ def evidence_at(
     """``ev`` with another junction's kerb corners and the street bearings around it."""
     from dataclasses import replace
 
-    corners = np.array(
-        [frame.enu_from_geographic(lat=c.lat, lon=c.lon) for c in inter.corners], dtype=float
-    )
+    corners = _corners_enu(inter, frame)
     bearings = [st.bearing_deg for st in inter.streets]
     for _name, brg in map_data.street_bearings(
         lat=inter.lat, lon=inter.lon, radius_m=settings.street_search_m

@@ -38,7 +38,7 @@ from camloc_geo.absolute._model import (
     Match,
     Tie,
 )
-from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine
+from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine_many
 from camloc_geo.absolute._scoring import (
     plausibility_at,
     score,
@@ -458,7 +458,8 @@ def refine_leaders(
 ) -> list[Candidate]:
     """Stage 5: refine the ``refine_top`` leading candidates, then score them again (the
     plausibility averaged over their refined uncertainty)."""
-    top = [refine(c, world_cam, c.evidence or ev, settings) for c in cands[: settings.refine_top]]
+    leaders = cands[: settings.refine_top]
+    top = refine_many(leaders, world_cam, [c.evidence or ev for c in leaders], settings)
     top = _rescore_many(top, world_cam, ev, settings, [0.0] * len(top), expected=True)
     return top + cands[settings.refine_top :]
 

@@ -18,7 +18,7 @@ from camloc_geo.absolute._scoring import (
     placement,
     street_angle_under_car,
 )
-from camloc_geo.absolute._similarity import Similarity2D, rot2
+from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
 
 FloatArray = npt.NDArray[np.float64]
@@ -187,28 +187,39 @@ def position_sigmas_m(
         resid_jac, x0 = problem
         _r, J = resid_jac(x0)
         rows.append((k, J.T @ J, _position_jacobian(cand.enu_from_world, Cw)))
+    for (k, _JtJ, _Jp), sigma in zip(rows, _propagated_sigmas(rows), strict=True):
+        out[k] = sigma
+    return out
+
+
+def _propagated_sigmas(rows: list[tuple[int, FloatArray, FloatArray]]) -> list[float | None]:
+    """:func:`_propagated_sigma` of each ``(index, JᵀJ, Jp)``: the pseudo-inverses and the
+    propagation in one batched call each (LAPACK and the products per matrix: the same bits
+    as one at a time); one at a time when the batch fails, a failing one None."""
     if not rows:
-        return out
+        return []
     try:
         cov = np.linalg.pinv(np.stack([JtJ for _k, JtJ, _Jp in rows]))
-    except np.linalg.LinAlgError:  # one at a time: a failing candidate gets None
-        for k, JtJ, Jp in rows:
-            out[k] = _propagated_sigma(JtJ, Jp)
-        return out
+    except np.linalg.LinAlgError:
+        return [_propagated_sigma(JtJ, Jp) for _k, JtJ, Jp in rows]
     Jp = np.stack([Jp for _k, _JtJ, Jp in rows])
     cov_p = Jp @ cov @ Jp.transpose(0, 2, 1)
-    for (k, _JtJ, _Jp), tr in zip(rows, (cov_p[:, 0, 0] + cov_p[:, 1, 1]).tolist(), strict=True):
-        out[k] = float(math.sqrt(max(tr, 0.0)))
-    return out
+    return [float(math.sqrt(max(tr, 0.0))) for tr in (cov_p[:, 0, 0] + cov_p[:, 1, 1]).tolist()]
 
 
 def _position_jacobian(enu_from_world: Similarity2D, Cw: FloatArray) -> FloatArray:
     """Jacobian ``(2, 4)`` of the camera's ENU position w.r.t. (θ, tx, ty, ln s), with
     ``Cw`` the camera centre's (x, y) in the world frame."""
-    theta, s = enu_from_world.rotation_rad, enu_from_world.scale
-    R2 = rot2(theta)
-    dR = np.array([[-math.sin(theta), -math.cos(theta)], [math.cos(theta), -math.sin(theta)]])
-    return np.column_stack([s * dR @ Cw, [1.0, 0.0], [0.0, 1.0], s * R2 @ Cw])
+    theta, s = float(enu_from_world.rotation_rad), float(enu_from_world.scale)
+    c, sn = math.cos(theta), math.sin(theta)
+    cx, cy = float(Cw[0]), float(Cw[1])
+    # s dR(θ) C and s R(θ) C, with dR = ∂R/∂θ, on floats
+    return np.array(
+        [
+            [(s * -sn) * cx + (s * -c) * cy, 1.0, 0.0, (s * c) * cx + (s * -sn) * cy],
+            [(s * c) * cx + (s * -sn) * cy, 0.0, 1.0, (s * sn) * cx + (s * c) * cy],
+        ]
+    )
 
 
 def _propagated_sigma(JtJ: FloatArray, Jp: FloatArray) -> float | None:
@@ -229,17 +240,37 @@ def refine(cand: Candidate, world_cam: Camera, ev: Evidence, settings: LocateSet
     least squares on the Mahalanobis residuals of every matched point plus the scale prior,
     and its covariance is propagated to the camera position.
     """
-    problem = _similarity_problem(cand, ev, settings)
-    if problem is None:
-        return cand
-    resid_jac, x0 = problem
-    x, J = gauss_newton(resid_jac, x0, sigma_tol=_SIGMA_TOL)
-    theta, tx, ty, ls = x
-    sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
-    return replace(
-        cand,
-        enu_from_world=sim,
-        camera=sim.camera(world_cam),
-        sigma_m=_position_sigma_m(J, sim, world_cam),
-        refined=True,
-    )
+    return refine_many([cand], world_cam, [ev], settings)[0]
+
+
+def refine_many(
+    cands: Sequence[Candidate],
+    world_cam: Camera,
+    evs: Sequence[Evidence],
+    settings: LocateSettings,
+) -> list[Candidate]:
+    """:func:`refine` of several candidates (each on its evidence): each its own fit, their
+    position sigmas in one batch (:func:`_propagated_sigmas`, the same bits)."""
+    out = list(cands)
+    fitted: list[tuple[int, Similarity2D]] = []
+    rows: list[tuple[int, FloatArray, FloatArray]] = []  # (index, JᵀJ, Jp)
+    Cw = world_cam.center_in_world[:2]
+    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        problem = _similarity_problem(cand, ev, settings)
+        if problem is None:
+            continue
+        resid_jac, x0 = problem
+        x, J = gauss_newton(resid_jac, x0, sigma_tol=_SIGMA_TOL)
+        theta, tx, ty, ls = x
+        sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
+        fitted.append((k, sim))
+        rows.append((k, J.T @ J, _position_jacobian(sim, Cw)))
+    for (k, sim), sigma in zip(fitted, _propagated_sigmas(rows), strict=True):
+        out[k] = replace(
+            cands[k],
+            enu_from_world=sim,
+            camera=sim.camera(world_cam),
+            sigma_m=sigma,
+            refined=True,
+        )
+    return out
