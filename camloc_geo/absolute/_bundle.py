@@ -371,7 +371,7 @@ def _position_sigmas(
     call and the position's finite differences in one evaluation (LAPACK per matrix; the
     position depends on the camera centre and the similarity only, elementwise): the same
     bits as one fit at a time."""
-    if len(results) < 2 or len({np.shape(r.jac) for r in results}) != 1:
+    if len(results) < 2 or len({np.shape(r.x) for r in results}) != 1:
         return [_position_sigma(r, state, n_cam) for r in results]
     s2s = []
     for res in results:

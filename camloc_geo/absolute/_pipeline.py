@@ -304,12 +304,13 @@ def _sigma_points(
     Rz[:2, :2] = sim.rotation
     # Similarity2D.camera's centre: scale · Rz · C + (T, 0); Rz · C is the same for all.
     scaled = sim.scale * Rz @ world_cam.center_in_world
-    out = []
-    for shift in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
-        T = np.asarray(sim.translation_m) + np.array(shift)
-        moved = Similarity2D(sim.rotation_rad, T, sim.scale)
-        out.append((scaled + np.array([T[0], T[1], 0.0]), moved))
-    return out
+    shifts = np.array([[step, 0.0], [-step, 0.0], [0.0, step], [0.0, -step]])
+    T = np.asarray(sim.translation_m) + shifts  # the four translations, row by row
+    centres = scaled + np.column_stack([T, np.zeros(4)])
+    return [
+        (centre, Similarity2D(sim.rotation_rad, t, sim.scale))
+        for centre, t in zip(centres, T, strict=True)
+    ]
 
 
 def _cues(cand: Candidate, ev: Evidence) -> tuple[float, list[Flag]]:

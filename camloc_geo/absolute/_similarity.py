@@ -102,8 +102,8 @@ class Similarity2D:
 
     def camera(self, camera_in_source: Camera) -> Camera:
         """A camera posed in the source frame, posed in the target frame (z kept, scaled)."""
-        Rz = np.eye(3)
-        Rz[:2, :2] = self.rotation
+        c, s = math.cos(self.rotation_rad), math.sin(self.rotation_rad)
+        Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])  # rot2 in the xy block
         R = camera_in_source.cam_from_world_rotation @ Rz.T
         T = self.translation_m
         C = self.scale * Rz @ camera_in_source.center_in_world + np.array([T[0], T[1], 0.0])
