@@ -42,16 +42,18 @@ _UNKNOWN = _Unknown()
 
 class _ObservationTable:
     """An evidence's observations stacked (the same on every placement): their rows by id,
-    world positions ``(n, 2)``, covariances ``(n, 2, 2)`` and map variances ``(n, 1, 1)``."""
+    world positions ``(n, 2)``, covariances ``(n, 2, 2)`` and map covariances
+    ``σ² I`` ``(n, 2, 2)``."""
 
-    __slots__ = ("cov_world", "map_var", "row", "world_xy")
+    __slots__ = ("cov_world", "map_cov", "row", "world_xy")
 
     def __init__(self, ev: Evidence) -> None:
         obs = ev.observations
         self.row = {id(o): i for i, o in enumerate(obs)}
         self.world_xy = np.array([o.world_xy for o in obs], dtype=np.float64).reshape(-1, 2)
         self.cov_world = np.array([o.cov_world for o in obs], dtype=np.float64).reshape(-1, 2, 2)
-        self.map_var = np.array([o.sigma_map_m**2 for o in obs], dtype=np.float64)[:, None, None]
+        map_var = np.array([o.sigma_map_m**2 for o in obs], dtype=np.float64)
+        self.map_cov = map_var[:, None, None] * np.eye(2)
 
 
 class _Placement:
@@ -83,7 +85,7 @@ class _Placement:
             R2 = sim.rotation
             s = sim.scale
             enu = s * table.world_xy @ R2.T + sim.translation_m
-            cov = (s**2) * (R2 @ table.cov_world @ R2.T) + table.map_var * np.eye(2)
+            cov = (s**2) * (R2 @ table.cov_world @ R2.T) + table.map_cov
             try:
                 prec = np.linalg.inv(cov)  # LAPACK per matrix
             except np.linalg.LinAlgError:  # the singular one raises where it is used
