@@ -286,13 +286,14 @@ def _bundle_many(
         # Jacobian as the joint fit's own (steps of 1e-7 relative), every problem in one
         # batch; the map rows likewise (steps of 1e-6), one batch whose first row per problem
         # is the residual itself.
-        h_ann = [1e-7 * np.maximum(1.0, np.abs(z[:n_cam])) for z in zs]
-        X = np.vstack(
-            [np.vstack([z[:n_cam], z[:n_cam] + np.diag(h)]) for z, h in zip(zs, h_ann, strict=True)]
-        )
+        zs_all = np.stack(zs)  # (k, n_z)
+        H_ann = 1e-7 * np.maximum(1.0, np.abs(zs_all[:, :n_cam]))
+        h_ann = list(H_ann)
+        X = _forward_rows(zs_all[:, :n_cam], H_ann)
         Rb = prob.residuals_batch(X, state.rotation0, state.principal_point, state.focal_px)
-        h_map = [1e-6 * np.maximum(1.0, np.abs(z)) for z in zs]
-        Z = np.vstack([np.vstack([z, z + np.diag(h)]) for z, h in zip(zs, h_map, strict=True)])
+        H_map = 1e-6 * np.maximum(1.0, np.abs(zs_all))
+        h_map = list(H_map)
+        Z = _forward_rows(zs_all, H_map)
         owner = np.repeat(np.asarray(ids, dtype=np.int64), n_z + 1)
         Mb_all = map_rows(Z, owner)
         out = []
@@ -324,6 +325,19 @@ def _bundle_many(
         _accept(p, res, r0, state, n_cam, sigma)
         for p, res, r0, sigma in zip(problems, results, starts, sigmas, strict=True)
     ]
+
+
+def _forward_rows(zs: FloatArray, hs: FloatArray) -> FloatArray:
+    """Each parameter vector ``zs[k]`` then it moved by ``hs[k, j]`` along each parameter
+    ``j``, stacked: ``(k (n + 1), n)``, the rows of ``np.vstack([z, z + np.diag(h)])`` per
+    vector (the same additions), built in three array operations."""
+    k, n = zs.shape
+    steps = np.zeros((k, n + 1, n))
+    idx = np.arange(n)
+    steps[:, idx + 1, idx] = hs
+    rows = zs[:, None, :] + steps
+    rows[:, 0, :] = zs  # the vector itself, untouched (as vstack's first row)
+    return np.asarray(rows.reshape(k * (n + 1), n), dtype=np.float64)
 
 
 def _accept(
