@@ -41,6 +41,11 @@ loading the map around one point of the Baltimore extract (subprocess, time and 
 Results go to ``benchmarks/out/absolute.json`` and ``benchmarks/out/absolute.png``::
 
     python benchmarks/absolute.py [--n 300] [--seed 0]
+
+``--timing-only`` runs the library timing alone (Baltimore's first eight oracle junctions,
+corners and two references, each ``--repeat`` times; wall and CPU medians) and writes
+``timing_only.json``: a few seconds, for comparing two trees run alternately in the same
+minutes on a shared machine, where the wall-clock median follows the load.
 """
 
 from __future__ import annotations
@@ -487,6 +492,7 @@ def time_library(maps: dict[str, MapData], seed: int, repeat: int) -> dict[str, 
     m = maps["baltimore.osm.pbf"]
     rng = np.random.default_rng(seed + 1)
     per: dict[str, list[float]] = {"locate": [], "calibrate_and_locate": []}
+    cpu: dict[str, list[float]] = {"locate": [], "calibrate_and_locate": []}
     for inter in _junctions(m)[:8]:
         ls = make_located_scene(m, inter, rng, min_corners=2, n_references=2)
         if ls is None:
@@ -495,16 +501,19 @@ def time_library(maps: dict[str, MapData], seed: int, repeat: int) -> dict[str, 
         cal = calibrate(scene)
         locate(scene, m, calibration=cal)  # warm the per-map indexes
         for _ in range(repeat):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             locate(scene, m, calibration=cal)
             per["locate"].append(time.perf_counter() - t0)
-            t0 = time.perf_counter()
+            cpu["locate"].append(time.process_time() - c0)
+            t0, c0 = time.perf_counter(), time.process_time()
             locate(scene, m)
             per["calibrate_and_locate"].append(time.perf_counter() - t0)
+            cpu["calibrate_and_locate"].append(time.process_time() - c0)
     return {
         k: {
             "ms_median": 1000 * float(np.median(v)),
             "ms_p90": 1000 * float(np.percentile(v, 90)),
+            "cpu_ms_median": 1000 * float(np.median(cpu[k])),
             "calls": len(v),
         }
         for k, v in per.items()
@@ -587,6 +596,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--repeat", type=int, default=5, help="repeats of each timing")
     ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument(
+        "--timing-only",
+        action="store_true",
+        help="only the library timing (locate with the map loaded, wall and CPU medians): "
+        "print it and write timing_only.json, for before/after runs interleaved in the "
+        "same minutes",
+    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
     logging.getLogger("camloc_geo").setLevel(logging.ERROR)  # per-annotator notes
@@ -594,6 +610,22 @@ def main(argv: list[str] | None = None) -> int:
         log.error("shared extracts not found at %s", OSM)
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
+    if args.timing_only:
+        name, lat, lon, r = PLACES[0]
+        lib = time_library(
+            {name: load_map(OSM / name, lat, lon, radius_m=r)}, args.seed, args.repeat
+        )
+        (args.out / "timing_only.json").write_text(json.dumps(lib, indent=1))
+        log.info(
+            "library locate %.2f ms median wall, %.2f ms CPU (with calibration %.2f / %.2f ms); "
+            "load average %s",
+            lib["locate"]["ms_median"],
+            lib["locate"]["cpu_ms_median"],
+            lib["calibrate_and_locate"]["ms_median"],
+            lib["calibrate_and_locate"]["cpu_ms_median"],
+            lib["load_average"],
+        )
+        return 0
     t_start = time.perf_counter()
     load_before = os.getloadavg()
     maps: dict[str, MapData] = {}
