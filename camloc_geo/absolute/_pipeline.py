@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from camloc_geo._ties import is_tie
+from camloc_geo._ties import TIE_MIN_SCORE, is_tie
 from camloc_geo.absolute._bundle import bundle_adjust_many
 from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
@@ -600,7 +600,10 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     positions = {id(c): c.east_north for c in cands}
     for c in cands:
         c.ambiguous_with = []
-    for a, b in itertools.combinations(cands, 2):
+    # A tie needs both scores at least TIE_MIN_SCORE (is_tie's rule): the pairs of the rest
+    # need no test.
+    contenders = [c for c in cands if c.score >= TIE_MIN_SCORE]
+    for a, b in itertools.combinations(contenders, 2):
         if _tie(a, b, settings, positions):
             a.ambiguous_with.append(b.rank)
             b.ambiguous_with.append(a.rank)
