@@ -1419,7 +1419,19 @@ def detect_vanishing_points(
             if math.isfinite(logf_std)
             else math.inf
         )
-        if shift > max(_FEW_LINES_MIN_SHIFT, _FEW_LINES_SHIFT_Z * shift_std):
+        if has_prior and shift > max(_FEW_LINES_MIN_SHIFT, _FEW_LINES_SHIFT_Z * shift_std):
+            # with a prior (EXIF) the focal length does not need it: it goes
+            U, _, Vt = np.linalg.svd(R)
+            best = _Model(R=U @ Vt, f_n=f, labels=labels, score=best.score, logf_std=logf_std)
+            log.debug(
+                "direction %d (%d lines) left out: it pulls the focal length from the prior "
+                "by %.3f (+/- %.3f)",
+                weak,
+                n_lines[weak],
+                shift,
+                shift_std,
+            )
+        elif shift > max(_FEW_LINES_MIN_SHIFT, _FEW_LINES_SHIFT_Z * shift_std):
             best.few_shift = min(shift, _MAX_STATED_STD)
             if not (math.isfinite(logf_std) and logf_std <= _LOOSE_FOCAL_STD):
                 best.rests_on_few = n_lines[weak]

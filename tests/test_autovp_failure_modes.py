@@ -336,3 +336,24 @@ def test_side_wall_off_square_with_few_lines_widens_the_focal_sigma(
     res_off = detect_vanishing_points(None, segments=segs, image_size=size)
     assert res_off.focal_px == pytest.approx(res.focal_px, rel=1e-6)
     assert res_off.focal_std_rel < res.focal_std_rel - 0.01
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_side_wall_of_few_lines_that_disagrees_with_the_exif_prior_is_left_out(
+    seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The same off-square side wall with an EXIF focal length (4 %): the wall pulls the
+    focal length 5-7 % away from the prior and the facade (as on a real Heidelberg castle
+    photo, -17 % with its EXIF kept); it is left out and the focal length stays within 1 %."""
+    segs, size = facade_segments(-20.0, n_side=9, side_skew_deg=5.0, facade_yaw_deg=10.0, seed=seed)
+    res = detect_vanishing_points(
+        None, segments=segs, image_size=size, focal_prior_px=800.0, focal_prior_sigma_rel=0.04
+    )
+    assert abs(math.log(res.focal_px / 800.0)) < 0.01
+    assert res.n_lines[2] == 0  # the side wall is out
+    assert res.focal_source == "prior-given"
+    monkeypatch.setattr(autovp, "_FEW_LINES", autovp._WEAK_LINES)  # the check off
+    res_off = detect_vanishing_points(
+        None, segments=segs, image_size=size, focal_prior_px=800.0, focal_prior_sigma_rel=0.04
+    )
+    assert abs(math.log(res_off.focal_px / 800.0)) > 0.04
