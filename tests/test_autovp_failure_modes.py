@@ -357,3 +357,24 @@ def test_side_wall_of_few_lines_that_disagrees_with_the_exif_prior_is_left_out(
         None, segments=segs, image_size=size, focal_prior_px=800.0, focal_prior_sigma_rel=0.04
     )
     assert abs(math.log(res_off.focal_px / 800.0)) > 0.04
+
+
+@pytest.mark.parametrize("pitch_deg", [-60.0, -65.0, -70.0, -75.0])
+def test_rendered_facade_looking_up_steeply_is_right_or_warned(pitch_deg: float) -> None:
+    """The facade drawn into an image (so the line detector runs too): looking up 60-65
+    degrees it is read right; at 70-75 it is read as looking down 18-14 degrees, and then
+    the warning names the looking-up reading and the confidence is below 0.2."""
+    cv2 = pytest.importorskip("cv2")
+    segs, (w, h) = facade_segments(pitch_deg, seed=0, noise_px=0.0)
+    img = np.full((h, w, 3), 235, np.uint8)
+    for x0, y0, x1, y1 in np.round(segs * 16).astype(int):
+        cv2.line(img, (x0, y0), (x1, y1), (40, 40, 40), 3, cv2.LINE_AA, shift=4)
+    res = detect_vanishing_points(img, seed=0)
+    if pitch_deg > -66.0:
+        assert res.pitch_deg == pytest.approx(pitch_deg, abs=1.0)
+        assert abs(res.focal_px / 800.0 - 1.0) < 0.03
+        return
+    assert res.pitch_deg == pytest.approx(90.0 + pitch_deg - 2.0, abs=2.0)  # 18 / 14 down
+    assert res.confidence < 0.2
+    said = [m for w in res.warnings for m in re.findall(r"or up (\d+) degrees", w)]
+    assert [float(x) for x in said] == [pytest.approx(-pitch_deg, abs=1.0)]
