@@ -73,7 +73,8 @@ row says so):
 - the share of photos with the pitch within 5 degrees, where the truth gives gravity,
   and the same figures for the outdoor photos looking up by more than 5 degrees (the
   Strecha photos: looking up 5 to 15 degrees; none of the sets looks up steeply, so the
-  steep case is checked on synthetic facades only, ``tests/test_autovp_failure_modes.py``).
+  steep case, 40-80 degrees, is checked on synthetic facades only, as segments and drawn
+  into images, ``tests/test_autovp_failure_modes.py``).
 
 Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 """
