@@ -251,6 +251,8 @@ LUND_SCENES = {
     6: "landhaus-graz",
     7: "heidelberg-castle",
 }
+#: Sets summarised by scene too (the second part of a photo's name).
+SCENE_SETS = ("lund",)
 #: Sensor widths (mm) of the Lund photos' cameras, EXIF ``Model`` -> width, from openMVG's
 #: CameraSensorSizeDatabase (``sensor_database.csv``: "Nikon D60,23.6", "Nikon Coolpix
 #: 4200,7.11").
@@ -511,7 +513,8 @@ def plots(runs: dict[str, list[dict[str, Any]]], out_dir: Path) -> None:
     ax.set_xlabel("horizon error / image height")
     ax.set_ylabel("share of photos")
     ax.set_title("Real photos: horizon error")
-    ax.legend()
+    if ax.get_legend_handles_labels()[0]:  # no set with horizon truth: no legend
+        ax.legend()
     fig.tight_layout()
     fig.savefig(out_dir / "vp_real_horizon.png", dpi=120)
     plt.close(fig)
@@ -596,6 +599,11 @@ def main(argv: list[str] | None = None) -> int:
         summary[tag] = {"all": summarise(rows)}
         for s in sorted({r["set"] for r in rows}):
             summary[tag][s] = summarise([r for r in rows if r["set"] == s])
+            if s in SCENE_SETS:  # and by scene ("lund/7-heidelberg-castle/...")
+                for scene in sorted({r["name"].split("/")[1] for r in rows if r["set"] == s}):
+                    summary[tag][f"{s} / {scene}"] = summarise(
+                        [r for r in rows if r["set"] == s and r["name"].split("/")[1] == scene]
+                    )
         outdoor = [r for r in rows if r["set"] != "yud"]
         if outdoor and len(outdoor) != len(rows):
             summary[tag]["outdoor (all but yud)"] = summarise(outdoor)
