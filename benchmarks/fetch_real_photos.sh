@@ -5,17 +5,38 @@
 #   openMVG/ImageDataset_SceauxCastle 11 photos of the Chateau de Sceaux, published K, EXIF kept
 #   rperrot/ReconstructionDataSet    about 530 outdoor photos of churches, doors and facades
 #                                    (Canon DSLR, EXIF kept: the focal length truth), a few GB
+#   erik-norlin/Structure-From-Motion the photo sets of Lund University's computer-vision course
+#                                    (Kronan, a courtyard, a cathedral gate, a fountain, the Landhaus
+#                                    in Graz, Heidelberg castle, ...; Nikon D60 and Coolpix 4200,
+#                                    EXIF kept), about 60 MB; no licence given, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
-# owner+name/repo, a bare git directory), else from GitHub.
-# A mirror that lacks the photo blobs (large files left out) is skipped for GitHub.
+# owner+name/repo, a bare git directory; default /work/.mirror when it exists), else from GitHub.
+# A mirror that lacks some blobs (large files left out) gives the photos it does hold (its JPEG
+# files are copied out one by one, blob by blob); with none of them, GitHub is tried.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
-mirror="${CAMLOC_MIRROR_DIR:-}"
-sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet}"
+default_mirror=""
+[ -d /work/.mirror ] && default_mirror=/work/.mirror
+mirror="${CAMLOC_MIRROR_DIR:-$default_mirror}"
+sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion}"
 mkdir -p "$dest"
+
+# copy_present_photos GIT_DIR DEST: the JPEG files (and small text files: calibrations, readmes)
+# of HEAD whose blobs the mirror holds; prints how many photos came.
+copy_present_photos() {
+  local git_dir="$1" out="$2" n=0 path
+  while IFS= read -r path; do
+    git --git-dir="$git_dir" cat-file -e "HEAD:$path" 2>/dev/null || continue
+    mkdir -p "$out/$(dirname "$path")"
+    git --git-dir="$git_dir" cat-file blob "HEAD:$path" >"$out/$path"
+    case "$path" in *.[jJ][pP][gG] | *.[jJ][pP][eE][gG]) n=$((n + 1)) ;; esac
+  done < <(git --git-dir="$git_dir" ls-tree -r --name-only HEAD \
+    | grep -iE '\.(jpe?g|txt|camera|md)$')
+  echo "$n"
+}
 for full in $sets; do
   name="${full#*/}"
   if [ -d "$dest/$name" ]; then
@@ -26,6 +47,15 @@ for full in $sets; do
   if [ -n "$mirror" ] && [ -d "$local_git" ] && git -C "$local_git" rev-parse -q --verify HEAD >/dev/null \
     && git --git-dir="$local_git" fsck --connectivity-only HEAD >/dev/null 2>&1; then
     git clone -q "$local_git" "$dest/$name" && echo "$name: cloned from $local_git" && continue
+  fi
+  if [ -n "$mirror" ] && [ -d "$local_git" ]; then
+    n=$(copy_present_photos "$local_git" "$dest/$name.part")
+    if [ "$n" -gt 0 ]; then
+      mv "$dest/$name.part" "$dest/$name"
+      echo "$name: $n photos copied from $local_git (the blobs it holds)"
+      continue
+    fi
+    rm -rf "${dest:?}/$name.part"
   fi
   git clone --depth 1 "https://github.com/$full" "$dest/$name" || {
     echo "$name: could not clone https://github.com/$full (no network?); skipped" >&2

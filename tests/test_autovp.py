@@ -398,7 +398,7 @@ def test_principal_point_refinement_moves_towards_truth() -> None:
     true_pp = np.array([w / 2 + 20.0, h / 2 - 15.0])
     # render with an off-centre principal point: shift the centred rendering
     img = render_scene(R, f, (w, h), n_lines=250, seed=7)
-    shift = np.float64([[1, 0, true_pp[0] - w / 2], [0, 1, true_pp[1] - h / 2]])
+    shift = np.array([[1, 0, true_pp[0] - w / 2], [0, 1, true_pp[1] - h / 2]], dtype=np.float64)
     img = cv2.warpAffine(img, shift, (w, h), borderValue=235)
     fixed = detect_vanishing_points(img, focal_px=f)
     free = detect_vanishing_points(img, focal_px=f, estimate_principal_point=True)
@@ -447,7 +447,7 @@ def project_segments(
     rng = np.random.default_rng(seed)
     w, h = size
     K = np.array([[f, 0, w / 2], [0, f, h / 2], [0, 0, 1.0]])
-    out = []
+    out: list[list[float]] = []
     while len(out) < n:
         depth = rng.uniform(8, 40)
         p = R[2] * depth + rng.uniform(-1, 1, 3) * depth * 0.6
@@ -642,3 +642,45 @@ def test_real_building_photo_focal_and_pitch(name: str) -> None:
     err = abs(math.log(res.focal_px / f_true))
     assert err < 0.10 or err < 2 * res.focal_std_rel
     assert abs(res.pitch_deg - pitch_true) < 2.0
+
+
+LUND = Path(os.environ.get("CAMLOC_LUND_DIR", str(PHOTOS / "Structure-From-Motion" / "data")))
+LUND_MISSING = (
+    "Lund course photos not found: run benchmarks/fetch_real_photos.sh, or git clone "
+    "https://github.com/erik-norlin/Structure-From-Motion and set CAMLOC_LUND_DIR to its data "
+    "folder"
+)
+#: Coolpix 4200 at 7.8 mm over its 7.11 mm sensor, times the long side (2272 px)
+LUND_HEIDELBERG_F_PX = 7.8 / 7.11 * 2272
+
+
+@pytest.mark.skipif(not (LUND / "7").exists(), reason=LUND_MISSING)
+def test_real_photo_gable_of_few_lines_is_in_the_sigma() -> None:
+    """Heidelberg castle's facade, looking up 21 degrees: a direction of 7 lines pulls the
+    focal length 10 % high. It stays there (the facade and the vertical fix it too), but the
+    stated sigma says so: within 1.5 sigmas (it was 3.0 sigmas, at a stated 3.3 %)."""
+    res = detect_vanishing_points(str(LUND / "7" / "DSCN7409.JPG"))
+    err = abs(math.log(res.focal_px / LUND_HEIDELBERG_F_PX))
+    assert 0.07 < err < 0.12
+    assert err < 1.5 * res.focal_std_rel
+    assert res.pitch_deg == pytest.approx(-21.0, abs=2.0)
+
+
+@pytest.mark.skipif(not (LUND / "7").exists(), reason=LUND_MISSING)
+def test_real_photo_direction_of_few_lines_against_the_exif_is_left_out() -> None:
+    """With its EXIF, a Heidelberg castle photo was pulled to -17 % by a direction of 6
+    lines (at a stated 5.5 %); that direction now goes and the EXIF holds."""
+    res = detect_vanishing_points(str(LUND / "7" / "DSCN7414.JPG"), use_exif=True)
+    assert res.focal_source == "exif-35mm"
+    assert abs(math.log(res.focal_px / LUND_HEIDELBERG_F_PX)) < 0.03
+
+
+@pytest.mark.skipif(not (LUND / "6").exists(), reason=LUND_MISSING)
+def test_real_photo_focal_resting_on_a_few_lines_is_warned() -> None:
+    """A statue niche of the Landhaus in Graz: the focal length rests on 8 lines that pull it
+    to -25 %; it was stated at 3.2 % with confidence 0.87 and no warning."""
+    res = detect_vanishing_points(str(LUND / "6" / "DSCN2117.JPG"))
+    assert any("rests on a direction of only 8 lines" in w for w in res.warnings)
+    assert res.confidence < 0.2
+    assert res.focal_std_rel > 0.3
+    assert res.focal_source == "estimated"

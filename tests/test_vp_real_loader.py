@@ -44,3 +44,37 @@ def test_exif_folder_truth_prefers_the_focal_plane_to_the_35mm_tag(tmp_path: Pat
     assert a["exif"] is True
     assert a["up"] is None
     assert a["size"] == (600, 400)
+
+
+def test_lund_truth_is_the_focal_length_over_the_sensor_width(tmp_path: Path) -> None:
+    # a Nikon D60 photo at 29 mm, stored landscape but turned by its EXIF orientation (8),
+    # and a Coolpix 4200 photo at 7.8 mm; scene 5 (indoors) and an unknown camera are left out
+    d60 = _jpeg(tmp_path / "2" / "DSC_0025.JPG", (300, 200), {0x920A: 29.0, 0xA405: 43})
+    with PIL_Image.open(d60) as im:
+        exif = im.getexif()
+        exif[0x0110] = "NIKON D60"
+        exif[0x0112] = 8
+        im.save(d60, exif=exif)
+    e4200 = _jpeg(tmp_path / "7" / "DSCN7409.JPG", (400, 300), {0x920A: 7.8})
+    with PIL_Image.open(e4200) as im:
+        exif = im.getexif()
+        exif[0x0110] = "E4200"
+        im.save(e4200, exif=exif)
+    _jpeg(tmp_path / "5" / "DSC_0336.JPG", (300, 200), {0x920A: 30.0})  # not an outdoor set
+    other = _jpeg(tmp_path / "3" / "DSC_0001.JPG", (300, 200), {0x920A: 30.0})
+    with PIL_Image.open(other) as im:
+        exif = im.getexif()
+        exif[0x0110] = "Some Phone"
+        im.save(other, exif=exif)
+    rows = vp_real.load_lund(tmp_path)
+    assert [r["name"] for r in rows] == [
+        "lund/2-courtyard/DSC_0025.JPG",
+        "lund/7-heidelberg-castle/DSCN7409.JPG",
+    ]
+    a, b = rows
+    assert a["f"] == pytest.approx(29.0 / 23.6 * 300)
+    assert a["size"] == (200, 300)  # as OpenCV decodes it: turned upright
+    assert a["pp"] == (100.0, 150.0)
+    assert b["f"] == pytest.approx(7.8 / 7.11 * 400)
+    assert b["exif"] is True
+    assert b["up"] is None
