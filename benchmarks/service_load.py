@@ -11,6 +11,11 @@ answers or parsed bodies can help. ``--check`` answers are compared with the lib
 ``locate_scene`` on the same extract (what ``camloc locate`` prints).
 
     python benchmarks/service_load.py --workers 2 --requests 600 --concurrency 8
+    python benchmarks/service_load.py --client raw --serve-args "--loop asyncio --http h11"
+
+The server's CPU per request is split between the serving process and the workers, and the
+load client's own CPU is quoted apart (``--client raw``: a minimal keep-alive client on
+asyncio streams, lighter than httpx on two shared cores).
 """
 
 from __future__ import annotations
@@ -84,8 +89,10 @@ def scene_bodies(n: int, seed: int = 0) -> list[bytes]:
 
 
 async def _load(
-    url: str, bodies: list[bytes], n: int, conc: int, max_s: float
+    url: str, bodies: list[bytes], n: int, conc: int, max_s: float, kind: str = "httpx"
 ) -> tuple[list[float], int, dict[int, Any]]:
+    if kind == "raw":
+        return await _load_raw(url, bodies, n, conc, max_s)
     lat: list[float] = []
     answers: dict[int, Any] = {}
     errors = 0
@@ -109,6 +116,62 @@ async def _load(
                     answers[k] = r.json()
 
         await asyncio.gather(*(one() for _ in range(conc)))
+    return lat, errors, answers
+
+
+async def _post_raw(
+    reader: asyncio.StreamReader, writer: asyncio.StreamWriter, head: bytes, body: bytes
+) -> tuple[int, bytes]:
+    """One keep-alive POST on an open connection: ``(status, body)`` (Content-Length only)."""
+    writer.write(head + str(len(body)).encode() + b"\r\n\r\n" + body)
+    status_line = await reader.readline()
+    status = int(status_line.split(b" ", 2)[1])
+    length = 0
+    while True:
+        line = await reader.readline()
+        if line in (b"\r\n", b"\n", b""):
+            break
+        name, _, value = line.partition(b":")
+        if name.strip().lower() == b"content-length":
+            length = int(value)
+    return status, await reader.readexactly(length)
+
+
+async def _load_raw(
+    url: str, bodies: list[bytes], n: int, conc: int, max_s: float, keep: int = 50
+) -> tuple[list[float], int, dict[int, Any]]:
+    """:func:`_load` with a minimal HTTP/1.1 client on asyncio streams (keep-alive, one
+    connection per concurrent client), so that on two shared cores the load client takes
+    less from the server it measures; only the first ``keep`` answers are parsed (to check)."""
+    host, port = url.rsplit("/", 1)[-1].split(":")
+    head = (
+        f"POST /v1/locate HTTP/1.1\r\nHost: {host}:{port}\r\n"
+        "Content-Type: application/json\r\nContent-Length: "
+    ).encode()
+    lat: list[float] = []
+    answers: dict[int, Any] = {}
+    errors = 0
+    sent = 0
+    t_end = time.perf_counter() + max_s
+
+    async def one() -> None:
+        nonlocal sent, errors
+        reader, writer = await asyncio.open_connection(host, int(port), limit=1 << 24)
+        try:
+            while sent < n and time.perf_counter() < t_end:
+                k = sent % len(bodies)
+                sent += 1
+                t0 = time.perf_counter()
+                status, data = await _post_raw(reader, writer, head, bodies[k])
+                lat.append(time.perf_counter() - t0)
+                if status != 200:
+                    errors += 1
+                elif k not in answers and len(answers) < keep:
+                    answers[k] = json.loads(data)
+        finally:
+            writer.close()
+
+    await asyncio.gather(*(one() for _ in range(conc)))
     return lat, errors, answers
 
 
@@ -152,6 +215,17 @@ def main() -> int:
     ap.add_argument("--max-seconds", type=float, default=60.0)
     ap.add_argument("--check", type=int, default=10, help="answers compared with the library")
     ap.add_argument("--label", default="", help="name of this run in the JSON (e.g. before)")
+    ap.add_argument(
+        "--client",
+        choices=("httpx", "raw"),
+        default="httpx",
+        help="load client: httpx, or a minimal keep-alive client on asyncio streams",
+    )
+    ap.add_argument(
+        "--serve-args",
+        default="",
+        help="more camloc serve options, e.g. '--loop asyncio --http h11' (the old stack)",
+    )
     args = ap.parse_args()
     OUT.mkdir(exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix="camloc-load-"))
@@ -172,6 +246,7 @@ def main() -> int:
             str(args.workers),
             "--log-level",
             "warning",
+            *args.serve_args.split(),
         ],
         env=env,
     )
@@ -193,11 +268,11 @@ def main() -> int:
             if warm_errors == 0:
                 break
         cpu0 = _server_cpu_s(proc.pid)
-        t0 = time.perf_counter()
+        t0, client0 = time.perf_counter(), time.process_time()
         lat, errors, answers = asyncio.run(
-            _load(url, bodies, args.requests, args.concurrency, args.max_seconds)
+            _load(url, bodies, args.requests, args.concurrency, args.max_seconds, args.client)
         )
-        wall = time.perf_counter() - t0
+        wall, client_cpu_s = time.perf_counter() - t0, time.process_time() - client0
         cpu1 = _server_cpu_s(proc.pid)
         per_process = {k: v - cpu0.get(k, 0.0) for k, v in cpu1.items()}
         server_cpu_s = sum(per_process.values())
@@ -218,6 +293,16 @@ def main() -> int:
         # CPU the server spent per request: robust to other load on the machine; the rate two
         # idle cores could serve is 2 / this
         "server_cpu_ms_per_request": round(server_cpu_s / max(len(lat), 1) * 1000.0, 1),
+        # of which the serving process (HTTP, routing, the pool's dispatch) and the workers
+        "serving_cpu_ms_per_request": round(
+            per_process.get(proc.pid, 0.0) / max(len(lat), 1) * 1000.0, 2
+        ),
+        "worker_cpu_ms_per_request": round(
+            (server_cpu_s - per_process.get(proc.pid, 0.0)) / max(len(lat), 1) * 1000.0, 2
+        ),
+        # the load client's own CPU (it shares the cores with the server)
+        "client": args.client,
+        "client_cpu_ms_per_request": round(client_cpu_s / max(len(lat), 1) * 1000.0, 2),
         "capacity_2_cores_per_s": round(2.0 / max(server_cpu_s / max(len(lat), 1), 1e-9), 1),
         "load_average_1min": round(os.getloadavg()[0], 2),
         # how the work fell on the processes (supervisor and workers), share of the CPU

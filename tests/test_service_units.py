@@ -4,8 +4,9 @@ the service calls (corner and street radius filters, crowd merge, job result sha
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
@@ -252,3 +253,43 @@ def test_raw_scene_is_the_scene_parsed_in_process() -> None:
 
     raw = json.dumps(SCENE).encode()
     assert scene_from_raw(raw, Settings()) == parse_scene(SCENE)
+
+
+def _serve_args(*argv: str) -> Any:
+    import argparse
+
+    from camloc_geo.cli import serve
+
+    parser = argparse.ArgumentParser()
+    serve.register(parser.add_subparsers())
+    return parser.parse_args(["serve", *argv])
+
+
+def test_serve_hands_its_loop_parser_and_access_log_to_uvicorn(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import uvicorn
+
+    from camloc_geo.cli import serve
+
+    seen: dict[str, Any] = {}
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: seen.update(kw, app=app))
+    monkeypatch.setenv("CAMLOC_WORKERS", "0")  # restored after the test (run sets it)
+    assert serve.run(_serve_args("--workers", "2")) == 0
+    assert (seen["loop"], seen["http"], seen["access_log"]) == ("auto", "auto", True)
+    assert os.environ["CAMLOC_WORKERS"] == "2"
+    args = _serve_args("--loop", "asyncio", "--http", "h11", "--no-access-log")
+    assert serve.run(args) == 0
+    assert (seen["loop"], seen["http"], seen["access_log"]) == ("asyncio", "h11", False)
+
+
+@pytest.mark.parametrize(("option", "module"), [("--loop", "uvloop"), ("--http", "httptools")])
+def test_serve_names_a_missing_speed_up(
+    monkeypatch: pytest.MonkeyPatch, option: str, module: str
+) -> None:
+    from camloc_geo._errors import InputError
+    from camloc_geo.cli import serve
+
+    monkeypatch.setattr(serve, "_importable", lambda name: name != module)
+    with pytest.raises(InputError, match=rf"{option} {module}: {module} is not installed"):
+        serve.run(_serve_args(option, module))

@@ -31,6 +31,24 @@ def register(subparsers: Any) -> None:
         ),
     )
     p.add_argument("--log-level", default="info", help="uvicorn log level")
+    p.add_argument(
+        "--loop",
+        choices=("auto", "asyncio", "uvloop"),
+        default="auto",
+        help="event loop (auto: uvloop when installed, from the service extra; else asyncio)",
+    )
+    p.add_argument(
+        "--http",
+        choices=("auto", "h11", "httptools"),
+        default="auto",
+        help="HTTP parser (auto: httptools when installed, from the service extra; else h11)",
+    )
+    p.add_argument(
+        "--no-access-log",
+        dest="access_log",
+        action="store_false",
+        help="no line per request on the log (the access log is on by default)",
+    )
     p.set_defaults(func=run)
 
 
@@ -48,6 +66,12 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--port must be 1-65535, not {args.port}")
     if args.workers < 1:
         raise InputError("--workers must be at least 1")
+    for option, module in (("loop", "uvloop"), ("http", "httptools")):
+        if getattr(args, option) == module and not _importable(module):
+            raise InputError(
+                f"--{option} {module}: {module} is not installed "
+                f'(python -m pip install "camloc-geo[service]")'
+            )
     import os
 
     from camloc_geo.service.settings import Settings
@@ -63,5 +87,14 @@ def run(args: argparse.Namespace) -> int:
         host=args.host,
         port=args.port,
         log_level=args.log_level,
+        loop=args.loop,
+        http=args.http,
+        access_log=args.access_log,
     )
     return 0
+
+
+def _importable(module: str) -> bool:
+    from importlib.util import find_spec
+
+    return find_spec(module) is not None
