@@ -43,9 +43,10 @@ the reported one (a cuboid is not a car: on two-box cars with ground clearance i
 it ends, so a long video holds only the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
-residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
-0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``; 0.6 m for
-a silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
+residuals); the contact's unknown height (a tyre on the road or the body's lower edge, up
+to 0.25 m up, not corrected: the root mean square of a height uniform over that range,
+0.144 m, over the camera's height ``H`` moves the speed by ``0.144 / H``; 0.6 m for a
+silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
 of the track's two halves in time beyond their noise (a contact that followed another
 vehicle through a merge, a corner sliding along the body); the
 calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
@@ -136,7 +137,8 @@ _SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and backgrou
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
 _CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
 _CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
-_CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
+_CLEARANCE_MAX_M = 0.25  # the lowest silhouette point: a tyre (0) up to a body's lower edge
+_CONTACT_HEIGHT_SIGMA_M = _CLEARANCE_MAX_M / math.sqrt(3.0)  # RMS of an uncorrected height
 _MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is a piece
 _PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
 
@@ -1068,9 +1070,11 @@ def _fit_track(
     sp = np.linalg.norm(draws, axis=1)
     sp = sp[np.isfinite(sp)]
     sigma_cal = float(np.std(sp, ddof=1)) if len(sp) >= 2 else 0.0
-    # the contact's height is unknown between the road (a tyre) and the body's lower edge:
-    # a point h up casts onto the ground H / (H - h) farther from the camera's foot, and so
-    # does its velocity (H: the camera's height)
+    # the contact's height is unknown between the road (a tyre) and the body's lower edge
+    # (0-0.25 m): a point h up casts onto the ground H / (H - h) farther from the camera's
+    # foot, and so does its velocity (H: the camera's height). Not corrected (a detected
+    # silhouette's lowest point is often its shadow on the road); its error is one-sided,
+    # and the term is its root mean square for a height uniform over the range
     height_m = max(1.0, float(cam.center_in_world[2]))
     sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
     # a silhouette lower than any vehicle standing on its contact is a piece of one (a
