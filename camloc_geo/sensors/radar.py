@@ -55,6 +55,8 @@ calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
 blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
+A measured speed whose ``sigma_kmh`` exceeds 5 % of it carries a ``warning`` naming the
+main cause (a track that held other vehicles, a piece of a vehicle, ...).
 """
 
 from __future__ import annotations
@@ -118,8 +120,9 @@ CSV_COLUMNS = (
     "heading_deg",
     "contact",
     "reason",
+    "warning",
 )
-"""Columns of :meth:`RadarResult.to_csv`, one row per vehicle."""
+"""Columns of :meth:`RadarResult.to_csv`, one row per vehicle (``warning`` added last)."""
 
 _SEED = 20261123
 _MAX_BLOBS = 64  # largest blobs kept per frame (bounds the work per frame)
@@ -141,6 +144,7 @@ _CLEARANCE_MAX_M = 0.25  # the lowest silhouette point: a tyre (0) up to a body'
 _CONTACT_HEIGHT_SIGMA_M = _CLEARANCE_MAX_M / math.sqrt(3.0)  # RMS of an uncorrected height
 _MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is a piece
 _PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
+_UNCERTAIN_REL = 0.05  # sigma_kmh above this fraction of the speed: a warning (2 sigma > 10 %)
 
 
 # --------------------------------------------------------------------------- results
@@ -213,6 +217,10 @@ class VehicleSpeed:
         Why the vehicle was skipped (None when measured).
     track_world_m
         ``(frame, x, y)`` of the ground contact in each frame used (metres, world frame).
+    warning
+        Set when the speed is uncertain: ``sigma_kmh`` above 5 % of the speed (2 sigma
+        above 10 %), with its main cause (e.g. a track that held other vehicles). The
+        speed is still given; do not use it as a measurement of record.
     """
 
     vehicle_id: int
@@ -229,6 +237,7 @@ class VehicleSpeed:
     n_segments: int = 0
     reason: str | None = None
     track_world_m: list[tuple[int, float, float]] = field(default_factory=list)
+    warning: str | None = None
 
     @property
     def measured(self) -> bool:
@@ -251,6 +260,7 @@ class VehicleSpeed:
             "contact": self.contact,
             "n_segments": self.n_segments,
             "reason": self.reason,
+            "warning": self.warning,
         }
         if track:
             out["track_world_m"] = [[f, round(x, 4), round(y, 4)] for f, x, y in self.track_world_m]
@@ -1118,6 +1128,16 @@ def _fit_track(
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
     world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
+    warning = _uncertainty_warning(
+        speed,
+        {
+            "fit": sigma_fit,
+            "calibration": sigma_cal,
+            "model": sigma_model,
+            "contact": sigma_contact,
+        },
+        tall_m < _MIN_VEHICLE_HEIGHT_M,
+    )
     return VehicleSpeed(
         t.vid,
         "measured",
@@ -1133,7 +1153,32 @@ def _fit_track(
         len(set(labels)),
         None,
         world,
+        warning,
     )
+
+
+_CAUSES = {
+    "fit": "its ground contact is noisy or seen over too short a time",
+    "calibration": "the camera's calibration is uncertain",
+    "model": "its track is inconsistent (it held other vehicles in merged blobs, or its "
+    "contact slid along the body)",
+    "contact": "its ground contact's height is unknown",
+}
+
+
+def _uncertainty_warning(speed: float, parts: dict[str, float], piece: bool) -> str | None:
+    """A warning when the speed's sigma exceeds ``_UNCERTAIN_REL`` of it, naming the main
+    cause (the largest term of ``parts``, m/s); None otherwise."""
+    sigma = math.sqrt(sum(v**2 for v in parts.values()))
+    if speed <= 0 or sigma <= _UNCERTAIN_REL * speed:
+        return None
+    main = max(parts, key=lambda k: parts[k])
+    cause = (
+        "only a piece of the vehicle was seen (its contact may be the body's top edge)"
+        if main == "contact" and piece
+        else _CAUSES[main]
+    )
+    return f"uncertain speed: sigma {100 * sigma / speed:.0f} % of it; {cause}"
 
 
 def _apparent_height_m(
@@ -1525,13 +1570,15 @@ def _run(
                 box = current[k]
                 if k in shifts:  # the features' motion: robust to a blob that merges or splits
                     t.velocity = shifts[k]
-                elif t.frames:
+                elif t.frames and not _resized(t.boxes[-1], box):
                     gap = max(1, i - t.frames[-1])
                     last = t.boxes[-1]
                     t.velocity = (
                         ((box[0] + box[2]) - (last[0] + last[2])) / 2 / gap,
                         ((box[1] + box[3]) - (last[1] + last[3])) / 2 / gap,
                     )
+                # (a box that changed size, a merged blob that split or a blob that merged,
+                # moved its centre by more than the vehicle did: the motion is kept)
                 t.box = box
                 t.missed = 0
                 c, kind = _contact(fg, box, scale, labels, own.get(k))
@@ -1677,6 +1724,12 @@ def _shadows(frame: Any, background: Any) -> Any:
     textured = var_b > _TEXTURE_MIN**2
     hidden = (textured & (ncc < _SHADOW_NCC)).astype(np.uint8) * 255
     return cv2.bitwise_and(shadow, cv2.bitwise_not(hidden))
+
+
+def _resized(a: Box, b: Box) -> bool:
+    """True when box ``b`` differs from ``a`` in width or height by more than 20 % + 2 px."""
+    wa, ha, wb, hb = a[2] - a[0], a[3] - a[1], b[2] - b[0], b[3] - b[1]
+    return abs(wb - wa) > 0.2 * wa + 2.0 or abs(hb - ha) > 0.2 * ha + 2.0
 
 
 def _centre(box: Box) -> tuple[float, float]:
