@@ -4,7 +4,10 @@
   a neighbour is not;
 - a track that comes out of a merge on a vehicle driving the other way is cut there;
 - the model term of ``sigma_kmh``: a track whose halves disagree beyond their noise;
-- a silhouette too low for a vehicle standing on its contact is recognised as a piece.
+- a silhouette too low for a vehicle standing on its contact is recognised as a piece;
+- a box that changes size (a merged blob splitting) is recognised, its centre's jump is no
+  motion;
+- an uncertain speed (sigma above 5 % of it) carries a warning naming its main cause.
 """
 
 from __future__ import annotations
@@ -19,7 +22,9 @@ from camloc_geo.sensors.radar import (
     _halves_disagreement,
     _identity_switches,
     _join_fragments,
+    _resized,
     _Track,
+    _uncertainty_warning,
 )
 
 
@@ -112,3 +117,24 @@ def test_apparent_height_tells_a_piece() -> None:
     piece = whole.copy()
     piece[:, 1] = mids[:, 1]
     assert abs(_apparent_height_m(cam, ground, contacts, piece) - 0.6) < 0.05
+
+
+def test_resized_box() -> None:
+    car = (100.0, 50.0, 140.0, 80.0)
+    assert not _resized(car, (103.0, 51.0, 144.0, 82.0))  # moved, a little nearer
+    assert _resized((60.0, 50.0, 140.0, 80.0), car)  # a merged neighbour split off
+    assert _resized(car, (100.0, 40.0, 140.0, 80.0))  # taller by a third
+
+
+def test_uncertainty_warning_names_the_cause() -> None:
+    parts = {"fit": 0.1, "calibration": 0.1, "model": 0.2, "contact": 0.2}
+    assert _uncertainty_warning(15.0, parts, False) is None  # sigma 2.2 %
+    merged = {**parts, "model": 1.5}
+    text = _uncertainty_warning(15.0, merged, False)
+    assert text is not None
+    assert "sigma 10 %" in text
+    assert "merged" in text
+    piece = {**parts, "contact": 1.2}
+    text = _uncertainty_warning(15.0, piece, True)
+    assert text is not None
+    assert "piece" in text

@@ -43,9 +43,10 @@ the reported one (a cuboid is not a car: on two-box cars with ground clearance i
 it ends, so a long video holds only the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
-residuals); the contact's unknown height (a tyre on the road or the body's lower edge:
-0.08 m, 1 sigma, over the camera's height ``H`` moves the speed by ``0.08 / H``; 0.6 m for
-a silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
+residuals); the contact's unknown height (a tyre on the road or the body's lower edge, up
+to 0.25 m up, not corrected: the root mean square of a height uniform over that range,
+0.144 m, over the camera's height ``H`` moves the speed by ``0.144 / H``; 0.6 m for a
+silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
 of the track's two halves in time beyond their noise (a contact that followed another
 vehicle through a merge, a corner sliding along the body); the
 calibration's part: the contact pixels are recast and refitted with ``n_samples`` cameras
@@ -54,6 +55,8 @@ calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
 blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
+A measured speed whose ``sigma_kmh`` exceeds 5 % of it carries a ``warning`` naming the
+main cause (a track that held other vehicles, a piece of a vehicle, ...).
 """
 
 from __future__ import annotations
@@ -117,8 +120,9 @@ CSV_COLUMNS = (
     "heading_deg",
     "contact",
     "reason",
+    "warning",
 )
-"""Columns of :meth:`RadarResult.to_csv`, one row per vehicle."""
+"""Columns of :meth:`RadarResult.to_csv`, one row per vehicle (``warning`` added last)."""
 
 _SEED = 20261123
 _MAX_BLOBS = 64  # largest blobs kept per frame (bounds the work per frame)
@@ -136,9 +140,11 @@ _SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and backgrou
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
 _CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
 _CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
-_CONTACT_HEIGHT_SIGMA_M = 0.08  # the lowest silhouette point: a tyre (0) or a body's edge
+_CLEARANCE_MAX_M = 0.25  # the lowest silhouette point: a tyre (0) up to a body's lower edge
+_CONTACT_HEIGHT_SIGMA_M = _CLEARANCE_MAX_M / math.sqrt(3.0)  # RMS of an uncorrected height
 _MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is a piece
 _PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
+_UNCERTAIN_REL = 0.05  # sigma_kmh above this fraction of the speed: a warning (2 sigma > 10 %)
 
 
 # --------------------------------------------------------------------------- results
@@ -211,6 +217,10 @@ class VehicleSpeed:
         Why the vehicle was skipped (None when measured).
     track_world_m
         ``(frame, x, y)`` of the ground contact in each frame used (metres, world frame).
+    warning
+        Set when the speed is uncertain: ``sigma_kmh`` above 5 % of the speed (2 sigma
+        above 10 %), with its main cause (e.g. a track that held other vehicles). The
+        speed is still given; do not use it as a measurement of record.
     """
 
     vehicle_id: int
@@ -227,6 +237,7 @@ class VehicleSpeed:
     n_segments: int = 0
     reason: str | None = None
     track_world_m: list[tuple[int, float, float]] = field(default_factory=list)
+    warning: str | None = None
 
     @property
     def measured(self) -> bool:
@@ -249,6 +260,7 @@ class VehicleSpeed:
             "contact": self.contact,
             "n_segments": self.n_segments,
             "reason": self.reason,
+            "warning": self.warning,
         }
         if track:
             out["track_world_m"] = [[f, round(x, 4), round(y, 4)] for f, x, y in self.track_world_m]
@@ -1068,9 +1080,11 @@ def _fit_track(
     sp = np.linalg.norm(draws, axis=1)
     sp = sp[np.isfinite(sp)]
     sigma_cal = float(np.std(sp, ddof=1)) if len(sp) >= 2 else 0.0
-    # the contact's height is unknown between the road (a tyre) and the body's lower edge:
-    # a point h up casts onto the ground H / (H - h) farther from the camera's foot, and so
-    # does its velocity (H: the camera's height)
+    # the contact's height is unknown between the road (a tyre) and the body's lower edge
+    # (0-0.25 m): a point h up casts onto the ground H / (H - h) farther from the camera's
+    # foot, and so does its velocity (H: the camera's height). Not corrected (a detected
+    # silhouette's lowest point is often its shadow on the road); its error is one-sided,
+    # and the term is its root mean square for a height uniform over the range
     height_m = max(1.0, float(cam.center_in_world[2]))
     sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
     # a silhouette lower than any vehicle standing on its contact is a piece of one (a
@@ -1114,6 +1128,16 @@ def _fit_track(
     heading = math.degrees(math.atan2(vel[0], vel[1])) % 360.0
     heading = 0.0 if heading >= 359.99995 else heading
     world = [(int(f), float(x), float(y)) for f, (x, y) in zip(frames, ground[0], strict=True)]
+    warning = _uncertainty_warning(
+        speed,
+        {
+            "fit": sigma_fit,
+            "calibration": sigma_cal,
+            "model": sigma_model,
+            "contact": sigma_contact,
+        },
+        tall_m < _MIN_VEHICLE_HEIGHT_M,
+    )
     return VehicleSpeed(
         t.vid,
         "measured",
@@ -1129,7 +1153,32 @@ def _fit_track(
         len(set(labels)),
         None,
         world,
+        warning,
     )
+
+
+_CAUSES = {
+    "fit": "its ground contact is noisy or seen over too short a time",
+    "calibration": "the camera's calibration is uncertain",
+    "model": "its track is inconsistent (it held other vehicles in merged blobs, or its "
+    "contact slid along the body)",
+    "contact": "its ground contact's height is unknown",
+}
+
+
+def _uncertainty_warning(speed: float, parts: dict[str, float], piece: bool) -> str | None:
+    """A warning when the speed's sigma exceeds ``_UNCERTAIN_REL`` of it, naming the main
+    cause (the largest term of ``parts``, m/s); None otherwise."""
+    sigma = math.sqrt(sum(v**2 for v in parts.values()))
+    if speed <= 0 or sigma <= _UNCERTAIN_REL * speed:
+        return None
+    main = max(parts, key=lambda k: parts[k])
+    cause = (
+        "only a piece of the vehicle was seen (its contact may be the body's top edge)"
+        if main == "contact" and piece
+        else _CAUSES[main]
+    )
+    return f"uncertain speed: sigma {100 * sigma / speed:.0f} % of it; {cause}"
 
 
 def _apparent_height_m(
@@ -1521,13 +1570,15 @@ def _run(
                 box = current[k]
                 if k in shifts:  # the features' motion: robust to a blob that merges or splits
                     t.velocity = shifts[k]
-                elif t.frames:
+                elif t.frames and not _resized(t.boxes[-1], box):
                     gap = max(1, i - t.frames[-1])
                     last = t.boxes[-1]
                     t.velocity = (
                         ((box[0] + box[2]) - (last[0] + last[2])) / 2 / gap,
                         ((box[1] + box[3]) - (last[1] + last[3])) / 2 / gap,
                     )
+                # (a box that changed size, a merged blob that split or a blob that merged,
+                # moved its centre by more than the vehicle did: the motion is kept)
                 t.box = box
                 t.missed = 0
                 c, kind = _contact(fg, box, scale, labels, own.get(k))
@@ -1673,6 +1724,12 @@ def _shadows(frame: Any, background: Any) -> Any:
     textured = var_b > _TEXTURE_MIN**2
     hidden = (textured & (ncc < _SHADOW_NCC)).astype(np.uint8) * 255
     return cv2.bitwise_and(shadow, cv2.bitwise_not(hidden))
+
+
+def _resized(a: Box, b: Box) -> bool:
+    """True when box ``b`` differs from ``a`` in width or height by more than 20 % + 2 px."""
+    wa, ha, wb, hb = a[2] - a[0], a[3] - a[1], b[2] - b[0], b[3] - b[1]
+    return abs(wb - wa) > 0.2 * wa + 2.0 or abs(hb - ha) > 0.2 * ha + 2.0
 
 
 def _centre(box: Box) -> tuple[float, float]:
