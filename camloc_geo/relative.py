@@ -787,18 +787,17 @@ class _JointProblem:
         self.sigma_line = settings.sigma_line_rel * diag
         seg_rows, seg_axis, seg_ann = [], [], []
         pt_world, pt_pix, pt_ann = [], [], []
+        worlds = {ws: _object_points(size, ws) for ws in set(width_signs)}
         for slot, (i, segs, ws) in enumerate(zip(indices, segments, width_signs, strict=True)):
-            ann = scene.annotations[i]
+            axes = scene.annotations[i].axes
             for axis in AXES:
                 s = segs[axis]
                 seg_rows.append(s)
                 seg_axis += [_AXIS_INDEX[axis]] * len(s)
                 seg_ann += [slot] * len(s)
-            world = _object_points(size, ws)
-            for j, name in enumerate(("origin", "length", "width", "height")):
-                pt_world.append(world[j])
-                pt_pix.append(getattr(ann.axes, name))
-                pt_ann.append(slot)
+            pt_world.append(worlds[ws])
+            pt_pix += [axes.origin, axes.length, axes.width, axes.height]
+            pt_ann += [slot] * 4
         self.size = size
         self.ws_common = 1.0 if sum(width_signs) >= 0 else -1.0
         # _corner_points of each corner (4, 4, 3), for set_corners and best_corners
@@ -807,17 +806,17 @@ class _JointProblem:
         self.segments = np.vstack(seg_rows)
         self.seg_axis = np.asarray(seg_axis)
         self.seg_ann = np.asarray(seg_ann)
-        self.pt_world = np.asarray(pt_world, float)
+        self.pt_world = np.vstack(pt_world)
         self.pt_pix = np.asarray(pt_pix, float)
         self.pt_ann = np.asarray(pt_ann)
         # An edge end's pixel is uncertain by the click noise and, along the edge, by the
         # object's size uncertainty (a preset's 5 % of the edge's length in pixels).
-        edge_px = np.zeros(len(self.pt_pix))
-        for j in range(0, len(self.pt_pix), 4):
-            edge_px[j + 1 : j + 4] = np.linalg.norm(
-                self.pt_pix[j + 1 : j + 4] - self.pt_pix[j], axis=1
-            )
-        self._sigma_pt_each = np.sqrt(self.sigma_pt**2 + (size_sigma_rel * edge_px) ** 2)
+        clicks = self.pt_pix.reshape(-1, 4, 2)
+        edge_px = np.zeros((len(clicks), 4))
+        edge_px[:, 1:] = np.linalg.norm(clicks[:, 1:] - clicks[:, :1], axis=2)
+        self._sigma_pt_each = np.sqrt(
+            self.sigma_pt**2 + (size_sigma_rel * edge_px.reshape(-1)) ** 2
+        )
         self.ground_corner_sigma_rel = settings.ground_corner_sigma_rel
         self.n_annotators = len(indices)
         self._z_min = 0.05
@@ -827,6 +826,8 @@ class _JointProblem:
         # segment_residuals_px's numerator is V · n for a vanishing point V = (x, y, w).
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self._seg_nT = np.ascontiguousarray(self._seg_n.T)
+        self._mid_x, self._mid_y = self._mid[:, 0].copy(), self._mid[:, 1].copy()
         # Segments detected in the scene's photo (set_photo_segments): their rows follow the
         # clicks' (owned by no annotator, like the priors), with their own fixed sigma.
         self._seg_axis_all = self.seg_axis
@@ -920,6 +921,8 @@ class _JointProblem:
         self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self._seg_nT = np.ascontiguousarray(self._seg_n.T)
+        self._mid_x, self._mid_y = self._mid[:, 0].copy(), self._mid[:, 1].copy()
         self.weights = self._weights  # the scales of all segment rows
         self._memo.clear()
 
@@ -1081,6 +1084,13 @@ class _JointProblem:
             X, R0, pp_fixed, f_fixed, self._seg_scale, self._pt_scale
         )
 
+    @staticmethod
+    def _f_rows(f: FloatArray) -> FloatArray:
+        """``(P, 3, 1)``: ``f``, ``f``, 1 per row of ``R`` (the diagonal of ``K``)."""
+        out = np.ones((len(f), 3, 1))
+        out[:, :2, 0] = f[:, None]
+        return out
+
     def _residuals_batch_scaled(
         self,
         X: FloatArray,
@@ -1093,29 +1103,26 @@ class _JointProblem:
         """:meth:`residuals_batch` with the rows scaled by ``seg_scale`` (every segment's,
         the photo's after the annotations') and ``pt_scale`` (every click's)."""
         f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
-        cx, cy = pp[:, 0:1], pp[:, 1:2]
-        fc = f[:, None]
-        # Vanishing point of world axis i: K R e_i, i.e. column i of K R: V[p, i] = (x, y, w).
-        V = np.empty((len(X), 3, 3))
-        V[:, :, 0] = fc * R[:, 0, :] + cx * R[:, 2, :]
-        V[:, :, 1] = fc * R[:, 1, :] + cy * R[:, 2, :]
-        V[:, :, 2] = R[:, 2, :]
-        Vs = V[:, self._seg_axis_all, :]  # (P, n_seg + n_photo, 3)
-        px, py, pw = Vs[..., 0], Vs[..., 1], Vs[..., 2]
-        mx, my = self._mid[:, 0], self._mid[:, 1]
+        # Vanishing point of world axis i: K R e_i, column i of KR = [f R₀ + cx R₂; f R₁ + cy R₂;
+        # R₂] (rows of R); each segment takes its axis' column: KRs (P, 3, n_seg + n_photo).
+        KR = R * self._f_rows(f)
+        KR[:, :2, :] += pp[:, :, None] * R[:, 2:3, :]
+        KRs = KR[:, :, self._seg_axis_all]
+        px, py, pw = KRs[:, 0], KRs[:, 1], KRs[:, 2]
         # Line through the midpoint (mx, my, 1) and the vanishing point; the first endpoint's
         # distance from it: its numerator is linear in the point, V · n (n precomputed).
-        la = my * pw - py
-        lb = px - mx * pw
-        norm = np.sqrt(la * la + lb * lb)
-        num = np.einsum("psk,sk->ps", Vs, self._seg_n)
+        num = px * self._seg_nT[0] + py * self._seg_nT[1] + pw * self._seg_nT[2]
+        norm = np.hypot(self._mid_y * pw - py, px - self._mid_x * pw)
         r_all = num / np.maximum(norm, 1e-300) * seg_scale
         n_seg = len(self.segments)
         r_seg = r_all[:, :n_seg]
         pc = (self.pt_world[None, :, :] - C[:, None, :]) @ np.swapaxes(R, 1, 2)
-        z = np.maximum(pc[:, :, 2], self._z_min)
-        u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * pt_scale
-        v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * pt_scale
+        z = np.maximum(pc[:, :, 2:3], self._z_min)
+        # u and v at once: (P, n_pt, 2)
+        uv = (pc[:, :, :2] / z * f[:, None, None] + (pp[:, None, :] - self.pt_pix)) * pt_scale[
+            :, None
+        ]
+        u, v = uv[:, :, 0], uv[:, :, 1]
         parts = [r_seg, u, v]
         if len(self.photo_segments):
             parts.append(r_all[:, n_seg:])
@@ -1282,9 +1289,14 @@ def _fit(
     """
     from camloc_geo._optimize import soft_l1_least_squares
 
+    lo, hi = prob.log_f_bounds
+
     def clamp_focal(x: FloatArray) -> FloatArray:
+        v = float(x[0])
+        if lo <= v <= hi:
+            return x  # the usual case: no copy (the solver never changes x in place)
         x = x.copy()
-        x[0] = float(np.clip(x[0], *prob.log_f_bounds))
+        x[0] = min(max(v, lo), hi)
         return x
 
     return soft_l1_least_squares(
@@ -2594,12 +2606,18 @@ def _calibrate_usable(scene: Scene, settings: CalibrationSettings) -> Calibratio
         return cluster_result()
 
 
-def _width_sign_for(scene: Scene, index: int, camera: Camera) -> float:
-    ann = scene.annotations[index]
-    R = camera.cam_from_world_rotation
-    m0 = camera.cam_from_img @ np.array([*ann.axes.origin, 1.0])
-    s = direction_sign(R[:, 1], m0, np.asarray(ann.axes.width, float) - np.asarray(ann.axes.origin))
-    return s or 1.0
+def _width_signs_for(scene: Scene, indices: list[int], camera: Camera) -> list[float]:
+    """Each annotator's width sign under ``camera``: the sign of the camera's world y axis
+    that moves their origin click toward their width click (1 where ambiguous)."""
+    y_axis = camera.cam_from_world_rotation[:, 1]
+    cam_from_img = camera.cam_from_img
+    out = []
+    for i in indices:
+        axes = scene.annotations[i].axes
+        m0 = cam_from_img @ np.array([*axes.origin, 1.0])
+        step = np.asarray(axes.width, float) - np.asarray(axes.origin)
+        out.append(direction_sign(y_axis, m0, step) or 1.0)
+    return out
 
 
 def _robust_vp(segments: FloatArray, diag: float, name: str) -> VanishingPoint:
@@ -2862,7 +2880,7 @@ def _joint(
         cam0 = seed_or_maker() if callable(seed_or_maker) else seed_or_maker
         if cam0 is None:
             continue
-        width_signs = [_width_sign_for(scene, i, cam0) for i in indices]
+        width_signs = _width_signs_for(scene, indices, cam0)
         prob = _JointProblem(
             scene,
             segs,
