@@ -761,7 +761,8 @@ def _ground_corner_evidence(prob: _JointProblem, r: FloatArray) -> float:
     edge_sq = np.sum((clicks[:, 1] - clicks[:, 0]) ** 2, axis=1) + np.sum(
         (clicks[:, 2] - clicks[:, 0]) ** 2, axis=1
     )  # per annotator: |length edge|² + |width edge|², pixels²
-    term_var = prob.ground_corner_sigma_rel**2 * float(np.average(edge_sq, weights=a_pt[::4])) / 2.0
+    a_ann = a_pt[::4]  # per annotator: the weighted mean of edge_sq (np.average's arithmetic)
+    term_var = prob.ground_corner_sigma_rel**2 * float((edge_sq * a_ann).sum() / a_ann.sum()) / 2.0
     if term_var <= 0.0:
         return 1.0
     excess = max(click_var - line_end_var, 0.0)
@@ -1283,11 +1284,12 @@ def _fit(
     method: Literal["lm", "scipy"] = "lm",
     sigma_tol: float | None = _SIGMA_TOL,
 ) -> LeastSquaresResult:
-    """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`.
+    """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`
+    (``method="lm"``: its loop's steps by ``soft_l1_least_squares_small``).
 
     The focal length is clamped to plausible fields of view inside the parameterisation.
     """
-    from camloc_geo._optimize import soft_l1_least_squares
+    from camloc_geo._optimize import soft_l1_least_squares, soft_l1_least_squares_small
 
     lo, hi = prob.log_f_bounds
 
@@ -1299,19 +1301,31 @@ def _fit(
         x[0] = min(max(v, lo), hi)
         return x
 
+    project = clamp_focal if f_fixed is None else None
+    # Every fit starts near its minimum (a closed-form seed, or the previous fit): a light
+    # initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations, the
+    # reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
+    if method == "lm":  # the same steps as soft_l1_least_squares's loop, cheaper a step
+        return soft_l1_least_squares_small(
+            lambda x: prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed),
+            x0,
+            f_scale=_F_SCALE,
+            project=project,
+            tol=tol,
+            max_nfev=max_nfev,
+            damping=1e-4,
+            sigma_tol=sigma_tol,
+        )
     return soft_l1_least_squares(
         lambda x: prob.residuals(x, R0, pp_fixed, f_fixed),
         lambda x: prob.jacobian(x, R0, pp_fixed, f_fixed),
         x0,
         f_scale=_F_SCALE,
-        project=clamp_focal if f_fixed is None else None,
+        project=project,
         method=method,
         tol=tol,
         max_nfev=max_nfev,
         fun_and_jac=lambda x: prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed),
-        # Every fit starts near its minimum (a closed-form seed, or the previous fit): a
-        # light initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations,
-        # the reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
         damping=1e-4,
         sigma_tol=sigma_tol,
     )
@@ -1332,7 +1346,7 @@ def _score_test(
     """
     # The parameters with the principal point inserted, as _pinned_pp_sensitivity builds
     # them (the same evaluation serves both).
-    x1 = np.insert(np.asarray(x_fixed, dtype=float), int(f_fixed is None), pp_fixed)
+    x1 = _with_pp(x_fixed, int(f_fixed is None), pp_fixed)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
@@ -1343,6 +1357,12 @@ def _score_test(
         return float(g @ _sym_inverse(Jw.T @ Jw) @ g)
     except np.linalg.LinAlgError:
         return 0.0
+
+
+def _with_pp(x: npt.ArrayLike, k: int, pp: npt.ArrayLike) -> FloatArray:
+    """``x`` with the principal point's two entries inserted at ``k`` (``np.insert``)."""
+    x = np.asarray(x, dtype=float)
+    return np.concatenate([x[:k], np.asarray(pp, dtype=float).reshape(2), x[k:]])
 
 
 def _sym_inverse(A: FloatArray) -> FloatArray:
@@ -3118,7 +3138,7 @@ def _pinned_pp_sensitivity(
     ``cov(θ, δ) = σ² S``. None when the Hessian is singular.
     """
     k = int(f_fixed is None)
-    x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
+    x1 = _with_pp(x, k, pp)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     if prob.pp_prior_sigma > 0.0:
         # the data's information alone (the prior's two rows come last); the prior is σ here
@@ -3179,15 +3199,16 @@ def _output_covariance(
     z_of_x = ([0] if f_fixed is None else []) + ([1, 2] if pp_model is None else [])
     z_of_x += [3, 4, 5, 6, 7, 8]
     A = np.zeros((9, 9))
-    A[np.ix_(z_of_x, z_of_x)] = cov
+    block = np.ix_(z_of_x, z_of_x)
+    A[block] = cov
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
-        A[np.ix_(z_of_x, z_of_x)] += D @ D.T
+        A[block] += D @ D.T
     if pp_model is not None and sigma_pp_px > 0.0:
         S = _pinned_pp_sensitivity(prob, x, R0, pp_model, f_fixed)
         if S is not None:
             s2_pp = sigma_pp_px**2
-            A[np.ix_(z_of_x, z_of_x)] += s2_pp * (S @ S.T)
+            A[block] += s2_pp * (S @ S.T)
             A[np.ix_(z_of_x, [1, 2])] = s2_pp * S
             A[np.ix_([1, 2], z_of_x)] = s2_pp * S.T
             A[1, 1] = A[2, 2] = s2_pp
