@@ -8,6 +8,10 @@ drawing one or two of the street's painted lane lines,
 not depend on the frames). The sets per seed:
 
 - ``traffic``: that scene, the annotators' noise drawn as ``render_street`` draws it;
+- ``traffic_photo``: the same scene with the street's background frame as its
+  ``image.path`` (:func:`~camloc_geo.testing.traffic_render.street_photo`, what
+  ``render_street`` writes beside the video), so ``calibrate`` adds the photo's painted
+  lines to the annotators' (``photo_lines``, the default): the scene a radar user has;
 - ``car_only``: the same annotation without the lane lines (``render_street``'s scene
   before issue 28: the car alone);
 - ``traffic_draws``: the same camera with ``--draws`` more noise draws (the spread of the
@@ -27,7 +31,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -39,14 +45,19 @@ from camloc_geo.api import calibrate_scene
 from camloc_geo.camera import Camera
 from camloc_geo.testing.road_lines import road_line_scene, street_noise, street_scene
 from camloc_geo.testing.synthetic import make_scene
-from camloc_geo.testing.traffic_render import random_street
+from camloc_geo.testing.traffic_render import random_street, street_photo
 
 OUT_DIR = Path(__file__).parent / "out"
 IMAGE_SIZE = (960, 540)
 
 
 def traffic_scene(
-    seed: int, *, noise_seed: int | None = None, click_px: float = 1.0, lane_lines: bool = True
+    seed: int,
+    *,
+    noise_seed: int | None = None,
+    click_px: float = 1.0,
+    lane_lines: bool = True,
+    photo_dir: Path | None = None,
 ) -> Any:
     """The camera and annotated scene ``render_street`` makes for ``random_street(seed)``.
 
@@ -61,6 +72,10 @@ def traffic_scene(
     lane_lines
         The annotators also draw the painted lane lines (as ``render_street``); False: the
         car alone.
+    photo_dir
+        Write the street's background frame there (``street_photo``, as ``render_street``
+        writes it beside the video) and name it as the scene's ``image.path``. None: no
+        photo.
 
     Returns
     -------
@@ -70,9 +85,16 @@ def traffic_scene(
     cam, _ = random_street(np.random.default_rng(seed), n_vehicles=10, duration_s=20.0)
     base = seed if noise_seed is None else noise_seed
     if lane_lines:
-        return street_scene(cam, base, click_px=click_px, image_size=IMAGE_SIZE)
-    rng = np.random.default_rng(base + 7)
-    return make_scene(cam, rng, noise=street_noise(click_px), n_annotators=3, image_size=IMAGE_SIZE)
+        syn = street_scene(cam, base, click_px=click_px, image_size=IMAGE_SIZE)
+    else:
+        rng = np.random.default_rng(base + 7)
+        syn = make_scene(
+            cam, rng, noise=street_noise(click_px), n_annotators=3, image_size=IMAGE_SIZE
+        )
+    if photo_dir is not None:
+        path = street_photo(cam, seed, Path(photo_dir) / f"street_{seed}.png")
+        syn.scene["image"]["path"] = str(path)
+    return syn
 
 
 def focal_row(scene: dict[str, Any], truth: Camera) -> dict[str, Any] | None:
@@ -126,6 +148,7 @@ def plot(result: dict[str, Any], path: Path) -> None:
     fig, ax = plt.subplots(figsize=(9, 4.5))
     styles = {
         "traffic": ("C0", 0.0),
+        "traffic_photo": ("C4", 0.08),
         "car_only": ("C3", -0.15),
         "noise_free": ("C2", 0.15),
         "road_lines": ("C1", 0.3),
@@ -167,15 +190,21 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     scenes: dict[str, list[dict[str, Any]]] = {
         "traffic": [],
+        "traffic_photo": [],
         "car_only": [],
         "traffic_draws": [],
         "noise_free": [],
         "road_lines": [],
     }
     empty = {"focal_error": None, "focal_sigma_rel": None, "z": None}
+    photo_dir = Path(tempfile.mkdtemp(prefix="camloc-calibrate-traffic-"))
     for seed in range(args.first_seed, args.first_seed + args.seeds):
         syn = traffic_scene(seed)
         scenes["traffic"].append({"seed": seed, **(focal_row(syn.scene, syn.camera) or empty)})
+        shot = traffic_scene(seed, photo_dir=photo_dir)
+        scenes["traffic_photo"].append(
+            {"seed": seed, **(focal_row(shot.scene, shot.camera) or empty)}
+        )
         car = traffic_scene(seed, lane_lines=False)
         scenes["car_only"].append({"seed": seed, **(focal_row(car.scene, car.camera) or empty)})
         exact = traffic_scene(seed, click_px=0.0)
@@ -189,6 +218,7 @@ def main(argv: list[str] | None = None) -> int:
             )
         road = road_line_scene(seed)
         scenes["road_lines"].append({"seed": seed, **(focal_row(road.scene, road.camera) or empty)})
+    shutil.rmtree(photo_dir, ignore_errors=True)
     result: dict[str, Any] = {
         "seeds": [args.first_seed, args.first_seed + args.seeds - 1],
         "draws": args.draws,

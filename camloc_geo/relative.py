@@ -761,7 +761,8 @@ def _ground_corner_evidence(prob: _JointProblem, r: FloatArray) -> float:
     edge_sq = np.sum((clicks[:, 1] - clicks[:, 0]) ** 2, axis=1) + np.sum(
         (clicks[:, 2] - clicks[:, 0]) ** 2, axis=1
     )  # per annotator: |length edge|² + |width edge|², pixels²
-    term_var = prob.ground_corner_sigma_rel**2 * float(np.average(edge_sq, weights=a_pt[::4])) / 2.0
+    a_ann = a_pt[::4]  # per annotator: the weighted mean of edge_sq (np.average's arithmetic)
+    term_var = prob.ground_corner_sigma_rel**2 * float((edge_sq * a_ann).sum() / a_ann.sum()) / 2.0
     if term_var <= 0.0:
         return 1.0
     excess = max(click_var - line_end_var, 0.0)
@@ -787,35 +788,36 @@ class _JointProblem:
         self.sigma_line = settings.sigma_line_rel * diag
         seg_rows, seg_axis, seg_ann = [], [], []
         pt_world, pt_pix, pt_ann = [], [], []
+        worlds = {ws: _object_points(size, ws) for ws in set(width_signs)}
         for slot, (i, segs, ws) in enumerate(zip(indices, segments, width_signs, strict=True)):
-            ann = scene.annotations[i]
+            axes = scene.annotations[i].axes
             for axis in AXES:
                 s = segs[axis]
                 seg_rows.append(s)
                 seg_axis += [_AXIS_INDEX[axis]] * len(s)
                 seg_ann += [slot] * len(s)
-            world = _object_points(size, ws)
-            for j, name in enumerate(("origin", "length", "width", "height")):
-                pt_world.append(world[j])
-                pt_pix.append(getattr(ann.axes, name))
-                pt_ann.append(slot)
+            pt_world.append(worlds[ws])
+            pt_pix += [axes.origin, axes.length, axes.width, axes.height]
+            pt_ann += [slot] * 4
         self.size = size
         self.ws_common = 1.0 if sum(width_signs) >= 0 else -1.0
+        # _corner_points of each corner (4, 4, 3), for set_corners and best_corners
+        self._corner_table = np.stack([_corner_points(size, self.ws_common, c) for c in range(4)])
         self.corners = np.zeros(len(indices), dtype=int)
         self.segments = np.vstack(seg_rows)
         self.seg_axis = np.asarray(seg_axis)
         self.seg_ann = np.asarray(seg_ann)
-        self.pt_world = np.asarray(pt_world, float)
+        self.pt_world = np.vstack(pt_world)
         self.pt_pix = np.asarray(pt_pix, float)
         self.pt_ann = np.asarray(pt_ann)
         # An edge end's pixel is uncertain by the click noise and, along the edge, by the
         # object's size uncertainty (a preset's 5 % of the edge's length in pixels).
-        edge_px = np.zeros(len(self.pt_pix))
-        for j in range(0, len(self.pt_pix), 4):
-            edge_px[j + 1 : j + 4] = np.linalg.norm(
-                self.pt_pix[j + 1 : j + 4] - self.pt_pix[j], axis=1
-            )
-        self._sigma_pt_each = np.sqrt(self.sigma_pt**2 + (size_sigma_rel * edge_px) ** 2)
+        clicks = self.pt_pix.reshape(-1, 4, 2)
+        edge_px = np.zeros((len(clicks), 4))
+        edge_px[:, 1:] = np.linalg.norm(clicks[:, 1:] - clicks[:, :1], axis=2)
+        self._sigma_pt_each = np.sqrt(
+            self.sigma_pt**2 + (size_sigma_rel * edge_px.reshape(-1)) ** 2
+        )
         self.ground_corner_sigma_rel = settings.ground_corner_sigma_rel
         self.n_annotators = len(indices)
         self._z_min = 0.05
@@ -825,6 +827,8 @@ class _JointProblem:
         # segment_residuals_px's numerator is V · n for a vanishing point V = (x, y, w).
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self._seg_nT = np.ascontiguousarray(self._seg_n.T)
+        self._mid_x, self._mid_y = self._mid[:, 0].copy(), self._mid[:, 1].copy()
         # Segments detected in the scene's photo (set_photo_segments): their rows follow the
         # clicks' (owned by no annotator, like the priors), with their own fixed sigma.
         self._seg_axis_all = self.seg_axis
@@ -842,8 +846,11 @@ class _JointProblem:
         self.pp_prior = np.array([width / 2.0, height / 2.0])
         self.pp_prior_sigma = settings.principal_point_prior_sigma_rel * math.hypot(width, height)
         # The last few evaluations: the covariance, the score test, the jackknife and the
-        # annotators' RMS all look again at points the fits have just evaluated.
-        self._memo: dict[tuple[Any, ...], tuple[FloatArray, FloatArray | None]] = {}
+        # annotators' RMS all look again at points the fits have just evaluated. They are
+        # remembered with every annotator's weight 1 (the weights scale whole rows): a fit
+        # after a reweighting starts from the point the last one ended at without a new
+        # evaluation.
+        self._memo: dict[tuple[Any, ...], _Evaluation] = {}
 
     def _memo_key(
         self,
@@ -851,24 +858,56 @@ class _JointProblem:
         R0: FloatArray,
         pp_fixed: tuple[float, float] | None,
         f_fixed: float | None,
-        weights: FloatArray | None = None,
     ) -> tuple[Any, ...]:
-        w = self._weights if weights is None else weights
         return (
             np.asarray(x, dtype=float).tobytes(),
             np.asarray(R0, dtype=float).tobytes(),
             pp_fixed,
             f_fixed,
-            w.tobytes(),
             self.corners.tobytes(),
             self.log_f_prior_sigma,
             self.pp_prior_sigma,
         )
 
-    def _remember(self, key: tuple[Any, ...], r: FloatArray, J: FloatArray | None) -> None:
+    def _remember(self, key: tuple[Any, ...], r: FloatArray, J: FloatArray | None) -> _Evaluation:
         if len(self._memo) >= _MEMO_SIZE:
             self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = (r, J)
+        ev = _Evaluation(r, J)
+        self._memo[key] = ev
+        return ev
+
+    def _weighted(self, ev: _Evaluation) -> _Evaluation:
+        """``ev`` (unweighted) at the current weights; the same arrays while they hold."""
+        w_ev = ev.weighted
+        current = w_ev is not None and ev.weights_version == self._weights_version
+        if current and w_ev is not None and (w_ev.J is not None or ev.J is None):
+            return w_ev
+        w = self._row_weights(len(ev.r))
+        w_ev = _Evaluation(ev.r * w, None if ev.J is None else ev.J * w[:, None])
+        ev.weighted, ev.weights_version = w_ev, self._weights_version
+        return w_ev
+
+    def _row_weights(self, n_rows: int) -> FloatArray:
+        """√weight of each of ``n_rows`` residual rows: an annotation row its annotator's,
+        the photo's segments and the priors 1."""
+        w = self._row_w.get(n_rows)
+        if w is None:
+            w = np.ones(n_rows)
+            w[: len(self._row_w_ann)] = self._row_w_ann
+            self._row_w[n_rows] = w
+        return w
+
+    def _unit_residuals_batch(
+        self,
+        X: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> FloatArray:
+        """:meth:`residuals_batch` with every annotator's weight 1."""
+        return self._residuals_batch_scaled(
+            X, R0, pp_fixed, f_fixed, self._seg_scale_unit, self._pt_scale_unit
+        )
 
     def set_photo_segments(
         self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
@@ -883,6 +922,8 @@ class _JointProblem:
         self._mid = np.column_stack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, np.ones(len(seg))])
         x1, y1, mxs, mys = seg[:, 0], seg[:, 1], self._mid[:, 0], self._mid[:, 1]
         self._seg_n = np.column_stack([y1 - mys, mxs - x1, x1 * mys - y1 * mxs])
+        self._seg_nT = np.ascontiguousarray(self._seg_n.T)
+        self._mid_x, self._mid_y = self._mid[:, 0].copy(), self._mid[:, 1].copy()
         self.weights = self._weights  # the scales of all segment rows
         self._memo.clear()
 
@@ -894,9 +935,7 @@ class _JointProblem:
         corner, so their four clicks are the world points :func:`_corner_points` gives.
         """
         self.corners = np.asarray(corners, dtype=int)
-        self.pt_world = np.vstack(
-            [_corner_points(self.size, self.ws_common, int(c)) for c in self.corners]
-        )
+        self.pt_world = self._corner_table[self.corners].reshape(-1, 3)
 
     def best_corners(
         self,
@@ -907,8 +946,7 @@ class _JointProblem:
     ) -> npt.NDArray[np.int_]:
         """For each annotator, the corner hypothesis whose points best explain their clicks."""
         f, (cx, cy), R, C = self.unpack(x, R0, pp_fixed, f_fixed)
-        hyp = np.stack([_corner_points(self.size, self.ws_common, c) for c in range(4)])  # (4,4,3)
-        pc = (hyp.reshape(-1, 3) - C) @ R.T
+        pc = (self._corner_table.reshape(-1, 3) - C) @ R.T  # the 4 hypotheses' 4 points
         z = np.maximum(pc[:, 2], self._z_min)
         proj = (pc[:, :2] / z[:, None] * f + np.array([cx, cy])).reshape(4, 4, 2)
         clicks = self.pt_pix.reshape(-1, 4, 2)  # (n_annotators, 4, 2)
@@ -922,9 +960,24 @@ class _JointProblem:
         pp_fixed: tuple[float, float] | None,
         f_fixed: float | None,
     ) -> tuple[float, tuple[float, float], FloatArray, FloatArray]:
-        """Focal length, principal point, rotation and camera centre of a parameter vector."""
-        f, pp, R, C = self._unpack_batch(np.asarray(x, float)[None, :], R0, pp_fixed, f_fixed)
-        return float(f[0]), (float(pp[0, 0]), float(pp[0, 1])), R[0], C[0]
+        """Focal length, principal point, rotation and camera centre of a parameter vector.
+
+        As :meth:`_unpack_batch` of the one vector, in Python floats where that is cheaper.
+        """
+        xs = np.asarray(x, dtype=float).tolist()
+        k = 0
+        if f_fixed is None:
+            f = math.exp(min(max(xs[0], self.log_f_bounds[0]), self.log_f_bounds[1]))
+            k = 1
+        else:
+            f = float(f_fixed)
+        if pp_fixed is None:
+            pp = (float(xs[k]), float(xs[k + 1]))
+            k += 2
+        else:
+            pp = (float(pp_fixed[0]), float(pp_fixed[1]))
+        R = np.array(_rotvec_rows(*xs[k : k + 3])) @ R0
+        return f, pp, R, np.array(xs[k + 3 : k + 6])
 
     def _unpack_batch(
         self,
@@ -959,12 +1012,11 @@ class _JointProblem:
         """Normalised residuals (segments, then point u, then point v)."""
         x = np.asarray(x, dtype=float)
         key = self._memo_key(x, R0, pp_fixed, f_fixed)
-        hit = self._memo.get(key)
-        if hit is not None:
-            return hit[0]
-        r = np.asarray(self.residuals_batch(x[None, :], R0, pp_fixed, f_fixed)[0], dtype=float)
-        self._remember(key, r, None)
-        return r
+        ev = self._memo.get(key)
+        if ev is None:
+            r = self._unit_residuals_batch(x[None, :], R0, pp_fixed, f_fixed)[0]
+            ev = self._remember(key, r, None)
+        return self._weighted(ev).r
 
     def unweighted_residuals(
         self,
@@ -975,21 +1027,17 @@ class _JointProblem:
     ) -> FloatArray:
         """The annotation residuals (segments, point u, point v) with every weight 1.
 
-        From a remembered evaluation at the current weights where there is one (the rows
-        divided by their annotator's √weight), else evaluated.
+        From a remembered evaluation where there is one (they are remembered unweighted),
+        else evaluated.
         """
         n_rows = len(self.segments) + 2 * len(self.pt_pix)
         x = np.asarray(x, dtype=float)
-        hit = self._memo.get(self._memo_key(x, R0, pp_fixed, f_fixed))
-        if hit is not None and np.all(self._weights > 0.0):
-            scale = np.concatenate([self._w_seg, self._w_pt, self._w_pt])
-            return np.asarray(hit[0][:n_rows] / scale, dtype=np.float64)
-        saved = self.weights
-        self.weights = np.ones(self.n_annotators)
-        try:
-            return self.residuals(x, R0, pp_fixed, f_fixed)[:n_rows]
-        finally:
-            self.weights = saved
+        key = self._memo_key(x, R0, pp_fixed, f_fixed)
+        ev = self._memo.get(key)
+        if ev is None:
+            r = self._unit_residuals_batch(x[None, :], R0, pp_fixed, f_fixed)[0]
+            ev = self._remember(key, r, None)
+        return ev.r[:n_rows]
 
     def jacobian(
         self,
@@ -1011,19 +1059,19 @@ class _JointProblem:
         """The residuals and their forward-difference Jacobian from one batched evaluation."""
         x = np.asarray(x, dtype=float)
         key = self._memo_key(x, R0, pp_fixed, f_fixed)
-        hit = self._memo.get(key)
-        if hit is not None and hit[1] is not None:
-            return hit[0], hit[1]
-        n = len(x)
-        h = 1e-7 * np.maximum(1.0, np.abs(x))
-        X = np.empty((n + 1, n))
-        X[:] = x
-        X[1:] += np.diag(h)
-        Rb = self.residuals_batch(X, R0, pp_fixed, f_fixed)
-        J = np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
-        r = np.asarray(Rb[0], dtype=np.float64)
-        self._remember(key, r, J)
-        return r, J
+        ev = self._memo.get(key)
+        if ev is None or ev.J is None:
+            n = len(x)
+            h = 1e-7 * np.maximum(1.0, np.abs(x))
+            X = np.empty((n + 1, n))
+            X[:] = x
+            X[1:] += np.diag(h)
+            Rb = self._unit_residuals_batch(X, R0, pp_fixed, f_fixed)
+            J = np.asarray(((Rb[1:] - Rb[0]) / h[:, None]).T.reshape(-1, n), dtype=np.float64)
+            ev = self._remember(key, np.asarray(Rb[0], dtype=np.float64), J)
+        w_ev = self._weighted(ev)
+        assert w_ev.J is not None
+        return w_ev.r, w_ev.J
 
     def residuals_batch(
         self,
@@ -1033,30 +1081,49 @@ class _JointProblem:
         f_fixed: float | None,
     ) -> FloatArray:
         """Residuals of a batch of parameter vectors ``(P, n)`` → ``(P, m)``."""
+        return self._residuals_batch_scaled(
+            X, R0, pp_fixed, f_fixed, self._seg_scale, self._pt_scale
+        )
+
+    @staticmethod
+    def _f_rows(f: FloatArray) -> FloatArray:
+        """``(P, 3, 1)``: ``f``, ``f``, 1 per row of ``R`` (the diagonal of ``K``)."""
+        out = np.ones((len(f), 3, 1))
+        out[:, :2, 0] = f[:, None]
+        return out
+
+    def _residuals_batch_scaled(
+        self,
+        X: FloatArray,
+        R0: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+        seg_scale: FloatArray,
+        pt_scale: FloatArray,
+    ) -> FloatArray:
+        """:meth:`residuals_batch` with the rows scaled by ``seg_scale`` (every segment's,
+        the photo's after the annotations') and ``pt_scale`` (every click's)."""
         f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
-        cx, cy = pp[:, 0:1], pp[:, 1:2]
-        fc = f[:, None]
-        # Vanishing point of world axis i: K R e_i, i.e. column i of K R: V[p, i] = (x, y, w).
-        V = np.empty((len(X), 3, 3))
-        V[:, :, 0] = fc * R[:, 0, :] + cx * R[:, 2, :]
-        V[:, :, 1] = fc * R[:, 1, :] + cy * R[:, 2, :]
-        V[:, :, 2] = R[:, 2, :]
-        Vs = V[:, self._seg_axis_all, :]  # (P, n_seg + n_photo, 3)
-        px, py, pw = Vs[..., 0], Vs[..., 1], Vs[..., 2]
-        mx, my = self._mid[:, 0], self._mid[:, 1]
+        # Vanishing point of world axis i: K R e_i, column i of KR = [f R₀ + cx R₂; f R₁ + cy R₂;
+        # R₂] (rows of R); each segment takes its axis' column: KRs (P, 3, n_seg + n_photo).
+        KR = R * self._f_rows(f)
+        KR[:, :2, :] += pp[:, :, None] * R[:, 2:3, :]
+        KRs = KR[:, :, self._seg_axis_all]
+        px, py, pw = KRs[:, 0], KRs[:, 1], KRs[:, 2]
         # Line through the midpoint (mx, my, 1) and the vanishing point; the first endpoint's
         # distance from it: its numerator is linear in the point, V · n (n precomputed).
-        la = my * pw - py
-        lb = px - mx * pw
-        norm = np.sqrt(la * la + lb * lb)
-        num = np.einsum("psk,sk->ps", Vs, self._seg_n)
-        r_all = num / np.maximum(norm, 1e-300) * self._seg_scale
+        num = px * self._seg_nT[0] + py * self._seg_nT[1] + pw * self._seg_nT[2]
+        norm = np.hypot(self._mid_y * pw - py, px - self._mid_x * pw)
+        r_all = num / np.maximum(norm, 1e-300) * seg_scale
         n_seg = len(self.segments)
         r_seg = r_all[:, :n_seg]
         pc = (self.pt_world[None, :, :] - C[:, None, :]) @ np.swapaxes(R, 1, 2)
-        z = np.maximum(pc[:, :, 2], self._z_min)
-        u = (pc[:, :, 0] / z * fc + cx - self.pt_pix[:, 0]) * self._pt_scale
-        v = (pc[:, :, 1] / z * fc + cy - self.pt_pix[:, 1]) * self._pt_scale
+        z = np.maximum(pc[:, :, 2:3], self._z_min)
+        # u and v at once: (P, n_pt, 2)
+        uv = (pc[:, :, :2] / z * f[:, None, None] + (pp[:, None, :] - self.pt_pix)) * pt_scale[
+            :, None
+        ]
+        u, v = uv[:, :, 0], uv[:, :, 1]
         parts = [r_seg, u, v]
         if len(self.photo_segments):
             parts.append(r_all[:, n_seg:])
@@ -1077,6 +1144,14 @@ class _JointProblem:
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
         self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
         self._pt_scale = self._w_pt / self._sigma_pt_each
+        self._row_w_ann = np.concatenate([self._w_seg, self._w_pt, self._w_pt])
+        self._row_w: dict[int, FloatArray] = {}
+        self._weights_version = getattr(self, "_weights_version", 0) + 1
+        n_seg = len(self.segments)
+        self._seg_scale_unit = np.concatenate(
+            [np.full(n_seg, 1.0 / self.sigma_line), self._photo_scale]
+        )
+        self._pt_scale_unit = 1.0 / self._sigma_pt_each
 
     def per_annotator_rms(
         self,
@@ -1099,6 +1174,20 @@ class _JointProblem:
 
 
 _MEMO_SIZE = 8  # evaluations a _JointProblem remembers
+
+
+class _Evaluation:
+    """A remembered evaluation: residuals ``r``, Jacobian ``J`` (or None), and the same at
+    the weights of ``weights_version`` (``weighted``), kept for the next call."""
+
+    __slots__ = ("J", "r", "weighted", "weights_version")
+
+    def __init__(self, r: FloatArray, J: FloatArray | None) -> None:
+        self.r, self.J = r, J
+        self.weighted: _Evaluation | None = None
+        self.weights_version = -1
+
+
 _F_SCALE = 2.5  # soft-L1 scale of the normalised residuals (in sigmas)
 _GOOD_SEED_SCORE = 1.0  # median annotator RMS (in sigmas) at which a seed's fit is good
 
@@ -1107,9 +1196,15 @@ def _rotvec_matrices(rotvecs: FloatArray) -> FloatArray:
     """Rotation matrices ``(P, 3, 3)`` of rotation vectors ``(P, 3)`` (Rodrigues, vectorised).
 
     The joint fit evaluates a batch of nearby parameter vectors per Jacobian; scipy's
-    ``Rotation.from_rotvec`` costs more in its per-call checks than the formula itself.
+    ``Rotation.from_rotvec`` costs more in its per-call checks than the formula itself. The
+    matrices are small, so numpy's per-call overhead is the cost: up to
+    ``_ROTVEC_SCALAR_MAX`` vectors (one evaluation and its Jacobian) go through
+    :func:`_rotvec_rows` in Python floats and one array construction (19 -> 2 µs for one
+    vector, 20 -> 12 µs for eight); larger batches through the array formula.
     """
     w = np.asarray(rotvecs, dtype=float)
+    if len(w) <= _ROTVEC_SCALAR_MAX:
+        return np.array([_rotvec_rows(x, y, z) for x, y, z in w.tolist()]).reshape(-1, 3, 3)
     theta2 = np.einsum("pi,pi->p", w, w)
     theta = np.sqrt(theta2)
     small = theta2 < 1e-12
@@ -1126,6 +1221,28 @@ def _rotvec_matrices(rotvecs: FloatArray) -> FloatArray:
     )
 
 
+_ROTVEC_SCALAR_MAX = 12  # batches up to this size: Python floats (see _rotvec_matrices)
+
+
+def _rotvec_rows(x: float, y: float, z: float) -> list[list[float]]:
+    """The rotation matrix of one rotation vector ``(x, y, z)`` as nested lists.
+
+    ``R = I + a K + b K²`` (as :func:`_rotvec_matrices`), with ``K² = w wᵀ − θ² I``.
+    """
+    t2 = x * x + y * y + z * z
+    if t2 < 1e-12:
+        a, b = 1.0 - t2 / 6.0, 0.5 - t2 / 24.0
+    else:
+        t = math.sqrt(t2)
+        a, b = math.sin(t) / t, (1.0 - math.cos(t)) / t2
+    bx, by, bz = b * x, b * y, b * z
+    return [
+        [1.0 - (by * y + bz * z), bx * y - a * z, bx * z + a * y],
+        [bx * y + a * z, 1.0 - (bx * x + bz * z), by * z - a * x],
+        [bx * z - a * y, by * z + a * x, 1.0 - (bx * x + by * y)],
+    ]
+
+
 def _small_rotvec(R: FloatArray) -> FloatArray:
     """Rotation vector of a rotation matrix turned by less than ~170° (the log map).
 
@@ -1134,9 +1251,10 @@ def _small_rotvec(R: FloatArray) -> FloatArray:
     :func:`camloc_geo.camera.rotvec_from_rotation` takes over there.
     """
     R = np.asarray(R, dtype=float)
-    cos_t = float(np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0))
+    (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = R.tolist()  # Python floats: cheaper
+    cos_t = min(max((r00 + r11 + r22 - 1.0) / 2.0, -1.0), 1.0)
     theta = math.acos(cos_t)
-    v = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    v = np.array([r21 - r12, r02 - r20, r10 - r01])
     if theta < 1e-6:
         return np.asarray(0.5 * v, dtype=np.float64)  # sin θ ≈ θ
     if theta > math.radians(170.0):
@@ -1166,30 +1284,48 @@ def _fit(
     method: Literal["lm", "scipy"] = "lm",
     sigma_tol: float | None = _SIGMA_TOL,
 ) -> LeastSquaresResult:
-    """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`.
+    """One robust fit (soft-L1) by :func:`camloc_geo._optimize.soft_l1_least_squares`
+    (``method="lm"``: its loop's steps by ``soft_l1_least_squares_small``).
 
     The focal length is clamped to plausible fields of view inside the parameterisation.
     """
-    from camloc_geo._optimize import soft_l1_least_squares
+    from camloc_geo._optimize import soft_l1_least_squares, soft_l1_least_squares_small
+
+    lo, hi = prob.log_f_bounds
 
     def clamp_focal(x: FloatArray) -> FloatArray:
+        v = float(x[0])
+        if lo <= v <= hi:
+            return x  # the usual case: no copy (the solver never changes x in place)
         x = x.copy()
-        x[0] = float(np.clip(x[0], *prob.log_f_bounds))
+        x[0] = min(max(v, lo), hi)
         return x
 
+    project = clamp_focal if f_fixed is None else None
+    # Every fit starts near its minimum (a closed-form seed, or the previous fit): a light
+    # initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations, the
+    # reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
+    if method == "lm":  # the same steps as soft_l1_least_squares's loop, cheaper a step
+        return soft_l1_least_squares_small(
+            lambda x: prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed),
+            x0,
+            f_scale=_F_SCALE,
+            project=project,
+            tol=tol,
+            max_nfev=max_nfev,
+            damping=1e-4,
+            sigma_tol=sigma_tol,
+        )
     return soft_l1_least_squares(
         lambda x: prob.residuals(x, R0, pp_fixed, f_fixed),
         lambda x: prob.jacobian(x, R0, pp_fixed, f_fixed),
         x0,
         f_scale=_F_SCALE,
-        project=clamp_focal if f_fixed is None else None,
+        project=project,
         method=method,
         tol=tol,
         max_nfev=max_nfev,
         fun_and_jac=lambda x: prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed),
-        # Every fit starts near its minimum (a closed-form seed, or the previous fit): a
-        # light initial damping takes fewer steps (the seed's fit 13.0 -> 12.7 evaluations,
-        # the reweighting fits 5.1 -> 4.1, the final 3.4 -> 2.1).
         damping=1e-4,
         sigma_tol=sigma_tol,
     )
@@ -1210,7 +1346,7 @@ def _score_test(
     """
     # The parameters with the principal point inserted, as _pinned_pp_sensitivity builds
     # them (the same evaluation serves both).
-    x1 = np.insert(np.asarray(x_fixed, dtype=float), int(f_fixed is None), pp_fixed)
+    x1 = _with_pp(x_fixed, int(f_fixed is None), pp_fixed)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     # Robust (soft-L1) weights at the current residuals, as the fit sees them.
     z = (r / _F_SCALE) ** 2
@@ -1221,6 +1357,12 @@ def _score_test(
         return float(g @ _sym_inverse(Jw.T @ Jw) @ g)
     except np.linalg.LinAlgError:
         return 0.0
+
+
+def _with_pp(x: npt.ArrayLike, k: int, pp: npt.ArrayLike) -> FloatArray:
+    """``x`` with the principal point's two entries inserted at ``k`` (``np.insert``)."""
+    x = np.asarray(x, dtype=float)
+    return np.concatenate([x[:k], np.asarray(pp, dtype=float).reshape(2), x[k:]])
 
 
 def _sym_inverse(A: FloatArray) -> FloatArray:
@@ -2226,12 +2368,15 @@ def _newton_steps(H: FloatArray, g: FloatArray, x: FloatArray) -> list[FloatArra
     Hs = H / d[:, :, None] / d[:, None, :]
     out: list[FloatArray | None] = [None] * len(H)
     try:
-        lam = np.abs(np.linalg.eigvalsh(0.5 * (Hs + np.swapaxes(Hs, 1, 2))))
+        lam = np.abs(np.linalg.eigvalsh(Hs))  # its lower triangle: Hs is symmetric
     except np.linalg.LinAlgError:
         return [_newton_step(H[k], g[k], x[k]) for k in range(len(H))]
     with np.errstate(divide="ignore", invalid="ignore"):
         cond = lam.max(axis=1) / lam.min(axis=1)
     ok = np.isfinite(cond) & (cond <= 1e10)
+    if ok.all():  # the usual case: no selection
+        steps = np.linalg.solve(Hs, (g / d)[:, :, None])[:, :, 0] / d
+        return list(np.asarray(x - steps, dtype=np.float64))
     if np.any(ok):
         steps = np.linalg.solve(Hs[ok], (g[ok] / d[ok])[:, :, None])[:, :, 0] / d[ok]
         for k, step in zip(np.flatnonzero(ok), x[ok] - steps, strict=True):
@@ -2267,18 +2412,25 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     focals: list[float] = []
     turns: list[FloatArray] = []
     influence: list[float | None] = []
-    for x in _leave_one_out_steps(state, steps=2):
-        if x is None or not np.all(np.isfinite(x)):
+    xs = _leave_one_out_steps(state, steps=2)
+    live = [a for a, x in enumerate(xs) if x is not None and np.all(np.isfinite(x))]
+    answers: dict[int, tuple[float, FloatArray, FloatArray]] = {}
+    if live:  # every leave-out camera unpacked at once (as prob.unpack, one by one)
+        f_b, _pp, R_b, C_b = prob._unpack_batch(np.array([xs[a] for a in live]), *args)
+        c_b = (C_b - origin) @ M  # Mᵀ (C - origin), row by row
+        turn_b = (R_b @ M) @ R.T
+        answers = {a: (float(f_b[k]), c_b[k], turn_b[k]) for k, a in enumerate(live)}
+    for a in range(len(xs)):
+        if a not in answers:
             influence.append(None)
             continue
-        f_i, _pp, R_i, C_i = prob.unpack(x, *args)
-        c_i = M.T @ (C_i - origin)
+        f_i, c_i, turn_matrix = answers[a]
         if c_i[2] <= 0.0:
             influence.append(None)  # no answer without them
             continue
         centres.append(c_i)
         focals.append(f_i)
-        turn = _small_rotvec((R_i @ M) @ R.T)
+        turn = _small_rotvec(turn_matrix)
         if np.linalg.norm(turn) < math.radians(30.0):
             turns.append(turn)
         influence.append(float(np.linalg.norm(c_i - c)))
@@ -2474,12 +2626,18 @@ def _calibrate_usable(scene: Scene, settings: CalibrationSettings) -> Calibratio
         return cluster_result()
 
 
-def _width_sign_for(scene: Scene, index: int, camera: Camera) -> float:
-    ann = scene.annotations[index]
-    R = camera.cam_from_world_rotation
-    m0 = camera.cam_from_img @ np.array([*ann.axes.origin, 1.0])
-    s = direction_sign(R[:, 1], m0, np.asarray(ann.axes.width, float) - np.asarray(ann.axes.origin))
-    return s or 1.0
+def _width_signs_for(scene: Scene, indices: list[int], camera: Camera) -> list[float]:
+    """Each annotator's width sign under ``camera``: the sign of the camera's world y axis
+    that moves their origin click toward their width click (1 where ambiguous)."""
+    y_axis = camera.cam_from_world_rotation[:, 1]
+    cam_from_img = camera.cam_from_img
+    out = []
+    for i in indices:
+        axes = scene.annotations[i].axes
+        m0 = cam_from_img @ np.array([*axes.origin, 1.0])
+        step = np.asarray(axes.width, float) - np.asarray(axes.origin)
+        out.append(direction_sign(y_axis, m0, step) or 1.0)
+    return out
 
 
 def _robust_vp(segments: FloatArray, diag: float, name: str) -> VanishingPoint:
@@ -2587,7 +2745,7 @@ def _reassign_corners(
                 continue
             errs = []
             for c in (int(prob.corners[a]), int(best[a])):
-                pts = _corner_points(prob.size, prob.ws_common, c)
+                pts = prob._corner_table[c]
                 pc = (pts - C) @ R.T
                 z = np.maximum(pc[:, 2], prob._z_min)
                 proj = pc[:, :2] / z[:, None] * f + np.array([cx, cy])
@@ -2683,9 +2841,20 @@ def _focal_prior(
 
 
 def _cauchy_weights(rms: FloatArray) -> FloatArray:
-    scale = max(1.0, float(np.median(rms)))
+    scale = max(1.0, _median(rms))
     w = 1.0 / (1.0 + (rms / (2.0 * scale)) ** 2)
     return np.asarray(w / w.max(), dtype=np.float64)
+
+
+def _median(values: FloatArray) -> float:
+    """``np.median`` of a few values (the middle one, or the mean of the middle two), in
+    Python floats: 1 µs instead of numpy's 12 µs of per-call overhead."""
+    v = sorted(np.asarray(values, dtype=float).tolist())
+    n = len(v)
+    if n == 0 or any(x != x for x in v):  # empty or NaN: NaN, as numpy
+        return math.nan
+    mid = n // 2
+    return float(v[mid]) if n % 2 else (v[mid - 1] + v[mid]) / 2.0
 
 
 def _joint(
@@ -2731,7 +2900,7 @@ def _joint(
         cam0 = seed_or_maker() if callable(seed_or_maker) else seed_or_maker
         if cam0 is None:
             continue
-        width_signs = [_width_sign_for(scene, i, cam0) for i in indices]
+        width_signs = _width_signs_for(scene, indices, cam0)
         prob = _JointProblem(
             scene,
             segs,
@@ -2748,7 +2917,7 @@ def _joint(
         res = _fit(
             prob, x0, R0, pp_fixed, f_fixed, tol=1e-4, max_nfev=60, sigma_tol=_SEED_SIGMA_TOL
         )
-        score = float(np.median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed)))
+        score = _median(prob.per_annotator_rms(res.x, R0, pp_fixed, f_fixed))
         below_ground = bool(prob.unpack(res.x, R0, pp_fixed, f_fixed)[3][2] <= 0.0)
         if best_key is None or score < best_key[1]:
             best, best_key = (score, prob, res, R0, width_signs), (below_ground, score)
@@ -2969,7 +3138,7 @@ def _pinned_pp_sensitivity(
     ``cov(θ, δ) = σ² S``. None when the Hessian is singular.
     """
     k = int(f_fixed is None)
-    x1 = np.insert(np.asarray(x, dtype=float), k, np.asarray(pp, dtype=float))
+    x1 = _with_pp(x, k, pp)
     r, J = prob.residuals_and_jacobian(x1, R0, None, f_fixed)
     if prob.pp_prior_sigma > 0.0:
         # the data's information alone (the prior's two rows come last); the prior is σ here
@@ -3030,15 +3199,16 @@ def _output_covariance(
     z_of_x = ([0] if f_fixed is None else []) + ([1, 2] if pp_model is None else [])
     z_of_x += [3, 4, 5, 6, 7, 8]
     A = np.zeros((9, 9))
-    A[np.ix_(z_of_x, z_of_x)] = cov
+    block = np.ix_(z_of_x, z_of_x)
+    A[block] = cov
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
-        A[np.ix_(z_of_x, z_of_x)] += D @ D.T
+        A[block] += D @ D.T
     if pp_model is not None and sigma_pp_px > 0.0:
         S = _pinned_pp_sensitivity(prob, x, R0, pp_model, f_fixed)
         if S is not None:
             s2_pp = sigma_pp_px**2
-            A[np.ix_(z_of_x, z_of_x)] += s2_pp * (S @ S.T)
+            A[block] += s2_pp * (S @ S.T)
             A[np.ix_(z_of_x, [1, 2])] = s2_pp * S
             A[np.ix_([1, 2], z_of_x)] = s2_pp * S.T
             A[1, 1] = A[2, 2] = s2_pp

@@ -16,6 +16,7 @@ from camloc_geo._optimize import (
     soft_l1_cost,
     soft_l1_least_squares,
     soft_l1_least_squares_many,
+    soft_l1_least_squares_small,
 )
 from camloc_geo.absolute._similarity import rot2
 from camloc_geo.scene import load_scene
@@ -134,6 +135,96 @@ def test_sigma_tol_stops_within_that_fraction_of_a_sigma(seed: int) -> None:
     assert float(d @ np.linalg.solve(cov, d)) > 0.0
     # The stop's residuals and Jacobian are those of the returned x (no step after them).
     np.testing.assert_allclose(early.fun, fun(early.x))
+
+
+def _assert_same_fit(a: Any, b: Any) -> None:
+    assert a.nfev == b.nfev
+    assert a.success == b.success
+    assert a.cost == b.cost
+    np.testing.assert_array_equal(a.x, b.x)
+    np.testing.assert_array_equal(a.fun, b.fun)
+    np.testing.assert_array_equal(a.jac, b.jac)
+
+
+@pytest.mark.parametrize("sigma_tol", [None, 0.1])
+def test_small_loop_takes_the_loops_steps_bit_for_bit(sigma_tol: float | None) -> None:
+    """soft_l1_least_squares_small is soft_l1_least_squares's lm loop, cheaper a step."""
+    seen_far = 0
+    for seed in range(4):
+        fun, jac, x0 = _curve_problem(seed)
+        for start in (x0, np.array([50.0, 8.0, -40.0])):  # near; far off (rejected steps)
+
+            def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
+                return f(x), j(x)
+
+            def clamp(x: np.ndarray) -> np.ndarray:  # a bound that binds on the far start
+                return np.asarray(np.concatenate([[min(x[0], 30.0)], x[1:]]))
+
+            for project in (None, clamp):
+                kw: dict[str, Any] = {
+                    "f_scale": 2.5,
+                    "max_nfev": 60,
+                    "sigma_tol": sigma_tol,
+                    "project": project,
+                }
+                with np.errstate(over="ignore", invalid="ignore"):  # far off: exp overflows
+                    loop = soft_l1_least_squares(fun, jac, start, fun_and_jac=both, **kw)
+                    small = soft_l1_least_squares_small(both, start, **kw)
+                _assert_same_fit(small, loop)
+                seen_far += int(loop.nfev > 10)
+    assert seen_far > 0  # the far starts did take many steps
+
+
+def test_small_loop_matches_the_loop_on_the_calibration_problems() -> None:
+    """Every fit of a few calibrations, replayed through soft_l1_least_squares: the same."""
+    from camloc_geo.scene import parse_scene
+    from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
+
+    compared: list[int] = []
+    original = relative._fit
+
+    def spy(prob: Any, x0: Any, R0: Any, pp: Any, f: Any, **kw: Any) -> Any:
+        res = original(prob, x0, R0, pp, f, **kw)
+        if kw.get("method", "lm") != "lm":
+            return res
+
+        def both(x: np.ndarray) -> Any:
+            return prob.residuals_and_jacobian(x, R0, pp, f)
+
+        def clamp(x: np.ndarray) -> np.ndarray:
+            x = x.copy()
+            x[0] = float(np.clip(x[0], *prob.log_f_bounds))
+            return x
+
+        loop = soft_l1_least_squares(
+            lambda x: both(x)[0],
+            lambda x: both(x)[1],
+            x0,
+            f_scale=relative._F_SCALE,
+            project=clamp if f is None else None,
+            tol=kw.get("tol", 1e-10),
+            max_nfev=kw.get("max_nfev", 200),
+            fun_and_jac=both,
+            damping=1e-4,
+            sigma_tol=kw.get("sigma_tol", relative._SIGMA_TOL),
+        )
+        _assert_same_fit(res, loop)
+        compared.append(res.nfev)
+        return res
+
+    scenes = [load_scene(SCENE)]
+    for seed in (1, 2):
+        rng = np.random.default_rng(seed)
+        syn = make_scene(random_camera(rng), rng, noise=NoiseModel(), n_annotators=4)
+        scenes.append(parse_scene(syn.scene))
+    relative._fit = spy  # type: ignore[assignment]
+    try:
+        for scene in scenes:
+            relative.calibrate(scene)
+    finally:
+        relative._fit = original
+    assert len(compared) >= 6
+    assert max(compared) >= 3  # fits that took steps
 
 
 def test_lm_soft_l1_matches_scipy_on_the_calibration_problems() -> None:

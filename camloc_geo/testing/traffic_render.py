@@ -50,6 +50,7 @@ __all__ = [
     "random_street",
     "render_street",
     "street_camera",
+    "street_photo",
 ]
 
 FloatArray = npt.NDArray[np.float64]
@@ -430,8 +431,14 @@ def render_street(
     annotation_px: float = 1.0,
     fourcc: str = "MJPG",
     texture_m_per_px: float = 0.025,
+    photo: bool = False,
 ) -> RenderedVideo:
     """Render a street video (MJPG ``.avi``) and return it with its truth and annotated scene.
+
+    With ``photo``, the scene's ``image.path`` is the street's background frame
+    (:func:`street_photo`), written beside the video as a PNG of the same name: the photo a
+    radar user can take from the video, whose painted lines ``calibrate`` adds to the
+    annotators' (``CalibrationSettings.photo_lines``).
 
     Parameters
     ----------
@@ -455,6 +462,9 @@ def render_street(
         Codec; MJPG is available in every OpenCV build.
     texture_m_per_px
         Resolution of the asphalt texture (coarser: faster, for small test videos).
+    photo
+        Write the background frame and name it in the scene (default False: no
+        ``image.path``, the scene the radar benchmarks calibrate).
 
     Raises
     ------
@@ -467,16 +477,7 @@ def render_street(
     rng = np.random.default_rng(seed)
     # The parked car's clicks and the painted lane lines, as 3 annotators draw them.
     scene = street_scene(camera, seed, click_px=annotation_px, image_size=size).scene
-    background = _background(camera, size, rng, texture_m_per_px)
-    ref = PRESETS["sedan"]
-    parked = StreetVehicle(
-        (ref.length_m / 2, ref.width_m / 2),
-        0.0,
-        0.0,
-        shape=SHAPES["sedan"],
-        colour=COLOURS["silver"],
-    )
-    _draw(background, camera, parked, 0.0, sun)
+    background = _street_background(camera, size, rng, texture_m_per_px, sun)
     n_frames = round(duration_s * fps)
     path = Path(path)
     eye = camera.center_in_world[:2]
@@ -498,7 +499,89 @@ def render_street(
         noise_sigma=noise_sigma,
     )
     boxes, contacts = _truth(camera, vehicles, fps, n_frames, size)
+    if photo:
+        scene["image"]["path"] = str(
+            _write_photo(path.with_suffix(".png"), _noisy(background, seed, noise_sigma))
+        )
     return RenderedVideo(path, camera, scene, fps, n_frames, size, vehicles, boxes, contacts)
+
+
+def _street_background(
+    camera: Camera,
+    size: tuple[int, int],
+    rng: np.random.Generator,
+    texture_m_per_px: float,
+    sun: bool,
+) -> Any:
+    """The street without traffic: asphalt, markings and the parked reference sedan."""
+    background = _background(camera, size, rng, texture_m_per_px)
+    ref = PRESETS["sedan"]
+    parked = StreetVehicle(
+        (ref.length_m / 2, ref.width_m / 2),
+        0.0,
+        0.0,
+        shape=SHAPES["sedan"],
+        colour=COLOURS["silver"],
+    )
+    _draw(background, camera, parked, 0.0, sun)
+    return background
+
+
+def _noisy(image: Any, seed: int, noise_sigma: float) -> npt.NDArray[np.uint8]:
+    """``image`` with one draw of Gaussian sensor noise (its own generator: ``seed + 13``)."""
+    noise = np.random.default_rng(seed + 13).normal(0.0, noise_sigma, np.shape(image))
+    return np.asarray(np.clip(np.asarray(image, float) + noise, 0, 255), np.uint8)
+
+
+def _write_photo(path: Path, image: npt.NDArray[np.uint8]) -> Path:
+    import cv2
+
+    if not cv2.imwrite(str(path), image):
+        raise RuntimeError(f"cannot write the street photo {path}")
+    return path.resolve()
+
+
+def street_photo(
+    camera: Camera,
+    seed: int,
+    path: str | Path,
+    *,
+    noise_sigma: float = 2.0,
+    sun: bool = True,
+    texture_m_per_px: float = 0.025,
+) -> Path:
+    """Write the background frame :func:`render_street` gives its scene, without a video.
+
+    The street as ``render_street(..., seed=seed)`` draws it before any traffic (asphalt
+    texture, painted lines, kerbs, the parked reference sedan and its shadows) with one draw
+    of the sensor noise: the photo a radar user takes from the video (a frame without
+    passing cars) and names as the scene's ``image.path``.
+
+    Parameters
+    ----------
+    camera
+        The camera (the frame size is its principal point's double).
+    seed
+        ``render_street``'s seed (the texture and the noise).
+    path
+        The PNG to write.
+    noise_sigma, sun, texture_m_per_px
+        As :func:`render_street`.
+
+    Returns
+    -------
+    Path
+        The absolute path written.
+
+    Raises
+    ------
+    RuntimeError
+        OpenCV cannot write ``path``.
+    """
+    size = (round(2 * camera.principal_point[0]), round(2 * camera.principal_point[1]))
+    rng = np.random.default_rng(seed)
+    background = _street_background(camera, size, rng, texture_m_per_px, sun)
+    return _write_photo(Path(path), _noisy(background, seed, noise_sigma))
 
 
 def random_street(
