@@ -131,6 +131,15 @@ def test_batched_position_sigmas_are_the_single_ones(
         ]
         assert many == one
         assert all(s is not None and s > 0 for s in many)
+        # against the refinement's own whitened Jacobian at the candidate's similarity
+        for c, e, sigma in zip(cands, evs, many, strict=True):
+            problem = _refine._similarity_problem(c, e, settings)
+            assert problem is not None
+            resid_jac, x0 = problem
+            _r, J = resid_jac(x0)
+            plain = _refine._position_sigma_m(J, c.enu_from_world, world_cam)
+            assert plain is not None
+            assert sigma == pytest.approx(plain, rel=1e-9)
 
 
 def test_ground_observation_matches_one_cast_per_pixel(
