@@ -273,3 +273,15 @@ def test_bundle_position_sigmas_batched_are_the_single_ones(
     assert any(len(got) >= 2 for got, _one in seen)
     for got, one in seen:
         assert got == one
+
+
+def test_a_result_keeps_no_placement_memo(
+    located: list[tuple[Scene, CalibrationResult]], baltimore: MapData
+) -> None:
+    scene, cal = located[0]
+    result = _pipeline.locate(scene, baltimore, calibration=cal)
+    evs = {id(c.evidence): c.evidence for c in result.candidates if c.evidence is not None}
+    assert evs
+    for ev in evs.values():
+        assert ev.placement_memo == {}
+        assert ev.observation_table is None
