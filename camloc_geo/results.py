@@ -614,7 +614,7 @@ def _lonlat_of_points(
 
 def _collection_properties(result: LocateResult) -> CandidateCollectionProperties:
     cal = result.calibration
-    _h, pitch, roll = cal.camera.angles_deg
+    _h, pitch, roll = _angles_deg(cal.camera)
     return CandidateCollectionProperties(
         scene=result.scene_id,
         methods_tried=result.methods_tried,

@@ -131,6 +131,15 @@ def test_batched_position_sigmas_are_the_single_ones(
         ]
         assert many == one
         assert all(s is not None and s > 0 for s in many)
+        # against the refinement's own whitened Jacobian at the candidate's similarity
+        for c, e, sigma in zip(cands, evs, many, strict=True):
+            problem = _refine._similarity_problem(c, e, settings)
+            assert problem is not None
+            resid_jac, x0 = problem
+            _r, J = resid_jac(x0)
+            plain = _refine._position_sigma_m(J, c.enu_from_world, world_cam)
+            assert plain is not None
+            assert sigma == pytest.approx(plain, rel=1e-9)
 
 
 def test_ground_observation_matches_one_cast_per_pixel(
@@ -264,3 +273,15 @@ def test_bundle_position_sigmas_batched_are_the_single_ones(
     assert any(len(got) >= 2 for got, _one in seen)
     for got, one in seen:
         assert got == one
+
+
+def test_a_result_keeps_no_placement_memo(
+    located: list[tuple[Scene, CalibrationResult]], baltimore: MapData
+) -> None:
+    scene, cal = located[0]
+    result = _pipeline.locate(scene, baltimore, calibration=cal)
+    evs = {id(c.evidence): c.evidence for c in result.candidates if c.evidence is not None}
+    assert evs
+    for ev in evs.values():
+        assert ev.placement_memo == {}
+        assert ev.observation_table is None

@@ -133,7 +133,18 @@ def locate(
             result.intersection = top_ev.intersection
     except NoCandidatesError as exc:
         result.reason = str(exc)
+    finally:
+        _forget_placements(ev, result.candidates)
     return result
+
+
+def _forget_placements(ev: Evidence, cands: list[Candidate]) -> None:
+    """Empty the placement memos of the evidence the result keeps (its candidates'): they
+    serve one run of :func:`locate`, and would hold every placement tried (~100 per scene)
+    for as long as the result lives."""
+    for e in {id(e): e for e in [ev, *(c.evidence for c in cands)] if e is not None}.values():
+        e.placement_memo.clear()
+        e.observation_table = None
 
 
 def _other_junction_candidates(

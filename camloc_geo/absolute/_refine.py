@@ -160,12 +160,40 @@ def position_sigma_m(
     """1-sigma position uncertainty of a candidate as it stands (no refinement): the
     covariance of the least-squares fit of ``enu_from_world`` to its matched evidence,
     linearised at the candidate's own similarity."""
-    problem = _similarity_problem(cand, ev, settings)
-    if problem is None:
+    return position_sigmas_m([cand], world_cam, [ev], settings)[0]
+
+
+def _normal_matrix_at_start(
+    cand: Candidate, ev: Evidence, settings: LocateSettings
+) -> FloatArray | None:
+    """``JᵀJ`` of the refinement's problem at the candidate's own similarity, None with no
+    match: ``Σ_k D_kᵀ Λ_k D_k`` over the matched points (``D_k`` the point's ENU position's
+    Jacobian in (θ, tx, ty, ln s), ``Λ_k`` its precision) plus the scale prior's and the
+    bearing prior's rows; the refinement's whitened ``J`` gives the same matrix up to
+    rounding (``Λ = L Lᵀ``), without its Cholesky factors and closure."""
+    obs_q = _matched_points(cand, ev)
+    if not obs_q:
         return None
-    resid_jac, x0 = problem
-    _r, J = resid_jac(x0)
-    return _position_sigma_m(J, cand.enu_from_world, world_cam)
+    street_brg = _street_bearing_prior(cand, ev, settings)
+    sim = cand.enu_from_world
+    here = placement(ev, sim)
+    prec = np.stack([here.carried(o)[1] for o, _q in obs_q])  # (n, 2, 2)
+    P = np.array([o.world_xy for o, _q in obs_q], dtype=np.float64)
+    s, theta = float(sim.scale), float(sim.rotation_rad)
+    a, b = s * math.cos(theta), s * math.sin(theta)
+    px, py = P[:, 0], P[:, 1]
+    D = np.zeros((len(obs_q), 2, 4))
+    D[:, 0, 0] = -b * px - a * py  # ∂/∂θ of s R(θ) p: s (−sin p + cos p⊥)
+    D[:, 1, 0] = a * px - b * py
+    D[:, 0, 1] = 1.0  # ∂/∂tx, ∂/∂ty
+    D[:, 1, 2] = 1.0
+    D[:, 0, 3] = a * px - b * py  # ∂/∂ln s: s R(θ) p
+    D[:, 1, 3] = b * px + a * py
+    JtJ = np.einsum("nia,nij,njb->ab", D, prec, D)
+    JtJ[3, 3] += (1.0 / max(settings.scale_sigma_rel, 1e-6)) ** 2
+    if street_brg is not None:
+        JtJ[0, 0] += (math.degrees(1.0) / settings.bearing_sigma_deg) ** 2
+    return np.asarray(JtJ, dtype=np.float64)
 
 
 def position_sigmas_m(
@@ -181,12 +209,9 @@ def position_sigmas_m(
     rows: list[tuple[int, FloatArray, FloatArray]] = []  # (index, JᵀJ, Jp)
     Cw = world_cam.center_in_world[:2]
     for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
-        problem = _similarity_problem(cand, ev, settings)
-        if problem is None:
-            continue
-        resid_jac, x0 = problem
-        _r, J = resid_jac(x0)
-        rows.append((k, J.T @ J, _position_jacobian(cand.enu_from_world, Cw)))
+        JtJ = _normal_matrix_at_start(cand, ev, settings)
+        if JtJ is not None:
+            rows.append((k, JtJ, _position_jacobian(cand.enu_from_world, Cw)))
     for (k, _JtJ, _Jp), sigma in zip(rows, _propagated_sigmas(rows), strict=True):
         out[k] = sigma
     return out
