@@ -1139,7 +1139,7 @@ class _JointProblem:
 
     @weights.setter
     def weights(self, value: FloatArray) -> None:
-        self._weights = np.asarray(value, dtype=float)
+        self._weights = np.array(value, dtype=float)  # a copy: the version below holds
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
         self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
