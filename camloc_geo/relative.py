@@ -703,12 +703,7 @@ def _ground_corner_sensitivity(
     JW = J * w[:, None]
     H = J.T @ JW
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
-    clicks = prob.pt_pix.reshape(-1, 4, 2)
-    # 1-sigma moves of each click along its annotator's length and width edges, pixels:
-    # steps[j, e] for click j, edge e (a zero edge gives no column)
-    edges = np.stack([clicks[:, 1] - clicks[:, 0], clicks[:, 2] - clicks[:, 0]], axis=1)
-    steps = np.repeat(rel * edges, 4, axis=0)  # (n_pt, 2, 2)
-    live = np.repeat(np.linalg.norm(edges, axis=2) > 0.0, 4, axis=0)  # (n_pt, 2)
+    steps, live = prob.ground_corner_steps()
     if not np.any(live):
         return None
     # Jᵀ W dr, dr nonzero only at the click's u and v rows: one column per (click, edge)
@@ -757,10 +752,7 @@ def _ground_corner_evidence(prob: _JointProblem, r: FloatArray) -> float:
     a_seg, a_pt = w_seg**2, w_pt**2  # the annotators' weights per row
     line_end_var = 2.0 * float(a_seg @ d_seg**2) / max(float(a_seg.sum()) - 6.0, 1.0)
     click_var = float(a_pt @ (d_u**2 + d_v**2)) / max(2.0 * float(a_pt.sum()) - 3.0, 1.0)
-    clicks = prob.pt_pix.reshape(-1, 4, 2)
-    edge_sq = np.sum((clicks[:, 1] - clicks[:, 0]) ** 2, axis=1) + np.sum(
-        (clicks[:, 2] - clicks[:, 0]) ** 2, axis=1
-    )  # per annotator: |length edge|² + |width edge|², pixels²
+    edge_sq = prob.ground_corner_edge_sq()  # per annotator: |length edge|² + |width edge|², px²
     a_ann = a_pt[::4]  # per annotator: the weighted mean of edge_sq (np.average's arithmetic)
     term_var = prob.ground_corner_sigma_rel**2 * float((edge_sq * a_ann).sum() / a_ann.sum()) / 2.0
     if term_var <= 0.0:
@@ -851,6 +843,9 @@ class _JointProblem:
         # after a reweighting starts from the point the last one ended at without a new
         # evaluation.
         self._memo: dict[tuple[Any, ...], _Evaluation] = {}
+        self._jtj_inverse: tuple[FloatArray, FloatArray] | None = None  # see _jtj_inverse
+        self._ground_corner_steps: tuple[FloatArray, npt.NDArray[np.bool_]] | None = None
+        self._ground_corner_edge_sq: FloatArray | None = None
 
     def _memo_key(
         self,
@@ -908,6 +903,27 @@ class _JointProblem:
         return self._residuals_batch_scaled(
             X, R0, pp_fixed, f_fixed, self._seg_scale_unit, self._pt_scale_unit
         )
+
+    def ground_corner_steps(self) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+        """1-sigma moves of each click along its annotator's length and width edges
+        (pixels): ``steps (n_pt, 2, 2)`` for click j, edge e, and which are ``live`` (a zero
+        edge gives no column). Fixed by the clicks: computed once."""
+        if self._ground_corner_steps is None:
+            clicks = self.pt_pix.reshape(-1, 4, 2)
+            edges = np.stack([clicks[:, 1] - clicks[:, 0], clicks[:, 2] - clicks[:, 0]], axis=1)
+            steps = np.repeat(self.ground_corner_sigma_rel * edges, 4, axis=0)
+            live = np.repeat(np.linalg.norm(edges, axis=2) > 0.0, 4, axis=0)
+            self._ground_corner_steps = (steps, live)
+        return self._ground_corner_steps
+
+    def ground_corner_edge_sq(self) -> FloatArray:
+        """Per annotator ``|length edge|² + |width edge|²`` of the clicks, pixels²."""
+        if self._ground_corner_edge_sq is None:
+            clicks = self.pt_pix.reshape(-1, 4, 2)
+            self._ground_corner_edge_sq = np.sum(
+                (clicks[:, 1] - clicks[:, 0]) ** 2, axis=1
+            ) + np.sum((clicks[:, 2] - clicks[:, 0]) ** 2, axis=1)
+        return self._ground_corner_edge_sq
 
     def set_photo_segments(
         self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
@@ -1139,7 +1155,7 @@ class _JointProblem:
 
     @weights.setter
     def weights(self, value: FloatArray) -> None:
-        self._weights = np.asarray(value, dtype=float)
+        self._weights = np.array(value, dtype=float)  # a copy: the version below holds
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
         self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
@@ -2775,12 +2791,23 @@ def _reassign_corners(
     return x
 
 
-def _param_sigma(res: Any, sl: slice) -> float | None:
+def _jtj_inverse(prob: _JointProblem, jac: FloatArray) -> FloatArray:
+    """``_sym_inverse(jac.T @ jac)``, remembered by ``prob`` for the last ``jac`` object
+    (the focal prior's check and the covariance look at the same final fit)."""
+    last = prob._jtj_inverse
+    if last is not None and last[0] is jac:
+        return last[1]
+    inv = _sym_inverse(jac.T @ jac)
+    prob._jtj_inverse = (jac, inv)
+    return inv
+
+
+def _param_sigma(prob: _JointProblem, res: Any, sl: slice) -> float | None:
     """Largest 1-sigma of a block of fitted parameters (Gauss-Newton covariance)."""
     dof = max(len(res.fun) - len(res.x), 1)
     s2 = max(2.0 * res.cost / dof, 1e-12)
     try:
-        cov = _sym_inverse(res.jac.T @ res.jac) * s2
+        cov = _jtj_inverse(prob, res.jac) * s2
     except np.linalg.LinAlgError:
         return None
     return float(np.sqrt(np.max(np.clip(np.diag(cov)[sl], 0, None))))
@@ -2815,7 +2842,7 @@ def _focal_prior(
       MAP comparison) is lower.
     """
     sigma = settings.focal_prior_sigma_log
-    sig_log_f = _param_sigma(res, slice(0, 1))
+    sig_log_f = _param_sigma(prob, res, slice(0, 1))
     if sig_log_f is None or sig_log_f > settings.focal_prior_when_sigma_log:
         prob.log_f_prior_sigma = sigma
         return _fit(prob, res.x, R0, pp_fixed, None)
@@ -2926,7 +2953,8 @@ def _joint(
     x0 = res.x
     for _ in range(3):  # iteratively reweighted over annotators
         new_w = _cauchy_weights(prob.per_annotator_rms(x0, R0, pp_fixed, f_fixed))
-        if np.allclose(new_w, prob.weights, atol=0.02):
+        if bool(np.all(np.abs(new_w - prob.weights) <= 0.02 + 1e-5 * np.abs(prob.weights))):
+            # (np.allclose(new_w, prob.weights, atol=0.02) without its per-call overhead)
             break
         prob.weights = new_w
         x0 = _fit(
@@ -2962,7 +2990,9 @@ def _joint(
         improvement = (cost_fixed - cost_free) / s2
         # Freeing the principal point must pay for itself clearly: a chi-square(2) jump at
         # p < 1e-6 (27.6) on top of the BIC penalty, and a well-determined result.
-        pp_sigma = _param_sigma(res_free, slice(int(f_fixed is None), int(f_fixed is None) + 2))
+        pp_sigma = _param_sigma(
+            prob, res_free, slice(int(f_fixed is None), int(f_fixed is None) + 2)
+        )
         well_determined = pp_sigma is not None and pp_sigma < 0.02 * math.hypot(width, height)
         justified = improvement > 27.6 + 2.0 * math.log(n_res) and well_determined
         if free_pp or (justified and res_free.success):
@@ -3192,7 +3222,7 @@ def _output_covariance(
     dof = max(len(fun) - n_x, 1)
     s2 = max(2.0 * soft_l1_cost(fun, _F_SCALE) / dof, 1e-12)
     try:
-        cov = _sym_inverse(J.T @ J) * s2
+        cov = _jtj_inverse(prob, J) * s2
     except np.linalg.LinAlgError:
         return None
     # Positions of x's entries in z = (log f, pp x, pp y, ω, C).
