@@ -121,6 +121,39 @@ def test_photo_looking_up_60_degrees_or_more_is_right_or_warned(
     assert float(said[0]) == pytest.approx(abs(pitch_deg), abs=1.0)
 
 
+@pytest.mark.parametrize("facade_yaw_deg", [0.0, 10.0])
+@pytest.mark.parametrize("pitch_deg", [-60.0, -70.0, -80.0])
+def test_square_on_facade_looking_up_steeply_is_still_warned(
+    pitch_deg: float, facade_yaw_deg: float
+) -> None:
+    """Seen square-on (or 10 degrees off), a facade looking up 60-80 degrees is read as
+    looking down 30-10 degrees; the roll test (cameras do not roll) leaves it warned: its
+    verticals roll the camera 0 degrees, the looking-down reading 0-12."""
+    segs, size = facade_segments(pitch_deg, facade_yaw_deg=facade_yaw_deg)
+    res = detect_vanishing_points(None, segments=segs, image_size=size)
+    if abs(res.pitch_deg - pitch_deg) <= 1.0:
+        return  # got it right
+    assert res.pitch_deg == pytest.approx(90.0 + pitch_deg, abs=2.5)
+    assert not res.vertical_identified
+    assert res.confidence < 0.5
+    said = [m for w in res.warnings for m in re.findall(r"or up (\d+) degrees", w)]
+    assert [float(x) for x in said] == [pytest.approx(-pitch_deg, abs=2.0)]
+
+
+def test_rolls_more_compares_the_two_readings_rolls() -> None:
+    """Reading a direction 30 degrees off the image's vertical axis as the vertical rolls
+    the camera 30 degrees: more than 10 beyond a reading that rolls it 0, not beyond one
+    that rolls it 25."""
+    t = math.radians(30.0)
+    level = np.array([0.0, -1.0, 0.0])  # rolls 0
+    rolled = np.array([math.sin(t), -math.cos(t), 0.0])  # rolls 30
+    rolled_25 = np.array([math.sin(math.radians(25.0)), -math.cos(math.radians(25.0)), 0.0])
+    dirs = np.array([level, rolled, [0.0, 0.0, 1.0]])
+    assert autovp._rolls_more(dirs, 1, 0)
+    assert not autovp._rolls_more(dirs, 0, 1)
+    assert not autovp._rolls_more(np.array([rolled_25, rolled, [0.0, 0.0, 1.0]]), 1, 0)
+
+
 def test_steep_up_rival_is_named_with_the_lines_it_has() -> None:
     """The -60 degree facade (seed 0) was read as looking down 27 degrees with no warning:
     the reading kept and the rival's lines are stated."""
