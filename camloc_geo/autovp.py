@@ -69,7 +69,10 @@ degrees, resting on a few courses of a side wall), and a comparably supported ri
 named in a warning. Beyond that (looking up 60-80 degrees is the frame of looking down
 30-10) the prior may keep the looking-down reading, but a rival with twice the lines that
 would make the camera look up steeply is then named in a warning and the confidence is
-halved (``_steep_up_rival``).
+halved (``_steep_up_rival``). Neither counts a rival that would roll the camera more than
+10 degrees beyond the kept reading (``_rolls_more``): cameras rarely roll, and a street
+camera's lane markings, seen at an angle, converge off the image's vertical axis, where a
+facade's verticals seen looking up do not.
 """
 
 from __future__ import annotations
@@ -1585,7 +1588,9 @@ def _vertical_index(
     slopes, paving joints or a side wall's courses. That is then not a clear
     identification. Beyond that tilt (looking up 55-60 degrees, read as looking down
     30-35) the prior stands, unless its vertical has fewer than :data:`_MIN_SUPPORT`
-    distinct lines, and the ambiguity is only stated.
+    distinct lines, and the ambiguity is only stated. A rival that would roll the camera
+    more than :data:`_ROLL_MARGIN_DEG` beyond the likeliest reading does not win
+    (:func:`_rolls_more`).
 
     Returns
     -------
@@ -1648,7 +1653,9 @@ def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | 
     :data:`_FEW_LINES` distinct lines and the rival :data:`_VERTICAL_SUPPORT_RATIO` times as
     many (and at least :data:`_WEAK_LINES`), the prior alone decided: the caller says so.
     (A level camera down a corridor or a street, its verticals many, is left alone: the
-    street's lines would have it look up 75-90 degrees.)
+    street's lines would have it look up 75-90 degrees.) A rival that would roll the camera
+    more than :data:`_ROLL_MARGIN_DEG` beyond the kept reading is not counted
+    (:func:`_rolls_more`: a street camera's lane markings, seen at an angle).
 
     Parameters
     ----------
