@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/vp_real.py [--strecha DIR] [--sceaux DIR] [--lund DIR] [--yud DIR]
                                  [--limit N] [--sets strecha,sceaux,perrot,lund,exif,yud]
+    python benchmarks/vp_real.py --sets street [--street-frames 30]
 
 The photos (none of them is in this repository; their licences keep them out):
 
@@ -53,6 +54,12 @@ The photos (none of them is in this repository; their licences keep them out):
     separated): each is a set named by its folder, truth from EXIF as for ``perrot``,
     run with and without it. Photos without a usable EXIF focal length are skipped
     (counted in the log).
+``street`` (not photographs; only when ``--sets`` names it)
+    ``--street-frames`` (30) rendered traffic frames
+    (:mod:`camloc_geo.testing.traffic_render`: a pole camera 6-9 m up looking down 15-23
+    degrees at a road with lane markings, a parked car and traffic; no building, so no
+    vertical line but the cars' edges). The product's main case with exact truth: the
+    steep looking-up warning must stay silent there.
 ``yud``
     The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
     published calibration, horizon from the ground-truth vanishing points; research use
@@ -70,6 +77,9 @@ row says so):
 - the ROC AUC of ``1 - confidence`` as a predictor of a focal error over 10 %;
 - "confidently wrong": off by more than 10 % and more than twice the stated sigma, with
   no warning and confidence at least 0.5;
+- how often the steep looking-up warning ("..., or up 60 degrees ...") is given
+  (``n_warned_looking_up``), and where the truth gives gravity, on photos that do not look
+  up 45 degrees (``n_warned_looking_up_wrongly``);
 - the share of photos with the pitch within 5 degrees, where the truth gives gravity,
   and the same figures for the outdoor photos looking up by more than 5 degrees (the
   Strecha photos: looking up 5 to 15 degrees; none of the sets looks up steeply, so the
@@ -316,6 +326,46 @@ def load_lund(root: Path) -> list[dict[str, Any]]:
     return out
 
 
+def load_street_set(n_frames: int) -> list[dict[str, Any]]:
+    """Rendered traffic frames: ``n_frames`` pole cameras 6-9 m up looking down 15-23
+    degrees at a road (lane markings, kerbs, a parked car, traffic), as
+    :mod:`camloc_geo.testing.traffic_render` draws its videos' frames (seeds 0, 1, ...).
+
+    Not photographs: the product's main case (a street webcam looking down at a road)
+    with exact truth, where the steep looking-up warning must stay silent. Truth: the
+    camera's focal length, principal point and gravity.
+    """
+    from camloc_geo.testing import traffic_render as tr
+
+    out = []
+    for seed in range(n_frames):
+        rng = np.random.default_rng(seed)
+        cam, vehicles = tr.random_street(rng, n_vehicles=6, duration_s=10.0)
+        w, h = round(2 * cam.principal_point[0]), round(2 * cam.principal_point[1])
+        img = tr._background(cam, (w, h), rng, 0.025)
+        sedan = tr.PRESETS["sedan"]
+        parked = tr.StreetVehicle(
+            (sedan.length_m / 2, sedan.width_m / 2), 0.0, 0.0, shape=tr.SHAPES["sedan"]
+        )
+        t_s = float(rng.uniform(0.0, 10.0))
+        for veh in [parked, *vehicles]:
+            tr._draw(img, cam, veh, t_s, True)
+        img = np.clip(img + rng.normal(0.0, 2.0, img.shape), 0, 255).astype(np.uint8)
+        up = cam.cam_from_world_rotation @ np.array([0.0, 0.0, 1.0])
+        out.append(
+            {
+                "set": "street",
+                "name": f"street/seed{seed}",
+                "path": img,
+                "f": float(cam.img_from_cam[0, 0]),
+                "pp": (float(cam.principal_point[0]), float(cam.principal_point[1])),
+                "up": up if up[1] < 0 else -up,
+                "size": (w, h),
+            }
+        )
+    return out
+
+
 def load_yud_set(root: Path) -> list[dict[str, Any]]:
     out = []
     for g in load_yud(root):
@@ -422,6 +472,11 @@ def _tilt_coverage(ok: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
+def _warned_up(row: dict[str, Any]) -> bool:
+    """Whether the steep looking-up warning ("..., or up 60 degrees (...)") was given."""
+    return any(" or up " in w for w in row.get("warnings", []))
+
+
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     ok = [r for r in rows if "f" in r]
     n = len(rows)
@@ -457,6 +512,12 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "roc_auc_confidence_vs_err10": roc_auc(1.0 - conf, bad) if len(ok) else None,
         "n_confidently_wrong": int(confidently_wrong.sum()),
         "n_warned": int(warned.sum()),
+        # the steep looking-up warning ("... or up 60 degrees ..."), and where the truth
+        # gives gravity, how often it fires on a photo that does not look up 45 degrees
+        "n_warned_looking_up": int(sum(_warned_up(r) for r in ok)),
+        "n_warned_looking_up_wrongly": int(
+            sum(_warned_up(r) and r.get("pitch_true_deg", -90.0) > -45.0 for r in with_up)
+        ),
         **_tilt_coverage(ok),
         "n_with_horizon_truth": len(hz),
         "horizon_auc_pct": 100.0 * horizon_auc(hz) if hz else None,
@@ -562,6 +623,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sets", default="strecha,sceaux,perrot,lund,exif,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
+        "--street-frames",
+        type=int,
+        default=30,
+        help="rendered traffic frames in the 'street' set (not run unless --sets has it)",
+    )
+    ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
     args = ap.parse_args(argv)
@@ -581,6 +648,8 @@ def main(argv: list[str] | None = None) -> int:
             log.warning("%s: not found at %s (%s)", name, root, HOW_TO_GET)
             continue
         data.extend(loader(root)[: args.limit])
+    if "street" in wanted:
+        data.extend(load_street_set(args.street_frames))
     for d in args.exif_dir if "exif" in wanted else []:
         if not d.is_dir():
             log.warning("--exif-dir %s: not a folder", d)
@@ -604,7 +673,7 @@ def main(argv: list[str] | None = None) -> int:
                     summary[tag][f"{s} / {scene}"] = summarise(
                         [r for r in rows if r["set"] == s and r["name"].split("/")[1] == scene]
                     )
-        outdoor = [r for r in rows if r["set"] != "yud"]
+        outdoor = [r for r in rows if r["set"] not in ("yud", "street")]
         if outdoor and len(outdoor) != len(rows):
             summary[tag]["outdoor (all but yud)"] = summarise(outdoor)
         # photos looking up at a building, where the truth gives gravity
@@ -625,6 +694,7 @@ def main(argv: list[str] | None = None) -> int:
         ("roc_auc_confidence_vs_err10", "ROC AUC", "{:.2f}"),
         ("n_confidently_wrong", "conf.wrong", "{}"),
         ("n_warned", "warned", "{}"),
+        ("n_warned_looking_up", "warned up", "{}"),
         ("horizon_auc_pct", "hz AUC %", "{:.1f}"),
         ("share_pitch_within_5deg", "pitch<=5deg", "{:.2f}"),
         ("pitch_sigma_cover_1", "pitch 1sig", "{:.2f}"),

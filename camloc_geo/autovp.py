@@ -69,7 +69,10 @@ degrees, resting on a few courses of a side wall), and a comparably supported ri
 named in a warning. Beyond that (looking up 60-80 degrees is the frame of looking down
 30-10) the prior may keep the looking-down reading, but a rival with twice the lines that
 would make the camera look up steeply is then named in a warning and the confidence is
-halved (``_steep_up_rival``).
+halved (``_steep_up_rival``). Neither counts a rival that would roll the camera more than
+10 degrees beyond the kept reading (``_rolls_more``): cameras rarely roll, and a street
+camera's lane markings, seen at an angle, converge off the image's vertical axis, where a
+facade's verticals seen looking up do not.
 """
 
 from __future__ import annotations
@@ -170,6 +173,14 @@ _VERTICAL_RIVAL_TILT_DEG = 15.0
 #: in a warning and the confidence is halved (``_steep_up_rival``).
 _STEEP_UP_MIN_DEG = 45.0
 _STEEP_UP_MAX_DEG = 82.0
+#: A rival reading of the vertical that rolls the camera by more than this (degrees) beyond
+#: the kept reading's roll is no evidence of looking up: cameras rarely roll. A street camera
+#: looking down 15-40 degrees across or along a road at an angle (yaw 10-25 degrees) sees
+#: its lane markings converge to a point off the image's vertical axis: read as the
+#: vertical they roll it 20-70 degrees (rendered traffic frames: 50-69). A facade seen
+#: looking up at an angle is the other way round: its verticals roll it 0 degrees, the
+#: looking-down reading 10-28 (``_rolls_more``).
+_ROLL_MARGIN_DEG = 10.0
 #: Distinct lines (all directions) at which the chance of a wrong Manhattan frame is 1:
 #: it falls as the cube of this over the number of lines (see ``_finish``).
 _MODEL_ERROR_LINES = 25.0
@@ -1577,7 +1588,9 @@ def _vertical_index(
     slopes, paving joints or a side wall's courses. That is then not a clear
     identification. Beyond that tilt (looking up 55-60 degrees, read as looking down
     30-35) the prior stands, unless its vertical has fewer than :data:`_MIN_SUPPORT`
-    distinct lines, and the ambiguity is only stated.
+    distinct lines, and the ambiguity is only stated. A rival that would roll the camera
+    more than :data:`_ROLL_MARGIN_DEG` beyond the likeliest reading does not win
+    (:func:`_rolls_more`).
 
     Returns
     -------
@@ -1598,6 +1611,7 @@ def _vertical_index(
         and n_lines[k] >= _VERTICAL_SUPPORT_RATIO * max(1, n_lines[kv])
         # a vertical with hardly any lines of its own does not hold against them
         and (angle[k] < angle[kv] + _VERTICAL_RIVAL_TILT_DEG or n_lines[kv] < _MIN_SUPPORT)
+        and not _rolls_more(dirs, k, kv)
     ]
     if rivals:
         k_new = max(rivals, key=lambda k: n_lines[k])
@@ -1609,6 +1623,27 @@ def _vertical_index(
     return kv, identified, k2
 
 
+def _rolls_more(dirs: FloatArray, k: int, kv: int) -> bool:
+    """Whether reading direction ``k`` as the vertical rolls the camera by more than
+    :data:`_ROLL_MARGIN_DEG` beyond reading ``kv`` so.
+
+    Cameras rarely roll (webcams are mounted level, photos are held level); a rival reading
+    that needs a roll the kept one does not is no evidence for itself. (Lane markings seen
+    from a street camera looking down at a road at an angle converge off the image's
+    vertical axis; a facade's verticals seen looking up do not.)
+
+    Parameters
+    ----------
+    dirs
+        ``(3, 3)`` unit directions (rows) in the camera frame.
+    k, kv
+        Indices of the rival and of the kept reading.
+    """
+    roll_k = abs(pitch_roll_from_up(_up_sign(dirs[k]))[1])
+    roll_kv = abs(pitch_roll_from_up(_up_sign(dirs[kv]))[1])
+    return roll_k > roll_kv + _ROLL_MARGIN_DEG
+
+
 def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | None:
     """A better-supported direction that would make the camera look up steeply, or None.
 
@@ -1618,7 +1653,9 @@ def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | 
     :data:`_FEW_LINES` distinct lines and the rival :data:`_VERTICAL_SUPPORT_RATIO` times as
     many (and at least :data:`_WEAK_LINES`), the prior alone decided: the caller says so.
     (A level camera down a corridor or a street, its verticals many, is left alone: the
-    street's lines would have it look up 75-90 degrees.)
+    street's lines would have it look up 75-90 degrees.) A rival that would roll the camera
+    more than :data:`_ROLL_MARGIN_DEG` beyond the kept reading is not counted
+    (:func:`_rolls_more`: a street camera's lane markings, seen at an angle).
 
     Parameters
     ----------
@@ -1639,6 +1676,7 @@ def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | 
             -_STEEP_UP_MAX_DEG < pitch <= -_STEEP_UP_MIN_DEG < kept_pitch
             and n_lines[kv] < _FEW_LINES
             and n_lines[k] >= max(_WEAK_LINES, _VERTICAL_SUPPORT_RATIO * max(1, n_lines[kv]))
+            and not _rolls_more(dirs, k, kv)
             and (best is None or n_lines[k] > n_lines[best])
         ):
             best = k
