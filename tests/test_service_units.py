@@ -394,3 +394,36 @@ def test_fast_path_answers_exactly_as_the_fastapi_routes(
     assert [a[0] for a in with_fast] == [200, 200, 200, 422, 422, 422, 422, 422, 401, 401, 415]
     assert with_fast == without
     assert len(with_fast[1][2]["features"]) < len(with_fast[0][2]["features"])
+
+
+def test_fast_path_cuts_off_a_body_without_length_over_the_limit(tmp_path: Path) -> None:
+    import asyncio
+    from collections.abc import AsyncIterator
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", max_request_bytes=1_000, workers=0))
+
+    async def chunks() -> AsyncIterator[bytes]:  # no Content-Length: streamed
+        for _ in range(4):
+            yield b" " * 400
+
+    async def post() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.post(
+                "/v1/locate", content=chunks(), headers={"content-type": "application/json"}
+            )
+
+    r = asyncio.run(post())
+    app.state.compute.shutdown()
+    assert r.status_code == 413
+    assert r.json()["error"] == {
+        "type": "limit_exceeded",
+        "message": "request body over 1000 bytes",
+        "field": "body",
+    }
+    assert r.json()["request_id"] == r.headers["x-request-id"]
