@@ -293,3 +293,137 @@ def test_serve_names_a_missing_speed_up(
     monkeypatch.setattr(serve, "_importable", lambda name: name != module)
     with pytest.raises(InputError, match=rf"{option} {module}: {module} is not installed"):
         serve.run(_serve_args(option, module))
+
+
+@pytest.mark.parametrize(
+    ("query", "expected"),
+    [
+        (b"", (True, None)),
+        (b"max_candidates=5", (True, 5)),
+        (b"other=1&max_candidates=100", (True, 100)),
+        (b"other=x", (True, None)),
+        (b"max_candidates=0", (False, None)),
+        (b"max_candidates=101", (False, None)),
+        (b"max_candidates=abc", (False, None)),
+        (b"max_candidates=-3", (False, None)),
+        (b"max_candidates=5.0", (False, None)),
+        (b"max_candidates=", (False, None)),
+        (b"max_candidates=%D9%A3", (False, None)),  # an Arabic-Indic 3: FastAPI's to judge
+        (b"max_candidates=2&max_candidates=3", (False, None)),
+    ],
+)
+def test_fast_path_takes_only_plain_queries(query: bytes, expected: tuple[bool, Any]) -> None:
+    from camloc_geo.service.fastpath import max_candidates_of
+
+    assert max_candidates_of(query) == expected
+
+
+def test_fast_path_answers_exactly_as_the_fastapi_routes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the same requests to the app with and without the fast path: same status, same body
+    import asyncio
+    import shutil
+
+    import httpx
+    from pydantic import SecretStr
+
+    from camloc_geo.service import app as app_module
+    from camloc_geo.service import create_app, fastpath
+    from camloc_geo.service.settings import Settings
+
+    (tmp_path / "maps").mkdir()
+    shutil.copy(SAMPLES / "baltimore.osm.pbf", tmp_path / "maps")
+    settings = Settings(
+        map_dir=tmp_path / "maps", data_dir=tmp_path / "d", api_key=SecretStr("k\u00e9y"), workers=0
+    )
+    plain: list[bool] = []
+    real_plain = fastpath.SceneFastPath._plain
+
+    def spy(self: Any, scope: Any) -> tuple[bool, int | None]:
+        out = real_plain(self, scope)
+        plain.append(out[0])
+        return out
+
+    monkeypatch.setattr(fastpath.SceneFastPath, "_plain", spy)
+    body = json.dumps(SCENE).encode()
+    key = "k\u00e9y".encode("latin-1")  # how HTTP headers carry it (FastAPI reads Latin-1)
+    json_key = {"content-type": "application/json", "x-api-key": key}
+    requests: list[tuple[str, str, bytes, dict[str, Any]]] = [
+        ("/v1/locate", "", body, json_key),
+        ("/v1/locate", "max_candidates=2", body, json_key),
+        ("/v1/calibrate", "", body, {**json_key, "content-type": "Application/JSON; charset=x"}),
+        ("/v1/locate", "", b'{"format": "camloc-scene/1", "image": {"width": NaN}}', json_key),
+        ("/v1/locate", "", json.dumps([1]).encode(), json_key),
+        ("/v1/calibrate", "", json.dumps({**SCENE, "annotations": []}).encode(), json_key),
+        # FastAPI's to judge
+        ("/v1/locate", "max_candidates=0", body, json_key),
+        ("/v1/locate", "max_candidates=abc", body, json_key),
+        ("/v1/locate", "", body, {**json_key, "x-api-key": b"wrong"}),
+        ("/v1/locate", "", body, {"content-type": "application/json"}),
+        ("/v1/calibrate", "", body, {**json_key, "content-type": "text/plain"}),
+    ]
+
+    def drop_id(r: httpx.Response) -> Any:
+        data = r.json()
+        if isinstance(data, dict):
+            data.pop("request_id", None)
+            if "error" in data and data["error"].get("type") == "internal":
+                data["error"].pop("message")
+        return r.status_code, r.headers["content-type"], data
+
+    async def answers(fast: bool) -> list[Any]:
+        if not fast:
+            monkeypatch.setattr(app_module, "FAST_ROUTES", {})
+        app = create_app(settings)
+        transport = httpx.ASGITransport(app=app)
+        out = []
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            for path, query, content, headers in requests:
+                url = f"{path}?{query}" if query else path
+                r = await client.post(url, content=content, headers=headers)
+                out.append(drop_id(r))
+        app.state.compute.shutdown()
+        return out
+
+    with_fast = asyncio.run(answers(True))
+    assert plain == [True] * 6 + [False] * 5
+    plain.clear()
+    without = asyncio.run(answers(False))
+    assert plain == []
+    assert [a[0] for a in with_fast] == [200, 200, 200, 422, 422, 422, 422, 422, 401, 401, 415]
+    assert with_fast == without
+    assert len(with_fast[1][2]["features"]) < len(with_fast[0][2]["features"])
+
+
+def test_fast_path_cuts_off_a_body_without_length_over_the_limit(tmp_path: Path) -> None:
+    import asyncio
+    from collections.abc import AsyncIterator
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", max_request_bytes=1_000, workers=0))
+
+    async def chunks() -> AsyncIterator[bytes]:  # no Content-Length: streamed
+        for _ in range(4):
+            yield b" " * 400
+
+    async def post() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.post(
+                "/v1/locate", content=chunks(), headers={"content-type": "application/json"}
+            )
+
+    r = asyncio.run(post())
+    app.state.compute.shutdown()
+    assert r.status_code == 413
+    assert r.json()["error"] == {
+        "type": "limit_exceeded",
+        "message": "request body over 1000 bytes",
+        "field": "body",
+    }
+    assert r.json()["request_id"] == r.headers["x-request-id"]

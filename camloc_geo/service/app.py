@@ -15,11 +15,13 @@ from fastapi import FastAPI
 from camloc_geo import __version__
 from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import ERROR_STATUS, install_error_handlers
+from camloc_geo.service.fastpath import SceneFastPath
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.middleware import RequestLimits
 from camloc_geo.service.routers import ROUTERS
 from camloc_geo.service.routers.jobs import JobRunner
 from camloc_geo.service.routers.meta import install_docs
+from camloc_geo.service.routers.scenes import FAST_ROUTES
 from camloc_geo.service.settings import Settings
 from camloc_geo.service.store import Store
 
@@ -69,6 +71,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(router)
     install_error_handlers(app)
     install_docs(app)
+    # (the last added is the outermost: a request's id and body limit come first)
+    app.add_middleware(SceneFastPath, compute=compute, settings=settings, routes=FAST_ROUTES)
     app.add_middleware(
         RequestLimits,
         max_bytes=settings.max_request_bytes,

@@ -168,10 +168,14 @@ class Compute:
                 self._processes = None
             raise
 
-    async def run_json(self, fn: Callable[..., Any], *args: Any) -> Response:
+    async def run_bytes(self, fn: Callable[..., Any], *args: Any) -> bytes:
         """:meth:`run`, the answer written as JSON by the worker (the serving process only
         sends the bytes: no nested dict to copy between processes or to serialise)."""
-        return Response(await self.run(_as_json, fn, *args), media_type="application/json")
+        return await self.run(_as_json, fn, *args)
+
+    async def run_json(self, fn: Callable[..., Any], *args: Any) -> Response:
+        """:meth:`run_bytes` as a JSON response."""
+        return Response(await self.run_bytes(fn, *args), media_type="application/json")
 
     def executor(self) -> Executor:
         """The thread pool (for work that needs no map: parsing, the database)."""

@@ -34,6 +34,7 @@ __all__ = [
     "UnauthorizedError",
     "UnsupportedMediaError",
     "error_response",
+    "error_response_for",
     "install_error_handlers",
 ]
 
@@ -100,16 +101,20 @@ def error_response(
     return JSONResponse(body, status_code=status)
 
 
-async def _known(request: Request, exc: Exception) -> JSONResponse:
+def error_response_for(exc: BaseException, rid: str) -> JSONResponse:
+    """The answer to an exception: its row of :data:`ERROR_STATUS`, or a logged 500."""
     for cls, status, kind in ERROR_STATUS:
         if isinstance(exc, cls):
             if status >= 500:
-                log.warning("request %s: %s", request_id(request), exc)
+                log.warning("request %s: %s", rid, exc)
             message = " ".join(str(exc).split())
-            return error_response(
-                status, kind, message, getattr(exc, "field", None), request_id(request)
-            )
-    return await _unexpected(request, exc)
+            return error_response(status, kind, message, getattr(exc, "field", None), rid)
+    log.error("request %s failed", rid, exc_info=exc)
+    return error_response(500, "internal", f"internal error (request id {rid})", None, rid)
+
+
+async def _known(request: Request, exc: Exception) -> JSONResponse:
+    return error_response_for(exc, request_id(request))
 
 
 async def _unexpected(request: Request, exc: Exception) -> JSONResponse:

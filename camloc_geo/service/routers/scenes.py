@@ -10,6 +10,7 @@ from fastapi import APIRouter, Query
 from fastapi.responses import HTMLResponse, Response
 
 from camloc_geo.service.deps import ApiKey, SceneBytes, Workers, scene_from_raw
+from camloc_geo.service.fastpath import WorkCall
 from camloc_geo.service.models import LocateQuery
 from camloc_geo.service.work import locate_body
 
@@ -17,7 +18,7 @@ if TYPE_CHECKING:
     from camloc_geo.scene import Scene
     from camloc_geo.service.mapstore import MapStore
 
-__all__ = ["SCENE_BODY", "router"]
+__all__ = ["FAST_ROUTES", "SCENE_BODY", "router"]
 
 router = APIRouter(tags=["scenes"], dependencies=[ApiKey])
 
@@ -68,10 +69,24 @@ def review_work(maps: MapStore, scene: Scene | bytes) -> str:
         return path.read_text(encoding="utf-8")
 
 
+def _locate_call(raw: bytes, max_candidates: int | None) -> tuple[Any, tuple[Any, ...]]:
+    return locate_work, (raw, max_candidates)
+
+
+def _calibrate_call(raw: bytes, _max_candidates: int | None) -> tuple[Any, tuple[Any, ...]]:
+    return calibrate_work, (raw,)
+
+
+FAST_ROUTES: dict[str, WorkCall] = {"/v1/locate": _locate_call, "/v1/calibrate": _calibrate_call}
+"""The worker call of each endpoint that :class:`~camloc_geo.service.fastpath.SceneFastPath`
+answers on its plain requests; the routes below make the same call."""
+
+
 @router.post("/v1/calibrate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
 async def calibrate(body: SceneBytes, workers: Workers) -> Response:
     """Relative pose (focal length, rotation, camera position in the car's frame)."""
-    return await workers.run_json(calibrate_work, body.raw)
+    fn, args = _calibrate_call(body.raw, None)
+    return await workers.run_json(fn, *args)
 
 
 @router.post("/v1/locate", openapi_extra=SCENE_BODY, response_model=dict[str, Any])
@@ -79,7 +94,8 @@ async def locate(
     body: SceneBytes, workers: Workers, q: Annotated[LocateQuery, Query()]
 ) -> Response:
     """Candidate camera positions as the candidate GeoJSON, best first."""
-    return await workers.run_json(locate_work, body.raw, q.max_candidates)
+    fn, args = _locate_call(body.raw, q.max_candidates)
+    return await workers.run_json(fn, *args)
 
 
 @router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
