@@ -103,7 +103,7 @@ _unexpected_skips: list[str] = []
 
 
 def pytest_runtest_logreport(report: pytest.TestReport) -> None:
-    if report.skipped:
+    if report.skipped and not hasattr(report, "wasxfail"):  # an expected failure is no skip
         reason = str(report.longrepr[-1]) if isinstance(report.longrepr, tuple) else ""
         if not any(word in reason for word in _ALLOWED_SKIP_WORDS):
             _unexpected_skips.append(f"{report.nodeid}: {reason}")
