@@ -1975,7 +1975,7 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         try:
             result = _calibrate_annotations(_with_focal(scene, focal_px), settings)
             moved = _calibrate_annotations(
-                _with_focal(scene, focal_px * math.exp(std_rel)), settings
+                _with_focal(scene, focal_px * math.exp(std_rel)), settings, quiet=True
             )
         except InputError:
             raise exc from None
@@ -2043,7 +2043,9 @@ def _photo_focal(scene: Scene) -> tuple[float, float] | None:
     return f, sd
 
 
-def _calibrate_annotations(scene: Scene, settings: CalibrationSettings) -> CalibrationResult:
+def _calibrate_annotations(
+    scene: Scene, settings: CalibrationSettings, *, quiet: bool = False
+) -> CalibrationResult:
     """:func:`calibrate` from the annotations (and the photo's agreeing lines) alone.
 
     Crowd input degrades gracefully: clicks just outside the image are clamped (counted in
@@ -2058,6 +2060,8 @@ def _calibrate_annotations(scene: Scene, settings: CalibrationSettings) -> Calib
         A validated scene with at least one annotation.
     settings
         Tuning; defaults documented in :class:`CalibrationSettings`.
+    quiet
+        Log no warnings (they are still in the result): a sensitivity refit.
 
     Returns
     -------
@@ -2087,14 +2091,16 @@ def _calibrate_annotations(scene: Scene, settings: CalibrationSettings) -> Calib
     finally:
         # After the re-admission (its withdrawn warnings are not logged); before any error.
         for msg in screening.warnings[len(scene.input_warnings) :]:
-            log.warning("%s", msg)  # the scene's own were logged when it was read
+            if not quiet:
+                log.warning("%s", msg)  # the scene's own were logged when it was read
     problem = implausibility(result, scene.image_size)
     if problem is not None:
         result, dropped = _leave_one_out(clean, settings, result, problem)
         slot_name = clean.annotations[dropped].annotator
         reason = f"without this annotator the result is plausible (with: {problem})"
         msg = f"annotator {slot_name!r} (annotations[{kept[dropped]}]) left out: {reason}"
-        log.warning("%s", msg)
+        if not quiet:
+            log.warning("%s", msg)
         excluded.append({"annotator": slot_name, "index": kept[dropped], "reason": reason})
         screening.warnings.append(msg)
         # The result was fitted without the dropped slot: its indices skip it.
@@ -2115,7 +2121,8 @@ def _calibrate_annotations(scene: Scene, settings: CalibrationSettings) -> Calib
         dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
     )
     for msg in _photo_disagreement(scene, result):
-        log.warning("%s", msg)
+        if not quiet:
+            log.warning("%s", msg)
         result.warnings.append(msg)
     return result
 
