@@ -127,7 +127,9 @@ class CalibrationSettings:
         others) join the final fit with a small weight: each at ``PHOTO_SEGMENT_SIGMA``
         line sigmas, per axis at most as much as the annotators' average lines of that axis
         count, under the fit's robust loss (:func:`_add_photo_segments`). Lines that
-        disagree are not used (a clear disagreement is a warning); False: never.
+        disagree are not used (a clear disagreement is a warning); False: never. Also where
+        the annotations cannot fix the focal length: the photo's trustworthy one is used
+        (:func:`calibrate`); False: the refusal stands.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -1940,8 +1942,111 @@ def _remap(
     return result
 
 
+PHOTO_FOCAL_MIN_CONFIDENCE = 0.5  # autovp's confidence needed to take the photo's focal length
+
+
 def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> CalibrationResult:
     """Camera intrinsics, orientation and position relative to the annotated object.
+
+    Where the annotations cannot fix the focal length (no ``camera.focal_px`` and fewer than
+    two finite, consistent vanishing points) and the scene carries its photo
+    (``image.path``, ``CalibrationSettings.photo_lines`` on), the focal length comes from
+    the photo's own vanishing points (:mod:`camloc_geo.autovp`) when they are trustworthy
+    (:func:`_photo_focal`): ``intrinsics_method`` is then ``"photo_focal"``, a warning says
+    so, ``focal_sigma_px`` is the photo's, and the position and rotation sigmas include its
+    effect (the answer's move under a one-sigma change of the focal length). Otherwise the
+    refusal stands. See :func:`_calibrate_annotations` for the rest.
+    """
+    settings = settings or CalibrationSettings()
+    try:
+        return _calibrate_annotations(scene, settings)
+    except DegenerateGeometryError as exc:
+        if (
+            scene.camera.focal_px is not None
+            or not settings.photo_lines
+            or "give camera.focal_px" not in str(exc)
+        ):
+            raise
+        photo = _photo_focal(scene)
+        if photo is None:
+            raise
+        focal_px, std_rel = photo
+        refusal = str(exc)
+        try:
+            result = _calibrate_annotations(_with_focal(scene, focal_px), settings)
+            moved = _calibrate_annotations(
+                _with_focal(scene, focal_px * math.exp(std_rel)), settings, quiet=True
+            )
+        except InputError:
+            raise exc from None
+    sigma_f = focal_px * std_rel
+    result.focal_sigma_px = sigma_f
+    dC = np.abs(moved.camera.center_in_world - result.camera.center_in_world)
+    for name in ("position_sigma_m", "position_sigma_fit_m"):
+        value = getattr(result, name)
+        if value is not None:
+            setattr(result, name, np.hypot(value, dC))
+    dR = moved.camera.cam_from_world_rotation @ result.camera.cam_from_world_rotation.T
+    d_angle = np.abs(
+        np.degrees(np.array([dR[2, 1] - dR[1, 2], dR[0, 2] - dR[2, 0], dR[1, 0] - dR[0, 1]]) / 2.0)
+    )
+    for name in ("rotation_sigma_deg", "rotation_sigma_fit_deg"):
+        value = getattr(result, name)
+        if value is not None:
+            setattr(result, name, np.hypot(value, d_angle))
+    result.intrinsics_method = "photo_focal"
+    result.intrinsics_reason = (
+        f"the annotations could not fix the focal length ({refusal}); it comes from the photo's "
+        f"vanishing points: {focal_px:.1f} +/- {sigma_f:.1f} px"
+    )
+    msg = (
+        "the annotations could not fix the focal length; it came from the photo's vanishing "
+        f"points (image.path): {focal_px:.0f} +/- {sigma_f:.0f} px "
+        f"({100.0 * std_rel:.1f} %); give camera.focal_px if it is known"
+    )
+    log.warning("%s", msg)
+    result.warnings.append(msg)
+    return result
+
+
+def _with_focal(scene: Scene, focal_px: float) -> Scene:
+    """``scene`` with ``camera.focal_px`` set."""
+    return scene.model_copy(
+        update={"camera": scene.camera.model_copy(update={"focal_px": float(focal_px)})}
+    )
+
+
+def _photo_focal(scene: Scene) -> tuple[float, float] | None:
+    """The photo's focal length and its relative sigma, when autovp's answer is trustworthy.
+
+    Trustworthy: the photo's size is the scene's, autovp estimated it (or read it from EXIF;
+    not its default or a bound), ``confidence`` at least ``PHOTO_FOCAL_MIN_CONFIDENCE``, a
+    finite positive sigma, and no warning about the focal length. Otherwise None.
+    """
+    res = _photo_result(scene)
+    if res is None or tuple(res.image_size) != tuple(scene.image_size):
+        return None
+    f, sd = float(res.focal_px), float(res.focal_std_rel)
+    loose = any("focal length" in w for w in res.warnings)
+    if (
+        res.focal_source in ("prior", "bound", "given")
+        or loose
+        or float(res.confidence) < PHOTO_FOCAL_MIN_CONFIDENCE
+        or not (math.isfinite(f) and f > 0.0 and math.isfinite(sd) and sd > 0.0)
+    ):
+        log.info(
+            "image.path: the photo's focal length is not trustworthy (%s, confidence %.2f)",
+            res.focal_source,
+            float(res.confidence),
+        )
+        return None
+    return f, sd
+
+
+def _calibrate_annotations(
+    scene: Scene, settings: CalibrationSettings, *, quiet: bool = False
+) -> CalibrationResult:
+    """:func:`calibrate` from the annotations (and the photo's agreeing lines) alone.
 
     Crowd input degrades gracefully: clicks just outside the image are clamped (counted in
     ``clamped_clicks``), annotators whose work is unusable are left out with a warning
@@ -1955,6 +2060,8 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         A validated scene with at least one annotation.
     settings
         Tuning; defaults documented in :class:`CalibrationSettings`.
+    quiet
+        Log no warnings (they are still in the result): a sensitivity refit.
 
     Returns
     -------
@@ -1968,7 +2075,6 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         When no annotator's work determines a camera (the first annotator's problem is named),
         or no plausible camera is found (the reason is named).
     """
-    settings = settings or CalibrationSettings()
     if not scene.annotations:
         raise SceneError("at least one annotation is needed to calibrate", "annotations")
     names = [a.annotator for a in scene.annotations]
@@ -1985,14 +2091,16 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
     finally:
         # After the re-admission (its withdrawn warnings are not logged); before any error.
         for msg in screening.warnings[len(scene.input_warnings) :]:
-            log.warning("%s", msg)  # the scene's own were logged when it was read
+            if not quiet:
+                log.warning("%s", msg)  # the scene's own were logged when it was read
     problem = implausibility(result, scene.image_size)
     if problem is not None:
         result, dropped = _leave_one_out(clean, settings, result, problem)
         slot_name = clean.annotations[dropped].annotator
         reason = f"without this annotator the result is plausible (with: {problem})"
         msg = f"annotator {slot_name!r} (annotations[{kept[dropped]}]) left out: {reason}"
-        log.warning("%s", msg)
+        if not quiet:
+            log.warning("%s", msg)
         excluded.append({"annotator": slot_name, "index": kept[dropped], "reason": reason})
         screening.warnings.append(msg)
         # The result was fitted without the dropped slot: its indices skip it.
@@ -2013,7 +2121,8 @@ def calibrate(scene: Scene, settings: CalibrationSettings | None = None) -> Cali
         dict.fromkeys([*result.outlier_annotators, *(e["annotator"] for e in excluded)])
     )
     for msg in _photo_disagreement(scene, result):
-        log.warning("%s", msg)
+        if not quiet:
+            log.warning("%s", msg)
         result.warnings.append(msg)
     return result
 
