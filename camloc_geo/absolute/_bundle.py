@@ -39,7 +39,7 @@ import numpy.typing as npt
 from camloc_geo._optimize import (
     LeastSquaresResult,
     soft_l1_cost,
-    soft_l1_least_squares_many,
+    soft_l1_least_squares_many_small,
 )
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
@@ -317,7 +317,7 @@ def _bundle_many(
             starts.extend(r for r, _J in got)
         return got
 
-    results = soft_l1_least_squares_many(
+    results = soft_l1_least_squares_many_small(
         recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200, sigma_tol=_SIGMA_TOL
     )
     sigmas = _position_sigmas(results, state, n_cam)
