@@ -21,6 +21,9 @@ Two problems, two solvers, both typed and tested against
     The ``lm`` loop for several independent problems in lockstep (the absolute bundle
     adjustment of the leading candidates): each takes exactly the steps it takes alone
     (tested bit for bit), their evaluations are made in one call per round.
+:func:`soft_l1_least_squares_many_small`
+    The lockstep loop of :func:`soft_l1_least_squares_many`, step for step (tested bit for
+    bit), with :func:`soft_l1_least_squares_small`'s leaner bookkeeping (the bundle).
 :func:`gauss_newton`
     Plain Gauss-Newton for nearly linear problems with an analytic Jacobian (the absolute
     refinement of ``enu_from_world``): a handful of steps, stopping when the cost stops
@@ -44,6 +47,7 @@ __all__ = [
     "soft_l1_cost",
     "soft_l1_least_squares",
     "soft_l1_least_squares_many",
+    "soft_l1_least_squares_many_small",
     "soft_l1_least_squares_small",
 ]
 
@@ -466,6 +470,144 @@ def soft_l1_least_squares_many(
             )
         )
     return out
+
+
+def soft_l1_least_squares_many_small(
+    fun_and_jac_many: ManyResidualsAndJacobians,
+    x0s: list[FloatArray],
+    *,
+    f_scale: float,
+    tol: float = 1e-10,
+    max_nfev: int = 200,
+    damping: float = 1e-3,
+    sigma_tol: float | None = None,
+) -> list[LeastSquaresResult]:
+    """:func:`soft_l1_least_squares_many`, step for step, with fewer array operations a step.
+
+    The same iterations, tests and arithmetic, so the same results bit for bit (tested);
+    only a round's bookkeeping is leaner, as :func:`soft_l1_least_squares_small`'s: the
+    soft-L1 weights come from the square roots the cost already took, and the damped and
+    undamped normal equations of every problem go straight into one preallocated stack for
+    the round's single batched solve (problems of one size; otherwise, or when a system is
+    singular, :func:`_solve_many`'s path). Worth it where the problems are small (10-15
+    parameters, ~100 residuals) and the step's numpy calls, not its evaluation, cost.
+
+    Parameters
+    ----------
+    fun_and_jac_many, x0s, f_scale, tol, max_nfev, damping, sigma_tol
+        As :func:`soft_l1_least_squares_many`.
+    """
+    xs = [np.asarray(x0, dtype=np.float64).copy() for x0 in x0s]
+    n = len(xs)
+    c2 = f_scale**2
+    first = fun_and_jac_many(list(range(n)), xs)
+    rs = [r for r, _J in first]
+    Js = [J for _r, J in first]
+    # soft-L1: cost 0.5 Σ 2c² (root - 1), IRLS weight 1/root (soft_l1_cost's arithmetic)
+    roots = [np.sqrt(1.0 + r * r / c2) for r in rs]
+    costs = [float(0.5 * np.sum(2.0 * c2 * (root - 1.0))) for root in roots]
+    lams = [damping] * n
+    nfevs = [1] * n
+    successes = [False] * n
+    active = list(range(n))
+    k_sys = 2 if sigma_tol is not None else 1
+    sizes = {len(x) for x in xs}
+    n_par = len(xs[0]) if len(sizes) == 1 else 0
+    while active:
+        trial_ids: list[int] = []
+        trial_xs: list[FloatArray] = []
+        trial_dxs: list[FloatArray] = []
+        still: list[int] = []
+        systems: list[tuple[int, FloatArray, FloatArray, FloatArray]] = []
+        for i in active:
+            if nfevs[i] >= max_nfev:
+                continue
+            r, J, x = rs[i], Js[i], xs[i]
+            Jw = J * (1.0 / roots[i])[:, None]
+            A = J.T @ Jw
+            g = Jw.T @ r
+            if float(np.abs(g).max()) * max(1.0, float(np.abs(x).max())) < tol * max(
+                costs[i], 1e-300
+            ):
+                successes[i] = True
+                continue
+            diag = A.diagonal().copy()
+            diag[diag <= 0] = 1e-12
+            systems.append((i, A, g, diag))
+        solved: list[FloatArray | None] = []
+        if systems and n_par:
+            # The round's systems in one stack, damped (and undamped) per problem, as
+            # _solve_many stacks them: A + lam·diag(diag) is A with lam·diag added to its
+            # diagonal (every (n + 1)th element of the flattened matrix).
+            m = len(systems)
+            mats = np.empty((m * k_sys, n_par, n_par))
+            rhs = np.empty((m * k_sys, n_par, 1))
+            flat = mats.reshape(m * k_sys, n_par * n_par)
+            for j, (i, A, g, diag) in enumerate(systems):
+                mats[k_sys * j] = A
+                flat[k_sys * j, :: n_par + 1] += lams[i] * diag
+                rhs[k_sys * j, :, 0] = g
+                if k_sys == 2:
+                    mats[2 * j + 1] = A
+                    rhs[2 * j + 1, :, 0] = g
+            try:
+                sols = np.asarray(np.linalg.solve(mats, rhs)[:, :, 0], np.float64)
+            except np.linalg.LinAlgError:
+                pass  # some system is singular: _solve_many tells which
+            else:
+                solved = [sols[k_sys * j : k_sys * (j + 1)] for j in range(m)]
+        if systems and not solved:
+            pending = [(i, A + lams[i] * np.diag(diag), A, g) for i, A, g, diag in systems]
+            solved = _solve_many(pending, with_gauss_newton=sigma_tol is not None)
+        for (i, _A, g, _diag), sol in zip(systems, solved, strict=True):
+            if sol is None:
+                lams[i] *= 10.0
+                if lams[i] <= 1e12:
+                    still.append(i)  # retried next round with the same residuals
+                continue
+            if sigma_tol is not None and _within_sigma(
+                float(g @ sol[1]), costs[i], len(rs[i]), len(g), sigma_tol
+            ):
+                successes[i] = True
+                continue
+            dx = np.asarray(-sol[0], np.float64)
+            trial_ids.append(i)
+            trial_xs.append(xs[i] + dx)
+            trial_dxs.append(dx)
+        evaluated = fun_and_jac_many(trial_ids, trial_xs) if trial_ids else []
+        for i, x_new, dx, (r_new, J_new) in zip(
+            trial_ids, trial_xs, trial_dxs, evaluated, strict=True
+        ):
+            nfevs[i] += 1
+            root_new = np.sqrt(1.0 + r_new * r_new / c2)
+            cost_new = float(0.5 * np.sum(2.0 * c2 * (root_new - 1.0)))
+            if cost_new <= costs[i]:
+                x = xs[i]
+                step_small = float(np.abs(dx).max()) <= tol * (1e-3 + float(np.abs(x).max()))
+                gain_small = costs[i] - cost_new <= tol * max(costs[i], 1e-300)
+                xs[i], rs[i], costs[i], Js[i], roots[i] = x_new, r_new, cost_new, J_new, root_new
+                lams[i] = max(lams[i] * 0.3, 1e-12)
+                if step_small or gain_small:
+                    successes[i] = True
+                    continue
+            else:
+                lams[i] *= 10.0
+                if lams[i] > 1e12:
+                    successes[i] = True  # no descent direction left: at a (local) minimum
+                    continue
+            still.append(i)
+        active = sorted(still)
+    return [
+        LeastSquaresResult(
+            x=xs[i],
+            cost=costs[i],
+            fun=rs[i],
+            jac=Js[i] * np.sqrt(1.0 / roots[i])[:, None],
+            success=successes[i],
+            nfev=nfevs[i],
+        )
+        for i in range(n)
+    ]
 
 
 def _solve_many(

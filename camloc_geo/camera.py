@@ -249,16 +249,24 @@ def angles_from_rotation(cam_from_world_rotation: npt.ArrayLike) -> tuple[float,
     looking straight down or up, where roll absorbs the rotation.
     """
     R = np.asarray(cam_from_world_rotation, dtype=float).reshape(3, 3)
-    right, _down, forward = R[0], R[1], R[2]  # rows of R = camera axes in the world
-    pitch = math.degrees(math.asin(float(np.clip(-forward[2], -1.0, 1.0))))
-    horiz = math.hypot(forward[0], forward[1])
+    right = R[0]  # rows of R = camera axes in the world
+    f0, f1, f2 = R[2].tolist()  # the forward axis, as Python floats (cheaper than numpy's)
+    z = -f2
+    if z > 1.0:  # np.clip(z, -1, 1) on a Python float, NaN kept
+        z = 1.0
+    elif z < -1.0:
+        z = -1.0
+    pitch = math.degrees(math.asin(z))
+    horiz = math.hypot(f0, f1)
     if horiz < 1e-12:
         heading = 0.0
-        right0 = np.array([1.0, 0.0, 0.0])
+        r0, r1, r2 = 1.0, 0.0, 0.0
     else:
-        heading = math.degrees(math.atan2(forward[0], forward[1])) % 360.0
-        right0 = np.array([forward[1], -forward[0], 0.0]) / horiz
-    down0 = np.cross(forward, right0)
+        heading = math.degrees(math.atan2(f0, f1)) % 360.0
+        r0, r1, r2 = f1 / horiz, -f0 / horiz, 0.0 / horiz
+    right0 = np.array([r0, r1, r2])
+    # np.cross(forward, right0), written out (the same products and differences)
+    down0 = np.array([f1 * r2 - f2 * r1, f2 * r0 - f0 * r2, f0 * r1 - f1 * r0])
     roll = math.degrees(math.atan2(float(right @ down0), float(right @ right0)))
     return heading, pitch, roll
 

@@ -1122,6 +1122,35 @@ class _JointProblem:
         """:meth:`residuals_batch` with the rows scaled by ``seg_scale`` (every segment's,
         the photo's after the annotations') and ``pt_scale`` (every click's)."""
         f, pp, R, C = self._unpack_batch(X, R0, pp_fixed, f_fixed)
+        return self._residuals_of_parts(f, pp, R, C, pp_fixed, f_fixed, seg_scale, pt_scale)
+
+    def residuals_of_unpacked(
+        self,
+        f: FloatArray,
+        pp: FloatArray,
+        R: FloatArray,
+        C: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+    ) -> FloatArray:
+        """:meth:`residuals_batch` of a batch already unpacked by :meth:`_unpack_batch`
+        (``f`` ``(P,)``, ``pp`` ``(P, 2)`` or ``(1, 2)``, ``R`` ``(P, 3, 3)``, ``C``
+        ``(P, 3)``): the same rows, for a caller that unpacks a larger batch once."""
+        return self._residuals_of_parts(
+            f, pp, R, C, pp_fixed, f_fixed, self._seg_scale, self._pt_scale
+        )
+
+    def _residuals_of_parts(
+        self,
+        f: FloatArray,
+        pp: FloatArray,
+        R: FloatArray,
+        C: FloatArray,
+        pp_fixed: tuple[float, float] | None,
+        f_fixed: float | None,
+        seg_scale: FloatArray,
+        pt_scale: FloatArray,
+    ) -> FloatArray:
         # Vanishing point of world axis i: K R e_i, column i of KR = [f R₀ + cx R₂; f R₁ + cy R₂;
         # R₂] (rows of R); each segment takes its axis' column: KRs (P, 3, n_seg + n_photo).
         KR = R * self._f_rows(f)

@@ -495,32 +495,11 @@ def output_json_schema(kind: OutputKind) -> dict[str, Any]:
 
 # ------------------------------------------------------------------------- candidates
 def _angles_deg(camera: Camera) -> tuple[float, float, float]:
-    """``camera.angles_deg`` (:func:`camloc_geo.camera.angles_from_rotation`), the same
-    numbers to the bit, without its ~30 us of ``np.clip`` and ``np.cross`` on single values
-    (a candidate collection takes the angles of every candidate)."""
-    import numpy as np
+    """``camera.angles_deg`` (:func:`camloc_geo.camera.angles_from_rotation`, which now takes
+    its clamp and cross product on Python floats itself)."""
+    from camloc_geo.camera import angles_from_rotation
 
-    R = np.asarray(camera.cam_from_world_rotation, dtype=float).reshape(3, 3)
-    right, forward = R[0], R[2]
-    f0, f1, f2 = forward.tolist()
-    z = -f2
-    if z > 1.0:  # np.clip(z, -1, 1), NaN kept
-        z = 1.0
-    elif z < -1.0:
-        z = -1.0
-    pitch = math.degrees(math.asin(z))
-    horiz = math.hypot(f0, f1)
-    if horiz < 1e-12:
-        heading = 0.0
-        r0, r1, r2 = 1.0, 0.0, 0.0
-    else:
-        heading = math.degrees(math.atan2(f0, f1)) % 360.0
-        r0, r1, r2 = f1 / horiz, -f0 / horiz, 0.0 / horiz
-    right0 = np.array([r0, r1, r2])
-    # np.cross(forward, right0), written out (the same products and differences)
-    down0 = np.array([f1 * r2 - f2 * r1, f2 * r0 - f0 * r2, f0 * r1 - f1 * r0])
-    roll = math.degrees(math.atan2(float(right @ down0), float(right @ right0)))
-    return heading, pitch, roll
+    return angles_from_rotation(camera.cam_from_world_rotation)
 
 
 def _match_properties(m: Match, lonlat: list[float]) -> MatchProperties:

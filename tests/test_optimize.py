@@ -16,6 +16,7 @@ from camloc_geo._optimize import (
     soft_l1_cost,
     soft_l1_least_squares,
     soft_l1_least_squares_many,
+    soft_l1_least_squares_many_small,
     soft_l1_least_squares_small,
 )
 from camloc_geo.absolute._similarity import rot2
@@ -56,8 +57,14 @@ def test_lm_soft_l1_matches_scipy_on_a_curve_with_outliers(seed: int) -> None:
     assert via.cost == pytest.approx(ref.cost, rel=1e-6)
 
 
+LOCKSTEP = [soft_l1_least_squares_many, soft_l1_least_squares_many_small]
+
+
+@pytest.mark.parametrize("lockstep", LOCKSTEP)
 @pytest.mark.parametrize("sigma_tol", [None, 0.1])
-def test_lockstep_problems_take_the_steps_they_take_alone(sigma_tol: float | None) -> None:
+def test_lockstep_problems_take_the_steps_they_take_alone(
+    sigma_tol: float | None, lockstep: Any
+) -> None:
     problems = [_curve_problem(seed) for seed in range(4)]
     starts = [x0 + 0.3 * k for k, (_f, _j, x0) in enumerate(problems)]
     starts[3] = np.array([50.0, 8.0, -40.0])  # far off: many rejected steps
@@ -67,9 +74,7 @@ def test_lockstep_problems_take_the_steps_they_take_alone(sigma_tol: float | Non
         batches.append(list(ids))
         return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
 
-    together = soft_l1_least_squares_many(
-        many, starts, f_scale=2.5, max_nfev=60, sigma_tol=sigma_tol
-    )
+    together = lockstep(many, starts, f_scale=2.5, max_nfev=60, sigma_tol=sigma_tol)
     for (fun, jac, _x0), x0, res in zip(problems, starts, together, strict=True):
 
         def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
@@ -88,7 +93,8 @@ def test_lockstep_problems_take_the_steps_they_take_alone(sigma_tol: float | Non
     assert sum(len(b) for b in batches) == sum(r.nfev for r in together)
 
 
-def test_lockstep_with_a_singular_problem_matches_alone() -> None:
+@pytest.mark.parametrize("lockstep", LOCKSTEP)
+def test_lockstep_with_a_singular_problem_matches_alone(lockstep: Any) -> None:
     # Problem 1 has a dead parameter (a zero Jacobian column): its undamped normal matrix
     # is singular, so the batched solve falls back to one system at a time.
     fun0, jac0, x0 = _curve_problem(0)
@@ -103,7 +109,7 @@ def test_lockstep_with_a_singular_problem_matches_alone() -> None:
     def many(ids: list[int], xs: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
         return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
 
-    together = soft_l1_least_squares_many(many, [x0, x0], f_scale=2.5, max_nfev=40, sigma_tol=0.1)
+    together = lockstep(many, [x0, x0], f_scale=2.5, max_nfev=40, sigma_tol=0.1)
     for (fun, jac), res in zip(problems, together, strict=True):
 
         def both(x: np.ndarray, f: Any = fun, j: Any = jac) -> tuple[np.ndarray, np.ndarray]:
@@ -116,6 +122,34 @@ def test_lockstep_with_a_singular_problem_matches_alone() -> None:
         np.testing.assert_array_equal(res.x, alone.x)
     assert together[0].success
     assert np.all(np.isfinite(together[1].x))
+
+
+def test_lean_lockstep_matches_lockstep_on_problems_of_two_sizes() -> None:
+    # Two parameter counts in one round: the lean loop's one-stack solve does not apply and
+    # it takes _solve_many's path; every problem's steps are still the lockstep loop's.
+    fun0, jac0, x0 = _curve_problem(0)
+    fun1, jac1, _x1 = _curve_problem(1)
+
+    def fun_ab(x: np.ndarray) -> np.ndarray:  # c held at 0.5
+        return np.asarray(fun1(np.array([x[0], x[1], 0.5])))
+
+    def jac_ab(x: np.ndarray) -> np.ndarray:
+        return np.asarray(jac1(np.array([x[0], x[1], 0.5]))[:, :2])
+
+    problems = [(fun0, jac0), (fun_ab, jac_ab)]
+    starts = [x0, np.array([1.0, -0.5])]
+
+    def many(ids: list[int], xs: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+        return [(problems[i][0](x), problems[i][1](x)) for i, x in zip(ids, xs, strict=True)]
+
+    ref = soft_l1_least_squares_many(many, starts, f_scale=2.5, max_nfev=40, sigma_tol=0.1)
+    lean = soft_l1_least_squares_many_small(many, starts, f_scale=2.5, max_nfev=40, sigma_tol=0.1)
+    for a, b in zip(ref, lean, strict=True):
+        assert a.nfev == b.nfev > 2
+        assert a.cost == b.cost
+        np.testing.assert_array_equal(a.x, b.x)
+        np.testing.assert_array_equal(a.jac, b.jac)
+    np.testing.assert_allclose(lean[1].x, [2.0, -1.3], atol=0.1)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -102,3 +102,22 @@ def test_the_vectorised_ground_corner_columns_equal_the_loop() -> None:
     assert D.shape == ref.shape == (len(x), 8 * len(clicks))
     scale = float(np.abs(ref @ ref.T).max())
     np.testing.assert_allclose(D @ D.T, ref @ ref.T, rtol=1e-9, atol=1e-9 * scale)
+
+
+def test_residuals_of_a_batch_unpacked_with_another_equal_the_batch_alone() -> None:
+    # The bundle unpacks its annotation and map batches in one call and takes the
+    # annotation rows from the slice (relative._ROTVEC_SCALAR_MAX: both batches large).
+    state = _state(6)
+    prob = state.problem
+    args = (state.rotation0, state.principal_point, state.focal_px)
+    x = np.asarray(state.x, dtype=float)
+    rng = np.random.default_rng(0)
+    X = x + 1e-3 * rng.standard_normal((15, len(x)))
+    other = x + 1e-2 * rng.standard_normal((20, len(x)))
+    f, pp, R, C = prob._unpack_batch(np.concatenate([X, other]), *args)
+    pp_x = pp[:15] if len(pp) > 1 else pp
+    got = prob.residuals_of_unpacked(f[:15], pp_x, R[:15], C[:15], *args[1:])
+    alone = prob.residuals_batch(X, *args)
+    assert got.shape == alone.shape == (15, len(prob.residuals(x, *args)))
+    np.testing.assert_array_equal(got, alone)
+    assert not np.allclose(got[0], got[1])  # the rows are the batch's own

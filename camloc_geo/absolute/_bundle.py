@@ -39,13 +39,14 @@ import numpy.typing as npt
 from camloc_geo._optimize import (
     LeastSquaresResult,
     soft_l1_cost,
-    soft_l1_least_squares_many,
+    soft_l1_least_squares_many_small,
 )
 from camloc_geo.absolute._evidence import Evidence
 from camloc_geo.absolute._model import Candidate, LocateSettings, Observation
 from camloc_geo.absolute._refine import _matched_points, _street_bearing_prior
 from camloc_geo.absolute._similarity import Similarity2D
 from camloc_geo.camera import Camera
+from camloc_geo.relative import _ROTVEC_SCALAR_MAX
 
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult, JointState
@@ -234,14 +235,17 @@ def _bundle_many(
         if p.street_brg is not None:
             BRG[k] = p.street_brg
 
-    def map_rows(Z: FloatArray, owner: npt.NDArray[np.int64]) -> FloatArray:
+    def map_rows(
+        Z: FloatArray,
+        owner: npt.NDArray[np.int64],
+        cam: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    ) -> FloatArray:
         """The map rows of parameter vectors ``Z`` ``(P, n)``, row ``p`` of problem
         ``owner[p]``: each matched map point's pixel residual over its sigma (u, padded to
         ``n_max``, then v), the scale prior, then the street-bearing prior (a column left
-        unused by a problem without one)."""
-        f, pp, R, C = prob._unpack_batch(
-            Z[:, :n_cam], state.rotation0, state.principal_point, state.focal_px
-        )
+        unused by a problem without one). ``cam``: ``Z``'s camera parts unpacked
+        (``_unpack_batch``)."""
+        f, pp, R, C = cam
         theta, tx, ty, ls = Z[:, n_cam], Z[:, n_cam + 1], Z[:, n_cam + 2], Z[:, n_cam + 3]
         q_en, pixels, sigma_map = Q[owner], PX[owner], SM[owner]
         s = np.exp(ls)
@@ -290,12 +294,24 @@ def _bundle_many(
         H_ann = 1e-7 * np.maximum(1.0, np.abs(zs_all[:, :n_cam]))
         h_ann = list(H_ann)
         X = _forward_rows(zs_all[:, :n_cam], H_ann)
-        Rb = prob.residuals_batch(X, state.rotation0, state.principal_point, state.focal_px)
         H_map = 1e-6 * np.maximum(1.0, np.abs(zs_all))
         h_map = list(H_map)
         Z = _forward_rows(zs_all, H_map)
+        args = (state.rotation0, state.principal_point, state.focal_px)
+        n_x = len(X)
+        if n_x > _ROTVEC_SCALAR_MAX and len(Z) > _ROTVEC_SCALAR_MAX:
+            # Both batches' cameras unpacked in one call: row by row, the same bits as
+            # apart while both batches take _rotvec_matrices' array formula (its small
+            # batches go through Python floats, which can differ in the last bit).
+            f, pp, R, C = prob._unpack_batch(np.concatenate([X, Z[:, :n_cam]]), *args)
+            pp_x, pp_z = (pp[:n_x], pp[n_x:]) if len(pp) > 1 else (pp, pp)
+            Rb = prob.residuals_of_unpacked(f[:n_x], pp_x, R[:n_x], C[:n_x], *args[1:])
+            cam_z = (f[n_x:], pp_z, R[n_x:], C[n_x:])
+        else:
+            Rb = prob.residuals_batch(X, *args)
+            cam_z = prob._unpack_batch(Z[:, :n_cam], *args)
         owner = np.repeat(np.asarray(ids, dtype=np.int64), n_z + 1)
-        Mb_all = map_rows(Z, owner)
+        Mb_all = map_rows(Z, owner, cam_z)
         out = []
         for k, i in enumerate(ids):
             ra = Rb[k * (n_cam + 1) : (k + 1) * (n_cam + 1)]
@@ -317,7 +333,7 @@ def _bundle_many(
             starts.extend(r for r, _J in got)
         return got
 
-    results = soft_l1_least_squares_many(
+    results = soft_l1_least_squares_many_small(
         recorded, [p.z0 for p in problems], f_scale=_F_SCALE, max_nfev=200, sigma_tol=_SIGMA_TOL
     )
     sigmas = _position_sigmas(results, state, n_cam)
