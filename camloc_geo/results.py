@@ -574,12 +574,12 @@ def _lonlat_of_points(
     """
     import numpy as np
 
-    from camloc_geo.absolute import view_cone
+    from camloc_geo.absolute._cone import view_cones as _view_cones
 
     cands = result.candidates
     parts = [np.asarray([m.map_en for m in c.matches], dtype=float).reshape(-1, 2) for c in cands]
     if view_cones:
-        parts += [view_cone(c.camera, result.image_size, range_m) for c in cands]
+        parts += _view_cones([c.camera for c in cands], result.image_size, range_m)
     if not parts:
         return [], []
     ll = result.frame.points_geographic_from_enu(np.vstack(parts)).tolist()

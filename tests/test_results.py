@@ -184,3 +184,24 @@ def test_schema_command_prints_each_output_schema(capsys: pytest.CaptureFixture[
         schema = json.loads(capsys.readouterr().out)
         assert schema["title"] == f"camloc {kind} output"
         assert schema == output_json_schema(kind)  # type: ignore[arg-type]
+
+
+def test_batched_view_cones_match_one_call_per_camera(located: Any) -> None:
+    from camloc_geo.absolute import view_cone, view_cones
+    from camloc_geo.camera import Camera, RadialDistortion
+
+    cams = [c.camera for c in located.result.candidates]
+    rng = np.random.default_rng(3)
+    for _ in range(20):  # random poses, some looking up, with and without distortion
+        q, _r = np.linalg.qr(rng.normal(size=(3, 3)))
+        rot = q * np.sign(np.linalg.det(q))
+        center = np.array([*rng.uniform(-40, 40, 2), rng.uniform(2, 12)])
+        dist = RadialDistortion(float(rng.uniform(-0.3, 0.1)), 700.0) if _ % 2 else None
+        cams.append(Camera(float(rng.uniform(400, 1500)), (640.0, 360.0), rot, -rot @ center, dist))
+    assert len(cams) > 20
+    batched = view_cones(cams, (1280, 720), 45.0)
+    for cam, ring in zip(cams, batched, strict=True):
+        one = view_cone(cam, (1280, 720), 45.0)
+        assert ring.shape == one.shape
+        assert np.array_equal(ring, one)  # the same numbers to the last bit
+    assert view_cones([], (1280, 720), 45.0) == []
