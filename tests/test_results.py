@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -205,3 +206,17 @@ def test_batched_view_cones_match_one_call_per_camera(located: Any) -> None:
         assert ring.shape == one.shape
         assert np.array_equal(ring, one)  # the same numbers to the last bit
     assert view_cones([], (1280, 720), 45.0) == []
+
+
+def test_one_bearing_wraps_as_the_array_formula() -> None:
+    from camloc_geo.geodesy import normalize_bearing_deg
+
+    rng = np.random.default_rng(5)
+    edge = [0.0, -0.0, -1e-20, -1e-300, 360.0, -360.0, 359.99999999999994, 720.5, 1e308]
+    values = [*edge, *rng.uniform(-1e4, 1e4, 500).tolist()]
+    arr = normalize_bearing_deg(np.asarray(values))
+    one = [normalize_bearing_deg(v) for v in values]
+    assert all(type(v) is float for v in one)
+    assert np.array_equal(np.asarray(one), arr)
+    assert all(0.0 <= v < 360.0 for v in one)
+    assert math.isnan(normalize_bearing_deg(float("nan")))
