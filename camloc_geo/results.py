@@ -521,6 +521,9 @@ def _candidate_feature(
     from camloc_geo.geodesy import normalize_bearing_deg
 
     heading, pitch_c, roll_c = _angles_deg(c.camera)
+    # Flag.__str__'s formula; ``_value_`` is the member's value without the enum property's
+    # descriptor (~1 us a flag)
+    flags = [f.kind._value_ if f.label is None else f"{f.kind._value_}:{f.label}" for f in c.flags]
     props = CandidateProperties(
         rank=c.rank,
         score=c.score,
@@ -537,7 +540,7 @@ def _candidate_feature(
         scale=c.scale,
         refined=c.refined,
         merged=c.merged,
-        flags=[f.kind.value if f.label is None else f"{f.kind.value}:{f.label}" for f in c.flags],
+        flags=flags,
         scene=result.scene_id,
         matches=[_match_properties(m, ll) for m, ll in zip(c.matches, match_lonlat, strict=True)],
         ambiguous_with=list(c.ambiguous_with),

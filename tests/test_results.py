@@ -220,3 +220,18 @@ def test_one_bearing_wraps_as_the_array_formula() -> None:
     assert np.array_equal(np.asarray(one), arr)
     assert all(0.0 <= v < 360.0 for v in one)
     assert math.isnan(normalize_bearing_deg(float("nan")))
+
+
+def test_candidate_flags_are_their_string_forms(located: Any) -> None:
+    import dataclasses
+
+    from camloc_geo.absolute import Flag, FlagKind
+    from camloc_geo.results import candidates_collection
+
+    res = located.result
+    flags = [Flag(FlagKind.OCCLUDED, "intersection.corners[2]"), Flag(FlagKind.POOR_FIT)]
+    cands = [dataclasses.replace(res.candidates[0], flags=flags), *res.candidates[1:]]
+    coll = candidates_collection(dataclasses.replace(res, candidates=cands))
+    got = [f.properties.flags for f in coll.features if f.properties.kind == "candidate"]
+    assert got[0] == ["occluded:intersection.corners[2]", "poor_fit"]
+    assert got[1:] == [[str(f) for f in c.flags] for c in res.candidates[1:]]
