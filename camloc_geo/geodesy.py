@@ -66,6 +66,11 @@ def normalize_bearing_deg(bearing_deg: Any) -> Any:
     -------
     The same kind of value, wrapped into [0, 360).
     """
+    if isinstance(bearing_deg, float) and math.isfinite(bearing_deg):
+        # One Python float (a candidate's heading): the same floor modulo as np.mod, bit for
+        # bit, without the array round trip.
+        mod = bearing_deg % 360.0
+        return 0.0 if mod >= 360.0 else float(mod)
     wrapped = np.mod(np.asarray(bearing_deg, dtype=float), 360.0)
     wrapped = np.where(wrapped >= 360.0, 0.0, wrapped)
     return float(wrapped) if np.ndim(wrapped) == 0 else wrapped

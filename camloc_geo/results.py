@@ -521,13 +521,16 @@ def _candidate_feature(
     from camloc_geo.geodesy import normalize_bearing_deg
 
     heading, pitch_c, roll_c = _angles_deg(c.camera)
+    # Flag.__str__'s formula; ``_value_`` is the member's value without the enum property's
+    # descriptor (~1 us a flag)
+    flags = [f.kind._value_ if f.label is None else f"{f.kind._value_}:{f.label}" for f in c.flags]
     props = CandidateProperties(
         rank=c.rank,
         score=c.score,
         lat=c.lat,
         lon=c.lon,
         height_m=c.camera.height_m,
-        heading_deg=float(normalize_bearing_deg(heading)),
+        heading_deg=normalize_bearing_deg(float(heading)),
         pitch_deg=pitch_c,
         roll_deg=roll_c,
         focal_px=c.camera.focal_px,
@@ -537,7 +540,7 @@ def _candidate_feature(
         scale=c.scale,
         refined=c.refined,
         merged=c.merged,
-        flags=[str(f) for f in c.flags],
+        flags=flags,
         scene=result.scene_id,
         matches=[_match_properties(m, ll) for m, ll in zip(c.matches, match_lonlat, strict=True)],
         ambiguous_with=list(c.ambiguous_with),
@@ -574,12 +577,12 @@ def _lonlat_of_points(
     """
     import numpy as np
 
-    from camloc_geo.absolute import view_cone
+    from camloc_geo.absolute._cone import view_cones as _view_cones
 
     cands = result.candidates
     parts = [np.asarray([m.map_en for m in c.matches], dtype=float).reshape(-1, 2) for c in cands]
     if view_cones:
-        parts += [view_cone(c.camera, result.image_size, range_m) for c in cands]
+        parts += _view_cones([c.camera for c in cands], result.image_size, range_m)
     if not parts:
         return [], []
     ll = result.frame.points_geographic_from_enu(np.vstack(parts)).tolist()

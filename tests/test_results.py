@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -184,3 +185,53 @@ def test_schema_command_prints_each_output_schema(capsys: pytest.CaptureFixture[
         schema = json.loads(capsys.readouterr().out)
         assert schema["title"] == f"camloc {kind} output"
         assert schema == output_json_schema(kind)  # type: ignore[arg-type]
+
+
+def test_batched_view_cones_match_one_call_per_camera(located: Any) -> None:
+    from camloc_geo.absolute import view_cone, view_cones
+    from camloc_geo.camera import Camera, RadialDistortion
+
+    cams = [c.camera for c in located.result.candidates]
+    rng = np.random.default_rng(3)
+    for _ in range(20):  # random poses, some looking up, with and without distortion
+        q, _r = np.linalg.qr(rng.normal(size=(3, 3)))
+        rot = q * np.sign(np.linalg.det(q))
+        center = np.array([*rng.uniform(-40, 40, 2), rng.uniform(2, 12)])
+        dist = RadialDistortion(float(rng.uniform(-0.3, 0.1)), 700.0) if _ % 2 else None
+        cams.append(Camera(float(rng.uniform(400, 1500)), (640.0, 360.0), rot, -rot @ center, dist))
+    assert len(cams) > 20
+    batched = view_cones(cams, (1280, 720), 45.0)
+    for cam, ring in zip(cams, batched, strict=True):
+        one = view_cone(cam, (1280, 720), 45.0)
+        assert ring.shape == one.shape
+        assert np.array_equal(ring, one)  # the same numbers to the last bit
+    assert view_cones([], (1280, 720), 45.0) == []
+
+
+def test_one_bearing_wraps_as_the_array_formula() -> None:
+    from camloc_geo.geodesy import normalize_bearing_deg
+
+    rng = np.random.default_rng(5)
+    edge = [0.0, -0.0, -1e-20, -1e-300, 360.0, -360.0, 359.99999999999994, 720.5, 1e308]
+    values = [*edge, *rng.uniform(-1e4, 1e4, 500).tolist()]
+    arr = normalize_bearing_deg(np.asarray(values))
+    one = [normalize_bearing_deg(v) for v in values]
+    assert all(type(v) is float for v in one)
+    assert np.array_equal(np.asarray(one), arr)
+    assert all(0.0 <= v < 360.0 for v in one)
+    assert math.isnan(normalize_bearing_deg(float("nan")))
+
+
+def test_candidate_flags_are_their_string_forms(located: Any) -> None:
+    import dataclasses
+
+    from camloc_geo.absolute import Flag, FlagKind
+    from camloc_geo.results import candidates_collection
+
+    res = located.result
+    flags = [Flag(FlagKind.OCCLUDED, "intersection.corners[2]"), Flag(FlagKind.POOR_FIT)]
+    cands = [dataclasses.replace(res.candidates[0], flags=flags), *res.candidates[1:]]
+    coll = candidates_collection(dataclasses.replace(res, candidates=cands))
+    got = [f.properties.flags for f in coll.features if f.properties.kind == "candidate"]
+    assert got[0] == ["occluded:intersection.corners[2]", "poor_fit"]
+    assert got[1:] == [[str(f) for f in c.flags] for c in res.candidates[1:]]

@@ -61,7 +61,7 @@ The pipeline, one function per stage (:func:`locate` reads as the list):
 
 from __future__ import annotations
 
-from camloc_geo.absolute._cone import view_cone
+from camloc_geo.absolute._cone import view_cone, view_cones
 from camloc_geo.absolute._cues import (
     CUE_FLOOR,
     OFF_STREET_FACTOR,
@@ -108,5 +108,6 @@ __all__ = [
     "locate",
     "mark_ties",
     "view_cone",
+    "view_cones",
     "view_log_factor",
 ]
