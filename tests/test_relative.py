@@ -582,8 +582,12 @@ def _flagged(influence: list[float | None]) -> set[int]:
     return {i for i, v in enumerate(vals) if np.isfinite(v) and v > 3.0 * med}
 
 
-@pytest.mark.parametrize("seed", [1, 2, 3, 5])
+@pytest.mark.parametrize("seed", [1, 2, 3, 5, 18, 35, 41])
 def test_one_step_jackknife_matches_the_refits(seed: int) -> None:
+    """Seeds 18, 35 and 41: without one annotator the rest leave the focal length loose
+    (or fix it), so a refit switches the weak focal prior where the joint fit did not; the
+    one-step jackknife makes the same choice (before: 0.8x, 1.3-1.4x and 2.2-3.1x the
+    refits' position spread)."""
     scene = parse_scene(_crowd_scene(seed))
     fast = calibrate(scene)
     slow = calibrate(scene, CalibrationSettings(jackknife_method="refit"))
