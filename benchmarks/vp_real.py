@@ -686,10 +686,10 @@ def main(argv: list[str] | None = None) -> int:
         for s in sorted({r["set"] for r in rows}):
             summary[tag][s] = summarise([r for r in rows if r["set"] == s])
             if s == "lund":  # the development and the held-out halves
-                for half, numbers in (("dev", LUND_DEV), ("held-out", LUND_HELD_OUT)):
-                    part = [r for r in rows if r["set"] == s and _lund_number(r) in numbers]
+                for half, scenes in (("dev", LUND_DEV), ("held-out", LUND_HELD_OUT)):
+                    part = [r for r in rows if r["set"] == s and _lund_number(r) in scenes]
                     if part:
-                        summary[tag][f"lund {half} {numbers}"] = summarise(part)
+                        summary[tag][f"lund {half} {scenes}"] = summarise(part)
             if s in SCENE_SETS:  # and by scene ("lund/7-heidelberg-castle/...")
                 for scene in sorted({r["name"].split("/")[1] for r in rows if r["set"] == s}):
                     summary[tag][f"{s} / {scene}"] = summarise(
