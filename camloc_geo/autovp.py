@@ -39,8 +39,13 @@ Pipeline
    systematic bias: residual distortion, edge detection), which is large where the
    geometry leaves the focal length loose (a level camera looking down a street), and
    how far it moves when a horizontal direction's lines on either side of the horizon are
-   left out (``_split_horizon_logf_std``: paths or paving not parallel to the facades).
-   An EXIF
+   left out (``_split_horizon_logf_std``: paths or paving not parallel to the facades),
+   and takes the larger of the least-squares sigma and a delete-one-line jackknife over
+   the directions of fewer than 24 distinct lines (``_line_jackknife_logf_std``: a roof
+   slope or a shadow that lines up with a vanishing point by chance). Where no focal
+   length or prior is given and the photo leaves the focal length loose (sigma over
+   10 %), the default prior joins (``_with_default_prior``: log-normal around the longer
+   side, sigma 0.35, what cameras are). An EXIF
    focal length (or any ``focal_prior_px``) is a prior in the fit. ``warnings`` say when
    the focal length is loose, the vertical is weakly supported or ambiguous.
 
