@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/vp_real.py [--strecha DIR] [--sceaux DIR] [--lund DIR] [--yud DIR]
                                  [--limit N] [--sets strecha,sceaux,perrot,lund,exif,yud]
+                                 (lund-dev, lund-held-out: one half of the Lund scenes)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
 
 The photos (none of them is in this repository; their licences keep them out):
@@ -33,7 +34,7 @@ The photos (none of them is in this repository; their licences keep them out):
     through ``CAMLOC_SENSOR_DB``; ``FocalLengthIn35mmFilm`` last), so it is as good as the
     camera's rounding of the focal length to whole millimetres (about 2-3 %). No gravity
     or horizon truth. Run with and without the EXIF.
-``lund``
+``lund`` (``lund-dev``, ``lund-held-out``: one half of its scenes, see :data:`LUND_DEV`)
     The photo sets of Lund University's computer-vision course (Structure from Motion
     assignment; copies in the public repositories ``erik-norlin/Structure-From-Motion`` and
     ``ziyong-was-taken/Structure-From-Motion``, no licence given: kept out, fetched by
@@ -263,6 +264,12 @@ LUND_SCENES = {
 }
 #: Sets summarised by scene too (the second part of a photo's name).
 SCENE_SETS = ("lund",)
+#: The Lund scenes split by building, so that a change tuned on some is checked on others:
+#: the development half (looked at, its debug drawings read) and the held-out half (only
+#: its summary figures are read). Each half has one scene where the focal length is loose
+#: (a frontal gate; a curved niche) and one or two that read well.
+LUND_DEV = (1, 3, 6)  # Kronan, the cathedral gate, the Landhaus in Graz: 22 photos
+LUND_HELD_OUT = (2, 4, 7)  # the courtyard, the fountain niche, Heidelberg castle: 30 photos
 #: Sensor widths (mm) of the Lund photos' cameras, EXIF ``Model`` -> width, from openMVG's
 #: CameraSensorSizeDatabase (``sensor_database.csv``: "Nikon D60,23.6", "Nikon Coolpix
 #: 4200,7.11").
@@ -324,6 +331,11 @@ def load_lund(root: Path) -> list[dict[str, Any]]:
     if skipped:
         log.info("lund: %d photos without a usable focal length skipped", skipped)
     return out
+
+
+def _lund_number(row: dict[str, Any]) -> int:
+    """The Lund scene number of a row or truth record (``"lund/3-cathedral-gate/..."`` -> 3)."""
+    return int(row["name"].split("/")[1].split("-")[0])
 
 
 def load_street_set(n_frames: int) -> list[dict[str, Any]]:
@@ -642,12 +654,17 @@ def main(argv: list[str] | None = None) -> int:
         ("lund", args.lund, load_lund),
         ("yud", args.yud, load_yud_set),
     ):
-        if name not in wanted:
+        halves = {"lund-dev": LUND_DEV, "lund-held-out": LUND_HELD_OUT} if name == "lund" else {}
+        numbers = {n for h, ns in halves.items() if h in wanted for n in ns}
+        if name not in wanted and not numbers:
             continue
         if not root.exists():
             log.warning("%s: not found at %s (%s)", name, root, HOW_TO_GET)
             continue
-        data.extend(loader(root)[: args.limit])
+        loaded = loader(root)
+        if name not in wanted:
+            loaded = [t for t in loaded if _lund_number(t) in numbers]
+        data.extend(loaded[: args.limit])
     if "street" in wanted:
         data.extend(load_street_set(args.street_frames))
     for d in args.exif_dir if "exif" in wanted else []:
@@ -668,6 +685,11 @@ def main(argv: list[str] | None = None) -> int:
         summary[tag] = {"all": summarise(rows)}
         for s in sorted({r["set"] for r in rows}):
             summary[tag][s] = summarise([r for r in rows if r["set"] == s])
+            if s == "lund":  # the development and the held-out halves
+                for half, scenes in (("dev", LUND_DEV), ("held-out", LUND_HELD_OUT)):
+                    part = [r for r in rows if r["set"] == s and _lund_number(r) in scenes]
+                    if part:
+                        summary[tag][f"lund {half} {scenes}"] = summarise(part)
             if s in SCENE_SETS:  # and by scene ("lund/7-heidelberg-castle/...")
                 for scene in sorted({r["name"].split("/")[1] for r in rows if r["set"] == s}):
                     summary[tag][f"{s} / {scene}"] = summarise(

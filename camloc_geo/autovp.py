@@ -39,8 +39,13 @@ Pipeline
    systematic bias: residual distortion, edge detection), which is large where the
    geometry leaves the focal length loose (a level camera looking down a street), and
    how far it moves when a horizontal direction's lines on either side of the horizon are
-   left out (``_split_horizon_logf_std``: paths or paving not parallel to the facades).
-   An EXIF
+   left out (``_split_horizon_logf_std``: paths or paving not parallel to the facades),
+   and takes the larger of the least-squares sigma and a delete-one-line jackknife over
+   the directions of fewer than 24 distinct lines (``_line_jackknife_logf_std``: a roof
+   slope or a shadow that lines up with a vanishing point by chance). Where no focal
+   length or prior is given and the photo leaves the focal length loose (sigma over
+   10 %), the default prior joins (``_with_default_prior``: log-normal around the longer
+   side, sigma 0.35, what cameras are). An EXIF
    focal length (or any ``focal_prior_px``) is a prior in the fit. ``warnings`` say when
    the focal length is loose, the vertical is weakly supported or ambiguous.
 
@@ -148,8 +153,20 @@ _WEAK_LINES = 6
 _FEW_LINES = 12
 _FEW_LINES_SHIFT_Z = 2.0
 _FEW_LINES_MIN_SHIFT = 0.03
+#: A direction with fewer distinct lines than this has its lines left out one at a time
+#: (a delete-one-line jackknife of the focal length, ``_line_jackknife_logf_std``).
+_JACKKNIFE_LINES = 24
 #: Above this focal sigma the photo does not fix the focal length (a default is used).
 _PRIOR_ONLY_STD = 0.25
+#: Where no focal length or prior is given, the photo's estimate is combined with what
+#: cameras are: log-normal, centred on :data:`_F_PRIOR_REL` times the longer side (a 35 mm
+#: equivalent of about 35 mm), with this sigma of ``log(focal)`` (0.7-1.4 times at 1 sigma,
+#: 0.5-2 at 2: phones' main cameras 0.72-0.75, webcams 0.5-0.9, compact and kit zooms
+#: 0.55-2). Only where the photo leaves the focal length loose (its own sigma over
+#: :data:`_LOOSE_FOCAL_STD`, which is warned of): a frontal facade (one finite horizontal
+#: vanishing point, a vertical one far off) then gets the default, or near it, rather than
+#: a random value out of a loose fit. A photo that fixes its focal length keeps its own.
+_F_DEFAULT_SIGMA = 0.35
 #: Largest focal sigma stated for an estimate that rests on a weak direction.
 _MAX_STATED_STD = 1.0
 #: Above this relative standard deviation of the focal length a warning is given.
@@ -535,6 +552,9 @@ class _Model:
     rests_on_few: int = 0
     few_shift: float = 0.0  # |log| pull of the focal length by such a direction (in sigma)
     n_lines: tuple[int, int, int] | None = None  # distinct lines of each column of R
+    # the photo's own estimate (normalised) and sigma of log(focal), before the default prior
+    f_data_n: float = float("nan")
+    data_logf_std: float = float("nan")
 
 
 def _labels(
@@ -828,6 +848,48 @@ def _split_horizon_logf_std(
             )
             total += math.log(f / m.f_n) ** 2
     return 0.5 * math.sqrt(total)
+
+
+def _line_jackknife_logf_std(
+    m: _Model,
+    s: _Segs,
+    segs_px: FloatArray,
+    merge_px: float,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> float:
+    """Delete-one-line jackknife of ``log(focal)`` over the lines of thinly supported
+    directions.
+
+    Where a direction has fewer than :data:`_JACKKNIFE_LINES` distinct lines, each of its
+    lines (all the segments on it) is left out in turn and the focal length refitted; the
+    jackknife variance ``(n - 1) / n * sum((theta_i - mean) ** 2)`` of each such direction
+    is summed. A roof slope, a shadow on the ground or a gable's edge that lines up with a
+    horizontal vanishing point by chance, in a direction that fixes the focal length with
+    a dozen lines, moves it by itself; the least-squares sigma, which takes every line for
+    a true one, cannot see that.
+    """
+    total = 0.0
+    for k in range(3):
+        sel = np.flatnonzero(m.labels == k)
+        if len(sel) == 0:
+            continue
+        groups = _line_groups(segs_px[sel], merge_px)
+        n = int(groups.max()) + 1
+        if not (_MIN_SUPPORT <= n < _JACKKNIFE_LINES):
+            continue
+        theta = np.empty(n)
+        for g in range(n):
+            labels = m.labels.copy()
+            labels[sel[groups == g]] = -1
+            _, f, _, _ = _refine(
+                m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
+            )
+            theta[g] = math.log(f / m.f_n)
+        total += (n - 1) / n * float(np.sum((theta - theta.mean()) ** 2))
+    return math.sqrt(total)
 
 
 def _up_sign(d: FloatArray) -> FloatArray:
@@ -1462,11 +1524,21 @@ def detect_vanishing_points(
         split_std = _split_horizon_logf_std(
             best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
         )
-        best.logf_std = math.sqrt(best.logf_std**2 + sys_std**2 + split_std**2 + best.few_shift**2)
+        jack_std = _line_jackknife_logf_std(
+            best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
+        )
+        # the jackknife measures the same sampling spread as the least-squares sigma,
+        # outliers that pose as lines included: the larger of the two
+        stat_std = max(best.logf_std, jack_std)
+        best.logf_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2)
         if best.weak_only:
             best.logf_std = min(best.logf_std, _MAX_STATED_STD)
     elif f_fixed is not None:
         _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias, f_free=False)
+    best.f_data_n, best.data_logf_std = best.f_n, best.logf_std
+    if f_fixed is None and not has_prior and not best.logf_std <= _LOOSE_FOCAL_STD:
+        # the photo leaves the focal length loose (warned): what cameras are joins in
+        best = _with_default_prior(best, s, tau, f_bounds, prior_w)
     info: dict[str, Any] = {}
     if np.count_nonzero(best.labels >= 0) >= 4:
         _refine(
@@ -1685,24 +1757,32 @@ def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | 
 
 def _n_distinct_lines(segs: FloatArray, merge_px: float = 4.0) -> int:
     """Number of distinct straight lines among segments (greedy, longest first)."""
+    groups = _line_groups(segs, merge_px)
+    return int(groups.max()) + 1 if len(groups) else 0
+
+
+def _line_groups(segs: FloatArray, merge_px: float = 4.0) -> npt.NDArray[np.int64]:
+    """The distinct straight line (0, 1, ...) each segment lies on (greedy, longest first:
+    a segment joins the first longer one it is collinear with, within ``merge_px`` and 3
+    degrees)."""
+    groups = np.full(len(segs), -1, dtype=np.int64)
     if len(segs) == 0:
-        return 0
+        return groups
     p1, p2 = segs[:, :2], segs[:, 2:]
     d = p2 - p1
     ln = np.hypot(d[:, 0], d[:, 1])
     u = d / ln[:, None]
     mid = 0.5 * (p1 + p2)
-    free = np.ones(len(segs), bool)
     n = 0
     for i in np.argsort(-ln):
-        if not free[i]:
+        if groups[i] >= 0:
             continue
-        n += 1
         rel = mid - mid[i]
         dist = np.abs(u[i, 0] * rel[:, 1] - u[i, 1] * rel[:, 0])
         same = (dist < merge_px) & (np.abs(u @ u[i]) > math.cos(math.radians(3.0)))
-        free &= ~same
-    return n
+        groups[same & (groups < 0)] = n
+        n += 1
+    return groups
 
 
 def _focal_prior(f_n: FloatArray, f_prior: float, sigma: float = _F_PRIOR_SIGMA) -> FloatArray:
@@ -1823,7 +1903,11 @@ def _finish(
     warnings: list[str] = []
     if f_free:
         lo_b, hi_b = f_bounds
-        at_bound = not (lo_b * 1.02 < m.f_n < hi_b / 1.02)
+        f_data = m.f_n if math.isnan(m.f_data_n) else m.f_data_n
+        at_bound = not (lo_b * 1.02 < f_data < hi_b / 1.02)
+        # the photo's own sigma decides whether it fixes the focal length (a default
+        # prior, where one was combined, only narrows the stated one)
+        data_std = logf_std if math.isnan(m.data_logf_std) else m.data_logf_std
         # How likely the focal length is within 10 %, as the stated sigma says (a default
         # the photo cannot fix is no likelier to be right than its sigma says): the
         # probability of |log error| < log(1.1) under the stated Gaussian.
@@ -1853,7 +1937,7 @@ def _finish(
                 f"not square to the rest may pose as one): +/- {100 * logf_std:.0f} %; give "
                 "--focal-px if it is known"
             )
-        elif not math.isfinite(logf_std) or logf_std > _PRIOR_ONLY_STD:
+        elif not math.isfinite(data_std) or data_std > _PRIOR_ONLY_STD:
             focal_source = "prior"
         else:
             focal_source = "estimated"
@@ -1863,8 +1947,8 @@ def _finish(
                 "or a photo with EXIF"
             )
         elif (
-            math.isfinite(logf_std)
-            and logf_std > _LOOSE_FOCAL_STD
+            math.isfinite(data_std)
+            and data_std > _LOOSE_FOCAL_STD
             and not m.weak_only
             and not m.rests_on_few
         ):
@@ -1931,6 +2015,40 @@ def _finish(
         inlier_share=explained,
         warnings=warnings,
     )
+
+
+def _with_default_prior(
+    m: _Model,
+    s: _Segs,
+    tau: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> _Model:
+    """The photo's focal length combined with the default prior (:data:`_F_DEFAULT_SIGMA`).
+
+    A Gaussian posterior in ``log(focal)``: the photo's estimate weighs by its stated sigma
+    (least squares and the systematic terms), the default (:data:`_F_PRIOR_REL` times the
+    longer side) by :data:`_F_DEFAULT_SIGMA`. Where the focal length moves by more than
+    0.5 %, the rotation is refitted with the focal length held there (the vanishing points
+    and the horizon follow). ``f_data_n`` and ``data_logf_std`` keep the photo's own.
+    """
+    sd = m.logf_std if math.isfinite(m.logf_std) and m.logf_std > 0 else math.inf
+    w_data = 0.0 if math.isinf(sd) else 1.0 / sd**2
+    w_prior = 1.0 / _F_DEFAULT_SIGMA**2
+    if not w_data + w_prior > 0.0:
+        return m
+    var = 1.0 / (w_data + w_prior)
+    log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(_F_PRIOR_REL))
+    f_post = min(max(math.exp(log_f), f_bounds[0]), f_bounds[1])
+    R = m.R
+    if abs(math.log(f_post / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
+        R, _, _, _ = _refine(
+            m.R, f_post, s, m.labels, tau, False, f_post, f_bounds, prior_w=prior_w, max_nfev=20
+        )
+        U, _, Vt = np.linalg.svd(R)
+        R = U @ Vt
+    m.R, m.f_n, m.logf_std = R, f_post, math.sqrt(var)
+    return m
 
 
 def _updown(pitch_deg: float) -> str:

@@ -128,16 +128,27 @@ def test_square_on_facade_looking_up_steeply_is_still_warned(
 ) -> None:
     """Seen square-on (or 10 degrees off), a facade looking up 60-80 degrees is read as
     looking down 30-10 degrees; the roll test (cameras do not roll) leaves it warned: its
-    verticals roll the camera 0 degrees, the looking-down reading 0-12."""
+    verticals roll the camera 0 degrees, the looking-down reading 0-12. Where that reading
+    leaves the focal length loose (70-80 degrees up: its vertical has 0-5 lines), the
+    focal length is near the default (1.0 times the longer side, the true one is 0.78), so
+    both readings' pitch are 1-4 degrees off; looking up 80 degrees, 10 degrees off
+    square, the looking-up reading would then be 83 degrees up, past the looking-up
+    check's 82: the answer says instead that the photo does not fix the focal length and
+    has few vertical lines."""
     segs, size = facade_segments(pitch_deg, facade_yaw_deg=facade_yaw_deg)
     res = detect_vanishing_points(None, segments=segs, image_size=size)
     if abs(res.pitch_deg - pitch_deg) <= 1.0:
         return  # got it right
-    assert res.pitch_deg == pytest.approx(90.0 + pitch_deg, abs=2.5)
-    assert not res.vertical_identified
+    loose = res.focal_std_rel > 0.25
+    assert res.pitch_deg == pytest.approx(90.0 + pitch_deg, abs=5.0 if loose else 2.5)
     assert res.confidence < 0.5
     said = [m for w in res.warnings for m in re.findall(r"or up (\d+) degrees", w)]
-    assert [float(x) for x in said] == [pytest.approx(-pitch_deg, abs=2.0)]
+    if loose and not said:
+        assert any("does not fix the focal length" in w for w in res.warnings)
+        assert any("few vertical lines" in w for w in res.warnings)
+        return
+    assert not res.vertical_identified
+    assert [float(x) for x in said] == [pytest.approx(-pitch_deg, abs=5.0 if loose else 2.0)]
 
 
 @pytest.mark.parametrize("roll_deg", [5.0, 10.0])
@@ -448,12 +459,15 @@ def corner_segments(
 
 @pytest.mark.parametrize("seed", [0, 2, 3])
 def test_paths_below_the_horizon_that_disagree_with_the_facades_widen_the_sigma(
-    seed: int,
+    seed: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Paths on a lawn 6 degrees off a facade's direction pull its vanishing point (focal
     length 3-5 % low). Leaving out either side of the horizon moves the focal length, so
     the stated sigma grows to cover the error (2.2-2.6 % were stated without that check,
-    the error 1.4-1.9 sigma); with the same paths parallel to the facade it stays small."""
+    the error 1.4-1.9 sigma); with the same paths parallel to the facade it stays small.
+    (The default focal prior, which joins where the stated sigma passes 10 %, is off here:
+    it would pull this 700 px camera towards 1024 px and hide what is tested.)"""
+    monkeypatch.setattr(autovp, "_F_DEFAULT_SIGMA", math.inf)
     segs, size = corner_segments(12, 6.0, seed)
     res = detect_vanishing_points(None, segments=segs, image_size=size)
     err = abs(math.log(res.focal_px / 700.0))
@@ -474,7 +488,10 @@ def test_side_wall_off_square_with_few_lines_widens_the_focal_sigma(
     by 7 lines only (as Heidelberg castle's and Herz-Jesu's gables, 10-12 % off on real
     photos): the side wall pulls the focal length 6-8 % low. The pull (the focal length
     with and without that direction) goes into the sigma, which then covers the error
-    within one sigma; without that check it was 1.3-1.6 sigmas on three of the four."""
+    within one sigma; without that check it was 1.3-1.6 sigmas on three of the four. (The
+    default focal prior is off: the check's sigma passes 10 % on one seed, where the prior
+    would then join and move the focal length the check itself leaves alone.)"""
+    monkeypatch.setattr(autovp, "_F_DEFAULT_SIGMA", math.inf)
     segs, size = facade_segments(-20.0, n_side=9, side_skew_deg=5.0, facade_yaw_deg=10.0, seed=seed)
     res = detect_vanishing_points(None, segments=segs, image_size=size)
     err = abs(math.log(res.focal_px / 800.0))
