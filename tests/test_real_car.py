@@ -1,9 +1,9 @@
 """Real cars annotated by hand on York Urban photos (issue #24's "hand-annotated real car").
 
-The photos (York Urban DB P1020171 and P1020822, 640x480, research use only) are not in this
-repository; the scenes under ``tests/data/real_car/`` hold only the clicks, read by eye off
-zoomed pixel-grid crops. The focal length is known independently: York Urban's published
-calibration, ``cameraParameters.mat``, f = 674.9 px. See benchmarks/README.md, "real_car".
+The photos (York Urban DB P1020171, P1020822 and P1080031, 640x480, research use only) are
+not in this repository; the scenes under ``tests/data/real_car/`` hold only the clicks, read
+by eye off zoomed pixel-grid crops. The focal length is known independently: York Urban's
+published calibration, ``cameraParameters.mat``, f = 674.9 px. See benchmarks/README.md, "real_car".
 """
 
 from __future__ import annotations
@@ -130,3 +130,66 @@ def test_hand_annotated_corolla_focal_within_10_percent_and_2_sigma(
     focal_px, sigma_px = out["focal_px"], out["focal_sigma_px"]
     assert abs(focal_px / FOCAL_PX - 1.0) < 0.10
     assert abs(focal_px - FOCAL_PX) < 2.0 * sigma_px
+
+
+# P1080031: a Toronto taxi, a Toyota Camry (2002-2006 XV30 by its roofline and taillights;
+# scene size 4.81 x 1.80 x 1.48 m, the maker's 4,805 x 1,795 x ~1,485 mm, within 2 % of the
+# 2007-2011 XV40 too), stopped at the kerb, seen from behind and to its left: the side spans
+# 155 px, the rear 47 px, its ground corners inside the photo. Three annotators (hand-a,
+# hand-b, hand-c) clicked from their own crops; besides the car (wheel hubs, tyre contacts,
+# the bumper's lower edge) they used the kerb and the building: its front along the street
+# (length), its other face on the side street (width), window edges and a pole (upright).
+#
+# Camera height truth, estimated without calibrate: 2.35 +/- 0.12 m above the road (again a
+# camera held high). (1) The published horizon crosses the taxi's vertical through the top of
+# its roof (~1.43 m there) at 1.67x that height (vertical point's cross-ratio included):
+# 2.39 m. (2) It crosses two women standing on the sidewalk at 1.32x and 1.35x their height:
+# 2.11-2.29 m above the sidewalk for 1.60-1.70 m, plus a 0.10-0.15 m kerb.
+TAXI = Path(__file__).parent / "data" / "real_car" / "yud_P1080031_camry_taxi.json"
+TAXI_HEIGHT_M = 2.35
+
+
+def _calibrate_taxi(tmp_path: Path, capsys: pytest.CaptureFixture[str], with_photo: bool) -> dict:
+    scene = json.loads(TAXI.read_text(encoding="utf-8"))
+    assert scene["image"]["width"] == 640
+    names = [a["annotator"] for a in scene["annotations"]]
+    assert names == ["hand-a", "hand-b", "hand-c"]
+    if with_photo:
+        scene["image"]["path"] = str(YUD / scene["image"]["path"])
+    else:
+        del scene["image"]["path"]
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene), encoding="utf-8")
+    code = main(["calibrate", str(path)])
+    captured = capsys.readouterr()
+    assert code == 0
+    assert "Traceback" not in captured.err
+    out: dict = json.loads(captured.out)
+    assert out["excluded_annotators"] == []
+    return out
+
+
+def _assert_issue_24_check(out: dict) -> None:
+    focal_px, sigma_px = out["focal_px"], out["focal_sigma_px"]
+    assert abs(focal_px / FOCAL_PX - 1.0) < 0.10
+    assert abs(focal_px - FOCAL_PX) < 2.0 * sigma_px
+    assert abs(out["height_m"] - TAXI_HEIGHT_M) < 0.5
+
+
+def test_hand_annotated_taxi_clicks_alone_meet_issue_24(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The clicks alone (no photo needed): 673.8 +/- 14.4 px (-0.2 %), 2.21 +/- 0.14 m."""
+    out = _calibrate_taxi(tmp_path, capsys, with_photo=False)
+    _assert_issue_24_check(out)
+    assert out["intrinsics_method"].startswith("joint_fit")
+
+
+@pytest.mark.skipif(not (YUD / "P1080031" / "P1080031.jpg").exists(), reason=YUD_MISSING)
+def test_hand_annotated_taxi_with_its_photo_meets_issue_24(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With the photo's lines joined in: 665.1 +/- 13.2 px (-1.5 %), 2.15 +/- 0.10 m."""
+    out = _calibrate_taxi(tmp_path, capsys, with_photo=True)
+    _assert_issue_24_check(out)
+    assert not any("could not fix the focal length" in w for w in out["warnings"])
