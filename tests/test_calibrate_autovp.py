@@ -321,3 +321,52 @@ def test_lines_filled_from_a_distorted_photo_are_undistorted(tmp_path: Path) -> 
     assert abs(result.camera.focal_px / cam.focal_px - 1.0) < 0.01
     err = np.linalg.norm(result.camera.center_in_world - cam.center_in_world)
     assert err < 0.01 * np.linalg.norm(cam.center_in_world)
+
+
+def test_a_photo_whose_focal_length_disagrees_widens_every_sigma(tmp_path: Path) -> None:
+    """Annotators' clicks of ``_camera()`` (f = 1200 px) with the photo of a camera at the
+    same place with f = 900 px: two witnesses 29 % apart. The answer is not moved, every
+    stated sigma (and the covariance) is widened by one factor so that the photo's focal
+    length lies within two sigma, and a warning says so (a slip shared by all annotators,
+    as on the hand-annotated Corolla, shows in nothing else)."""
+    cam = _camera()
+    size = (1280, 720)
+    photo_cam = Camera.from_center(
+        900.0, cam.principal_point, cam.cam_from_world_rotation, cam.center_in_world
+    )
+    noise = NoiseModel(
+        point_px=1.0, line_px=1.0, wrong_corner_prob=0.0, sloppy_prob=0.0, size_rel=0.0
+    )
+    syn = make_scene(cam, np.random.default_rng(5), noise=noise, n_annotators=3, image_size=size)
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps(syn.scene))
+    cv2.imwrite(str(tmp_path / "snap.png"), _render(photo_cam, size))
+    syn.scene["image"]["path"] = "snap.png"
+    with_photo = tmp_path / "scene.json"
+    with_photo.write_text(json.dumps(syn.scene))
+    settings = CalibrationSettings(photo_lines=False)  # the photo only as a witness
+    plain = calibrate(load_scene(bare), settings)
+    result = calibrate(load_scene(with_photo), settings)
+    msgs = [w for w in result.warnings if "disagree on the focal length" in w]
+    assert len(msgs) == 1
+    f_photo = float(msgs[0].split("(")[1].split(" against")[0])
+    assert f_photo == pytest.approx(900.0, rel=0.06)
+    assert result.camera.focal_px == pytest.approx(plain.camera.focal_px)
+    assert plain.focal_sigma_px is not None
+    assert result.focal_sigma_px is not None
+    factor = result.focal_sigma_px / plain.focal_sigma_px
+    assert factor > 2.0
+    assert float(msgs[0].split("widened ")[1].split("x ")[0]) == pytest.approx(factor, abs=0.051)
+    sd_rel = result.focal_sigma_px / result.camera.focal_px
+    assert abs(math.log(f_photo / result.camera.focal_px)) == pytest.approx(2.0 * sd_rel, rel=0.01)
+    assert plain.position_sigma_m is not None
+    assert result.position_sigma_m is not None
+    np.testing.assert_allclose(result.position_sigma_m, factor * plain.position_sigma_m)
+    assert plain.rotation_sigma_deg is not None
+    assert result.rotation_sigma_deg is not None
+    np.testing.assert_allclose(result.rotation_sigma_deg, factor * plain.rotation_sigma_deg)
+    assert plain.parameter_covariance is not None
+    assert result.parameter_covariance is not None
+    np.testing.assert_allclose(
+        result.parameter_covariance, factor**2 * plain.parameter_covariance, atol=1e-12
+    )
