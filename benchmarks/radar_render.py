@@ -22,7 +22,10 @@ relative error, the mean signed error (bias), the fraction within 2 ``sigma_kmh`
 (extra measured tracks of a vehicle); and the calibration's focal-length error per scene.
 Vehicles the radar marks uncertain (``warning``: ``sigma_kmh`` above 5 % of the speed) are
 counted (``n_warned``) with their errors, and the maximum and p90 over the others are given
-beside those over all (``rel_max_unwarned``, ``rel_p90_unwarned``).
+beside those over all (``rel_max_unwarned``, ``rel_p90_unwarned``). True vehicles with no
+measured track are counted (``dropped``, with the nearest each came to the camera while in
+view, ``dropped_nearest_m``), and the radar's skipped tracks by the kind of their reason
+(``skipped_reasons``, e.g. ``too far from the camera``): nothing left out goes unreported.
 
 Writes ``benchmarks/out/radar_render.json`` and ``radar_render.png`` (CDFs).
 

@@ -10,7 +10,9 @@
 - an uncertain speed (sigma above 5 % of it) carries a warning naming its main cause;
 - segments of a track whose contacts lie on one line of travel are merged, a contact on
   another corner is not;
-- a segment whose contact stands still while the vehicle's features move is recognised.
+- a segment whose contact stands still while the vehicle's features move is recognised;
+- segments whose speeds disagree beyond their noise are pooled (random effects), and the
+  pooled speed's error is widened.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from camloc_geo.sensors.radar import (
     _join_fragments,
     _merge_segments,
     _resized,
+    _segments_pooled,
     _still_segments,
     _Track,
     _uncertainty_warning,
@@ -175,3 +178,23 @@ def test_still_contact_segment_is_found() -> None:
     # features that barely move tell nothing: nothing is left out
     t.klt = [(0.1, 0.0)] * 20
     assert _still_segments(t, use, labels) == set()
+
+
+def test_disagreeing_segments_are_pooled() -> None:
+    rng = np.random.default_rng(8)
+    unit = np.array([1.0, 0.0])
+    times = np.concatenate([np.arange(a, a + 0.8, 0.05) for a in (0.0, 2.0, 4.0)])
+    labels = [int(t // 2) for t in times]
+    speed = np.where(np.array(labels) == 2, 8.4, 7.4)  # the last, near, segment slides
+    ground = np.column_stack([speed * times, np.zeros(len(times))])
+    noise = np.where(np.array(labels) == 2, 0.01, 0.1)
+    ground[:, 0] += rng.normal(0.0, 1.0, len(times)) * noise
+    weights = 1.0 / noise**2  # the near segment weighs 100 times more
+    pooled = _segments_pooled(times, labels, ground, weights, unit)
+    assert pooled is not None
+    mean, sigma = pooled
+    assert 7.4 < mean < 8.1  # not the near segment's 8.4
+    assert sigma > 0.2  # the disagreement is in the error
+    # segments that agree: nothing to pool, the joint fit stands
+    ground[:, 0] = 7.4 * times + rng.normal(0.0, 1.0, len(times)) * noise
+    assert _segments_pooled(times, labels, ground, weights, unit) is None

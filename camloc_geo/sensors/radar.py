@@ -32,7 +32,13 @@ radar (see ``docs/radar.md``):
 4. **Speed.** The contact's ground positions are fitted, by iteratively reweighted (Huber)
    least squares weighted by each frame's ground variance (a pixel's footprint on the
    road), with one velocity shared by all segments and one offset per segment (constant
-   velocity over the track). Speed = |velocity| in km/h.
+   velocity over the track). Speed = |velocity| in km/h. Frames where a detection pixel
+   at the contact covers more than 1 m of road are not used (far away the contact moves
+   in steps of a pixel and stalls; a track left too short is skipped, "too far");
+   segments that fit one offset are merged (:func:`_merge_segments`), segments whose
+   contact stands still while the features move are left out (:func:`_still_segments`),
+   and segments whose speeds disagree beyond their noise are pooled as a random-effects
+   mean (:func:`_segments_pooled`).
 
 Without a silhouette in most frames (boxes given for a video whose background shows no
 foreground) a cuboid (weak prior: a car, 4.5 × 1.8 × 1.5 m) moving at constant velocity
@@ -1207,6 +1213,18 @@ def _fit_track(
     # their noise; what they disagree by beyond it (a contact that followed another vehicle
     # through a merge, a corner sliding along the body) is model error
     sigma_model = _halves_disagreement(times, labels, ground[0], weights, unit)
+    # its segments, fitted apart, must agree too: where they disagree beyond their noise
+    # (near the camera the lowest corner slides from the body's edge to a tyre, a metre in
+    # a second, and those frames weigh most) their speeds are combined as a random-effects
+    # mean, each weighed by its variance plus theirs between them, and the combined
+    # speed's standard error is model error
+    pooled = _segments_pooled(times, labels, ground[0], weights, unit)
+    if pooled is not None and pooled[0] * dur >= 1.0:
+        speed_re, sigma_re = pooled
+        sigma_cal *= speed_re / speed
+        sigma_contact *= speed_re / speed
+        sigma_model = max(sigma_model, sigma_re)
+        vel, speed = unit * speed_re, speed_re
     # without a silhouette (given boxes only), refine with a cuboid moving at constant
     # velocity whose image box matches the boxes: a box's bottom centre is no fixed point
     refined = (
@@ -1333,6 +1351,52 @@ def _halves_disagreement(
         fits.append((float((solve[0] @ g) @ unit), _along_track_var(solve, w, res, unit)))
     (v1, e1), (v2, e2) = fits
     return max(0.0, abs(v1 - v2) - 2.0 * math.sqrt(e1 + e2)) / 2.0
+
+
+def _segments_pooled(
+    times: FloatArray, labels: list[int], ground: FloatArray, weights: FloatArray, unit: FloatArray
+) -> tuple[float, float] | None:
+    """Random-effects mean (m/s) of a track's segments' speeds along ``unit``, and its
+    standard error, when they disagree beyond their noise; None when they agree (or fewer
+    than three segments of at least 5 frames and 0.2 s can be fitted: with two, a short
+    stretch on another vehicle would weigh as much as a long true one).
+
+    Each segment's velocity is fitted apart (same weights); their spread beyond their own
+    standard errors (DerSimonian-Laird) is a variance between segments, added to each
+    one's before they are averaged: a segment whose contact slid along the body no longer
+    outweighs the others for being near the camera. Pooled only when the disagreement is
+    significant (Cochran's Q above its chi-squared 99 % quantile).
+    """
+    from scipy.stats import chi2
+
+    speeds, variances = [], []
+    lab = np.asarray(labels)
+    for s in sorted(set(labels)):
+        sel = lab == s
+        tt = times[sel]
+        if sel.sum() < 5 or float(np.ptp(tt)) < 0.2:
+            continue
+        a = _design(tt, [0] * int(sel.sum()))
+        w, g = weights[sel], ground[sel]
+        sw = np.sqrt(w)[:, None]
+        solve = np.asarray(np.linalg.pinv(a * sw) * sw.T, np.float64)
+        res = g - a @ (solve @ g)
+        speeds.append(float((solve[0] @ g) @ unit))
+        variances.append(max(_along_track_var(solve, w, res, unit), 1e-6))
+    if len(speeds) < 3:
+        return None  # two: their variance between them rests on one difference
+    v, var = np.array(speeds), np.array(variances)
+    w0 = 1.0 / var
+    mean0 = float(np.sum(w0 * v) / np.sum(w0))
+    q = float(np.sum(w0 * (v - mean0) ** 2))
+    spread = float(np.sum(w0) - np.sum(w0**2) / np.sum(w0))
+    if q <= float(chi2.ppf(0.99, len(v) - 1)):
+        return None  # within their noise (99 %): the joint fit stands
+    tau2 = max(0.0, (q - (len(v) - 1)) / spread) if spread > 0 else 0.0
+    if tau2 <= 0.0:
+        return None
+    w1 = 1.0 / (var + tau2)
+    return float(np.sum(w1 * v) / np.sum(w1)), float(math.sqrt(1.0 / np.sum(w1)))
 
 
 _CAR_DIMS_M = np.array([4.5, 1.8, 1.5])
