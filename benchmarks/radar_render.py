@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import tempfile
 import time
@@ -153,12 +154,11 @@ def _dropped(
 
 
 def _reason_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
-    """Skipped tracks counted by the kind of reason (its words before the first colon or
-    number)."""
+    """Skipped tracks counted by the kind of reason (its words before the first colon,
+    numbers as N)."""
     out: dict[str, int] = {}
     for r in rows:
-        text = r["reason"].split(":")[0]
-        kind = " ".join(w for w in text.split() if not w[:1].isdigit())
+        kind = re.sub(r"\d+(\.\d+)?", "N", r["reason"].split(":")[0])
         out[kind] = out.get(kind, 0) + 1
     return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
