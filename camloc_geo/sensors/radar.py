@@ -1063,20 +1063,25 @@ def _merge_segments(
         dof = 2 * (len(times) - a.shape[1])
         if dof < 2:
             break
-        _solve, w, res = _irls(a, ground, prior)
+        solve, w, res = _irls(a, ground, prior)
         rss = float(np.sum(w[:, None] * res**2))
         s2 = max(rss / dof, 1e-12)
-        sw = np.sqrt(w)[:, None]
+        coef = solve @ ground
+        # the rise of the weighted residuals when two offsets are made one (a linear
+        # constraint c @ coef = 0 on the weighted fit): (c @ coef)^2 / (c M^-1 c), M = A'WA
+        m_inv = np.linalg.pinv(a.T @ (w[:, None] * a))
+        segs = sorted(set(labels))
         first: dict[int, float] = {}
         for s, t in zip(labels, times, strict=True):
             first[s] = min(first.get(s, math.inf), float(t))
         order = sorted(first, key=lambda s: first[s])
         best: tuple[float, int, int] | None = None
         for keep, gone in itertools.pairwise(order):
-            merged = [keep if s == gone else s for s in labels]
-            a2 = _design(times, merged)
-            coef, *_ = np.linalg.lstsq(a2 * sw, ground * sw, rcond=None)
-            rise = (float(np.sum(w[:, None] * (ground - a2 @ coef) ** 2)) - rss) / s2
+            i, j = 1 + segs.index(keep), 1 + segs.index(gone)
+            var = float(m_inv[i, i] + m_inv[j, j] - 2.0 * m_inv[i, j])
+            if var <= 0:
+                continue
+            rise = float(np.sum((coef[i] - coef[j]) ** 2)) / var / s2
             if best is None or rise < best[0]:
                 best = (rise, keep, gone)
         if best is None or best[0] > _SEGMENT_MERGE_CHI2:
@@ -1365,7 +1370,7 @@ def _segments_pooled(
     outweighs the others for being near the camera. Pooled only when the disagreement is
     significant (Cochran's Q above its chi-squared 99 % quantile).
     """
-    from scipy.stats import chi2
+    from scipy.special import chdtri  # chi-squared quantiles (scipy.stats: 1 s to import)
 
     speeds, variances = [], []
     lab = np.asarray(labels)
@@ -1388,7 +1393,7 @@ def _segments_pooled(
     mean0 = float(np.sum(w0 * v) / np.sum(w0))
     q = float(np.sum(w0 * (v - mean0) ** 2))
     spread = float(np.sum(w0) - np.sum(w0**2) / np.sum(w0))
-    if q <= float(chi2.ppf(0.99, len(v) - 1)):
+    if q <= float(chdtri(len(v) - 1, 0.01)):
         return None  # within their noise (99 %): the joint fit stands
     tau2 = max(0.0, (q - (len(v) - 1)) / spread) if spread > 0 else 0.0
     if tau2 <= 0.0:
