@@ -1169,10 +1169,12 @@ def _fit_track(
     dur = float(times.max() - times.min()) if len(times) else 0.0
     if len(times) < 3 or dur < min_track_s:
         if not near.all():
+            finite = res_m[np.isfinite(res_m)]
+            worst = f"up to {float(np.max(finite)):.1f} m" if len(finite) else "metres"
             return skipped(
                 f"too far from the camera: a detection pixel at its ground contact covers "
-                f"up to {float(np.max(res_m)):.1f} m of road (> {_MAX_GROUND_PER_PX_M:g} m "
-                f"in a usable frame), leaving {dur:.2f} s (< {min_track_s:g} s)",
+                f"{worst} of road (> {_MAX_GROUND_PER_PX_M:g} m in a usable frame), "
+                f"leaving {dur:.2f} s (< {min_track_s:g} s)",
                 len(times),
                 dur,
             )
@@ -1368,7 +1370,9 @@ def _segments_pooled(
     standard errors (DerSimonian-Laird) is a variance between segments, added to each
     one's before they are averaged: a segment whose contact slid along the body no longer
     outweighs the others for being near the camera. Pooled only when the disagreement is
-    significant (Cochran's Q above its chi-squared 99 % quantile).
+    significant (Cochran's Q above its chi-squared 99 % quantile). :func:`_fit_track` takes
+    the standard error as model error and keeps the joint fit's speed (the mean follows a
+    calibration's error along the track).
     """
     from scipy.special import chdtri  # chi-squared quantiles (scipy.stats: 1 s to import)
 
