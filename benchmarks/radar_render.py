@@ -22,7 +22,10 @@ relative error, the mean signed error (bias), the fraction within 2 ``sigma_kmh`
 (extra measured tracks of a vehicle); and the calibration's focal-length error per scene.
 Vehicles the radar marks uncertain (``warning``: ``sigma_kmh`` above 5 % of the speed) are
 counted (``n_warned``) with their errors, and the maximum and p90 over the others are given
-beside those over all (``rel_max_unwarned``, ``rel_p90_unwarned``).
+beside those over all (``rel_max_unwarned``, ``rel_p90_unwarned``). True vehicles with no
+measured track are counted (``dropped``, with the nearest each came to the camera while in
+view, ``dropped_nearest_m``), and the radar's skipped tracks by the kind of their reason
+(``skipped_reasons``, e.g. ``too far from the camera``): nothing left out goes unreported.
 
 Writes ``benchmarks/out/radar_render.json`` and ``radar_render.png`` (CDFs).
 
@@ -36,6 +39,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import tempfile
 import time
@@ -117,6 +121,46 @@ def _match(video: RenderedVideo, result: RadarResult, run: str, seed: int) -> li
             }
         )
     return rows
+
+
+def _dropped(
+    video: RenderedVideo, result: RadarResult, got: list[dict[str, Any]], run: str, seed: int
+) -> list[dict[str, Any]]:
+    """True vehicles (wholly in view >= 0.5 s) with no measured track, with the nearest they
+    came to the camera while in view; and one ``run + "/skip"`` row per skipped track with
+    its reason (the radar's own account of what it left out)."""
+    measured = {r["vehicle"] for r in got}
+    eye = video.camera.center_in_world[:2]
+    out = []
+    for k, per in video.boxes.items():
+        if k in measured or len(per) / video.fps < 0.5:
+            continue
+        veh = video.vehicles[k]
+        near = min(float(np.linalg.norm(veh.centre_at(f / video.fps) - eye)) for f in per)
+        out.append(
+            {
+                "seed": seed,
+                "run": run,
+                "vehicle": k,
+                "true_kmh": round(veh.speed_kmh, 3),
+                "nearest_m": round(near, 1),
+                "frames_in_view": len(per),
+            }
+        )
+    for v in result.vehicles:
+        if not v.measured:
+            out.append({"seed": seed, "run": run + "/skip", "reason": v.reason or ""})
+    return out
+
+
+def _reason_counts(rows: list[dict[str, Any]]) -> dict[str, int]:
+    """Skipped tracks counted by the kind of reason (its words before the first colon,
+    numbers as N)."""
+    out: dict[str, int] = {}
+    for r in rows:
+        kind = re.sub(r"\d+(\.\d+)?", "N", r["reason"].split(":")[0])
+        out[kind] = out.get(kind, 0) + 1
+    return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
 
 def _shapes() -> dict[str, Any]:
@@ -202,6 +246,7 @@ def main(argv: list[str] | None = None) -> int:
     n_true = 0
     focal_errors = []
     cal_failures: list[int] = []
+    dropped: list[dict[str, Any]] = []
     seconds: dict[str, float] = dict.fromkeys(runs, 0.0)
     with tempfile.TemporaryDirectory(prefix="camloc-radar-render-") as tmp:
         for seed in range(args.first_seed, args.first_seed + args.seeds):
@@ -236,6 +281,7 @@ def main(argv: list[str] | None = None) -> int:
                 seconds[run] += time.process_time() - t0
                 got = _match(video, res, run, seed)
                 rows.extend(got)
+                dropped.extend(_dropped(video, res, got, run, seed))
                 print(
                     f"seed {seed} {run}: " + " ".join(f"{100 * r['signed_rel']:+.1f}" for r in got),
                     file=sys.stderr,
@@ -252,13 +298,17 @@ def main(argv: list[str] | None = None) -> int:
         "brnocompspeed_state_of_the_art_kmh": BRNO,
     }
     for run in runs:
+        mine = [d for d in dropped if d["run"] == run]
         summary[run] = {
             **_stats([r for r in rows if r["run"] == run], n_true),
+            "dropped": len(mine),
+            "dropped_nearest_m": sorted(d["nearest_m"] for d in mine),
+            "skipped_reasons": _reason_counts([d for d in dropped if d["run"] == run + "/skip"]),
             "cpu_s": round(seconds[run], 1),
         }
     OUT_DIR.mkdir(exist_ok=True)
     (OUT_DIR / f"{args.name}.json").write_text(
-        json.dumps({"summary": summary, "vehicles": rows}, indent=2)
+        json.dumps({"summary": summary, "vehicles": rows, "dropped": dropped}, indent=2)
     )
     print(json.dumps(summary, indent=2))
     try:

@@ -7,7 +7,12 @@
 - a silhouette too low for a vehicle standing on its contact is recognised as a piece;
 - a box that changes size (a merged blob splitting) is recognised, its centre's jump is no
   motion;
-- an uncertain speed (sigma above 5 % of it) carries a warning naming its main cause.
+- an uncertain speed (sigma above 5 % of it) carries a warning naming its main cause;
+- segments of a track whose contacts lie on one line of travel are merged, a contact on
+  another corner is not;
+- a segment whose contact stands still while the vehicle's features move is recognised;
+- segments whose speeds disagree beyond their noise are pooled (random effects), and the
+  pooled speed's error is widened.
 """
 
 from __future__ import annotations
@@ -22,7 +27,10 @@ from camloc_geo.sensors.radar import (
     _halves_disagreement,
     _identity_switches,
     _join_fragments,
+    _merge_segments,
     _resized,
+    _segments_pooled,
+    _still_segments,
     _Track,
     _uncertainty_warning,
 )
@@ -138,3 +146,55 @@ def test_uncertainty_warning_names_the_cause() -> None:
     text = _uncertainty_warning(15.0, piece, True)
     assert text is not None
     assert "piece" in text
+
+
+def test_segments_on_one_line_are_merged() -> None:
+    rng = np.random.default_rng(5)
+    # four stretches of one contact at 8 m/s with gaps between them (coasting in merges)
+    times = np.concatenate([np.arange(a, a + 0.3, 0.05) for a in (0.0, 1.0, 2.0, 3.0)])
+    labels = [int(t) for t in times]
+    ground = np.column_stack([8.0 * times, np.full(len(times), -5.0)])
+    ground += rng.normal(0.0, 0.1, ground.shape)
+    prior = np.ones(len(times))
+    assert len(set(_merge_segments(times, labels, ground, prior))) == 1
+    # the last stretch on another corner, 2 m ahead: kept apart
+    moved = ground.copy()
+    moved[np.array(labels) == 3, 0] += 2.0
+    merged = _merge_segments(times, labels, moved, prior)
+    assert len(set(merged)) == 2
+    assert merged[-1] != merged[0]
+
+
+def test_still_contact_segment_is_found() -> None:
+    t = _Track(1, (0.0, 0.0, 10.0, 10.0))
+    for i in range(20):
+        t.frames.append(i)
+        t.klt.append((2.0, 1.0))  # the vehicle's features move 2.2 px a frame
+        # the first 10 frames a patch of the road holds the lowest corner: still
+        t.contacts.append((100.0, 200.0) if i < 10 else (100.0 + 2.0 * i, 200.0 + i))
+    use = list(range(20))
+    labels = [0] * 10 + [1] * 10
+    assert _still_segments(t, use, labels) == {0}
+    # features that barely move tell nothing: nothing is left out
+    t.klt = [(0.1, 0.0)] * 20
+    assert _still_segments(t, use, labels) == set()
+
+
+def test_disagreeing_segments_are_pooled() -> None:
+    rng = np.random.default_rng(8)
+    unit = np.array([1.0, 0.0])
+    times = np.concatenate([np.arange(a, a + 0.8, 0.05) for a in (0.0, 2.0, 4.0)])
+    labels = [int(t // 2) for t in times]
+    speed = np.where(np.array(labels) == 2, 8.4, 7.4)  # the last, near, segment slides
+    ground = np.column_stack([speed * times, np.zeros(len(times))])
+    noise = np.where(np.array(labels) == 2, 0.01, 0.1)
+    ground[:, 0] += rng.normal(0.0, 1.0, len(times)) * noise
+    weights = 1.0 / noise**2  # the near segment weighs 100 times more
+    pooled = _segments_pooled(times, labels, ground, weights, unit)
+    assert pooled is not None
+    mean, sigma = pooled
+    assert 7.4 < mean < 8.1  # not the near segment's 8.4
+    assert sigma > 0.2  # the disagreement is in the error
+    # segments that agree: nothing to pool, the joint fit stands
+    ground[:, 0] = 7.4 * times + rng.normal(0.0, 1.0, len(times)) * noise
+    assert _segments_pooled(times, labels, ground, weights, unit) is None
