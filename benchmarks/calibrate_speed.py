@@ -2,7 +2,8 @@
 
 Draws ``--n`` held-out five-annotator crowd scenes (``benchmarks/relative.py``'s scene
 distribution and noise model, a seed of their own) and, per scene, measures the CPU time
-(``time.process_time``, median of ``--repeats`` calls after a warm-up) of
+(``time.process_time``, median of ``--repeats`` calls after a warm-up, the methods taken in
+turn call by call) of
 
 - ``closed_form``: the paper's method, ``CalibrationSettings(joint_fit=False)``
   (``camloc calibrate --no-joint-fit``);
@@ -18,7 +19,8 @@ y, z and the rotation sigma about the camera's x, y, z) and the annotators they 
 (influence above three times the median annotator's). Writes
 
 - ``benchmarks/out/calibrate_speed.json``: per-method median CPU times and their ratio to
-  the closed form, sigma ratios (median, fraction within 10 %), flag agreement, one row
+  the closed form (the ratio of the medians, and the median over scenes of each scene's own
+  ratio: paired, so a drift of the machine's speed between scenes does not enter it), sigma ratios (median, fraction within 10 %), flag agreement, one row
   per scene; with ``--profile``, the top functions of a cProfile of the default calibrate;
 - ``benchmarks/out/calibrate_speed.png``: the CPU time per scene of each method, and the
   one-step sigmas against the refits' with the ±10 % band.
@@ -32,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import gc
 import io
 import json
 import logging
@@ -81,6 +84,24 @@ def cpu_ms(scene: Scene, settings: CalibrationSettings, repeats: int) -> float:
         calibrate(scene, settings)
         times.append((time.process_time() - c0) * 1000.0)
     return float(np.median(times))
+
+
+def interleaved_cpu_ms(scene: Scene, repeats: int) -> dict[str, float]:
+    """Median CPU milliseconds of each method on one scene, the methods taken in turn.
+
+    ``repeats`` rounds of one call of each fast method (the closed form, the joint fit, the
+    default), then one refit call: the methods compared meet the same state of the machine
+    (a drift of its speed, a collection of the garbage another call left) instead of one
+    method's calls running back to back. The garbage is collected before the scene.
+    """
+    gc.collect()
+    fast = [m for m in METHODS if m != "refit_jackknife"]
+    times: dict[str, list[float]] = {m: [] for m in METHODS}
+    for _ in range(repeats):
+        for method in fast:
+            times[method].append(cpu_ms(scene, METHODS[method], 1))
+    times["refit_jackknife"].append(cpu_ms(scene, METHODS["refit_jackknife"], 1))
+    return {m: float(np.median(t)) for m, t in times.items()}
 
 
 def sigmas(result: CalibrationResult) -> list[float] | None:
@@ -197,9 +218,7 @@ def main(argv: list[str] | None = None) -> int:
     rows: list[dict[str, Any]] = []
     for i, scene in enumerate(scenes):
         row: dict[str, Any] = {"index": i, "cpu_ms": {}}
-        for method, settings in METHODS.items():
-            reps = 1 if method == "refit_jackknife" else args.repeats
-            row["cpu_ms"][method] = cpu_ms(scene, settings, reps)
+        row["cpu_ms"] = interleaved_cpu_ms(scene, args.repeats)
         fast = calibrate(scene)
         slow = calibrate(scene, METHODS["refit_jackknife"])
         row["sigma_one_step"] = sigmas(fast)
@@ -215,6 +234,11 @@ def main(argv: list[str] | None = None) -> int:
     summary: dict[str, Any] = {
         "median_cpu_ms": med,
         "ratio_to_closed_form": {m: med[m] / med["closed_form"] for m in METHODS},
+        # the same per scene, then its median over the scenes (paired: robust to drift)
+        "ratio_to_closed_form_per_scene_median": {
+            m: float(np.median([r["cpu_ms"][m] / r["cpu_ms"]["closed_form"] for r in rows]))
+            for m in METHODS
+        },
         "target_ratio": TARGET_RATIO,
         "sigma_components": [
             "jackknife_x_m",
