@@ -20,8 +20,9 @@ y, z and the rotation sigma about the camera's x, y, z) and the annotators they 
 
 - ``benchmarks/out/calibrate_speed.json``: per-method median CPU times and their ratio to
   the closed form (the ratio of the medians, and the median over scenes of each scene's own
-  ratio: paired, so a drift of the machine's speed between scenes does not enter it), sigma ratios (median, fraction within 10 %), flag agreement, one row
-  per scene; with ``--profile``, the top functions of a cProfile of the default calibrate;
+  ratio: paired, so a drift of the machine's speed between scenes does not enter it), sigma
+  ratios (median, fraction within 10 %), flag agreement, one row per scene; with
+  ``--profile``, the top functions of a cProfile of the default calibrate;
 - ``benchmarks/out/calibrate_speed.png``: the CPU time per scene of each method, and the
   one-step sigmas against the refits' with the ±10 % band.
 
