@@ -2326,17 +2326,27 @@ def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
                 f"{axis} vanishing direction is {best:.1f} degrees from the fit's "
                 f"(the annotators' lines or the photo's detected lines are off)"
             )
-    f_photo = float(res.focal_px)
-    if res.focal_source == "estimated" and result.focal_sigma_px is not None:
-        rel = math.log(f_photo / cam.focal_px)
-        sd = math.hypot(float(res.focal_std_rel or 0.0), result.focal_sigma_px / cam.focal_px)
-        if abs(rel) > math.log(1.1) and abs(rel) > 3.0 * sd:
-            out.append(
-                f"image.path: the photo's lines give a focal length of {f_photo:.0f} px, "
-                f"{100.0 * (math.exp(rel) - 1.0):+.0f} % from the annotators' fit "
-                f"({cam.focal_px:.0f} ± {result.focal_sigma_px:.0f} px)"
-            )
+    rel = _photo_focal_gap(res, result)
+    if rel is not None:
+        out.append(
+            f"image.path: the photo's lines give a focal length of {float(res.focal_px):.0f} "
+            f"px, {100.0 * (math.exp(rel) - 1.0):+.0f} % from the annotators' fit "
+            f"({cam.focal_px:.0f} ± {result.focal_sigma_px:.0f} px)"
+        )
     return out
+
+
+def _photo_focal_gap(res: Any, result: CalibrationResult) -> float | None:
+    """``log(f_photo / f)`` where the photo's own focal length estimate (``res``, autovp's)
+    is more than 10 % and three combined sigmas from the annotators' fit; else None."""
+    if res.focal_source != "estimated" or result.focal_sigma_px is None:
+        return None
+    f_fit = float(result.camera.focal_px)
+    rel = math.log(float(res.focal_px) / f_fit)
+    sd = math.hypot(float(res.focal_std_rel or 0.0), result.focal_sigma_px / f_fit)
+    if abs(rel) > math.log(1.1) and abs(rel) > 3.0 * sd:
+        return rel
+    return None
 
 
 def _photo_focal_widening(scene: Scene, result: CalibrationResult) -> tuple[float, str] | None:
@@ -2364,15 +2374,13 @@ def _photo_focal_widening(scene: Scene, result: CalibrationResult) -> tuple[floa
     if result.intrinsics_method == "photo_focal":
         return None  # the focal length is the photo's own
     res = _photo_result(scene) if result.camera is not None else None
-    if res is None or res.focal_source != "estimated":
+    if res is None:
+        return None
+    rel = _photo_focal_gap(res, result)
+    if rel is None:
         return None
     f_fit = float(result.camera.focal_px)
-    rel = math.log(float(res.focal_px) / f_fit)
-    sd_fit = result.focal_sigma_px / f_fit
-    sd = math.hypot(float(res.focal_std_rel or 0.0), sd_fit)
-    if not (abs(rel) > math.log(1.1) and abs(rel) > 3.0 * sd):
-        return None
-    factor = abs(rel) / (2.0 * sd_fit)
+    factor = abs(rel) / (2.0 * (result.focal_sigma_px / f_fit))
     if not factor > 1.0:
         return None
     return factor, (
@@ -2569,19 +2577,16 @@ def _leave_one_out_steps(
     prob.weights = state.weights
     try:
         args = (state.rotation0, state.principal_point, state.focal_px)
-        n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
         owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
         x0 = np.asarray(state.x, dtype=float)
         r, J = prob.residuals_and_jacobian(x0, *args)
-        owner = np.concatenate([owner_base, np.full(len(r) - n_seg - 2 * n_pt, -1)])
         w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
         Jw = J * w[:, None]
         # Per-annotator blocks of the normal equations, all at once.
         n_ann = prob.n_annotators
-        onehot = owner[None, :] == np.arange(n_ann)[:, None]  # (n_ann, m)
+        mask = _owner_mask(owner_base, len(r), n_ann)  # (n_ann, m)
         H_all = J.T @ Jw
         g_all = Jw.T @ r
-        mask = onehot.astype(float)
         H_a = np.swapaxes(mask[:, :, None] * J[None], 1, 2) @ Jw  # (n_ann, n, n), batched BLAS
         g_a = mask @ (Jw * r[:, None])
         xs = _newton_steps(
@@ -2607,8 +2612,7 @@ def _leave_one_out_steps(
             if saved_prior > 0.0:
                 # The refit decides on its data-only fit: step there first (on copies).
                 prob.log_f_prior_sigma = 0.0
-                owner_d = np.concatenate([owner_base, np.full(len(r) - 1 - len(owner_base), -1)])
-                mask_d = (owner_d[None, :] == np.arange(n_ann)[:, None]).astype(float)
+                mask_d = _owner_mask(owner_base, len(r) - 1, n_ann)  # without its row
                 xs_d = list(xs)
                 live = [a for a in range(n_ann) if xs_d[a] is not None]
                 if live:
@@ -2624,8 +2628,7 @@ def _leave_one_out_steps(
             if switch:
                 prob.log_f_prior_sigma = 0.0 if saved_prior > 0.0 else prior_sigma
                 m = len(r) - 1 if saved_prior > 0.0 else len(r) + 1  # the focal prior's row
-                owner_t = np.concatenate([owner_base, np.full(m - len(owner_base), -1)])
-                mask_t = (owner_t[None, :] == np.arange(n_ann)[:, None]).astype(float)
+                mask_t = _owner_mask(owner_base, m, n_ann)
                 for _ in range(max(steps, 2)):
                     live = [a for a in switch if xs[a] is not None]
                     if not live:
@@ -2635,6 +2638,13 @@ def _leave_one_out_steps(
     finally:
         prob.weights = saved
         prob.log_f_prior_sigma = saved_prior
+
+
+def _owner_mask(owner_base: npt.NDArray[np.int_], n_rows: int, n_ann: int) -> FloatArray:
+    """``(n_ann, n_rows)``: 1 where a row is the annotator's own; the rows after
+    ``owner_base`` (the photo's segments, the priors) are nobody's."""
+    owner = np.concatenate([owner_base, np.full(n_rows - len(owner_base), -1)])
+    return (owner[None, :] == np.arange(n_ann)[:, None]).astype(float)
 
 
 def _leave_one_out_step(
