@@ -45,6 +45,18 @@ FOCAL_PX = 674.9  # York Urban's published calibration
 # refusal stands (tests/test_calibrate_photo_fallback.py). See benchmarks/README.md, "real_car".
 
 
+def _run_calibrate(scene: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> dict:
+    """``camloc calibrate`` on ``scene`` through the CLI: exit 0, no traceback, its JSON."""
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene), encoding="utf-8")
+    code = main(["calibrate", str(path)])
+    captured = capsys.readouterr()
+    assert code == 0
+    assert "Traceback" not in captured.err
+    out: dict = json.loads(captured.out)
+    return out
+
+
 @pytest.mark.skipif(not (YUD / "P1020171" / "P1020171.jpg").exists(), reason=YUD_MISSING)
 def test_hand_annotated_pickup_takes_the_focal_length_from_its_photo(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -55,13 +67,7 @@ def test_hand_annotated_pickup_takes_the_focal_length_from_its_photo(
     assert scene["image"]["width"] == 640
     assert len(scene["annotations"]) == 2
     scene["image"]["path"] = str(YUD / scene["image"]["path"])
-    path = tmp_path / "scene.json"
-    path.write_text(json.dumps(scene), encoding="utf-8")
-    code = main(["calibrate", str(path)])
-    captured = capsys.readouterr()
-    assert code == 0
-    assert "Traceback" not in captured.err
-    out = json.loads(captured.out)
+    out = _run_calibrate(scene, tmp_path, capsys)
     assert out["intrinsics_method"] == "photo_focal"
     focal_px, sigma_px = out["focal_px"], out["focal_sigma_px"]
     assert abs(focal_px / 674.9 - 1.0) < 0.10
@@ -89,14 +95,7 @@ def _calibrate_corolla(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> di
     assert scene["image"]["width"] == 640
     assert [a["annotator"] for a in scene["annotations"]] == ["hand-a", "hand-b"]
     scene["image"]["path"] = str(YUD / scene["image"]["path"])
-    path = tmp_path / "scene.json"
-    path.write_text(json.dumps(scene), encoding="utf-8")
-    code = main(["calibrate", str(path)])
-    captured = capsys.readouterr()
-    assert code == 0
-    assert "Traceback" not in captured.err
-    out: dict = json.loads(captured.out)
-    return out
+    return _run_calibrate(scene, tmp_path, capsys)
 
 
 @pytest.mark.skipif(not (YUD / "P1020822" / "P1020822.jpg").exists(), reason=YUD_MISSING)
@@ -163,13 +162,7 @@ def _calibrate_taxi(tmp_path: Path, capsys: pytest.CaptureFixture[str], with_pho
         scene["image"]["path"] = str(YUD / scene["image"]["path"])
     else:
         del scene["image"]["path"]
-    path = tmp_path / "scene.json"
-    path.write_text(json.dumps(scene), encoding="utf-8")
-    code = main(["calibrate", str(path)])
-    captured = capsys.readouterr()
-    assert code == 0
-    assert "Traceback" not in captured.err
-    out: dict = json.loads(captured.out)
+    out = _run_calibrate(scene, tmp_path, capsys)
     assert out["excluded_annotators"] == []
     return out
 
