@@ -99,6 +99,22 @@ class _Page:
         self.page.goto(path.resolve().as_uri(), wait_until="load")
         self.page.wait_for_selector(selector, state="attached", timeout=5000)
 
+    def click_for_popup(self, locator: Any) -> None:
+        """Click a marker to open its popup; click once more if no popup came.
+
+        Rarely (about 1 run in 10 under a loaded CI, never in 30 quiet runs) the first click
+        on a freshly loaded map opened no popup within 3 s; the cause was not pinned down
+        (a click Leaflet swallows while the page settles is the likely one). What the popup
+        shows is asserted as before.
+        """
+        locator.click()
+        try:
+            self.page.locator(".leaflet-popup-content").wait_for(timeout=3000)
+        except Exception:  # playwright's TimeoutError
+            # (a second click on a marker whose popup is open would close it: only if none)
+            if self.page.locator(".leaflet-popup-content").count() == 0:
+                locator.click()
+
     def popup_text(self) -> str:
         """Text of the open popup, once its fade-in animation has finished."""
         popup = self.page.locator(".leaflet-popup-content")
@@ -142,7 +158,7 @@ def test_candidate_popup_shows_properties_and_overlay(tab: _Page, pages: dict[st
     tab.open(pages["candidates"], ".camloc-candidate")
     page = tab.page
     # the best candidate is the marker labelled 1
-    page.locator('.camloc-candidate [data-rank="1"]').click()
+    tab.click_for_popup(page.locator('.camloc-candidate [data-rank="1"]'))
     text = tab.popup_text()
     assert "rank\t1" in text
     assert f"{best.score:.4f}" in text
@@ -162,7 +178,7 @@ def test_summary_map_renders_offline(tab: _Page, pages: dict[str, Any]) -> None:
     assert page.locator(".leaflet-marker-icon.camloc-summary-marker").count() == 2
     assert page.locator(".camloc-legend").count() == 1
     assert page.locator(".leaflet-control-scale").count() == 1
-    page.locator(".camloc-summary-marker").first.click()
+    tab.click_for_popup(page.locator(".camloc-summary-marker").first)
     text = tab.popup_text()
     assert "score" in text
     assert "method" in text
@@ -227,7 +243,7 @@ def test_tied_candidates_are_marked_and_explained(
     page.screenshot(path=str(ARTIFACTS / "tied_map.png"))
     assert shot.stat().st_size > 10_000
     # a tied candidate's popup names the other and why; the banner folds to its headline
-    page.locator('.camloc-candidate [data-rank="2"]').click()
+    tab.click_for_popup(page.locator('.camloc-candidate [data-rank="2"]'))
     popup = tab.popup_text()
     assert "Tied with candidates 1 (score" in popup
     assert f"{res.candidates[0].score:.3f}" in popup
@@ -253,7 +269,7 @@ def test_summary_map_rings_a_tied_camera(tab: _Page, pages: dict[str, Any], tmp_
     page = tab.page
     assert page.locator(".camloc-summary-marker").count() == 2
     assert page.locator(".camloc-summary-marker .camloc-tied-arrow").count() == 1
-    page.locator(".camloc-summary-marker .camloc-tied-arrow").click()
+    tab.click_for_popup(page.locator(".camloc-summary-marker .camloc-tied-arrow"))
     text = tab.popup_text()
     assert "tied with candidates 2 and 4" in text
     assert "odds under 10 to 1" in text
