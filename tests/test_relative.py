@@ -702,3 +702,93 @@ def test_a_seed_fit_below_the_ground_lets_the_next_seed_try() -> None:
     assert abs(cal.camera.focal_px / 1214.74 - 1.0) < 0.10
     assert not cal.excluded_annotators
     assert cal.camera.height_m > 0.0
+
+
+def _rounded_face_scene(camera: Camera, turn_deg: float, width_scene_lines: bool) -> dict:
+    """Three annotators' clicks on the preset sedan; their length and height lines are scene
+    lines (kerb, lane line, poles) and one of the car's side, their width lines three edges
+    of the car's near end, all turned ``turn_deg`` about the length axis (the silhouettes of
+    a rounded face read as straight edges, every one the same way); with
+    ``width_scene_lines``, two stop lines across the street as well."""
+    from camloc_geo.objects import PRESETS
+    from camloc_geo.testing.synthetic import _visible_segment
+
+    size = PRESETS["sedan"]
+    L, W, H = size.length_m, size.width_m, size.height_m
+    tilt = np.array([0.0, math.cos(math.radians(turn_deg)), math.sin(math.radians(turn_deg))])
+    rng = np.random.default_rng(1)
+
+    def seg(p: Any, q: Any) -> list[float]:
+        uv = _visible_segment(camera, np.asarray(p, float), np.asarray(q, float), (1920, 1080))
+        assert uv is not None
+        return [float(v) for v in uv + rng.normal(0.0, 0.5, 4)]
+
+    names = ("origin", "length", "width", "height")
+    annotations = []
+    for k in range(3):
+        z_side = 0.35 + 0.05 * k
+        length = [seg((-12, -1.6, 0), (18, -1.6, 0)), seg((-15, -4.8, 0), (10, -4.8, 0))]
+        length.append(seg((0.3, 0, z_side), (L - 0.3, 0, z_side)))
+        height = [
+            seg((6, -4, 0), (6, -4, 4)),
+            seg((12, 5, 0), (12, 5, 6)),
+            seg((3, 7, 0), (3, 7, 5)),
+        ]
+        half = (W - 0.3) / 2.0 * tilt
+        mids = [np.array([0.0, W / 2.0, z]) for z in (0.35, 0.65, 0.95)]
+        width = [seg(mid - half, mid + half) for mid in mids]
+        if width_scene_lines:
+            width += [seg((-3, -5, 0), (-3, 4, 0)), seg((-7, -6, 0), (-7, 6, 0))]
+        pix = camera.project(np.array([[0, 0, 0], [L, 0, 0], [0, W, 0], [0, 0, H]], float))
+        annotations.append(
+            {
+                "annotator": f"a{k}",
+                "axes": dict(zip(names, pix.tolist(), strict=True)),
+                "vp_lines": {"length": length, "width": width, "height": height},
+            }
+        )
+    return {
+        "format": "camloc-scene/1",
+        "id": "rounded-face",
+        "image": {"width": 1920, "height": 1080},
+        "object": {"preset": "sedan"},
+        "annotations": annotations,
+    }
+
+
+@pytest.mark.parametrize("turn_deg", [3.0, -3.0])
+def test_a_width_resting_on_one_rounded_face_is_warned_and_its_sigma_covers_the_error(
+    turn_deg: float,
+) -> None:
+    """Issue 24: width lines that are all the car's own (one face, every one turned 3 degrees,
+    as a rounded body's silhouettes are) pull the focal length 6 % off; without the car-line
+    term the fit states 2-3x too small a sigma. With it: a warning naming the width axis,
+    and 2 sigma covers the error. The answer itself does not move."""
+    camera = camera_aimed_at_car(4.0, 14.0)
+    scene = parse_scene(_rounded_face_scene(camera, turn_deg, width_scene_lines=False))
+    plain = calibrate(scene, CalibrationSettings(car_line_sigma_deg=0.0))
+    result = calibrate(scene)
+    err = result.camera.focal_px - camera.focal_px
+    assert plain.focal_sigma_px is not None
+    assert result.focal_sigma_px is not None
+    assert abs(err) > 0.04 * camera.focal_px
+    assert abs(err) > 2.0 * plain.focal_sigma_px  # confidently wrong without the term
+    assert abs(err) < 2.0 * result.focal_sigma_px
+    assert result.camera.focal_px == pytest.approx(plain.camera.focal_px, abs=1e-9)
+    warned = [w for w in result.warnings if "car's own edges" in w]
+    assert len(warned) == 1
+    assert warned[0].startswith("vp_lines.width:")
+    assert "stop line" in warned[0]
+
+
+def test_scene_lines_along_the_width_take_the_car_line_term_and_warning_away() -> None:
+    """The same turned face with two stop lines across the street: the fit rests on them
+    (focal within 1.5 %); no warning, and the sigmas are those without the term."""
+    camera = camera_aimed_at_car(4.0, 14.0)
+    scene = parse_scene(_rounded_face_scene(camera, 3.0, width_scene_lines=True))
+    plain = calibrate(scene, CalibrationSettings(car_line_sigma_deg=0.0))
+    result = calibrate(scene)
+    assert abs(result.camera.focal_px / camera.focal_px - 1.0) < 0.015
+    assert not any("car's own edges" in w for w in result.warnings)
+    assert result.focal_sigma_px == pytest.approx(plain.focal_sigma_px, rel=1e-12)
+    assert result.position_sigma_m == pytest.approx(plain.position_sigma_m, rel=1e-12)
