@@ -876,36 +876,34 @@ def _car_faces(
     margin = max(CAR_LINE_MARGIN_MIN_PX, CAR_LINE_MARGIN_REL * float(np.hypot(*span)))
     on_car = _inside_hull(segments, hull, margin)
     out[on_car] = 6
-    if not projected:
+    car = np.flatnonzero(on_car)
+    if not projected or not len(car):
         return out
+    best = np.full(len(car), np.inf)  # the depth of the face each car line is on so far
     for face in range(6):
         n_axis, side = divmod(face, 2)
         corners = bits[:, n_axis] == side
-        quad = _convex_hull(pts[corners])
         depth = float(pc[corners, 2].mean())
-        holds = on_car & (axis_of != n_axis) & _inside_hull(segments, quad, margin)
-        for i in np.flatnonzero(holds):
-            if out[i] == 6 or depth < _face_depth(pc, bits, int(out[i])):
-                out[i] = face
+        holds = (axis_of[car] != n_axis) & (depth < best)
+        if np.any(holds):
+            holds &= _inside_hull(segments[car], _convex_hull(pts[corners]), margin)
+            out[car[holds]], best[holds] = face, depth
     return out
-
-
-def _face_depth(pc: FloatArray, bits: FloatArray, face: int) -> float:
-    """Mean camera depth of a box face's corners."""
-    n_axis, side = divmod(face, 2)
-    return float(pc[bits[:, n_axis] == side, 2].mean())
 
 
 def _segment_offsets_px(segments: FloatArray, vp: FloatArray) -> FloatArray:
     """Signed distance (px) of each segment's first end from the line through its midpoint
-    and the vanishing point ``vp`` (homogeneous): the joint fit's segment residual."""
+    and its vanishing point (homogeneous, ``(3,)`` or one per segment ``(k, 3)``): the joint
+    fit's segment residual."""
     seg = np.asarray(segments, dtype=float).reshape(-1, 4)
-    ones = np.ones((len(seg), 1))
-    p1 = np.hstack([seg[:, 0:2], ones])
-    mid = np.hstack([(seg[:, 0:2] + seg[:, 2:4]) / 2.0, ones])
-    line = np.cross(mid, np.asarray(vp, dtype=float)[None, :])
-    norm = np.maximum(np.hypot(line[:, 0], line[:, 1]), 1e-300)
-    return np.asarray(np.einsum("kd,kd->k", line, p1) / norm, dtype=np.float64)
+    v = np.broadcast_to(np.asarray(vp, dtype=float), (len(seg), 3))
+    mx, my = (seg[:, 0] + seg[:, 2]) / 2.0, (seg[:, 1] + seg[:, 3]) / 2.0
+    # the line mid × v, written out (np.cross costs more on small arrays)
+    la = my * v[:, 2] - v[:, 1]
+    lb = v[:, 0] - mx * v[:, 2]
+    lc = mx * v[:, 1] - my * v[:, 0]
+    num = la * seg[:, 0] + lb * seg[:, 1] + lc
+    return np.asarray(num / np.maximum(np.hypot(la, lb), 1e-300), dtype=np.float64)
 
 
 @dataclass
@@ -963,7 +961,6 @@ def _car_line_sensitivity(
     ``share_min``; where scene lines or other faces witness the axis too, they shrink by
     themselves.
     """
-    empty = _CarLines(None, {}, {}, {}, {})
     r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
     f, pp, R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
     K = np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]])
@@ -973,54 +970,61 @@ def _car_line_sensitivity(
     axis_of = np.concatenate([prob.seg_axis, prob.photo_axis]) if n_photo else prob.seg_axis
     rows = np.concatenate([np.arange(n_seg), n_seg + 2 * n_pt + np.arange(n_photo)])
     scale = np.concatenate([prob._w_seg / prob.sigma_line, prob._photo_scale[:n_photo]])
-    faces = _car_faces(prob, x, R0, pp_fixed, f_fixed, segs, axis_of)
+    considered = np.isin(axis_of, [AXES.index(a) for a in axes])
+    faces = np.full(len(segs), -1, dtype=int)
+    faces[considered] = _car_faces(
+        prob, x, R0, pp_fixed, f_fixed, segs[considered], axis_of[considered]
+    )
+    out = _CarLines(None, {}, {}, {}, {})
+    for a, name in enumerate(AXES):
+        sel = axis_of == a
+        if name in axes and np.any(sel):
+            out.n_all[name], out.n_car[name] = int(sel.sum()), int((faces[sel] >= 0).sum())
+            out.share[name], out.face[name] = 0.0, ""
+    if not np.any(faces >= 0):
+        return out  # no car lines: nothing to turn
     w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
     JW = J * w[:, None]
     try:
         H_inv = np.linalg.inv(J.T @ JW)
     except np.linalg.LinAlgError:
-        return empty
+        return out
     h = 1e-6
-    out = _CarLines(None, {}, {}, {}, {})
     cols = []
     for a, name in enumerate(AXES):
         sel = np.flatnonzero(axis_of == a)
-        if name not in axes or not len(sel):
-            continue
         car = faces[sel] >= 0
-        out.n_all[name], out.n_car[name] = len(sel), int(car.sum())
-        base = _segment_offsets_px(segs[sel], K @ R[:, a])
-        G = np.column_stack(
-            [
-                (_segment_offsets_px(segs[sel], K @ (R[:, a] + h * R[:, b])) - base)
-                / h
-                * scale[sel]
-                for b in range(3)
-                if b != a
-            ]
-        )  # (len(sel), 2): each row's residual per radian of turn toward the other axes
-
-        def moved(
-            mask: npt.NDArray[np.bool_], sel: npt.NDArray[np.int_] = sel, G: FloatArray = G
-        ) -> FloatArray:
-            c = np.zeros((len(r), 2))
-            c[rows[sel[mask]]] = G[mask]
-            return np.asarray(JW.T @ c, dtype=np.float64)  # (n, 2): Jᵀ W dr
-
-        b_all = moved(np.ones(len(sel), dtype=bool))
+        if name not in axes or not np.any(car):
+            continue
+        seg_a = segs[sel]
+        base = _segment_offsets_px(seg_a, K @ R[:, a])
+        # (len(sel), 2): each row's residual per radian of turn toward the other two axes
+        G = (
+            np.column_stack(
+                [
+                    (_segment_offsets_px(seg_a, K @ (R[:, a] + h * R[:, b])) - base) / h
+                    for b in range(3)
+                    if b != a
+                ]
+            )
+            * scale[sel, None]
+        )
+        JW_a = JW[rows[sel]]
+        b_all = JW_a.T @ G  # (n, 2): Jᵀ W dr when every line of the axis turns
         m_all = float(np.trace(b_all.T @ H_inv @ b_all))
-        groups = {int(g): moved(faces[sel] == g) for g in np.unique(faces[sel][car])}
+        groups = {}
         best, best_face = 0.0, ""
-        for g, b_g in groups.items():
+        for g in np.unique(faces[sel][car]):
+            on = faces[sel] == g
+            b_g = JW_a[on].T @ G[on]  # ... when the lines of face g turn
+            groups[int(g)] = b_g
             m_g = float(np.trace(b_g.T @ H_inv @ b_g))
-            sh = math.sqrt(m_g / m_all) if m_all > 0.0 else 0.0
-            if sh > best:
-                best, best_face = min(sh, 1.0), (_FACE_NAMES[g] if g < 6 else "body")
+            share = math.sqrt(m_g / m_all) if m_all > 0.0 else 0.0
+            if share > best:
+                best, best_face = min(share, 1.0), (_FACE_NAMES[g] if g < 6 else "body")
         out.share[name], out.face[name] = best, best_face
-        if sigma_deg > 0.0 and groups and best >= share_min:
+        if sigma_deg > 0.0 and best >= share_min:
             cols += [b_g * math.radians(sigma_deg) for b_g in groups.values()]
-    if not out.share:
-        return empty
     if cols:
         D = -H_inv @ np.hstack(cols)
         if np.all(np.isfinite(D)):
