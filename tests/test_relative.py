@@ -792,3 +792,29 @@ def test_scene_lines_along_the_width_take_the_car_line_term_and_warning_away() -
     assert not any("car's own edges" in w for w in result.warnings)
     assert result.focal_sigma_px == pytest.approx(plain.focal_sigma_px, rel=1e-12)
     assert result.position_sigma_m == pytest.approx(plain.position_sigma_m, rel=1e-12)
+
+
+def test_the_car_lines_and_their_faces_on_the_hand_annotated_taxi() -> None:
+    """York Urban P1080031's taxi (clicks in the repository, no photo): of each annotator's
+    lines, the wheel-hub and tyre-contact lines lie on the car's near side, the bumper's
+    lower edge on its near end (the rear, at the clicked corner); the kerb, the building's
+    window rows and string course, its window edges and the traffic-light pole are scene
+    lines (-1)."""
+    from camloc_geo.relative import _FACE_NAMES, _car_faces
+
+    path = SCENES_DIR.parent / "real_car" / "yud_P1080031_camry_taxi.json"
+    data = json.loads(path.read_text(encoding="utf-8"))
+    del data["image"]["path"]
+    state = calibrate(parse_scene(data)).joint_state
+    assert state is not None
+    prob = state.problem
+    faces = _car_faces(
+        prob, state.x, state.rotation0, state.principal_point, state.focal_px,
+        prob.segments, prob.seg_axis,
+    )  # fmt: skip
+    near_side, near_end = _FACE_NAMES.index("near side"), _FACE_NAMES.index("near end")
+    assert (near_side, near_end) == (2, 0)
+    # hand-a, hand-b: length (hubs, contacts, kerb, building), width (building x2, bumper),
+    # height (3 scene uprights); hand-c: one contact line, the kerb and the building
+    expected = [2, 2, -1, -1, -1, -1, 0, -1, -1, -1] * 2 + [2, -1, -1, -1, -1, 0, -1, -1]
+    assert faces.tolist() == expected
