@@ -131,8 +131,10 @@ class CalibrationSettings:
         the rear faces of the hand-annotated York Urban taxi and Corolla need, 2.0-4.1°)
         enters the stated sigmas as a consider covariance. ``car_line_sigma_deg`` 0 turns
         the term off (the warning stays). The height axis is left out by default: no real
-        car's uprights were measured, and the synthetic box's corner edges would trip it
-        on 23 % of the high street cameras of ``tests/test_calibrate_traffic.py``.
+        car's uprights were measured; tumblehome leans a face's two sides toward each other
+        (their lines meet above the car, not a shared turn, which this term does not
+        describe); and the synthetic box's corner edges would trip it on 23 % of the high
+        street cameras of ``tests/test_calibrate_traffic.py``.
     photo_lines
         Where the scene carries its photo (``image.path``), segments detected in it
         (:mod:`camloc_geo.autovp`) that agree with the annotators' fit (within
