@@ -643,12 +643,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
-    ap.add_argument(
-        "--arcs",
-        choices=("uncounted", "drop", "keep"),
-        default=None,
-        help="pieces of curves: not counted as lines (the default), left out, or kept",
-    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -681,9 +675,7 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    opts: dict[str, Any] = {"estimate_distortion": False} if args.no_distortion else {}
-    if args.arcs:
-        opts["arcs"] = args.arcs
+    opts = {"estimate_distortion": False} if args.no_distortion else {}
     runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:

@@ -34,9 +34,7 @@ Pipeline
    ``k1``), a few rounds with relabelling; kept when it differs from 0 by more than twice
    its standard deviation. A known ``k1`` is applied instead when given.
 6. Honest uncertainty: a direction supported by fewer than 6 distinct lines is left out of
-   the final fit (pieces of curves, chains of segments that turn one way along a circle,
-   the rims of a basin or an arch cut by LSD into straight pieces, are not counted:
-   ``_arc_pieces``); ``focal_std_rel`` adds to the least-squares sigma how far the focal
+   the final fit; ``focal_std_rel`` adds to the least-squares sigma how far the focal
    length moves when each direction's segments are turned by :data:`BIAS_DEG` (a
    systematic bias: residual distortion, edge detection), which is large where the
    geometry leaves the focal length loose (a level camera looking down a street), and
@@ -205,40 +203,6 @@ _ROLL_MARGIN_DEG = 10.0
 _MODEL_ERROR_LINES = 25.0
 #: Residual noise (in inlier distances) that scales a focal-length prior's weight.
 _PRIOR_NOISE_PX = 0.5
-#: Arcs (issue 24): LSD cuts a curved outline (a basin's rim, an arch) into short straight
-#: pieces that pose as a direction. A chain of at least ``_ARC_MIN_PIECES`` segments, end
-#: to end (gaps under ``_ARC_GAP_REL`` of the image diagonal, the next piece starting on
-#: the line of the one before), each turning the same way by ``_ARC_TURN_DEG`` degrees with
-#: a similar curvature (consecutive curvatures within a factor ``_ARC_CURVATURE_RATIO``),
-#: ``_ARC_MIN_TOTAL_DEG`` degrees in all, is a curve where each three consecutive pieces'
-#: end points lie on a circle (rms residual under ``_ARC_RESIDUAL_REL`` of its radius or
-#: ``_ARC_RESIDUAL_NOISE`` times the end points' noise) of radius at most
-#: ``_ARC_MAX_RADIUS_REL`` diagonals (``_arc_pieces``). Its pieces are not counted among a
-#: direction's distinct lines (or, asked for, left out). Corners (one turn), window frames
-#: (90 degrees), gables (turns both ways) and straight edges cut into collinear pieces (no
-#: turn) are not curves; nor are straight edges bowed by a lens (division model: a circle
-#: of ``1 / (2 h |k1|)`` half diagonals for an edge ``h`` half diagonals from the centre,
-#: over 1.5 diagonals for ``|k1|`` under about 0.17).
-_ARC_GAP_REL = 0.005
-_ARC_TURN_DEG = (2.0, 20.0)
-_ARC_MIN_PIECES = 3
-_ARC_MIN_TOTAL_DEG = 12.0
-_ARC_CURVATURE_RATIO = 3.0
-_ARC_RESIDUAL_REL = 0.005
-_ARC_RESIDUAL_NOISE = 5.0
-_ARC_MAX_RADIUS_REL = 1.5
-#: Pieces shorter than this (share of the diagonal) are not looked at for arcs.
-_ARC_MIN_PIECE_REL = 0.004
-#: The total turn of a chain must also exceed ``_ARC_TURN_Z`` times its noise: that of the
-#: pieces' directions, whose end points scatter by ``_ARC_NOISE_PX`` pixels of the
-#: detection image (a piece of ``L`` pixels: ``sqrt(12) * noise / L`` radians), so that
-#: short wobbly pieces along a straight edge do not make an arc.
-_ARC_NOISE_PX = 0.3
-_ARC_TURN_Z = 2.5
-#: A piece of an arc strays from it by its sagitta ``L^2 / 8R``; LSD's pieces of the
-#: arches of a gate stray by at most 2.1 px (7 times the noise): one that would stray by
-#: more than this many times the noise is a straight edge the chain runs into.
-_ARC_SAGITTA_NOISE = 10.0
 
 
 # --------------------------------------------------------------------------- images
@@ -313,7 +277,6 @@ def detect_segments(
     method: str = "auto",
     mask: npt.NDArray[Any] | None = None,
     trim_borders: bool = True,
-    drop_arcs: bool = False,
 ) -> FloatArray:
     """Detect straight line segments.
 
@@ -337,12 +300,6 @@ def detect_segments(
     trim_borders
         Ignore uniform bars along the image borders (letterboxing, black frames), whose
         edges would otherwise pose as long horizontal or vertical lines.
-    drop_arcs
-        Leave out the pieces of curves: a chain of three or more segments end to end, each
-        turning the same way by 2-20 degrees with a similar curvature, whose end points lie
-        on a circle of at most 0.6 image diagonals (a basin's rim or an arch that the
-        detector cut into straight pieces). The chains are looked for among all detected
-        pieces, the short ones included.
 
     Returns
     -------
@@ -350,33 +307,6 @@ def detect_segments(
         ``(N, 4)`` rows ``x1, y1, x2, y2`` in continuous pixel coordinates (the centre of
         the top-left pixel is ``(0.5, 0.5)``), longest first. Possibly empty.
     """
-    segs, _ = _detect_segments(
-        image,
-        min_length_px=min_length_px,
-        max_segments=max_segments,
-        max_side_px=max_side_px,
-        method=method,
-        mask=mask,
-        trim_borders=trim_borders,
-        arcs="drop" if drop_arcs else "keep",
-    )
-    return segs
-
-
-def _detect_segments(
-    image: str | os.PathLike[str] | npt.NDArray[Any],
-    *,
-    min_length_px: float | None,
-    max_segments: int,
-    max_side_px: int,
-    method: str,
-    mask: npt.NDArray[Any] | None,
-    trim_borders: bool,
-    arcs: str,
-) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
-    """:func:`detect_segments`, and which segments are pieces of curves (``arcs``:
-    ``"keep"``: not looked for, all False; ``"drop"``: left out, all False; ``"flag"``:
-    looked for and flagged)."""
     import cv2
 
     gray = load_image(image)
@@ -426,17 +356,7 @@ def _detect_segments(
     # top-left pixel at 0, 0): shift to the continuous convention, then undo the shrink.
     segs = (segs + 0.5) / scale + np.array([x0, y0, x0, y0], dtype=np.float64)
     if len(segs) == 0:
-        return np.zeros((0, 4)), np.zeros(0, dtype=bool)
-    full_diag = math.hypot(full_w, full_h)
-    arc = np.zeros(len(segs), dtype=bool)
-    if arcs in ("drop", "flag"):
-        raw_len = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
-        segs = segs[raw_len >= _ARC_MIN_PIECE_REL * full_diag]
-        arc = _arc_pieces(segs, full_diag, _ARC_NOISE_PX / scale)
-        if arcs == "drop":
-            if arc.any():
-                log.debug("%d segments are pieces of curves: left out", int(arc.sum()))
-            segs, arc = segs[~arc], arc[~arc]
+        return np.zeros((0, 4))
     if mask is not None:
         pts = [segs[:, 0:2], segs[:, 2:4], 0.5 * (segs[:, 0:2] + segs[:, 2:4])]
         inside = np.ones(len(segs), dtype=bool)
@@ -444,12 +364,12 @@ def _detect_segments(
             ix = np.clip(np.floor(p[:, 0]).astype(np.int64), 0, full_w - 1)
             iy = np.clip(np.floor(p[:, 1]).astype(np.int64), 0, full_h - 1)
             inside &= mask[iy, ix]
-        segs, arc = segs[inside], arc[inside]
+        segs = segs[inside]
     lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
     keep = lengths >= min_length_px
-    segs, lengths, arc = segs[keep], lengths[keep], arc[keep]
+    segs, lengths = segs[keep], lengths[keep]
     order = np.argsort(-lengths, kind="stable")[:max_segments]
-    return np.ascontiguousarray(segs[order]), np.ascontiguousarray(arc[order])
+    return np.ascontiguousarray(segs[order])
 
 
 def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
@@ -468,184 +388,6 @@ def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, in
     if y1 - y0 < 8 or x1 - x0 < 8:
         return 0, 0, w, h
     return x0, y0, x1, y1
-
-
-def _arc_pieces(segs: FloatArray, diag_px: float, noise_px: float) -> npt.NDArray[np.bool_]:
-    """Which segments are pieces of a curve cut into straight pieces (see ``_ARC_*``).
-
-    Parameters
-    ----------
-    segs
-        ``(N, 4)`` segments ``x1, y1, x2, y2`` in pixels.
-    diag_px
-        The image diagonal in the same pixels.
-    noise_px
-        Scatter of the end points, in the same pixels.
-
-    Returns
-    -------
-    numpy.ndarray
-        ``(N,)`` booleans, True for the pieces of an arc.
-    """
-    from scipy.spatial import cKDTree
-
-    n = len(segs)
-    out = np.zeros(n, dtype=bool)
-    if n < _ARC_MIN_PIECES:
-        return out
-    p = np.asarray(segs, dtype=np.float64).reshape(n, 2, 2)
-    d = p[:, 1] - p[:, 0]
-    length = np.hypot(d[:, 0], d[:, 1])
-    u = d / np.where(length > 0, length, 1.0)[:, None]
-    ends = np.concatenate([p[:, 0], p[:, 1]])  # row k: segment k % n, its end k // n
-    gap_px = _ARC_GAP_REL * diag_px
-    pairs = cKDTree(ends).query_pairs(gap_px, output_type="ndarray")
-    if len(pairs) == 0:
-        return out
-    a, b = pairs[:, 0], pairs[:, 1]
-    si, sj, ei, ej = a % n, b % n, a // n, b // n
-    ok = si != sj
-    a, b, si, sj, ei, ej = a[ok], b[ok], si[ok], sj[ok], ei[ok], ej[ok]
-    # i runs into the junction, j runs out of it
-    ui = np.where((ei == 1)[:, None], u[si], -u[si])
-    uj = np.where((ej == 0)[:, None], u[sj], -u[sj])
-    turn = np.arctan2(ui[:, 0] * uj[:, 1] - ui[:, 1] * uj[:, 0], np.sum(ui * uj, axis=1))
-    gap = np.hypot(*(ends[a] - ends[b]).T)
-    # end to end, not overlapping: the far ends are further apart than either piece is long
-    far = np.hypot(*(ends[(a + n) % (2 * n)] - ends[(b + n) % (2 * n)]).T)
-    lo, hi = np.radians(_ARC_TURN_DEG[0]), np.radians(_ARC_TURN_DEG[1])
-    noise = math.sqrt(12.0) * noise_px * np.hypot(1.0 / length[si], 1.0 / length[sj])
-    # the next piece starts on the line of the first (up to the turn over the gap), not
-    # beside it: the other edge of a thick curve, a few pixels off, is not its continuation
-    step = ends[b] - ends[a]
-    lateral = np.abs(ui[:, 0] * step[:, 1] - ui[:, 1] * step[:, 0])
-    ok = (
-        (np.abs(turn) >= lo)
-        & (np.abs(turn) <= hi)
-        & (far > np.maximum(length[si], length[sj]))
-        & (lateral <= 3.0 * noise_px + gap * np.abs(np.sin(turn)))
-    )
-    a, b, turn, gap, noise = a[ok], b[ok], turn[ok], gap[ok], noise[ok]
-    # each end keeps its nearest such neighbour, and a link holds where both ends agree
-    best = np.full(2 * n, -1, dtype=np.int64)
-    best_gap = np.full(2 * n, np.inf)
-    for k in np.argsort(gap, kind="stable"):
-        for x in (a[k], b[k]):
-            if best[x] < 0:
-                best[x], best_gap[x] = k, gap[k]
-    link_end = np.full(2 * n, -1, dtype=np.int64)  # the end a segment's end is linked to
-    link_turn = np.zeros(2 * n)  # turn walking out through this end (radians, signed)
-    link_noise = np.zeros(2 * n)  # its noise (radians)
-    for k in range(len(a)):
-        if best[a[k]] == k and best[b[k]] == k:
-            link_end[a[k]], link_end[b[k]] = b[k], a[k]
-            # walking from a's segment out through end a: turn as computed when a's end
-            # is its end 1 (forward); the other way round it changes sign
-            link_turn[a[k]] = turn[k]
-            link_turn[b[k]] = turn[k]
-            link_noise[a[k]] = link_noise[b[k]] = noise[k]
-    seen = np.zeros(n, dtype=bool)
-    for start in range(n):
-        if seen[start] or (link_end[start] < 0 and link_end[start + n] < 0):
-            continue
-        # go back to one end of the chain (or round a closed one)
-        s0, e_out = start, 0  # walking backwards: out through end 0
-        steps = 0
-        while link_end[s0 + e_out * n] >= 0 and steps < n:
-            nxt = link_end[s0 + e_out * n]
-            s0, e_out = nxt % n, 1 - nxt // n
-            steps += 1
-            if s0 == start:
-                break
-        # walk forwards from s0: out through the end it was not entered by
-        chain = [s0]
-        turns: list[float] = []
-        noises: list[float] = []
-        seg, e_out = s0, 1 - e_out
-        while link_end[seg + e_out * n] >= 0 and len(chain) <= n:
-            k = seg + e_out * n
-            nxt = link_end[k]
-            t = link_turn[k]
-            # the stored turn treats the lower-numbered end row as "i"; orient it to the walk
-            if k != min(k, nxt):
-                t = -t
-            seg, e_out = nxt % n, 1 - nxt // n
-            if seg == s0:
-                break
-            chain.append(seg)
-            turns.append(float(t))
-            noises.append(float(link_noise[k]))
-        seen[chain] = True
-        _mark_arcs(
-            np.array(chain), np.array(turns), np.array(noises), p, length, diag_px, noise_px, out
-        )
-    return out
-
-
-def _circle_fit(pts: FloatArray) -> tuple[float, float] | None:
-    """Radius and rms residual of the least-squares (Kasa) circle through ``(K, 2)`` points."""
-    A = np.column_stack([pts, np.ones(len(pts))])
-    sol = np.linalg.lstsq(A, -(pts**2).sum(axis=1), rcond=None)[0]
-    centre = -0.5 * sol[:2]
-    r2 = float(centre @ centre - sol[2])
-    if not r2 > 0:
-        return None
-    radius = math.sqrt(r2)
-    resid = np.hypot(*(pts - centre).T) - radius
-    return radius, float(np.sqrt(np.mean(resid**2)))
-
-
-def _mark_arcs(
-    chain: npt.NDArray[np.int64],
-    turns: FloatArray,
-    noises: FloatArray,
-    p: FloatArray,
-    length: FloatArray,
-    diag_px: float,
-    noise_px: float,
-    out: npt.NDArray[np.bool_],
-) -> None:
-    """Mark in ``out`` the runs of ``chain`` that turn one way with a similar curvature and
-    fit a circle (see :func:`_arc_pieces`); ``turns[k]`` is the turn from ``chain[k]`` to
-    ``chain[k + 1]``, ``noises[k]`` its noise."""
-    if len(chain) < _ARC_MIN_PIECES:
-        return
-    curv = turns / (0.5 * (length[chain[:-1]] + length[chain[1:]]))
-    start = 0
-    for k in range(1, len(turns) + 1):
-        brk = k == len(turns)
-        if not brk:
-            c0, c1 = curv[k - 1], curv[k]
-            brk = c0 * c1 <= 0 or max(abs(c0), abs(c1)) > _ARC_CURVATURE_RATIO * min(
-                abs(c0), abs(c1)
-            )
-        if not brk:
-            continue
-        run = chain[start : k + 1]  # links start .. k-1 join pieces start .. k
-        total_turn = abs(float(turns[start:k].sum()))
-        total_noise = math.sqrt(float(np.sum(noises[start:k] ** 2)))
-        start = k
-        if len(run) < _ARC_MIN_PIECES or total_turn < max(
-            math.radians(_ARC_MIN_TOTAL_DEG), _ARC_TURN_Z * total_noise
-        ):
-            continue
-        # an ellipse's curvature varies along it: each window of three pieces must lie on
-        # a circle (its four end points: the two turns agree with the pieces' lengths)
-        for i in range(len(run) - _ARC_MIN_PIECES + 1):
-            win = run[i : i + _ARC_MIN_PIECES]
-            fit = _circle_fit(p[win].reshape(-1, 2))
-            if fit is None:
-                continue
-            radius, rms = fit
-            if radius > _ARC_MAX_RADIUS_REL * diag_px or rms > max(
-                _ARC_RESIDUAL_REL * radius, _ARC_RESIDUAL_NOISE * noise_px
-            ):
-                continue
-            # a straight piece cut from an arc is a chord the detector took for a line: it
-            # strays from the arc by at most a few pixels (its sagitta, L^2 / 8R); a long
-            # straight edge that the chain runs into (a door jamb below an arch) does not
-            sagitta = length[win] ** 2 / (8.0 * radius)
-            out[win[sagitta <= _ARC_SAGITTA_NOISE * noise_px]] = True
 
 
 # ------------------------------------------------------------------------ geometry
@@ -1413,7 +1155,6 @@ def detect_vanishing_points(
     bias_deg: float | None = None,
     distortion_k1: float | None = None,
     estimate_distortion: bool = True,
-    arcs: str = "uncounted",
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -1482,13 +1223,6 @@ def detect_vanishing_points(
         into pieces. It is kept when it differs from 0 by more than twice its standard
         deviation (then the segments are undistorted and the fit redone); the result
         reports it with its sigma either way (``distortion``, ``distortion_std``).
-    arcs
-        What to do with the pieces of curves (see :func:`detect_segments`, ``drop_arcs``):
-        the rims of a round basin or an arch, cut by the line detector into short
-        straight pieces. ``"uncounted"`` (default): they stay in the fit but are not
-        counted among the distinct lines that support a direction, so a direction made of
-        them is weak (left out under 6 lines, checked under 12); ``"drop"``: left out of
-        the fit; ``"keep"``: not looked for. Given ``segments`` are looked at too.
 
     Returns
     -------
@@ -1539,30 +1273,13 @@ def detect_vanishing_points(
         raise InputError(f"principal_point must be two finite numbers, got {principal_point!r}")
     if max_iterations < 1:
         raise InputError(f"max_iterations must be positive, got {max_iterations}")
-    if arcs not in ("uncounted", "drop", "keep"):
-        raise InputError(f"arcs must be 'uncounted', 'drop' or 'keep', got {arcs!r}")
     if segments is None:
         assert gray is not None
-        segs_px, arc = _detect_segments(
-            gray,
-            min_length_px=None,
-            max_segments=500,
-            max_side_px=1024,
-            method="auto",
-            mask=mask,
-            trim_borders=True,
-            arcs="flag" if arcs == "uncounted" else arcs,
-        )
+        segs_px = detect_segments(gray, mask=mask)
     else:
         segs_px = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
         ln = np.hypot(segs_px[:, 2] - segs_px[:, 0], segs_px[:, 3] - segs_px[:, 1])
         segs_px = segs_px[np.isfinite(ln) & (ln > 1e-6)]
-        arc = np.zeros(len(segs_px), dtype=bool)
-        if arcs != "keep":
-            noise_px = _ARC_NOISE_PX * max(1.0, max(w, h) / 1024.0)
-            arc = _arc_pieces(segs_px, math.hypot(w, h), noise_px)
-            if arcs == "drop":
-                segs_px, arc = segs_px[~arc], arc[~arc]
     if len(segs_px) < _MIN_SEGMENTS:
         raise NotEnoughStructureError(
             f"not enough structure: {len(segs_px)} straight line segments found "
@@ -1581,7 +1298,7 @@ def detect_vanishing_points(
         pp_t = (float(pp[0]), float(pp[1]))
         und = undistort_points_px(segs_px.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
         ok = np.all(np.isfinite(und), axis=1)
-        segs_px, segs_photo, arc = und[ok], segs_px[ok], arc[ok]
+        segs_px, segs_photo = und[ok], segs_px[ok]
     hints = _prepare_hints(axes_hint, pp, scale)
     if axes_hint:
         # An annotated axis is a straight line of the image too: fit it with the segments
@@ -1593,12 +1310,6 @@ def detect_vanishing_points(
             ]
         )
         segs_px = np.vstack([axis_segs, segs_px])
-        arc = np.r_[np.zeros(len(axis_segs), dtype=bool), arc]
-
-    def counted(segs: FloatArray) -> FloatArray:
-        """``segs`` with the pieces of curves as NaN rows (not counted as lines)."""
-        return np.where(arc[:, None], np.nan, segs) if arc.any() else segs
-
     diag = math.hypot(w, h)
     tau = inlier_px if inlier_px is not None else max(1.0, _TAU_PER_800 * diag / 800.0)
     s = _prepare(segs_px, pp, scale)
@@ -1737,11 +1448,10 @@ def detect_vanishing_points(
     # A direction supported by a few lines only (paving joints, shadows, a roof slope) is
     # left out: it would pull the focal length and the horizon wherever it lies.
     merge_px = max(4.0, 0.01 * diag)
-    n_lines = [_n_distinct_lines(counted(segs_px)[best.labels == k], merge_px) for k in range(3)]
+    n_lines = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
     weak = int(np.argmin(n_lines))
     others = sorted(n_lines)[1:]
-    # (a direction whose inliers are all pieces of curves counts 0 lines: it goes too)
-    if n_lines[weak] < _WEAK_LINES and np.any(best.labels == weak) and min(others) >= _MIN_SUPPORT:
+    if 0 < n_lines[weak] < _WEAK_LINES and min(others) >= _MIN_SUPPORT:
         labels = np.where(best.labels == weak, -1, best.labels)
         R, f, logf_std, _ = _refine(
             best.R, best.f_n, s, labels, tau, f_fixed is None, f_prior, f_bounds, prior_w=prior_w
@@ -1806,16 +1516,16 @@ def detect_vanishing_points(
                 shift_std,
                 ": it rests on it" if best.rests_on_few else "",
             )
-    nl = [_n_distinct_lines(counted(segs_px)[best.labels == k], merge_px) for k in range(3)]
+    nl = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
     best.n_lines = (nl[0], nl[1], nl[2])
     bias = BIAS_DEG if bias_deg is None else bias_deg
     if f_fixed is None and math.isfinite(best.logf_std):
         sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
         split_std = _split_horizon_logf_std(
-            best, s, counted(segs_px), merge_px, tau, f_prior, f_bounds, prior_w
+            best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
         )
         jack_std = _line_jackknife_logf_std(
-            best, s, counted(segs_px), merge_px, tau, f_prior, f_bounds, prior_w
+            best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
         )
         # the jackknife measures the same sampling spread as the least-squares sigma,
         # outliers that pose as lines included: the larger of the two
@@ -1858,7 +1568,6 @@ def detect_vanishing_points(
         min_inlier_share,
         prior_source=focal_prior_source if has_prior else None,
         prior_sigma=prior_sigma if has_prior else None,
-        count_px=counted(segs_px),
     )
     result.distortion_std = k1_std
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
@@ -2049,23 +1758,19 @@ def _steep_up_rival(dirs: FloatArray, n_lines: Sequence[int], kv: int) -> int | 
 def _n_distinct_lines(segs: FloatArray, merge_px: float = 4.0) -> int:
     """Number of distinct straight lines among segments (greedy, longest first)."""
     groups = _line_groups(segs, merge_px)
-    return int(groups.max()) + 1 if len(groups) else 0  # -1 (uncounted rows) gives 0
+    return int(groups.max()) + 1 if len(groups) else 0
 
 
 def _line_groups(segs: FloatArray, merge_px: float = 4.0) -> npt.NDArray[np.int64]:
     """The distinct straight line (0, 1, ...) each segment lies on (greedy, longest first:
     a segment joins the first longer one it is collinear with, within ``merge_px`` and 3
-    degrees). Rows of NaN (pieces of curves, which are not counted) get -1."""
+    degrees)."""
     groups = np.full(len(segs), -1, dtype=np.int64)
     if len(segs) == 0:
         return groups
     p1, p2 = segs[:, :2], segs[:, 2:]
     d = p2 - p1
     ln = np.hypot(d[:, 0], d[:, 1])
-    counted = np.isfinite(ln)
-    if not counted.all():
-        groups[counted] = _line_groups(segs[counted], merge_px)
-        return groups
     u = d / ln[:, None]
     mid = 0.5 * (p1 + p2)
     n = 0
@@ -2136,15 +1841,13 @@ def _finish(
     min_inlier_share: float,
     prior_source: str | None = None,
     prior_sigma: float | None = None,
-    count_px: FloatArray | None = None,
 ) -> AutoVPResult:
     dirs = m.R.T.copy()  # rows
     support = np.array([s.weight[m.labels == k].sum() for k in range(3)])
     counts = np.array([np.count_nonzero(m.labels == k) for k in range(3)])
     # Count distinct lines (both edges of a drawn line, or a broken edge, are one line).
     merge_px = max(4.0, 0.01 * math.hypot(*size))
-    cnt = segs_px if count_px is None else count_px  # pieces of curves as NaN rows
-    distinct = np.array([_n_distinct_lines(cnt[m.labels == k], merge_px) for k in range(3)])
+    distinct = np.array([_n_distinct_lines(segs_px[m.labels == k], merge_px) for k in range(3)])
     srt = np.sort(distinct)[::-1]
     if srt[1] < _MIN_SUPPORT:
         raise NotEnoughStructureError(

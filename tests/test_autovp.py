@@ -678,10 +678,9 @@ def test_real_photo_direction_of_few_lines_against_the_exif_is_left_out() -> Non
 @pytest.mark.skipif(not (LUND / "6").exists(), reason=LUND_MISSING)
 def test_real_photo_focal_resting_on_a_few_lines_is_warned() -> None:
     """A statue niche of the Landhaus in Graz: the focal length rests on 8 lines that pull it
-    to -25 %; it was stated at 3.2 % with confidence 0.87 and no warning. (One of the 8 is a
-    piece of the niche's curved top: 7 are counted since pieces of curves are not.)"""
+    to -25 %; it was stated at 3.2 % with confidence 0.87 and no warning."""
     res = detect_vanishing_points(str(LUND / "6" / "DSCN2117.JPG"))
-    assert any("rests on a direction of only 7 lines" in w for w in res.warnings)
+    assert any("rests on a direction of only 8 lines" in w for w in res.warnings)
     assert res.confidence < 0.2
     assert res.focal_std_rel > 0.3
     assert res.focal_source == "estimated"
