@@ -104,7 +104,8 @@ class CalibrationSettings:
         centre, this uncertainty is propagated into every sigma of
         :class:`CalibrationResult` (and its ``parameter_covariance``); 0 turns it off.
     jackknife, jackknife_method
-        Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators).
+        Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators; the
+        photo's lines, where they joined the fit, are left out in turn as one more group).
         ``one_step``: per left-out annotator, the Newton step of the infinitesimal
         jackknife from the joint solution and one Gauss-Newton step more, on the fit's own
         residuals and Jacobian (no refits; ~2 ms; within 10 % of the refits' sigmas in
@@ -126,7 +127,9 @@ class CalibrationSettings:
         ``PHOTO_SEGMENT_TOL`` line sigmas of one axis' vanishing point, and clearly off the
         others) join the final fit with a small weight: each at ``PHOTO_SEGMENT_SIGMA``
         line sigmas, per axis at most as much as the annotators' average lines of that axis
-        count, under the fit's robust loss (:func:`_add_photo_segments`). Lines that
+        count, under the fit's robust loss (:func:`_add_photo_segments`). The jackknife
+        leaves the photo's lines out in turn like one more annotator (they share their
+        biases), so the stated sigmas include how much the answer leans on them. Lines that
         disagree are not used (a clear disagreement is a warning); False: never. Also where
         the annotations cannot fix the focal length: the photo's trustworthy one is used
         (:func:`calibrate`); False: the refusal stands.
