@@ -2786,7 +2786,10 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
 
     Each annotator's leave-out camera comes from two steps of :func:`_leave_one_out_steps`
     on the joint fit's state, the focal prior chosen per leave-out as a refit chooses it;
-    the spread and the influences are then as in :func:`_jackknife`. All six sigmas within
+    where the photo's detected lines joined the fit, they are left out in turn as one more
+    group (its camera joins the spread, not ``annotator_influence_m``: a detected segment
+    set shares its biases, so the photo is one witness, issue 28). The spread and the
+    influences are then as in :func:`_jackknife`. All six sigmas within
     10 % of the refits' in 90-100 % of held-out crowd scenes (benchmarks/README.md).
     """
     state = result.joint_state
