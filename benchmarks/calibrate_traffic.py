@@ -21,7 +21,8 @@ not depend on the frames). The sets per seed:
   6-9 m up whose annotators also drew one long lane line each).
 
 Per scene: the focal error ``f / f_true - 1``, the stated ``focal_sigma_px`` and ``z`` =
-error / sigma. Writes ``benchmarks/out/calibrate_traffic.json`` and
+error / sigma; per set also the 2-sigma coverage and the median ``|z|`` (a Gaussian: 95 %,
+0.67). Writes ``benchmarks/out/calibrate_traffic.json`` and
 ``benchmarks/out/calibrate_traffic.png`` (focal error per seed with the stated 2-sigma).
 
 Usage: ``python benchmarks/calibrate_traffic.py [--first-seed 300] [--seeds 20] [--draws 5]``
@@ -134,6 +135,7 @@ def summary(rows: list[dict[str, Any] | None]) -> dict[str, Any]:
         "within_6pct": round(float(np.mean(np.abs(e) < 0.06)), 3),
         "median_sigma_rel": round(float(np.median([r["focal_sigma_rel"] for r in ok])), 4),
         "cover_2sigma": round(float(np.mean(np.abs(z) < 2.0)), 3) if z.size else None,
+        "median_abs_z": round(float(np.median(np.abs(z))), 3) if z.size else None,
         "lines_left_out": int(sum(r["warnings"] for r in ok)),
     }
 
@@ -235,7 +237,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"calibrate on street scenes, seeds {result['seeds']}, {result['seconds']} s")
     print(
         f"{'set':14s} {'n':>4s} {'median':>7s} {'mean':>7s} {'sd':>6s} {'med|e|':>7s} "
-        f"{'max|e|':>7s} {'<3%':>5s} {'<6%':>5s} {'sigma':>6s} {'2σcov':>6s} {'drop':>4s}"
+        f"{'max|e|':>7s} {'<3%':>5s} {'<6%':>5s} {'sigma':>6s} {'2σcov':>6s} {'|z|':>5s} "
+        f"{'drop':>4s}"
     )
     for name, s in result["summary"].items():
         if not s["n"]:
@@ -247,7 +250,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{100 * s['sd']:5.2f}% {100 * s['median_abs']:6.2f}% {100 * s['max_abs']:6.2f}% "
             f"{100 * s['within_3pct']:4.0f}% {100 * s['within_6pct']:4.0f}% "
             f"{100 * s['median_sigma_rel']:5.2f}% {100 * (s['cover_2sigma'] or 0):5.0f}% "
-            f"{s['lines_left_out']:4d}"
+            f"{s['median_abs_z'] or 0:5.2f} {s['lines_left_out']:4d}"
         )
     return 0
 

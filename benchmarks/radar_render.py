@@ -13,7 +13,11 @@ Runs per video (``cv2.setNumThreads(1)``):
   to or cancels the radar's);
 - ``detection_true_camera``: background subtraction, the true camera with no calibration
   uncertainty (the radar's own error);
-- ``tracks_true_camera``: the exact per-frame boxes given (``--tracks``), noise-free camera.
+- ``tracks_true_camera``: the exact per-frame boxes given (``--tracks``), noise-free camera;
+- ``detection_background_photo`` (only when named in ``--runs``): as ``detection``, the
+  scene's ``image.path`` being the video's background frame (the radar's own median of
+  frames sampled over the video), so ``calibrate`` also takes the photo's lines
+  (issue 28: does lending the radar's background frame to ``calibrate`` help?).
 
 Every measured vehicle is matched to the true vehicle whose footprint centre is nearest to
 its ground track; error = measured - true speed. Reported per run: p50/p90/max of the
@@ -60,6 +64,7 @@ from camloc_geo.testing.traffic_render import RenderedVideo, random_street, rend
 
 OUT_DIR = Path(__file__).parent / "out"
 RUNS = ("detection", "detection_true_camera", "tracks_true_camera")
+EXTRA_RUNS = ("detection_background_photo",)  # measured on request (--runs)
 BRNO = {  # BrnoCompSpeed state of the art, km/h
     "Macko et al. 2025 (median)": 0.58,
     "Kocur 2020 (mean)": 0.75,
@@ -76,6 +81,21 @@ def true_calibration(cal: CalibrationResult, camera: Camera) -> CalibrationResul
         focal_sigma_px=0.0,
         rotation_sigma_deg=None,
     )
+
+
+def background_photo(video_path: Path, out: Path) -> Path:
+    """Write the video's background frame (the radar's median of sampled frames) as PNG."""
+    from camloc_geo.sensors.radar import _background_init, _open_video
+
+    cap, _w, _h, _fps, n = _open_video(video_path)
+    try:
+        frame = _background_init(cap, n, 1.0, n)
+    finally:
+        cap.release()
+    if frame is None:
+        raise InputError(f"{video_path}: too few frames for a background")
+    cv2.imwrite(str(out), frame)
+    return out.resolve()
 
 
 def _exact_scene(video: RenderedVideo) -> dict[str, Any]:
@@ -238,13 +258,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--name", default="radar_render")
     args = ap.parse_args(argv)
     runs = [r for r in args.runs.split(",") if r]
-    unknown = set(runs) - set(RUNS)
+    unknown = set(runs) - set(RUNS) - set(EXTRA_RUNS)
     if unknown:
-        ap.error(f"unknown runs {sorted(unknown)}; choose from {', '.join(RUNS)}")
+        ap.error(f"unknown runs {sorted(unknown)}; choose from {', '.join(RUNS + EXTRA_RUNS)}")
     cv2.setNumThreads(1)
     rows: list[dict[str, Any]] = []
     n_true = 0
     focal_errors = []
+    focal_sigmas: list[float] = []
+    focal_errors_bg: list[float] = []
+    focal_sigmas_bg: list[float] = []
     cal_failures: list[int] = []
     dropped: list[dict[str, Any]] = []
     seconds: dict[str, float] = dict.fromkeys(runs, 0.0)
@@ -272,6 +295,27 @@ def main(argv: list[str] | None = None) -> int:
                 "detection_true_camera": (cal_true, None),
                 "tracks_true_camera": (cal_true, video.boxes),
             }
+            if "detection_background_photo" in runs:
+                shot = dict(video.scene)
+                shot["image"] = {
+                    **video.scene["image"],
+                    "path": str(background_photo(video.path, Path(tmp) / f"s{seed}_bg.png")),
+                }
+                try:
+                    cal_bg: CalibrationResult | None = calibrate_scene(shot)
+                except InputError as exc:
+                    print(f"seed {seed}: calibrate with the photo failed: {exc}", file=sys.stderr)
+                    cal_bg = None
+                if cal_bg is not None:
+                    focal_errors_bg.append(
+                        round(float(cal_bg.camera.focal_px / cam.focal_px - 1.0), 4)
+                    )
+                    focal_sigmas_bg.append(
+                        round(float((cal_bg.focal_sigma_px or 0.0) / cam.focal_px), 4)
+                    )
+                plan["detection_background_photo"] = (cal_bg, None)
+            if cal is not None:
+                focal_sigmas.append(round(float((cal.focal_sigma_px or 0.0) / cam.focal_px), 4))
             for run in runs:
                 calib, tracks = plan[run]
                 if calib is None:
@@ -293,6 +337,9 @@ def main(argv: list[str] | None = None) -> int:
         "fps": 20.0,
         "true_vehicles": n_true,
         "focal_rel_error": focal_errors,
+        "focal_rel_sigma": focal_sigmas,
+        "focal_rel_error_background_photo": focal_errors_bg,
+        "focal_rel_sigma_background_photo": focal_sigmas_bg,
         "calibration_failures": cal_failures,
         "targets": TARGETS,
         "brnocompspeed_state_of_the_art_kmh": BRNO,

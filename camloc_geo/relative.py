@@ -104,7 +104,8 @@ class CalibrationSettings:
         centre, this uncertainty is propagated into every sigma of
         :class:`CalibrationResult` (and its ``parameter_covariance``); 0 turns it off.
     jackknife, jackknife_method
-        Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators).
+        Add the leave-one-annotator-out spread to the uncertainty (2-12 annotators; the
+        photo's lines, where they joined the fit, are left out in turn as one more group).
         ``one_step``: per left-out annotator, the Newton step of the infinitesimal
         jackknife from the joint solution and one Gauss-Newton step more, on the fit's own
         residuals and Jacobian (no refits; ~2 ms; within 10 % of the refits' sigmas in
@@ -141,7 +142,9 @@ class CalibrationSettings:
         ``PHOTO_SEGMENT_TOL`` line sigmas of one axis' vanishing point, and clearly off the
         others) join the final fit with a small weight: each at ``PHOTO_SEGMENT_SIGMA``
         line sigmas, per axis at most as much as the annotators' average lines of that axis
-        count, under the fit's robust loss (:func:`_add_photo_segments`). Lines that
+        count, under the fit's robust loss (:func:`_add_photo_segments`). The jackknife
+        leaves the photo's lines out in turn like one more annotator (they share their
+        biases), so the stated sigmas include how much the answer leans on them. Lines that
         disagree are not used (a clear disagreement is a warning); False: never. Also where
         the annotations cannot fix the focal length: the photo's trustworthy one is used
         (:func:`calibrate`); False: the refusal stands.
@@ -2743,6 +2746,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     measures that, and is added to ``position_sigma_m`` (and, for the rotation turned onto the
     main fit's, ``ε = rotvec(R₋ᵢ · Rᵀ)``, to ``rotation_sigma_deg``); each annotator's
     influence (how far the camera moves without them) goes to ``annotator_influence_m``.
+    Where the fit used lines detected in the scene's photo (``photo_segments``), the photo
+    is one more witness: a refit without its lines (``photo_lines`` off) joins the spread.
     """
     n = len(scene.annotations)
     c = result.camera.center_in_world
@@ -2762,12 +2767,21 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     turns: list[FloatArray] = []
     R = result.camera.cam_from_world_rotation
     influence: list[float | None] = []
-    for j in range(n):
-        sub = scene.model_copy(
-            update={"annotations": [a for k, a in enumerate(scene.annotations) if k != j]}
+    # Leave out each annotator in turn, then (where the fit used them) the photo's lines.
+    leave_outs: list[tuple[Scene, CalibrationSettings]] = [
+        (
+            scene.model_copy(
+                update={"annotations": [a for k, a in enumerate(scene.annotations) if k != j]}
+            ),
+            sub_settings,
         )
+        for j in range(n)
+    ]
+    if result.photo_segments:
+        leave_outs.append((scene, replace(sub_settings, photo_lines=False)))
+    for sub, sub_set in leave_outs:
         try:
-            res = _calibrate_usable(sub, sub_settings)
+            res = _calibrate_usable(sub, sub_set)
         except (InputError, np.linalg.LinAlgError):
             influence.append(None)
             continue
@@ -2780,7 +2794,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
         if np.linalg.norm(turn) < math.radians(30.0):  # else another frame: not a spread
             turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
-    result.annotator_influence_m = influence
+    result.annotator_influence_m = influence[:n]  # the photo's is nobody's
     _add_jackknife_spread(result, centres, turns, focals)
 
 
@@ -2821,7 +2835,11 @@ def _add_jackknife_spread(
 
 
 def _leave_one_out_steps(
-    state: JointState, steps: int = 1, settings: CalibrationSettings | None = None
+    state: JointState,
+    steps: int = 1,
+    settings: CalibrationSettings | None = None,
+    *,
+    photo_group: bool = False,
 ) -> list[FloatArray | None]:
     """Parameter vectors of the joint fit without each annotator, by Gauss-Newton steps.
 
@@ -2841,6 +2859,12 @@ def _leave_one_out_steps(
     the annotator's steps are taken again with the prior switched. Without this, the one
     influential annotator whose absence leaves the focal length loose moved the camera by
     the data alone (e.g. 4.5 m where the refit, prior on, moves it 2.4 m).
+
+    ``photo_group``: where the fit holds segments detected in the scene's photo
+    (:func:`_add_photo_segments`), they are one more group, left out in turn like an
+    annotator; its parameter vector is the last of the list (one more than
+    ``problem.n_annotators``). Without it (or without photo segments) the photo's rows are
+    nobody's: every leave-out keeps them.
     """
     prob = state.problem
     saved = prob.weights
@@ -2849,12 +2873,16 @@ def _leave_one_out_steps(
     try:
         args = (state.rotation0, state.principal_point, state.focal_px)
         owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
+        n_ann = prob.n_annotators
+        n_photo = len(prob.photo_segments)
+        if photo_group and n_photo:  # the photo's rows (after the clicks'): one more group
+            owner_base = np.concatenate([owner_base, np.full(n_photo, n_ann)])
+            n_ann += 1
         x0 = np.asarray(state.x, dtype=float)
         r, J = prob.residuals_and_jacobian(x0, *args)
         w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
         Jw = J * w[:, None]
-        # Per-annotator blocks of the normal equations, all at once.
-        n_ann = prob.n_annotators
+        # Per-annotator (and the photo's) blocks of the normal equations, all at once.
         mask = _owner_mask(owner_base, len(r), n_ann)  # (n_ann, m)
         H_all = J.T @ Jw
         g_all = Jw.T @ r
@@ -2912,8 +2940,9 @@ def _leave_one_out_steps(
 
 
 def _owner_mask(owner_base: npt.NDArray[np.int_], n_rows: int, n_ann: int) -> FloatArray:
-    """``(n_ann, n_rows)``: 1 where a row is the annotator's own; the rows after
-    ``owner_base`` (the photo's segments, the priors) are nobody's."""
+    """``(n_ann, n_rows)``: 1 where a row is the group's own (an annotator's, or the photo's
+    where ``owner_base`` names it); the rows after ``owner_base`` (the priors, and the
+    photo's segments where it does not name them) are nobody's."""
     owner = np.concatenate([owner_base, np.full(n_rows - len(owner_base), -1)])
     return (owner[None, :] == np.arange(n_ann)[:, None]).astype(float)
 
@@ -3028,7 +3057,10 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
 
     Each annotator's leave-out camera comes from two steps of :func:`_leave_one_out_steps`
     on the joint fit's state, the focal prior chosen per leave-out as a refit chooses it;
-    the spread and the influences are then as in :func:`_jackknife`. All six sigmas within
+    where the photo's detected lines joined the fit, they are left out in turn as one more
+    group (its camera joins the spread, not ``annotator_influence_m``: a detected segment
+    set shares its biases, so the photo is one witness, issue 28). The spread and the
+    influences are then as in :func:`_jackknife`. All six sigmas within
     10 % of the refits' in 90-100 % of held-out crowd scenes (benchmarks/README.md).
     """
     state = result.joint_state
@@ -3042,7 +3074,8 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     focals: list[float] = []
     turns: list[FloatArray] = []
     influence: list[float | None] = []
-    xs = _leave_one_out_steps(state, steps=2, settings=settings)
+    xs = _leave_one_out_steps(state, steps=2, settings=settings, photo_group=True)
+    n_ann = prob.n_annotators  # xs[n_ann], where there is one: without the photo's lines
     live = [a for a, x in enumerate(xs) if x is not None and np.all(np.isfinite(x))]
     answers: dict[int, tuple[float, FloatArray, FloatArray]] = {}
     if live:  # every leave-out camera unpacked at once (as prob.unpack, one by one)
@@ -3051,19 +3084,24 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
         turn_b = (R_b @ M) @ R.T
         answers = {a: (float(f_b[k]), c_b[k], turn_b[k]) for k, a in enumerate(live)}
     for a in range(len(xs)):
-        if a not in answers:
-            influence.append(None)
+        if a not in answers or answers[a][1][2] <= 0.0:  # no answer without them
+            if a < n_ann:
+                influence.append(None)
             continue
         f_i, c_i, turn_matrix = answers[a]
-        if c_i[2] <= 0.0:
-            influence.append(None)  # no answer without them
-            continue
         centres.append(c_i)
         focals.append(f_i)
         turn = _small_rotvec(turn_matrix)
         if np.linalg.norm(turn) < math.radians(30.0):
             turns.append(turn)
-        influence.append(float(np.linalg.norm(c_i - c)))
+        if a < n_ann:
+            influence.append(float(np.linalg.norm(c_i - c)))
+        else:
+            log.info(
+                "without the photo's lines: focal length %+.1f %%, camera moved %.2f m",
+                100.0 * (f_i / result.camera.focal_px - 1.0),
+                float(np.linalg.norm(c_i - c)),
+            )
     result.annotator_influence_m = influence
     _add_jackknife_spread(result, centres, turns, focals)
 

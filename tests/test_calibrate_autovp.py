@@ -148,9 +148,10 @@ def _noisy_scene_with_photo(tmp_path: Path, seed: int, photo: bool) -> Path:
 
 def test_the_photos_agreeing_lines_strengthen_the_fit(tmp_path: Path) -> None:
     """The photo's segments whose vanishing points agree with the annotators' fit join it
-    with a small weight: over 12 noise draws the focal error and its stated sigma both
-    shrink (measured: mean |error| 4.9 -> 4.2 %, median sigma 7.4 -> 6.7 %), and the sigma
-    stays honest (median error/sigma 0.50)."""
+    with a small weight: over 12 noise draws the focal error shrinks and the stated sigma
+    does not grow (measured: mean |error| 4.9 -> 4.2 %, median sigma 7.4 -> 7.2 %; 6.7 %
+    before the photo's lines were a leave-out group of the jackknife, issue 28), and the
+    sigma stays honest (median error/sigma 0.50)."""
     f_true = _camera().focal_px
     err: dict[bool, list[float]] = {True: [], False: []}
     sig: dict[bool, list[float]] = {True: [], False: []}
@@ -169,7 +170,7 @@ def test_the_photos_agreeing_lines_strengthen_the_fit(tmp_path: Path) -> None:
             else:
                 assert result.photo_segments == {}
     assert np.mean(err[True]) < np.mean(err[False])
-    assert np.median(sig[True]) < 0.95 * np.median(sig[False])
+    assert np.median(sig[True]) < np.median(sig[False])
     z = np.array(err[True]) / np.array(sig[True])
     assert 0.3 < float(np.median(z)) < 1.0
 
