@@ -125,7 +125,8 @@ def test_hand_annotated_corolla_height_within_half_a_metre(
         "clicked its far ground corner at (590-591, 406-407), 7-9 px from where York Urban's "
         "published camera puts it for a car parallel to the street (596.6, 401.1); the rear "
         "face's 30-65 px width lines read nearly flat. The fit gives 926 +/- 40 px (+37 %; "
-        "116 px since the sigmas are widened where the photo disagrees); "
+        "58 px with the car-line term, the width resting on the rear face, warned; 116 px "
+        "since the sigmas are widened where the photo disagrees); "
         "with that one click moved it gives 718 +/- 37 px (+6.4 %, inside 2 sigma)"
     ),
 )
