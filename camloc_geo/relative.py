@@ -796,6 +796,22 @@ CAR_LINE_HINTS = {
 # The box faces at x = 0, x = L, y = 0, y = W, z = 0, z = H of the fit's frame (the origin
 # corner is the clicked one, the nearest to the camera).
 _FACE_NAMES = ("near end", "far end", "near side", "far side", "underside", "roof")
+#: Face ``n_axis * 2 + side``: its four box corners (index ``4 i + 2 j + k`` of the corner
+#: at bits ``(i, j, k)``, :func:`_car_faces`) in cyclic order, and the axis it is normal to.
+_FACE_CORNERS = np.array(
+    [
+        [4 * i + 2 * j + k for i, j, k in cyc]
+        for n_axis in range(3)
+        for side in (0, 1)
+        for cyc in [
+            [
+                tuple(side if d == n_axis else uv[(d - n_axis - 1) % 3] for d in range(3))
+                for uv in ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0))
+            ]
+        ]
+    ]
+)
+_FACE_NORMAL_AXIS = np.repeat(np.arange(3), 2)
 
 
 def _convex_hull(points: FloatArray) -> FloatArray:
@@ -884,15 +900,28 @@ def _car_faces(
     car = np.flatnonzero(on_car)
     if not projected or not len(car):
         return out
-    best = np.full(len(car), np.inf)  # the depth of the face each car line is on so far
-    for face in range(6):
-        n_axis, side = divmod(face, 2)
-        corners = bits[:, n_axis] == side
-        depth = float(pc[corners, 2].mean())
-        holds = (axis_of[car] != n_axis) & (depth < best)
-        if np.any(holds):
-            holds &= _inside_hull(segments[car], _convex_hull(pts[corners]), margin)
-            out[car[holds]], best[holds] = face, depth
+    # All six faces at once: each face's image quad (its corners in cyclic order, turned
+    # counter-clockwise), which car lines it holds, and the nearest such face per line.
+    quads = pts[_FACE_CORNERS]  # (6, 4, 2)
+    edge = np.roll(quads, -1, axis=1) - quads
+    area2 = np.einsum("fk,fk->f", quads[:, :, 0], np.roll(quads[:, :, 1], -1, axis=1)) - (
+        np.einsum("fk,fk->f", quads[:, :, 1], np.roll(quads[:, :, 0], -1, axis=1))
+    )
+    normal = np.stack([edge[:, :, 1], -edge[:, :, 0]], axis=2) * np.sign(area2)[:, None, None]
+    normal /= np.maximum(np.linalg.norm(normal, axis=2, keepdims=True), 1e-12)
+    offset = np.einsum("fkd,fkd->fk", normal, quads)
+    seg = segments[car]
+    holds = np.ones((6, len(car)), dtype=bool)
+    for end in (seg[:, 0:2], seg[:, 2:4]):
+        holds &= (np.einsum("fkd,sd->fsk", normal, end) - offset[:, None, :]).max(axis=2) <= margin
+    # a face seen edge-on (no area) holds nothing; nor a face parallel to the line's axis' normal
+    holds &= (np.abs(area2) > 1e-9)[:, None]
+    holds &= _FACE_NORMAL_AXIS[:, None] != axis_of[car][None, :]
+    depth = pc[_FACE_CORNERS, 2].mean(axis=1)  # (6,)
+    masked = np.where(holds, depth[:, None], np.inf)
+    face = np.argmin(masked, axis=0)
+    seen = np.isfinite(masked[face, np.arange(len(car))])
+    out[car[seen]] = face[seen]
     return out
 
 
