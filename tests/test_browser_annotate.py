@@ -543,6 +543,9 @@ def test_car_line_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> No
     assert alerts.is_visible()
     assert "Width lines rest on the car's own edges" in alerts.inner_text()
     tab.page.keyboard.press("3")
+    assert "at least one line off the car, as long as the car's width edge" in (
+        tab.page.inner_text("#step-text")
+    )
     tab.shot("16_width_lines_on_the_car")
     tab.page.screenshot(path="/tmp/pagehint_on_car.png")
 

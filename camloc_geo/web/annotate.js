@@ -938,8 +938,14 @@
         "<li>the <span class='swatch' style='background:" + COLOURS.height + "'></span><b>top</b> of the car straight above the first corner (at its roof's height).</li></ol>" +
         "<p class='muted small'>Hidden corners: click where they would be. The car is assumed to be a sedan; change it in the last step.</p>";
     },
-    length: function () { return lineText("length", "parallel to the car's length: the car's own sides, lane markings, kerbs, road edges along the street"); },
-    width: function () { return lineText("width", "parallel to the car's width: the car's front or back edge, stop lines, crossings, kerbs of the cross street"); },
+    length: function () {
+      return lineText("length", "parallel to the car's length: kerbs, lane markings, road edges and building edges along the street, " +
+        "and the car's own sides", true);
+    },
+    width: function () {
+      return lineText("width", "parallel to the car's width: stop lines, crossings, kerbs of the cross street, building edges, " +
+        "and the car's front or back edge", true);
+    },
     height: function () { return lineText("height", "that stand straight up: the car's corners, poles, lamp posts, building edges"); },
     corners: function () {
       var txt = "<p>Click the <b>kerb corners of the junction</b> that you can see (where the kerbs of two streets meet), " +
@@ -959,9 +965,12 @@
         (config.mode === "crowd" ? "<b>submit</b> your work." : "<b>save</b> the scene file (it downloads) and run <code>camloc calibrate</code> on it.") + "</p>";
     }
   };
-  function lineText(k, what) {
+  function lineText(k, what, carHint) {
     return "<p>Draw <b>two or more lines</b> " + what + ". Click one end, then the other end. " +
-      "Long lines far apart help most.</p><p><span class='swatch' style='background:" + COLOURS[k] + "'></span>" +
+      "Long lines far apart help most.</p>" +
+      (carHint ? "<p class='car-hint'>Draw at least one line <b>off the car</b>, as long as the car's " + k + " edge or longer: " +
+        "a rounded car's own edges are curved and bias the result.</p>" : "") +
+      "<p><span class='swatch' style='background:" + COLOURS[k] + "'></span>" +
       "Dotted guides show where the lines meet; they should all cross in one point (far away is fine).</p>";
   }
 
