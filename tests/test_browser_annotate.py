@@ -613,3 +613,39 @@ def test_car_outline_matches_python(tab: Tab, files: dict[str, Any]) -> None:
         assert js["inside"] == expected.tolist()
         n_inside += int(expected.sum())
     assert 100 < n_inside < 500  # both kinds are tested, of 600
+
+
+REAL_CAR = Path(__file__).parent / "data" / "real_car"
+
+
+@pytest.mark.parametrize(
+    ("name", "car_only", "warned"),
+    [
+        ("yud_P1020822_corolla", False, ["width"]),  # the rear face's own width lines
+        ("yud_P1080031_camry_taxi", False, []),  # kerb and building along both axes
+        ("yud_P1080031_camry_taxi", True, ["length", "width"]),  # hubs, tyres, bumper only
+    ],
+)
+def test_car_line_warning_agrees_with_calibrate_on_real_cars(
+    tab: Tab, files: dict[str, Any], name: str, car_only: bool, warned: list[str]
+) -> None:
+    """On the hand-annotated York Urban cars (no photo needed), every annotator's page warns
+    on exactly the axes ``calibrate`` names in its car-line warning for all of them."""
+    from test_real_car import _car_lines_only
+
+    from camloc_geo.relative import calibrate
+
+    scene = json.loads((REAL_CAR / f"{name}.json").read_text(encoding="utf-8"))
+    del scene["image"]["path"]  # the photo's segments are calibrate's, not the page's
+    if car_only:
+        scene = _car_lines_only(scene)
+    result = calibrate(parse_scene(scene))
+    got = sorted(
+        w.split(":")[0].removeprefix("vp_lines.") for w in result.warnings if "car's own edges" in w
+    )
+    assert got == warned
+    tab.open(files["page"])
+    for ann in scene["annotations"]:
+        st = {"axes": ann["axes"], "lines": ann["vp_lines"]}
+        cl = tab.page.evaluate("(st) => camlocGeometry.carLines(st)", st)
+        assert sorted(k for k, v in cl.items() if v["warn"]) == warned, ann["annotator"]

@@ -344,7 +344,7 @@
     return { hull: hull, margin: Math.max(CAR_LINE_MARGIN_MIN_PX, CAR_LINE_MARGIN_REL * Math.hypot(x1 - x0, y1 - y0)) };
   }
 
-  /* Per axis of CAR_LINE_AXES with two or more lines: which lines lie on the car (both ends
+  /* Per axis of CAR_LINE_AXES with lines: which lines lie on the car (both ends
    * on its outline), the car's own edge of that axis (px), the longest line off the car
    * (px), and warn: no line off the car is at least as long as the car's edge, so the
    * axis rests on the car's own edges (calibrate's car-line warning, issue 24). Empty
@@ -355,7 +355,7 @@
     if (!outline) return out;
     CAR_LINE_AXES.forEach(function (k) {
       var segs = st.lines[k];
-      if (segs.length < 2) return;
+      if (!segs.length) return;
       var o = st.axes.origin, edge = Math.hypot(st.axes[k][0] - o[0], st.axes[k][1] - o[1]);
       var onCar = segs.map(function (s) { return insideHull(s, outline.hull, outline.margin); });
       var longestOff = 0;
@@ -1154,7 +1154,7 @@
       var cl = a.carLines[k];
       if (!cl || !cl.warn) return;
       var name = "<span class='swatch' style='background:" + COLOURS[k] + "'></span>" + k.charAt(0).toUpperCase() + k.slice(1) + " lines";
-      var which = cl.nCar === cl.n ? "all " + cl.n + " on the car" :
+      var which = cl.n === 1 ? "the only one is on the car" : cl.nCar === cl.n ? "all " + cl.n + " on the car" :
         cl.nCar + " of " + cl.n + " on the car, the others shorter than its " + k + " edge";
       h += check("warn", "&#9888; <span class='car-lines'>" + name + " rest on the car's own edges (" + which +
         "): a rounded body's edges are curved silhouettes that bias the " + k + " direction and the focal length. " +
