@@ -541,7 +541,11 @@ def test_car_line_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> No
     assert checks.index("own edges") < checks.index("Width lines meet")
     alerts = tab.page.locator("#alerts")
     assert alerts.is_visible()
-    assert "Width lines rest on the car's own edges" in alerts.inner_text()
+    over_photo = alerts.inner_text()
+    assert (
+        "Width lines rest on the car's own edges (all 3 on the car): draw a stop line" in over_photo
+    )
+    assert f"off the car and at least {round(edge_px)} px long" in over_photo
     tab.page.keyboard.press("3")
     assert "at least one line off the car, as long as the car's width edge" in (
         tab.page.inner_text("#step-text")

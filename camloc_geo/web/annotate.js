@@ -1114,7 +1114,8 @@
   }
 
   var checkList = [];
-  function check(cls, html) { checkList.push([cls, html]); return ""; }
+  /* A check for the list; short: its shorter form over the photo (default: the same). */
+  function check(cls, html, short) { checkList.push([cls, html, short || html]); return ""; }
   function fmt(x) { return Math.round(x).toLocaleString("en-US"); }
 
   function renderChecks() {
@@ -1156,10 +1157,11 @@
       var name = "<span class='swatch' style='background:" + COLOURS[k] + "'></span>" + k.charAt(0).toUpperCase() + k.slice(1) + " lines";
       var which = cl.n === 1 ? "the only one is on the car" : cl.nCar === cl.n ? "all " + cl.n + " on the car" :
         cl.nCar + " of " + cl.n + " on the car, the others shorter than its " + k + " edge";
-      h += check("warn", "&#9888; <span class='car-lines'>" + name + " rest on the car's own edges (" + which +
-        "): a rounded body's edges are curved silhouettes that bias the " + k + " direction and the focal length. " +
-        "Draw " + CAR_LINE_HINTS[k] + ", off the car and at least as long as its " + k + " edge (" +
-        fmt(cl.edgePx) + " px).</span>");
+      var head = "&#9888; " + name + " rest on the car's own edges (" + which + ")";
+      h += check("warn", head + ": a rounded body's edges are curved silhouettes that bias the " + k +
+        " direction and the focal length. Draw " + CAR_LINE_HINTS[k] + ", off the car and at least as long as its " +
+        k + " edge (" + fmt(cl.edgePx) + " px).",
+        head + ": draw " + CAR_LINE_HINTS[k] + ", off the car and at least " + fmt(cl.edgePx) + " px long.");
     });
     if (a.intrinsics) {
       var intr = a.intrinsics;
@@ -1191,7 +1193,7 @@
     }).join("");
     var alerts = checkList.filter(function (c) { return c[0] === "bad" || c[0] === "warn"; });
     var al = $("alerts");
-    al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[1] + "</div>"; }).join("");
+    al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[2] + "</div>"; }).join("");
     al.hidden = !alerts.length;
   }
 
