@@ -478,3 +478,178 @@ def test_step_one_shows_the_ground_corner_drawing(tab: Tab, files: dict[str, Any
     assert "tyre contact" in svg
     assert svg.count("<circle") == doc_svg.count("<circle") >= 5
     tab.shot("00_step1_ground_corner")
+
+
+def _on_car_scene(files: dict[str, Any]) -> tuple[dict[str, Any], Any, tuple[float, ...]]:
+    """The truth scene with its width lines all on the car (the box's edges across it), and
+    a long kerb along the car so that only the width axis rests on the car."""
+    ls = files["ls"]
+    scene = json.loads(json.dumps(files["truth"]))
+    size = scene["object"]
+    L, W, H = size["length_m"], size["width_m"], size["height_m"]
+    cam = ls.camera_world
+    ann = scene["annotations"][0]
+    ws = 1.0 if np.linalg.norm(cam.project([0, W, 0]) - ann["axes"]["width"]) < 1e-3 else -1.0
+    ends = [([0, 0, 0], [0, ws * W, 0]), ([0, 0, H], [0, ws * W, H]), ([L, 0, H], [L, ws * W, H])]
+    ann["vp_lines"]["width"] = [
+        cam.project(np.array([a, b], float)).reshape(-1).tolist() for a, b in ends
+    ]
+    kerb = cam.project(np.array([[-6.0, -ws * 3.0, 0.0], [10.0, -ws * 3.0, 0.0]]))
+    ann["vp_lines"]["length"].append(kerb.reshape(-1).tolist())
+    return scene, cam, (L, W, H, ws)
+
+
+def test_car_line_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> None:
+    """Width lines all on the car's own edges: a warning naming the axis and what to draw,
+    in the checks and over the photo; a long width line off the car clears it; none before
+    the car is marked (issue 24)."""
+    # No car yet: lines alone never warn.
+    tab.open(files["page"])
+    tab.page.keyboard.press("3")
+    for s in ([1000.0, 1000.0, 1020.0, 990.0], [1400.0, 1000.0, 1420.0, 985.0]):
+        tab.click_image(s[0], s[1])
+        tab.click_image(s[2], s[3])
+    assert len(tab.state()["lines"]["width"]) == 2
+    assert tab.page.evaluate("camloc.analysis().carLines") == {}
+    assert "own edges" not in tab.page.inner_text("#checks-body")
+
+    scene, cam, (L, _W, _H, ws) = _on_car_scene(files)
+    path = tmp_path / "on_car.json"
+    path.write_text(json.dumps(scene))
+    page_path = tmp_path / "on_car.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(page_path), "--scene", str(path)]) == 0
+    tab.open(page_path)
+    cl = tab.page.evaluate("camloc.analysis().carLines")
+    assert cl["width"]["onCar"] == [True, True, True]
+    assert cl["width"]["warn"] is True
+    assert cl["length"]["onCar"] == [True, True, True, False]  # the kerb is off the car
+    assert cl["length"]["warn"] is False
+    edge_px = float(
+        np.hypot(
+            *np.subtract(
+                scene["annotations"][0]["axes"]["width"], scene["annotations"][0]["axes"]["origin"]
+            )
+        )
+    )
+    assert cl["width"]["edgePx"] == pytest.approx(edge_px, abs=1e-6)
+    checks = tab.page.inner_text("#checks-body")
+    assert "Width lines rest on the car's own edges (all 3 on the car)" in checks
+    assert "stop line, crossing or building edge across the street" in checks
+    assert f"at least as long as its width edge ({round(edge_px)} px)" in checks
+    assert "Length lines rest" not in checks
+    # problems come first: the warning is in the list before the vanishing points' lines
+    assert checks.index("own edges") < checks.index("Width lines meet")
+    alerts = tab.page.locator("#alerts")
+    assert alerts.is_visible()
+    over_photo = alerts.inner_text()
+    assert (
+        "Width lines rest on the car's own edges (all 3 on the car): draw a stop line" in over_photo
+    )
+    assert f"off the car and at least {round(edge_px)} px long" in over_photo
+    tab.page.keyboard.press("3")
+    assert "at least one line off the car, as long as the car's width edge" in (
+        tab.page.inner_text("#step-text")
+    )
+    tab.shot("16_width_lines_on_the_car")
+    tab.page.screenshot(path="/tmp/pagehint_on_car.png")
+
+    # A short width line off the car does not lift it ...
+    far = cam.project(np.array([[L + 3.5, 0.0, 0.0], [L + 3.5, ws * 0.7, 0.0]]))
+    assert np.hypot(*(far[1] - far[0])) < edge_px
+    tab.click_image(*far[0])
+    tab.click_image(*far[1])
+    cl = tab.page.evaluate("camloc.analysis().carLines")
+    assert cl["width"]["onCar"] == [True, True, True, False]
+    checks = tab.page.inner_text("#checks-body")
+    assert "(3 of 4 on the car, the others shorter than its width edge)" in checks
+    tab.page.keyboard.press("Control+z")
+    # ... a stop line across the street, longer than the car's width edge, does.
+    stop = cam.project(np.array([[8.0, -4.0 * ws, 0.0], [8.0, 6.0 * ws, 0.0]]))
+    assert np.hypot(*(stop[1] - stop[0])) > edge_px
+    tab.click_image(*stop[0])
+    tab.click_image(*stop[1])
+    assert len(tab.state()["lines"]["width"]) == 4
+    assert tab.page.evaluate("camloc.analysis().carLines.width.warn") is False
+    assert "own edges" not in tab.page.inner_text("#checks-body")
+    assert "own edges" not in tab.page.inner_text("#alerts")
+    tab.page.screenshot(path="/tmp/pagehint_cleared.png")
+
+
+def test_car_outline_matches_python(tab: Tab, files: dict[str, Any]) -> None:
+    """The page's car outline and on-the-car test are relative.py's (the click-box
+    outline, the same margin)."""
+    from camloc_geo import relative
+
+    tab.open(files["page"])
+    margin = tab.page.evaluate("camlocGeometry.carLineMargin")
+    assert margin == {
+        "rel": relative.CAR_LINE_MARGIN_REL,
+        "minPx": relative.CAR_LINE_MARGIN_MIN_PX,
+    }
+    rng = np.random.default_rng(3)
+    bits = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+    n_inside = 0
+    for _ in range(20):
+        o = rng.uniform(300, 1500, 2)
+        edges = rng.normal(0, 120, (3, 2))
+        axes = {"origin": o.tolist()}
+        axes.update(
+            {k: (o + e).tolist() for k, e in zip(("length", "width", "height"), edges, strict=True)}
+        )
+        # ends in and around the click box, many near its outline and the margin
+        ends = o + rng.uniform(-0.1, 1.1, (60, 3)) @ edges + rng.normal(0, 25, (60, 2))
+        segs = ends.reshape(30, 4)
+        js = tab.page.evaluate(
+            """([axes, segs]) => {
+                const g = window.camlocGeometry, ol = g.carOutline(axes);
+                return {ol: ol, inside: segs.map((s) => g.insideHull(s, ol.hull, ol.margin))};
+            }""",
+            [axes, segs.tolist()],
+        )
+        hull = relative._convex_hull(o + bits @ edges)
+        assert np.allclose(js["ol"]["hull"], hull)
+        span = hull.max(axis=0) - hull.min(axis=0)
+        m = max(
+            relative.CAR_LINE_MARGIN_MIN_PX, relative.CAR_LINE_MARGIN_REL * float(np.hypot(*span))
+        )
+        assert js["ol"]["margin"] == pytest.approx(m)
+        expected = relative._inside_hull(segs, hull, m)
+        assert js["inside"] == expected.tolist()
+        n_inside += int(expected.sum())
+    assert 100 < n_inside < 500  # both kinds are tested, of 600
+
+
+REAL_CAR = Path(__file__).parent / "data" / "real_car"
+
+
+@pytest.mark.parametrize(
+    ("name", "car_only", "warned"),
+    [
+        ("yud_P1020822_corolla", False, ["width"]),  # the rear face's own width lines
+        ("yud_P1080031_camry_taxi", False, []),  # kerb and building along both axes
+        ("yud_P1080031_camry_taxi", True, ["length", "width"]),  # hubs, tyres, bumper only
+    ],
+)
+def test_car_line_warning_agrees_with_calibrate_on_real_cars(
+    tab: Tab, files: dict[str, Any], name: str, car_only: bool, warned: list[str]
+) -> None:
+    """On the hand-annotated York Urban cars (no photo needed), every annotator's page warns
+    on exactly the axes ``calibrate`` names in its car-line warning for all of them."""
+    from test_real_car import _car_lines_only
+
+    from camloc_geo.relative import calibrate
+
+    scene = json.loads((REAL_CAR / f"{name}.json").read_text(encoding="utf-8"))
+    del scene["image"]["path"]  # the photo's segments are calibrate's, not the page's
+    if car_only:
+        scene = _car_lines_only(scene)
+    result = calibrate(parse_scene(scene))
+    got = sorted(
+        w.split(":")[0].removeprefix("vp_lines.") for w in result.warnings if "car's own edges" in w
+    )
+    assert got == warned
+    tab.open(files["page"])
+    for ann in scene["annotations"]:
+        st = {"axes": ann["axes"], "lines": ann["vp_lines"]}
+        cl = tab.page.evaluate("(st) => camlocGeometry.carLines(st)", st)
+        assert sorted(k for k, v in cl.items() if v["warn"]) == warned, ann["annotator"]

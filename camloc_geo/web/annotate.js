@@ -23,6 +23,7 @@
     taxi_ny: [5.0, 1.95, 1.85], bus: [12.0, 2.55, 3.1]
   };
   var INFINITY_DIAGONALS = 1e3;
+  var AXIS_POINTS = ["origin", "length", "width", "height"];
 
   // ------------------------------------------------------------------ geometry (vanishing.py)
   function cross(a, b) {
@@ -265,10 +266,114 @@
       "consistent vanishing points" };
   }
 
+  // ------------------------------------------------------------------ the car's own lines
+  /* relative.py's CAR_LINE_MARGIN_REL and CAR_LINE_MARGIN_MIN_PX: a line end this far
+   * outside the car's outline (of the outline's bounding-box diagonal, at least 2 px) is
+   * still on the car. tests/test_browser_annotate.py checks they are the same. */
+  var CAR_LINE_MARGIN_REL = 0.05;
+  var CAR_LINE_MARGIN_MIN_PX = 2.0;
+  var CAR_LINE_AXES = ["length", "width"];
+  /* What to draw instead (relative.CAR_LINE_HINTS, "across it" spelled out). */
+  var CAR_LINE_HINTS = {
+    length: "a kerb, lane line or building edge along the car",
+    width: "a stop line, crossing or building edge across the street (along the car's width)"
+  };
+
+  /* Convex hull (Andrew's monotone chain) of 2-D points, as relative._convex_hull. */
+  function convexHull(points) {
+    var seen = {}, pts = [];
+    points.forEach(function (p) {
+      var key = p[0] + "," + p[1];
+      if (!seen[key]) { seen[key] = true; pts.push([p[0], p[1]]); }
+    });
+    pts.sort(function (a, b) { return a[0] - b[0] || a[1] - b[1]; });
+    if (pts.length < 3) return pts;
+    function half(seq) {
+      var out = [];
+      seq.forEach(function (p) {
+        while (out.length >= 2) {
+          var a = out[out.length - 2], b = out[out.length - 1];
+          if ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0) break;
+          out.pop();
+        }
+        out.push(p);
+      });
+      return out;
+    }
+    var lower = half(pts), upper = half(pts.slice().reverse());
+    return lower.slice(0, -1).concat(upper.slice(0, -1));
+  }
+
+  /* Whether both ends of segment s lie inside the hull or within margin px of it
+   * (relative._inside_hull). */
+  function insideHull(s, hull, margin) {
+    if (hull.length < 3) return false;
+    var ends = [[s[0], s[1]], [s[2], s[3]]];
+    for (var e = 0; e < 2; e++) {
+      var worst = -Infinity;
+      for (var i = 0; i < hull.length; i++) {
+        var a = hull[i], b = hull[(i + 1) % hull.length];
+        var nx = b[1] - a[1], ny = -(b[0] - a[0]);
+        var n = Math.hypot(nx, ny);
+        if (n < 1e-12) n = 1e-12;
+        worst = Math.max(worst, (nx * (ends[e][0] - a[0]) + ny * (ends[e][1] - a[1])) / n);
+      }
+      if (worst > margin) return false;
+    }
+    return true;
+  }
+
+  /* The car's image outline from its four clicks: the hull of the box the three edges from
+   * the ground corner span (o + any sum of the edges; relative.py's outline where the
+   * fitted camera is not at hand), and the margin a line end may lie outside it.
+   * Returns {hull, margin} or null (the car not marked, or its clicks on one line). */
+  function carOutline(axes) {
+    if (!AXIS_POINTS.every(function (k) { return axes[k]; })) return null;
+    var o = axes.origin;
+    var e = ["length", "width", "height"].map(function (k) { return [axes[k][0] - o[0], axes[k][1] - o[1]]; });
+    var pts = [];
+    for (var i = 0; i < 2; i++) for (var j = 0; j < 2; j++) for (var k = 0; k < 2; k++) {
+      pts.push([o[0] + i * e[0][0] + j * e[1][0] + k * e[2][0], o[1] + i * e[0][1] + j * e[1][1] + k * e[2][1]]);
+    }
+    var hull = convexHull(pts);
+    if (hull.length < 3) return null;
+    var x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+    hull.forEach(function (p) {
+      x0 = Math.min(x0, p[0]); x1 = Math.max(x1, p[0]); y0 = Math.min(y0, p[1]); y1 = Math.max(y1, p[1]);
+    });
+    return { hull: hull, margin: Math.max(CAR_LINE_MARGIN_MIN_PX, CAR_LINE_MARGIN_REL * Math.hypot(x1 - x0, y1 - y0)) };
+  }
+
+  /* Per axis of CAR_LINE_AXES with lines: which lines lie on the car (both ends
+   * on its outline), the car's own edge of that axis (px), the longest line off the car
+   * (px), and warn: no line off the car is at least as long as the car's edge, so the
+   * axis rests on the car's own edges (calibrate's car-line warning, issue 24). Empty
+   * before the car is marked. */
+  function carLines(st) {
+    var out = {};
+    var outline = carOutline(st.axes);
+    if (!outline) return out;
+    CAR_LINE_AXES.forEach(function (k) {
+      var segs = st.lines[k];
+      if (!segs.length) return;
+      var o = st.axes.origin, edge = Math.hypot(st.axes[k][0] - o[0], st.axes[k][1] - o[1]);
+      var onCar = segs.map(function (s) { return insideHull(s, outline.hull, outline.margin); });
+      var longestOff = 0;
+      segs.forEach(function (s, i) {
+        if (!onCar[i]) longestOff = Math.max(longestOff, Math.hypot(s[2] - s[0], s[3] - s[1]));
+      });
+      var nCar = onCar.filter(Boolean).length;
+      out[k] = { onCar: onCar, nCar: nCar, n: segs.length, edgePx: edge, longestOffPx: longestOff,
+        warn: nCar > 0 && longestOff < edge };
+    });
+    return out;
+  }
+
   /* Everything the checks panel shows, from an annotation state (pure: tests call it). */
   function analyse(st, width, height, hints) {
     var diag = Math.hypot(width, height);
-    var out = { vps: {}, intrinsics: null, horizon: null, messages: [], wrongCorner: null };
+    var out = { vps: {}, intrinsics: null, horizon: null, messages: [], wrongCorner: null,
+      carOutline: carOutline(st.axes), carLines: carLines(st) };
     var hv = {};
     AXES.forEach(function (k) {
       var segs = st.lines[k];
@@ -303,7 +408,9 @@
   window.camlocGeometry = {
     fitVanishingPoint: fitVanishingPoint, estimateIntrinsics: estimateIntrinsics,
     orthocentre: orthocentre, focalFromPair: focalFromPair, analyse: analyse,
-    segmentResiduals: segmentResiduals
+    segmentResiduals: segmentResiduals, convexHull: convexHull, insideHull: insideHull,
+    carOutline: carOutline, carLines: carLines,
+    carLineMargin: { rel: CAR_LINE_MARGIN_REL, minPx: CAR_LINE_MARGIN_MIN_PX }
   };
 
   // ------------------------------------------------------------------ page set-up
@@ -324,7 +431,6 @@
     { key: "extras", title: "Known places (optional)" },
     { key: "save", title: config.mode === "crowd" ? "Check and submit" : "Check and save" }
   ];
-  var AXIS_POINTS = ["origin", "length", "width", "height"];
 
   function emptyState() {
     return {
@@ -689,6 +795,7 @@
       seg(toScreen(pending), toScreen(mouseImg), COLOURS[STEPS[step].key] || "#fff", 2, [6, 4]);
     }
     if (pending) dot(toScreen(pending), COLOURS[STEPS[step].key] || "#fff", 4);
+    drawCarOutline();
     drawCar();
     S.corners.forEach(function (c, i) { badge(toScreen(c), String(i + 1), CORNER_COLOUR, "#002b33"); });
     S.references.forEach(function (r, i) { badge(toScreen(r.pixel), "P" + (i + 1), REF_COLOUR, "#062b12"); });
@@ -744,6 +851,23 @@
       dot(o, "#ffffff", 6);
       label(o, analysis.wrongCorner ? "origin (wrong corner?)" : "origin", analysis.wrongCorner ? "#ff6b6b" : "#ffffff");
     }
+  }
+  /* The car's outline, dashed, while an axis rests on the car's own lines: lines inside
+   * it count as the car's. */
+  function drawCarOutline() {
+    var cl = analysis.carLines, ol = analysis.carOutline;
+    if (!ol || !CAR_LINE_AXES.some(function (k) { return cl[k] && cl[k].warn; })) return;
+    var pts = ol.hull.map(toScreen);
+    ctx.setLineDash([6, 4]);
+    ctx.lineWidth = 3; ctx.strokeStyle = "rgba(0,0,0,0.6)";
+    ctx.beginPath();
+    pts.forEach(function (p, i) { if (i) ctx.lineTo(p[0], p[1]); else ctx.moveTo(p[0], p[1]); });
+    ctx.closePath(); ctx.stroke();
+    ctx.lineWidth = 1.5; ctx.strokeStyle = "#ffb340";
+    ctx.stroke();
+    ctx.setLineDash([]);
+    var top = pts.reduce(function (a, b) { return b[1] < a[1] ? b : a; });
+    label([top[0], top[1] - 14], "the car: lines inside are its own", "#ffb340");
   }
   function drawHorizon(cw, ch) {
     var h = analysis.horizon;
@@ -814,8 +938,14 @@
         "<li>the <span class='swatch' style='background:" + COLOURS.height + "'></span><b>top</b> of the car straight above the first corner (at its roof's height).</li></ol>" +
         "<p class='muted small'>Hidden corners: click where they would be. The car is assumed to be a sedan; change it in the last step.</p>";
     },
-    length: function () { return lineText("length", "parallel to the car's length: the car's own sides, lane markings, kerbs, road edges along the street"); },
-    width: function () { return lineText("width", "parallel to the car's width: the car's front or back edge, stop lines, crossings, kerbs of the cross street"); },
+    length: function () {
+      return lineText("length", "parallel to the car's length: kerbs, lane markings, road edges and building edges along the street, " +
+        "and the car's own sides", true);
+    },
+    width: function () {
+      return lineText("width", "parallel to the car's width: stop lines, crossings, kerbs of the cross street, building edges, " +
+        "and the car's front or back edge", true);
+    },
     height: function () { return lineText("height", "that stand straight up: the car's corners, poles, lamp posts, building edges"); },
     corners: function () {
       var txt = "<p>Click the <b>kerb corners of the junction</b> that you can see (where the kerbs of two streets meet), " +
@@ -835,9 +965,12 @@
         (config.mode === "crowd" ? "<b>submit</b> your work." : "<b>save</b> the scene file (it downloads) and run <code>camloc calibrate</code> on it.") + "</p>";
     }
   };
-  function lineText(k, what) {
+  function lineText(k, what, carHint) {
     return "<p>Draw <b>two or more lines</b> " + what + ". Click one end, then the other end. " +
-      "Long lines far apart help most.</p><p><span class='swatch' style='background:" + COLOURS[k] + "'></span>" +
+      "Long lines far apart help most.</p>" +
+      (carHint ? "<p class='car-hint'>Draw at least one line <b>off the car</b>, as long as the car's " + k + " edge or longer: " +
+        "a rounded car's own edges are curved and bias the result.</p>" : "") +
+      "<p><span class='swatch' style='background:" + COLOURS[k] + "'></span>" +
       "Dotted guides show where the lines meet; they should all cross in one point (far away is fine).</p>";
   }
 
@@ -981,7 +1114,8 @@
   }
 
   var checkList = [];
-  function check(cls, html) { checkList.push([cls, html]); return ""; }
+  /* A check for the list; short: its shorter form over the photo (default: the same). */
+  function check(cls, html, short) { checkList.push([cls, html, short || html]); return ""; }
   function fmt(x) { return Math.round(x).toLocaleString("en-US"); }
 
   function renderChecks() {
@@ -1016,6 +1150,19 @@
         }
       }
     });
+    // an axis resting on the car's own edges (calibrate's car-line warning, issue 24)
+    CAR_LINE_AXES.forEach(function (k) {
+      var cl = a.carLines[k];
+      if (!cl || !cl.warn) return;
+      var name = "<span class='swatch' style='background:" + COLOURS[k] + "'></span>" + k.charAt(0).toUpperCase() + k.slice(1) + " lines";
+      var which = cl.n === 1 ? "the only one is on the car" : cl.nCar === cl.n ? "all " + cl.n + " on the car" :
+        cl.nCar + " of " + cl.n + " on the car, the others shorter than its " + k + " edge";
+      var head = "&#9888; " + name + " rest on the car's own edges (" + which + ")";
+      h += check("warn", head + ": a rounded body's edges are curved silhouettes that bias the " + k +
+        " direction and the focal length. Draw " + CAR_LINE_HINTS[k] + ", off the car and at least as long as its " +
+        k + " edge (" + fmt(cl.edgePx) + " px).",
+        head + ": draw " + CAR_LINE_HINTS[k] + ", off the car and at least " + fmt(cl.edgePx) + " px long.");
+    });
     if (a.intrinsics) {
       var intr = a.intrinsics;
       if (intr.error) {
@@ -1046,7 +1193,7 @@
     }).join("");
     var alerts = checkList.filter(function (c) { return c[0] === "bad" || c[0] === "warn"; });
     var al = $("alerts");
-    al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[1] + "</div>"; }).join("");
+    al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[2] + "</div>"; }).join("");
     al.hidden = !alerts.length;
   }
 
