@@ -3,8 +3,9 @@
 - Writes are atomic: the data go to a temporary file in the target's directory, which then
   replaces the target (:func:`os.replace`); a failure halfway leaves the old file (or none),
   never a truncated one.
-- :func:`check_output_path` refuses a missing directory, a directory as a file, and an output
-  that is one of the inputs, each with an :class:`~camloc_geo.InputError` of one line.
+- :func:`check_output_path` refuses a missing directory, a directory as a file, a directory
+  nothing can be written in (read-only, no permission, ``/proc``) and an output that is one of
+  the inputs, each with an :class:`~camloc_geo.InputError` of one line, before any work.
 - :func:`read_json_file` reads JSON with the same error style for every command.
 """
 
@@ -56,13 +57,15 @@ def check_output_path(
     ------
     InputError
         The directory is missing (it is never created), the path is a directory (or, with
-        ``directory``, not one), or the output would overwrite an input.
+        ``directory``, not one), nothing can be written in the directory, or the output would
+        overwrite an input.
     """
     p = Path(path)
     if directory:
         if not p.is_dir():
             what = "is not a directory" if p.exists() else "does not exist"
             raise InputError(f"{option} {p}: directory {what} (create it first)")
+        _check_writable(p, f"{option} {p}")
         return p
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
@@ -76,7 +79,26 @@ def check_output_path(
     for src in inputs:
         if src is not None and _same_file(p, Path(src)):
             raise InputError(f"{option} {p}: would overwrite the input {src}; choose another file")
+    _check_writable(parent, f"{option} {p}")
     return p
+
+
+def _check_writable(folder: Path, what: str) -> None:
+    """Refuse a folder nothing can be written in, by creating and removing an empty file there.
+
+    :func:`os.access` is not enough: it says yes to root on a read-only file system or in
+    ``/proc``; the outputs are written through a temporary file in the same folder
+    (:func:`atomic_path`), so this is the very operation that must succeed.
+    """
+    try:
+        fd, name = tempfile.mkstemp(prefix=".camloc-write-test.", dir=folder)
+    except OSError as exc:
+        raise InputError(
+            f"{what}: cannot write in the directory {folder} ({exc.strerror or exc})"
+        ) from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(name)
 
 
 @contextlib.contextmanager
