@@ -69,3 +69,54 @@ def test_vp_output_in_an_unwritable_directory_is_refused_before_work(
     assert main(["vp", str(tmp_path / "missing.jpg"), option, str(target)]) == 2
     line = one_line_error(capsys.readouterr().err, "vp")
     assert f"{option} {target}: cannot write in the directory" in line
+
+
+# ------------------------------------------------------------------------------- photos
+@pytest.mark.parametrize(
+    ("width", "height", "size_text"),
+    [(60000, 60000, "(3600 MP)"), (10000, 10000, "10000x10000 pixels (100 MP)")],
+)
+def test_vp_refuses_a_decompression_bomb_from_its_header(
+    width: int, height: int, size_text: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # 60000 x 60000 used to end in exit 1 "failed: DecompressionBombError" (raised while
+    # reading the EXIF); 100 MP printed Pillow's DecompressionBombWarning (two more lines)
+    photo = png_header(tmp_path / "bomb.png", width, height)
+    assert main(["vp", str(photo)]) == 2
+    line = one_line_error(capsys.readouterr().err, "vp")
+    assert f"image {photo} is too large" in line or f"image {photo} is {width}x" in line
+    assert size_text in line
+    assert "limit is 50 megapixels" in line
+
+
+@pytest.mark.parametrize(
+    "tags",
+    [
+        {0xA405: 2000},  # FocalLengthIn35mmFilm 2000 mm: 53 times the longer side
+        {0x920A: 5000.0, 0xA20E: 1280 / 6.0, 0xA210: 4},  # 5 m lens on a 6 mm sensor
+        {0x920A: 0.01, 0xA20E: 1280 / 6.0, 0xA210: 4},  # 0.01 mm
+    ],
+)
+def test_an_implausible_exif_focal_length_is_ignored_with_a_warning(
+    tags: dict[int, object], tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from PIL import Image
+
+    from camloc_geo.exif import focal_from_exif
+
+    photo = tmp_path / "p.jpg"
+    exif = Image.Exif()
+    sub = exif.get_ifd(0x8769)
+    sub.update(tags)
+    Image.new("RGB", (1280, 720), (90, 90, 90)).save(photo, exif=exif)
+    # before: a prior of 101829, 1600000 or 3 px that pinned autovp's fit to its bound
+    assert focal_from_exif(photo) is None
+    assert f"{photo}: EXIF focal length ignored" in caplog.text
+    assert "plausible: 0.3 to 6" in caplog.text
+
+
+def test_exif_plausible_range_is_the_range_autovp_searches() -> None:
+    from camloc_geo.autovp import FOCAL_BOUNDS_REL
+    from camloc_geo.exif import PLAUSIBLE_FOCAL_REL
+
+    assert PLAUSIBLE_FOCAL_REL == FOCAL_BOUNDS_REL
