@@ -7,6 +7,9 @@
   nothing can be written in (read-only, no permission, ``/proc``) and an output that is one of
   the inputs, each with an :class:`~camloc_geo.InputError` of one line, before any work.
 - :func:`read_json_file` reads JSON with the same error style for every command.
+- :func:`read_image_gray` decodes a photo (OpenCV, EXIF orientation applied) after the size
+  checks of :func:`camloc_geo._limits.check_image_file`; every failure names the file and what
+  is wrong with it (empty, truncated or corrupt, not an image, too large, too small).
 """
 
 from __future__ import annotations
@@ -21,9 +24,19 @@ from typing import Any
 
 from camloc_geo._errors import InputError
 
-__all__ = ["atomic_path", "check_output_path", "read_json_file", "write_text_atomic"]
+__all__ = [
+    "MIN_IMAGE_SIDE_PX",
+    "atomic_path",
+    "check_output_path",
+    "read_image_gray",
+    "read_json_file",
+    "write_text_atomic",
+]
 
 PathLike = str | os.PathLike[str]
+
+MIN_IMAGE_SIDE_PX = 8
+"""Smallest image side (pixels) worth looking for lines in."""
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -165,3 +178,103 @@ def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
         raise InputError(
             f"{p}: not a {what} (line {exc.lineno} column {exc.colno}: {exc.msg})"
         ) from exc
+
+
+_MAGIC = (
+    (b"\xff\xd8\xff", "JPEG"),
+    (b"\x89PNG\r\n\x1a\n", "PNG"),
+    (b"GIF8", "GIF"),
+    (b"BM", "BMP"),
+    (b"II*\x00", "TIFF"),
+    (b"MM\x00*", "TIFF"),
+)
+
+
+def _image_format(path: Path, head: bytes) -> str | None:
+    """The image format of a file (``JPEG``, ``PNG``...) from its header, or None.
+
+    Pillow's reading of the header first, else the first bytes (``head``): a JPEG cut off
+    inside its header is still named a JPEG.
+    """
+    try:
+        import warnings
+
+        from PIL import Image
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                if im.format:
+                    return str(im.format)
+    except Exception:  # any failure: try the first bytes
+        pass
+    if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
+        return "WEBP"
+    return next((name for magic, name in _MAGIC if head.startswith(magic)), None)
+
+
+def _png_intact(path: Path) -> bool:
+    """False when a PNG's chunks are cut off or fail their checksums (Pillow's ``verify``).
+
+    Checked before OpenCV decodes it: libpng would print its own error line on stderr.
+    """
+    try:
+        import warnings
+
+        from PIL import Image
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                im.verify()
+    except Exception:  # whatever the reason, not intact
+        return False
+    return True
+
+
+def read_image_gray(path: PathLike) -> Any:
+    """Decode an image file to an 8-bit grayscale array, as the user sees it.
+
+    OpenCV decodes it and applies its EXIF orientation (a portrait photo stored sideways
+    comes out upright). The header is checked first (:func:`camloc_geo._limits.check_image_file`:
+    a regular file, at most ``MAX_IMAGE_PIXELS``), so a decompression bomb is refused before
+    any memory is spent on it.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``uint8``.
+
+    Raises
+    ------
+    InputError
+        One line naming the file: missing, not a regular file, empty, too large, not an
+        image, truncated or corrupt, or smaller than ``MIN_IMAGE_SIDE_PX`` on a side.
+    """
+    import cv2
+    import numpy as np
+
+    from camloc_geo._limits import check_image_file
+
+    p = Path(path)
+    check_image_file(p)  # regular file, size from the header before decoding
+    try:
+        buf = np.fromfile(str(p), dtype=np.uint8)
+    except OSError as exc:
+        raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
+    if buf.size == 0:
+        raise InputError(f"cannot decode image {p}: the file is empty (0 bytes)")
+    fmt = _image_format(p, buf[:16].tobytes())
+    arr = None if fmt == "PNG" and not _png_intact(p) else cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    if arr is None:
+        raise InputError(
+            f"cannot decode image {p}: a truncated or corrupt {fmt} file"
+            if fmt
+            else f"cannot decode image {p}: not an image file (JPEG, PNG, TIFF, WebP, BMP...)"
+        )
+    h, w = arr.shape[:2]
+    if min(h, w) < MIN_IMAGE_SIDE_PX:
+        raise InputError(
+            f"image {p} is too small: {w}x{h} pixels (at least {MIN_IMAGE_SIDE_PX} on a side)"
+        )
+    return np.ascontiguousarray(arr, dtype=np.uint8)

@@ -120,3 +120,154 @@ def test_exif_plausible_range_is_the_range_autovp_searches() -> None:
     from camloc_geo.exif import PLAUSIBLE_FOCAL_REL
 
     assert PLAUSIBLE_FOCAL_REL == FOCAL_BOUNDS_REL
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("empty.jpg", "cannot decode image {p}: the file is empty (0 bytes)"),
+        ("cut.jpg", "cannot decode image {p}: a truncated or corrupt JPEG file"),
+        ("cut_in_header.jpg", "cannot decode image {p}: a truncated or corrupt JPEG file"),
+        ("cut.png", "cannot decode image {p}: a truncated or corrupt PNG file"),
+        ("text.jpg", "cannot decode image {p}: not an image file (JPEG, PNG, TIFF, WebP, BMP...)"),
+        ("tiny.png", "image {p} is too small: 1x1 pixels (at least 8 on a side)"),
+    ],
+)
+def test_vp_names_the_file_and_what_is_wrong(
+    name: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: "cannot decode image 'x' (not a supported image file)" for all of them, and
+    # "libpng error: PNG input buffer is incomplete" on stderr for the cut PNG
+    photo = _bad_photo(tmp_path, name)
+    assert main(["vp", str(photo)]) == 2
+    assert one_line_error(capsys.readouterr().err, "vp").endswith(message.format(p=photo))
+
+
+def _good_photo(path: Path, size: tuple[int, int], orientation: int | None = None) -> Path:
+    """A photo of ``size`` (as stored) with a few lines, and an EXIF orientation if given."""
+    import numpy as np
+    from PIL import Image, ImageDraw
+
+    im = Image.new("RGB", size, (90, 90, 90))
+    draw = ImageDraw.Draw(im)
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        draw.line(
+            [tuple(rng.uniform(0, size[0], 2)), tuple(rng.uniform(0, size[1], 2))], "white", 2
+        )
+    exif = Image.Exif()
+    if orientation is not None:
+        exif[0x0112] = orientation
+    im.save(path, exif=exif)
+    return path
+
+
+def _bad_photo(tmp_path: Path, name: str) -> Path:
+    """The bad photos of these tests, made in ``tmp_path``."""
+    p = tmp_path / name
+    if name == "empty.jpg":
+        p.write_bytes(b"")
+    elif name in ("cut.jpg", "cut_in_header.jpg"):
+        whole = _good_photo(tmp_path / "whole.jpg", (640, 480)).read_bytes()
+        p.write_bytes(whole[: len(whole) // 3] if name == "cut.jpg" else whole[:200])
+    elif name == "cut.png":
+        from PIL import Image
+
+        Image.new("RGB", (640, 480), (20, 90, 200)).save(tmp_path / "whole.png")
+        whole = (tmp_path / "whole.png").read_bytes()
+        p.write_bytes(whole[: len(whole) // 2])
+    elif name == "text.jpg":
+        p.write_text("I am not a photo\n", encoding="utf-8")
+    elif name == "tiny.png":
+        from PIL import Image
+
+        Image.new("RGB", (1, 1)).save(p)
+    elif name == "folder.jpg":
+        p.mkdir()
+    elif name == "bomb.png":
+        png_header(p, 60000, 60000)
+    elif name == "other size.jpg":  # a scaled copy: the overlay's background only
+        _good_photo(p, (1280, 960))
+    elif name == "other shape.jpg":
+        _good_photo(p, (1280, 720))
+    elif name == "turned.jpg":  # stored 640x480, displayed 480x640 (EXIF orientation 6)
+        _good_photo(p, (640, 480), orientation=6)
+    else:  # pragma: no cover - a typo in a test
+        raise AssertionError(name)
+    return p
+
+
+# ---------------------------------------------------------------- calibrate's scene photo
+REAL_CAR = Path(__file__).resolve().parent / "data" / "real_car" / "yud_P1020822_corolla.json"
+
+
+def _scene_with_photo(tmp_path: Path, photo: str | None) -> Path:
+    import json
+
+    data = json.loads(REAL_CAR.read_text(encoding="utf-8"))  # a 640x480 scene
+    data["image"] = {"width": 640, "height": 480}
+    if photo is not None:
+        data["image"]["path"] = photo
+    scene = tmp_path / f"scene-{len(list(tmp_path.iterdir()))}.json"
+    scene.write_text(json.dumps(data), encoding="utf-8")
+    return scene
+
+
+def _calibrate(scene: Path, capsys: pytest.CaptureFixture[str]) -> tuple[dict, str]:
+    import json
+
+    assert main(["calibrate", str(scene)]) == 0
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err
+    return json.loads(captured.out), captured.err
+
+
+@pytest.mark.parametrize(
+    ("name", "why"),
+    [
+        ("empty.jpg", "the file is empty (0 bytes)"),
+        ("cut.jpg", "a truncated or corrupt JPEG file"),
+        ("text.jpg", "not an image file"),
+        ("tiny.png", "is too small: 1x1 pixels"),
+        ("folder.jpg", "is not a regular file"),
+        ("bomb.png", "is too large (3600 MP)"),
+        ("other size.jpg", "is 1280x960 pixels as displayed but the scene's image is 640x480"),
+        ("other shape.jpg", "is 1280x720 pixels as displayed but the scene's image is 640x480"),
+        ("turned.jpg", "is 480x640 pixels as displayed but the scene's image is 640x480 (turned"),
+    ],
+)
+def test_calibrate_leaves_a_bad_photo_out_with_a_warning_and_uses_the_annotations(
+    name: str,
+    why: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    # before: the photo was skipped silently (empty, cut, text, tiny, bomb), said "does not
+    # exist" (a folder), or was used although its pixels are not the scene's (other size,
+    # turned: its lines then widened every stated sigma with a focal length of its own)
+    (tmp_path / "photos").mkdir()
+    photo = _bad_photo(tmp_path / "photos", name)
+    without, _ = _calibrate(_scene_with_photo(tmp_path, None), capsys)
+    result, _ = _calibrate(_scene_with_photo(tmp_path, str(photo)), capsys)
+    notes = [w for w in result["warnings"] if w.startswith("image.path: ")]
+    assert len(notes) == 1, result["warnings"]
+    assert why in notes[0]
+    assert str(photo) in notes[0]
+    assert notes[0].endswith(
+        ": a scaled copy, used as the overlay's background only (no lines detected in it)"
+        if name == "other size.jpg"
+        else "the photo is not used (no lines detected in it, no background for the overlay)"
+    )
+    assert notes[0] in caplog.text  # also on stderr
+    assert result["focal_px"] == pytest.approx(without["focal_px"], rel=1e-9)
+    assert result["focal_sigma_px"] == pytest.approx(without["focal_sigma_px"], rel=1e-9)
+
+
+def test_calibrate_uses_a_photo_its_exif_orientation_turns_to_the_scene_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # stored 480x640, displayed 640x480 (EXIF orientation 6): the grid the annotators saw
+    photo = _good_photo(tmp_path / "upright.jpg", (480, 640), orientation=6)
+    result, _ = _calibrate(_scene_with_photo(tmp_path, photo.name), capsys)
+    assert not any("the photo is not used" in w for w in result["warnings"])
