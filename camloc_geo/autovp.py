@@ -1237,6 +1237,13 @@ def detect_vanishing_points(
         raise InputError("give an image, or segments with image_size")
     if focal_px is not None and not (math.isfinite(focal_px) and focal_px > 0):
         raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
+    if focal_px is not None and not 1e-3 <= focal_px / max(w, h) <= 1e3:
+        raise InputError(
+            f"focal_px {focal_px:g} is not a focal length for a {w}x{h} image (give "
+            f"{1e-3 * max(w, h):g} to {1e3 * max(w, h):g} px)"
+        )
+    if isinstance(seed, bool) or not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise InputError(f"seed must be a non-negative integer, got {seed!r}")
     if focal_prior_px is not None and not (math.isfinite(focal_prior_px) and focal_prior_px > 0):
         raise InputError(f"focal_prior_px must be a positive number, got {focal_prior_px!r}")
     if not (math.isfinite(focal_prior_sigma_rel) and focal_prior_sigma_rel > 0):

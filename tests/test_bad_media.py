@@ -271,3 +271,20 @@ def test_calibrate_uses_a_photo_its_exif_orientation_turns_to_the_scene_size(
     photo = _good_photo(tmp_path / "upright.jpg", (480, 640), orientation=6)
     result, _ = _calibrate(_scene_with_photo(tmp_path, photo.name), capsys)
     assert not any("the photo is not used" in w for w in result["warnings"])
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        (["--focal-px", "1e300"], "focal_px 1e+300 is not a focal length for a 640x480 image"),
+        (["--seed", "-1"], "seed must be a non-negative integer, got -1"),
+    ],
+)
+def test_vp_refuses_absurd_options(
+    option: list[str], message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: 1e300 printed numpy's RuntimeWarning lines then "no vanishing point
+    # hypothesis"; a negative seed was exit 1 "failed: ValueError: expected non-negative"
+    photo = _good_photo(tmp_path / "p.jpg", (640, 480))
+    assert main(["vp", str(photo), *option]) == 2
+    assert message in one_line_error(capsys.readouterr().err, "vp")
