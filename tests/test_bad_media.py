@@ -288,3 +288,30 @@ def test_vp_refuses_absurd_options(
     photo = _good_photo(tmp_path / "p.jpg", (640, 480))
     assert main(["vp", str(photo), *option]) == 2
     assert message in one_line_error(capsys.readouterr().err, "vp")
+
+
+# --------------------------------------------------------------------- service uploads
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("cut.jpg", "body: the snapshot is a truncated or corrupt JPEG file"),
+        ("cut.png", "body: the snapshot is a truncated or corrupt PNG file"),
+        ("tiny.png", "body: the snapshot is 1×1: too small to annotate (at least 8 pixels a side)"),
+    ],
+)
+def test_service_refuses_a_cut_off_or_tiny_snapshot(
+    name: str, message: str, tmp_path: Path
+) -> None:
+    # before: POST /v1/tasks made a task of it (only the header was read), which its
+    # annotators then got as a broken or 1-pixel image
+    pytest.importorskip("fastapi")
+    from camloc_geo import SceneError
+    from camloc_geo.service.routers.crowd import image_info
+
+    raw = _bad_photo(tmp_path, name).read_bytes()
+    with pytest.raises(SceneError) as info:
+        image_info(raw, 40_000_000)
+    assert str(info.value) == message
+    whole = tmp_path / ("whole.jpg" if name == "cut.jpg" else "whole.png")
+    if whole.exists():
+        assert image_info(whole.read_bytes(), 40_000_000)[1:] == (640, 480)

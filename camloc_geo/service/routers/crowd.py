@@ -34,6 +34,8 @@ __all__ = ["router"]
 router = APIRouter(tags=["crowd"])
 
 IMAGE_TYPES = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
+MIN_SNAPSHOT_SIDE_PX = 8
+"""Smallest snapshot side (pixels) a task is made for."""
 IMAGE_MEDIA_TYPES = tuple(f"image/{kind.lower()}" for kind in IMAGE_TYPES)
 _UPLOAD_DOC = {
     "requestBody": {
@@ -66,7 +68,41 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
             f"the snapshot is {width}×{height}; this server accepts at most {max_pixels} pixels",
             "body",
         )
+    if min(width, height) < MIN_SNAPSHOT_SIDE_PX:
+        raise SceneError(
+            f"the snapshot is {width}×{height}: too small to annotate (at least "
+            f"{MIN_SNAPSHOT_SIDE_PX} pixels a side)",
+            "body",
+        )
+    if not _complete(raw, fmt):
+        raise SceneError(f"the snapshot is a truncated or corrupt {fmt} file", "body")
     return IMAGE_TYPES[fmt], width, height
+
+
+def _complete(raw: bytes, fmt: str) -> bool:
+    """Whether the image data are all there: a cut-off upload would be served to annotators.
+
+    A JPEG is decoded at 1/8 scale (Pillow's draft mode: a few milliseconds, little memory),
+    a WebP fully (its size is already bounded); a PNG's chunks and checksums are verified
+    without decompressing.
+    """
+    import warnings
+
+    from PIL import Image
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(io.BytesIO(raw)) as img:
+                if fmt == "PNG":
+                    img.verify()
+                else:
+                    if fmt == "JPEG":
+                        img.draft("L", (max(1, img.width // 8), max(1, img.height // 8)))
+                    img.load()
+    except Exception:  # any decoder failure: the data are not all there
+        return False
+    return True
 
 
 def servable_work(maps: MapStore, network: bool, point: tuple[float, float] | None) -> None:
