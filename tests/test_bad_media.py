@@ -315,3 +315,59 @@ def test_service_refuses_a_cut_off_or_tiny_snapshot(
     whole = tmp_path / ("whole.jpg" if name == "cut.jpg" else "whole.png")
     if whole.exists():
         assert image_info(whole.read_bytes(), 40_000_000)[1:] == (640, 480)
+
+
+# ------------------------------------------------------------------------------- videos
+def _video(path: Path, n_frames: int, size: tuple[int, int] = (640, 480)) -> Path:
+    import cv2
+    import numpy as np
+
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"MJPG"), 25.0, size)
+    if not writer.isOpened():  # pragma: no cover - OpenCV built without its AVI writer
+        pytest.skip("OpenCV cannot write MJPG AVI here")
+    for i in range(n_frames):
+        frame = np.full((size[1], size[0], 3), 90, np.uint8)
+        cv2.rectangle(frame, (10 + 5 * i, 200), (110 + 5 * i, 260), (200, 50, 50), -1)
+        writer.write(frame)
+    writer.release()
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("empty.avi", "cannot open video {p}: the file is empty (0 bytes)"),
+        ("one.avi", "video {p} has a single frame (a still image?)"),
+        ("photo.jpg", "video {p} has a single frame (a still image?)"),
+        ("photo.avi", "video {p} has a single frame (a still image?)"),
+    ],
+)
+def test_radar_names_an_empty_or_one_frame_video(
+    name: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: "not a video file OpenCV can read" (empty), "no vehicle found in the video
+    # (X, 1 frames)" (a still image, a one-frame video)
+    p = tmp_path / name
+    if name == "empty.avi":
+        p.write_bytes(b"")
+    elif name == "one.avi":
+        _video(p, 1)
+    else:  # a photo, under its own name or posing as a video
+        p.write_bytes(_good_photo(tmp_path / "still.jpg", (640, 480)).read_bytes())
+    scene = _scene_with_photo(tmp_path, None)
+    assert main(["radar", str(p), "--scene", str(scene)]) == 2
+    assert message.format(p=p) in one_line_error(capsys.readouterr().err, "radar")
+
+
+def test_vp_names_the_photo_without_structure(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from PIL import Image
+
+    photo = tmp_path / "blank.png"
+    Image.new("RGB", (10, 10), (90, 90, 90)).save(photo)
+    assert main(["vp", str(photo)]) == 2
+    line = one_line_error(capsys.readouterr().err, "vp")
+    assert line == f"camloc vp: error: {photo}: not enough structure: 0 straight line segments " + (
+        "found (at least 6 needed)"
+    )
