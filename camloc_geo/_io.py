@@ -180,6 +180,7 @@ def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
         ) from exc
 
 
+_FORMATS = "JPEG, PNG, TIFF, WebP, BMP, GIF..."
 _MAGIC = (
     (b"\xff\xd8\xff", "JPEG"),
     (b"\x89PNG\r\n\x1a\n", "PNG"),
@@ -238,7 +239,8 @@ def read_image_gray(path: PathLike) -> Any:
     OpenCV decodes it and applies its EXIF orientation (a portrait photo stored sideways
     comes out upright). The header is checked first (:func:`camloc_geo._limits.check_image_file`:
     a regular file, at most ``MAX_IMAGE_PIXELS``), so a decompression bomb is refused before
-    any memory is spent on it.
+    any memory is spent on it; a file whose header Pillow cannot read is refused too, its size
+    being unknown (JPEG, PNG, TIFF, WebP, BMP, GIF, PNM... are read).
 
     Returns
     -------
@@ -257,7 +259,7 @@ def read_image_gray(path: PathLike) -> Any:
     from camloc_geo._limits import check_image_file
 
     p = Path(path)
-    check_image_file(p)  # regular file, size from the header before decoding
+    header_size = check_image_file(p)  # regular file, size from the header before decoding
     try:
         buf = np.fromfile(str(p), dtype=np.uint8)
     except OSError as exc:
@@ -265,12 +267,19 @@ def read_image_gray(path: PathLike) -> Any:
     if buf.size == 0:
         raise InputError(f"cannot decode image {p}: the file is empty (0 bytes)")
     fmt = _image_format(p, buf[:16].tobytes())
-    arr = None if fmt == "PNG" and not _png_intact(p) else cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    if header_size == (0, 0):
+        # Pillow cannot read the header, so the size is not known: OpenCV is not asked (it
+        # would allocate what a Radiance HDR or EXR header claims, up to 2^30 pixels)
+        arr = None
+    elif fmt == "PNG" and not _png_intact(p):
+        arr = None
+    else:
+        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
     if arr is None:
         raise InputError(
             f"cannot decode image {p}: a truncated or corrupt {fmt} file"
             if fmt
-            else f"cannot decode image {p}: not an image file (JPEG, PNG, TIFF, WebP, BMP...)"
+            else f"cannot decode image {p}: not an image file camloc reads ({_FORMATS})"
         )
     h, w = arr.shape[:2]
     if min(h, w) < MIN_IMAGE_SIDE_PX:

@@ -26,7 +26,7 @@ def register(subparsers: Any) -> None:
             "JSON. Vanishing points at infinity are null. Never uses the network."
         ),
     )
-    p.add_argument("image", metavar="IMAGE", help="photo (any format OpenCV reads)")
+    p.add_argument("image", metavar="IMAGE", help="photo (JPEG, PNG, TIFF, WebP, BMP, GIF...)")
     p.add_argument("--focal-px", type=float, default=None, help="known focal length, pixels")
     p.add_argument(
         "--principal-point",
