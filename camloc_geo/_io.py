@@ -25,6 +25,8 @@ from typing import Any
 from camloc_geo._errors import InputError
 
 __all__ = [
+    "MAX_IMAGE_BYTES_PER_PIXEL",
+    "MAX_IMAGE_EXTRA_BYTES",
     "MIN_IMAGE_SIDE_PX",
     "atomic_path",
     "check_output_path",
@@ -37,6 +39,10 @@ PathLike = str | os.PathLike[str]
 
 MIN_IMAGE_SIDE_PX = 8
 """Smallest image side (pixels) worth looking for lines in."""
+MAX_IMAGE_BYTES_PER_PIXEL = 8
+"""Most bytes a pixel takes in an image file (16-bit RGBA, uncompressed)."""
+MAX_IMAGE_EXTRA_BYTES = 64_000_000
+"""Room for the rest of an image file (EXIF, thumbnails, ICC profile): a larger file is padded."""
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -250,8 +256,10 @@ def read_image_gray(path: PathLike) -> Any:
     Raises
     ------
     InputError
-        One line naming the file: missing, not a regular file, empty, too large, not an
-        image, truncated or corrupt, or smaller than ``MIN_IMAGE_SIDE_PX`` on a side.
+        One line naming the file: missing, not a regular file, empty, too large (pixels, or
+        bytes beyond ``MAX_IMAGE_BYTES_PER_PIXEL`` a pixel plus ``MAX_IMAGE_EXTRA_BYTES``: the
+        file is read whole), not an image, truncated or corrupt, or smaller than
+        ``MIN_IMAGE_SIDE_PX`` on a side.
     """
     import cv2
     import numpy as np
@@ -259,28 +267,41 @@ def read_image_gray(path: PathLike) -> Any:
     from camloc_geo._limits import check_image_file
 
     p = Path(path)
-    header_size = check_image_file(p)  # regular file, size from the header before decoding
+    width, height = check_image_file(p)  # regular file, size from the header before decoding
     try:
-        buf = np.fromfile(str(p), dtype=np.uint8)
+        n_bytes = p.stat().st_size
+        with open(p, "rb") as fh:
+            head = fh.read(16)
     except OSError as exc:
         raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
-    if buf.size == 0:
+    if n_bytes == 0:
         raise InputError(f"cannot decode image {p}: the file is empty (0 bytes)")
-    fmt = _image_format(p, buf[:16].tobytes())
-    if header_size == (0, 0):
+    fmt = _image_format(p, head)
+    if (width, height) == (0, 0):
         # Pillow cannot read the header, so the size is not known: OpenCV is not asked (it
         # would allocate what a Radiance HDR or EXR header claims, up to 2^30 pixels)
-        arr = None
-    elif fmt == "PNG" and not _png_intact(p):
-        arr = None
-    else:
-        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
-    if arr is None:
         raise InputError(
             f"cannot decode image {p}: a truncated or corrupt {fmt} file"
             if fmt
             else f"cannot decode image {p}: not an image file camloc reads ({_FORMATS})"
         )
+    most = MAX_IMAGE_BYTES_PER_PIXEL * width * height + MAX_IMAGE_EXTRA_BYTES
+    if n_bytes > most:  # the whole file is read into memory: bound it by what it can hold
+        raise InputError(
+            f"image {p} is {n_bytes / 1e6:.0f} MB for {width}x{height} pixels, more than any "
+            f"encoding of them takes ({most / 1e6:.0f} MB): padded or corrupt"
+        )
+    if fmt == "PNG" and not _png_intact(p):
+        arr = None
+    else:
+        try:
+            buf = np.fromfile(str(p), dtype=np.uint8)
+        except OSError as exc:
+            raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
+        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+        del buf
+    if arr is None:
+        raise InputError(f"cannot decode image {p}: a truncated or corrupt {fmt or 'image'} file")
     h, w = arr.shape[:2]
     if min(h, w) < MIN_IMAGE_SIDE_PX:
         raise InputError(

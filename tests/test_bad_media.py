@@ -374,3 +374,17 @@ def test_vp_names_the_photo_without_structure(
     assert line == f"camloc vp: error: {photo}: not enough structure: 0 straight line segments " + (
         "found (at least 6 needed)"
     )
+
+
+def test_vp_refuses_a_photo_padded_far_beyond_its_pixels(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the file is read whole: a 640x480 JPEG followed by 100 MB (a sparse file here) used
+    # to take 100 MB more memory, unbounded by the pixel limit
+    photo = _good_photo(tmp_path / "padded.jpg", (640, 480))
+    with open(photo, "r+b") as fh:
+        fh.truncate(100_000_000)
+    assert main(["vp", str(photo)]) == 2
+    line = one_line_error(capsys.readouterr().err, "vp")
+    assert f"image {photo} is 100 MB for 640x480 pixels, more than any encoding" in line
+    assert "(66 MB): padded or corrupt" in line
