@@ -220,6 +220,23 @@ def _image_format(path: Path, head: bytes) -> str | None:
     return next((name for magic, name in _MAGIC if head.startswith(magic)), None)
 
 
+_SIMPLE_FORMATS = ("JPEG", "PNG", "GIF", "BMP", "WEBP")
+"""Formats OpenCV decodes in every variant: a failure means the file is cut off or corrupt."""
+
+
+def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
+    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning lines on stderr."""
+    logging_ = getattr(getattr(cv2, "utils", None), "logging", None)
+    if logging_ is None:  # pragma: no cover - an OpenCV build without cv2.utils.logging
+        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    level = logging_.getLogLevel()
+    logging_.setLogLevel(min(level, logging_.LOG_LEVEL_ERROR))
+    try:
+        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    finally:
+        logging_.setLogLevel(level)
+
+
 def _png_intact(path: Path) -> bool:
     """False when a PNG's chunks are cut off or fail their checksums (Pillow's ``verify``).
 
@@ -298,10 +315,15 @@ def read_image_gray(path: PathLike) -> Any:
             buf = np.fromfile(str(p), dtype=np.uint8)
         except OSError as exc:
             raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
-        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+        arr = _imdecode_quietly(cv2, buf)
         del buf
+    if arr is None and fmt in _SIMPLE_FORMATS:
+        raise InputError(f"cannot decode image {p}: a truncated or corrupt {fmt} file")
     if arr is None:
-        raise InputError(f"cannot decode image {p}: a truncated or corrupt {fmt or 'image'} file")
+        raise InputError(
+            f"cannot decode image {p}: a {fmt or 'image'} file OpenCV does not decode (truncated, "
+            "corrupt, or a kind it does not read, e.g. 32-bit float samples)"
+        )
     h, w = arr.shape[:2]
     if min(h, w) < MIN_IMAGE_SIDE_PX:
         raise InputError(

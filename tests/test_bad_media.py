@@ -132,6 +132,7 @@ def test_exif_plausible_range_is_the_range_autovp_searches() -> None:
         ("text.jpg", "cannot decode image {p}: not an image file camloc reads (JPEG, PNG, TIFF,"),
         ("bomb.hdr", "cannot decode image {p}: not an image file camloc reads (JPEG, PNG, TIFF,"),
         ("tiny.png", "image {p} is too small: 1x1 pixels (at least 8 on a side)"),
+        ("float.tif", "cannot decode image {p}: a TIFF file OpenCV does not decode (truncated,"),
     ],
 )
 def test_vp_names_the_file_and_what_is_wrong(
@@ -181,6 +182,11 @@ def _bad_photo(tmp_path: Path, name: str) -> Path:
         p.write_text("I am not a photo\n", encoding="utf-8")
     elif name == "bomb.hdr":  # a Radiance HDR claiming 30000 x 30000 (Pillow cannot read it)
         p.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n" + b"\0" * 40)
+    elif name == "float.tif":  # 32-bit float samples: OpenCV printed a WARN line, then
+        import numpy as np  # "truncated or corrupt"
+        from PIL import Image
+
+        Image.fromarray(np.random.default_rng(0).random((48, 64)).astype(np.float32)).save(p)
     elif name == "tiny.png":
         from PIL import Image
 
