@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import os
 import tempfile
@@ -25,11 +26,14 @@ from typing import Any
 from camloc_geo._errors import InputError
 
 __all__ = [
+    "EXIF_TURNED_QUARTER",
     "MAX_IMAGE_BYTES_PER_PIXEL",
     "MAX_IMAGE_EXTRA_BYTES",
     "MIN_IMAGE_SIDE_PX",
     "atomic_path",
     "check_output_path",
+    "displayed_size",
+    "image_data_complete",
     "read_image_gray",
     "read_json_file",
     "write_text_atomic",
@@ -330,3 +334,48 @@ def read_image_gray(path: PathLike) -> Any:
             f"image {p} is too small: {w}x{h} pixels (at least {MIN_IMAGE_SIDE_PX} on a side)"
         )
     return np.ascontiguousarray(arr, dtype=np.uint8)
+
+
+EXIF_TURNED_QUARTER = (5, 6, 7, 8)
+"""EXIF ``Orientation`` values that turn the stored image a quarter (width and height swap)."""
+
+
+def displayed_size(im: Any) -> tuple[int, int]:
+    """Width and height of an open Pillow image as viewers show it (EXIF orientation applied).
+
+    OpenCV's decoder and browsers (``<img>``, canvas ``drawImage``) turn a photo whose EXIF
+    ``Orientation`` is 5-8 a quarter: its pixels, and so the annotations', are in that grid.
+    """
+    width, height = (int(v) for v in im.size)
+    try:
+        orientation = im.getexif().get(0x0112)
+    except Exception:  # a malformed EXIF block: as stored
+        return width, height
+    return (height, width) if orientation in EXIF_TURNED_QUARTER else (width, height)
+
+
+def image_data_complete(data: bytes, fmt: str) -> bool:
+    """Whether an image's data are all there (``fmt``: Pillow's ``JPEG``, ``PNG``, ``WEBP``...).
+
+    A cut-off upload or file would be shown to annotators as a broken picture. A JPEG is
+    decoded at 1/8 scale (Pillow's draft mode: a few milliseconds, little memory), a PNG's
+    chunks and checksums are verified without decompressing, anything else decoded fully:
+    call it only after the pixel count has been bounded.
+    """
+    import warnings
+
+    from PIL import Image
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(io.BytesIO(data)) as img:
+                if fmt == "PNG":
+                    img.verify()
+                else:
+                    if fmt == "JPEG":
+                        img.draft("L", (max(1, img.width // 8), max(1, img.height // 8)))
+                    img.load()
+    except Exception:  # any decoder failure: the data are not all there
+        return False
+    return True

@@ -394,3 +394,67 @@ def test_vp_refuses_a_photo_padded_far_beyond_its_pixels(
     line = one_line_error(capsys.readouterr().err, "vp")
     assert f"image {photo} is 100 MB for 640x480 pixels, more than any encoding" in line
     assert "(66 MB): padded or corrupt" in line
+
+
+# --------------------------------------------------------------------- annotate's photo
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs POSIX FIFOs")
+def test_annotate_never_opens_a_fifo(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    # before: read_bytes() on the FIFO waited for a writer forever
+    fifo = tmp_path / "snap.jpg"
+    os.mkfifo(fifo)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "camloc_geo.cli",
+            "annotate",
+            str(fifo),
+            "-o",
+            str(tmp_path / "a.html"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,  # a guard against the old hang, not a measurement
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])},
+    )
+    assert proc.returncode == 2
+    assert one_line_error(proc.stderr, "annotate") == (
+        f"camloc annotate: error: image {fifo} is not a regular file"
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("cut.jpg", "{p} is a truncated or corrupt JPEG file"),
+        ("cut.png", "{p} is a truncated or corrupt PNG file"),
+        ("tiny.png", "{p} is 1x1 pixels: too small to annotate (at least 8 a side)"),
+    ],
+)
+def test_annotate_refuses_a_cut_off_or_tiny_photo(
+    name: str, message: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # before: the page was written, with a broken or 1-pixel picture to click on
+    photo = _bad_photo(tmp_path, name)
+    assert main(["annotate", str(photo), "-o", str(tmp_path / "a.html")]) == 2
+    line = one_line_error(capsys.readouterr().err, "annotate")
+    assert line == f"camloc annotate: error: {message.format(p=photo)}"
+    assert not (tmp_path / "a.html").exists()
+
+
+def test_annotate_and_service_give_the_size_the_browser_shows(tmp_path: Path) -> None:
+    # stored 640x480 with EXIF orientation 6: browsers (and OpenCV) show it 480x640, so
+    # the scene's image size must be 480x640 (before: 640x480, the photo then drawn
+    # squeezed into the wrong frame and the clicks in another grid than calibrate's)
+    from camloc_geo.web import read_image
+
+    photo = _bad_photo(tmp_path, "turned.jpg")
+    info = read_image(photo)
+    assert (info.width, info.height) == (480, 640)
+    pytest.importorskip("fastapi")
+    from camloc_geo.service.routers.crowd import image_info
+
+    assert image_info(photo.read_bytes(), 40_000_000) == ("jpg", 480, 640)

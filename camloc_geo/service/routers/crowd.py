@@ -13,6 +13,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse
 
 from camloc_geo import CamlocError, MapDataError, SceneError
+from camloc_geo._io import displayed_size, image_data_complete
 from camloc_geo.service.deps import (
     ApiKey,
     SceneBody,
@@ -54,7 +55,7 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
     try:
         with Image.open(io.BytesIO(raw)) as img:
             fmt = img.format or ""
-            width, height = img.size
+            width, height = displayed_size(img)  # as the annotators' browsers show it
     except (UnidentifiedImageError, OSError, ValueError):
         raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
     except Image.DecompressionBombError:
@@ -74,35 +75,9 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
             f"{MIN_SNAPSHOT_SIDE_PX} pixels a side)",
             "body",
         )
-    if not _complete(raw, fmt):
+    if not image_data_complete(raw, fmt):
         raise SceneError(f"the snapshot is a truncated or corrupt {fmt} file", "body")
     return IMAGE_TYPES[fmt], width, height
-
-
-def _complete(raw: bytes, fmt: str) -> bool:
-    """Whether the image data are all there: a cut-off upload would be served to annotators.
-
-    A JPEG is decoded at 1/8 scale (Pillow's draft mode: a few milliseconds, little memory),
-    a WebP fully (its size is already bounded); a PNG's chunks and checksums are verified
-    without decompressing.
-    """
-    import warnings
-
-    from PIL import Image
-
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            with Image.open(io.BytesIO(raw)) as img:
-                if fmt == "PNG":
-                    img.verify()
-                else:
-                    if fmt == "JPEG":
-                        img.draft("L", (max(1, img.width // 8), max(1, img.height // 8)))
-                    img.load()
-    except Exception:  # any decoder failure: the data are not all there
-        return False
-    return True
 
 
 def servable_work(maps: MapStore, network: bool, point: tuple[float, float] | None) -> None:
