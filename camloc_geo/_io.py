@@ -19,6 +19,7 @@ import io
 import json
 import os
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
@@ -228,17 +229,33 @@ _SIMPLE_FORMATS = ("JPEG", "PNG", "GIF", "BMP", "WEBP")
 """Formats OpenCV decodes in every variant: a failure means the file is cut off or corrupt."""
 
 
+_QUIET = threading.Lock()
+_quiet_users = 0
+_loud_level: int | None = None
+
+
 def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
-    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning lines on stderr."""
+    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning lines on stderr.
+
+    OpenCV's log level is process-wide: it is lowered while any thread decodes here and
+    restored by the last one out.
+    """
+    global _quiet_users, _loud_level
     logging_ = getattr(getattr(cv2, "utils", None), "logging", None)
     if logging_ is None:  # pragma: no cover - an OpenCV build without cv2.utils.logging
         return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
-    level = logging_.getLogLevel()
-    logging_.setLogLevel(min(level, logging_.LOG_LEVEL_ERROR))
+    with _QUIET:
+        if _quiet_users == 0:
+            _loud_level = logging_.getLogLevel()
+            logging_.setLogLevel(min(_loud_level, logging_.LOG_LEVEL_ERROR))
+        _quiet_users += 1
     try:
         return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
     finally:
-        logging_.setLogLevel(level)
+        with _QUIET:
+            _quiet_users -= 1
+            if _quiet_users == 0 and _loud_level is not None:
+                logging_.setLogLevel(_loud_level)
 
 
 def _png_intact(path: Path) -> bool:
