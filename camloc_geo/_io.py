@@ -235,7 +235,7 @@ _loud_level: int | None = None
 
 
 def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
-    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning lines on stderr.
+    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning and error lines on stderr.
 
     OpenCV's log level is process-wide: it is lowered while any thread decodes here and
     restored by the last one out.
@@ -247,7 +247,7 @@ def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
     with _QUIET:
         if _quiet_users == 0:
             _loud_level = logging_.getLogLevel()
-            logging_.setLogLevel(min(_loud_level, logging_.LOG_LEVEL_ERROR))
+            logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)  # our message names the fault
         _quiet_users += 1
     try:
         return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
