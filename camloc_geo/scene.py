@@ -711,6 +711,8 @@ def _photo_problem(photo: Path, image_size: tuple[int, int]) -> tuple[str | None
         gray = read_image_gray(photo)
     except InputError as exc:
         return str(exc), False
+    except Exception as exc:  # the photo is optional: a decoder's failure never sinks the scene
+        return f"cannot read image {photo}: {type(exc).__name__}: {exc}", False
     h, w = (int(v) for v in gray.shape[:2])
     width, height = image_size
     if (w, h) == (width, height):

@@ -458,3 +458,23 @@ def test_annotate_and_service_give_the_size_the_browser_shows(tmp_path: Path) ->
     from camloc_geo.service.routers.crowd import image_info
 
     assert image_info(photo.read_bytes(), 40_000_000) == ("jpg", 480, 640)
+
+
+def test_a_decoder_failure_never_sinks_the_scene(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # any exception of the decoder (cv2.error, MemoryError...) leaves the photo out
+    import camloc_geo._io as io_module
+    from camloc_geo.scene import load_scene
+
+    def broken(path: object) -> object:
+        raise MemoryError("no room")
+
+    photo = _good_photo(tmp_path / "p.jpg", (640, 480))
+    monkeypatch.setattr(io_module, "read_image_gray", broken)
+    scene = load_scene(_scene_with_photo(tmp_path, photo.name))
+    assert scene.image_file() is None
+    assert [w for w in scene.input_warnings if w.startswith("image.path")] == [
+        f"image.path: cannot read image {photo}: MemoryError: no room; the photo is not used "
+        "(no lines detected in it, no background for the overlay)"
+    ]
