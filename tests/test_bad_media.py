@@ -478,3 +478,18 @@ def test_a_decoder_failure_never_sinks_the_scene(
         f"image.path: cannot read image {photo}: MemoryError: no room; the photo is not used "
         "(no lines detected in it, no background for the overlay)"
     ]
+
+
+def test_service_refuses_a_100_mp_header_without_pillows_warning(tmp_path: Path) -> None:
+    import warnings
+
+    pytest.importorskip("fastapi")
+    from camloc_geo.service.errors import LimitError
+    from camloc_geo.service.routers.crowd import image_info
+
+    raw = png_header(tmp_path / "big.png", 10000, 10000).read_bytes()
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        with pytest.raises(LimitError, match="10000×10000; this server accepts at most"):
+            image_info(raw, 40_000_000)
+    assert [str(w.message) for w in seen] == []  # before: DecompressionBombWarning

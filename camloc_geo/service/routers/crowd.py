@@ -49,13 +49,21 @@ _UPLOAD_DOC = {
 
 
 def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
-    """``(extension, width, height)`` of an uploaded snapshot, from its header only."""
+    """``(extension, width, height)`` of an uploaded snapshot, as browsers show it.
+
+    The size comes from the header (EXIF orientation applied); then the data are checked
+    complete (:func:`camloc_geo._io.image_data_complete`).
+    """
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     try:
-        with Image.open(io.BytesIO(raw)) as img:
-            fmt = img.format or ""
-            width, height = displayed_size(img)  # as the annotators' browsers show it
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # Pillow's bomb warning: the limit is checked below
+            with Image.open(io.BytesIO(raw)) as img:
+                fmt = img.format or ""
+                width, height = displayed_size(img)  # as the annotators' browsers show it
     except (UnidentifiedImageError, OSError, ValueError):
         raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
     except Image.DecompressionBombError:
