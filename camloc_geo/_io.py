@@ -3,26 +3,51 @@
 - Writes are atomic: the data go to a temporary file in the target's directory, which then
   replaces the target (:func:`os.replace`); a failure halfway leaves the old file (or none),
   never a truncated one.
-- :func:`check_output_path` refuses a missing directory, a directory as a file, and an output
-  that is one of the inputs, each with an :class:`~camloc_geo.InputError` of one line.
+- :func:`check_output_path` refuses a missing directory, a directory as a file, a directory
+  nothing can be written in (read-only, no permission, ``/proc``) and an output that is one of
+  the inputs, each with an :class:`~camloc_geo.InputError` of one line, before any work.
 - :func:`read_json_file` reads JSON with the same error style for every command.
+- :func:`read_image_gray` decodes a photo (OpenCV, EXIF orientation applied) after the size
+  checks of :func:`camloc_geo._limits.check_image_file`; every failure names the file and what
+  is wrong with it (empty, truncated or corrupt, not an image, too large, too small).
 """
 
 from __future__ import annotations
 
 import contextlib
+import io
 import json
 import os
 import tempfile
+import threading
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
 from camloc_geo._errors import InputError
 
-__all__ = ["atomic_path", "check_output_path", "read_json_file", "write_text_atomic"]
+__all__ = [
+    "EXIF_TURNED_QUARTER",
+    "MAX_IMAGE_BYTES_PER_PIXEL",
+    "MAX_IMAGE_EXTRA_BYTES",
+    "MIN_IMAGE_SIDE_PX",
+    "atomic_path",
+    "check_output_path",
+    "displayed_size",
+    "image_data_complete",
+    "read_image_gray",
+    "read_json_file",
+    "write_text_atomic",
+]
 
 PathLike = str | os.PathLike[str]
+
+MIN_IMAGE_SIDE_PX = 8
+"""Smallest image side (pixels) worth looking for lines in."""
+MAX_IMAGE_BYTES_PER_PIXEL = 8
+"""Most bytes a pixel takes in an image file (16-bit RGBA, uncompressed)."""
+MAX_IMAGE_EXTRA_BYTES = 64_000_000
+"""Room for the rest of an image file (EXIF, thumbnails, ICC profile): a larger file is padded."""
 
 
 def _same_file(a: Path, b: Path) -> bool:
@@ -56,13 +81,15 @@ def check_output_path(
     ------
     InputError
         The directory is missing (it is never created), the path is a directory (or, with
-        ``directory``, not one), or the output would overwrite an input.
+        ``directory``, not one), nothing can be written in the directory, or the output would
+        overwrite an input.
     """
     p = Path(path)
     if directory:
         if not p.is_dir():
             what = "is not a directory" if p.exists() else "does not exist"
             raise InputError(f"{option} {p}: directory {what} (create it first)")
+        _check_writable(p, f"{option} {p}")
         return p
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
@@ -76,7 +103,26 @@ def check_output_path(
     for src in inputs:
         if src is not None and _same_file(p, Path(src)):
             raise InputError(f"{option} {p}: would overwrite the input {src}; choose another file")
+    _check_writable(parent, f"{option} {p}")
     return p
+
+
+def _check_writable(folder: Path, what: str) -> None:
+    """Refuse a folder nothing can be written in, by creating and removing an empty file there.
+
+    :func:`os.access` is not enough: it says yes to root on a read-only file system or in
+    ``/proc``; the outputs are written through a temporary file in the same folder
+    (:func:`atomic_path`), so this is the very operation that must succeed.
+    """
+    try:
+        fd, name = tempfile.mkstemp(prefix=".camloc-write-test.", dir=folder)
+    except OSError as exc:
+        raise InputError(
+            f"{what}: cannot write in the directory {folder} ({exc.strerror or exc})"
+        ) from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(name)
 
 
 @contextlib.contextmanager
@@ -143,3 +189,210 @@ def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
         raise InputError(
             f"{p}: not a {what} (line {exc.lineno} column {exc.colno}: {exc.msg})"
         ) from exc
+
+
+_FORMATS = "JPEG, PNG, TIFF, WebP, BMP, GIF..."
+_MAGIC = (
+    (b"\xff\xd8\xff", "JPEG"),
+    (b"\x89PNG\r\n\x1a\n", "PNG"),
+    (b"GIF8", "GIF"),
+    (b"BM", "BMP"),
+    (b"II*\x00", "TIFF"),
+    (b"MM\x00*", "TIFF"),
+)
+
+
+def _image_format(path: Path, head: bytes) -> str | None:
+    """The image format of a file (``JPEG``, ``PNG``...) from its header, or None.
+
+    Pillow's reading of the header first, else the first bytes (``head``): a JPEG cut off
+    inside its header is still named a JPEG.
+    """
+    try:
+        import warnings
+
+        from PIL import Image
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                if im.format:
+                    return str(im.format)
+    except Exception:  # any failure: try the first bytes
+        pass
+    if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
+        return "WEBP"
+    return next((name for magic, name in _MAGIC if head.startswith(magic)), None)
+
+
+_SIMPLE_FORMATS = ("JPEG", "PNG", "GIF", "BMP", "WEBP")
+"""Formats OpenCV decodes in every variant: a failure means the file is cut off or corrupt."""
+
+
+_QUIET = threading.Lock()
+_quiet_users = 0
+_loud_level: int | None = None
+
+
+def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
+    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning and error lines on stderr.
+
+    OpenCV's log level is process-wide: it is lowered while any thread decodes here and
+    restored by the last one out.
+    """
+    global _quiet_users, _loud_level
+    logging_ = getattr(getattr(cv2, "utils", None), "logging", None)
+    if logging_ is None:  # pragma: no cover - an OpenCV build without cv2.utils.logging
+        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    with _QUIET:
+        if _quiet_users == 0:
+            _loud_level = logging_.getLogLevel()
+            logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)  # our message names the fault
+        _quiet_users += 1
+    try:
+        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+    finally:
+        with _QUIET:
+            _quiet_users -= 1
+            if _quiet_users == 0 and _loud_level is not None:
+                logging_.setLogLevel(_loud_level)
+
+
+def _png_intact(path: Path) -> bool:
+    """False when a PNG's chunks are cut off or fail their checksums (Pillow's ``verify``).
+
+    Checked before OpenCV decodes it: libpng would print its own error line on stderr.
+    """
+    try:
+        import warnings
+
+        from PIL import Image
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(path) as im:
+                im.verify()
+    except Exception:  # whatever the reason, not intact
+        return False
+    return True
+
+
+def read_image_gray(path: PathLike) -> Any:
+    """Decode an image file to an 8-bit grayscale array, as the user sees it.
+
+    OpenCV decodes it and applies its EXIF orientation (a portrait photo stored sideways
+    comes out upright). The header is checked first (:func:`camloc_geo._limits.check_image_file`:
+    a regular file, at most ``MAX_IMAGE_PIXELS``), so a decompression bomb is refused before
+    any memory is spent on it; a file whose header Pillow cannot read is refused too, its size
+    being unknown (JPEG, PNG, TIFF, WebP, BMP, GIF, PNM... are read).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``uint8``.
+
+    Raises
+    ------
+    InputError
+        One line naming the file: missing, not a regular file, empty, too large (pixels, or
+        bytes beyond ``MAX_IMAGE_BYTES_PER_PIXEL`` a pixel plus ``MAX_IMAGE_EXTRA_BYTES``: the
+        file is read whole), not an image, truncated or corrupt, or smaller than
+        ``MIN_IMAGE_SIDE_PX`` on a side.
+    """
+    import cv2
+    import numpy as np
+
+    from camloc_geo._limits import check_image_file
+
+    p = Path(path)
+    width, height = check_image_file(p)  # regular file, size from the header before decoding
+    try:
+        n_bytes = p.stat().st_size
+        with open(p, "rb") as fh:
+            head = fh.read(16)
+    except OSError as exc:
+        raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
+    if n_bytes == 0:
+        raise InputError(f"cannot decode image {p}: the file is empty (0 bytes)")
+    fmt = _image_format(p, head)
+    if (width, height) == (0, 0):
+        # Pillow cannot read the header, so the size is not known: OpenCV is not asked (it
+        # would allocate what a Radiance HDR or EXR header claims, up to 2^30 pixels)
+        raise InputError(
+            f"cannot decode image {p}: a truncated or corrupt {fmt} file"
+            if fmt
+            else f"cannot decode image {p}: not an image file camloc reads ({_FORMATS})"
+        )
+    most = MAX_IMAGE_BYTES_PER_PIXEL * width * height + MAX_IMAGE_EXTRA_BYTES
+    if n_bytes > most:  # the whole file is read into memory: bound it by what it can hold
+        raise InputError(
+            f"image {p} is {n_bytes / 1e6:.0f} MB for {width}x{height} pixels, more than any "
+            f"encoding of them takes ({most / 1e6:.0f} MB): padded or corrupt"
+        )
+    if fmt == "PNG" and not _png_intact(p):
+        arr = None
+    else:
+        try:
+            buf = np.fromfile(str(p), dtype=np.uint8)
+        except OSError as exc:
+            raise InputError(f"cannot read image {p}: {exc.strerror or exc}") from None
+        arr = _imdecode_quietly(cv2, buf)
+        del buf
+    if arr is None and fmt in _SIMPLE_FORMATS:
+        raise InputError(f"cannot decode image {p}: a truncated or corrupt {fmt} file")
+    if arr is None:
+        raise InputError(
+            f"cannot decode image {p}: a {fmt or 'image'} file OpenCV does not decode (truncated, "
+            "corrupt, or a kind it does not read, e.g. 32-bit float samples)"
+        )
+    h, w = arr.shape[:2]
+    if min(h, w) < MIN_IMAGE_SIDE_PX:
+        raise InputError(
+            f"image {p} is too small: {w}x{h} pixels (at least {MIN_IMAGE_SIDE_PX} on a side)"
+        )
+    return np.ascontiguousarray(arr, dtype=np.uint8)
+
+
+EXIF_TURNED_QUARTER = (5, 6, 7, 8)
+"""EXIF ``Orientation`` values that turn the stored image a quarter (width and height swap)."""
+
+
+def displayed_size(im: Any) -> tuple[int, int]:
+    """Width and height of an open Pillow image as viewers show it (EXIF orientation applied).
+
+    OpenCV's decoder and browsers (``<img>``, canvas ``drawImage``) turn a photo whose EXIF
+    ``Orientation`` is 5-8 a quarter: its pixels, and so the annotations', are in that grid.
+    """
+    width, height = (int(v) for v in im.size)
+    try:
+        orientation = im.getexif().get(0x0112)
+    except Exception:  # a malformed EXIF block: as stored
+        return width, height
+    return (height, width) if orientation in EXIF_TURNED_QUARTER else (width, height)
+
+
+def image_data_complete(data: bytes, fmt: str) -> bool:
+    """Whether an image's data are all there (``fmt``: Pillow's ``JPEG``, ``PNG``, ``WEBP``...).
+
+    A cut-off upload or file would be shown to annotators as a broken picture. A JPEG is
+    decoded at 1/8 scale (Pillow's draft mode: a few milliseconds, little memory), a PNG's
+    chunks and checksums are verified without decompressing, anything else decoded fully:
+    call it only after the pixel count has been bounded.
+    """
+    import warnings
+
+    from PIL import Image
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with Image.open(io.BytesIO(data)) as img:
+                if fmt == "PNG":
+                    img.verify()
+                else:
+                    if fmt == "JPEG":
+                        img.draft("L", (max(1, img.width // 8), max(1, img.height // 8)))
+                    img.load()
+    except Exception:  # any decoder failure: the data are not all there
+        return False
+    return True

@@ -7,6 +7,7 @@ that drives time or memory is bounded here, and every refusal names the limit.
 from __future__ import annotations
 
 import os
+import re
 import stat
 import warnings
 from pathlib import Path
@@ -106,8 +107,10 @@ def check_image_file(path: str | os.PathLike[str]) -> tuple[int, int]:
             with Image.open(p) as im:
                 width, height = im.size
     except Image.DecompressionBombError as exc:  # far above our limit too
+        found = re.search(r"\((\d+) pixels\)", str(exc))
+        size = f" ({int(found.group(1)) / 1e6:.0f} MP)" if found else ""
         raise InputError(
-            f"image {p} is too large ({exc}); the supported limit is "
+            f"image {p} is too large{size}; the supported limit is "
             f"{MAX_IMAGE_PIXELS / 1e6:g} megapixels"
         ) from None
     except Exception:  # not a format Pillow reads: OpenCV decodes it or says so

@@ -486,7 +486,8 @@ def vanishing_points(
     Parameters
     ----------
     image
-        Path of a photo (any format OpenCV reads) or a grey/colour image array.
+        Path of a photo (JPEG, PNG, TIFF, WebP, BMP, GIF...: a header Pillow reads, decoded
+        by OpenCV) or a grey/colour image array.
     focal_px, principal_point
         Known intrinsics, pixels (default: estimated / the image centre).
     ignore_boxes_px

@@ -88,7 +88,6 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -217,28 +216,21 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
         A path to an image file, or an array: ``(H, W)`` gray, ``(H, W, 3)`` BGR or
         ``(H, W, 4)`` BGRA, any numeric dtype (integers span their dtype's range, floats
         are taken in ``[0, 1]`` when their maximum is at most 1, else in ``[0, 255]``).
-        Files are decoded by OpenCV, which applies the EXIF orientation.
+        Files are decoded by OpenCV, which applies the EXIF orientation
+        (:func:`camloc_geo._io.read_image_gray`).
 
     Raises
     ------
     InputError
-        The file cannot be read or decoded, or the array is not an image.
+        The file cannot be read or decoded (the message names the file and why), or the
+        array is not an image.
     """
     import cv2
 
     if isinstance(image, (str, os.PathLike)):
-        from camloc_geo._limits import check_image_file
+        from camloc_geo._io import read_image_gray
 
-        path = Path(image)
-        check_image_file(path)  # regular file, size from the header before decoding
-        try:
-            buf = np.fromfile(str(path), dtype=np.uint8)
-        except OSError as exc:
-            raise InputError(f"cannot read image {str(path)!r}: {exc.strerror or exc}") from exc
-        arr = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE) if buf.size else None
-        if arr is None:
-            raise InputError(f"cannot decode image {str(path)!r} (not a supported image file)")
-        return np.asarray(arr, dtype=np.uint8)
+        return np.asarray(read_image_gray(image), dtype=np.uint8)
     arr = np.asarray(image)
     if arr.ndim == 3 and arr.shape[2] == 1:
         arr = arr[:, :, 0]
@@ -1245,6 +1237,13 @@ def detect_vanishing_points(
         raise InputError("give an image, or segments with image_size")
     if focal_px is not None and not (math.isfinite(focal_px) and focal_px > 0):
         raise InputError(f"focal_px must be a positive number, got {focal_px!r}")
+    if focal_px is not None and not 1e-3 <= focal_px / max(w, h) <= 1e3:
+        raise InputError(
+            f"focal_px {focal_px:g} is not a focal length for a {w}x{h} image (give "
+            f"{1e-3 * max(w, h):g} to {1e3 * max(w, h):g} px)"
+        )
+    if isinstance(seed, bool) or not (isinstance(seed, (int, np.integer)) and seed >= 0):
+        raise InputError(f"seed must be a non-negative integer, got {seed!r}")
     if focal_prior_px is not None and not (math.isfinite(focal_prior_px) and focal_prior_px > 0):
         raise InputError(f"focal_prior_px must be a positive number, got {focal_prior_px!r}")
     if not (math.isfinite(focal_prior_sigma_rel) and focal_prior_sigma_rel > 0):

@@ -18,6 +18,11 @@ Sources, best first:
     ``sensor_width_camera_database.txt`` (``Make Model;width_mm`` a line; e.g.
     https://github.com/openMVG/CameraSensorSizeDatabase). No table is bundled. Sigma 5 %.
 
+A focal length outside ``PLAUSIBLE_FOCAL_REL`` times the longer image side (the range the
+vanishing-point fit searches, :data:`camloc_geo.autovp.FOCAL_BOUNDS_REL`) is a broken tag
+(``FocalLength`` 5000 mm on a phone, ``FocalLengthIn35mmFilm`` 2000): it is ignored with a
+warning, since as a prior it would pin the fit to the bound of that range.
+
 The sigmas are for the prior; the vanishing points may still pull the focal length away
 from it where they fix it well (see :func:`camloc_geo.autovp.detect_vanishing_points`).
 """
@@ -27,6 +32,8 @@ from __future__ import annotations
 import logging
 import math
 import os
+import struct
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -50,6 +57,8 @@ _FP_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 1e-3}  # EXIF FocalPlaneResolutionUn
 SIGMA_35MM = 0.04
 SIGMA_FOCAL_PLANE = 0.05
 SIGMA_SENSOR_TABLE = 0.05
+#: Plausible focal lengths, as multiples of the longer image side (autovp's FOCAL_BOUNDS_REL).
+PLAUSIBLE_FOCAL_REL = (0.3, 6.0)
 
 
 @dataclass(frozen=True)
@@ -98,7 +107,12 @@ def _sensor_width_mm(make: str, model: str, db_path: str | os.PathLike[str]) -> 
 
 
 def focal_from_tags(
-    tags: dict[int, Any], width_px: int, height_px: int, sensor_db: str | None = None
+    tags: dict[int, Any],
+    width_px: int,
+    height_px: int,
+    sensor_db: str | None = None,
+    *,
+    name: str = "photo",
 ) -> ExifFocal | None:
     """Focal length in pixels from EXIF tags (tag number -> value).
 
@@ -111,12 +125,38 @@ def focal_from_tags(
         the longer side are used).
     sensor_db
         Path of a sensor-width table; default: ``CAMLOC_SENSOR_DB``.
+    name
+        The photo, for the warning about an implausible focal length.
 
     Returns
     -------
     ExifFocal or None
-        None when the tags do not give the focal length.
+        None when the tags do not give the focal length, or give one outside
+        ``PLAUSIBLE_FOCAL_REL`` times the longer side (then with a warning).
     """
+    found = _focal_from_tags(tags, width_px, height_px, sensor_db)
+    if found is None:
+        return None
+    lo, hi = PLAUSIBLE_FOCAL_REL
+    rel = found.focal_px / max(width_px, height_px, 1)
+    if not lo <= rel <= hi:
+        log.warning(
+            "%s: EXIF focal length ignored: %s gives %.0f px, %.2g times the image's longer side "
+            "(plausible: %g to %g)",
+            name,
+            found.source,
+            found.focal_px,
+            rel,
+            lo,
+            hi,
+        )
+        return None
+    return found
+
+
+def _focal_from_tags(
+    tags: dict[int, Any], width_px: int, height_px: int, sensor_db: str | None
+) -> ExifFocal | None:
     diag_px = math.hypot(width_px, height_px)
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
     if f35 is not None and 8.0 <= f35 <= 2000.0:
@@ -162,12 +202,21 @@ def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) 
     if not Path(path).is_file():  # a FIFO or a device would block; the reader names it
         return None
     try:
-        with Image.open(path) as im:
-            width, height = im.size
-            exif = im.getexif()
-            tags: dict[int, Any] = dict(exif)
-            tags.update(exif.get_ifd(_TAG_EXIF_IFD))
-    except (OSError, UnidentifiedImageError, ValueError, SyntaxError) as exc:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # Pillow's bomb and EXIF warnings: the image's
+            with Image.open(path) as im:  # reader checks its size and names the problem
+                width, height = im.size
+                exif = im.getexif()
+                tags: dict[int, Any] = dict(exif)
+                tags.update(exif.get_ifd(_TAG_EXIF_IFD))
+    except (
+        OSError,
+        UnidentifiedImageError,
+        Image.DecompressionBombError,
+        ValueError,
+        SyntaxError,
+        struct.error,
+    ) as exc:
         log.debug("no EXIF read from %s: %s", path, exc)
         return None
-    return focal_from_tags(tags, width, height, sensor_db)
+    return focal_from_tags(tags, width, height, sensor_db, name=str(path))

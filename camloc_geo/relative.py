@@ -39,7 +39,7 @@ from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo._optimize import soft_l1_cost
 from camloc_geo.camera import Camera, rotvec_from_rotation
 from camloc_geo.objects import ObjectSize
-from camloc_geo.scene import Annotation, Scene, pixel_problem
+from camloc_geo.scene import Annotation, Scene, line_photo, pixel_problem
 from camloc_geo.vanishing import (
     AXES,
     IntrinsicsEstimate,
@@ -1874,7 +1874,7 @@ def _photo_segments_px(scene: Scene, segments: npt.ArrayLike) -> FloatArray:
 
 def _auto_segments(scene: Scene, index: int, axes: list[str]) -> dict[str, FloatArray]:
     """Segments for axes an annotator drew no lines for, from the image (if any)."""
-    path = scene.image_file()
+    path = line_photo(scene)  # not a scaled copy: its pixels are the annotations'
     if path is None or not path.is_file():  # is_file: a FIFO or a device would block
         return {}
     try:
@@ -2503,7 +2503,7 @@ PHOTO_SEGMENT_MIN_REL = 0.02  # ... if at least this long (fraction of the image
 
 def _photo_result(scene: Scene) -> Any | None:
     """The scene photo's detected vanishing points and segments (cached), or None."""
-    path = scene.image_file()
+    path = line_photo(scene)  # not a scaled copy: its pixels are the annotations'
     if path is None or not path.is_file():  # is_file: a FIFO or a device would block
         return None
     try:

@@ -443,6 +443,10 @@ class Scene(_Model):
     base_dir: str | None = Field(default=None, exclude=True)
     # Evidence left out or clamped while reading (one line each), see input_warnings.
     _input_warnings: list[str] = PrivateAttr(default_factory=list)
+    # The photo image.path names was found unusable while reading (see input_warnings).
+    _photo_unusable: bool = PrivateAttr(default=False)
+    # ... or found to be a scaled copy of the image: the overlay's background only.
+    _photo_scaled: bool = PrivateAttr(default=False)
 
     @field_validator("format")
     @classmethod
@@ -561,13 +565,29 @@ class Scene(_Model):
         return self.image.width, self.image.height
 
     def image_file(self) -> Path | None:
-        """Absolute path of the snapshot, if the scene names one."""
-        if not self.image.path:
+        """Absolute path of the snapshot, if the scene names one (it may not exist).
+
+        None also when :func:`load_scene` found the photo unusable (not an image, truncated,
+        or of another shape than ``image.width`` x ``image.height``): ``input_warnings``
+        says why, and the photo is then used for nothing (no lines, no focal length, no
+        background). A scaled copy of the image is the overlay's background only: see
+        :meth:`line_photo`.
+        """
+        if not self.image.path or self._photo_unusable:
             return None
         p = Path(self.image.path)
         if not p.is_absolute() and self.base_dir:
             p = Path(self.base_dir) / p
         return p
+
+
+def line_photo(scene: Scene) -> Path | None:
+    """The photo to detect lines in: :meth:`Scene.image_file`, unless it is a scaled copy.
+
+    Its pixels must be the annotations' pixels; a photo of another size than the scene's
+    image (same shape, warned when the scene was read) serves the overlay only.
+    """
+    return None if scene._photo_scaled else scene.image_file()
 
 
 def pixel_problem(
@@ -613,12 +633,22 @@ def _drop_unusable_evidence(scene: Scene) -> Scene:
     notes: list[str] = []
     update: dict[str, Any] = {}
     photo = scene.image_file()
-    if photo is not None and (scene.base_dir or photo.is_absolute()) and not photo.is_file():
+    photo_unusable = photo_scaled = False
+    if photo is not None and (scene.base_dir or photo.is_absolute()):
         # Only where the path can be resolved: a scene posted without its file names none.
-        notes.append(
-            f"image.path: {str(photo)!r} does not exist; the photo is not used (no lines "
-            "detected in it, no background for the overlay)"
-        )
+        problem, scaled = _photo_problem(photo, (w, h))
+        if scaled:
+            notes.append(
+                f"image.path: {problem}: a scaled copy, used as the overlay's background only "
+                "(no lines detected in it)"
+            )
+            photo_scaled = True
+        elif problem is not None:
+            notes.append(
+                f"image.path: {problem}; the photo is not used (no lines detected in it, no "
+                "background for the overlay)"
+            )
+            photo_unusable = photo.exists()
 
     def screen(items: list[Any], name: str, attr: str) -> list[Any] | None:
         kept, changed = [], False
@@ -658,7 +688,42 @@ def _drop_unusable_evidence(scene: Scene) -> Scene:
         log.warning("%s", note)
     out = scene.model_copy(update=update)
     out._input_warnings = notes
+    out._photo_unusable = photo_unusable
+    out._photo_scaled = photo_scaled
     return out
+
+
+def _photo_problem(photo: Path, image_size: tuple[int, int]) -> tuple[str | None, bool]:
+    """Why the scene's photo cannot be used (one clause naming it), and whether it is only
+    a scaled copy of the scene's image; ``(None, False)`` for a usable photo.
+
+    The photo is decoded as the line detector will (:func:`camloc_geo._io.read_image_gray`:
+    header size checks first, EXIF orientation applied), and its size compared with the
+    scene's ``image.width`` x ``image.height``: the annotations' pixels are in that grid.
+    """
+    if not photo.exists():
+        return f"{str(photo)!r} does not exist", False
+    if not photo.is_file():  # a directory; a FIFO or a device would block
+        return f"{str(photo)!r} is not a regular file", False
+    from camloc_geo._io import read_image_gray
+
+    try:
+        gray = read_image_gray(photo)
+    except InputError as exc:
+        return str(exc), False
+    except Exception as exc:  # the photo is optional: a decoder's failure never sinks the scene
+        return f"cannot read image {photo}: {type(exc).__name__}: {exc}", False
+    h, w = (int(v) for v in gray.shape[:2])
+    width, height = image_size
+    if (w, h) == (width, height):
+        return None, False
+    scaled = abs(w * height - h * width) <= 0.01 * w * height
+    quarter = (h, w) == (width, height)
+    turned = " (turned a quarter: check its EXIF orientation)" if quarter else ""
+    return (
+        f"the photo {str(photo)!r} is {w}x{h} pixels as displayed but the scene's image is "
+        f"{width}x{height}{turned}"
+    ), scaled
 
 
 class _CornerBox:

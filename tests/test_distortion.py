@@ -126,8 +126,12 @@ def test_missing_photo_is_warned(tmp_path: Path) -> None:
     assert any("nowhere.jpg" in w and "does not exist" in w for w in loaded.input_warnings)
     assert loaded.camera.distortion is not None
     assert loaded.camera.distortion.k1 == -0.05
-    (tmp_path / "nowhere.jpg").write_bytes(b"x")
+    from PIL import Image
+
+    Image.new("RGB", (1280, 720)).save(tmp_path / "nowhere.jpg")  # a photo of the scene's size
     assert not any("image.path" in w for w in load_scene(path).input_warnings)
+    (tmp_path / "nowhere.jpg").write_bytes(b"x")  # not a photo: warned, as a missing one
+    assert any("not an image file" in w for w in load_scene(path).input_warnings)
 
 
 def test_calibrate_undistorts_the_annotations() -> None:

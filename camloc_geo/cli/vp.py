@@ -6,7 +6,7 @@ import argparse
 import logging
 from typing import Any
 
-from camloc_geo._errors import InputError
+from camloc_geo._errors import InputError, NotEnoughStructureError
 
 __all__ = ["register", "run"]
 
@@ -26,7 +26,7 @@ def register(subparsers: Any) -> None:
             "JSON. Vanishing points at infinity are null. Never uses the network."
         ),
     )
-    p.add_argument("image", metavar="IMAGE", help="photo (any format OpenCV reads)")
+    p.add_argument("image", metavar="IMAGE", help="photo (JPEG, PNG, TIFF, WebP, BMP, GIF...)")
     p.add_argument("--focal-px", type=float, default=None, help="known focal length, pixels")
     p.add_argument(
         "--principal-point",
@@ -90,7 +90,6 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc vp``."""
-    from camloc_geo.api import vanishing_points
     from camloc_geo.autovp import draw_segments
     from camloc_geo.cli import atomic_output, output_path, write_json
 
@@ -116,16 +115,10 @@ def run(args: argparse.Namespace) -> int:
                 focal_prior_sigma_rel=ex.sigma_rel,
                 focal_prior_source=ex.source,
             )
-    res = vanishing_points(
-        args.image,
-        focal_px=args.focal_px,
-        principal_point=tuple(args.principal_point) if args.principal_point else None,
-        ignore_boxes_px=args.ignore or (),
-        axes_px=args.axis or (),
-        estimate_principal_point=args.estimate_principal_point,
-        seed=args.seed,
-        **options,
-    )
+    try:
+        res = _vanishing_points(args, options)
+    except NotEnoughStructureError as exc:  # name the photo, as every other refusal does
+        raise NotEnoughStructureError(f"{args.image}: {exc}") from None
     for w in res.warnings:
         log.warning("%s: %s", args.image, w)
     if draw_path is not None:
@@ -136,3 +129,18 @@ def run(args: argparse.Namespace) -> int:
     out["image"] = str(args.image)
     write_json(out, args.output, inputs=[args.image])
     return 0
+
+
+def _vanishing_points(args: argparse.Namespace, options: dict[str, Any]) -> Any:
+    from camloc_geo.api import vanishing_points
+
+    return vanishing_points(
+        args.image,
+        focal_px=args.focal_px,
+        principal_point=tuple(args.principal_point) if args.principal_point else None,
+        ignore_boxes_px=args.ignore or (),
+        axes_px=args.axis or (),
+        estimate_principal_point=args.estimate_principal_point,
+        seed=args.seed,
+        **options,
+    )

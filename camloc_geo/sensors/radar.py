@@ -522,6 +522,8 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
     import cv2
 
     p = check_regular_file(path, "video")
+    if p.stat().st_size == 0:
+        raise InputError(f"cannot open video {p}: the file is empty (0 bytes)")
     cap = cv2.VideoCapture(str(p))
     if not cap.isOpened():
         raise InputError(f"cannot open video {p}: not a video file OpenCV can read")
@@ -532,6 +534,12 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
     if w <= 0 or h <= 0:
         cap.release()
         raise InputError(f"cannot read video {p}: it states no frame size")
+    if n == 1:  # OpenCV reads a photo as a video of one frame
+        cap.release()
+        raise InputError(
+            f"video {p} has a single frame (a still image?): speeds need a video of the moving "
+            "vehicles"
+        )
     if w * h > MAX_VIDEO_PIXELS:
         cap.release()
         raise InputError(

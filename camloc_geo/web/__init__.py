@@ -24,12 +24,14 @@ import html
 import io
 import json
 import os
+import stat
 import warnings
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
 
 from camloc_geo._errors import InputError, SceneError
+from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete
 
 __all__ = [
     "MAX_IMAGE_BYTES",
@@ -93,11 +95,14 @@ def read_image(image: bytes | str | os.PathLike[str], *, name: str | None = None
         path = Path(image)
         label = str(path)
         try:
-            size = path.stat().st_size
+            st = path.stat()
         except FileNotFoundError:
             raise InputError(f"image not found: {path}") from None
         except OSError as exc:
             raise InputError(f"cannot read image {path}: {exc.strerror or exc}") from None
+        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
+            raise InputError(f"image {path} is not a regular file")
+        size = st.st_size
         if size > MAX_IMAGE_BYTES:
             raise InputError(
                 f"{path.name}: {size / 1e6:.0f} MB is too large; the page takes "
@@ -120,7 +125,7 @@ def read_image(image: bytes | str | os.PathLike[str], *, name: str | None = None
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             with Image.open(io.BytesIO(data)) as im:
                 fmt = (im.format or "").upper()
-                width, height = im.size
+                width, height = displayed_size(im)  # as the browser shows it
     except Image.DecompressionBombError:
         raise InputError(
             f"{label} has too many pixels; the page takes images up to "
@@ -140,6 +145,13 @@ def read_image(image: bytes | str | os.PathLike[str], *, name: str | None = None
             f"{label} is {width}x{height} pixels; the page takes images up to "
             f"{MAX_IMAGE_PIXELS / 1e6:.0f} megapixels (scale it down first)"
         )
+    if min(width, height) < MIN_IMAGE_SIDE_PX:
+        raise InputError(
+            f"{label} is {width}x{height} pixels: too small to annotate (at least "
+            f"{MIN_IMAGE_SIDE_PX} a side)"
+        )
+    if not image_data_complete(data, fmt):
+        raise InputError(f"{label} is a truncated or corrupt {fmt} file")
     return ImageInfo(data, SUPPORTED_FORMATS[fmt], int(width), int(height), name)
 
 

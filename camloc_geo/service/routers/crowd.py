@@ -13,6 +13,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse
 
 from camloc_geo import CamlocError, MapDataError, SceneError
+from camloc_geo._io import displayed_size, image_data_complete
 from camloc_geo.service.deps import (
     ApiKey,
     SceneBody,
@@ -34,6 +35,8 @@ __all__ = ["router"]
 router = APIRouter(tags=["crowd"])
 
 IMAGE_TYPES = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
+MIN_SNAPSHOT_SIDE_PX = 8
+"""Smallest snapshot side (pixels) a task is made for."""
 IMAGE_MEDIA_TYPES = tuple(f"image/{kind.lower()}" for kind in IMAGE_TYPES)
 _UPLOAD_DOC = {
     "requestBody": {
@@ -46,13 +49,21 @@ _UPLOAD_DOC = {
 
 
 def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
-    """``(extension, width, height)`` of an uploaded snapshot, from its header only."""
+    """``(extension, width, height)`` of an uploaded snapshot, as browsers show it.
+
+    The size comes from the header (EXIF orientation applied); then the data are checked
+    complete (:func:`camloc_geo._io.image_data_complete`).
+    """
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
     try:
-        with Image.open(io.BytesIO(raw)) as img:
-            fmt = img.format or ""
-            width, height = img.size
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # Pillow's bomb warning: the limit is checked below
+            with Image.open(io.BytesIO(raw)) as img:
+                fmt = img.format or ""
+                width, height = displayed_size(img)  # as the annotators' browsers show it
     except (UnidentifiedImageError, OSError, ValueError):
         raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
     except Image.DecompressionBombError:
@@ -66,6 +77,14 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
             f"the snapshot is {width}×{height}; this server accepts at most {max_pixels} pixels",
             "body",
         )
+    if min(width, height) < MIN_SNAPSHOT_SIDE_PX:
+        raise SceneError(
+            f"the snapshot is {width}×{height}: too small to annotate (at least "
+            f"{MIN_SNAPSHOT_SIDE_PX} pixels a side)",
+            "body",
+        )
+    if not image_data_complete(raw, fmt):
+        raise SceneError(f"the snapshot is a truncated or corrupt {fmt} file", "body")
     return IMAGE_TYPES[fmt], width, height
 
 
