@@ -52,6 +52,7 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from .annotation import GUIDANCE, STEPS, Annotation
+from .imagefile import SnapshotError, check_regular_file, read_snapshot
 from .layers import DRAW_ORDER, apply_style, wgs84, write_gpkg_layer
 from .runner import WorkerCanceledError, WorkerError, run_worker
 
@@ -76,6 +77,41 @@ LAYER_TITLES = {
 RESULTS_NAME = "camloc_results.gpkg"
 MARKER_PX = 6.0
 """Click markers' radius on screen (pixels, at any zoom)."""
+
+
+MAX_SCENE_BYTES = 10_000_000
+"""Largest scene file loaded (bytes): ``camloc_geo._limits.MAX_SCENE_BYTES``, copied because the
+plugin does not import camloc_geo (keep the two equal)."""
+
+
+def _output_problem(path: str, what: str) -> str | None:
+    """Why ``path`` cannot be written as a ``what`` (one line), or None.
+
+    An existing FIFO, device or folder is refused before anything opens it (writing to a FIFO
+    blocks until someone reads it).
+    """
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        return f"cannot write the {what} {path}: its folder is missing or not writable"
+    if os.path.lexists(path):
+        problem = check_regular_file(path, what)
+        if problem:
+            return problem
+        if not os.access(path, os.W_OK):
+            return f"cannot write the {what} {path}: the file is read-only"
+    return None
+
+
+def _extract_problem(osm: str) -> str | None:
+    """Why ``osm`` is not an OSM extract or a folder of extracts (one line), or None."""
+    if os.path.isdir(osm):
+        return None
+    problem = check_regular_file(osm, "OSM extract")
+    if problem:
+        return problem
+    if os.path.getsize(osm) == 0:
+        return f"the OSM extract {osm} is empty (0 bytes)"
+    return None
 
 
 class ImageView(QGraphicsView):
@@ -428,14 +464,26 @@ class CamlocDock(QDockWidget):
             self.open_snapshot(path)
 
     def open_snapshot(self, path: str) -> bool:
-        """Show the image and start a new annotation for it (any number of times)."""
-        pix = QPixmap(path)
-        if pix.isNull():
-            self.set_status(f"cannot read the image {path}")
+        """Show the image and start a new annotation for it (any number of times).
+
+        The image is read as viewers show it (EXIF orientation applied), so the scene's
+        ``image.width``/``height`` are the grid calibrate, the browser page and ``camloc vp``
+        use. A FIFO or device, an empty, truncated or non-image file, or an image over
+        ``MAX_IMAGE_PIXELS`` is refused with one status line (False); the open snapshot and
+        its annotation stay as they were.
+        """
+        try:
+            image, turned = read_snapshot(path)
+        except SnapshotError as exc:
+            self.set_status(str(exc))
+            return False
+        pix = QPixmap.fromImage(image)
+        if pix.isNull():  # out of memory for the pixmap
+            self.set_status(f"cannot show the image {path}: not enough memory for it")
             return False
         self._stop_page()
         scene_id = os.path.splitext(os.path.basename(path))[0]
-        self.annotation = Annotation(pix.width(), pix.height(), scene_id=scene_id)
+        self.annotation = Annotation(image.width(), image.height(), scene_id=scene_id)
         self.annotation.image_path = os.path.basename(path)
         self.image_file = os.path.abspath(path)
         self.view.set_pixmap(pix)
@@ -444,9 +492,10 @@ class CamlocDock(QDockWidget):
         self.steps.blockSignals(False)
         self.redraw()
         self._show_guidance()
+        upright = " (turned upright, as its EXIF orientation says)" if turned else ""
         self.set_status(
-            f"{pix.width()}×{pix.height()} px. Annotate here, or in the browser with its "
-            "zoom and checks (Annotate in browser…)."
+            f"{image.width()}×{image.height()} px{upright}. Annotate here, or in the browser "
+            "with its zoom and checks (Annotate in browser…)."
         )
         return True
 
@@ -656,12 +705,21 @@ class CamlocDock(QDockWidget):
 
     def load_scene(self, path: str) -> bool:
         """Load a scene file (for example one saved by the annotation page)."""
+        problem = check_regular_file(path, "scene")  # a FIFO would block QGIS on open()
+        if problem:
+            self.set_status(problem)
+            return False
         try:
+            if os.path.getsize(path) > MAX_SCENE_BYTES:
+                raise ValueError(
+                    f"{os.path.getsize(path) / 1e6:.0f} MB, more than the "
+                    f"{MAX_SCENE_BYTES / 1e6:g} MB a scene may be"
+                )
             with open(path, encoding="utf-8") as fh:
                 scene = json.load(fh)
             if not isinstance(scene, dict):
                 raise ValueError("not a JSON object")
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, RecursionError) as exc:
             self.set_status(f"cannot read the scene {path}: {exc}")
             return False
         image = (scene.get("image") or {}).get("path")
@@ -719,6 +777,10 @@ class CamlocDock(QDockWidget):
 
     def save_scene(self, path: str) -> bool:
         """Validate the scene with the library and write it; False (status says why) if invalid."""
+        problem = _output_problem(path, "scene file")
+        if problem:
+            self.set_status(f"not saved: {problem}")
+            return False
         try:
             run_worker({"task": "check_scene", "scene": self.scene(), "save_to": path})
         except WorkerError as exc:
@@ -776,10 +838,15 @@ class CamlocDock(QDockWidget):
             return None
         osm = self.osm_edit.text().strip()
         gpkg = self.results_path()
-        folder = os.path.dirname(os.path.abspath(gpkg))
-        if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
-            self.set_status(f"cannot write results to {gpkg}: pick another GeoPackage")
+        problem = _output_problem(gpkg, "GeoPackage")
+        if problem:
+            self.set_status(f"cannot write results: {problem}; pick another GeoPackage")
             return None
+        if osm:
+            problem = _extract_problem(osm)
+            if problem:
+                self.set_status(problem)
+                return None
         self._remove_results()  # their GeoPackage tables are about to be replaced
         job = {
             "task": "locate",

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -352,3 +354,257 @@ def test_annotation_page_round_trip(dock, qgis_iface, tmp_path, monkeypatch, art
     assert "prior.radius_m" in err.value.read().decode()
     dock.grab().save(str(artifacts / "dock_scene_from_page.png"))
     dock.shutdown()
+
+
+# --- snapshots opened as safely as camloc_geo opens them (no hang, bounded, displayed grid) ---
+
+
+def _upright_photo(path: Path, orientation: int = 6) -> Path:
+    """A 480x640 portrait photo as a phone stores it: turned sideways, EXIF ``Orientation``.
+
+    Upright it shows sky (blue) over road (grey) with a red mark in the top-left corner;
+    stored, it is 640x480 and the viewer turns it back (6: 90° clockwise).
+    """
+    from PIL import Image, ImageDraw
+
+    upright = Image.new("RGB", (480, 640), (157, 183, 201))
+    draw = ImageDraw.Draw(upright)
+    draw.rectangle((0, 380, 479, 639), fill=(110, 110, 110))
+    draw.rectangle((0, 0, 79, 79), fill=(220, 20, 20))
+    draw.polygon([(240, 60), (180, 160), (300, 160)], fill=(255, 255, 255))  # "up" arrow
+    stored = upright.rotate(90, expand=True)  # counter-clockwise: the sensor's grid
+    exif = Image.Exif()
+    exif[0x0112] = orientation
+    stored.save(path, quality=92, exif=exif.tobytes())
+    return path
+
+
+def _png_claiming(path: Path, width: int, height: int) -> Path:
+    """A small PNG whose header claims ``width`` x ``height`` (a decompression bomb's header)."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (
+            struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        )
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    idat = zlib.compress(b"\x00" * 4096)
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", idat) + chunk(b"IEND", b"")
+    )
+    return path
+
+
+class _Unblocker:
+    """Opens a FIFO's other end now and then from another process, so code that blocks on it
+    returns (the suite never hangs; a thread would not run while Qt holds the GIL)."""
+
+    SCRIPT = (
+        "import os, sys, time\n"
+        "end = time.monotonic() + 120\n"
+        "while time.monotonic() < end:\n"
+        "    time.sleep(0.5)\n"
+        "    for flags, what in ((os.O_RDONLY, 'reader'), (os.O_WRONLY, 'writer')):\n"
+        "        try:\n"
+        "            os.close(os.open(sys.argv[1], flags | os.O_NONBLOCK))\n"
+        "            if what == 'writer':\n"
+        "                print('someone read it', flush=True)\n"
+        "        except OSError:\n"
+        "            pass\n"
+    )
+
+    def __init__(self, fifo: Path) -> None:
+        self.fifo = str(fifo)
+        self.proc: subprocess.Popen[str] | None = None
+        self.used = False
+
+    def __enter__(self) -> _Unblocker:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", self.SCRIPT, self.fifo], stdout=subprocess.PIPE, text=True
+        )
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        assert self.proc is not None
+        self.proc.kill()
+        out, _ = self.proc.communicate(timeout=10)
+        self.used = "someone read it" in out
+
+
+def _no_run(dock) -> None:
+    """Assert that Run refused to start (a started run is canceled first: no abort)."""
+    task = dock.run()
+    if task is not None:
+        dock.cancel()
+        dock.wait(30)
+        pytest.fail(f"Run started; status: {dock.status.text()}")
+
+
+def test_exif_rotated_photo_opens_in_the_displayed_grid(dock, tmp_path, artifacts):
+    from PIL import Image, ImageOps
+
+    photo = _upright_photo(tmp_path / "portrait.jpg")
+    with Image.open(photo) as im:
+        assert im.size == (640, 480)  # stored sideways
+        displayed = ImageOps.exif_transpose(im).size  # what browsers and camloc show
+    assert displayed == (480, 640)
+    assert dock.open_snapshot(str(photo)), dock.status.text()
+    assert (dock.annotation.width, dock.annotation.height) == displayed
+    assert dock.scene()["image"]["width"] == 480
+    assert dock.scene()["image"]["height"] == 640
+    rect = dock.view.scene().sceneRect()
+    assert (rect.width(), rect.height()) == (480.0, 640.0)
+    assert "480×640" in dock.status.text()
+    assert "EXIF" in dock.status.text()
+    # the pixels are upright too: the red mark top left, the road at the bottom
+    image = dock.view._pixmap_item.pixmap().toImage()
+    red = QColor(image.pixel(30, 30))
+    assert red.red() > 180, red.name()
+    assert red.green() < 80, red.name()
+    road = QColor(image.pixel(240, 600))
+    assert abs(road.red() - 110) < 20, road.name()
+    assert abs(road.blue() - 110) < 20, road.name()
+    # a click lands where the analyst sees it, inside the displayed grid
+    dock.set_step("origin")
+    dock.view.clicked.emit(400.0, 600.0)  # outside the stored 640x480 grid's height
+    assert dock.annotation.axes["origin"] == [400.0, 600.0]
+    dock.grab().save(str(artifacts / "dock_exif_rotated.png"))
+
+
+def test_a_fifo_is_refused_without_blocking(dock, tmp_path):
+    good = _snapshot(tmp_path / "snapshot.png")
+    assert dock.open_snapshot(str(good))
+    fifo = tmp_path / "camera.jpg"
+    os.mkfifo(fifo)
+    with _Unblocker(fifo) as unblocker:  # should the dock open it, it returns (EOF)
+        assert not dock.open_snapshot(str(fifo))
+        assert "not a regular file" in dock.status.text()
+        assert str(fifo) in dock.status.text()
+        assert dock.image_file == str(good)  # the open snapshot stays
+        scene_fifo = tmp_path / "scene.json"
+        os.mkfifo(scene_fifo)
+        assert not dock.load_scene(str(scene_fifo))
+        assert "not a regular file" in dock.status.text()
+        assert not dock.save_scene(str(fifo))
+        assert "not a regular file" in dock.status.text()
+    assert not unblocker.used  # nothing ever opened the FIFO
+
+
+def test_run_refuses_a_fifo_as_extract_or_geopackage(dock, qgis_iface, tmp_path):
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    fifo = tmp_path / "extract.osm.pbf"
+    os.mkfifo(fifo)
+    with _Unblocker(fifo):
+        dock.osm_edit.setText(str(fifo))
+        dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+        _no_run(dock)
+        assert "not a regular file" in dock.status.text()
+        assert "OSM extract" in dock.status.text()
+        dock.osm_edit.setText(str(SAMPLE_OSM))
+        dock.gpkg_edit.setText(str(fifo))
+        _no_run(dock)
+        assert "not a regular file" in dock.status.text()
+        assert "GeoPackage" in dock.status.text()
+        folder = tmp_path / "results.gpkg"
+        folder.mkdir()
+        dock.gpkg_edit.setText(str(folder))
+        _no_run(dock)
+        assert "is a folder" in dock.status.text()
+        dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+        empty = tmp_path / "empty.osm"
+        empty.write_bytes(b"")
+        dock.osm_edit.setText(str(empty))
+        _no_run(dock)
+        assert "empty (0 bytes)" in dock.status.text()
+    assert dock.task is None
+    assert dock.run_button.isEnabled()
+
+
+def test_a_decompression_bomb_header_is_refused_before_decoding(dock, tmp_path):
+    import resource
+
+    bomb = _png_claiming(tmp_path / "bomb.png", 60000, 60000)
+    assert bomb.stat().st_size < 1000
+    before_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    assert not dock.open_snapshot(str(bomb))
+    text = dock.status.text()
+    assert "60000x60000" in text, text
+    assert "3600 MP" in text, text
+    assert "50 megapixels" in text, text
+    assert str(bomb) in text
+    # just over the limit is refused too (Qt 5 would decode 8000x8000: 256 MB)
+    assert not dock.open_snapshot(str(_png_claiming(tmp_path / "b2.png", 8000, 8000)))
+    assert "64 MP" in dock.status.text()
+    after_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    assert after_kb - before_kb < 100_000  # nothing near the 256 MB or 14 GB decoded
+    assert not dock.view.has_image()
+
+
+@pytest.mark.parametrize(
+    ("name", "make", "said"),
+    [
+        ("empty.jpg", lambda p: p.write_bytes(b""), "the file is empty (0 bytes)"),
+        ("notes.png", lambda p: p.write_text("not an image\n"), "not an image file QGIS reads"),
+        ("folder.jpg", lambda p: p.mkdir(), "is a folder"),
+        ("missing.jpg", lambda p: None, "not found"),
+    ],
+)
+def test_an_unreadable_file_gives_one_status_line(dock, tmp_path, name, make, said):
+    path = tmp_path / name
+    make(path)
+    assert not dock.open_snapshot(str(path))
+    text = dock.status.text()
+    assert said in text, text
+    assert str(path) in text, text
+    assert "\n" not in text
+    assert "Traceback" not in text
+    assert not dock.view.has_image()
+
+
+@pytest.mark.parametrize("fmt", ["JPEG", "PNG", "GIF", "BMP", "WEBP", "TIFF"])
+def test_a_truncated_image_is_refused(dock, tmp_path, fmt):
+    from camloc.imagefile import read_snapshot
+    from PIL import Image
+
+    ext = {"JPEG": "jpg", "TIFF": "tif"}.get(fmt, fmt.lower())
+    full = tmp_path / f"full.{ext}"
+    img = Image.new("RGB", (320, 240), (30, 140, 60))
+    img.paste((200, 30, 30), (0, 120, 320, 240))
+    img.save(full, format=fmt)
+    width, height = read_snapshot(str(full))[0].size().width(), 240
+    assert (width, height) == (320, 240)
+    cut = tmp_path / f"cut.{ext}"
+    cut.write_bytes(full.read_bytes()[: full.stat().st_size * 2 // 3])
+    assert not dock.open_snapshot(str(cut))
+    text = dock.status.text()
+    assert str(cut) in text, text
+    assert "truncated or corrupt" in text, text
+
+
+def test_complete_images_pass_the_end_checks(tmp_path):
+    """The JPEG, GIF and BMP end checks accept what encoders write (no false refusal)."""
+    from camloc.imagefile import read_snapshot
+    from PIL import Image
+
+    img = Image.new("RGB", (300, 200), (30, 140, 60))
+    for i in range(0, 300, 7):  # some texture: 0xFF bytes in the JPEG's coded data
+        img.paste((255, 255, (i * 37) % 256), (i, 0, i + 3, 200))
+    cases = {
+        "baseline.jpg": {"quality": 95},
+        "progressive.jpg": {"quality": 90, "progressive": True},
+        "restart.jpg": {"quality": 90, "restart_marker_blocks": 1},
+        "plain.gif": {},
+        "plain.bmp": {},
+    }
+    for name, opts in cases.items():
+        path = tmp_path / name
+        img.save(path, **opts)
+        image, turned = read_snapshot(str(path))
+        assert (image.width(), image.height(), turned) == (300, 200, False), name
+    trailer = tmp_path / "trailer.jpg"  # bytes after the end (some phones append data)
+    trailer.write_bytes((tmp_path / "baseline.jpg").read_bytes() + b"\x00MOREDATA" * 10)
+    assert read_snapshot(str(trailer))[0].width() == 300
