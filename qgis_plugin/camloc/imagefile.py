@@ -11,8 +11,8 @@ shapely/pyproj wheels crash inside QGIS, see docs/qgis.md). The same rules, with
 - the EXIF orientation is applied (``setAutoTransform``): the annotation is in the grid that
   viewers, the browser page, ``camloc vp`` and calibrate use;
 - an empty, truncated or non-image file is refused with one line naming the file (Qt decodes
-  a cut-off JPEG, GIF or BMP without an error, grey or black below the cut: those are checked
-  here for their end).
+  a cut-off JPEG, GIF or BMP without an error, grey or black below the cut, and libpng logs
+  its own error for a cut-off PNG: those four are checked here for their end first).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import mmap
 import os
 import re
 import stat
+import zlib
 
 from qgis.PyQt.QtGui import QImage, QImageIOHandler, QImageReader
 
@@ -114,17 +115,40 @@ def _gif_complete(data: mmap.mmap) -> bool:
     return False
 
 
-def data_complete(path: str, fmt: str) -> bool:
-    """Whether a JPEG, GIF or BMP file holds all its data (other formats: Qt says so itself).
+def _png_complete(data: mmap.mmap) -> bool:
+    """Whether a PNG's chunks run to ``IEND``, each with its checksum right (not decompressed)."""
+    n = len(data)
+    pos = 8  # after the signature
+    with memoryview(data) as view:
+        while pos + 12 <= n:
+            length = int.from_bytes(view[pos : pos + 4], "big")
+            end = pos + 8 + length
+            if end + 4 > n:
+                return False
+            crc = int.from_bytes(view[end : end + 4], "big")
+            if zlib.crc32(view[pos + 4 : end]) != crc:
+                return False
+            if view[pos + 4 : pos + 8] == b"IEND":
+                return True
+            pos = end + 4
+    return False
 
-    The file is mapped, not read: memory stays bounded whatever its size.
+
+def data_complete(path: str, fmt: str) -> bool:
+    """Whether a JPEG, PNG, GIF or BMP file holds all its data (other formats: Qt says so).
+
+    Qt decodes a cut-off JPEG, GIF or BMP without an error (grey or black below the cut), and
+    refuses a cut-off PNG only after libpng has written its own error to the log. The file is
+    mapped, not read: memory stays bounded whatever its size.
     """
-    if fmt not in ("jpeg", "jpg", "gif", "bmp"):
+    if fmt not in ("jpeg", "jpg", "png", "gif", "bmp"):
         return True
     try:
         with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
             if fmt in ("jpeg", "jpg"):
                 return data[:2] == b"\xff\xd8" and _jpeg_complete(data)
+            if fmt == "png":
+                return _png_complete(data)
             if fmt == "gif":
                 return _gif_complete(data)
             # BMP: the header gives the file's size

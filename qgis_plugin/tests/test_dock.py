@@ -566,7 +566,7 @@ def test_an_unreadable_file_gives_one_status_line(dock, tmp_path, name, make, sa
 
 
 @pytest.mark.parametrize("fmt", ["JPEG", "PNG", "GIF", "BMP", "WEBP", "TIFF"])
-def test_a_truncated_image_is_refused(dock, tmp_path, fmt):
+def test_a_truncated_image_is_refused(dock, tmp_path, fmt, capfd):
     from camloc.imagefile import read_snapshot
     from PIL import Image
 
@@ -583,6 +583,10 @@ def test_a_truncated_image_is_refused(dock, tmp_path, fmt):
     text = dock.status.text()
     assert str(cut) in text, text
     assert "truncated or corrupt" in text, text
+    if fmt in ("JPEG", "PNG", "GIF", "BMP"):  # refused before the decoder could complain
+        err = capfd.readouterr().err
+        assert "libpng" not in err, err
+        assert "JPEG" not in err, err
 
 
 def test_complete_images_pass_the_end_checks(tmp_path):
