@@ -312,6 +312,8 @@ class CamlocDock(QDockWidget):
         self.iface = iface
         self.annotation = Annotation()
         self.image_file: str | None = None
+        self.image_size: tuple[int, int] | None = None
+        """The open snapshot's displayed width and height (EXIF orientation applied)."""
         self.result_layers: list[QgsVectorLayer] = []
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
@@ -486,6 +488,7 @@ class CamlocDock(QDockWidget):
         self.annotation = Annotation(image.width(), image.height(), scene_id=scene_id)
         self.annotation.image_path = os.path.basename(path)
         self.image_file = os.path.abspath(path)
+        self.image_size = (image.width(), image.height())
         self.view.set_pixmap(pix)
         self.steps.blockSignals(True)
         self.steps.setCurrentRow(0)
@@ -682,6 +685,26 @@ class CamlocDock(QDockWidget):
         self.set_status(
             f"Scene received: {anns} car annotation(s), {corners} kerb corner(s). "
             + ("Run when ready." if not missing else "Still to do: " + "; ".join(missing))
+            + self._grid_warning()
+        )
+
+    def _grid_warning(self) -> str:
+        """A warning when the scene's image size is not the open snapshot's displayed size."""
+        if self.image_size is None:
+            return ""
+        shown = self.image_size
+        scene = (self.annotation.width, self.annotation.height)
+        if scene == shown or not all(scene):
+            return ""
+        if scene == shown[::-1]:
+            return (
+                f" Warning: the scene is {scene[0]}×{scene[1]} px, the snapshot shown upright "
+                f"{shown[0]}×{shown[1]}: it was annotated turned a quarter (its stored grid, "
+                "EXIF orientation ignored); annotate it again."
+            )
+        return (
+            f" Warning: the scene is {scene[0]}×{scene[1]} px but the open snapshot is "
+            f"{shown[0]}×{shown[1]}: is it the scene's image?"
         )
 
     def _settings_from_annotation(self) -> None:

@@ -612,3 +612,28 @@ def test_complete_images_pass_the_end_checks(tmp_path):
     trailer = tmp_path / "trailer.jpg"  # bytes after the end (some phones append data)
     trailer.write_bytes((tmp_path / "baseline.jpg").read_bytes() + b"\x00MOREDATA" * 10)
     assert read_snapshot(str(trailer))[0].width() == 300
+
+
+def test_a_scene_in_the_stored_grid_is_flagged(dock, tmp_path):
+    """A scene annotated sideways (EXIF ignored, the old dock) says so when it is loaded."""
+    photo = _upright_photo(tmp_path / "portrait.jpg")
+    scene = {
+        "format": "camloc-scene/1",
+        "id": "portrait",
+        "image": {"width": 640, "height": 480, "path": "portrait.jpg"},
+        "annotations": [],
+    }
+    path = tmp_path / "portrait.json"
+    path.write_text(json.dumps(scene))
+    assert dock.load_scene(str(path))  # opens the scene's image beside it
+    assert dock.image_file == str(photo)
+    assert dock.image_size == (480, 640)
+    assert "turned a quarter" in dock.status.text()
+    scene["image"].update(width=480, height=640)
+    path.write_text(json.dumps(scene))
+    assert dock.load_scene(str(path))
+    assert "Warning" not in dock.status.text()
+    scene["image"].update(width=1920, height=1080)
+    path.write_text(json.dumps(scene))
+    assert dock.load_scene(str(path))
+    assert "is it the scene's image" in dock.status.text()
