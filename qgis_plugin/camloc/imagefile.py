@@ -29,6 +29,13 @@ MAX_IMAGE_PIXELS = 50_000_000
 """Largest snapshot opened (width × height): ``camloc_geo._limits.MAX_IMAGE_PIXELS``, copied
 because the plugin does not import camloc_geo (keep the two equal)."""
 
+MAX_IMAGE_BYTES_PER_PIXEL = 8
+MAX_IMAGE_EXTRA_BYTES = 64_000_000
+"""A file larger than ``MAX_IMAGE_BYTES_PER_PIXEL`` a pixel plus ``MAX_IMAGE_EXTRA_BYTES`` is
+padded or corrupt (``camloc_geo._io``'s, copied: keep them equal)."""
+MIN_IMAGE_SIDE_PX = 8
+"""Smallest image side (``camloc_geo._io.MIN_IMAGE_SIDE_PX``, copied: keep them equal)."""
+
 _JPEG_MARKER = re.compile(rb"\xff[^\x00\xd0-\xd7\xff]")
 """In a JPEG's entropy-coded data, the next marker (``FF 00`` is a stuffed byte, ``FF D0``-``D7``
 restart markers, ``FF FF`` fill)."""
@@ -173,7 +180,8 @@ def read_snapshot(path: str) -> tuple[QImage, bool]:
     SnapshotError
         One line naming the file: missing, not a regular file (FIFO, device, folder), empty,
         not an image Qt reads, its size unknown from the header, over
-        :data:`MAX_IMAGE_PIXELS`, truncated or corrupt.
+        :data:`MAX_IMAGE_PIXELS`, under :data:`MIN_IMAGE_SIDE_PX` on a side, larger in bytes
+        than its pixels can take (padded), truncated or corrupt.
     """
     problem = check_regular_file(path, "image")
     if problem:
@@ -200,6 +208,18 @@ def read_snapshot(path: str) -> tuple[QImage, bool]:
         raise SnapshotError(
             f"image {path} is {width}x{height} pixels ({width * height / 1e6:.0f} MP); "
             f"the supported limit is {MAX_IMAGE_PIXELS / 1e6:g} megapixels"
+        )
+    if min(width, height) < MIN_IMAGE_SIDE_PX:
+        raise SnapshotError(
+            f"image {path} is too small: {width}x{height} pixels "
+            f"(at least {MIN_IMAGE_SIDE_PX} on a side)"
+        )
+    n_bytes = os.path.getsize(path)
+    most = MAX_IMAGE_BYTES_PER_PIXEL * width * height + MAX_IMAGE_EXTRA_BYTES
+    if n_bytes > most:  # the end checks would read it all
+        raise SnapshotError(
+            f"image {path} is {n_bytes / 1e6:.0f} MB for {width}x{height} pixels, more than "
+            f"any encoding of them takes ({most / 1e6:.0f} MB): padded or corrupt"
         )
     if hasattr(reader, "setAllocationLimit"):  # Qt 6: its 128 MB default would refuse 40 MP
         reader.setAllocationLimit(MAX_IMAGE_PIXELS * 8 // 2**20 + 1)

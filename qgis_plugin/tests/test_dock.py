@@ -637,3 +637,52 @@ def test_a_scene_in_the_stored_grid_is_flagged(dock, tmp_path):
     path.write_text(json.dumps(scene))
     assert dock.load_scene(str(path))
     assert "is it the scene's image" in dock.status.text()
+
+
+def test_the_copied_limits_are_the_librarys():
+    """The plugin copies camloc_geo's limits (it does not import the library in QGIS)."""
+    from camloc import dock as dock_module
+    from camloc import imagefile
+
+    names = {
+        "camloc_geo._limits": ("MAX_IMAGE_PIXELS", "MAX_SCENE_BYTES"),
+        "camloc_geo._io": (
+            "MAX_IMAGE_BYTES_PER_PIXEL",
+            "MAX_IMAGE_EXTRA_BYTES",
+            "MIN_IMAGE_SIDE_PX",
+        ),
+    }
+    code = (
+        "import importlib, json, sys\n"
+        "names = json.loads(sys.argv[1])\n"
+        "found = {n: getattr(importlib.import_module(m), n)\n"
+        "         for m, ns in names.items() for n in ns}\n"
+        "print(json.dumps(found))\n"
+    )
+    out = subprocess.run(  # the library in its own process, as the plugin's worker runs it
+        [sys.executable, "-c", code, json.dumps(names)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    ).stdout
+    library = json.loads(out)
+    assert len(library) == 5
+    ours = {n: getattr(imagefile, n, None) for n in library}
+    ours["MAX_SCENE_BYTES"] = dock_module.MAX_SCENE_BYTES
+    assert ours == library
+
+
+def test_a_tiny_or_padded_image_is_refused(dock, tmp_path):
+    from PIL import Image
+
+    tiny = tmp_path / "tiny.png"
+    Image.new("RGB", (5, 400)).save(tiny)
+    assert not dock.open_snapshot(str(tiny))
+    assert "too small: 5x400 pixels" in dock.status.text()
+    padded = tmp_path / "padded.png"
+    Image.new("RGB", (100, 100)).save(padded)
+    with open(padded, "ab") as fh:  # 70 MB after IEND
+        fh.truncate(padded.stat().st_size + 70_000_000)
+    assert not dock.open_snapshot(str(padded))
+    assert "padded or corrupt" in dock.status.text()
