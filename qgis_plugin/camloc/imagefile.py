@@ -17,11 +17,11 @@ shapely/pyproj wheels crash inside QGIS, see docs/qgis.md). The same rules, with
 
 from __future__ import annotations
 
-import mmap
 import os
 import re
 import stat
 import zlib
+from typing import BinaryIO
 
 from qgis.PyQt.QtGui import QImage, QImageIOHandler, QImageReader
 
@@ -63,7 +63,73 @@ def check_regular_file(path: str, what: str) -> str | None:
     return None
 
 
-def _jpeg_complete(data: mmap.mmap) -> bool:
+class _FileBytes:
+    """Random access to a file's bytes through a 1 MB window.
+
+    Memory stays bounded whatever the file's size, and a file cut while it is read (still
+    being copied or synced) gives short reads: a memory map would kill QGIS with SIGBUS.
+    """
+
+    WINDOW = 1 << 20
+
+    def __init__(self, fh: BinaryIO, size: int) -> None:
+        self.fh = fh
+        self.size = size
+        self.start = 0
+        self.buf = b""
+
+    def __len__(self) -> int:
+        return self.size
+
+    def _load(self, pos: int) -> None:
+        self.fh.seek(pos)
+        self.buf = self.fh.read(self.WINDOW)
+        self.start = pos
+
+    def __getitem__(self, pos: int) -> int:
+        i = pos - self.start
+        if not 0 <= i < len(self.buf):
+            self._load(pos)
+            if not self.buf:
+                raise IndexError(pos)  # shorter than it was: cut meanwhile
+            i = 0
+        return self.buf[i]
+
+    def read(self, pos: int, n: int) -> bytes:
+        """Up to ``n`` bytes from ``pos`` (fewer at the end)."""
+        i = pos - self.start
+        if i >= 0 and i + n <= len(self.buf):
+            return self.buf[i : i + n]
+        self.fh.seek(pos)
+        return self.fh.read(n)
+
+    def search(self, pattern: re.Pattern[bytes], pos: int) -> int | None:
+        """Where the next match of a two-byte ``pattern`` starts at or after ``pos``."""
+        while pos < self.size:
+            self._load(pos)
+            found = pattern.search(self.buf)
+            if found is not None:
+                return pos + found.start()
+            if len(self.buf) < 2:
+                return None
+            pos += len(self.buf) - 1  # one byte of overlap: a match across the edge
+        return None
+
+    def crc32(self, start: int, end: int) -> int | None:
+        """CRC-32 of bytes ``start:end`` (None if the file ends before)."""
+        crc = 0
+        self.fh.seek(start)
+        left = end - start
+        while left > 0:
+            chunk = self.fh.read(min(left, self.WINDOW))
+            if not chunk:
+                return None
+            crc = zlib.crc32(chunk, crc)
+            left -= len(chunk)
+        return crc
+
+
+def _jpeg_complete(data: _FileBytes) -> bool:
     """Whether a JPEG's segments run to its end-of-image marker (a cut-off file does not)."""
     n = len(data)
     pos = 2  # after SOI
@@ -86,13 +152,13 @@ def _jpeg_complete(data: mmap.mmap) -> bool:
         if pos > n:
             return False
         if marker == 0xDA:  # SOS: entropy-coded data up to the next marker
-            found = _JPEG_MARKER.search(data, pos)
+            found = data.search(_JPEG_MARKER, pos)
             if found is None:
                 return False
-            pos = found.start()
+            pos = found
 
 
-def _gif_complete(data: mmap.mmap) -> bool:
+def _gif_complete(data: _FileBytes) -> bool:
     """Whether a GIF's blocks run to its trailer (``;``)."""
     n = len(data)
     if n < 13:
@@ -122,22 +188,21 @@ def _gif_complete(data: mmap.mmap) -> bool:
     return False
 
 
-def _png_complete(data: mmap.mmap) -> bool:
+def _png_complete(data: _FileBytes) -> bool:
     """Whether a PNG's chunks run to ``IEND``, each with its checksum right (not decompressed)."""
     n = len(data)
     pos = 8  # after the signature
-    with memoryview(data) as view:
-        while pos + 12 <= n:
-            length = int.from_bytes(view[pos : pos + 4], "big")
-            end = pos + 8 + length
-            if end + 4 > n:
-                return False
-            crc = int.from_bytes(view[end : end + 4], "big")
-            if zlib.crc32(view[pos + 4 : end]) != crc:
-                return False
-            if view[pos + 4 : pos + 8] == b"IEND":
-                return True
-            pos = end + 4
+    while pos + 12 <= n:
+        head = data.read(pos, 8)
+        length = int.from_bytes(head[:4], "big")
+        end = pos + 8 + length
+        if len(head) < 8 or end + 4 > n:
+            return False
+        if data.crc32(pos + 4, end) != int.from_bytes(data.read(end, 4), "big"):
+            return False
+        if head[4:] == b"IEND":
+            return True
+        pos = end + 4
     return False
 
 
@@ -146,21 +211,22 @@ def data_complete(path: str, fmt: str) -> bool:
 
     Qt decodes a cut-off JPEG, GIF or BMP without an error (grey or black below the cut), and
     refuses a cut-off PNG only after libpng has written its own error to the log. The file is
-    mapped, not read: memory stays bounded whatever its size.
+    read through a 1 MB window: memory stays bounded whatever its size.
     """
     if fmt not in ("jpeg", "jpg", "png", "gif", "bmp"):
         return True
     try:
-        with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        with open(path, "rb") as fh:
+            data = _FileBytes(fh, os.fstat(fh.fileno()).st_size)
             if fmt in ("jpeg", "jpg"):
-                return data[:2] == b"\xff\xd8" and _jpeg_complete(data)
+                return data.read(0, 2) == b"\xff\xd8" and _jpeg_complete(data)
             if fmt == "png":
                 return _png_complete(data)
             if fmt == "gif":
                 return _gif_complete(data)
             # BMP: the header gives the file's size
-            return len(data) >= 6 and len(data) >= int.from_bytes(data[2:6], "little")
-    except (OSError, ValueError):
+            return len(data) >= 6 and len(data) >= int.from_bytes(data.read(2, 4), "little")
+    except (OSError, ValueError, IndexError):
         return False
 
 

@@ -589,11 +589,14 @@ def test_a_truncated_image_is_refused(dock, tmp_path, fmt, capfd):
         assert "JPEG" not in err, err
 
 
-def test_complete_images_pass_the_end_checks(tmp_path):
-    """The JPEG, GIF and BMP end checks accept what encoders write (no false refusal)."""
-    from camloc.imagefile import read_snapshot
+@pytest.mark.parametrize("window", [7, 1 << 20])
+def test_complete_images_pass_the_end_checks(tmp_path, monkeypatch, window):
+    """The end checks accept what encoders write, cut ones fail, whatever the read window."""
+    import numpy as np
+    from camloc.imagefile import _FileBytes, data_complete, read_snapshot
     from PIL import Image
 
+    monkeypatch.setattr(_FileBytes, "WINDOW", window)  # 7 bytes: every edge case of the window
     img = Image.new("RGB", (300, 200), (30, 140, 60))
     for i in range(0, 300, 7):  # some texture: 0xFF bytes in the JPEG's coded data
         img.paste((255, 255, (i * 37) % 256), (i, 0, i + 3, 200))
@@ -603,15 +606,30 @@ def test_complete_images_pass_the_end_checks(tmp_path):
         "restart.jpg": {"quality": 90, "restart_marker_blocks": 1},
         "plain.gif": {},
         "plain.bmp": {},
+        "plain.png": {},
     }
     for name, opts in cases.items():
         path = tmp_path / name
         img.save(path, **opts)
         image, turned = read_snapshot(str(path))
         assert (image.width(), image.height(), turned) == (300, 200, False), name
+        cut = tmp_path / f"cut_{name}"
+        cut.write_bytes(path.read_bytes()[: path.stat().st_size * 2 // 3])
+        fmt = {"jpg": "jpeg"}.get(path.suffix[1:], path.suffix[1:])
+        assert not data_complete(str(cut), fmt), name
     trailer = tmp_path / "trailer.jpg"  # bytes after the end (some phones append data)
     trailer.write_bytes((tmp_path / "baseline.jpg").read_bytes() + b"\x00MOREDATA" * 10)
     assert read_snapshot(str(trailer))[0].width() == 300
+    if window > 1000:  # files of several windows: noise, megabytes
+        noise = np.random.default_rng(1).integers(0, 256, (1000, 1500, 3), dtype=np.uint8)
+        for name, fmt in (("noise.jpg", "jpeg"), ("noise.png", "png")):
+            path = tmp_path / name
+            Image.fromarray(noise).save(path, quality=97)
+            data = path.read_bytes()
+            assert len(data) > 2 * window
+            assert data_complete(str(path), fmt), name
+            path.write_bytes(data[: len(data) - 3000])
+            assert not data_complete(str(path), fmt), name
 
 
 def test_a_scene_in_the_stored_grid_is_flagged(dock, tmp_path):
