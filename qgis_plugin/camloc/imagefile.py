@@ -23,7 +23,7 @@ import stat
 import zlib
 from typing import BinaryIO
 
-from qgis.PyQt.QtGui import QImage, QImageIOHandler, QImageReader
+from qgis.PyQt.QtGui import QImage, QImageReader
 
 MAX_IMAGE_PIXELS = 50_000_000
 """Largest snapshot opened (width × height): ``camloc_geo._limits.MAX_IMAGE_PIXELS``, copied
@@ -299,5 +299,6 @@ def read_snapshot(path: str) -> tuple[QImage, bool]:
             f"cannot read the image {path}: {reader.errorString()} "
             f"(a truncated or corrupt {fmt.upper() or 'image'} file)"
         )
-    turned = bool(int(reader.transformation()) & int(QImageIOHandler.TransformationRotate90))
+    # from the sizes, not the transformation flags (their enum differs between PyQt5 and 6)
+    turned = width != height and (image.width(), image.height()) == (height, width)
     return image, turned

@@ -489,6 +489,10 @@ def test_a_fifo_is_refused_without_blocking(dock, tmp_path):
         assert "not a regular file" in dock.status.text()
         assert not dock.save_scene(str(fifo))
         assert "not a regular file" in dock.status.text()
+        link = tmp_path / "link.jpg"  # a link to a FIFO is a FIFO
+        link.symlink_to(fifo)
+        assert not dock.open_snapshot(str(link))
+        assert "not a regular file" in dock.status.text()
     assert not unblocker.used  # nothing ever opened the FIFO
 
 
