@@ -746,11 +746,14 @@ class CamlocDock(QDockWidget):
             self.set_status(f"cannot read the scene {path}: {exc}")
             return False
         image = (scene.get("image") or {}).get("path")
-        if image and not self.image_file:
+        refused = ""
+        if isinstance(image, str) and image and not self.image_file:
             candidate = os.path.join(os.path.dirname(path), image)
-            if os.path.isfile(candidate):
-                self.open_snapshot(candidate)
+            if os.path.lexists(candidate) and not self.open_snapshot(candidate):
+                refused = self.status.text()
         self.receive_scene(scene)
+        if refused:  # say why its image is not shown
+            self.set_status(f"{self.status.text()} Its image was not opened: {refused}")
         return True
 
     # --- map pick --------------------------------------------------------------------------

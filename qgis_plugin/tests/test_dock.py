@@ -708,3 +708,16 @@ def test_a_tiny_or_padded_image_is_refused(dock, tmp_path):
         fh.truncate(padded.stat().st_size + 70_000_000)
     assert not dock.open_snapshot(str(padded))
     assert "padded or corrupt" in dock.status.text()
+
+
+def test_a_scene_whose_image_is_refused_says_why(dock, tmp_path):
+    (tmp_path / "cam.jpg").write_bytes(b"")
+    path = tmp_path / "cam.json"
+    scene = {"format": "camloc-scene/1", "id": "cam", "image": {"path": "cam.jpg"}}
+    path.write_text(json.dumps(scene))
+    assert dock.load_scene(str(path))
+    assert not dock.view.has_image()
+    text = dock.status.text()
+    assert "Scene received" in text
+    assert "Its image was not opened" in text
+    assert "the file is empty (0 bytes)" in text
