@@ -13,7 +13,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse
 
 from camloc_geo import CamlocError, MapDataError, SceneError
-from camloc_geo._io import displayed_size, image_data_complete
+from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete
 from camloc_geo.service.deps import (
     ApiKey,
     SceneBody,
@@ -35,8 +35,6 @@ __all__ = ["router"]
 router = APIRouter(tags=["crowd"])
 
 IMAGE_TYPES = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
-MIN_SNAPSHOT_SIDE_PX = 8
-"""Smallest snapshot side (pixels) a task is made for."""
 IMAGE_MEDIA_TYPES = tuple(f"image/{kind.lower()}" for kind in IMAGE_TYPES)
 _UPLOAD_DOC = {
     "requestBody": {
@@ -77,10 +75,10 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
             f"the snapshot is {width}×{height}; this server accepts at most {max_pixels} pixels",
             "body",
         )
-    if min(width, height) < MIN_SNAPSHOT_SIDE_PX:
+    if min(width, height) < MIN_IMAGE_SIDE_PX:
         raise SceneError(
             f"the snapshot is {width}×{height}: too small to annotate (at least "
-            f"{MIN_SNAPSHOT_SIDE_PX} pixels a side)",
+            f"{MIN_IMAGE_SIDE_PX} pixels a side)",
             "body",
         )
     if not image_data_complete(raw, fmt):
