@@ -1004,7 +1004,9 @@ def _car_line_sensitivity(
     axis_of = np.concatenate([prob.seg_axis, prob.photo_axis]) if n_photo else prob.seg_axis
     rows = np.concatenate([np.arange(n_seg), n_seg + 2 * n_pt + np.arange(n_photo)])
     scale = np.concatenate([prob._w_seg / prob.sigma_line, prob._photo_scale[:n_photo]])
-    considered = np.isin(axis_of, [AXES.index(a) for a in axes])
+    considered = np.zeros(len(AXES), dtype=bool)
+    considered[[AXES.index(a) for a in axes]] = True
+    considered = considered[axis_of]
     faces = np.full(len(segs), -1, dtype=int)
     faces[considered] = _car_faces(
         prob, x, R0, pp_fixed, f_fixed, segs[considered], axis_of[considered]
@@ -1031,18 +1033,14 @@ def _car_line_sensitivity(
         if name not in axes or not np.any(car):
             continue
         seg_a = segs[sel]
-        base = _segment_offsets_px(seg_a, K @ R[:, a])
+        k_a = len(sel)
+        others = [b for b in range(3) if b != a]
+        # the axis' vanishing point and the two turned ones, each for every segment: one call
+        vps = K @ np.column_stack([R[:, a]] + [R[:, a] + h * R[:, b] for b in others])
+        offsets = _segment_offsets_px(np.tile(seg_a, (3, 1)), np.repeat(vps.T, k_a, axis=0))
+        base = offsets[:k_a]
         # (len(sel), 2): each row's residual per radian of turn toward the other two axes
-        G = (
-            np.column_stack(
-                [
-                    (_segment_offsets_px(seg_a, K @ (R[:, a] + h * R[:, b])) - base) / h
-                    for b in range(3)
-                    if b != a
-                ]
-            )
-            * scale[sel, None]
-        )
+        G = (offsets[k_a:].reshape(2, k_a).T - base[:, None]) / h * scale[sel, None]
         JW_a = JW[rows[sel]]
         b_all = JW_a.T @ G  # (n, 2): Jᵀ W dr when every line of the axis turns
         m_all = float(np.trace(b_all.T @ H_inv @ b_all))
