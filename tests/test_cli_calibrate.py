@@ -189,3 +189,31 @@ def test_usage_error_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
         main(["calibrate"])
     assert info.value.code == 2
     assert "Traceback" not in capsys.readouterr().err
+
+
+def test_fit_warnings_reach_stderr_once(tmp_path: Path) -> None:
+    """The fit's own warnings (not only the scene's) are on stderr, each once, besides JSON.
+
+    The hand-annotated taxi's own lines alone (no kerb, no building): the length and width
+    directions rest on the car's edges, a warning that used to be in the JSON only.
+    """
+    from test_real_car import TAXI, _car_lines_only
+
+    scene = json.loads(TAXI.read_text(encoding="utf-8"))
+    scene["image"].pop("path", None)
+    path = _write(tmp_path, _car_lines_only(scene))
+    proc = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", "calibrate", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    warnings = json.loads(proc.stdout)["warnings"]
+    car = [w for w in warnings if "rests on the car's own edges" in w]
+    assert len(car) == 2  # length and width
+    lines = proc.stderr.splitlines()
+    for w in warnings:
+        assert sum(w in line for line in lines) == 1, w
+    assert "Traceback" not in proc.stderr

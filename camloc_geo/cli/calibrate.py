@@ -3,9 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import logging
+from collections.abc import Iterator
 from typing import Any
 
 from camloc_geo.cli import write_json
+
+log = logging.getLogger(__name__)
 
 __all__ = ["register", "run"]
 
@@ -42,9 +47,35 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.cli import output_path
 
     output_path(args.output, inputs=[args.scene])
-    scene = scene_from(args.scene)
-    result = calibrate_scene(
-        scene, joint_fit=not args.no_joint_fit, principal_point=args.principal_point
-    )
+    with _logged_warnings() as logged:
+        scene = scene_from(args.scene)
+        result = calibrate_scene(
+            scene, joint_fit=not args.no_joint_fit, principal_point=args.principal_point
+        )
+    # Every warning of the answer also on stderr, once: those the library logged while
+    # reading and screening the scene are there already; the fit's own (a loose focal
+    # length, lines resting on the car's own edges, a photo that disagrees) are not.
+    for msg in result.warnings:
+        if msg not in logged:
+            log.warning("%s", msg)
     write_json({"scene": scene.id, **result.to_dict()}, args.output, inputs=[args.scene])
     return 0
+
+
+@contextlib.contextmanager
+def _logged_warnings() -> Iterator[set[str]]:
+    """The messages of the warnings ``camloc_geo`` logs inside the block."""
+    seen: set[str] = set()
+
+    class _Collect(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            if record.levelno >= logging.WARNING:
+                seen.add(record.getMessage())
+
+    handler = _Collect()
+    root = logging.getLogger("camloc_geo")
+    root.addHandler(handler)
+    try:
+        yield seen
+    finally:
+        root.removeHandler(handler)
