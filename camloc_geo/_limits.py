@@ -15,6 +15,7 @@ from pathlib import Path
 from camloc_geo._errors import InputError
 
 __all__ = [
+    "FOCAL_BOUNDS_REL",
     "MAX_ANNOTATORS",
     "MAX_IMAGE_PIXELS",
     "MAX_LANDMARKS",
@@ -49,6 +50,10 @@ MAX_LANDMARKS = 1000
 MIN_WEIGHT = 1e-6
 MAX_WEIGHT = 1e6
 """Range of a reference's relative weight."""
+
+FOCAL_BOUNDS_REL = (0.3, 6.0)
+"""Focal lengths searched when unknown, and plausible ones (an EXIF tag outside is broken),
+as multiples of the longer image side."""
 
 MAX_IMAGE_PIXELS = 50_000_000
 """Largest image decoded (width × height), checked from the file header before decoding."""

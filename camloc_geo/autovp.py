@@ -97,6 +97,10 @@ from scipy.spatial.transform import Rotation
 
 from camloc_geo._errors import DegenerateGeometryError, InputError, NotEnoughStructureError
 
+# Focal length bounds, as multiples of the longer image side, searched when unknown (EXIF's
+# plausibility check reads the same range).
+from camloc_geo._limits import FOCAL_BOUNDS_REL
+
 __all__ = [
     "AutoVPResult",
     "detect_segments",
@@ -112,8 +116,6 @@ log = logging.getLogger(__name__)
 
 FloatArray = npt.NDArray[np.float64]
 
-#: Focal length bounds, as multiples of the longer image side, searched when unknown.
-FOCAL_BOUNDS_REL = (0.3, 6.0)
 #: A vanishing direction this close (degrees) to the image plane is reported at infinity.
 INFINITY_TOL_DEG = 0.05
 #: Prior on the focal length (relative to the longer side): log-normal centre and sigma.
@@ -795,6 +797,23 @@ def _systematic_logf_std(
     return math.sqrt(total)
 
 
+def _logf_move(
+    m: _Model,
+    s: _Segs,
+    labels: npt.NDArray[np.int_],
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> float:
+    """``log(f / m.f_n)``: how far the focal length moves when refitted (from ``m``, up to
+    20 evaluations) with the segments ``labels`` marks ``-1`` left out."""
+    _, f, _, _ = _refine(
+        m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
+    )
+    return math.log(f / m.f_n)
+
+
 def _split_horizon_logf_std(
     m: _Model,
     s: _Segs,
@@ -835,10 +854,7 @@ def _split_horizon_logf_std(
             continue
         for side in (above, ~above):
             labels = np.where(sel & side, -1, m.labels)
-            _, f, _, _ = _refine(
-                m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
-            )
-            total += math.log(f / m.f_n) ** 2
+            total += _logf_move(m, s, labels, tau_px, f_prior, f_bounds, prior_w) ** 2
     return 0.5 * math.sqrt(total)
 
 
@@ -876,10 +892,7 @@ def _line_jackknife_logf_std(
         for g in range(n):
             labels = m.labels.copy()
             labels[sel[groups == g]] = -1
-            _, f, _, _ = _refine(
-                m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
-            )
-            theta[g] = math.log(f / m.f_n)
+            theta[g] = _logf_move(m, s, labels, tau_px, f_prior, f_bounds, prior_w)
         total += (n - 1) / n * float(np.sum((theta - theta.mean()) ** 2))
     return math.sqrt(total)
 

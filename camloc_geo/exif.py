@@ -19,7 +19,7 @@ Sources, best first:
     https://github.com/openMVG/CameraSensorSizeDatabase). No table is bundled. Sigma 5 %.
 
 A focal length outside ``PLAUSIBLE_FOCAL_REL`` times the longer image side (the range the
-vanishing-point fit searches, :data:`camloc_geo.autovp.FOCAL_BOUNDS_REL`) is a broken tag
+vanishing-point fit searches, :data:`camloc_geo._limits.FOCAL_BOUNDS_REL`) is a broken tag
 (``FocalLength`` 5000 mm on a phone, ``FocalLengthIn35mmFilm`` 2000): it is ignored with a
 warning, since as a prior it would pin the fit to the bound of that range.
 
@@ -37,6 +37,8 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from camloc_geo._limits import FOCAL_BOUNDS_REL
 
 __all__ = ["ExifFocal", "focal_from_exif", "focal_from_tags"]
 
@@ -57,8 +59,8 @@ _FP_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 1e-3}  # EXIF FocalPlaneResolutionUn
 SIGMA_35MM = 0.04
 SIGMA_FOCAL_PLANE = 0.05
 SIGMA_SENSOR_TABLE = 0.05
-#: Plausible focal lengths, as multiples of the longer image side (autovp's FOCAL_BOUNDS_REL).
-PLAUSIBLE_FOCAL_REL = (0.3, 6.0)
+#: Plausible focal lengths, as multiples of the longer image side: the range autovp searches.
+PLAUSIBLE_FOCAL_REL = FOCAL_BOUNDS_REL
 
 
 @dataclass(frozen=True)
