@@ -277,8 +277,21 @@ def _png_intact(path: Path) -> bool:
     return True
 
 
+_GRAY_CACHE: dict[tuple[str, int, int, int], Any] = {}
+_GRAY_CACHE_LOCK = threading.Lock()
+GRAY_CACHE_ENTRIES = 2
+"""How many decoded photos :func:`read_image_gray` keeps (a scene's photo is decoded when the
+scene is read, to check it, and again by the line detector: the second is a cache hit)."""
+GRAY_CACHE_MAX_PIXELS = 25_000_000
+"""Larger photos are not kept (at most ``GRAY_CACHE_ENTRIES`` x 25 MB held)."""
+
+
 def read_image_gray(path: PathLike) -> Any:
     """Decode an image file to an 8-bit grayscale array, as the user sees it.
+
+    The last ``GRAY_CACHE_ENTRIES`` photos decoded are kept, keyed on the file's resolved
+    path, modification time, size and inode: reading the same unchanged file again returns
+    the same **read-only** array without decoding it (copy it to change it).
 
     OpenCV decodes it and applies its EXIF orientation (a portrait photo stored sideways
     comes out upright). The header is checked first (:func:`camloc_geo._limits.check_image_file`:
@@ -299,12 +312,39 @@ def read_image_gray(path: PathLike) -> Any:
         file is read whole), not an image, truncated or corrupt, or smaller than
         ``MIN_IMAGE_SIDE_PX`` on a side.
     """
+    p = Path(path)
+    try:
+        st = p.stat()
+        key: tuple[str, int, int, int] | None = (
+            str(p.resolve()),
+            st.st_mtime_ns,
+            st.st_size,
+            st.st_ino,
+        )
+    except (OSError, RuntimeError):  # missing, a loop of links: the checks below say why
+        key = None
+    if key is not None:
+        with _GRAY_CACHE_LOCK:
+            hit = _GRAY_CACHE.get(key)
+        if hit is not None:
+            return hit
+    gray = _decode_image_gray(p)
+    if key is not None and gray.size <= GRAY_CACHE_MAX_PIXELS:
+        gray.setflags(write=False)
+        with _GRAY_CACHE_LOCK:
+            _GRAY_CACHE[key] = gray
+            while len(_GRAY_CACHE) > GRAY_CACHE_ENTRIES:
+                del _GRAY_CACHE[next(iter(_GRAY_CACHE))]
+    return gray
+
+
+def _decode_image_gray(p: Path) -> Any:
+    """:func:`read_image_gray` without its cache."""
     import cv2
     import numpy as np
 
     from camloc_geo._limits import check_image_file
 
-    p = Path(path)
     width, height = check_image_file(p)  # regular file, size from the header before decoding
     try:
         n_bytes = p.stat().st_size

@@ -493,3 +493,45 @@ def test_service_refuses_a_100_mp_header_without_pillows_warning(tmp_path: Path)
         with pytest.raises(LimitError, match="10000×10000; this server accepts at most"):
             image_info(raw, 40_000_000)
     assert [str(w.message) for w in seen] == []  # before: DecompressionBombWarning
+
+
+def test_calibrate_decodes_the_scene_photo_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # before: the photo was decoded when the scene was read (to check it) and again by the
+    # line detector
+    from camloc_geo import _io
+
+    photo = _good_photo(tmp_path / "once.jpg", (640, 480))
+    calls: list[Path] = []
+    real = _io._decode_image_gray
+
+    def counting(p: Path):  # type: ignore[no-untyped-def]
+        calls.append(p)
+        return real(p)
+
+    monkeypatch.setattr(_io, "_decode_image_gray", counting)
+    _calibrate(_scene_with_photo(tmp_path, photo.name), capsys)
+    assert [p.name for p in calls] == ["once.jpg"]
+
+
+def test_the_decoded_photo_cache_follows_the_file(tmp_path: Path) -> None:
+    import numpy as np
+
+    from camloc_geo import _io
+
+    photo = _good_photo(tmp_path / "cached.png", (320, 240))
+    first = _io.read_image_gray(photo)
+    assert _io.read_image_gray(photo) is first  # unchanged file: not decoded again
+    assert not first.flags.writeable  # shared: a caller cannot change what others get
+    from PIL import Image
+
+    Image.new("L", (320, 240), 200).save(photo)  # rewritten in place
+    os.utime(photo, ns=(1, 1))  # another modification time whatever the clock's resolution
+    again = _io.read_image_gray(photo)
+    assert again is not first
+    assert np.all(again == 200)
+    for i in range(_io.GRAY_CACHE_ENTRIES + 1):  # bounded: the oldest go
+        _io.read_image_gray(_good_photo(tmp_path / f"other{i}.png", (320, 240)))
+    assert len(_io._GRAY_CACHE) == _io.GRAY_CACHE_ENTRIES
+    assert _io.read_image_gray(photo) is not again
