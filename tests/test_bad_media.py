@@ -535,3 +535,34 @@ def test_the_decoded_photo_cache_follows_the_file(tmp_path: Path) -> None:
         _io.read_image_gray(_good_photo(tmp_path / f"other{i}.png", (320, 240)))
     assert len(_io._GRAY_CACHE) == _io.GRAY_CACHE_ENTRIES
     assert _io.read_image_gray(photo) is not again
+
+
+def test_the_library_names_a_one_frame_video_for_every_front_end(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # before: a file stating no frame count (or a wrong one) decoded to one frame came back
+    # as a result with no vehicle; only the CLI turned it into this message (the service,
+    # the QGIS plugin and batch saw "no vehicle found")
+    import cv2
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.api import radar_scene
+
+    video = _video(tmp_path / "one.avi", 1)
+    real_capture = cv2.VideoCapture
+
+    class NoCount:
+        """OpenCV's capture, stating no frame count (as some containers do)."""
+
+        def __init__(self, *args: object) -> None:
+            self._cap = real_capture(*args)
+
+        def get(self, prop: int) -> float:
+            return 0.0 if prop == cv2.CAP_PROP_FRAME_COUNT else float(self._cap.get(prop))
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(self._cap, name)
+
+    monkeypatch.setattr(cv2, "VideoCapture", NoCount)
+    with pytest.raises(InputError, match=r"has a single frame \(a still image\?\)"):
+        radar_scene(_scene_with_photo(tmp_path, None), video)

@@ -73,11 +73,6 @@ def run(args: argparse.Namespace) -> int:
         max_frames=args.max_frames,
         progress=progress,
     )
-    if not result.vehicles and result.video.n_frames == 1:  # read from a file stating no count
-        raise InputError(
-            f"video {args.video} has a single frame (a still image?): speeds need a video of "
-            "the moving vehicles"
-        )
     if not result.vehicles:
         raise InputError(f"{result.warnings[0]} ({args.video}, {result.video.n_frames} frames)")
     for w in result.warnings:

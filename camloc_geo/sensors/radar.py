@@ -518,6 +518,14 @@ def _check_tracks(tracks: Mapping[int, Mapping[int, Any]]) -> TrackBoxes:
 
 
 # --------------------------------------------------------------------------- video
+def _single_frame(path: str | os.PathLike[str]) -> InputError:
+    """The error for a video of one frame (a still image): speeds need two or more."""
+    return InputError(
+        f"video {path} has a single frame (a still image?): speeds need a video of the moving "
+        "vehicles"
+    )
+
+
 def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | None, int]:
     import cv2
 
@@ -536,10 +544,7 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
         raise InputError(f"cannot read video {p}: it states no frame size")
     if n == 1:  # OpenCV reads a photo as a video of one frame
         cap.release()
-        raise InputError(
-            f"video {p} has a single frame (a still image?): speeds need a video of the moving "
-            "vehicles"
-        )
+        raise _single_frame(p)
     if w * h > MAX_VIDEO_PIXELS:
         cap.release()
         raise InputError(
@@ -1605,6 +1610,8 @@ def measure_speeds(
     n_done, vehicles, noise = result
     if n_done == 0:
         raise InputError(f"cannot decode any frame of video {video_path}")
+    if n_done == 1:  # a file stating no frame count, or a wrong one
+        raise _single_frame(video_path)
     if given is not None and n_done < limit and max(max(p) for p in given.values() if p) >= n_done:
         log.warning("some track boxes are after the video's last frame (%d)", n_done - 1)
     info = VideoInfo(
