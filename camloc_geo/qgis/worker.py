@@ -592,10 +592,11 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
         a, b = item["a"], item["b"]
         if item.get("kind", "distance") == "height":
             m = sensors.point_height(cal, a, b)
-            value = getattr(m, "height_m", None)
         else:
             m = sensors.ground_distance(cal, [a, b])
-            value = getattr(m, "distance_m", None)
+        # the library's Measurement holds ``value_m`` (``to_dict`` names it distance_m or
+        # height_m); reading those names as attributes gave a null value in every row
+        value = m.value_m
         rows.append(
             (
                 None,
