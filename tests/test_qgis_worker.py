@@ -425,3 +425,21 @@ def test_measure_job_gives_the_library_values(tmp_path):
     assert rows[0]["sigma_m"] == pytest.approx(dist.sigma_m, rel=1e-9)
     assert 5.0 < rows[0]["value_m"] < 40.0
     assert 2.0 < rows[1]["value_m"] < 30.0
+
+
+@pytest.mark.parametrize(
+    ("pairs", "message"),
+    [
+        ([{"kind": "distance", "a": [1241, 631]}], "PAIRS item 0: 'b' must be a pixel [x, y]"),
+        ([{"kind": "area", "a": [1, 2], "b": [3, 4]}], "kind 'area' is not one of"),
+        ([{"a": [1, 2], "b": [3, "x"]}], "PAIRS item 0: 'b' must be a pixel"),
+        ([[1, 2, 3, 4]], "PAIRS item 0: must be an object"),
+        ({"a": [1, 2]}, "PAIRS must be a JSON list"),
+    ],
+)
+def test_measure_job_names_a_bad_pair(tmp_path, pairs, message):
+    """A bad PAIRS item is named (was: "missing job parameter 'b'", or an unknown kind
+    silently measured as a distance)."""
+    with pytest.raises(InputError) as info:
+        run_job({"task": "measure", "scene": str(SCENE), "pairs": pairs, "out_dir": str(tmp_path)})
+    assert message in str(info.value)
