@@ -216,3 +216,62 @@ def test_cli_subprocess(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     feature = json.loads(proc.stdout)["features"][0]
     assert feature["properties"]["names_matched"] == ["Otto-Braun-Straße", "Mollstraße"]
+
+
+def test_cli_list_refused_before_any_output(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A missing or headless list prints nothing on stdout (was: an empty collection)."""
+    assert main(["geocode", "--osm", str(BERLIN), "--list", str(tmp_path / "none.csv")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert "cannot read the list" in captured.err
+    rows = tmp_path / "bad.csv"
+    rows.write_text("foo,bar\n1,2\n", encoding="utf-8")
+    assert main(["geocode", "--osm", str(BERLIN), "--list", str(rows)]) == 2
+    assert capsys.readouterr().out == ""
+
+
+def test_cli_output_never_overwrites_the_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o`` naming the list is refused and the list kept (was: the list truncated)."""
+    rows = tmp_path / "cams.csv"
+    text = "id,title\n1,Karl-Liebknecht-Str. / Wadzeckstr.\n"
+    rows.write_text(text, encoding="utf-8")
+    assert main(["geocode", "--osm", str(BERLIN), "--list", str(rows), "-o", str(rows)]) == 2
+    assert "would overwrite the input" in capsys.readouterr().err
+    assert rows.read_text(encoding="utf-8") == text
+
+
+def test_cli_output_in_missing_folder_is_bad_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A missing output folder is exit 2 naming it (was: exit 1, FileNotFoundError)."""
+    out = tmp_path / "no" / "out.geojson"
+    assert main(["geocode", "Alexanderstraße", "--osm", str(BERLIN), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "does not exist (create it first)" in err
+    assert not out.parent.exists()
+
+
+def test_cli_output_is_atomic(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A list that fails half way leaves the earlier output file as it was, no temp files."""
+    import camloc_geo.cli.geocode as geocode_cli
+
+    out = tmp_path / "out.geojson"
+    out.write_text("old", encoding="utf-8")
+    rows = tmp_path / "cams.csv"
+    rows.write_text("id,title\n1,Alexanderstraße\n2,Alexanderstraße\n", encoding="utf-8")
+    real = geocode_cli._data_rows
+
+    def broken(*args: object, **kwargs: object):  # type: ignore[no-untyped-def]
+        for n, row in enumerate(real(*args, **kwargs)):  # type: ignore[arg-type]
+            if n == 1:
+                raise RuntimeError("disk on fire")
+            yield row
+
+    monkeypatch.setattr(geocode_cli, "_data_rows", broken)
+    assert main(["geocode", "--osm", str(BERLIN), "--list", str(rows), "-o", str(out)]) == 1
+    assert out.read_text(encoding="utf-8") == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cams.csv", "out.geojson"]

@@ -401,3 +401,45 @@ def test_geocodelist_agrees_with_camloc_batch_on_a_multi_city_list(tmp_path):
         assert abs(q_lat - lat) < 1e-5, cam_id  # about 1 m
         assert abs(q_lon - lon) < 1e-5, cam_id
     assert placed >= 6
+
+
+def test_measure_job_gives_the_library_values(tmp_path):
+    """camloc:measure's rows carry the measured metres (was: value_m null in every row)."""
+    from camloc_geo.api import calibrate_scene
+    from camloc_geo.sensors import ground_distance, point_height
+
+    pairs = [
+        {"kind": "distance", "a": [1241, 631], "b": [1345, 531]},
+        {"kind": "height", "a": [1035, 503], "b": [1040, 128]},
+    ]
+    res = run_job(
+        {"task": "measure", "scene": str(SCENE), "pairs": pairs, "out_dir": str(tmp_path)}
+    )
+    rows = [f["properties"] for f in _read(res["layers"]["measurements"])]
+    cal = calibrate_scene(SCENE)
+    dist = ground_distance(cal, [[1241, 631], [1345, 531]])
+    height = point_height(cal, [1035, 503], [1040, 128])
+    assert [r["kind"] for r in rows] == ["distance", "height"]
+    assert rows[0]["value_m"] == pytest.approx(dist.value_m, rel=1e-9)
+    assert rows[1]["value_m"] == pytest.approx(height.value_m, rel=1e-9)
+    assert rows[0]["sigma_m"] == pytest.approx(dist.sigma_m, rel=1e-9)
+    assert 5.0 < rows[0]["value_m"] < 40.0
+    assert 2.0 < rows[1]["value_m"] < 30.0
+
+
+@pytest.mark.parametrize(
+    ("pairs", "message"),
+    [
+        ([{"kind": "distance", "a": [1241, 631]}], "PAIRS item 0: 'b' must be a pixel [x, y]"),
+        ([{"kind": "area", "a": [1, 2], "b": [3, 4]}], "kind 'area' is not one of"),
+        ([{"a": [1, 2], "b": [3, "x"]}], "PAIRS item 0: 'b' must be a pixel"),
+        ([[1, 2, 3, 4]], "PAIRS item 0: must be an object"),
+        ({"a": [1, 2]}, "PAIRS must be a JSON list"),
+    ],
+)
+def test_measure_job_names_a_bad_pair(tmp_path, pairs, message):
+    """A bad PAIRS item is named (was: "missing job parameter 'b'", or an unknown kind
+    silently measured as a distance)."""
+    with pytest.raises(InputError) as info:
+        run_job({"task": "measure", "scene": str(SCENE), "pairs": pairs, "out_dir": str(tmp_path)})
+    assert message in str(info.value)

@@ -79,7 +79,11 @@ def _column(header: list[str], options: tuple[str, ...]) -> str | None:
 
 
 def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
-    """(row number, id, title, point) of each CSV row, one at a time."""
+    """(row number, id, title, point) of each CSV row, one at a time.
+
+    The file is opened and its header checked at once, before the first row is asked for,
+    so a missing or headless list fails before any output is written.
+    """
     from camloc_geo._errors import InputError
 
     csv.field_size_limit(1 << 20)
@@ -87,7 +91,7 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
         fh = path.open(newline="", encoding="utf-8-sig", errors="replace")
     except OSError as exc:
         raise InputError(f"cannot read the list {path}: {exc.strerror or exc}") from None
-    with fh:
+    try:
         reader = csv.reader(fh)
         try:
             header = next(reader)
@@ -95,12 +99,25 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
             raise InputError(f"the list {path} is empty") from None
         except csv.Error as exc:
             raise InputError(f"the list {path} is not CSV: {exc}") from None
+        except (OSError, UnicodeError) as exc:
+            raise InputError(f"cannot read the list {path}: {exc}") from None
         title_col = _column(header, _TITLE_COLUMNS)
         if title_col is None:
             raise InputError(
                 f"the list {path} has no title column (one of {', '.join(_TITLE_COLUMNS)}); "
                 f"its columns: {', '.join(header)}"
             )
+    except BaseException:
+        fh.close()
+        raise
+    return _data_rows(fh, reader, header, title_col)
+
+
+def _data_rows(
+    fh: IO[str], reader: Any, header: list[str], title_col: str
+) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
+    """The rows after the header of an opened list (closes ``fh`` at the end)."""
+    with fh:
         idx = {h: i for i, h in enumerate(header)}
         t_i = idx[title_col]
         id_col = _column(header, _ID_COLUMNS)
@@ -134,14 +151,24 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
 
 
 @contextmanager
-def _feature_writer(out: str | None) -> Iterator[Any]:
-    fh: IO[str]
-    close = False
-    if out in (None, "-"):
-        fh = sys.stdout
-    else:
-        fh = open(str(out), "w", encoding="utf-8")  # noqa: SIM115
-        close = True
+def _feature_writer(out: Path | None) -> Iterator[Any]:
+    """Stream features to stdout, or to ``out`` atomically (nothing is left on failure)."""
+    if out is None:
+        with _features_to(sys.stdout) as write:
+            yield write
+        return
+    from camloc_geo.cli import atomic_output
+
+    with (
+        atomic_output(out) as tmp,
+        open(tmp, "w", encoding="utf-8") as fh,
+        _features_to(fh) as write,
+    ):
+        yield write
+
+
+@contextmanager
+def _features_to(fh: IO[str]) -> Iterator[Any]:
     first = [True]
     fh.write('{"type": "FeatureCollection", "features": [\n')
 
@@ -155,10 +182,7 @@ def _feature_writer(out: str | None) -> Iterator[Any]:
         yield write
     finally:
         fh.write("\n]}\n")
-        if close:
-            fh.close()
-        else:
-            fh.flush()
+        fh.flush()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -171,7 +195,12 @@ def run(args: argparse.Namespace) -> int:
     near = _parse_near(args.near)
     if args.radius_m is not None and not (args.radius_m > 0):
         raise InputError(f"--radius-m must be positive, got {args.radius_m}")
-    maps = [whole_map(p) for p in extract_paths(args.osm)]
+    from camloc_geo.cli import output_path
+
+    paths = extract_paths(args.osm)
+    out = output_path(args.output, inputs=[args.list, *paths])
+    rows = _rows(Path(args.list)) if args.list else None
+    maps = [whole_map(p) for p in paths]
 
     def matches_of(title: str, point: tuple[float, float] | None) -> list[dict[str, Any]]:
         found = geocode_title_in_maps(
@@ -181,13 +210,13 @@ def run(args: argparse.Namespace) -> int:
             found = found[:1]
         return [m.to_feature() for m in found]
 
-    with _feature_writer(args.output) as write:
+    with _feature_writer(out) as write:
         for title in args.titles:
             for rank, feature in enumerate(matches_of(title, None)):
                 feature["properties"]["rank"] = rank
                 write(feature)
-        if args.list:
-            for row_no, ident, title, point in _rows(Path(args.list)):
+        if rows is not None:
+            for row_no, ident, title, point in rows:
                 for rank, feature in enumerate(matches_of(title, point)):
                     props = feature["properties"]
                     props["row"] = row_no

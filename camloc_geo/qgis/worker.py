@@ -578,6 +578,44 @@ def _task_geocodelist(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     }
 
 
+_MEASURE_KINDS = ("distance", "height")
+
+
+def _measure_pairs(pairs: Any) -> list[dict[str, Any]]:
+    """``PAIRS`` checked item by item: a clear one-line error naming the item and the fault."""
+    example = '[{"kind": "distance", "a": [x, y], "b": [x, y]}]'
+    if pairs is None:
+        return []
+    if not isinstance(pairs, list):
+        raise InputError(f"PAIRS must be a JSON list like {example}")
+    out: list[dict[str, Any]] = []
+    for i, item in enumerate(pairs):
+        if not isinstance(item, dict):
+            raise InputError(f"PAIRS item {i}: must be an object like {example}")
+        kind = item.get("kind", "distance")
+        if kind not in _MEASURE_KINDS:
+            raise InputError(
+                f"PAIRS item {i}: kind {kind!r} is not one of {', '.join(_MEASURE_KINDS)}"
+            )
+        ends = []
+        for end in ("a", "b"):
+            px = item.get(end)
+            if (
+                not isinstance(px, list)
+                or len(px) != 2
+                or not all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+                    for v in px
+                )
+            ):
+                raise InputError(
+                    f"PAIRS item {i}: '{end}' must be a pixel [x, y] of two numbers, got {px!r}"
+                )
+            ends.append([float(v) for v in px])
+        out.append({"kind": kind, "a": ends[0], "b": ends[1]})
+    return out
+
+
 def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     """``scene``; ``pairs``: list of ``{"kind": "distance"|"height", "a": [x, y], "b": [x, y]}``."""
     import importlib
@@ -586,22 +624,24 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
 
     sensors: Any = importlib.import_module("camloc_geo.sensors")
 
+    pairs = _measure_pairs(job.get("pairs"))
     cal = calibrate_scene(job["scene"])
     rows: list[tuple[dict[str, Any] | None, dict[str, Any]]] = []
-    for i, item in enumerate(job.get("pairs") or []):
+    for i, item in enumerate(pairs):
         a, b = item["a"], item["b"]
-        if item.get("kind", "distance") == "height":
+        if item["kind"] == "height":
             m = sensors.point_height(cal, a, b)
-            value = getattr(m, "height_m", None)
         else:
             m = sensors.ground_distance(cal, [a, b])
-            value = getattr(m, "distance_m", None)
+        # the library's Measurement holds ``value_m`` (``to_dict`` names it distance_m or
+        # height_m); reading those names as attributes gave a null value in every row
+        value = m.value_m
         rows.append(
             (
                 None,
                 {
                     "index": i,
-                    "kind": item.get("kind", "distance"),
+                    "kind": item["kind"],
                     "value_m": _num(value),
                     "sigma_m": _num(getattr(m, "sigma_m", None)),
                 },

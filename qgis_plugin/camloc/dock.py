@@ -437,25 +437,37 @@ class CamlocDock(QDockWidget):
         self.save_button.clicked.connect(self._save_dialog)
         for b in (self.run_button, self.cancel_button, self.save_button):
             row4.addWidget(b)
-        lay.addLayout(row4)
+        # Run, its progress and the status line stay below the scrolled part, always in sight:
+        # inside it they fell below the fold of a 1000-pixel-high screen, so the analyst had
+        # to scroll to find Run and to read the result.
+        footer = QWidget()
+        foot = QVBoxLayout(footer)
+        foot.setContentsMargins(lay.contentsMargins())
+        foot.addLayout(row4)
         self.progress = QProgressBar()
         self.progress.setRange(0, 100)
         self.progress.setVisible(False)
-        lay.addWidget(self.progress)
+        foot.addWidget(self.progress)
         self.status = QLabel(
             "Open a snapshot, then annotate it here or in the browser (Annotate in browser…)."
         )
         self.status.setWordWrap(True)
         self.status.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.status.setTextInteractionFlags(Qt.TextSelectableByMouse)
-        lay.addWidget(self.status)
+        foot.addWidget(self.status)
         scroll = QScrollArea()
         scroll.setWidgetResizable(True)
         scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)  # wrap, never cut
         scroll.setFrameShape(QScrollArea.NoFrame)
         self.setMinimumWidth(380)
         scroll.setWidget(body)
-        self.setWidget(scroll)
+        outer = QWidget()
+        whole = QVBoxLayout(outer)
+        whole.setContentsMargins(0, 0, 0, 0)
+        whole.setSpacing(0)
+        whole.addWidget(scroll, 1)
+        whole.addWidget(footer)
+        self.setWidget(outer)
 
     # --- snapshot and clicks ---------------------------------------------------------------
     def _open_dialog(self) -> None:

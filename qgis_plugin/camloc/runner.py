@@ -216,6 +216,25 @@ def run_worker(
     return final
 
 
+PATH_KEYS = ("scene", "osm", "list", "image", "save_to")
+"""Job fields that name a file or folder of the user's (the worker reads them)."""
+
+
+def absolute_paths(job: dict[str, Any]) -> dict[str, Any]:
+    """The job with its relative file paths made absolute against this process's folder.
+
+    The worker runs in its own temporary folder, so a relative path (``qgis_process run
+    camloc:locate --SCENE=scene.json``, relative to the shell's folder) would be looked for
+    there and reported missing.
+    """
+    out = dict(job)
+    for key in PATH_KEYS:
+        value = out.get(key)
+        if isinstance(value, str) and value and not os.path.isabs(value):
+            out[key] = os.path.abspath(os.path.expanduser(value))
+    return out
+
+
 def _run_in(
     found: tuple[str, str],
     job: dict[str, Any],
@@ -226,7 +245,7 @@ def _run_in(
     log: Callable[[str], None] | None,
 ) -> dict[str, Any]:
     python, module = found
-    job = {**job, "out_dir": work}
+    job = {**absolute_paths(job), "out_dir": work}
     job_path = Path(work) / "job.json"
     job_path.write_text(json.dumps(job), encoding="utf-8")
     proc = subprocess.Popen(

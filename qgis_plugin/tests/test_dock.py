@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from conftest import HERE, SAMPLE_OSM, SAMPLE_SCENE, metres_between, truth
 from qgis.core import (
+    QgsApplication,
     QgsCoordinateReferenceSystem,
     QgsCoordinateTransform,
     QgsMapRendererSequentialJob,
@@ -721,3 +722,16 @@ def test_a_scene_whose_image_is_refused_says_why(dock, tmp_path):
     assert "Scene received" in text
     assert "Its image was not opened" in text
     assert "the file is empty (0 bytes)" in text
+
+
+def test_run_and_status_stay_in_sight_in_a_short_dock(dock, tmp_path):
+    """On a short screen the form scrolls, Run and the status line do not (they were below
+    the fold of a 1600x1000 QGIS window: Run and the result's status needed a scroll)."""
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    dock.resize(420, 560)
+    QgsApplication.processEvents()
+    for widget in (dock.run_button, dock.cancel_button, dock.save_button, dock.status):
+        shown = widget.visibleRegion().boundingRect()
+        assert shown.height() == widget.height(), widget  # whole, not scrolled away or cut
+    top = dock.run_button.mapTo(dock, dock.run_button.rect().topLeft()).y()
+    assert top + dock.run_button.height() <= dock.height()

@@ -155,3 +155,41 @@ def test_qgis_process_geocodelist_takes_a_folder_of_extracts(profile_home, tmp_p
     assert rows["main"] == ("not_found", 0)
     assert rows["milton"][0] == "title_only"
     assert rows["berlin"][0] == "title_only"  # another extract of the folder
+
+
+def test_qgis_process_reads_relative_paths_from_the_shell_folder(profile_home, tmp_path):
+    """``--SCENE=scene.json`` is the shell's file (was: "scene file not found", the worker
+    looked in its own temporary folder); the same for OSM and LIST."""
+    shutil.copy(SAMPLE_SCENE, tmp_path / "scene.json")
+    shutil.copy(SAMPLE_OSM, tmp_path / "extract.osm.pbf")
+    (tmp_path / "cams.csv").write_text("id,title\nc1,Eastern Ave & S Broadway\n")
+    runs = {
+        "locate": [
+            "camloc:locate",
+            "--SCENE=scene.json",
+            "--OSM=extract.osm.pbf",
+            "--CANDIDATES=cand.gpkg",
+        ],
+        "list": [
+            "camloc:geocodelist",
+            "--LIST=cams.csv",
+            "--OSM=extract.osm.pbf",
+            "--CAMERAS=cams.gpkg",
+        ],
+    }
+    for what, args in runs.items():
+        r = subprocess.run(
+            [QGIS_PROCESS, "run", *args],
+            capture_output=True,
+            text=True,
+            env=_env(profile_home),
+            cwd=tmp_path,
+            timeout=300,
+        )
+        assert r.returncode == 0, (what, r.stdout + r.stderr)
+    from osgeo import ogr
+
+    cand_ds = ogr.Open(str(tmp_path / "cand.gpkg"))  # keep the dataset: its layer needs it
+    assert cand_ds.GetLayer(0).GetFeatureCount() == 12
+    cams_ds = ogr.Open(str(tmp_path / "cams.gpkg"))
+    assert [f.GetField("status") for f in cams_ds.GetLayer(0)] == ["title_only"]
