@@ -351,6 +351,8 @@ def detect_segments(
     segs = (segs + 0.5) / scale + np.array([x0, y0, x0, y0], dtype=np.float64)
     if len(segs) == 0:
         return np.zeros((0, 4))
+    if trim_borders:
+        segs = segs[~_along_border(segs, (x0, y0, x1, y1), _BORDER_EDGE_PX / scale)]
     if mask is not None:
         pts = [segs[:, 0:2], segs[:, 2:4], 0.5 * (segs[:, 0:2] + segs[:, 2:4])]
         inside = np.ones(len(segs), dtype=bool)
@@ -364,6 +366,41 @@ def detect_segments(
     segs, lengths = segs[keep], lengths[keep]
     order = np.argsort(-lengths, kind="stable")[:max_segments]
     return np.ascontiguousarray(segs[order])
+
+
+#: Segments whose two end points lie this close (pixels of the detection image) to the
+#: same side of the image are the frame's own edge: a dark or bright first row or column
+#: that a video codec or a sensor leaves (seen on dash-camera frames), not a scene line.
+_BORDER_EDGE_PX = 2.5
+
+
+def _along_border(
+    segs: FloatArray, box: tuple[int, int, int, int], edge_px: float
+) -> npt.NDArray[np.bool_]:
+    """Whether each segment runs along a side of ``box`` (``x0, y0, x1, y1``).
+
+    Parameters
+    ----------
+    segs
+        ``(N, 4)`` rows ``x1, y1, x2, y2``, pixels.
+    box
+        The image (or its content without uniform bars), ``x0, y0, x1, y1`` in pixels.
+    edge_px
+        Both end points within this distance of the same side.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` booleans.
+    """
+    x0, y0, x1, y1 = box
+    xs, ys = segs[:, [0, 2]], segs[:, [1, 3]]
+    return (
+        np.all(xs - x0 <= edge_px, axis=1)
+        | np.all(x1 - xs <= edge_px, axis=1)
+        | np.all(ys - y0 <= edge_px, axis=1)
+        | np.all(y1 - ys <= edge_px, axis=1)
+    )
 
 
 def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
