@@ -16,6 +16,10 @@
 #   Phoenix8215/FCN_KITTI            two KITTI road frames (um_000000 of training and of
 #                                    testing) with their calibration files; KITTI is
 #                                    non-commercial (CC BY-NC-SA 3.0), so kept out
+#   open-mmlab/mmdetection3d         its demo and test data: two KITTI object frames and
+#                                    the six cameras of a nuScenes sample with their
+#                                    calibration (about 80 MB; KITTI and nuScenes are
+#                                    non-commercial, so kept out)
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -28,7 +32,7 @@ dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
 [ -d /work/.mirror ] && default_mirror=/work/.mirror
 mirror="${CAMLOC_MIRROR_DIR:-$default_mirror}"
-sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion jeremy-shannon/CarND-Advanced-Lane-Lines Phoenix8215/FCN_KITTI}"
+sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion jeremy-shannon/CarND-Advanced-Lane-Lines Phoenix8215/FCN_KITTI open-mmlab/mmdetection3d}"
 mkdir -p "$dest"
 
 # copy_present_photos GIT_DIR DEST: the JPEG and PNG files (and small text files: calibrations,

@@ -69,11 +69,16 @@ The photos (none of them is in this repository; their licences keep them out):
     1280x720, not undistorted; ``jeremy-shannon/CarND-Advanced-Lane-Lines``), truth the
     camera's own chessboard calibration (OpenCV on the repository's 20 ``camera_cal``
     photos: fx 1156.5, fy 1151.3 px); 2 KITTI road frames (``Phoenix8215/FCN_KITTI``,
-    ``um_000000`` of training and of testing, 1242x375) with their published ``P2``. The
-    development half: the 8 frames of the project video; held out: the 3 challenge-video
-    frames, the harder-challenge frame and the 2 KITTI frames. No gravity truth. Fetched
-    by ``benchmarks/fetch_real_photos.sh`` (KITTI: non-commercial; the Udacity frames: no
-    licence given).
+    ``um_000000`` of training and of testing, 1242x375) and 2 KITTI object frames
+    (``open-mmlab/mmdetection3d``'s demo ``000008`` and test ``000000``) with their
+    published ``P2``; the 6 cameras of nuScenes scene-0061's first sample (mmdetection3d's
+    demo, 1600x900, published ``cam2img``; gravity from ``ego2global`` and ``cam2ego``,
+    so these have horizon and pitch truth). The development half (fixed before any result
+    was read): the 8 frames of the project video, the 2 KITTI object frames, nuScenes
+    CAM_FRONT, CAM_FRONT_LEFT and CAM_BACK; held out: the 3 challenge-video frames, the
+    harder-challenge frame, the 2 KITTI road frames and the other 3 nuScenes cameras.
+    Fetched by ``benchmarks/fetch_real_photos.sh`` (KITTI and nuScenes: non-commercial;
+    the Udacity frames: no licence given).
 ``yud``
     The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
     published calibration, horizon from the ground-truth vanishing points; research use
@@ -397,7 +402,7 @@ STREET_TRUTH = HERE / "street_truth.json"
 #: The halves of the driving frames, fixed by sequence before any result was read.
 DRIVE_HALVES = ("dev", "held-out")
 #: The sets of the driving frames (the ``set`` of :data:`STREET_TRUTH`'s frames).
-DRIVE_SETS = ("udacity-lane", "kitti-road")
+DRIVE_SETS = ("udacity-lane", "kitti", "nuscenes")
 
 
 def load_drive_set(
@@ -412,8 +417,10 @@ def load_drive_set(
         relative to it).
     truth_path
         The truth file (:data:`STREET_TRUTH`): ``cameras`` (a calibration shared by the
-        frames that name it) and ``frames`` (file, sha256, size, ``half``, and either
-        ``camera`` or their own ``focal_px`` / ``principal_point``).
+        frames that name it) and ``frames`` (file, sha256, size, ``half``, either
+        ``camera`` or their own ``focal_px`` / ``principal_point``, and where the dataset
+        gives the vehicle's pose, ``up_in_cam``: the world's up in the camera frame, x
+        right, y down, z forward).
     halves
         Which halves to load (``"dev"``, ``"held-out"``).
 
@@ -427,7 +434,8 @@ def load_drive_set(
     ------
     ValueError
         If the truth file is malformed (a frame without a focal length, an unknown
-        camera, a focal length that is not a positive number).
+        camera, a focal length that is not a positive number, an ``up_in_cam`` that is
+        not a 3-vector).
     """
     import hashlib
 
@@ -464,6 +472,13 @@ def load_drive_set(
             changed += 1
             continue
         w, h = (int(v) for v in fr["size"])
+        up = None
+        if fr.get("up_in_cam") is not None:
+            up = np.asarray(fr["up_in_cam"], dtype=float)
+            if up.shape != (3,) or not np.all(np.isfinite(up)) or np.linalg.norm(up) < 0.5:
+                raise ValueError(f"{truth_path}: frame {fr['file']}: up_in_cam is not a 3-vector")
+            up = up / np.linalg.norm(up)
+            up = up if up[1] < 0 else -up
         out.append(
             {
                 "set": fr["set"],
@@ -471,7 +486,7 @@ def load_drive_set(
                 "path": str(path),
                 "f": 0.5 * (fx + fy),
                 "pp": (cx, cy),
-                "up": None,
+                "up": up,
                 "size": (w, h),
                 "half": fr["half"],
             }
