@@ -168,6 +168,15 @@ _PRIOR_ONLY_STD = 0.25
 #: vanishing point, a vertical one far off) then gets the default, or near it, rather than
 #: a random value out of a loose fit. A photo that fixes its focal length keeps its own.
 _F_DEFAULT_SIGMA = 0.35
+#: Frames wider than this (longer over shorter side) are no common sensor shape (4:3, 3:2,
+#: 16:9): a band cut out of a frame (the focal length still near the longer side) or a
+#: wide-angle camera whose shorter side spans what a 16:9 frame's would (the focal length
+#: near :data:`_WIDE_SHORT_REL` times the shorter side). KITTI's 1242x375 frames are the
+#: second kind: 0.58 times the longer side, where the default put 1.0. The default prior
+#: then sits between the two readings (their geometric mean) and its sigma takes in half
+#: their log-ratio (``_default_focal_prior``).
+_WIDE_ASPECT = 1.9
+_WIDE_SHORT_REL = 16.0 / 9.0
 #: Largest focal sigma stated for an estimate that rests on a weak direction.
 _MAX_STATED_STD = 1.0
 #: Above this relative standard deviation of the focal length a warning is given.
@@ -1587,7 +1596,9 @@ def detect_vanishing_points(
     best.f_data_n, best.data_logf_std = best.f_n, best.logf_std
     if f_fixed is None and not has_prior and not best.logf_std <= _LOOSE_FOCAL_STD:
         # the photo leaves the focal length loose (warned): what cameras are joins in
-        best = _with_default_prior(best, s, tau, f_bounds, prior_w)
+        best = _with_default_prior(
+            best, s, tau, f_bounds, prior_w, _default_focal_prior(float(w), float(h))
+        )
     info: dict[str, Any] = {}
     if np.count_nonzero(best.labels >= 0) >= 4:
         _refine(
@@ -2066,28 +2077,57 @@ def _finish(
     )
 
 
+def _default_focal_prior(width_px: float, height_px: float) -> tuple[float, float]:
+    """What cameras are, for a frame of this shape: the centre (relative to the longer side)
+    and the sigma of ``log(focal)`` of the default prior.
+
+    Parameters
+    ----------
+    width_px, height_px
+        The image's size.
+
+    Returns
+    -------
+    tuple of float
+        :data:`_F_PRIOR_REL` and :data:`_F_DEFAULT_SIGMA` for the common sensor shapes (up
+        to :data:`_WIDE_ASPECT`); for wider frames the geometric mean of the two readings
+        (the longer side kept; a wide-angle camera whose shorter side spans a 16:9 frame's)
+        and :data:`_F_DEFAULT_SIGMA` with half their log-ratio added in quadrature.
+    """
+    aspect = max(width_px, height_px) / max(min(width_px, height_px), 1e-9)
+    if not aspect > _WIDE_ASPECT:
+        return _F_PRIOR_REL, _F_DEFAULT_SIGMA
+    wide_rel = _WIDE_SHORT_REL / aspect  # relative to the longer side
+    half_gap = 0.5 * abs(math.log(_F_PRIOR_REL / wide_rel))
+    return math.sqrt(_F_PRIOR_REL * wide_rel), math.hypot(_F_DEFAULT_SIGMA, half_gap)
+
+
 def _with_default_prior(
     m: _Model,
     s: _Segs,
     tau: float,
     f_bounds: tuple[float, float],
     prior_w: float | None,
+    default: tuple[float, float] = (_F_PRIOR_REL, _F_DEFAULT_SIGMA),
 ) -> _Model:
     """The photo's focal length combined with the default prior (:data:`_F_DEFAULT_SIGMA`).
 
     A Gaussian posterior in ``log(focal)``: the photo's estimate weighs by its stated sigma
-    (least squares and the systematic terms), the default (:data:`_F_PRIOR_REL` times the
-    longer side) by :data:`_F_DEFAULT_SIGMA`. Where the focal length moves by more than
-    0.5 %, the rotation is refitted with the focal length held there (the vanishing points
-    and the horizon follow). ``f_data_n`` and ``data_logf_std`` keep the photo's own.
+    (least squares and the systematic terms), the default (``default``: the centre relative
+    to the longer side and the sigma, :func:`_default_focal_prior`; for the common sensor
+    shapes :data:`_F_PRIOR_REL` times the longer side and :data:`_F_DEFAULT_SIGMA`). Where
+    the focal length moves by more than 0.5 %, the rotation is refitted with the focal
+    length held there (the vanishing points and the horizon follow). ``f_data_n`` and
+    ``data_logf_std`` keep the photo's own.
     """
+    centre, sigma = default
     sd = m.logf_std if math.isfinite(m.logf_std) and m.logf_std > 0 else math.inf
     w_data = 0.0 if math.isinf(sd) else 1.0 / sd**2
-    w_prior = 1.0 / _F_DEFAULT_SIGMA**2
+    w_prior = 1.0 / sigma**2
     if not w_data + w_prior > 0.0:
         return m
     var = 1.0 / (w_data + w_prior)
-    log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(_F_PRIOR_REL))
+    log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(centre))
     f_post = min(max(math.exp(log_f), f_bounds[0]), f_bounds[1])
     R = m.R
     if abs(math.log(f_post / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:

@@ -1,8 +1,9 @@
-"""autovp.detect_segments: the frame's own edge (a codec's dark first row) is no scene line."""
+"""autovp on street-level frames: the frame's own edge, the default focal prior of wide crops."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from camloc_geo.autovp import _along_border, detect_segments
 
@@ -44,3 +45,26 @@ def test_along_border_needs_both_end_points_on_the_same_side() -> None:
         ]
     )
     assert _along_border(segs, box, 2.5).tolist() == [True, True, False, False, False]
+
+
+def test_default_focal_prior_is_unchanged_for_common_sensor_shapes() -> None:
+    from camloc_geo.autovp import _F_DEFAULT_SIGMA, _F_PRIOR_REL, _default_focal_prior
+
+    for w, h in [(640, 480), (3072, 2048), (1280, 720), (720, 1280), (1000, 1000)]:
+        assert _default_focal_prior(w, h) == (_F_PRIOR_REL, _F_DEFAULT_SIGMA)
+
+
+def test_default_focal_prior_of_a_wide_crop_lies_between_its_two_readings() -> None:
+    import math
+
+    from camloc_geo.autovp import _F_DEFAULT_SIGMA, _default_focal_prior
+
+    # KITTI's 1242x375: the longer side kept (1.0) or a wide-angle camera whose shorter
+    # side spans a 16:9 frame's (16/9 * 375 / 1242 = 0.537); KITTI's own is 0.58
+    centre, sigma = _default_focal_prior(1242, 375)
+    assert centre == pytest.approx(math.sqrt(16.0 / 9.0 * 375 / 1242))
+    assert 0.70 < centre < 0.76
+    assert sigma > _F_DEFAULT_SIGMA
+    assert abs(math.log(0.581 / centre)) < 1.0 * sigma  # KITTI's truth within 1 sigma
+    assert abs(math.log(1.0 / centre)) < 1.0 * sigma  # and so is a cut band's
+    assert _default_focal_prior(375, 1242) == (centre, sigma)  # portrait alike
