@@ -20,6 +20,11 @@
 #                                    the six cameras of a nuScenes sample with their
 #                                    calibration (about 80 MB; KITTI and nuScenes are
 #                                    non-commercial, so kept out)
+#   marikhu/BrnoCompSpeed            BrnoCompSpeed (Sochor et al. 2018): one frame of each
+#                                    traffic camera over a highway (sessions 0-6, left,
+#                                    centre, right; 1920x1080) and the dataset's reference
+#                                    calibrations (results/*/system_dubska_optimal_calib.json);
+#                                    CC BY-NC-SA 4.0, so kept out; about 190 MB
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -32,12 +37,11 @@ dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
 [ -d /work/.mirror ] && default_mirror=/work/.mirror
 mirror="${CAMLOC_MIRROR_DIR:-$default_mirror}"
-sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion jeremy-shannon/CarND-Advanced-Lane-Lines Phoenix8215/FCN_KITTI open-mmlab/mmdetection3d}"
+sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion jeremy-shannon/CarND-Advanced-Lane-Lines Phoenix8215/FCN_KITTI open-mmlab/mmdetection3d marikhu/BrnoCompSpeed}"
 mkdir -p "$dest"
 
-# copy_present_photos GIT_DIR DEST: the JPEG and PNG files (and small text files: calibrations,
-# readmes)
-# of HEAD whose blobs the mirror holds; prints how many photos came.
+# copy_present_photos GIT_DIR DEST: the JPEG and PNG files (and small text and JSON files:
+# calibrations, readmes) of HEAD whose blobs the mirror holds; prints how many photos came.
 copy_present_photos() {
   local git_dir="$1" out="$2" n=0 path
   while IFS= read -r path; do
@@ -46,7 +50,7 @@ copy_present_photos() {
     git --git-dir="$git_dir" cat-file blob "HEAD:$path" >"$out/$path"
     case "$path" in *.[jJ][pP][gG] | *.[jJ][pP][eE][gG] | *.[pP][nN][gG]) n=$((n + 1)) ;; esac
   done < <(git --git-dir="$git_dir" ls-tree -r --name-only HEAD \
-    | grep -iE '\.(jpe?g|png|txt|camera|md)$')
+    | grep -iE '\.(jpe?g|png|txt|camera|md|json)$')
   echo "$n"
 }
 for full in $sets; do

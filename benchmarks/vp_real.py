@@ -77,8 +77,14 @@ The photos (none of them is in this repository; their licences keep them out):
     was read): the 8 frames of the project video, the 2 KITTI object frames, nuScenes
     CAM_FRONT, CAM_FRONT_LEFT and CAM_BACK; held out: the 3 challenge-video frames, the
     harder-challenge frame, the 2 KITTI road frames and the other 3 nuScenes cameras.
-    Fetched by ``benchmarks/fetch_real_photos.sh`` (KITTI and nuScenes: non-commercial;
-    the Udacity frames: no licence given).
+    And 15 traffic cameras over a highway, looking down 9-26 degrees along it
+    (BrnoCompSpeed, Sochor et al. 2018, sessions 0-4, left, centre and right; 1920x1080;
+    ``marikhu/BrnoCompSpeed``): truth the dataset's reference calibration
+    (``system_dubska_optimal_calib.json``: the two road vanishing points and the image
+    centre as principal point, so the focal length is ``sqrt(-(vp1 - pp).(vp2 - pp))`` and
+    the up direction their cross product); development half sessions 0, 2 and 4, held out
+    1 and 3. Fetched by ``benchmarks/fetch_real_photos.sh`` (KITTI, nuScenes and
+    BrnoCompSpeed: non-commercial; the Udacity frames: no licence given).
 ``yud``
     The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
     published calibration, horizon from the ground-truth vanishing points; research use
@@ -402,7 +408,7 @@ STREET_TRUTH = HERE / "street_truth.json"
 #: The halves of the driving frames, fixed by sequence before any result was read.
 DRIVE_HALVES = ("dev", "held-out")
 #: The sets of the driving frames (the ``set`` of :data:`STREET_TRUTH`'s frames).
-DRIVE_SETS = ("udacity-lane", "kitti", "nuscenes")
+DRIVE_SETS = ("udacity-lane", "kitti", "nuscenes", "brno")
 
 
 def load_drive_set(

@@ -164,10 +164,14 @@ def test_level_street_frames_are_never_confidently_wrong() -> None:
     # A level dash camera looking down a highway: one finite vanishing point, (almost) no
     # vertical line. The focal length then rests on the default prior: vp must say so
     # (a warning, a wide sigma, a low confidence) rather than give a sure wrong number.
+    from camloc_geo import NotEnoughStructureError
     from camloc_geo.autovp import detect_vanishing_points
 
     for t in _dev_frames():
-        res = detect_vanishing_points(t["path"], seed=0, use_exif=False)
+        try:
+            res = detect_vanishing_points(t["path"], seed=0, use_exif=False)
+        except NotEnoughStructureError:
+            continue  # a refusal (4 of the 9 BrnoCompSpeed dev frames) is no wrong answer
         err = abs(math.log(res.focal_px / float(t["f"])))
         assert res.focal_std_rel is not None
         sure = not res.warnings and res.confidence >= 0.5
@@ -199,3 +203,20 @@ def test_drive_loader_reads_the_up_direction_where_the_truth_gives_it(tmp_path: 
     frame["up_in_cam"] = [0.0, 1.0]
     with pytest.raises(ValueError, match="up_in_cam is not a 3-vector"):
         vp_real.load_drive_set(photos, _truth(tmp_path, [frame]))
+
+
+def test_traffic_camera_without_verticals_does_not_rest_on_a_few_lines_surely() -> None:
+    # BrnoCompSpeed session4_left (development half): a camera over a highway, no vertical
+    # line, the road's direction right to the pixel, "across the road" 4 lines of a car and
+    # a guard rail. The focal length (-48 %, the truth 3602 px) rests on those 4: it was
+    # stated at 11 %; now the sigma says the photo does not fix it.
+    from camloc_geo.autovp import detect_vanishing_points
+
+    (t,) = [fr for fr in _dev_frames() if fr["name"] == "brno/session4_left/screen.png"]
+    res = detect_vanishing_points(t["path"], seed=0, use_exif=False)
+    assert res.n_lines[0] == 0
+    assert res.focal_std_rel is not None
+    assert res.focal_std_rel > 0.25
+    assert abs(math.log(res.focal_px / t["f"])) <= 2.0 * res.focal_std_rel
+    assert res.confidence < 0.5
+    assert any("only 4 lines" in w for w in res.warnings)
