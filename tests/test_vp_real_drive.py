@@ -18,8 +18,8 @@ vp_real = pytest.importorskip("vp_real")
 
 HOW_TO_FETCH = (
     "the driving frames are not here: run benchmarks/fetch_real_photos.sh (it copies "
-    "jeremy-shannon/CarND-Advanced-Lane-Lines, Phoenix8215/FCN_KITTI and "
-    "open-mmlab/mmdetection3d into "
+    "jeremy-shannon/CarND-Advanced-Lane-Lines, Phoenix8215/FCN_KITTI, "
+    "open-mmlab/mmdetection3d and marikhu/BrnoCompSpeed into "
     "~/.cache/camloc_geo/photos, or CAMLOC_PHOTOS_DIR)"
 )
 
