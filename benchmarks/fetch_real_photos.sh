@@ -9,6 +9,22 @@
 #                                    (Kronan, a courtyard, a cathedral gate, a fountain, the Landhaus
 #                                    in Graz, Heidelberg castle, ...; Nikon D60 and Coolpix 4200,
 #                                    EXIF kept), about 60 MB; no licence given, so kept out
+#   jeremy-shannon/CarND-Advanced-Lane-Lines  Udacity's Advanced Lane Finding frames (a dash
+#                                    camera on a highway, 1280x720, 12 frames) and the 20
+#                                    chessboard photos of that camera (its calibration); no
+#                                    licence given, so kept out
+#   Phoenix8215/FCN_KITTI            two KITTI road frames (um_000000 of training and of
+#                                    testing) with their calibration files; KITTI is
+#                                    non-commercial (CC BY-NC-SA 3.0), so kept out
+#   open-mmlab/mmdetection3d         its demo and test data: two KITTI object frames and
+#                                    the six cameras of a nuScenes sample with their
+#                                    calibration (about 80 MB; KITTI and nuScenes are
+#                                    non-commercial, so kept out)
+#   marikhu/BrnoCompSpeed            BrnoCompSpeed (Sochor et al. 2018): one frame of each
+#                                    traffic camera over a highway (sessions 0-6, left,
+#                                    centre, right; 1920x1080) and the dataset's reference
+#                                    calibrations (results/*/system_dubska_optimal_calib.json);
+#                                    CC BY-NC-SA 4.0, so kept out; about 190 MB
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -21,20 +37,20 @@ dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
 [ -d /work/.mirror ] && default_mirror=/work/.mirror
 mirror="${CAMLOC_MIRROR_DIR:-$default_mirror}"
-sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion}"
+sets="${CAMLOC_PHOTO_SETS:-openMVG/SfM_quality_evaluation openMVG/ImageDataset_SceauxCastle rperrot/ReconstructionDataSet erik-norlin/Structure-From-Motion jeremy-shannon/CarND-Advanced-Lane-Lines Phoenix8215/FCN_KITTI open-mmlab/mmdetection3d marikhu/BrnoCompSpeed}"
 mkdir -p "$dest"
 
-# copy_present_photos GIT_DIR DEST: the JPEG files (and small text files: calibrations, readmes)
-# of HEAD whose blobs the mirror holds; prints how many photos came.
+# copy_present_photos GIT_DIR DEST: the JPEG and PNG files (and small text and JSON files:
+# calibrations, readmes) of HEAD whose blobs the mirror holds; prints how many photos came.
 copy_present_photos() {
   local git_dir="$1" out="$2" n=0 path
   while IFS= read -r path; do
     git --git-dir="$git_dir" cat-file -e "HEAD:$path" 2>/dev/null || continue
     mkdir -p "$out/$(dirname "$path")"
     git --git-dir="$git_dir" cat-file blob "HEAD:$path" >"$out/$path"
-    case "$path" in *.[jJ][pP][gG] | *.[jJ][pP][eE][gG]) n=$((n + 1)) ;; esac
+    case "$path" in *.[jJ][pP][gG] | *.[jJ][pP][eE][gG] | *.[pP][nN][gG]) n=$((n + 1)) ;; esac
   done < <(git --git-dir="$git_dir" ls-tree -r --name-only HEAD \
-    | grep -iE '\.(jpe?g|txt|camera|md)$')
+    | grep -iE '\.(jpe?g|png|txt|camera|md|json)$')
   echo "$n"
 }
 for full in $sets; do
@@ -44,6 +60,7 @@ for full in $sets; do
     continue
   fi
   local_git="$mirror/${full%%/*}+$name/repo"
+  [ -d "$local_git/.git" ] && local_git="$local_git/.git" # a mirror with a work tree
   if [ -n "$mirror" ] && [ -d "$local_git" ] && git -C "$local_git" rev-parse -q --verify HEAD >/dev/null \
     && git --git-dir="$local_git" fsck --connectivity-only HEAD >/dev/null 2>&1; then
     git clone -q "$local_git" "$dest/$name" && echo "$name: cloned from $local_git" && continue

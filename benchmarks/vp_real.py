@@ -4,7 +4,8 @@ Usage::
 
     python benchmarks/vp_real.py [--strecha DIR] [--sceaux DIR] [--lund DIR] [--yud DIR]
                                  [--limit N] [--sets strecha,sceaux,perrot,lund,exif,yud]
-                                 (lund-dev, lund-held-out: one half of the Lund scenes)
+                                 (lund-dev, lund-held-out: one half of the Lund scenes;
+                                  drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
 
 The photos (none of them is in this repository; their licences keep them out):
@@ -61,6 +62,29 @@ The photos (none of them is in this repository; their licences keep them out):
     degrees at a road with lane markings, a parked car and traffic; no building, so no
     vertical line but the cars' edges). The product's main case with exact truth: the
     steep looking-up warning must stay silent there.
+``drive`` (``drive-dev``, ``drive-held-out``: one half, split by sequence)
+    Street-level frames from a car looking along the road, truth in
+    ``benchmarks/street_truth.json`` (file, sha256, calibration, sequence, half): 12
+    frames of Udacity's Advanced Lane Finding project (a dash camera on a highway,
+    1280x720, not undistorted; ``jeremy-shannon/CarND-Advanced-Lane-Lines``), truth the
+    camera's own chessboard calibration (OpenCV on the repository's 20 ``camera_cal``
+    photos: fx 1156.5, fy 1151.3 px); 2 KITTI road frames (``Phoenix8215/FCN_KITTI``,
+    ``um_000000`` of training and of testing, 1242x375) and 2 KITTI object frames
+    (``open-mmlab/mmdetection3d``'s demo ``000008`` and test ``000000``) with their
+    published ``P2``; the 6 cameras of nuScenes scene-0061's first sample (mmdetection3d's
+    demo, 1600x900, published ``cam2img``; gravity from ``ego2global`` and ``cam2ego``,
+    so these have horizon and pitch truth). The development half (fixed before any result
+    was read): the 8 frames of the project video, the 2 KITTI object frames, nuScenes
+    CAM_FRONT, CAM_FRONT_LEFT and CAM_BACK; held out: the 3 challenge-video frames, the
+    harder-challenge frame, the 2 KITTI road frames and the other 3 nuScenes cameras.
+    And 15 traffic cameras over a highway, looking down 9-26 degrees along it
+    (BrnoCompSpeed, Sochor et al. 2018, sessions 0-4, left, centre and right; 1920x1080;
+    ``marikhu/BrnoCompSpeed``): truth the dataset's reference calibration
+    (``system_dubska_optimal_calib.json``: the two road vanishing points and the image
+    centre as principal point, so the focal length is ``sqrt(-(vp1 - pp).(vp2 - pp))`` and
+    the up direction their cross product); development half sessions 0, 2 and 4, held out
+    1 and 3. Fetched by ``benchmarks/fetch_real_photos.sh`` (KITTI, nuScenes and
+    BrnoCompSpeed: non-commercial; the Udacity frames: no licence given).
 ``yud``
     The York Urban DB (102 photos, indoor and outdoor, 640x480; focal length from the
     published calibration, horizon from the ground-truth vanishing points; research use
@@ -147,7 +171,8 @@ HOW_TO_GET = (
     "images folder; git clone https://github.com/rperrot/ReconstructionDataSet and set "
     "CAMLOC_PERROT_DIR to it; the Lund course photos: the data folder of "
     "https://github.com/erik-norlin/Structure-From-Motion in CAMLOC_LUND_DIR; "
-    "CAMLOC_YUD_DIR: the York Urban DB (York University)"
+    "CAMLOC_YUD_DIR: the York Urban DB (York University); the driving frames (drive): "
+    "benchmarks/fetch_real_photos.sh"
 )
 
 
@@ -378,6 +403,109 @@ def load_street_set(n_frames: int) -> list[dict[str, Any]]:
     return out
 
 
+#: Truth of the street-level driving frames (sets ``drive``, ``drive-dev``, ``drive-held-out``).
+STREET_TRUTH = HERE / "street_truth.json"
+#: The halves of the driving frames, fixed by sequence before any result was read.
+DRIVE_HALVES = ("dev", "held-out")
+#: The sets of the driving frames (the ``set`` of :data:`STREET_TRUTH`'s frames).
+DRIVE_SETS = ("udacity-lane", "kitti", "nuscenes", "brno")
+
+
+def load_drive_set(
+    photos: Path, truth_path: Path = STREET_TRUTH, halves: tuple[str, ...] = DRIVE_HALVES
+) -> list[dict[str, Any]]:
+    """Street-level driving frames and their published (or chessboard) calibration.
+
+    Parameters
+    ----------
+    photos
+        The folder ``benchmarks/fetch_real_photos.sh`` fills (each frame's ``file`` is
+        relative to it).
+    truth_path
+        The truth file (:data:`STREET_TRUTH`): ``cameras`` (a calibration shared by the
+        frames that name it) and ``frames`` (file, sha256, size, ``half``, either
+        ``camera`` or their own ``focal_px`` / ``principal_point``, and where the dataset
+        gives the vehicle's pose, ``up_in_cam``: the world's up in the camera frame, x
+        right, y down, z forward).
+    halves
+        Which halves to load (``"dev"``, ``"held-out"``).
+
+    Returns
+    -------
+    list of dict
+        One truth record a frame present with the content the truth file pins; a frame
+        missing or whose sha256 differs is skipped and counted in the log.
+
+    Raises
+    ------
+    ValueError
+        If the truth file is malformed (a frame without a focal length, an unknown
+        camera, a focal length that is not a positive number, an ``up_in_cam`` that is
+        not a 3-vector).
+    """
+    import hashlib
+
+    doc = json.loads(truth_path.read_text(encoding="utf-8"))
+    cameras = doc.get("cameras", {})
+    out = []
+    missing = changed = 0
+    for fr in doc["frames"]:
+        if fr.get("half") not in halves:
+            continue
+        cam = fr
+        if "camera" in fr:
+            if fr["camera"] not in cameras:
+                raise ValueError(
+                    f"{truth_path}: frame {fr['file']}: unknown camera {fr['camera']!r}"
+                )
+            cam = cameras[fr["camera"]]
+        try:
+            fx, fy = (float(v) for v in cam["focal_px"])
+            cx, cy = (float(v) for v in cam["principal_point"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(
+                f"{truth_path}: frame {fr.get('file')}: no usable focal_px / principal_point"
+            ) from exc
+        if not (fx > 0 and fy > 0 and math.isfinite(fx) and math.isfinite(fy)):
+            raise ValueError(
+                f"{truth_path}: frame {fr['file']}: focal length {fx}, {fy} is not positive"
+            )
+        path = photos / fr["file"]
+        if not path.is_file():
+            missing += 1
+            continue
+        if hashlib.sha256(path.read_bytes()).hexdigest() != fr["sha256"]:
+            changed += 1
+            continue
+        w, h = (int(v) for v in fr["size"])
+        up = None
+        if fr.get("up_in_cam") is not None:
+            up = np.asarray(fr["up_in_cam"], dtype=float)
+            if up.shape != (3,) or not np.all(np.isfinite(up)) or np.linalg.norm(up) < 0.5:
+                raise ValueError(f"{truth_path}: frame {fr['file']}: up_in_cam is not a 3-vector")
+            up = up / np.linalg.norm(up)
+            up = up if up[1] < 0 else -up
+        out.append(
+            {
+                "set": fr["set"],
+                "name": f"{fr['set']}/{fr['sequence']}/{Path(fr['file']).name}",
+                "path": str(path),
+                "f": 0.5 * (fx + fy),
+                "pp": (cx, cy),
+                "up": up,
+                "size": (w, h),
+                "half": fr["half"],
+            }
+        )
+    if missing or changed:
+        log.info(
+            "drive: %d frames missing, %d with another content than the truth file pins, skipped",
+            missing,
+            changed,
+        )
+    return out
+
+
 def load_yud_set(root: Path) -> list[dict[str, Any]]:
     out = []
     for g in load_yud(root):
@@ -424,6 +552,8 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             "f_true": t["f"],
             "has_horizon_truth": t["up"] is not None,
         }
+        if "half" in t:
+            row["half"] = t["half"]
         if t["up"] is not None:
             row["pitch_true_deg"] = pitch_roll_from_up(t["up"])[0]
         try:
@@ -643,6 +773,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
+    ap.add_argument(
+        "--drive-photos",
+        type=Path,
+        default=PHOTOS,
+        help="the folder the driving frames' 'file' paths are relative to",
+    )
+    ap.add_argument("--drive-truth", type=Path, default=STREET_TRUTH)
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -667,6 +804,15 @@ def main(argv: list[str] | None = None) -> int:
         data.extend(loaded[: args.limit])
     if "street" in wanted:
         data.extend(load_street_set(args.street_frames))
+    drive_halves = tuple(h for h in DRIVE_HALVES if "drive" in wanted or f"drive-{h}" in wanted)
+    if drive_halves:
+        drive = load_drive_set(args.drive_photos, args.drive_truth, drive_halves)
+        if not drive:
+            log.warning(
+                "drive: no frames found in %s (run benchmarks/fetch_real_photos.sh)",
+                args.drive_photos,
+            )
+        data.extend(drive[: args.limit])
     for d in args.exif_dir if "exif" in wanted else []:
         if not d.is_dir():
             log.warning("--exif-dir %s: not a folder", d)
@@ -690,11 +836,20 @@ def main(argv: list[str] | None = None) -> int:
                     part = [r for r in rows if r["set"] == s and _lund_number(r) in scenes]
                     if part:
                         summary[tag][f"lund {half} {scenes}"] = summarise(part)
+            if s in DRIVE_SETS:  # the driving frames' development and held-out halves
+                for half in DRIVE_HALVES:
+                    part = [r for r in rows if r["set"] == s and r.get("half") == half]
+                    if part:
+                        summary[tag][f"{s} {half}"] = summarise(part)
             if s in SCENE_SETS:  # and by scene ("lund/7-heidelberg-castle/...")
                 for scene in sorted({r["name"].split("/")[1] for r in rows if r["set"] == s}):
                     summary[tag][f"{s} / {scene}"] = summarise(
                         [r for r in rows if r["set"] == s and r["name"].split("/")[1] == scene]
                     )
+        for half in DRIVE_HALVES:
+            part = [r for r in rows if r["set"] in DRIVE_SETS and r.get("half") == half]
+            if part:
+                summary[tag][f"drive {half} (all driving sets)"] = summarise(part)
         outdoor = [r for r in rows if r["set"] not in ("yud", "street")]
         if outdoor and len(outdoor) != len(rows):
             summary[tag]["outdoor (all but yud)"] = summarise(outdoor)

@@ -168,6 +168,15 @@ _PRIOR_ONLY_STD = 0.25
 #: vanishing point, a vertical one far off) then gets the default, or near it, rather than
 #: a random value out of a loose fit. A photo that fixes its focal length keeps its own.
 _F_DEFAULT_SIGMA = 0.35
+#: Frames wider than this (longer over shorter side) are no common sensor shape (4:3, 3:2,
+#: 16:9): a band cut out of a frame (the focal length still near the longer side) or a
+#: wide-angle camera whose shorter side spans what a 16:9 frame's would (the focal length
+#: near :data:`_WIDE_SHORT_REL` times the shorter side). KITTI's 1242x375 frames are the
+#: second kind: 0.58 times the longer side, where the default put 1.0. The default prior
+#: then sits between the two readings (their geometric mean) and its sigma takes in half
+#: their log-ratio (``_default_focal_prior``).
+_WIDE_ASPECT = 1.9
+_WIDE_SHORT_REL = 16.0 / 9.0
 #: Largest focal sigma stated for an estimate that rests on a weak direction.
 _MAX_STATED_STD = 1.0
 #: Above this relative standard deviation of the focal length a warning is given.
@@ -351,6 +360,8 @@ def detect_segments(
     segs = (segs + 0.5) / scale + np.array([x0, y0, x0, y0], dtype=np.float64)
     if len(segs) == 0:
         return np.zeros((0, 4))
+    if trim_borders:
+        segs = segs[~_along_border(segs, (x0, y0, x1, y1), _BORDER_EDGE_PX / scale)]
     if mask is not None:
         pts = [segs[:, 0:2], segs[:, 2:4], 0.5 * (segs[:, 0:2] + segs[:, 2:4])]
         inside = np.ones(len(segs), dtype=bool)
@@ -364,6 +375,41 @@ def detect_segments(
     segs, lengths = segs[keep], lengths[keep]
     order = np.argsort(-lengths, kind="stable")[:max_segments]
     return np.ascontiguousarray(segs[order])
+
+
+#: Segments whose two end points lie this close (pixels of the detection image) to the
+#: same side of the image are the frame's own edge: a dark or bright first row or column
+#: that a video codec or a sensor leaves (seen on dash-camera frames), not a scene line.
+_BORDER_EDGE_PX = 2.5
+
+
+def _along_border(
+    segs: FloatArray, box: tuple[int, int, int, int], edge_px: float
+) -> npt.NDArray[np.bool_]:
+    """Whether each segment runs along a side of ``box`` (``x0, y0, x1, y1``).
+
+    Parameters
+    ----------
+    segs
+        ``(N, 4)`` rows ``x1, y1, x2, y2``, pixels.
+    box
+        The image (or its content without uniform bars), ``x0, y0, x1, y1`` in pixels.
+    edge_px
+        Both end points within this distance of the same side.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` booleans.
+    """
+    x0, y0, x1, y1 = box
+    xs, ys = segs[:, [0, 2]], segs[:, [1, 3]]
+    return (
+        np.all(xs - x0 <= edge_px, axis=1)
+        | np.all(x1 - xs <= edge_px, axis=1)
+        | np.all(ys - y0 <= edge_px, axis=1)
+        | np.all(y1 - ys <= edge_px, axis=1)
+    )
 
 
 def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
@@ -1530,6 +1576,22 @@ def detect_vanishing_points(
             )
     nl = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
     best.n_lines = (nl[0], nl[1], nl[2])
+    # With no line left in one direction (no building over a highway: no vertical; or a
+    # direction of a few lines left out above), the focal length rests on the other two
+    # alone; where the weaker of them has a few lines only (a car's edges, a guard rail: a
+    # traffic camera's "across the road"), the photo does not fix the focal length: say so
+    # (BrnoCompSpeed session4_left: -54 % at a stated 11 %, on 4 lines).
+    lined = [nl[k] for k in range(3) if nl[k] > 0]
+    if (
+        len(lined) == 2
+        and f_fixed is None
+        and not has_prior
+        and not best.weak_only
+        and min(lined) < _WEAK_LINES
+    ):
+        best.weak_only = min(lined)
+        best.logf_std = _MAX_STATED_STD
+        log.debug("one direction without lines: the focal length rests on %d", min(lined))
     bias = BIAS_DEG if bias_deg is None else bias_deg
     if f_fixed is None and math.isfinite(best.logf_std):
         sys_std = _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias)
@@ -1550,7 +1612,9 @@ def detect_vanishing_points(
     best.f_data_n, best.data_logf_std = best.f_n, best.logf_std
     if f_fixed is None and not has_prior and not best.logf_std <= _LOOSE_FOCAL_STD:
         # the photo leaves the focal length loose (warned): what cameras are joins in
-        best = _with_default_prior(best, s, tau, f_bounds, prior_w)
+        best = _with_default_prior(
+            best, s, tau, f_bounds, prior_w, _default_focal_prior(float(w), float(h))
+        )
     info: dict[str, Any] = {}
     if np.count_nonzero(best.labels >= 0) >= 4:
         _refine(
@@ -2029,28 +2093,57 @@ def _finish(
     )
 
 
+def _default_focal_prior(width_px: float, height_px: float) -> tuple[float, float]:
+    """What cameras are, for a frame of this shape: the centre (relative to the longer side)
+    and the sigma of ``log(focal)`` of the default prior.
+
+    Parameters
+    ----------
+    width_px, height_px
+        The image's size.
+
+    Returns
+    -------
+    tuple of float
+        :data:`_F_PRIOR_REL` and :data:`_F_DEFAULT_SIGMA` for the common sensor shapes (up
+        to :data:`_WIDE_ASPECT`); for wider frames the geometric mean of the two readings
+        (the longer side kept; a wide-angle camera whose shorter side spans a 16:9 frame's)
+        and :data:`_F_DEFAULT_SIGMA` with half their log-ratio added in quadrature.
+    """
+    aspect = max(width_px, height_px) / max(min(width_px, height_px), 1e-9)
+    if not aspect > _WIDE_ASPECT:
+        return _F_PRIOR_REL, _F_DEFAULT_SIGMA
+    wide_rel = _WIDE_SHORT_REL / aspect  # relative to the longer side
+    half_gap = 0.5 * abs(math.log(_F_PRIOR_REL / wide_rel))
+    return math.sqrt(_F_PRIOR_REL * wide_rel), math.hypot(_F_DEFAULT_SIGMA, half_gap)
+
+
 def _with_default_prior(
     m: _Model,
     s: _Segs,
     tau: float,
     f_bounds: tuple[float, float],
     prior_w: float | None,
+    default: tuple[float, float] = (_F_PRIOR_REL, _F_DEFAULT_SIGMA),
 ) -> _Model:
     """The photo's focal length combined with the default prior (:data:`_F_DEFAULT_SIGMA`).
 
     A Gaussian posterior in ``log(focal)``: the photo's estimate weighs by its stated sigma
-    (least squares and the systematic terms), the default (:data:`_F_PRIOR_REL` times the
-    longer side) by :data:`_F_DEFAULT_SIGMA`. Where the focal length moves by more than
-    0.5 %, the rotation is refitted with the focal length held there (the vanishing points
-    and the horizon follow). ``f_data_n`` and ``data_logf_std`` keep the photo's own.
+    (least squares and the systematic terms), the default (``default``: the centre relative
+    to the longer side and the sigma, :func:`_default_focal_prior`; for the common sensor
+    shapes :data:`_F_PRIOR_REL` times the longer side and :data:`_F_DEFAULT_SIGMA`). Where
+    the focal length moves by more than 0.5 %, the rotation is refitted with the focal
+    length held there (the vanishing points and the horizon follow). ``f_data_n`` and
+    ``data_logf_std`` keep the photo's own.
     """
+    centre, sigma = default
     sd = m.logf_std if math.isfinite(m.logf_std) and m.logf_std > 0 else math.inf
     w_data = 0.0 if math.isinf(sd) else 1.0 / sd**2
-    w_prior = 1.0 / _F_DEFAULT_SIGMA**2
+    w_prior = 1.0 / sigma**2
     if not w_data + w_prior > 0.0:
         return m
     var = 1.0 / (w_data + w_prior)
-    log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(_F_PRIOR_REL))
+    log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(centre))
     f_post = min(max(math.exp(log_f), f_bounds[0]), f_bounds[1])
     R = m.R
     if abs(math.log(f_post / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
