@@ -48,6 +48,34 @@ def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
     assert all(f["properties"]["intersection"] in kept for f in corners)
 
 
+def test_corners_within_streets_keeps_to_the_radius(whole_map: MapData) -> None:
+    """``streets`` on a whole map (the service's ``/v1/corners?streets=``) answered with a
+    junction 2.3 km outside ``radius_m`` and, for names not in the map, said they "do not
+    meet within None m" of the map's centre instead of the point asked about."""
+    from camloc_geo import MapDataError
+    from camloc_geo.api import corners_within
+
+    lat, lon = 39.28558, -76.59348
+    milton = "N Milton Ave & E Biddle St"
+    near = corners_within(
+        lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets="Eastern Ave & S Broadway"
+    )
+    assert near["features"][0]["properties"]["streets"] == ["Eastern Avenue", "South Broadway"]
+    with pytest.raises(MapDataError) as far:
+        corners_within(lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets=milton)
+    msg = str(far.value)
+    assert "do not meet within 100 m of lat=39.285580, lon=-76.593480" in msg
+    assert "lat=39.304766, lon=-76.582644" in msg  # where they do meet, 2.3 km away
+    wider = corners_within(lat=lat, lon=lon, radius_m=2500, map_source=whole_map, streets=milton)
+    assert wider["features"][0]["properties"]["kind"] == "intersection"
+    with pytest.raises(MapDataError) as none:
+        corners_within(lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets="Foo & Bar")
+    msg = str(none.value)
+    assert "None" not in msg
+    assert "lat=39.285580, lon=-76.593480" in msg
+    assert "'Foo': no match" in msg
+
+
 def test_intersections_within_measures_exactly_what_a_full_scan_does(whole_map: MapData) -> None:
     # intersections_within measures only the nodes near the point (picked in the map's
     # frame); every intersection within the radius, and its distance, as a scan of all.
