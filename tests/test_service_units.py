@@ -455,3 +455,46 @@ def test_fast_path_cuts_off_a_body_without_length_over_the_limit(tmp_path: Path)
         "field": "body",
     }
     assert r.json()["request_id"] == r.headers["x-request-id"]
+
+
+def test_fastapi_refusals_come_in_the_service_error_shape(tmp_path: Path) -> None:
+    """A bad query or path value, an unknown path and a wrong method answered
+    ``{"detail": ...}`` only; every error is now ``{"error": {...}, "request_id"}`` as
+    docs/service.md says, with FastAPI's ``detail`` kept for the clients that read it."""
+    import asyncio
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def calls() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return [
+                await client.get("/v1/corners", params={"lat": "95", "lon": "0"}),
+                await client.post("/v1/locate?max_candidates=0", json=SCENE),
+                await client.get("/v1/jobs/zzz"),
+                await client.get("/v1/nope"),
+                await client.get("/v1/locate"),
+            ]
+
+    lat, cands, job, nope, method = asyncio.run(calls())
+    app.state.compute.shutdown()
+    assert lat.status_code == 422
+    body = lat.json()
+    assert body["error"]["type"] == "invalid_input"
+    assert body["error"]["field"] == "lat"
+    assert body["error"]["message"] == "lat: Input should be less than or equal to 90 (got '95')"
+    assert body["request_id"] == lat.headers["x-request-id"]
+    assert body["detail"][0]["loc"] == ["query", "lat"]  # FastAPI's own, kept
+    assert (cands.status_code, cands.json()["error"]["field"]) == (422, "max_candidates")
+    assert (job.status_code, job.json()["error"]["field"]) == (422, "job_id")
+    assert nope.status_code == 404
+    assert nope.json()["error"] == {"type": "not_found", "message": "Not Found"}
+    assert nope.json()["detail"] == "Not Found"
+    assert method.status_code == 405
+    assert method.json()["error"]["type"] == "method_not_allowed"
+    assert "allow" in {k.lower() for k in method.headers}
