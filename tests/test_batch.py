@@ -418,3 +418,26 @@ def test_candidates_carry_the_cores_ties(local_run: dict[str, Any]) -> None:
             assert others <= ranks - {rank}, (cam_id, rank, others)
             assert all(rank in ties[o] for o in others), (cam_id, rank, others)  # symmetric
         assert bool(cams.loc[cam_id, "tie"]) == bool(ties.get(1)), cam_id
+
+
+def test_geopackages_are_version_1_2(tmp_path: Path, local_run: dict[str, Any]) -> None:
+    """Batch and job GeoPackages open without a warning in QGIS 3.22's GDAL 3.6 (they were
+    GeoPackage 1.4, pyogrio's default: "may only be partially supported" on every open)."""
+    import sqlite3
+
+    from camloc_geo.results import job_result_geopackage
+
+    def user_version(path: Path) -> int:
+        with sqlite3.connect(path) as db:
+            return int(db.execute("pragma user_version").fetchone()[0])
+
+    assert user_version(local_run["out"]) == 10200
+    feature = {
+        "type": "Feature",
+        "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]},
+        "properties": {"kind": "camera", "id": "c1", "status": "title_only"},
+    }
+    job = tmp_path / "job.gpkg"
+    job.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": [feature]}))
+    assert user_version(job) == 10200
+    assert pyogrio.read_dataframe(job, layer="cameras")["id"].tolist() == ["c1"]

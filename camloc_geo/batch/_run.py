@@ -690,6 +690,11 @@ def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
 
 _GEOM_TYPES = {"cameras": "Point", "candidates": "Point", "view_cones": "Polygon"}
 
+GPKG_VERSION = "1.2"
+"""The GeoPackage version written. pyogrio's GDAL (3.7+) writes 1.4 by default, which the GDAL
+3.6 of QGIS 3.22 on Debian bookworm (and its ``ogrinfo``) reads with a warning on every open
+("user_version ... v1.4.0 may only be partially supported"); 1.2 is what that QGIS writes."""
+
 
 def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
     """Build the GeoPackage from the journal, a page of cameras at a time, then swap it in."""
@@ -710,6 +715,8 @@ def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
             kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
             if name in _GEOM_TYPES:
                 kwargs["geometry_type"] = _GEOM_TYPES[name]
+            if not started:
+                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
             pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
             started.add(name)
         buf.clear()
@@ -723,9 +730,11 @@ def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
         if name not in started:
             buf.clear()
             df = _layers_of([])[name]
-            kwargs = {"driver": "GPKG", "layer": name}
+            kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
             if name in _GEOM_TYPES:
                 kwargs["geometry_type"] = _GEOM_TYPES[name]
+            if not started:  # no camera at all: this layer creates the file
+                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
             pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
             started.add(name)
     os.replace(tmp, out)
