@@ -1277,6 +1277,27 @@ def _arrow_icon(
     )
 
 
+_PLACED_ONLY = {
+    "title_only": "at the junction its title names",
+    "street_only": "on the street its title names",
+}
+
+
+def _summary_heading(rows: Sequence[tuple[str, Mapping[str, Any]]]) -> str:
+    """"N camera(s) located", or, for a batch whose points are not all located scenes (their
+    status leads their ``flags``), how many of each: a title's junction is not a location."""
+    statuses: dict[str, int] = {}
+    for _s, f in rows:
+        flags = f["properties"].get("flags") or []
+        status = flags[0] if flags and flags[0] in (*_PLACED_ONLY, "located") else "located"
+        statuses[status] = statuses.get(status, 0) + 1
+    if set(statuses) <= {"located"}:
+        return f"<h4>{len(rows)} camera(s) located</h4>"
+    parts = [f"{statuses['located']} located"] if statuses.get("located") else []
+    parts += [f"{statuses[k]} {k} ({why})" for k, why in _PLACED_ONLY.items() if k in statuses]
+    return f"<h4>{len(rows)} camera(s) on the map</h4>" + html.escape(", ".join(parts)) + "<br>"
+
+
 def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
     """How a camera's best candidate is tied, for its popup; None when it is not."""
     others = _ties_of(props)
@@ -1399,7 +1420,7 @@ def build_summary_map(
         position="bottomleft",
         css_class="camloc-legend",
     ).add_to(fmap)
-    title = f"<h4>{len(rows)} camera(s) located</h4>"
+    title = _summary_heading(rows)
     n_tied = sum(t is not None for t in ties.values())
     if n_tied:
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"

@@ -541,3 +541,24 @@ def test_summary_map_marks_a_tied_best_candidate(tmp_path: Path, tied: Any) -> N
     assert "2 with a tied best candidate" in page
     assert "cam-clear (0.37)" in page
     assert "cam-clear (0.37) ≈" not in page
+
+
+def test_summary_map_heading_tells_located_from_title_only(tmp_path: Path, tied: Any) -> None:
+    """A batch summary with a title-only camera said "3 camera(s) located" although batch
+    reported 2 located and 1 title_only; the heading now counts each."""
+
+    def batch_row(status: str) -> dict[str, Any]:
+        props = {"kind": "candidate", "rank": 1, "lat": 39.28, "lon": -76.59, "score": 0.5}
+        props.update(method=f"title ({status})", flags=[status])
+        feature = {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]}}
+        return {"features": [{**feature, "properties": props}], "properties": {"reason": None}}
+
+    gj = candidates_geojson(tied.result)
+    statuses = (("a", "located"), ("b", "located"), ("c", "title_only"))
+    items = [(cam, batch_row(status)) for cam, status in statuses]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert "3 camera(s) on the map" in page
+    assert "2 located, 1 title_only (at the junction its title names)" in page
+    assert "camera(s) located" not in page
+    plain = maps.summary_map([("cam", gj)], tmp_path / "p.html", offline=True)
+    assert "1 camera(s) located" in plain.read_text(encoding="utf-8")
