@@ -174,6 +174,16 @@ def _fmt(value: Any, unit: str = "", digits: int = 2) -> str:
     return f"{value}{unit}"
 
 
+def _score_text(value: Any, digits: int = 3) -> str:
+    """A score as people read it: ``0.375``, then ``1.1e-15`` where three decimals would say
+    ``0.000`` (a tiny score is not a zero one; QGIS's ``score_text`` does the same)."""
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+        return "—"
+    if value == 0 or abs(value) >= 0.5 * 10.0**-digits:
+        return f"{value:.{digits}f}"
+    return f"{value:.1e}"
+
+
 # ------------------------------------------------------------------------ map elements
 class _Control(MacroElement):
     """A Leaflet control holding static HTML (legend, title)."""
@@ -336,7 +346,7 @@ def _legend_html(
             tie = f" ≈ tied with {_and(ties)}" if ties else ""
             rows.append(
                 f'{swatch}<span data-legend-rank="{rank}">{rank}: '
-                f"{_fmt(p.get('score'), digits=3)}{html.escape(tie)}</span><br>"
+                f"{_score_text(p.get('score'))}{html.escape(tie)}</span><br>"
             )
         if len(cands) > len(RANK_PALETTE):
             rows.append(
@@ -723,7 +733,7 @@ def _candidate_popup(
 ) -> str:
     rows = [
         ("rank", _fmt(props.get("rank"))),
-        ("score", _fmt(props.get("score"), digits=4)),
+        ("score", _score_text(props.get("score"), digits=4)),
         ("method", html.escape(str(props.get("method")))),
         ("lat", _fmt(props.get("lat"), "°", 7)),
         ("lon", _fmt(props.get("lon"), "°", 7)),
@@ -1024,7 +1034,7 @@ def build_candidates_map(
             max_width=500 if img else 360,
             auto_pan_padding_top_left=[10, 10 if banner is None else _BANNER_FOLDED_PX],
         )
-        tip = f"#{rank} score {p['score']:.3f} ({html.escape(str(p['method']))})"
+        tip = f"#{rank} score {_score_text(p['score'])} ({html.escape(str(p['method']))})"
         if ties:
             tip += f" ≈ tied with {_and(ties)}"
         folium.Marker(
@@ -1284,7 +1294,7 @@ _PLACED_ONLY = {
 
 
 def _summary_heading(rows: Sequence[tuple[str, Mapping[str, Any]]]) -> str:
-    """"N camera(s) located", or, for a batch whose points are not all located scenes (their
+    """ "N camera(s) located", or, for a batch whose points are not all located scenes (their
     status leads their ``flags``), how many of each: a title's junction is not a location."""
     statuses: dict[str, int] = {}
     for _s, f in rows:
@@ -1371,7 +1381,7 @@ def build_summary_map(
             f"<tr><th>{k}</th><td>{v}</td></tr>"
             for k, v in (
                 ("camera", html.escape(str(scene_id))),
-                ("score", _fmt(p.get("score"), digits=3)),
+                ("score", _score_text(p.get("score"))),
                 ("method", html.escape(str(p.get("method")))),
                 ("rank", _fmt(p.get("rank"))),
                 ("lat", _fmt(p.get("lat"), "°", 7)),

@@ -562,3 +562,17 @@ def test_summary_map_heading_tells_located_from_title_only(tmp_path: Path, tied:
     assert "camera(s) located" not in page
     plain = maps.summary_map([("cam", gj)], tmp_path / "p.html", offline=True)
     assert "1 camera(s) located" in plain.read_text(encoding="utf-8")
+
+
+def test_tiny_scores_are_not_printed_as_zero(tied_page: str, tied: Any) -> None:
+    """The legend said "5: 0.000" for a score of 1.1e-15 (and the popup 0.0000): a tiny
+    score read as an impossible one. It is now written as 1.1e-15; the leaders keep 0.375."""
+    # the legend sits in a script string: <, > and quotes are escaped there
+    page = tied_page.replace("\\u003c", "<").replace("\\u003e", ">").replace('\\"', '"')
+    score5 = tied.result.candidates[4].score
+    assert 0 < score5 < 1e-6
+    assert f'data-legend-rank="5">5: {score5:.1e}' in page
+    assert 'data-legend-rank="5">5: 0.000' not in page
+    score1 = tied.result.candidates[0].score
+    assert f'data-legend-rank="1">1: {score1:.3f}' in page
+    assert f"#5 score {score5:.1e}" in page  # the marker's tooltip
