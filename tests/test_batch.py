@@ -183,7 +183,9 @@ def test_layers_and_summary_map(world: dict[str, Path], local_run: dict[str, Any
     assert "markerClusterGroup" in page
     assert "maxZoom: 22" in page  # the cluster plug-in fails on a map without maxZoom
     assert 'src="http' not in page
-    assert "camera(s) located" in page
+    # located scenes and title-only cameras, counted apart (a title is not a location)
+    assert "camera(s) on the map" in page
+    assert "title_only (at the junction its title names)" in page
 
 
 def test_local_and_dask_give_identical_geopackages(
@@ -441,3 +443,22 @@ def test_geopackages_are_version_1_2(tmp_path: Path, local_run: dict[str, Any]) 
     job.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": [feature]}))
     assert user_version(job) == 10200
     assert pyogrio.read_dataframe(job, layer="cameras")["id"].tolist() == ["c1"]
+
+
+@pytest.mark.parametrize(
+    ("content", "what"),
+    [(b"", "an empty file"), (b"id,title\n", "no row under its header"), (b"hello\n", "no row")],
+)
+def test_cli_batch_refuses_a_list_without_cameras(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes, what: str
+) -> None:
+    """An empty file, a header alone or a text that is no list (was: exit 0, "0 cameras",
+    an empty GeoPackage written) is refused in one line, as POST /v1/jobs refuses it."""
+    lst = tmp_path / "cams.csv"
+    lst.write_bytes(content)
+    out = tmp_path / "o.gpkg"
+    assert main(["batch", str(lst), "-o", str(out), "--workers", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"the camera list cams.csv holds no camera ({what}" in err
+    assert "Traceback" not in err
+    assert not out.exists()
