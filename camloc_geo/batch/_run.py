@@ -327,6 +327,26 @@ def _chunks(
             yield a, g
 
 
+def _check_has_cameras(list_p: Path) -> None:
+    """Refuse a list without a single camera (as ``POST /v1/jobs`` does): an empty file, a
+    header alone, or a file that is no list (a photo, a text) used to end in an empty
+    GeoPackage and exit 0, as if every camera had been done."""
+    rows = read_camera_list(list_p)
+    try:
+        first = next(rows, None)
+    finally:
+        close = getattr(rows, "close", None)  # a generator: let it close its file now
+        if close is not None:
+            close()
+    if first is None:
+        size = list_p.stat().st_size
+        what = "an empty file" if size == 0 else "no row under its header"
+        raise InputError(
+            f"the camera list {list_p.name} holds no camera ({what}); a list is CSV with a "
+            "header (id,title and optional lat,lon,radius_m,streets,scene) or GeoJSON"
+        )
+
+
 def run_batch(
     list_path: str | os.PathLike[str],
     *,
@@ -388,6 +408,7 @@ def run_batch(
         raise InputError(f"camera list not found: {list_p}")
     if chunk_size < 1:
         raise InputError("chunk_size must be at least 1")
+    _check_has_cameras(list_p)
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
     counts: dict[str, int] = defaultdict(int)
