@@ -412,7 +412,20 @@ def corners_near(
     from camloc_geo.results import intersections_geojson
 
     if streets:
-        return intersections_geojson([m.find_intersection(streets, near=(lat, lon))])
+        found = m.find_intersection(streets, near=(lat, lon))
+        if m.radius_m is None or m.radius_m > radius_m:
+            # a map loaded for more than this point: the streets may meet far away; as
+            # without ``streets``, only an intersection whose centre lies within radius_m
+            from camloc_geo.geodesy import distance_m
+
+            away = float(distance_m(lat1=lat, lon1=lon, lat2=found.lat, lon2=found.lon))
+            if away > radius_m:
+                raise MapDataError(
+                    f"streets {streets!r} do not meet within {radius_m:g} m of "
+                    f"lat={lat:.6f}, lon={lon:.6f}: they meet {away:.0f} m away, at "
+                    f"lat={found.lat:.6f}, lon={found.lon:.6f} (a larger radius_m reaches it)"
+                )
+        return intersections_geojson([found])
     inters = list(m.intersections)
     if inters and (m.radius_m is None or m.radius_m > radius_m):
         # a map loaded for more than this point (a whole extract, a catalogue cell, a map

@@ -174,6 +174,16 @@ def _fmt(value: Any, unit: str = "", digits: int = 2) -> str:
     return f"{value}{unit}"
 
 
+def _score_text(value: Any, digits: int = 3) -> str:
+    """A score as people read it: ``0.375``, then ``1.1e-15`` where three decimals would say
+    ``0.000`` (a tiny score is not a zero one; QGIS's ``score_text`` does the same)."""
+    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
+        return "—"
+    if value == 0 or abs(value) >= 0.5 * 10.0**-digits:
+        return f"{value:.{digits}f}"
+    return f"{value:.1e}"
+
+
 # ------------------------------------------------------------------------ map elements
 class _Control(MacroElement):
     """A Leaflet control holding static HTML (legend, title)."""
@@ -336,7 +346,7 @@ def _legend_html(
             tie = f" ≈ tied with {_and(ties)}" if ties else ""
             rows.append(
                 f'{swatch}<span data-legend-rank="{rank}">{rank}: '
-                f"{_fmt(p.get('score'), digits=3)}{html.escape(tie)}</span><br>"
+                f"{_score_text(p.get('score'))}{html.escape(tie)}</span><br>"
             )
         if len(cands) > len(RANK_PALETTE):
             rows.append(
@@ -723,7 +733,7 @@ def _candidate_popup(
 ) -> str:
     rows = [
         ("rank", _fmt(props.get("rank"))),
-        ("score", _fmt(props.get("score"), digits=4)),
+        ("score", _score_text(props.get("score"), digits=4)),
         ("method", html.escape(str(props.get("method")))),
         ("lat", _fmt(props.get("lat"), "°", 7)),
         ("lon", _fmt(props.get("lon"), "°", 7)),
@@ -1024,7 +1034,7 @@ def build_candidates_map(
             max_width=500 if img else 360,
             auto_pan_padding_top_left=[10, 10 if banner is None else _BANNER_FOLDED_PX],
         )
-        tip = f"#{rank} score {p['score']:.3f} ({html.escape(str(p['method']))})"
+        tip = f"#{rank} score {_score_text(p['score'])} ({html.escape(str(p['method']))})"
         if ties:
             tip += f" ≈ tied with {_and(ties)}"
         folium.Marker(
@@ -1277,6 +1287,27 @@ def _arrow_icon(
     )
 
 
+_PLACED_ONLY = {
+    "title_only": "at the junction its title names",
+    "street_only": "on the street its title names",
+}
+
+
+def _summary_heading(rows: Sequence[tuple[str, Mapping[str, Any]]]) -> str:
+    """ "N camera(s) located", or, for a batch whose points are not all located scenes (their
+    status leads their ``flags``), how many of each: a title's junction is not a location."""
+    statuses: dict[str, int] = {}
+    for _s, f in rows:
+        flags = f["properties"].get("flags") or []
+        status = flags[0] if flags and flags[0] in (*_PLACED_ONLY, "located") else "located"
+        statuses[status] = statuses.get(status, 0) + 1
+    if set(statuses) <= {"located"}:
+        return f"<h4>{len(rows)} camera(s) located</h4>"
+    parts = [f"{statuses['located']} located"] if statuses.get("located") else []
+    parts += [f"{statuses[k]} {k} ({why})" for k, why in _PLACED_ONLY.items() if k in statuses]
+    return f"<h4>{len(rows)} camera(s) on the map</h4>" + html.escape(", ".join(parts)) + "<br>"
+
+
 def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
     """How a camera's best candidate is tied, for its popup; None when it is not."""
     others = _ties_of(props)
@@ -1350,7 +1381,7 @@ def build_summary_map(
             f"<tr><th>{k}</th><td>{v}</td></tr>"
             for k, v in (
                 ("camera", html.escape(str(scene_id))),
-                ("score", _fmt(p.get("score"), digits=3)),
+                ("score", _score_text(p.get("score"))),
                 ("method", html.escape(str(p.get("method")))),
                 ("rank", _fmt(p.get("rank"))),
                 ("lat", _fmt(p.get("lat"), "°", 7)),
@@ -1399,7 +1430,7 @@ def build_summary_map(
         position="bottomleft",
         css_class="camloc-legend",
     ).add_to(fmap)
-    title = f"<h4>{len(rows)} camera(s) located</h4>"
+    title = _summary_heading(rows)
     n_tied = sum(t is not None for t in ties.values())
     if n_tied:
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"

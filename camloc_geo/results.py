@@ -802,5 +802,8 @@ def job_result_geopackage(collection: dict[str, Any]) -> bytes:
                 geometry=[shape(f["geometry"]) if f["geometry"] else None for f in feats],
                 crs="EPSG:4326",
             )
-            frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio")
+            # GeoPackage 1.2, as QGIS 3.22's GDAL 3.6 reads without a warning (1.4 is
+            # pyogrio's default; camloc_geo.batch writes 1.2 for the same reason)
+            options = {} if path.exists() else {"dataset_options": {"VERSION": "1.2"}}
+            frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio", **options)
         return path.read_bytes() if path.exists() else b""

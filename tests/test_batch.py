@@ -183,7 +183,9 @@ def test_layers_and_summary_map(world: dict[str, Path], local_run: dict[str, Any
     assert "markerClusterGroup" in page
     assert "maxZoom: 22" in page  # the cluster plug-in fails on a map without maxZoom
     assert 'src="http' not in page
-    assert "camera(s) located" in page
+    # located scenes and title-only cameras, counted apart (a title is not a location)
+    assert "camera(s) on the map" in page
+    assert "title_only (at the junction its title names)" in page
 
 
 def test_local_and_dask_give_identical_geopackages(
@@ -418,3 +420,45 @@ def test_candidates_carry_the_cores_ties(local_run: dict[str, Any]) -> None:
             assert others <= ranks - {rank}, (cam_id, rank, others)
             assert all(rank in ties[o] for o in others), (cam_id, rank, others)  # symmetric
         assert bool(cams.loc[cam_id, "tie"]) == bool(ties.get(1)), cam_id
+
+
+def test_geopackages_are_version_1_2(tmp_path: Path, local_run: dict[str, Any]) -> None:
+    """Batch and job GeoPackages open without a warning in QGIS 3.22's GDAL 3.6 (they were
+    GeoPackage 1.4, pyogrio's default: "may only be partially supported" on every open)."""
+    import sqlite3
+
+    from camloc_geo.results import job_result_geopackage
+
+    def user_version(path: Path) -> int:
+        with sqlite3.connect(path) as db:
+            return int(db.execute("pragma user_version").fetchone()[0])
+
+    assert user_version(local_run["out"]) == 10200
+    feature = {
+        "type": "Feature",
+        "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]},
+        "properties": {"kind": "camera", "id": "c1", "status": "title_only"},
+    }
+    job = tmp_path / "job.gpkg"
+    job.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": [feature]}))
+    assert user_version(job) == 10200
+    assert pyogrio.read_dataframe(job, layer="cameras")["id"].tolist() == ["c1"]
+
+
+@pytest.mark.parametrize(
+    ("content", "what"),
+    [(b"", "an empty file"), (b"id,title\n", "no row under its header"), (b"hello\n", "no row")],
+)
+def test_cli_batch_refuses_a_list_without_cameras(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes, what: str
+) -> None:
+    """An empty file, a header alone or a text that is no list (was: exit 0, "0 cameras",
+    an empty GeoPackage written) is refused in one line, as POST /v1/jobs refuses it."""
+    lst = tmp_path / "cams.csv"
+    lst.write_bytes(content)
+    out = tmp_path / "o.gpkg"
+    assert main(["batch", str(lst), "-o", str(out), "--workers", "1", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"the camera list cams.csv holds no camera ({what}" in err
+    assert "Traceback" not in err
+    assert not out.exists()

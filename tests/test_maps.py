@@ -541,3 +541,38 @@ def test_summary_map_marks_a_tied_best_candidate(tmp_path: Path, tied: Any) -> N
     assert "2 with a tied best candidate" in page
     assert "cam-clear (0.37)" in page
     assert "cam-clear (0.37) ≈" not in page
+
+
+def test_summary_map_heading_tells_located_from_title_only(tmp_path: Path, tied: Any) -> None:
+    """A batch summary with a title-only camera said "3 camera(s) located" although batch
+    reported 2 located and 1 title_only; the heading now counts each."""
+
+    def batch_row(status: str) -> dict[str, Any]:
+        props = {"kind": "candidate", "rank": 1, "lat": 39.28, "lon": -76.59, "score": 0.5}
+        props.update(method=f"title ({status})", flags=[status])
+        feature = {"type": "Feature", "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]}}
+        return {"features": [{**feature, "properties": props}], "properties": {"reason": None}}
+
+    gj = candidates_geojson(tied.result)
+    statuses = (("a", "located"), ("b", "located"), ("c", "title_only"))
+    items = [(cam, batch_row(status)) for cam, status in statuses]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert "3 camera(s) on the map" in page
+    assert "2 located, 1 title_only (at the junction its title names)" in page
+    assert "camera(s) located" not in page
+    plain = maps.summary_map([("cam", gj)], tmp_path / "p.html", offline=True)
+    assert "1 camera(s) located" in plain.read_text(encoding="utf-8")
+
+
+def test_tiny_scores_are_not_printed_as_zero(tied_page: str, tied: Any) -> None:
+    """The legend said "5: 0.000" for a score of 1.1e-15 (and the popup 0.0000): a tiny
+    score read as an impossible one. It is now written as 1.1e-15; the leaders keep 0.375."""
+    # the legend sits in a script string: <, > and quotes are escaped there
+    page = tied_page.replace("\\u003c", "<").replace("\\u003e", ">").replace('\\"', '"')
+    score5 = tied.result.candidates[4].score
+    assert 0 < score5 < 1e-6
+    assert f'data-legend-rank="5">5: {score5:.1e}' in page
+    assert 'data-legend-rank="5">5: 0.000' not in page
+    score1 = tied.result.candidates[0].score
+    assert f'data-legend-rank="1">1: {score1:.3f}' in page
+    assert f"#5 score {score5:.1e}" in page  # the marker's tooltip

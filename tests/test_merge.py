@@ -145,3 +145,21 @@ def test_invalid_scene_is_named(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert "annotations[0].axes.origin" in line
     with pytest.raises(SceneError, match="at least one"):
         merge_scenes([])
+
+
+def test_output_never_overwrites_an_input_and_no_file_twice(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o a1.json`` replaced the first annotator's file with the merge, and the same file
+    given twice merged its annotators twice (w1, w1-2: counted double in the fit)."""
+    a1, a2 = write(tmp_path, [annotator(1, "w1"), annotator(2, "ann")])
+    before = Path(a1).read_text()
+    assert main(["merge", a1, a2, "-o", a1]) == 2
+    assert "would overwrite the input" in capsys.readouterr().err
+    assert Path(a1).read_text() == before
+    assert main(["merge", a1, a2, a1, "-o", str(tmp_path / "m.json")]) == 2
+    err = capsys.readouterr().err
+    assert f"{a1} is given twice" in err
+    assert not (tmp_path / "m.json").exists()
+    assert main(["merge", a1, a2, "-o", str(tmp_path / "no" / "m.json")]) == 2
+    assert "does not exist (create it first)" in capsys.readouterr().err

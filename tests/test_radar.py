@@ -328,3 +328,30 @@ def test_no_vehicle_is_exit_2(
     res = radar_scene(scene_file, empty.path)
     assert res.vehicles == []
     assert res.warnings == ["no vehicle found in the video"]
+
+
+def test_cli_a_text_named_jpg_is_one_line_on_stderr(tmp_path: Path) -> None:
+    """FFmpeg's own "[mjpeg @ 0x...] No JPEG data found in image" came before our error line;
+    the real process (FFmpeg writes to the file descriptor) now prints only ours."""
+    import os
+    import subprocess
+    import sys
+
+    fake = tmp_path / "photo.jpg"
+    fake.write_text("hello\n")
+    root = Path(__file__).resolve().parents[1]
+    env = {k: v for k, v in os.environ.items() if k != "OPENCV_FFMPEG_LOGLEVEL"}
+    env["PYTHONPATH"] = str(root) + os.pathsep + env.get("PYTHONPATH", "")
+    scene = root / "sample_maps" / "sample_scene.json"
+    proc = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", "radar", str(fake), "--scene", str(scene)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+        check=False,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        f"camloc radar: error: cannot read video {fake}: it states no frame size"
+    ]

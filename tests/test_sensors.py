@@ -191,3 +191,15 @@ def test_rotation_sigma_reported_and_propagated() -> None:
     assert ground_distance(replace(cal, rotation_sigma_deg=None), px).sigma_m > with_rot
     bigger = ground_distance(replace(cal, rotation_sigma_deg=sig * 10.0), px).sigma_m
     assert bigger > 2.0 * with_rot
+
+
+def test_cli_output_never_overwrites_the_scene(
+    scene_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``camloc measure scene.json ... -o scene.json`` replaced the scene with the
+    measurement; it is refused before any work, and the scene kept."""
+    before = scene_file.read_text()
+    args = ["measure", str(scene_file), "--height", "900,900", "900,800", "-o", str(scene_file)]
+    assert main(args) == 2
+    assert "would overwrite the input" in capsys.readouterr().err
+    assert scene_file.read_text() == before

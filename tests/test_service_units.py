@@ -48,6 +48,34 @@ def test_corners_within_keeps_only_the_radius(whole_map: MapData) -> None:
     assert all(f["properties"]["intersection"] in kept for f in corners)
 
 
+def test_corners_within_streets_keeps_to_the_radius(whole_map: MapData) -> None:
+    """``streets`` on a whole map (the service's ``/v1/corners?streets=``) answered with a
+    junction 2.3 km outside ``radius_m`` and, for names not in the map, said they "do not
+    meet within None m" of the map's centre instead of the point asked about."""
+    from camloc_geo import MapDataError
+    from camloc_geo.api import corners_within
+
+    lat, lon = 39.28558, -76.59348
+    milton = "N Milton Ave & E Biddle St"
+    near = corners_within(
+        lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets="Eastern Ave & S Broadway"
+    )
+    assert near["features"][0]["properties"]["streets"] == ["Eastern Avenue", "South Broadway"]
+    with pytest.raises(MapDataError) as far:
+        corners_within(lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets=milton)
+    msg = str(far.value)
+    assert "do not meet within 100 m of lat=39.285580, lon=-76.593480" in msg
+    assert "lat=39.304766, lon=-76.582644" in msg  # where they do meet, 2.3 km away
+    wider = corners_within(lat=lat, lon=lon, radius_m=2500, map_source=whole_map, streets=milton)
+    assert wider["features"][0]["properties"]["kind"] == "intersection"
+    with pytest.raises(MapDataError) as none:
+        corners_within(lat=lat, lon=lon, radius_m=100, map_source=whole_map, streets="Foo & Bar")
+    msg = str(none.value)
+    assert "None" not in msg
+    assert "lat=39.285580, lon=-76.593480" in msg
+    assert "'Foo': no match" in msg
+
+
 def test_intersections_within_measures_exactly_what_a_full_scan_does(whole_map: MapData) -> None:
     # intersections_within measures only the nodes near the point (picked in the map's
     # frame); every intersection within the radius, and its distance, as a scan of all.
@@ -427,3 +455,46 @@ def test_fast_path_cuts_off_a_body_without_length_over_the_limit(tmp_path: Path)
         "field": "body",
     }
     assert r.json()["request_id"] == r.headers["x-request-id"]
+
+
+def test_fastapi_refusals_come_in_the_service_error_shape(tmp_path: Path) -> None:
+    """A bad query or path value, an unknown path and a wrong method answered
+    ``{"detail": ...}`` only; every error is now ``{"error": {...}, "request_id"}`` as
+    docs/service.md says, with FastAPI's ``detail`` kept for the clients that read it."""
+    import asyncio
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def calls() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return [
+                await client.get("/v1/corners", params={"lat": "95", "lon": "0"}),
+                await client.post("/v1/locate?max_candidates=0", json=SCENE),
+                await client.get("/v1/jobs/zzz"),
+                await client.get("/v1/nope"),
+                await client.get("/v1/locate"),
+            ]
+
+    lat, cands, job, nope, method = asyncio.run(calls())
+    app.state.compute.shutdown()
+    assert lat.status_code == 422
+    body = lat.json()
+    assert body["error"]["type"] == "invalid_input"
+    assert body["error"]["field"] == "lat"
+    assert body["error"]["message"] == "lat: Input should be less than or equal to 90 (got '95')"
+    assert body["request_id"] == lat.headers["x-request-id"]
+    assert body["detail"][0]["loc"] == ["query", "lat"]  # FastAPI's own, kept
+    assert (cands.status_code, cands.json()["error"]["field"]) == (422, "max_candidates")
+    assert (job.status_code, job.json()["error"]["field"]) == (422, "job_id")
+    assert nope.status_code == 404
+    assert nope.json()["error"] == {"type": "not_found", "message": "Not Found"}
+    assert nope.json()["detail"] == "Not Found"
+    assert method.status_code == 405
+    assert method.json()["error"]["type"] == "method_not_allowed"
+    assert "allow" in {k.lower() for k in method.headers}

@@ -327,6 +327,26 @@ def _chunks(
             yield a, g
 
 
+def _check_has_cameras(list_p: Path) -> None:
+    """Refuse a list without a single camera (as ``POST /v1/jobs`` does): an empty file, a
+    header alone, or a file that is no list (a photo, a text) used to end in an empty
+    GeoPackage and exit 0, as if every camera had been done."""
+    rows = read_camera_list(list_p)
+    try:
+        first = next(rows, None)
+    finally:
+        close = getattr(rows, "close", None)  # a generator: let it close its file now
+        if close is not None:
+            close()
+    if first is None:
+        size = list_p.stat().st_size
+        what = "an empty file" if size == 0 else "no row under its header"
+        raise InputError(
+            f"the camera list {list_p.name} holds no camera ({what}); a list is CSV with a "
+            "header (id,title and optional lat,lon,radius_m,streets,scene) or GeoJSON"
+        )
+
+
 def run_batch(
     list_path: str | os.PathLike[str],
     *,
@@ -388,6 +408,7 @@ def run_batch(
         raise InputError(f"camera list not found: {list_p}")
     if chunk_size < 1:
         raise InputError("chunk_size must be at least 1")
+    _check_has_cameras(list_p)
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
     counts: dict[str, int] = defaultdict(int)
@@ -690,6 +711,11 @@ def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
 
 _GEOM_TYPES = {"cameras": "Point", "candidates": "Point", "view_cones": "Polygon"}
 
+GPKG_VERSION = "1.2"
+"""The GeoPackage version written. pyogrio's GDAL (3.7+) writes 1.4 by default, which the GDAL
+3.6 of QGIS 3.22 on Debian bookworm (and its ``ogrinfo``) reads with a warning on every open
+("user_version ... v1.4.0 may only be partially supported"); 1.2 is what that QGIS writes."""
+
 
 def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
     """Build the GeoPackage from the journal, a page of cameras at a time, then swap it in."""
@@ -710,6 +736,8 @@ def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
             kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
             if name in _GEOM_TYPES:
                 kwargs["geometry_type"] = _GEOM_TYPES[name]
+            if not started:
+                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
             pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
             started.add(name)
         buf.clear()
@@ -723,9 +751,11 @@ def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
         if name not in started:
             buf.clear()
             df = _layers_of([])[name]
-            kwargs = {"driver": "GPKG", "layer": name}
+            kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
             if name in _GEOM_TYPES:
                 kwargs["geometry_type"] = _GEOM_TYPES[name]
+            if not started:  # no camera at all: this layer creates the file
+                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
             pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
             started.add(name)
     os.replace(tmp, out)

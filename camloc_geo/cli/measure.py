@@ -52,9 +52,10 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.api import calibrate_scene
-    from camloc_geo.cli import write_json
+    from camloc_geo.cli import output_path, write_json
     from camloc_geo.sensors import ground_distance, point_height
 
+    output_path(args.output, inputs=[args.scene])  # before the work; never over the scene
     if not (args.click_sigma_px >= 0.0 and args.click_sigma_px < float("inf")):
         raise InputError(f"--click-sigma-px must be >= 0, not {args.click_sigma_px}")
     if args.ground is not None:
@@ -69,5 +70,5 @@ def run(args: argparse.Namespace) -> int:
         m = point_height(calibration, base, top, click_sigma_px=args.click_sigma_px)
     out = m.to_dict()
     out["click_sigma_px"] = args.click_sigma_px
-    write_json(out, args.output)
+    write_json(out, args.output, inputs=[args.scene])
     return 0

@@ -27,8 +27,20 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
-    from camloc_geo.cli import write_json
+    from pathlib import Path
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.cli import output_path, write_json
     from camloc_geo.merge import merge_scenes
 
-    write_json(merge_scenes(args.scenes, scene_id=args.scene_id), args.output)
+    out = output_path(args.output, inputs=args.scenes)  # never over an annotator's file
+    seen: dict[Path, str] = {}
+    for name in args.scenes:
+        key = Path(name).resolve()
+        if key in seen:  # its annotators would count twice in the fit
+            raise InputError(
+                f"{name} is given twice (also as {seen[key]}): each annotator's file once"
+            )
+        seen[key] = name
+    write_json(merge_scenes(args.scenes, scene_id=args.scene_id), out, inputs=args.scenes)
     return 0

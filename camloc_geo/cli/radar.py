@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from typing import Any
 
@@ -60,6 +61,10 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.cli import output_path, write_json
 
     out = output_path(args.output, inputs=[args.video, args.scene, args.tracks])
+    if not (args.verbose or args.debug):
+        # FFmpeg, under OpenCV, prints its own lines ("[mjpeg @ 0x...] No JPEG data found in
+        # image") next to our one-line error: silenced, read before the first VideoCapture
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     csv_out = out is not None and out.suffix.lower() == ".csv"
     if out is not None and out.suffix.lower() not in (".csv", ".json"):
         raise InputError(f"-o {out}: give a .json or .csv file")

@@ -297,10 +297,14 @@ class MapData:
         for w in wanted:
             close = close_matches(w, all_names)
             hints.append(f"{w!r}: " + (", ".join(repr(c) for c in close) if close else "no match"))
+        # where: the point asked about, else the map's; a whole extract has no radius
+        lat0, lon0 = near if near is not None else (self.frame.lat0, self.frame.lon0)
+        where = (
+            f"within {self.radius_m:g} m of" if self.radius_m is not None else "in the map, near"
+        )
         raise MapDataError(
-            f"streets {' & '.join(repr(w) for w in wanted)} do not meet within "
-            f"{self.radius_m} m of lat={self.frame.lat0:.6f}, lon={self.frame.lon0:.6f}; "
-            f"close matches: {'; '.join(hints)}"
+            f"streets {' & '.join(repr(w) for w in wanted)} do not meet {where} "
+            f"lat={lat0:.6f}, lon={lon0:.6f}; close matches: {'; '.join(hints)}"
         )
 
     def distance_to_m(self, inter: Intersection, *, lat: float, lon: float) -> float:

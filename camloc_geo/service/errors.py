@@ -11,7 +11,10 @@ import logging
 from typing import Any
 
 from fastapi import FastAPI, Request
+from fastapi.encoders import jsonable_encoder
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from camloc_geo import (
     CamlocError,
@@ -33,6 +36,7 @@ __all__ = [
     "TimeLimitError",
     "UnauthorizedError",
     "UnsupportedMediaError",
+    "error_body",
     "error_response",
     "error_response_for",
     "install_error_handlers",
@@ -91,14 +95,19 @@ def request_id(request: Request) -> str:
     return str(getattr(request.state, "request_id", "-"))
 
 
+def error_body(kind: str, message: str, field: str | None, rid: str) -> dict[str, Any]:
+    """``{"error": {"type", "message", "field"?}, "request_id"}``."""
+    body: dict[str, Any] = {"error": {"type": kind, "message": message}, "request_id": rid}
+    if field:
+        body["error"]["field"] = field
+    return body
+
+
 def error_response(
     status: int, kind: str, message: str, field: str | None, rid: str
 ) -> JSONResponse:
     """The JSON error answer."""
-    body: dict[str, Any] = {"error": {"type": kind, "message": message}, "request_id": rid}
-    if field:
-        body["error"]["field"] = field
-    return JSONResponse(body, status_code=status)
+    return JSONResponse(error_body(kind, message, field, rid), status_code=status)
 
 
 def error_response_for(exc: BaseException, rid: str) -> JSONResponse:
@@ -123,8 +132,51 @@ async def _unexpected(request: Request, exc: Exception) -> JSONResponse:
     return error_response(500, "internal", f"internal error (request id {rid})", None, rid)
 
 
+def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
+    """One line for FastAPI's validation errors (``lat: Input should be ... (got 95)``) and
+    the field of the first."""
+    parts = []
+    field = None
+    for err in errors:
+        loc = [str(x) for x in err.get("loc", ()) if x not in ("query", "path", "body", "header")]
+        name = ".".join(loc) or "request"
+        field = field or name
+        got = err.get("input")
+        got_text = f" (got {got!r})" if isinstance(got, (str, int, float)) else ""
+        parts.append(f"{name}: {err.get('msg', 'invalid')}{got_text}")
+    return "; ".join(parts) or "invalid request", field
+
+
+_HTTP_KINDS = {404: "not_found", 405: "method_not_allowed", 401: "unauthorized"}
+
+
+async def _invalid_request(request: Request, exc: Exception) -> JSONResponse:
+    """A query or path value FastAPI refused: the service's error shape, FastAPI's ``detail``
+    kept alongside for clients that read it (before, only ``{"detail": [...]}``)."""
+    errors = jsonable_encoder(getattr(exc, "errors", list)())
+    message, field = _validation_message(errors)
+    body = error_body("invalid_input", message, field, request_id(request))
+    body["detail"] = errors
+    return JSONResponse(body, status_code=422)
+
+
+async def _http_error(request: Request, exc: Exception) -> JSONResponse:
+    """Starlette's 404 (no such path), 405 (wrong method) and the like, in the service's
+    shape, ``detail`` kept."""
+    status = int(getattr(exc, "status_code", 500))
+    detail = getattr(exc, "detail", None)
+    kind = _HTTP_KINDS.get(status, "http_error")
+    message = str(detail) if detail else kind.replace("_", " ")
+    body = error_body(kind, message, None, request_id(request))
+    body["detail"] = detail
+    return JSONResponse(body, status_code=status, headers=getattr(exc, "headers", None))
+
+
 def install_error_handlers(app: FastAPI) -> None:
-    """Answer library and service errors through :data:`ERROR_STATUS`, the rest with a 500."""
+    """Answer library and service errors through :data:`ERROR_STATUS`, the rest with a 500;
+    FastAPI's own refusals (validation, unknown path, wrong method) in the same shape."""
     app.add_exception_handler(CamlocError, _known)
     app.add_exception_handler(ServiceError, _known)
+    app.add_exception_handler(RequestValidationError, _invalid_request)
+    app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(Exception, _unexpected)
