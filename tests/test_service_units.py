@@ -498,3 +498,32 @@ def test_fastapi_refusals_come_in_the_service_error_shape(tmp_path: Path) -> Non
     assert method.status_code == 405
     assert method.json()["error"]["type"] == "method_not_allowed"
     assert "allow" in {k.lower() for k in method.headers}
+
+
+def test_openapi_declares_the_error_answers(tmp_path: Path) -> None:
+    """/openapi.json listed 200 and 422 only: a 401, 404, 413, 415 or 503 was undocumented
+    (schemathesis' status-code conformance check failed on every route)."""
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    spec = app.openapi()
+    app.state.compute.shutdown()
+    for path, item in spec["paths"].items():
+        for method, op in item.items():
+            assert {"401", "404", "413", "415", "503"} <= set(op["responses"]), (method, path)
+    error = spec["paths"]["/v1/locate"]["post"]["responses"]["415"]["content"]
+    assert error["application/json"]["schema"] == {"$ref": "#/components/schemas/ErrorBody"}
+    # an HTML route's errors are JSON too (FastAPI would have put them under text/html)
+    html_error = spec["paths"]["/v1/maps"]["post"]["responses"]["415"]["content"]
+    assert set(html_error) == {"application/json"}
+    assert set(spec["paths"]["/annotate/{task_id}"]["get"]["responses"]["404"]["content"]) == {
+        "application/json"
+    }
+    body = spec["components"]["schemas"]["ErrorBody"]
+    assert body["required"] == ["error", "request_id"]
+    assert set(spec["components"]["schemas"]["ErrorDetail"]["properties"]) == {
+        "type",
+        "message",
+        "field",
+    }
