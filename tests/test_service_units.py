@@ -527,3 +527,62 @@ def test_openapi_declares_the_error_answers(tmp_path: Path) -> None:
         "message",
         "field",
     }
+
+
+def test_healthz_answers_head(tmp_path: Path) -> None:
+    """``curl -I /healthz`` (a load balancer's probe) was a 405; it is a 200 without a body."""
+    import asyncio
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def calls() -> tuple[httpx.Response, httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.head("/healthz"), await client.get("/healthz")
+
+    head, get = asyncio.run(calls())
+    app.state.compute.shutdown()
+    assert head.status_code == 200
+    assert head.content == b""
+    assert get.json()["status"] == "ok"
+    assert set(app.openapi()["paths"]["/healthz"]) == {"get"}
+
+
+def test_a_compressed_body_is_refused_by_name(tmp_path: Path) -> None:
+    """A gzip body (``Content-Encoding: gzip``) was read as JSON: "the body is not valid JSON:
+    'utf-8' codec can't decode byte 0x8b"; it is now a 415 naming the encoding, on the fast
+    path's routes too."""
+    import asyncio
+    import gzip
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    body = gzip.compress(json.dumps(SCENE).encode())
+    headers = {"content-type": "application/json", "content-encoding": "gzip"}
+
+    async def calls() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return [
+                await client.post(path, content=body, headers=headers)
+                for path in ("/v1/locate", "/v1/calibrate", "/v1/jobs")
+            ]
+
+    answers = asyncio.run(calls())
+    app.state.compute.shutdown()
+    for r in answers:
+        assert r.status_code == 415
+        assert r.json()["error"] == {
+            "type": "unsupported_media_type",
+            "message": "content encoding 'gzip' not supported; send the body uncompressed",
+            "field": "content-encoding",
+        }
