@@ -302,6 +302,7 @@ def test_serve_hands_its_loop_parser_and_access_log_to_uvicorn(
 
     seen: dict[str, Any] = {}
     monkeypatch.setattr(uvicorn, "run", lambda app, **kw: seen.update(kw, app=app))
+    monkeypatch.setattr(serve, "_check_listen", lambda host, port: None)  # port 8000 may be busy
     monkeypatch.setenv("CAMLOC_WORKERS", "0")  # restored after the test (run sets it)
     assert serve.run(_serve_args("--workers", "2")) == 0
     assert (seen["loop"], seen["http"], seen["access_log"]) == ("auto", "auto", True)
@@ -309,6 +310,36 @@ def test_serve_hands_its_loop_parser_and_access_log_to_uvicorn(
     args = _serve_args("--loop", "asyncio", "--http", "h11", "--no-access-log")
     assert serve.run(args) == 0
     assert (seen["loop"], seen["http"], seen["access_log"]) == ("asyncio", "h11", False)
+
+
+def test_serve_refuses_a_busy_port_in_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A port another server holds was found by uvicorn after the application started,
+    among its INFO lines, with its own exit status 3; it is now exit 2 before starting."""
+    import socket
+
+    import uvicorn
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.cli import serve
+
+    started: list[Any] = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: started.append(kw))
+    monkeypatch.setenv("CAMLOC_WORKERS", "0")
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        with pytest.raises(InputError, match=rf"--port {port}: cannot listen on .*in use"):
+            serve.run(_serve_args("--host", "127.0.0.1", "--port", str(port)))
+    assert started == []
+
+    def stops(app: str, **kw: Any) -> None:
+        raise SystemExit(3)
+
+    monkeypatch.setattr(uvicorn, "run", stops)
+    monkeypatch.setattr(serve, "_check_listen", lambda host, port: None)
+    with pytest.raises(RuntimeError, match="uvicorn status 3"):
+        serve.run(_serve_args("--port", str(port)))
 
 
 @pytest.mark.parametrize(("option", "module"), [("--loop", "uvloop"), ("--http", "httptools")])
