@@ -128,6 +128,8 @@ _MATCH_LAYERS = 5
 _CONES_SHOWN = 3
 _BANNER_PX = 150  # about the height of the tie banner: the candidates are fitted below it
 _BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
+BANNER_FOLD_BELOW_PX = (1200, 800)
+"""A map narrower or lower than this (pixels) opens with the banner folded to its headline."""
 
 
 # ----------------------------------------------------------------------------- styling
@@ -228,10 +230,25 @@ class _Banner(MacroElement):
     div.innerHTML = {{ this.html|tojson }};
     L.DomEvent.disableClickPropagation(div);
     L.DomEvent.disableScrollPropagation(div);
-    // an open popup would be under the banner: fold it to its headline meanwhile
     var map = {{ this._parent.get_name() }};
+    // on a small screen (a laptop's 1024x640) the whole explanation covered the tied
+    // candidates it is about: there it starts folded to its headline; a click on the
+    // headline folds or unfolds it anywhere
+    var size = map.getSize();
+    var folded = size.y < {{ this.fold_below[1] }} || size.x < {{ this.fold_below[0] }};
+    function show() {
+        if (folded) { L.DomUtil.addClass(div, "folded"); }
+        else { L.DomUtil.removeClass(div, "folded"); }
+    }
+    var head = div.querySelector("h4");
+    if (head) {
+        head.title = "click to show or hide the explanation";
+        L.DomEvent.on(head, "click", function () { folded = !folded; show(); });
+    }
+    show();
+    // an open popup would be under the banner: fold it to its headline meanwhile
     map.on("popupopen", function () { L.DomUtil.addClass(div, "folded"); });
-    map.on("popupclose", function () { L.DomUtil.removeClass(div, "folded"); });
+    map.on("popupclose", show);
 })();
 {% endmacro %}
 """
@@ -242,6 +259,7 @@ class _Banner(MacroElement):
         self._name = "CamlocBanner"
         self.html = html_text
         self.css_class = css_class
+        self.fold_below = BANNER_FOLD_BELOW_PX
 
 
 _PAGE_CSS = """
@@ -287,6 +305,9 @@ _PAGE_CSS = """
   box-shadow: 0 2px 7px rgba(0,0,0,0.45); font: 12.5px/1.4 sans-serif; color: #222; }
 .camloc-banner.folded .camloc-banner-body { display: none; }
 .camloc-banner.folded h4 { margin: 0; }
+.camloc-banner h4 { cursor: pointer; }
+.camloc-banner.folded h4::after { content: " \\25B8 why, and what decides"; font-weight: normal;
+  font-size: 11.5px; color: #555; }
 .camloc-banner.minor { background: rgba(255,255,255,0.93); border-color: #777; }
 .camloc-banner h4 { margin: 0 0 3px; font-size: 14px; color: #7a3e00; }
 .camloc-banner.minor h4 { color: #333; font-size: 12.5px; }

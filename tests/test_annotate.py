@@ -217,3 +217,28 @@ def test_ground_corner_drawing_is_the_docs_drawing_and_inlined(snapshot: Path) -
     assert doc.strip() in page
     assert "ground-corner.svg" in (root / "docs" / "annotate.md").read_text(encoding="utf-8")
     assert "ground-corner.svg" in (root / "docs" / "scene-format.md").read_text(encoding="utf-8")
+
+
+def test_cli_output_never_overwrites_the_photo_or_scene(
+    tmp_path: Path, snapshot: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o cam.jpg`` replaced the photo with the page and ``-o scene.json --scene
+    scene.json`` the scene; both are refused before any work, a missing folder is exit 2
+    (was exit 1, FileNotFoundError), and the page is written atomically."""
+    photo = tmp_path / "cam.jpg"
+    photo.write_bytes(snapshot.read_bytes())
+    assert main(["annotate", str(photo), "-o", str(photo)]) == 2
+    assert "would overwrite the input" in capsys.readouterr().err
+    assert photo.read_bytes() == snapshot.read_bytes()
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps(located_case().scene))
+    before = scene.read_text()
+    assert main(["annotate", str(photo), "-o", str(scene), "--scene", str(scene)]) == 2
+    assert "would overwrite the input" in capsys.readouterr().err
+    assert scene.read_text() == before
+    assert main(["annotate", str(photo), "-o", str(tmp_path / "no" / "p.html")]) == 2
+    assert "does not exist (create it first)" in capsys.readouterr().err
+    out = tmp_path / "page.html"
+    assert main(["annotate", str(photo), "-o", str(out)]) == 0
+    assert embedded_config(out.read_text())["mode"] == "file"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cam.jpg", "page.html", "scene.json"]

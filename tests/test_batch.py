@@ -462,3 +462,26 @@ def test_cli_batch_refuses_a_list_without_cameras(
     assert f"the camera list cams.csv holds no camera ({what}" in err
     assert "Traceback" not in err
     assert not out.exists()
+
+
+def test_cli_batch_outputs_never_overwrite_the_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--map cams.csv`` replaced the list with the summary page, ``-o cams.csv`` failed
+    after the whole run (exit 1, DataLayerError) and ``-o cams.geojson`` wrote a GeoPackage
+    under a GeoJSON name; all are refused before any work (exit 2)."""
+    lst = tmp_path / "cams.csv"
+    text = "id,title\n1,A & B\n"
+    lst.write_text(text, encoding="utf-8")
+    gpkg = str(tmp_path / "o.gpkg")
+    cases = [
+        (["-o", str(lst)], "-o " + str(lst) + ": would overwrite the input"),
+        (["-o", gpkg, "--map", str(lst)], "would overwrite the input"),
+        (["-o", gpkg, "--map", gpkg], "the same file as -o"),
+        (["-o", str(tmp_path / "o.geojson")], "writes a GeoPackage; name it .gpkg"),
+    ]
+    for extra, message in cases:
+        assert main(["batch", str(lst), *extra, "--workers", "1", "--no-progress"]) == 2
+        assert message in capsys.readouterr().err
+        assert lst.read_text(encoding="utf-8") == text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cams.csv"]  # no journal either

@@ -276,3 +276,33 @@ def test_summary_map_rings_a_tied_camera(tab: _Page, pages: dict[str, Any], tmp_
     assert "tied-cam" in text
     assert tab.blocked == []
     assert tab.errors == []
+
+
+def test_tie_banner_hides_no_tied_candidate_on_a_small_screen(
+    browser: Any, pages: dict[str, Any]
+) -> None:
+    """At 1024x640 (a small laptop) the banner's whole explanation was about 270 px high and
+    covered candidates 2 and 4, the rivals it tells of; there it now opens folded to its
+    headline, and a click on the headline unfolds it (and folds it again)."""
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 1024, "height": 640})
+        t.open(pages["tied"], ".camloc-candidate")
+        page = t.page
+        banner = page.locator(".camloc-banner")
+        assert banner.locator("h4").is_visible()
+        assert not banner.locator(".camloc-banner-body").is_visible()
+        for rank in (1, 2, 3, 4):
+            box = _box(page, f'.camloc-candidate [data-rank="{rank}"]')
+            assert not _overlap(box, _box(page, ".camloc-banner")), rank
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "tied_map_small.png"))
+        banner.locator("h4").click()
+        assert banner.locator(".camloc-banner-body").is_visible()
+        assert "view_hint" in banner.inner_text()
+        banner.locator("h4").click()
+        assert not banner.locator(".camloc-banner-body").is_visible()
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()

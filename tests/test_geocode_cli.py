@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -275,3 +276,47 @@ def test_cli_output_is_atomic(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -
     assert main(["geocode", "--osm", str(BERLIN), "--list", str(rows), "-o", str(out)]) == 1
     assert out.read_text(encoding="utf-8") == "old"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cams.csv", "out.geojson"]
+
+
+def test_cli_reader_closing_the_pipe_is_quiet(tmp_path: Path) -> None:
+    """``camloc geocode --list ... | head`` ended with "failed: BrokenPipeError" on stderr;
+    a closed stdout now stops the command quietly (exit 1), as Unix tools do."""
+    rows = tmp_path / "cams.csv"
+    rows.write_text(
+        "id,title\n" + "".join(f"{i},Karl-Liebknecht-Str. / Wadzeckstr.\n" for i in range(3000)),
+        encoding="utf-8",
+    )
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    cmd = [sys.executable, "-m", "camloc_geo.cli", "geocode", "--list", str(rows)]
+    proc = subprocess.Popen(
+        [*cmd, "--osm", str(BERLIN)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+    )
+    assert proc.stdout is not None
+    assert proc.stderr is not None
+    assert proc.stdout.read(100).startswith(b'{"type": "FeatureCollection"')
+    proc.stdout.close()  # the reader goes away, as head does
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    assert proc.wait(timeout=120) == 1
+    assert err == ""
+
+
+def test_cli_broken_pipe_elsewhere_is_still_reported(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A BrokenPipeError that is not stdout's (a socket) stays a named failure."""
+    import camloc_geo.cli.geocode as geocode_cli
+
+    def broken(args: object) -> int:
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(geocode_cli, "run", broken)
+    import camloc_geo.cli as cli
+
+    monkeypatch.setattr(cli, "_stdout_closed", lambda: False)
+    assert main(["geocode", "x", "--osm", str(BERLIN)]) == 1
+    assert "failed: BrokenPipeError" in capsys.readouterr().err

@@ -302,6 +302,7 @@ def test_serve_hands_its_loop_parser_and_access_log_to_uvicorn(
 
     seen: dict[str, Any] = {}
     monkeypatch.setattr(uvicorn, "run", lambda app, **kw: seen.update(kw, app=app))
+    monkeypatch.setattr(serve, "_check_listen", lambda host, port: None)  # port 8000 may be busy
     monkeypatch.setenv("CAMLOC_WORKERS", "0")  # restored after the test (run sets it)
     assert serve.run(_serve_args("--workers", "2")) == 0
     assert (seen["loop"], seen["http"], seen["access_log"]) == ("auto", "auto", True)
@@ -309,6 +310,36 @@ def test_serve_hands_its_loop_parser_and_access_log_to_uvicorn(
     args = _serve_args("--loop", "asyncio", "--http", "h11", "--no-access-log")
     assert serve.run(args) == 0
     assert (seen["loop"], seen["http"], seen["access_log"]) == ("asyncio", "h11", False)
+
+
+def test_serve_refuses_a_busy_port_in_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A port another server holds was found by uvicorn after the application started,
+    among its INFO lines, with its own exit status 3; it is now exit 2 before starting."""
+    import socket
+
+    import uvicorn
+
+    from camloc_geo._errors import InputError
+    from camloc_geo.cli import serve
+
+    started: list[Any] = []
+    monkeypatch.setattr(uvicorn, "run", lambda app, **kw: started.append(kw))
+    monkeypatch.setenv("CAMLOC_WORKERS", "0")
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        with pytest.raises(InputError, match=rf"--port {port}: cannot listen on .*in use"):
+            serve.run(_serve_args("--host", "127.0.0.1", "--port", str(port)))
+    assert started == []
+
+    def stops(app: str, **kw: Any) -> None:
+        raise SystemExit(3)
+
+    monkeypatch.setattr(uvicorn, "run", stops)
+    monkeypatch.setattr(serve, "_check_listen", lambda host, port: None)
+    with pytest.raises(RuntimeError, match="uvicorn status 3"):
+        serve.run(_serve_args("--port", str(port)))
 
 
 @pytest.mark.parametrize(("option", "module"), [("--loop", "uvloop"), ("--http", "httptools")])
@@ -498,3 +529,91 @@ def test_fastapi_refusals_come_in_the_service_error_shape(tmp_path: Path) -> Non
     assert method.status_code == 405
     assert method.json()["error"]["type"] == "method_not_allowed"
     assert "allow" in {k.lower() for k in method.headers}
+
+
+def test_openapi_declares_the_error_answers(tmp_path: Path) -> None:
+    """/openapi.json listed 200 and 422 only: a 401, 404, 413, 415 or 503 was undocumented
+    (schemathesis' status-code conformance check failed on every route)."""
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    spec = app.openapi()
+    app.state.compute.shutdown()
+    for path, item in spec["paths"].items():
+        for method, op in item.items():
+            assert {"401", "404", "413", "415", "503"} <= set(op["responses"]), (method, path)
+    error = spec["paths"]["/v1/locate"]["post"]["responses"]["415"]["content"]
+    assert error["application/json"]["schema"] == {"$ref": "#/components/schemas/ErrorBody"}
+    # an HTML route's errors are JSON too (FastAPI would have put them under text/html)
+    html_error = spec["paths"]["/v1/maps"]["post"]["responses"]["415"]["content"]
+    assert set(html_error) == {"application/json"}
+    assert set(spec["paths"]["/annotate/{task_id}"]["get"]["responses"]["404"]["content"]) == {
+        "application/json"
+    }
+    body = spec["components"]["schemas"]["ErrorBody"]
+    assert body["required"] == ["error", "request_id"]
+    assert set(spec["components"]["schemas"]["ErrorDetail"]["properties"]) == {
+        "type",
+        "message",
+        "field",
+    }
+
+
+def test_healthz_answers_head(tmp_path: Path) -> None:
+    """``curl -I /healthz`` (a load balancer's probe) was a 405; it is a 200 without a body."""
+    import asyncio
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def calls() -> tuple[httpx.Response, httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.head("/healthz"), await client.get("/healthz")
+
+    head, get = asyncio.run(calls())
+    app.state.compute.shutdown()
+    assert head.status_code == 200
+    assert head.content == b""
+    assert get.json()["status"] == "ok"
+    assert set(app.openapi()["paths"]["/healthz"]) == {"get"}
+
+
+def test_a_compressed_body_is_refused_by_name(tmp_path: Path) -> None:
+    """A gzip body (``Content-Encoding: gzip``) was read as JSON: "the body is not valid JSON:
+    'utf-8' codec can't decode byte 0x8b"; it is now a 415 naming the encoding, on the fast
+    path's routes too."""
+    import asyncio
+    import gzip
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    body = gzip.compress(json.dumps(SCENE).encode())
+    headers = {"content-type": "application/json", "content-encoding": "gzip"}
+
+    async def calls() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return [
+                await client.post(path, content=body, headers=headers)
+                for path in ("/v1/locate", "/v1/calibrate", "/v1/jobs")
+            ]
+
+    answers = asyncio.run(calls())
+    app.state.compute.shutdown()
+    for r in answers:
+        assert r.status_code == 415
+        assert r.json()["error"] == {
+            "type": "unsupported_media_type",
+            "message": "content encoding 'gzip' not supported; send the body uncompressed",
+            "field": "content-encoding",
+        }

@@ -283,11 +283,60 @@ def _main(argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("camloc: interrupted\n")
         return 130
+    except BrokenPipeError as exc:
+        if not _stdout_closed():  # another pipe or socket: an ordinary failure
+            if args.debug:
+                raise
+            sys.stderr.write(f"camloc {args.command}: failed: BrokenPipeError: {_one_line(exc)}\n")
+            return 1
+        # the reader closed stdout (camloc geocode ... | head): stop quietly, as Unix tools
+        # do, instead of "failed: BrokenPipeError"; stdout goes nowhere from here on, so the
+        # interpreter's own flush at exit does not complain either
+        _drop_stdout()
+        return 1
     except Exception as exc:  # the CLI boundary: never a traceback for the user
         if args.debug:
             raise
         sys.stderr.write(f"camloc {args.command}: failed: {type(exc).__name__}: {_one_line(exc)}\n")
         return 1
+
+
+def _stdout_closed() -> bool:
+    """True when stdout's reader has gone (a write or flush there raises BrokenPipeError)."""
+    import os
+
+    try:
+        sys.stdout.flush()
+        fd = sys.stdout.fileno()
+    except BrokenPipeError:
+        return True
+    except (OSError, ValueError, AttributeError):
+        return False
+    try:
+        os.write(fd, b"")
+    except BrokenPipeError:
+        return True
+    except OSError:
+        return False
+    import select
+
+    try:  # a pipe whose reader closed is "readable" (error/hang-up) for poll
+        poller = select.poll()
+        poller.register(fd, select.POLLERR | select.POLLHUP)
+        return any(ev & (select.POLLERR | select.POLLHUP) for _fd, ev in poller.poll(0))
+    except (OSError, AttributeError, ValueError):
+        return False
+
+
+def _drop_stdout() -> None:
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a descriptor (a test's)
+        pass
 
 
 def _one_line(exc: BaseException) -> str:

@@ -85,11 +85,17 @@ def junction_geojson(
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo._errors import InputError
+    from camloc_geo._io import write_text_atomic
+    from camloc_geo.cli import output_path
     from camloc_geo.scene import load_scene
     from camloc_geo.web import annotation_page_html
 
     if (args.lat is None) != (args.lon is None):
         raise InputError("give --lat and --lon together")
+    out = args.output or (Path(args.image).stem + ".annotate.html")
+    # before any work; never over the photo, the scene or the extract (-o cam.jpg replaced
+    # the photo with the page)
+    out_path = output_path(out, inputs=[args.image, args.scene, args.osm])
     lat, lon = args.lat, args.lon
     scene = load_scene(args.scene) if args.scene else None
     if args.osm and lat is None:
@@ -108,10 +114,9 @@ def run(args: argparse.Namespace) -> int:
         corners_geojson=corners,
         prior=(lat, lon) if lat is not None else None,
     )
-    out = args.output or (Path(args.image).stem + ".annotate.html")
-    if out == "-":
+    if out_path is None:
         sys.stdout.write(page)
     else:
-        Path(out).write_text(page, encoding="utf-8")
+        write_text_atomic(out_path, page)
         sys.stderr.write(f"camloc annotate: wrote {out}; open it in a browser\n")
     return 0

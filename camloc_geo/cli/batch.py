@@ -66,7 +66,21 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.batch import run_batch
+    from camloc_geo.cli import output_path
 
+    # before any work: the GeoPackage and the page never land on the list or an extract (the
+    # page used to overwrite the list with --map LIST.csv), nor on each other
+    inputs = [args.list, args.osm]
+    out = output_path(args.output, inputs=inputs)
+    if out is not None and out.suffix.lower() not in ("", ".gpkg"):
+        raise InputError(
+            f"-o {args.output}: camloc batch writes a GeoPackage; name it .gpkg "
+            "(its layers: cameras, candidates, view_cones, errors)"
+        )
+    if args.map is not None:
+        page = output_path(args.map, inputs=inputs, option="--map")
+        if page is not None and out is not None and page.resolve() == out.resolve():
+            raise InputError(f"--map {args.map}: the same file as -o; give the page its own name")
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers must be at least 1")
     if args.scheduler is not None and not args.scheduler.strip():

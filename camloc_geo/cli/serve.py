@@ -81,17 +81,54 @@ def run(args: argparse.Namespace) -> int:
         Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
         raise InputError(f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}") from None
-    uvicorn.run(
-        "camloc_geo.service:app_from_env",
-        factory=True,
-        host=args.host,
-        port=args.port,
-        log_level=args.log_level,
-        loop=args.loop,
-        http=args.http,
-        access_log=args.access_log,
-    )
+    _check_listen(args.host, args.port)
+    try:
+        uvicorn.run(
+            "camloc_geo.service:app_from_env",
+            factory=True,
+            host=args.host,
+            port=args.port,
+            log_level=args.log_level,
+            loop=args.loop,
+            http=args.http,
+            access_log=args.access_log,
+        )
+    except SystemExit as exc:  # uvicorn's own exit (3: the server could not start)
+        if exc.code in (None, 0):
+            return 0
+        raise RuntimeError(f"the server stopped (uvicorn status {exc.code}); see above") from None
     return 0
+
+
+def _check_listen(host: str, port: int) -> None:
+    """Refuse at once a host that does not resolve or a port another server holds.
+
+    uvicorn found out only after starting the application, among its INFO lines, and exited
+    with its own status 3 (``[Errno 98] ... address already in use``).
+    """
+    import socket
+
+    from camloc_geo._errors import InputError
+
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except (socket.gaierror, UnicodeError) as exc:
+        raise InputError(f"--host {host}: not an address of this machine ({exc})") from None
+    family, kind, proto, _name, address = infos[0]
+    with socket.socket(family, kind, proto) as sock:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn binds
+        try:
+            sock.bind(address)
+        except OSError as exc:
+            import errno
+
+            reason = exc.strerror or str(exc)
+            if exc.errno == errno.EADDRINUSE:
+                raise InputError(
+                    f"--port {port}: cannot listen on {host}:{port}: {reason} (another server "
+                    "there? pick another --port)"
+                ) from None
+            raise InputError(f"--host {host}: cannot listen on {host}:{port}: {reason}") from None
 
 
 def _importable(module: str) -> bool:

@@ -18,6 +18,7 @@ from camloc_geo.service.errors import ERROR_STATUS, install_error_handlers
 from camloc_geo.service.fastpath import SceneFastPath
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.middleware import RequestLimits
+from camloc_geo.service.models import ERROR_RESPONSES
 from camloc_geo.service.routers import ROUTERS
 from camloc_geo.service.routers.jobs import JobRunner
 from camloc_geo.service.routers.meta import install_docs
@@ -68,7 +69,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings, app.state.maps, app.state.store = settings, maps, store
     app.state.compute = compute
     for router in ROUTERS:
-        app.include_router(router)
+        app.include_router(router, responses=ERROR_RESPONSES)
     install_error_handlers(app)
     install_docs(app)
     # (the last added is the outermost: a request's id and body limit come first)

@@ -103,6 +103,8 @@ class SceneFastPath:
                 content_type = value
             elif name == b"x-api-key" and key is None:
                 key = value
+            elif name == b"content-encoding" and value.strip().lower() not in (b"", b"identity"):
+                return False, None  # refused by the route (415), in its words
         if content_type is None:
             return False, None
         if content_type.split(b";", 1)[0].strip().lower() != b"application/json":

@@ -11,7 +11,11 @@ from fastapi import Path
 from pydantic import BaseModel, Field
 
 __all__ = [
+    "ERROR_RESPONSES",
+    "HTML_ROUTE_ERRORS",
     "CornersQuery",
+    "ErrorBody",
+    "ErrorDetail",
     "JobId",
     "JobList",
     "LocateQuery",
@@ -74,3 +78,39 @@ class JobList(BaseModel):
     "scene"}, ...]}``. A camera that is not an object fails alone, in the job's result."""
 
     cameras: list[Any]
+
+
+class ErrorDetail(BaseModel):
+    """What went wrong: ``type`` (``docs/service.md``), a one-line ``message``, the culprit."""
+
+    type: str = Field(description="invalid_scene, map_data, invalid_input, not_found...")
+    message: str
+    field: str | None = Field(default=None, description="the field, parameter or header")
+
+
+class ErrorBody(BaseModel):
+    """Every error answer of the service."""
+
+    error: ErrorDetail
+    request_id: str = Field(description="also in the X-Request-ID header and the server's log")
+
+
+ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
+    401: {"model": ErrorBody, "description": "missing or wrong X-API-Key (CAMLOC_API_KEY)"},
+    404: {"model": ErrorBody, "description": "no such job, task or path"},
+    413: {"model": ErrorBody, "description": "a body or upload over the server's limits"},
+    415: {"model": ErrorBody, "description": "a content type this endpoint does not take"},
+    503: {"model": ErrorBody, "description": "Overpass unreachable, or the time limit"},
+}
+"""The error answers every route may give, declared in ``/openapi.json`` (before, only 422
+was, and client generators and schema checkers saw 401/404/413/415/503 as undocumented)."""
+
+HTML_ROUTE_ERRORS: dict[int | str, dict[str, Any]] = {
+    code: {
+        "description": spec["description"],
+        "content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorBody"}}},
+    }
+    for code, spec in ERROR_RESPONSES.items()
+}
+""":data:`ERROR_RESPONSES` for a route whose answer is HTML: FastAPI would declare a model's
+error under the route's ``text/html``; the errors are JSON."""

@@ -321,6 +321,8 @@ class CamlocDock(QDockWidget):
         self._loading = False
         self.page_task: WorkerTask | None = None
         self.page_server: Any = None
+        self._ready_note = False
+        """A complete scene was just loaded: the guidance says so until a step is picked."""
         self.inbox = _SceneInbox()
         self.inbox.received.connect(self.receive_scene)
         self._build()
@@ -498,6 +500,7 @@ class CamlocDock(QDockWidget):
         self._stop_page()
         scene_id = os.path.splitext(os.path.basename(path))[0]
         self.annotation = Annotation(image.width(), image.height(), scene_id=scene_id)
+        self._ready_note = False
         self.annotation.image_path = os.path.basename(path)
         self.image_file = os.path.abspath(path)
         self.image_size = (image.width(), image.height())
@@ -515,6 +518,7 @@ class CamlocDock(QDockWidget):
         return True
 
     def _step_changed(self, row: int) -> None:
+        self._ready_note = False  # the analyst picked a step: its own guidance from now on
         if 0 <= row < len(STEPS):
             self.annotation.set_step(STEPS[row][0])
             self.redraw()
@@ -525,6 +529,14 @@ class CamlocDock(QDockWidget):
             self.guidance.setText(
                 "<b>Start:</b> open a snapshot. The steps below mark the car (its corner and "
                 "edges), lines along its axes and the intersection's kerb corners."
+            )
+            return
+        if self._ready_note:
+            # a complete scene just loaded: step 1's "click the corner of the car" read as
+            # if nothing were marked yet
+            self.guidance.setText(
+                "<b>Everything needed is marked: Run</b> (at the bottom of the dock).<br>To "
+                "add lines or corners, or to redo a point, pick its step below."
             )
             return
         row = [s[0] for s in STEPS].index(self.annotation.step)
@@ -539,6 +551,7 @@ class CamlocDock(QDockWidget):
         if not self.view.has_image():
             self.set_status("Open a snapshot first.")
             return
+        self._ready_note = False
         what = self.annotation.click(x, y)
         self._sync_step_row()
         self.redraw()
@@ -687,6 +700,7 @@ class CamlocDock(QDockWidget):
         self.annotation = Annotation.from_scene(scene)
         if self.image_file and not self.annotation.image_path:
             self.annotation.image_path = os.path.basename(self.image_file)
+        self._ready_note = not self.annotation.problems()
         self._settings_from_annotation()
         self._sync_step_row()
         self.redraw()

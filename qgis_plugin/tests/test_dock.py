@@ -735,3 +735,17 @@ def test_run_and_status_stay_in_sight_in_a_short_dock(dock, tmp_path):
         assert shown.height() == widget.height(), widget  # whole, not scrolled away or cut
     top = dock.run_button.mapTo(dock, dock.run_button.rect().topLeft()).y()
     assert top + dock.run_button.height() <= dock.height()
+
+
+def test_a_complete_scene_loaded_says_run_not_click_the_car(dock, tmp_path):
+    """After Load scene… of a complete scene the guidance still read "1. Car corner on the
+    ground: click the corner of the car...", as if nothing were marked; it now says that all
+    is marked and to Run, until the analyst picks a step or clicks."""
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    assert dock.load_scene(str(SAMPLE_SCENE))
+    assert "Run when ready" in dock.status.text()
+    assert dock.guidance.text().startswith("<b>Everything needed is marked: Run</b>")
+    dock.set_step("lines_length")  # the analyst picks a step: its own guidance again
+    assert "Lines parallel to the length" in dock.guidance.text()
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "again.png")))
+    assert "Everything needed" not in dock.guidance.text()

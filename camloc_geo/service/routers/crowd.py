@@ -25,7 +25,7 @@ from camloc_geo.service.deps import (
 )
 from camloc_geo.service.errors import LimitError, NotFoundError
 from camloc_geo.service.mapstore import MapStore
-from camloc_geo.service.models import TaskId, TaskQuery
+from camloc_geo.service.models import HTML_ROUTE_ERRORS, TaskId, TaskQuery
 from camloc_geo.service.routers.scenes import scene_body_doc
 from camloc_geo.service.store import Store
 from camloc_geo.service.work import locate_body
@@ -146,7 +146,7 @@ def _task(store: Store, task_id: str) -> dict[str, Any]:
     return task
 
 
-@router.get("/annotate/{task_id}", response_class=HTMLResponse)
+@router.get("/annotate/{task_id}", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
 async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HTMLResponse:
     """The annotation page in crowd mode: a submit button instead of a download."""
     task = _task(store, task_id)

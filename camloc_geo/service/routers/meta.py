@@ -36,6 +36,13 @@ async def healthz(maps: Maps) -> dict[str, Any]:
     return {"status": "ok", "version": __version__, "extracts": len(maps.extracts)}
 
 
+@router.head("/healthz", include_in_schema=False)
+async def healthz_head(maps: Maps) -> dict[str, Any]:
+    """``HEAD /healthz`` (``curl -I``, load balancers' probes) answers as ``GET`` without a
+    body; it was a 405."""
+    return await healthz(maps)
+
+
 def _assets_dir() -> Path | None:
     try:
         folder = Path(str(resources.files("fastapi_offline") / "static"))

@@ -11,7 +11,7 @@ from fastapi.responses import HTMLResponse, Response
 
 from camloc_geo.service.deps import ApiKey, SceneBytes, Workers, scene_from_raw
 from camloc_geo.service.fastpath import WorkCall
-from camloc_geo.service.models import LocateQuery
+from camloc_geo.service.models import HTML_ROUTE_ERRORS, LocateQuery
 from camloc_geo.service.work import locate_body
 
 if TYPE_CHECKING:
@@ -98,7 +98,12 @@ async def locate(
     return await workers.run_json(fn, *args)
 
 
-@router.post("/v1/maps", response_class=HTMLResponse, openapi_extra=SCENE_BODY)
+@router.post(
+    "/v1/maps",
+    response_class=HTMLResponse,
+    openapi_extra=SCENE_BODY,
+    responses=HTML_ROUTE_ERRORS,
+)
 async def review_map(body: SceneBytes, workers: Workers) -> HTMLResponse:
     """The review page of a scene's candidates: one self-contained offline HTML file."""
     return HTMLResponse(await workers.run(review_work, body.raw))
