@@ -1206,6 +1206,7 @@ def detect_vanishing_points(
     bias_deg: float | None = None,
     distortion_k1: float | None = None,
     estimate_distortion: bool = True,
+    default_focal_prior: bool = True,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -1274,6 +1275,14 @@ def detect_vanishing_points(
         into pieces. It is kept when it differs from 0 by more than twice its standard
         deviation (then the segments are undistorted and the fit redone); the result
         reports it with its sigma either way (``distortion``, ``distortion_std``).
+    default_focal_prior
+        (Default on.) Where no focal length or prior is given and the photo leaves the
+        focal length loose (warned), combine it with what cameras are (log-normal around
+        the longer side) and refit the rotation there. Off: the photo's own vanishing
+        points and focal length, with their loose sigma (what a caller that has its own
+        focal length, such as ``calibrate`` lending the photo's lines to the annotators'
+        fit, needs: the default would move the vanishing points the lines are labelled
+        with).
 
     Returns
     -------
@@ -1610,7 +1619,12 @@ def detect_vanishing_points(
     elif f_fixed is not None:
         _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias, f_free=False)
     best.f_data_n, best.data_logf_std = best.f_n, best.logf_std
-    if f_fixed is None and not has_prior and not best.logf_std <= _LOOSE_FOCAL_STD:
+    if (
+        default_focal_prior
+        and f_fixed is None
+        and not has_prior
+        and not best.logf_std <= _LOOSE_FOCAL_STD
+    ):
         # the photo leaves the focal length loose (warned): what cameras are joins in
         best = _with_default_prior(
             best, s, tau, f_bounds, prior_w, _default_focal_prior(float(w), float(h))

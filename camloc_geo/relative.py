@@ -1832,8 +1832,14 @@ def _detect_vps(
     """
     from camloc_geo import autovp
 
+    # The photo's own vanishing points: the default focal prior of a photo that leaves its
+    # focal length loose would turn them about (the annotators' fit has its own focal
+    # length), and its lines would then seem to disagree with the fit.
     return autovp.detect_vanishing_points(
-        path, distortion_k1=distortion_k1, principal_point=principal_point
+        path,
+        distortion_k1=distortion_k1,
+        principal_point=principal_point,
+        default_focal_prior=False,
     )
 
 

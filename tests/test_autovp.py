@@ -703,6 +703,30 @@ def test_unobservable_focal_length_gets_the_default_with_its_spread() -> None:
         assert res.confidence < 0.25
 
 
+def test_the_default_focal_prior_can_be_left_out_for_a_caller_with_its_own() -> None:
+    """``calibrate`` lends a photo's lines to the annotators' fit, which has its own focal
+    length: the default prior must not turn the photo's vanishing points about (it did on a
+    street photo whose focal length the lines leave loose, and its lines then seemed 6.2
+    degrees off the fit's, `tests/test_calibrate_traffic.py`)."""
+    R = cam_from_world(0.0, 0.0, 0.0)
+    segs = project_segments(R, 600.0, (800, 600), seed=2)
+    with_default = detect_vanishing_points(None, segments=segs, image_size=(800, 600))
+    own = detect_vanishing_points(
+        None, segments=segs, image_size=(800, 600), default_focal_prior=False
+    )
+    assert with_default.focal_std_rel == pytest.approx(0.35, abs=0.01)  # the default's
+    assert own.focal_std_rel > 1.0  # the photo's own: loose, and said so
+    assert any("does not fix the focal length" in w for w in own.warnings)
+    # a photo that fixes its focal length is the same either way
+    segs = project_segments(cam_from_world(30.0, 5.0, 0.0), 600.0, (800, 600), seed=2)
+    a = detect_vanishing_points(None, segments=segs, image_size=(800, 600))
+    b = detect_vanishing_points(
+        None, segments=segs, image_size=(800, 600), default_focal_prior=False
+    )
+    assert b.focal_px == a.focal_px
+    np.testing.assert_array_equal(b.vanishing_points, a.vanishing_points)
+
+
 def test_line_groups_join_collinear_pieces() -> None:
     from camloc_geo.autovp import _line_groups, _n_distinct_lines
 
