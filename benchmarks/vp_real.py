@@ -109,7 +109,13 @@ row says so):
   and the same figures for the outdoor photos looking up by more than 5 degrees (the
   Strecha photos: looking up 5 to 15 degrees; none of the sets looks up steeply, so the
   steep case, 40-80 degrees, is checked on synthetic facades only, as segments and drawn
-  into images, ``tests/test_autovp_failure_modes.py``).
+  into images, ``tests/test_autovp_failure_modes.py``);
+- where the truth gives gravity (or, for BrnoCompSpeed, the road plane's normal; for
+  nuScenes the car body's up: its localisation is 2-D plus yaw, so the vehicle's pitch and
+  roll on the road are not in it), how often the stated ``pitch_std_deg`` and
+  ``roll_std_deg`` cover the error at 1 and 2 sigma and the median error / sigma
+  (``pitch_sigma_cover_1`` ... ``roll_median_err_over_sigma``, and the median absolute
+  errors ``pitch_abs_err_median_deg``, ``roll_abs_err_median_deg``).
 
 Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 """
@@ -877,6 +883,7 @@ def main(argv: list[str] | None = None) -> int:
         ("pitch_sigma_cover_1", "pitch 1sig", "{:.2f}"),
         ("pitch_sigma_cover_2", "pitch 2sig", "{:.2f}"),
         ("pitch_median_err_over_sigma", "p err/sig", "{:.2f}"),
+        ("roll_sigma_cover_1", "roll 1sig", "{:.2f}"),
         ("roll_sigma_cover_2", "roll 2sig", "{:.2f}"),
         ("roll_median_err_over_sigma", "r err/sig", "{:.2f}"),
         ("n_refused", "refused", "{}"),
