@@ -671,3 +671,17 @@ def test_a_resubmitted_annotation_is_not_a_second_annotator(tmp_path: Path) -> N
     assert (state.json()["annotations"], state.json()["status"]) == (1, "collecting")
     assert second.json()["annotations"] == 2  # a second person's work still completes it
     assert "duplicate" not in second.json()
+
+
+def test_job_geopackage_of_a_job_with_nothing_done_is_a_geopackage(tmp_path: Path) -> None:
+    """``/v1/jobs/{id}/result?format=gpkg`` before any camera was done answered 200 with 0
+    bytes (no GeoPackage: QGIS cannot open it); both layers are now always there."""
+    import pyogrio
+
+    from camloc_geo.results import job_result_geopackage
+
+    empty = tmp_path / "empty.gpkg"
+    empty.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": []}))
+    layers = dict(pyogrio.list_layers(empty))
+    assert layers == {"cameras": "Point", "candidates": "Point"}
+    assert len(pyogrio.read_dataframe(empty, layer="cameras")) == 0
