@@ -774,21 +774,38 @@ JOB_LAYERS = (("cameras", "camera"), ("candidates", "candidate"))
 def job_result_geopackage(collection: dict[str, Any]) -> bytes:
     """A job result (:func:`job_result_geojson`) as GeoPackage bytes, EPSG:4326.
 
-    Layers ``cameras`` and ``candidates`` (a layer without features is left out); list and
-    dict properties are stored as JSON text. Needs geopandas and pyogrio.
+    Layers ``cameras`` and ``candidates``, both always there (one without features has the
+    column ``id`` only: before, it was left out, and a job with no camera done yet gave 0
+    bytes, no GeoPackage at all); list and dict properties are stored as JSON text. Needs
+    geopandas and pyogrio.
     """
     import json
     import tempfile
     from pathlib import Path
 
     import geopandas as gpd
+    import pandas as pd
     from shapely.geometry import shape
 
     with tempfile.TemporaryDirectory(prefix="camloc-job-") as tmp:
         path = Path(tmp) / "job.gpkg"
         for layer, kind in JOB_LAYERS:
             feats = [f for f in collection["features"] if f["properties"].get("kind") == kind]
+            options = {} if path.exists() else {"dataset_options": {"VERSION": "1.2"}}
             if not feats:
+                empty = gpd.GeoDataFrame(
+                    {"id": pd.Series([], dtype=str)},
+                    geometry=gpd.GeoSeries([], crs="EPSG:4326"),
+                    crs="EPSG:4326",
+                )
+                empty.to_file(
+                    path,
+                    layer=layer,
+                    driver="GPKG",
+                    engine="pyogrio",
+                    geometry_type="Point",
+                    **options,
+                )
                 continue
             rows = [
                 {
@@ -804,6 +821,5 @@ def job_result_geopackage(collection: dict[str, Any]) -> bytes:
             )
             # GeoPackage 1.2, as QGIS 3.22's GDAL 3.6 reads without a warning (1.4 is
             # pyogrio's default; camloc_geo.batch writes 1.2 for the same reason)
-            options = {} if path.exists() else {"dataset_options": {"VERSION": "1.2"}}
             frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio", **options)
-        return path.read_bytes() if path.exists() else b""
+        return path.read_bytes()

@@ -366,3 +366,20 @@ def test_summary_map_with_extract_draws_its_streets(
     assert m is not None
     assert m.radius_m == pytest.approx(245 + 150, abs=5)  # half of 490 m, plus the margin
     assert map_around([], map_source=BALTIMORE) is None
+
+
+def test_two_outputs_of_one_command_are_distinct(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``locate -o x --map x`` wrote the GeoJSON and then the page over it (exit 0, no
+    GeoJSON left); ``vp -o x.png --draw x.png`` likewise. Both are refused before any work."""
+    out = tmp_path / "same.out"
+    args = ["locate", str(SCENE), "--osm", str(BALTIMORE), "-o", str(out), "--map", str(out)]
+    assert main([*args, "--offline"]) == 2
+    err = capsys.readouterr().err
+    assert f"--map {out}: the same file as -o" in err
+    assert not out.exists()
+    png = tmp_path / "x.png"
+    assert main(["vp", str(SCENE), "-o", str(png), "--draw", str(png)]) == 2  # checked first
+    assert "the same file as -o" in capsys.readouterr().err
+    assert not png.exists()

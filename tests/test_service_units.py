@@ -617,3 +617,71 @@ def test_a_compressed_body_is_refused_by_name(tmp_path: Path) -> None:
             "message": "content encoding 'gzip' not supported; send the body uncompressed",
             "field": "content-encoding",
         }
+
+
+def test_a_resubmitted_annotation_is_not_a_second_annotator(tmp_path: Path) -> None:
+    """The same scene posted twice to a task (a retry after a lost answer, a double click on
+    Submit) counted as two annotators, and completed a two-annotator task with one person's
+    work; the repeat now gets the state back with ``duplicate: true`` and counts nothing."""
+    import asyncio
+
+    import cv2
+    import httpx
+    import numpy as np
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "baltimore.osm.pbf").symlink_to(SAMPLES / "baltimore.osm.pbf")
+    app = create_app(Settings(data_dir=tmp_path / "d", map_dir=maps, workers=0))
+    photo = cv2.imencode(".png", np.full((1080, 1920, 3), 128, np.uint8))[1].tobytes()
+    one = json.loads(json.dumps(SCENE))
+    one["annotations"] = one["annotations"][:1]
+    other = json.loads(json.dumps(SCENE))
+    other["annotations"] = other["annotations"][1:2]
+
+    async def calls() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            task = await client.post(
+                "/v1/tasks?annotations=2", content=photo, headers={"content-type": "image/png"}
+            )
+            url = f"/v1/tasks/{task.json()['id']}"
+            return [
+                task,
+                await client.post(f"{url}/annotations", json=one),
+                await client.post(f"{url}/annotations", json=one),
+                await client.get(url),
+                await client.post(f"{url}/annotations", json=other),
+            ]
+
+    task, first, again, state, second = asyncio.run(calls())
+    app.state.compute.shutdown()
+    assert task.status_code == 201
+    assert first.json() == {"annotations": 1, "needed": 2, "status": "collecting"}
+    assert again.status_code == 200
+    assert again.json() == {
+        "annotations": 1,
+        "needed": 2,
+        "status": "collecting",
+        "duplicate": True,
+    }
+    assert (state.json()["annotations"], state.json()["status"]) == (1, "collecting")
+    assert second.json()["annotations"] == 2  # a second person's work still completes it
+    assert "duplicate" not in second.json()
+
+
+def test_job_geopackage_of_a_job_with_nothing_done_is_a_geopackage(tmp_path: Path) -> None:
+    """``/v1/jobs/{id}/result?format=gpkg`` before any camera was done answered 200 with 0
+    bytes (no GeoPackage: QGIS cannot open it); both layers are now always there."""
+    import pyogrio
+
+    from camloc_geo.results import job_result_geopackage
+
+    empty = tmp_path / "empty.gpkg"
+    empty.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": []}))
+    layers = dict(pyogrio.list_layers(empty))
+    assert layers == {"cameras": "Point", "candidates": "Point"}
+    assert len(pyogrio.read_dataframe(empty, layer="cameras")) == 0

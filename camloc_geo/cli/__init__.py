@@ -46,6 +46,7 @@ __all__ = [
     "NETWORK_HELP",
     "add_map_options",
     "atomic_output",
+    "distinct_outputs",
     "inline_of",
     "main",
     "network_of",
@@ -101,6 +102,27 @@ def output_path(
     if path is None or (str(path) == "-" and not directory):
         return None
     return check_output_path(path, inputs=inputs, option=option, directory=directory)
+
+
+def distinct_outputs(*outputs: tuple[str, Path | None]) -> None:
+    """Refuse two outputs of one command naming the same file (``-o x --map x``: the last
+    written replaced the other). ``outputs`` are ``(option, path)`` pairs; None is stdout.
+
+    Raises
+    ------
+    InputError
+        Two of them are the same file (exit 2, one line naming both options).
+    """
+    seen: dict[Path, str] = {}
+    for option, path in outputs:
+        if path is None:
+            continue
+        key = path.resolve()
+        if key in seen:
+            raise InputError(
+                f"{option} {path}: the same file as {seen[key]}; give each output its own name"
+            )
+        seen[key] = option
 
 
 def write_json(

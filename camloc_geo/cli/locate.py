@@ -10,6 +10,7 @@ from camloc_geo.cli import (
     NETWORK_HELP,
     add_map_options,
     atomic_output,
+    distinct_outputs,
     inline_of,
     network_of,
     output_path,
@@ -59,8 +60,9 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.api import locate_scene
 
     inputs = [args.scene, args.osm]
-    output_path(args.output, inputs=inputs)
+    out_path = output_path(args.output, inputs=inputs)
     map_path = output_path(args.map, inputs=inputs, option="--map")
+    distinct_outputs(("-o", out_path), ("--map", map_path))
     if args.overlays is not None:
         if map_path is None:
             raise InputError("--overlays needs --map OUT.html")

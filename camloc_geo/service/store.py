@@ -235,6 +235,24 @@ class Store:
             )
         return int(n) + 1
 
+    def add_annotation_once(self, task_id: str, scene: dict[str, Any]) -> tuple[int, bool]:
+        """Store one annotator's scene unless the task has the very same one already.
+
+        Returns how many the task has now and whether this one was new: a client's retry
+        (a lost answer, a double click on Submit) must not count as another annotator.
+        """
+        with self._tx() as db:
+            rows = db.execute(
+                "SELECT scene FROM annotations WHERE task_id = ?", (task_id,)
+            ).fetchall()
+            if any(json.loads(r["scene"]) == scene for r in rows):
+                return len(rows), False
+            db.execute(
+                "INSERT INTO annotations (task_id, n, created, scene) VALUES (?, ?, ?, ?)",
+                (task_id, len(rows), time.time(), json.dumps(scene)),
+            )
+        return len(rows) + 1, True
+
     def annotations(self, task_id: str) -> list[dict[str, Any]]:
         """Every annotator's scene of a task, in arrival order."""
         rows = self._db().execute(

@@ -58,6 +58,18 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
                 order_camloc_layers(node.parent())
 
 
+LABEL_MAX_CHARS = 48
+"""A parameter's label fits the Processing dialog as QGIS first opens it (688 px): longer ones
+widened the form past it, hiding the file pickers' browse buttons; details go in the help."""
+
+
+def _helped(param: Any, text: str) -> Any:
+    """``param`` with ``text`` as its help (a tooltip in the dialog; QGIS 3.16+)."""
+    if hasattr(param, "setHelp"):
+        param.setHelp(text)
+    return param
+
+
 class _CamlocAlgorithm(QgsProcessingAlgorithm):
     """Shared parts: group, help, the worker call and the typed sinks."""
 
@@ -89,12 +101,15 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             # takes files: OSM takes both, as camloc batch --osm does; OSM_FILE is the file
             # picker for the dialog
             self.addParameter(
-                QgsProcessingParameterFile(
-                    "OSM",
-                    "Folder of OSM extracts (each camera uses the one covering it), or one "
-                    "extract's path; empty: Overpass if allowed",
-                    behavior=QgsProcessingParameterFile.Folder,
-                    optional=True,
+                _helped(
+                    QgsProcessingParameterFile(
+                        "OSM",
+                        "OSM extracts: a folder, or one extract",
+                        behavior=QgsProcessingParameterFile.Folder,
+                        optional=True,
+                    ),
+                    "Each camera uses the extract covering it, as camloc batch --osm does; "
+                    "empty: Overpass, if allowed below",
                 )
             )
             self.addParameter(
@@ -108,12 +123,15 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             )
         else:
             self.addParameter(
-                QgsProcessingParameterFile(
-                    "OSM",
-                    "OSM extract (.osm, .osm.pbf, .osm.bz2, .osm.gz); empty: Overpass if allowed",
-                    behavior=QgsProcessingParameterFile.File,
-                    fileFilter=OSM_FILTER,
-                    optional=True,
+                _helped(
+                    QgsProcessingParameterFile(
+                        "OSM",
+                        "OSM extract (empty: Overpass if allowed)",
+                        behavior=QgsProcessingParameterFile.File,
+                        fileFilter=OSM_FILTER,
+                        optional=True,
+                    ),
+                    ".osm, .osm.pbf, .osm.bz2 or .osm.gz; empty: Overpass, if allowed below",
                 )
             )
         self.addParameter(
@@ -210,19 +228,25 @@ class LocateAlgorithm(_CamlocAlgorithm):
             )
         )
         self.addParameter(
-            QgsProcessingParameterNumber(
-                "RADIUS_M",
-                "Map radius around the scene (m; empty: prior radius + 200 m)",
-                type=QgsProcessingParameterNumber.Double,
-                minValue=10,
-                optional=True,
+            _helped(
+                QgsProcessingParameterNumber(
+                    "RADIUS_M",
+                    "Map radius around the scene (m)",
+                    type=QgsProcessingParameterNumber.Double,
+                    minValue=10,
+                    optional=True,
+                ),
+                "Empty: the scene's prior radius + 200 m",
             )
         )
         self.addParameter(
-            QgsProcessingParameterBoolean(
-                "CONTEXT",
-                "Also output the map model's streets and buildings (what locate matched)",
-                defaultValue=False,
+            _helped(
+                QgsProcessingParameterBoolean(
+                    "CONTEXT",
+                    "Also output the map model (streets, buildings)",
+                    defaultValue=False,
+                ),
+                "The streets and buildings locate matched the scene against",
             )
         )
         self.addParameter(

@@ -102,6 +102,18 @@ def _output_problem(path: str, what: str) -> str | None:
     return None
 
 
+def _same_file(a: str | None, b: str | None) -> bool:
+    """Whether two paths name one file (either may not exist yet)."""
+    if not a or not b:
+        return False
+    try:
+        if os.path.exists(a) and os.path.exists(b):
+            return os.path.samefile(a, b)
+    except OSError:
+        return False
+    return os.path.abspath(a) == os.path.abspath(b)
+
+
 def _extract_problem(osm: str) -> str | None:
     """Why ``osm`` is not an OSM extract or a folder of extracts (one line), or None."""
     if os.path.isdir(osm):
@@ -830,6 +842,11 @@ class CamlocDock(QDockWidget):
     def save_scene(self, path: str) -> bool:
         """Validate the scene with the library and write it; False (status says why) if invalid."""
         problem = _output_problem(path, "scene file")
+        if problem is None and _same_file(path, self.image_file):
+            # the library would have written the scene over the photo
+            problem = f"{path} is the open snapshot; give the scene its own .json file"
+        if problem is None and _same_file(path, self.osm_edit.text().strip()):
+            problem = f"{path} is the map extract; give the scene its own .json file"
         if problem:
             self.set_status(f"not saved: {problem}")
             return False
@@ -891,6 +908,9 @@ class CamlocDock(QDockWidget):
         osm = self.osm_edit.text().strip()
         gpkg = self.results_path()
         problem = _output_problem(gpkg, "GeoPackage")
+        for other, what in ((self.image_file, "the open snapshot"), (osm, "the map extract")):
+            if problem is None and _same_file(gpkg, other):
+                problem = f"{gpkg} is {what}"  # found only after the run, as an OGR error
         if problem:
             self.set_status(f"cannot write results: {problem}; pick another GeoPackage")
             return None

@@ -341,3 +341,22 @@ def test_geocodelist_one_row_per_camera_with_status(provider, tmp_path):
     apply_style(cam_layer, "cameras")
     apply_style(cand_layer, "list_candidates")
     assert cam_layer.labeling().settings().priority > cand_layer.labeling().settings().priority
+
+
+def test_parameter_labels_fit_the_dialog(provider):
+    """Labels of 60-75 characters ("OSM extract (.osm, .osm.pbf, .osm.bz2, .osm.gz); empty:
+    Overpass if allowed") widened the form past the Processing dialog as QGIS opens it
+    (688 px, seen under Xvfb): the labels were cut and the file pickers' browse buttons
+    hidden. Labels are short now; what they left out is the parameters' help."""
+    max_chars = 48  # camloc.algorithms.LABEL_MAX_CHARS
+    long = [
+        (alg.id(), p.name(), p.description())
+        for alg in provider.algorithms()
+        for p in alg.parameterDefinitions()
+        if len(p.description()) > max_chars
+    ]
+    assert long == []
+    locate = next(a for a in provider.algorithms() if a.id() == "camloc:locate")
+    radius = locate.parameterDefinition("RADIUS_M")
+    if hasattr(radius, "help"):
+        assert "prior radius + 200 m" in radius.help()

@@ -749,3 +749,30 @@ def test_a_complete_scene_loaded_says_run_not_click_the_car(dock, tmp_path):
     assert "Lines parallel to the length" in dock.guidance.text()
     assert dock.open_snapshot(str(_snapshot(tmp_path / "again.png")))
     assert "Everything needed" not in dock.guidance.text()
+
+
+def test_scene_and_results_never_go_over_the_snapshot_or_extract(dock, qgis_iface, tmp_path):
+    """Save scene… naming the open snapshot wrote the scene's JSON over the photo, and a
+    Results GeoPackage naming the snapshot or the extract failed only after the whole run
+    with "Opening of data source in update mode failed"; both are refused at once."""
+    import shutil
+
+    snap = _snapshot(tmp_path / "snapshot.png")
+    photo = snap.read_bytes()
+    assert dock.open_snapshot(str(snap))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    extract = tmp_path / "extract.osm.pbf"
+    shutil.copy(SAMPLE_OSM, extract)
+    dock.osm_edit.setText(str(extract))
+    assert not dock.save_scene(str(snap))
+    assert "is the open snapshot" in dock.status.text()
+    assert snap.read_bytes() == photo
+    assert not dock.save_scene(str(extract))
+    assert "is the map extract" in dock.status.text()
+    for target in (snap, extract):
+        dock.gpkg_edit.setText(str(target))
+        assert dock.run() is None
+        assert "pick another GeoPackage" in dock.status.text()
+    assert snap.read_bytes() == photo
+    assert extract.read_bytes() == SAMPLE_OSM.read_bytes()

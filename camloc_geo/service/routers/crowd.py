@@ -197,15 +197,28 @@ async def submit(
             f"task's snapshot is {task['width']}×{task['height']}",
             "image",
         )
+    if body.data in store.annotations(task_id):
+        # the same scene again (a retry after a lost answer, a double click on Submit): the
+        # answer it had, not a second annotator (it used to count twice and could complete
+        # the task with one person's work)
+        return {
+            "annotations": task["annotations"],
+            "needed": task["needed"],
+            "status": task["status"],
+            "duplicate": True,
+        }
     if task["status"] != "collecting":
         raise SceneError("this task has all its annotations already", "task")
-    n = store.add_annotation(task_id, body.data)
-    if n >= task["needed"]:
+    n, new = store.add_annotation_once(task_id, body.data)
+    if new and n >= task["needed"]:
         prior = task["base_scene"].get("prior")
         status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
         store.set_task_result(task_id, status, result)
     got = cast(dict[str, Any], store.task(task_id))
-    return {"annotations": n, "needed": task["needed"], "status": got["status"]}
+    answer = {"annotations": n, "needed": task["needed"], "status": got["status"]}
+    if not new:  # an identical submission raced this one in
+        answer["duplicate"] = True
+    return answer
 
 
 @router.get("/v1/tasks/{task_id}")
