@@ -61,6 +61,9 @@ SIGMA_FOCAL_PLANE = 0.05
 SIGMA_SENSOR_TABLE = 0.05
 #: Plausible focal lengths, as multiples of the longer image side: the range autovp searches.
 PLAUSIBLE_FOCAL_REL = FOCAL_BOUNDS_REL
+F35_PLAUSIBLE_MM = (8.0, 2000.0)
+"""A ``FocalLengthIn35mmFilm`` outside this is ignored (with a warning when nothing else gives
+the focal length): a fisheye's 8 mm to a 2000 mm telephoto."""
 
 
 @dataclass(frozen=True)
@@ -138,6 +141,16 @@ def focal_from_tags(
     """
     found = _focal_from_tags(tags, width_px, height_px, sensor_db)
     if found is None:
+        f35 = _num(tags.get(_TAG_FOCAL_35MM))
+        if f35 is not None and f35 > 0.0 and not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+            # 0 is EXIF's "unknown"; anything else the photo does carry: say why it is not used
+            log.warning(
+                "%s: EXIF focal length ignored: FocalLengthIn35mmFilm is %g mm (plausible: %g to "
+                "%g mm) and no other tag gives the focal length",
+                name,
+                f35,
+                *F35_PLAUSIBLE_MM,
+            )
         return None
     lo, hi = PLAUSIBLE_FOCAL_REL
     rel = found.focal_px / max(width_px, height_px, 1)
@@ -161,7 +174,7 @@ def _focal_from_tags(
 ) -> ExifFocal | None:
     diag_px = math.hypot(width_px, height_px)
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
-    if f35 is not None and 8.0 <= f35 <= 2000.0:
+    if f35 is not None and F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
         return ExifFocal(f35 * diag_px / FULL_FRAME_DIAGONAL_MM, SIGMA_35MM, "exif-35mm")
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
     if f_mm is None:

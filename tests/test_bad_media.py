@@ -115,6 +115,39 @@ def test_an_implausible_exif_focal_length_is_ignored_with_a_warning(
     assert "plausible: 0.3 to 6" in caplog.text
 
 
+@pytest.mark.parametrize("f35", [3.0, 5000.0])
+def test_an_implausible_35mm_tag_alone_is_named(
+    f35: float, tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    # before: dropped without a word, and vp then asked for "a photo with EXIF" although the
+    # photo has one
+    from PIL import Image
+
+    from camloc_geo.exif import focal_from_exif
+
+    photo = tmp_path / "p.jpg"
+    exif = Image.Exif()
+    exif.get_ifd(0x8769).update({0xA405: int(f35)})
+    Image.new("RGB", (1280, 720), (90, 90, 90)).save(photo, exif=exif)
+    assert focal_from_exif(photo) is None
+    assert f"{photo}: EXIF focal length ignored: FocalLengthIn35mmFilm is {f35:g} mm" in caplog.text
+
+
+def test_an_unknown_35mm_tag_is_not_a_fault(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from PIL import Image
+
+    from camloc_geo.exif import focal_from_exif
+
+    photo = tmp_path / "p.jpg"
+    exif = Image.Exif()
+    exif.get_ifd(0x8769).update({0xA405: 0})  # EXIF's "unknown"
+    Image.new("RGB", (1280, 720), (90, 90, 90)).save(photo, exif=exif)
+    assert focal_from_exif(photo) is None
+    assert "ignored" not in caplog.text
+
+
 def test_exif_plausible_range_is_the_range_autovp_searches() -> None:
     from camloc_geo.autovp import FOCAL_BOUNDS_REL
     from camloc_geo.exif import PLAUSIBLE_FOCAL_REL
