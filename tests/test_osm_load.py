@@ -181,3 +181,24 @@ def test_no_streets_near_point() -> None:
 def test_bad_arguments(lat: float, lon: float, radius: float) -> None:
     with pytest.raises(MapDataError):
         load_map(OSM / "baltimore.osm.pbf", lat, lon, radius)
+
+
+def _buildings_only(path: Path) -> Path:
+    nodes = [(1, 48.0, 11.0), (2, 48.0, 11.0005), (3, 48.0004, 11.0005), (4, 48.0004, 11.0)]
+    xml = ['<?xml version="1.0" encoding="UTF-8"?>', '<osm version="0.6">']
+    xml += [f'<node id="{i}" lat="{la}" lon="{lo}" version="1"/>' for i, la, lo in nodes]
+    xml.append('<way id="10" version="1">')
+    xml += [f'<nd ref="{i}"/>' for i in (1, 2, 3, 4, 1)]
+    xml += ['<tag k="building" v="yes"/>', "</way>", "</osm>"]
+    path.write_text("\n".join(xml), encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("radius_m", [1e9, 5000.0])
+def test_an_extract_of_buildings_alone_says_so_whatever_the_radius(
+    radius_m: float, tmp_path: Path
+) -> None:
+    # before: "no streets within 1000000000 m of ..." (the radius was not what was wrong)
+    osm = _buildings_only(tmp_path / "buildings.osm")
+    with pytest.raises(MapDataError, match=r"buildings\.osm holds buildings but no streets"):
+        load_map(osm, 48.0002, 11.00025, radius_m)

@@ -332,6 +332,9 @@ def read_extract(
                 f"inside the {radius_m:.0f} m asked for: junctions beyond are missing"
             )
     if not street_ways:
+        if radius_m is None or radius_m >= max(_edge_distances_m(lat, lon, bounds).values()) * 2:
+            # the whole extract was searched: its size, not the radius, says it
+            raise MapDataError(f"OSM extract {path.name} holds buildings but no streets")
         raise MapDataError(
             f"no streets within {radius_m:.0f} m of lat={lat:.6f}, lon={lon:.6f} in {path.name}"
         )
