@@ -383,3 +383,18 @@ def test_two_outputs_of_one_command_are_distinct(
     assert main(["vp", str(SCENE), "-o", str(png), "--draw", str(png)]) == 2  # checked first
     assert "the same file as -o" in capsys.readouterr().err
     assert not png.exists()
+
+
+def test_an_unknown_option_gets_the_command_s_own_usage(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # before: the top-level usage ("camloc [-h] [--version] ... COMMAND ...") for a typo in
+    # one command's options, which says nothing of what that command takes
+    from camloc_geo.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["calibrate", "--frobnicate", "scene.json"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: camloc calibrate ")
+    assert "camloc calibrate: error: unrecognized arguments: --frobnicate" in err

@@ -249,6 +249,18 @@ def _build_parser(
     return parser
 
 
+def _command_parser(
+    parser: argparse.ArgumentParser, command: str | None
+) -> argparse.ArgumentParser:
+    """The sub-parser of ``command`` (``parser`` itself without one)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction) and command in action.choices:
+            sub = action.choices[command]
+            assert isinstance(sub, argparse.ArgumentParser)
+            return sub
+    return parser
+
+
 _LONG_RUNNING = ("batch", "serve")
 """Commands that keep the garbage collector's default thresholds (they run for hours)."""
 
@@ -286,7 +298,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     parser = _build_parser(argv, all_commands=False)
-    args = parser.parse_args(argv)
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # the command's own usage names what it takes, not the list of commands
+        _command_parser(parser, getattr(args, "command", None)).error(
+            f"unrecognized arguments: {' '.join(unknown)}"
+        )
     logging.basicConfig(
         level=logging.WARNING - 10 * min(args.verbose, 2),
         format="camloc: %(levelname)s: %(message)s",
