@@ -783,6 +783,15 @@ class CamlocDock(QDockWidget):
         except (OSError, ValueError, RecursionError) as exc:
             self.set_status(f"cannot read the scene {path}: {exc}")
             return False
+        name = os.path.basename(path)
+        # the library's own check, at load (it used to come only at Run or Save): the analyst
+        # hears at once what is wrong with the file
+        invalid = self._scene_problem(scene)
+        try:
+            Annotation.from_scene(scene)  # a wrong shape ("annotations": 5) cannot be shown
+        except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
+            self.set_status(f"cannot load the scene {name}: {invalid or exc}")
+            return False
         image = (scene.get("image") or {}).get("path")
         refused = ""
         if isinstance(image, str) and image and not self.image_file:
@@ -790,9 +799,32 @@ class CamlocDock(QDockWidget):
             if os.path.lexists(candidate) and not self.open_snapshot(candidate):
                 refused = self.status.text()
         self.receive_scene(scene)
+        if invalid:  # one line: what is wrong comes first, it is what Run and Save will refuse
+            self.set_status(
+                f"Scene {name} loaded, but it is not valid: {invalid}. Fix it (here or in the "
+                "file) before Run or Save."
+            )
         if refused:  # say why its image is not shown
             self.set_status(f"{self.status.text()} Its image was not opened: {refused}")
         return True
+
+    def _scene_problem(self, scene: dict[str, Any]) -> str | None:
+        """What the library finds wrong with a scene (its first problems, one line), or None.
+
+        None too when the worker cannot say (no Python with camloc_geo): Run says that.
+        """
+        from qgis.PyQt.QtWidgets import QApplication
+
+        QApplication.setOverrideCursor(Qt.WaitCursor)
+        try:
+            run_worker({"task": "check_scene", "scene": scene})
+        except WorkerError as exc:
+            if exc.kind not in ("SceneError", "InputError"):
+                return None
+            return " ".join(str(exc).split())
+        finally:
+            QApplication.restoreOverrideCursor()
+        return None
 
     # --- map pick --------------------------------------------------------------------------
     def _pick_toggled(self, on: bool) -> None:
