@@ -102,6 +102,16 @@ def _output_problem(path: str, what: str) -> str | None:
     return None
 
 
+def _path_from(target: str, folder: str) -> str:
+    """``target`` as a scene file in ``folder`` names it: relative when it can be, with ``/``."""
+    target = os.path.abspath(target)
+    try:
+        rel = os.path.relpath(target, os.path.abspath(folder or "."))
+    except ValueError:  # another drive (Windows): only an absolute path reaches it
+        return target
+    return rel.replace(os.sep, "/")
+
+
 def _same_file(a: str | None, b: str | None) -> bool:
     """Whether two paths name one file (either may not exist yet)."""
     if not a or not b:
@@ -882,8 +892,11 @@ class CamlocDock(QDockWidget):
         if problem:
             self.set_status(f"not saved: {problem}")
             return False
+        scene = self.scene()
+        if self.image_file:  # the scene names its photo from its own folder, where it is saved
+            scene["image"]["path"] = _path_from(self.image_file, os.path.dirname(path))
         try:
-            run_worker({"task": "check_scene", "scene": self.scene(), "save_to": path})
+            run_worker({"task": "check_scene", "scene": scene, "save_to": path})
         except WorkerError as exc:
             self.set_status(f"not saved: {exc}")
             return False
@@ -952,9 +965,14 @@ class CamlocDock(QDockWidget):
                 self.set_status(problem)
                 return None
         self._remove_results()  # their GeoPackage tables are about to be replaced
+        scene = self.scene()
+        if self.image_file:
+            # the worker runs in a folder of its own, where the bare file name the scene
+            # holds names no file
+            scene["image"]["path"] = os.path.abspath(self.image_file)
         job = {
             "task": "locate",
-            "scene": self.scene(),
+            "scene": scene,
             "osm": osm or None,
             "network": not osm,
             "context": self.context_check.isChecked(),

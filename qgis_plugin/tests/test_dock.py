@@ -806,3 +806,36 @@ def test_a_scene_is_checked_when_it_is_loaded(dock, tmp_path):
     assert dock.load_scene(str(path))
     assert "not valid" not in dock.status.text()
     assert "Scene received" in dock.status.text()
+
+
+def test_a_scene_saved_elsewhere_still_names_its_photo(dock, tmp_path):
+    """Save scene… into another folder than the snapshot's wrote "path": "snapshot.png" (the
+    bare name), which names no file beside the scene: camloc calibrate warned that the photo
+    does not exist and left it out, and Load scene… in a fresh dock opened no image. The path
+    is now the photo's from the scene's folder; the run's job names it absolutely."""
+    (tmp_path / "photos").mkdir()
+    snap = _snapshot(tmp_path / "photos" / "snapshot.png")
+    assert dock.open_snapshot(str(snap))
+    _annotate(dock)
+    dock.annotation.set_location(lat=39.2856, lon=-76.5935)
+    out = tmp_path / "scenes" / "cam.json"
+    out.parent.mkdir()
+    assert dock.save_scene(str(out)), dock.status.text()
+    saved = json.loads(out.read_text())
+    assert saved["image"]["path"] == "../photos/snapshot.png"
+    assert (out.parent / saved["image"]["path"]).resolve() == snap.resolve()
+    same = tmp_path / "photos" / "cam.json"
+    assert dock.save_scene(str(same))
+    assert json.loads(same.read_text())["image"]["path"] == "snapshot.png"
+    dock.image_file = None  # a fresh dock: Load scene… opens the photo the scene names
+    dock.view.clear_overlays()
+    assert dock.load_scene(str(out))
+    assert dock.image_file is not None
+    assert os.path.samefile(dock.image_file, snap)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    task = dock.run()
+    assert task is not None
+    assert task.job["scene"]["image"]["path"] == str(snap.resolve())
+    dock.cancel()
+    assert dock.wait(60)
