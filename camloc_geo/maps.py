@@ -885,6 +885,28 @@ def _new_map(offline: bool, tiles: str | None, location: Sequence[float]) -> fol
 
 
 # ------------------------------------------------------------------------ candidate map
+def _left_out_html(cal: Mapping[str, Any], collection: Mapping[str, Any]) -> str:
+    """The title's line naming the annotators the calibration left out, and why (the
+    calibration's own warnings about them, at most two); empty when none was."""
+    left = [str(a) for a in cal.get("outlier_annotators") or []]
+    if not left:
+        return ""
+    why = [
+        str(w)
+        for w in collection.get("warnings") or []
+        if any(f"annotator {a!r}" in str(w) for a in left)
+    ][:2]
+    text = f"left out: annotator{'s' if len(left) > 1 else ''} " + ", ".join(left)
+    return (
+        '<small class="camloc-left-out" '
+        'style="display:block;max-width:300px;white-space:normal"><b>'
+        + html.escape(text)
+        + "</b>"
+        + "".join(f"<br>{html.escape(w)}" for w in why)
+        + "</small>"
+    )
+
+
 def build_candidates_map(
     result: LocateResult,
     map_data: MapData | None,
@@ -1092,6 +1114,7 @@ def build_candidates_map(
         f"<br><small>calibration: f = {_fmt(cal['focal_px'], ' px', 0)}, h = "
         f"{_fmt(cal['height_m'], ' m', 1)} ({html.escape(str(cal['method']))})</small>"
     )
+    title += _left_out_html(cal, collection)
     if not cands:
         title += f"<br><b>no candidates</b>: {html.escape(str(result.reason))}"
     _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)

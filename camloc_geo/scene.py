@@ -798,7 +798,9 @@ def _check_sizes(data: dict[str, Any]) -> None:
         items = data.get(key)
         if isinstance(items, list) and len(items) > limit:
             raise SceneError(f"{len(items)} {what}; the limit is {limit}", key)
-    for i, ann in enumerate(data.get("annotations") or []):
+    anns = data.get("annotations")
+    # a wrong type ("annotations": 5) is left to the validation, which names the field
+    for i, ann in enumerate(anns if isinstance(anns, list) else []):
         lines = ann.get("vp_lines") if isinstance(ann, dict) else None
         if not isinstance(lines, dict):
             continue

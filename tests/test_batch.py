@@ -485,3 +485,36 @@ def test_cli_batch_outputs_never_overwrite_the_list(
         assert message in capsys.readouterr().err
         assert lst.read_text(encoding="utf-8") == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cams.csv"]  # no journal either
+
+
+def test_cli_batch_warns_of_duplicate_camera_ids(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two rows with one id (a list pasted twice, a copied row) were accepted without a word,
+    and anything joining the GeoPackage on ``id`` mixed the cameras up; the run still does
+    every row, and names the ids on stderr, in the summary's warnings and in ``errors``."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text(
+        "id,title\ncam1,A & B\ncam2,C & D\ncam1,E & F\nbroken,\ncam2,G & H\ncam1,I & J\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "o.gpkg"
+    assert main(["batch", str(lst), "-o", str(out), "--workers", "1", "--no-progress"]) == 0
+    err = capsys.readouterr().err
+    assert "camloc batch: warning: cams.csv: 2 camera id(s) used on more than one row:" in err
+    assert "'cam1' on rows 1, 3, 6; 'cam2' on rows 2, 5" in err
+    cams = pyogrio.read_dataframe(out, layer="cameras")
+    assert cams["row"].tolist() == [1, 2, 3, 4, 5, 6]  # every row kept
+    assert cams["n_errors"].tolist()[0] >= 1  # the id's own errors row is counted
+    errs = pyogrio.read_dataframe(out, layer="errors")
+    dup = errs[errs["stage"] == "list"].sort_values("row")
+    assert dup["row"].tolist() == [1, 2, 3, 5, 6]
+    assert dup["message"].tolist()[0] == "camera id 'cam1' is also used by row(s) 3, 6 of the list"
+    assert dup["message"].tolist()[3] == "camera id 'cam2' is also used by row(s) 2 of the list"
+    summary = run_batch(lst, out_gpkg=out, progress=False, workers=1)  # resumed: still warned
+    assert len(summary.warnings) == 1
+    assert "'cam1' on rows 1, 3, 6" in summary.warnings[0]
+    assert summary.to_dict()["warnings"] == summary.warnings
+    lst.write_text("id,title\ncam1,A & B\ncam2,C & D\n", encoding="utf-8")
+    clean = run_batch(lst, out_gpkg=tmp_path / "c.gpkg", progress=False, workers=1)
+    assert clean.warnings == []

@@ -653,3 +653,83 @@ def test_car_line_warning_agrees_with_calibrate_on_real_cars(
         st = {"axes": ann["axes"], "lines": ann["vp_lines"]}
         cl = tab.page.evaluate("(st) => camlocGeometry.carLines(st)", st)
         assert sorted(k for k, v in cl.items() if v["warn"]) == warned, ann["annotator"]
+
+
+def test_a_reload_keeps_the_work_until_it_is_saved(tab: Tab, files: dict[str, Any]) -> None:
+    """A reload, the back button or a closed tab lost every click (nothing kept the work, and
+    nothing asked); now the page keeps unsaved work in the browser and restores it when
+    opened again, Undo goes back to the page as it opened, and a save forgets it."""
+    ann = files["truth"]["annotations"][0]
+    tab.open(files["page"])
+    page = tab.page
+    for k in ("origin", "length"):
+        tab.click_image(*ann["axes"][k])
+    clicked = tab.state()["axes"]
+    assert clicked["origin"] is not None
+    assert clicked["length"] is not None
+    page.reload(wait_until="load")
+    page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+    restored = tab.state()["axes"]
+    assert restored["origin"] == pytest.approx(clicked["origin"])
+    assert restored["length"] == pytest.approx(clicked["length"])
+    assert restored["width"] is None
+    assert "unsaved work on this photo" in page.inner_text("#save-status")
+    tab.shot("15_restored_after_reload")
+    tab.open(files["review"])  # another page of the same photo (a scene to review): not this draft
+    review = tab.state()["axes"]["origin"]
+    assert review == pytest.approx(files["truth"]["annotations"][0]["axes"]["origin"])
+    assert "unsaved work" not in page.inner_text("#save-status")
+    tab.open(files["page"])
+    assert tab.state()["axes"]["origin"] == pytest.approx(clicked["origin"])
+    page.click("#btn-undo")  # back to the page as it opened
+    assert tab.state()["axes"]["origin"] is None
+    page.click("#btn-redo")
+    assert tab.state()["axes"]["origin"] == pytest.approx(clicked["origin"])
+    tab.save()  # saved: nothing to restore any more
+    page.reload(wait_until="load")
+    page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+    assert tab.state()["axes"]["origin"] is None
+    assert "unsaved work" not in page.inner_text("#save-status")
+    # leaving with unsaved clicks asks first (the browser's "Leave site?")
+    asked: list[str] = []
+    page.on("dialog", lambda d: (asked.append(d.type), d.accept()))
+    tab.click_image(*ann["axes"]["origin"])
+    page.close(run_before_unload=True)
+    other = tab.context.new_page()  # events are delivered while Playwright waits
+    deadline = time.monotonic() + 5
+    while not asked and time.monotonic() < deadline:
+        other.wait_for_timeout(50)
+    assert asked == ["beforeunload"]
+
+
+def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path) -> None:
+    """On a 390x844 phone the 360 px panel left the photo a 30 px strip beside it (seen in a
+    Chromium screenshot): nothing could be clicked. Under 720 px the photo is on top, the
+    steps under it, and a tap places a point."""
+    context = browser.new_context(
+        viewport={"width": 390, "height": 844}, has_touch=True, is_mobile=True
+    )
+    page = context.new_page()
+    errors: list[str] = []
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    page.route(
+        "**/*",
+        lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+    )
+    try:
+        page.goto(files["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        box = page.locator("#canvas").bounding_box()
+        assert box is not None
+        assert box["width"] == pytest.approx(390, abs=1)
+        assert box["height"] >= 400
+        assert page.locator("#btn-save").bounding_box()["y"] >= box["y"] + box["height"] - 1
+        x, y = page.evaluate("camloc.screenFromImage(700, 500)")
+        page.tap("#canvas", position={"x": x - box["x"], "y": y - box["y"]})
+        origin = page.evaluate("camloc.state()")["axes"]["origin"]
+        assert origin == pytest.approx([700, 500], abs=2)
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "16_phone.png"))
+        assert errors == []
+    finally:
+        context.close()

@@ -576,3 +576,30 @@ def test_tiny_scores_are_not_printed_as_zero(tied_page: str, tied: Any) -> None:
     score1 = tied.result.candidates[0].score
     assert f'data-legend-rank="1">1: {score1:.3f}' in page
     assert f"#5 score {score5:.1e}" in page  # the marker's tooltip
+
+
+def test_review_map_names_the_annotators_left_out(
+    tmp_path: Path, fremantle: MapData, scene_result: tuple[Scene, LocateResult]
+) -> None:
+    """A crowd task whose annotator drew every line on the wrong axis: its result says the
+    annotator was left out, but the review page (POST /v1/maps on the task's merged scene)
+    showed only the candidates, as if all three annotators had agreed."""
+    import copy
+
+    scene, res = scene_result
+    page = tmp_path / "plain.html"
+    maps.candidates_map(res, fremantle, page, offline=True, scene=scene)
+    assert "left out" not in page.read_text(encoding="utf-8")
+    bad = copy.deepcopy(res)
+    why = (
+        "annotator 'w2' (annotations[2]) left out: vp_lines.length: 3 of 3 segments disagree "
+        "with everybody else's (drawn for another axis?)"
+    )
+    bad.calibration.outlier_annotators = ["w2"]
+    bad.calibration.warnings = [*bad.calibration.warnings, why]
+    page = tmp_path / "left_out.html"
+    maps.candidates_map(bad, fremantle, page, offline=True, scene=scene)
+    text = page.read_text(encoding="utf-8")
+    # the title control's HTML, as the page's script holds it (JSON-escaped)
+    assert "\\u003cb\\u003eleft out: annotator w2\\u003c/b\\u003e" in text
+    assert "(annotations[2]) left out: vp_lines.length: 3 of 3 segments disagree" in text

@@ -140,6 +140,10 @@ def test_missing_file() -> None:
             "finite",
         ),
         (lambda d: d.__setitem__("camera", {"focal_px": 0}), "camera.focal_px", "greater than 0"),
+        # was a TypeError ("'int' object is not iterable") from the size check, before the
+        # validation: "camloc calibrate: failed: TypeError", exit 1; the QGIS dock's load
+        (lambda d: d.__setitem__("annotations", 5), "annotations", "a valid list (got 5)"),
+        (lambda d: d.__setitem__("annotations", "x"), "annotations", "a valid list"),
         (
             lambda d: d.__setitem__("landmarks", [{"pixel": [1, 1], "kind": "tree", "name": "x"}]),
             "landmarks[0].kind",

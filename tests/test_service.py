@@ -369,8 +369,22 @@ def test_crowd_task_collects_and_locates(client: httpx.Client) -> None:
         r = client.post(f"/v1/tasks/{task['id']}/annotations", json=one)
         assert r.status_code == 200, r.text
         assert r.json()["annotations"] == i + 1
+        if i == 0:  # no map before the task is located: said in the service's error shape
+            early = client.get(f"/v1/tasks/{task['id']}/map")
+            assert early.status_code == 404
+            assert early.json()["error"]["message"] == (
+                f"task {task['id']} has no map: it is collecting (1 of 2 annotations)"
+            )
+            assert "map_url" not in client.get(f"/v1/tasks/{task['id']}").json()
     st = client.get(f"/v1/tasks/{task['id']}").json()
     assert st["status"] == "located", st
+    # the task's review page: there was none (a client had to POST the merged scene to
+    # /v1/maps itself)
+    assert st["map_url"] == f"/v1/tasks/{task['id']}/map"
+    page = client.get(st["map_url"])
+    assert page.status_code == 200, page.text
+    assert page.headers["content-type"].startswith("text/html")
+    assert "camloc-candidate" in page.text
     cands = [
         f for f in st["result"]["candidates"]["features"] if f["properties"]["kind"] == "candidate"
     ]

@@ -117,6 +117,29 @@ class Journal:
             raise
         return len(rows)
 
+    def duplicate_ids(self, limit: int = 20) -> dict[str, list[int]]:
+        """Camera ids recorded on more than one row: ``{id: [row, ...]}``, at most ``limit`` ids.
+
+        Counted by SQLite (an index-free ``GROUP BY``), so memory stays bounded whatever the
+        length of the list.
+        """
+        out: dict[str, list[int]] = {}
+        for i, rows in self.db.execute(
+            "SELECT id, group_concat(row) FROM (SELECT id, row FROM done ORDER BY row) "
+            "GROUP BY id HAVING COUNT(*) > 1 ORDER BY MIN(row) LIMIT ?",
+            (int(limit),),
+        ):
+            out[str(i)] = sorted(int(r) for r in str(rows).split(","))
+        return out
+
+    def n_duplicate_ids(self) -> int:
+        """How many camera ids are recorded on more than one row."""
+        return int(
+            self.db.execute(
+                "SELECT COUNT(*) FROM (SELECT id FROM done GROUP BY id HAVING COUNT(*) > 1)"
+            ).fetchone()[0]
+        )
+
     def count(self) -> int:
         """Cameras recorded."""
         return int(self.db.execute("SELECT COUNT(*) FROM done").fetchone()[0])

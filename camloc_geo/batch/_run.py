@@ -41,6 +41,8 @@ __all__ = ["BatchSummary", "process_chunk", "run_batch"]
 log = logging.getLogger(__name__)
 
 DEFAULT_CHUNK_SIZE = 16
+_NAMED_DUPLICATE_IDS = 10  # ids named in the warning line
+_MAX_DUPLICATE_IDS = 100_000  # ids whose rows get an ``errors`` row in the GeoPackage
 _WINDOW_ROWS = 1024
 
 
@@ -69,6 +71,10 @@ class BatchSummary:
     repeats
         Cameras computed by this run whose listing (no scene) a worker had already geocoded:
         its answer was reused.
+    warnings
+        What the run noticed about the list without refusing it, one line each (a camera id
+        used on more than one row). Also in the GeoPackage's ``errors`` layer (stage
+        ``list``) and, from ``camloc batch``, on stderr.
     """
 
     total: int
@@ -81,6 +87,7 @@ class BatchSummary:
     stage_s: dict[str, float] = field(default_factory=dict)
     elapsed_s: float = 0.0
     repeats: int = 0
+    warnings: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able summary."""
@@ -95,6 +102,7 @@ class BatchSummary:
             "stage_s": {k: round(v, 3) for k, v in self.stage_s.items()},
             "elapsed_s": round(self.elapsed_s, 3),
             "repeats": self.repeats,
+            "warnings": list(self.warnings),
         }
 
 
@@ -468,8 +476,10 @@ def run_batch(
         )
         if not first_pass:
             total = counted.n
+        dups = journal.duplicate_ids(limit=_MAX_DUPLICATE_IDS)
+        warnings = _duplicate_warnings(dups, journal.n_duplicate_ids(), list_p.name)
         t = time.perf_counter()
-        _write_gpkg(journal, out)
+        _write_gpkg(journal, out, duplicates=dups)
         stage["gpkg"] += time.perf_counter() - t
         map_path = None
         if summary_map is not None:
@@ -490,7 +500,22 @@ def run_batch(
         stage_s=dict(stage),
         elapsed_s=time.perf_counter() - t_start,
         repeats=counts["repeats"],
+        warnings=warnings,
     )
+
+
+def _duplicate_warnings(dups: dict[str, list[int]], n_dups: int, list_name: str) -> list[str]:
+    """The one line naming the camera ids used on more than one row (none: no line)."""
+    if not dups:
+        return []
+    shown = list(dups.items())[:_NAMED_DUPLICATE_IDS]
+    named = "; ".join(f"{cid!r} on rows {', '.join(str(r) for r in rows)}" for cid, rows in shown)
+    more = f" (and {n_dups - len(shown)} more)" if n_dups > len(shown) else ""
+    return [
+        f"{list_name}: {n_dups} camera id(s) used on more than one row: {named}{more}; each "
+        "row is geocoded and kept (rows tell them apart), but anything joining on id will "
+        "mix them up: give each camera its own id"
+    ]
 
 
 def _run_chunks(
@@ -678,7 +703,21 @@ def _points(lonlat: list[tuple[Any, Any]]) -> Any:
     return geoms
 
 
-def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
+def _duplicate_error(r: dict[str, Any], duplicates: dict[str, list[int]]) -> dict[str, Any] | None:
+    """The ``errors`` row of a camera whose id another row of the list uses too."""
+    rows = duplicates.get(str(r.get("id")))
+    if not rows or len(rows) < 2:
+        return None
+    others = ", ".join(str(o) for o in rows if o != r.get("row"))
+    return {
+        "stage": "list",
+        "message": f"camera id {r.get('id')!r} is also used by row(s) {others} of the list",
+    }
+
+
+def _layers_of(
+    records: list[dict[str, Any]], duplicates: dict[str, list[int]] | None = None
+) -> dict[str, Any]:
     from shapely.geometry import Polygon
 
     cams, cands, cones, cone_g, errs = [], [], [], [], []
@@ -688,7 +727,11 @@ def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
         cam = {k: r.get(k) for k in _CAMERA_COLUMNS}
         for k in ("names_read", "names_matched", "match_kinds"):
             cam[k] = " | ".join(r.get(k) or []) or None
-        cam["n_errors"] = len(r.get("errors") or [])
+        errors = list(r.get("errors") or [])
+        dup = _duplicate_error(r, duplicates or {})
+        if dup is not None:
+            errors.append(dup)
+        cam["n_errors"] = len(errors)
         cams.append(cam)
         cam_xy.append((r.get("lon"), r.get("lat")))
         for c in r.get("candidates") or []:
@@ -698,7 +741,7 @@ def _layers_of(records: list[dict[str, Any]]) -> dict[str, Any]:
         for c in r.get("cones") or []:
             cones.append({**c, "row": r["row"], "id": r["id"]})
             cone_g.append(Polygon(c["lonlat"]))
-        for e in r.get("errors") or []:
+        for e in errors:
             errs.append({**e, "row": r["row"], "id": r["id"], "status": r["status"]})
     cam_g, cand_g = _points(cam_xy), _points(cand_xy)
     return {
@@ -717,8 +760,17 @@ GPKG_VERSION = "1.2"
 ("user_version ... v1.4.0 may only be partially supported"); 1.2 is what that QGIS writes."""
 
 
-def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
-    """Build the GeoPackage from the journal, a page of cameras at a time, then swap it in."""
+def _write_gpkg(
+    journal: Journal,
+    out: Path,
+    page: int = 5000,
+    duplicates: dict[str, list[int]] | None = None,
+) -> None:
+    """Build the GeoPackage from the journal, a page of cameras at a time, then swap it in.
+
+    ``duplicates`` (``{id: rows}``, :meth:`Journal.duplicate_ids`) adds a ``list`` stage row
+    to the ``errors`` layer for each camera whose id another row uses too.
+    """
     import pyogrio
 
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -729,7 +781,7 @@ def _write_gpkg(journal: Journal, out: Path, page: int = 5000) -> None:
     buf: list[dict[str, Any]] = []
 
     def flush(final: bool) -> None:
-        layers = _layers_of(buf)
+        layers = _layers_of(buf, duplicates)
         for name, df in layers.items():
             if len(df) == 0 and (name in started or not final):
                 continue

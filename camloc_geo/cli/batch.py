@@ -99,6 +99,8 @@ def run(args: argparse.Namespace) -> int:
         restart=args.restart,
         offline_map=not args.online_map,
     )
+    for line in summary.warnings:
+        sys.stderr.write(f"camloc batch: warning: {line}\n")
     counts = ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))
     sys.stderr.write(
         f"camloc batch: {summary.total} cameras ({summary.computed} computed, "

@@ -1209,7 +1209,63 @@
       renderPanel();
     }
     $("save-status").textContent = lastSaved && lastSaved !== JSON.stringify(buildScene()) ? "Changed since the last save." : ($("save-status").textContent || "");
+    keepDraft();
   }
+
+  // ------------------------------------------------------------------ unsaved work
+  /* Work not yet saved or submitted is kept in this browser (localStorage, per photo and
+     task) after every change, and restored when the page is opened again: a reload, the back
+     button or a closed tab used to lose every click. Saving or submitting forgets it. */
+  function fingerprint(text) {
+    var h = 2166136261, stride = Math.max(1, Math.floor(text.length / 4096));
+    for (var i = 0; i < text.length; i += stride) { h ^= text.charCodeAt(i); h = Math.imul(h, 16777619); }
+    return (h >>> 0).toString(16) + ":" + text.length;
+  }
+  var DRAFT_KEY = "camloc-draft|" + [config.mode || "file", config.submitUrl || "", config.image.name, W, H,
+    fingerprint(document.getElementById("camloc-image").textContent.trim()),
+    // the scene the page opens with: another page of the same photo (a review of a scene)
+    // never picks up this one's draft
+    fingerprint(JSON.stringify(config.scene || null))].join("|");
+  var pristine = null;    // this page's state (clicks) as it opened or was last saved/submitted
+  function draftStore() { try { return window.localStorage || null; } catch (e) { return null; } }
+  function unsaved() { return pristine !== null && snapshot() !== pristine; }
+  function keepDraft() {
+    var st = draftStore();
+    if (!st || pristine === null) return;
+    try {
+      if (unsaved()) st.setItem(DRAFT_KEY, JSON.stringify({ state: S, base: base, step: step, saved: Date.now() }));
+      else st.removeItem(DRAFT_KEY);
+    } catch (e) { /* full or forbidden: the page works without it */ }
+  }
+  function markSaved() { pristine = snapshot(); keepDraft(); }
+  function restoreDraft() {
+    var st = draftStore(), d = null;
+    if (!st) return false;
+    try { d = JSON.parse(st.getItem(DRAFT_KEY) || "null"); } catch (e) { d = null; }
+    var ok = d && d.state && d.state.axes && d.state.lines && Array.isArray(d.state.corners);
+    if (!ok || JSON.stringify(d.state) === pristine) return false;
+    if (d.base && validateScene(d.base)) return false;
+    var before = snapshot();
+    base = d.base || base;
+    S = Object.assign(emptyState(), d.state);
+    undoStack = [before];  // Undo goes back to the page as it opened
+    redoStack = [];
+    step = typeof d.step === "number" ? Math.max(0, Math.min(STEPS.length - 1, d.step)) : firstIncompleteStep();
+    changed();
+    var when = new Date(d.saved || Date.now());
+    var msg = "Your unsaved work on this photo (" + when.toLocaleString() + ") was restored. " +
+      (config.mode === "crowd" ? "Submit it when done" : "Save it when done") + "; Undo goes back to the page as it opened.";
+    $("save-status").textContent = msg;
+    flash(msg, true);
+    return true;
+  }
+  window.addEventListener("beforeunload", function (e) {
+    if (!unsaved()) return undefined;
+    keepDraft();
+    e.preventDefault();
+    e.returnValue = "";  // the browser asks "Leave site? Changes you made may not be saved."
+    return "";
+  });
   function renderPanelKeepForm(f) {
     var saved = Array.prototype.slice.call(f.childNodes);
     renderPanel();
@@ -1253,6 +1309,7 @@
           return r.text().then(function (t) {
             if (!r.ok) throw new Error(t || ("HTTP " + r.status));
             lastSaved = JSON.stringify(sc);
+            markSaved();
             $("save-status").textContent = "Submitted. Thank you!";
             flash("Submitted. Thank you!", true);
           });
@@ -1267,6 +1324,7 @@
     a.click();
     a.remove();
     lastSaved = JSON.stringify(sc);
+    markSaved();
     $("save-status").textContent = miss.length ?
       "Saved " + a.download + ", but incomplete: " + miss.join("; ") + "." :
       "Saved " + a.download + ". Check it with: camloc calibrate " + a.download;
@@ -1284,6 +1342,7 @@
       if (err) { fatal("Cannot open " + file.name + ": " + err + "."); return; }
       loadScene(sc, 0);
       lastSaved = JSON.stringify(buildScene());
+      markSaved();  // what the file holds is saved already
       flash("Opened " + file.name + ": review the points, drag any that are off, then save.", true);
     };
     reader.onerror = function () { fatal("Cannot read " + file.name + "."); };
@@ -1435,6 +1494,8 @@
   } else {
     changed();
   }
+  pristine = snapshot();
+  restoreDraft();
   try { setupMap(); } catch (e) { $("map-box").hidden = true; }
   renderPanel();
 

@@ -102,6 +102,16 @@ def _output_problem(path: str, what: str) -> str | None:
     return None
 
 
+def _path_from(target: str, folder: str) -> str:
+    """``target`` as a scene file in ``folder`` names it: relative when it can be, with ``/``."""
+    target = os.path.abspath(target)
+    try:
+        rel = os.path.relpath(target, os.path.abspath(folder or "."))
+    except ValueError:  # another drive (Windows): only an absolute path reaches it
+        return target
+    return rel.replace(os.sep, "/")
+
+
 def _same_file(a: str | None, b: str | None) -> bool:
     """Whether two paths name one file (either may not exist yet)."""
     if not a or not b:
@@ -783,6 +793,15 @@ class CamlocDock(QDockWidget):
         except (OSError, ValueError, RecursionError) as exc:
             self.set_status(f"cannot read the scene {path}: {exc}")
             return False
+        name = os.path.basename(path)
+        # the library's own check, at load (it used to come only at Run or Save): the analyst
+        # hears at once what is wrong with the file
+        invalid = self._scene_problem(scene)
+        try:
+            Annotation.from_scene(scene)  # a wrong shape ("annotations": 5) cannot be shown
+        except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
+            self.set_status(f"cannot load the scene {name}: {invalid or exc}")
+            return False
         image = (scene.get("image") or {}).get("path")
         refused = ""
         if isinstance(image, str) and image and not self.image_file:
@@ -790,9 +809,32 @@ class CamlocDock(QDockWidget):
             if os.path.lexists(candidate) and not self.open_snapshot(candidate):
                 refused = self.status.text()
         self.receive_scene(scene)
+        if invalid:  # one line: what is wrong comes first, it is what Run and Save will refuse
+            self.set_status(
+                f"Scene {name} loaded, but it is not valid: {invalid}. Fix it (here or in the "
+                "file) before Run or Save."
+            )
         if refused:  # say why its image is not shown
             self.set_status(f"{self.status.text()} Its image was not opened: {refused}")
         return True
+
+    def _scene_problem(self, scene: dict[str, Any]) -> str | None:
+        """What the library finds wrong with a scene (its first problems, one line), or None.
+
+        None too when the worker cannot say (no Python with camloc_geo): Run says that.
+        """
+        from qgis.PyQt.QtWidgets import QApplication
+
+        QApplication.setOverrideCursor(Qt.WaitCursor)
+        try:
+            run_worker({"task": "check_scene", "scene": scene})
+        except WorkerError as exc:
+            if exc.kind not in ("SceneError", "InputError"):
+                return None
+            return " ".join(str(exc).split())
+        finally:
+            QApplication.restoreOverrideCursor()
+        return None
 
     # --- map pick --------------------------------------------------------------------------
     def _pick_toggled(self, on: bool) -> None:
@@ -850,8 +892,11 @@ class CamlocDock(QDockWidget):
         if problem:
             self.set_status(f"not saved: {problem}")
             return False
+        scene = self.scene()
+        if self.image_file:  # the scene names its photo from its own folder, where it is saved
+            scene["image"]["path"] = _path_from(self.image_file, os.path.dirname(path))
         try:
-            run_worker({"task": "check_scene", "scene": self.scene(), "save_to": path})
+            run_worker({"task": "check_scene", "scene": scene, "save_to": path})
         except WorkerError as exc:
             self.set_status(f"not saved: {exc}")
             return False
@@ -920,9 +965,14 @@ class CamlocDock(QDockWidget):
                 self.set_status(problem)
                 return None
         self._remove_results()  # their GeoPackage tables are about to be replaced
+        scene = self.scene()
+        if self.image_file:
+            # the worker runs in a folder of its own, where the bare file name the scene
+            # holds names no file
+            scene["image"]["path"] = os.path.abspath(self.image_file)
         job = {
             "task": "locate",
-            "scene": self.scene(),
+            "scene": scene,
             "osm": osm or None,
             "network": not osm,
             "context": self.context_check.isChecked(),

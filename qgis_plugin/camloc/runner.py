@@ -35,7 +35,15 @@ _found: dict[str, tuple[str, str] | None] = {}
 
 
 class WorkerError(Exception):
-    """The worker failed; the message names the problem (shown as a Processing error)."""
+    """The worker failed; the message names the problem (shown as a Processing error).
+
+    ``kind`` is the library's exception class name when the worker answered with one
+    (``SceneError``, ``InputError``...), None when the worker itself failed or is missing.
+    """
+
+    def __init__(self, message: str, kind: str | None = None) -> None:
+        super().__init__(message)
+        self.kind = kind
 
 
 class WorkerCanceledError(WorkerError):
@@ -313,7 +321,11 @@ def _run_in(
             + (": " + " | ".join(tail) if tail else "")
         )
     if not final.get("ok"):
-        raise WorkerError(str(final.get("error") or "the camloc worker failed"))
+        kind = final.get("kind")
+        raise WorkerError(
+            str(final.get("error") or "the camloc worker failed"),
+            kind=str(kind) if kind else None,
+        )
     if log and stderr.strip():
         for ln in stderr.strip().splitlines()[-20:]:
             log(ln)

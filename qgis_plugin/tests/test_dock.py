@@ -719,7 +719,8 @@ def test_a_scene_whose_image_is_refused_says_why(dock, tmp_path):
     assert dock.load_scene(str(path))
     assert not dock.view.has_image()
     text = dock.status.text()
-    assert "Scene received" in text
+    # the scene has no image size: said at load (it was "Scene received", then Run refused)
+    assert text.startswith("Scene cam.json loaded, but it is not valid: image.width: required")
     assert "Its image was not opened" in text
     assert "the file is empty (0 bytes)" in text
 
@@ -776,3 +777,65 @@ def test_scene_and_results_never_go_over_the_snapshot_or_extract(dock, qgis_ifac
         assert "pick another GeoPackage" in dock.status.text()
     assert snap.read_bytes() == photo
     assert extract.read_bytes() == SAMPLE_OSM.read_bytes()
+
+
+def test_a_scene_is_checked_when_it_is_loaded(dock, tmp_path):
+    """Load scene… took any JSON object: a scene breaking the contract was said to be
+    received, and only Run or Save named what was wrong (a scene of the wrong shape,
+    "annotations": 5, raised inside QGIS). Now the library's check runs at load: one line
+    names the problem; a shape the dock cannot show is refused."""
+    sample = json.loads(SAMPLE_SCENE.read_text())
+    bad = dict(sample, camera={"focal_px": -3})
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(bad))
+    assert dock.load_scene(str(path))
+    text = dock.status.text()
+    assert text.startswith("Scene bad.json loaded, but it is not valid: camera.focal_px")
+    assert "greater than 0" in text
+    assert "Fix it" in text
+    assert "\n" not in text
+    wrong = dict(sample, annotations=5)
+    path.write_text(json.dumps(wrong))
+    assert not dock.load_scene(str(path))
+    text = dock.status.text()
+    assert text == (
+        "cannot load the scene bad.json: annotations: Input should be a valid list (got 5)"
+    )
+    assert dock.annotation.axes  # the last good scene (the sample, with its lines) stays
+    path.write_text(json.dumps(sample))
+    assert dock.load_scene(str(path))
+    assert "not valid" not in dock.status.text()
+    assert "Scene received" in dock.status.text()
+
+
+def test_a_scene_saved_elsewhere_still_names_its_photo(dock, tmp_path):
+    """Save scene… into another folder than the snapshot's wrote "path": "snapshot.png" (the
+    bare name), which names no file beside the scene: camloc calibrate warned that the photo
+    does not exist and left it out, and Load scene… in a fresh dock opened no image. The path
+    is now the photo's from the scene's folder; the run's job names it absolutely."""
+    (tmp_path / "photos").mkdir()
+    snap = _snapshot(tmp_path / "photos" / "snapshot.png")
+    assert dock.open_snapshot(str(snap))
+    _annotate(dock)
+    dock.annotation.set_location(lat=39.2856, lon=-76.5935)
+    out = tmp_path / "scenes" / "cam.json"
+    out.parent.mkdir()
+    assert dock.save_scene(str(out)), dock.status.text()
+    saved = json.loads(out.read_text())
+    assert saved["image"]["path"] == "../photos/snapshot.png"
+    assert (out.parent / saved["image"]["path"]).resolve() == snap.resolve()
+    same = tmp_path / "photos" / "cam.json"
+    assert dock.save_scene(str(same))
+    assert json.loads(same.read_text())["image"]["path"] == "snapshot.png"
+    dock.image_file = None  # a fresh dock: Load scene… opens the photo the scene names
+    dock.view.clear_overlays()
+    assert dock.load_scene(str(out))
+    assert dock.image_file is not None
+    assert os.path.samefile(dock.image_file, snap)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    task = dock.run()
+    assert task is not None
+    assert task.job["scene"]["image"]["path"] == str(snap.resolve())
+    dock.cancel()
+    assert dock.wait(60)

@@ -7,6 +7,7 @@ and locates the merged scene.
 from __future__ import annotations
 
 import io
+import json
 from typing import Annotated, Any, cast
 
 from fastapi import APIRouter, Query, Request
@@ -26,7 +27,7 @@ from camloc_geo.service.deps import (
 from camloc_geo.service.errors import LimitError, NotFoundError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.models import HTML_ROUTE_ERRORS, TaskId, TaskQuery
-from camloc_geo.service.routers.scenes import scene_body_doc
+from camloc_geo.service.routers.scenes import review_work, scene_body_doc
 from camloc_geo.service.store import Store
 from camloc_geo.service.work import locate_body
 
@@ -225,7 +226,7 @@ async def submit(
 async def task_status(task_id: TaskId, store: ServiceStore) -> dict[str, Any]:
     """A task's progress, and its merged scene and candidates once located."""
     task = _task(store, task_id)
-    return {
+    answer = {
         "id": task_id,
         "status": task["status"],
         "annotations": task["annotations"],
@@ -233,3 +234,22 @@ async def task_status(task_id: TaskId, store: ServiceStore) -> dict[str, Any]:
         "image": {"width": task["width"], "height": task["height"]},
         "result": task["result"],
     }
+    if task["status"] == "located":
+        answer["map_url"] = f"/v1/tasks/{task_id}/map"
+    return answer
+
+
+@router.get("/v1/tasks/{task_id}/map", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
+async def task_map(task_id: TaskId, store: ServiceStore, workers: Workers) -> HTMLResponse:
+    """The review page of a located task (its merged scene's candidates, the annotators left
+    out named): one self-contained offline HTML file, as ``POST /v1/maps`` gives."""
+    task = _task(store, task_id)
+    if task["status"] != "located":
+        why = (
+            f"it is collecting ({task['annotations']} of {task['needed']} annotations)"
+            if task["status"] == "collecting"
+            else f"it {task['status']}: {(task['result'] or {}).get('reason') or 'no result'}"
+        )
+        raise NotFoundError(f"task {task_id} has no map: {why}", "task")
+    raw = json.dumps(task["result"]["scene"]).encode("utf-8")
+    return HTMLResponse(await workers.run(review_work, raw))
