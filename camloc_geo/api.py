@@ -24,9 +24,9 @@ import os
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any, SupportsFloat, SupportsIndex, Union
 
-from camloc_geo._errors import MapDataError, SceneError
+from camloc_geo._errors import InputError, MapDataError, SceneError
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
@@ -60,10 +60,10 @@ __all__ = [
     "vanishing_points",
 ]
 
-SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
+SceneLike = Union["Scene", dict[str, Any], str, "os.PathLike[str]"]
 """A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
 
-MapSource = Union[str, os.PathLike, "MapData", "MapCatalogue", None]
+MapSource = Union[str, "os.PathLike[str]", "MapData", "MapCatalogue", None]
 """A map: an extract or folder path, a :class:`~camloc_geo.osm.MapCatalogue`, an already
 loaded :class:`~camloc_geo.osm.MapData`, or None."""
 
@@ -71,6 +71,41 @@ DEFAULT_MIN_RADIUS_M = 300.0
 """The smallest map radius loaded around a scene (metres)."""
 
 _PRIOR_MARGIN_M = 200.0
+
+
+def _degrees(value: object, name: str) -> float:
+    """``value`` as a float of degrees, or a :class:`MapDataError` naming ``name``."""
+    if isinstance(value, bool):
+        raise MapDataError(f"{name} must be a number of degrees, got {value!r}")
+    try:
+        return float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise MapDataError(f"{name} must be a number of degrees, got {value!r}") from None
+
+
+def _metres(value: object, name: str) -> float:
+    """``value`` as a positive finite float of metres, or a :class:`MapDataError`."""
+    import math
+
+    try:
+        out = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        out = math.nan
+    if isinstance(value, bool) or not (math.isfinite(out) and out > 0):
+        raise MapDataError(f"{name} must be a positive number of metres, got {value!r}")
+    return out
+
+
+def _whole(value: object, name: str, error: type[InputError] = InputError) -> int:
+    """``value`` as an int (an int, a numpy integer), or ``error`` naming ``name``."""
+    import operator
+
+    if isinstance(value, bool):
+        raise error(f"{name} must be a whole number, got {value!r}")
+    try:
+        return operator.index(value)  # type: ignore[arg-type]
+    except TypeError:
+        raise error(f"{name} must be a whole number, got {value!r}") from None
 
 
 def scene_from(scene: SceneLike) -> Scene:
@@ -116,6 +151,8 @@ def calibrate_scene(
     from camloc_geo.relative import CalibrationSettings, calibrate
 
     sc = scene_from(scene)
+    if settings is not None and not isinstance(settings, CalibrationSettings):
+        raise InputError(f"settings must be a CalibrationSettings, not {type(settings).__name__}")
     if settings is None:
         modes = {"auto": None, "centre": False, "center": False, "free": True}
         if principal_point not in modes:
@@ -199,6 +236,7 @@ def map_for_scene(
         or the scene needs one.
     """
     sc = scene_from(scene)
+    _check_source(map_source)
     catalogue = _catalogue_of(map_source)
     loaded = catalogue is None and map_source is not None
     if loaded and not isinstance(map_source, (str, os.PathLike)):
@@ -273,7 +311,7 @@ def locate_scene(
     map_source: MapSource = None,
     network: bool = True,
     radius_m: float | None = None,
-    max_candidates: int | None = None,
+    max_candidates: SupportsIndex | None = None,
     calibration: CalibrationResult | None = None,
     settings: LocateSettings | None = None,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -302,8 +340,18 @@ def locate_scene(
     from dataclasses import replace
 
     from camloc_geo.absolute import LocateSettings, locate
+    from camloc_geo.relative import CalibrationResult
 
     sc = scene_from(scene)
+    if max_candidates is not None:
+        max_candidates = _whole(max_candidates, "max_candidates", SceneError)
+    if settings is not None and not isinstance(settings, LocateSettings):
+        raise InputError(f"settings must be a LocateSettings, not {type(settings).__name__}")
+    if calibration is not None and not isinstance(calibration, CalibrationResult):
+        raise InputError(
+            "calibration must be a CalibrationResult (from calibrate_scene), not "
+            f"{type(calibration).__name__}"
+        )
     map_data = map_for_scene(
         sc,
         map_source=map_source,
@@ -366,6 +414,12 @@ def locate_camera(
     from camloc_geo.cameras import CameraRow, geocode_camera, row_from_mapping
     from camloc_geo.osm import MapCatalogue, MapData
 
+    if not isinstance(camera, (CameraRow, Mapping)):
+        raise InputError(
+            "camera must be a CameraRow or a mapping of a list's columns (id, title, lat, "
+            f"lon, ...), not {type(camera).__name__}"
+        )
+    _check_source(map_source)
     row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)
     if isinstance(map_source, MapData):
         return geocode_camera(row, map_data=map_source)
@@ -375,8 +429,22 @@ def locate_camera(
     return geocode_camera(row, plan=catalogue)
 
 
+def _check_source(map_source: object) -> None:
+    """A :class:`MapDataError` when ``map_source`` is none of the kinds :data:`MapSource` names."""
+    if map_source is None or isinstance(map_source, (str, os.PathLike)):
+        return
+    from camloc_geo.osm import MapCatalogue, MapData
+
+    if not isinstance(map_source, (MapData, MapCatalogue)):
+        raise MapDataError(
+            "map_source must be an extract or folder path, a MapCatalogue or a MapData, "
+            f"not {type(map_source).__name__}"
+        )
+
+
 def _require_source(map_source: MapSource, network: bool) -> None:
     """Fail at once (before any heavy import) when no map can be had."""
+    _check_source(map_source)
     if map_source is None and not network:
         raise MapDataError(
             "no map: the network is off and no extract was given: give --osm EXTRACT "
@@ -386,9 +454,9 @@ def _require_source(map_source: MapSource, network: bool) -> None:
 
 def corners_near(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     streets: str | None = None,
@@ -400,6 +468,8 @@ def corners_near(
     ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
     from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
     """
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -446,9 +516,9 @@ def corners_near(
 
 def streets_near(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -465,6 +535,8 @@ def streets_near(
     MapSourceError
         Overpass could not be reached (within a few seconds) or failed.
     """
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     _require_source(map_source, network)
     catalogue = _catalogue_of(map_source)
     if catalogue is not None:
@@ -486,7 +558,7 @@ def streets_near(
 def vanishing_points(
     image: str | os.PathLike[str] | Any,
     *,
-    focal_px: float | None = None,
+    focal_px: SupportsFloat | None = None,
     principal_point: tuple[float, float] | None = None,
     ignore_boxes_px: Sequence[Sequence[float]] = (),
     axes_px: Sequence[Sequence[float]] = (),
@@ -523,22 +595,31 @@ def vanishing_points(
     from camloc_geo._errors import InputError
     from camloc_geo.autovp import detect_vanishing_points, load_image
 
-    if focal_px is not None and not focal_px > 0:
-        raise InputError(f"focal_px must be positive, got {focal_px}")
+    if focal_px is not None:
+        focal = _finite_numbers([focal_px], 1, "focal_px must be a positive number of pixels")
+        if isinstance(focal_px, bool) or not focal[0] > 0:
+            raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
+        focal_px = focal[0]
     img = load_image(image)
     mask = None
     if ignore_boxes_px:
         h, w = img.shape[:2]
         mask = np.ones((h, w), dtype=bool)
         for box in ignore_boxes_px:
-            if len(box) != 4 or not all(np.isfinite(box)):
-                raise InputError("ignore box: give four finite numbers x0 y0 x1 y1")
+            box = _finite_numbers(box, 4, "ignore box: give four finite numbers x0 y0 x1 y1")
             xa, xb = sorted((box[0], box[2]))
             ya, yb = sorted((box[1], box[3]))
             mask[
                 max(0, int(ya)) : max(0, int(np.ceil(yb))),
                 max(0, int(xa)) : max(0, int(np.ceil(xb))),
             ] = False
+    axes = [_finite_numbers(a, 4, "axis: give four finite numbers ox oy ex ey") for a in axes_px]
+    import inspect
+
+    known = inspect.signature(detect_vanishing_points).parameters
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise InputError(f"unknown vanishing-point option(s): {', '.join(unknown)}")
     return detect_vanishing_points(
         img,
         focal_px=focal_px,
@@ -546,9 +627,22 @@ def vanishing_points(
         seed=seed,
         mask=mask,
         estimate_principal_point=estimate_principal_point,
-        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes] or None,
         **options,
     )
+
+
+def _finite_numbers(values: object, count: int, message: str) -> list[float]:
+    """``values`` as ``count`` finite floats, or an :class:`InputError` with ``message``."""
+    import math
+
+    try:
+        out = [float(v) for v in values]  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        raise InputError(f"{message}, got {values!r}") from None
+    if len(out) != count or not all(math.isfinite(v) for v in out):
+        raise InputError(f"{message}, got {values!r}")
+    return out
 
 
 def map_around(
@@ -566,6 +660,12 @@ def map_around(
     """
     if not points:
         return None
+    pts: list[tuple[float, float]] = []
+    for k, p in enumerate(points):
+        if isinstance(p, (str, bytes)) or not hasattr(p, "__len__") or len(p) != 2:
+            raise MapDataError(f"points[{k}] must be a (lat, lon) pair, got {p!r}")
+        pts.append((_degrees(p[0], f"points[{k}] lat"), _degrees(p[1], f"points[{k}] lon")))
+    points = pts
     _require_source(map_source, network)
     from camloc_geo.geodesy import distance_m
     from camloc_geo.osm import MapData, load_map
@@ -607,6 +707,8 @@ def radar_scene(
     from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
     sc = scene_from(scene)
+    if not isinstance(video, (str, os.PathLike)):
+        raise InputError(f"video must be a file path, not {type(video).__name__}")
     size = (sc.image.width, sc.image.height)
     probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
     if isinstance(tracks, (str, os.PathLike)):
@@ -689,6 +791,7 @@ def guide_scene(
 
     if pose not in ("auto", "absolute", "relative"):
         raise InputError(f"pose must be auto, absolute or relative, not {pose!r}")
+    candidate = _whole(candidate, "candidate rank")
     if candidate < 1:
         raise InputError(f"candidate rank must be at least 1, not {candidate}")
     if candidates is not None and pose == "relative":
@@ -764,9 +867,9 @@ a catalogue cell): one radius rule, in one function."""
 
 def streets_within(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -779,6 +882,8 @@ def streets_within(
     """
     from camloc_geo.results import streets_json
 
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -810,6 +915,14 @@ def crowd_scene(
     """
     from camloc_geo.merge import merge_scenes
 
+    if isinstance(scenes, (str, bytes, os.PathLike, Mapping)) or not hasattr(scenes, "__iter__"):
+        raise SceneError(
+            f"scenes must be a list of scenes (paths, dicts or Scenes), not {type(scenes).__name__}"
+        )
+    if prior is not None and not isinstance(prior, Mapping):
+        raise SceneError(
+            f"prior must be a mapping {{lat, lon, radius_m}}, not {type(prior).__name__}", "prior"
+        )
     merged = dict(merge_scenes(list(scenes)))
     if prior is not None and merged.get("prior") is None:
         merged["prior"] = dict(prior)
