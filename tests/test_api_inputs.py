@@ -178,3 +178,47 @@ def test_numpy_numbers_are_accepted() -> None:
     assert doc["type"] == "FeatureCollection"
     out = api.locate_scene(_scene(), map_source=EXTRACT, max_candidates=np.int64(2))
     assert 1 <= len(out.result.candidates) <= 2
+
+
+@pytest.fixture(scope="module")
+def calibration() -> Any:
+    return api.calibrate_scene(SCENE)
+
+
+@pytest.mark.parametrize(
+    ("options", "words"),
+    [
+        ({"n_samples": 0}, "n_samples must be a whole number >= 2, got 0"),
+        ({"n_samples": "many"}, "n_samples must be a whole number >= 2"),
+        ({"click_sigma_px": -1.0}, "click_sigma_px must be a finite number of pixels >= 0"),
+        ({"click_sigma_px": float("nan")}, "click_sigma_px must be a finite number"),
+        ({"seed": "x"}, "seed must be a whole number >= 0"),
+    ],
+)
+def test_sensor_options_are_checked(calibration: Any, options: dict[str, Any], words: str) -> None:
+    """n_samples=0 said 'too close to the horizon'; -1 px: numpy's 'scale < 0'; 'x': TypeError."""
+    from camloc_geo.sensors import ground_distance, point_height
+
+    with pytest.raises(InputError) as info:
+        ground_distance(calibration, [(900, 700), (1000, 700)], **options)
+    assert words in str(info.value)
+    with pytest.raises(InputError) as info:
+        point_height(calibration, (1363.4, 592.9), (1369.0, 502.0), **options)
+    assert words in str(info.value)
+
+
+def test_sensor_refuses_what_is_not_a_calibration() -> None:
+    from camloc_geo.sensors import ground_distance
+
+    with pytest.raises(InputError, match="calibration must be a CalibrationResult"):
+        ground_distance({}, [(900, 700), (1000, 700)])  # type: ignore[arg-type]
+
+
+def test_sensor_numbers_unchanged(calibration: Any) -> None:
+    """The checks change nothing for good options (numpy integers accepted)."""
+    from camloc_geo.sensors import ground_distance
+
+    m = ground_distance(calibration, np.array([(900, 700), (1000, 700)]), n_samples=np.int64(400))
+    assert m.value_m == pytest.approx(1.2938980364696304, rel=1e-9)
+    assert m.n_samples == 400
+    assert all(type(v) in (int, float) for v in m.to_dict().values())
