@@ -285,13 +285,44 @@ def map_for_scene(
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class LocateOutput:
-    """What :func:`locate_scene` returns: the result and what it was computed from."""
+    """What :func:`locate_scene` returns: the result and what it was computed from.
+
+    Attributes
+    ----------
+    scene
+        The validated scene.
+    result
+        The candidates, best first (``result.candidates``: ``lat``, ``lon``, ``score``,
+        ``sigma_m``, ``flags``, ``ambiguous_with``...), ties, warnings and the reason when
+        there is none.
+    map_data
+        The map used, or None when the scene needed none.
+    """
 
     scene: Scene
     result: LocateResult
     map_data: MapData | None
+
+    def __repr__(self) -> str:
+        """One line for a notebook: the scene, how many candidates, the best, the map."""
+        cands = self.result.candidates
+        parts = [f"scene={self.scene.id!r}", f"candidates={len(cands)}"]
+        if cands:
+            best = cands[0]
+            sigma = "" if best.sigma_m is None else f", sigma_m={best.sigma_m:.1f}"
+            parts.append(
+                f"best=(lat={best.lat:.6f}, lon={best.lon:.6f}, score={best.score:.3f}{sigma})"
+            )
+        elif self.result.reason:
+            parts.append(f"reason={self.result.reason!r}")
+        if self.result.ties:
+            parts.append(f"ties={len(self.result.ties)}")
+        if self.result.warnings:
+            parts.append(f"warnings={len(self.result.warnings)}")
+        parts.append(f"map={self.map_data!r}")
+        return f"LocateOutput({', '.join(parts)})"
 
     @property
     def calibration(self) -> CalibrationResult:
