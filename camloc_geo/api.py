@@ -111,10 +111,22 @@ def _whole(value: object, name: str, error: type[InputError] = InputError) -> in
 def scene_from(scene: SceneLike) -> Scene:
     """A validated :class:`Scene` from a model, a dict or a path.
 
+    Parameters
+    ----------
+    scene
+        A :class:`~camloc_geo.scene.Scene` (returned as is), a ``camloc-scene/1`` dict, or the
+        path (``str`` or ``os.PathLike``) of a scene file.
+
+    Returns
+    -------
+    Scene
+        The validated scene.
+
     Raises
     ------
     SceneError
-        The scene does not validate; the message names the field.
+        The scene does not validate, the file is missing or unreadable, or ``scene`` is of
+        another type; the message names the field.
     """
     from camloc_geo.scene import Scene, load_scene, parse_scene
 
@@ -139,14 +151,31 @@ def calibrate_scene(
     Parameters
     ----------
     scene
-        Path, dict or model.
+        Path, dict or model (:func:`scene_from`).
     settings
-        Full settings; when given, ``joint_fit`` and ``principal_point`` are ignored.
+        Full :class:`~camloc_geo.relative.CalibrationSettings`; when given, ``joint_fit`` and
+        ``principal_point`` are ignored.
     joint_fit
         True: the joint robust fit of all annotators (default); False: the paper's
         per-annotator candidates and their largest cluster.
     principal_point
-        ``"auto"`` (freed only when the data justify it), ``"centre"`` or ``"free"``.
+        ``"auto"`` (freed only when the data justify it), ``"centre"`` (or ``"center"``) or
+        ``"free"``.
+
+    Returns
+    -------
+    CalibrationResult
+        ``camera`` (``focal_px``, ``principal_point``, ``cam_from_world``, ``height_m``...), the
+        per-annotator solutions, the uncertainties (``position_sigma_m``, ``focal_sigma_px``...)
+        and ``warnings``; ``to_dict()`` is the JSON ``camloc calibrate`` prints.
+
+    Raises
+    ------
+    SceneError
+        The scene does not validate, or ``principal_point`` is none of the modes.
+    InputError
+        ``settings`` is not a ``CalibrationSettings``; the annotations cannot determine a
+        camera (:class:`DegenerateGeometryError`, :class:`NotEnoughStructureError`).
     """
     from camloc_geo.relative import CalibrationSettings, calibrate
 
@@ -222,6 +251,8 @@ def map_for_scene(
 
     Parameters
     ----------
+    scene
+        Path, dict or model (:func:`scene_from`).
     map_source
         Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map;
         None: Overpass when ``network`` allows it. A folder or catalogue gives the map
@@ -230,10 +261,27 @@ def map_for_scene(
         May Overpass be queried (only when no ``map_source`` is given; a catalogue says
         itself whether it may).
     radius_m
-        Map radius around the scene's anchor (default :func:`scene_map_radius_m`).
+        Map radius around the scene's anchor, metres (default :func:`scene_map_radius_m`).
+    cache_folder, overpass_url
+        Overpass's response cache folder and server (default: osmnx's).
     required
         Force loading (True) or skipping (False) the map; None: load when an extract is given
         or the scene needs one.
+
+    Returns
+    -------
+    MapData or None
+        The map (a loaded ``map_source`` is returned as is).
+
+    Raises
+    ------
+    SceneError
+        The scene does not validate, or it gives no point to load the map around.
+    MapDataError
+        ``map_source`` of an unknown kind, a missing or unreadable extract, no map covering the
+        scene, or the network off when the scene needs a map.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
     sc = scene_from(scene)
     _check_source(map_source)
@@ -361,12 +409,22 @@ def locate_scene(
     calibration
         A relative pose computed before (default: :func:`calibrate_scene`).
     settings
-        Noise model and ranking knobs.
+        Noise model and ranking knobs (:class:`~camloc_geo.absolute.LocateSettings`).
+
+    Returns
+    -------
+    LocateOutput
+        ``result.candidates`` best first (``lat``, ``lon``, ``score``, ``sigma_m``,
+        ``flags``, ``ambiguous_with``), ``result.ties``, the scene and the map used;
+        ``to_geojson()`` is the candidate GeoJSON of ``docs/contract.md``.
 
     Raises
     ------
     SceneError, MapDataError, MapSourceError
-        Bad scene, unusable map, unreachable Overpass; each names the problem.
+        Bad scene or ``max_candidates``, unusable map, unreachable Overpass; each names the
+        problem.
+    InputError
+        ``calibration`` or ``settings`` of the wrong type.
     """
     from dataclasses import replace
 
@@ -403,6 +461,16 @@ def locate_scene(
 def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
     """The cameras of a list (CSV or GeoJSON, column variants in ``docs/batch.md``), streamed.
 
+    Parameters
+    ----------
+    path
+        The list's file (``.csv``, ``.geojson``/``.json``).
+
+    Returns
+    -------
+    Iterator[CameraRow]
+        One :class:`~camloc_geo.cameras.CameraRow` per row, read as iterated.
+
     Raises
     ------
     InputError
@@ -436,11 +504,20 @@ def locate_camera(
     map_source
         An extract, a folder of extracts, a :class:`~camloc_geo.osm.MapCatalogue` or a loaded
         map; None: Overpass when ``network`` allows it.
+    network, cache_folder, overpass_url
+        May Overpass be queried (off by default), its response cache folder and server.
 
     Returns
     -------
-    A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
-    ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
+    CameraResult
+        Never raised for a bad camera: its ``status`` and ``reason`` say what happened, in
+        the vocabulary of ``docs/contract.md``; ``to_dict()`` for JSON.
+
+    Raises
+    ------
+    InputError
+        ``camera`` is neither a ``CameraRow`` nor a mapping; ``map_source`` of an unknown
+        kind (:class:`MapDataError`).
     """
     from camloc_geo.cameras import CameraRow, geocode_camera, row_from_mapping
     from camloc_geo.osm import MapCatalogue, MapData
@@ -496,8 +573,30 @@ def corners_near(
 ) -> dict[str, Any]:
     """Intersections with their kerb corners around a point, as GeoJSON (``docs/contract.md``).
 
-    ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
-    from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
+    Parameters
+    ----------
+    lat, lon
+        The point, degrees WGS 84 (floats, numpy scalars).
+    radius_m
+        Only the intersections whose centre lies within this distance, metres.
+    map_source, network, cache_folder, overpass_url
+        Where the map comes from (:func:`streets_near`, the module's network policy).
+    streets
+        ``"A & B"``: only the intersection of those streets.
+
+    Returns
+    -------
+    dict
+        A GeoJSON FeatureCollection of intersections and corners (plain JSON types).
+
+    Raises
+    ------
+    MapDataError
+        ``lat``/``lon``/``radius_m`` not numbers or out of range, no map (network off and no
+        extract), an unreadable extract, a point outside it, or ``streets`` that do not meet
+        within ``radius_m``.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
     radius_m = _metres(radius_m, "radius_m")
@@ -557,12 +656,31 @@ def streets_near(
 ) -> MapData:
     """The map around a point (its ``streets`` carry names and bearings).
 
-    The map comes from ``map_source`` or, when ``network`` allows it, Overpass.
+    Parameters
+    ----------
+    lat, lon
+        The point, degrees WGS 84 (floats, numpy scalars).
+    radius_m
+        Map radius when loading from an extract or Overpass, metres (a folder or catalogue
+        gives its own cell or extract).
+    map_source
+        Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map
+        (returned as is); None: Overpass when ``network`` allows it.
+    network
+        May Overpass be queried (only without ``map_source``).
+    cache_folder, overpass_url
+        Overpass's response cache folder and server (default: osmnx's).
+
+    Returns
+    -------
+    MapData
+        Streets, intersections and buildings (shared through the load cache: read-only).
 
     Raises
     ------
     MapDataError
-        No extract and the network is off (at once), unreadable extract, no streets there.
+        ``lat``/``lon``/``radius_m`` not numbers or out of range, ``map_source`` of an unknown
+        kind, no extract and the network off (at once), unreadable extract, no streets there.
     MapSourceError
         Overpass could not be reached (within a few seconds) or failed.
     """
@@ -612,14 +730,23 @@ def vanishing_points(
         ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
     estimate_principal_point
         Also refine the principal point around the image centre.
+    seed
+        Seed of the robust sampling (the same seed gives the same answer).
     **options
         Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
         ``focal_prior_px``, ``distortion_k1``, ``estimate_distortion``, ...).
 
+    Returns
+    -------
+    AutoVPResult
+        The vanishing points, ``focal_px``, horizon, pitch and roll, with their quality.
+
     Raises
     ------
     InputError
-        Unreadable image, non-positive focal length, non-finite box, too little structure.
+        Unreadable image, non-positive focal length, a box or axis that is not four finite
+        numbers, an unknown option, too little structure
+        (:class:`NotEnoughStructureError`).
     """
     import numpy as np
 
@@ -688,6 +815,28 @@ def map_around(
 
     Centred on the points' mean, with a radius reaching the farthest point plus
     ``margin_m`` (at most ``max_radius_m``).
+
+    Parameters
+    ----------
+    points
+        ``(lat, lon)`` pairs, degrees WGS 84.
+    map_source, network
+        As for :func:`streets_near` (here the network is off by default).
+    margin_m, max_radius_m
+        Metres added to the farthest point, and the largest radius loaded.
+
+    Returns
+    -------
+    MapData or None
+        The map; None when ``points`` is empty.
+
+    Raises
+    ------
+    MapDataError
+        A point that is not a pair of numbers (named by its index), no map, an unreadable
+        extract.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
     if not points:
         return None
@@ -726,14 +875,37 @@ def radar_scene(
     """Virtual radar: calibrate the scene, then measure the vehicles' speeds in a video.
 
     The video must come from the scene's camera, with the same framing and frame size as
-    the scene's image. See :func:`camloc_geo.sensors.radar.measure_speeds` for the options
-    and ``docs/radar.md`` for the method.
+    the scene's image. See :func:`camloc_geo.sensors.radar.measure_speeds` for the method's
+    options and ``docs/radar.md`` for the method.
+
+    Parameters
+    ----------
+    scene
+        Path, dict or model (:func:`scene_from`).
+    video
+        The video file's path.
+    fps
+        Frame rate; default: the one the file states (refused when it states none).
+    tracks
+        Boxes per frame from any detector: a file or ``{id: {frame: (x1, y1, x2, y2)}}``;
+        None: background subtraction finds the vehicles.
+    min_track_s
+        Shorter tracks are not measured, seconds.
+    max_frames
+        Read at most this many frames.
+    progress
+        Show a tqdm progress bar on stderr.
+
+    Returns
+    -------
+    RadarResult
+        Per-vehicle speeds (``to_dict()`` for JSON).
 
     Raises
     ------
     InputError
-        The scene does not calibrate, the video is unreadable or not the scene's size, no
-        frame rate, malformed tracks (each a one-line message).
+        The scene does not calibrate, ``video`` is not a path, the video is unreadable or not
+        the scene's size, no frame rate, malformed tracks (each a one-line message).
     """
     from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
@@ -802,6 +974,11 @@ def guide_scene(
         Where the map comes from when the scene is located (see :func:`locate_scene`).
     settings
         Noise model and knobs (:class:`~camloc_geo.sensors.guide.GuideSettings`).
+
+    Returns
+    -------
+    GuideResult
+        The people matched to GPS traces, the pose used and ``warnings``.
 
     Raises
     ------
@@ -910,6 +1087,21 @@ def streets_within(
 
     ``near`` lists each street's name and bearing there; ``streets`` describes only those
     streets (not every street of the map, which may be a whole extract).
+
+    Parameters
+    ----------
+    lat, lon, radius_m, map_source, network, cache_folder, overpass_url
+        As for :func:`streets_near`.
+
+    Returns
+    -------
+    dict
+        ``{"near": [...], "streets": [...], ...}`` in plain JSON types.
+
+    Raises
+    ------
+    MapDataError, MapSourceError
+        As for :func:`streets_near`.
     """
     from camloc_geo.results import streets_json
 
@@ -939,10 +1131,23 @@ def crowd_scene(
     "lon", "radius_m"}``, the point the snapshot was taken near) is used when no annotator
     gave one.
 
+    Parameters
+    ----------
+    scenes
+        A list of scenes (paths, dicts or models), not one scene.
+    prior
+        ``{"lat", "lon", "radius_m"}``, or None.
+
+    Returns
+    -------
+    dict
+        The merged ``camloc-scene/1`` dict.
+
     Raises
     ------
     SceneError
-        No scene, a scene that does not validate, or scenes that conflict.
+        No scene, ``scenes`` not a list (a single path or dict), ``prior`` not a mapping, a
+        scene that does not validate, or scenes that conflict.
     """
     from camloc_geo.merge import merge_scenes
 

@@ -89,3 +89,21 @@ def test_user_script_type_checks_strict(tmp_path: Path, monkeypatch: pytest.Monk
         ]
     )
     assert status == 0, stdout + stderr
+
+
+def test_every_api_function_documents_parameters_returns_raises() -> None:
+    """``help()`` of each public entry point: numpydoc sections naming every parameter."""
+    import inspect
+
+    from camloc_geo import api
+
+    gaps = []
+    for name in api.__all__:
+        func = getattr(api, name)
+        if not inspect.isfunction(func):
+            continue
+        doc = inspect.getdoc(func) or ""
+        sections = ("Parameters", "Returns", "Raises")
+        gaps += [f"{name}: {s}" for s in sections if s + "\n---" not in doc]
+        gaps += [f"{name}: {p}" for p in inspect.signature(func).parameters if p not in doc]
+    assert gaps == []
