@@ -60,7 +60,7 @@ __all__ = [
     "vanishing_points",
 ]
 
-SceneLike = Union["Scene", dict[str, Any], str, "os.PathLike[str]"]
+SceneLike = Union["Scene", Mapping[str, Any], str, "os.PathLike[str]"]
 """A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
 
 MapSource = Union[str, "os.PathLike[str]", "MapData", "MapCatalogue", None]
@@ -114,8 +114,8 @@ def scene_from(scene: SceneLike) -> Scene:
     Parameters
     ----------
     scene
-        A :class:`~camloc_geo.scene.Scene` (returned as is), a ``camloc-scene/1`` dict, or the
-        path (``str`` or ``os.PathLike``) of a scene file.
+        A :class:`~camloc_geo.scene.Scene` (returned as is), a ``camloc-scene/1`` dict (or
+        any mapping), or the path (``str`` or ``os.PathLike``) of a scene file.
 
     Returns
     -------
@@ -132,8 +132,8 @@ def scene_from(scene: SceneLike) -> Scene:
 
     if isinstance(scene, Scene):
         return scene
-    if isinstance(scene, dict):
-        return parse_scene(scene)
+    if isinstance(scene, Mapping):  # a dict, or any mapping (MappingProxyType, a frozen dict)
+        return parse_scene(dict(scene))
     if isinstance(scene, (str, os.PathLike)):
         return load_scene(Path(scene))
     raise SceneError(f"a scene must be a path, a dict or a Scene, not {type(scene).__name__}")

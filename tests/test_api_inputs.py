@@ -222,3 +222,12 @@ def test_sensor_numbers_unchanged(calibration: Any) -> None:
     assert m.value_m == pytest.approx(1.2938980364696304, rel=1e-9)
     assert m.n_samples == 400
     assert all(type(v) in (int, float) for v in m.to_dict().values())
+
+
+def test_scene_may_be_any_mapping() -> None:
+    """A read-only mapping of a scene (MappingProxyType) was refused as 'not a dict'."""
+    import types
+
+    scene = api.scene_from(types.MappingProxyType(_scene()))
+    assert scene.id == "baltimore-eastern-broadway"
+    assert len(scene.annotations) == len(_scene()["annotations"])
