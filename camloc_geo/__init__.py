@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from camloc_geo._errors import (
     CamlocError,
     DegenerateGeometryError,
@@ -11,6 +13,15 @@ from camloc_geo._errors import (
     NotEnoughStructureError,
     SceneError,
 )
+
+if TYPE_CHECKING:  # the real signatures for type checkers; imported lazily at run time
+    from camloc_geo.api import (
+        calibrate_scene,
+        corners_near,
+        locate_scene,
+        map_for_scene,
+        streets_near,
+    )
 
 __version__ = "0.1.0"
 

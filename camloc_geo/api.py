@@ -24,9 +24,9 @@ import os
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any, SupportsFloat, SupportsIndex, Union
 
-from camloc_geo._errors import MapDataError, SceneError
+from camloc_geo._errors import InputError, MapDataError, SceneError
 
 if TYPE_CHECKING:
     from camloc_geo.absolute import LocateResult, LocateSettings
@@ -60,10 +60,10 @@ __all__ = [
     "vanishing_points",
 ]
 
-SceneLike = Union["Scene", dict[str, Any], str, os.PathLike]
+SceneLike = Union["Scene", Mapping[str, Any], str, "os.PathLike[str]"]
 """A scene: a model, a ``camloc-scene/1`` dict, or the path of a scene file."""
 
-MapSource = Union[str, os.PathLike, "MapData", "MapCatalogue", None]
+MapSource = Union[str, "os.PathLike[str]", "MapData", "MapCatalogue", None]
 """A map: an extract or folder path, a :class:`~camloc_geo.osm.MapCatalogue`, an already
 loaded :class:`~camloc_geo.osm.MapData`, or None."""
 
@@ -73,20 +73,67 @@ DEFAULT_MIN_RADIUS_M = 300.0
 _PRIOR_MARGIN_M = 200.0
 
 
+def _degrees(value: object, name: str) -> float:
+    """``value`` as a float of degrees, or a :class:`MapDataError` naming ``name``."""
+    if isinstance(value, bool):
+        raise MapDataError(f"{name} must be a number of degrees, got {value!r}")
+    try:
+        return float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise MapDataError(f"{name} must be a number of degrees, got {value!r}") from None
+
+
+def _metres(value: object, name: str) -> float:
+    """``value`` as a positive finite float of metres, or a :class:`MapDataError`."""
+    import math
+
+    try:
+        out = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        out = math.nan
+    if isinstance(value, bool) or not (math.isfinite(out) and out > 0):
+        raise MapDataError(f"{name} must be a positive number of metres, got {value!r}")
+    return out
+
+
+def _whole(value: object, name: str, error: type[InputError] = InputError) -> int:
+    """``value`` as an int (an int, a numpy integer), or ``error`` naming ``name``."""
+    import operator
+
+    if isinstance(value, bool):
+        raise error(f"{name} must be a whole number, got {value!r}")
+    try:
+        return operator.index(value)  # type: ignore[arg-type]
+    except TypeError:
+        raise error(f"{name} must be a whole number, got {value!r}") from None
+
+
 def scene_from(scene: SceneLike) -> Scene:
     """A validated :class:`Scene` from a model, a dict or a path.
+
+    Parameters
+    ----------
+    scene
+        A :class:`~camloc_geo.scene.Scene` (returned as is), a ``camloc-scene/1`` dict (or
+        any mapping), or the path (``str`` or ``os.PathLike``) of a scene file.
+
+    Returns
+    -------
+    Scene
+        The validated scene.
 
     Raises
     ------
     SceneError
-        The scene does not validate; the message names the field.
+        The scene does not validate, the file is missing or unreadable, or ``scene`` is of
+        another type; the message names the field.
     """
     from camloc_geo.scene import Scene, load_scene, parse_scene
 
     if isinstance(scene, Scene):
         return scene
-    if isinstance(scene, dict):
-        return parse_scene(scene)
+    if isinstance(scene, Mapping):  # a dict, or any mapping (MappingProxyType, a frozen dict)
+        return parse_scene(dict(scene))
     if isinstance(scene, (str, os.PathLike)):
         return load_scene(Path(scene))
     raise SceneError(f"a scene must be a path, a dict or a Scene, not {type(scene).__name__}")
@@ -104,18 +151,37 @@ def calibrate_scene(
     Parameters
     ----------
     scene
-        Path, dict or model.
+        Path, dict or model (:func:`scene_from`).
     settings
-        Full settings; when given, ``joint_fit`` and ``principal_point`` are ignored.
+        Full :class:`~camloc_geo.relative.CalibrationSettings`; when given, ``joint_fit`` and
+        ``principal_point`` are ignored.
     joint_fit
         True: the joint robust fit of all annotators (default); False: the paper's
         per-annotator candidates and their largest cluster.
     principal_point
-        ``"auto"`` (freed only when the data justify it), ``"centre"`` or ``"free"``.
+        ``"auto"`` (freed only when the data justify it), ``"centre"`` (or ``"center"``) or
+        ``"free"``.
+
+    Returns
+    -------
+    CalibrationResult
+        ``camera`` (``focal_px``, ``principal_point``, ``cam_from_world``, ``height_m``...), the
+        per-annotator solutions, the uncertainties (``position_sigma_m``, ``focal_sigma_px``...)
+        and ``warnings``; ``to_dict()`` is the JSON ``camloc calibrate`` prints.
+
+    Raises
+    ------
+    SceneError
+        The scene does not validate, or ``principal_point`` is none of the modes.
+    InputError
+        ``settings`` is not a ``CalibrationSettings``; the annotations cannot determine a
+        camera (:class:`DegenerateGeometryError`, :class:`NotEnoughStructureError`).
     """
     from camloc_geo.relative import CalibrationSettings, calibrate
 
     sc = scene_from(scene)
+    if settings is not None and not isinstance(settings, CalibrationSettings):
+        raise InputError(f"settings must be a CalibrationSettings, not {type(settings).__name__}")
     if settings is None:
         modes = {"auto": None, "centre": False, "center": False, "free": True}
         if principal_point not in modes:
@@ -185,6 +251,8 @@ def map_for_scene(
 
     Parameters
     ----------
+    scene
+        Path, dict or model (:func:`scene_from`).
     map_source
         Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map;
         None: Overpass when ``network`` allows it. A folder or catalogue gives the map
@@ -193,12 +261,30 @@ def map_for_scene(
         May Overpass be queried (only when no ``map_source`` is given; a catalogue says
         itself whether it may).
     radius_m
-        Map radius around the scene's anchor (default :func:`scene_map_radius_m`).
+        Map radius around the scene's anchor, metres (default :func:`scene_map_radius_m`).
+    cache_folder, overpass_url
+        Overpass's response cache folder and server (default: osmnx's).
     required
         Force loading (True) or skipping (False) the map; None: load when an extract is given
         or the scene needs one.
+
+    Returns
+    -------
+    MapData or None
+        The map (a loaded ``map_source`` is returned as is).
+
+    Raises
+    ------
+    SceneError
+        The scene does not validate, or it gives no point to load the map around.
+    MapDataError
+        ``map_source`` of an unknown kind, a missing or unreadable extract, no map covering the
+        scene, or the network off when the scene needs a map.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
     sc = scene_from(scene)
+    _check_source(map_source)
     catalogue = _catalogue_of(map_source)
     loaded = catalogue is None and map_source is not None
     if loaded and not isinstance(map_source, (str, os.PathLike)):
@@ -247,13 +333,44 @@ def map_for_scene(
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class LocateOutput:
-    """What :func:`locate_scene` returns: the result and what it was computed from."""
+    """What :func:`locate_scene` returns: the result and what it was computed from.
+
+    Attributes
+    ----------
+    scene
+        The validated scene.
+    result
+        The candidates, best first (``result.candidates``: ``lat``, ``lon``, ``score``,
+        ``sigma_m``, ``flags``, ``ambiguous_with``...), ties, warnings and the reason when
+        there is none.
+    map_data
+        The map used, or None when the scene needed none.
+    """
 
     scene: Scene
     result: LocateResult
     map_data: MapData | None
+
+    def __repr__(self) -> str:
+        """One line for a notebook: the scene, how many candidates, the best, the map."""
+        cands = self.result.candidates
+        parts = [f"scene={self.scene.id!r}", f"candidates={len(cands)}"]
+        if cands:
+            best = cands[0]
+            sigma = "" if best.sigma_m is None else f", sigma_m={best.sigma_m:.1f}"
+            parts.append(
+                f"best=(lat={best.lat:.6f}, lon={best.lon:.6f}, score={best.score:.3f}{sigma})"
+            )
+        elif self.result.reason:
+            parts.append(f"reason={self.result.reason!r}")
+        if self.result.ties:
+            parts.append(f"ties={len(self.result.ties)}")
+        if self.result.warnings:
+            parts.append(f"warnings={len(self.result.warnings)}")
+        parts.append(f"map={self.map_data!r}")
+        return f"LocateOutput({', '.join(parts)})"
 
     @property
     def calibration(self) -> CalibrationResult:
@@ -273,7 +390,7 @@ def locate_scene(
     map_source: MapSource = None,
     network: bool = True,
     radius_m: float | None = None,
-    max_candidates: int | None = None,
+    max_candidates: SupportsIndex | None = None,
     calibration: CalibrationResult | None = None,
     settings: LocateSettings | None = None,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -292,18 +409,38 @@ def locate_scene(
     calibration
         A relative pose computed before (default: :func:`calibrate_scene`).
     settings
-        Noise model and ranking knobs.
+        Noise model and ranking knobs (:class:`~camloc_geo.absolute.LocateSettings`).
+
+    Returns
+    -------
+    LocateOutput
+        ``result.candidates`` best first (``lat``, ``lon``, ``score``, ``sigma_m``,
+        ``flags``, ``ambiguous_with``), ``result.ties``, the scene and the map used;
+        ``to_geojson()`` is the candidate GeoJSON of ``docs/contract.md``.
 
     Raises
     ------
     SceneError, MapDataError, MapSourceError
-        Bad scene, unusable map, unreachable Overpass; each names the problem.
+        Bad scene or ``max_candidates``, unusable map, unreachable Overpass; each names the
+        problem.
+    InputError
+        ``calibration`` or ``settings`` of the wrong type.
     """
     from dataclasses import replace
 
     from camloc_geo.absolute import LocateSettings, locate
+    from camloc_geo.relative import CalibrationResult
 
     sc = scene_from(scene)
+    if max_candidates is not None:
+        max_candidates = _whole(max_candidates, "max_candidates", SceneError)
+    if settings is not None and not isinstance(settings, LocateSettings):
+        raise InputError(f"settings must be a LocateSettings, not {type(settings).__name__}")
+    if calibration is not None and not isinstance(calibration, CalibrationResult):
+        raise InputError(
+            "calibration must be a CalibrationResult (from calibrate_scene), not "
+            f"{type(calibration).__name__}"
+        )
     map_data = map_for_scene(
         sc,
         map_source=map_source,
@@ -323,6 +460,16 @@ def locate_scene(
 
 def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
     """The cameras of a list (CSV or GeoJSON, column variants in ``docs/batch.md``), streamed.
+
+    Parameters
+    ----------
+    path
+        The list's file (``.csv``, ``.geojson``/``.json``).
+
+    Returns
+    -------
+    Iterator[CameraRow]
+        One :class:`~camloc_geo.cameras.CameraRow` per row, read as iterated.
 
     Raises
     ------
@@ -357,15 +504,30 @@ def locate_camera(
     map_source
         An extract, a folder of extracts, a :class:`~camloc_geo.osm.MapCatalogue` or a loaded
         map; None: Overpass when ``network`` allows it.
+    network, cache_folder, overpass_url
+        May Overpass be queried (off by default), its response cache folder and server.
 
     Returns
     -------
-    A :class:`~camloc_geo.cameras.CameraResult`; never raises for a bad camera (its
-    ``status`` and ``reason`` say what happened, in the vocabulary of ``docs/contract.md``).
+    CameraResult
+        Never raised for a bad camera: its ``status`` and ``reason`` say what happened, in
+        the vocabulary of ``docs/contract.md``; ``to_dict()`` for JSON.
+
+    Raises
+    ------
+    InputError
+        ``camera`` is neither a ``CameraRow`` nor a mapping; ``map_source`` of an unknown
+        kind (:class:`MapDataError`).
     """
     from camloc_geo.cameras import CameraRow, geocode_camera, row_from_mapping
     from camloc_geo.osm import MapCatalogue, MapData
 
+    if not isinstance(camera, (CameraRow, Mapping)):
+        raise InputError(
+            "camera must be a CameraRow or a mapping of a list's columns (id, title, lat, "
+            f"lon, ...), not {type(camera).__name__}"
+        )
+    _check_source(map_source)
     row = camera if isinstance(camera, CameraRow) else row_from_mapping(camera, 1)
     if isinstance(map_source, MapData):
         return geocode_camera(row, map_data=map_source)
@@ -375,8 +537,22 @@ def locate_camera(
     return geocode_camera(row, plan=catalogue)
 
 
+def _check_source(map_source: object) -> None:
+    """A :class:`MapDataError` when ``map_source`` is none of the kinds :data:`MapSource` names."""
+    if map_source is None or isinstance(map_source, (str, os.PathLike)):
+        return
+    from camloc_geo.osm import MapCatalogue, MapData
+
+    if not isinstance(map_source, (MapData, MapCatalogue)):
+        raise MapDataError(
+            "map_source must be an extract or folder path, a MapCatalogue or a MapData, "
+            f"not {type(map_source).__name__}"
+        )
+
+
 def _require_source(map_source: MapSource, network: bool) -> None:
     """Fail at once (before any heavy import) when no map can be had."""
+    _check_source(map_source)
     if map_source is None and not network:
         raise MapDataError(
             "no map: the network is off and no extract was given: give --osm EXTRACT "
@@ -386,9 +562,9 @@ def _require_source(map_source: MapSource, network: bool) -> None:
 
 def corners_near(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     streets: str | None = None,
@@ -397,9 +573,33 @@ def corners_near(
 ) -> dict[str, Any]:
     """Intersections with their kerb corners around a point, as GeoJSON (``docs/contract.md``).
 
-    ``streets`` (``"A & B"``) keeps only the intersection of those streets. The map comes
-    from ``map_source`` or, when ``network`` allows it, Overpass (module docstring).
+    Parameters
+    ----------
+    lat, lon
+        The point, degrees WGS 84 (floats, numpy scalars).
+    radius_m
+        Only the intersections whose centre lies within this distance, metres.
+    map_source, network, cache_folder, overpass_url
+        Where the map comes from (:func:`streets_near`, the module's network policy).
+    streets
+        ``"A & B"``: only the intersection of those streets.
+
+    Returns
+    -------
+    dict
+        A GeoJSON FeatureCollection of intersections and corners (plain JSON types).
+
+    Raises
+    ------
+    MapDataError
+        ``lat``/``lon``/``radius_m`` not numbers or out of range, no map (network off and no
+        extract), an unreadable extract, a point outside it, or ``streets`` that do not meet
+        within ``radius_m``.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -446,9 +646,9 @@ def corners_near(
 
 def streets_near(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -456,15 +656,36 @@ def streets_near(
 ) -> MapData:
     """The map around a point (its ``streets`` carry names and bearings).
 
-    The map comes from ``map_source`` or, when ``network`` allows it, Overpass.
+    Parameters
+    ----------
+    lat, lon
+        The point, degrees WGS 84 (floats, numpy scalars).
+    radius_m
+        Map radius when loading from an extract or Overpass, metres (a folder or catalogue
+        gives its own cell or extract).
+    map_source
+        Extract, folder of extracts, :class:`~camloc_geo.osm.MapCatalogue` or a loaded map
+        (returned as is); None: Overpass when ``network`` allows it.
+    network
+        May Overpass be queried (only without ``map_source``).
+    cache_folder, overpass_url
+        Overpass's response cache folder and server (default: osmnx's).
+
+    Returns
+    -------
+    MapData
+        Streets, intersections and buildings (shared through the load cache: read-only).
 
     Raises
     ------
     MapDataError
-        No extract and the network is off (at once), unreadable extract, no streets there.
+        ``lat``/``lon``/``radius_m`` not numbers or out of range, ``map_source`` of an unknown
+        kind, no extract and the network off (at once), unreadable extract, no streets there.
     MapSourceError
         Overpass could not be reached (within a few seconds) or failed.
     """
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     _require_source(map_source, network)
     catalogue = _catalogue_of(map_source)
     if catalogue is not None:
@@ -486,7 +707,7 @@ def streets_near(
 def vanishing_points(
     image: str | os.PathLike[str] | Any,
     *,
-    focal_px: float | None = None,
+    focal_px: SupportsFloat | None = None,
     principal_point: tuple[float, float] | None = None,
     ignore_boxes_px: Sequence[Sequence[float]] = (),
     axes_px: Sequence[Sequence[float]] = (),
@@ -509,36 +730,54 @@ def vanishing_points(
         ``(ox, oy, ex, ey)`` annotated object axes (origin, end); up to 3.
     estimate_principal_point
         Also refine the principal point around the image centre.
+    seed
+        Seed of the robust sampling (the same seed gives the same answer).
     **options
         Passed to :func:`camloc_geo.autovp.detect_vanishing_points` (``use_exif``,
         ``focal_prior_px``, ``distortion_k1``, ``estimate_distortion``, ...).
 
+    Returns
+    -------
+    AutoVPResult
+        The vanishing points, ``focal_px``, horizon, pitch and roll, with their quality.
+
     Raises
     ------
     InputError
-        Unreadable image, non-positive focal length, non-finite box, too little structure.
+        Unreadable image, non-positive focal length, a box or axis that is not four finite
+        numbers, an unknown option, too little structure
+        (:class:`NotEnoughStructureError`).
     """
     import numpy as np
 
     from camloc_geo._errors import InputError
     from camloc_geo.autovp import detect_vanishing_points, load_image
 
-    if focal_px is not None and not focal_px > 0:
-        raise InputError(f"focal_px must be positive, got {focal_px}")
+    if focal_px is not None:
+        focal = _finite_numbers([focal_px], 1, "focal_px must be a positive number of pixels")
+        if isinstance(focal_px, bool) or not focal[0] > 0:
+            raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
+        focal_px = focal[0]
     img = load_image(image)
     mask = None
     if ignore_boxes_px:
         h, w = img.shape[:2]
         mask = np.ones((h, w), dtype=bool)
         for box in ignore_boxes_px:
-            if len(box) != 4 or not all(np.isfinite(box)):
-                raise InputError("ignore box: give four finite numbers x0 y0 x1 y1")
+            box = _finite_numbers(box, 4, "ignore box: give four finite numbers x0 y0 x1 y1")
             xa, xb = sorted((box[0], box[2]))
             ya, yb = sorted((box[1], box[3]))
             mask[
                 max(0, int(ya)) : max(0, int(np.ceil(yb))),
                 max(0, int(xa)) : max(0, int(np.ceil(xb))),
             ] = False
+    axes = [_finite_numbers(a, 4, "axis: give four finite numbers ox oy ex ey") for a in axes_px]
+    import inspect
+
+    known = inspect.signature(detect_vanishing_points).parameters
+    unknown = sorted(set(options) - set(known))
+    if unknown:
+        raise InputError(f"unknown vanishing-point option(s): {', '.join(unknown)}")
     return detect_vanishing_points(
         img,
         focal_px=focal_px,
@@ -546,9 +785,22 @@ def vanishing_points(
         seed=seed,
         mask=mask,
         estimate_principal_point=estimate_principal_point,
-        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes_px] or None,
+        axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes] or None,
         **options,
     )
+
+
+def _finite_numbers(values: object, count: int, message: str) -> list[float]:
+    """``values`` as ``count`` finite floats, or an :class:`InputError` with ``message``."""
+    import math
+
+    try:
+        out = [float(v) for v in values]  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        raise InputError(f"{message}, got {values!r}") from None
+    if len(out) != count or not all(math.isfinite(v) for v in out):
+        raise InputError(f"{message}, got {values!r}")
+    return out
 
 
 def map_around(
@@ -563,9 +815,37 @@ def map_around(
 
     Centred on the points' mean, with a radius reaching the farthest point plus
     ``margin_m`` (at most ``max_radius_m``).
+
+    Parameters
+    ----------
+    points
+        ``(lat, lon)`` pairs, degrees WGS 84.
+    map_source, network
+        As for :func:`streets_near` (here the network is off by default).
+    margin_m, max_radius_m
+        Metres added to the farthest point, and the largest radius loaded.
+
+    Returns
+    -------
+    MapData or None
+        The map; None when ``points`` is empty.
+
+    Raises
+    ------
+    MapDataError
+        A point that is not a pair of numbers (named by its index), no map, an unreadable
+        extract.
+    MapSourceError
+        Overpass could not be reached or failed.
     """
     if not points:
         return None
+    pts: list[tuple[float, float]] = []
+    for k, p in enumerate(points):
+        if isinstance(p, (str, bytes)) or not hasattr(p, "__len__") or len(p) != 2:
+            raise MapDataError(f"points[{k}] must be a (lat, lon) pair, got {p!r}")
+        pts.append((_degrees(p[0], f"points[{k}] lat"), _degrees(p[1], f"points[{k}] lon")))
+    points = pts
     _require_source(map_source, network)
     from camloc_geo.geodesy import distance_m
     from camloc_geo.osm import MapData, load_map
@@ -595,18 +875,43 @@ def radar_scene(
     """Virtual radar: calibrate the scene, then measure the vehicles' speeds in a video.
 
     The video must come from the scene's camera, with the same framing and frame size as
-    the scene's image. See :func:`camloc_geo.sensors.radar.measure_speeds` for the options
-    and ``docs/radar.md`` for the method.
+    the scene's image. See :func:`camloc_geo.sensors.radar.measure_speeds` for the method's
+    options and ``docs/radar.md`` for the method.
+
+    Parameters
+    ----------
+    scene
+        Path, dict or model (:func:`scene_from`).
+    video
+        The video file's path.
+    fps
+        Frame rate; default: the one the file states (refused when it states none).
+    tracks
+        Boxes per frame from any detector: a file or ``{id: {frame: (x1, y1, x2, y2)}}``;
+        None: background subtraction finds the vehicles.
+    min_track_s
+        Shorter tracks are not measured, seconds.
+    max_frames
+        Read at most this many frames.
+    progress
+        Show a tqdm progress bar on stderr.
+
+    Returns
+    -------
+    RadarResult
+        Per-vehicle speeds (``to_dict()`` for JSON).
 
     Raises
     ------
     InputError
-        The scene does not calibrate, the video is unreadable or not the scene's size, no
-        frame rate, malformed tracks (each a one-line message).
+        The scene does not calibrate, ``video`` is not a path, the video is unreadable or not
+        the scene's size, no frame rate, malformed tracks (each a one-line message).
     """
     from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
     sc = scene_from(scene)
+    if not isinstance(video, (str, os.PathLike)):
+        raise InputError(f"video must be a file path, not {type(video).__name__}")
     size = (sc.image.width, sc.image.height)
     probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
     if isinstance(tracks, (str, os.PathLike)):
@@ -670,6 +975,11 @@ def guide_scene(
     settings
         Noise model and knobs (:class:`~camloc_geo.sensors.guide.GuideSettings`).
 
+    Returns
+    -------
+    GuideResult
+        The people matched to GPS traces, the pose used and ``warnings``.
+
     Raises
     ------
     InputError
@@ -689,6 +999,7 @@ def guide_scene(
 
     if pose not in ("auto", "absolute", "relative"):
         raise InputError(f"pose must be auto, absolute or relative, not {pose!r}")
+    candidate = _whole(candidate, "candidate rank")
     if candidate < 1:
         raise InputError(f"candidate rank must be at least 1, not {candidate}")
     if candidates is not None and pose == "relative":
@@ -764,9 +1075,9 @@ a catalogue cell): one radius rule, in one function."""
 
 def streets_within(
     *,
-    lat: float,
-    lon: float,
-    radius_m: float = 150.0,
+    lat: SupportsFloat,
+    lon: SupportsFloat,
+    radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
     cache_folder: str | os.PathLike[str] | None = None,
@@ -776,9 +1087,26 @@ def streets_within(
 
     ``near`` lists each street's name and bearing there; ``streets`` describes only those
     streets (not every street of the map, which may be a whole extract).
+
+    Parameters
+    ----------
+    lat, lon, radius_m, map_source, network, cache_folder, overpass_url
+        As for :func:`streets_near`.
+
+    Returns
+    -------
+    dict
+        ``{"near": [...], "streets": [...], ...}`` in plain JSON types.
+
+    Raises
+    ------
+    MapDataError, MapSourceError
+        As for :func:`streets_near`.
     """
     from camloc_geo.results import streets_json
 
+    lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
+    radius_m = _metres(radius_m, "radius_m")
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -803,13 +1131,34 @@ def crowd_scene(
     "lon", "radius_m"}``, the point the snapshot was taken near) is used when no annotator
     gave one.
 
+    Parameters
+    ----------
+    scenes
+        A list of scenes (paths, dicts or models), not one scene.
+    prior
+        ``{"lat", "lon", "radius_m"}``, or None.
+
+    Returns
+    -------
+    dict
+        The merged ``camloc-scene/1`` dict.
+
     Raises
     ------
     SceneError
-        No scene, a scene that does not validate, or scenes that conflict.
+        No scene, ``scenes`` not a list (a single path or dict), ``prior`` not a mapping, a
+        scene that does not validate, or scenes that conflict.
     """
     from camloc_geo.merge import merge_scenes
 
+    if isinstance(scenes, (str, bytes, os.PathLike, Mapping)) or not hasattr(scenes, "__iter__"):
+        raise SceneError(
+            f"scenes must be a list of scenes (paths, dicts or Scenes), not {type(scenes).__name__}"
+        )
+    if prior is not None and not isinstance(prior, Mapping):
+        raise SceneError(
+            f"prior must be a mapping {{lat, lon, radius_m}}, not {type(prior).__name__}", "prior"
+        )
     merged = dict(merge_scenes(list(scenes)))
     if prior is not None and merged.get("prior") is None:
         merged["prior"] = dict(prior)

@@ -37,7 +37,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from camloc_geo._errors import DegenerateGeometryError
+from camloc_geo._errors import DegenerateGeometryError, InputError
 
 __all__ = [
     "Camera",
@@ -58,6 +58,28 @@ HorizonPolicy = Literal["nan", "error"]
 _UP = np.array([0.0, 0.0, 1.0])
 # Minimum cosine between a viewing ray and the ground (below the horizon) to count as a ground hit.
 _GROUND_EPS = 1e-9
+_ROTATION_TOL = 1e-6
+
+
+def _float(value: object, name: str) -> float:
+    """``value`` as a Python float (numpy scalars too), or an :class:`InputError` naming it."""
+    if isinstance(value, bool):
+        raise InputError(f"{name} must be a number, got {value!r}")
+    try:
+        return float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+
+
+def _rows(values: npt.ArrayLike, width: int, name: str) -> FloatArray:
+    """``values`` as floats whose last axis has ``width`` numbers, or an :class:`InputError`."""
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers, got {values!r}") from None
+    if arr.ndim == 0 or arr.shape[-1] != width:
+        raise InputError(f"{name} must be ({width},) or (N, {width}), got shape {arr.shape}")
+    return arr
 
 
 @dataclass(frozen=True)
@@ -86,6 +108,8 @@ class RadialDistortion:
     radius_px: float
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "k1", _float(self.k1, "distortion k1"))
+        object.__setattr__(self, "radius_px", _float(self.radius_px, "distortion radius_px"))
         if not math.isfinite(self.k1) or abs(self.k1) >= 1.0:
             raise DegenerateGeometryError(
                 f"distortion k1 must be finite and in (-1, 1), got {self.k1}"
@@ -299,16 +323,35 @@ class Camera:
     distortion: RadialDistortion | None = None
 
     def __post_init__(self) -> None:
-        R = np.asarray(self.cam_from_world_rotation, dtype=np.float64).reshape(3, 3)
-        t = np.asarray(self.cam_from_world_translation, dtype=np.float64).reshape(3)
-        if not (math.isfinite(self.focal_px) and self.focal_px > 0):
+        focal_px = _float(self.focal_px, "focal_px")
+        if not (math.isfinite(focal_px) and focal_px > 0):
             raise DegenerateGeometryError(f"focal_px must be positive, got {self.focal_px}")
+        R = _rows(self.cam_from_world_rotation, 3, "cam_from_world_rotation")
+        t = _rows(self.cam_from_world_translation, 3, "cam_from_world_translation")
+        if R.shape != (3, 3):
+            raise InputError(f"cam_from_world_rotation must be 3x3, got shape {R.shape}")
+        if t.size != 3:
+            raise InputError(f"cam_from_world_translation must be 3 numbers, got shape {t.shape}")
+        t = t.reshape(3)
         if not np.all(np.isfinite(R)) or not np.all(np.isfinite(t)):
             raise DegenerateGeometryError("camera pose is not finite")
+        if (
+            not np.allclose(R @ R.T, np.eye(3), rtol=0.0, atol=_ROTATION_TOL)
+            or np.linalg.det(R) <= 0
+        ):
+            raise DegenerateGeometryError(
+                "cam_from_world_rotation is not a proper rotation (R Rᵀ = I, det R = +1): "
+                "use project_to_rotation() for a nearly orthonormal matrix"
+            )
+        pp = _rows(self.principal_point, 2, "principal_point")
+        if pp.shape != (2,) or not np.all(np.isfinite(pp)):
+            raise InputError(
+                f"principal_point must be two finite numbers, got {self.principal_point!r}"
+            )
+        object.__setattr__(self, "focal_px", focal_px)
         object.__setattr__(self, "cam_from_world_rotation", R)
         object.__setattr__(self, "cam_from_world_translation", t)
-        cx, cy = self.principal_point
-        object.__setattr__(self, "principal_point", (float(cx), float(cy)))
+        object.__setattr__(self, "principal_point", (float(pp[0]), float(pp[1])))
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Camera):
@@ -343,8 +386,13 @@ class Camera:
         center_in_world: npt.ArrayLike,
     ) -> Camera:
         """Build a camera from its centre in the world frame instead of ``t``."""
-        R = np.asarray(cam_from_world_rotation, dtype=float).reshape(3, 3)
-        c = np.asarray(center_in_world, dtype=float).reshape(3)
+        R = _rows(cam_from_world_rotation, 3, "cam_from_world_rotation")
+        c = _rows(center_in_world, 3, "center_in_world")
+        if R.shape != (3, 3) or c.shape != (3,):
+            raise InputError(
+                f"cam_from_world_rotation must be 3x3 and center_in_world 3 numbers, got shapes "
+                f"{R.shape} and {c.shape}"
+            )
         return cls(focal_px, principal_point, R, -R @ c)
 
     # ---------------------------------------------------------------- properties
@@ -411,7 +459,7 @@ class Camera:
         -------
         ``(2,)`` or ``(N, 2)`` pixels; NaN rows for points at or behind the camera plane.
         """
-        pts = np.asarray(points_in_world, dtype=float)
+        pts = _rows(points_in_world, 3, "points_in_world")
         single = pts.ndim == 1
         pts = pts.reshape(-1, 3)
         points_in_cam = pts @ self.cam_from_world_rotation.T + self.cam_from_world_translation
@@ -426,7 +474,7 @@ class Camera:
 
     def rays_in_world(self, pixels: npt.ArrayLike) -> FloatArray:
         """Unit viewing directions, in the world frame, of ``(2,)`` or ``(N, 2)`` pixels."""
-        px = np.asarray(pixels, dtype=float)
+        px = _rows(pixels, 2, "pixels")
         single = px.ndim == 1
         px = px.reshape(-1, 2)
         if self.distortion is not None:
@@ -459,7 +507,7 @@ class Camera:
         -------
         ``(3,)`` or ``(N, 3)`` world points with z = ``ground_z_m``.
         """
-        px = np.asarray(pixels, dtype=float)
+        px = _rows(pixels, 2, "pixels")
         single = px.ndim == 1
         rays = self.rays_in_world(px.reshape(-1, 2)).reshape(-1, 3)
         center = self.center_in_world

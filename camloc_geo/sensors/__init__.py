@@ -34,7 +34,7 @@ virtual guide (people seen by the camera matched to GPS traces) is
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, SupportsFloat, SupportsIndex
 
 import numpy as np
 import numpy.typing as npt
@@ -94,6 +94,38 @@ def _pixels(pixels_px: npt.ArrayLike, what: str) -> FloatArray:
     if not np.all(np.isfinite(px)):
         raise InputError(f"{what}: pixels must be finite numbers")
     return px
+
+
+def _options(
+    calibration: object, click_sigma_px: object, n_samples: object, seed: object
+) -> tuple[float, int, int]:
+    """Checked ``(click_sigma_px, n_samples, seed)``; an :class:`InputError` naming a bad one."""
+    import math
+    import operator
+
+    if not hasattr(calibration, "camera"):
+        raise InputError(
+            "calibration must be a CalibrationResult (from calibrate_scene), not "
+            f"{type(calibration).__name__}"
+        )
+    try:
+        sigma = float(click_sigma_px)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        sigma = math.nan
+    if isinstance(click_sigma_px, bool) or not (math.isfinite(sigma) and sigma >= 0):
+        raise InputError(
+            f"click_sigma_px must be a finite number of pixels >= 0, got {click_sigma_px!r}"
+        )
+    whole: list[int] = []
+    for name, value, least in (("n_samples", n_samples, 2), ("seed", seed, 0)):
+        try:
+            k = operator.index(value)  # type: ignore[arg-type]
+        except TypeError:
+            k = -1
+        if isinstance(value, bool) or k < least:
+            raise InputError(f"{name} must be a whole number >= {least}, got {value!r}")
+        whole.append(k)
+    return sigma, whole[0], whole[1]
 
 
 def _rays(
@@ -254,9 +286,9 @@ def ground_distance(
     calibration: CalibrationResult,
     pixels_px: npt.ArrayLike,
     *,
-    click_sigma_px: float = 1.5,
-    n_samples: int = 400,
-    seed: int = _SEED,
+    click_sigma_px: SupportsFloat = 1.5,
+    n_samples: SupportsIndex = 400,
+    seed: SupportsIndex = _SEED,
 ) -> Measurement:
     """Virtual scale: length of the path through clicked ground pixels.
 
@@ -279,8 +311,11 @@ def ground_distance(
     Raises
     ------
     InputError
-        Fewer than two pixels, or a pixel at or above the horizon (named in the message).
+        Fewer than two pixels, or a pixel at or above the horizon (named in the message); a
+        ``calibration`` that is not one, ``click_sigma_px`` < 0, ``n_samples`` < 2, a
+        ``seed`` that is not a whole number >= 0.
     """
+    click_sigma_px, n_samples, seed = _options(calibration, click_sigma_px, n_samples, seed)
     pixels = _pixels(pixels_px, "ground")
     if len(pixels) < 2:
         raise InputError("ground: give at least two pixels")
@@ -300,9 +335,9 @@ def point_height(
     base_px: npt.ArrayLike,
     top_px: npt.ArrayLike,
     *,
-    click_sigma_px: float = 1.5,
-    n_samples: int = 400,
-    seed: int = _SEED,
+    click_sigma_px: SupportsFloat = 1.5,
+    n_samples: SupportsIndex = 400,
+    seed: SupportsIndex = _SEED,
 ) -> Measurement:
     """Virtual clinometer: height of a point vertically above a ground point.
 
@@ -328,8 +363,11 @@ def point_height(
     Raises
     ------
     InputError
-        The base pixel is at or above the horizon, or the top pixel is below its base.
+        The base pixel is at or above the horizon, or the top pixel is below its base; a
+        ``calibration`` that is not one, ``click_sigma_px`` < 0, ``n_samples`` < 2, a
+        ``seed`` that is not a whole number >= 0.
     """
+    click_sigma_px, n_samples, seed = _options(calibration, click_sigma_px, n_samples, seed)
     base = _pixels(base_px, "height base")
     top = _pixels(top_px, "height top")
     if len(base) != 1 or len(top) != 1:

@@ -1,0 +1,73 @@
+"""Results as a notebook user meets them: a short useful repr, JSON without numpy types."""
+
+from __future__ import annotations
+
+import json
+import threading
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camloc_geo import api
+
+REPO = Path(__file__).resolve().parents[1]
+SCENE = REPO / "sample_maps" / "sample_scene.json"
+EXTRACT = REPO / "sample_maps" / "baltimore.osm.pbf"
+
+
+def _foreign_types(value: Any, path: str = "$") -> list[str]:
+    """Paths of values whose type is not exactly a JSON type (np.float64 passes json.dumps)."""
+    if isinstance(value, dict):
+        return [p for k, v in value.items() for p in _foreign_types(v, f"{path}.{k}")]
+    if type(value) is list:
+        return [p for i, v in enumerate(value) for p in _foreign_types(v, f"{path}[{i}]")]
+    if value is None or type(value) in (str, int, float, bool):
+        return []
+    return [f"{path}: {type(value).__name__}"]
+
+
+@pytest.fixture(scope="module")
+def located() -> api.LocateOutput:
+    return api.locate_scene(SCENE, map_source=EXTRACT)
+
+
+def test_locate_output_repr_is_one_useful_line(located: api.LocateOutput) -> None:
+    """It printed the whole scene, every candidate and its evidence (30,568 characters)."""
+    text = repr(located)
+    best = located.result.candidates[0]
+    assert len(text) < 400
+    assert "\n" not in text
+    assert text.startswith("LocateOutput(scene='baltimore-eastern-broadway', candidates=")
+    assert f"lat={best.lat:.6f}, lon={best.lon:.6f}" in text
+    assert "MapData(" in text
+
+
+def test_geojson_of_results_holds_only_json_types(located: api.LocateOutput) -> None:
+    assert _foreign_types(located.to_geojson()) == []
+    lat, lon = located.result.candidates[0].lat, located.result.candidates[0].lon
+    assert _foreign_types(api.corners_near(lat=lat, lon=lon, map_source=EXTRACT)) == []
+    assert _foreign_types(api.streets_within(lat=lat, lon=lon, map_source=EXTRACT)) == []
+
+
+def test_calibrate_from_four_threads_gives_the_serial_answer() -> None:
+    """A notebook or the service calibrating one scene from several threads at once."""
+    serial = json.dumps(api.calibrate_scene(SCENE).to_dict(), sort_keys=True)
+    answers: list[str] = []
+    errors: list[BaseException] = []
+    barrier = threading.Barrier(4)
+
+    def run() -> None:
+        try:
+            barrier.wait()
+            answers.append(json.dumps(api.calibrate_scene(SCENE).to_dict(), sort_keys=True))
+        except BaseException as exc:  # reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=run) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert answers == [serial] * 4
