@@ -422,6 +422,42 @@ def test_crowd_mode_submits(browser: Any, files: dict[str, Any], tmp_path: Path)
         tab.wait_js("document.getElementById('save-status').textContent.includes('Submitted')")
         tab.shot("14_crowd_submitted")
         assert posted == [files["truth"]]
+        # done: Submit is off, and the page says the work is in (it stayed on: a second
+        # submission of edited work counted as another annotator)
+        assert tab.page.is_disabled("#btn-save")
+        assert "you can close this page" in tab.page.inner_text("#save-status")
+        tab.page.keyboard.press("Control+s")
+        tab.page.wait_for_timeout(200)
+        assert len(posted) == 1
+    finally:
+        tab.close()
+
+
+def test_crowd_page_of_a_full_task_says_so_before_any_work(
+    browser: Any, files: dict[str, Any], tmp_path: Path
+) -> None:
+    """A task with all its annotations served its page as if open: the annotator did the
+    whole annotation and learned at Submit that the task took no more work."""
+    from camloc_geo.web import annotation_page_html
+
+    page_path = tmp_path / "full.html"
+    note = "This task has all its 3 annotations already: it takes no more work. Thank you!"
+    page_path.write_text(
+        annotation_page_html(
+            files["snap"],
+            mode="crowd",
+            submit_url="https://crowd.invalid/submit",
+            closed=note,
+        )
+    )
+    tab = Tab(browser, tmp_path)
+    try:
+        tab.open(page_path)
+        assert tab.page.is_visible("#banner")
+        assert tab.page.inner_text("#banner") == note
+        assert tab.page.is_disabled("#btn-save")
+        assert tab.page.inner_text("#save-status") == note
+        assert tab.errors == []
     finally:
         tab.close()
 

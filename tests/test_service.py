@@ -396,6 +396,9 @@ def test_crowd_task_collects_and_locates(client: httpx.Client) -> None:
     )
     late = client.post(f"/v1/tasks/{task['id']}/annotations", json=SCENE)
     assert late.status_code == 422
+    # the page of the full task says so before any work (it was served as if open)
+    full = client.get(f"/annotate/{task['id']}").text
+    assert "This task has all its 2 annotations already: it takes no more work." in full
 
 
 def test_crowd_task_no_map_can_serve_is_refused(client: httpx.Client) -> None:

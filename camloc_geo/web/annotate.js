@@ -1104,7 +1104,10 @@
       changed(true);
     });
     var ss = $("btn-save-step");
-    if (ss) ss.addEventListener("click", save);
+    if (ss) {
+      ss.disabled = !!(submitted || config.closed);  // crowd: submitted, or the task is full
+      ss.addEventListener("click", save);
+    }
     var ap = $("ann-pick");
     if (ap) ap.addEventListener("change", function () {
       base = buildScene();
@@ -1297,11 +1300,18 @@
   }
 
   // ------------------------------------------------------------------ save / submit
+  var submitted = false;  // crowd mode: this page's work went in (one submission a page)
+  function crowdDone(msg) {
+    $("btn-save").disabled = true;
+    $("save-status").textContent = msg;
+  }
   function save() {
     var sc = buildScene();
     var miss = missing("save");
     var text = JSON.stringify(sc, null, 2) + "\n";
     if (config.mode === "crowd") {
+      if (config.closed) { fatal(config.closed); return; }
+      if (submitted) { flash("Already submitted: this page's work is in. Thank you! You can close the page."); return; }
       if (miss.length) { flash("Not yet: " + miss.join("; ") + "."); return; }
       $("save-status").textContent = "Submitting…";
       fetch(config.submitUrl, { method: "POST", headers: { "Content-Type": "application/json" }, body: text })
@@ -1310,7 +1320,8 @@
             if (!r.ok) throw new Error(t || ("HTTP " + r.status));
             lastSaved = JSON.stringify(sc);
             markSaved();
-            $("save-status").textContent = "Submitted. Thank you!";
+            submitted = true;
+            crowdDone("Submitted. Thank you! Your work is in; you can close this page.");
             flash("Submitted. Thank you!", true);
           });
         })
@@ -1495,7 +1506,12 @@
     changed();
   }
   pristine = snapshot();
-  restoreDraft();
+  if (config.closed) {  // the task takes no more work: said before any click, not at Submit
+    crowdDone(config.closed);
+    fatal(config.closed);
+  } else {
+    restoreDraft();
+  }
   try { setupMap(); } catch (e) { $("map-box").hidden = true; }
   renderPanel();
 
