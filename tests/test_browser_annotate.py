@@ -769,3 +769,34 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
         assert errors == []
     finally:
         context.close()
+
+
+def test_next_is_in_sight_on_a_laptop_screen(
+    browser: Any, files: dict[str, Any], tmp_path: Path
+) -> None:
+    """On a 1024x640 screen the step's long text pushed Back / Next below the panel's fold
+    (y 713 of 640 at step 2, Chromium screenshot): a finished step gave no visible way on.
+    They now stay at the bottom of the panel, over the text that scrolls."""
+    context = browser.new_context(viewport={"width": 1024, "height": 640})
+    page = context.new_page()
+    page.route(
+        "**/*",
+        lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+    )
+    try:
+        page.goto(files["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        for step in range(4):
+            page.keyboard.press(str(step + 1))
+            box = page.locator("#btn-next").bounding_box()
+            assert box is not None
+            assert box["y"] + box["height"] <= 640, (step, box)
+            hit = page.evaluate(
+                "([x, y]) => document.elementFromPoint(x, y).id",
+                [box["x"] + box["width"] / 2, box["y"] + box["height"] / 2],
+            )
+            assert hit == "btn-next", step
+        page.click("#btn-next", no_wait_after=True)
+        assert page.evaluate("camloc.step()") == 4
+    finally:
+        context.close()
