@@ -764,6 +764,21 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
         page.tap("#canvas", position={"x": x - box["x"], "y": y - box["y"]})
         origin = page.evaluate("camloc.state()")["axes"]["origin"]
         assert origin == pytest.approx([700, 500], abs=2)
+        # a line drawn by taps, then removed by tapping its end and the Delete button (a
+        # phone has no Delete key and no hover: a line could only be undone, last first)
+        page.keyboard.press("2")
+        for x, y in ((300, 800), (900, 700), (320, 900), (950, 760)):
+            sx, sy = page.evaluate(f"camloc.screenFromImage({x}, {y})")
+            page.tap("#canvas", position={"x": sx - box["x"], "y": sy - box["y"]})
+        assert len(page.evaluate("camloc.state()")["lines"]["length"]) == 2
+        sx, sy = page.evaluate("camloc.screenFromImage(300, 800)")
+        page.tap("#canvas", position={"x": sx - box["x"], "y": sy - box["y"]})
+        page.tap("#btn-delete")
+        left = page.evaluate("camloc.state()")["lines"]["length"]
+        assert len(left) == 1
+        assert left[0] == pytest.approx([320, 900, 950, 760], abs=2)
+        page.tap("#btn-delete")  # nothing tapped: says what to do
+        assert "Tap or click a point of this step first" in page.inner_text("#banner")
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / "16_phone.png"))
         assert errors == []

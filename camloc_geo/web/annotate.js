@@ -450,6 +450,7 @@
   var pending = null;     // first end of a line being drawn: [x, y]
   var mouseImg = null;    // cursor in image coordinates
   var hover = null;       // point under the cursor: {kind, ...}
+  var selected = null;    // point last tapped or clicked without moving: what Delete removes
   var drag = null;        // {target, moved} while moving a point, or {pan:true,...}
   var extrasKind = "reference";
   var analysis = analyse(S, W, H, {});
@@ -1201,6 +1202,7 @@
   }
 
   function changed(keepForm) {
+    selected = null;  // indices may have moved
     analysis = analyse(S, W, H, (base && base.camera) || {});
     render();
     if (keepForm) {
@@ -1444,7 +1446,7 @@
     if (!d) return;
     if (d.target) {
       if (d.moved) { setTarget(d.target, toImage(sp[0], sp[1])); changed(); }
-      else { undoStack.pop(); hover = d.target; render(); }
+      else { undoStack.pop(); hover = d.target; selected = d.target; render(); }
       return;
     }
     if (!d.moved && d.button === 0) place(toImage(sp[0], sp[1]));
@@ -1481,6 +1483,12 @@
   $("btn-zoom-in").addEventListener("click", function () { var r = canvas.getBoundingClientRect(); zoomAt(1.25, r.width / 2, r.height / 2); });
   $("btn-zoom-out").addEventListener("click", function () { var r = canvas.getBoundingClientRect(); zoomAt(0.8, r.width / 2, r.height / 2); });
   $("btn-fit").addEventListener("click", fit);
+  // a touch screen has no Delete key and no hover: tap a point, then this button
+  $("btn-delete").addEventListener("click", function () {
+    var t = selected || hover;
+    if (t) deleteTarget(t);
+    else flash("Tap or click a point of this step first (a line's end removes the line), then Delete.");
+  });
   $("scene-file").addEventListener("change", function (e) {
     var f = e.target.files && e.target.files[0];
     if (f) openSceneFile(f);
