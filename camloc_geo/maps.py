@@ -1363,6 +1363,35 @@ def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
     return None
 
 
+_STATUS_PREFIX = re.compile(r"^([a-z][a-z_]*): ")
+
+
+def _missing_html(missing: Sequence[tuple[str, Any]], shown: int = 10) -> str:
+    """The summary heading's line of cameras not on the map: counted by status (a batch
+    camera's reason starts with it: ``scene_error: scene broken.json: ...``), each named with
+    its status, the whole reason on hover. It listed bare names, so a broken scene, a title
+    not found and a camera without evidence read alike."""
+    statuses: dict[str, int] = {}
+    names = []
+    for scene_id, reason in missing[:shown]:
+        m = _STATUS_PREFIX.match(str(reason or ""))
+        status = m.group(1) if m else None
+        label = html.escape(str(scene_id)) + (f" ({status})" if status else "")
+        names.append(f'<span title="{html.escape(str(reason or ""))}">{label}</span>')
+    for _scene_id, reason in missing:
+        m = _STATUS_PREFIX.match(str(reason or ""))
+        if m:
+            statuses[m.group(1)] = statuses.get(m.group(1), 0) + 1
+    counted = ", ".join(f"{n} {st}" for st, n in sorted(statuses.items(), key=lambda kv: -kv[1]))
+    return (
+        f"{len(missing)} without candidates"
+        + (f" ({html.escape(counted)})" if counted else "")
+        + ": "
+        + ", ".join(names)
+        + (" …" if len(missing) > shown else "")
+    )
+
+
 def build_summary_map(
     items: Iterable[tuple[str, Any]],
     *,
@@ -1479,11 +1508,7 @@ def build_summary_map(
     if n_tied:
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
-        title += (
-            f"{len(missing)} without candidates: "
-            + html.escape(", ".join(str(s) for s, _r in missing[:10]))
-            + (" …" if len(missing) > 10 else "")
-        )
+        title += _missing_html(missing)
     _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
     if len(rows) >= 2:
         fmap.fit_bounds(

@@ -422,6 +422,42 @@ def test_crowd_mode_submits(browser: Any, files: dict[str, Any], tmp_path: Path)
         tab.wait_js("document.getElementById('save-status').textContent.includes('Submitted')")
         tab.shot("14_crowd_submitted")
         assert posted == [files["truth"]]
+        # done: Submit is off, and the page says the work is in (it stayed on: a second
+        # submission of edited work counted as another annotator)
+        assert tab.page.is_disabled("#btn-save")
+        assert "you can close this page" in tab.page.inner_text("#save-status")
+        tab.page.keyboard.press("Control+s")
+        tab.page.wait_for_timeout(200)
+        assert len(posted) == 1
+    finally:
+        tab.close()
+
+
+def test_crowd_page_of_a_full_task_says_so_before_any_work(
+    browser: Any, files: dict[str, Any], tmp_path: Path
+) -> None:
+    """A task with all its annotations served its page as if open: the annotator did the
+    whole annotation and learned at Submit that the task took no more work."""
+    from camloc_geo.web import annotation_page_html
+
+    page_path = tmp_path / "full.html"
+    note = "This task has all its 3 annotations already: it takes no more work. Thank you!"
+    page_path.write_text(
+        annotation_page_html(
+            files["snap"],
+            mode="crowd",
+            submit_url="https://crowd.invalid/submit",
+            closed=note,
+        )
+    )
+    tab = Tab(browser, tmp_path)
+    try:
+        tab.open(page_path)
+        assert tab.page.is_visible("#banner")
+        assert tab.page.inner_text("#banner") == note
+        assert tab.page.is_disabled("#btn-save")
+        assert tab.page.inner_text("#save-status") == note
+        assert tab.errors == []
     finally:
         tab.close()
 
@@ -728,8 +764,54 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
         page.tap("#canvas", position={"x": x - box["x"], "y": y - box["y"]})
         origin = page.evaluate("camloc.state()")["axes"]["origin"]
         assert origin == pytest.approx([700, 500], abs=2)
+        # a line drawn by taps, then removed by tapping its end and the Delete button (a
+        # phone has no Delete key and no hover: a line could only be undone, last first)
+        page.keyboard.press("2")
+        for x, y in ((300, 800), (900, 700), (320, 900), (950, 760)):
+            sx, sy = page.evaluate(f"camloc.screenFromImage({x}, {y})")
+            page.tap("#canvas", position={"x": sx - box["x"], "y": sy - box["y"]})
+        assert len(page.evaluate("camloc.state()")["lines"]["length"]) == 2
+        sx, sy = page.evaluate("camloc.screenFromImage(300, 800)")
+        page.tap("#canvas", position={"x": sx - box["x"], "y": sy - box["y"]})
+        page.tap("#btn-delete")
+        left = page.evaluate("camloc.state()")["lines"]["length"]
+        assert len(left) == 1
+        assert left[0] == pytest.approx([320, 900, 950, 760], abs=2)
+        page.tap("#btn-delete")  # nothing tapped: says what to do
+        assert "Tap or click a point of this step first" in page.inner_text("#banner")
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / "16_phone.png"))
         assert errors == []
+    finally:
+        context.close()
+
+
+def test_next_is_in_sight_on_a_laptop_screen(
+    browser: Any, files: dict[str, Any], tmp_path: Path
+) -> None:
+    """On a 1024x640 screen the step's long text pushed Back / Next below the panel's fold
+    (y 713 of 640 at step 2, Chromium screenshot): a finished step gave no visible way on.
+    They now stay at the bottom of the panel, over the text that scrolls."""
+    context = browser.new_context(viewport={"width": 1024, "height": 640})
+    page = context.new_page()
+    page.route(
+        "**/*",
+        lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+    )
+    try:
+        page.goto(files["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        for step in range(4):
+            page.keyboard.press(str(step + 1))
+            box = page.locator("#btn-next").bounding_box()
+            assert box is not None
+            assert box["y"] + box["height"] <= 640, (step, box)
+            hit = page.evaluate(
+                "([x, y]) => document.elementFromPoint(x, y).id",
+                [box["x"] + box["width"] / 2, box["y"] + box["height"] / 2],
+            )
+            assert hit == "btn-next", step
+        page.click("#btn-next", no_wait_after=True)
+        assert page.evaluate("camloc.step()") == 4
     finally:
         context.close()

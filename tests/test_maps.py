@@ -225,7 +225,8 @@ def test_summary_map_best_candidate_per_camera(
     assert len(div_icons(page, "camloc-summary-marker")) == 2
     assert "cam-a" in page
     assert "cam-b" in page
-    assert "1 without candidates: cam-c" in page
+    assert "1 without candidates: " in page
+    assert 'no evidence\\"\\u003ecam-c\\u003c/span\\u003e' in page  # the name, its reason on hover
     online = maps.summary_map(items, tmp_path / "summary_online.html").read_text(encoding="utf-8")
     assert "markercluster" in online.lower()
 
@@ -290,7 +291,8 @@ def test_cli_summary_map(
     assert remote_references(page) == []
     assert len(div_icons(page, "camloc-summary-marker")) == 1
     assert res.scene_id in page
-    assert "1 without candidates: b" in page
+    assert "1 without candidates: " in page
+    assert "\\u003eb\\u003c/span\\u003e" in page
     assert "Buildings" in page
 
 
@@ -603,3 +605,24 @@ def test_review_map_names_the_annotators_left_out(
     # the title control's HTML, as the page's script holds it (JSON-escaped)
     assert "\\u003cb\\u003eleft out: annotator w2\\u003c/b\\u003e" in text
     assert "(annotations[2]) left out: vp_lines.length: 3 of 3 segments disagree" in text
+
+
+def test_summary_map_says_why_cameras_are_not_on_it(tmp_path: Path) -> None:
+    """camloc batch --map listed the cameras without a point by bare name ("4 without
+    candidates: c1 Eastern Ave & S Broadway, c4 ..."): a broken scene, a title not in the
+    map and a camera without evidence read alike. They are now counted by status and each
+    named with it, the whole reason on hover."""
+
+    def empty(reason: str) -> dict[str, Any]:
+        return {"type": "FeatureCollection", "features": [], "properties": {"reason": reason}}
+
+    items = [
+        ("c1 Eastern", empty("scene_error: scene broken.json: image.height: required")),
+        ("c4 Eastern", empty("scene_error: scene garbage.json: malformed JSON")),
+        ("c6 Nowhere", empty("not_found: 'Nowhere St' is not a street name of this map")),
+    ]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert "3 without candidates (2 scene_error, 1 not_found): " in page
+    assert "c1 Eastern (scene_error)\\u003c/span\\u003e" in page
+    assert "c6 Nowhere (not_found)" in page
+    assert "scene broken.json: image.height: required" in page

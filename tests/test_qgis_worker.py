@@ -142,6 +142,20 @@ def test_geocodelist_job_isolates_bad_rows(tmp_path):
     assert res["layers"]["candidates"]["count"] >= 13
 
 
+def test_geocodelist_names_duplicate_camera_ids(tmp_path):
+    """camloc:geocodelist said nothing of a list with one id on two rows (camloc batch now
+    warns on stderr): the worker's warnings carry the line, which Processing shows."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\ncam1,A & B\ncam2,C & D\ncam1,E & F\n", encoding="utf-8")
+    res = run_job({"task": "geocodelist", "list": str(lst), "out_dir": str(tmp_path)})
+    assert len(res["warnings"]) == 1
+    assert "1 camera id(s) used on more than one row: 'cam1' on rows 1, 3" in res["warnings"][0]
+    clean = tmp_path / "clean.csv"
+    clean.write_text("id,title\ncam1,A & B\n", encoding="utf-8")
+    res = run_job({"task": "geocodelist", "list": str(clean), "out_dir": str(tmp_path / "c")})
+    assert res["warnings"] == []
+
+
 def test_geocodelist_gives_the_answers_of_camloc_batch(tmp_path):
     """The same list through ``camloc_geo.batch.run_batch`` (``camloc batch``) and the worker."""
     from camloc_geo.batch import results_from_journal, run_batch

@@ -301,6 +301,16 @@ def test_job_from_csv(client: httpx.Client) -> None:
     assert r.status_code == 202, r.text
     st = _wait_job(client, r.json()["id"], 1)
     assert st["done"] == 1
+    assert "warnings" not in r.json()
+    # one id on two rows: accepted, as camloc batch accepts it, and named (it went unsaid)
+    twice = csv_text + "c1,Eastern Ave & S Bond St,39.2853,-76.5957\n"
+    r = client.post("/v1/jobs", content=twice.encode(), headers={"content-type": "text/csv"})
+    assert r.status_code == 202, r.text
+    assert r.json()["warnings"] == [
+        "the list: 1 camera id(s) used on more than one row: 'c1' on rows 1, 2; each row is "
+        "geocoded and kept (rows tell them apart), but anything joining on id will mix them "
+        "up: give each camera its own id"
+    ]
 
 
 def test_job_survives_server_kill(tmp_path: Path) -> None:
@@ -396,6 +406,9 @@ def test_crowd_task_collects_and_locates(client: httpx.Client) -> None:
     )
     late = client.post(f"/v1/tasks/{task['id']}/annotations", json=SCENE)
     assert late.status_code == 422
+    # the page of the full task says so before any work (it was served as if open)
+    full = client.get(f"/annotate/{task['id']}").text
+    assert "This task has all its 2 annotations already: it takes no more work." in full
 
 
 def test_crowd_task_no_map_can_serve_is_refused(client: httpx.Client) -> None:

@@ -36,7 +36,7 @@ from camloc_geo.cameras import (
 from camloc_geo.cameras._list import count_camera_rows
 from camloc_geo.osm import Area, MapPlan, area_map, map_plan
 
-__all__ = ["BatchSummary", "process_chunk", "run_batch"]
+__all__ = ["BatchSummary", "duplicate_id_warnings", "process_chunk", "run_batch"]
 
 log = logging.getLogger(__name__)
 
@@ -502,6 +502,18 @@ def run_batch(
         repeats=counts["repeats"],
         warnings=warnings,
     )
+
+
+def duplicate_id_warnings(ids: Iterable[Any]) -> list[str]:
+    """The warning naming camera ids used on more than one row of a list held in memory (a
+    service job's), as ``camloc batch`` words it; ``ids`` in row order (rows from 1; None: a
+    row without an id, never a duplicate)."""
+    rows: dict[str, list[int]] = {}
+    for n, cid in enumerate(ids, start=1):
+        if cid is not None:
+            rows.setdefault(str(cid), []).append(n)
+    dups = {k: v for k, v in rows.items() if len(v) > 1}
+    return _duplicate_warnings(dups, len(dups), "the list")
 
 
 def _duplicate_warnings(dups: dict[str, list[int]], n_dups: int, list_name: str) -> list[str]:

@@ -541,7 +541,7 @@ def _task_geocodelist(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     def on_chunk(done: int) -> None:
         _progress(5 + 90.0 * done / max(n, 1), f"camera {done}/{n}")
 
-    run_batch(
+    summary = run_batch(
         path,
         out_gpkg=out_gpkg,
         map_source=osm,
@@ -573,7 +573,8 @@ def _task_geocodelist(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
                 out_dir, "list_candidates", "Point", LIST_CANDIDATE_FIELDS, candidates
             ),
         },
-        "warnings": [],
+        # what camloc batch says on stderr (camera ids used on more than one row)
+        "warnings": list(summary.warnings),
         "info": {"engine": "camloc_geo.batch", "n_cameras": len(cameras), "statuses": statuses},
     }
 

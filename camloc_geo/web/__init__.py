@@ -190,6 +190,7 @@ def annotation_page_html(
     image_name: str | None = None,
     prior: tuple[float, float] | None = None,
     title: str | None = None,
+    closed: str | None = None,
 ) -> str:
     """The annotation page as one HTML string.
 
@@ -214,6 +215,10 @@ def annotation_page_html(
         ``(lat, lon)`` of the camera's coarse location, written as the scene's ``prior``.
     title
         Page title (default: the image name).
+    closed
+        Crowd mode: the task takes no more work. This line is shown over the photo from the
+        start and Submit is off (an annotator used to learn it only at Submit, the work
+        done).
 
     Returns
     -------
@@ -246,6 +251,7 @@ def annotation_page_html(
         "scene": scene_data,
         "corners": corners_geojson,
         "prior": {"lat": prior[0], "lon": prior[1]} if prior else None,
+        "closed": closed if mode == "crowd" else None,
     }
     has_map = bool(corners_geojson and corners_geojson.get("features"))
     leaflet = ""

@@ -450,6 +450,7 @@
   var pending = null;     // first end of a line being drawn: [x, y]
   var mouseImg = null;    // cursor in image coordinates
   var hover = null;       // point under the cursor: {kind, ...}
+  var selected = null;    // point last tapped or clicked without moving: what Delete removes
   var drag = null;        // {target, moved} while moving a point, or {pan:true,...}
   var extrasKind = "reference";
   var analysis = analyse(S, W, H, {});
@@ -1104,7 +1105,10 @@
       changed(true);
     });
     var ss = $("btn-save-step");
-    if (ss) ss.addEventListener("click", save);
+    if (ss) {
+      ss.disabled = !!(submitted || config.closed);  // crowd: submitted, or the task is full
+      ss.addEventListener("click", save);
+    }
     var ap = $("ann-pick");
     if (ap) ap.addEventListener("change", function () {
       base = buildScene();
@@ -1198,6 +1202,7 @@
   }
 
   function changed(keepForm) {
+    selected = null;  // indices may have moved
     analysis = analyse(S, W, H, (base && base.camera) || {});
     render();
     if (keepForm) {
@@ -1297,11 +1302,18 @@
   }
 
   // ------------------------------------------------------------------ save / submit
+  var submitted = false;  // crowd mode: this page's work went in (one submission a page)
+  function crowdDone(msg) {
+    $("btn-save").disabled = true;
+    $("save-status").textContent = msg;
+  }
   function save() {
     var sc = buildScene();
     var miss = missing("save");
     var text = JSON.stringify(sc, null, 2) + "\n";
     if (config.mode === "crowd") {
+      if (config.closed) { fatal(config.closed); return; }
+      if (submitted) { flash("Already submitted: this page's work is in. Thank you! You can close the page."); return; }
       if (miss.length) { flash("Not yet: " + miss.join("; ") + "."); return; }
       $("save-status").textContent = "Submitting…";
       fetch(config.submitUrl, { method: "POST", headers: { "Content-Type": "application/json" }, body: text })
@@ -1310,7 +1322,8 @@
             if (!r.ok) throw new Error(t || ("HTTP " + r.status));
             lastSaved = JSON.stringify(sc);
             markSaved();
-            $("save-status").textContent = "Submitted. Thank you!";
+            submitted = true;
+            crowdDone("Submitted. Thank you! Your work is in; you can close this page.");
             flash("Submitted. Thank you!", true);
           });
         })
@@ -1433,7 +1446,7 @@
     if (!d) return;
     if (d.target) {
       if (d.moved) { setTarget(d.target, toImage(sp[0], sp[1])); changed(); }
-      else { undoStack.pop(); hover = d.target; render(); }
+      else { undoStack.pop(); hover = d.target; selected = d.target; render(); }
       return;
     }
     if (!d.moved && d.button === 0) place(toImage(sp[0], sp[1]));
@@ -1470,6 +1483,12 @@
   $("btn-zoom-in").addEventListener("click", function () { var r = canvas.getBoundingClientRect(); zoomAt(1.25, r.width / 2, r.height / 2); });
   $("btn-zoom-out").addEventListener("click", function () { var r = canvas.getBoundingClientRect(); zoomAt(0.8, r.width / 2, r.height / 2); });
   $("btn-fit").addEventListener("click", fit);
+  // a touch screen has no Delete key and no hover: tap a point, then this button
+  $("btn-delete").addEventListener("click", function () {
+    var t = selected || hover;
+    if (t) deleteTarget(t);
+    else flash("Tap or click a point of this step first (a line's end removes the line), then Delete.");
+  });
   $("scene-file").addEventListener("change", function (e) {
     var f = e.target.files && e.target.files[0];
     if (f) openSceneFile(f);
@@ -1495,7 +1514,12 @@
     changed();
   }
   pristine = snapshot();
-  restoreDraft();
+  if (config.closed) {  // the task takes no more work: said before any click, not at Submit
+    crowdDone(config.closed);
+    fatal(config.closed);
+  } else {
+    restoreDraft();
+  }
   try { setupMap(); } catch (e) { $("map-box").hidden = true; }
   renderPanel();
 

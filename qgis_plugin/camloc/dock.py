@@ -448,8 +448,15 @@ class CamlocDock(QDockWidget):
         out.addWidget(self.gpkg_edit)
         out.addWidget(gpkg_button)
         form.addRow("Results", out)
-        self.context_check = QCheckBox("Also load the map model's streets and buildings")
-        form.addRow(self.context_check)  # its own row: a long label never widens the dock
+        # a check box's text never wraps: at 47 characters ("Also load the map model's
+        # streets and buildings") it made the form 452 px wide, wider than the dock at 420 px,
+        # and, with no horizontal scroll bar, cut the guidance and the Undo button
+        self.context_check = QCheckBox("Also load the map's streets, buildings")
+        self.context_check.setToolTip(
+            "Also load the map model's streets (as wide as the model thinks) and buildings as "
+            "layers, to check the map the candidates were matched on."
+        )
+        form.addRow(self.context_check)
         lay.addLayout(form)
         row4 = QHBoxLayout()
         self.run_button = QPushButton("Run")

@@ -839,3 +839,17 @@ def test_a_scene_saved_elsewhere_still_names_its_photo(dock, tmp_path):
     assert task.job["scene"]["image"]["path"] == str(snap.resolve())
     dock.cancel()
     assert dock.wait(60)
+
+
+def test_the_form_fits_the_dock_at_its_minimum_width(dock):
+    """The dock's form had a minimum width of 452 px (a check box's unwrappable 47-character
+    text) while the dock may be 380 px wide: with the horizontal scroll bar off, the guidance,
+    the step list and the Undo button were cut at the right edge (seen at 420 px)."""
+    from qgis.PyQt.QtWidgets import QScrollArea
+
+    dock.resize(dock.minimumWidth(), 700)
+    QgsApplication.processEvents()
+    scroll = dock.findChild(QScrollArea)
+    need = scroll.widget().minimumSizeHint().width()
+    assert need <= scroll.viewport().width(), need
+    assert scroll.widget().width() <= scroll.viewport().width()

@@ -155,11 +155,18 @@ async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HT
     def work() -> str:
         from camloc_geo.web import annotation_page_html
 
+        closed = None
+        if task["status"] != "collecting":
+            closed = (
+                f"This task has all its {task['needed']} annotations already: it takes no "
+                "more work. Thank you!"
+            )
         return annotation_page_html(
             store.task_image(task),
             scene=task["base_scene"],
             mode="crowd",
             submit_url=f"/v1/tasks/{task_id}/annotations",
+            closed=closed,
         )
 
     return HTMLResponse(await run_cpu(request, work))

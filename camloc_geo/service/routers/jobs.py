@@ -120,7 +120,17 @@ async def create_job(
             f"over {limit} cameras; this server accepts at most {limit} per job", "cameras"
         )
     job_id = await run_cpu(request, lambda: store.create_job(cameras))
-    return {"id": job_id, "status_url": f"/v1/jobs/{job_id}", "total": len(cameras)}
+    answer: dict[str, Any] = {
+        "id": job_id,
+        "status_url": f"/v1/jobs/{job_id}",
+        "total": len(cameras),
+    }
+    from camloc_geo.batch._run import duplicate_id_warnings
+
+    warnings = duplicate_id_warnings(c.get("id") if isinstance(c, dict) else None for c in cameras)
+    if warnings:  # accepted, as camloc batch accepts it, but named
+        answer["warnings"] = warnings
+    return answer
 
 
 @router.get("/v1/jobs/{job_id}")
