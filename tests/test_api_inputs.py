@@ -231,3 +231,17 @@ def test_scene_may_be_any_mapping() -> None:
     scene = api.scene_from(types.MappingProxyType(_scene()))
     assert scene.id == "baltimore-eastern-broadway"
     assert len(scene.annotations) == len(_scene()["annotations"])
+
+
+def test_vanishing_points_of_8_bit_values_in_a_wide_integer_array() -> None:
+    """img.astype(int) (int64 holding 0..255) was scaled by 255 / 2**63 to black: 'not
+    enough structure'; now the same answer as the uint8 photo."""
+    pytest.importorskip("cv2")
+    from tests.test_autovp import cam_from_world, render_scene
+
+    img = render_scene(cam_from_world(30.0, 12.0, 4.0), 700.0)
+    ref = api.vanishing_points(img)
+    assert ref.focal_px is not None
+    for dtype in (np.int64, np.int32, np.uint32):
+        wide = api.vanishing_points(img.astype(dtype))
+        assert wide.focal_px == ref.focal_px
