@@ -217,7 +217,7 @@ def scene_anchor(scene: Scene) -> tuple[float, float] | None:
 def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
     """The map radius for a scene: ``radius_m``, or the prior's radius + 200 m (≥ 300 m)."""
     if radius_m is not None:
-        return float(radius_m)
+        return _metres(radius_m, "radius_m")
     return max(
         DEFAULT_MIN_RADIUS_M, (scene.prior.radius_m if scene.prior else 0.0) + _PRIOR_MARGIN_M
     )
@@ -567,7 +567,7 @@ def corners_near(
     radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
-    streets: str | None = None,
+    streets: str | Sequence[str] | None = None,
     cache_folder: str | os.PathLike[str] | None = None,
     overpass_url: str | None = None,
 ) -> dict[str, Any]:
@@ -582,7 +582,7 @@ def corners_near(
     map_source, network, cache_folder, overpass_url
         Where the map comes from (:func:`streets_near`, the module's network policy).
     streets
-        ``"A & B"``: only the intersection of those streets.
+        ``"A & B"`` or ``["A", "B"]``: only the intersection of those streets.
 
     Returns
     -------
@@ -600,6 +600,13 @@ def corners_near(
     """
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
     radius_m = _metres(radius_m, "radius_m")
+    if streets is not None and (
+        not isinstance(streets, (str, list, tuple))
+        or not all(isinstance(n, str) for n in ([] if isinstance(streets, str) else streets))
+    ):
+        raise MapDataError(
+            f"streets must be 'A & B' or a list of street names, not {type(streets).__name__}"
+        )
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -835,7 +842,7 @@ def map_around(
     map_source, network
         As for :func:`streets_near` (here the network is off by default).
     margin_m, max_radius_m
-        Metres added to the farthest point, and the largest radius loaded.
+        Metres added to the farthest point (>= 0), and the largest radius loaded (> 0).
 
     Returns
     -------
@@ -858,6 +865,8 @@ def map_around(
             raise MapDataError(f"points[{k}] must be a (lat, lon) pair, got {p!r}")
         pts.append((_degrees(p[0], f"points[{k}] lat"), _degrees(p[1], f"points[{k}] lon")))
     points = pts
+    margin_m = _metres(margin_m, "margin_m") if margin_m != 0 else 0.0
+    max_radius_m = _metres(max_radius_m, "max_radius_m")
     _require_source(map_source, network)
     from camloc_geo.geodesy import distance_m
     from camloc_geo.osm import MapData, load_map
