@@ -103,3 +103,15 @@ def test_bad_input_is_named(
     with pytest.raises(error) as info:
         call(baltimore)
     assert words in str(info.value)
+
+
+def test_title_match_repr_is_short(baltimore: MapData) -> None:
+    """repr() printed the whole Intersection (streets, corners, nodes) and the parsed title:
+    2,335 characters for one junction; the fields stay, repr leaves those three out."""
+    best = geocode_title("Eastern Ave & S Broadway", map_data=baltimore)[0]
+    text = repr(best)
+    assert len(text) < 600
+    assert text.startswith("TitleMatch(status='junction', lat=39.28557975, lon=-76.59348405")
+    assert "Corner(" not in text
+    assert best.intersection is not None
+    assert best.intersection.id == "c49537218"

@@ -136,16 +136,16 @@ class TitleMatch:
     lat: float | None = None
     lon: float | None = None
     uncertainty_m: float | None = None
-    intersection: Intersection | None = None
+    intersection: Intersection | None = field(default=None, repr=False)
     names_read: list[str] = field(default_factory=list)
     names_matched: list[str] = field(default_factory=list)
     match_kinds: list[str] = field(default_factory=list)
     name_scores: list[float] = field(default_factory=list)
     score: float = 0.0
     reason: str = ""
-    geometry: dict[str, Any] | None = None
+    geometry: dict[str, Any] | None = field(default=None, repr=False)
     title: str = ""
-    parsed: ParsedTitle | None = None
+    parsed: ParsedTitle | None = field(default=None, repr=False)
     source: str = ""
     suggestions: dict[str, list[str]] = field(default_factory=dict)
 
