@@ -665,13 +665,14 @@ class GuideResult:
     unmatched_gps: list[dict[str, Any]]
     enu_from_world: Similarity2D | None
     frame: LocalFrame
-    ground_tracks_en: dict[str, FloatArray]
-    ground_times_s: dict[str, FloatArray]
-    gps_en: dict[str, FloatArray]
-    gps_times_s: dict[str, FloatArray]
-    timeline: list[dict[str, Any]]
-    settings: GuideSettings
-    camera_world_xy: FloatArray
+    # per-point data: left out of repr() (80,437 characters for 4 people over 60 s)
+    ground_tracks_en: dict[str, FloatArray] = field(repr=False)
+    ground_times_s: dict[str, FloatArray] = field(repr=False)
+    gps_en: dict[str, FloatArray] = field(repr=False)
+    gps_times_s: dict[str, FloatArray] = field(repr=False)
+    timeline: list[dict[str, Any]] = field(repr=False)
+    settings: GuideSettings = field(repr=False)
+    camera_world_xy: FloatArray = field(repr=False)
     pose_source: str | None = None
     solved_pose: dict[str, Any] | None = None
     warnings: list[str] = field(default_factory=list)

@@ -246,7 +246,7 @@ class VehicleSpeed:
     contact: str
     n_segments: int = 0
     reason: str | None = None
-    track_world_m: list[tuple[int, float, float]] = field(default_factory=list)
+    track_world_m: list[tuple[int, float, float]] = field(default_factory=list, repr=False)
     warning: str | None = None
 
     @property
