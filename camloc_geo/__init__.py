@@ -37,6 +37,11 @@ def __getattr__(name: str) -> object:
     raise AttributeError(f"module 'camloc_geo' has no attribute {name!r}")
 
 
+def __dir__() -> list[str]:
+    """The module's names with the lazy entry points (tab completion in a notebook)."""
+    return sorted(set(globals()) | set(_API))
+
+
 __all__ = [
     "CamlocError",
     "DegenerateGeometryError",

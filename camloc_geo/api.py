@@ -217,7 +217,7 @@ def scene_anchor(scene: Scene) -> tuple[float, float] | None:
 def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
     """The map radius for a scene: ``radius_m``, or the prior's radius + 200 m (≥ 300 m)."""
     if radius_m is not None:
-        return float(radius_m)
+        return _metres(radius_m, "radius_m")
     return max(
         DEFAULT_MIN_RADIUS_M, (scene.prior.radius_m if scene.prior else 0.0) + _PRIOR_MARGIN_M
     )
@@ -567,7 +567,7 @@ def corners_near(
     radius_m: SupportsFloat = 150.0,
     map_source: MapSource = None,
     network: bool = True,
-    streets: str | None = None,
+    streets: str | Sequence[str] | None = None,
     cache_folder: str | os.PathLike[str] | None = None,
     overpass_url: str | None = None,
 ) -> dict[str, Any]:
@@ -582,7 +582,7 @@ def corners_near(
     map_source, network, cache_folder, overpass_url
         Where the map comes from (:func:`streets_near`, the module's network policy).
     streets
-        ``"A & B"``: only the intersection of those streets.
+        ``"A & B"`` or ``["A", "B"]``: only the intersection of those streets.
 
     Returns
     -------
@@ -600,6 +600,13 @@ def corners_near(
     """
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
     radius_m = _metres(radius_m, "radius_m")
+    if streets is not None and (
+        not isinstance(streets, (str, list, tuple))
+        or not all(isinstance(n, str) for n in ([] if isinstance(streets, str) else streets))
+    ):
+        raise MapDataError(
+            f"streets must be 'A & B' or a list of street names, not {type(streets).__name__}"
+        )
     m = streets_near(
         lat=lat,
         lon=lon,
@@ -721,7 +728,8 @@ def vanishing_points(
     ----------
     image
         Path of a photo (JPEG, PNG, TIFF, WebP, BMP, GIF...: a header Pillow reads, decoded
-        by OpenCV) or a grey/colour image array.
+        by OpenCV) or a grey/colour image array: ``uint8``, ``uint16`` (16-bit), floats
+        (0..1, or 0..255 when larger than 1), or wider integers holding 0..255.
     focal_px, principal_point
         Known intrinsics, pixels (default: estimated / the image centre).
     ignore_boxes_px
@@ -758,6 +766,17 @@ def vanishing_points(
         if isinstance(focal_px, bool) or not focal[0] > 0:
             raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
         focal_px = focal[0]
+    if (
+        isinstance(image, np.ndarray)
+        and np.issubdtype(image.dtype, np.integer)
+        and image.dtype.itemsize >= 4
+        and image.size
+        and image.min() >= 0
+        and image.max() <= 255
+    ):
+        # 8-bit values held in a wide integer array (img.astype(int), np.array(pil, int)):
+        # load_image would scale them by the dtype's range (255 / 2**63) to black
+        image = image.astype(np.uint8)
     img = load_image(image)
     mask = None
     if ignore_boxes_px:
@@ -823,7 +842,7 @@ def map_around(
     map_source, network
         As for :func:`streets_near` (here the network is off by default).
     margin_m, max_radius_m
-        Metres added to the farthest point, and the largest radius loaded.
+        Metres added to the farthest point (>= 0), and the largest radius loaded (> 0).
 
     Returns
     -------
@@ -846,6 +865,8 @@ def map_around(
             raise MapDataError(f"points[{k}] must be a (lat, lon) pair, got {p!r}")
         pts.append((_degrees(p[0], f"points[{k}] lat"), _degrees(p[1], f"points[{k}] lon")))
     points = pts
+    margin_m = _metres(margin_m, "margin_m") if margin_m != 0 else 0.0
+    max_radius_m = _metres(max_radius_m, "max_radius_m")
     _require_source(map_source, network)
     from camloc_geo.geodesy import distance_m
     from camloc_geo.osm import MapData, load_map

@@ -27,6 +27,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 import re
 from pathlib import Path
 from typing import Any, Literal
@@ -827,8 +828,10 @@ def load_scene(path: str | Path) -> Scene:
     ------
     SceneError
         Unreadable file, malformed JSON (with line and column), or a field breaking the
-        contract.
+        contract, or ``path`` is not a path.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise SceneError(f"a scene file's path must be a str or a Path, not {type(path).__name__}")
     p = Path(path)
     try:
         check_regular_file(p, "scene file")  # a FIFO or a device would block
@@ -948,6 +951,8 @@ def parse_compass(text: str | None) -> float | None:
     """
     if not text:
         return None
+    if not isinstance(text, str):
+        raise InputError(f"compass words must be text, not {type(text).__name__}")
     text = text[:500]
     for rx in (_VERB_RE, _BOUND_RE, _WARD_RE, _SIDE_RE, _PAREN_RE, _ALONE_RE):
         for m in rx.finditer(text):

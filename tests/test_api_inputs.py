@@ -231,3 +231,41 @@ def test_scene_may_be_any_mapping() -> None:
     scene = api.scene_from(types.MappingProxyType(_scene()))
     assert scene.id == "baltimore-eastern-broadway"
     assert len(scene.annotations) == len(_scene()["annotations"])
+
+
+def test_vanishing_points_of_8_bit_values_in_a_wide_integer_array() -> None:
+    """img.astype(int) (int64 holding 0..255) was scaled by 255 / 2**63 to black: 'not
+    enough structure'; now the same answer as the uint8 photo."""
+    pytest.importorskip("cv2")
+    from tests.test_autovp import cam_from_world, render_scene
+
+    img = render_scene(cam_from_world(30.0, 12.0, 4.0), 700.0)
+    ref = api.vanishing_points(img)
+    assert ref.focal_px is not None
+    for dtype in (np.int64, np.int32, np.uint32):
+        wide = api.vanishing_points(img.astype(dtype))
+        assert wide.focal_px == ref.focal_px
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: api.map_for_scene(_scene(), map_source=EXTRACT, radius_m="x"), "radius_m must"),  # type: ignore[arg-type]
+        (lambda: api.locate_scene(_scene(), map_source=EXTRACT, radius_m=[1]), "radius_m must"),  # type: ignore[arg-type]
+        (lambda: api.map_around([(LAT, LON)], map_source=EXTRACT, margin_m="x"), "margin_m must"),  # type: ignore[arg-type]
+        (lambda: api.corners_near(lat=LAT, lon=LON, map_source=EXTRACT, streets=5), "streets must"),  # type: ignore[arg-type]
+    ],
+)
+def test_more_bad_options_are_map_data_errors(call: Callable[[], object], words: str) -> None:
+    """Before: ValueError from float('x'), TypeError from float([1]) / 'x' + float / iter(5)."""
+    with pytest.raises(MapDataError, match=words):
+        call()
+
+
+def test_corners_near_takes_a_list_of_street_names() -> None:
+    both = api.corners_near(
+        lat=LAT, lon=LON, map_source=EXTRACT, streets=["Eastern Avenue", "South Broadway"]
+    )
+    text = api.corners_near(lat=LAT, lon=LON, map_source=EXTRACT, streets="Eastern & Broadway")
+    assert both["features"]
+    assert both["features"][0]["properties"] == text["features"][0]["properties"]

@@ -71,3 +71,27 @@ def test_calibrate_from_four_threads_gives_the_serial_answer() -> None:
         t.join()
     assert errors == []
     assert answers == [serial] * 4
+
+
+def test_a_scene_with_a_photo_from_four_threads_gives_the_serial_answer(tmp_path: Path) -> None:
+    """The photo's decoded pixels and detected vanishing points are cached per file version:
+    threads sharing those caches get the serial answer."""
+    pytest.importorskip("cv2")
+    from tests.test_calibrate_autovp import _noisy_scene_with_photo
+
+    scene = _noisy_scene_with_photo(tmp_path, 3, True)
+    answers: list[str] = []
+    barrier = threading.Barrier(4)
+
+    def run() -> None:
+        barrier.wait()
+        answers.append(json.dumps(api.calibrate_scene(scene).to_dict(), sort_keys=True))
+
+    threads = [threading.Thread(target=run) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    serial = json.dumps(api.calibrate_scene(scene).to_dict(), sort_keys=True)
+    assert answers == [serial] * 4
+    assert "photo" in serial  # the photo's lines were used (a real photo path, not skipped)

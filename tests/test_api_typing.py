@@ -107,3 +107,12 @@ def test_every_api_function_documents_parameters_returns_raises() -> None:
         gaps += [f"{name}: {s}" for s in sections if s + "\n---" not in doc]
         gaps += [f"{name}: {p}" for p in inspect.signature(func).parameters if p not in doc]
     assert gaps == []
+
+
+def test_dir_lists_the_lazy_entry_points() -> None:
+    """Tab completion (``dir(camloc_geo)``) did not offer calibrate_scene & co."""
+    import camloc_geo
+
+    names = dir(camloc_geo)
+    assert {"calibrate_scene", "locate_scene", "corners_near", "InputError"} <= set(names)
+    assert set(camloc_geo.__all__) <= set(names)

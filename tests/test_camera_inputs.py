@@ -65,3 +65,12 @@ def test_numpy_scalars_become_floats() -> None:
     assert json.loads(json.dumps(doc))["focal_px"] == 900.0
     uv = cam.project(np.array([[0.0, 0.0, 0.0]], dtype=np.float32))
     assert uv.tolist() == [[960.0, 540.0]]
+
+
+def test_a_rotation_rounded_in_json_is_still_a_rotation() -> None:
+    """Only matrices that are not rotations are refused: one rounded to 5 decimals passes."""
+    from camloc_geo.camera import rotation_from_angles
+
+    R = np.round(rotation_from_angles(33.3, -12.7, 2.1), 5)
+    cam = Camera(900.0, (960.0, 540.0), R, T0)
+    assert cam.cam_from_world_rotation.tolist() == R.tolist()

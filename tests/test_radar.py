@@ -355,3 +355,14 @@ def test_cli_a_text_named_jpg_is_one_line_on_stderr(tmp_path: Path) -> None:
     assert proc.stderr.splitlines() == [
         f"camloc radar: error: cannot read video {fake}: it states no frame size"
     ]
+
+
+def test_vehicle_repr_leaves_out_its_track(
+    videos: list[SyntheticVideo], calibration: CalibrationResult
+) -> None:
+    """repr() of a vehicle printed every (frame, x, y) of its ground track."""
+    result = measure_speeds(calibration, videos[0].path, image_size=SIZE)
+    best = _best(result)
+    assert best.track_world_m  # still there
+    assert "track_world_m" not in repr(best)
+    assert f"speed_kmh={best.speed_kmh!r}" in repr(best)

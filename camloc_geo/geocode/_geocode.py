@@ -27,7 +27,7 @@ import shapely
 import shapely.ops
 from shapely.geometry import LineString, MultiLineString, mapping
 
-from camloc_geo._errors import InputError
+from camloc_geo._errors import InputError, MapDataError
 from camloc_geo.geocode._index import GeocodeIndex, Landmark, index_for
 from camloc_geo.geocode._normalize import (
     STREET_TYPES,
@@ -136,16 +136,16 @@ class TitleMatch:
     lat: float | None = None
     lon: float | None = None
     uncertainty_m: float | None = None
-    intersection: Intersection | None = None
+    intersection: Intersection | None = field(default=None, repr=False)
     names_read: list[str] = field(default_factory=list)
     names_matched: list[str] = field(default_factory=list)
     match_kinds: list[str] = field(default_factory=list)
     name_scores: list[float] = field(default_factory=list)
     score: float = 0.0
     reason: str = ""
-    geometry: dict[str, Any] | None = None
+    geometry: dict[str, Any] | None = field(default=None, repr=False)
     title: str = ""
-    parsed: ParsedTitle | None = None
+    parsed: ParsedTitle | None = field(default=None, repr=False)
     source: str = ""
     suggestions: dict[str, list[str]] = field(default_factory=dict)
 
@@ -646,6 +646,40 @@ def _not_found(
     )
 
 
+def check_near(near: object, radius_m: object) -> tuple[tuple[float, float] | None, float | None]:
+    """``near`` as a ``(lat, lon)`` pair of floats and ``radius_m`` as a float, or an
+    :class:`InputError` naming the one that is wrong."""
+    point: tuple[float, float] | None = None
+    if near is not None:
+        try:
+            lat0, lon0 = (float(v) for v in near)  # type: ignore[attr-defined]
+        except (TypeError, ValueError):
+            raise InputError(f"near must be (lat, lon) in degrees, got {near!r}") from None
+        if not (-90.0 <= lat0 <= 90.0 and -180.0 <= lon0 <= 180.0):
+            raise InputError(f"near must be (lat, lon) in degrees, got {near!r}")
+        point = (lat0, lon0)
+    radius: float | None = None
+    if radius_m is not None:
+        try:
+            radius = float(radius_m)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            radius = math.nan
+        if isinstance(radius_m, bool) or not (math.isfinite(radius) and radius > 0):
+            raise InputError(f"radius_m must be a positive number of metres, got {radius_m!r}")
+    return point, radius
+
+
+def check_map(map_data: object, name: str) -> None:
+    """A :class:`MapDataError` when ``map_data`` is not a loaded map."""
+    from camloc_geo.osm import MapData
+
+    if not isinstance(map_data, MapData):
+        raise MapDataError(
+            f"{name} must be a MapData (camloc_geo.osm.load_map or "
+            f"camloc_geo.geocode.whole_map), not {type(map_data).__name__}"
+        )
+
+
 def geocode_title(
     title: str,
     *,
@@ -681,20 +715,19 @@ def geocode_title(
     Raises
     ------
     InputError
-        ``near`` or ``radius_m`` out of range, or ``area`` not in the map.
+        ``near`` not a ``(lat, lon)`` pair of numbers in range, ``radius_m`` not a positive
+        number.
+    MapDataError
+        ``map_data`` is not a :class:`~camloc_geo.osm.MapData`, or ``area`` is not a named
+        place of the map.
     """
-    if near is not None:
-        lat0, lon0 = float(near[0]), float(near[1])
-        if not (-90.0 <= lat0 <= 90.0 and -180.0 <= lon0 <= 180.0):
-            raise InputError(f"near must be (lat, lon) in degrees, got {near!r}")
-        near = (lat0, lon0)
-    if radius_m is not None and not (math.isfinite(radius_m) and radius_m > 0):
-        raise InputError(f"radius_m must be a positive number of metres, got {radius_m}")
+    near, radius_m = check_near(near, radius_m)
+    check_map(map_data, "map_data")
     index = index_for(map_data)
     if area and near is None:
         marks = _landmark_hits(area, index)
         if not marks:
-            raise InputError(f"area {area!r} is not a named place of the map {map_data.source}")
+            raise MapDataError(f"area {area!r} is not a named place of the map {map_data.source}")
         mark = max(marks, key=lambda m: m[2])[0]
         near = (mark.lat, mark.lon)
         radius_m = radius_m or 1500.0

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camloc_geo._errors import MapDataError
-from camloc_geo.geocode._geocode import TitleMatch, geocode_title
+from camloc_geo.geocode._geocode import TitleMatch, check_map, check_near, geocode_title
 
 if TYPE_CHECKING:
     from camloc_geo.osm import MapData
@@ -34,9 +34,16 @@ def whole_map(path: str | os.PathLike[str]) -> MapData:
 
     The same map, anchored at the same point, as every front end gets for a point in this
     extract (:class:`camloc_geo.osm.MapCatalogue`), loaded once per process.
+
+    Raises
+    ------
+    MapDataError
+        ``path`` is not a path, or the extract is missing or unreadable.
     """
     from camloc_geo.osm import area_map
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise MapDataError(f"an extract's path must be a str or a Path, not {type(path).__name__}")
     p = Path(path).expanduser().absolute()
     return area_map(("file", str(p)))
 
@@ -65,7 +72,25 @@ def geocode_title_in_maps(
     Returns
     -------
     Matches, best first (never empty).
+
+    Raises
+    ------
+    InputError
+        ``near`` or ``radius_m`` as for :func:`geocode_title`.
+    MapDataError
+        No maps, ``maps`` not a list of :class:`~camloc_geo.osm.MapData`, or ``area`` a
+        named place of none of them.
     """
+    if isinstance(maps, (str, bytes, os.PathLike)) or not hasattr(maps, "__iter__"):
+        raise MapDataError(
+            f"maps must be a list of MapData (whole_map(path) for each), not {type(maps).__name__}"
+        )
+    maps = list(maps)
+    if not maps:
+        raise MapDataError("no maps to search: give at least one MapData")
+    for k, m in enumerate(maps):
+        check_map(m, f"maps[{k}]")
+    near, radius_m = check_near(near, radius_m)
     chosen = list(maps)
     if near is not None:
         chosen = [m for m in maps if map_contains(m, near[0], near[1])] or list(maps)

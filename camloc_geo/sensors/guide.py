@@ -47,6 +47,7 @@ import csv
 import io
 import json
 import math
+import os
 import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -129,8 +130,17 @@ def parse_time(value: Any, *, what: str = "time") -> float:
 
 
 def format_time(t_s: float) -> str:
-    """ISO 8601 UTC of UNIX seconds (milliseconds, ``Z``)."""
-    dt = datetime.fromtimestamp(t_s, tz=timezone.utc)
+    """ISO 8601 UTC of UNIX seconds (milliseconds, ``Z``).
+
+    Raises
+    ------
+    InputError
+        ``t_s`` is not a finite number of seconds within the years 1..9999.
+    """
+    try:
+        dt = datetime.fromtimestamp(float(t_s), tz=timezone.utc)
+    except (TypeError, ValueError, OverflowError, OSError):
+        raise InputError(f"time: {t_s!r} is not a number of UNIX seconds") from None
     return dt.isoformat(timespec="milliseconds").replace("+00:00", "Z")
 
 
@@ -404,8 +414,14 @@ def read_gps(source: str | Path) -> list[GpsTrace]:
     Raises
     ------
     InputError
-        Unreadable file, a point without time or with bad coordinates, no trace.
+        Unreadable file, a point without time or with bad coordinates, no trace, or
+        ``source`` is not a path.
     """
+    if not isinstance(source, (str, os.PathLike)):
+        raise InputError(
+            f"GPS traces: give a .gpx or .csv path (or GpsTrace objects), not "
+            f"{type(source).__name__}"
+        )
     path = Path(source)
     name = path.name
     try:
@@ -649,13 +665,14 @@ class GuideResult:
     unmatched_gps: list[dict[str, Any]]
     enu_from_world: Similarity2D | None
     frame: LocalFrame
-    ground_tracks_en: dict[str, FloatArray]
-    ground_times_s: dict[str, FloatArray]
-    gps_en: dict[str, FloatArray]
-    gps_times_s: dict[str, FloatArray]
-    timeline: list[dict[str, Any]]
-    settings: GuideSettings
-    camera_world_xy: FloatArray
+    # per-point data: left out of repr() (80,437 characters for 4 people over 60 s)
+    ground_tracks_en: dict[str, FloatArray] = field(repr=False)
+    ground_times_s: dict[str, FloatArray] = field(repr=False)
+    gps_en: dict[str, FloatArray] = field(repr=False)
+    gps_times_s: dict[str, FloatArray] = field(repr=False)
+    timeline: list[dict[str, Any]] = field(repr=False)
+    settings: GuideSettings = field(repr=False)
+    camera_world_xy: FloatArray = field(repr=False)
     pose_source: str | None = None
     solved_pose: dict[str, Any] | None = None
     warnings: list[str] = field(default_factory=list)
@@ -919,6 +936,8 @@ def match_people(
         No tracks or traces, a foot pixel above the horizon, traces that overlap no track in
         time, bad settings.
     """
+    if settings is not None and not isinstance(settings, GuideSettings):
+        raise InputError(f"settings must be a GuideSettings, not {type(settings).__name__}")
     settings = settings or GuideSettings()
     settings.check()
     if pose is not None and pose.camera_world is not None:

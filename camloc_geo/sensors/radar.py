@@ -246,7 +246,7 @@ class VehicleSpeed:
     contact: str
     n_segments: int = 0
     reason: str | None = None
-    track_world_m: list[tuple[int, float, float]] = field(default_factory=list)
+    track_world_m: list[tuple[int, float, float]] = field(default_factory=list, repr=False)
     warning: str | None = None
 
     @property
@@ -485,6 +485,7 @@ def read_tracks(path: str | os.PathLike[str]) -> TrackBoxes:
     InputError
         Missing, too large or malformed file (the message names the line or detection).
     """
+    _check_path(path, "tracks file")
     p = check_regular_file(path, "tracks file")
     size = p.stat().st_size
     if size > MAX_TRACKS_BYTES:
@@ -526,9 +527,16 @@ def _single_frame(path: str | os.PathLike[str]) -> InputError:
     )
 
 
+def _check_path(path: object, what: str) -> None:
+    """An :class:`InputError` when ``path`` is not a ``str`` or ``os.PathLike``."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"{what}: give a file path, not {type(path).__name__}")
+
+
 def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | None, int]:
     import cv2
 
+    _check_path(path, "video")
     p = check_regular_file(path, "video")
     if p.stat().st_size == 0:
         raise InputError(f"cannot open video {p}: the file is empty (0 bytes)")
