@@ -215,7 +215,7 @@ class AnnotatorSolution:
         out["width_sign"] = self.width_sign
         out["candidates"] = {k: v.tolist() for k, v in self.candidates.items()}
         if self.height_check is not None:
-            out["height_check_ratio"] = self.height_check
+            out["height_check_ratio"] = float(self.height_check)  # never a numpy scalar
         return out
 
 
@@ -369,6 +369,25 @@ class CalibrationResult:
     def height_m(self) -> float:
         """Camera height above the ground."""
         return self.camera.height_m
+
+    def __repr__(self) -> str:
+        """One line for a notebook: focal length, height, method, annotators, warnings.
+
+        (The dataclass' own repr printed every array and per-annotator solution: ~6,000
+        characters.) ``to_dict()`` gives everything.
+        """
+        cam = self.camera
+        f_sigma = "" if self.focal_sigma_px is None else f" ± {self.focal_sigma_px:.1f}"
+        parts = [
+            f"focal_px={cam.focal_px:.1f}{f_sigma}",
+            f"height_m={cam.height_m:.2f}",
+            f"method={self.method!r}",
+            f"intrinsics={self.intrinsics_method!r}",
+            f"annotators={len(self.annotators)}",
+        ]
+        if self.warnings:
+            parts.append(f"warnings={len(self.warnings)}")
+        return f"CalibrationResult({', '.join(parts)})"
 
     @property
     def corner_mistakes(self) -> list[str]:

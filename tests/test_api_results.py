@@ -95,3 +95,28 @@ def test_a_scene_with_a_photo_from_four_threads_gives_the_serial_answer(tmp_path
     serial = json.dumps(api.calibrate_scene(scene).to_dict(), sort_keys=True)
     assert answers == [serial] * 4
     assert "photo" in serial  # the photo's lines were used (a real photo path, not skipped)
+
+
+def test_calibration_and_locate_results_repr_in_one_line(located: api.LocateOutput) -> None:
+    """CalibrationResult printed every array and annotator (~6,200 characters),
+    LocateResult every candidate, observation and the calibration (~28,500)."""
+    cal = located.result.calibration
+    text = repr(cal)
+    assert len(text) < 200
+    assert "\n" not in text
+    assert text.startswith(f"CalibrationResult(focal_px={cal.camera.focal_px:.1f} ± ")
+    assert f"height_m={cal.camera.height_m:.2f}" in text
+    text = repr(located.result)
+    best = located.result.candidates[0]
+    assert len(text) < 300
+    assert "\n" not in text
+    assert text.startswith("LocateResult(scene_id='baltimore-eastern-broadway', candidates=")
+    assert f"lat={best.lat:.6f}, lon={best.lon:.6f}" in text
+
+
+def test_each_annotator_s_solution_holds_only_json_types() -> None:
+    """height_check_ratio was an np.float64 (json.dumps takes it, other encoders do not)."""
+    cal = api.calibrate_scene(SCENE)
+    solutions = [a.to_dict() for a in cal.annotators]
+    assert any("height_check_ratio" in s for s in solutions)
+    assert _foreign_types(solutions) == []

@@ -337,3 +337,22 @@ class LocateResult:
     cues_applied: bool = False  # the scene's cues (camloc_geo.absolute._cues) are in the scores
     ties: list[Tie] = field(default_factory=list)  # groups of tied candidates (mark_ties)
     leaders_tie: bool = False  # candidates 1 and 2 tie: the best point is not decided
+
+    def __repr__(self) -> str:
+        """One line for a notebook: the scene, candidates, the best, ties, warnings.
+
+        (The dataclass' own repr printed every candidate, observation and the calibration:
+        ~28,000 characters.)
+        """
+        parts = [f"scene_id={self.scene_id!r}", f"candidates={len(self.candidates)}"]
+        if self.candidates:
+            best = self.candidates[0]
+            parts.append(f"best=(lat={best.lat:.6f}, lon={best.lon:.6f}, score={best.score:.3f})")
+        elif self.reason:
+            parts.append(f"reason={self.reason!r}")
+        parts.append(f"methods_tried={self.methods_tried!r}")
+        if self.ties:
+            parts.append(f"ties={len(self.ties)}")
+        if self.warnings:
+            parts.append(f"warnings={len(self.warnings)}")
+        return f"LocateResult({', '.join(parts)})"
