@@ -13,6 +13,7 @@ from camloc_geo.geocode import geocode_title, geocode_title_in_maps, whole_map
 from camloc_geo.osm import MapData
 
 REPO = Path(__file__).resolve().parents[1]
+OSM_DIR = REPO / "data" / "osm"
 
 
 @pytest.fixture(scope="module")
@@ -115,3 +116,17 @@ def test_title_match_repr_is_short(baltimore: MapData) -> None:
     assert "Corner(" not in text
     assert best.intersection is not None
     assert best.intersection.id == "c49537218"
+
+
+def test_an_extract_copied_into_the_folder_after_a_first_look_is_found(tmp_path: Path) -> None:
+    """The folder's plan was cached on its name alone, for good: a camera outside every
+    extract stayed 'no_map' after the extract covering it was copied in."""
+    import shutil
+
+    from camloc_geo.cameras import CameraRow, geocode_camera
+
+    shutil.copy(OSM_DIR / "monaco.osm.pbf", tmp_path)
+    row = CameraRow(row=1, id="c", title="Eastern Ave & S Broadway", lat=39.2851, lon=-76.5934)
+    assert geocode_camera(row, map_source=tmp_path).status == "no_map"
+    shutil.copy(OSM_DIR / "baltimore.osm.pbf", tmp_path)
+    assert geocode_camera(row, map_source=tmp_path).status != "no_map"

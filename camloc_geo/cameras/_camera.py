@@ -36,6 +36,8 @@ from __future__ import annotations
 import logging
 import math
 import os
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any
 
@@ -683,13 +685,37 @@ def _geocode(
     return _with_map(row, res, m, extract=name)
 
 
-_PLANS: dict[tuple[str, bool], MapPlan] = {}
+_PLANS: OrderedDict[tuple[str, bool, int, int], MapPlan] = OrderedDict()
+_PLANS_LOCK = threading.Lock()
+PLAN_CACHE_ENTRIES = 16
+"""How many map sources' plans are kept (the most recently used)."""
+
+
+def _source_version(map_source: str | os.PathLike[str]) -> tuple[int, int]:
+    """``(mtime_ns, size)`` of an extract or a folder of extracts (a folder's modification
+    time changes when an extract is added, removed or renamed in it); ``(0, 0)`` when it is
+    not on disk (the plan then says why)."""
+    try:
+        st = os.stat(map_source)
+    except (OSError, TypeError, ValueError):
+        return 0, 0
+    return st.st_mtime_ns, st.st_size
 
 
 def _cached_plan(map_source: str | os.PathLike[str], network: bool) -> MapPlan:
+    """The map plan of a source, kept per version of it (an extract copied into a folder
+    after a first look is found), at most ``PLAN_CACHE_ENTRIES`` sources."""
     from camloc_geo.osm import map_plan
 
-    key = (str(map_source), bool(network))
-    if key not in _PLANS:
-        _PLANS[key] = map_plan(map_source, network=network)
-    return _PLANS[key]
+    key = (str(map_source), bool(network), *_source_version(map_source))
+    with _PLANS_LOCK:
+        plan = _PLANS.get(key)
+        if plan is not None:
+            _PLANS.move_to_end(key)
+            return plan
+    plan = map_plan(map_source, network=network)
+    with _PLANS_LOCK:
+        _PLANS[key] = plan
+        while len(_PLANS) > PLAN_CACHE_ENTRIES:
+            _PLANS.popitem(last=False)
+    return plan
