@@ -518,3 +518,40 @@ def test_cli_batch_warns_of_duplicate_camera_ids(
     lst.write_text("id,title\ncam1,A & B\ncam2,C & D\n", encoding="utf-8")
     clean = run_batch(lst, out_gpkg=tmp_path / "c.gpkg", progress=False, workers=1)
     assert clean.warnings == []
+
+
+def test_a_spreadsheet_s_windows_1252_list_with_decimal_commas_is_read(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A European Excel export: semicolons, decimal commas, Windows-1252 accents. It was
+    refused whole ("is not UTF-8 text") and, once re-saved as UTF-8, every camera lost its
+    point ("lat '39,2851' is not a number")."""
+    from camloc_geo.cameras import read_camera_list
+
+    path = tmp_path / "export.csv"
+    path.write_bytes(
+        "id;title;lat;lon\ncam1;Café Broadway;39,2851;-76,5934\ncam2;Bond St;39.28;-76.59\n".encode(
+            "cp1252"
+        )
+    )
+    rows = list(read_camera_list(path))
+    assert [r.title for r in rows] == ["Café Broadway", "Bond St"]
+    assert (rows[0].lat, rows[0].lon) == (39.2851, -76.5934)
+    assert (rows[1].lat, rows[1].lon) == (39.28, -76.59)
+    assert not rows[0].problems
+    assert caplog.text.count("export.csv is not UTF-8 text: read as Windows-1252") == 1
+    list(read_camera_list(path))  # read again (batch counts, then reads): said once
+    assert caplog.text.count("is not UTF-8 text") == 1
+    caplog.clear()
+    utf8 = tmp_path / "utf8.csv"
+    utf8.write_text('id,title,lat,lon\ncam1,Café,"39,2851",-76.5934\n', encoding="utf-8")
+    (row,) = read_camera_list(utf8)
+    assert row.title == "Café"
+    assert row.lat == 39.2851
+    assert "not UTF-8" not in caplog.text
+    # a thousands separator or a list of numbers is still not a number
+    odd = tmp_path / "odd.csv"
+    odd.write_text("id;title;lat;lon\nc;t;1,234,5;2\n", encoding="utf-8")
+    (row,) = read_camera_list(odd)
+    assert row.lat is None
+    assert any("is not a number" in p for p in row.problems)

@@ -26,16 +26,24 @@ length of the list.
 
 from __future__ import annotations
 
+import codecs
 import csv
 import json
+import logging
 import math
 import os
+import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
+
+log = logging.getLogger(__name__)
+
+_DECIMAL_COMMA = re.compile(r"\s*[+-]?\d+,\d+\s*")
+"""A number written with a decimal comma (``39,2851``: a European spreadsheet's export)."""
 
 __all__ = [
     "COLUMN_VARIANTS",
@@ -139,6 +147,8 @@ def _clean(value: Any) -> str:
 def _number(value: Any, name: str, problems: list[str]) -> float | None:
     if value is None or (isinstance(value, str) and not value.strip()):
         return None
+    if isinstance(value, str) and _DECIMAL_COMMA.fullmatch(value):
+        value = value.replace(",", ".")
     try:
         num = float(value)
     except (TypeError, ValueError):
@@ -256,8 +266,50 @@ def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
     return tuple(problems)
 
 
+def _text_encoding(path: Path) -> str:
+    """``utf-8-sig`` for UTF-8 text (with or without a byte-order mark), else the
+    Windows-1252 that spreadsheets export on Western systems (``latin-1`` where even that
+    does not decode), with a warning: a list saved so is read, not refused.
+
+    One streaming pass over the bytes (an incremental decoder: bounded memory).
+    """
+    decoder: codecs.IncrementalDecoder = codecs.getincrementaldecoder("utf-8")()
+    with open(path, "rb") as fh:
+        try:
+            while chunk := fh.read(1 << 20):
+                decoder.decode(chunk)
+            decoder.decode(b"", final=True)
+            return "utf-8-sig"
+        except UnicodeDecodeError:
+            pass
+        fh.seek(0)
+        decoder = codecs.getincrementaldecoder("cp1252")()
+        try:
+            while chunk := fh.read(1 << 20):
+                decoder.decode(chunk)
+            encoding = "cp1252"
+        except UnicodeDecodeError:
+            encoding = "latin-1"
+    st = path.stat()
+    key = (str(path.resolve()), st.st_mtime_ns, st.st_size)
+    if key not in _ENCODING_WARNED:  # the list is read twice (count, then rows): say it once
+        if len(_ENCODING_WARNED) > 1000:
+            _ENCODING_WARNED.clear()
+        _ENCODING_WARNED.add(key)
+        log.warning(
+            "camera list %s is not UTF-8 text: read as %s (a spreadsheet's export); check "
+            "accented names, and save it as UTF-8 to be sure",
+            path.name,
+            "Windows-1252" if encoding == "cp1252" else "Latin-1",
+        )
+    return encoding
+
+
+_ENCODING_WARNED: set[tuple[str, int, int]] = set()
+
+
 def _read_csv(path: Path) -> Iterator[CameraRow]:
-    with open(path, encoding="utf-8-sig", newline="") as fh:
+    with open(path, encoding=_text_encoding(path), newline="") as fh:
         yield from read_camera_csv(
             fh, base_dir=path.resolve().parent, tsv=path.name.lower().endswith(".tsv")
         )
