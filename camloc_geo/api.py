@@ -766,17 +766,6 @@ def vanishing_points(
         if isinstance(focal_px, bool) or not focal[0] > 0:
             raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
         focal_px = focal[0]
-    if (
-        isinstance(image, np.ndarray)
-        and np.issubdtype(image.dtype, np.integer)
-        and image.dtype.itemsize >= 4
-        and image.size
-        and image.min() >= 0
-        and image.max() <= 255
-    ):
-        # 8-bit values held in a wide integer array (img.astype(int), np.array(pil, int)):
-        # load_image would scale them by the dtype's range (255 / 2**63) to black
-        image = image.astype(np.uint8)
     img = load_image(image)
     mask = None
     if ignore_boxes_px:

@@ -235,8 +235,10 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
     ----------
     image
         A path to an image file, or an array: ``(H, W)`` gray, ``(H, W, 3)`` BGR or
-        ``(H, W, 4)`` BGRA, any numeric dtype (integers span their dtype's range, floats
-        are taken in ``[0, 1]`` when their maximum is at most 1, else in ``[0, 255]``).
+        ``(H, W, 4)`` BGRA, any numeric dtype (8- and 16-bit integers span their dtype's
+        range; 32- and 64-bit integers are read as 8-bit values when they are at most 255,
+        16-bit ones up to 65535, else scaled by their maximum; floats are taken in
+        ``[0, 1]`` when their maximum is at most 1, else in ``[0, 255]``).
         Files are decoded by OpenCV, which applies the EXIF orientation
         (:func:`camloc_geo._io.read_image_gray`).
 
@@ -267,6 +269,11 @@ def load_image(image: str | os.PathLike[str] | npt.NDArray[Any]) -> npt.NDArray[
             raise InputError("image array contains NaN or infinite values")
         if arr.dtype == np.bool_:
             a = a * 255.0
+        elif np.issubdtype(arr.dtype, np.integer) and arr.dtype.itemsize >= 4:
+            # a wide integer array holds 8- or 16-bit values (img.astype(int), np.array(pil,
+            # int)), not values spanning 2**31 or 2**63: by its dtype's range it was black
+            top = float(a.max()) if a.size else 0.0
+            a = a * (1.0 if top <= 255.0 else 255.0 / 65535.0 if top <= 65535.0 else 255.0 / top)
         elif np.issubdtype(arr.dtype, np.integer):
             a = a * (255.0 / float(np.iinfo(arr.dtype.str).max))  # e.g. 16-bit images
         elif a.size and a.max() <= 1.0:

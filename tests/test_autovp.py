@@ -777,3 +777,17 @@ def test_real_photo_third_direction_of_a_few_lines_is_jackknifed() -> None:
     assert 0.07 < err < 0.12
     assert res.focal_std_rel > 0.045
     assert err < 2.0 * res.focal_std_rel
+
+
+def test_load_image_reads_wide_integer_arrays_by_their_values() -> None:
+    """int64 holding 0..255 (img.astype(int)) was scaled by 255 / 2**63 to black; only the
+    api worked around it. 16-bit values in an int32 array are read as 16-bit."""
+    from camloc_geo.autovp import load_image
+
+    rng = np.random.default_rng(0)
+    img8 = rng.integers(0, 256, (40, 60), dtype=np.uint8)
+    for dtype in (np.int64, np.int32, np.uint32, np.uint64):
+        np.testing.assert_array_equal(load_image(img8.astype(dtype)), img8)
+    img16 = img8.astype(np.int32) * 257  # 0..65535
+    np.testing.assert_array_equal(load_image(img16), img8)
+    np.testing.assert_array_equal(load_image(img8.astype(np.uint16) * 257), img8)  # unchanged
