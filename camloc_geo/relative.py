@@ -29,6 +29,7 @@ import functools
 import logging
 import math
 import re
+import threading
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -1871,11 +1872,27 @@ def _scene_lens(scene: Scene) -> tuple[float | None, tuple[float, float] | None]
     return float(dist.k1), (None if pp is None else (float(pp[0]), float(pp[1])))
 
 
+_DETECT_LOCKS: dict[tuple[Any, ...], threading.Lock] = {}
+_DETECT_LOCKS_GUARD = threading.Lock()
+
+
 def _detect_scene_vps(scene: Scene, path: Path) -> Any:
-    """:func:`_detect_vps` of ``path`` (an existing file) with ``scene``'s lens."""
+    """:func:`_detect_vps` of ``path`` (an existing file) with ``scene``'s lens.
+
+    Threads asking for the same photo at once wait for the first one's detection (the
+    cache would otherwise miss in each of them: 4 threads, 4 detections of one photo).
+    """
     stat = path.stat()
     k1, pp = _scene_lens(scene)
-    return _detect_vps(str(path.resolve()), stat.st_mtime_ns, stat.st_size, k1, pp)
+    key = (str(path.resolve()), stat.st_mtime_ns, stat.st_size, k1, pp)
+    with _DETECT_LOCKS_GUARD:
+        lock = _DETECT_LOCKS.get(key)
+        if lock is None:
+            if len(_DETECT_LOCKS) >= 64:  # bounded: a lock dropped here costs a detection
+                _DETECT_LOCKS.clear()
+            lock = _DETECT_LOCKS[key] = threading.Lock()
+    with lock:
+        return _detect_vps(*key)
 
 
 def _photo_segments_px(scene: Scene, segments: npt.ArrayLike) -> FloatArray:

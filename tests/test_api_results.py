@@ -73,13 +73,25 @@ def test_calibrate_from_four_threads_gives_the_serial_answer() -> None:
     assert answers == [serial] * 4
 
 
-def test_a_scene_with_a_photo_from_four_threads_gives_the_serial_answer(tmp_path: Path) -> None:
+def test_a_scene_with_a_photo_from_four_threads_gives_the_serial_answer(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The photo's decoded pixels and detected vanishing points are cached per file version:
-    threads sharing those caches get the serial answer."""
+    threads sharing those caches get the serial answer, and the photo is detected once (it
+    was detected in each of the 4 threads: the cache missed in all of them)."""
     pytest.importorskip("cv2")
+    from camloc_geo import autovp
     from tests.test_calibrate_autovp import _noisy_scene_with_photo
 
     scene = _noisy_scene_with_photo(tmp_path, 3, True)
+    detections: list[object] = []
+    real_detect = autovp.detect_vanishing_points
+
+    def counting(*args: Any, **kwargs: Any) -> Any:
+        detections.append(args[0])
+        return real_detect(*args, **kwargs)
+
+    monkeypatch.setattr(autovp, "detect_vanishing_points", counting)
     answers: list[str] = []
     barrier = threading.Barrier(4)
 
@@ -95,6 +107,7 @@ def test_a_scene_with_a_photo_from_four_threads_gives_the_serial_answer(tmp_path
     serial = json.dumps(api.calibrate_scene(scene).to_dict(), sort_keys=True)
     assert answers == [serial] * 4
     assert "photo" in serial  # the photo's lines were used (a real photo path, not skipped)
+    assert len(detections) == 1
 
 
 def test_calibration_and_locate_results_repr_in_one_line(located: api.LocateOutput) -> None:
