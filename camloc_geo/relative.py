@@ -2593,20 +2593,16 @@ def _add_photo_segments(
     segs, labels = segs[keep], labels[keep]
     if len(segs) == 0:
         return {}
-    f, (cx, cy), R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
-    K_inv = np.linalg.inv(np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]))
+    f, pp, R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
     # Each of the photo's vanishing points (its own clustering: no choice by the fit) that
     # is within PHOTO_AXIS_TOL_DEG of one of the fit's axes, and the nearest to it, lends
     # that axis its segments.
     cluster_axis = {}
     for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
-        d = K_inv @ vp
-        n = float(np.linalg.norm(d))
-        if not (n > 0.0 and np.isfinite(n)) or np.count_nonzero(labels == k) < PHOTO_MIN_SEGMENTS:
+        if np.count_nonzero(labels == k) < PHOTO_MIN_SEGMENTS:
             continue
-        cosines = np.abs(R.T @ (d / n))  # against the fit's world axes in the camera frame
-        i = int(np.argmax(cosines))
-        if math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG:
+        i = _photo_direction_axis(vp, f, pp, R)
+        if i is not None:
             cluster_axis[k] = i
     if len(set(cluster_axis.values())) < len(cluster_axis):
         return {}  # two of the photo's directions on one axis: ambiguous
@@ -3050,20 +3046,21 @@ def _leave_one_out_steps(
         prob.log_f_prior_sigma = saved_prior
 
 
-def _photo_direction_agrees(
-    vp_px: FloatArray, axis: int, f: float, pp: tuple[float, float], R: FloatArray
-) -> bool:
-    """Whether a photo's vanishing point lends ``axis`` its segments for the camera
-    ``(f, pp, R)``: the nearest of its axes, within ``PHOTO_AXIS_TOL_DEG``
-    (:func:`_add_photo_segments`'s test)."""
+def _photo_direction_axis(
+    vp_px: FloatArray, f: float, pp: tuple[float, float], R: FloatArray
+) -> int | None:
+    """The axis (index) a photo's vanishing point lends its segments to for the camera
+    ``(f, pp, R)``: the nearest of the camera's world axes, if within ``PHOTO_AXIS_TOL_DEG``;
+    None where none is (or the point gives no direction)."""
     K_inv = np.linalg.inv(np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]]))
     d = K_inv @ np.asarray(vp_px, dtype=float)
     n = float(np.linalg.norm(d))
     if not (n > 0.0 and np.isfinite(n)):
-        return False
-    cosines = np.abs(R.T @ (d / n))
+        return None
+    cosines = np.abs(R.T @ (d / n))  # against the world axes in the camera frame
     i = int(np.argmax(cosines))
-    return i == axis and math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG
+    near = math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG
+    return i if near else None
 
 
 def _photo_rows_lost(
@@ -3076,7 +3073,7 @@ def _photo_rows_lost(
 
     ``(len(xs), n_owned)``: True on the photo's rows (the last ``len(prob.photo_segments)``
     of the first ``n_owned``) of an axis whose photo vanishing point
-    (``prob.photo_axis_vp``) fails :func:`_photo_direction_agrees` at the annotator's
+    (``prob.photo_axis_vp``) no longer lends it its segments at the annotator's
     leave-out ``xs[a]``; the photo's own group (the last, where present) and failed
     leave-outs lose nothing. None when no leave-out loses a row.
     """
@@ -3089,7 +3086,7 @@ def _photo_rows_lost(
             continue
         f, pp, R, _C = prob.unpack(x_a, *args)
         for axis, vp in prob.photo_axis_vp.items():
-            if not _photo_direction_agrees(vp, axis, f, pp, R):
+            if _photo_direction_axis(vp, f, pp, R) != axis:
                 lost[a, first:] |= prob.photo_axis == axis
     return lost if lost.any() else None
 
