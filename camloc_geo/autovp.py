@@ -869,6 +869,42 @@ def _systematic_logf_std(
     return math.sqrt(total)
 
 
+def _refit_without(
+    m: _Model,
+    s: _Segs,
+    labels: npt.NDArray[np.int_],
+    tau_px: float,
+    f_free: bool,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    info: dict[str, Any] | None = None,
+) -> tuple[FloatArray, float]:
+    """Rotation and focal length refitted from ``m`` (up to 20 evaluations) with the
+    segments ``labels`` marks ``-1`` left out: every leave-out term's refit."""
+    R, f, _, _ = _refine(
+        m.R,
+        m.f_n,
+        s,
+        labels,
+        tau_px,
+        f_free,
+        f_prior,
+        f_bounds,
+        prior_w=prior_w,
+        max_nfev=20,
+        info=info,
+    )
+    return R, f
+
+
+def _tilt_move_deg(R: FloatArray, kv: int, p0: float, r0: float) -> tuple[float, float]:
+    """Pitch and roll of the rotation ``R`` (vertical axis ``kv``) less ``p0`` and ``r0``,
+    degrees; the roll's move wrapped into [-180, 180)."""
+    p1, r1 = pitch_roll_from_up(_up_sign(R[:, kv]))
+    return p1 - p0, (r1 - r0 + 180.0) % 360.0 - 180.0
+
+
 def _logf_move(
     m: _Model,
     s: _Segs,
@@ -880,9 +916,7 @@ def _logf_move(
 ) -> float:
     """``log(f / m.f_n)``: how far the focal length moves when refitted (from ``m``, up to
     20 evaluations) with the segments ``labels`` marks ``-1`` left out."""
-    _, f, _, _ = _refine(
-        m.R, m.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w, max_nfev=20
-    )
+    _, f = _refit_without(m, s, labels, tau_px, True, f_prior, f_bounds, prior_w)
     return math.log(f / m.f_n)
 
 
@@ -975,20 +1009,8 @@ def _line_jackknife_logf_std(
         for g in range(n):
             labels = m.labels.copy()
             labels[sel[groups == g]] = -1
-            R, f, _, _ = _refine(
-                m.R,
-                m.f_n,
-                s,
-                labels,
-                tau_px,
-                f_free,
-                f_prior,
-                f_bounds,
-                prior_w=prior_w,
-                max_nfev=20,
-            )
-            p1, r1 = pitch_roll_from_up(_up_sign(R[:, kv]))
-            theta[g] = (math.log(f / m.f_n), p1 - p0, (r1 - r0 + 180.0) % 360.0 - 180.0)
+            R, f = _refit_without(m, s, labels, tau_px, f_free, f_prior, f_bounds, prior_w)
+            theta[g] = (math.log(f / m.f_n), *_tilt_move_deg(R, kv, p0, r0))
         spread = (n - 1) / n * np.sum((theta - theta.mean(axis=0)) ** 2, axis=0)
         total += float(spread[0])
         tilt_total += spread[1:]
@@ -1095,24 +1117,11 @@ def _split_tilt_deg(
         """Significant move (degrees, 0 where not) of pitch and roll without those lines."""
         labels = np.where(left_out, -1, m.labels)
         info: dict[str, Any] = {}
-        R, _, _, _ = _refine(
-            m.R,
-            m.f_n,
-            s,
-            labels,
-            tau_px,
-            f_free,
-            f_prior,
-            f_bounds,
-            prior_w=prior_w,
-            max_nfev=20,
-            info=info,
-        )
+        R, _ = _refit_without(m, s, labels, tau_px, f_free, f_prior, f_bounds, prior_w, info)
         cov = info.get("cov_rot")
         if cov is None or not np.all(np.isfinite(cov)):
             return None
-        p1, r1 = pitch_roll_from_up(_up_sign(R[:, kv]))
-        move = np.array([p1 - p0, (r1 - r0 + 180.0) % 360.0 - 180.0])
+        move = np.array(_tilt_move_deg(R, kv, p0, r0))
         sd = np.sqrt(np.maximum(np.diag(J @ cov @ J.T) - var_full, 0.0))
         return np.where(np.abs(move) > _SPLIT_TILT_Z * sd, move, 0.0)
 
