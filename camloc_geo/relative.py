@@ -322,6 +322,13 @@ class CalibrationResult:
     photo_segments
         Segments detected in the scene's photo that joined the fit, per axis
         (``CalibrationSettings.photo_lines``); empty when none did.
+    object_proportions
+        The trusted annotators' clicked edges measured back through the fitted camera,
+        against the stated size (joint fit only): ``scale`` per axis (clicked / stated,
+        median over the annotators), ``chi2`` and ``spread_log`` of their disagreement,
+        ``disagrees`` (chi-square above 9.21 and spread above 0.2: a warning, and the
+        position sigmas include half the spread of the camera's distance). A car of another
+        class than the preset, or ground corners at the tyre contacts, shows here.
     """
 
     camera: Camera
@@ -350,6 +357,7 @@ class CalibrationResult:
     parameter_covariance: FloatArray | None = field(default=None, repr=False, compare=False)
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
     photo_segments: dict[str, int] = field(default_factory=dict)
+    object_proportions: dict[str, Any] | None = None
 
     @property
     def focal_sigma_with_principal_point_px(self) -> float | None:
@@ -463,6 +471,8 @@ class CalibrationResult:
             out["camera_in_world_sigma_jackknife_m"] = self.position_sigma_jackknife_m.tolist()
         if self.photo_segments:
             out["photo_segments"] = dict(self.photo_segments)
+        if self.object_proportions is not None:
+            out["object_proportions"] = self.object_proportions
         out["cluster"] = self.cluster
         out["annotators"] = [a.to_dict() for a in self.annotators]
         if self.warnings:
@@ -3815,6 +3825,10 @@ def _joint(
     corner_xyz = np.array([_corner_points(size, prob.ws_common, c)[0] for c in chosen_corners])
     out_corner = chosen_corners[int(np.argmin(np.linalg.norm(corner_xyz - C, axis=1)))]
     M, origin, ws_out = _frame_at_corner(size, prob.ws_common, out_corner)
+    size_sigma = 0.0 if _size_given(scene) else settings.size_sigma_rel
+    props = _box_proportions(
+        prob, Camera.from_center(f, pp, R, C), size, size_sigma, settings.outlier_weight
+    )
     R, C = R @ M, M.T @ (C - origin)
     camera = Camera.from_center(f, pp, R, C)
     corner_names = [_CORNER_NAMES[_relabel_corner(int(c), out_corner)] for c in prob.corners]
@@ -3831,6 +3845,10 @@ def _joint(
     # the length, width and height ends together), so with their average: size_sigma_rel /
     # √3. (The full 5 % over-stated it: crowd position sigmas covered 88-90 % at 1 sigma,
     # median error/sigma 0.34-0.40, benchmarks/calibrate_coverage.py.)
+    if props is not None and props.disagrees:
+        # The clicked box is not the stated car: the answer's scale is off by up to the
+        # spread of its edges' scales (half of it at one sigma; benchmarks/crowd_slips.py).
+        size_rel = math.hypot(size_rel, 0.5 * props.spread)
     car_lines = _car_line_sensitivity(
         prob,
         np.asarray(res.x, dtype=float),
@@ -3934,6 +3952,10 @@ def _joint(
         )
     for axis in car_lines.axes_on_car(settings.car_line_share_warn):
         result.warnings.append(_car_line_warning(axis, car_lines, settings.car_line_sigma_deg))
+    if props is not None:
+        result.object_proportions = props.to_dict()
+        if props.disagrees:
+            result.warnings.append(_proportion_warning(props, size))
     lo, hi = prob.f_bounds
     if f_fixed is None and not lo * 1.001 < f < hi / 1.001:
         result.warnings.append(
@@ -3941,6 +3963,105 @@ def _joint(
             "the lines do not determine it and the position is unreliable; give camera.focal_px"
         )
     return result
+
+
+PROPORTION_CHI2 = 9.21  # chi-square(2) at p = 0.01: the clicked box's proportions disagree ...
+PROPORTION_SPREAD = 0.2  # ... and its edges' scales spread by more than this (natural log)
+
+
+@dataclass(frozen=True)
+class _Proportions:
+    """The clicked car's edges against the stated size (:func:`_box_proportions`)."""
+
+    scale: dict[str, float]  # per axis: the clicked edge's length / the stated one (median)
+    chi2: float  # of the three log scales' disagreement, 2 degrees of freedom
+    spread: float  # largest minus smallest log scale
+    n_annotators: int
+
+    @property
+    def disagrees(self) -> bool:
+        """True when the proportions are off beyond the clicks' and the preset's noise."""
+        return self.chi2 > PROPORTION_CHI2 and self.spread > PROPORTION_SPREAD
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the scales, the test and its verdict."""
+        return {
+            "scale": {k: round(v, 4) for k, v in self.scale.items()},
+            "chi2": round(self.chi2, 2),
+            "spread_log": round(self.spread, 4),
+            "annotators": self.n_annotators,
+            "disagrees": self.disagrees,
+        }
+
+
+def _box_proportions(
+    prob: _JointProblem,
+    camera: Camera,
+    size: ObjectSize,
+    size_sigma_rel: float,
+    weight_min: float,
+) -> _Proportions | None:
+    """How long the trusted annotators' clicked edges are, in the fitted camera, vs ``size``.
+
+    The fit holds the car at the stated size, so its scale is a compromise of the three
+    edges; their lengths measured back through the fitted camera (the length and width
+    ends cast onto the ground, the height end onto the vertical above the clicked corner)
+    are proportional to the clicked box. A car of another class than the preset (a van
+    called a sedan: its roof 1.6x higher, its length 1.15x), or ground corners clicked at
+    the tyre contacts instead of the ground under the body's corners (the length edge
+    ~1.5 m short), gives proportions the preset does not have; the scale of the whole
+    answer (the camera's distance) is then off by up to their spread, with no residual to
+    show it. Each axis' log scale (median over the annotators) has the clicks' noise
+    (``sqrt(2) sigma_pt`` over the edge's pixel length, x1.25/sqrt(n) for the median) and
+    the preset's ``size_sigma_rel``; their weighted disagreement is the chi-square.
+    None when no trusted annotator's clicks can be measured.
+    """
+    clicks = prob.pt_pix.reshape(-1, 4, 2)
+    stated = np.array([size.length_m, size.width_m, size.height_m])
+    logs, edges = [], []
+    for slot in range(prob.n_annotators):
+        if prob.weights[slot] < weight_min:
+            continue
+        px = clicks[slot]
+        ground = camera.ground_from_pixels(px[:3])
+        if not np.all(np.isfinite(ground)):
+            continue
+        length = abs(float(ground[1, 0] - ground[0, 0]))
+        width = abs(float(ground[2, 1] - ground[0, 1]))
+        try:
+            top = float(camera.point_on_vertical(ground[0, :2], px[3])[2])
+        except DegenerateGeometryError:
+            continue
+        measured = np.array([length, width, top])
+        edge_px = np.linalg.norm(px[1:] - px[0], axis=1)
+        if not (np.all(measured > 0.0) and np.all(edge_px > 0.0)):
+            continue
+        logs.append(np.log(measured / stated))
+        edges.append(edge_px)
+    if not logs:
+        return None
+    n = len(logs)
+    med = np.median(np.array(logs), axis=0)
+    click_rel = math.sqrt(2.0) * prob.sigma_pt / np.median(np.array(edges), axis=0)
+    var = (1.25 * click_rel) ** 2 / n + size_sigma_rel**2
+    w = 1.0 / var
+    mean = float(np.sum(w * med) / np.sum(w))
+    chi2 = float(np.sum(w * (med - mean) ** 2))
+    scale = {axis: float(math.exp(v)) for axis, v in zip(AXES, med, strict=True)}
+    return _Proportions(scale, chi2, float(np.ptp(med)), n)
+
+
+def _proportion_warning(props: _Proportions, size: ObjectSize) -> str:
+    """The warning for a clicked box whose proportions are not the stated size's."""
+    parts = ", ".join(f"{axis} x{props.scale[axis]:.2f}" for axis in AXES)
+    return (
+        f"object: the clicked car's edges do not have the stated size's proportions ({parts} "
+        f"of {size.length_m:.2f} x {size.width_m:.2f} x {size.height_m:.2f} m): a car of another "
+        "class than the preset (a van or an SUV called a sedan), or ground corners clicked at "
+        "the tyre contacts instead of the ground under the body's corners (docs/annotate.md)? "
+        f"The camera's distance is uncertain by their spread ({100.0 * props.spread:.0f} %, "
+        "included in the position sigmas); check object.preset and the corner clicks"
+    )
 
 
 def _car_line_warning(axis: str, car_lines: _CarLines, sigma_deg: float) -> str:
