@@ -7,7 +7,9 @@ same checks stay quiet on clean work.
 
 from __future__ import annotations
 
+import json
 import logging
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -115,3 +117,29 @@ def test_every_annotator_at_the_tyre_contacts_is_said(seed: int) -> None:
     assert props is not None
     assert props["scale"]["length"] / props["scale"]["height"] < 0.8
     assert _within_2_sigma(result, syn.camera)
+
+
+# ------------------------------------------------------------------ one line off its axis
+NONPARALLEL = json.loads(
+    (Path(__file__).parent / "data" / "crowd_slips_nonparallel.json").read_text()
+)
+
+
+@pytest.mark.parametrize("key", sorted(NONPARALLEL))
+def test_one_long_line_off_its_axis_is_inside_two_sigma(key: str) -> None:
+    """One annotator's single long line 12-15 deg off its axis (benchmarks/crowd_slips.py,
+    scenes 13 and 50) carries the whole fit: focal length x2.9-5.7. The one-step jackknife
+    found no camera without that annotator and left it out of the spread: stated 578-2227 px
+    and 10-60 m for errors of 2850-5900 px and 64-161 m. Now that leave-out is refitted."""
+    case = NONPARALLEL[key]
+    result = calibrate(parse_scene(case["scene"]))
+    truth = case["truth"]
+    slot = [a["annotator"] for a in case["scene"]["annotations"]].index(case["annotator"])
+    influence = result.annotator_influence_m[slot]
+    assert influence is not None
+    assert influence > 50.0
+    err = float(np.linalg.norm(result.camera.center_in_world - np.array(truth["camera_in_world"])))
+    assert result.position_sigma_m is not None
+    assert err <= 2.0 * float(np.linalg.norm(result.position_sigma_m))
+    assert result.focal_sigma_px is not None
+    assert abs(result.camera.focal_px - truth["focal_px"]) <= 2.0 * result.focal_sigma_px
