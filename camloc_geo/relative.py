@@ -2033,14 +2033,27 @@ def _screen_annotation(
     return new, None, clamped, notes
 
 
+def _work_key(ann: Annotation) -> tuple[float, ...]:
+    """An annotator's clicks and lines, rounded to 0.01 px (the annotator's name left out)."""
+    values: list[float] = []
+    for name in ("origin", "length", "width", "height"):
+        values += getattr(ann.axes, name)
+    for axis in AXES:
+        values.append(-1.0)  # separates the axes' lines
+        for seg in getattr(ann.vp_lines, axis):
+            values += seg
+    return tuple(round(float(v), 2) for v in values)
+
+
 def _screen_annotations(scene: Scene, sigma_line_rel: float = 0.001) -> _Screening:
     """Clamp slips onto the image; leave out annotators and hints that cannot be used.
 
     An annotator is left out (with a warning naming them and the reason) when a click is not
     finite or lies farther outside the image than the margin
-    (:attr:`~camloc_geo.scene.Scene.pixel_margin_px`), or when their axes are degenerate (an
-    edge end on the origin, two edges collinear). Clicks within the margin are clamped and
-    counted. Camera hints outside plausible ranges are ignored with a warning.
+    (:attr:`~camloc_geo.scene.Scene.pixel_margin_px`), when their axes are degenerate (an
+    edge end on the origin, two edges collinear), or when their clicks and lines are another
+    annotator's (a duplicated submission, under any name). Clicks within the margin are
+    clamped and counted. Camera hints outside plausible ranges are ignored with a warning.
     """
     margin = scene.pixel_margin_px
     kept: list[int] = []
@@ -2048,8 +2061,20 @@ def _screen_annotations(scene: Scene, sigma_line_rel: float = 0.001) -> _Screeni
     excluded: list[dict[str, Any]] = []
     warnings: list[str] = list(scene.input_warnings)
     clamped = 0
+    seen: dict[tuple[float, ...], int] = {}
     for i, ann in enumerate(scene.annotations):
         new, reason, n, notes = _screen_annotation(scene, i, margin)
+        first = None if new is None else seen.setdefault(_work_key(new), i)
+        if new is not None and first is not None and first != i:
+            # The same work submitted twice is one witness: counted twice it halves the
+            # annotators' spread and doubles its own weight (benchmarks/crowd_slips.py).
+            new, reason = (
+                None,
+                (
+                    f"annotator: the same clicks and lines as annotations[{first}] "
+                    f"({scene.annotations[first].annotator!r}); a duplicated submission counts once"
+                ),
+            )
         if new is None:
             geometry = not (reason or "").split(": ", 1)[-1].startswith("pixel")
             excluded.append(
@@ -2517,13 +2542,13 @@ def _calibrate_annotations(
         clean = clean.model_copy(
             update={"annotations": [a for j, a in enumerate(clean.annotations) if j != dropped]}
         )
-    if settings.joint_fit and settings.jackknife and 2 <= len(kept) <= _MAX_JACKKNIFE:
-        if (
-            settings.jackknife_method == "refit"
-            or result.joint_state is None
-            or not _jackknife_one_step(result, settings)
-        ):
-            _jackknife(result, clean, settings)
+    jackknife = settings.joint_fit and settings.jackknife and 2 <= len(kept) <= _MAX_JACKKNIFE
+    if jackknife and (
+        settings.jackknife_method == "refit"
+        or result.joint_state is None
+        or not _jackknife_one_step(result, settings)  # no answer without someone: refit
+    ):
+        _jackknife(result, clean, settings)
     result = _remap(result, kept, len(scene.annotations), excluded, names)
     result.excluded_annotators = sorted(excluded, key=lambda e: int(e["index"]))
     result.clamped_clicks = screening.clamped_clicks

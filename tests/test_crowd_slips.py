@@ -143,3 +143,35 @@ def test_one_long_line_off_its_axis_is_inside_two_sigma(key: str) -> None:
     assert err <= 2.0 * float(np.linalg.norm(result.position_sigma_m))
     assert result.focal_sigma_px is not None
     assert abs(result.camera.focal_px - truth["focal_px"]) <= 2.0 * result.focal_sigma_px
+
+
+# ------------------------------------------------------------------ duplicated submissions
+@pytest.mark.parametrize("seed", [0, 3])
+def test_a_duplicated_submission_counts_once(seed: int) -> None:
+    """The same work twice more (under another name): left out, named, and the answer and
+    its sigmas those of the scene without the copies (the copies shrank the jackknife's
+    spread and tripled one annotator's weight)."""
+    syn = _scene(seed, "sedan", n=4)
+    base = _cal(syn)
+    copies = [dict(syn.scene["annotations"][1], annotator=f"w2-again{k}") for k in (1, 2)]
+    syn.scene["annotations"] += copies
+    result = _cal(syn)
+    excluded = {e["index"]: e["reason"] for e in result.excluded_annotators}
+    assert sorted(excluded) == [4, 5]
+    assert all("same clicks and lines as annotations[1] ('w2')" in r for r in excluded.values())
+    assert any("'w2-again1' (annotations[4]) left out" in w for w in result.warnings)
+    assert np.allclose(result.camera.center_in_world, base.camera.center_in_world, atol=1e-9)
+    assert result.position_sigma_m is not None
+    assert base.position_sigma_m is not None
+    assert np.allclose(result.position_sigma_m, base.position_sigma_m, rtol=1e-9)
+
+
+def test_a_near_copy_is_not_a_duplicate() -> None:
+    """Work that differs by one click (0.5 px) is another witness, kept."""
+    syn = _scene(0, "sedan", n=4)
+    near = json.loads(json.dumps(syn.scene["annotations"][1]))
+    near["annotator"] = "w5"
+    near["axes"]["height"][0] += 0.5
+    syn.scene["annotations"].append(near)
+    result = _cal(syn)
+    assert result.excluded_annotators == []
