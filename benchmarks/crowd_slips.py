@@ -311,7 +311,7 @@ def duplicate(syn: SyntheticScene, rng: np.random.Generator) -> tuple[str, int |
 
 
 def duplicate_sloppy(syn: SyntheticScene, rng: np.random.Generator) -> tuple[str, int | None]:
-    """9b. A wrong-corner or sloppy-free annotator's submission three times (ballot stuffing)."""
+    """9b. The same submission three times (same name)."""
     i = _pick(syn, rng)
     for _ in range(2):
         syn.scene["annotations"].append(copy.deepcopy(_ann(syn, i)))
