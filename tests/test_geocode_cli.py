@@ -320,3 +320,46 @@ def test_cli_broken_pipe_elsewhere_is_still_reported(
     monkeypatch.setattr(cli, "_stdout_closed", lambda: False)
     assert main(["geocode", "x", "--osm", str(BERLIN)]) == 1
     assert "failed: BrokenPipeError" in capsys.readouterr().err
+
+
+def test_cli_list_read_as_batch_reads_it(tmp_path: Path) -> None:
+    """A spreadsheet's semicolon list with a byte-order mark and decimal commas, and the same
+    list as GeoJSON: ``camloc batch`` read both, ``camloc geocode --list`` refused the first
+    ('has no title column ...; its columns: id;title;lat;lon') and could not read the second."""
+    rows = tmp_path / "cams.csv"
+    rows.write_text(
+        "id;title;lat;lon\r\n"
+        "c1;Karl-Liebknecht-Str. / Wadzeckstr.;;\r\n"
+        "c2;Grunerstr. x Alexanderstr.;52,5205;13,4150\r\n",
+        encoding="utf-8-sig",
+    )
+    out = tmp_path / "out.geojson"
+    args = ["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out.read_text())["features"]]
+    assert [(p["id"], p["row"], p["status"]) for p in props] == [
+        ("c1", 2, "junction"),
+        ("c2", 3, "junction"),
+    ]
+    assert props[1]["lat"] == pytest.approx(52.5208, abs=5e-4)
+    collection = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [13.415, 52.5205]},
+                "properties": {"id": "g1", "title": "Grunerstr. x Alexanderstr."},
+            },
+            {"type": "Feature", "geometry": None, "properties": {"title": "Wadzeckstr."}},
+        ],
+    }
+    listed = tmp_path / "cams.geojson"
+    listed.write_text(json.dumps(collection), encoding="utf-8")
+    out2 = tmp_path / "out2.geojson"
+    args = ["geocode", "--list", str(listed), "--osm", str(BERLIN), "--best", "-o", str(out2)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out2.read_text())["features"]]
+    assert [(p["id"], p["row"], p["status"]) for p in props] == [
+        ("g1", 1, "junction"),
+        (None, 2, "street"),
+    ]
