@@ -252,3 +252,14 @@ def test_scraped_and_spanish_titles_are_placed() -> None:
     assert best.status == "junction"
     assert _dist_m(best.lat, best.lon, 21.87163, -102.279456) < 30
     assert best.to_feature()["properties"]["view_bearing_deg"] == 0.0
+
+
+def test_junction_beyond_the_radius_is_named(baltimore) -> None:  # type: ignore[no-untyped-def]
+    """A list point 340 m off its junction (the sweep's webcam 'Ashland Av and N Glover'):
+    the reason said only 'do not meet in this map within 300 m' although they do meet, 337 m
+    away; it now says where (camloc batch's reason for the camera)."""
+    found = geocode_title(
+        "Ashland Av and N Glover", map_data=baltimore, near=(39.3035, -76.5780), radius_m=300
+    )
+    assert found[0].status == "not_found"
+    assert "they meet 337 m away, at 39.30105,-76.58031" in found[0].reason
