@@ -360,7 +360,9 @@ def test_geocode_camera_never_raises(world: dict[str, Path]) -> None:
     assert "nope.json" in (res.reason or "")
 
 
-def test_title_in_two_extracts_is_ambiguous(tmp_path: Path) -> None:
+def test_title_in_two_extracts_at_one_junction_is_placed(tmp_path: Path) -> None:
+    """Two extracts of one area name the same junction: placed once, the other named (it was
+    'ambiguous' with no point; two places in two extracts still are: test_geocode_cli)."""
     osm = tmp_path / "osm"
     osm.mkdir()
     (osm / "baltimore_a.osm.pbf").symlink_to(BALTIMORE)
@@ -377,16 +379,17 @@ def test_title_in_two_extracts_is_ambiguous(tmp_path: Path) -> None:
         lst, out_gpkg=tmp_path / "o.gpkg", map_source=osm, progress=False, workers=1
     )
     cams = pyogrio.read_dataframe(tmp_path / "o.gpkg", layer="cameras").set_index("id")
-    assert cams.loc["1", "status"] == "ambiguous"
-    assert bool(cams.loc["1", "tie"])
-    assert "baltimore_a.osm.pbf" in cams.loc["1", "reason"]
-    assert "baltimore_b.osm.pbf" in cams.loc["1", "reason"]
+    assert cams.loc["1", "status"] == "title_only"
+    assert not bool(cams.loc["1", "tie"])
+    assert cams.loc["1", "extract"] == "baltimore_a.osm.pbf"
+    assert "the same junction in baltimore_b.osm.pbf" in cams.loc["1", "reason"]
+    assert math.isclose(cams.loc["1", "lat"], cams.loc["2", "lat"], abs_tol=5e-4)
     assert cams.loc["2", "status"] == "title_only"
     assert cams.loc["2", "extract"] == "baltimore_b.osm.pbf"
     assert cams.loc["3", "status"] == "title_only"
     assert math.isclose(cams.loc["3", "lat"], cams.loc["3", "geometry"].y)
     assert math.isclose(cams.loc["3", "lon"], cams.loc["3", "geometry"].x)
-    assert summary.statuses == {"ambiguous": 1, "title_only": 2}
+    assert summary.statuses == {"title_only": 3}
 
 
 def test_cli_batch_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -555,3 +558,32 @@ def test_a_spreadsheet_s_windows_1252_list_with_decimal_commas_is_read(
     (row,) = read_camera_list(odd)
     assert row.lat is None
     assert any("is not a number" in p for p in row.problems)
+
+
+def test_overlapping_extracts_place_a_title_without_point(tmp_path: Path) -> None:
+    """One area in two extracts (data/osm holds aguascalientes as .pbf and .bz2; a city
+    extract inside a region's is as common): a title without a point was 'ambiguous' with no
+    point ('the title matches in several extracts: ...'); the same junction in both is now
+    title_only, the other extract named. A title missing everywhere took its reason from the
+    first extract by name (Helsinki's 'closest: Aleksi, ...' for a Berlin title); it now comes
+    from the extract where most of its names exist."""
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "a_helsinki.osm.pbf").symlink_to(HELSINKI)
+    (osm / "berlin.osm.pbf").symlink_to(REPO / "data" / "osm" / "berlin_alexanderplatz.osm.pbf")
+    (osm / "berlin_copy.osm.pbf").symlink_to(
+        REPO / "data" / "osm" / "berlin_alexanderplatz.osm.pbf"
+    )
+    res = geocode_camera(
+        CameraRow(row=1, id="b1", title="Grunerstr. x Alexanderstr."), map_source=osm
+    )
+    assert res.status == "title_only"
+    assert res.lat is not None
+    assert abs(res.lat - 52.5208) < 5e-4
+    assert "the same junction in berlin_copy.osm.pbf" in (res.reason or "")
+    miss = geocode_camera(
+        CameraRow(row=2, id="b2", title="Alexanderstr. & Qzxwvstr."), map_source=osm
+    )
+    assert miss.status == "not_found"
+    assert "Qzxwv" in (miss.reason or "")
+    assert "Aleksi" not in (miss.reason or "")

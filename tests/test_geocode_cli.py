@@ -77,14 +77,48 @@ def test_cli_folder_ambiguous_and_near(tmp_path: Path, capsys: pytest.CaptureFix
     assert Path(features[0]["properties"]["source"]).name == BERLIN.name
 
 
-def test_two_extracts_one_title_is_ambiguous(tmp_path: Path) -> None:
+def test_two_extracts_naming_one_junction_place_it(tmp_path: Path) -> None:
+    """Overlapping extracts (here one area twice, as data/osm's aguascalientes .pbf and .bz2)
+    name the same junction: placed, the other extract named (was 'ambiguous', no point)."""
     a = tmp_path / "a.osm.pbf"
     b = tmp_path / "b.osm.pbf"
     shutil.copy(BERLIN, a)
     shutil.copy(BERLIN, b)
     found = geocode_title_in_maps("Grunerstr. x Alexanderstr.", [whole_map(a), whole_map(b)])
-    assert [m.status for m in found] == ["ambiguous", "ambiguous"]
-    assert "placed in 2 extracts" in found[0].reason
+    assert [m.status for m in found] == ["junction"]
+    assert "the same junction in b.osm.pbf" in found[0].reason
+
+
+def test_two_extracts_two_places_are_ambiguous() -> None:
+    from camloc_geo.geocode import TitleMatch
+    from camloc_geo.geocode._maps import miss_rank, one_place
+
+    here = TitleMatch(status="junction", lat=52.5208, lon=13.4152, source="a.osm.pbf")
+    near = TitleMatch(status="junction", lat=52.5210, lon=13.4155, source="b.osm.pbf")
+    far = TitleMatch(status="junction", lat=48.8604, lon=2.3549, source="c.osm.pbf")
+    tied = TitleMatch(status="ambiguous", lat=52.5208, lon=13.4152, source="d.osm.pbf")
+    assert one_place([here, near])
+    assert not one_place([here, far])
+    assert not one_place([here, tied])
+    # a miss where both names exist says more than one where neither does
+    both = TitleMatch(status="not_found", names_matched=["Alexanderstraße", "Grunerstraße"])
+    none = TitleMatch(status="not_found", names_matched=["", ""])
+    assert sorted([none, both], key=miss_rank)[0] is both
+
+
+def test_a_title_missing_everywhere_says_why_from_its_own_city(tmp_path: Path) -> None:
+    """A Berlin title missing from a folder of extracts took its reason from whichever
+    extract sorted first ('not a street name of this map (closest: Aleksi, ...)': Helsinki's
+    names); the reason now comes from the extract where the most of its names exist."""
+    folder = tmp_path / "maps"
+    folder.mkdir()
+    shutil.copy(BERLIN, folder / "berlin.osm.pbf")
+    shutil.copy(OSM / "bristol_whitelion.osm.pbf", folder / "a_bristol.osm.pbf")
+    maps = [whole_map(p) for p in sorted(folder.iterdir())]
+    found = geocode_title_in_maps("Alexanderstr. & Qzxwvstr.", maps)
+    assert found[0].status == "not_found"
+    assert Path(found[0].source).name == "berlin.osm.pbf"
+    assert "Qzxwv" in found[0].reason
 
 
 def test_cli_list_streams(tmp_path: Path) -> None:
@@ -320,3 +354,46 @@ def test_cli_broken_pipe_elsewhere_is_still_reported(
     monkeypatch.setattr(cli, "_stdout_closed", lambda: False)
     assert main(["geocode", "x", "--osm", str(BERLIN)]) == 1
     assert "failed: BrokenPipeError" in capsys.readouterr().err
+
+
+def test_cli_list_read_as_batch_reads_it(tmp_path: Path) -> None:
+    """A spreadsheet's semicolon list with a byte-order mark and decimal commas, and the same
+    list as GeoJSON: ``camloc batch`` read both, ``camloc geocode --list`` refused the first
+    ('has no title column ...; its columns: id;title;lat;lon') and could not read the second."""
+    rows = tmp_path / "cams.csv"
+    rows.write_text(
+        "id;title;lat;lon\r\n"
+        "c1;Karl-Liebknecht-Str. / Wadzeckstr.;;\r\n"
+        "c2;Grunerstr. x Alexanderstr.;52,5205;13,4150\r\n",
+        encoding="utf-8-sig",
+    )
+    out = tmp_path / "out.geojson"
+    args = ["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out.read_text())["features"]]
+    assert [(p["id"], p["row"], p["status"]) for p in props] == [
+        ("c1", 2, "junction"),
+        ("c2", 3, "junction"),
+    ]
+    assert props[1]["lat"] == pytest.approx(52.5208, abs=5e-4)
+    collection = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [13.415, 52.5205]},
+                "properties": {"id": "g1", "title": "Grunerstr. x Alexanderstr."},
+            },
+            {"type": "Feature", "geometry": None, "properties": {"title": "Wadzeckstr."}},
+        ],
+    }
+    listed = tmp_path / "cams.geojson"
+    listed.write_text(json.dumps(collection), encoding="utf-8")
+    out2 = tmp_path / "out2.geojson"
+    args = ["geocode", "--list", str(listed), "--osm", str(BERLIN), "--best", "-o", str(out2)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out2.read_text())["features"]]
+    assert [(p["id"], p["row"], p["status"]) for p in props] == [
+        ("g1", 1, "junction"),
+        (None, 2, "street"),
+    ]

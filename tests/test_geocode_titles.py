@@ -63,6 +63,45 @@ def baltimore():  # type: ignore[no-untyped-def]
             None,
             None,
         ),
+        # the fourth sweep's webcam list: these were read as one name, or kept the
+        # direction in a name, or read HTML tags as street names
+        (
+            "C. Defensa Nacional esq. Calle Hacienda",
+            ["C. Defensa Nacional", "Calle Hacienda"],
+            None,
+            None,
+            None,
+        ),
+        ("Alexanderstr. Ecke Grunerstr.", ["Alexanderstr", "Grunerstr"], None, None, None),
+        ("Carrera 7 con Calle 26", ["Carrera 7", "Calle 26"], None, None, None),
+        (
+            "Av. de los Fundadores / Jose Alonso Flores hacia el norte",
+            ["Av. de los Fundadores", "Jose Alonso Flores"],
+            None,
+            None,
+            0.0,
+        ),
+        (
+            "Gontardstr. / Rathausstr. (Blick nach Osten)",
+            ["Gontardstr", "Rathausstr"],
+            None,
+            None,
+            90.0,
+        ),
+        (
+            "Камера 12: Аргуновская ул. / 2-я Новоостанкинская (на север)",
+            ["Аргуновская ул", "2-я Новоостанкинская"],
+            "12",
+            None,
+            0.0,
+        ),
+        (
+            "<script>alert(1)</script><b>E Monument St</b> &amp; N Lakewood Ave",
+            ["E Monument St", "N Lakewood Ave"],
+            None,
+            None,
+            None,
+        ),
     ],
 )
 def test_parse_title(
@@ -194,3 +233,33 @@ def test_a_landmark_name_never_stands_in_for_a_street(baltimore) -> None:  # typ
                 assert best.status == "junction", (title, best.status, best.reason)
             checked += 1
     assert checked >= 10
+
+
+def test_scraped_and_spanish_titles_are_placed() -> None:
+    """Titles of the sweep's webcam list that were not_found: 'esq.' and 'Ecke' were not read
+    as separators, 'hacia el norte' stayed in the second name, HTML tags were names."""
+    berlin = load_map(OSM / "berlin_alexanderplatz.osm.pbf", 52.5219, 13.4132, radius_m=None)
+    best = geocode_title("Alexanderstr. Ecke Grunerstr.", map_data=berlin)[0]
+    assert best.status == "junction"
+    assert _dist_m(best.lat, best.lon, 52.520833, 13.415198) < 30
+    ags = load_map(OSM / "aguascalientes.osm.pbf", 21.8689, -102.2717, radius_m=None)
+    best = geocode_title("C. Defensa Nacional esq. Calle Hacienda", map_data=ags)[0]
+    assert best.status == "junction"
+    assert _dist_m(best.lat, best.lon, 21.874077, -102.280185) < 30
+    best = geocode_title("Av. de los Fundadores / Jose Alonso Flores hacia el norte", map_data=ags)[
+        0
+    ]
+    assert best.status == "junction"
+    assert _dist_m(best.lat, best.lon, 21.87163, -102.279456) < 30
+    assert best.to_feature()["properties"]["view_bearing_deg"] == 0.0
+
+
+def test_junction_beyond_the_radius_is_named(baltimore) -> None:  # type: ignore[no-untyped-def]
+    """A list point 340 m off its junction (the sweep's webcam 'Ashland Av and N Glover'):
+    the reason said only 'do not meet in this map within 300 m' although they do meet, 337 m
+    away; it now says where (camloc batch's reason for the camera)."""
+    found = geocode_title(
+        "Ashland Av and N Glover", map_data=baltimore, near=(39.3035, -76.5780), radius_m=300
+    )
+    assert found[0].status == "not_found"
+    assert "they meet 337 m away, at 39.30105,-76.58031" in found[0].reason

@@ -552,6 +552,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
+    from camloc_geo.geocode._maps import miss_rank, one_place
     from camloc_geo.osm import area_map
 
     if not (row.title or row.streets):
@@ -560,7 +561,7 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         res.errors.append({"stage": "input", "message": res.reason})
         return res
     found: list[tuple[Any, list[Any], str]] = []
-    misses: list[tuple[float, str]] = []
+    misses: list[tuple[tuple[float, int], str]] = []
     for f in files:
         try:
             m = area_map(("file", f))
@@ -575,12 +576,20 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         if matches and matches[0].status not in ("not_found",):
             found.append((m, matches, os.path.basename(f)))
         elif matches:
-            misses.append((-(_finite(matches[0].score) or 0.0), matches[0].reason or ""))
+            misses.append((miss_rank(matches[0]), matches[0].reason or ""))
     placed = [
         (m, mt, name)
         for m, mt, name in found
         if mt[0].status in ("junction", "address", "landmark", "ambiguous")
     ]
+    if len(placed) >= 2 and one_place([mt[0] for _m, mt, _name in placed]):
+        # overlapping extracts (or one area in two formats) name the same junction
+        top = max(_finite(mt[0].score) or 0.0 for _m, mt, _name in placed)
+        m, matches, name = next(p for p in placed if (_finite(p[1][0].score) or 0.0) == top)
+        others = ", ".join(other for _m, _mt, other in placed if other != name)
+        res = _with_map(row, res, m, matches, extract=name)
+        res.reason = (res.reason or "") + f"; the same junction in {others}"
+        return res
     if len(placed) >= 2:
         res.method = "title"
         res.tie = True
@@ -599,7 +608,11 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     if placed or found:
         m, matches, name = (placed or found)[0]
         return _with_map(row, res, m, matches, extract=name)
-    reason = min(misses)[1] if misses else "the title names no street found in any extract"
+    reason = (
+        min(misses, key=lambda x: x[0])[1]
+        if misses
+        else "the title names no street found in any extract"
+    )
     return res.fail(
         "not_found", reason or "the title names no street found in any extract", "title"
     )

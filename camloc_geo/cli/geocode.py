@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 import json
 import sys
 from collections.abc import Iterator
@@ -13,7 +14,16 @@ from typing import IO, Any
 
 __all__ = ["register", "run"]
 
-_TITLE_COLUMNS = ("title", "name", "camera_title", "description", "location")
+_TITLE_COLUMNS = (
+    "title",
+    "name",
+    "camera_title",
+    "camera_name",
+    "description",
+    "desc",
+    "label",
+    "location",
+)
 _ID_COLUMNS = ("id", "camera_id", "cam_id", "number")
 _LAT_COLUMNS = ("lat", "latitude", "y")
 _LON_COLUMNS = ("lon", "lng", "longitude", "x")
@@ -48,7 +58,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--list",
         metavar="LIST.csv",
-        help="CSV of titles (column title or name; optional id, lat, lon), streamed",
+        help="CSV (any of , ; tab |) or GeoJSON list of titles (column title or name; optional id, lat, lon), streamed",
     )
     parser.add_argument("--best", action="store_true", help="only the best match per title")
     parser.add_argument("-o", "--output", metavar="OUT.geojson", help="output file (stdout)")
@@ -79,21 +89,42 @@ def _column(header: list[str], options: tuple[str, ...]) -> str | None:
 
 
 def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
-    """(row number, id, title, point) of each CSV row, one at a time.
+    """(row number, id, title, point) of each row of a CSV or GeoJSON list, one at a time.
+
+    The list is read as ``camloc batch`` reads it: a CSV's delimiter is detected among
+    ``, ; tab |``, its text is UTF-8 (a byte-order mark is fine) or else Windows-1252 with a
+    warning, and a coordinate may use a decimal comma; a GeoJSON list (a FeatureCollection, or
+    one Feature per line) gives the point from its geometry. A CSV row's number is its line
+    in a spreadsheet (the header is row 1); a GeoJSON feature's is its position (from 1).
 
     The file is opened and its header checked at once, before the first row is asked for,
     so a missing or headless list fails before any output is written.
     """
     from camloc_geo._errors import InputError
+    from camloc_geo.cameras._list import _list_kind, _text_encoding
 
-    csv.field_size_limit(1 << 20)
+    csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
     try:
-        fh = path.open(newline="", encoding="utf-8-sig", errors="replace")
+        kind = _list_kind(path)
+        if kind == "geojson":
+            return _geojson_rows(path)
+        encoding = _text_encoding(path)
+        fh = path.open(newline="", encoding=encoding, errors="replace")
     except OSError as exc:
         raise InputError(f"cannot read the list {path}: {exc.strerror or exc}") from None
     try:
-        reader = csv.reader(fh)
         try:
+            sample = fh.read(8192)
+            fh.seek(0)
+            delimiter = ","
+            if path.name.lower().endswith(".tsv"):
+                delimiter = "\t"
+            elif sample:
+                try:
+                    delimiter = csv.Sniffer().sniff(sample, delimiters=",;\t|").delimiter
+                except csv.Error:
+                    delimiter = ","
+            reader = csv.reader(fh, delimiter=delimiter)
             header = next(reader)
         except StopIteration:
             raise InputError(f"the list {path} is empty") from None
@@ -111,6 +142,38 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
         fh.close()
         raise
     return _data_rows(fh, reader, header, title_col)
+
+
+def _geojson_rows(
+    path: Path,
+) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
+    """The features of a GeoJSON list as (number, id, title, point); the first is read at
+    once so that a list that is no GeoJSON fails before any output."""
+    from camloc_geo.cameras import read_camera_list
+
+    cameras = read_camera_list(path)
+    first = next(cameras, None)
+
+    def rows() -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
+        if first is None:
+            return
+        for cam in itertools.chain([first], cameras):
+            point = None
+            lat, lon = cam.lat, cam.lon
+            if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
+                point = (lat, lon)
+            ident = None if cam.id == f"row-{cam.row}" else cam.id
+            yield cam.row, ident, cam.title, point
+
+    return rows()
+
+
+def _coordinate(text: str) -> float:
+    """A coordinate of a CSV cell; a decimal comma (``39,2851``) is read as a point."""
+    text = text.strip()
+    if text.count(",") == 1 and "." not in text:
+        text = text.replace(",", ".")
+    return float(text)
 
 
 def _data_rows(
@@ -141,8 +204,8 @@ def _data_rows(
             point = None
             if lat_col is not None and lon_col is not None:
                 try:
-                    lat = float(row[idx[lat_col]])
-                    lon = float(row[idx[lon_col]])
+                    lat = _coordinate(row[idx[lat_col]])
+                    lon = _coordinate(row[idx[lon_col]])
                     if -90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0:
                         point = (lat, lon)
                 except (ValueError, IndexError):

@@ -772,14 +772,17 @@ def _two_names(
 ) -> list[TitleMatch]:
     pairs = [(i, j) for i in range(len(names)) for j in range(i + 1, len(names))]
     cands: list[tuple[int, int, _Candidate]] = []
+    beyond: list[_Candidate] = []  # junctions of the names outside radius_m of near
     for i, j in pairs:
         if not hits[i] or not hits[j]:
             continue
         # the model's junctions first, then nodes the streets share that it lacks
         found = _junction_candidates(hits[i], hits[j], index, map_data)
         found += _geometric_candidates(hits[i], hits[j], index)
-        found = _filter_rank(found, near, radius_m)
-        cands.extend((i, j, c) for c in _group(found))
+        kept = _filter_rank(found, near, radius_m)
+        if near is not None and radius_m is not None and len(kept) < len(found):
+            beyond.extend(c for c in found if c.dist_m > radius_m)
+        cands.extend((i, j, c) for c in _group(kept))
     base = _base(parsed, title, map_data)
     if cands:
         cands.sort(key=lambda r: (-round(r[2].score, 6), r[2].dist_m))
@@ -834,6 +837,12 @@ def _two_names(
         shown = [hits[k][0].display for k in range(len(names))]
         where = "" if radius_m is None else f" within {radius_m:.0f} m"
         reason = f"{' and '.join(repr(s) for s in shown)} do not meet in this map{where}"
+        if beyond:
+            nearest = min(beyond, key=lambda c: c.dist_m)
+            reason += (
+                f" of the point; they meet {nearest.dist_m:.0f} m away, at "
+                f"{nearest.lat:.5f},{nearest.lon:.5f} (is the point or its radius off?)"
+            )
     return [
         _not_found(
             parsed,

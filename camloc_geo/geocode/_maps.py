@@ -8,12 +8,51 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from camloc_geo._errors import MapDataError
-from camloc_geo.geocode._geocode import TitleMatch, check_map, check_near, geocode_title
+from camloc_geo.geocode._geocode import (
+    SAME_JUNCTION_M,
+    TitleMatch,
+    check_map,
+    check_near,
+    geocode_title,
+)
+from camloc_geo.geodesy import great_circle_m
 
 if TYPE_CHECKING:
     from camloc_geo.osm import MapData
 
-__all__ = ["extract_paths", "geocode_title_in_maps", "map_contains", "whole_map"]
+__all__ = [
+    "extract_paths",
+    "geocode_title_in_maps",
+    "map_contains",
+    "miss_rank",
+    "one_place",
+    "whole_map",
+]
+
+
+def one_place(matches: Sequence[TitleMatch]) -> bool:
+    """Whether the best matches of several extracts are one place: each a single placement
+    (not ``ambiguous`` within its extract) with a point, all within
+    :data:`~camloc_geo.geocode._geocode.SAME_JUNCTION_M` of each other (extracts that
+    overlap, or one area in two formats, name the same junction)."""
+    points = []
+    for m in matches:
+        if m.status == "ambiguous" or m.lat is None or m.lon is None:
+            return False
+        points.append((m.lat, m.lon))
+    return all(
+        great_circle_m(lat1=a[0], lon1=a[1], lat2=b[0], lon2=b[1]) <= SAME_JUNCTION_M
+        for i, a in enumerate(points)
+        for b in points[i + 1 :]
+    )
+
+
+def miss_rank(match: TitleMatch) -> tuple[float, int]:
+    """Sort key of a title's misses in several extracts, most telling first: the highest
+    score, then the most names found (an extract where both streets exist but do not meet
+    says more than one where neither name exists)."""
+    found = sum(1 for n in match.names_matched if n)
+    return (-(match.score if match.score == match.score else 0.0), -found)
 
 
 def extract_paths(path: str | os.PathLike[str]) -> list[Path]:
@@ -107,6 +146,11 @@ def geocode_title_in_maps(
     if not results:
         raise MapDataError(f"area {area!r} is not a named place of any map")
     placed = [r for r in results if r[0].placed]
+    if len(placed) >= 2 and near is None and one_place([r[0] for r in placed]):
+        same = sorted(placed, key=lambda r: -r[0].score)[0]
+        others = ", ".join(Path(r[0].source).name for r in placed if r is not same)
+        same[0].reason += f"; the same junction in {others}"
+        return same
     if len(placed) >= 2 and near is None:
         out: list[TitleMatch] = []
         where = ", ".join(Path(r[0].source).name for r in placed)
@@ -119,5 +163,5 @@ def geocode_title_in_maps(
         return out
     if placed:
         return placed[0]
-    ranked = sorted(results, key=lambda r: -max(m.score for m in r))
+    ranked = sorted(results, key=lambda r: miss_rank(r[0]))
     return ranked[0]

@@ -5,6 +5,7 @@ See :func:`parse_title`.
 
 from __future__ import annotations
 
+import html
 import re
 import unicodedata
 from dataclasses import dataclass, field, replace
@@ -73,15 +74,21 @@ _WORDS: dict[str, str] = {
     "noroeste": "nw",
     "sureste": "se",
     "suroeste": "sw",
+    "norden": "n",
+    "sueden": "s",
+    "suden": "s",
+    "osten": "e",
+    "westen": "w",
 }
 _BOUND = {"nb": "n", "sb": "s", "eb": "e", "wb": "w"}
 _CUES = (
     "looking|facing|view|viewing|views|towards|toward|heading|direction|dir|vers|richtung|blick"
-    "|hacia|sentido|para"
+    "|hacia|sentido|para|na"
 )
 _DIR_ALT = "|".join(sorted([*_WORDS, *_POINTS], key=len, reverse=True))
 _CUE_RE = re.compile(
-    rf"\b(?:{_CUES})\s*(?:to\s+the\s+|to\s+|the\s+)?[:\-]?\s*({_DIR_ALT})(?:ward|wards|bound)?\b",
+    rf"\b(?:{_CUES})\s*(?:to\s+the\s+|to\s+|the\s+|(?:el|al|la|le|nach|au|du)\s+)?[:\-]?\s*"
+    rf"({_DIR_ALT})(?:ward|wards|bound)?\b",
     re.IGNORECASE,
 )
 _BOUND_RE = re.compile(
@@ -94,21 +101,26 @@ _DIR_WORD_RE = re.compile(
 )
 _PAREN_RE = re.compile(r"[(\[{]([^()\[\]{}]*)[)\]}]")
 _CAMERA_PREFIX_RE = re.compile(
-    r"^\s*(?:(?:cam(?:era)?|cctv|webcam|kamera|camara|camera)\s*(?:no\.?|nr\.?|#)?\s*)?"
+    r"^\s*(?:(?:cam(?:era)?|cctv|webcam|kamera|camara|camera|камера)\s*(?:no\.?|nr\.?|#)?\s*)?"
     r"#?(\d{1,6}[a-z]?)\s*(?:[-–—:|.]\s*|\s+-\s*)(?=\D)",
     re.IGNORECASE,
 )
 _CAMERA_WORD_RE = re.compile(
-    r"^\s*(?:cam(?:era)?|cctv|webcam|kamera|camara)\s*(?:no\.?|nr\.?|#)?\s*(\d{1,6}[a-z]?)\b\s*",
+    r"^\s*(?:cam(?:era)?|cctv|webcam|kamera|camara|камера)\s*(?:no\.?|nr\.?|#)?\s*(\d{1,6}[a-z]?)\b\s*",
     re.IGNORECASE,
 )
 _SEGMENT_RE = re.compile(r"\s+[-–—|]+\s+|\s*[–—|]\s*|\s*:\s+")
 _SEPARATOR_RE = re.compile(
     r"\s*(?:&|@|\+|×|/|\\|"
-    r"(?<=\s)(?:and|at|y|et|und|x|near)(?=\s)|"
+    r"(?<=\s)(?:and|at|y|et|und|x|near|esq\.?|esquina|ecke|con)(?=\s)|"
     r"\s(?:и)\s)\s*",
     re.IGNORECASE,
 )
+_SCRIPT_RE = re.compile(
+    r"<\s*(script|style)\b[^>]*>.*?(?:<\s*/\s*\1\s*>|$)", re.IGNORECASE | re.DOTALL
+)
+_TAG_RE = re.compile(r"</?[a-z][a-z0-9]*\b[^<>]{0,300}>|<!--.*?-->", re.IGNORECASE | re.DOTALL)
+_ENTITY_RE = re.compile(r"&(?:#\d{1,7}|#x[0-9a-f]{1,6}|[a-z]{2,8});", re.IGNORECASE)
 _CALLE_SLASH_RE = re.compile(r"\bc/", re.IGNORECASE)
 _FRACTION_RE = re.compile(r"(?<=\d)/(?=\d)")
 _NUMBER_ONLY_RE = re.compile(r"#?\d{1,6}[a-z]?", re.IGNORECASE)
@@ -205,6 +217,8 @@ def parse_compass_words(text: str) -> float | None:
 
 def _clean(title: str, notes: list[str]) -> str:
     text = unicodedata.normalize("NFKC", title)
+    if "<" in text or "&" in text:
+        text = _markup_removed(text, notes)
     if _CONTROL_RE.search(text):
         text = _CONTROL_RE.sub(" ", text)
         notes.append("control characters removed")
@@ -212,6 +226,18 @@ def _clean(title: str, notes: list[str]) -> str:
         text = text[:MAX_TITLE_CHARS]
         notes.append(f"title cut to its first {MAX_TITLE_CHARS} characters")
     return " ".join(text.split())
+
+
+def _markup_removed(text: str, notes: list[str]) -> str:
+    """A title scraped from a web page, without its HTML: script and style elements with
+    their content and every tag are removed, entities (``&amp;``) read."""
+    stripped = _SCRIPT_RE.sub(" ", text)
+    stripped = _TAG_RE.sub(" ", stripped)
+    if _ENTITY_RE.search(stripped):
+        stripped = html.unescape(stripped)
+    if stripped != text:
+        notes.append("HTML markup removed")
+    return stripped
 
 
 def _split_names(segment: str) -> list[str]:
