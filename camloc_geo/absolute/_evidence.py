@@ -153,8 +153,35 @@ class _Observer:
             return None
 
 
+SWAP_FAR_M = 20_000.0
+"""A reference farther than this from the map's (or the prior's) point whose (lon, lat) read
+the other way round lies within it was given as (lon, lat): it is read swapped."""
+
+
+def _reference_enu(
+    i: int, lat: float, lon: float, frame: LocalFrame, anchored: bool, warnings: list[str]
+) -> FloatArray:
+    """A reference's map point in the local frame, a (lon, lat) slip read the right way.
+
+    ``anchored``: the frame stands at the map's or the prior's point (not at the references'
+    own mean), so a reference thousands of km from it is a slip, not the scene's place.
+    """
+    en = np.array(frame.enu_from_geographic(lat=lat, lon=lon), dtype=float)
+    if not anchored or abs(lon) > 90.0 or float(np.hypot(*en)) <= SWAP_FAR_M:
+        return en
+    swapped = np.array(frame.enu_from_geographic(lat=lon, lon=lat), dtype=float)
+    if float(np.hypot(*swapped)) > SWAP_FAR_M:
+        return en
+    warnings.append(
+        f"references[{i}]: lat={lat:.6f}, lon={lon:.6f} is {np.hypot(*en) / 1000:.0f} km "
+        f"from the map, lat={lon:.6f}, lon={lat:.6f} {np.hypot(*swapped):.0f} m: read as "
+        "(lon, lat) swapped; give lat first"
+    )
+    return swapped
+
+
 def _references(
-    scene: Scene, frame: LocalFrame, observe: _Observer
+    scene: Scene, frame: LocalFrame, observe: _Observer, anchored: bool
 ) -> list[tuple[Observation, FloatArray]]:
     refs = []
     for i, ref in enumerate(scene.references):
@@ -162,7 +189,7 @@ def _references(
         obs = observe(ref.pixel, "reference", f"references[{i}]", sigma)
         if obs is not None:
             refs.append(
-                (obs, np.array(frame.enu_from_geographic(lat=ref.lat, lon=ref.lon), dtype=float))
+                (obs, _reference_enu(i, ref.lat, ref.lon, frame, anchored, observe.warnings))
             )
     return refs
 
@@ -366,7 +393,7 @@ def gather_evidence(
     frame = result.frame
     observe = _Observer(world_cam, settings, scene)
     observe.warnings = result.warnings
-    refs = _references(scene, frame, observe)
+    refs = _references(scene, frame, observe, map_data is not None or scene.prior is not None)
     ce = _corners(scene, map_data, frame, observe)
     result.intersection = ce.intersection
     landmarks = _landmarks(scene, map_data, frame, observe)
