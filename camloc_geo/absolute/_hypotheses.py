@@ -80,6 +80,39 @@ def worst_reference(
     return best[1], best[2]
 
 
+REFERENCE_CONFLICT_Z = 4.0
+"""Two references whose ground distance (as the calibrated camera sees their pixels) and
+map distance differ by more than this many standard deviations disagree
+(:func:`reference_conflict`)."""
+
+
+def reference_conflict(
+    refs: list[tuple[Observation, FloatArray]], settings: LocateSettings
+) -> tuple[float, float, float] | None:
+    """How far two references disagree: ``(z, ground_m, map_m)``, None when they agree.
+
+    Two references fix any camera exactly up to the scale of the car's frame, so a wrong
+    lat/lon (another corner's, a typo) leaves no residual except the scale the fit needs:
+    their distance apart on the ground, as the calibrated camera casts their pixels, and on
+    the map must agree within the pixels' noise, the map's and the car's size (5 %). ``z``
+    is the difference in standard deviations; the pair disagrees beyond
+    :data:`REFERENCE_CONFLICT_Z`.
+    """
+    if len(refs) != 2:
+        return None
+    (oa, qa), (ob, qb) = refs
+    gap_world = np.asarray(ob.world_xy - oa.world_xy, dtype=float)
+    ground_m = float(np.linalg.norm(gap_world))
+    map_m = float(np.linalg.norm(np.asarray(qb - qa, dtype=float)))
+    if ground_m <= 0.0:
+        return None
+    u = gap_world / ground_m
+    var = float(u @ (oa.cov_world + ob.cov_world) @ u)
+    var += oa.sigma_map_m**2 + ob.sigma_map_m**2 + (settings.scale_sigma_rel * ground_m) ** 2
+    z = abs(ground_m - map_m) / math.sqrt(max(var, 1e-12))
+    return (z, ground_m, map_m) if z > REFERENCE_CONFLICT_Z else None
+
+
 def _gen_bearing_point(
     method: str, obs: Observation, points: FloatArray, bearings: Sequence[float]
 ) -> list[Hypothesis]:
@@ -228,6 +261,8 @@ def generate_hypotheses(
     if len(ev.refs) >= 2:
         tried.append("two_references")
         hyps += _gen_references(ev, settings)
+        if len(ev.refs) == 2 and _warn_conflicting_references(ev, settings, result):
+            hyps += single_reference_hypotheses(ev)
     if len(ev.refs) == 1 and not ev.corners and not scene.landmarks:
         tried.append("one_reference")
         if not ev.street_bearings:
@@ -248,6 +283,42 @@ def generate_hypotheses(
         reasons = warn or ["the evidence fits nothing"]
         raise NoCandidatesError("no hypothesis: " + "; ".join(reasons))
     return hyps
+
+
+def _warn_conflicting_references(
+    ev: Evidence, settings: LocateSettings, result: LocateResult
+) -> bool:
+    """With exactly two references that disagree (:func:`reference_conflict`): a warning,
+    and True (each is then also tried alone, :func:`single_reference_hypotheses`)."""
+    conflict = reference_conflict(ev.refs, settings)
+    if conflict is None:
+        return False
+    z, ground_m, map_m = conflict
+    (oa, _qa), (ob, _qb) = ev.refs
+    result.warnings.append(
+        f"{oa.label} and {ob.label} disagree: {ground_m:.1f} m apart as the calibrated "
+        f"camera sees their pixels, {map_m:.1f} m on the map ({z:.0f} standard "
+        "deviations); one lat/lon is probably wrong (another point's, swapped or "
+        "mistyped): each was also tried alone with the car along a street"
+        + ("" if ev.street_bearings else " (no street bearing near them: not tried)")
+    )
+    return True
+
+
+def single_reference_hypotheses(ev: Evidence) -> list[Hypothesis]:
+    """Each reference alone with the car along a street (``one_reference``).
+
+    Two references fix any camera exactly, so the fit of a pair of which one is wrong (a
+    lat/lon from another point, rounded, mistyped) stands wherever the wrong one pulls it,
+    with nothing to say so. Each one alone with the car along a street puts the right camera
+    among the candidates; the scoring (robust to one outlier, the car parallel to its
+    street) weighs them against the joint fit.
+    """
+    bearings = unique_bearings(ev.street_bearings)
+    out = []
+    for obs, q in ev.refs:
+        out += _gen_bearing_point("one_reference", obs, q[None, :], bearings)
+    return out
 
 
 def _warn_corner_counts(ev: Evidence, result: LocateResult) -> None:

@@ -21,6 +21,7 @@ from camloc_geo.absolute._evidence import (
     evidence_at,
     frame_anchor,
     gather_evidence,
+    named_junctions,
     other_junctions,
 )
 from camloc_geo.absolute._hypotheses import (
@@ -28,6 +29,7 @@ from camloc_geo.absolute._hypotheses import (
     NoCandidatesError,
     corner_hypotheses,
     generate_hypotheses,
+    single_reference_hypotheses,
 )
 from camloc_geo.absolute._model import (
     Candidate,
@@ -120,14 +122,17 @@ def locate(
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
         cands = score_hypotheses(hyps, world_cam, ev, settings)
+        cands += _references_alone(cands, world_cam, ev, settings)
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
         cands = expected_plausibility(cands, world_cam, ev, settings)
         cands = refine_leaders(cands, world_cam, ev, settings)
         cands = rank(cands, settings, result)
+        _warn_references_off_street(cands, ev, result)
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
         mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
+        _warn_other_junction(scene, map_data, ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -136,6 +141,75 @@ def locate(
     finally:
         _forget_placements(ev, result.candidates)
     return result
+
+
+def _references_alone(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Two references alone whose joint fit puts the car off or across its street: each
+    reference also tried alone with the car along a street, scored.
+
+    (When the two disagree on their distance apart, :func:`generate_hypotheses` has tried
+    them already.)
+    """
+    if len(ev.refs) != 2 or ev.corners or ev.landmarks:
+        return []
+    if any(c.method == "one_reference" for c in cands):
+        return []
+    joint = [c for c in cands if c.method == "two_references"]
+    if not any({f.kind for f in c.flags} & _CAR_FLAGS for c in joint):
+        return []
+    return score_hypotheses(single_reference_hypotheses(ev), world_cam, ev, settings)
+
+
+_REFERENCE_MISS_M2 = 16.0
+"""A reference the best candidate misses by more than 4 standard deviations (squared) is
+named as the one to check when that candidate trusts the other reference alone."""
+
+_CAR_FLAGS = {FlagKind.CAR_OFF_STREET, FlagKind.CAR_NOT_PARALLEL_TO_STREET}
+
+
+def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: LocateResult) -> None:
+    """Warn when two references alone put the car off or across its street.
+
+    Two references fix a camera exactly whatever their lat/lon, so a wrong one (another
+    point's, rounded to 4 decimals) moves the answer tens of metres with a small sigma and
+    no misfit. The map is the only witness left: the car of a real camera stands on a street,
+    along it. Measured (``benchmarks/absolute_slips.py --n 60``): 7 of 60 right answers carry
+    such a flag, but 28 of 35 answers more than 10 m off with one reference on another kerb
+    corner.
+    """
+    if len(ev.refs) != 2 or ev.corners or ev.landmarks or not cands:
+        return
+    top = cands[0]
+    if top.method not in ("one_reference", "two_references"):
+        return
+    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
+    if top.method == "one_reference" and not kinds:
+        worst = max(
+            (m for m in top.matches if m.kind == "reference"),
+            key=lambda m: m.misfit_m,
+            default=None,
+        )
+        if worst is not None and worst.mahalanobis2 > _REFERENCE_MISS_M2:
+            result.warnings.append(
+                f"references: the best candidate trusts one reference alone, with the car "
+                f"along a street: {worst.label} lies {worst.misfit_m:.0f} m from where it puts "
+                "that pixel; check that reference's lat/lon (another point's, rounded, "
+                "swapped?)"
+            )
+        return
+    if not kinds:
+        return
+    where = (
+        "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
+    )
+    result.warnings.append(
+        f"references: the two references put the car {where}; if the car does stand on a "
+        "street, along it, one reference's lat/lon is wrong (another point's, rounded, "
+        "swapped): check both, or add a third; the one_reference candidates trust each "
+        "alone"
+    )
 
 
 def _forget_placements(ev: Evidence, cands: list[Candidate]) -> None:
@@ -155,22 +229,55 @@ def _other_junction_candidates(
     settings: LocateSettings,
     result: LocateResult,
 ) -> list[Candidate]:
-    """Corner hypotheses at the other junctions a prior-only scene may show, scored."""
+    """Corner hypotheses at the other junctions the scene may show, scored with their
+    prior odds (:func:`~camloc_geo.absolute._evidence.other_junctions`)."""
     others = other_junctions(scene, map_data, ev)
     if not others:
         return []
     assert map_data is not None
-    assert scene.prior is not None
     out = []
-    for inter in others:
+    for inter, log_prior in others:
         ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
-        out += score_hypotheses(corner_hypotheses(ev_j, settings), world_cam, ev_j, settings)
-    result.warnings.append(
-        f"corners: no intersection lat/lon in the scene, so the corners were matched at the "
-        f"{len(others) + 1} junctions with kerb corners within {scene.prior.radius_m:g} m of "
-        "the prior; give intersection.lat/lon (or street names) to fix the junction"
-    )
+        hyps = corner_hypotheses(ev_j, settings)
+        for h in hyps:
+            h.log_prior += log_prior
+        out += score_hypotheses(hyps, world_cam, ev_j, settings)
+    hint = scene.intersection
+    n_equal = sum(1 for _x, lp in others if lp == 0.0)  # as likely as the scene's own
+    if scene.prior is not None and hint is not None and hint.lat is None and n_equal:
+        result.warnings.append(
+            f"corners: no intersection lat/lon in the scene, so the corners were matched at "
+            f"the {n_equal + 1} junctions with kerb corners within "
+            f"{scene.prior.radius_m:g} m of the prior; give intersection.lat/lon (or street "
+            "names) to fix the junction"
+        )
     return out
+
+
+def _warn_other_junction(
+    scene: Scene, map_data: MapData | None, ev: Evidence, result: LocateResult
+) -> None:
+    """Warn when the best candidate stands at a junction the scene did not name."""
+    named = named_junctions(scene, map_data, ev)
+    if named is None or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.intersection_id is None or top.intersection_id in named:
+        return
+    assert map_data is not None
+    there = map_data.intersection(top.intersection_id)
+    hint = scene.intersection
+    assert hint is not None
+    said = (
+        f"lat={hint.lat:.6f}, lon={hint.lon:.6f}"
+        if hint.lat is not None and hint.lon is not None
+        else " & ".join(hint.streets or [])
+    )
+    result.warnings.append(
+        f"intersection: the corners fit junction {there.id} ({' & '.join(there.street_names)}) "
+        f"better than the scene's own ({said}): is the cross street or the lat/lon of "
+        "another junction? Check the best candidate's junction"
+    )
 
 
 def _rescore(

@@ -68,6 +68,10 @@ def _street_bearing_prior(cand: Candidate, ev: Evidence, settings: LocateSetting
     return None
 
 
+_LOG_SCALE_MAX = 5.0
+"""The log scale :func:`_residuals` evaluates at most (a scale of 148: 100 scale sigmas)."""
+
+
 def _residuals(
     obs_q: list[tuple[Observation, FloatArray]],
     start: Similarity2D,
@@ -111,7 +115,10 @@ def _residuals(
 
     def resid_jac(x: FloatArray) -> tuple[FloatArray, FloatArray]:
         theta, tx, ty, ls = (float(v) for v in x)
-        s = math.exp(ls)
+        # A wild step (one matched point, a far start) may ask for any scale: exp() of it
+        # overflowed. Clamped, the scale prior's residual (ls / s_sigma, unclamped) makes
+        # the step costlier than the start, and Gauss-Newton refuses it.
+        s = math.exp(min(max(ls, -_LOG_SCALE_MAX), _LOG_SCALE_MAX))
         a, b = s * math.cos(theta), s * math.sin(theta)
         turned = a * U + b * V  # L_kᵀ s R(θ) p_k: also the log scale's column
         r = np.empty(m)
@@ -286,6 +293,8 @@ def refine_many(
             continue
         resid_jac, x0 = problem
         x, J = gauss_newton(resid_jac, x0, sigma_tol=_SIGMA_TOL)
+        if not np.all(np.isfinite(x)) or abs(float(x[3])) > _LOG_SCALE_MAX:
+            continue  # the fit ran away (a reference thousands of km off): kept unrefined
         theta, tx, ty, ls = x
         sim = Similarity2D(float(theta), np.array([tx, ty]), math.exp(ls))
         fitted.append((k, sim))

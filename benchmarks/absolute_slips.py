@@ -1,0 +1,590 @@
+"""Absolute localisation under the slips real crowds make in the absolute inputs.
+
+:mod:`benchmarks.absolute` samples real junctions (osmnx's own street graph of the extracts in
+``data/osm``) and places synthetic cameras there; its only slips are click noise and the
+kerbs' map error. Here each scene is located twice per slip: as annotated (the clean
+variant of the slip's method) and with **one** slip injected, as users of the CLI or the
+annotation page make them:
+
+``corners_ccw``
+    the visible kerb corners listed counter-clockwise (the list reversed; two or more);
+``corners_rotated``
+    the list starting at another corner (rotated by one; three or more);
+``corner_missing``
+    one listed corner left out (two or more: one or more remain);
+``corner_extra``
+    one corner of a neighbouring junction (in view) clicked too, at a random place in the list;
+``corner_centreline``
+    one corner clicked where the road centre lines cross (the junction's point);
+``corner_far_pavement``
+    one corner clicked at the far side of a wide pavement, 3-6 m out from the kerb corner;
+``wrong_cross_street``
+    the intersection named by its streets, the cross street a parallel one a block away (the
+    named pair meets at a neighbouring junction), no lat/lon;
+``intersection_latlon_off``
+    the intersection's lat/lon 50-150 m off;
+``control_streets``
+    no slip: the intersection named by two of its own streets, no lat/lon (the control of
+    ``wrong_cross_street``);
+``reference_swapped``
+    a reference's lat/lon given as (lon, lat);
+``reference_4_decimals``
+    a reference's lat/lon with 4 decimals (~11 m steps);
+``reference_other_corner``
+    a reference on a visible kerb corner with the lat/lon of another corner of the junction;
+``bearing_cross_street``
+    one reference with ``street_bearing_deg`` of the cross street (the car in the other one);
+``landmark_neighbour``
+    two landmarks, the first named by the nearest other named building's name.
+
+Per slip: the top and closest candidates under 10 / 15 m, refusals (a clear error), empty
+answers, and **confidently wrong** answers: the top candidate more than 15 m off, not tied,
+no warning the clean run did not give, and a ``sigma_m`` whose two sigmas do not reach the
+truth. Also **silently lost**: no candidate within 15 m and no new warning (a tie between
+wrong candidates is not confident, but it is no help either). Results go to
+``benchmarks/out/absolute_slips.json`` and ``absolute_slips.png``::
+
+    python benchmarks/absolute_slips.py [--n 60] [--seed 0] [--slips corners_ccw,...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import re
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from absolute import (
+    ORACLE_MATCH_M,
+    OSM,
+    OUT,
+    PLACES,
+    _oracle_points,
+    _variant,
+)
+
+from camloc_geo.absolute import LocateResult, locate
+from camloc_geo.geodesy import distance_m
+from camloc_geo.osm import MapData, load_map
+from camloc_geo.relative import calibrate
+from camloc_geo.scene import parse_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
+
+log = logging.getLogger("bench_absolute_slips")
+
+CONFIDENT_M = 15.0
+"""A top candidate farther than this from the truth is wrong."""
+SIGMA_COVER = 2.0
+"""A wrong top candidate is covered when its ``sigma_m`` times this reaches the truth."""
+
+
+class Ctx:
+    """What a slip needs besides the scene: the map, the junction, the true camera."""
+
+    def __init__(self, m: MapData, inter: Any, ls: LocatedScene, rng: np.random.Generator):
+        self.m, self.inter, self.ls, self.rng = m, inter, ls, rng
+        self.frame = m.frame
+        self.centre = np.array(self.frame.enu_from_geographic(lat=inter.lat, lon=inter.lon))
+        self.cam = ls.camera_enu
+        w, h = ls.scene["image"]["width"], ls.scene["image"]["height"]
+        self.size = (w, h)
+
+    def pixel_of(self, en: np.ndarray) -> list[float] | None:
+        """The click of a ground point (ENU), None when out of view or near the horizon."""
+        p = self.cam.project([float(en[0]), float(en[1]), 0.0])
+        w, h = self.size
+        if not np.all(np.isfinite(p)) or not (10 <= p[0] <= w - 10 and 10 <= p[1] <= h - 10):
+            return None
+        if self.cam.horizon_line() @ np.array([p[0], p[1], 1.0]) <= 20:
+            return None
+        return (np.asarray(p, float) + self.rng.normal(0.0, 2.0, 2)).tolist()
+
+    def ground_of(self, pixel: list[float]) -> np.ndarray:
+        g = self.cam.ground_from_pixels(np.asarray([pixel], float))[0]
+        return np.asarray(g[:2], float)
+
+    def enu(self, lat: float, lon: float) -> np.ndarray:
+        return np.array(self.frame.enu_from_geographic(lat=lat, lon=lon), float)
+
+    def latlon(self, en: np.ndarray) -> tuple[float, float]:
+        lon, lat = self.frame.geographic_from_enu(float(en[0]), float(en[1]))
+        return float(lat), float(lon)
+
+    def car_bearing_deg(self) -> float:
+        """Bearing of the car's length axis (mod 180) from the two true cameras."""
+        Rw = self.cam.cam_from_world_rotation.T @ self.ls.camera_world.cam_from_world_rotation
+        x = Rw[:, 0]
+        return math.degrees(math.atan2(x[0], x[1])) % 180.0
+
+
+Slip = Callable[[dict[str, Any], Ctx], dict[str, Any] | None]
+
+
+def _corners(scene: dict[str, Any]) -> list[list[float]]:
+    return list(scene.get("intersection", {}).get("corners", []))
+
+
+def slip_ccw(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    if len(cs) < 2:
+        return None
+    scene["intersection"]["corners"] = cs[::-1]
+    return scene
+
+
+def slip_rotated(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    if len(cs) < 3:
+        return None
+    scene["intersection"]["corners"] = cs[1:] + cs[:1]
+    return scene
+
+
+def slip_missing(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    if len(cs) < 2:
+        return None
+    k = int(c.rng.integers(len(cs)))
+    scene["intersection"]["corners"] = cs[:k] + cs[k + 1 :]
+    return scene
+
+
+def _neighbour_junctions(c: Ctx, lo: float, hi: float) -> list[Any]:
+    out = []
+    for x, d in c.m.intersections_within(lat=c.inter.lat, lon=c.inter.lon, radius_m=hi):
+        if x.id != c.inter.id and d >= lo and x.corners:
+            out.append(x)
+    return out
+
+
+def slip_extra(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    if not cs:
+        return None
+    seen = []
+    for x in _neighbour_junctions(c, 20.0, 150.0):
+        for k in x.corners:
+            p = c.pixel_of(c.enu(k.lat, k.lon))
+            if p is not None and all(math.dist(p, q) > 10 for q in cs):
+                seen.append(p)
+    if not seen:
+        return None
+    p = seen[int(c.rng.integers(len(seen)))]
+    at = int(c.rng.integers(len(cs) + 1))
+    scene["intersection"]["corners"] = [*cs[:at], p, *cs[at:]]
+    return scene
+
+
+def slip_centreline(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    p = c.pixel_of(c.centre)
+    if not cs or p is None:
+        return None
+    k = int(c.rng.integers(len(cs)))
+    cs[k] = p
+    scene["intersection"]["corners"] = cs
+    return scene
+
+
+def slip_far_pavement(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    cs = _corners(scene)
+    if not cs:
+        return None
+    k = int(c.rng.integers(len(cs)))
+    g = c.ground_of(cs[k])
+    out = g - c.centre
+    norm = float(np.linalg.norm(out))
+    if not np.all(np.isfinite(g)) or norm < 1.0:
+        return None
+    p = c.pixel_of(g + out / norm * float(c.rng.uniform(3.0, 6.0)))
+    if p is None:
+        return None
+    cs[k] = p
+    scene["intersection"]["corners"] = cs
+    return scene
+
+
+def slip_wrong_cross_street(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    names = {s.name for s in c.inter.streets if s.name}
+    for x in _neighbour_junctions(c, 40.0, 200.0):
+        other = {s.name for s in x.streets if s.name}
+        shared, new = names & other, other - names
+        if shared and new:
+            it = scene["intersection"]
+            it.pop("lat", None)
+            it.pop("lon", None)
+            it["streets"] = [sorted(shared)[0], sorted(new)[0]]
+            return scene
+    return None
+
+
+def control_streets(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    """No slip: the intersection named by two of its own streets (no lat/lon), a control
+    for ``wrong_cross_street``."""
+    names = sorted({s.name for s in c.inter.streets if s.name})
+    if len(names) < 2:
+        return None
+    it = scene["intersection"]
+    it.pop("lat", None)
+    it.pop("lon", None)
+    it["streets"] = names[:2]
+    return scene
+
+
+def slip_latlon_off(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    it = scene["intersection"]
+    if "lat" not in it:
+        return None
+    az = c.rng.uniform(0, 2 * math.pi)
+    d = c.rng.uniform(50.0, 150.0)
+    en = c.enu(it["lat"], it["lon"]) + d * np.array([math.sin(az), math.cos(az)])
+    it["lat"], it["lon"] = c.latlon(en)
+    return scene
+
+
+def slip_ref_swapped(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    refs = scene.get("references") or []
+    if not refs:
+        return None
+    refs[0]["lat"], refs[0]["lon"] = refs[0]["lon"], refs[0]["lat"]
+    if abs(refs[0]["lat"]) > 90:
+        return None
+    return scene
+
+
+def slip_ref_4_decimals(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    refs = scene.get("references") or []
+    if not refs:
+        return None
+    refs[0]["lat"], refs[0]["lon"] = round(refs[0]["lat"], 4), round(refs[0]["lon"], 4)
+    return scene
+
+
+def slip_ref_other_corner(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    refs = scene.get("references") or []
+    clicks = _corners(c.ls.scene)
+    if not refs or not clicks or len(c.inter.corners) < 2:
+        return None
+    k = int(c.rng.integers(len(clicks)))
+    order = c.ls.visible_corner_orders[k]
+    others = [x for x in c.inter.corners if x.order != order]
+    wrong = others[int(c.rng.integers(len(others)))]
+    refs[0] = {"pixel": clicks[k], "lat": wrong.lat, "lon": wrong.lon}
+    return scene
+
+
+def slip_bearing_cross(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    car = c.car_bearing_deg()
+    for s in c.inter.streets:
+        d = abs((s.bearing_deg - car + 90.0) % 180.0 - 90.0)
+        if d > 30.0:
+            scene["street_bearing_deg"] = float(s.bearing_deg % 360.0)
+            return scene
+    return None
+
+
+def slip_landmark_neighbour(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    lms = scene.get("landmarks") or []
+    if not lms:
+        return None
+    name = lms[0]["name"]
+    try:
+        b = c.m.find_building(name, near=(c.inter.lat, c.inter.lon))
+    except ValueError:
+        return None
+    here = np.asarray(b.centroid, float)  # (lon, lat)
+    best: tuple[float, str] | None = None
+    taken = {lm["name"] for lm in lms}
+    for o in c.m.buildings:
+        if not o.name or o.name in taken:
+            continue
+        d = distance_m(lat1=here[1], lon1=here[0], lat2=o.centroid[1], lon2=o.centroid[0])
+        if d < 150.0 and (best is None or d < best[0]):
+            best = (d, o.name)
+    if best is None:
+        return None
+    lms[0]["name"] = best[1]
+    return scene
+
+
+# name: (method whose clean variant is slipped, slip)
+SLIPS: dict[str, tuple[str, Slip]] = {
+    "corners_ccw": ("corners", slip_ccw),
+    "corners_rotated": ("corners", slip_rotated),
+    "corner_missing": ("corners", slip_missing),
+    "corner_extra": ("corners", slip_extra),
+    "corner_centreline": ("corners", slip_centreline),
+    "corner_far_pavement": ("corners", slip_far_pavement),
+    "wrong_cross_street": ("corners", slip_wrong_cross_street),
+    "intersection_latlon_off": ("corners", slip_latlon_off),
+    "control_streets": ("corners", control_streets),
+    "reference_swapped": ("two_references", slip_ref_swapped),
+    "reference_4_decimals": ("two_references", slip_ref_4_decimals),
+    "reference_other_corner": ("two_references", slip_ref_other_corner),
+    "bearing_cross_street": ("one_reference", slip_bearing_cross),
+    "landmark_neighbour": ("landmark", slip_landmark_neighbour),
+}
+
+
+def _key(w: str) -> str:
+    """A warning without its figures, to tell a new warning from the clean run's."""
+    return re.sub(r"[-+]?\d[\d.,]*", "#", w)
+
+
+def _run(scene_data: dict[str, Any], m: MapData, cal: Any) -> tuple[LocateResult | None, str]:
+    sc = parse_scene(scene_data)
+    try:
+        return locate(sc, m, calibration=cal), ""
+    except ValueError as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+
+
+def _entry(res: LocateResult | None, err: str, ls: LocatedScene, clean_keys: set[str]) -> dict:
+    if res is None:
+        return {"refused": err[:300]}
+    if not res.candidates:
+        return {"empty": (res.reason or "")[:300]}
+    errs = [
+        float(distance_m(lat1=c.lat, lon1=c.lon, lat2=ls.lat, lon2=ls.lon)) for c in res.candidates
+    ]
+    top = res.candidates[0]
+    new = [w for w in res.warnings if not w.startswith("ambiguous:") and _key(w) not in clean_keys]
+    covered = top.sigma_m is not None and SIGMA_COVER * top.sigma_m >= errs[0]
+    tied = bool(top.ambiguous_with)
+    return {
+        "n": len(errs),
+        "top": round(errs[0], 2),
+        "closest": round(min(errs), 2),
+        "top_sigma_m": None if top.sigma_m is None else round(top.sigma_m, 2),
+        "top_tied": tied,
+        "top_method": top.method,
+        "top_flags": sorted({str(f).split(":")[0] for f in top.flags}),
+        "new_warnings": [w[:240] for w in new],
+        "warnings": [w[:160] for w in res.warnings if not w.startswith("ambiguous:")],
+        "confidently_wrong": bool(errs[0] > CONFIDENT_M and not tied and not new and not covered),
+        "wrong_uncovered": bool(errs[0] > CONFIDENT_M and not covered),
+        "silently_lost": bool(min(errs) > CONFIDENT_M and not new),
+    }
+
+
+def run(n: int, seed: int, maps: dict[str, MapData], slips: list[str]) -> list[dict[str, Any]]:
+    by_place = {name: _oracle_points(name, maps[name]) for name in maps}
+    once: list[tuple[str, Any]] = []
+    for k in range(max((len(js) for js in by_place.values()), default=0)):
+        once += [(name, js[k]) for name, js in by_place.items() if k < len(js)]
+    order = (once * (n // max(len(once), 1) + 1))[:n]
+    noise = NoiseModel()
+    need_landmarks = any(SLIPS[s][0] == "landmark" for s in slips)
+    rows = []
+    for i, (name, oj) in enumerate(order):
+        m = maps[name]
+        inter, _w = m.match_intersection(
+            lat=oj["lat"], lon=oj["lon"], max_distance_m=ORACLE_MATCH_M
+        )
+        row: dict[str, Any] = {"place": name, "oracle": [oj["lat"], oj["lon"]], "slips": {}}
+        rows.append(row)
+        if inter is None or not inter.corners:
+            row["placed"] = False
+            continue
+        rng = np.random.default_rng([seed, i])
+        ls = make_located_scene(
+            m, inter, rng, noise=noise, corner_sigma_m=1.5, n_references=2, max_corners=4
+        )
+        if ls is None:
+            row["placed"] = False
+            continue
+        ls.scene["intersection"]["lat"] = oj["lat"]
+        ls.scene["intersection"]["lon"] = oj["lon"]
+        row["placed"] = True
+        try:
+            cal = calibrate(parse_scene(ls.scene))
+        except ValueError:
+            row["calibration_error"] = True
+            continue
+        lsl = cal_l = None
+        if need_landmarks:
+            lsl = make_located_scene(
+                m,
+                inter,
+                np.random.default_rng([seed, i, 1]),
+                noise=noise,
+                n_landmarks=2,
+                landmark_sigma_m=1.0,
+                max_tries=150,
+            )
+            if lsl is not None:
+                try:
+                    cal_l = calibrate(parse_scene(lsl.scene))
+                except ValueError:
+                    lsl = None
+        clean_cache: dict[str, tuple[dict[str, Any], set[str]]] = {}
+        for s in slips:
+            method, fn = SLIPS[s]
+            src, c = (lsl, cal_l) if method == "landmark" else (ls, cal)
+            if src is None:
+                continue
+            base = _variant(src, method)
+            if base is None:
+                continue
+            slipped = fn(
+                json.loads(json.dumps(base)),
+                Ctx(m, inter, src, np.random.default_rng([seed, i, 7, len(s)])),
+            )
+            if slipped is None:
+                continue
+            if method not in clean_cache:
+                res, err = _run(base, m, c)
+                keys = {_key(w) for w in (res.warnings if res else [])}
+                clean_cache[method] = (_entry(res, err, src, keys), keys)
+            clean, keys = clean_cache[method]
+            res, err = _run(slipped, m, c)
+            row["slips"][s] = {"clean": clean, "slipped": _entry(res, err, src, keys)}
+        if (i + 1) % 10 == 0:
+            log.info("%d/%d scenes", i + 1, len(order))
+    return rows
+
+
+def _fig(entries: list[dict[str, Any]]) -> dict[str, Any]:
+    total = len(entries)
+    if not total:
+        return {"scenes": 0}
+    found = [e for e in entries if "n" in e]
+
+    def frac(pred: Callable[[dict[str, Any]], bool]) -> float:
+        return round(sum(1 for e in found if pred(e)) / total, 4)
+
+    return {
+        "scenes": total,
+        "refused": sum(1 for e in entries if "refused" in e),
+        "empty": sum(1 for e in entries if "empty" in e),
+        "top_lt_10m": frac(lambda e: e["top"] < 10),
+        "top_lt_15m": frac(lambda e: e["top"] < 15),
+        "closest_lt_10m": frac(lambda e: e["closest"] < 10),
+        "closest_lt_15m": frac(lambda e: e["closest"] < 15),
+        "warned": frac(lambda e: bool(e["new_warnings"])),
+        "any_warning": frac(lambda e: bool(e.get("warnings"))),
+        "wrong_uncovered": frac(lambda e: e["wrong_uncovered"]),
+        "confidently_wrong": frac(lambda e: e["confidently_wrong"]),
+        "confidently_wrong_n": sum(1 for e in found if e["confidently_wrong"]),
+        "silently_lost": frac(lambda e: e["silently_lost"]),
+    }
+
+
+def summarise(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
+    out = {}
+    for s in slips:
+        got = [r["slips"][s] for r in rows if s in r.get("slips", {})]
+        out[s] = {
+            "method": SLIPS[s][0],
+            "clean": _fig([g["clean"] for g in got]),
+            "slipped": _fig([g["slipped"] for g in got]),
+        }
+    return out
+
+
+def plot(summary: dict[str, Any], path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(summary)
+    y = np.arange(len(names))
+    fig, axes = plt.subplots(1, 3, figsize=(16, 0.45 * len(names) + 2), sharey=True)
+    for ax, key, title in (
+        (axes[0], "top_lt_10m", "top candidate < 10 m"),
+        (axes[1], "closest_lt_15m", "closest candidate < 15 m"),
+        (axes[2], "confidently_wrong", "confidently wrong (top > 15 m, no warning/tie/sigma)"),
+    ):
+        clean = [summary[s]["clean"].get(key, 0.0) for s in names]
+        slipped = [summary[s]["slipped"].get(key, 0.0) for s in names]
+        ax.barh(y - 0.2, clean, 0.4, label="clean", color="#56B4E9")
+        ax.barh(y + 0.2, slipped, 0.4, label="one slip", color="#D55E00")
+        ax.set_title(title, fontsize=9)
+        ax.set_xlim(0, 1)
+        ax.grid(axis="x", alpha=0.3)
+    axes[0].set_yticks(y)
+    axes[0].set_yticklabels([f"{s} (n={summary[s]['slipped']['scenes']})" for s in names])
+    axes[0].invert_yaxis()
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=60, help="number of junction cameras")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
+    ap.add_argument("--out", type=Path, default=OUT)
+    ap.add_argument("--tag", default="", help="suffix of the output files")
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
+    logging.getLogger("camloc_geo").setLevel(logging.ERROR)
+    slips = [s for s in args.slips.split(",") if s]
+    unknown = [s for s in slips if s not in SLIPS]
+    if unknown:
+        ap.error(f"unknown slips {unknown}; known: {', '.join(SLIPS)}")
+    t0 = time.perf_counter()
+    maps = {}
+    for name, lat, lon, r in PLACES:
+        try:
+            maps[name] = load_map(OSM / name, lat, lon, radius_m=r)
+        except Exception as exc:  # a broken extract must not stop the benchmark
+            log.warning("%s: %s", name, exc)
+    rows = run(args.n, args.seed, maps, slips)
+    summary = summarise(rows, slips)
+    args.out.mkdir(parents=True, exist_ok=True)
+    stem = "absolute_slips" + (f"_{args.tag}" if args.tag else "")
+    doc = {
+        "benchmark": "absolute_slips",
+        "n_requested": args.n,
+        "seed": args.seed,
+        "confident_m": CONFIDENT_M,
+        "sigma_cover": SIGMA_COVER,
+        "summary": summary,
+        "wall_s": time.perf_counter() - t0,
+        "scenes": rows,
+    }
+    (args.out / f"{stem}.json").write_text(json.dumps(doc, indent=1))
+    plot(summary, args.out / f"{stem}.png")
+    for s, v in summary.items():
+        a, b = v["clean"], v["slipped"]
+        if not b.get("scenes"):
+            log.info("%-24s no scene", s)
+            continue
+        log.info(
+            "%-24s n=%3d  top<10 %3.0f%% -> %3.0f%%  closest<15 %3.0f%% -> %3.0f%%  "
+            "refused %d empty %d warned %3.0f%%  confidently wrong %3.0f%% -> %3.0f%% (%d)  "
+            "silently lost %3.0f%%",
+            s,
+            b["scenes"],
+            100 * a.get("top_lt_10m", 0),
+            100 * b.get("top_lt_10m", 0),
+            100 * a.get("closest_lt_15m", 0),
+            100 * b.get("closest_lt_15m", 0),
+            b["refused"],
+            b["empty"],
+            100 * b.get("warned", 0),
+            100 * a.get("confidently_wrong", 0),
+            100 * b.get("confidently_wrong", 0),
+            b.get("confidently_wrong_n", 0),
+            100 * b.get("silently_lost", 0),
+        )
+    log.info("wrote %s (%.0f s)", args.out / f"{stem}.json", time.perf_counter() - t0)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

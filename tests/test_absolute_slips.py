@@ -1,0 +1,170 @@
+"""The slips crowds make in the absolute inputs (``benchmarks/absolute_slips.py``).
+
+Each test is a slip that used to give a confidently wrong answer (the top candidate far off,
+no warning, no tie); noise-free annotations at real Baltimore junctions, so every figure is
+the slip's alone.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from camloc_geo.absolute import LocateResult, locate
+from camloc_geo.geodesy import distance_m
+from camloc_geo.osm import MapData, load_map
+from camloc_geo.scene import parse_scene
+from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
+
+OSM = Path(__file__).resolve().parents[1] / "data" / "osm"
+
+
+@pytest.fixture(scope="module")
+def baltimore() -> MapData:
+    return load_map(OSM / "baltimore.osm.pbf", 39.2851, -76.5934, radius_m=300)
+
+
+def _located(m: MapData, inter_id: str, seed: int, **kw: Any) -> LocatedScene:
+    ls = make_located_scene(
+        m,
+        m.intersection(inter_id),
+        np.random.default_rng(seed),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        **kw,
+    )
+    assert ls is not None
+    return ls
+
+
+def _errors(res: LocateResult, ls: LocatedScene) -> list[float]:
+    return [
+        float(distance_m(lat1=c.lat, lon1=c.lon, lat2=ls.lat, lon2=ls.lon)) for c in res.candidates
+    ]
+
+
+def _refs_on_wrong_corner(m: MapData, inter_id: str, seed: int) -> tuple[dict, LocatedScene]:
+    """Two references, the first clicked on a visible kerb corner but given the lat/lon of
+    another corner of the junction."""
+    ls = _located(m, inter_id, seed, n_references=2, min_corners=1)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    inter = m.intersection(inter_id)
+    wrong = next(c for c in inter.corners if c.order != ls.visible_corner_orders[0])
+    scene["references"][0] = {
+        "pixel": ls.scene["intersection"]["corners"][0],
+        "lat": wrong.lat,
+        "lon": wrong.lon,
+    }
+    return scene, ls
+
+
+def test_reference_on_another_corner_keeps_the_truth_and_warns(baltimore: MapData) -> None:
+    # Old code: one candidate, 27.9 m off, no warning. Now each reference is also tried
+    # alone along the streets (a candidate 0.7 m off), and the joint fit's car across its
+    # street is a warning.
+    scene, ls = _refs_on_wrong_corner(baltimore, "c49531205", 9)
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert errs[0] > 15.0  # the pair still pulls the best candidate off...
+    assert min(errs) < 2.0  # ...but the truth is among the candidates
+    assert any(c.method == "one_reference" for c in res.candidates)
+    warned = [w for w in res.warnings if w.startswith("references: the two references")]
+    assert warned
+    assert "across its street" in warned[0]
+
+
+def test_reference_on_another_corner_off_street_warns(baltimore: MapData) -> None:
+    # Old code: 20.8 m off, no warning.
+    scene, ls = _refs_on_wrong_corner(baltimore, "n49471323", 10)
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] > 15.0
+    assert any("off any street" in w for w in res.warnings)
+
+
+def test_two_consistent_references_stay_quiet(baltimore: MapData) -> None:
+    # The same cameras with both references right: the best candidate is the truth and no
+    # reference warning is given.
+    for inter_id, seed in (("c49531205", 9), ("n49471323", 10)):
+        ls = _located(baltimore, inter_id, seed, n_references=2, min_corners=1)
+        scene = json.loads(json.dumps(ls.scene))
+        scene.pop("intersection")
+        res = locate(parse_scene(scene), baltimore)
+        assert _errors(res, ls)[0] < 2.0
+        assert not [w for w in res.warnings if w.startswith("references")]
+
+
+def test_reference_lat_lon_swapped_is_read_swapped(baltimore: MapData) -> None:
+    # Old code: no candidate at all ("every hypothesis puts the camera more than 450 m from
+    # the prior"). The (lon, lat) pair lies 12,800 km from the map, read the other way round
+    # metres from it: read swapped, with a warning.
+    ls = _located(baltimore, "c49531205", 9, n_references=2, min_corners=1)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    ref = scene["references"][0]
+    ref["lat"], ref["lon"] = ref["lon"], ref["lat"]
+    res = locate(parse_scene(scene), baltimore)
+    assert res.candidates
+    assert _errors(res, ls)[0] < 2.0
+    swapped = [w for w in res.warnings if w.startswith("references[0]:")]
+    assert swapped
+    assert "(lon, lat) swapped" in swapped[0]
+
+
+def test_far_reference_not_near_the_map_either_way_is_not_swapped(baltimore: MapData) -> None:
+    # A reference far off whose swap is no nearer is left as given (no warning).
+    ls = _located(baltimore, "c49531205", 9, n_references=2, min_corners=1)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene["references"][0]["lat"] = 10.0
+    scene["references"][0]["lon"] = 10.0
+    res = locate(parse_scene(scene), baltimore)
+    assert not [w for w in res.warnings if "(lon, lat) swapped" in w]
+    # ...but the pair's disagreement is named.
+    assert any(w.startswith("references[0] and references[1] disagree") for w in res.warnings)
+
+
+@pytest.mark.parametrize(
+    ("inter_id", "seed", "streets"),
+    [
+        ("c49531205", 9, ["Aliceanna Street", "South Bethel Street"]),
+        ("n49471327", 5, ["Fleet Street", "South Bond Street"]),
+    ],
+)
+def test_cross_street_a_block_away_finds_the_junction(
+    baltimore: MapData, inter_id: str, seed: int, streets: list[str]
+) -> None:
+    # The corners of one junction, named by its main street and the cross street a block
+    # away. Old code matched them at the named junction only: every candidate 40-150 m off,
+    # no warning. Now the junctions within the prior where one of the named streets meets
+    # are tried too (at odds of 0.2): the real one fits, and the warning names it.
+    ls = _located(baltimore, inter_id, seed, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    it = scene["intersection"]
+    it.pop("lat")
+    it.pop("lon")
+    it["streets"] = streets
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert min(errs) < 1.0
+    assert errs[0] < 1.0 or res.candidates[0].ambiguous_with
+    warned = [w for w in res.warnings if w.startswith("intersection: the corners fit")]
+    assert warned
+    assert inter_id in warned[0]
+
+
+def test_streets_named_right_get_no_junction_warning(baltimore: MapData) -> None:
+    ls = _located(baltimore, "c49531205", 9, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    it = scene["intersection"]
+    it.pop("lat")
+    it.pop("lon")
+    it["streets"] = ["Aliceanna Street", "South Broadway"]
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 1.0
+    assert res.candidates[0].intersection_id == "c49531205"
+    assert not [w for w in res.warnings if w.startswith("intersection: the corners fit")]
