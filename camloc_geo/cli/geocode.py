@@ -58,7 +58,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--list",
         metavar="LIST.csv",
-        help="CSV (any of , ; tab |) or GeoJSON list of titles (column title or name; optional id, lat, lon), streamed",
+        help=(
+            "CSV (any of , ; tab |) or GeoJSON list of titles"
+            " (column title or name; optional id, lat, lon), streamed"
+        ),
     )
     parser.add_argument("--best", action="store_true", help="only the best match per title")
     parser.add_argument("-o", "--output", metavar="OUT.geojson", help="output file (stdout)")
