@@ -620,6 +620,8 @@ class _Model:
     # how far pitch and roll move (degrees) when either half of a direction's lines is left
     # out, where the halves disagree beyond their noise (two families taken for one)
     tilt_split_deg: tuple[float, float] = (0.0, 0.0)
+    # spread of pitch and roll (degrees) over the rival frames (``_rival_logf_std``)
+    tilt_rival_deg: tuple[float, float] = (0.0, 0.0)
     weak_only: int = 0  # the focal length rests on a direction with this few lines
     # the focal length rests on a direction with this few lines (at least _WEAK_LINES, fewer
     # than _FEW_LINES) that pulls it away from the other two directions (a warning)
@@ -1036,7 +1038,7 @@ def _line_jackknife_logf_std(
 
 def _rival_logf_std(
     best: _Model, models: Sequence[_Model], weight: Any, s: _Segs, tau_px: float
-) -> float:
+) -> tuple[float, tuple[float, float]]:
     """Spread of ``log(focal)`` over the Manhattan frames the photo supports about as well.
 
     The hypotheses refined (:data:`_N_REFINED` distinct frames) are modes of the fit; the
@@ -1072,10 +1074,16 @@ def _rival_logf_std(
     -------
     float
         Standard deviation of ``log(focal)`` across the modes (0 when no rival is close).
+    tuple of float
+        The same of pitch and roll (degrees; each rival's vertical is its direction
+        nearest the kept frame's): a rival frame tilts the horizon too.
     """
     w_best = float(weight(best))
     if not (w_best > 0.0 and math.isfinite(w_best) and best.score > 0.0):
-        return 0.0
+        return 0.0, (0.0, 0.0)
+    up_best = _up_sign(best.R[:, _vertical_index(best.R.T)[0]])
+    p0, r0 = pitch_roll_from_up(up_best)
+    tilt_num = np.zeros(2)
     _, c_best = _label_scores(best.R, best.f_n, s, tau_px * _LABEL_TAU, _LABEL_ANGLE_DEG)
     c_best = c_best * (w_best / best.score)  # with the focal-length prior's factor
     n = len(c_best)
@@ -1092,13 +1100,16 @@ def _rival_logf_std(
         w = 0.5 * math.erfc(z / math.sqrt(2.0))  # Phi(-z)
         num += w * math.log(m.f_n / best.f_n) ** 2
         den += w
+        kv = int(np.argmax(np.abs(m.R.T @ up_best)))
+        tilt_num += w * np.square(_tilt_move_deg(m.R, kv, p0, r0))
         log.debug(
             "rival frame: %.2f standard errors below, weight %.2f, log focal %+.3f",
             z,
             w,
             math.log(m.f_n / best.f_n),
         )
-    return math.sqrt(num / den)
+    tilt = np.sqrt(tilt_num / den)
+    return math.sqrt(num / den), (float(tilt[0]), float(tilt[1]))
 
 
 def _level_reading_move_deg(m: _Model, segs_px: FloatArray, merge_px: float) -> None:
@@ -1245,7 +1256,8 @@ def _tilt_std_deg(
 ) -> tuple[float, float]:
     """1-sigma of pitch and roll (degrees): the larger of least squares and the
     delete-one-line jackknife (``m.tilt_jack_deg``), the systematic part, what the lines
-    cannot fix where no line is vertical (``m.tilt_consider_deg``) and, when the principal
+    cannot fix where no line is vertical (``m.tilt_consider_deg``), the spread over rival
+    frames (``m.tilt_rival_deg``) and, when the principal
     point is assumed rather than known, its uncertainty (``pp_sigma_n`` in normalised
     units: pitch is measured from the optical axis through it)."""
     kv = _vertical_index(m.R.T, m.n_lines)[0]
@@ -1260,6 +1272,7 @@ def _tilt_std_deg(
     # as the direction's included: the larger of the two
     var = var + np.maximum(stat, np.square(m.tilt_jack_deg))
     var = var + np.square(m.tilt_consider_deg) + np.square(m.tilt_split_deg)
+    var = var + np.square(m.tilt_rival_deg)
     if pp_sigma_n > 0:
         # an offset of the principal point turns the optical axis: by its full angle in
         # pitch, and about the vertical, which shows as roll in proportion to the pitch
@@ -1755,14 +1768,14 @@ def detect_vanishing_points(
         labels0=best.labels,
         prior_w=prior_w,
     )
-    rival_std = 0.0
+    rival_std, rival_tilt = 0.0, (0.0, 0.0)
     if f_fixed is None and rivals:
         # frames the photo supports about as well, refined as far as the kept one: a mode
         # each, whose focal lengths go into the sigma
         rivals = [
             _fit(m.R, m.f_n, s, tau, True, f_prior, f_bounds, 2, m.labels, prior_w) for m in rivals
         ]
-        rival_std = _rival_logf_std(best, [best, *rivals], model_weight, s, tau)
+        rival_std, rival_tilt = _rival_logf_std(best, [best, *rivals], model_weight, s, tau)
     if estimate_principal_point and principal_point is None:
         # Free the principal point around the image centre (a Gaussian prior), on the
         # final inliers.
@@ -1974,6 +1987,7 @@ def detect_vanishing_points(
         prior_w,
         info.get("cov_rot"),
     )
+    best.tilt_rival_deg = rival_tilt
     pitch_std, roll_std = _tilt_std_deg(best, info.get("cov_rot"), pp_sigma_n)
     result = _finish(
         best,

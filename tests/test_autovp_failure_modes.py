@@ -635,8 +635,9 @@ def test_rival_logf_std_counts_a_rival_by_the_chance_it_is_the_better_frame(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """A rival frame as well supported as the kept one (a tie: Phi(0) = 1/2) adds
-    ``sqrt(1/2 * d**2 / (1 + 1/2))`` of its focal length's log-distance ``d``; one the
-    segments clearly support less adds nothing; the kept frame itself is skipped."""
+    ``sqrt(1/2 * d**2 / (1 + 1/2))`` of its focal length's log-distance ``d``, and so of its
+    roll; one the segments clearly support less adds nothing; the kept frame itself is
+    skipped."""
     n = 100
     per_frame = {
         1.0: np.ones(n),  # the kept frame
@@ -659,9 +660,17 @@ def test_rival_logf_std_counts_a_rival_by_the_chance_it_is_the_better_frame(
     def weight(m: autovp._Model) -> float:
         return m.score
 
+    roll = math.radians(5.0)  # the tie also rolls the camera 5 degrees
+    tie.R = np.array(
+        [[math.cos(roll), -math.sin(roll), 0.0], [math.sin(roll), math.cos(roll), 0.0], [0, 0, 1]]
+    )
     d = math.log(1.3)
-    expected = math.sqrt(0.5 * d**2 / 1.5)
-    assert autovp._rival_logf_std(best, [best, tie], weight, s, 1.0) == pytest.approx(expected)
-    assert autovp._rival_logf_std(best, [best, weak], weight, s, 1.0) < 1e-6
+    logf_std, (pitch_std, roll_std) = autovp._rival_logf_std(best, [best, tie], weight, s, 1.0)
+    assert logf_std == pytest.approx(math.sqrt(0.5 * d**2 / 1.5))
+    assert roll_std == pytest.approx(math.sqrt(0.5 * 5.0**2 / 1.5), rel=1e-3)
+    assert pitch_std < 1e-6
+    logf_std, tilt = autovp._rival_logf_std(best, [best, weak], weight, s, 1.0)
+    assert logf_std < 1e-6
+    assert max(tilt) < 1e-4
     same = model(1.0)
-    assert autovp._rival_logf_std(best, [best, same], weight, s, 1.0) == pytest.approx(0.0)
+    assert autovp._rival_logf_std(best, [best, same], weight, s, 1.0) == (0.0, (0.0, 0.0))
