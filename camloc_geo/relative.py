@@ -3988,6 +3988,7 @@ def _joint(
         )
     for axis in car_lines.axes_on_car(settings.car_line_share_warn):
         result.warnings.append(_car_line_warning(axis, car_lines, settings.car_line_sigma_deg))
+    result.warnings += _segments_off(scene, prob, r[:n_seg])
     if props is not None:
         result.object_proportions = props.to_dict([a.annotator for a in scene.annotations])
         if props.disagrees:
@@ -4154,6 +4155,36 @@ def _proportion_warning(props: _Proportions, size: ObjectSize) -> str:
         f"The camera's distance is uncertain by their spread ({100.0 * props.spread:.0f} %, "
         "included in the position sigmas); check object.preset and the corner clicks"
     )
+
+
+SEGMENT_OFF_SIGMA = 7.0  # an annotator's segment this many line sigmas off the fit: named
+SEGMENT_OFF_MAX = 3  # ... at most this many warnings
+
+
+def _segments_off(scene: Scene, prob: _JointProblem, r_seg: FloatArray) -> list[str]:
+    """Warnings naming annotators' segments far off the final fit's vanishing point.
+
+    A line drawn along something not parallel to the car's axis (a kerb's curve, a roof's
+    slope, a stop line at an angle), 5-15 degrees off, is often kept by the line screen (its
+    miss of the consensus point is within 1 % of the diagonal) and only down-weighted by the
+    fit; its residual in the final fit is then ``SEGMENT_OFF_SIGMA`` line sigmas or more, which
+    no clean crowd scene reached (99th percentile of the largest: 5.3; 150 scenes), and it
+    belonged to the slipped annotator in every scene where it was
+    (``benchmarks/crowd_slips.py``, ``nonparallel_line``). Named with the segment's pixels,
+    the largest first.
+    """
+    off = np.flatnonzero(np.abs(r_seg) > SEGMENT_OFF_SIGMA)
+    out = []
+    for j in off[np.argsort(-np.abs(r_seg[off]))][:SEGMENT_OFF_MAX]:
+        slot, axis = int(prob.seg_ann[j]), AXES[int(prob.seg_axis[j])]
+        seg = ", ".join(str(round(float(v))) for v in prob.segments[j])
+        out.append(
+            f"annotator {scene.annotations[slot].annotator!r} (annotations[{slot}]): the "
+            f"vp_lines.{axis} segment [{seg}] is {abs(float(r_seg[j])):.1f} line sigmas off the "
+            f"fit's {axis} vanishing point: is it parallel to the car's {axis} (not a kerb's "
+            "curve, a roof's slope, a line at an angle)?"
+        )
+    return out
 
 
 def _car_line_warning(axis: str, car_lines: _CarLines, sigma_deg: float) -> str:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +20,13 @@ from camloc_geo.camera import Camera
 from camloc_geo.objects import PRESETS
 from camloc_geo.relative import CalibrationResult, calibrate
 from camloc_geo.scene import parse_scene
-from camloc_geo.testing.synthetic import NoiseModel, SyntheticScene, make_scene, random_camera
+from camloc_geo.testing.synthetic import (
+    NoiseModel,
+    SyntheticScene,
+    _visible_segment,
+    make_scene,
+    random_camera,
+)
 
 CLEAN = NoiseModel(wrong_corner_prob=0.0, sloppy_prob=0.0)
 
@@ -84,6 +91,7 @@ def test_sedan_proportions_stay_quiet(seed: int) -> None:
     assert all(0.8 < v < 1.2 for v in props["scale"].values())
     assert props["odd_annotators"] == []
     assert not any("the other annotators'" in w for w in result.warnings)
+    assert not any("line sigmas off" in w for w in result.warnings)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
@@ -200,3 +208,23 @@ def test_a_near_copy_is_not_a_duplicate() -> None:
     syn.scene["annotations"].append(near)
     result = _cal(syn)
     assert result.excluded_annotators == []
+
+
+@pytest.mark.parametrize("seed", [2, 3, 6, 7, 9])
+def test_a_kerb_curve_drawn_as_a_length_line_is_named(seed: int) -> None:
+    """One annotator adds a long ground line 10 deg off the car's length (a kerb's curve)
+    that the line screen keeps: the fit's residual names it (8-18 line sigmas off); the old
+    code said nothing."""
+    syn = _scene(seed, "sedan")
+    off = math.radians(10.0)
+    a = np.array([-15.0, -6.0, 0.0])
+    b = a + 20.0 * np.array([math.cos(off), math.sin(off), 0.0])
+    seg = _visible_segment(syn.camera, a, b, (1920, 1080))
+    assert seg is not None
+    syn.scene["annotations"][1]["vp_lines"]["length"].append([float(v) for v in seg])
+    result = _cal(syn)
+    named = [w for w in result.warnings if "line sigmas off" in w]
+    assert len(named) == 1
+    assert named[0].startswith("annotator 'w2' (annotations[1]): the vp_lines.length segment [")
+    sigmas = float(named[0].split(" is ")[1].split(" line sigmas")[0])
+    assert sigmas > 7.0
