@@ -387,6 +387,14 @@ def classify(syn: SyntheticScene, slipped: int | None) -> dict[str, Any]:
         "height_m": hgt >= BARS["height_m"],
         "focal_rel": foc >= BARS["focal_rel"],
     }
+    named = set(res.outlier_annotators) | set(res.corner_mistakes)
+    named |= {e["annotator"] for e in res.excluded_annotators}
+    if slipped is None:
+        said = bool(res.warnings)
+    else:
+        who = names[slipped]
+        said = who in named or any(f"'{who}'" in w or f"({who})" in w for w in res.warnings)
+    row["warned"] = said
     if not any(outside.values()):
         row["outcome"] = "ok"
         return row
@@ -398,14 +406,6 @@ def classify(syn: SyntheticScene, slipped: int | None) -> dict[str, Any]:
         "focal_rel": fs is None or abs(cam.focal_px - truth.focal_px) <= 2.0 * fs,
     }
     row["sigma_covers"] = all(covered[k] for k, out in outside.items() if out)
-    named = set(res.outlier_annotators) | set(res.corner_mistakes)
-    named |= {e["annotator"] for e in res.excluded_annotators}
-    if slipped is None:
-        said = bool(res.warnings)
-    else:
-        who = names[slipped]
-        said = who in named or any(f"'{who}'" in w for w in res.warnings)
-    row["warned"] = said
     row["warnings"] = [w[:160] for w in res.warnings]
     row["outcome"] = "flagged" if said or row["sigma_covers"] else "confidently_wrong"
     return row
@@ -433,6 +433,9 @@ def run(slips: list[str], n: int, seed: int) -> dict[str, Any]:
             "n": n,
             "share": {o: counts[o] / n for o in OUTCOMES},
             "refused": sum(bool(r.get("refused")) for r in rows),
+            # the slip said (the annotator named, or any warning for a crowd-wide slip),
+            # whatever the outcome: what a crowd's quality control sees
+            "said": sum(bool(r.get("warned") or r.get("refused")) for r in rows) / n,
             "confidently_wrong_scenes": [
                 {
                     k: r[k]
@@ -507,12 +510,12 @@ def main(argv: list[str] | None = None) -> int:
     plot(result, args.out / f"{name}.png")
     w = sys.stdout.write
     w(f"crowd slips, {args.n} scenes per slip, seed {args.seed}, {result['wall_time_s']} s\n")
-    w(f"{'slip':22s}{'ok':>7s}{'flagged':>9s}{'conf.wrong':>12s}{'refused':>9s}\n")
+    w(f"{'slip':22s}{'ok':>7s}{'flagged':>9s}{'conf.wrong':>12s}{'refused':>9s}{'said':>7s}\n")
     for s, v in per_slip.items():
         sh = v["share"]
         w(
             f"{s:22s}{sh['ok']:7.0%}{sh['flagged']:9.0%}{sh['confidently_wrong']:12.0%}"
-            f"{v['refused']:9d}\n"
+            f"{v['refused']:9d}{v['said']:7.0%}\n"
         )
     return 0
 
