@@ -587,3 +587,53 @@ def test_overlapping_extracts_place_a_title_without_point(tmp_path: Path) -> Non
     assert miss.status == "not_found"
     assert "Qzxwv" in (miss.reason or "")
     assert "Aleksi" not in (miss.reason or "")
+
+
+def test_sigterm_stops_batch_and_its_workers(tmp_path: Path) -> None:
+    """``kill``/``timeout``/``docker stop`` send SIGTERM: Python's default ended camloc batch
+    at once and left its worker processes running, orphaned, for ever (seen on the sweep's
+    webcam list: two workers alive 10 minutes later). SIGTERM now stops the run as Ctrl-C
+    does: exit 143, one line saying the finished cameras are kept, the workers stopped."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\n1,Eastern Ave & S Broadway\n", encoding="utf-8")
+    code = (
+        "import os, signal, sys, time\n"
+        "import camloc_geo.batch\n"
+        "def run_batch(*a, **k):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(30)\n"
+        "camloc_geo.batch.run_batch = run_batch\n"
+        "from camloc_geo.cli import main\n"
+        f"sys.exit(main(['batch', {str(lst)!r}, '-o', {str(tmp_path / 'o.gpkg')!r}]))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert proc.returncode == 143, proc.stderr
+    assert "camloc batch: stopped; the cameras finished are kept in" in proc.stderr
+    assert "o.camloc-batch.sqlite" in proc.stderr
+    assert "terminated (SIGTERM)" in proc.stderr
+
+
+def _sleep_in_worker(seconds: float) -> int:
+    import time as _time
+
+    _time.sleep(seconds)
+    return os.getpid()
+
+
+def test_interrupted_runner_stops_its_workers() -> None:
+    """A cancelled local runner (Ctrl-C, SIGTERM) stops workers busy with a chunk instead of
+    leaving them to finish it (the interpreter's exit joined them: tens of seconds)."""
+    from camloc_geo.batch._run import _LocalRunner
+
+    runner = _LocalRunner(2)
+    futures = {runner.submit(_sleep_in_worker, 120.0) for _ in range(2)}
+    processes = list(runner.ex._processes.values())  # type: ignore[attr-defined]
+    assert len(processes) == 2
+    runner.close(cancel=True)
+    for proc in processes:
+        proc.join(timeout=30)
+        assert not proc.is_alive()
+    assert len(futures) == 2

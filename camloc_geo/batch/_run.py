@@ -204,7 +204,19 @@ def _local_executor(workers: int) -> Executor:
         method = "fork" if "fork" in methods and threading.active_count() == 1 else "spawn"
         if method != "fork" and "forkserver" in methods:
             method = "forkserver"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context(method),
+        initializer=_worker_signals,
+    )
+
+
+def _worker_signals() -> None:
+    """A worker ends on SIGTERM (a forked worker inherited the CLI's handler, which turns
+    SIGTERM into an exception that the pool's task loop catches: the worker lived on)."""
+    import signal
+
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 class _DaskRunner:
@@ -244,7 +256,23 @@ class _LocalRunner:
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
+        if cancel:
+            # an interruption (Ctrl-C, SIGTERM): the workers' running chunks are not waited
+            # for (a chunk searching every extract takes tens of seconds; the interpreter's
+            # exit joined them, and a SIGTERM left them orphaned); what is not in the
+            # journal is computed again by the rerun
+            self._stop_workers()
         self.ex.shutdown(wait=not cancel, cancel_futures=cancel)
+
+    def _stop_workers(self) -> None:
+        stop = getattr(self.ex, "terminate_workers", None)  # Python >= 3.14
+        if stop is not None:
+            stop()
+            return
+        processes = getattr(self.ex, "_processes", None) or {}
+        for proc in list(processes.values()):
+            if proc.is_alive():
+                proc.terminate()
 
 
 class _Counted:
