@@ -267,6 +267,8 @@ _PAGE_CSS = """
   border-radius: 5px; box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif;
   color: #222; }
 .camloc-legend { max-width: 260px; }
+.camloc-summary-title { max-height: 40vh; overflow-y: auto; }
+.camloc-more summary { cursor: pointer; color: #124; }
 .leaflet-control-layers-expanded { font: 12px/1.4 sans-serif; padding: 4px 8px; }
 .leaflet-container { font-family: sans-serif; }
 .camloc-legend h4, .camloc-title h4 { margin: 0 0 4px; font-size: 13px; }
@@ -1366,30 +1368,57 @@ def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
 _STATUS_PREFIX = re.compile(r"^([a-z][a-z_]*): ")
 
 
+MISSING_LABEL_CHARS = 60
+"""A camera's name in the summary's list of cameras not on the map is cut here (the whole
+name and reason on hover): one scraped title of 300 characters filled the heading box."""
+MISSING_LISTED = 500
+"""At most this many cameras not on the map are named on the page (the rest are counted; the
+GeoPackage's ``cameras`` layer has them all)."""
+
+
+def _missing_label(scene_id: Any, reason: Any) -> str:
+    m = _STATUS_PREFIX.match(str(reason or ""))
+    status = m.group(1) if m else None
+    name = " ".join(str(scene_id).split())
+    short = name if len(name) <= MISSING_LABEL_CHARS else name[: MISSING_LABEL_CHARS - 1] + "…"
+    hover = name + ": " + str(reason or "") if short != name else str(reason or "")
+    label = html.escape(short) + (f" ({status})" if status else "")
+    return f'<span title="{html.escape(hover)}">{label}</span>'
+
+
 def _missing_html(missing: Sequence[tuple[str, Any]], shown: int = 10) -> str:
     """The summary heading's line of cameras not on the map: counted by status (a batch
     camera's reason starts with it: ``scene_error: scene broken.json: ...``), each named with
     its status, the whole reason on hover. It listed bare names, so a broken scene, a title
-    not found and a camera without evidence read alike."""
+    not found and a camera without evidence read alike. The first ``shown`` are named in the
+    line, the others (up to :data:`MISSING_LISTED`) under a fold: they were left out ("…")."""
     statuses: dict[str, int] = {}
-    names = []
-    for scene_id, reason in missing[:shown]:
-        m = _STATUS_PREFIX.match(str(reason or ""))
-        status = m.group(1) if m else None
-        label = html.escape(str(scene_id)) + (f" ({status})" if status else "")
-        names.append(f'<span title="{html.escape(str(reason or ""))}">{label}</span>')
+    names = [_missing_label(scene_id, reason) for scene_id, reason in missing[:shown]]
     for _scene_id, reason in missing:
         m = _STATUS_PREFIX.match(str(reason or ""))
         if m:
             statuses[m.group(1)] = statuses.get(m.group(1), 0) + 1
     counted = ", ".join(f"{n} {st}" for st, n in sorted(statuses.items(), key=lambda kv: -kv[1]))
-    return (
+    text = (
         f"{len(missing)} without candidates"
         + (f" ({html.escape(counted)})" if counted else "")
         + ": "
         + ", ".join(names)
-        + (" …" if len(missing) > shown else "")
     )
+    rest = missing[shown:MISSING_LISTED]
+    if rest:
+        more = ", ".join(_missing_label(scene_id, reason) for scene_id, reason in rest)
+        unlisted = len(missing) - shown - len(rest)
+        tail = (
+            f", and {unlisted} more (the GeoPackage's cameras layer has them all)"
+            if unlisted
+            else ""
+        )
+        text += (
+            f'<details class="camloc-more"><summary>and {len(missing) - shown} more</summary>'
+            f"{more}{tail}</details>"
+        )
+    return text
 
 
 def build_summary_map(
@@ -1509,7 +1538,7 @@ def build_summary_map(
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
         title += _missing_html(missing)
-    _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
+    _Control(title, position="topleft", css_class="camloc-title camloc-summary-title").add_to(fmap)
     if len(rows) >= 2:
         fmap.fit_bounds(
             [[float(lats.min()), float(lons.min())], [float(lats.max()), float(lons.max())]],

@@ -626,3 +626,28 @@ def test_summary_map_says_why_cameras_are_not_on_it(tmp_path: Path) -> None:
     assert "c1 Eastern (scene_error)\\u003c/span\\u003e" in page
     assert "c6 Nowhere (not_found)" in page
     assert "scene broken.json: image.height: required" in page
+
+
+def test_summary_map_names_every_camera_not_on_it_briefly(tmp_path: Path) -> None:
+    """The sweep's 40-webcam list: 12 cameras without a point, of which the page named 10 and
+    an ellipsis (two cameras nowhere on the page), and one scraped title of 300 characters
+    filled the heading box (a third of a phone's screen). Names are now cut at 60 characters
+    (the whole name and reason on hover) and the cameras past the first 10 are under a fold."""
+
+    def empty(reason: str) -> dict[str, Any]:
+        return {"type": "FeatureCollection", "features": [], "properties": {"reason": reason}}
+
+    long_title = "html-01 <b>Cam</b> & E Monument St " + "very long description " * 12
+    items = [(long_title, empty("not_found: 'Cam' is not a street name of this map"))]
+    items += [(f"c{k} Nowhere St", empty("not_found: no such street")) for k in range(11)]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert "12 without candidates (12 not_found): " in page
+    label = maps._missing_label(long_title, "not_found: x")
+    shown = label.split(">", 1)[1].rsplit("<", 1)[0]
+    assert shown.endswith("description ve\u2026 (not_found)")
+    assert len(shown) < 90
+    assert "\\u003cb\\u003e" not in page.split("without candidates")[1][:400]
+    assert "and 2 more\\u003c/summary\\u003e" in page
+    assert "c9 Nowhere St (not_found)" in page
+    assert "c10 Nowhere St (not_found)" in page
+    assert "camloc-summary-title" in page
