@@ -130,6 +130,10 @@ _BANNER_PX = 150  # about the height of the tie banner: the candidates are fitte
 _BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
 BANNER_FOLD_BELOW_PX = (1200, 800)
 """A map narrower or lower than this (pixels) opens with the banner folded to its headline."""
+SMALL_SCREEN_PX = 720
+"""A map narrower than this (a phone) opens with its layer list folded to Leaflet's layers
+button and its legend folded to its heading: unfolded, the two covered the whole map of a
+390x844 phone, the candidates under them."""
 
 
 # ----------------------------------------------------------------------------- styling
@@ -216,6 +220,56 @@ var {{ this.get_name() }} = L.control({position: {{ this.position|tojson }}});
         self.position = position
         self.css_class = css_class
         self.css = css
+
+
+class _SmallScreenFolds(MacroElement):
+    """On a map narrower than :data:`SMALL_SCREEN_PX`: the layer list folded to its button
+    (a tap opens it, a tap on the map folds it) and the legend to its heading (a tap on it
+    unfolds or folds it)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+setTimeout(function () {  // after every control of the page is on the map
+    var map = {{ this._parent.get_name() }};
+    if (map.getSize().x >= {{ this.below }}) { return; }
+    var box = map.getContainer();
+    var layers = box.querySelector(".leaflet-control-layers");
+    if (layers) {
+        L.DomUtil.removeClass(layers, "leaflet-control-layers-expanded");
+        var button = layers.querySelector(".leaflet-control-layers-toggle");
+        if (button) {
+            button.title = "layers";
+            L.DomEvent.on(button, "click", function (e) {
+                L.DomEvent.preventDefault(e);
+                L.DomUtil.addClass(layers, "leaflet-control-layers-expanded");
+            });
+        }
+        map.on("click", function () {
+            L.DomUtil.removeClass(layers, "leaflet-control-layers-expanded");
+        });
+    }
+    var legend = box.querySelector(".camloc-legend");
+    if (legend) {
+        L.DomUtil.addClass(legend, "folded");
+        var head = legend.querySelector("h4");
+        if (head) {
+            head.title = "tap to show or hide the legend";
+            L.DomEvent.on(head, "click", function () {
+                var fold = !L.DomUtil.hasClass(legend, "folded");
+                (fold ? L.DomUtil.addClass : L.DomUtil.removeClass)(legend, "folded");
+            });
+        }
+    }
+}, 0);
+{% endmacro %}
+"""
+    )
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._name = "CamlocSmallScreen"
+        self.below = SMALL_SCREEN_PX
 
 
 class _Banner(MacroElement):
@@ -305,6 +359,13 @@ _PAGE_CSS = """
   z-index: 1000; max-width: min(640px, calc(100% - 640px)); min-width: 320px;
   background: #fff8e1; border: 2px solid #b26a00; border-radius: 6px; padding: 7px 11px;
   box-shadow: 0 2px 7px rgba(0,0,0,0.45); font: 12.5px/1.4 sans-serif; color: #222; }
+.camloc-legend.folded { max-height: 1.45em; overflow: hidden; }
+@media (max-width: 719px) {
+  .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
+    width: calc(100% - 40px); }
+}
+.camloc-legend.folded h4 { cursor: pointer; }
+.camloc-legend.folded h4::after { content: " \\25B8"; font-weight: normal; color: #555; }
 .camloc-banner.folded .camloc-banner-body { display: none; }
 .camloc-banner.folded h4 { margin: 0; }
 .camloc-banner h4 { cursor: pointer; }
@@ -1094,6 +1155,7 @@ def build_candidates_map(
     fg_cands.add_to(fmap)
 
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _SmallScreenFolds().add_to(fmap)
     _Control(
         _legend_html(
             scene_id=result.scene_id,
@@ -1521,6 +1583,7 @@ def build_summary_map(
         ).add_to(parent)
     parent.add_to(fmap)
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _SmallScreenFolds().add_to(fmap)
     _Control(
         _legend_html(
             scene_id=None,
