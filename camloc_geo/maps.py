@@ -322,6 +322,8 @@ _PAGE_CSS = """
   color: #222; }
 .camloc-legend { max-width: 260px; }
 .camloc-summary-title { max-height: 40vh; overflow-y: auto; }
+.camloc-title { overflow-wrap: anywhere; }
+.camloc-title:not(.camloc-summary-title) { max-width: min(290px, calc(100vw - 80px)); }
 .camloc-more summary { cursor: pointer; color: #124; }
 .leaflet-control-layers-expanded { font: 12px/1.4 sans-serif; padding: 4px 8px; }
 .leaflet-container { font-family: sans-serif; }

@@ -340,3 +340,35 @@ def test_phone_sees_the_candidates_not_the_controls(browser: Any, pages: dict[st
         assert t.errors == []
     finally:
         t.close()
+
+
+def test_long_scene_id_wraps_beside_the_banner(
+    browser: Any, pages: dict[str, Any], tmp_path: Path
+) -> None:
+    """A scene id of 270 characters with HTML in it (a scraped webcam title, through
+    POST /v1/maps): escaped, but one unbroken line across the whole page, under the tie
+    banner and the layer list (Chromium at 1280x800). The title box now wraps at 290 px,
+    beside the banner."""
+    long_id = "<img src=x onerror=alert(1)> Cam 3 - Main St / 5th Ave " + "x" * 200
+    from camloc_geo.api import locate_scene
+
+    samples = Path(__file__).resolve().parents[1] / "sample_maps"
+    tie = locate_scene(samples / "sample_scene.json", map_source=samples / "baltimore.osm.pbf")
+    tie.result.scene_id = long_id
+    page_path = maps.candidates_map(
+        tie.result, tie.map_data, tmp_path / "long.html", offline=True, scene=tie.scene
+    )
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 1280, "height": 800})
+        t.open(page_path, ".camloc-candidate")
+        page = t.page
+        title = _box(page, ".camloc-title")
+        assert title["width"] <= 320
+        assert not _overlap(title, _box(page, ".camloc-banner"))
+        assert "onerror=alert(1)" in page.locator(".camloc-title").inner_text()
+        assert page.locator(".camloc-title img").count() == 0
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
