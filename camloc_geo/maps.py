@@ -1182,7 +1182,8 @@ def build_candidates_map(
     )
     title += _left_out_html(cal, collection)
     if not cands:
-        title += f"<br><b>no candidates</b>: {html.escape(str(result.reason))}"
+        why = str(result.reason or "").strip() or "the locate result gives no reason"
+        title += f"<br><b>no candidates</b>: {html.escape(why)}"
     _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
 
     pts = [[f["properties"]["lat"], f["properties"]["lon"]] for f in cands[:6]]

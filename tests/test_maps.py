@@ -651,3 +651,19 @@ def test_summary_map_names_every_camera_not_on_it_briefly(tmp_path: Path) -> Non
     assert "c9 Nowhere St (not_found)" in page
     assert "c10 Nowhere St (not_found)" in page
     assert "camloc-summary-title" in page
+
+
+def test_review_map_without_candidates_never_says_none(tmp_path: Path) -> None:
+    """A result without candidates and without a reason (one read back from a file) gave
+    the title 'no candidates: None'."""
+    import copy
+
+    md = fremantle_map()
+    scene, res = located(md, 0)
+    empty = copy.copy(res)
+    empty.candidates = []
+    empty.reason = None
+    page = maps.candidates_map(empty, md, tmp_path / "e.html", offline=True, scene=scene)
+    text = page.read_text(encoding="utf-8")
+    assert "no candidates\\u003c/b\\u003e: the locate result gives no reason" in text
+    assert "\\u003c/b\\u003e: None" not in text
