@@ -397,3 +397,22 @@ def test_cli_list_read_as_batch_reads_it(tmp_path: Path) -> None:
         ("g1", 1, "junction"),
         (None, 2, "street"),
     ]
+
+
+def test_a_match_far_from_the_list_point_says_so(tmp_path: Path) -> None:
+    """A list row with a London point and a Berlin title: placed in Berlin (junction, score
+    1) without a word, 933 km from the point the list gave; the reason now says how far."""
+    rows = tmp_path / "far.csv"
+    rows.write_text(
+        "id,title,lat,lon\n"
+        "far,Grunerstr. x Alexanderstr.,51.5154,-0.1419\n"
+        "near,Grunerstr. x Alexanderstr.,52.5205,13.4150\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out.geojson"
+    args = ["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out.read_text())["features"]]
+    assert props[0]["status"] == "junction"
+    assert "; 933 km from the point given (51.51540,-0.14190)" in props[0]["reason"]
+    assert "from the point given" not in props[1]["reason"]
