@@ -637,3 +637,31 @@ def test_interrupted_runner_stops_its_workers() -> None:
         proc.join(timeout=30)
         assert not proc.is_alive()
     assert len(futures) == 2
+
+
+def test_scheduler_address_as_the_cli_gives_it(tmp_path: Path) -> None:
+    """camloc batch --scheduler tcp://HOST:PORT failed on its first wait ('failed:
+    ValueError: No clients found ...', exit 1): the client it makes for the address is not
+    the default one, which distributed.wait asks for. Only a Client object (the library's
+    other way, and the only one tested) worked."""
+    from distributed import LocalCluster
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text(
+        "id,title\n1,Unioninkatu & Kaisaniemenkatu\n2,Mikonkatu / Yliopistonkatu\n",
+        encoding="utf-8",
+    )
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "helsinki.osm.pbf").symlink_to(HELSINKI)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+    ) as lc:
+        summary = run_batch(
+            lst,
+            out_gpkg=tmp_path / "o.gpkg",
+            map_source=osm,
+            scheduler=lc.scheduler_address,
+            progress=False,
+        )
+    assert summary.statuses == {"title_only": 2}

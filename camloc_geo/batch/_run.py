@@ -236,7 +236,11 @@ class _DaskRunner:
     def wait_one(self, futures: set[Any]) -> set[Any]:
         from distributed import wait
 
-        done, _ = wait(list(futures), return_when="FIRST_COMPLETED")
+        # distributed.wait asks for the default client, and the client camloc batch makes
+        # for --scheduler is not the default (set_as_default=False): 'ValueError: No
+        # clients found' on the first wait; as_current makes it the one asked for
+        with self.client.as_current():
+            done, _ = wait(list(futures), return_when="FIRST_COMPLETED")
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
