@@ -1560,6 +1560,13 @@ def build_summary_map(
                 ("flags", html.escape(_fmt(list(p.get("flags") or [])))),
             )
         )
+        why = " ".join(str(reasons[i] or "").split())
+        if why:
+            # what placed the camera and what was wrong (a camloc batch camera: "junction of
+            # the map's model; list row: lat 'abc' is not a number", "...; 933 km from the
+            # point given"): the popup showed the numbers only
+            short = why if len(why) <= 300 else why[:299] + "…"
+            body += f"<tr><th>reason</th><td>{html.escape(short)}</td></tr>"
         note = ""
         if tie:
             note = (

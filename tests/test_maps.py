@@ -667,3 +667,35 @@ def test_review_map_without_candidates_never_says_none(tmp_path: Path) -> None:
     text = page.read_text(encoding="utf-8")
     assert "no candidates\\u003c/b\\u003e: the locate result gives no reason" in text
     assert "\\u003c/b\\u003e: None" not in text
+
+
+def test_summary_popup_shows_the_camera_reason(tmp_path: Path) -> None:
+    """A camloc batch camera placed at its title's junction despite a bad list row
+    ("junction of the map's model; list row: lat 'abc' is not a number") showed score,
+    method and sigma in its popup but not that warning: the reason is now a popup row."""
+    item = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [13.415, 52.5208]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": 1,
+                    "lat": 52.5208,
+                    "lon": 13.415,
+                    "score": 1.0,
+                    "method": "title (title_only)",
+                },
+            }
+        ],
+        "properties": {
+            "reason": "junction of the map's model; list row: lat 'abc' is not a number"
+        },
+    }
+    page = maps.summary_map([("badlat <i>x</i>", item)], tmp_path / "s.html", offline=True)
+    text = page.read_text(encoding="utf-8")
+    assert (
+        "<tr><th>reason</th><td>junction of the map&#x27;s model; list row: lat &#x27;abc&#x27;"
+        " is not a number</td></tr>" in text
+    )
