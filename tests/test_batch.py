@@ -665,3 +665,23 @@ def test_scheduler_address_as_the_cli_gives_it(tmp_path: Path) -> None:
             progress=False,
         )
     assert summary.statuses == {"title_only": 2}
+
+
+def test_interrupted_dask_run_cancels_its_chunks() -> None:
+    """Ctrl-C or SIGTERM during a --scheduler run left its submitted chunks computing on the
+    cluster for nobody; a cancelled runner now cancels them."""
+    from distributed import Client, LocalCluster
+
+    from camloc_geo.batch._run import _DaskRunner
+
+    with (
+        LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+        ) as lc,
+        Client(lc) as client,
+    ):
+        runner = _DaskRunner(client)
+        futures = [runner.submit(_sleep_in_worker, 3.0) for _ in range(3)]
+        runner.close(cancel=True)
+        for fut in futures:
+            assert fut.status == "cancelled"

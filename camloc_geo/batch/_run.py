@@ -229,9 +229,13 @@ class _DaskRunner:
         else:
             self.client = scheduler
             self.own = False
+        self.pending: set[Any] = set()
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
-        return self.client.submit(fn, *args, pure=False)
+        fut = self.client.submit(fn, *args, pure=False)
+        self.pending.add(fut)
+        fut.add_done_callback(self.pending.discard)
+        return fut
 
     def wait_one(self, futures: set[Any]) -> set[Any]:
         from distributed import wait
@@ -244,6 +248,11 @@ class _DaskRunner:
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
+        if cancel and self.pending:
+            # an interruption: the chunks still queued or running on the cluster are
+            # cancelled (they went on computing for nobody, on a cluster shared with others)
+            self.client.cancel(list(self.pending))
+        self.pending.clear()
         if self.own:
             self.client.close()
 
