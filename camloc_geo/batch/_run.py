@@ -230,12 +230,18 @@ class _DaskRunner:
             self.client = scheduler
             self.own = False
         self.pending: set[Any] = set()
+        self._lock = threading.Lock()  # done callbacks come from the client's thread
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
         fut = self.client.submit(fn, *args, pure=False)
-        self.pending.add(fut)
-        fut.add_done_callback(self.pending.discard)
+        with self._lock:
+            self.pending.add(fut)
+        fut.add_done_callback(self._forget)
         return fut
+
+    def _forget(self, fut: Any) -> None:
+        with self._lock:
+            self.pending.discard(fut)
 
     def wait_one(self, futures: set[Any]) -> set[Any]:
         from distributed import wait
@@ -248,11 +254,13 @@ class _DaskRunner:
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
-        if cancel and self.pending:
+        with self._lock:
+            pending = list(self.pending)
+            self.pending.clear()
+        if cancel and pending:
             # an interruption: the chunks still queued or running on the cluster are
             # cancelled (they went on computing for nobody, on a cluster shared with others)
-            self.client.cancel(list(self.pending))
-        self.pending.clear()
+            self.client.cancel(pending)
         if self.own:
             self.client.close()
 
