@@ -685,3 +685,25 @@ def test_interrupted_dask_run_cancels_its_chunks() -> None:
         runner.close(cancel=True)
         for fut in futures:
             assert fut.status == "cancelled"
+
+
+def test_point_just_outside_an_extract_is_placed_by_its_title(tmp_path: Path) -> None:
+    """A camera whose rough point lies 69 m past the edge of a city's extract was no_map
+    ('is outside every extract') although the junction its title names is in the extract,
+    within the point's search radius; it is now placed there, the reason saying so. A point
+    far from every extract, or a title the edge extract lacks, stays no_map."""
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "bristol.osm.pbf").symlink_to(REPO / "data" / "osm" / "bristol_whitelion.osm.pbf")
+
+    def camera(lat: float, lon: float, title: str) -> Any:
+        return geocode_camera(
+            CameraRow(row=1, id="e", title=title, lat=lat, lon=lon), map_source=osm
+        )
+
+    edge = camera(51.45679, -2.59555, "Bell Lane & Small Street")
+    assert edge.status == "title_only"
+    assert abs(edge.lat - 51.45529) < 1e-4
+    assert "the list's point lies 69 m outside bristol.osm.pbf" in (edge.reason or "")
+    assert camera(51.4600, -2.5800, "Bell Lane & Small Street").status == "no_map"
+    assert camera(51.45679, -2.59555, "Qzxwv Street & Frobnitz Road").status == "no_map"
