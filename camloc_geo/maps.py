@@ -130,6 +130,10 @@ _BANNER_PX = 150  # about the height of the tie banner: the candidates are fitte
 _BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
 BANNER_FOLD_BELOW_PX = (1200, 800)
 """A map narrower or lower than this (pixels) opens with the banner folded to its headline."""
+SMALL_SCREEN_PX = 720
+"""A map narrower than this (a phone) opens with its layer list folded to Leaflet's layers
+button and its legend folded to its heading: unfolded, the two covered the whole map of a
+390x844 phone, the candidates under them."""
 
 
 # ----------------------------------------------------------------------------- styling
@@ -218,6 +222,56 @@ var {{ this.get_name() }} = L.control({position: {{ this.position|tojson }}});
         self.css = css
 
 
+class _SmallScreenFolds(MacroElement):
+    """On a map narrower than :data:`SMALL_SCREEN_PX`: the layer list folded to its button
+    (a tap opens it, a tap on the map folds it) and the legend to its heading (a tap on it
+    unfolds or folds it)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+setTimeout(function () {  // after every control of the page is on the map
+    var map = {{ this._parent.get_name() }};
+    if (map.getSize().x >= {{ this.below }}) { return; }
+    var box = map.getContainer();
+    var layers = box.querySelector(".leaflet-control-layers");
+    if (layers) {
+        L.DomUtil.removeClass(layers, "leaflet-control-layers-expanded");
+        var button = layers.querySelector(".leaflet-control-layers-toggle");
+        if (button) {
+            button.title = "layers";
+            L.DomEvent.on(button, "click", function (e) {
+                L.DomEvent.preventDefault(e);
+                L.DomUtil.addClass(layers, "leaflet-control-layers-expanded");
+            });
+        }
+        map.on("click", function () {
+            L.DomUtil.removeClass(layers, "leaflet-control-layers-expanded");
+        });
+    }
+    var legend = box.querySelector(".camloc-legend");
+    if (legend) {
+        L.DomUtil.addClass(legend, "folded");
+        var head = legend.querySelector("h4");
+        if (head) {
+            head.title = "tap to show or hide the legend";
+            L.DomEvent.on(head, "click", function () {
+                var fold = !L.DomUtil.hasClass(legend, "folded");
+                (fold ? L.DomUtil.addClass : L.DomUtil.removeClass)(legend, "folded");
+            });
+        }
+    }
+}, 0);
+{% endmacro %}
+"""
+    )
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._name = "CamlocSmallScreen"
+        self.below = SMALL_SCREEN_PX
+
+
 class _Banner(MacroElement):
     """A box at the top centre of the map (over the tiles, under nothing)."""
 
@@ -267,6 +321,10 @@ _PAGE_CSS = """
   border-radius: 5px; box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif;
   color: #222; }
 .camloc-legend { max-width: 260px; }
+.camloc-summary-title { max-height: 40vh; overflow-y: auto; }
+.camloc-title { overflow-wrap: anywhere; }
+.camloc-title:not(.camloc-summary-title) { max-width: min(290px, calc(100vw - 80px)); }
+.camloc-more summary { cursor: pointer; color: #124; }
 .leaflet-control-layers-expanded { font: 12px/1.4 sans-serif; padding: 4px 8px; }
 .leaflet-container { font-family: sans-serif; }
 .camloc-legend h4, .camloc-title h4 { margin: 0 0 4px; font-size: 13px; }
@@ -303,6 +361,13 @@ _PAGE_CSS = """
   z-index: 1000; max-width: min(640px, calc(100% - 640px)); min-width: 320px;
   background: #fff8e1; border: 2px solid #b26a00; border-radius: 6px; padding: 7px 11px;
   box-shadow: 0 2px 7px rgba(0,0,0,0.45); font: 12.5px/1.4 sans-serif; color: #222; }
+.camloc-legend.folded { max-height: 1.45em; overflow: hidden; }
+@media (max-width: 719px) {
+  .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
+    width: calc(100% - 40px); }
+}
+.camloc-legend.folded h4 { cursor: pointer; }
+.camloc-legend.folded h4::after { content: " \\25B8"; font-weight: normal; color: #555; }
 .camloc-banner.folded .camloc-banner-body { display: none; }
 .camloc-banner.folded h4 { margin: 0; }
 .camloc-banner h4 { cursor: pointer; }
@@ -1092,6 +1157,7 @@ def build_candidates_map(
     fg_cands.add_to(fmap)
 
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _SmallScreenFolds().add_to(fmap)
     _Control(
         _legend_html(
             scene_id=result.scene_id,
@@ -1116,7 +1182,8 @@ def build_candidates_map(
     )
     title += _left_out_html(cal, collection)
     if not cands:
-        title += f"<br><b>no candidates</b>: {html.escape(str(result.reason))}"
+        why = str(result.reason or "").strip() or "the locate result gives no reason"
+        title += f"<br><b>no candidates</b>: {html.escape(why)}"
     _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
 
     pts = [[f["properties"]["lat"], f["properties"]["lon"]] for f in cands[:6]]
@@ -1366,30 +1433,57 @@ def _summary_tie(props: Mapping[str, Any], reason: str | None) -> str | None:
 _STATUS_PREFIX = re.compile(r"^([a-z][a-z_]*): ")
 
 
+MISSING_LABEL_CHARS = 60
+"""A camera's name in the summary's list of cameras not on the map is cut here (the whole
+name and reason on hover): one scraped title of 300 characters filled the heading box."""
+MISSING_LISTED = 500
+"""At most this many cameras not on the map are named on the page (the rest are counted; the
+GeoPackage's ``cameras`` layer has them all)."""
+
+
+def _missing_label(scene_id: Any, reason: Any) -> str:
+    m = _STATUS_PREFIX.match(str(reason or ""))
+    status = m.group(1) if m else None
+    name = " ".join(str(scene_id).split())
+    short = name if len(name) <= MISSING_LABEL_CHARS else name[: MISSING_LABEL_CHARS - 1] + "…"
+    hover = name + ": " + str(reason or "") if short != name else str(reason or "")
+    label = html.escape(short) + (f" ({status})" if status else "")
+    return f'<span title="{html.escape(hover)}">{label}</span>'
+
+
 def _missing_html(missing: Sequence[tuple[str, Any]], shown: int = 10) -> str:
     """The summary heading's line of cameras not on the map: counted by status (a batch
     camera's reason starts with it: ``scene_error: scene broken.json: ...``), each named with
     its status, the whole reason on hover. It listed bare names, so a broken scene, a title
-    not found and a camera without evidence read alike."""
+    not found and a camera without evidence read alike. The first ``shown`` are named in the
+    line, the others (up to :data:`MISSING_LISTED`) under a fold: they were left out ("…")."""
     statuses: dict[str, int] = {}
-    names = []
-    for scene_id, reason in missing[:shown]:
-        m = _STATUS_PREFIX.match(str(reason or ""))
-        status = m.group(1) if m else None
-        label = html.escape(str(scene_id)) + (f" ({status})" if status else "")
-        names.append(f'<span title="{html.escape(str(reason or ""))}">{label}</span>')
+    names = [_missing_label(scene_id, reason) for scene_id, reason in missing[:shown]]
     for _scene_id, reason in missing:
         m = _STATUS_PREFIX.match(str(reason or ""))
         if m:
             statuses[m.group(1)] = statuses.get(m.group(1), 0) + 1
     counted = ", ".join(f"{n} {st}" for st, n in sorted(statuses.items(), key=lambda kv: -kv[1]))
-    return (
+    text = (
         f"{len(missing)} without candidates"
         + (f" ({html.escape(counted)})" if counted else "")
         + ": "
         + ", ".join(names)
-        + (" …" if len(missing) > shown else "")
     )
+    rest = missing[shown:MISSING_LISTED]
+    if rest:
+        more = ", ".join(_missing_label(scene_id, reason) for scene_id, reason in rest)
+        unlisted = len(missing) - shown - len(rest)
+        tail = (
+            f", and {unlisted} more (the GeoPackage's cameras layer has them all)"
+            if unlisted
+            else ""
+        )
+        text += (
+            f'<details class="camloc-more"><summary>and {len(missing) - shown} more</summary>'
+            f"{more}{tail}</details>"
+        )
+    return text
 
 
 def build_summary_map(
@@ -1466,6 +1560,13 @@ def build_summary_map(
                 ("flags", html.escape(_fmt(list(p.get("flags") or [])))),
             )
         )
+        why = " ".join(str(reasons[i] or "").split())
+        if why:
+            # what placed the camera and what was wrong (a camloc batch camera: "junction of
+            # the map's model; list row: lat 'abc' is not a number", "...; 933 km from the
+            # point given"): the popup showed the numbers only
+            short = why if len(why) <= 300 else why[:299] + "…"
+            body += f"<tr><th>reason</th><td>{html.escape(short)}</td></tr>"
         note = ""
         if tie:
             note = (
@@ -1492,6 +1593,7 @@ def build_summary_map(
         ).add_to(parent)
     parent.add_to(fmap)
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
+    _SmallScreenFolds().add_to(fmap)
     _Control(
         _legend_html(
             scene_id=None,
@@ -1509,7 +1611,7 @@ def build_summary_map(
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
         title += _missing_html(missing)
-    _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
+    _Control(title, position="topleft", css_class="camloc-title camloc-summary-title").add_to(fmap)
     if len(rows) >= 2:
         fmap.fit_bounds(
             [[float(lats.min()), float(lons.min())], [float(lats.max()), float(lons.max())]],

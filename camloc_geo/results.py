@@ -743,8 +743,9 @@ def job_result_geojson(job_id: str, results: Iterable[dict[str, Any]]) -> dict[s
     """The result of a camera-list job as one GeoJSON FeatureCollection.
 
     Per camera (in list order) one ``camera`` feature (its status, reason and best position;
-    no geometry when it was not placed), then its ``candidate`` features, each carrying the
-    camera's id as ``camera_id``.
+    no geometry when it was not placed; ``row``, its row of the list from 1, when the results
+    give it), then its ``candidate`` features, each carrying the camera's id as ``camera_id``
+    and its row as ``camera_row`` (two rows of a list may share an id).
     """
     feats: list[dict[str, Any]] = []
     for r in results:
@@ -759,6 +760,8 @@ def job_result_geojson(job_id: str, results: Iterable[dict[str, Any]]) -> dict[s
         for c in r.get("candidates", []) or []:
             cp = dict(c["properties"])
             cp["camera_id"] = r.get("id")
+            if r.get("row") is not None:
+                cp["camera_row"] = r["row"]
             feats.append({"type": "Feature", "geometry": c["geometry"], "properties": cp})
     return {
         "type": "FeatureCollection",
@@ -769,6 +772,15 @@ def job_result_geojson(job_id: str, results: Iterable[dict[str, Any]]) -> dict[s
 
 JOB_LAYERS = (("cameras", "camera"), ("candidates", "candidate"))
 """GeoPackage layers of a job result: ``(layer name, feature kind)``."""
+
+
+_NUMERIC_NAMES = frozenset({"lat", "lon", "score", "rank", "row", "camera_row", "scale"})
+
+
+def _numeric_name(name: str) -> bool:
+    """Whether a job result's property is a number by its name (``heading_deg``, ``height_m``,
+    ``focal_px``, ``score``...)."""
+    return name in _NUMERIC_NAMES or name.endswith(("_deg", "_m", "_px"))
 
 
 def job_result_geopackage(collection: dict[str, Any]) -> bytes:
@@ -819,6 +831,11 @@ def job_result_geopackage(collection: dict[str, Any]) -> bytes:
                 geometry=[shape(f["geometry"]) if f["geometry"] else None for f in feats],
                 crs="EPSG:4326",
             )
+            for col in frame.columns:
+                # a numeric column null in every row (no camera of the job has a heading
+                # yet) was written as a String field, which QGIS then styles and sorts as text
+                if col != "geometry" and _numeric_name(str(col)) and frame[col].isna().all():
+                    frame[col] = frame[col].astype("float64")
             # GeoPackage 1.2, as QGIS 3.22's GDAL 3.6 reads without a warning (1.4 is
             # pyogrio's default; camloc_geo.batch writes 1.2 for the same reason)
             frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio", **options)

@@ -587,3 +587,123 @@ def test_overlapping_extracts_place_a_title_without_point(tmp_path: Path) -> Non
     assert miss.status == "not_found"
     assert "Qzxwv" in (miss.reason or "")
     assert "Aleksi" not in (miss.reason or "")
+
+
+def test_sigterm_stops_batch_and_its_workers(tmp_path: Path) -> None:
+    """``kill``/``timeout``/``docker stop`` send SIGTERM: Python's default ended camloc batch
+    at once and left its worker processes running, orphaned, for ever (seen on the sweep's
+    webcam list: two workers alive 10 minutes later). SIGTERM now stops the run as Ctrl-C
+    does: exit 143, one line saying the finished cameras are kept, the workers stopped."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\n1,Eastern Ave & S Broadway\n", encoding="utf-8")
+    code = (
+        "import os, signal, sys, time\n"
+        "import camloc_geo.batch\n"
+        "def run_batch(*a, **k):\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)\n"
+        "    time.sleep(30)\n"
+        "camloc_geo.batch.run_batch = run_batch\n"
+        "from camloc_geo.cli import main\n"
+        f"sys.exit(main(['batch', {str(lst)!r}, '-o', {str(tmp_path / 'o.gpkg')!r}]))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert proc.returncode == 143, proc.stderr
+    assert "camloc batch: stopped; the cameras finished are kept in" in proc.stderr
+    assert "o.camloc-batch.sqlite" in proc.stderr
+    assert "terminated (SIGTERM)" in proc.stderr
+
+
+def _sleep_in_worker(seconds: float) -> int:
+    import time as _time
+
+    _time.sleep(seconds)
+    return os.getpid()
+
+
+def test_interrupted_runner_stops_its_workers() -> None:
+    """A cancelled local runner (Ctrl-C, SIGTERM) stops workers busy with a chunk instead of
+    leaving them to finish it (the interpreter's exit joined them: tens of seconds)."""
+    from camloc_geo.batch._run import _LocalRunner
+
+    runner = _LocalRunner(2)
+    futures = {runner.submit(_sleep_in_worker, 120.0) for _ in range(2)}
+    processes = list(runner.ex._processes.values())  # type: ignore[attr-defined]
+    assert len(processes) == 2
+    runner.close(cancel=True)
+    for proc in processes:
+        proc.join(timeout=30)
+        assert not proc.is_alive()
+    assert len(futures) == 2
+
+
+def test_scheduler_address_as_the_cli_gives_it(tmp_path: Path) -> None:
+    """camloc batch --scheduler tcp://HOST:PORT failed on its first wait ('failed:
+    ValueError: No clients found ...', exit 1): the client it makes for the address is not
+    the default one, which distributed.wait asks for. Only a Client object (the library's
+    other way, and the only one tested) worked."""
+    from distributed import LocalCluster
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text(
+        "id,title\n1,Unioninkatu & Kaisaniemenkatu\n2,Mikonkatu / Yliopistonkatu\n",
+        encoding="utf-8",
+    )
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "helsinki.osm.pbf").symlink_to(HELSINKI)
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+    ) as lc:
+        summary = run_batch(
+            lst,
+            out_gpkg=tmp_path / "o.gpkg",
+            map_source=osm,
+            scheduler=lc.scheduler_address,
+            progress=False,
+        )
+    assert summary.statuses == {"title_only": 2}
+
+
+def test_interrupted_dask_run_cancels_its_chunks() -> None:
+    """Ctrl-C or SIGTERM during a --scheduler run left its submitted chunks computing on the
+    cluster for nobody; a cancelled runner now cancels them."""
+    from distributed import Client, LocalCluster
+
+    from camloc_geo.batch._run import _DaskRunner
+
+    with (
+        LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=":0"
+        ) as lc,
+        Client(lc) as client,
+    ):
+        runner = _DaskRunner(client)
+        futures = [runner.submit(_sleep_in_worker, 3.0) for _ in range(3)]
+        runner.close(cancel=True)
+        for fut in futures:
+            assert fut.status == "cancelled"
+
+
+def test_point_just_outside_an_extract_is_placed_by_its_title(tmp_path: Path) -> None:
+    """A camera whose rough point lies 69 m past the edge of a city's extract was no_map
+    ('is outside every extract') although the junction its title names is in the extract,
+    within the point's search radius; it is now placed there, the reason saying so. A point
+    far from every extract, or a title the edge extract lacks, stays no_map."""
+    osm = tmp_path / "osm"
+    osm.mkdir()
+    (osm / "bristol.osm.pbf").symlink_to(REPO / "data" / "osm" / "bristol_whitelion.osm.pbf")
+
+    def camera(lat: float, lon: float, title: str) -> Any:
+        return geocode_camera(
+            CameraRow(row=1, id="e", title=title, lat=lat, lon=lon), map_source=osm
+        )
+
+    edge = camera(51.45679, -2.59555, "Bell Lane & Small Street")
+    assert edge.status == "title_only"
+    assert abs(edge.lat - 51.45529) < 1e-4
+    assert "the list's point lies 69 m outside bristol.osm.pbf" in (edge.reason or "")
+    assert camera(51.4600, -2.5800, "Bell Lane & Small Street").status == "no_map"
+    assert camera(51.45679, -2.59555, "Qzxwv Street & Frobnitz Road").status == "no_map"

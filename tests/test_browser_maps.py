@@ -306,3 +306,69 @@ def test_tie_banner_hides_no_tied_candidate_on_a_small_screen(
         assert t.errors == []
     finally:
         t.close()
+
+
+def test_phone_sees_the_candidates_not_the_controls(browser: Any, pages: dict[str, Any]) -> None:
+    """On a 390x844 phone the review page's layer list (12 lines, always open) and its
+    legend (20 lines) covered the map: candidates 1, 3 and most others were under them
+    (Chromium screenshot of camloc locate --map on the sample scene). Below 720 px the
+    layer list opens folded to Leaflet's layers button, the legend to its heading, the tie
+    banner sits at the bottom; each opens on a tap."""
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 390, "height": 844})
+        t.open(pages["tied"], ".camloc-candidate")
+        page = t.page
+        page.wait_for_selector(".camloc-legend.folded", timeout=5000)
+        layers = page.locator(".leaflet-control-layers")
+        assert "leaflet-control-layers-expanded" not in (layers.get_attribute("class") or "")
+        legend = _box(page, ".camloc-legend")
+        assert legend["height"] < 40
+        covers = [_box(page, ".camloc-legend"), _box(page, ".leaflet-control-layers")]
+        covers.append(_box(page, ".camloc-banner"))
+        for rank in (1, 2, 3, 4):
+            box = _box(page, f'.camloc-candidate [data-rank="{rank}"]')
+            assert not any(_overlap(box, c) for c in covers), rank
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "tied_map_phone.png"))
+        page.locator(".leaflet-control-layers-toggle").click()
+        assert "leaflet-control-layers-expanded" in (layers.get_attribute("class") or "")
+        assert page.get_by_text("Buildings").is_visible()
+        page.locator(".camloc-legend h4").click()
+        assert _box(page, ".camloc-legend")["height"] > 200
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
+
+
+def test_long_scene_id_wraps_beside_the_banner(
+    browser: Any, pages: dict[str, Any], tmp_path: Path
+) -> None:
+    """A scene id of 270 characters with HTML in it (a scraped webcam title, through
+    POST /v1/maps): escaped, but one unbroken line across the whole page, under the tie
+    banner and the layer list (Chromium at 1280x800). The title box now wraps at 290 px,
+    beside the banner."""
+    long_id = "<img src=x onerror=alert(1)> Cam 3 - Main St / 5th Ave " + "x" * 200
+    from camloc_geo.api import locate_scene
+
+    samples = Path(__file__).resolve().parents[1] / "sample_maps"
+    tie = locate_scene(samples / "sample_scene.json", map_source=samples / "baltimore.osm.pbf")
+    tie.result.scene_id = long_id
+    page_path = maps.candidates_map(
+        tie.result, tie.map_data, tmp_path / "long.html", offline=True, scene=tie.scene
+    )
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 1280, "height": 800})
+        t.open(page_path, ".camloc-candidate")
+        page = t.page
+        title = _box(page, ".camloc-title")
+        assert title["width"] <= 320
+        assert not _overlap(title, _box(page, ".camloc-banner"))
+        assert "onerror=alert(1)" in page.locator(".camloc-title").inner_text()
+        assert page.locator(".camloc-title img").count() == 0
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()

@@ -398,3 +398,21 @@ def test_an_unknown_option_gets_the_command_s_own_usage(
     err = capsys.readouterr().err
     assert err.startswith("usage: camloc calibrate ")
     assert "camloc calibrate: error: unrecognized arguments: --frobnicate" in err
+
+
+def test_summary_map_names_apart_two_outputs_of_one_scene(tmp_path: Path) -> None:
+    """Two locate outputs of one scene id (a rerun, an edited scene) were two markers, two
+    tooltips and two popups saying 'cam' (Chromium): a reviewer could not tell which file
+    each was. A shared id is now followed by the file's name; a unique id is left alone."""
+    run1 = tmp_path / "run1.geojson"
+    run1.write_text(json.dumps(_collection([_candidate(39.2851, -76.5934)], "cam")))
+    run2 = tmp_path / "run2.geojson"
+    run2.write_text(json.dumps(_collection([_candidate(39.2855, -76.5931)], "cam")))
+    other = tmp_path / "other.geojson"
+    other.write_text(json.dumps(_collection([_candidate(39.2858, -76.5938)], "cam-7")))
+    out = tmp_path / "s.html"
+    assert main(["summary-map", str(run1), str(run2), str(other), "-o", str(out), "--inline"]) == 0
+    page = out.read_text(encoding="utf-8")
+    assert "cam (run1.geojson)" in page
+    assert "cam (run2.geojson)" in page
+    assert "cam-7 (other.geojson)" not in page

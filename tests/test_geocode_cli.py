@@ -397,3 +397,46 @@ def test_cli_list_read_as_batch_reads_it(tmp_path: Path) -> None:
         ("g1", 1, "junction"),
         (None, 2, "street"),
     ]
+
+
+def test_a_match_far_from_the_list_point_says_so(tmp_path: Path) -> None:
+    """A list row with a London point and a Berlin title: placed in Berlin (junction, score
+    1) without a word, 933 km from the point the list gave; the reason now says how far."""
+    rows = tmp_path / "far.csv"
+    rows.write_text(
+        "id,title,lat,lon\n"
+        "far,Grunerstr. x Alexanderstr.,51.5154,-0.1419\n"
+        "near,Grunerstr. x Alexanderstr.,52.5205,13.4150\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out.geojson"
+    args = ["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]
+    assert main(args) == 0
+    props = [f["properties"] for f in json.loads(out.read_text())["features"]]
+    assert props[0]["status"] == "junction"
+    assert "; 933 km from the point given (51.51540,-0.14190)" in props[0]["reason"]
+    assert "from the point given" not in props[1]["reason"]
+
+
+def test_cli_list_names_a_bad_point(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A row whose point is unusable ('abc', one of the two, out of range) lost its point
+    without a word and its title was searched everywhere; stderr now names the row."""
+    rows = tmp_path / "bad.csv"
+    rows.write_text(
+        "id,title,lat,lon\n"
+        "a,Grunerstr. x Alexanderstr.,abc,13.4\n"
+        "b,Grunerstr. x Alexanderstr.,52.52,\n"
+        "c,Grunerstr. x Alexanderstr.,952.52,13.4\n"
+        "d,Grunerstr. x Alexanderstr.,,\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "out.geojson"
+    args = ["geocode", "--list", str(rows), "--osm", str(BERLIN), "--best", "-o", str(out)]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "row 2: lat 'abc' is not a number; searched without a point" in err
+    assert "row 3: give both lat and lon, or neither" in err
+    assert "row 4: lat/lon 952.52,13.4 is out of range" in err
+    assert "row 5" not in err
+    props = [f["properties"] for f in json.loads(out.read_text())["features"]]
+    assert [p["status"] for p in props] == ["junction"] * 4

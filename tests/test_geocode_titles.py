@@ -95,6 +95,8 @@ def baltimore():  # type: ignore[no-untyped-def]
             None,
             0.0,
         ),
+        ("Rauhankatu & Unioninkatu (itään)", ["Rauhankatu", "Unioninkatu"], None, None, 90.0),
+        ("南京西路 @ 中山北路一段 (北向)", ["南京西路", "中山北路一段"], None, None, 0.0),
         (
             "<script>alert(1)</script><b>E Monument St</b> &amp; N Lakewood Ave",
             ["E Monument St", "N Lakewood Ave"],

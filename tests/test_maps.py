@@ -626,3 +626,76 @@ def test_summary_map_says_why_cameras_are_not_on_it(tmp_path: Path) -> None:
     assert "c1 Eastern (scene_error)\\u003c/span\\u003e" in page
     assert "c6 Nowhere (not_found)" in page
     assert "scene broken.json: image.height: required" in page
+
+
+def test_summary_map_names_every_camera_not_on_it_briefly(tmp_path: Path) -> None:
+    """The sweep's 40-webcam list: 12 cameras without a point, of which the page named 10 and
+    an ellipsis (two cameras nowhere on the page), and one scraped title of 300 characters
+    filled the heading box (a third of a phone's screen). Names are now cut at 60 characters
+    (the whole name and reason on hover) and the cameras past the first 10 are under a fold."""
+
+    def empty(reason: str) -> dict[str, Any]:
+        return {"type": "FeatureCollection", "features": [], "properties": {"reason": reason}}
+
+    long_title = "html-01 <b>Cam</b> & E Monument St " + "very long description " * 12
+    items = [(long_title, empty("not_found: 'Cam' is not a street name of this map"))]
+    items += [(f"c{k} Nowhere St", empty("not_found: no such street")) for k in range(11)]
+    page = maps.summary_map(items, tmp_path / "s.html", offline=True).read_text(encoding="utf-8")
+    assert "12 without candidates (12 not_found): " in page
+    label = maps._missing_label(long_title, "not_found: x")
+    shown = label.split(">", 1)[1].rsplit("<", 1)[0]
+    assert shown.endswith("description ve\u2026 (not_found)")
+    assert len(shown) < 90
+    assert "\\u003cb\\u003e" not in page.split("without candidates")[1][:400]
+    assert "and 2 more\\u003c/summary\\u003e" in page
+    assert "c9 Nowhere St (not_found)" in page
+    assert "c10 Nowhere St (not_found)" in page
+    assert "camloc-summary-title" in page
+
+
+def test_review_map_without_candidates_never_says_none(tmp_path: Path) -> None:
+    """A result without candidates and without a reason (one read back from a file) gave
+    the title 'no candidates: None'."""
+    import copy
+
+    md = fremantle_map()
+    scene, res = located(md, 0)
+    empty = copy.copy(res)
+    empty.candidates = []
+    empty.reason = None
+    page = maps.candidates_map(empty, md, tmp_path / "e.html", offline=True, scene=scene)
+    text = page.read_text(encoding="utf-8")
+    assert "no candidates\\u003c/b\\u003e: the locate result gives no reason" in text
+    assert "\\u003c/b\\u003e: None" not in text
+
+
+def test_summary_popup_shows_the_camera_reason(tmp_path: Path) -> None:
+    """A camloc batch camera placed at its title's junction despite a bad list row
+    ("junction of the map's model; list row: lat 'abc' is not a number") showed score,
+    method and sigma in its popup but not that warning: the reason is now a popup row."""
+    item = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [13.415, 52.5208]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": 1,
+                    "lat": 52.5208,
+                    "lon": 13.415,
+                    "score": 1.0,
+                    "method": "title (title_only)",
+                },
+            }
+        ],
+        "properties": {
+            "reason": "junction of the map's model; list row: lat 'abc' is not a number"
+        },
+    }
+    page = maps.summary_map([("badlat <i>x</i>", item)], tmp_path / "s.html", offline=True)
+    text = page.read_text(encoding="utf-8")
+    assert (
+        "<tr><th>reason</th><td>junction of the map&#x27;s model; list row: lat &#x27;abc&#x27;"
+        " is not a number</td></tr>" in text
+    )

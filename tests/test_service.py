@@ -311,6 +311,17 @@ def test_job_from_csv(client: httpx.Client) -> None:
         "geocoded and kept (rows tell them apart), but anything joining on id will mix them "
         "up: give each camera its own id"
     ]
+    # ... and the result does tell them apart: each camera feature has its row, each
+    # candidate its camera's (the warning said so, but no feature had a row: the two c1
+    # cameras and their candidates could not be told apart; found through httpx on a
+    # real camloc serve with the sweep's 40-webcam list)
+    job_id = r.json()["id"]
+    _wait_job(client, job_id, 2)
+    feats = client.get(f"/v1/jobs/{job_id}/result").json()["features"]
+    cams = [f["properties"] for f in feats if f["properties"]["kind"] == "camera"]
+    assert [(c["id"], c["row"]) for c in cams] == [("c1", 1), ("c1", 2)]
+    cands = [f["properties"] for f in feats if f["properties"]["kind"] == "candidate"]
+    assert sorted({c["camera_row"] for c in cands}) == [1, 2]
 
 
 def test_job_survives_server_kill(tmp_path: Path) -> None:

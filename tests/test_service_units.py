@@ -685,3 +685,35 @@ def test_job_geopackage_of_a_job_with_nothing_done_is_a_geopackage(tmp_path: Pat
     layers = dict(pyogrio.list_layers(empty))
     assert layers == {"cameras": "Point", "candidates": "Point"}
     assert len(pyogrio.read_dataframe(empty, layer="cameras")) == 0
+
+
+def test_job_geopackage_types_null_numbers_as_numbers(tmp_path: Path) -> None:
+    """A job of title-only cameras has no heading or height anywhere: heading_deg and
+    height_m were String fields of the GeoPackage (ogrinfo: 'heading_deg (String) =
+    (null)'), so QGIS sorted and styled them as text; they are Real now."""
+    import pyogrio
+
+    from camloc_geo.results import job_result_geojson, job_result_geopackage
+
+    gj = job_result_geojson(
+        "j1",
+        [
+            {
+                "id": "a",
+                "row": 1,
+                "status": "title_only",
+                "lat": 2.0,
+                "lon": 1.0,
+                "heading_deg": None,
+                "height_m": None,
+                "reason": "junction",
+            },
+        ],
+    )
+    path = tmp_path / "job.gpkg"
+    path.write_bytes(job_result_geopackage(gj))
+    info = pyogrio.read_info(path, layer="cameras")
+    types = dict(zip(info["fields"], info["dtypes"], strict=True))
+    assert types["heading_deg"] == "float64"
+    assert types["height_m"] == "float64"
+    assert types["reason"] == "object"

@@ -204,7 +204,19 @@ def _local_executor(workers: int) -> Executor:
         method = "fork" if "fork" in methods and threading.active_count() == 1 else "spawn"
         if method != "fork" and "forkserver" in methods:
             method = "forkserver"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context(method),
+        initializer=_worker_signals,
+    )
+
+
+def _worker_signals() -> None:
+    """A worker ends on SIGTERM (a forked worker inherited the CLI's handler, which turns
+    SIGTERM into an exception that the pool's task loop catches: the worker lived on)."""
+    import signal
+
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 class _DaskRunner:
@@ -217,17 +229,38 @@ class _DaskRunner:
         else:
             self.client = scheduler
             self.own = False
+        self.pending: set[Any] = set()
+        self._lock = threading.Lock()  # done callbacks come from the client's thread
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Any:
-        return self.client.submit(fn, *args, pure=False)
+        fut = self.client.submit(fn, *args, pure=False)
+        with self._lock:
+            self.pending.add(fut)
+        fut.add_done_callback(self._forget)
+        return fut
+
+    def _forget(self, fut: Any) -> None:
+        with self._lock:
+            self.pending.discard(fut)
 
     def wait_one(self, futures: set[Any]) -> set[Any]:
         from distributed import wait
 
-        done, _ = wait(list(futures), return_when="FIRST_COMPLETED")
+        # distributed.wait asks for the default client, and the client camloc batch makes
+        # for --scheduler is not the default (set_as_default=False): 'ValueError: No
+        # clients found' on the first wait; as_current makes it the one asked for
+        with self.client.as_current():
+            done, _ = wait(list(futures), return_when="FIRST_COMPLETED")
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
+        with self._lock:
+            pending = list(self.pending)
+            self.pending.clear()
+        if cancel and pending:
+            # an interruption: the chunks still queued or running on the cluster are
+            # cancelled (they went on computing for nobody, on a cluster shared with others)
+            self.client.cancel(pending)
         if self.own:
             self.client.close()
 
@@ -244,7 +277,23 @@ class _LocalRunner:
         return set(done)
 
     def close(self, cancel: bool = False) -> None:
+        if cancel:
+            # an interruption (Ctrl-C, SIGTERM): the workers' running chunks are not waited
+            # for (a chunk searching every extract takes tens of seconds; the interpreter's
+            # exit joined them, and a SIGTERM left them orphaned); what is not in the
+            # journal is computed again by the rerun
+            self._stop_workers()
         self.ex.shutdown(wait=not cancel, cancel_futures=cancel)
+
+    def _stop_workers(self) -> None:
+        stop = getattr(self.ex, "terminate_workers", None)  # Python >= 3.14
+        if stop is not None:
+            stop()
+            return
+        processes = getattr(self.ex, "_processes", None) or {}
+        for proc in list(processes.values()):
+            if proc.is_alive():
+                proc.terminate()
 
 
 class _Counted:

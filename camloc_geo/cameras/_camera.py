@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Any
 
 from camloc_geo._errors import (
     DegenerateGeometryError,
+    InputError,
     MapDataError,
     MapSourceError,
     NotEnoughStructureError,
@@ -685,6 +686,11 @@ def _geocode(
         if row.has_scene and not (row.title or row.streets):
             # a scene with references may not need a map at all
             return _with_map(row, res, None)
+        edge = _edge_extract(plan, row)
+        if edge is not None:
+            near_res = _at_the_edge(row, res, plan, *edge)
+            if near_res is not None:
+                return near_res
         return res.fail("no_map", str(area[1]), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
@@ -696,6 +702,66 @@ def _geocode(
         return res.fail("map_error", str(exc), "map")
     name = "overpass" if kind == "net" else os.path.basename(str(area[1]))
     return _with_map(row, res, m, extract=name)
+
+
+def _edge_extract(plan: MapPlan, row: CameraRow) -> tuple[str, float, float, float] | None:
+    """For a titled camera whose point no extract contains: the extract whose bounds come
+    nearest its point within the title's search radius, as ``(path, distance_m, lat, lon)``
+    (the point of the bounds nearest the camera's); None when there is none."""
+    if row.lat is None or row.lon is None or not (row.title or row.streets):
+        return None
+    files = [
+        f
+        for f in getattr(plan, "files", ()) or ()
+        if not row.area or row.area.lower() in os.path.basename(f).lower()
+    ]
+    if not files:
+        return None
+    from camloc_geo.geodesy import great_circle_m
+    from camloc_geo.osm import extract_bounds
+
+    radius = (row.radius_m or 150.0) + 150.0  # as _title_matches searches
+    best: tuple[str, float, float, float] | None = None
+    for f in files:
+        try:
+            s, w, n, e = extract_bounds(f)
+        except (MapDataError, OSError):
+            continue
+        lat, lon = min(max(row.lat, s), n), min(max(row.lon, w), e)
+        d = great_circle_m(lat1=row.lat, lon1=row.lon, lat2=lat, lon2=lon)
+        if d <= radius and (best is None or d < best[1]):
+            best = (f, d, lat, lon)
+    return best
+
+
+def _at_the_edge(
+    row: CameraRow,
+    res: CameraResult,
+    plan: MapPlan,
+    path: str,
+    dist_m: float,
+    lat: float,
+    lon: float,
+) -> CameraResult | None:
+    """The camera placed by its title on an extract its point lies just outside of (a
+    rough point past the edge of a city's extract was 'no_map' although the junction its
+    title names is in the extract, within the point's radius); None when not placed."""
+    from camloc_geo.osm import area_map
+
+    try:
+        m = area_map(plan.area_for_point(lat, lon, name=row.area))
+    except (MapDataError, MapSourceError, InputError):
+        return None
+    import copy
+
+    placed = _with_map(row, copy.deepcopy(res), m, extract=os.path.basename(path))
+    if placed.status not in PLACED_STATUSES:
+        return None
+    placed.reason = (placed.reason or "") + (
+        f"; the list's point lies {dist_m:.0f} m outside {os.path.basename(path)}: placed at"
+        " what its title names there"
+    )
+    return placed
 
 
 _PLANS: OrderedDict[tuple[str, bool, int, int], MapPlan] = OrderedDict()

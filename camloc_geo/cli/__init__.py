@@ -287,12 +287,34 @@ def _fast_exit(argv: Sequence[str] | None) -> None:
         gc.freeze()
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, ``timeout``, ``docker stop``, a scheduler's limit) during a command.
+
+    A :class:`KeyboardInterrupt`, so that every clean-up an interruption gets (``camloc
+    batch`` stopping its worker processes, atomic outputs left as they were) runs for it too:
+    Python's default for SIGTERM ends the process at once, and ``camloc batch``'s workers
+    were left running, orphaned, for ever.
+    """
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise Terminated()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     _one_shot_gc(argv)
+    import signal
+    import threading
+
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         return _main(argv)
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         _fast_exit(argv)
 
 
@@ -318,7 +340,10 @@ def _main(argv: Sequence[str] | None) -> int:
             raise
         sys.stderr.write(f"camloc {args.command}: error: {_one_line(exc)}\n")
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        if isinstance(exc, Terminated):
+            sys.stderr.write("camloc: terminated (SIGTERM)\n")
+            return 143
         sys.stderr.write("camloc: interrupted\n")
         return 130
     except BrokenPipeError as exc:

@@ -85,20 +85,30 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--workers must be at least 1")
     if args.scheduler is not None and not args.scheduler.strip():
         raise InputError("--scheduler needs an address such as tcp://HOST:8786")
-    summary = run_batch(
-        args.list,
-        out_gpkg=args.output,
-        map_source=args.osm,
-        network=args.network,
-        scheduler=args.scheduler,
-        summary_map=args.map,
-        progress=not args.no_progress and sys.stderr.isatty(),
-        workers=args.workers,
-        area=args.area,
-        chunk_size=args.chunk_size,
-        restart=args.restart,
-        offline_map=not args.online_map,
-    )
+    try:
+        summary = run_batch(
+            args.list,
+            out_gpkg=args.output,
+            map_source=args.osm,
+            network=args.network,
+            scheduler=args.scheduler,
+            summary_map=args.map,
+            progress=not args.no_progress and sys.stderr.isatty(),
+            workers=args.workers,
+            area=args.area,
+            chunk_size=args.chunk_size,
+            restart=args.restart,
+            offline_map=not args.online_map,
+        )
+    except KeyboardInterrupt:
+        from camloc_geo.batch import journal_path
+
+        if out is not None:
+            sys.stderr.write(
+                "camloc batch: stopped; the cameras finished are kept in "
+                f"{journal_path(out)}: run the same command again to continue\n"
+            )
+        raise
     for line in summary.warnings:
         sys.stderr.write(f"camloc batch: warning: {line}\n")
     counts = ", ".join(f"{n} {s}" for s, n in sorted(summary.statuses.items()))

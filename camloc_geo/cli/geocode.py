@@ -58,10 +58,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--list",
         metavar="LIST.csv",
-        help=(
-            "CSV (any of , ; tab |) or GeoJSON list of titles"
-            " (column title or name; optional id, lat, lon), streamed"
-        ),
+        help="CSV (any of , ; tab |) or GeoJSON list of titles (column title or name; "
+        "optional id, lat, lon), streamed",
     )
     parser.add_argument("--best", action="store_true", help="only the best match per title")
     parser.add_argument("-o", "--output", metavar="OUT.geojson", help="output file (stdout)")
@@ -161,6 +159,9 @@ def _geojson_rows(
         if first is None:
             return
         for cam in itertools.chain([first], cameras):
+            for problem in cam.problems:
+                if "title column" not in problem:
+                    sys.stderr.write(f"camloc geocode: feature {cam.row}: {problem}\n")
             point = None
             lat, lon = cam.lat, cam.lon
             if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
@@ -206,14 +207,34 @@ def _data_rows(
             ident = row[idx[id_col]] if id_col is not None and idx[id_col] < len(row) else None
             point = None
             if lat_col is not None and lon_col is not None:
-                try:
-                    lat = _coordinate(row[idx[lat_col]])
-                    lon = _coordinate(row[idx[lon_col]])
-                    if -90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0:
-                        point = (lat, lon)
-                except (ValueError, IndexError):
-                    point = None
+                cells = [row[idx[c]] if idx[c] < len(row) else "" for c in (lat_col, lon_col)]
+                point, problem = _point_of(cells[0], cells[1])
+                if problem:
+                    # a bad point was dropped without a word and the title searched
+                    # everywhere (camloc batch names it in the camera's reason)
+                    sys.stderr.write(
+                        f"camloc geocode: row {row_no}: {problem}; searched without a point\n"
+                    )
             yield row_no, ident, title, point
+
+
+def _point_of(lat_text: str, lon_text: str) -> tuple[tuple[float, float] | None, str | None]:
+    """A row's point and what is wrong with it (None, None: no point given)."""
+    if not lat_text.strip() and not lon_text.strip():
+        return None, None
+    if not lat_text.strip() or not lon_text.strip():
+        return None, "give both lat and lon, or neither"
+    try:
+        lat = _coordinate(lat_text)
+    except ValueError:
+        return None, f"lat {lat_text.strip()[:40]!r} is not a number"
+    try:
+        lon = _coordinate(lon_text)
+    except ValueError:
+        return None, f"lon {lon_text.strip()[:40]!r} is not a number"
+    if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0):
+        return None, f"lat/lon {lat:g},{lon:g} is out of range"
+    return (lat, lon), None
 
 
 @contextmanager

@@ -114,7 +114,9 @@ def run(args: argparse.Namespace) -> int:
         clean_candidates(p, read_json_file(p, what="GeoJSON file (camloc locate output)"))
         for p in args.inputs
     ]
-    items = [(scene_id, gj) for scene_id, gj, _n in cleaned]
+    items = _named_apart(
+        [(scene_id, gj) for scene_id, gj, _n in cleaned], [Path(p).name for p in args.inputs]
+    )
     best = [_best_lat_lon(gj) for _s, gj in items]
     pts = [p for p in best if p is not None]
     if not pts and any(n > 0 for _s, _g, n in cleaned):
@@ -135,6 +137,21 @@ def run(args: argparse.Namespace) -> int:
             map_data=map_data,
         )
     return 0
+
+
+def _named_apart(
+    items: list[tuple[str, dict[str, Any]]], files: list[str]
+) -> list[tuple[str, dict[str, Any]]]:
+    """The cameras, a scene id that several inputs share followed by each one's file name
+    ("cam-3 (run2.geojson)"): two outputs of one scene (a rerun, an edited scene) were two
+    markers and popups under one name, which the reviewer could not tell apart."""
+    from collections import Counter
+
+    seen = Counter(scene_id for scene_id, _gj in items)
+    return [
+        ((f"{scene_id} ({name})" if seen[scene_id] > 1 else scene_id), gj)
+        for (scene_id, gj), name in zip(items, files, strict=True)
+    ]
 
 
 def _best_lat_lon(gj: dict[str, Any]) -> tuple[float, float] | None:

@@ -105,8 +105,11 @@ def geocode_title_in_maps(
 ) -> list[TitleMatch]:
     """Geocode a title in several maps (the extracts of a folder).
 
-    With ``near``, only the maps containing it are searched. A title placed in two or more
-    maps is ``ambiguous``: the best match of each is returned, marked so.
+    With ``near``, only the maps containing it are searched (all of them when none does). A
+    title placed in two or more maps at different places is ``ambiguous``: the best match of
+    each is returned, marked so. With ``near`` and no ``radius_m``, a match farther than
+    :data:`FAR_FROM_POINT_M` from it says so in its reason (a point in London and a Baltimore
+    title were placed in Baltimore, 6,000 km away, without a word).
 
     Returns
     -------
@@ -120,6 +123,33 @@ def geocode_title_in_maps(
         No maps, ``maps`` not a list of :class:`~camloc_geo.osm.MapData`, or ``area`` a
         named place of none of them.
     """
+    found = _in_maps(title, maps, near=near, radius_m=radius_m, area=area)
+    if near is not None:
+        for m in found:
+            if m.lat is None or m.lon is None:
+                continue
+            d = great_circle_m(lat1=near[0], lon1=near[1], lat2=m.lat, lon2=m.lon)
+            if d > FAR_FROM_POINT_M:
+                far = f"{d / 1000:,.1f} km" if d < 100_000 else f"{d / 1000:,.0f} km"
+                m.reason += (
+                    f"; {far} from the point given ({near[0]:.5f},{near[1]:.5f}): is it this "
+                    "camera's point?"
+                )
+    return found
+
+
+FAR_FROM_POINT_M = 1000.0
+"""A match this far from the point it was searched near says so in its reason."""
+
+
+def _in_maps(
+    title: str,
+    maps: Sequence[MapData],
+    *,
+    near: tuple[float, float] | None,
+    radius_m: float | None,
+    area: str | None,
+) -> list[TitleMatch]:
     if isinstance(maps, (str, bytes, os.PathLike)) or not hasattr(maps, "__iter__"):
         raise MapDataError(
             f"maps must be a list of MapData (whole_map(path) for each), not {type(maps).__name__}"

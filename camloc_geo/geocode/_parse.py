@@ -79,6 +79,20 @@ _WORDS: dict[str, str] = {
     "suden": "s",
     "osten": "e",
     "westen": "w",
+    # Finnish (read after anyascii: pohjoiseen, etelään, itään, länteen)
+    "pohjoinen": "n",
+    "pohjoiseen": "n",
+    "etela": "s",
+    "etelaan": "s",
+    "ita": "e",
+    "itaan": "e",
+    "lansi": "w",
+    "lanteen": "w",
+    # Chinese (北向, 南向, 東向/东向, 西向: "facing north"...)
+    "beixiang": "n",
+    "nanxiang": "s",
+    "dongxiang": "e",
+    "xixiang": "w",
 }
 _BOUND = {"nb": "n", "sb": "s", "eb": "e", "wb": "w"}
 _CUES = (

@@ -163,15 +163,20 @@ class Store:
     def job_results(self, job_id: str) -> list[dict[str, Any]]:
         """The finished cameras' results, in list order."""
         rows = self._db().execute(
-            "SELECT result FROM job_cameras WHERE job_id = ? AND state = 'done' ORDER BY idx",
+            "SELECT idx, result FROM job_cameras WHERE job_id = ? AND state = 'done' ORDER BY idx",
             (job_id,),
         )
         from camloc_geo.cameras import normalize_status
 
-        out = [json.loads(r["result"]) for r in rows]
-        for r in out:  # results stored by an older server: its status words
-            if isinstance(r, dict) and isinstance(r.get("status"), str):
-                r["status"] = normalize_status(r["status"])
+        out = []
+        for rec in rows:
+            r = json.loads(rec["result"])
+            if isinstance(r, dict):
+                # the camera's row of the list (from 1): it tells apart cameras sharing an id
+                r.setdefault("row", int(rec["idx"]) + 1)
+                if isinstance(r.get("status"), str):  # stored by an older server: its words
+                    r["status"] = normalize_status(r["status"])
+            out.append(r)
         return out
 
     # --- crowd tasks ---------------------------------------------------------------------
