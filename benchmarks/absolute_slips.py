@@ -23,6 +23,9 @@ annotation page make them:
     named pair meets at a neighbouring junction), no lat/lon;
 ``intersection_latlon_off``
     the intersection's lat/lon 50-150 m off;
+``control_streets``
+    no slip: the intersection named by two of its own streets, no lat/lon (the control of
+    ``wrong_cross_street``);
 ``reference_swapped``
     a reference's lat/lon given as (lon, lat);
 ``reference_4_decimals``
@@ -225,6 +228,19 @@ def slip_wrong_cross_street(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | N
     return None
 
 
+def control_streets(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    """No slip: the intersection named by two of its own streets (no lat/lon), a control
+    for ``wrong_cross_street``."""
+    names = sorted({s.name for s in c.inter.streets if s.name})
+    if len(names) < 2:
+        return None
+    it = scene["intersection"]
+    it.pop("lat", None)
+    it.pop("lon", None)
+    it["streets"] = names[:2]
+    return scene
+
+
 def slip_latlon_off(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     it = scene["intersection"]
     if "lat" not in it:
@@ -311,6 +327,7 @@ SLIPS: dict[str, tuple[str, Slip]] = {
     "corner_far_pavement": ("corners", slip_far_pavement),
     "wrong_cross_street": ("corners", slip_wrong_cross_street),
     "intersection_latlon_off": ("corners", slip_latlon_off),
+    "control_streets": ("corners", control_streets),
     "reference_swapped": ("two_references", slip_ref_swapped),
     "reference_4_decimals": ("two_references", slip_ref_4_decimals),
     "reference_other_corner": ("two_references", slip_ref_other_corner),

@@ -126,3 +126,45 @@ def test_far_reference_not_near_the_map_either_way_is_not_swapped(baltimore: Map
     assert not [w for w in res.warnings if "(lon, lat) swapped" in w]
     # ...but the pair's disagreement is named.
     assert any(w.startswith("references[0] and references[1] disagree") for w in res.warnings)
+
+
+@pytest.mark.parametrize(
+    ("inter_id", "seed", "streets"),
+    [
+        ("c49531205", 9, ["Aliceanna Street", "South Bethel Street"]),
+        ("n49471327", 5, ["Fleet Street", "South Bond Street"]),
+    ],
+)
+def test_cross_street_a_block_away_finds_the_junction(
+    baltimore: MapData, inter_id: str, seed: int, streets: list[str]
+) -> None:
+    # The corners of one junction, named by its main street and the cross street a block
+    # away. Old code matched them at the named junction only: every candidate 40-150 m off,
+    # no warning. Now the junctions within the prior where one of the named streets meets
+    # are tried too (at odds of 0.2): the real one fits, and the warning names it.
+    ls = _located(baltimore, inter_id, seed, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    it = scene["intersection"]
+    it.pop("lat")
+    it.pop("lon")
+    it["streets"] = streets
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert min(errs) < 1.0
+    assert errs[0] < 1.0 or res.candidates[0].ambiguous_with
+    warned = [w for w in res.warnings if w.startswith("intersection: the corners fit")]
+    assert warned
+    assert inter_id in warned[0]
+
+
+def test_streets_named_right_get_no_junction_warning(baltimore: MapData) -> None:
+    ls = _located(baltimore, "c49531205", 9, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    it = scene["intersection"]
+    it.pop("lat")
+    it.pop("lon")
+    it["streets"] = ["Aliceanna Street", "South Broadway"]
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 1.0
+    assert res.candidates[0].intersection_id == "c49531205"
+    assert not [w for w in res.warnings if w.startswith("intersection: the corners fit")]

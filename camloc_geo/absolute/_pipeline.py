@@ -21,6 +21,7 @@ from camloc_geo.absolute._evidence import (
     evidence_at,
     frame_anchor,
     gather_evidence,
+    named_junctions,
     other_junctions,
 )
 from camloc_geo.absolute._hypotheses import (
@@ -131,6 +132,7 @@ def locate(
         _warn_references_off_street(cands, ev, result)
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
         mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
+        _warn_other_junction(scene, map_data, ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -227,22 +229,55 @@ def _other_junction_candidates(
     settings: LocateSettings,
     result: LocateResult,
 ) -> list[Candidate]:
-    """Corner hypotheses at the other junctions a prior-only scene may show, scored."""
+    """Corner hypotheses at the other junctions the scene may show, scored with their
+    prior odds (:func:`~camloc_geo.absolute._evidence.other_junctions`)."""
     others = other_junctions(scene, map_data, ev)
     if not others:
         return []
     assert map_data is not None
-    assert scene.prior is not None
     out = []
-    for inter in others:
+    for inter, log_prior in others:
         ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
-        out += score_hypotheses(corner_hypotheses(ev_j, settings), world_cam, ev_j, settings)
-    result.warnings.append(
-        f"corners: no intersection lat/lon in the scene, so the corners were matched at the "
-        f"{len(others) + 1} junctions with kerb corners within {scene.prior.radius_m:g} m of "
-        "the prior; give intersection.lat/lon (or street names) to fix the junction"
-    )
+        hyps = corner_hypotheses(ev_j, settings)
+        for h in hyps:
+            h.log_prior += log_prior
+        out += score_hypotheses(hyps, world_cam, ev_j, settings)
+    hint = scene.intersection
+    n_equal = sum(1 for _x, lp in others if lp == 0.0)  # as likely as the scene's own
+    if scene.prior is not None and hint is not None and hint.lat is None and n_equal:
+        result.warnings.append(
+            f"corners: no intersection lat/lon in the scene, so the corners were matched at "
+            f"the {n_equal + 1} junctions with kerb corners within "
+            f"{scene.prior.radius_m:g} m of the prior; give intersection.lat/lon (or street "
+            "names) to fix the junction"
+        )
     return out
+
+
+def _warn_other_junction(
+    scene: Scene, map_data: MapData | None, ev: Evidence, result: LocateResult
+) -> None:
+    """Warn when the best candidate stands at a junction the scene did not name."""
+    named = named_junctions(scene, map_data, ev)
+    if named is None or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.intersection_id is None or top.intersection_id in named:
+        return
+    assert map_data is not None
+    there = map_data.intersection(top.intersection_id)
+    hint = scene.intersection
+    assert hint is not None
+    said = (
+        f"lat={hint.lat:.6f}, lon={hint.lon:.6f}"
+        if hint.lat is not None and hint.lon is not None
+        else " & ".join(hint.streets or [])
+    )
+    result.warnings.append(
+        f"intersection: the corners fit junction {there.id} ({' & '.join(there.street_names)}) "
+        f"better than the scene's own ({said}): is the cross street or the lat/lon of "
+        "another junction? Check the best candidate's junction"
+    )
 
 
 def _rescore(
