@@ -168,3 +168,36 @@ def test_streets_named_right_get_no_junction_warning(baltimore: MapData) -> None
     assert _errors(res, ls)[0] < 1.0
     assert res.candidates[0].intersection_id == "c49531205"
     assert not [w for w in res.warnings if w.startswith("intersection: the corners fit")]
+
+
+def _car_bearing_deg(ls: LocatedScene) -> float:
+    enu_from_world = ls.camera_enu.cam_from_world_rotation.T @ (
+        ls.camera_world.cam_from_world_rotation
+    )
+    x = enu_from_world[:, 0]
+    return float(np.degrees(np.arctan2(x[0], x[1]))) % 180.0
+
+
+@pytest.mark.parametrize(("inter_id", "seed"), [("c49531205", 9), ("n49471327", 5)])
+def test_cross_street_bearing_is_outvoted_by_the_map(
+    baltimore: MapData, inter_id: str, seed: int
+) -> None:
+    # One reference and the street bearing of the cross street (the car stands in the other
+    # street). Old code: only the stated bearing was tried and the map's streets were not
+    # consulted, so both candidates stood 20-100 m off (tied with each other), no warning.
+    # Now the map's streets are tried at odds of 0.2 and the car-parallel test decides.
+    ls = _located(baltimore, inter_id, seed, n_references=1, min_corners=1)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    car = _car_bearing_deg(ls)
+    cross = next(
+        s.bearing_deg
+        for s in baltimore.intersection(inter_id).streets
+        if abs((s.bearing_deg - car + 90.0) % 180.0 - 90.0) > 30.0
+    )
+    scene["street_bearing_deg"] = cross
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert min(errs[:2]) < 5.0
+    assert errs[0] < 5.0 or res.candidates[0].ambiguous_with
+    assert any(w.startswith("street_bearing_deg: the best candidate") for w in res.warnings)

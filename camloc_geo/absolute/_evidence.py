@@ -39,6 +39,8 @@ class Evidence:
     streets: LocalIndex | None = None  # the map's centre lines (ENU), half widths, STRtree
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
+    stated_bearing: float | None = None  # the scene's street_bearing_deg
+    map_bearings: list[float] = field(default_factory=list)  # the map's others, with one
     intersection: Intersection | None = None  # the junction whose corners these are
     scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
     map_data: MapData | None = None
@@ -66,7 +68,7 @@ class Evidence:
 
     @property
     def street_tree(self) -> Any:
-        """STRtree over the street centre lines, None without any (or with a scene bearing)."""
+        """STRtree over the street centre lines, None without any."""
         return None if self.streets is None else self.streets.tree
 
     @property
@@ -317,6 +319,23 @@ def _landmarks(
     return landmarks
 
 
+UNSTATED_BEARING_PRIOR = 0.2
+"""The prior odds of the car along a map street other than the scene's ``street_bearing_deg``
+against along the stated one, where the stated one puts the car across the map's street.
+A stated bearing is often the cross street's (the car in the other street:
+``benchmarks/absolute_slips.py``); the map's streets and the car-parallel test then decide,
+within the tie rule's odds (0.2 > 0.1) where they cannot."""
+
+
+def bearing_log_prior(bearing_deg: float, stated_deg: float | None) -> float:
+    """The log prior of the car along ``bearing_deg``: 0 without a stated bearing or within
+    5 degrees of it, else ``log(UNSTATED_BEARING_PRIOR)``."""
+    if stated_deg is None:
+        return 0.0
+    d = abs((float(bearing_deg) - float(stated_deg) + 90.0) % 180.0 - 90.0)
+    return 0.0 if d <= 5.0 else math.log(UNSTATED_BEARING_PRIOR)
+
+
 def unique_bearings(bearings: Iterable[float]) -> list[float]:
     """Bearings folded into [0, 180), those within 5° of an earlier one dropped."""
     out: list[float] = []
@@ -398,11 +417,25 @@ def gather_evidence(
     result.intersection = ce.intersection
     landmarks = _landmarks(scene, map_data, frame, observe)
     bearings = ce.bearings
-    if scene.street_bearing_deg is not None:
-        bearings = [scene.street_bearing_deg]
-    elif map_data is not None:
+    map_bearings: list[float] = []
+    if map_data is not None:
         spots = _search_spots(scene, frame, settings, refs, ce.intersection, landmarks)
-        _map_street_bearings(map_data, frame, settings, spots, bearings, result.warnings)
+        _map_street_bearings(
+            map_data,
+            frame,
+            settings,
+            spots,
+            bearings,
+            result.warnings if scene.street_bearing_deg is None else [],
+        )
+    if scene.street_bearing_deg is not None:
+        # The stated bearing alone; the map's streets are kept for when its candidates
+        # put the car across the map's street (a crowd states the cross street's bearing
+        # as readily as the car's street's: _pipeline._map_bearing_candidates).
+        map_bearings = [
+            b for b in unique_bearings(bearings) if bearing_log_prior(b, scene.street_bearing_deg)
+        ]
+        bearings = [scene.street_bearing_deg]
     ev = Evidence(
         refs,
         ce.corners,
@@ -412,6 +445,8 @@ def gather_evidence(
         unique_bearings(bearings),
     )
     ev.intersection = ce.intersection
+    ev.stated_bearing = scene.street_bearing_deg
+    ev.map_bearings = map_bearings
     ev.scene, ev.map_data, ev.frame = scene, map_data, frame
     _add_map_context(ev, scene, map_data, frame, settings)
     size = scene.object_size
@@ -436,7 +471,7 @@ def _add_map_context(
             frame.enu_from_geographic(lat=scene.prior.lat, lon=scene.prior.lon), dtype=float
         )
         ev.prior_radius_m = scene.prior.radius_m
-    if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
+    if map_data is not None and map_data.streets:
         ev.streets = map_data.street_index
 
 

@@ -234,6 +234,19 @@ def _gen_one_reference(ev: Evidence, street_bearing: float | None) -> list[Hypot
     return _gen_bearing_point("one_reference", obs, q[None, :], unique_bearings(bearings))
 
 
+def bearing_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    """The hypotheses that rest on a street bearing (one reference, one kerb corner or a
+    junction with one modelled corner, one landmark), along ``ev.street_bearings``."""
+    out = []
+    if len(ev.refs) == 1 and not ev.corners and not ev.landmarks:
+        out += _gen_one_reference(ev, None)
+    if len(ev.corners) == 1 or (ev.corners and len(ev.map_corners) == 1):
+        out += corner_hypotheses(ev, settings)
+    if len(ev.landmarks) == 1:
+        out += _gen_landmarks(ev, settings)
+    return out
+
+
 def flag_worst_reference(ev: Evidence, settings: LocateSettings, result: LocateResult) -> None:
     """Name the reference that agrees least with the others (three or more references)."""
     worst = worst_reference(ev.refs, settings)

@@ -17,6 +17,7 @@ from camloc_geo._ties import TIE_MIN_SCORE, is_tie
 from camloc_geo.absolute._bundle import bundle_adjust_many
 from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
+    UNSTATED_BEARING_PRIOR,
     Evidence,
     evidence_at,
     frame_anchor,
@@ -27,6 +28,7 @@ from camloc_geo.absolute._evidence import (
 from camloc_geo.absolute._hypotheses import (
     Hypothesis,
     NoCandidatesError,
+    bearing_hypotheses,
     corner_hypotheses,
     generate_hypotheses,
     single_reference_hypotheses,
@@ -42,6 +44,7 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine_many
 from camloc_geo.absolute._scoring import (
+    car_bearing_deg,
     plausibility_at,
     score,
     unmatched_flags,
@@ -123,6 +126,7 @@ def locate(
         hyps = generate_hypotheses(scene, ev, settings, result)
         cands = score_hypotheses(hyps, world_cam, ev, settings)
         cands += _references_alone(cands, world_cam, ev, settings)
+        cands += _map_bearing_candidates(cands, world_cam, ev, settings)
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
@@ -133,6 +137,7 @@ def locate(
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
         mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
         _warn_other_junction(scene, map_data, ev, result)
+        _warn_stated_bearing(ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -161,6 +166,37 @@ def _references_alone(
         return []
     return score_hypotheses(single_reference_hypotheses(ev), world_cam, ev, settings)
 
+
+def _map_bearing_candidates(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """The map's other street bearings, scored at odds of
+    :data:`~camloc_geo.absolute._evidence.UNSTATED_BEARING_PRIOR`, when every candidate along
+    the scene's ``street_bearing_deg`` is implausible on the map (its car off or across the
+    street under it, or the camera inside a building).
+
+    A crowd states the cross street's bearing as readily as the car's street's (the car in
+    the other street: ``benchmarks/absolute_slips.py``); then the map's streets, and the
+    car-parallel test, decide. A stated bearing that some candidate's car lies along is
+    taken at its word (the scene's candidates stay exactly its own).
+    """
+    if ev.stated_bearing is None or not ev.map_bearings or not cands:
+        return []
+    if any(not ({f.kind for f in c.flags} & _IMPLAUSIBLE) for c in cands):
+        return []
+    ev_map = replace(ev, street_bearings=list(ev.map_bearings))
+    hyps = bearing_hypotheses(ev_map, settings)
+    odds = math.log(UNSTATED_BEARING_PRIOR)
+    for h in hyps:
+        h.log_prior += odds
+    return score_hypotheses(hyps, world_cam, ev_map, settings)
+
+
+_IMPLAUSIBLE = {
+    FlagKind.CAR_OFF_STREET,
+    FlagKind.CAR_NOT_PARALLEL_TO_STREET,
+    FlagKind.INSIDE_BUILDING,
+}
 
 _REFERENCE_MISS_M2 = 16.0
 """A reference the best candidate misses by more than 4 standard deviations (squared) is
@@ -252,6 +288,25 @@ def _other_junction_candidates(
             "names) to fix the junction"
         )
     return out
+
+
+STATED_BEARING_WARN_DEG = 20.0
+"""The best candidate's car this far from the scene's ``street_bearing_deg`` is a warning."""
+
+
+def _warn_stated_bearing(ev: Evidence, result: LocateResult) -> None:
+    """Warn when the best candidate's car does not lie along the stated street bearing."""
+    if ev.stated_bearing is None or not result.candidates:
+        return
+    car = car_bearing_deg(result.candidates[0].enu_from_world) % 180.0
+    d = abs((car - ev.stated_bearing + 90.0) % 180.0 - 90.0)
+    if d <= STATED_BEARING_WARN_DEG:
+        return
+    result.warnings.append(
+        f"street_bearing_deg: the best candidate puts the car along {car:.0f} degrees (or "
+        f"{car + 180.0:.0f}), {d:.0f} degrees from the stated {ev.stated_bearing:g}: the map's "
+        "streets fit better; is the stated bearing the cross street's?"
+    )
 
 
 def _warn_other_junction(
