@@ -201,3 +201,26 @@ def test_cross_street_bearing_is_outvoted_by_the_map(
     assert min(errs[:2]) < 5.0
     assert errs[0] < 5.0 or res.candidates[0].ambiguous_with
     assert any(w.startswith("street_bearing_deg: the best candidate") for w in res.warnings)
+
+
+@pytest.mark.parametrize(("inter_id", "seed"), [("c49531205", 9), ("n49478228", 8)])
+def test_corners_listed_counter_clockwise_are_read_so_with_a_warning(
+    baltimore: MapData, inter_id: str, seed: int
+) -> None:
+    # The visible corners listed counter-clockwise. Old code: c49531205 (4 corners) had no
+    # answer ("no hypothesis fits the corners evidence"), n49478228 (3) put the best
+    # candidate 37 m off. Now the reversed order is tried at odds of 0.1 and named.
+    ls = _located(baltimore, inter_id, seed, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    scene["intersection"]["corners"] = scene["intersection"]["corners"][::-1]
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 1.0
+    assert any("counter-clockwise" in w for w in res.warnings)
+
+
+def test_corners_listed_clockwise_get_no_order_warning(baltimore: MapData) -> None:
+    for inter_id, seed in (("c49531205", 9), ("n49478228", 8)):
+        ls = _located(baltimore, inter_id, seed, min_corners=2)
+        res = locate(parse_scene(ls.scene), baltimore)
+        assert _errors(res, ls)[0] < 1.0
+        assert not any("counter-clockwise" in w for w in res.warnings)

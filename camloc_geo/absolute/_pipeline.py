@@ -31,6 +31,7 @@ from camloc_geo.absolute._hypotheses import (
     bearing_hypotheses,
     corner_hypotheses,
     generate_hypotheses,
+    is_reversed,
     single_reference_hypotheses,
 )
 from camloc_geo.absolute._model import (
@@ -138,6 +139,7 @@ def locate(
         mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
         _warn_other_junction(scene, map_data, ev, result)
         _warn_stated_bearing(ev, result)
+        _warn_reversed_corners(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -288,6 +290,21 @@ def _other_junction_candidates(
             "names) to fix the junction"
         )
     return out
+
+
+def _warn_reversed_corners(result: LocateResult) -> None:
+    """Warn when the best candidate reads the visible corners counter-clockwise."""
+    if not result.candidates:
+        return
+    top = result.candidates[0]
+    ev = top.evidence
+    if ev is None or not is_reversed(top.corner_assignment, len(ev.map_corners)):
+        return
+    result.warnings.append(
+        "intersection.corners: the best candidate reads the listed corners counter-clockwise "
+        "(they fit the map better that way): the scene lists them clockwise as seen on "
+        "screen; check their order"
+    )
 
 
 STATED_BEARING_WARN_DEG = 20.0
