@@ -224,3 +224,22 @@ def test_corners_listed_clockwise_get_no_order_warning(baltimore: MapData) -> No
         res = locate(parse_scene(ls.scene), baltimore)
         assert _errors(res, ls)[0] < 1.0
         assert not any("counter-clockwise" in w for w in res.warnings)
+
+
+def test_corner_clicked_at_the_centre_lines_crossing_is_named(baltimore: MapData) -> None:
+    # One of three corners clicked where the centre lines cross instead of at the kerb: the
+    # best candidate leaves it 12 m from its map corner (old code: no word about it).
+    inter = baltimore.intersection("c49531205")
+    ls = _located(baltimore, "c49531205", 9, min_corners=3)
+    e, n = baltimore.frame.enu_from_geographic(lat=inter.lat, lon=inter.lon)
+    px = ls.camera_enu.project([e, n, 0.0])
+    scene = json.loads(json.dumps(ls.scene))
+    scene["intersection"]["corners"][0] = [float(px[0]), float(px[1])]
+    res = locate(parse_scene(scene), baltimore)
+    named = [w for w in res.warnings if w.startswith("intersection.corners[0]: the best")]
+    assert named
+    metres = float(named[0].split(" puts it ")[1].split(" m ")[0])
+    assert metres >= 5.0
+    # The clean scene gets no such warning.
+    clean = locate(parse_scene(ls.scene), baltimore)
+    assert not [w for w in clean.warnings if "from its map corner" in w]

@@ -140,6 +140,7 @@ def locate(
         _warn_other_junction(scene, map_data, ev, result)
         _warn_stated_bearing(ev, result)
         _warn_reversed_corners(result)
+        _warn_corner_outlier(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -290,6 +291,29 @@ def _other_junction_candidates(
             "names) to fix the junction"
         )
     return out
+
+
+CORNER_OUTLIER_M2 = 16.0
+"""A matched corner of the best candidate this far off (squared standard deviations of the
+noise model: 4 sigma) is a warning."""
+
+
+def _warn_corner_outlier(result: LocateResult) -> None:
+    """Warn when the best candidate leaves one matched kerb corner far off its map corner."""
+    if not result.candidates:
+        return
+    worst = max(
+        (m for m in result.candidates[0].matches if m.kind == "corner"),
+        key=lambda m: m.mahalanobis2,
+        default=None,
+    )
+    if worst is None or worst.mahalanobis2 <= CORNER_OUTLIER_M2:
+        return
+    result.warnings.append(
+        f"{worst.label}: the best candidate puts it {worst.misfit_m:.0f} m from its map corner "
+        "(more than 4 standard deviations): clicked off the kerb corner (where the centre "
+        "lines cross, across a wide pavement, another junction's)? Check it"
+    )
 
 
 def _warn_reversed_corners(result: LocateResult) -> None:
