@@ -243,3 +243,39 @@ def test_corner_clicked_at_the_centre_lines_crossing_is_named(baltimore: MapData
     # The clean scene gets no such warning.
     clean = locate(parse_scene(ls.scene), baltimore)
     assert not [w for w in clean.warnings if "from its map corner" in w]
+
+
+@pytest.mark.parametrize(("inter_id", "seed"), [("c49531205", 9), ("n49531211", 24)])
+def test_landmark_named_by_its_neighbour(baltimore: MapData, inter_id: str, seed: int) -> None:
+    # Two landmarks, the first named by the nearest other named building. Old code: the
+    # best candidate 100-115 m off, no warning. Now each named landmark is also read as its
+    # neighbours within 60 m (odds 0.1), and the warning names the building read.
+    ls = make_located_scene(
+        baltimore,
+        baltimore.intersection(inter_id),
+        np.random.default_rng(seed),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        n_landmarks=2,
+        max_tries=150,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene.pop("references", None)
+    inter = baltimore.intersection(inter_id)
+    named = baltimore.find_building(scene["landmarks"][0]["name"], near=(inter.lat, inter.lon))
+    taken = {lm["name"] for lm in scene["landmarks"]}
+    neighbour = min(
+        (b for b in baltimore.buildings if b.name and b.name not in taken),
+        key=lambda b: distance_m(
+            lat1=named.centroid[1], lon1=named.centroid[0], lat2=b.centroid[1], lon2=b.centroid[0]
+        ),
+    )
+    scene["landmarks"][0]["name"] = neighbour.name
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 2.0
+    warned = [w for w in res.warnings if w.startswith("landmarks: the best candidate reads")]
+    assert warned
+    assert named.name is not None
+    assert named.name in warned[0]

@@ -39,6 +39,7 @@ class Evidence:
     streets: LocalIndex | None = None  # the map's centre lines (ENU), half widths, STRtree
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
+    substitution: str | None = None  # a landmark read as a neighbouring building's
     stated_bearing: float | None = None  # the scene's street_bearing_deg
     map_bearings: list[float] = field(default_factory=list)  # the map's others, with one
     intersection: Intersection | None = None  # the junction whose corners these are
@@ -334,6 +335,62 @@ def bearing_log_prior(bearing_deg: float, stated_deg: float | None) -> float:
         return 0.0
     d = abs((float(bearing_deg) - float(stated_deg) + 90.0) % 180.0 - 90.0)
     return 0.0 if d <= 5.0 else math.log(UNSTATED_BEARING_PRIOR)
+
+
+NEIGHBOUR_BUILDING_M = 60.0
+"""How far from a named landmark's building its neighbours are tried under its name."""
+
+MAX_NEIGHBOUR_BUILDINGS = 3
+"""At most this many neighbouring named buildings per landmark are tried."""
+
+
+def landmark_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
+    """``ev`` with one named landmark's building replaced by a neighbouring named building,
+    each with a note (``landmarks[0] as 'Other Hall'``).
+
+    Crowds name a landmark by the building next to it (``benchmarks/absolute_slips.py``);
+    the nearest :data:`MAX_NEIGHBOUR_BUILDINGS` other named buildings within
+    :data:`NEIGHBOUR_BUILDING_M` of the named one stand in for it, one landmark at a time.
+    """
+    scene, map_data, frame = ev.scene, ev.map_data, ev.frame
+    if scene is None or map_data is None or frame is None or not scene.landmarks:
+        return []
+    from dataclasses import replace
+
+    by_label = {o.label: k for k, (o, _pts) in enumerate(ev.landmarks)}
+    named = [b for b in map_data.buildings if b.name]
+    out = []
+    for i, lm in enumerate(scene.landmarks):
+        k = by_label.get(f"landmarks[{i}]")
+        if k is None or lm.name is None:
+            continue
+        near_lm = (lm.lat, lm.lon) if lm.lat is not None and lm.lon is not None else None
+        if near_lm is None and scene.prior is not None:
+            near_lm = (scene.prior.lat, scene.prior.lon)
+        try:
+            building = map_data.find_building(lm.name, near=near_lm)
+        except MapDataError:
+            continue
+        cx, cy = building.centroid
+        here = LocalFrame(lat=cy, lon=cx)
+        others = []
+        for b in named:
+            if b.name == building.name:
+                continue
+            e, n = here.enu_from_geographic(lat=b.centroid[1], lon=b.centroid[0])
+            d = math.hypot(e, n)
+            if d <= NEIGHBOUR_BUILDING_M:
+                others.append((d, b))
+        others.sort(key=lambda t: t[0])
+        for _d, b in others[:MAX_NEIGHBOUR_BUILDINGS]:
+            pts_ll = list(b.corners if lm.kind == "building_corner" else b.face_midpoints)
+            if not pts_ll:
+                continue
+            pts = frame.points_enu_from_geographic(np.asarray(pts_ll, dtype=float))
+            lms = list(ev.landmarks)
+            lms[k] = (lms[k][0], pts)
+            out.append((replace(ev, landmarks=lms), f"landmarks[{i}] as {b.name!r}"))
+    return out
 
 
 def unique_bearings(bearings: Iterable[float]) -> list[float]:

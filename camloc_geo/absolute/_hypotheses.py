@@ -260,6 +260,11 @@ def _gen_landmarks(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
     return out
 
 
+def landmark_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
+    """The ``landmark`` hypotheses of ``ev``'s landmarks (public name of the generator)."""
+    return _gen_landmarks(ev, settings)
+
+
 def _gen_one_reference(ev: Evidence, street_bearing: float | None) -> list[Hypothesis]:
     if len(ev.refs) != 1:
         return []

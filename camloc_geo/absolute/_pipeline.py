@@ -22,6 +22,7 @@ from camloc_geo.absolute._evidence import (
     evidence_at,
     frame_anchor,
     gather_evidence,
+    landmark_alternatives,
     named_junctions,
     other_junctions,
 )
@@ -32,6 +33,7 @@ from camloc_geo.absolute._hypotheses import (
     corner_hypotheses,
     generate_hypotheses,
     is_reversed,
+    landmark_hypotheses,
     single_reference_hypotheses,
 )
 from camloc_geo.absolute._model import (
@@ -128,6 +130,7 @@ def locate(
         cands = score_hypotheses(hyps, world_cam, ev, settings)
         cands += _references_alone(cands, world_cam, ev, settings)
         cands += _map_bearing_candidates(cands, world_cam, ev, settings)
+        cands += _neighbour_building_candidates(cands, world_cam, ev, settings)
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
@@ -141,6 +144,7 @@ def locate(
         _warn_stated_bearing(ev, result)
         _warn_reversed_corners(result)
         _warn_corner_outlier(result)
+        _warn_substituted_landmark(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -193,6 +197,46 @@ def _map_bearing_candidates(
     for h in hyps:
         h.log_prior += odds
     return score_hypotheses(hyps, world_cam, ev_map, settings)
+
+
+NEIGHBOUR_BUILDING_PRIOR = 0.1
+"""The prior odds of a named landmark being a neighbouring named building's corner."""
+
+
+def _neighbour_building_candidates(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Named landmarks read as a neighbouring building's, one at a time (odds
+    :data:`NEIGHBOUR_BUILDING_PRIOR`), in scenes whose only evidence is landmarks: crowds
+    name a landmark by the building next to it. (Tried only where every landmark candidate
+    fitted poorly or stood implausibly on the map, it found half as many: the wrong
+    building's corners fit some placement as well.)"""
+    if not ev.landmarks or ev.corners or ev.refs:
+        return []
+    if not any(c.method == "landmark" for c in cands):
+        return []
+    odds = math.log(NEIGHBOUR_BUILDING_PRIOR)
+    out = []
+    for ev_alt, note in landmark_alternatives(ev):
+        ev_alt.substitution = note
+        hyps = landmark_hypotheses(ev_alt, settings)
+        for h in hyps:
+            h.log_prior += odds
+        out += score_hypotheses(hyps, world_cam, ev_alt, settings)
+    return out
+
+
+def _warn_substituted_landmark(result: LocateResult) -> None:
+    """Warn when the best candidate reads a landmark as a neighbouring building's."""
+    if not result.candidates:
+        return
+    ev = result.candidates[0].evidence
+    if ev is None or ev.substitution is None:
+        return
+    result.warnings.append(
+        f"landmarks: the best candidate reads {ev.substitution} (a neighbouring building): "
+        "its corners fit where the named building's do not; check the landmark's name"
+    )
 
 
 _IMPLAUSIBLE = {
