@@ -322,7 +322,8 @@ def _landmarks(
 
 UNSTATED_BEARING_PRIOR = 0.2
 """The prior odds of the car along a map street other than the scene's ``street_bearing_deg``
-against along the stated one, where the stated one puts the car across the map's street.
+against along the stated one, tried where every candidate along the stated one is
+implausible on the map.
 A stated bearing is often the cross street's (the car in the other street:
 ``benchmarks/absolute_slips.py``); the map's streets and the car-parallel test then decide,
 within the tie rule's odds (0.2 > 0.1) where they cannot."""
@@ -486,9 +487,9 @@ def gather_evidence(
             result.warnings if scene.street_bearing_deg is None else [],
         )
     if scene.street_bearing_deg is not None:
-        # The stated bearing alone; the map's streets are kept for when its candidates
-        # put the car across the map's street (a crowd states the cross street's bearing
-        # as readily as the car's street's: _pipeline._map_bearing_candidates).
+        # The stated bearing alone; the map's other streets are kept for when every
+        # candidate along it is implausible on the map (a crowd states the cross street's
+        # bearing as readily as the car's street's: _pipeline._map_bearing_candidates).
         map_bearings = [
             b for b in unique_bearings(bearings) if bearing_log_prior(b, scene.street_bearing_deg)
         ]
