@@ -130,10 +130,18 @@ def _gen_bearing_point(
     return out
 
 
-def corner_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis]:
-    """The kerb-corner hypotheses: visible corners assigned to the map's, in order."""
+def corner_hypotheses(
+    ev: Evidence, settings: LocateSettings, *, counter_clockwise: bool = False
+) -> list[Hypothesis]:
+    """The kerb-corner hypotheses: visible corners assigned to the map's, in order.
+
+    ``counter_clockwise``: instead, the list read backwards (at
+    :data:`REVERSED_ORDER_PRIOR`), only the assignments the clockwise reading does not give.
+    """
     k, n = len(ev.corners), len(ev.map_corners)
     if k == 0 or n == 0:
+        return []
+    if counter_clockwise and (k < 2 or n < 2):
         return []
     if k == 1:
         return _gen_bearing_point("corners", ev.corners[0], ev.map_corners, ev.street_bearings)
@@ -151,6 +159,8 @@ def corner_hypotheses(ev: Evidence, settings: LocateSettings) -> list[Hypothesis
     world = np.array([o.world_xy for o in ev.corners])
     wts = _weights(ev.corners)
     for assign, consecutive, reversed_ in _both_orders(k, n):
+        if reversed_ != counter_clockwise:
+            continue
         used = [i for i, j in enumerate(assign) if j >= 0]
         if len(used) < 2:
             continue
