@@ -34,6 +34,9 @@ annotation page make them:
     a reference on a visible kerb corner with the lat/lon of another corner of the junction;
 ``bearing_cross_street``
     one reference with ``street_bearing_deg`` of the cross street (the car in the other one);
+``control_bearing``
+    no slip: ``street_bearing_deg`` of the car's own street (the control of
+    ``bearing_cross_street``);
 ``landmark_neighbour``
     two landmarks, the first named by the nearest other named building's name.
 
@@ -293,6 +296,17 @@ def slip_bearing_cross(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     return None
 
 
+def control_bearing(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    """No slip: ``street_bearing_deg`` of the car's own street (the control of
+    ``bearing_cross_street``)."""
+    car = c.car_bearing_deg()
+    best = min(c.inter.streets, key=lambda s: abs((s.bearing_deg - car + 90.0) % 180.0 - 90.0))
+    if abs((best.bearing_deg - car + 90.0) % 180.0 - 90.0) > 10.0:
+        return None
+    scene["street_bearing_deg"] = float(best.bearing_deg % 360.0)
+    return scene
+
+
 def slip_landmark_neighbour(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     lms = scene.get("landmarks") or []
     if not lms:
@@ -332,6 +346,7 @@ SLIPS: dict[str, tuple[str, Slip]] = {
     "reference_4_decimals": ("two_references", slip_ref_4_decimals),
     "reference_other_corner": ("two_references", slip_ref_other_corner),
     "bearing_cross_street": ("one_reference", slip_bearing_cross),
+    "control_bearing": ("one_reference", control_bearing),
     "landmark_neighbour": ("landmark", slip_landmark_neighbour),
 }
 

@@ -39,6 +39,9 @@ class Evidence:
     streets: LocalIndex | None = None  # the map's centre lines (ENU), half widths, STRtree
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
+    substitution: str | None = None  # a landmark read as a neighbouring building's
+    stated_bearing: float | None = None  # the scene's street_bearing_deg
+    map_bearings: list[float] = field(default_factory=list)  # the map's others, with one
     intersection: Intersection | None = None  # the junction whose corners these are
     scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
     map_data: MapData | None = None
@@ -66,7 +69,7 @@ class Evidence:
 
     @property
     def street_tree(self) -> Any:
-        """STRtree over the street centre lines, None without any (or with a scene bearing)."""
+        """STRtree over the street centre lines, None without any."""
         return None if self.streets is None else self.streets.tree
 
     @property
@@ -317,6 +320,80 @@ def _landmarks(
     return landmarks
 
 
+UNSTATED_BEARING_PRIOR = 0.2
+"""The prior odds of the car along a map street other than the scene's ``street_bearing_deg``
+against along the stated one, tried where every candidate along the stated one is
+implausible on the map.
+A stated bearing is often the cross street's (the car in the other street:
+``benchmarks/absolute_slips.py``); the map's streets and the car-parallel test then decide,
+within the tie rule's odds (0.2 > 0.1) where they cannot."""
+
+
+def bearing_log_prior(bearing_deg: float, stated_deg: float | None) -> float:
+    """The log prior of the car along ``bearing_deg``: 0 without a stated bearing or within
+    5 degrees of it, else ``log(UNSTATED_BEARING_PRIOR)``."""
+    if stated_deg is None:
+        return 0.0
+    d = abs((float(bearing_deg) - float(stated_deg) + 90.0) % 180.0 - 90.0)
+    return 0.0 if d <= 5.0 else math.log(UNSTATED_BEARING_PRIOR)
+
+
+NEIGHBOUR_BUILDING_M = 60.0
+"""How far from a named landmark's building its neighbours are tried under its name."""
+
+MAX_NEIGHBOUR_BUILDINGS = 3
+"""At most this many neighbouring named buildings per landmark are tried."""
+
+
+def landmark_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
+    """``ev`` with one named landmark's building replaced by a neighbouring named building,
+    each with a note (``landmarks[0] as 'Other Hall'``).
+
+    Crowds name a landmark by the building next to it (``benchmarks/absolute_slips.py``);
+    the nearest :data:`MAX_NEIGHBOUR_BUILDINGS` other named buildings within
+    :data:`NEIGHBOUR_BUILDING_M` of the named one stand in for it, one landmark at a time.
+    """
+    scene, map_data, frame = ev.scene, ev.map_data, ev.frame
+    if scene is None or map_data is None or frame is None or not scene.landmarks:
+        return []
+    from dataclasses import replace
+
+    by_label = {o.label: k for k, (o, _pts) in enumerate(ev.landmarks)}
+    named = [b for b in map_data.buildings if b.name]
+    out = []
+    for i, lm in enumerate(scene.landmarks):
+        k = by_label.get(f"landmarks[{i}]")
+        if k is None or lm.name is None:
+            continue
+        near_lm = (lm.lat, lm.lon) if lm.lat is not None and lm.lon is not None else None
+        if near_lm is None and scene.prior is not None:
+            near_lm = (scene.prior.lat, scene.prior.lon)
+        try:
+            building = map_data.find_building(lm.name, near=near_lm)
+        except MapDataError:
+            continue
+        cx, cy = building.centroid
+        here = LocalFrame(lat=cy, lon=cx)
+        others = []
+        for b in named:
+            if b.name == building.name:
+                continue
+            e, n = here.enu_from_geographic(lat=b.centroid[1], lon=b.centroid[0])
+            d = math.hypot(e, n)
+            if d <= NEIGHBOUR_BUILDING_M:
+                others.append((d, b))
+        others.sort(key=lambda t: t[0])
+        for _d, b in others[:MAX_NEIGHBOUR_BUILDINGS]:
+            pts_ll = list(b.corners if lm.kind == "building_corner" else b.face_midpoints)
+            if not pts_ll:
+                continue
+            pts = frame.points_enu_from_geographic(np.asarray(pts_ll, dtype=float))
+            lms = list(ev.landmarks)
+            lms[k] = (lms[k][0], pts)
+            out.append((replace(ev, landmarks=lms), f"landmarks[{i}] as {b.name!r}"))
+    return out
+
+
 def unique_bearings(bearings: Iterable[float]) -> list[float]:
     """Bearings folded into [0, 180), those within 5° of an earlier one dropped."""
     out: list[float] = []
@@ -398,11 +475,25 @@ def gather_evidence(
     result.intersection = ce.intersection
     landmarks = _landmarks(scene, map_data, frame, observe)
     bearings = ce.bearings
-    if scene.street_bearing_deg is not None:
-        bearings = [scene.street_bearing_deg]
-    elif map_data is not None:
+    map_bearings: list[float] = []
+    if map_data is not None:
         spots = _search_spots(scene, frame, settings, refs, ce.intersection, landmarks)
-        _map_street_bearings(map_data, frame, settings, spots, bearings, result.warnings)
+        _map_street_bearings(
+            map_data,
+            frame,
+            settings,
+            spots,
+            bearings,
+            result.warnings if scene.street_bearing_deg is None else [],
+        )
+    if scene.street_bearing_deg is not None:
+        # The stated bearing alone; the map's other streets are kept for when every
+        # candidate along it is implausible on the map (a crowd states the cross street's
+        # bearing as readily as the car's street's: _pipeline._map_bearing_candidates).
+        map_bearings = [
+            b for b in unique_bearings(bearings) if bearing_log_prior(b, scene.street_bearing_deg)
+        ]
+        bearings = [scene.street_bearing_deg]
     ev = Evidence(
         refs,
         ce.corners,
@@ -412,6 +503,8 @@ def gather_evidence(
         unique_bearings(bearings),
     )
     ev.intersection = ce.intersection
+    ev.stated_bearing = scene.street_bearing_deg
+    ev.map_bearings = map_bearings
     ev.scene, ev.map_data, ev.frame = scene, map_data, frame
     _add_map_context(ev, scene, map_data, frame, settings)
     size = scene.object_size
@@ -436,7 +529,7 @@ def _add_map_context(
             frame.enu_from_geographic(lat=scene.prior.lat, lon=scene.prior.lon), dtype=float
         )
         ev.prior_radius_m = scene.prior.radius_m
-    if map_data is not None and map_data.streets and scene.street_bearing_deg is None:
+    if map_data is not None and map_data.streets:
         ev.streets = map_data.street_index
 
 

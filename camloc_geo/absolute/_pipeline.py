@@ -17,18 +17,23 @@ from camloc_geo._ties import TIE_MIN_SCORE, is_tie
 from camloc_geo.absolute._bundle import bundle_adjust_many
 from camloc_geo.absolute._cues import cue_log_likelihood
 from camloc_geo.absolute._evidence import (
+    UNSTATED_BEARING_PRIOR,
     Evidence,
     evidence_at,
     frame_anchor,
     gather_evidence,
+    landmark_alternatives,
     named_junctions,
     other_junctions,
 )
 from camloc_geo.absolute._hypotheses import (
     Hypothesis,
     NoCandidatesError,
+    bearing_hypotheses,
     corner_hypotheses,
     generate_hypotheses,
+    is_reversed,
+    landmark_hypotheses,
     single_reference_hypotheses,
 )
 from camloc_geo.absolute._model import (
@@ -42,6 +47,7 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine_many
 from camloc_geo.absolute._scoring import (
+    car_bearing_deg,
     plausibility_at,
     score,
     unmatched_flags,
@@ -122,8 +128,11 @@ def locate(
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
         cands = score_hypotheses(hyps, world_cam, ev, settings)
+        cands += _counter_clockwise_candidates(cands, world_cam, ev, settings)
         cands += _references_alone(cands, world_cam, ev, settings)
-        cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result)
+        cands += _map_bearing_candidates(cands, world_cam, ev, settings)
+        cands += _neighbour_building_candidates(cands, world_cam, ev, settings)
+        cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result, cands)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
         cands = expected_plausibility(cands, world_cam, ev, settings)
@@ -133,6 +142,10 @@ def locate(
         result.candidates = bundle_leaders(cands, cal, ev, settings, result)
         mark_ties(result.candidates, settings, result)  # on the leaders' adjusted positions
         _warn_other_junction(scene, map_data, ev, result)
+        _warn_stated_bearing(ev, result)
+        _warn_reversed_corners(result)
+        _warn_corner_outlier(result)
+        _warn_substituted_landmark(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -141,6 +154,24 @@ def locate(
     finally:
         _forget_placements(ev, result.candidates)
     return result
+
+
+def _counter_clockwise_candidates(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """The visible corners read counter-clockwise (odds 0.1), kept only when one of those
+    readings outweighs every clockwise corner candidate (kept always, they nearly doubled
+    the candidates of every corner scene, to no gain where the order was right)."""
+    if len(ev.corners) < 2 or len(ev.map_corners) < 2:
+        return []
+    hyps = corner_hypotheses(ev, settings, counter_clockwise=True)
+    if not hyps:
+        return []
+    back = score_hypotheses(hyps, world_cam, ev, settings)
+    ahead = [c for c in cands if c.method == "corners"]
+    if ahead and max(map(_weight, back)) <= max(map(_weight, ahead)):
+        return []
+    return back
 
 
 def _references_alone(
@@ -162,6 +193,82 @@ def _references_alone(
     return score_hypotheses(single_reference_hypotheses(ev), world_cam, ev, settings)
 
 
+def _map_bearing_candidates(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """The map's other street bearings, scored at odds of
+    :data:`~camloc_geo.absolute._evidence.UNSTATED_BEARING_PRIOR`, when every candidate along
+    the scene's ``street_bearing_deg`` is implausible on the map (its car off or across the
+    street under it, or the camera inside a building).
+
+    A crowd states the cross street's bearing as readily as the car's street's (the car in
+    the other street: ``benchmarks/absolute_slips.py``); then the map's streets, and the
+    car-parallel test, decide. A stated bearing that some candidate's car lies along is
+    taken at its word (the scene's candidates stay exactly its own).
+    """
+    if ev.stated_bearing is None or not ev.map_bearings or not cands:
+        return []
+    if any(not ({f.kind for f in c.flags} & _IMPLAUSIBLE) for c in cands):
+        return []
+    ev_map = replace(ev, street_bearings=list(ev.map_bearings))
+    hyps = bearing_hypotheses(ev_map, settings)
+    odds = math.log(UNSTATED_BEARING_PRIOR)
+    for h in hyps:
+        h.log_prior += odds
+    return score_hypotheses(hyps, world_cam, ev_map, settings)
+
+
+NEIGHBOUR_BUILDING_PRIOR = 0.1
+"""The prior odds of a named landmark being a neighbouring named building's corner."""
+
+
+def _neighbour_building_candidates(
+    cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Named landmarks read as a neighbouring building's, one at a time (odds
+    :data:`NEIGHBOUR_BUILDING_PRIOR`), in scenes whose only evidence is landmarks: crowds
+    name a landmark by the building next to it. (Tried only where every landmark candidate
+    fitted poorly or stood implausibly on the map, it found half as many: the wrong
+    building's corners fit some placement as well.)"""
+    if not ev.landmarks or ev.corners or ev.refs:
+        return []
+    if not any(c.method == "landmark" for c in cands):
+        return []
+    odds = math.log(NEIGHBOUR_BUILDING_PRIOR)
+    out = []
+    for ev_alt, note in landmark_alternatives(ev):
+        ev_alt.substitution = note
+        hyps = landmark_hypotheses(ev_alt, settings)
+        for h in hyps:
+            h.log_prior += odds
+        scored = score_hypotheses(hyps, world_cam, ev_alt, settings)
+        if scored:
+            # The best reading of each neighbour only: all of them crowded right candidates
+            # of the named buildings out of the first max_candidates (absolute.py --n 200:
+            # landmark closest < 10 m 91 -> 88 %).
+            out.append(max(scored, key=lambda c: c.log_likelihood + math.log(max(c.prior, 1e-300))))
+    return out
+
+
+def _warn_substituted_landmark(result: LocateResult) -> None:
+    """Warn when the best candidate reads a landmark as a neighbouring building's."""
+    if not result.candidates:
+        return
+    ev = result.candidates[0].evidence
+    if ev is None or ev.substitution is None:
+        return
+    result.warnings.append(
+        f"landmarks: the best candidate reads {ev.substitution} (a neighbouring building): "
+        "its corners fit where the named building's do not; check the landmark's name"
+    )
+
+
+_IMPLAUSIBLE = {
+    FlagKind.CAR_OFF_STREET,
+    FlagKind.CAR_NOT_PARALLEL_TO_STREET,
+    FlagKind.INSIDE_BUILDING,
+}
+
 _REFERENCE_MISS_M2 = 16.0
 """A reference the best candidate misses by more than 4 standard deviations (squared) is
 named as the one to check when that candidate trusts the other reference alone."""
@@ -175,9 +282,9 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
     Two references fix a camera exactly whatever their lat/lon, so a wrong one (another
     point's, rounded to 4 decimals) moves the answer tens of metres with a small sigma and
     no misfit. The map is the only witness left: the car of a real camera stands on a street,
-    along it. Measured (``benchmarks/absolute_slips.py --n 60``): 7 of 60 right answers carry
-    such a flag, but 28 of 35 answers more than 10 m off with one reference on another kerb
-    corner.
+    along it. Measured (``benchmarks/absolute_slips.py --n 120``): 8 of 117 clean
+    two-reference scenes get a reference warning (their car off the map's street: street
+    widths are estimates), 38 % of those with one reference on another kerb corner.
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not cands:
         return
@@ -228,20 +335,43 @@ def _other_junction_candidates(
     ev: Evidence,
     settings: LocateSettings,
     result: LocateResult,
+    named_cands: list[Candidate],
 ) -> list[Candidate]:
     """Corner hypotheses at the other junctions the scene may show, scored with their
-    prior odds (:func:`~camloc_geo.absolute._evidence.other_junctions`)."""
+    prior odds (:func:`~camloc_geo.absolute._evidence.other_junctions`).
+
+    ``named_cands``: the candidates at the scene's own junction. The junctions where only
+    some of the named streets meet count only when one of their candidates outweighs every
+    candidate at a named junction (prior odds included): kept always, a same-shaped
+    neighbour tied with the sample scene's right candidate at odds of 9 to 1 and tripled its
+    candidates; tried only when no named candidate was plausible, they found a tenth of the
+    wrong cross streets.
+    """
     others = other_junctions(scene, map_data, ev)
     if not others:
         return []
     assert map_data is not None
-    out = []
+    out: list[Candidate] = []
+    # The junctions as likely as the scene's own first; then the neighbours (where only
+    # some of the named streets meet), kept only when one of them beats every candidate at
+    # a named junction, its prior odds included.
     for inter, log_prior in others:
+        if log_prior < 0.0:
+            continue
+        ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
+        out += score_hypotheses(corner_hypotheses(ev_j, settings), world_cam, ev_j, settings)
+    neighbours: list[Candidate] = []
+    for inter, log_prior in others:
+        if log_prior >= 0.0:
+            continue
         ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
         hyps = corner_hypotheses(ev_j, settings)
         for h in hyps:
             h.log_prior += log_prior
-        out += score_hypotheses(hyps, world_cam, ev_j, settings)
+        neighbours += score_hypotheses(hyps, world_cam, ev_j, settings)
+    named = [*named_cands, *out]
+    if neighbours and (not named or max(map(_weight, neighbours)) > max(map(_weight, named))):
+        out += neighbours
     hint = scene.intersection
     n_equal = sum(1 for _x, lp in others if lp == 0.0)  # as likely as the scene's own
     if scene.prior is not None and hint is not None and hint.lat is None and n_equal:
@@ -252,6 +382,69 @@ def _other_junction_candidates(
             "names) to fix the junction"
         )
     return out
+
+
+def _weight(c: Candidate) -> float:
+    """A scored candidate's log weight: its log likelihood (prior odds included) and log
+    plausibility."""
+    return c.log_likelihood + math.log(max(c.prior, 1e-300))
+
+
+CORNER_OUTLIER_M2 = 16.0
+"""A matched corner of the best candidate this far off (squared standard deviations of the
+noise model: 4 sigma) is a warning."""
+
+
+def _warn_corner_outlier(result: LocateResult) -> None:
+    """Warn when the best candidate leaves one matched kerb corner far off its map corner."""
+    if not result.candidates:
+        return
+    worst = max(
+        (m for m in result.candidates[0].matches if m.kind == "corner"),
+        key=lambda m: m.mahalanobis2,
+        default=None,
+    )
+    if worst is None or worst.mahalanobis2 <= CORNER_OUTLIER_M2:
+        return
+    result.warnings.append(
+        f"{worst.label}: the best candidate puts it {worst.misfit_m:.0f} m from its map corner "
+        "(more than 4 standard deviations): clicked off the kerb corner (where the centre "
+        "lines cross, across a wide pavement, another junction's)? Check it"
+    )
+
+
+def _warn_reversed_corners(result: LocateResult) -> None:
+    """Warn when the best candidate reads the visible corners counter-clockwise."""
+    if not result.candidates:
+        return
+    top = result.candidates[0]
+    ev = top.evidence
+    if ev is None or not is_reversed(top.corner_assignment, len(ev.map_corners)):
+        return
+    result.warnings.append(
+        "intersection.corners: the best candidate reads the listed corners counter-clockwise "
+        "(they fit the map better that way): the scene lists them clockwise as seen on "
+        "screen; check their order"
+    )
+
+
+STATED_BEARING_WARN_DEG = 20.0
+"""The best candidate's car this far from the scene's ``street_bearing_deg`` is a warning."""
+
+
+def _warn_stated_bearing(ev: Evidence, result: LocateResult) -> None:
+    """Warn when the best candidate's car does not lie along the stated street bearing."""
+    if ev.stated_bearing is None or not result.candidates:
+        return
+    car = car_bearing_deg(result.candidates[0].enu_from_world) % 180.0
+    d = abs((car - ev.stated_bearing + 90.0) % 180.0 - 90.0)
+    if d <= STATED_BEARING_WARN_DEG:
+        return
+    result.warnings.append(
+        f"street_bearing_deg: the best candidate puts the car along {car:.0f} degrees (or "
+        f"{car + 180.0:.0f}), {d:.0f} degrees from the stated {ev.stated_bearing:g}: the map's "
+        "streets fit better; is the stated bearing the cross street's?"
+    )
 
 
 def _warn_other_junction(
