@@ -781,11 +781,25 @@ def parse_scene(data: Any, *, base_dir: str | Path | None = None) -> Scene:
             shown = json.dumps(err["input"], default=str)
             if len(shown) <= 60:
                 msg = f"{msg} (got {shown})"
+        if _looks_swapped(loc, err):
+            msg += "; latitude is -90 to 90: are lat and lon swapped?"
         extra = f" (+{exc.error_count() - 1} more problems)" if exc.error_count() > 1 else ""
         raise SceneError(msg + extra, _loc_to_path(loc) or None) from None
     except RecursionError:
         raise SceneError("the scene is nested too deeply to be a scene") from None
     return _drop_unusable_evidence(scene)
+
+
+def _looks_swapped(loc: tuple[Any, ...], err: Any) -> bool:
+    """Whether a refused latitude is a longitude's value (a (lon, lat) pair read as (lat, lon))."""
+    value = err.get("input")
+    return (
+        bool(loc)
+        and loc[-1] == "lat"
+        and err.get("type") in ("greater_than_equal", "less_than_equal")
+        and isinstance(value, (int, float))
+        and 90 < abs(value) <= 180
+    )
 
 
 def _check_sizes(data: dict[str, Any]) -> None:

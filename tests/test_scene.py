@@ -163,6 +163,31 @@ def test_parse_errors_name_the_field(
     assert message in str(info.value)
 
 
+@pytest.mark.parametrize(
+    ("where", "value", "swapped"),
+    [
+        ("prior", {"lat": -76.5935, "lon": 39.2856}, False),  # a valid (if odd) latitude
+        ("prior", {"lat": -120.5, "lon": 39.2856}, True),  # a longitude read as latitude
+        ("prior", {"lat": 95.0, "lon": 10.0}, True),
+        ("prior", {"lat": 300.0, "lon": 10.0}, False),  # no longitude either: no hint
+    ],
+)
+def test_a_latitude_that_is_a_longitude_hints_at_a_swap(
+    good: dict[str, Any], where: str, value: dict[str, float], swapped: bool
+) -> None:
+    """Crowds and spreadsheets give (lon, lat): the refusal says so (found by the absolute
+    slips sweep, where such a reference was refused with pydantic's bare range message)."""
+    data = copy.deepcopy(good)
+    data[where] = {**value, "radius_m": 150}
+    if value["lat"] == -76.5935:
+        parse_scene(data)
+        return
+    with pytest.raises(SceneError) as info:
+        parse_scene(data)
+    assert info.value.field == f"{where}.lat"
+    assert ("are lat and lon swapped?" in str(info.value)) is swapped
+
+
 def test_unknown_preset_is_rejected_when_the_scene_is_read(good: dict[str, Any]) -> None:
     """Not only when the size is first used (a scene with references may never use it)."""
     data = copy.deepcopy(good)
