@@ -265,3 +265,15 @@ def test_junction_beyond_the_radius_is_named(baltimore) -> None:  # type: ignore
     )
     assert found[0].status == "not_found"
     assert "they meet 337 m away, at 39.30105,-76.58031" in found[0].reason
+
+
+def test_taiwanese_road_sections_in_either_order() -> None:
+    """OSM writes 'Section 1, Nanjing East Road' where signs and webcam titles write
+    'Nanjing E. Rd. Sec. 1' (the reviewer sweep's Taipei webcam was not_found)."""
+    assert name_tokens("Nanjing E. Rd. Sec. 1") == name_tokens("Section 1, Nanjing East Road")
+    assert name_tokens("Zhongshan N. Rd. Sec. 2") == name_tokens("Zhongshan North Road Section 2")
+    assert name_tokens("Section Road") == ("section", "road")  # no number: an ordinary word
+    taipei = load_map(OSM / "taipei.osm", 25.05224, 121.52256, radius_m=None)
+    best = geocode_title("Zhongshan N Rd Sec 1 / Nanjing E. Rd. Sec. 1", map_data=taipei)[0]
+    assert best.status == "junction"
+    assert _dist_m(best.lat, best.lon, 25.05217, 121.52257) < 30

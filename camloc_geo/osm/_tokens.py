@@ -346,13 +346,24 @@ def name_tokens(name: str) -> tuple[str, ...]:
     True
     >>> name_tokens("Fifth Avenue") == name_tokens("5th Ave")
     True
+    >>> name_tokens("Zhongshan N. Rd. Sec. 2") == name_tokens("Section 2, Zhongshan North Road")
+    True
     """
     text = anyascii(unicodedata.normalize("NFKC", name)).casefold()
     text = _CALLE_RE.sub("calle ", text)
     text = _APOSTROPHE_RE.sub("", text)
     text = _GLUED_STR_RE.sub(r"\1 strasse", text)
     tokens = _NON_WORD_RE.sub(" ", text).split()
-    return tuple(_canonical(tokens))
+    return _section_last(_canonical(tokens))
+
+
+def _section_last(tokens: list[str]) -> tuple[str, ...]:
+    """Taiwanese road sections at the end, however written: OSM's ``Section 2, Zhongshan
+    North Road`` and the signs' ``Zhongshan N. Rd. Sec. 2`` both end ``section 2``."""
+    for i, tok in enumerate(tokens[:-1]):
+        if tok in ("sec", "section") and tokens[i + 1].isdigit() and len(tokens) > 2:
+            return (*tokens[:i], *tokens[i + 2 :], "section", tokens[i + 1])
+    return tuple(tokens)
 
 
 def core_tokens(tokens: tuple[str, ...]) -> tuple[str, ...]:
