@@ -102,6 +102,13 @@ row says so):
 - the ROC AUC of ``1 - confidence`` as a predictor of a focal error over 10 %;
 - "confidently wrong": off by more than 10 % and more than twice the stated sigma, with
   no warning and confidence at least 0.5;
+- whether the rival frames' weights are calibrated (``rival_calibration``): each photo's
+  rival Manhattan frames are recorded as found by ``camloc_geo.autovp`` (its weight
+  ``Phi(-z)`` and log focal ratio to the kept frame, and the kept frame's own sigma, by
+  wrapping two private helpers while the photo runs); over the rivals whose focal length
+  lies beyond the kept frame's own sigma (and 3 %), how often the mixture puts the truth at
+  the rival (``expected_at_rival``, the sum of ``w / (1 + sum w)``) against how many lie
+  nearer the truth than the kept frame (``observed_nearer``);
 - how often the steep looking-up warning ("..., or up 60 degrees ...") is given
   (``n_warned_looking_up``), and where the truth gives gravity, on photos that do not look
   up 45 degrees (``n_warned_looking_up_wrongly``);
@@ -139,7 +146,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from vp_yud import horizon_auc, load_yud
 
-from camloc_geo import NotEnoughStructureError
+from camloc_geo import NotEnoughStructureError, autovp
 from camloc_geo.autovp import detect_vanishing_points, horizon_from_up, pitch_roll_from_up
 
 log = logging.getLogger("vp_real")
@@ -548,6 +555,57 @@ def horizon_err(
     return max(e) / h
 
 
+class _RivalRecorder:
+    """Records the rival frames of one ``detect_vanishing_points`` call (weight and log
+    focal ratio of each, and the kept frame's own sigma) by wrapping ``autovp``'s
+    ``_rival_modes`` and ``_rival_spread`` while it runs."""
+
+    def __init__(self) -> None:
+        self.modes: list[tuple[float, float]] = []
+        self.own_logf_std: float | None = None
+
+    def __enter__(self) -> _RivalRecorder:
+        self._modes, self._spread = autovp._rival_modes, autovp._rival_spread
+
+        def modes(*args: Any, **kwargs: Any) -> Any:
+            out = self._modes(*args, **kwargs)
+            self.modes = [(float(w), float(d)) for w, d, _ in out]
+            return out
+
+        def spread(modes_: Any, own_logf_std: float | None = None) -> Any:
+            if own_logf_std is None:
+                return self._spread(modes_)
+            self.own_logf_std = float(own_logf_std)
+            return self._spread(modes_, own_logf_std)
+
+        vars(autovp)["_rival_modes"] = modes  # (typed as the originals are not)
+        vars(autovp)["_rival_spread"] = spread
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        autovp._rival_modes, autovp._rival_spread = self._modes, self._spread
+
+
+def rival_calibration(rows: list[dict[str, Any]], min_d: float = 0.03) -> dict[str, Any]:
+    """How often the rival frames beyond the kept frame's own sigma are nearer the truth,
+    against how often the sigma's mixture puts the truth there."""
+    n, expected, observed = 0, 0.0, 0
+    for r in rows:
+        own = r.get("own_logf_std")
+        rivals = r.get("rivals") or []
+        if "f" not in r or own is None or not rivals:
+            continue
+        e = math.log1p(r["focal_err"])  # log(f_kept / f_true)
+        den = 1.0 + sum(w for w, _ in rivals)
+        for w, d in rivals:
+            if abs(d) <= max(own, min_d):
+                continue
+            n += 1
+            expected += w / den
+            observed += int(abs(e + d) < abs(e))  # log(f_rival / f_true) = e + d
+    return {"n_beyond_own": n, "expected_at_rival": expected, "observed_nearer": observed}
+
+
 def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict[str, Any]]:
     rows = []
     for t in data:
@@ -563,7 +621,8 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
         if t["up"] is not None:
             row["pitch_true_deg"] = pitch_roll_from_up(t["up"])[0]
         try:
-            res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
+            with _RivalRecorder() as rec:
+                res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
         except NotEnoughStructureError as exc:
             row.update(error=str(exc), time_s=time.perf_counter() - t0)
             rows.append(row)
@@ -583,6 +642,8 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             k1_std=res.distortion_std,
             pitch_std_deg=res.pitch_std_deg,
             roll_std_deg=res.roll_std_deg,
+            rivals=rec.modes,
+            own_logf_std=rec.own_logf_std,
         )
         if t["up"] is not None:
             p_true, r_true = pitch_roll_from_up(t["up"])
@@ -676,6 +737,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
             else None
         ),
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
+        "rival_calibration": rival_calibration(rows),
     }
     return out
 

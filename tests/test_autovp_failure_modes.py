@@ -674,3 +674,39 @@ def test_rival_logf_std_counts_a_rival_by_the_chance_it_is_the_better_frame(
     assert max(tilt) < 1e-4
     same = model(1.0)
     assert autovp._rival_logf_std(best, [best, same], weight, s, 1.0) == (0.0, (0.0, 0.0))
+
+
+def test_rival_logf_std_counts_only_what_lies_beyond_the_kept_frames_own_sigma(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A rival mode whose focal length lies within the kept frame's own sigma is the same
+    answer, whose spread that sigma already states: it adds nothing. One beyond it adds
+    the excess of its squared log-distance over the own variance, at the same weight."""
+    n = 100
+    per_frame = {
+        1.0: np.ones(n),  # the kept frame
+        1.03: np.where(np.arange(n) % 2 == 0, 1.5, 0.5),  # a tie 3 % off
+        1.3: np.where(np.arange(n) % 2 == 0, 1.5, 0.5),  # a tie 30 % off
+    }
+
+    def fake_scores(R: np.ndarray, f_n: float, *_: object) -> tuple[np.ndarray, np.ndarray]:
+        return np.zeros(n, dtype=np.int64), per_frame[round(f_n, 3)]
+
+    monkeypatch.setattr(autovp, "_label_scores", fake_scores)
+    s = autovp._prepare(np.array([[0.0, 0.0, 10.0, 0.0]]), np.zeros(2), 100.0)
+
+    def model(f_n: float) -> autovp._Model:
+        score = float(per_frame[f_n].sum())
+        return autovp._Model(R=np.eye(3), f_n=f_n, labels=np.zeros(n, np.int64), score=score)
+
+    def weight(m: autovp._Model) -> float:
+        return m.score
+
+    best, near, far = model(1.0), model(1.03), model(1.3)
+    own = 0.05
+    near_std = autovp._rival_logf_std(best, [best, near], weight, s, 1.0, own_logf_std=own)[0]
+    assert near_std == 0.0  # 3 % off, inside a 5 % sigma
+    assert autovp._rival_logf_std(best, [best, near], weight, s, 1.0)[0] > 0.01  # not so at 0
+    d = math.log(1.3)
+    far_std = autovp._rival_logf_std(best, [best, far], weight, s, 1.0, own_logf_std=own)[0]
+    assert far_std == pytest.approx(math.sqrt(0.5 * (d**2 - own**2) / 1.5))
