@@ -1,0 +1,361 @@
+"""Reviewers' verdicts on the review maps: the reader (:func:`camloc_geo.maps.read_verdicts`)
+and, in headless Debian Chromium with the network off, the page's verdict controls: a verdict
+survives a reload, the export parses back, the badges and the phone-sized page."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from camloc_geo import maps
+from camloc_geo._errors import InputError
+
+# ------------------------------------------------------------------------------ reader
+
+
+def _write_csv(path: Path, rows: list[dict[str, Any]], bom: bool = True) -> Path:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(maps.VERDICT_FIELDS), lineterminator="\r\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow(r)
+    path.write_text(("\ufeff" if bom else "") + buf.getvalue(), encoding="utf-8")
+    return path
+
+
+ROW = {
+    "camera": "cam-7",
+    "rank": "2",
+    "lat": "-32.0561234",
+    "lon": "115.7456789",
+    "verdict": "yes",
+    "note": 'kerb, "the" tree',
+    "reviewer": "Ana",
+    "time": "2026-11-25T01:10:00.000Z",
+    "page": "summary",
+    "identity": "0123456789abcdef",
+}
+
+
+def test_read_verdicts_csv_values(tmp_path: Path) -> None:
+    rows = maps.read_verdicts(
+        _write_csv(tmp_path / "v.csv", [ROW, {**ROW, "camera": "x", "verdict": "no", "rank": ""}])
+    )
+    assert rows[0] == {
+        "camera": "cam-7",
+        "rank": 2,
+        "lat": -32.0561234,
+        "lon": 115.7456789,
+        "verdict": "yes",
+        "note": 'kerb, "the" tree',
+        "reviewer": "Ana",
+        "time": "2026-11-25T01:10:00.000Z",
+        "page": "summary",
+        "identity": "0123456789abcdef",
+    }
+    assert rows[1]["rank"] is None
+    assert rows[1]["verdict"] == "no"
+    assert list(rows[0]) == list(maps.VERDICT_FIELDS)
+
+
+def test_read_verdicts_undoes_the_formula_guard(tmp_path: Path) -> None:
+    rows = maps.read_verdicts(_write_csv(tmp_path / "v.csv", [{**ROW, "note": "'=1+1"}]))
+    assert rows[0]["note"] == "=1+1"
+
+
+def test_read_verdicts_geojson(tmp_path: Path) -> None:
+    props = {**ROW, "rank": 3, "lat": 51.5, "lon": -0.12}
+    doc = {
+        "type": "FeatureCollection",
+        "properties": {"format": "camloc-verdicts/1"},
+        "features": [
+            {"type": "Feature", "properties": props, "geometry": None},
+            {"type": "Feature", "properties": {**props, "verdict": "unsure", "lat": None}},
+        ],
+    }
+    path = tmp_path / "v.geojson"
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    rows = maps.read_verdicts(path)
+    assert [(r["rank"], r["lat"], r["lon"], r["verdict"]) for r in rows] == [
+        (3, 51.5, -0.12, "yes"),
+        (3, None, -0.12, "unsure"),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"verdict": "maybe"}, "line 2: verdict 'maybe' is not one of yes, no, unsure"),
+        ({"rank": "two"}, "line 2: rank 'two' is not a whole number"),
+        ({"lat": "abc"}, "line 2: lat 'abc' is not a number"),
+        ({"lon": "190"}, "line 2: lon '190' is out of range"),
+        ({"camera": ""}, "line 2: no camera id"),
+    ],
+)
+def test_read_verdicts_names_the_bad_row(
+    tmp_path: Path, change: dict[str, str], message: str
+) -> None:
+    path = _write_csv(tmp_path / "v.csv", [{**ROW, **change}])
+    with pytest.raises(InputError, match=message):
+        maps.read_verdicts(path)
+
+
+def test_read_verdicts_bad_files(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="no such verdicts file"):
+        maps.read_verdicts(tmp_path / "none.csv")
+    other = tmp_path / "other.csv"
+    other.write_text("a,b\n1,2\n", encoding="utf-8")
+    with pytest.raises(InputError, match="no column camera, verdict"):
+        maps.read_verdicts(other)
+    broken = tmp_path / "b.geojson"
+    broken.write_text("{not json", encoding="utf-8")
+    with pytest.raises(InputError, match="not valid JSON"):
+        maps.read_verdicts(broken)
+    nofeat = tmp_path / "n.geojson"
+    nofeat.write_text('{"type": "Feature"}', encoding="utf-8")
+    with pytest.raises(InputError, match="no 'features' list"):
+        maps.read_verdicts(nofeat)
+
+
+# ----------------------------------------------------------------------------- browser
+needs_browser = pytest.mark.skipif(
+    not Path("/usr/bin/chromium").exists(), reason="Debian chromium is not installed"
+)
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    from test_browser_maps import CHROMIUM, LAUNCH_ARGS
+
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=str(CHROMIUM), args=LAUNCH_ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture(scope="module")
+def vpages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    from test_maps import fremantle_map, located
+
+    out = tmp_path_factory.mktemp("verdicts")
+    md = fremantle_map()
+    scene, res = located(md, 0)
+    _s2, res2 = located(md, 2)
+    cand = maps.candidates_map(res, md, out / "candidates.html", offline=True, scene=scene)
+    summary = maps.summary_map(
+        [(res.scene_id, res), ("other", res2)], out / "summary.html", offline=True, map_data=md
+    )
+    return {"candidates": cand, "summary": summary, "result": res, "result2": res2}
+
+
+@pytest.fixture
+def tab(browser: Any) -> Iterator[Any]:
+    from test_browser_maps import _Page
+
+    t = _Page(browser)
+    yield t
+    t.close()
+
+
+def _open_popup(tab: Any, locator: Any) -> Any:
+    tab.click_for_popup(locator)
+    buttons = tab.page.locator(".leaflet-popup-content .camloc-verdict button")
+    buttons.first.wait_for(timeout=3000)
+    return tab.page.locator(".leaflet-popup-content .camloc-verdict")
+
+
+def _close_popup(page: Any) -> None:
+    page.locator(".leaflet-popup-close-button").dispatch_event("click")
+    page.wait_for_function("!document.querySelector('.leaflet-popup')", timeout=3000)
+
+
+def _download(page: Any, which: str) -> tuple[str, str]:
+    with page.expect_download() as info:
+        page.locator(f'button[data-export="{which}"]').click()
+    d = info.value
+    return str(d.suggested_filename), Path(d.path()).read_text(encoding="utf-8")
+
+
+@pytest.mark.browser
+@needs_browser
+def test_candidate_verdict_survives_reload_and_exports(
+    tab: Any, vpages: dict[str, Any], tmp_path: Path
+) -> None:
+    res = vpages["result"]
+    second = res.candidates[1]
+    tab.open(vpages["candidates"], ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    count = page.locator(".camloc-vcount")
+    assert count.inner_text() == f"0 of {len(res.candidates)} candidates reviewed"
+    box = _open_popup(tab, page.locator('.camloc-candidate [data-rank="2"]'))
+    box.locator('button[data-verdict="yes"]').click()
+    box.locator("input").fill("=the lamp post, left")
+    assert page.locator(".leaflet-popup").count() == 1  # the click did not close the popup
+    assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "true"
+    assert count.inner_text() == f"1 of {len(res.candidates)} candidates reviewed"
+    # rank 1 "not this one", then rank 2 is still the camera
+    _close_popup(page)
+    box1 = _open_popup(tab, page.locator('.camloc-candidate [data-rank="1"]'))
+    box1.locator('button[data-verdict="no"]').click()
+    assert count.inner_text() == f"2 of {len(res.candidates)} candidates reviewed"
+    badges = page.evaluate(
+        """() => Array.from(document.querySelectorAll('.camloc-candidate [data-verdict-mark]'))
+            .map(m => [m.getAttribute('data-verdict-mark'), m.getAttribute('data-verdict'),
+                       getComputedStyle(m, '::after').content,
+                       m.closest('.leaflet-marker-icon').getAttribute('aria-label')])"""
+    )
+    marks = {k: (v, c, label) for k, v, c, label in badges}
+    assert marks["2"] == ("yes", '"✓"', "candidate 2: This is the camera")
+    assert marks["1"] == ("no", '"✗"', "candidate 1: Not this one")
+    assert marks["3"][0] is None
+    # reload: the verdicts, the note and the badges are still there
+    page.reload(wait_until="load")
+    page.wait_for_selector(".camloc-vcount")
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent.startsWith('2 of')", timeout=3000
+    )
+    assert (
+        page.locator('.camloc-candidate [data-verdict-mark="2"]').get_attribute("data-verdict")
+        == "yes"
+    )
+    box = _open_popup(tab, page.locator('.camloc-candidate [data-rank="2"]'))
+    assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "true"
+    assert box.locator("input").input_value() == "=the lamp post, left"
+    _close_popup(page)
+    page.locator(".camloc-verdicts input").fill("Ana Reviewer")
+    name, text = _download(page, "csv")
+    assert name.startswith("verdicts-fremantle-0-")
+    assert name.endswith(".csv")
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    rows = maps.read_verdicts(path)
+    assert [(r["camera"], r["rank"], r["verdict"]) for r in rows] == [
+        ("fremantle-0", 1, "no"),
+        ("fremantle-0", 2, "yes"),
+    ]
+    assert rows[1]["lat"] == pytest.approx(second.lat, abs=1e-7)
+    assert rows[1]["lon"] == pytest.approx(second.lon, abs=1e-7)
+    assert rows[1]["note"] == "=the lamp post, left"
+    assert "'=the lamp post" in text  # guarded against spreadsheet formulas
+    assert {r["reviewer"] for r in rows} == {"Ana Reviewer"}
+    assert {r["page"] for r in rows} == {"candidates"}
+    assert all(r["time"].endswith("Z") for r in rows)
+    name, text = _download(page, "geojson")
+    doc = json.loads(text)
+    assert doc["properties"]["format"] == "camloc-verdicts/1"
+    feat = doc["features"][1]
+    assert feat["geometry"]["coordinates"] == pytest.approx([second.lon, second.lat], abs=1e-7)
+    assert feat["properties"]["verdict"] == "yes"
+    gpath = tmp_path / name
+    gpath.write_text(text, encoding="utf-8")
+    assert maps.read_verdicts(gpath) == rows
+    assert tab.blocked == []
+    assert tab.errors == []
+
+
+@pytest.mark.browser
+@needs_browser
+def test_summary_verdicts_pick_another_rank_and_keep_apart(
+    tab: Any, vpages: dict[str, Any], tmp_path: Path
+) -> None:
+    res, res2 = vpages["result"], vpages["result2"]
+    tab.open(vpages["summary"], ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    count = page.locator(".camloc-vcount")
+    # the candidate page's verdicts (same browser storage) are not this page's
+    assert count.inner_text() == "0 of 2 cameras reviewed"
+    marker = page.locator(".camloc-summary-marker").nth(0)
+    box = _open_popup(tab, marker)
+    camera = page.locator(".leaflet-popup-content b").first.inner_text()
+    picked = res if camera == res.scene_id else res2
+    box.locator("select").select_option("3")
+    assert count.inner_text() == "1 of 2 cameras reviewed"
+    assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "false"
+    page.reload(wait_until="load")
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent.startsWith('1 of')", timeout=3000
+    )
+    page.locator(".camloc-verdicts input").fill("")
+    name, text = _download(page, "csv")
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    rows = maps.read_verdicts(path)
+    third = picked.candidates[2]
+    assert len(rows) == 1
+    assert (rows[0]["camera"], rows[0]["rank"], rows[0]["verdict"]) == (camera, 3, "yes")
+    assert rows[0]["lat"] == pytest.approx(third.lat, abs=1e-7)
+    assert rows[0]["lon"] == pytest.approx(third.lon, abs=1e-7)
+    assert rows[0]["page"] == "summary"
+    assert rows[0]["reviewer"] == ""
+    assert tab.blocked == []
+    assert tab.errors == []
+
+
+@pytest.mark.browser
+@needs_browser
+def test_verdicts_on_a_phone(browser: Any, vpages: dict[str, Any]) -> None:
+    from test_browser_maps import ARTIFACTS, _Page
+
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 390, "height": 844})
+        t.open(vpages["candidates"], ".camloc-verdicts .camloc-vcount")
+        page = t.page
+        ARTIFACTS.mkdir(exist_ok=True)
+        # folded to its counter, top right under the layers button
+        panel = page.locator(".camloc-verdicts").bounding_box()
+        assert panel is not None
+        assert panel["width"] <= 220
+        assert panel["height"] <= 40
+        assert panel["y"] < 200
+        assert page.locator('button[data-export="csv"]').is_hidden()
+        covered = [page.locator(".camloc-legend").bounding_box()]
+        covered += [
+            page.locator(f'.camloc-candidate [data-rank="{rank}"]').bounding_box()
+            for rank in range(1, 5)
+        ]
+        for item in covered:
+            assert item is not None
+            assert not (
+                item["x"] < panel["x"] + panel["width"]
+                and panel["x"] < item["x"] + item["width"]
+                and item["y"] < panel["y"] + panel["height"]
+                and panel["y"] < item["y"] + item["height"]
+            ), item
+        page.locator(".camloc-vfold").click()
+        assert page.locator('button[data-export="csv"]').is_visible()
+        assert page.locator(".camloc-vfold").get_attribute("aria-expanded") == "true"
+        page.screenshot(path=str(ARTIFACTS / "verdicts_phone_tools.png"))
+        page.locator(".camloc-vfold").click()
+        assert page.locator('button[data-export="csv"]').is_hidden()
+        box = _open_popup(t, page.locator('.camloc-candidate [data-rank="1"]'))
+        # keyboard: tab to the "Unsure" button and press it
+        box.locator('button[data-verdict="no"]').focus()
+        page.keyboard.press("Tab")
+        page.keyboard.press("Enter")
+        assert box.locator('button[data-verdict="unsure"]').get_attribute("aria-pressed") == "true"
+        popup = page.locator(".leaflet-popup-content-wrapper").bounding_box()
+        assert popup is not None
+        assert popup["width"] <= 390
+        # the whole popup on the screen (it was placed before the controls made it taller)
+        page.wait_for_timeout(400)  # Leaflet's pan animation (0.25 s)
+        popup = page.locator(".leaflet-popup-content-wrapper").bounding_box()
+        assert popup is not None
+        assert popup["y"] >= 0
+        assert popup["y"] + popup["height"] <= 844
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "verdicts_phone_popup.png"))
+        _close_popup(page)
+        page.wait_for_timeout(300)
+        page.screenshot(path=str(ARTIFACTS / "verdicts_phone.png"))
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
