@@ -1557,6 +1557,7 @@ def build_summary_map(
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
     map_data: MapData | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -1574,6 +1575,9 @@ def build_summary_map(
     map_data
         A map to draw under the cameras (its streets and buildings within 500 m of its
         centre): the only context an offline page has.
+    verdicts
+        Rows of :func:`read_verdicts`: shown again on the page (a browser that has verdicts
+        of its own for this page keeps those; see docs/candidates.md).
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
@@ -1676,7 +1680,10 @@ def build_summary_map(
             [it["camera"], it["rank"], it["lat"], it["lon"], it["others"]]
             for it in v_items.values()
         ]
-        _Verdicts(_verdict_config("summary", v_items, v_identity, "summary")).add_to(fmap)
+        config = _verdict_config("summary", v_items, v_identity, "summary")
+        if verdicts:
+            config["given"] = _given_verdicts(v_items, verdicts)
+        _Verdicts(config).add_to(fmap)
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _SmallScreenFolds().add_to(fmap)
     _Control(
@@ -1714,6 +1721,7 @@ def summary_map(
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
     map_data: MapData | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write the summary map of many cameras; see :func:`build_summary_map`.
 
@@ -1725,7 +1733,12 @@ def summary_map(
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     fmap = build_summary_map(
-        items, offline=offline, tiles=tiles, cluster=cluster, map_data=map_data
+        items,
+        offline=offline,
+        tiles=tiles,
+        cluster=cluster,
+        map_data=map_data,
+        verdicts=verdicts,
     )
     page = _render(fmap, offline)
     from camloc_geo._io import write_text_atomic
@@ -2059,8 +2072,23 @@ class _Verdicts(MacroElement):
         return div;
     };
     panel.addTo(map);
-    function refresh() { load(); cfg.order.forEach(mark); counted(); }
+    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); }
+    function seed() {  // verdicts handed in with the page (summary-map --verdicts), once
+        if (!cfg.given || state.seeded) { return; }
+        Object.keys(cfg.given).forEach(function (k) {
+            if (!state.items[k] && cfg.items[k]) { state.items[k] = cfg.given[k]; }
+        });
+        state.seeded = true;
+        save();
+    }
     setTimeout(refresh, 0);  // after the markers are on the map
+    // a marker's icon is made anew when its layer is shown again (layer list, clusters)
+    var again = null;
+    map.on("layeradd", function () {
+        if (again === null) {
+            again = setTimeout(function () { again = null; cfg.order.forEach(mark); }, 0);
+        }
+    });
     window.addEventListener("pageshow", refresh);  // back button (a page from the bfcache)
     window.addEventListener("storage", function (e) { if (e.key === KEY) { refresh(); } });
 })();
@@ -2115,6 +2143,47 @@ def _verdict_config(
         "note_chars": VERDICT_NOTE_CHARS,
         "file": f"verdicts-{_safe(file_stem)[:60]}-{identity[:8]}",
     }
+
+
+def _given_verdicts(
+    items: Mapping[str, Mapping[str, Any]], verdicts: Sequence[Mapping[str, Any]]
+) -> dict[str, dict[str, Any]]:
+    """The summary page's stored form (key ``c<i>``) of exported verdict rows: a summary
+    page's row of the camera first, else a review page's "yes" on one of its candidates,
+    else its row on the camera's best candidate; the last such row of a camera wins. Rows
+    of cameras not on the page, or choosing a rank the page does not have, are left out
+    (counted in a warning)."""
+    by_camera: dict[str, list[tuple[str, Mapping[str, Any]]]] = {}
+    for key, it in items.items():
+        by_camera.setdefault(str(it["camera"]), []).append((key, it))
+    given: dict[str, tuple[int, dict[str, Any]]] = {}
+    unused = 0
+    for row in verdicts:
+        placed = False
+        for key, it in by_camera.get(str(row.get("camera")), []):
+            ranks = {it["rank"], *(o[0] for o in it.get("others") or [])}
+            rank = row.get("rank")
+            if row.get("page") == "summary":
+                level = 3
+            elif row.get("verdict") == "yes" and rank in ranks:
+                level = 2
+            elif rank == it["rank"]:
+                level = 1
+            else:
+                continue
+            if row.get("verdict") == "yes" and rank not in ranks:
+                continue
+            item = {"verdict": row.get("verdict"), "note": row.get("note") or ""}
+            item["time"] = row.get("time") or ""
+            if row.get("verdict") == "yes" and rank is not None:
+                item["rank"] = rank
+            if level >= given.get(key, (0, {}))[0]:
+                given[key] = (level, item)
+            placed = True
+        unused += not placed
+    if unused:
+        log.warning("%d verdict row(s) name no camera or candidate of this page: left out", unused)
+    return {key: item for key, (_level, item) in given.items()}
 
 
 def _verdict_box(key: str) -> str:

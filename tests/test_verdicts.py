@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -359,3 +360,101 @@ def test_verdicts_on_a_phone(browser: Any, vpages: dict[str, Any]) -> None:
         assert t.errors == []
     finally:
         t.close()
+
+
+# ------------------------------------------------------------------ summary-map --verdicts
+def _gj(scene: str, ranks: list[tuple[int, float, float]]) -> dict[str, Any]:
+    feats = [
+        {
+            "type": "Feature",
+            "geometry": {"type": "Point", "coordinates": [lon, lat]},
+            "properties": {
+                "kind": "candidate",
+                "rank": rank,
+                "score": 1.0 / rank,
+                "lat": lat,
+                "lon": lon,
+                "method": "corners",
+                "heading_deg": 90.0,
+            },
+        }
+        for rank, lat, lon in ranks
+    ]
+    return {"type": "FeatureCollection", "properties": {"scene": scene}, "features": feats}
+
+
+def test_given_verdicts_pick_the_row_per_camera() -> None:
+    fmap = maps.build_summary_map(
+        [
+            ("a", _gj("a", [(1, 51.5, -0.1), (2, 51.5001, -0.1001)])),
+            ("b", _gj("b", [(1, 51.6, -0.2)])),
+        ],
+        offline=True,
+        verdicts=[
+            {**ROW, "camera": "a", "page": "candidates", "rank": 1, "verdict": "no"},
+            {**ROW, "camera": "a", "page": "candidates", "rank": 2, "verdict": "yes"},
+            {**ROW, "camera": "b", "page": "summary", "rank": 1, "verdict": "unsure"},
+            {**ROW, "camera": "b", "page": "candidates", "rank": 1, "verdict": "yes"},
+            {**ROW, "camera": "zzz", "page": "summary", "rank": 1, "verdict": "no"},
+        ],
+    )
+    page = fmap.get_root().render()
+    config = json.loads(re.search(r"var cfg = (\{.*?\});\n", page).group(1))  # type: ignore[union-attr]
+    given = config["given"]
+    assert {k: (v["verdict"], v.get("rank")) for k, v in given.items()} == {
+        "c0": ("yes", 2),  # the review page's "yes" on rank 2 wins over its "no" on rank 1
+        "c1": ("unsure", None),  # the summary page's row wins
+    }
+    assert config["items"]["c0"]["others"] == [[2, 51.5001, -0.1001, "0.500"]]
+
+
+def test_summary_map_cli_verdicts(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from camloc_geo.cli import main
+
+    gj = tmp_path / "a.geojson"
+    gj.write_text(json.dumps(_gj("a", [(1, 51.5, -0.1)])), encoding="utf-8")
+    good = _write_csv(
+        tmp_path / "v.csv", [{**ROW, "camera": "a", "rank": "1", "lat": "", "lon": ""}]
+    )
+    out = tmp_path / "s.html"
+    assert main(["summary-map", str(gj), "-o", str(out), "--inline", "--verdicts", str(good)]) == 0
+    assert '"given": {"c0": {' in out.read_text(encoding="utf-8")
+    bad = _write_csv(tmp_path / "bad.csv", [{**ROW, "verdict": "maybe"}])
+    assert main(["summary-map", str(gj), "-o", str(out), "--verdicts", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "line 2: verdict 'maybe' is not one of yes, no, unsure" in err
+
+
+@pytest.mark.browser
+@needs_browser
+def test_summary_page_shows_given_verdicts(
+    tab: Any, vpages: dict[str, Any], tmp_path: Path
+) -> None:
+    res, res2 = vpages["result"], vpages["result2"]
+    page_path = maps.summary_map(
+        [(res.scene_id, res), ("other", res2)],
+        tmp_path / "given.html",
+        offline=True,
+        verdicts=[{**ROW, "camera": "other", "rank": 1, "verdict": "no", "note": "wrong street"}],
+    )
+    tab.open(page_path, ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
+        timeout=3000,
+    )
+    marks = page.evaluate(
+        """() => Array.from(document.querySelectorAll('[data-verdict-mark]'))
+            .map(m => m.getAttribute('data-verdict'))"""
+    )
+    assert sorted(str(m) for m in marks) == ["None", "no"]
+    # the layer list hides and shows the cameras again: the badge comes back with them
+    label = page.locator(".leaflet-control-layers label", has_text="Cameras (best candidate)")
+    label.locator("input").uncheck()
+    label.locator("input").check()
+    page.wait_for_function(
+        "document.querySelectorAll('[data-verdict-mark][data-verdict=\"no\"]').length === 1",
+        timeout=3000,
+    )
+    assert tab.errors == []
