@@ -336,8 +336,11 @@ def test_verdicts_on_a_phone(browser: Any, vpages: dict[str, Any]) -> None:
         page.screenshot(path=str(ARTIFACTS / "verdicts_phone_tools.png"))
         page.locator(".camloc-vfold").click()
         assert page.locator('button[data-export="csv"]').is_hidden()
-        box = _open_popup(t, page.locator('.camloc-candidate [data-rank="1"]'))
-        # keyboard: tab to the "Unsure" button and press it
+        # keyboard only: the marker opens its popup with Enter, Tab reaches "Unsure"
+        page.locator('.leaflet-marker-icon:has([data-rank="1"])').focus()
+        page.keyboard.press("Enter")
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator("button").first.wait_for(timeout=3000)
         box.locator('button[data-verdict="no"]').focus()
         page.keyboard.press("Tab")
         page.keyboard.press("Enter")
