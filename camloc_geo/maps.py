@@ -1803,7 +1803,7 @@ _VERDICT_CSS = """
 .camloc-verdicts.folded .camloc-vtools, .camloc-verdicts.folded .camloc-vwarn { display: none; }
 .camloc-verdicts .camloc-vtools { display: flex; flex-wrap: wrap; gap: 4px; margin-top: 3px;
   align-items: center; }
-.camloc-verdicts input { width: 9em; margin: 0; }
+.camloc-verdicts input { width: 8em; margin: 0; }
 .camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
 """
 
@@ -2016,21 +2016,25 @@ class _Verdicts(MacroElement):
         a.click();
         setTimeout(function () { URL.revokeObjectURL(url); a.remove(); }, 2000);
     }
-    // a phone's map (narrower than {{ this.small }} px): top right, under the layers button,
-    // folded to its counter (at the bottom right it covered the legend and candidates)
-    var small = map.getSize().x < {{ this.small }};
+    // a phone's map (narrower than {{ this.small }} px): top right, under the layers button
+    // (at the bottom right it covered the legend and candidates); a map smaller than
+    // {{ this.fold_below[0] }}x{{ this.fold_below[1] }} px: folded to its counter (unfolded,
+    // it covered candidates 1 and 3 of the tied test scene at 800x600)
+    var size = map.getSize();
+    var small = size.x < {{ this.small }};
+    var folded = small || size.x < {{ this.fold_below[0] }} || size.y < {{ this.fold_below[1] }};
     var panel = L.control({position: small ? "topright" : "bottomright"});
     panel.onAdd = function () {
-        var div = L.DomUtil.create("div", "camloc-verdicts" + (small ? " folded" : ""));
+        var div = L.DomUtil.create("div", "camloc-verdicts" + (folded ? " folded" : ""));
         div.setAttribute("role", "region");
         div.setAttribute("aria-label", "verdicts");
         var head = el("div", "camloc-vhead");
         count = el("span", "camloc-vcount");
         count.setAttribute("aria-live", "polite");
         head.appendChild(count);
-        var fold = el("button", "camloc-vfold", small ? "\u25b8" : "\u25be");
+        var fold = el("button", "camloc-vfold", folded ? "\u25b8" : "\u25be");
         fold.type = "button";
-        fold.setAttribute("aria-expanded", small ? "false" : "true");
+        fold.setAttribute("aria-expanded", folded ? "false" : "true");
         fold.setAttribute("aria-label", "show or hide the export tools");
         fold.addEventListener("click", function () {
             var open = L.DomUtil.hasClass(div, "folded");
@@ -2052,11 +2056,13 @@ class _Verdicts(MacroElement):
         });
         L.DomEvent.on(who, "keydown keypress keyup", L.DomEvent.stopPropagation);
         tools.appendChild(who);
+        tools.appendChild(el("span", "", "Export"));
         [["CSV", "text/csv", csv], ["GeoJSON", "application/geo+json", geojson]].forEach(
             function (f) {
-                var b = el("button", "camloc-vexport", "Export " + f[0]);
+                var b = el("button", "camloc-vexport", f[0]);
                 b.type = "button";
                 b.setAttribute("data-export", f[0].toLowerCase());
+                b.setAttribute("aria-label", "export the verdicts as " + f[0]);
                 b.title = "download the verdicts as " + f[0] + " (nothing leaves this page)";
                 b.addEventListener("click", function () {
                     download(cfg.file + (f[0] === "CSV" ? ".csv" : ".geojson"), f[2](), f[1]);
@@ -2103,6 +2109,7 @@ class _Verdicts(MacroElement):
         self.css = _VERDICT_CSS
         self.store = _VERDICT_STORE
         self.small = SMALL_SCREEN_PX
+        self.fold_below = BANNER_FOLD_BELOW_PX
 
 
 def _page_identity(parts: Any) -> str:

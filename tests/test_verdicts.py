@@ -461,3 +461,50 @@ def test_summary_page_shows_given_verdicts(
         timeout=3000,
     )
     assert tab.errors == []
+
+
+@pytest.mark.browser
+@needs_browser
+@pytest.mark.parametrize(("width", "height"), [(1400, 900), (800, 600)])
+def test_verdict_panel_covers_no_candidate(
+    browser: Any, tmp_path: Path, width: int, height: int
+) -> None:
+    """The tied sample scene (12 candidates): unfolded at 800x600 the panel covered
+    candidates 1 and 3; on a map under 1200x800 it opens folded to its counter."""
+    from test_browser_maps import _Page
+
+    from camloc_geo.api import locate_scene
+
+    samples = Path(__file__).resolve().parents[1] / "sample_maps"
+    tie = locate_scene(samples / "sample_scene.json", map_source=samples / "baltimore.osm.pbf")
+    path = maps.candidates_map(
+        tie.result,
+        tie.map_data,
+        tmp_path / "tied.html",
+        offline=True,
+        scene=tie.scene,
+        overlay_top=0,
+    )
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": width, "height": height})
+        t.open(path, ".camloc-verdicts .camloc-vcount")
+        page = t.page
+        folded = width < 1200
+        assert page.locator('button[data-export="csv"]').is_visible() != folded
+        panel = page.locator(".camloc-verdicts").bounding_box()
+        assert panel is not None
+        dots = page.locator(".camloc-candidate")
+        assert dots.count() == len(tie.result.candidates)
+        for i in range(dots.count()):
+            d = dots.nth(i).bounding_box()
+            assert d is not None
+            assert not (
+                d["x"] < panel["x"] + panel["width"]
+                and panel["x"] < d["x"] + d["width"]
+                and d["y"] < panel["y"] + panel["height"]
+                and panel["y"] < d["y"] + d["height"]
+            ), dots.nth(i).inner_text()
+        assert t.errors == []
+    finally:
+        t.close()
