@@ -153,7 +153,14 @@ def vpages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     summary = maps.summary_map(
         [(res.scene_id, res), ("other", res2)], out / "summary.html", offline=True, map_data=md
     )
-    return {"candidates": cand, "summary": summary, "result": res, "result2": res2}
+    cand2 = maps.candidates_map(res2, md, out / "candidates2.html", offline=True, overlay_top=0)
+    return {
+        "candidates": cand,
+        "candidates2": cand2,
+        "summary": summary,
+        "result": res,
+        "result2": res2,
+    }
 
 
 @pytest.fixture
@@ -270,7 +277,6 @@ def test_summary_verdicts_pick_another_rank_and_keep_apart(
     tab.open(vpages["summary"], ".camloc-verdicts .camloc-vcount")
     page = tab.page
     count = page.locator(".camloc-vcount")
-    # the candidate page's verdicts (same browser storage) are not this page's
     assert count.inner_text() == "0 of 2 cameras reviewed"
     marker = page.locator(".camloc-summary-marker").nth(0)
     box = _open_popup(tab, marker)
@@ -508,3 +514,35 @@ def test_verdict_panel_covers_no_candidate(
         assert t.errors == []
     finally:
         t.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_verdicts_kept_apart_and_back_button(tab: Any, vpages: dict[str, Any]) -> None:
+    """One browser (one storage): another scene's page does not see this page's verdicts, and
+    the back button brings this page back with them."""
+    res2 = vpages["result2"]
+    page = tab.page
+    tab.open(vpages["candidates"], ".camloc-verdicts .camloc-vcount")
+    box = _open_popup(tab, page.locator('.camloc-candidate [data-rank="3"]'))
+    box.locator('button[data-verdict="unsure"]').click()
+    assert page.locator(".camloc-vcount").inner_text().startswith("1 of ")
+    tab.open(vpages["candidates2"], ".camloc-verdicts .camloc-vcount")
+    page.wait_for_timeout(100)
+    assert page.locator(".camloc-vcount").inner_text() == (
+        f"0 of {len(res2.candidates)} candidates reviewed"
+    )
+    assert page.locator("[data-verdict-mark][data-verdict]").count() == 0
+    tab.open(vpages["summary"], ".camloc-verdicts .camloc-vcount")
+    page.wait_for_timeout(100)
+    assert page.locator(".camloc-vcount").inner_text() == "0 of 2 cameras reviewed"
+    page.go_back(wait_until="load")
+    page.go_back(wait_until="load")
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent.startsWith('1 of ')",
+        timeout=3000,
+    )
+    mark = page.locator('.camloc-candidate [data-verdict-mark="3"]')
+    assert mark.get_attribute("data-verdict") == "unsure"
+    assert tab.blocked == []
+    assert tab.errors == []
