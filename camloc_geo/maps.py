@@ -1876,6 +1876,7 @@ class _Verdicts(MacroElement):
         if (same) { delete v.verdict; delete v.rank; }
         else { v.verdict = verdict; if (rank !== null) { v.rank = rank; } else { delete v.rank; } }
         v.time = new Date().toISOString();
+        delete v.reviewer;  // a handed-in verdict changed here is this reviewer's
         state.items[k] = v;
         if (cfg.kind === "candidates" && v.verdict === "yes") {
             // one candidate is the camera: a "yes" on another is withdrawn
@@ -1948,6 +1949,7 @@ class _Verdicts(MacroElement):
         note.addEventListener("input", function () {
             var w = state.items[k] || {};
             w.note = note.value;
+            delete w.reviewer;
             state.items[k] = w;
             save();
         });
@@ -1978,7 +1980,9 @@ class _Verdicts(MacroElement):
             if (!v || !v.verdict) { return; }
             var it = cfg.items[k], c = chosen(k);
             out.push({camera: it.camera, rank: c.rank, lat: c.lat, lon: c.lon,
-                      verdict: v.verdict, note: v.note || "", reviewer: who, time: v.time || "",
+                      verdict: v.verdict, note: v.note || "",
+                      reviewer: typeof v.reviewer === "string" ? v.reviewer : who,
+                      time: v.time || "",
                       page: cfg.kind, identity: cfg.identity});
         });
         return out;
@@ -2182,6 +2186,7 @@ def _given_verdicts(
                 continue
             item = {"verdict": row.get("verdict"), "note": row.get("note") or ""}
             item["time"] = row.get("time") or ""
+            item["reviewer"] = row.get("reviewer") or ""
             if row.get("verdict") == "yes" and rank is not None:
                 item["rank"] = rank
             if level >= given.get(key, (0, {}))[0]:

@@ -458,6 +458,15 @@ def test_summary_page_shows_given_verdicts(
             .map(m => m.getAttribute('data-verdict'))"""
     )
     assert sorted(str(m) for m in marks) == ["None", "no"]
+    # exported again under its own reviewer and time, whoever exports
+    page.locator(".camloc-verdicts input").fill("Bo")
+    name, text = _download(page, "csv")
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    rows = maps.read_verdicts(path)
+    assert [(r["camera"], r["verdict"], r["note"], r["reviewer"], r["time"]) for r in rows] == [
+        ("other", "no", "wrong street", "Ana", ROW["time"])
+    ]
     # the layer list hides and shows the cameras again: the badge comes back with them
     label = page.locator(".leaflet-control-layers label", has_text="Cameras (best candidate)")
     label.locator("input").uncheck()
