@@ -407,14 +407,12 @@ def test_given_verdicts_pick_the_row_per_camera() -> None:
             {**ROW, "camera": "zzz", "page": "summary", "rank": 1, "verdict": "no"},
         ],
     )
-    page = fmap.get_root().render()
-    config = json.loads(re.search(r"var cfg = (\{.*?\});\n", page).group(1))  # type: ignore[union-attr]
-    given = config["given"]
+    given = _config(fmap)["given"]
     assert {k: (v["verdict"], v.get("rank")) for k, v in given.items()} == {
         "c0": ("yes", 2),  # the review page's "yes" on rank 2 wins over its "no" on rank 1
         "c1": ("unsure", None),  # the summary page's row wins
     }
-    assert config["items"]["c0"]["others"] == [[2, 51.5001, -0.1001, "0.500"]]
+    assert _config(fmap)["items"]["c0"]["others"] == [[2, 51.5001, -0.1001, "0.500"]]
 
 
 def test_summary_map_cli_verdicts(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -555,3 +553,49 @@ def test_verdicts_kept_apart_and_back_button(tab: Any, vpages: dict[str, Any]) -
     assert mark.get_attribute("data-verdict") == "unsure"
     assert tab.blocked == []
     assert tab.errors == []
+
+
+def _config(fmap: Any) -> dict[str, Any]:
+    found = re.search(r"var cfg = (\{.*?\});\n", fmap.get_root().render())
+    assert found is not None
+    out: dict[str, Any] = json.loads(found.group(1))
+    return out
+
+
+def test_page_identity_is_the_candidates(vpages: dict[str, Any]) -> None:
+    """The same candidates give the same storage key (a page written again finds its
+    verdicts); another scene's, or a moved candidate, another."""
+    import copy
+
+    from test_maps import fremantle_map
+
+    res, res2 = vpages["result"], vpages["result2"]
+    md = fremantle_map()
+    one = _config(maps.build_candidates_map(res, md, offline=True))
+    again = _config(maps.build_candidates_map(res, None, offline=True))
+    other = _config(maps.build_candidates_map(res2, md, offline=True))
+    assert one["identity"] == again["identity"]
+    assert len(one["identity"]) == 16
+    assert one["identity"] != other["identity"]
+    assert one["kind"] == "candidates"
+    assert one["order"] == [str(c.rank) for c in res.candidates]
+    assert one["items"]["2"]["lat"] == pytest.approx(res.candidates[1].lat, abs=1e-7)
+    from camloc_geo.results import candidates_geojson
+
+    gj = candidates_geojson(res)
+    moved = copy.deepcopy(gj)
+    for f in moved["features"]:
+        if f["properties"].get("rank") == 2 and f["properties"]["kind"] == "candidate":
+            f["properties"]["lat"] += 1e-4
+    base = _config(maps.build_summary_map([("a", gj)], offline=True))
+    assert (
+        base["identity"] == _config(maps.build_summary_map([("a", gj)], offline=True))["identity"]
+    )
+    assert (
+        base["identity"]
+        != _config(maps.build_summary_map([("a", moved)], offline=True))["identity"]
+    )
+    assert (
+        base["identity"] != _config(maps.build_summary_map([("b", gj)], offline=True))["identity"]
+    )
+    assert base["noun"] == "cameras"
