@@ -65,6 +65,8 @@ __all__ = [
     "RANK_OTHER",
     "RANK_PALETTE",
     "SCORE_SCALE",
+    "VERDICTS",
+    "VERDICT_FIELDS",
     "build_candidates_map",
     "build_summary_map",
     "candidates_map",
@@ -72,6 +74,7 @@ __all__ = [
     "leaflet_assets",
     "rank_colour",
     "rank_style",
+    "read_verdicts",
     "score_colour",
     "summary_map",
 ]
@@ -365,6 +368,9 @@ _PAGE_CSS = """
 @media (max-width: 719px) {
   .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
     width: calc(100% - 40px); }
+  .leaflet-popup-content { max-width: calc(100vw - 70px) !important; max-height: 62vh;
+    overflow-y: auto; }
+  .camloc-popup img { width: 100%; }
 }
 .camloc-legend.folded h4 { cursor: pointer; }
 .camloc-legend.folded h4::after { content: " \\25B8"; font-weight: normal; color: #555; }
@@ -815,7 +821,11 @@ def _map_layers(
 
 
 def _candidate_popup(
-    props: Mapping[str, Any], image_src: str | None, image_link: str | None, tie_note: str = ""
+    props: Mapping[str, Any],
+    image_src: str | None,
+    image_link: str | None,
+    tie_note: str = "",
+    verdict_key: str | None = None,
 ) -> str:
     rows = [
         ("rank", _fmt(props.get("rank"))),
@@ -861,6 +871,8 @@ def _candidate_popup(
         tie_note,
         f"<table>{body}</table>",
     ]
+    if verdict_key is not None:
+        parts.append(_verdict_box(verdict_key))
     matches = props.get("matches") or []
     if matches:
         mrows = []
@@ -887,8 +899,10 @@ def _dot_icon(
     outline: float,
     css_class: str,
     tied_with: Sequence[int] = (),
+    verdict_key: str | None = None,
 ) -> folium.DivIcon:
-    """A numbered disc; a tied one sits in a dashed ring with an "≈" badge."""
+    """A numbered disc; a tied one sits in a dashed ring with an "≈" badge; with a
+    ``verdict_key``, wrapped to wear the reviewer's verdict badge."""
     text = _text_colour(fill)
     inner = (
         f'<div class="camloc-dot" data-rank="{html.escape(label)}" data-fill="{fill}" '
@@ -901,6 +915,8 @@ def _dot_icon(
             f'<div class="camloc-tied" data-tied-with="{ties}">{inner}'
             '<span class="camloc-badge">≈</span></div>'
         )
+    if verdict_key is not None:
+        inner = _vmark(verdict_key, inner)
     return folium.DivIcon(
         html=inner, icon_size=(size, size), icon_anchor=(size // 2, size // 2), class_name=css_class
     )
@@ -1138,7 +1154,7 @@ def build_candidates_map(
         ties = [r for r in _ties_of(p) if r in by_rank]
         note = _tie_note(p, by_rank, collection)
         popup = folium.Popup(
-            _candidate_popup(p, img, link, note),
+            _candidate_popup(p, img, link, note, verdict_key=str(rank)),
             max_width=500 if img else 360,
             auto_pan_padding_top_left=[10, 10 if banner is None else _BANNER_FOLDED_PX],
         )
@@ -1148,13 +1164,39 @@ def build_candidates_map(
         folium.Marker(
             [p["lat"], p["lon"]],
             icon=_dot_icon(
-                str(rank), rank_colour(rank), size, outline, "camloc-candidate", tied_with=ties
+                str(rank),
+                rank_colour(rank),
+                size,
+                outline,
+                "camloc-candidate",
+                tied_with=ties,
+                verdict_key=str(rank),
             ),
             popup=popup,
             tooltip=tip,
             z_index_offset=z,
         ).add_to(fg_cands)
     fg_cands.add_to(fmap)
+    scene_name = str(result.scene_id)
+    v_items = {
+        str(p["rank"]): {
+            "camera": scene_name,
+            "rank": int(p["rank"]),
+            "lat": _num(p.get("lat"), 7),
+            "lon": _num(p.get("lon"), 7),
+            "label": f"candidate {int(p['rank'])}",
+        }
+        for p in cand_props
+    }
+    v_identity = [
+        scene_name,
+        [
+            [it["rank"], it["lat"], it["lon"], _num(p.get("score"), 6)]
+            for it, p in zip(v_items.values(), cand_props, strict=True)
+        ],
+    ]
+    if cand_props:
+        _Verdicts(_verdict_config("candidates", v_items, v_identity, scene_name)).add_to(fmap)
 
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _SmallScreenFolds().add_to(fmap)
@@ -1349,8 +1391,12 @@ def candidates_map(
 
 
 # --------------------------------------------------------------------------- summary map
-def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
-    """The best candidate feature of a GeoJSON dict or LocateResult, and the scene's reason."""
+def _best_feature(
+    item: Any, others: list[list[Any]] | None = None
+) -> tuple[dict[str, Any] | None, str | None]:
+    """The best candidate feature of a GeoJSON dict or LocateResult, and the scene's reason;
+    ``others`` (when given) receives ``[rank, lat, lon, score text]`` of the other candidates
+    (at most 8, by rank) for the summary page's "pick another candidate"."""
     if isinstance(item, Mapping):
         gj = item
     else:
@@ -1363,11 +1409,27 @@ def _best_feature(item: Any) -> tuple[dict[str, Any] | None, str | None]:
     reason = (gj.get("properties") or {}).get("reason")
     if not cands:
         return None, reason
-    return min(cands, key=lambda f: f["properties"].get("rank", 1 << 30)), reason
+    cands = sorted(cands, key=lambda f: _rank_of(f["properties"]))
+    if others is not None:
+        for f in cands[1:9]:
+            q = f["properties"]
+            lat, lon = _num(q.get("lat"), 7), _num(q.get("lon"), 7)
+            if isinstance(q.get("rank"), int) and lat is not None and lon is not None:
+                others.append([int(q["rank"]), lat, lon, _score_text(q.get("score"))])
+    return cands[0], reason
+
+
+def _rank_of(props: Mapping[str, Any]) -> int:
+    rank = props.get("rank")
+    return rank if isinstance(rank, int) and not isinstance(rank, bool) else 1 << 30
 
 
 def _arrow_icon(
-    heading: float | None, fill: str, css_class: str, tied: bool = False
+    heading: float | None,
+    fill: str,
+    css_class: str,
+    tied: bool = False,
+    verdict_key: str | None = None,
 ) -> folium.DivIcon:
     """A heading arrow (a dot without heading); a tied camera's in a dashed ring with "≈"."""
     if heading is None or not math.isfinite(heading):
@@ -1393,6 +1455,8 @@ def _arrow_icon(
             f'<div class="camloc-tied-arrow" data-tied="1">{svg}'
             '<span class="camloc-badge">≈</span></div>'
         )
+    if verdict_key is not None:
+        svg = _vmark(verdict_key, svg)
     return folium.DivIcon(
         html=svg, icon_size=(size, size), icon_anchor=(h, h), class_name=css_class
     )
@@ -1493,6 +1557,7 @@ def build_summary_map(
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
     map_data: MapData | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -1510,16 +1575,22 @@ def build_summary_map(
     map_data
         A map to draw under the cameras (its streets and buildings within 500 m of its
         centre): the only context an offline page has.
+    verdicts
+        Rows of :func:`read_verdicts`: shown again on the page (a browser that has verdicts
+        of its own for this page keeps those; see docs/candidates.md).
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
     reasons: dict[int, str | None] = {}
+    alternatives: dict[int, list[list[Any]]] = {}
     for scene_id, item in items:
-        best, reason = _best_feature(item)
+        others: list[list[Any]] = []
+        best, reason = _best_feature(item, others)
         if best is None:
             missing.append((scene_id, reason))
         else:
             reasons[len(rows)] = reason
+            alternatives[len(rows)] = others
             rows.append((scene_id, best))
     ties = {i: _summary_tie(f["properties"], reasons[i]) for i, (_s, f) in enumerate(rows)}
     if rows:
@@ -1576,7 +1647,7 @@ def build_summary_map(
             )
         popup = folium.Popup(
             f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>{note}'
-            f"<table>{body}</table></div>",
+            f"<table>{body}</table>{_verdict_box(f'c{i}')}</div>",
             max_width=320,
         )
         folium.Marker(
@@ -1587,11 +1658,32 @@ def build_summary_map(
                 score_colour(p.get("score", 0.0)),
                 "camloc-summary-marker",
                 tied=tie is not None,
+                verdict_key=f"c{i}",
             ),
             tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})"
             + (f" ≈ {html.escape(tie)}" if tie else ""),
         ).add_to(parent)
     parent.add_to(fmap)
+    v_items = {}
+    for i, (scene_id, f) in enumerate(rows):
+        p = f["properties"]
+        v_items[f"c{i}"] = {
+            "camera": str(scene_id),
+            "rank": p.get("rank") if isinstance(p.get("rank"), int) else None,
+            "lat": _num(p.get("lat"), 7),
+            "lon": _num(p.get("lon"), 7),
+            "label": f"camera {scene_id}",
+            "others": alternatives[i],
+        }
+    if v_items:
+        v_identity = [
+            [it["camera"], it["rank"], it["lat"], it["lon"], it["others"]]
+            for it in v_items.values()
+        ]
+        config = _verdict_config("summary", v_items, v_identity, "summary")
+        if verdicts:
+            config["given"] = _given_verdicts(v_items, verdicts)
+        _Verdicts(config).add_to(fmap)
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _SmallScreenFolds().add_to(fmap)
     _Control(
@@ -1629,6 +1721,7 @@ def summary_map(
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
     map_data: MapData | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write the summary map of many cameras; see :func:`build_summary_map`.
 
@@ -1640,7 +1733,12 @@ def summary_map(
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
     fmap = build_summary_map(
-        items, offline=offline, tiles=tiles, cluster=cluster, map_data=map_data
+        items,
+        offline=offline,
+        tiles=tiles,
+        cluster=cluster,
+        map_data=map_data,
+        verdicts=verdicts,
     )
     page = _render(fmap, offline)
     from camloc_geo._io import write_text_atomic
@@ -1648,6 +1746,570 @@ def summary_map(
     write_text_atomic(out, page)
     log.info("wrote %s (%d bytes)", out, len(page.encode("utf-8")))
     return out
+
+
+# ----------------------------------------------------------------------------- verdicts
+VERDICTS: tuple[str, ...] = ("yes", "no", "unsure")
+"""A reviewer's verdict on a candidate (on the summary page: on a camera's chosen candidate):
+``yes`` (this is the camera; on the summary page "confirm"), ``no`` (not this one; "reject"),
+``unsure``."""
+
+VERDICT_FIELDS: tuple[str, ...] = (
+    "camera",
+    "rank",
+    "lat",
+    "lon",
+    "verdict",
+    "note",
+    "reviewer",
+    "time",
+    "page",
+    "identity",
+)
+"""Columns of an exported verdicts CSV (and properties of its GeoJSON's features), in order."""
+
+VERDICT_NOTE_CHARS = 200
+"""Longest note a reviewer can type into a verdict control."""
+
+_VERDICT_STORE = "camloc-verdicts/v1/"
+
+_VERDICT_CSS = """
+.camloc-vmark { position: relative; width: 100%; height: 100%; }
+.camloc-vmark[data-verdict]::after { position: absolute; bottom: -9px; left: -9px; width: 17px;
+  height: 17px; border-radius: 50%; border: 1.5px solid #fff; box-sizing: border-box;
+  font: bold 12px/14px sans-serif; text-align: center; color: #fff;
+  box-shadow: 0 0 0 1px #111; }
+.camloc-vmark[data-verdict="yes"]::after { content: "\\2713"; background: #1b7f3b; }
+.camloc-vmark[data-verdict="no"]::after { content: "\\2717"; background: #b00020; }
+.camloc-vmark[data-verdict="unsure"]::after { content: "?"; background: #555; }
+.camloc-verdict { margin: 6px 0 5px; border-top: 1px solid #ccc; padding-top: 5px; }
+.camloc-verdict .camloc-vbtns { display: flex; flex-wrap: wrap; gap: 4px; }
+.camloc-verdict button, .camloc-verdicts button { font: 12px sans-serif; padding: 3px 7px;
+  border: 1px solid #777; border-radius: 4px; background: #f5f5f5; cursor: pointer;
+  min-height: 28px; }
+.camloc-verdict button[aria-pressed="true"] { color: #fff; border-color: #111; }
+.camloc-verdict button.v-yes[aria-pressed="true"] { background: #1b7f3b; }
+.camloc-verdict button.v-no[aria-pressed="true"] { background: #b00020; }
+.camloc-verdict button.v-unsure[aria-pressed="true"] { background: #555; }
+.camloc-verdict input, .camloc-verdict select, .camloc-verdicts input { font: 12px sans-serif;
+  margin-top: 4px; box-sizing: border-box; max-width: 100%; }
+.camloc-verdict input { width: 100%; }
+.camloc-verdicts { background: rgba(255,255,255,0.95); padding: 5px 8px; border-radius: 5px;
+  box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif; color: #222;
+  max-width: min(300px, calc(100vw - 30px)); box-sizing: border-box; }
+.camloc-verdicts .camloc-vhead { display: flex; align-items: center; gap: 6px; }
+.camloc-verdicts .camloc-vcount { font-weight: bold; }
+.camloc-verdicts button.camloc-vfold { min-height: 0; padding: 0 5px; margin-left: auto; }
+.camloc-verdicts.folded .camloc-vtools, .camloc-verdicts.folded .camloc-vwarn { display: none; }
+.camloc-verdicts .camloc-vtools { display: flex; flex-wrap: wrap; gap: 4px; margin-top: 3px;
+  align-items: center; }
+.camloc-verdicts input { width: 8em; margin: 0; }
+.camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
+"""
+
+
+class _Verdicts(MacroElement):
+    """The reviewer's verdicts: a control in each popup's ``.camloc-verdict`` placeholder, a
+    badge on marked markers, a counter, the reviewer's name and the export buttons, all kept
+    in the browser's localStorage under the page's kind and identity (see docs/candidates.md).
+    """
+
+    _template = Template(
+        """
+{% macro header(this, kwargs) %}
+<style>{{ this.css }}</style>
+{% endmacro %}
+{% macro script(this, kwargs) %}
+(function () {
+    var cfg = {{ this.config|tojson }};
+    var map = {{ this._parent.get_name() }};
+    var KEY = {{ this.store|tojson }} + cfg.kind + "/" + cfg.identity;
+    var WHO = {{ this.store|tojson }} + "reviewer";
+    var SYM = {yes: "\\u2713", no: "\\u2717", unsure: "?"};
+    var LABEL = cfg.labels;
+    var store = null;
+    try { store = window.localStorage; store.getItem(WHO); } catch (e) { store = null; }
+    var state = {items: {}};
+    function load() {
+        state = {items: {}};
+        if (!store) { return; }
+        try {
+            var s = JSON.parse(store.getItem(KEY) || "null");
+            if (s && typeof s.items === "object" && s.items) { state = s; }
+        } catch (e) { state = {items: {}}; }
+    }
+    function save() {
+        if (!store) { return; }
+        try { store.setItem(KEY, JSON.stringify(state)); } catch (e) { warn("not saved: " + e); }
+    }
+    function reviewer() {
+        try { return (store && store.getItem(WHO)) || ""; } catch (e) { return ""; }
+    }
+    function el(tag, cls, text) {
+        var e = document.createElement(tag);
+        if (cls) { e.className = cls; }
+        if (text !== undefined) { e.textContent = text; }
+        return e;
+    }
+    function mark(k) {
+        var v = state.items[k] && state.items[k].verdict;
+        var it = cfg.items[k];
+        document.querySelectorAll('[data-verdict-mark="' + k + '"]').forEach(function (m) {
+            if (v) { m.setAttribute("data-verdict", v); }
+            else { m.removeAttribute("data-verdict"); }
+            var icon = m.closest(".leaflet-marker-icon") || m;
+            icon.setAttribute("aria-label", it.label + (v ? ": " + LABEL[v] : ": not reviewed"));
+        });
+    }
+    var count, warnBox;
+    function warn(text) { if (warnBox) { warnBox.textContent = text; } }
+    function counted() {
+        var n = 0;
+        cfg.order.forEach(function (k) { if (state.items[k] && state.items[k].verdict) { n++; } });
+        if (count) {
+            count.textContent = n + " of " + cfg.order.length + " " + cfg.noun + " reviewed";
+        }
+    }
+    function set(k, verdict, rank) {
+        var v = state.items[k] || {};
+        var same = v.verdict === verdict && (rank === null || v.rank === rank);
+        if (same) { delete v.verdict; delete v.rank; }
+        else { v.verdict = verdict; if (rank !== null) { v.rank = rank; } else { delete v.rank; } }
+        v.time = new Date().toISOString();
+        delete v.reviewer;  // a handed-in verdict changed here is this reviewer's
+        state.items[k] = v;
+        if (cfg.kind === "candidates" && v.verdict === "yes") {
+            // one candidate is the camera: a "yes" on another is withdrawn
+            cfg.order.forEach(function (o) {
+                var w = state.items[o];
+                if (o !== k && w && w.verdict === "yes") {
+                    delete w.verdict;
+                    w.time = v.time;
+                    mark(o);
+                }
+            });
+        }
+        save(); mark(k); counted();
+    }
+    function render(box, k) {
+        var it = cfg.items[k];
+        if (!it) { return; }
+        box.textContent = "";
+        var buttons = [], pick = null;
+        function sync() {  // the controls' states from the stored verdict, in place (a click
+            // target taken out of the page made Leaflet take the click for the map's)
+            var v = state.items[k] || {};
+            buttons.forEach(function (b) {
+                var val = b.getAttribute("data-verdict");
+                var on = v.verdict === val && (val !== "yes" || !v.rank || v.rank === it.rank);
+                b.setAttribute("aria-pressed", on ? "true" : "false");
+            });
+            if (pick) {
+                var other = v.verdict === "yes" && v.rank && v.rank !== it.rank;
+                pick.value = other ? String(v.rank) : "";
+            }
+        }
+        var group = el("div", "camloc-vbtns");
+        group.setAttribute("role", "group");
+        group.setAttribute("aria-label", "verdict on " + it.label);
+        cfg.verdicts.forEach(function (val) {
+            var b = el("button", "v-" + val, SYM[val] + " " + LABEL[val]);
+            b.type = "button";
+            b.setAttribute("data-verdict", val);
+            b.addEventListener("click", function () {
+                set(k, val, val === "yes" && cfg.kind === "summary" ? it.rank : null);
+                sync();
+            });
+            buttons.push(b);
+            group.appendChild(b);
+        });
+        box.appendChild(group);
+        if (it.others && it.others.length) {
+            pick = el("select");
+            pick.setAttribute("aria-label", "or pick another candidate of " + it.camera);
+            pick.appendChild(el("option", "", "or the camera is candidate\\u2026"));
+            pick.options[0].value = "";
+            it.others.forEach(function (o) {
+                var opt = el("option", "", "rank " + o[0] + " (score " + o[3] + ")");
+                opt.value = String(o[0]);
+                pick.appendChild(opt);
+            });
+            pick.addEventListener("change", function () {
+                if (pick.value) { set(k, "yes", parseInt(pick.value, 10)); }
+                sync();
+            });
+            box.appendChild(pick);
+        }
+        var note = el("input");
+        note.type = "text";
+        note.maxLength = cfg.note_chars;
+        note.placeholder = "note (optional)";
+        note.setAttribute("aria-label", "note on " + it.label);
+        note.value = (state.items[k] || {}).note || "";
+        note.addEventListener("input", function () {
+            var w = state.items[k] || {};
+            w.note = note.value;
+            delete w.reviewer;
+            state.items[k] = w;
+            save();
+        });
+        L.DomEvent.on(note, "keydown keypress keyup", L.DomEvent.stopPropagation);
+        box.appendChild(note);
+        sync();
+    }
+    map.on("popupopen", function (e) {
+        var root = e.popup.getElement();
+        if (!root) { return; }
+        var boxes = root.querySelectorAll(".camloc-verdict[data-verdict-key]");
+        boxes.forEach(function (box) { render(box, box.getAttribute("data-verdict-key")); });
+        // the popup grew by the controls after Leaflet placed it: place and pan it again
+        if (boxes.length) { e.popup.update(); }
+    });
+    function chosen(k) {
+        var it = cfg.items[k], v = state.items[k];
+        var rank = (v.verdict === "yes" && v.rank) ? v.rank : it.rank;
+        var lat = it.lat, lon = it.lon;
+        (it.others || []).forEach(function (o) { if (o[0] === rank) { lat = o[1]; lon = o[2]; } });
+        return {rank: rank, lat: lat, lon: lon};
+    }
+    function rows() {
+        var who = reviewer();
+        var out = [];
+        cfg.order.forEach(function (k) {
+            var v = state.items[k];
+            if (!v || !v.verdict) { return; }
+            var it = cfg.items[k], c = chosen(k);
+            out.push({camera: it.camera, rank: c.rank, lat: c.lat, lon: c.lon,
+                      verdict: v.verdict, note: v.note || "",
+                      reviewer: typeof v.reviewer === "string" ? v.reviewer : who,
+                      time: v.time || "",
+                      page: cfg.kind, identity: cfg.identity});
+        });
+        return out;
+    }
+    function cell(x) {
+        var s = x === null || x === undefined ? "" : String(x);
+        if (/^[=+\\-@\\t\\r]/.test(s) && typeof x === "string") { s = "'" + s; }
+        return /[",\\r\\n]/.test(s) ? '"' + s.replace(/"/g, '""') + '"' : s;
+    }
+    function csv() {
+        var lines = [cfg.fields.join(",")];
+        rows().forEach(function (r) {
+            lines.push(cfg.fields.map(function (f) { return cell(r[f]); }).join(","));
+        });
+        return "\\ufeff" + lines.join("\\r\\n") + "\\r\\n";
+    }
+    function geojson() {
+        return JSON.stringify({
+            type: "FeatureCollection",
+            properties: {format: "camloc-verdicts/1", page: cfg.kind, identity: cfg.identity,
+                         exported: new Date().toISOString()},
+            features: rows().map(function (r) {
+                return {type: "Feature", properties: r,
+                        geometry: (typeof r.lat === "number" && typeof r.lon === "number")
+                            ? {type: "Point", coordinates: [r.lon, r.lat]} : null};
+            })
+        }, null, 1);
+    }
+    function download(name, text, type) {
+        var url = URL.createObjectURL(new Blob([text], {type: type}));
+        var a = el("a");
+        a.href = url;
+        a.download = name;
+        document.body.appendChild(a);
+        a.click();
+        setTimeout(function () { URL.revokeObjectURL(url); a.remove(); }, 2000);
+    }
+    // a phone's map (narrower than {{ this.small }} px): top right, under the layers button
+    // (at the bottom right it covered the legend and candidates); a map smaller than
+    // {{ this.fold_below[0] }}x{{ this.fold_below[1] }} px: folded to its counter (unfolded,
+    // it covered candidates 1 and 3 of the tied test scene at 800x600)
+    var size = map.getSize();
+    var small = size.x < {{ this.small }};
+    var folded = small || size.x < {{ this.fold_below[0] }} || size.y < {{ this.fold_below[1] }};
+    var panel = L.control({position: small ? "topright" : "bottomright"});
+    panel.onAdd = function () {
+        var div = L.DomUtil.create("div", "camloc-verdicts" + (folded ? " folded" : ""));
+        div.setAttribute("role", "region");
+        div.setAttribute("aria-label", "verdicts");
+        var head = el("div", "camloc-vhead");
+        count = el("span", "camloc-vcount");
+        count.setAttribute("aria-live", "polite");
+        head.appendChild(count);
+        var fold = el("button", "camloc-vfold", folded ? "\u25b8" : "\u25be");
+        fold.type = "button";
+        fold.setAttribute("aria-expanded", folded ? "false" : "true");
+        fold.setAttribute("aria-label", "show or hide the export tools");
+        fold.addEventListener("click", function () {
+            var open = L.DomUtil.hasClass(div, "folded");
+            (open ? L.DomUtil.removeClass : L.DomUtil.addClass)(div, "folded");
+            fold.textContent = open ? "\u25be" : "\u25b8";
+            fold.setAttribute("aria-expanded", open ? "true" : "false");
+        });
+        head.appendChild(fold);
+        div.appendChild(head);
+        var tools = el("div", "camloc-vtools");
+        var who = el("input");
+        who.type = "text";
+        who.maxLength = 80;
+        who.placeholder = "your name";
+        who.setAttribute("aria-label", "reviewer's name (in the export)");
+        who.value = reviewer();
+        who.addEventListener("input", function () {
+            try { if (store) { store.setItem(WHO, who.value); } } catch (e) { warn("not saved"); }
+        });
+        L.DomEvent.on(who, "keydown keypress keyup", L.DomEvent.stopPropagation);
+        tools.appendChild(who);
+        tools.appendChild(el("span", "", "Export"));
+        [["CSV", "text/csv", csv], ["GeoJSON", "application/geo+json", geojson]].forEach(
+            function (f) {
+                var b = el("button", "camloc-vexport", f[0]);
+                b.type = "button";
+                b.setAttribute("data-export", f[0].toLowerCase());
+                b.setAttribute("aria-label", "export the verdicts as " + f[0]);
+                b.title = "download the verdicts as " + f[0] + " (nothing leaves this page)";
+                b.addEventListener("click", function () {
+                    download(cfg.file + (f[0] === "CSV" ? ".csv" : ".geojson"), f[2](), f[1]);
+                });
+                tools.appendChild(b);
+            });
+        div.appendChild(tools);
+        warnBox = el("small", "camloc-vwarn");
+        div.appendChild(warnBox);
+        if (!store) { warn("verdicts are not kept: this browser gives the page no storage"); }
+        L.DomEvent.disableClickPropagation(div);
+        L.DomEvent.disableScrollPropagation(div);
+        return div;
+    };
+    panel.addTo(map);
+    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); }
+    function seed() {  // verdicts handed in with the page (summary-map --verdicts), once
+        if (!cfg.given || state.seeded) { return; }
+        Object.keys(cfg.given).forEach(function (k) {
+            if (!state.items[k] && cfg.items[k]) { state.items[k] = cfg.given[k]; }
+        });
+        state.seeded = true;
+        save();
+    }
+    setTimeout(refresh, 0);  // after the markers are on the map
+    // a marker's icon is made anew when its layer is shown again (layer list, clusters)
+    var again = null;
+    map.on("layeradd", function () {
+        if (again === null) {
+            again = setTimeout(function () { again = null; cfg.order.forEach(mark); }, 0);
+        }
+    });
+    window.addEventListener("pageshow", refresh);  // back button (a page from the bfcache)
+    window.addEventListener("storage", function (e) { if (e.key === KEY) { refresh(); } });
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, config: Mapping[str, Any]) -> None:
+        super().__init__()
+        self._name = "CamlocVerdicts"
+        self.config = dict(config)
+        self.css = _VERDICT_CSS
+        self.store = _VERDICT_STORE
+        self.small = SMALL_SCREEN_PX
+        self.fold_below = BANNER_FOLD_BELOW_PX
+
+
+def _page_identity(parts: Any) -> str:
+    """16 hex digits of the SHA-256 of the page's cameras and candidates: two pages share
+    stored verdicts only when they show the same candidates of the same cameras."""
+    import hashlib
+    import json
+
+    blob = json.dumps(parts, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(blob.encode("utf-8")).hexdigest()[:16]
+
+
+def _verdict_labels(kind: str) -> dict[str, str]:
+    if kind == "summary":
+        return {"yes": "Confirm", "no": "Reject", "unsure": "Unsure"}
+    return {"yes": "This is the camera", "no": "Not this one", "unsure": "Unsure"}
+
+
+def _num(value: Any, nd: int) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return round(float(value), nd) if math.isfinite(value) else None
+
+
+def _verdict_config(
+    kind: str, items: Mapping[str, Mapping[str, Any]], identity_parts: Any, file_stem: str
+) -> dict[str, Any]:
+    identity = _page_identity([kind, identity_parts])
+    return {
+        "kind": kind,
+        "identity": identity,
+        "items": dict(items),
+        "order": list(items),
+        "labels": _verdict_labels(kind),
+        "verdicts": list(VERDICTS),
+        "fields": list(VERDICT_FIELDS),
+        "noun": "cameras" if kind == "summary" else "candidates",
+        "note_chars": VERDICT_NOTE_CHARS,
+        "file": f"verdicts-{_safe(file_stem)[:60]}-{identity[:8]}",
+    }
+
+
+def _given_verdicts(
+    items: Mapping[str, Mapping[str, Any]], verdicts: Sequence[Mapping[str, Any]]
+) -> dict[str, dict[str, Any]]:
+    """The summary page's stored form (key ``c<i>``) of exported verdict rows: a summary
+    page's row of the camera first, else a review page's "yes" on one of its candidates,
+    else its row on the camera's best candidate; the last such row of a camera wins. Rows
+    of cameras not on the page, or choosing a rank the page does not have, are left out
+    (counted in a warning)."""
+    by_camera: dict[str, list[tuple[str, Mapping[str, Any]]]] = {}
+    for key, it in items.items():
+        by_camera.setdefault(str(it["camera"]), []).append((key, it))
+    given: dict[str, tuple[int, dict[str, Any]]] = {}
+    unused = 0
+    for row in verdicts:
+        placed = False
+        for key, it in by_camera.get(str(row.get("camera")), []):
+            ranks = {it["rank"], *(o[0] for o in it.get("others") or [])}
+            rank = row.get("rank")
+            if row.get("page") == "summary":
+                level = 3
+            elif row.get("verdict") == "yes" and rank in ranks:
+                level = 2
+            elif rank == it["rank"]:
+                level = 1
+            else:
+                continue
+            if row.get("verdict") == "yes" and rank not in ranks:
+                continue
+            item = {"verdict": row.get("verdict"), "note": row.get("note") or ""}
+            item["time"] = row.get("time") or ""
+            item["reviewer"] = row.get("reviewer") or ""
+            if row.get("verdict") == "yes" and rank is not None:
+                item["rank"] = rank
+            if level >= given.get(key, (0, {}))[0]:
+                given[key] = (level, item)
+            placed = True
+        unused += not placed
+    if unused:
+        log.warning("%d verdict row(s) name no camera or candidate of this page: left out", unused)
+    return {key: item for key, (_level, item) in given.items()}
+
+
+def _verdict_box(key: str) -> str:
+    """The popup's placeholder the page's script fills with the verdict control."""
+    return f'<div class="camloc-verdict" data-verdict-key="{html.escape(key)}"></div>'
+
+
+def _vmark(key: str, inner: str) -> str:
+    """A marker's HTML wrapped so that its verdict badge can be drawn on it."""
+    return f'<div class="camloc-vmark" data-verdict-mark="{html.escape(key)}">{inner}</div>'
+
+
+def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
+    """Read the verdicts a reviewer exported from a review or summary page.
+
+    Parameters
+    ----------
+    path
+        The exported ``.csv`` or ``.geojson`` (see docs/candidates.md, "Verdicts").
+
+    Returns
+    -------
+    list of dict
+        One row per reviewed candidate or camera, keys :data:`VERDICT_FIELDS`: ``camera``,
+        ``note``, ``reviewer``, ``time``, ``page``, ``identity`` as ``str``, ``verdict`` one of
+        :data:`VERDICTS`, ``rank`` an ``int`` (or None), ``lat``/``lon`` floats in degrees (or
+        None).
+
+    Raises
+    ------
+    InputError
+        The file is missing, is neither an exported CSV nor GeoJSON, lacks a column, or a row
+        has a verdict, rank or position that is not one (the message names the row).
+    """
+    import csv
+    import json
+
+    from camloc_geo._errors import InputError
+
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise InputError(f"{p}: no such verdicts file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{p}: cannot read the verdicts file: {exc}") from None
+    raw: list[tuple[str, Mapping[str, Any]]] = []
+    if text.lstrip().startswith("{"):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{p}: not valid JSON: {exc}") from None
+        feats = data.get("features") if isinstance(data, dict) else None
+        if not isinstance(feats, list):
+            raise InputError(f"{p}: not a verdicts GeoJSON (no 'features' list)")
+        for i, f in enumerate(feats):
+            props = f.get("properties") if isinstance(f, dict) else None
+            if not isinstance(props, dict):
+                raise InputError(f"{p}: features[{i}] has no properties")
+            raw.append((f"features[{i}]", props))
+    else:
+        reader = csv.DictReader(text.splitlines())
+        missing = [f for f in ("camera", "verdict") if f not in (reader.fieldnames or [])]
+        if missing:
+            raise InputError(
+                f"{p}: not a verdicts CSV: no column {', '.join(missing)} "
+                f"(columns: {', '.join(VERDICT_FIELDS)})"
+            )
+        for i, row in enumerate(reader, start=2):
+            raw.append((f"line {i}", row))
+    return [_verdict_row(p, where, r) for where, r in raw]
+
+
+def _unformula(value: Any) -> str:
+    """A text cell as typed: the export's "'" guard before = + - @ removed."""
+    s = "" if value is None else str(value)
+    return s[1:] if len(s) >= 2 and s[0] == "'" and s[1] in "=+-@\t\r" else s
+
+
+def _verdict_row(path: Path, where: str, row: Mapping[str, Any]) -> dict[str, Any]:
+    from camloc_geo._errors import InputError
+
+    verdict = str(row.get("verdict") or "").strip()
+    if verdict not in VERDICTS:
+        raise InputError(
+            f"{path}: {where}: verdict {verdict!r} is not one of {', '.join(VERDICTS)}"
+        )
+    camera = _unformula(row.get("camera"))
+    if not camera:
+        raise InputError(f"{path}: {where}: no camera id")
+    out: dict[str, Any] = {"camera": camera, "verdict": verdict}
+    rank = row.get("rank")
+    if rank in (None, ""):
+        out["rank"] = None
+    else:
+        try:
+            out["rank"] = int(str(rank))
+        except ValueError:
+            raise InputError(f"{path}: {where}: rank {rank!r} is not a whole number") from None
+    for key, bound in (("lat", 90.0), ("lon", 180.0)):
+        value = row.get(key)
+        if value in (None, ""):
+            out[key] = None
+            continue
+        try:
+            num = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"{path}: {where}: {key} {value!r} is not a number") from None
+        if not (math.isfinite(num) and -bound <= num <= bound):
+            raise InputError(f"{path}: {where}: {key} {value!r} is out of range")
+        out[key] = num
+    for key in ("note", "reviewer", "time", "page", "identity"):
+        out[key] = _unformula(row.get(key))
+    return {k: out[k] for k in VERDICT_FIELDS}
 
 
 # ------------------------------------------------------------------------------ offline

@@ -45,6 +45,14 @@ def register(subparsers: Any) -> None:
         ),
     )
     p.add_argument("--no-cluster", action="store_true", help="plain markers on online pages too")
+    p.add_argument(
+        "--verdicts",
+        metavar="FILE",
+        help=(
+            "show the verdicts a reviewer exported from a summary or review page (.csv or "
+            ".geojson) again on this page (see docs/candidates.md)"
+        ),
+    )
     p.set_defaults(func=run)
 
 
@@ -107,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
     from camloc_geo.cli import atomic_output, output_path, read_json_file
 
-    out = output_path(args.output, inputs=[*args.inputs, args.osm], option="-o")
+    out = output_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
     if out is None:
         raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
     cleaned = [
@@ -121,6 +129,11 @@ def run(args: argparse.Namespace) -> int:
     pts = [p for p in best if p is not None]
     if not pts and any(n > 0 for _s, _g, n in cleaned):
         raise InputError("no usable camera position in the inputs (every candidate was skipped)")
+    verdicts = None
+    if args.verdicts:
+        from camloc_geo.maps import read_verdicts
+
+        verdicts = read_verdicts(args.verdicts)
     map_data = None
     if args.osm:
         from camloc_geo.api import map_around
@@ -135,6 +148,7 @@ def run(args: argparse.Namespace) -> int:
             offline=args.inline or args.offline,
             cluster=not args.no_cluster,
             map_data=map_data,
+            verdicts=verdicts,
         )
     return 0
 
