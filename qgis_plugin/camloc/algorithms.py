@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from typing import Any
 
 from qgis.core import (
@@ -14,6 +15,7 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingFeedback,
     QgsProcessingLayerPostProcessorInterface,
+    QgsProcessingOutputLayerDefinition,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
@@ -21,6 +23,8 @@ from qgis.core import (
     QgsProcessingParameterNumber,
     QgsProcessingParameterPoint,
     QgsProcessingParameterString,
+    QgsProperty,
+    QgsVectorLayer,
 )
 
 from .layers import (
@@ -28,6 +32,7 @@ from .layers import (
     apply_style,
     fields_of,
     order_camloc_layers,
+    save_style_in_gpkg,
     wgs84,
     wkb_of,
     write_to_sink,
@@ -56,6 +61,12 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
             node = project.layerTreeRoot().findLayer(layer.id())
             if node is not None and node.parent() is not None:
                 order_camloc_layers(node.parent())
+
+
+def _gpkg_path(dest: str) -> str | None:
+    """The GeoPackage file of an output destination (``x.gpkg|layername=t``), else None."""
+    path = str(dest).split("|")[0]
+    return path if path.lower().endswith(".gpkg") and os.path.isfile(path) else None
 
 
 LABEL_MAX_CHARS = 48
@@ -171,6 +182,7 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         results: dict[str, Any],
     ) -> int:
         fields = fields_of(desc)
+        parameters = self._own_gpkg_tables(parameters, context)
         sink, dest = self.parameterAsSink(parameters, name, context, fields, wkb_of(desc), wgs84())
         if sink is None:
             if parameters.get(name) is None:
@@ -182,7 +194,64 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             styler = _post_processors.setdefault(dest, _Styler(kind))
             context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
         results[name] = dest
+        if kind and _gpkg_path(dest):
+            self.__dict__.setdefault("_style_later", []).append((dest, kind))
         return n
+
+    def _own_gpkg_tables(
+        self, parameters: dict[str, Any], context: QgsProcessingContext
+    ) -> dict[str, Any]:
+        """``parameters`` where outputs naming one plain ``.gpkg`` file each get a table.
+
+        QGIS writes a plain ``out.gpkg`` destination as a new file: two outputs given the same
+        file (``--CANDIDATES=out.gpkg --VIEW_CONES=out.gpkg``) left only the last one, the
+        candidates silently lost. Each such output now goes to its own table, named after
+        the output in lower case (``candidates``, ``view_cones``).
+        """
+        paths: dict[str, list[str]] = {}
+        for param in self.destinationParameterDefinitions():
+            value = parameters.get(param.name())
+            if not isinstance(param, QgsProcessingParameterFeatureSink) or value in (None, ""):
+                continue
+            try:
+                dest = self.parameterAsOutputLayer(parameters, param.name(), context)
+            except Exception:  # QGIS reports a bad destination itself
+                continue
+            if dest and dest.lower().endswith(".gpkg") and "'" not in dest:
+                paths.setdefault(os.path.abspath(dest), []).append(param.name())
+        shared = {n: p for p, names in paths.items() if len(names) > 1 for n in names}
+        if not shared:
+            return parameters
+        out = dict(parameters)
+        for name, path in shared.items():
+            uri = f"ogr:dbname='{path}' table=\"{name.lower()}\" (geom)"
+            value = parameters[name]
+            if isinstance(value, QgsProcessingOutputLayerDefinition):
+                new = QgsProcessingOutputLayerDefinition(
+                    QgsProperty.fromValue(uri), value.destinationProject
+                )
+                new.destinationName = value.destinationName
+                new.createOptions = value.createOptions
+                out[name] = new
+            else:
+                out[name] = uri
+        return out
+
+    def postProcessAlgorithm(
+        self, context: QgsProcessingContext, feedback: QgsProcessingFeedback
+    ) -> dict[str, Any]:
+        """Store each GeoPackage output's default style in the GeoPackage itself.
+
+        The styles were applied only to layers QGIS loaded at the end of a run: a GeoPackage
+        written by ``qgis_process`` or opened later (Layer › Add Layer, the Browser) showed
+        plain dots, no labels, a cone for every candidate. Runs on the main thread.
+        """
+        for dest, kind in self.__dict__.pop("_style_later", []):
+            layer = QgsVectorLayer(dest, kind, "ogr")
+            error = save_style_in_gpkg(layer, kind)
+            if error:
+                feedback.pushInfo(f"camloc: the style of {dest} was not saved: {error}")
+        return {}
 
     def _osm(self, parameters: dict[str, Any], context: QgsProcessingContext) -> str | None:
         path = self.parameterAsFile(parameters, "OSM", context)

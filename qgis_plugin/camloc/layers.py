@@ -399,6 +399,25 @@ def apply_style(layer: QgsVectorLayer, kind: str) -> None:
     _score_columns(layer)
 
 
+STYLE_NAME = "camloc"
+"""Name of the default style camloc stores in a GeoPackage (its ``layer_styles`` table)."""
+
+
+def save_style_in_gpkg(layer: QgsVectorLayer, kind: str) -> str:
+    """Apply ``kind``'s default style to a GeoPackage layer and store it there as default.
+
+    QGIS then draws the layer styled wherever it is opened (Add Layer, the Browser, another
+    project). Main thread only (symbols and fonts). Returns an error message, empty on success.
+    """
+    if not layer.isValid():
+        return "the layer cannot be opened"
+    provider = layer.dataProvider()
+    if provider is None or not provider.isSaveAndLoadStyleToDatabaseSupported():
+        return "its format cannot hold a style"
+    apply_style(layer, kind)
+    return str(layer.saveStyleToDatabase(STYLE_NAME, f"camloc {kind}", True, "") or "")
+
+
 def _score_columns(layer: QgsVectorLayer) -> None:
     """The attribute table shows ``score_text`` next to ``score``, wide enough for 1.2e-15."""
     fields = layer.fields()

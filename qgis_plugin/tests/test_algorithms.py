@@ -360,3 +360,40 @@ def test_parameter_labels_fit_the_dialog(provider):
     radius = locate.parameterDefinition("RADIUS_M")
     if hasattr(radius, "help"):
         assert "prior radius + 200 m" in radius.help()
+
+
+def test_outputs_sharing_one_geopackage_each_get_their_table(provider, tmp_path):
+    # qgis_process.bin run camloc:locate --CANDIDATES=out.gpkg --VIEW_CONES=out.gpkg left
+    # only the cones: QGIS wrote each plain .gpkg destination as a new file
+    from osgeo import ogr
+
+    gpkg = tmp_path / "out.gpkg"
+    res = _locate(tmp_path, CANDIDATES=str(gpkg), VIEW_CONES=str(gpkg), MATCHED_CORNERS=None)
+    ds = ogr.Open(str(gpkg))
+    names = {ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())}
+    assert {"candidates", "view_cones"} <= names
+    assert ds.GetLayerByName("candidates").GetFeatureCount() == 12
+    assert ds.GetLayerByName("view_cones").GetFeatureCount() == 12
+    assert _layer(res["CANDIDATES"]).featureCount() == 12
+    assert _layer(res["VIEW_CONES"]).wkbType() != _layer(res["CANDIDATES"]).wkbType()
+    # outputs in files of their own keep QGIS's naming (the table is the file's name)
+    assert Path(res["INTERSECTION"].split("|")[0]).name == "intersection.gpkg"
+
+
+def test_geopackage_outputs_carry_their_style_when_opened_later(provider, tmp_path):
+    # a GeoPackage written by processing.run / qgis_process opened in QGIS afterwards drew
+    # plain dots without labels and a cone for every candidate: the styles were applied only
+    # to layers loaded at the end of a run in the desktop
+    from qgis.core import QgsRuleBasedRenderer
+
+    res = _locate(tmp_path)
+    cands = QgsVectorLayer(res["CANDIDATES"], "fresh", "ogr")  # loads the default style
+    assert isinstance(cands.renderer(), QgsRuleBasedRenderer)
+    assert cands.renderer().rootRule().children()[0].filterExpression() == '"tie"'
+    assert cands.labelsEnabled()
+    assert cands.customProperty("camloc/kind") == "candidates"
+    cones = QgsVectorLayer(res["VIEW_CONES"], "fresh", "ogr")
+    assert isinstance(cones.renderer(), QgsRuleBasedRenderer)
+    assert cones.customProperty("camloc/kind") == "view_cones"
+    # the feature tables are untouched
+    assert cands.featureCount() == 12
