@@ -415,6 +415,14 @@ def save_style_in_gpkg(layer: QgsVectorLayer, kind: str) -> str:
     if provider is None or not provider.isSaveAndLoadStyleToDatabaseSupported():
         return "its format cannot hold a style"
     apply_style(layer, kind)
+    return store_default_style(layer, kind)
+
+
+def store_default_style(layer: QgsVectorLayer, kind: str) -> str:
+    """Store a styled GeoPackage layer's style there as its default; an error, empty if none."""
+    provider = layer.dataProvider()
+    if provider is None or not provider.isSaveAndLoadStyleToDatabaseSupported():
+        return "its format cannot hold a style"
     return str(layer.saveStyleToDatabase(STYLE_NAME, f"camloc {kind}", True, "") or "")
 
 
