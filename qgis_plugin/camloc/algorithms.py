@@ -51,9 +51,12 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
     def __init__(self, kind: str) -> None:
         super().__init__()
         self.kind = kind
+        self.title = ""
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
+        if self.title:  # which camera (scene) or list the layer is of
+            layer.setName(self.title)
         # Processing adds each output on top as it loads it: re-stack the camloc layers so
         # candidates are drawn above cones whatever the loading order
         project = context.project()
@@ -67,6 +70,22 @@ def _gpkg_path(dest: str) -> str | None:
     """The GeoPackage file of an output destination (``x.gpkg|layername=t``), else None."""
     path = str(dest).split("|")[0]
     return path if path.lower().endswith(".gpkg") and os.path.isfile(path) else None
+
+
+def _scene_id(candidates: dict[str, Any], scene_path: str) -> str:
+    """The scene's id as its candidates carry it, else the scene file's name."""
+    try:
+        data = candidates.get("data")
+        if data is None:
+            with open(candidates["path"], encoding="utf-8") as fh:
+                data = json.load(fh)
+        for feat in data.get("features") or []:
+            sid = (feat.get("properties") or {}).get("scene")
+            if sid:
+                return str(sid)
+    except (OSError, ValueError, KeyError, AttributeError):
+        pass
+    return os.path.basename(scene_path)
 
 
 LABEL_MAX_CHARS = 48
@@ -192,6 +211,10 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         del sink
         if context.willLoadLayerOnCompletion(dest):
             styler = _post_processors.setdefault(dest, _Styler(kind))
+            styler.kind = kind
+            of = self.__dict__.get("_layers_of", "")
+            param = self.parameterDefinition(name)
+            styler.title = f"{param.description()} ({of})" if of and param is not None else ""
             context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
         results[name] = dest
         if kind and _gpkg_path(dest):
@@ -373,6 +396,8 @@ class LocateAlgorithm(_CamlocAlgorithm):
         if res is None:
             return {}
         layers = res["layers"]
+        # the loaded layers say which camera: 'Camera candidates (baltimore-eastern-broadway)'
+        self._layers_of = _scene_id(layers["candidates"], scene)
         results: dict[str, Any] = {}
         n = self._sink(
             parameters, "CANDIDATES", layers["candidates"], "candidates", context, results
@@ -524,6 +549,7 @@ class GeocodeListAlgorithm(_CamlocAlgorithm):
         if res is None:
             return {}
         layers = res["layers"]
+        self._layers_of = os.path.basename(job["list"] or "")  # 'Cameras (cams.csv)'
         results: dict[str, Any] = {}
         n = self._sink(parameters, "CAMERAS", layers["cameras"], "cameras", context, results)
         self._sink(

@@ -167,6 +167,10 @@ def test_run_and_load_results_draws_candidates_above_cones(provider, tmp_path):
     order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
     names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
     assert order.index("candidates") < order.index("view_cones"), (order, names)
+    # each layer says which camera it is of (two runs gave two 'Camera candidates')
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    assert f"Camera candidates ({sid})" in names, names
+    assert f"View cones ({sid})" in names, names
     assert order.index("matched_corners") < order.index("view_cones"), order
     # the map draws the layer tree's order: the candidates last, on top
     drawn = project.layerTreeRoot().layerOrder()
