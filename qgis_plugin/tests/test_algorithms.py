@@ -88,6 +88,12 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     assert _layer(res["VIEW_CONES"]).featureCount() == 12
     matched = _layer(res["MATCHED_CORNERS"])
     assert matched.featureCount() == 36
+    # every layer of a camera names it: cones and matched points merged from several runs
+    # (Merge vector layers, one GeoPackage per city) could not be told apart
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    assert {f["scene"] for f in cands.getFeatures()} == {sid}
+    assert {f["scene"] for f in _layer(res["VIEW_CONES"]).getFeatures()} == {sid}
+    assert {f["scene"] for f in matched.getFeatures()} == {sid}
     assert _types(matched)["misfit_m"] == QVariant.Double
     inter = _layer(res["INTERSECTION"])
     kinds = sorted(f["kind"] for f in inter.getFeatures())
