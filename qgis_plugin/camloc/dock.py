@@ -20,6 +20,7 @@ import os
 from typing import Any
 
 from qgis.core import (
+    Qgis,
     QgsApplication,
     QgsCoordinateTransform,
     QgsProject,
@@ -1017,9 +1018,16 @@ class CamlocDock(QDockWidget):
         self.cancel_button.setEnabled(False)
         self.progress.setVisible(False)
         if not ok:
-            self.set_status(
-                "Canceled." if task.error in (None, "canceled") else f"camloc: {task.error}"
-            )
+            if task.error in (None, "canceled"):
+                self.set_status("Canceled.")
+                return
+            line = " ".join(str(task.error).split())  # one line, whatever the library wrote
+            self.set_status(f"camloc: {line}")
+            # QGIS's message bar too: the run may have been started long ago, the dock hidden
+            if self.iface is not None:
+                self.iface.messageBar().pushMessage(
+                    "camloc", f"the camera was not located: {line}", Qgis.Critical, 15
+                )
             return
         self._load_results(task)
 

@@ -853,3 +853,27 @@ def test_the_form_fits_the_dock_at_its_minimum_width(dock):
     need = scroll.widget().minimumSizeHint().width()
     assert need <= scroll.viewport().width(), need
     assert scroll.widget().width() <= scroll.viewport().width()
+
+
+def test_a_failed_run_says_why_in_the_message_bar_in_one_line(dock, qgis_iface, tmp_path):
+    # a run that fails (here the extract does not cover the picked junction) said so only in
+    # the dock's status line: with the dock closed or scrolled, nothing told the analyst
+    from qgis.core import Qgis
+
+    other = SAMPLE_OSM.parent / "fremantle.osm"
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.osm_edit.setText(str(other))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    bar = qgis_iface.messageBar()
+    bar.clear_messages()
+    assert dock.run() is not None
+    assert dock.wait()
+    assert dock.result_layers == []
+    said = bar.get_messages(Qgis.Critical)
+    assert len(said) == 1, said
+    assert "\n" not in said[0]
+    assert "fremantle.osm" in said[0], said
+    assert "outside" in said[0], said
+    assert "\n" not in dock.status.text()
