@@ -1067,12 +1067,14 @@ class CamlocDock(QDockWidget):
         cands = kinds.get("candidates")
         n = cands.featureCount() if cands is not None else 0
         tied = cands is not None and any(f["tie"] for f in cands.getFeatures())
-        msg = f"{n} candidate(s) in {task.gpkg}; best first."
+        # the file's name: a whole path is one word too long to wrap, and cut the rest off
+        msg = f"{n} candidate(s) in {os.path.basename(task.gpkg)}; best first."
         if tied:  # the library's tie, from the data (never from warning text)
             msg += " ★ marks a tie: add a viewing direction or a landmark to decide."
         if not n and task.info.get("reason"):
             msg = f"No candidate: {task.info['reason']}"
         self.set_status(msg)
+        self.status.setToolTip(task.gpkg)
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
             project = QgsProject.instance()
@@ -1115,6 +1117,18 @@ class CamlocDock(QDockWidget):
 
     def set_status(self, text: str) -> None:
         self.status.setText(text)
+        self.status.setToolTip("")
+        self._fit_status()
+
+    def _fit_status(self) -> None:
+        """Give the status line the height of all its wrapped lines (the footer kept one)."""
+        width = self.status.width()
+        if width > 0:
+            self.status.setMinimumHeight(self.status.heightForWidth(width))
+
+    def resizeEvent(self, event: Any) -> None:
+        super().resizeEvent(event)
+        self._fit_status()
 
     def shutdown(self) -> None:
         """Stop what runs in the background (the plugin calls this on unload)."""

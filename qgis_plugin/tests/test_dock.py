@@ -22,6 +22,7 @@ from qgis.core import (
 from qgis.PyQt.QtCore import QPointF, QSize, Qt
 from qgis.PyQt.QtGui import QColor, QImage, QPainter, QPen, QPolygonF
 from qgis.PyQt.QtTest import QTest
+from qgis.PyQt.QtWidgets import QApplication
 
 EXPECTED = HERE / "data" / "expected_scene.json"
 PICK = (39.2856, -76.5935)  # lat, lon of the intersection clicked on the map
@@ -189,6 +190,17 @@ def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
     # scene (the three-annotator sample is within 5 m, see test_algorithms)
     assert best < 20.0
     assert "candidate(s)" in dock.status.text()
+    # the status line is read whole: the GeoPackage by its name (the path in the tooltip), every
+    # line in sight; the full /tmp/... path, a word too long to wrap, cut the tie note off
+    status = dock.status
+    assert "results.gpkg" in status.text()
+    assert str(tmp_path) not in status.text()
+    assert str(gpkg) in status.toolTip()
+    assert "marks a tie" in status.text()
+    QApplication.processEvents()
+    assert status.height() >= status.heightForWidth(status.width()), status.text()
+    longest = max(status.text().split(), key=status.fontMetrics().horizontalAdvance)
+    assert status.fontMetrics().horizontalAdvance(longest) <= status.width(), longest
     matched = [f["what"] for f in layers[1].getFeatures() if f["rank"] == 1]
     assert "your kerb corner 0" in matched  # the analyst's words, not intersection.corners[0]
     # a second run replaces the layers (same GeoPackage tables), no duplicates
