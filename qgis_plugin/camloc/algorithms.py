@@ -143,12 +143,16 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
                 )
             )
             self.addParameter(
-                QgsProcessingParameterFile(
-                    "OSM_FILE",
-                    "Or one OSM extract file",
-                    behavior=QgsProcessingParameterFile.File,
-                    fileFilter=OSM_FILTER,
-                    optional=True,
+                _helped(
+                    QgsProcessingParameterFile(
+                        "OSM_FILE",
+                        "Or one OSM extract file",
+                        behavior=QgsProcessingParameterFile.File,
+                        fileFilter=OSM_FILTER,
+                        optional=True,
+                    ),
+                    "The same as OSM with a file picker (.osm, .osm.pbf, .osm.bz2, .osm.gz); "
+                    "give OSM or this, not both",
                 )
             )
         else:
@@ -311,12 +315,15 @@ class LocateAlgorithm(_CamlocAlgorithm):
         )
         self._add_map_params()
         self.addParameter(
-            QgsProcessingParameterNumber(
-                "MAX_CANDIDATES",
-                "At most this many candidates",
-                type=QgsProcessingParameterNumber.Integer,
-                minValue=1,
-                optional=True,
+            _helped(
+                QgsProcessingParameterNumber(
+                    "MAX_CANDIDATES",
+                    "At most this many candidates",
+                    type=QgsProcessingParameterNumber.Integer,
+                    minValue=1,
+                    optional=True,
+                ),
+                "Empty: every candidate found (at most 32), best first",
             )
         )
         self.addParameter(
@@ -440,9 +447,17 @@ class CornersAlgorithm(_CamlocAlgorithm):
     )
 
     def initAlgorithm(self, config=None):
-        self.addParameter(QgsProcessingParameterPoint("POINT", "Around this point", optional=True))
         self.addParameter(
-            QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True)
+            _helped(
+                QgsProcessingParameterPoint("POINT", "Around this point", optional=True),
+                "Click on the canvas (any project CRS); with RADIUS_M. Empty: give EXTENT",
+            )
+        )
+        self.addParameter(
+            _helped(
+                QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True),
+                "Used when POINT is empty; at most 10 km across",
+            )
         )
         self.addParameter(
             QgsProcessingParameterNumber(
@@ -454,8 +469,12 @@ class CornersAlgorithm(_CamlocAlgorithm):
             )
         )
         self.addParameter(
-            QgsProcessingParameterString(
-                "STREETS", "Only the intersection of 'A & B'", optional=True
+            _helped(
+                QgsProcessingParameterString(
+                    "STREETS", "Only the intersection of 'A & B'", optional=True
+                ),
+                "Two street names joined by '&' (any script: 中山北路二段 & 南京東路一段); "
+                "empty: every intersection found",
             )
         )
         self._add_map_params()
@@ -574,7 +593,11 @@ class MeasureAlgorithm(_CamlocAlgorithm):
             QgsProcessingParameterFile("SCENE", "Scene file", fileFilter=SCENE_FILTER)
         )
         self.addParameter(
-            QgsProcessingParameterString("PAIRS", "Pixel pairs (JSON)", multiLine=True)
+            _helped(
+                QgsProcessingParameterString("PAIRS", "Pixel pairs (JSON)", multiLine=True),
+                'A JSON list: [{"kind": "distance" or "height", "a": [x, y], "b": [x, y]}, ...] '
+                "in the snapshot's pixels",
+            )
         )
         self.addParameter(
             QgsProcessingParameterFeatureSink(

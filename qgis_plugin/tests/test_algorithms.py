@@ -407,3 +407,20 @@ def test_geopackage_outputs_carry_their_style_when_opened_later(provider, tmp_pa
     assert cones.customProperty("camloc/kind") == "view_cones"
     # the feature tables are untouched
     assert cands.featureCount() == 12
+
+
+def test_every_optional_input_says_what_empty_means(provider):
+    # MAX_CANDIDATES, POINT, EXTENT, STREETS and OSM_FILE opened empty in the dialog with no
+    # tooltip: nothing said what an empty field does (every candidate? no filter?)
+    from qgis.core import QgsProcessingDestinationParameter
+
+    silent = [
+        f"{alg.id()}:{p.name()}"
+        for alg in provider.algorithms()
+        for p in alg.parameterDefinitions()
+        if not isinstance(p, QgsProcessingDestinationParameter)
+        and (p.defaultValue() is None or p.name() == "PAIRS")
+        and not (p.help() if hasattr(p, "help") else "")
+        and p.name() not in ("SCENE", "LIST")  # required, the label says it
+    ]
+    assert silent == []
