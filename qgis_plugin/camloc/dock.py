@@ -338,6 +338,10 @@ class CamlocDock(QDockWidget):
         self.image_size: tuple[int, int] | None = None
         """The open snapshot's displayed width and height (EXIF orientation applied)."""
         self.result_layers: list[QgsVectorLayer] = []
+        self._result_key: tuple[str, str] | None = None  # (GeoPackage, table prefix) shown
+        self._restore: tuple[str, dict[str, str]] | None = None  # (group, uris) to put back
+        self._result_group = ""
+        self._result_uris: dict[str, str] = {}
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
         self.task: QgsTask | None = None
@@ -972,7 +976,16 @@ class CamlocDock(QDockWidget):
             if problem:
                 self.set_status(problem)
                 return None
-        self._remove_results()  # their GeoPackage tables are about to be replaced
+        prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id) or "scene"
+        self._restore = None
+        if self._result_key == (os.path.abspath(gpkg), prefix):
+            # their GeoPackage tables are about to be replaced; put back if the run fails
+            self._restore = (self._result_group, dict(self._result_uris))
+            self._remove_results()
+        else:
+            # another camera's (or GeoPackage's) layers: they stay in the project as they are
+            self.result_layers = []
+        self._result_key = None
         scene = self.scene()
         if self.image_file:
             # the worker runs in a folder of its own, where the bare file name the scene
@@ -985,8 +998,7 @@ class CamlocDock(QDockWidget):
             "network": not osm,
             "context": self.context_check.isChecked(),
         }
-        prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id)
-        task = LocateTask(job, gpkg, prefix or "scene")
+        task = LocateTask(job, gpkg, prefix)
         task.on_done = self._run_done
         task.progressChanged.connect(self._task_progress)
         self.task = task
@@ -1018,6 +1030,10 @@ class CamlocDock(QDockWidget):
         self.cancel_button.setEnabled(False)
         self.progress.setVisible(False)
         if not ok:
+            restore, self._restore = self._restore, None
+            if restore is not None:  # the tables were not replaced: the last results come back
+                self._load_layers(restore[0], restore[1], None)
+                self._result_key = (os.path.abspath(task.gpkg), task.prefix)
             if task.error in (None, "canceled"):
                 self.set_status("Canceled.")
                 return
@@ -1032,25 +1048,34 @@ class CamlocDock(QDockWidget):
         self._load_results(task)
 
     def _load_results(self, task: LocateTask) -> None:
-        """Load the task's layers one per event-loop turn (each turn a few tens of ms, so the
-        GUI never stalls for the whole batch), candidates on top; then report and zoom."""
+        """Load the task's layers, then report and zoom."""
+        self._restore = None
+        self._result_key = (os.path.abspath(task.gpkg), task.prefix)
+        self._load_layers(f"camloc: {self.annotation.scene_id}", task.uris, task)
+
+    def _load_layers(self, name: str, uris: dict[str, str], task: LocateTask | None) -> None:
+        """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never
+        stalls for the whole batch) into the group ``name``, candidates on top; then report
+        ``task`` (None: layers put back after a failed run, nothing to report)."""
         from qgis.PyQt.QtCore import QTimer
 
         root = QgsProject.instance().layerTreeRoot()
-        name = f"camloc: {self.annotation.scene_id}"
         group = root.findGroup(name) or root.insertGroup(0, name)
-        todo = [k for k in DRAW_ORDER if k in task.uris]  # top to bottom
+        self._result_group = name
+        self._result_uris = dict(uris)
+        todo = [k for k in DRAW_ORDER if k in uris]  # top to bottom
         self.result_layers = []
         self._loading = True
 
         def next_layer() -> None:
             if not todo:
                 self._loading = False
-                self._report(task)
+                if task is not None:
+                    self._report(task)
                 return
             kind = todo.pop(0)
             opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan
-            layer = QgsVectorLayer(task.uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
+            layer = QgsVectorLayer(uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
             if layer.isValid():
                 apply_style(layer, kind)
                 QgsProject.instance().addMapLayer(layer, False)
