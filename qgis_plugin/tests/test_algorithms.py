@@ -424,3 +424,20 @@ def test_every_optional_input_says_what_empty_means(provider):
         and p.name() not in ("SCENE", "LIST")  # required, the label says it
     ]
     assert silent == []
+
+
+def test_geocodelist_layers_loaded_name_their_list(provider, tmp_path):
+    import processing
+    from qgis.core import QgsProject
+
+    lst = tmp_path / "harbour.csv"
+    lst.write_text("id,title,lat,lon\ncam1,Eastern Ave & S Broadway,39.2856,-76.5935\n")
+    project = QgsProject.instance()
+    project.clear()
+    processing.runAndLoadResults(
+        "camloc:geocodelist",
+        {"LIST": str(lst), "OSM": str(SAMPLE_OSM), "CAMERAS": "TEMPORARY_OUTPUT"},
+    )
+    names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
+    assert names == ["Cameras (harbour.csv)"]
+    project.clear()
