@@ -366,6 +366,12 @@ def _label(layer: QgsVectorLayer, expr: str, priority: int = 5, size: float = 9)
     pal.fieldName = expr
     pal.isExpression = True
     pal.priority = priority
+    if layer.geometryType() == QgsWkbTypes.PointGeometry:
+        # beside the marker, not on it: around the point at distance 0 put '#1 0.38' under the
+        # 7 mm tie star (seen in the canvas screenshot)
+        pal.placement = QgsPalLayerSettings.OrderedPositionsAroundPoint
+        pal.offsetType = QgsPalLayerSettings.FromSymbolBounds
+        pal.dist = 0.8  # mm from the symbol's edge
     fmt = QgsTextFormat()
     fmt.setSize(size)
     buf = QgsTextBufferSettings()

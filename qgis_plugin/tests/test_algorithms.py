@@ -121,6 +121,12 @@ def test_locate_default_style_ties_stars_best_red_unlikely_faded(provider, tmp_p
     assert len({rule.symbol().color().name() for rule in rules}) >= 4
     assert layer.labelsEnabled()
     expr = layer.labeling().settings().fieldName
+    # labels beside the marker (from the symbol's bounds), not under the 7 mm tie star
+    from qgis.core import QgsPalLayerSettings
+
+    pal = layer.labeling().settings()
+    assert pal.placement == QgsPalLayerSettings.OrderedPositionsAroundPoint
+    assert pal.offsetType == QgsPalLayerSettings.FromSymbolBounds
     assert '"rank"' in expr
     assert '"score_text"' in expr
     widths = {c.name: c.width for c in layer.attributeTableConfig().columns()}
