@@ -83,6 +83,7 @@ CONE_FIELDS: list[Field] = [
     ("score_text", "string"),
     ("tie", "bool"),
     ("leading", "bool"),
+    ("scene", "string"),
 ]
 MATCH_FIELDS: list[Field] = [
     ("rank", "int"),
@@ -93,6 +94,7 @@ MATCH_FIELDS: list[Field] = [
     ("pixel_y", "double"),
     ("misfit_m", "double"),
     ("map_corner", "string"),
+    ("scene", "string"),
 ]
 INTERSECTION_FIELDS: list[Field] = [
     ("kind", "string"),
@@ -302,6 +304,7 @@ def _locate_layers(gj: dict[str, Any], out_dir: Path) -> dict[str, Any]:
                     "score_text": score_text(score),
                     "tie": bool(cand and cand["tie"]),
                     "leading": bool(cand and _leading(cand)),
+                    "scene": cand.get("scene") if cand else None,
                 },
             )
         )
@@ -323,6 +326,7 @@ def _locate_layers(gj: dict[str, Any], out_dir: Path) -> dict[str, Any]:
                     "pixel_y": _num(pixel[1]),
                     "misfit_m": _num(p.get("misfit_m")),
                     "map_corner": p.get("map_corner"),
+                    "scene": (by_rank.get(p.get("rank")) or {}).get("scene"),
                 },
             )
         )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from typing import Any
 
 from qgis.core import (
@@ -14,6 +15,7 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingFeedback,
     QgsProcessingLayerPostProcessorInterface,
+    QgsProcessingOutputLayerDefinition,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
@@ -21,6 +23,8 @@ from qgis.core import (
     QgsProcessingParameterNumber,
     QgsProcessingParameterPoint,
     QgsProcessingParameterString,
+    QgsProperty,
+    QgsVectorLayer,
 )
 
 from .layers import (
@@ -28,6 +32,7 @@ from .layers import (
     apply_style,
     fields_of,
     order_camloc_layers,
+    save_style_in_gpkg,
     wgs84,
     wkb_of,
     write_to_sink,
@@ -46,9 +51,12 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
     def __init__(self, kind: str) -> None:
         super().__init__()
         self.kind = kind
+        self.title = ""
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
+        if self.title:  # which camera (scene) or list the layer is of
+            layer.setName(self.title)
         # Processing adds each output on top as it loads it: re-stack the camloc layers so
         # candidates are drawn above cones whatever the loading order
         project = context.project()
@@ -56,6 +64,28 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
             node = project.layerTreeRoot().findLayer(layer.id())
             if node is not None and node.parent() is not None:
                 order_camloc_layers(node.parent())
+
+
+def _gpkg_path(dest: str) -> str | None:
+    """The GeoPackage file of an output destination (``x.gpkg|layername=t``), else None."""
+    path = str(dest).split("|")[0]
+    return path if path.lower().endswith(".gpkg") and os.path.isfile(path) else None
+
+
+def _scene_id(candidates: dict[str, Any], scene_path: str) -> str:
+    """The scene's id as its candidates carry it, else the scene file's name."""
+    try:
+        data = candidates.get("data")
+        if data is None:
+            with open(candidates["path"], encoding="utf-8") as fh:
+                data = json.load(fh)
+        for feat in data.get("features") or []:
+            sid = (feat.get("properties") or {}).get("scene")
+            if sid:
+                return str(sid)
+    except (OSError, ValueError, KeyError, AttributeError):
+        pass
+    return os.path.basename(scene_path)
 
 
 LABEL_MAX_CHARS = 48
@@ -113,12 +143,16 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
                 )
             )
             self.addParameter(
-                QgsProcessingParameterFile(
-                    "OSM_FILE",
-                    "Or one OSM extract file",
-                    behavior=QgsProcessingParameterFile.File,
-                    fileFilter=OSM_FILTER,
-                    optional=True,
+                _helped(
+                    QgsProcessingParameterFile(
+                        "OSM_FILE",
+                        "Or one OSM extract file",
+                        behavior=QgsProcessingParameterFile.File,
+                        fileFilter=OSM_FILTER,
+                        optional=True,
+                    ),
+                    "The same as OSM with a file picker (.osm, .osm.pbf, .osm.bz2, .osm.gz); "
+                    "give OSM or this, not both",
                 )
             )
         else:
@@ -171,6 +205,7 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         results: dict[str, Any],
     ) -> int:
         fields = fields_of(desc)
+        parameters = self._own_gpkg_tables(parameters, context)
         sink, dest = self.parameterAsSink(parameters, name, context, fields, wkb_of(desc), wgs84())
         if sink is None:
             if parameters.get(name) is None:
@@ -180,9 +215,70 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         del sink
         if context.willLoadLayerOnCompletion(dest):
             styler = _post_processors.setdefault(dest, _Styler(kind))
+            styler.kind = kind
+            of = self.__dict__.get("_layers_of", "")
+            param = self.parameterDefinition(name)
+            styler.title = f"{param.description()} ({of})" if of and param is not None else ""
             context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
         results[name] = dest
+        if kind and _gpkg_path(dest):
+            self.__dict__.setdefault("_style_later", []).append((dest, kind))
         return n
+
+    def _own_gpkg_tables(
+        self, parameters: dict[str, Any], context: QgsProcessingContext
+    ) -> dict[str, Any]:
+        """``parameters`` where outputs naming one plain ``.gpkg`` file each get a table.
+
+        QGIS writes a plain ``out.gpkg`` destination as a new file: two outputs given the same
+        file (``--CANDIDATES=out.gpkg --VIEW_CONES=out.gpkg``) left only the last one, the
+        candidates silently lost. Each such output now goes to its own table, named after
+        the output in lower case (``candidates``, ``view_cones``).
+        """
+        paths: dict[str, list[str]] = {}
+        for param in self.destinationParameterDefinitions():
+            value = parameters.get(param.name())
+            if not isinstance(param, QgsProcessingParameterFeatureSink) or value in (None, ""):
+                continue
+            try:
+                dest = self.parameterAsOutputLayer(parameters, param.name(), context)
+            except Exception:  # QGIS reports a bad destination itself
+                continue
+            if dest and dest.lower().endswith(".gpkg") and "'" not in dest:
+                paths.setdefault(os.path.abspath(dest), []).append(param.name())
+        shared = {n: p for p, names in paths.items() if len(names) > 1 for n in names}
+        if not shared:
+            return parameters
+        out = dict(parameters)
+        for name, path in shared.items():
+            uri = f"ogr:dbname='{path}' table=\"{name.lower()}\" (geom)"
+            value = parameters[name]
+            if isinstance(value, QgsProcessingOutputLayerDefinition):
+                new = QgsProcessingOutputLayerDefinition(
+                    QgsProperty.fromValue(uri), value.destinationProject
+                )
+                new.destinationName = value.destinationName
+                new.createOptions = value.createOptions
+                out[name] = new
+            else:
+                out[name] = uri
+        return out
+
+    def postProcessAlgorithm(
+        self, context: QgsProcessingContext, feedback: QgsProcessingFeedback
+    ) -> dict[str, Any]:
+        """Store each GeoPackage output's default style in the GeoPackage itself.
+
+        The styles were applied only to layers QGIS loaded at the end of a run: a GeoPackage
+        written by ``qgis_process`` or opened later (Layer › Add Layer, the Browser) showed
+        plain dots, no labels, a cone for every candidate. Runs on the main thread.
+        """
+        for dest, kind in self.__dict__.pop("_style_later", []):
+            layer = QgsVectorLayer(dest, kind, "ogr")
+            error = save_style_in_gpkg(layer, kind)
+            if error:
+                feedback.pushInfo(f"camloc: the style of {dest} was not saved: {error}")
+        return {}
 
     def _osm(self, parameters: dict[str, Any], context: QgsProcessingContext) -> str | None:
         path = self.parameterAsFile(parameters, "OSM", context)
@@ -219,12 +315,15 @@ class LocateAlgorithm(_CamlocAlgorithm):
         )
         self._add_map_params()
         self.addParameter(
-            QgsProcessingParameterNumber(
-                "MAX_CANDIDATES",
-                "At most this many candidates",
-                type=QgsProcessingParameterNumber.Integer,
-                minValue=1,
-                optional=True,
+            _helped(
+                QgsProcessingParameterNumber(
+                    "MAX_CANDIDATES",
+                    "At most this many candidates",
+                    type=QgsProcessingParameterNumber.Integer,
+                    minValue=1,
+                    optional=True,
+                ),
+                "Empty: every candidate found (at most 32), best first",
             )
         )
         self.addParameter(
@@ -304,6 +403,8 @@ class LocateAlgorithm(_CamlocAlgorithm):
         if res is None:
             return {}
         layers = res["layers"]
+        # the loaded layers say which camera: 'Camera candidates (baltimore-eastern-broadway)'
+        self._layers_of = _scene_id(layers["candidates"], scene)
         results: dict[str, Any] = {}
         n = self._sink(
             parameters, "CANDIDATES", layers["candidates"], "candidates", context, results
@@ -346,9 +447,17 @@ class CornersAlgorithm(_CamlocAlgorithm):
     )
 
     def initAlgorithm(self, config=None):
-        self.addParameter(QgsProcessingParameterPoint("POINT", "Around this point", optional=True))
         self.addParameter(
-            QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True)
+            _helped(
+                QgsProcessingParameterPoint("POINT", "Around this point", optional=True),
+                "Click on the canvas (any project CRS); with RADIUS_M. Empty: give EXTENT",
+            )
+        )
+        self.addParameter(
+            _helped(
+                QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True),
+                "Used when POINT is empty; at most 10 km across",
+            )
         )
         self.addParameter(
             QgsProcessingParameterNumber(
@@ -360,8 +469,12 @@ class CornersAlgorithm(_CamlocAlgorithm):
             )
         )
         self.addParameter(
-            QgsProcessingParameterString(
-                "STREETS", "Only the intersection of 'A & B'", optional=True
+            _helped(
+                QgsProcessingParameterString(
+                    "STREETS", "Only the intersection of 'A & B'", optional=True
+                ),
+                "Two street names joined by '&' (any script: 中山北路二段 & 南京東路一段); "
+                "empty: every intersection found",
             )
         )
         self._add_map_params()
@@ -455,6 +568,7 @@ class GeocodeListAlgorithm(_CamlocAlgorithm):
         if res is None:
             return {}
         layers = res["layers"]
+        self._layers_of = os.path.basename(job["list"] or "")  # 'Cameras (cams.csv)'
         results: dict[str, Any] = {}
         n = self._sink(parameters, "CAMERAS", layers["cameras"], "cameras", context, results)
         self._sink(
@@ -479,7 +593,11 @@ class MeasureAlgorithm(_CamlocAlgorithm):
             QgsProcessingParameterFile("SCENE", "Scene file", fileFilter=SCENE_FILTER)
         )
         self.addParameter(
-            QgsProcessingParameterString("PAIRS", "Pixel pairs (JSON)", multiLine=True)
+            _helped(
+                QgsProcessingParameterString("PAIRS", "Pixel pairs (JSON)", multiLine=True),
+                'A JSON list: [{"kind": "distance" or "height", "a": [x, y], "b": [x, y]}, ...] '
+                "in the snapshot's pixels",
+            )
         )
         self.addParameter(
             QgsProcessingParameterFeatureSink(

@@ -20,6 +20,7 @@ import os
 from typing import Any
 
 from qgis.core import (
+    Qgis,
     QgsApplication,
     QgsCoordinateTransform,
     QgsProject,
@@ -337,6 +338,10 @@ class CamlocDock(QDockWidget):
         self.image_size: tuple[int, int] | None = None
         """The open snapshot's displayed width and height (EXIF orientation applied)."""
         self.result_layers: list[QgsVectorLayer] = []
+        self._result_key: tuple[str, str] | None = None  # (GeoPackage, table prefix) shown
+        self._restore: tuple[str, dict[str, str]] | None = None  # (group, uris) to put back
+        self._result_group = ""
+        self._result_uris: dict[str, str] = {}
         self.map_tool: QgsMapToolEmitPoint | None = None
         self._previous_tool = None
         self.task: QgsTask | None = None
@@ -971,7 +976,16 @@ class CamlocDock(QDockWidget):
             if problem:
                 self.set_status(problem)
                 return None
-        self._remove_results()  # their GeoPackage tables are about to be replaced
+        prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id) or "scene"
+        self._restore = None
+        if self._result_key == (os.path.abspath(gpkg), prefix):
+            # their GeoPackage tables are about to be replaced; put back if the run fails
+            self._restore = (self._result_group, dict(self._result_uris))
+            self._remove_results()
+        else:
+            # another camera's (or GeoPackage's) layers: they stay in the project as they are
+            self.result_layers = []
+        self._result_key = None
         scene = self.scene()
         if self.image_file:
             # the worker runs in a folder of its own, where the bare file name the scene
@@ -984,8 +998,7 @@ class CamlocDock(QDockWidget):
             "network": not osm,
             "context": self.context_check.isChecked(),
         }
-        prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id)
-        task = LocateTask(job, gpkg, prefix or "scene")
+        task = LocateTask(job, gpkg, prefix)
         task.on_done = self._run_done
         task.progressChanged.connect(self._task_progress)
         self.task = task
@@ -1017,32 +1030,52 @@ class CamlocDock(QDockWidget):
         self.cancel_button.setEnabled(False)
         self.progress.setVisible(False)
         if not ok:
-            self.set_status(
-                "Canceled." if task.error in (None, "canceled") else f"camloc: {task.error}"
-            )
+            restore, self._restore = self._restore, None
+            if restore is not None:  # the tables were not replaced: the last results come back
+                self._load_layers(restore[0], restore[1], None)
+                self._result_key = (os.path.abspath(task.gpkg), task.prefix)
+            if task.error in (None, "canceled"):
+                self.set_status("Canceled.")
+                return
+            line = " ".join(str(task.error).split())  # one line, whatever the library wrote
+            self.set_status(f"camloc: {line}")
+            # QGIS's message bar too: the run may have been started long ago, the dock hidden
+            if self.iface is not None:
+                self.iface.messageBar().pushMessage(
+                    "camloc", f"the camera was not located: {line}", Qgis.Critical, 15
+                )
             return
         self._load_results(task)
 
     def _load_results(self, task: LocateTask) -> None:
-        """Load the task's layers one per event-loop turn (each turn a few tens of ms, so the
-        GUI never stalls for the whole batch), candidates on top; then report and zoom."""
+        """Load the task's layers, then report and zoom."""
+        self._restore = None
+        self._result_key = (os.path.abspath(task.gpkg), task.prefix)
+        self._load_layers(f"camloc: {self.annotation.scene_id}", task.uris, task)
+
+    def _load_layers(self, name: str, uris: dict[str, str], task: LocateTask | None) -> None:
+        """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never
+        stalls for the whole batch) into the group ``name``, candidates on top; then report
+        ``task`` (None: layers put back after a failed run, nothing to report)."""
         from qgis.PyQt.QtCore import QTimer
 
         root = QgsProject.instance().layerTreeRoot()
-        name = f"camloc: {self.annotation.scene_id}"
         group = root.findGroup(name) or root.insertGroup(0, name)
-        todo = [k for k in DRAW_ORDER if k in task.uris]  # top to bottom
+        self._result_group = name
+        self._result_uris = dict(uris)
+        todo = [k for k in DRAW_ORDER if k in uris]  # top to bottom
         self.result_layers = []
         self._loading = True
 
         def next_layer() -> None:
             if not todo:
                 self._loading = False
-                self._report(task)
+                if task is not None:
+                    self._report(task)
                 return
             kind = todo.pop(0)
             opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan
-            layer = QgsVectorLayer(task.uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
+            layer = QgsVectorLayer(uris[kind], LAYER_TITLES.get(kind, kind), "ogr", opts)
             if layer.isValid():
                 apply_style(layer, kind)
                 QgsProject.instance().addMapLayer(layer, False)
@@ -1059,12 +1092,14 @@ class CamlocDock(QDockWidget):
         cands = kinds.get("candidates")
         n = cands.featureCount() if cands is not None else 0
         tied = cands is not None and any(f["tie"] for f in cands.getFeatures())
-        msg = f"{n} candidate(s) in {task.gpkg}; best first."
+        # the file's name: a whole path is one word too long to wrap, and cut the rest off
+        msg = f"{n} candidate(s) in {os.path.basename(task.gpkg)}; best first."
         if tied:  # the library's tie, from the data (never from warning text)
             msg += " ★ marks a tie: add a viewing direction or a landmark to decide."
         if not n and task.info.get("reason"):
             msg = f"No candidate: {task.info['reason']}"
         self.set_status(msg)
+        self.status.setToolTip(task.gpkg)
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
             project = QgsProject.instance()
@@ -1107,6 +1142,18 @@ class CamlocDock(QDockWidget):
 
     def set_status(self, text: str) -> None:
         self.status.setText(text)
+        self.status.setToolTip("")
+        self._fit_status()
+
+    def _fit_status(self) -> None:
+        """Give the status line the height of all its wrapped lines (the footer kept one)."""
+        width = self.status.width()
+        if width > 0:
+            self.status.setMinimumHeight(self.status.heightForWidth(width))
+
+    def resizeEvent(self, event: Any) -> None:
+        super().resizeEvent(event)
+        self._fit_status()
 
     def shutdown(self) -> None:
         """Stop what runs in the background (the plugin calls this on unload)."""

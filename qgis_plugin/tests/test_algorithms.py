@@ -88,6 +88,12 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     assert _layer(res["VIEW_CONES"]).featureCount() == 12
     matched = _layer(res["MATCHED_CORNERS"])
     assert matched.featureCount() == 36
+    # every layer of a camera names it: cones and matched points merged from several runs
+    # (Merge vector layers, one GeoPackage per city) could not be told apart
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    assert {f["scene"] for f in cands.getFeatures()} == {sid}
+    assert {f["scene"] for f in _layer(res["VIEW_CONES"]).getFeatures()} == {sid}
+    assert {f["scene"] for f in matched.getFeatures()} == {sid}
     assert _types(matched)["misfit_m"] == QVariant.Double
     inter = _layer(res["INTERSECTION"])
     kinds = sorted(f["kind"] for f in inter.getFeatures())
@@ -115,6 +121,12 @@ def test_locate_default_style_ties_stars_best_red_unlikely_faded(provider, tmp_p
     assert len({rule.symbol().color().name() for rule in rules}) >= 4
     assert layer.labelsEnabled()
     expr = layer.labeling().settings().fieldName
+    # labels beside the marker (from the symbol's bounds), not under the 7 mm tie star
+    from qgis.core import QgsPalLayerSettings
+
+    pal = layer.labeling().settings()
+    assert pal.placement == QgsPalLayerSettings.OrderedPositionsAroundPoint
+    assert pal.offsetType == QgsPalLayerSettings.FromSymbolBounds
     assert '"rank"' in expr
     assert '"score_text"' in expr
     widths = {c.name: c.width for c in layer.attributeTableConfig().columns()}
@@ -167,6 +179,10 @@ def test_run_and_load_results_draws_candidates_above_cones(provider, tmp_path):
     order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
     names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
     assert order.index("candidates") < order.index("view_cones"), (order, names)
+    # each layer says which camera it is of (two runs gave two 'Camera candidates')
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    assert f"Camera candidates ({sid})" in names, names
+    assert f"View cones ({sid})" in names, names
     assert order.index("matched_corners") < order.index("view_cones"), order
     # the map draws the layer tree's order: the candidates last, on top
     drawn = project.layerTreeRoot().layerOrder()
@@ -360,3 +376,74 @@ def test_parameter_labels_fit_the_dialog(provider):
     radius = locate.parameterDefinition("RADIUS_M")
     if hasattr(radius, "help"):
         assert "prior radius + 200 m" in radius.help()
+
+
+def test_outputs_sharing_one_geopackage_each_get_their_table(provider, tmp_path):
+    # qgis_process.bin run camloc:locate --CANDIDATES=out.gpkg --VIEW_CONES=out.gpkg left
+    # only the cones: QGIS wrote each plain .gpkg destination as a new file
+    from osgeo import ogr
+
+    gpkg = tmp_path / "out.gpkg"
+    res = _locate(tmp_path, CANDIDATES=str(gpkg), VIEW_CONES=str(gpkg), MATCHED_CORNERS=None)
+    ds = ogr.Open(str(gpkg))
+    names = {ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())}
+    assert {"candidates", "view_cones"} <= names
+    assert ds.GetLayerByName("candidates").GetFeatureCount() == 12
+    assert ds.GetLayerByName("view_cones").GetFeatureCount() == 12
+    assert _layer(res["CANDIDATES"]).featureCount() == 12
+    assert _layer(res["VIEW_CONES"]).wkbType() != _layer(res["CANDIDATES"]).wkbType()
+    # outputs in files of their own keep QGIS's naming (the table is the file's name)
+    assert Path(res["INTERSECTION"].split("|")[0]).name == "intersection.gpkg"
+
+
+def test_geopackage_outputs_carry_their_style_when_opened_later(provider, tmp_path):
+    # a GeoPackage written by processing.run / qgis_process opened in QGIS afterwards drew
+    # plain dots without labels and a cone for every candidate: the styles were applied only
+    # to layers loaded at the end of a run in the desktop
+    from qgis.core import QgsRuleBasedRenderer
+
+    res = _locate(tmp_path)
+    cands = QgsVectorLayer(res["CANDIDATES"], "fresh", "ogr")  # loads the default style
+    assert isinstance(cands.renderer(), QgsRuleBasedRenderer)
+    assert cands.renderer().rootRule().children()[0].filterExpression() == '"tie"'
+    assert cands.labelsEnabled()
+    assert cands.customProperty("camloc/kind") == "candidates"
+    cones = QgsVectorLayer(res["VIEW_CONES"], "fresh", "ogr")
+    assert isinstance(cones.renderer(), QgsRuleBasedRenderer)
+    assert cones.customProperty("camloc/kind") == "view_cones"
+    # the feature tables are untouched
+    assert cands.featureCount() == 12
+
+
+def test_every_optional_input_says_what_empty_means(provider):
+    # MAX_CANDIDATES, POINT, EXTENT, STREETS and OSM_FILE opened empty in the dialog with no
+    # tooltip: nothing said what an empty field does (every candidate? no filter?)
+    from qgis.core import QgsProcessingDestinationParameter
+
+    silent = [
+        f"{alg.id()}:{p.name()}"
+        for alg in provider.algorithms()
+        for p in alg.parameterDefinitions()
+        if not isinstance(p, QgsProcessingDestinationParameter)
+        and (p.defaultValue() is None or p.name() == "PAIRS")
+        and not (p.help() if hasattr(p, "help") else "")
+        and p.name() not in ("SCENE", "LIST")  # required, the label says it
+    ]
+    assert silent == []
+
+
+def test_geocodelist_layers_loaded_name_their_list(provider, tmp_path):
+    import processing
+    from qgis.core import QgsProject
+
+    lst = tmp_path / "harbour.csv"
+    lst.write_text("id,title,lat,lon\ncam1,Eastern Ave & S Broadway,39.2856,-76.5935\n")
+    project = QgsProject.instance()
+    project.clear()
+    processing.runAndLoadResults(
+        "camloc:geocodelist",
+        {"LIST": str(lst), "OSM": str(SAMPLE_OSM), "CAMERAS": "TEMPORARY_OUTPUT"},
+    )
+    names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
+    assert names == ["Cameras (harbour.csv)"]
+    project.clear()
