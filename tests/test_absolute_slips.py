@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from camloc_geo import MapDataError
 from camloc_geo.absolute import LocateResult, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
@@ -279,3 +280,23 @@ def test_landmark_named_by_its_neighbour(baltimore: MapData, inter_id: str, seed
     assert warned
     assert named.name is not None
     assert named.name in warned[0]
+
+
+def test_one_street_name_and_a_prior_try_that_streets_junctions(baltimore: MapData) -> None:
+    """The scene contract names '(some of)' the junction's streets: one name with a prior was
+    refused ('give at least two street names'; the QGIS sweep's Moscow scene, its one street
+    on both sides of the junction). Its junctions within the prior are tried now."""
+    ls = _located(baltimore, "c49531205", 9, min_corners=2)
+    scene = json.loads(json.dumps(ls.scene))
+    it = scene["intersection"]
+    it.pop("lat")
+    it.pop("lon")
+    it["streets"] = ["South Broadway"]
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert min(errs) < 1.0
+    assert errs[0] < 1.0 or res.candidates[0].ambiguous_with
+    assert any("junctions along 'South Broadway'" in w for w in res.warnings)
+    it["streets"] = ["No Such Street"]
+    with pytest.raises(MapDataError, match="'No Such Street' meets no other street"):
+        locate(parse_scene(scene), baltimore)

@@ -15,6 +15,7 @@ from camloc_geo.absolute._model import EvidenceKind, LocateResult, LocateSetting
 from camloc_geo.camera import Camera
 from camloc_geo.geodesy import LocalFrame
 from camloc_geo.osm._local import LocalIndex
+from camloc_geo.osm._names import close_matches, split_street_query
 from camloc_geo.scene import Scene
 
 if TYPE_CHECKING:
@@ -234,10 +235,31 @@ def choose_intersection(scene: Scene, map_data: MapData, frame: LocalFrame) -> I
             )
         return inter
     if hint.streets:
+        names = split_street_query(list(hint.streets))
+        if len(names) == 1:  # "(some of) its streets": the junctions along that one street
+            return _junction_of_one_street(map_data, names[0], near or (frame.lat0, frame.lon0))
         return map_data.find_intersection(list(hint.streets), near=near)
     if scene.prior is not None:
         return map_data.nearest_intersection(lat=scene.prior.lat, lon=scene.prior.lon)
     return map_data.nearest_intersection(lat=frame.lat0, lon=frame.lon0)
+
+
+def _junction_of_one_street(
+    map_data: MapData, name: str, near: tuple[float, float]
+) -> Intersection:
+    """The junction along the one named street nearest to ``near`` (the prior, else the
+    map's point); with a prior, :func:`other_junctions` tries its other junctions within it."""
+    found = [x for x in map_data.street_junctions([name]) if x.corners] or (
+        map_data.street_junctions([name])
+    )
+    if not found:
+        close = close_matches(name, map_data.street_names())
+        raise MapDataError(
+            f"intersection.streets: {name!r} meets no other street in this map; close "
+            f"matches: {', '.join(repr(c) for c in close) if close else 'none'}"
+        )
+    lat, lon = near
+    return min(found, key=lambda x: map_data.distance_to_m(x, lat=lat, lon=lon))
 
 
 @dataclass

@@ -375,11 +375,14 @@ def _other_junction_candidates(
     hint = scene.intersection
     n_equal = sum(1 for _x, lp in others if lp == 0.0)  # as likely as the scene's own
     if scene.prior is not None and hint is not None and hint.lat is None and n_equal:
+        one = hint.streets or []
+        along = f" along {one[0]!r}" if len(one) == 1 else ""
+        more = "a second street name" if along else "street names"
         result.warnings.append(
             f"corners: no intersection lat/lon in the scene, so the corners were matched at "
-            f"the {n_equal + 1} junctions with kerb corners within "
-            f"{scene.prior.radius_m:g} m of the prior; give intersection.lat/lon (or street "
-            "names) to fix the junction"
+            f"the {n_equal + 1} junctions{along} with kerb corners within "
+            f"{scene.prior.radius_m:g} m of the prior; give intersection.lat/lon (or {more}) "
+            "to fix the junction"
         )
     return out
 
