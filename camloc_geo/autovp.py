@@ -94,7 +94,7 @@ import logging
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -164,6 +164,10 @@ _FEW_LINES_MIN_SHIFT = 0.03
 #: A direction with fewer distinct lines than this has its lines left out one at a time
 #: (a delete-one-line jackknife of the focal length, ``_line_jackknife_logf_std``).
 _JACKKNIFE_LINES = 24
+#: A direction of ``_WEAK_LINES`` to ``_JACKKNIFE_LINES`` distinct lines of which at least this
+#: share of segments are tangent pieces of a curve (``_curve_share``) is not established
+#: (``_curve_direction``).
+_CURVE_SHARE = 0.45
 #: A half of a direction's lines whose leaving out moves pitch or roll by more than this
 #: many of its standard deviations is another family (``_split_tilt_deg``).
 _SPLIT_TILT_Z = 2.0
@@ -628,6 +632,9 @@ class _Model:
     # than _FEW_LINES) that pulls it away from the other two directions (a warning)
     rests_on_few: int = 0
     few_shift: float = 0.0  # |log| pull of the focal length by such a direction (in sigma)
+    # the focal length rests on a direction of this many lines, tangent pieces of curves
+    # (``_curve_direction``: a warning)
+    thin_only: int = 0
     n_lines: tuple[int, int, int] | None = None  # distinct lines of each column of R
     # the photo's own estimate (normalised) and sigma of log(focal), before the default prior
     f_data_n: float = float("nan")
@@ -1095,6 +1102,95 @@ def _rival_logf_std(
         nearest the kept frame's): a rival frame tilts the horizon too.
     """
     return _rival_spread(_rival_modes(best, models, weight, s, tau_px), own_logf_std)
+
+
+def _curve_share(segs_px: FloatArray, sel: npt.NDArray[np.bool_], diag_rel: float = 0.006) -> float:
+    """Share of the selected segments continued at an end by a segment bent by 2-25 degrees."""
+    if not sel.any():
+        return float("nan")
+    w = float(np.ptp(segs_px[:, [0, 2]])) or 1.0
+    h = float(np.ptp(segs_px[:, [1, 3]])) or 1.0
+    tol = max(3.0, diag_rel * math.hypot(w, h))
+    d = segs_px[:, 2:] - segs_px[:, :2]
+    ang = np.arctan2(d[:, 1], d[:, 0])
+    ends = np.concatenate([segs_px[:, :2], segs_px[:, 2:]])  # 2N x 2
+    owner = np.concatenate([np.arange(len(segs_px))] * 2)
+    hits = 0
+    idx = np.flatnonzero(sel)
+    for i in idx:
+        e = np.stack([segs_px[i, :2], segs_px[i, 2:]])
+        dist = np.min(np.linalg.norm(ends[:, None, :] - e[None, :, :], axis=2), axis=1)
+        near = owner[(dist < tol) & (owner != i)]
+        if near.size == 0:
+            continue
+        da = np.abs((ang[near] - ang[i] + np.pi / 2) % np.pi - np.pi / 2)
+        if np.any((da > math.radians(2.0)) & (da < math.radians(25.0))):
+            hits += 1
+    return hits / len(idx)
+
+
+def _curve_direction(
+    m: _Model,
+    s: _Segs,
+    segs_px: FloatArray,
+    n_lines: Sequence[int],
+    tau: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> _Model:
+    """Check that a direction of few lines is not made of tangent pieces of curves.
+
+    A direction of :data:`_WEAK_LINES` to :data:`_JACKKNIFE_LINES` distinct lines at least
+    :data:`_CURVE_SHARE` of whose segments are continued, end to end, by a segment turned by
+    2-25 degrees (:func:`_curve_share`) is the near-straight stretches of round things (a
+    basin's rim, steps, an arch): its lines meet wherever the curves' tangents do. The focal
+    length is fitted again without it:
+
+    - where the other two then leave it loose (a sigma over :data:`_LOOSE_FOCAL_STD`: a
+      frontal scene, whose focal length rests on that direction), the photo is said not to
+      fix it: the stated sigma is at least that of the fit without it (at most
+      :data:`_MAX_STATED_STD`), the default focal length joins in where it is over 10 %, and
+      a warning names the direction (``thin_only``);
+    - where they fix it and the direction pulls it away from them by more than
+      :data:`_FEW_LINES_MIN_SHIFT` and :data:`_FEW_LINES_SHIFT_Z` times the sigma of the
+      pull, the direction is left out (the model returned is the fit without it).
+
+    Otherwise ``m`` is returned as it is.
+    """
+    for k in range(3):
+        if not _WEAK_LINES <= n_lines[k] < _JACKKNIFE_LINES:
+            continue
+        if _curve_share(segs_px, m.labels == k) < _CURVE_SHARE:
+            continue
+        labels = np.where(m.labels == k, -1, m.labels)
+        R, f, logf_std, _ = _refine(
+            m.R, m.f_n, s, labels, tau, True, f_prior, f_bounds, prior_w=prior_w
+        )
+        if math.isfinite(logf_std) and logf_std <= _LOOSE_FOCAL_STD:
+            shift = abs(math.log(m.f_n / f)) if f > 0 else math.inf
+            base_std = m.logf_std if math.isfinite(m.logf_std) else 0.0
+            shift_std = math.sqrt(max(0.0, logf_std**2 - base_std**2))
+            if shift > max(_FEW_LINES_MIN_SHIFT, _FEW_LINES_SHIFT_Z * shift_std):
+                U, _, Vt = np.linalg.svd(R)
+                log.debug(
+                    "direction %d (%d lines, pieces of curves) left out: it pulls the focal "
+                    "length by %.3f (+/- %.3f)",
+                    k,
+                    n_lines[k],
+                    shift,
+                    shift_std,
+                )
+                return replace(m, R=U @ Vt, f_n=f, labels=labels, logf_std=logf_std)
+            continue
+        m.logf_std = max(
+            m.logf_std if math.isfinite(m.logf_std) else 0.0,
+            min(logf_std, _MAX_STATED_STD) if math.isfinite(logf_std) else _MAX_STATED_STD,
+        )
+        m.thin_only = int(n_lines[k])
+        log.debug("focal length rests on direction %d (%d lines, pieces of curves)", k, n_lines[k])
+        return m
+    return m
 
 
 def _rival_modes(
@@ -1940,6 +2036,8 @@ def detect_vanishing_points(
                 shift_std,
                 ": it rests on it" if best.rests_on_few else "",
             )
+    if f_fixed is None and not has_prior and not best.weak_only:
+        best = _curve_direction(best, s, segs_px, n_lines, tau, f_prior, f_bounds, prior_w)
     nl = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
     best.n_lines = (nl[0], nl[1], nl[2])
     # With no line left in one direction (no building over a highway: no vertical; or a
@@ -1973,7 +2071,7 @@ def detect_vanishing_points(
         own_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2)
         rival_std = _rival_spread(rival_modes, own_std)[0]
         best.logf_std = math.sqrt(own_std**2 + rival_std**2)
-        if best.weak_only:
+        if best.weak_only or best.thin_only:
             best.logf_std = min(best.logf_std, _MAX_STATED_STD)
     elif f_fixed is not None:
         _systematic_logf_std(best, s, tau, f_prior, f_bounds, prior_w, bias, f_free=False)
@@ -2423,6 +2521,7 @@ def _finish(
             and data_std > _LOOSE_FOCAL_STD
             and not m.weak_only
             and not m.rests_on_few
+            and not m.thin_only
         ):
             n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
             why = (
@@ -2434,6 +2533,12 @@ def _finish(
                 f"the focal length is uncertain (+/- {100 * logf_std:.0f} %): {why}; give "
                 "--focal-px if it is known"
             )
+    if m.thin_only and f_free:
+        warnings.append(
+            f"the focal length rests on a direction of {m.thin_only} lines that are pieces of "
+            "curves (a round rim, steps or an arch may pose as one): the photo does not fix it "
+            f"(+/- {100 * data_std:.0f} % without a default); give --focal-px if it is known"
+        )
     if distinct[perm[0]] < _MIN_SUPPORT:
         warnings.append(
             f"few vertical lines ({int(distinct[perm[0]])}): the vertical direction, pitch and "
