@@ -227,8 +227,9 @@ var {{ this.get_name() }} = L.control({position: {{ this.position|tojson }}});
 
 class _SmallScreenFolds(MacroElement):
     """On a map narrower than :data:`SMALL_SCREEN_PX`: the layer list folded to its button
-    (a tap opens it, a tap on the map folds it) and the legend to its heading (a tap on it
-    unfolds or folds it)."""
+    (a tap opens it, a tap on the map folds it), the legend to its heading (a tap on it
+    unfolds or folds it), and the top controls hidden while a popup is open (it fills the
+    screen's width; they covered its first rows)."""
 
     _template = Template(
         """
@@ -252,6 +253,10 @@ setTimeout(function () {  // after every control of the page is on the map
             L.DomUtil.removeClass(layers, "leaflet-control-layers-expanded");
         });
     }
+    // the popup fills a phone's width: the top controls (title box, zoom, layers, the
+    // verdicts' counter) drew over its first rows; they step aside while it is open
+    map.on("popupopen", function () { L.DomUtil.addClass(box, "camloc-popup-open"); });
+    map.on("popupclose", function () { L.DomUtil.removeClass(box, "camloc-popup-open"); });
     var legend = box.querySelector(".camloc-legend");
     if (legend) {
         L.DomUtil.addClass(legend, "folded");
@@ -365,6 +370,7 @@ _PAGE_CSS = """
   background: #fff8e1; border: 2px solid #b26a00; border-radius: 6px; padding: 7px 11px;
   box-shadow: 0 2px 7px rgba(0,0,0,0.45); font: 12.5px/1.4 sans-serif; color: #222; }
 .camloc-legend.folded { max-height: 1.45em; overflow: hidden; }
+.camloc-popup-open .leaflet-top .leaflet-control { visibility: hidden; }
 @media (max-width: 719px) {
   .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
     width: calc(100% - 40px); }

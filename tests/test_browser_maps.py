@@ -342,6 +342,38 @@ def test_phone_sees_the_candidates_not_the_controls(browser: Any, pages: dict[st
         t.close()
 
 
+def test_phone_popup_is_not_under_the_title_box(browser: Any, pages: dict[str, Any]) -> None:
+    """On a 390x844 phone an open popup fills the width and the title box (scene id,
+    candidates, calibration) drew over its first rows: rank, score, lat and lon were
+    unreadable (Chromium screenshot of the verdicts' phone test). The top controls step
+    aside while a popup is open and come back when it closes."""
+    t = _Page(browser)
+    try:
+        t.page.set_viewport_size({"width": 390, "height": 844})
+        t.open(pages["candidates"], ".camloc-candidate")
+        page = t.page
+        page.wait_for_selector(".camloc-legend.folded", timeout=5000)
+        assert page.locator(".camloc-title").is_visible()
+        t.click_for_popup(page.locator('.camloc-candidate [data-rank="1"]'))
+        t.popup_text()
+        popup = _box(page, ".leaflet-popup-content-wrapper")
+        shown = [
+            _box(page, sel)
+            for sel in (".camloc-title", ".leaflet-control-zoom")
+            if page.locator(sel).is_visible()
+        ]
+        assert not any(_overlap(popup, c) for c in shown)
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / "candidates_map_phone_popup.png"))
+        page.locator(".leaflet-popup-close-button").click()
+        page.wait_for_selector(".leaflet-popup", state="detached", timeout=3000)
+        assert page.locator(".camloc-title").is_visible()
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
+
+
 def test_long_scene_id_wraps_beside_the_banner(
     browser: Any, pages: dict[str, Any], tmp_path: Path
 ) -> None:
