@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 from annotate_synthetic import BALTIMORE, located_case, render_snapshot
+from conftest import CHROMIUM
 
 from camloc_geo.cli import main
 from camloc_geo.geodesy import distance_m
@@ -25,30 +26,12 @@ from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import NoiseModel, make_scene, random_camera
 from camloc_geo.vanishing import estimate_intrinsics, fit_vanishing_point
 
-CHROMIUM = Path("/usr/bin/chromium")
 ARTIFACTS = Path(__file__).parent / "artifacts" / "annotate"
-LAUNCH_ARGS = [
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--no-first-run",
-    "--disable-sync",
-]
 
 pytestmark = [
     pytest.mark.browser,
     pytest.mark.skipif(not CHROMIUM.exists(), reason="Debian chromium is not installed"),
 ]
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=str(CHROMIUM), args=LAUNCH_ARGS)
-        yield b
-        b.close()
 
 
 @pytest.fixture(scope="module")

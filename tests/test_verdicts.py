@@ -131,17 +131,6 @@ needs_browser = pytest.mark.skipif(
 
 
 @pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    from test_browser_maps import CHROMIUM, LAUNCH_ARGS
-
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=str(CHROMIUM), args=LAUNCH_ARGS)
-        yield b
-        b.close()
-
-
-@pytest.fixture(scope="module")
 def vpages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     from test_maps import fremantle_map, located
 
