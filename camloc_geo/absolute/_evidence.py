@@ -249,9 +249,8 @@ def _junction_of_one_street(
 ) -> Intersection:
     """The junction along the one named street nearest to ``near`` (the prior, else the
     map's point); with a prior, :func:`other_junctions` tries its other junctions within it."""
-    found = [x for x in map_data.street_junctions([name]) if x.corners] or (
-        map_data.street_junctions([name])
-    )
+    junctions = map_data.street_junctions([name])
+    found = [x for x in junctions if x.corners] or junctions
     if not found:
         close = close_matches(name, map_data.street_names())
         raise MapDataError(
