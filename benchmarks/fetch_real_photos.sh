@@ -25,13 +25,19 @@
 #                                    centre, right; 1920x1080) and the dataset's reference
 #                                    calibrations (results/*/system_dubska_optimal_calib.json);
 #                                    CC BY-NC-SA 4.0, so kept out; about 190 MB
+#   ianare/exif-samples, drewnoakes/metadata-extractor-images  12 handheld street photos
+#                                    (benchmarks/street_photos.json: compact cameras and phones,
+#                                    EXIF kept), copied one by one (commit and path pinned, the
+#                                    content checked against its sha256); EXIF test collections
+#                                    without a licence for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
 # owner+name/repo, a bare git directory; default /work/.mirror when it exists), else from GitHub.
 # A mirror that lacks some blobs (large files left out) gives the photos it does hold (its JPEG
 # files are copied out one by one, blob by blob); with none of them, GitHub is tried.
-# Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above to fetch fewer.
+# Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
+# "street-photos" for the handheld street photos) to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
@@ -54,6 +60,7 @@ copy_present_photos() {
   echo "$n"
 }
 for full in $sets; do
+  [[ "$full" == */* ]] || continue # "street-photos": the single files below
   name="${full#*/}"
   if [ -d "$dest/$name" ]; then
     echo "$name: already in $dest"
@@ -79,4 +86,34 @@ for full in $sets; do
     rm -rf "${dest:?}/$name"
   }
 done
+
+# The handheld street photos: single files of two repositories (one of them about 400 MB),
+# from the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
+if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
+  manifest="$(dirname "$0")/street_photos.json"
+  got=0 failed=0
+  while IFS=$'\t' read -r file repo commit path sha; do
+    out="$dest/$file"
+    if [ -f "$out" ] && [ "$(sha256sum "$out" | cut -d' ' -f1)" = "$sha" ]; then
+      got=$((got + 1))
+      continue
+    fi
+    mkdir -p "$(dirname "$out")"
+    git_dir="$mirror/${repo%%/*}+${repo#*/}/repo"
+    [ -d "$git_dir/.git" ] && git_dir="$git_dir/.git"
+    if ! { [ -n "$mirror" ] && git --git-dir="$git_dir" cat-file blob "$commit:$path" >"$out" 2>/dev/null; }; then
+      curl -fsSL "https://raw.githubusercontent.com/$repo/$commit/${path// /%20}" -o "$out" || true
+    fi
+    if [ -f "$out" ] && [ "$(sha256sum "$out" | cut -d' ' -f1)" = "$sha" ]; then
+      got=$((got + 1))
+    else
+      rm -f "$out"
+      failed=$((failed + 1))
+    fi
+  done < <(python3 -c 'import json, sys
+for p in json.load(open(sys.argv[1]))["photos"]:
+    print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' "$manifest")
+  echo "street-photos: $got photos in $dest/street-photos"
+  [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
+fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"

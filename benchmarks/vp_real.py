@@ -3,8 +3,11 @@
 Usage::
 
     python benchmarks/vp_real.py [--strecha DIR] [--sceaux DIR] [--lund DIR] [--yud DIR]
-                                 [--limit N] [--sets strecha,sceaux,perrot,lund,exif,yud]
+                                 [--limit N]
+                                 [--sets strecha,sceaux,perrot,lund,street-photos,exif,yud]
                                  (lund-dev, lund-held-out: one half of the Lund scenes;
+                                  street-photos-dev, street-photos-held-out: one half of
+                                  the handheld street photos;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
 
@@ -50,6 +53,20 @@ The photos (none of them is in this repository; their licences keep them out):
     good as the whole-millimetre focal length (1.5-3.5 %); it agrees with the course's own
     calibration (``f35 / 35 * long side``) within 1.1 %. No gravity truth. Run with and
     without the EXIF (the EXIF prior is the 35 mm tag, 2.7 % below the truth on the D60).
+``street-photos`` (``street-photos-dev``, ``street-photos-held-out``)
+    Ordinary handheld photos taken standing on a street or square (a street receding,
+    facades, a church front on a square, a phone box on a pavement), compact cameras and
+    phones, EXIF kept: 12 photos listed in ``benchmarks/street_photos.json`` (file,
+    sha256, repository, commit, path, camera, what it shows, half), from the public
+    repositories ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo,
+    Nikon Coolpix P6000, 640x480; one Nikon D70s photo between apartment blocks) and
+    ``drewnoakes/metadata-extractor-images`` (BlackBerry Z10, Samsung SM-J327T1, Nikon
+    D40, Panasonic DMC-LX3, Canon PowerShot S30), both EXIF test collections, so no
+    licence is given for the photos themselves: kept out, copied by
+    ``benchmarks/fetch_real_photos.sh`` (from a local mirror, else GitHub's raw files).
+    Chosen by what they show before any result on them was read; the halves by a rule
+    fixed then: sorted by sha256, every other one dev. Truth: the EXIF focal length as for
+    ``perrot``; no gravity truth. Run with and without the EXIF.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
     (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
@@ -239,35 +256,58 @@ def load_sceaux(root: Path) -> list[dict[str, Any]]:
 _PHOTO_SUFFIXES = {".jpg", ".jpeg"}
 
 
+def exif_focal_truth(path: Path) -> tuple[Any, tuple[int, int]] | None:
+    """The focal-length truth of a photo from its EXIF, and its stored size.
+
+    The focal length from the focal-plane resolution or a sensor table
+    (:func:`camloc_geo.exif.focal_from_tags` without ``FocalLengthIn35mmFilm``) is
+    preferred to the 35 mm tag (a whole number of millimetres, and the crop it assumes).
+
+    Parameters
+    ----------
+    path
+        A JPEG photo.
+
+    Returns
+    -------
+    tuple or None
+        The :class:`camloc_geo.exif.ExifFocal` and ``(width, height)`` as stored (before
+        the EXIF orientation: the focal length in pixels is the same either way); None
+        where the photo cannot be read or its EXIF gives no usable focal length.
+    """
+    from PIL import Image
+
+    from camloc_geo.exif import focal_from_exif, focal_from_tags
+
+    try:
+        with Image.open(path) as im:
+            w, h = im.size
+            exif = im.getexif()
+            tags: dict[int, Any] = dict(exif)
+            tags.update(exif.get_ifd(0x8769))
+    except (OSError, ValueError, SyntaxError):
+        return None
+    no35 = {k: v for k, v in tags.items() if k != 0xA405}
+    ex = focal_from_tags(no35, w, h) or focal_from_exif(path)
+    return None if ex is None else (ex, (w, h))
+
+
 def load_exif_folder(root: Path, set_name: str) -> list[dict[str, Any]]:
     """Photos under ``root`` (recursively) whose EXIF gives the focal length: the truth.
 
     The focal length from the focal-plane resolution or a sensor table is preferred to
     ``FocalLengthIn35mmFilm`` (a whole number of millimetres, and the crop it assumes).
     """
-    from PIL import Image
-
-    from camloc_geo.exif import focal_from_exif, focal_from_tags
-
     out = []
     skipped = 0
     for p in sorted(q for q in root.rglob("*") if q.suffix.lower() in _PHOTO_SUFFIXES):
         if any(part.startswith(".") for part in p.relative_to(root).parts):
             continue
-        try:
-            with Image.open(p) as im:
-                w, h = im.size
-                exif = im.getexif()
-                tags: dict[int, Any] = dict(exif)
-                tags.update(exif.get_ifd(0x8769))
-        except (OSError, ValueError, SyntaxError):
+        got = exif_focal_truth(p)
+        if got is None:
             skipped += 1
             continue
-        no35 = {k: v for k, v in tags.items() if k != 0xA405}
-        ex = focal_from_tags(no35, w, h) or focal_from_exif(p)
-        if ex is None:
-            skipped += 1
-            continue
+        ex, (w, h) = got
         out.append(
             {
                 "set": set_name,
@@ -515,6 +555,83 @@ def load_drive_set(
             "drive: %d frames missing, %d with another content than the truth file pins, skipped",
             missing,
             changed,
+        )
+    return out
+
+
+#: Handheld street photos (sets ``street-photos``, ``street-photos-dev``,
+#: ``street-photos-held-out``): file, sha256, source, half; truth from their EXIF.
+STREET_PHOTOS = HERE / "street_photos.json"
+#: The halves of the street photos, fixed by a rule before any result was read.
+STREET_PHOTO_HALVES = ("dev", "held-out")
+
+
+def load_street_photos(
+    photos: Path,
+    manifest: Path = STREET_PHOTOS,
+    halves: tuple[str, ...] = STREET_PHOTO_HALVES,
+) -> list[dict[str, Any]]:
+    """Handheld photos taken on a street or square, truth from their EXIF focal length.
+
+    Parameters
+    ----------
+    photos
+        The folder ``benchmarks/fetch_real_photos.sh`` fills (each photo's ``file`` is
+        relative to it).
+    manifest
+        :data:`STREET_PHOTOS`: ``photos`` (file, sha256, repository, commit, path,
+        camera, scene, ``half``).
+    halves
+        Which halves to load (``"dev"``, ``"held-out"``).
+
+    Returns
+    -------
+    list of dict
+        One truth record a photo present with the content the manifest pins (set
+        ``"street-photos"``, ``half`` kept); a photo missing, with another content or
+        without a usable EXIF focal length is skipped and counted in the log.
+    """
+    import hashlib
+
+    doc = json.loads(manifest.read_text(encoding="utf-8"))
+    out = []
+    missing = changed = no_exif = 0
+    for ph in doc["photos"]:
+        if ph.get("half") not in halves:
+            continue
+        path = photos / ph["file"]
+        if not path.is_file():
+            missing += 1
+            continue
+        if hashlib.sha256(path.read_bytes()).hexdigest() != ph["sha256"]:
+            changed += 1
+            continue
+        got = exif_focal_truth(path)
+        if got is None:
+            no_exif += 1
+            continue
+        ex, (w, h) = got
+        out.append(
+            {
+                "set": "street-photos",
+                "name": f"street-photos/{Path(ph['file']).name}",
+                "path": str(path),
+                "f": ex.focal_px,
+                "f_source": ex.source,
+                "pp": (w / 2.0, h / 2.0),
+                "up": None,
+                "size": (w, h),
+                "exif": True,
+                "half": ph["half"],
+            }
+        )
+    if missing or changed or no_exif:
+        log.info(
+            "street-photos: %d missing, %d with another content than the manifest pins, "
+            "%d without a usable EXIF focal length, skipped",
+            missing,
+            changed,
+            no_exif,
         )
     return out
 
@@ -830,7 +947,7 @@ def main(argv: list[str] | None = None) -> int:
         help="a folder of outdoor photos whose EXIF gives the focal length (repeatable)",
     )
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
-    ap.add_argument("--sets", default="strecha,sceaux,perrot,lund,exif,yud")
+    ap.add_argument("--sets", default="strecha,sceaux,perrot,lund,street-photos,exif,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
         "--street-frames",
@@ -848,6 +965,12 @@ def main(argv: list[str] | None = None) -> int:
         help="the folder the driving frames' 'file' paths are relative to",
     )
     ap.add_argument("--drive-truth", type=Path, default=STREET_TRUTH)
+    ap.add_argument(
+        "--street-photos",
+        type=Path,
+        default=STREET_PHOTOS,
+        help="the handheld street photos' manifest (files relative to --drive-photos)",
+    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -881,6 +1004,17 @@ def main(argv: list[str] | None = None) -> int:
                 args.drive_photos,
             )
         data.extend(drive[: args.limit])
+    street_halves = tuple(
+        h for h in STREET_PHOTO_HALVES if {"street-photos", f"street-photos-{h}"} & wanted
+    )
+    if street_halves:
+        street = load_street_photos(args.drive_photos, args.street_photos, street_halves)
+        if not street:
+            log.warning(
+                "street-photos: none found in %s (run benchmarks/fetch_real_photos.sh)",
+                args.drive_photos,
+            )
+        data.extend(street[: args.limit])
     for d in args.exif_dir if "exif" in wanted else []:
         if not d.is_dir():
             log.warning("--exif-dir %s: not a folder", d)
@@ -906,6 +1040,11 @@ def main(argv: list[str] | None = None) -> int:
                         summary[tag][f"lund {half} {scenes}"] = summarise(part)
             if s in DRIVE_SETS:  # the driving frames' development and held-out halves
                 for half in DRIVE_HALVES:
+                    part = [r for r in rows if r["set"] == s and r.get("half") == half]
+                    if part:
+                        summary[tag][f"{s} {half}"] = summarise(part)
+            if s == "street-photos":  # the development and the held-out halves
+                for half in STREET_PHOTO_HALVES:
                     part = [r for r in rows if r["set"] == s and r.get("half") == half]
                     if part:
                         summary[tag][f"{s} {half}"] = summarise(part)
