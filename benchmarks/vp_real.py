@@ -803,6 +803,51 @@ def _warned_up(row: dict[str, Any]) -> bool:
     return any(" or up " in w for w in row.get("warnings", []))
 
 
+#: Issue 24's bars on handheld street photos: with the EXIF stripped, the focal length
+#: within 10 % on this share and confidently wrong on at most this share (1 in 29); with the
+#: EXIF kept, within 10 % on this share.
+ISSUE24_STRIPPED_WITHIN_10 = 0.75
+ISSUE24_STRIPPED_CONFIDENTLY_WRONG = 1.0 / 29.0
+ISSUE24_KEPT_WITHIN_10 = 0.95
+
+
+def issue24_bars(stripped: dict[str, Any] | None, kept: dict[str, Any] | None) -> dict[str, Any]:
+    """Issue 24's main check on a set of street photos, from two :func:`summarise` results.
+
+    Parameters
+    ----------
+    stripped, kept
+        The summaries of the runs with the EXIF ignored and with it as the prior (either
+        may be None: that bar is then not judged).
+
+    Returns
+    -------
+    dict
+        For each bar its measured value, the bar and ``met`` (None where not judged).
+    """
+
+    def bar(value: float | None, limit: float, at_least: bool) -> dict[str, Any]:
+        met = None if value is None else (value >= limit if at_least else value <= limit)
+        return {"value": value, "bar": limit, "met": met}
+
+    cw = None
+    if stripped and stripped.get("n_images"):
+        cw = stripped["n_confidently_wrong"] / stripped["n_images"]
+    return {
+        "stripped_within_10pct": bar(
+            stripped.get("share_focal_within_10pct") if stripped else None,
+            ISSUE24_STRIPPED_WITHIN_10,
+            True,
+        ),
+        "stripped_confidently_wrong_share": bar(cw, ISSUE24_STRIPPED_CONFIDENTLY_WRONG, False),
+        "kept_within_10pct": bar(
+            kept.get("share_focal_within_10pct") if kept else None,
+            ISSUE24_KEPT_WITHIN_10,
+            True,
+        ),
+    }
+
+
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     ok = [r for r in rows if "f" in r]
     n = len(rows)
@@ -1064,6 +1109,17 @@ def main(argv: list[str] | None = None) -> int:
         up = [r for r in outdoor if r.get("pitch_true_deg", 0.0) < -LOOKING_UP_DEG]
         if up:
             summary[tag][f"outdoor looking up > {LOOKING_UP_DEG:.0f} deg"] = summarise(up)
+    # issue 24's bars, on the street photos and on any --exif-dir folder (a user's own
+    # street photos, e.g. the issue's 29)
+    exif_sets = {d.name for d in args.exif_dir} if "exif" in wanted else set()
+    bars = {}
+    for key in sorted(summary.get("no EXIF", {})):
+        if key.startswith("street-photos") or key in exif_sets:
+            bars[key] = issue24_bars(
+                summary["no EXIF"].get(key), summary.get("EXIF prior", {}).get(key)
+            )
+    if bars:
+        summary["issue 24 bars"] = bars
     args.out.mkdir(parents=True, exist_ok=True)
     with open(args.out / "vp_real.json", "w", encoding="utf-8") as fh:
         json.dump({"summary": summary, "per_image": runs}, fh, indent=1, default=float)
@@ -1091,12 +1147,22 @@ def main(argv: list[str] | None = None) -> int:
     ]
     lines = [f"{'run / set':40s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
     for tag, per in summary.items():
+        if tag == "issue 24 bars":
+            continue
         for s, sm in per.items():
             cells = []
             for k, _, fmt in keys:
                 v = sm.get(k)
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
             lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
+    for key, judged in bars.items():
+        for name, b in judged.items():
+            if b["value"] is None:
+                continue
+            verdict = "met" if b["met"] else "NOT met"
+            lines.append(
+                f"issue 24 bar / {key} / {name}: {b['value']:.3f} (bar {b['bar']:.3f}) {verdict}"
+            )
     log.info("\n".join(lines))
     return 0
 

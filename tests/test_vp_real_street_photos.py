@@ -91,3 +91,18 @@ def test_fetched_street_photos_match_the_manifest() -> None:
     for t in rows:
         w, h = t["size"]
         assert 0.4 < t["f"] / max(w, h) < 5.0
+
+
+def test_issue24_bars_judge_the_three_figures() -> None:
+    stripped = {"n_images": 29, "share_focal_within_10pct": 0.76, "n_confidently_wrong": 1}
+    kept = {"n_images": 29, "share_focal_within_10pct": 0.93, "n_confidently_wrong": 0}
+    bars = vp_real.issue24_bars(stripped, kept)
+    assert bars["stripped_within_10pct"]["met"] is True
+    assert bars["stripped_confidently_wrong_share"]["value"] == pytest.approx(1 / 29)
+    assert bars["stripped_confidently_wrong_share"]["met"] is True
+    assert bars["kept_within_10pct"]["met"] is False
+    two_wrong = dict(stripped, n_confidently_wrong=2, share_focal_within_10pct=0.5)
+    bars = vp_real.issue24_bars(two_wrong, None)
+    assert bars["stripped_confidently_wrong_share"]["met"] is False
+    assert bars["stripped_within_10pct"]["met"] is False
+    assert bars["kept_within_10pct"] == {"value": None, "bar": 0.95, "met": None}
