@@ -242,8 +242,16 @@ def _lookup(
             if toks not in hits or hits[toks].score < hit.score:
                 hits[toks] = hit
     core = core_tokens(toks)
-    for full in index.by_core.get(core, ()):
+    same_core = index.by_core.get(core, ())
+    q_types = types_of(toks)
+    # The title names a street type the map has for this core ("2nd Avenue", and the map has
+    # a 2nd Avenue): a name of that core with only other types ("South 2nd Street") is
+    # another street, not a loose spelling of it.
+    typed_exists = bool(q_types) and any(types_of(full) & q_types for full in same_core)
+    for full in same_core:
         if full in hits:
+            continue
+        if typed_exists and types_of(full) and not (types_of(full) & q_types):
             continue
         factor = _compatible(toks, full)
         if factor is None:

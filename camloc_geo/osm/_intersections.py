@@ -93,7 +93,10 @@ MIN_CORNER_GAP_DEG = 15.0
 MAX_RING_NODES = 200
 """A roundabout's ring is followed through at most this many nodes."""
 MAX_RING_RADIUS_M = 60.0
-"""Rings wider than this (gyratories, squares around a park) get no corners."""
+"""Rings wider than this (gyratories, squares around a park) get no ring corners: each place
+where a street meets such a ring is modelled as an ordinary junction of the two (the ring is
+nearly straight over a junction's extent)."""
+WIDE_RING_REASON = "a wide ring"
 MIN_MEDIAN_M = 0.5
 """A median opening's corners need a median at least this wide between the carriageways."""
 MAX_CORNER_GAP_DEG = 160.0
@@ -790,8 +793,10 @@ def _roundabout_corners(
         return [], "the ring is not a circle"
     radius = math.sqrt(radius_sq)
     spread = np.abs(np.hypot(*(xy - centre).T) - radius)
-    if radius > MAX_RING_RADIUS_M or float(np.median(spread)) > 0.25 * radius + 2.0:
+    if float(np.median(spread)) > 0.25 * radius + 2.0:
         return [], f"a ring of {radius:.0f} m radius (or no circle)"
+    if radius > MAX_RING_RADIUS_M:
+        return [], f"{WIDE_RING_REASON} of {radius:.0f} m radius"
     ring_name, ring_names = street_label(ring_data)
     ring_width, ring_source = resolve_width_m(
         width=ring_data.get("width"),
@@ -1022,12 +1027,28 @@ def build_intersections(
         if _is_roundabout(Gp, osm_nodes):
             kind = "roundabout"
             modelled, reason = _roundabout_corners(Gp, members, arms, north_america)
-            warnings.append(
-                f"roundabout: kerb corners not modelled ({reason})"
-                if reason
-                else "roundabout: the corners are where each approach's kerbs meet the ring's "
-                "outer kerb"
-            )
+            wide = reason is not None and reason.startswith(WIDE_RING_REASON)
+            own: list[str] = []
+            if wide:
+                # Großer Stern, Place de l'Étoile: where a street meets a ring this wide, the
+                # ring is a street like any other over the junction's extent
+                modelled, plain_reason = _model_corners(streets, centre, own)
+                if plain_reason:
+                    modelled = []
+            if wide and modelled:
+                kind = "junction"
+                warnings += own
+                warnings.append(
+                    f"on the ring of a roundabout ({reason}): modelled as an ordinary junction "
+                    "of the ring and the street(s) meeting it"
+                )
+            else:
+                warnings.append(
+                    f"roundabout: kerb corners not modelled ({reason})"
+                    if reason
+                    else "roundabout: the corners are where each approach's kerbs meet the "
+                    "ring's outer kerb"
+                )
         else:
             modelled, reason = _model_corners(streets, centre, warnings)
             if reason and len(members) > 1:
