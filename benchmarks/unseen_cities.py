@@ -154,6 +154,9 @@ def locate_city(
             row["calibration_error"] = str(exc)[:300]
             rows.append(row)
             continue
+        # when both methods miss one scene, a poor calibration is the first suspect
+        row["focal_err_rel"] = round(cal.camera.focal_px / ls.camera_enu.focal_px - 1.0, 4)
+        row["height_m"] = round(ls.camera_enu.height_m, 2)
         for method in METHODS:
             data = json.loads(json.dumps(ls.scene))
             refs = data.pop("references", [])

@@ -84,3 +84,22 @@ def test_type_left_out_or_matching_still_places(harrisburg) -> None:  # type: ig
     assert best.placed
     assert best.lat == pytest.approx(40.2086, abs=0.001)
     assert best.lon == pytest.approx(-76.7894, abs=0.001)
+
+
+def test_group_leaving_two_streets_is_split_into_its_nodes() -> None:
+    """Harrisburg's Beacon Drive: a one-way loop with a 25 m unnamed cut-through.
+
+    The two nodes the cut-through joins were grouped (a short piece across a one-way
+    carriageway) into one junction that only two arms leave, and dropped: osmnx's two
+    junctions there had no camloc intersection within 100 m. Each node is now a junction.
+    """
+    from camloc_geo.osm import load_map
+
+    m = load_map(OSM / "harrisburg.osm.pbf", 40.30777, -76.82923, 150.0)
+    by_node = {x.osm_nodes: x for x in m.intersections}
+    for node in (2374400296, 2374400298):
+        x = by_node[(node,)]
+        assert x.kind == "junction"
+        assert len(x.streets) == 3
+        assert len(x.corners) >= 2
+        assert all(5.0 < d < 12.0 for d in x.corner_distances_m)

@@ -996,7 +996,9 @@ def build_intersections(
     groups = group_junction_nodes(
         Gp, junction_nodes(Gp), near_m=tolerance_m, divided_m=max(GROUP_DIVIDED_M, tolerance_m)
     )
-    for members, cx, cy in groups:
+    queue = list(groups)
+    while queue:
+        members, cx, cy = queue.pop(0)
         centre = np.array([cx, cy], dtype=float)
         dist_centre = float(np.hypot(*centre))
         if radius_m is not None and dist_centre > radius_m:
@@ -1013,6 +1015,12 @@ def build_intersections(
             streets = _group_streets(arms, frame)
             if len(streets) < 3:
                 streets = sorted((_single_street(a) for a in arms), key=lambda s: s.bearing)
+        if len(streets) < 3 and len(members) > 1:
+            # a group that leaves fewer than three streets is no junction as a whole (a
+            # one-way loop with a short cut-through, Harrisburg's Beacon Drive): its nodes
+            # are taken one by one
+            queue[:0] = [([n], float(Gp.nodes[n]["x"]), float(Gp.nodes[n]["y"])) for n in members]
+            continue
         if len(streets) < 3:
             if rejected is not None:
                 for node in members:
