@@ -40,6 +40,15 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--max-frames", type=int, help="process only the first N frames")
     p.add_argument(
+        "--video-lines",
+        action=argparse.BooleanOptionalAction,
+        default=False,
+        help=(
+            "calibrate with the video's own lines too: the moving vehicles' tracks and edges "
+            "(the JSON's calibration.witnesses says which were used); default: the scene alone"
+        ),
+    )
+    p.add_argument(
         "--progress",
         action=argparse.BooleanOptionalAction,
         default=None,
@@ -77,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         min_track_s=args.min_track_s,
         max_frames=args.max_frames,
         progress=progress,
+        video_lines=args.video_lines,
     )
     if not result.vehicles:
         raise InputError(f"{result.warnings[0]} ({args.video}, {result.video.n_frames} frames)")

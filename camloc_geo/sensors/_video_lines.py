@@ -201,13 +201,21 @@ def _scan(
         else:
             level = diff
         fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
-        if frame.ndim == 3:
-            fg = cv2.bitwise_and(fg, cv2.bitwise_not(_shadows(frame, bg_f)))
         fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, k3)
+        # The work below is done in the foreground's bounding box only (+ a margin).
+        bx, by, bw, bh = cv2.boundingRect(fg)
+        has_fg = bool(bw * bh > 0 and cv2.countNonZero(fg) > 50)
+        x0, y0 = max(bx - 8, 0), max(by - 8, 0)
+        x1, y1 = min(bx + bw + 8, width), min(by + bh + 8, height)
+        if has_fg and frame.ndim == 3:
+            box = (slice(y0, y1), slice(x0, x1))
+            shadow = _shadows(np.ascontiguousarray(frame[box]), np.ascontiguousarray(bg_f[box]))
+            fg[box] = cv2.bitwise_and(fg[box], cv2.bitwise_not(shadow))
         fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, k7)
-        has_fg = bool(cv2.countNonZero(fg) > 50)
         if has_fg and i % _EDGE_STRIDE == 0:
-            edges.append(_frame_edges(grey, cv2.dilate(fg, k7), static, lsd))
+            fg_near = cv2.dilate(fg[y0:y1, x0:x1], k7)
+            found = _frame_edges(grey[y0:y1, x0:x1], fg_near, static[y0:y1, x0:x1], lsd)
+            edges.append(found + np.array([x0, y0, x0, y0], dtype=float))
         # Tracks: KLT features on the foreground, followed while they stay straight.
         if prev_grey is not None and pts is not None and len(pts):
             none: Any = None
@@ -237,9 +245,16 @@ def _scan(
             if pts is not None:
                 for x, y in pts.reshape(-1, 2):
                     cv2.circle(mask, (int(x), int(y)), 5, 0, -1)
-            new = cv2.goodFeaturesToTrack(grey, _MAX_FEATURES, 0.01, 5, mask=mask, blockSize=5)
+            new = cv2.goodFeaturesToTrack(
+                np.ascontiguousarray(grey[y0:y1, x0:x1]),
+                _MAX_FEATURES,
+                0.01,
+                5,
+                mask=np.ascontiguousarray(mask[y0:y1, x0:x1]),
+                blockSize=5,
+            )
             if new is not None:
-                new = new.reshape(-1, 1, 2).astype(np.float32)
+                new = (new.reshape(-1, 1, 2) + np.array([x0, y0])).astype(np.float32)
                 live += [[(float(x), float(y))] for x, y in new.reshape(-1, 2)]
                 pts = new if pts is None else np.vstack([pts, new])
         prev_grey = grey
