@@ -2703,7 +2703,7 @@ def _add_photo_segments(
 
 
 VIDEO_SEGMENT_SIGMA = 1.0  # a video segment joins the fit at this many line sigmas
-VIDEO_GROUP_CAP = 1.0  # ... a group at most this many annotators' lines of its axis
+VIDEO_GROUP_CAP = 3.0  # ... a group at most this many annotators' lines of its axis
 VIDEO_AGREE = 3.0  # a group agrees: its median residual to the fit's point, line sigmas
 VIDEO_MIN_SEGMENTS = 12  # a group needs this many segments to count
 
