@@ -897,7 +897,7 @@ def radar_scene(
     min_track_s: float = 0.5,
     max_frames: int | None = None,
     progress: bool = False,
-    video_lines: bool = False,
+    video_lines: bool = True,
 ) -> RadarResult:
     """Virtual radar: calibrate the scene, then measure the vehicles' speeds in a video.
 
@@ -924,8 +924,9 @@ def radar_scene(
         Show a tqdm progress bar on stderr.
     video_lines
         Calibrate with the video's own lines as one more witness (the moving vehicles'
-        tracks and edges, :func:`calibrate_scene`'s ``video``); False (default): from the
-        scene alone. The JSON's ``calibration`` says which witnesses were used.
+        tracks and edges, :func:`calibrate_scene`'s ``video``; default); False: from the
+        scene alone (as before session 36). The JSON's ``calibration`` says which
+        witnesses were used.
 
     Returns
     -------

@@ -16,7 +16,8 @@ def register(subparsers: Any) -> None:
         "radar",
         help="measure vehicle speeds (km/h) in a video of the calibrated camera",
         description=(
-            "Virtual radar: calibrate the scene, find the vehicles in the video (background "
+            "Virtual radar: calibrate the scene (and, by default, the video's own lines: "
+            "--no-video-lines), find the vehicles in the video (background "
             "subtraction, or the boxes of --tracks), follow them with KLT features and fit "
             "the ground-plane motion of each vehicle's ground contact. Prints JSON (or writes "
             "-o FILE: .json, or .csv with one row per vehicle) with speed_kmh and sigma_kmh "
@@ -42,10 +43,11 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--video-lines",
         action=argparse.BooleanOptionalAction,
-        default=False,
+        default=True,
         help=(
             "calibrate with the video's own lines too: the moving vehicles' tracks and edges "
-            "(the JSON's calibration.witnesses says which were used); default: the scene alone"
+            "(default; the JSON's calibration.witnesses says which were used); "
+            "--no-video-lines: from the scene alone"
         ),
     )
     p.add_argument(
