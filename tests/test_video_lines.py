@@ -199,3 +199,27 @@ def test_cli_radar_says_which_witnesses_calibrated_it(
     f_true = video.camera.focal_px
     assert abs(used["focal_px"] / f_true - 1.0) < 0.03
     assert abs(plain["focal_px"] / f_true - 1.0) > 0.05
+
+
+def test_photo_and_video_are_two_witness_groups_of_the_jackknife(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    from camloc_geo.testing.traffic_render import street_photo
+
+    video, lines = street
+    scene = _car_only_scene(video.camera)
+    scene["image"]["path"] = str(street_photo(video.camera, SEED, tmp_path / "street.png"))
+    f_true = video.camera.focal_px
+    one = calibrate_scene(scene, settings=CalibrationSettings(video_lines=lines))
+    refit = calibrate_scene(
+        scene, settings=CalibrationSettings(video_lines=lines, jackknife_method="refit")
+    )
+    assert one.photo_segments
+    assert set(one.video_segments) == {"length", "width", "height"}
+    assert one.camera.focal_px == pytest.approx(refit.camera.focal_px, rel=1e-9)
+    assert abs(one.camera.focal_px / f_true - 1.0) < 0.03
+    # the one-step jackknife (two witness groups beside the annotators) as the refits
+    assert one.focal_sigma_px == pytest.approx(refit.focal_sigma_px, rel=0.25)
+    # without the video the photo alone leaves this scene loose
+    photo_only = calibrate_scene(scene)
+    assert photo_only.focal_sigma_px > 2.0 * one.focal_sigma_px
