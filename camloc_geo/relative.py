@@ -150,8 +150,10 @@ class CalibrationSettings:
         the annotations cannot fix the focal length: the photo's trustworthy one is used
         (:func:`calibrate`); False: the refusal stands.
     video_lines
-        Witness segments of the scene's video (:func:`camloc_geo.sensors.video_lines`: the
-        moving vehicles' tracks and edges, grouped by their own vanishing points). Each
+        Witness segments of the scene's video (a ``VideoLines`` of
+        :func:`camloc_geo.sensors._video_lines.video_lines`: the moving vehicles' tracks
+        and edges, grouped by their own vanishing points; ``calibrate_scene(video=...)``
+        reads it). Each
         group whose point is nearest one of the fit's axes (within ``PHOTO_AXIS_NEAR_DEG``)
         and whose segments agree with that axis' vanishing point (median residual within
         ``VIDEO_AGREE`` line sigmas) joins the final fit, each segment at
@@ -2719,17 +2721,18 @@ def _add_video_segments(
 ) -> dict[str, int]:
     """Give ``prob`` the video's witness groups that agree with the fit at ``x``.
 
-    ``video`` is a :class:`camloc_geo.sensors.VideoLines`: segments of the moving vehicles
-    (tracks along the street, edges across it and upright), grouped by their own vanishing
-    points. A group serves the fit's axis nearest its point (within ``PHOTO_AXIS_NEAR_DEG``;
-    two groups on one axis: neither), and joins where the median residual of its segments to
-    that axis' vanishing point of the fit is within ``VIDEO_AGREE`` line sigmas; otherwise a
-    warning names the group, the axis and the residual (``prob.video_warnings``). Each
-    segment joins at ``VIDEO_SEGMENT_SIGMA`` line sigmas, widened so that a group counts at
-    most as ``VIDEO_GROUP_CAP`` times the annotators' average lines of that axis (at least
-    2): the video is one witness, however many frames it has. Returns the segments used per
-    axis name. Nothing where the video's frame size is not the scene's, or the scene has a
-    lens distortion (``camera.distortion``: the video's segments are the raw frames').
+    ``video`` is a :class:`camloc_geo.sensors._video_lines.VideoLines`: segments of the moving
+    vehicles (tracks along the street, edges across it and upright), grouped by their own
+    vanishing points. A group serves the fit's axis nearest its point (within
+    ``PHOTO_AXIS_NEAR_DEG``; two groups on one axis: neither), and joins where the median
+    residual of its segments to that axis' vanishing point of the fit is within ``VIDEO_AGREE``
+    line sigmas; otherwise a warning names the group, the axis and the residual
+    (``prob.video_warnings``). Each segment joins at ``VIDEO_SEGMENT_SIGMA`` line sigmas,
+    widened so that a group counts at most as ``VIDEO_GROUP_CAP`` times the annotators' average
+    lines of that axis (at least 2): the video is one witness, however many frames it has.
+    Returns the segments used per axis name. Nothing where the video's frame size is not the
+    scene's, or the scene has a lens distortion (``camera.distortion``: the video's segments are
+    the raw frames').
     """
     from camloc_geo.sensors._video_lines import GROUPS, _residual_px
 
