@@ -108,6 +108,7 @@ def test_the_video_brings_a_loose_car_only_scene_within_3_percent(
     assert set(with_video.video_segments) == {"length", "width", "height"}
     assert with_video.to_dict()["video_segments"] == with_video.video_segments
     # honest: the error is within 2 stated sigmas, and the jackknife left the video out
+    assert with_video.focal_sigma_px is not None
     assert abs(err) * f_true < 2.0 * with_video.focal_sigma_px
     assert not any(w.startswith("video") for w in with_video.warnings)
 
@@ -222,4 +223,6 @@ def test_photo_and_video_are_two_witness_groups_of_the_jackknife(
     assert one.focal_sigma_px == pytest.approx(refit.focal_sigma_px, rel=0.25)
     # without the video the photo alone leaves this scene loose
     photo_only = calibrate_scene(scene)
+    assert photo_only.focal_sigma_px is not None
+    assert one.focal_sigma_px is not None
     assert photo_only.focal_sigma_px > 2.0 * one.focal_sigma_px
