@@ -18,14 +18,20 @@ not depend on the frames). The sets per seed:
   focal error per camera: bias vs scatter);
 - ``noise_free``: the same camera annotated without noise (the method's own bias);
 - ``road_lines``: :func:`camloc_geo.testing.road_lines.road_line_scene` (a street camera
-  6-9 m up whose annotators also drew one long lane line each).
+  6-9 m up whose annotators also drew one long lane line each);
+- with ``--video``: ``traffic_video`` and ``car_only_video``, the ``traffic`` and
+  ``car_only`` scenes calibrated with the video's own lines too
+  (:func:`camloc_geo.sensors._video_lines.video_lines` on the street video
+  ``render_street`` makes for the seed: 10 vehicles, 20 s; what ``camloc radar`` does by
+  default). Rendering and reading a video take ~30 s of CPU each.
 
 Per scene: the focal error ``f / f_true - 1``, the stated ``focal_sigma_px`` and ``z`` =
 error / sigma; per set also the 2-sigma coverage and the median ``|z|`` (a Gaussian: 95 %,
 0.67). Writes ``benchmarks/out/calibrate_traffic.json`` and
 ``benchmarks/out/calibrate_traffic.png`` (focal error per seed with the stated 2-sigma).
 
-Usage: ``python benchmarks/calibrate_traffic.py [--first-seed 300] [--seeds 20] [--draws 5]``
+Usage: ``python benchmarks/calibrate_traffic.py [--first-seed 300] [--seeds 20] [--draws 5]
+[--video [--video-dir DIR]]``
 """
 
 from __future__ import annotations
@@ -44,9 +50,10 @@ import numpy as np
 from camloc_geo import InputError
 from camloc_geo.api import calibrate_scene
 from camloc_geo.camera import Camera
+from camloc_geo.relative import CalibrationSettings
 from camloc_geo.testing.road_lines import road_line_scene, street_noise, street_scene
 from camloc_geo.testing.synthetic import make_scene
-from camloc_geo.testing.traffic_render import random_street, street_photo
+from camloc_geo.testing.traffic_render import random_street, render_street, street_photo
 
 OUT_DIR = Path(__file__).parent / "out"
 IMAGE_SIZE = (960, 540)
@@ -98,10 +105,24 @@ def traffic_scene(
     return syn
 
 
-def focal_row(scene: dict[str, Any], truth: Camera) -> dict[str, Any] | None:
+def street_video_lines(seed: int, video_dir: Path) -> Any:
+    """The video witness lines of ``render_street``'s video for ``random_street(seed)``
+    (rendered into ``video_dir`` unless ``s{seed}.avi`` is there already)."""
+    from camloc_geo.sensors._video_lines import video_lines
+
+    path = video_dir / f"s{seed}.avi"
+    if not path.is_file():
+        cam, vehicles = random_street(np.random.default_rng(seed), n_vehicles=10, duration_s=20.0)
+        render_street(path, cam, vehicles, duration_s=20.0, seed=seed)
+    return video_lines(path, image_size=IMAGE_SIZE)
+
+
+def focal_row(
+    scene: dict[str, Any], truth: Camera, settings: CalibrationSettings | None = None
+) -> dict[str, Any] | None:
     """Focal error, stated sigma and z of one scene, or None when ``calibrate`` refuses it."""
     try:
-        res = calibrate_scene(scene)
+        res = calibrate_scene(scene, settings=settings)
     except InputError:
         return None
     f_true = truth.focal_px
@@ -113,6 +134,7 @@ def focal_row(scene: dict[str, Any], truth: Camera) -> dict[str, Any] | None:
         "z": round(float(err / sigma), 3) if sigma > 0 else None,
         "height_m": round(float(truth.center_in_world[2]), 2),
         "warnings": len(res.warnings),
+        **({"video_segments": res.video_segments} if settings is not None else {}),
     }
 
 
@@ -154,8 +176,12 @@ def plot(result: dict[str, Any], path: Path) -> None:
         "car_only": ("C3", -0.15),
         "noise_free": ("C2", 0.15),
         "road_lines": ("C1", 0.3),
+        "traffic_video": ("C5", 0.22),
+        "car_only_video": ("C6", -0.22),
     }
     for name, (colour, dx) in styles.items():
+        if name not in result["scenes"]:
+            continue
         rows = result["scenes"][name]
         seeds = [r["seed"] for r in rows if r["focal_error"] is not None]
         err = [100 * r["focal_error"] for r in rows if r["focal_error"] is not None]
@@ -188,6 +214,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--draws", type=int, default=5, help="extra noise draws per camera")
     ap.add_argument("--out", type=Path, default=OUT_DIR)
+    ap.add_argument("--video", action="store_true", help="also the sets with the video's lines")
+    ap.add_argument("--video-dir", type=Path, help="keep (and reuse) the rendered videos here")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     scenes: dict[str, list[dict[str, Any]]] = {
@@ -198,6 +226,9 @@ def main(argv: list[str] | None = None) -> int:
         "noise_free": [],
         "road_lines": [],
     }
+    if args.video:
+        scenes["traffic_video"] = []
+        scenes["car_only_video"] = []
     empty = {"focal_error": None, "focal_sigma_rel": None, "z": None}
     photo_dir = Path(tempfile.mkdtemp(prefix="camloc-calibrate-traffic-"))
     for seed in range(args.first_seed, args.first_seed + args.seeds):
@@ -220,6 +251,13 @@ def main(argv: list[str] | None = None) -> int:
             )
         road = road_line_scene(seed)
         scenes["road_lines"].append({"seed": seed, **(focal_row(road.scene, road.camera) or empty)})
+        if args.video:
+            video_dir = args.video_dir or photo_dir
+            video_dir.mkdir(parents=True, exist_ok=True)
+            with_video = CalibrationSettings(video_lines=street_video_lines(seed, video_dir))
+            for name, base in (("traffic_video", syn), ("car_only_video", car)):
+                row = focal_row(base.scene, base.camera, with_video) or empty
+                scenes[name].append({"seed": seed, **row})
     shutil.rmtree(photo_dir, ignore_errors=True)
     result: dict[str, Any] = {
         "seeds": [args.first_seed, args.first_seed + args.seeds - 1],

@@ -9,8 +9,10 @@ into a temporary directory, never into the repository.
 Runs per video (``cv2.setNumThreads(1)``):
 
 - ``detection``: background subtraction, the camera calibrated from the scene as 3
-  annotators clicked it with 1 px noise (what a user gets; the calibration's own error adds
-  to or cancels the radar's);
+  annotators clicked it with 1 px noise and from the video's own lines (the moving vehicles'
+  tracks and edges, ``calibrate_scene(video=...)``, what ``camloc radar`` does by default
+  since session 36; ``--no-video-lines``: the scene alone, as before) (what a user gets; the
+  calibration's own error adds to or cancels the radar's);
 - ``detection_true_camera``: background subtraction, the true camera with no calibration
   uncertainty (the radar's own error);
 - ``tracks_true_camera``: the exact per-frame boxes given (``--tracks``), noise-free camera;
@@ -256,6 +258,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duration", type=float, default=20.0, help="seconds per video")
     ap.add_argument("--runs", default=",".join(RUNS), help="comma-separated subset of runs")
     ap.add_argument("--name", default="radar_render")
+    ap.add_argument(
+        "--video-lines",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="calibrate with the video's own lines too (camloc radar's default)",
+    )
     args = ap.parse_args(argv)
     runs = [r for r in args.runs.split(",") if r]
     unknown = set(runs) - set(RUNS) - set(EXTRA_RUNS)
@@ -281,7 +289,9 @@ def main(argv: list[str] | None = None) -> int:
             )
             n_true += sum(1 for per in video.boxes.values() if len(per) / video.fps >= 0.5)
             try:
-                cal: CalibrationResult | None = calibrate_scene(video.scene)
+                cal: CalibrationResult | None = calibrate_scene(
+                    video.scene, video=video.path if args.video_lines else None
+                )
             except InputError as exc:
                 print(f"seed {seed}: calibrate failed: {exc}", file=sys.stderr)
                 cal = None
@@ -341,6 +351,7 @@ def main(argv: list[str] | None = None) -> int:
         "focal_rel_error_background_photo": focal_errors_bg,
         "focal_rel_sigma_background_photo": focal_sigmas_bg,
         "calibration_failures": cal_failures,
+        "video_lines": args.video_lines,
         "targets": TARGETS,
         "brnocompspeed_state_of_the_art_kmh": BRNO,
     }

@@ -145,6 +145,7 @@ def calibrate_scene(
     settings: CalibrationSettings | None = None,
     joint_fit: bool = True,
     principal_point: str = "auto",
+    video: str | os.PathLike[str] | None = None,
 ) -> CalibrationResult:
     """Relative pose of the camera from the scene's annotations.
 
@@ -161,6 +162,12 @@ def calibrate_scene(
     principal_point
         ``"auto"`` (freed only when the data justify it), ``"centre"`` (or ``"center"``) or
         ``"free"``.
+    video
+        A video of the scene's camera (the scene image's size): the moving vehicles' tracks
+        and edges join the fit as one more witness group
+        (:func:`camloc_geo.sensors._video_lines.video_lines`,
+        ``CalibrationSettings.video_lines``; ``video_segments`` in the result says how many
+        per axis). Overrides ``settings.video_lines``.
 
     Returns
     -------
@@ -191,6 +198,15 @@ def calibrate_scene(
         settings = CalibrationSettings(
             joint_fit=joint_fit, free_principal_point=modes[principal_point]
         )
+    if video is not None:
+        from dataclasses import replace
+
+        from camloc_geo.sensors._video_lines import video_lines
+
+        if not isinstance(video, (str, os.PathLike)):
+            raise InputError(f"video must be a file path, not {type(video).__name__}")
+        lines = video_lines(video, image_size=(sc.image.width, sc.image.height))
+        settings = replace(settings, video_lines=lines)
     return calibrate(sc, settings)
 
 
@@ -881,6 +897,7 @@ def radar_scene(
     min_track_s: float = 0.5,
     max_frames: int | None = None,
     progress: bool = False,
+    video_lines: bool = True,
 ) -> RadarResult:
     """Virtual radar: calibrate the scene, then measure the vehicles' speeds in a video.
 
@@ -905,6 +922,11 @@ def radar_scene(
         Read at most this many frames.
     progress
         Show a tqdm progress bar on stderr.
+    video_lines
+        Calibrate with the video's own lines as one more witness (the moving vehicles'
+        tracks and edges, :func:`calibrate_scene`'s ``video``; default); False: from the
+        scene alone (as before session 36). The JSON's ``calibration`` says which
+        witnesses were used.
 
     Returns
     -------
@@ -926,7 +948,7 @@ def radar_scene(
     probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
     if isinstance(tracks, (str, os.PathLike)):
         tracks = read_tracks(tracks)
-    calibration = calibrate_scene(sc)
+    calibration = calibrate_scene(sc, video=video if video_lines else None)
     return measure_speeds(
         calibration,
         video,

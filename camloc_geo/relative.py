@@ -149,6 +149,19 @@ class CalibrationSettings:
         disagree are not used (a clear disagreement is a warning); False: never. Also where
         the annotations cannot fix the focal length: the photo's trustworthy one is used
         (:func:`calibrate`); False: the refusal stands.
+    video_lines
+        Witness segments of the scene's video (a ``VideoLines`` of
+        :func:`camloc_geo.sensors._video_lines.video_lines`: the moving vehicles' tracks
+        and edges, grouped by their own vanishing points; ``calibrate_scene(video=...)``
+        reads it). Each
+        group whose point is nearest one of the fit's axes (within ``PHOTO_AXIS_NEAR_DEG``)
+        and whose segments agree with that axis' vanishing point (median residual within
+        ``VIDEO_AGREE`` line sigmas) joins the final fit, each segment at
+        ``VIDEO_SEGMENT_SIGMA`` line sigmas, per group at most as much as ``VIDEO_GROUP_CAP``
+        times the annotators' average lines of that axis count, under the fit's robust loss
+        (:func:`_add_video_segments`). A group that clearly disagrees is a warning and is
+        not used. The jackknife leaves the video's segments out in turn as one more group
+        (like the photo's). None (default): no video.
     principal_point_prior_sigma_rel
         When the principal point is fitted (``free_principal_point``), a Gaussian prior
         holds it near the image centre with this 1-sigma, a fraction of the image diagonal
@@ -180,6 +193,7 @@ class CalibrationSettings:
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
     photo_lines: bool = True
+    video_lines: Any = None
 
 
 @dataclass
@@ -357,6 +371,7 @@ class CalibrationResult:
     parameter_covariance: FloatArray | None = field(default=None, repr=False, compare=False)
     joint_state: JointState | None = field(default=None, repr=False, compare=False)
     photo_segments: dict[str, int] = field(default_factory=dict)
+    video_segments: dict[str, int] = field(default_factory=dict)
     object_proportions: dict[str, Any] | None = None
 
     @property
@@ -471,6 +486,8 @@ class CalibrationResult:
             out["camera_in_world_sigma_jackknife_m"] = self.position_sigma_jackknife_m.tolist()
         if self.photo_segments:
             out["photo_segments"] = dict(self.photo_segments)
+        if self.video_segments:
+            out["video_segments"] = dict(self.video_segments)
         if self.object_proportions is not None:
             out["object_proportions"] = self.object_proportions
         out["cluster"] = self.cluster
@@ -1161,6 +1178,9 @@ class _JointProblem:
         self._photo_scale = np.zeros(0)
         self.photo_segments = np.zeros((0, 4))
         self.photo_axis = np.zeros(0, dtype=int)
+        # Which witness each of those rows is: 0 the photo's, 1 the video's.
+        self.photo_source = np.zeros(0, dtype=int)
+        self.video_warnings: list[str] = []
         # The photo's vanishing point (pixels, homogeneous) lending each axis its segments.
         self.photo_axis_vp: dict[int, FloatArray] = {}
         self.weights = np.ones(self.n_annotators)
@@ -1282,11 +1302,27 @@ class _JointProblem:
             ) + np.sum((clicks[:, 2] - clicks[:, 0]) ** 2, axis=1)
         return self._ground_corner_edge_sq
 
+    def add_video_segments(
+        self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
+    ) -> None:
+        """Add the video's witness segments after the photo's (``photo_source`` 1)."""
+        segs = np.asarray(segments, dtype=float).reshape(-1, 4)
+        sigma = np.broadcast_to(np.asarray(sigma_px, float), (len(segs),))
+        n_photo = len(self.photo_segments)
+        source = np.concatenate([self.photo_source[:n_photo], np.ones(len(segs), dtype=int)])
+        self.set_photo_segments(
+            np.vstack([self.photo_segments, segs]),
+            np.concatenate([self.photo_axis, np.asarray(axes, dtype=int).reshape(-1)]),
+            np.concatenate([1.0 / self._photo_scale[:n_photo], sigma]),
+        )
+        self.photo_source = source
+
     def set_photo_segments(
         self, segments: npt.ArrayLike, axes: npt.ArrayLike, sigma_px: npt.ArrayLike
     ) -> None:
         """Add segments detected in the photo: ``(k, 4)``, their axis index, 1-sigma (px)."""
         photo = np.asarray(segments, dtype=float).reshape(-1, 4)
+        self.photo_source = np.zeros(len(photo), dtype=int)
         self.photo_segments = photo
         self.photo_axis = np.asarray(axes, dtype=int).reshape(-1)
         self._photo_scale = 1.0 / np.broadcast_to(np.asarray(sigma_px, float), (len(photo),))
@@ -2668,6 +2704,101 @@ def _add_photo_segments(
     return used
 
 
+VIDEO_SEGMENT_SIGMA = 1.0  # a video segment joins the fit at this many line sigmas
+VIDEO_GROUP_CAP = 3.0  # ... a group at most this many annotators' lines of its axis
+VIDEO_AGREE = 3.0  # a group agrees: its median residual to the fit's point, line sigmas
+VIDEO_MIN_SEGMENTS = 12  # a group needs this many segments to count
+
+
+def _add_video_segments(
+    scene: Scene,
+    video: Any,
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+) -> dict[str, int]:
+    """Give ``prob`` the video's witness groups that agree with the fit at ``x``.
+
+    ``video`` is a :class:`camloc_geo.sensors._video_lines.VideoLines`: segments of the moving
+    vehicles (tracks along the street, edges across it and upright), grouped by their own
+    vanishing points. A group serves the fit's axis nearest its point (within
+    ``PHOTO_AXIS_NEAR_DEG``; two groups on one axis: neither), and joins where the median
+    residual of its segments to that axis' vanishing point of the fit is within ``VIDEO_AGREE``
+    line sigmas; otherwise a warning names the group, the axis and the residual
+    (``prob.video_warnings``). Each segment joins at ``VIDEO_SEGMENT_SIGMA`` line sigmas,
+    widened so that a group counts at most as ``VIDEO_GROUP_CAP`` times the annotators' average
+    lines of that axis (at least 2): the video is one witness, however many frames it has.
+    Returns the segments used per axis name. Nothing where the video's frame size is not the
+    scene's, or the scene has a lens distortion (``camera.distortion``: the video's segments are
+    the raw frames').
+    """
+    from camloc_geo.sensors._video_lines import GROUPS, _residual_px
+
+    if tuple(video.image_size) != tuple(scene.image_size):
+        prob.video_warnings.append(
+            f"video: its frames are {video.image_size[0]}x{video.image_size[1]}, the scene's "
+            f"image {scene.image_size[0]}x{scene.image_size[1]}; its lines are not used"
+        )
+        return {}
+    if _scene_lens(scene)[0] is not None:
+        log.info("video: the scene has a lens distortion; the video's lines are not used")
+        return {}
+    f, pp, R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    K = np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]])
+    K_inv = np.linalg.inv(K)
+    segs_all = np.asarray(video.segments, dtype=float).reshape(-1, 4)
+    labels = np.asarray(video.labels, dtype=int).reshape(-1)
+    group_axis: dict[int, int] = {}
+    for k, vp in enumerate(np.asarray(video.vanishing_points, dtype=float)):
+        if not np.all(np.isfinite(vp)) or np.count_nonzero(labels == k) < VIDEO_MIN_SEGMENTS:
+            continue
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if not (n > 0.0 and np.isfinite(n)):
+            continue
+        cosines = np.abs(R.T @ (d / n))
+        i = int(np.argmax(cosines))
+        angle = math.degrees(math.acos(min(1.0, float(cosines[i]))))
+        if angle <= PHOTO_AXIS_NEAR_DEG:
+            group_axis[k] = i
+    taken = list(group_axis.values())
+    used: dict[str, int] = {}
+    segs_out: list[FloatArray] = []
+    axes_out: list[FloatArray] = []
+    sigma_out: list[FloatArray] = []
+    axis_name = {i: name for name, i in _AXIS_INDEX.items()}
+    for k, i in group_axis.items():
+        if taken.count(i) > 1:
+            continue  # two of the video's groups on one axis: ambiguous
+        segs = segs_all[labels == k]
+        resid = _residual_px(segs, K @ R[:, i])
+        med = float(np.median(resid)) / prob.sigma_line
+        if not med <= VIDEO_AGREE:
+            prob.video_warnings.append(
+                f"video: its {GROUPS[k]} lines ({len(segs)}) disagree with the annotators' "
+                f"{axis_name[i]} axis (median residual {med:.1f} line sigmas); not used "
+                f"(the annotators' {axis_name[i]} lines or the video's are off)"
+            )
+            continue
+        sigma = np.full(len(segs), VIDEO_SEGMENT_SIGMA * prob.sigma_line)
+        cap = VIDEO_GROUP_CAP * max(float(np.sum(prob.seg_axis == i)) / prob.n_annotators, 2.0)
+        if len(segs) > cap:
+            sigma *= math.sqrt(len(segs) / cap)
+        segs_out.append(segs)
+        axes_out.append(np.full(len(segs), i))
+        sigma_out.append(sigma)
+        used[axis_name[i]] = used.get(axis_name[i], 0) + len(segs)
+    if not segs_out:
+        return {}
+    prob.add_video_segments(
+        np.vstack(segs_out), np.concatenate(axes_out), np.concatenate(sigma_out)
+    )
+    log.info("video: %s segments agree with the annotators' fit", used)
+    return used
+
+
 def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     """Warnings where the scene's photo and the annotators' fit clearly disagree.
 
@@ -2910,6 +3041,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     ]
     if result.photo_segments:
         leave_outs.append((scene, replace(sub_settings, photo_lines=False)))
+    if result.video_segments:
+        leave_outs.append((scene, replace(sub_settings, video_lines=None)))
     for sub, sub_set in leave_outs:
         try:
             res = _calibrate_usable(sub, sub_set)
@@ -3006,9 +3139,11 @@ def _leave_one_out_steps(
         owner_base = np.concatenate([prob.seg_ann, prob.pt_ann, prob.pt_ann])
         n_ann = prob.n_annotators
         n_photo = len(prob.photo_segments)
-        if photo_group and n_photo:  # the photo's rows (after the clicks'): one more group
-            owner_base = np.concatenate([owner_base, np.full(n_photo, n_ann)])
-            n_ann += 1
+        if photo_group and n_photo:  # the photo's and the video's rows: a group each
+            sources = sorted(set(prob.photo_source.tolist()))
+            group = np.searchsorted(np.asarray(sources), prob.photo_source)
+            owner_base = np.concatenate([owner_base, n_ann + group])
+            n_ann += len(sources)
         x0 = np.asarray(state.x, dtype=float)
         h = 1e-7 * np.maximum(1.0, np.abs(x0))  # forward-difference steps
         r, J = prob.residuals_and_jacobian(x0, *args)
@@ -3149,7 +3284,7 @@ def _photo_rows_lost(
         f, pp, R, _C = prob.unpack(x_a, *args)
         for axis, vp in prob.photo_axis_vp.items():
             if _photo_direction_axis(vp, f, pp, R) != axis:
-                lost[a, first:] |= prob.photo_axis == axis
+                lost[a, first:] |= (prob.photo_axis == axis) & (prob.photo_source == 0)
     return lost if lost.any() else None
 
 
@@ -3320,7 +3455,8 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
             influence.append(float(np.linalg.norm(c_i - c)))
         else:
             log.info(
-                "without the photo's lines: focal length %+.1f %%, camera moved %.2f m",
+                "without one witness group's lines (photo, video): focal length %+.1f %%, "
+                "camera moved %.2f m",
                 100.0 * (f_i / result.camera.focal_px - 1.0),
                 float(np.linalg.norm(c_i - c)),
             )
@@ -3843,6 +3979,13 @@ def _joint(
         photo_used = _add_photo_segments(scene, prob, res.x, R0, pp_fixed, f_fixed)
         if photo_used:
             res = _fit(prob, res.x, R0, pp_fixed, f_fixed, tol=1e-8)
+    video_used: dict[str, int] = {}
+    if settings.video_lines is not None:
+        video_used = _add_video_segments(
+            scene, settings.video_lines, prob, res.x, R0, pp_fixed, f_fixed
+        )
+        if video_used:
+            res = _fit(prob, res.x, R0, pp_fixed, f_fixed, tol=1e-8)
     if f_fixed is None and settings.focal_prior_sigma_log > 0.0:
         res = _focal_prior(prob, res, R0, pp_fixed, settings)
     chosen: tuple[Any, tuple[float, float] | None] = (res, pp_fixed)
@@ -4002,7 +4145,9 @@ def _joint(
         width_sign=ws_out,
         joint_state=state,
         photo_segments=photo_used,
+        video_segments=video_used,
     )
+    result.warnings.extend(prob.video_warnings)
     if len(chosen_corners) > 1:
         result.warnings.append(
             "annotators marked different corners of the car ("

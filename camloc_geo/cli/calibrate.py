@@ -38,6 +38,14 @@ def register(subparsers: Any) -> None:
         default="auto",
         help="principal point model of the joint fit (default: auto, decided by the data)",
     )
+    p.add_argument(
+        "--video",
+        metavar="VIDEO",
+        help=(
+            "a video of the scene's camera (the image's size): the moving vehicles' tracks and "
+            "edges join the fit as one more witness (video_segments in the JSON)"
+        ),
+    )
     p.set_defaults(func=run)
 
 
@@ -46,11 +54,18 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.api import calibrate_scene, scene_from
     from camloc_geo.cli import output_path
 
-    output_path(args.output, inputs=[args.scene])
+    output_path(args.output, inputs=[args.scene, args.video])
     with _logged_warnings() as logged:
         scene = scene_from(args.scene)
+        if args.video is not None:
+            from camloc_geo.sensors.radar import probe_video
+
+            probe_video(args.video, image_size=(scene.image.width, scene.image.height))
         result = calibrate_scene(
-            scene, joint_fit=not args.no_joint_fit, principal_point=args.principal_point
+            scene,
+            joint_fit=not args.no_joint_fit,
+            principal_point=args.principal_point,
+            video=args.video,
         )
     # Every warning of the answer also on stderr, once: those the library logged while
     # reading and screening the scene are there already; the fit's own (a loose focal

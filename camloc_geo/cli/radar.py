@@ -16,7 +16,8 @@ def register(subparsers: Any) -> None:
         "radar",
         help="measure vehicle speeds (km/h) in a video of the calibrated camera",
         description=(
-            "Virtual radar: calibrate the scene, find the vehicles in the video (background "
+            "Virtual radar: calibrate the scene (and, by default, the video's own lines: "
+            "--no-video-lines), find the vehicles in the video (background "
             "subtraction, or the boxes of --tracks), follow them with KLT features and fit "
             "the ground-plane motion of each vehicle's ground contact. Prints JSON (or writes "
             "-o FILE: .json, or .csv with one row per vehicle) with speed_kmh and sigma_kmh "
@@ -39,6 +40,16 @@ def register(subparsers: Any) -> None:
         help="shorter tracks are skipped with a reason (default 0.5 s)",
     )
     p.add_argument("--max-frames", type=int, help="process only the first N frames")
+    p.add_argument(
+        "--video-lines",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help=(
+            "calibrate with the video's own lines too: the moving vehicles' tracks and edges "
+            "(default; the JSON's calibration.witnesses says which were used); "
+            "--no-video-lines: from the scene alone"
+        ),
+    )
     p.add_argument(
         "--progress",
         action=argparse.BooleanOptionalAction,
@@ -77,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
         min_track_s=args.min_track_s,
         max_frames=args.max_frames,
         progress=progress,
+        video_lines=args.video_lines,
     )
     if not result.vehicles:
         raise InputError(f"{result.warnings[0]} ({args.video}, {result.video.n_frames} frames)")

@@ -300,6 +300,10 @@ class RadarResult:
         Detected blobs seen in fewer than 3 frames, dropped as noise (not vehicles).
     warnings
         Things the caller should know (e.g. no vehicle found).
+    calibration
+        The calibration used (:func:`calibration_summary`): its focal length and sigma, and
+        which witnesses it rests on (``"annotators"``, ``"photo"``, ``"video"``), with the
+        photo's and the video's segments per axis.
     """
 
     video: VideoInfo
@@ -308,6 +312,7 @@ class RadarResult:
     processing_s: float
     noise_blobs: int = 0
     warnings: list[str] = field(default_factory=list)
+    calibration: dict[str, Any] = field(default_factory=dict)
 
     @property
     def measured(self) -> list[VehicleSpeed]:
@@ -330,6 +335,7 @@ class RadarResult:
             "processing_s": round(self.processing_s, 3),
             "processing_fps": round(self.frames_per_second, 1),
             "warnings": list(self.warnings),
+            **({"calibration": dict(self.calibration)} if self.calibration else {}),
             "vehicles": [v.to_dict(track=tracks) for v in self.vehicles],
         }
 
@@ -1652,7 +1658,31 @@ def measure_speeds(
         time.perf_counter() - t0,
         noise,
         warnings,
+        calibration_summary(calibration),
     )
+
+
+def calibration_summary(calibration: CalibrationResult) -> dict[str, Any]:
+    """The calibration's focal length, its sigma and the witnesses it used (JSON-ready).
+
+    ``witnesses``: ``"annotators"`` always, ``"photo"`` where the scene photo's detected
+    lines joined the fit (``photo_segments``), ``"video"`` where the video's lines did
+    (``video_segments``, :func:`camloc_geo.sensors._video_lines.video_lines`).
+    """
+    out: dict[str, Any] = {"focal_px": round(float(calibration.camera.focal_px), 2)}
+    if calibration.focal_sigma_px is not None:
+        out["focal_sigma_px"] = round(float(calibration.focal_sigma_px), 2)
+    witnesses = ["annotators"]
+    photo = dict(getattr(calibration, "photo_segments", {}) or {})
+    video = dict(getattr(calibration, "video_segments", {}) or {})
+    if photo:
+        witnesses.append("photo")
+        out["photo_segments"] = photo
+    if video:
+        witnesses.append("video")
+        out["video_segments"] = video
+    out["witnesses"] = witnesses
+    return out
 
 
 def _run(

@@ -1,0 +1,228 @@
+"""The video as a calibration witness (issue 28): camloc_geo.sensors._video_lines."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from camloc_geo import InputError
+from camloc_geo.api import calibrate_scene
+from camloc_geo.relative import CalibrationSettings
+from camloc_geo.sensors._video_lines import GROUPS, VideoLines, _residual_px, video_lines
+from camloc_geo.testing.road_lines import street_noise
+from camloc_geo.testing.synthetic import make_scene
+from camloc_geo.testing.traffic_render import (
+    RenderedVideo,
+    random_street,
+    render_street,
+    street_camera,
+)
+
+# Development camera 0 of benchmarks/calibrate_traffic.py (random_street(0)), its car
+# annotated alone by 3 annotators with 1 px noise (noise draw 2000): short width and height
+# lines only, the focal length 6.7 % high. Its video's vehicles give the across-street and
+# vertical points.
+SEED = 0
+NOISE_SEED = 2000
+
+
+def _axis_angle_deg(vp: np.ndarray, cam: Any, axis: int) -> float:
+    f, pp, R = cam.focal_px, cam.principal_point, cam.cam_from_world_rotation
+    K = np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]])
+    d = np.linalg.solve(K, vp)
+    c = abs(float(R[:, axis] @ d)) / float(np.linalg.norm(d))
+    return math.degrees(math.acos(min(1.0, c)))
+
+
+@pytest.fixture(scope="module")
+def street(tmp_path_factory: pytest.TempPathFactory) -> tuple[RenderedVideo, VideoLines]:
+    cam, vehicles = random_street(np.random.default_rng(SEED), n_vehicles=6, duration_s=12.0)
+    path = tmp_path_factory.mktemp("video_lines") / "street.avi"
+    video = render_street(path, cam, vehicles, duration_s=12.0, seed=SEED, texture_m_per_px=0.05)
+    return video, video_lines(video.path, image_size=video.image_size)
+
+
+def _car_only_scene(cam: Any) -> dict[str, Any]:
+    syn = make_scene(
+        cam,
+        np.random.default_rng(SEED + NOISE_SEED + 7),
+        noise=street_noise(1.0),
+        n_annotators=3,
+        image_size=(960, 540),
+    )
+    return syn.scene
+
+
+def test_groups_meet_at_the_true_vanishing_points(
+    street: tuple[RenderedVideo, VideoLines],
+) -> None:
+    video, lines = street
+    cam = video.camera
+    assert lines.image_size == (960, 540)
+    f, pp, R = cam.focal_px, cam.principal_point, cam.cam_from_world_rotation
+    K = np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]])
+    for k, name in enumerate(GROUPS):
+        segs = lines.group(name)
+        assert len(segs) >= 12, (name, lines.counts)
+        # the segments of each group pass through the true vanishing point of its axis
+        res = _residual_px(segs, K @ R[:, k])
+        assert float(np.median(res)) < 0.5, (name, float(np.median(res)))
+    # the tracks pin the street's point: well under a degree
+    assert _axis_angle_deg(lines.vanishing_points[0], cam, 0) < 0.5
+    assert lines.counts["street"] > lines.counts["across"]
+    d = lines.to_dict()
+    assert set(d["segments"]) >= set(GROUPS)
+    assert d["frames"] == video.n_frames
+
+
+def test_static_scenery_never_counts(tmp_path: Path) -> None:
+    # A street without traffic: the renderer's street end and painted lines are static.
+    cam = street_camera(7.0)
+    video = render_street(
+        tmp_path / "empty.avi", cam, [], duration_s=2.0, seed=1, texture_m_per_px=0.05
+    )
+    lines = video_lines(video.path)
+    assert len(lines.segments) == 0
+    assert lines.counts["edges"] == 0
+    assert lines.counts["tracks"] == 0
+    assert np.all(np.isnan(lines.vanishing_points))
+
+
+def test_the_video_brings_a_loose_car_only_scene_within_3_percent(
+    street: tuple[RenderedVideo, VideoLines],
+) -> None:
+    video, lines = street
+    scene = _car_only_scene(video.camera)
+    f_true = video.camera.focal_px
+    without = calibrate_scene(scene)
+    assert abs(without.camera.focal_px / f_true - 1.0) > 0.05  # the old answer: 6.7 % off
+    assert not without.video_segments
+    with_video = calibrate_scene(scene, settings=CalibrationSettings(video_lines=lines))
+    err = with_video.camera.focal_px / f_true - 1.0
+    assert abs(err) < 0.03, err
+    assert set(with_video.video_segments) == {"length", "width", "height"}
+    assert with_video.to_dict()["video_segments"] == with_video.video_segments
+    # honest: the error is within 2 stated sigmas, and the jackknife left the video out
+    assert with_video.focal_sigma_px is not None
+    assert abs(err) * f_true < 2.0 * with_video.focal_sigma_px
+    assert not any(w.startswith("video") for w in with_video.warnings)
+
+
+def test_calibrate_scene_takes_the_video_path(street: tuple[RenderedVideo, VideoLines]) -> None:
+    video, lines = street
+    scene = _car_only_scene(video.camera)
+    a = calibrate_scene(scene, video=video.path)
+    b = calibrate_scene(scene, settings=CalibrationSettings(video_lines=lines))
+    assert a.camera.focal_px == pytest.approx(b.camera.focal_px, rel=1e-9)
+    assert a.video_segments == b.video_segments
+
+
+def test_a_video_of_another_camera_is_warned_and_not_used(
+    street: tuple[RenderedVideo, VideoLines],
+) -> None:
+    _video, lines = street
+    # Another camera's scene (same frame size, rolled 8 degrees): the video's lines disagree.
+    other = street_camera(7.5, hfov_deg=60.0, along_m=-10.0, aim_xy_m=(8.0, -6.0), roll_deg=8.0)
+    syn = make_scene(
+        other,
+        np.random.default_rng(3),
+        noise=street_noise(1.0),
+        n_annotators=3,
+        image_size=(960, 540),
+    )
+    plain = calibrate_scene(syn.scene)
+    res = calibrate_scene(syn.scene, settings=CalibrationSettings(video_lines=lines))
+    warned = [w for w in res.warnings if w.startswith("video: its")]
+    assert warned, res.warnings
+    assert "disagree" in warned[0]
+    assert len(res.video_segments) < 3
+    if not res.video_segments:
+        assert res.camera.focal_px == pytest.approx(plain.camera.focal_px, rel=1e-9)
+
+
+def test_a_video_of_another_size_is_refused(tmp_path: Path) -> None:
+    cam = street_camera(7.0, image_size=(480, 270))
+    video = render_street(tmp_path / "small.avi", cam, [], duration_s=1.0, seed=1)
+    with pytest.raises(InputError, match="480x270"):
+        video_lines(video.path, image_size=(960, 540))
+
+
+def test_bad_video_path_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="video"):
+        video_lines(tmp_path / "missing.avi")
+    bad = tmp_path / "bad.avi"
+    bad.write_text("not a video")
+    with pytest.raises(InputError, match="video"):
+        video_lines(bad)
+
+
+def test_cli_calibrate_video_option(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    assert main(["calibrate", str(scene_path)]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert "video_segments" not in plain
+    assert main(["calibrate", str(scene_path), "--video", str(video.path)]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out["video_segments"]) == {"length", "width", "height"}
+    f_true = video.camera.focal_px
+    assert abs(out["focal_px"] / f_true - 1.0) < 0.03
+    assert abs(plain["focal_px"] / f_true - 1.0) > 0.05
+
+
+def test_cli_radar_says_which_witnesses_calibrated_it(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    args = ["radar", str(video.path), "--scene", str(scene_path), "--max-frames", "60"]
+    assert main([*args, "--no-video-lines"]) == 0
+    plain = json.loads(capsys.readouterr().out)["calibration"]
+    assert plain["witnesses"] == ["annotators"]
+    assert "video_segments" not in plain
+    assert main([*args, "--video-lines"]) == 0
+    used = json.loads(capsys.readouterr().out)["calibration"]
+    assert used["witnesses"] == ["annotators", "video"]
+    assert set(used["video_segments"]) == {"length", "width", "height"}
+    f_true = video.camera.focal_px
+    assert abs(used["focal_px"] / f_true - 1.0) < 0.03
+    assert abs(plain["focal_px"] / f_true - 1.0) > 0.05
+
+
+def test_photo_and_video_are_two_witness_groups_of_the_jackknife(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    from camloc_geo.testing.traffic_render import street_photo
+
+    video, lines = street
+    scene = _car_only_scene(video.camera)
+    scene["image"]["path"] = str(street_photo(video.camera, SEED, tmp_path / "street.png"))
+    f_true = video.camera.focal_px
+    one = calibrate_scene(scene, settings=CalibrationSettings(video_lines=lines))
+    refit = calibrate_scene(
+        scene, settings=CalibrationSettings(video_lines=lines, jackknife_method="refit")
+    )
+    assert one.photo_segments
+    assert set(one.video_segments) == {"length", "width", "height"}
+    assert one.camera.focal_px == pytest.approx(refit.camera.focal_px, rel=1e-9)
+    assert abs(one.camera.focal_px / f_true - 1.0) < 0.03
+    # the one-step jackknife (two witness groups beside the annotators) as the refits
+    assert one.focal_sigma_px == pytest.approx(refit.focal_sigma_px, rel=0.25)
+    # without the video the photo alone leaves this scene loose
+    photo_only = calibrate_scene(scene)
+    assert photo_only.focal_sigma_px is not None
+    assert one.focal_sigma_px is not None
+    assert photo_only.focal_sigma_px > 2.0 * one.focal_sigma_px
