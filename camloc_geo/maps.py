@@ -1003,6 +1003,7 @@ def build_candidates_map(
     tiles: str | None = "OpenStreetMap",
     overlay_images: Mapping[int, str] | None = None,
     overlay_links: Mapping[int, str] | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> folium.Map:
     """The review map of one scene's candidates, as a :class:`folium.Map`.
 
@@ -1022,6 +1023,10 @@ def build_candidates_map(
         ``rank → img src`` (a data URI or a relative path) shown in the candidate's popup.
     overlay_links
         ``rank → href`` of the full-size overlay (the thumbnail links to it).
+    verdicts
+        Rows of :func:`read_verdicts`: those of this scene shown again on its candidates (a
+        browser that has verdicts of its own for this page keeps those; see
+        docs/candidates.md).
 
     Returns
     -------
@@ -1202,7 +1207,10 @@ def build_candidates_map(
         ],
     ]
     if cand_props:
-        _Verdicts(_verdict_config("candidates", v_items, v_identity, scene_name)).add_to(fmap)
+        config = _verdict_config("candidates", v_items, v_identity, scene_name)
+        if verdicts:
+            config["given"] = _given_candidate_verdicts(scene_name, v_items, verdicts)
+        _Verdicts(config).add_to(fmap)
 
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _SmallScreenFolds().add_to(fmap)
@@ -1302,6 +1310,7 @@ def candidates_map(
     overlay_top: int = _OVERLAY_TOP,
     thumbnail_width: int = 480,
     max_bytes: int = MAX_PAGE_BYTES,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
 ) -> Path:
     """Write the review map of one scene's candidates as an HTML page.
 
@@ -1331,6 +1340,9 @@ def candidates_map(
         cut, until the page fits ``max_bytes``).
     max_bytes
         Size budget of a page with embedded overlays.
+    verdicts
+        Rows of :func:`read_verdicts` shown again on the page (see
+        :func:`build_candidates_map`).
 
     Returns
     -------
@@ -1354,6 +1366,7 @@ def candidates_map(
             tiles=tiles,
             overlay_images=links,
             overlay_links=links,
+            verdicts=verdicts,
         )
         page = _render(fmap, offline)
     else:
@@ -1373,6 +1386,7 @@ def candidates_map(
                 tiles=tiles,
                 overlay_images=srcs,
                 overlay_links=links,
+                verdicts=verdicts,
             )
             page = _render(fmap, offline)
             size = len(page.encode("utf-8"))
@@ -2089,10 +2103,16 @@ class _Verdicts(MacroElement):
     };
     panel.addTo(map);
     function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); }
-    function seed() {  // verdicts handed in with the page (summary-map --verdicts), once
+    function seed() {  // verdicts handed in with the page (--verdicts FILE), once
         if (!cfg.given || state.seeded) { return; }
+        var hasYes = cfg.kind === "candidates" && cfg.order.some(function (k) {
+            return state.items[k] && state.items[k].verdict === "yes";
+        });
         Object.keys(cfg.given).forEach(function (k) {
-            if (!state.items[k] && cfg.items[k]) { state.items[k] = cfg.given[k]; }
+            var g = cfg.given[k];
+            // one candidate is the camera: a handed-in "yes" does not add a second one
+            if (hasYes && g.verdict === "yes") { return; }
+            if (!state.items[k] && cfg.items[k]) { state.items[k] = g; }
         });
         state.seeded = true;
         save();
@@ -2202,6 +2222,78 @@ def _given_verdicts(
     if unused:
         log.warning("%d verdict row(s) name no camera or candidate of this page: left out", unused)
     return {key: item for key, (_level, item) in given.items()}
+
+
+_GIVEN_MOVED_M = 30.0
+"""A handed-in verdict on a review page's candidate is left out when its position (as
+exported) lies farther than this from the candidate of the same rank on the page: the scene
+was located again and the ranks moved."""
+
+
+def _given_candidate_verdicts(
+    scene_name: str,
+    items: Mapping[str, Mapping[str, Any]],
+    verdicts: Sequence[Mapping[str, Any]],
+) -> dict[str, dict[str, Any]]:
+    """The review page's stored form (key ``str(rank)``) of exported verdict rows of its
+    camera: a review page's row of a candidate first, else a summary page's row naming the
+    candidate's rank (its "confirm" is "this is the camera"); the last such row wins. Rows of
+    other cameras, of ranks the page does not have, or whose position is more than
+    :data:`_GIVEN_MOVED_M` from the page's candidate are left out (counted in a warning). At
+    most one candidate keeps "yes" (the latest by time)."""
+    given: dict[str, tuple[int, dict[str, Any]]] = {}
+    unused = moved = 0
+    for row in verdicts:
+        rank = row.get("rank")
+        key = str(rank)
+        it = items.get(key)
+        if str(row.get("camera")) != scene_name or rank is None or it is None:
+            unused += 1
+            continue
+        lat, lon = row.get("lat"), row.get("lon")
+        if (
+            lat is not None
+            and lon is not None
+            and it.get("lat") is not None
+            and it.get("lon") is not None
+            and _distance_m({"lat": lat, "lon": lon}, it) > _GIVEN_MOVED_M
+        ):
+            moved += 1
+            continue
+        level = 2 if row.get("page") == "candidates" else 1
+        item = {
+            "verdict": row.get("verdict"),
+            "note": row.get("note") or "",
+            "time": row.get("time") or "",
+            "reviewer": row.get("reviewer") or "",
+        }
+        if level >= given.get(key, (0, {}))[0]:
+            given[key] = (level, item)
+    out = {key: item for key, (_level, item) in given.items()}
+    yes = [k for k, v in out.items() if v["verdict"] == "yes"]
+    if len(yes) > 1:  # one candidate is the camera: the latest "yes" stays
+        keep = max(yes, key=lambda k: str(out[k]["time"]))
+        for k in yes:
+            if k != keep:
+                del out[k]
+        log.warning(
+            "verdicts: %d candidates of %s given 'yes': kept candidate %s (the latest)",
+            len(yes),
+            scene_name,
+            keep,
+        )
+    if unused:
+        log.warning(
+            "%d verdict row(s) name another camera or a rank not on this page: left out", unused
+        )
+    if moved:
+        log.warning(
+            "%d verdict row(s) lie more than %.0f m from this page's candidate of their rank "
+            "(the scene was located again): left out",
+            moved,
+            _GIVEN_MOVED_M,
+        )
+    return out
 
 
 def _verdict_box(key: str) -> str:

@@ -588,3 +588,112 @@ def test_page_identity_is_the_candidates(vpages: dict[str, Any]) -> None:
         base["identity"] != _config(maps.build_summary_map([("b", gj)], offline=True))["identity"]
     )
     assert base["noun"] == "cameras"
+
+
+# ----------------------------------------------------------------- locate --map --verdicts
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
+
+
+@pytest.fixture(scope="module")
+def tied() -> Any:
+    """The sample scene located on the Baltimore extract (12 candidates, 1 and 2 tied)."""
+    from camloc_geo.api import locate_scene
+
+    return locate_scene(SAMPLES / "sample_scene.json", map_source=SAMPLES / "baltimore.osm.pbf")
+
+
+def _cand_row(tied: Any, rank: int, **change: Any) -> dict[str, Any]:
+    c = tied.result.candidates[rank - 1]
+    row = {**ROW, "camera": str(tied.result.scene_id), "rank": rank, "lat": c.lat, "lon": c.lon}
+    row["page"] = "candidates"
+    return {**row, **change}
+
+
+def test_given_candidate_verdicts_pick_the_row_per_rank(tied: Any) -> None:
+    fmap = maps.build_candidates_map(
+        tied.result,
+        tied.map_data,
+        offline=True,
+        verdicts=[
+            _cand_row(tied, 1, verdict="no", note="wrong kerb"),
+            _cand_row(tied, 2, verdict="unsure", page="summary"),
+            _cand_row(tied, 2, verdict="yes", time="2026-11-25T01:00:00.000Z"),  # page row wins
+            _cand_row(tied, 3, verdict="yes", time="2026-11-25T01:30:00.000Z"),  # latest yes
+            _cand_row(tied, 4, verdict="no", lat=tied.result.candidates[3].lat + 0.001),  # moved
+            _cand_row(tied, 5, verdict="no", camera="another camera"),  # not this scene: out
+            {**_cand_row(tied, 7, verdict="no"), "rank": 99},  # no such rank: out
+            {**_cand_row(tied, 6, verdict="unsure"), "lat": None, "lon": None},  # no position
+        ],
+    )
+    given = _config(fmap)["given"]
+    assert {k: (v["verdict"], v["note"]) for k, v in given.items()} == {
+        "1": ("no", "wrong kerb"),
+        "3": ("yes", ROW["note"]),
+        "6": ("unsure", ROW["note"]),
+    }
+    assert given["3"]["reviewer"] == "Ana"
+    assert given["3"]["time"] == "2026-11-25T01:30:00.000Z"
+    # without verdicts the page hands in none
+    assert "given" not in _config(maps.build_candidates_map(tied.result, None, offline=True))
+
+
+def test_locate_map_cli_verdicts(
+    tied: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    good = _write_csv(tmp_path / "v.csv", [_cand_row(tied, 2, verdict="no", note="tree")])
+    out = tmp_path / "m.html"
+    scene, osm = str(SAMPLES / "sample_scene.json"), str(SAMPLES / "baltimore.osm.pbf")
+    args = ["locate", scene, "--osm", osm, "-o", str(tmp_path / "c.geojson"), "--offline"]
+    assert main([*args, "--map", str(out), "--verdicts", str(good)]) == 0
+    found = re.search(r"var cfg = (\{.*?\});\n", out.read_text(encoding="utf-8"))
+    assert found is not None
+    given = json.loads(found.group(1))["given"]
+    assert {k: (v["verdict"], v["note"]) for k, v in given.items()} == {"2": ("no", "tree")}
+    capsys.readouterr()
+    assert main([*args, "--verdicts", str(good)]) == 2
+    assert "--verdicts needs --map OUT.html" in capsys.readouterr().err
+    bad = _write_csv(tmp_path / "bad.csv", [{**ROW, "rank": "two"}])
+    assert main([*args, "--map", str(tmp_path / "n.html"), "--verdicts", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "line 2: rank 'two' is not a whole number" in err
+    assert not (tmp_path / "n.html").exists()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_review_page_shows_given_verdicts(tab: Any, tied: Any, tmp_path: Path) -> None:
+    page_path = maps.candidates_map(
+        tied.result,
+        tied.map_data,
+        tmp_path / "given.html",
+        offline=True,
+        overlay_top=0,
+        verdicts=[
+            _cand_row(tied, 2, verdict="yes", note="the lamp post"),
+            _cand_row(tied, 1, verdict="no"),
+        ],
+    )
+    tab.open(page_path, ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    n = len(tied.result.candidates)
+    page.wait_for_function(
+        f"document.querySelector('.camloc-vcount').textContent === '2 of {n} candidates reviewed'",
+        timeout=3000,
+    )
+    marks = page.evaluate(
+        """() => Object.fromEntries(Array.from(
+            document.querySelectorAll('.camloc-candidate [data-verdict-mark]'))
+            .map(m => [m.getAttribute('data-verdict-mark'), m.getAttribute('data-verdict')]))"""
+    )
+    assert marks["1"] == "no"
+    assert marks["2"] == "yes"
+    assert sorted(k for k, v in marks.items() if v) == ["1", "2"]
+    box = _open_popup(tab, page.locator('.camloc-candidate [data-rank="2"]'))
+    assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "true"
+    assert box.locator("input").input_value() == "the lamp post"
+    page.screenshot(path=str(tmp_path / "given.png"))
+    assert tab.blocked == []
+    assert tab.errors == []
