@@ -1004,6 +1004,7 @@ def build_candidates_map(
     overlay_images: Mapping[int, str] | None = None,
     overlay_links: Mapping[int, str] | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> folium.Map:
     """The review map of one scene's candidates, as a :class:`folium.Map`.
 
@@ -1027,6 +1028,10 @@ def build_candidates_map(
         Rows of :func:`read_verdicts`: those of this scene shown again on its candidates (a
         browser that has verdicts of its own for this page keeps those; see
         docs/candidates.md).
+    verdict_service
+        Path (or URL) of a camloc service's verdicts endpoint (``/v1/verdicts``): the page,
+        when opened over HTTP(S), shares its verdicts there (docs/service.md, "Verdicts");
+        opened from a file it keeps them in the browser only. None: never.
 
     Returns
     -------
@@ -1208,6 +1213,7 @@ def build_candidates_map(
     ]
     if cand_props:
         config = _verdict_config("candidates", v_items, v_identity, scene_name)
+        config["service"] = verdict_service
         if verdicts:
             config["given"] = _given_candidate_verdicts(scene_name, v_items, verdicts)
         _Verdicts(config).add_to(fmap)
@@ -1311,6 +1317,7 @@ def candidates_map(
     thumbnail_width: int = 480,
     max_bytes: int = MAX_PAGE_BYTES,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> Path:
     """Write the review map of one scene's candidates as an HTML page.
 
@@ -1343,6 +1350,9 @@ def candidates_map(
     verdicts
         Rows of :func:`read_verdicts` shown again on the page (see
         :func:`build_candidates_map`).
+    verdict_service
+        The service's verdicts endpoint the page shares its verdicts with when opened over
+        HTTP (see :func:`build_candidates_map`).
 
     Returns
     -------
@@ -1367,6 +1377,7 @@ def candidates_map(
             overlay_images=links,
             overlay_links=links,
             verdicts=verdicts,
+            verdict_service=verdict_service,
         )
         page = _render(fmap, offline)
     else:
@@ -1387,6 +1398,7 @@ def candidates_map(
                 overlay_images=srcs,
                 overlay_links=links,
                 verdicts=verdicts,
+                verdict_service=verdict_service,
             )
             page = _render(fmap, offline)
             size = len(page.encode("utf-8"))
@@ -1578,6 +1590,7 @@ def build_summary_map(
     cluster: bool = True,
     map_data: MapData | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -1598,6 +1611,9 @@ def build_summary_map(
     verdicts
         Rows of :func:`read_verdicts`: shown again on the page (a browser that has verdicts
         of its own for this page keeps those; see docs/candidates.md).
+    verdict_service
+        A camloc service's verdicts endpoint, shared when the page is opened over HTTP (see
+        :func:`build_candidates_map`).
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
@@ -1701,6 +1717,7 @@ def build_summary_map(
             for it in v_items.values()
         ]
         config = _verdict_config("summary", v_items, v_identity, "summary")
+        config["service"] = verdict_service
         if verdicts:
             config["given"] = _given_verdicts(v_items, verdicts)
         _Verdicts(config).add_to(fmap)
@@ -1742,6 +1759,7 @@ def summary_map(
     cluster: bool = True,
     map_data: MapData | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> Path:
     """Write the summary map of many cameras; see :func:`build_summary_map`.
 
@@ -1759,6 +1777,7 @@ def summary_map(
         cluster=cluster,
         map_data=map_data,
         verdicts=verdicts,
+        verdict_service=verdict_service,
     )
     page = _render(fmap, offline)
     from camloc_geo._io import write_text_atomic
@@ -1825,6 +1844,8 @@ _VERDICT_CSS = """
   align-items: center; }
 .camloc-verdicts input { width: 8em; margin: 0; }
 .camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
+.camloc-verdicts .camloc-vshare { flex-basis: 100%; color: #1b5e20; }
+.camloc-verdicts .camloc-vshare.bad { color: #b00020; }
 """
 
 
@@ -1850,6 +1871,11 @@ class _Verdicts(MacroElement):
     var store = null;
     try { store = window.localStorage; store.getItem(WHO); } catch (e) { store = null; }
     var state = {items: {}};
+    // served by a camloc service (over HTTP): verdicts shared there too; from a file: none
+    var remote = null;
+    if (cfg.service && /^https?:$/.test(window.location.protocol)) {
+        remote = cfg.service.replace(/\\/+$/, "") + "/" + cfg.kind + "/" + cfg.identity;
+    }
     function load() {
         state = {items: {}};
         if (!store) { return; }
@@ -1891,6 +1917,7 @@ class _Verdicts(MacroElement):
         }
     }
     function set(k, verdict, rank) {
+        var changed = [k];
         var v = state.items[k] || {};
         var same = v.verdict === verdict && (rank === null || v.rank === rank);
         if (same) { delete v.verdict; delete v.rank; }
@@ -1906,10 +1933,94 @@ class _Verdicts(MacroElement):
                     delete w.verdict;
                     w.time = v.time;
                     mark(o);
+                    changed.push(o);
                 }
             });
         }
-        save(); mark(k); counted();
+        save(); mark(k); counted(); share(changed);
+    }
+    // ---- sharing with the service (remote): the latest time of a key wins
+    var shareBox = null, noteTimer = null;
+    function shared(text, bad) {
+        if (!shareBox) { return; }
+        shareBox.textContent = text;
+        shareBox.className = "camloc-vshare" + (bad ? " bad" : "");
+    }
+    function wire(k) {
+        var v = state.items[k] || {};
+        return {verdict: v.verdict || null, rank: v.rank || null,
+                note: (v.note || "").slice(0, cfg.note_chars),
+                reviewer: (typeof v.reviewer === "string" ? v.reviewer : reviewer()).slice(0, 80),
+                time: v.time || null};
+    }
+    function failed(what) {
+        return function (e) {
+            shared("not shared with the service (" + what + ": " + e + ")", true);
+        };
+    }
+    function answer(r) {
+        if (r.ok) { return r.json(); }
+        return r.json().then(function (b) {
+            throw (b && b.error && b.error.message) || ("HTTP " + r.status);
+        }, function () { throw "HTTP " + r.status; });
+    }
+    function share(keys) {
+        if (!remote || !keys.length) { return; }
+        var body = {items: {}};
+        keys.forEach(function (k) { if (cfg.items[k]) { body.items[k] = wire(k); } });
+        shared("sharing\u2026", false);
+        fetch(remote, {method: "POST", headers: {"Content-Type": "application/json"},
+                       body: JSON.stringify(body), credentials: "same-origin"})
+            .then(answer).then(function (doc) { adopt(doc, false); }, failed("sending"));
+    }
+    function adopt(doc, pushBack) {
+        // the service's items newer than this browser's are taken; this browser's newer
+        // ones (given offline, or handed in with the page) are sent
+        var server = (doc && doc.items) || {}, newer = [];
+        Object.keys(server).forEach(function (k) {
+            var s = server[k], v = state.items[k];
+            if (!cfg.items[k] || !s) { return; }
+            if (!v || !v.time || (s.time && s.time > v.time)) {
+                var w = {time: s.time || "", note: s.note || "", reviewer: s.reviewer || ""};
+                if (s.verdict) { w.verdict = s.verdict; }
+                if (s.verdict && s.rank) { w.rank = s.rank; }
+                state.items[k] = w;
+            }
+        });
+        if (cfg.kind === "candidates") {  // one candidate is the camera: the latest "yes"
+            var yes = cfg.order.filter(function (k) {
+                return state.items[k] && state.items[k].verdict === "yes";
+            });
+            yes.sort(function (a, b) {
+                return (state.items[a].time || "") < (state.items[b].time || "") ? 1 : -1;
+            });
+            yes.slice(1).forEach(function (k) {
+                delete state.items[k].verdict;
+                state.items[k].time = state.items[yes[0]].time;
+            });
+        }
+        cfg.order.forEach(function (k) {
+            var v = state.items[k], s = server[k];
+            if (v && v.time && (!s || !s.time || v.time > s.time)) { newer.push(k); }
+        });
+        save(); cfg.order.forEach(mark); counted(); rerender();
+        var n = 0;
+        Object.keys(server).forEach(function (k) { if (server[k] && server[k].verdict) { n++; } });
+        shared("shared with the service (" + n + " there)", false);
+        if (pushBack && newer.length) { share(newer); }
+    }
+    function pull() {
+        if (!remote) { return; }
+        fetch(remote, {credentials: "same-origin", cache: "no-store"})
+            .then(answer).then(function (doc) { adopt(doc, true); }, failed("reading"));
+    }
+    function rerender() {  // an open popup's controls follow a verdict that came in
+        document.querySelectorAll(".leaflet-popup .camloc-verdict[data-verdict-key]")
+            .forEach(function (box) {
+                if (box.contains(document.activeElement) &&
+                    document.activeElement.tagName === "INPUT") { return; }
+                render(box, box.getAttribute("data-verdict-key"));
+            });
     }
     function render(box, k) {
         var it = cfg.items[k];
@@ -1969,9 +2080,12 @@ class _Verdicts(MacroElement):
         note.addEventListener("input", function () {
             var w = state.items[k] || {};
             w.note = note.value;
+            w.time = new Date().toISOString();
             delete w.reviewer;
             state.items[k] = w;
             save();
+            if (noteTimer !== null) { clearTimeout(noteTimer); }
+            noteTimer = setTimeout(function () { noteTimer = null; share([k]); }, 600);
         });
         L.DomEvent.on(note, "keydown keypress keyup", L.DomEvent.stopPropagation);
         box.appendChild(note);
@@ -2093,6 +2207,11 @@ class _Verdicts(MacroElement):
                 });
                 tools.appendChild(b);
             });
+        if (remote) {
+            shareBox = el("small", "camloc-vshare", "sharing\u2026");
+            shareBox.setAttribute("aria-live", "polite");
+            tools.appendChild(shareBox);
+        }
         div.appendChild(tools);
         warnBox = el("small", "camloc-vwarn");
         div.appendChild(warnBox);
@@ -2102,7 +2221,7 @@ class _Verdicts(MacroElement):
         return div;
     };
     panel.addTo(map);
-    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); }
+    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); pull(); }
     function seed() {  // verdicts handed in with the page (--verdicts FILE), once
         if (!cfg.given || state.seeded) { return; }
         var hasYes = cfg.kind === "candidates" && cfg.order.some(function (k) {
@@ -2127,6 +2246,12 @@ class _Verdicts(MacroElement):
     });
     window.addEventListener("pageshow", refresh);  // back button (a page from the bfcache)
     window.addEventListener("storage", function (e) { if (e.key === KEY) { refresh(); } });
+    if (remote) {  // the other reviewers' verdicts: on coming back to the page, and every 30 s
+        window.addEventListener("focus", pull);
+        setInterval(function () {
+            if (document.visibilityState !== "hidden") { pull(); }
+        }, 30000);
+    }
 })();
 {% endmacro %}
 """

@@ -1,0 +1,348 @@
+"""Reviewers' verdicts shared through the service: ``/v1/verdicts`` on a real ``camloc
+serve`` process (loopback, httpx), the store's merge rule, and in headless Chromium a review
+page served by the service sharing one reviewer's verdicts with another's browser."""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+from test_service import SCENE, Server
+
+from camloc_geo.service.models import VerdictItem, utc_text
+from camloc_geo.service.verdicts import VERDICTS_FILE, VerdictStore
+from camloc_geo.service.work import LimitError
+
+IDENT = "0123456789abcdef"
+URL = f"/v1/verdicts/candidates/{IDENT}"
+
+
+@pytest.fixture(scope="module")
+def vserver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    tmp = tmp_path_factory.mktemp("vservice")
+    srv = Server(tmp, CAMLOC_VERDICT_DIR=str(tmp / "shared-verdicts"))
+    srv.start()
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture(scope="module")
+def vclient(vserver: Server) -> Iterator[httpx.Client]:
+    with httpx.Client(base_url=vserver.url, timeout=60.0) as c:
+        yield c
+
+
+# ---------------------------------------------------------------------------- the store
+def test_store_merge_latest_wins_and_limit(tmp_path: Path) -> None:
+    store = VerdictStore(tmp_path / "v", max_rows=3)
+    assert (tmp_path / "v" / VERDICTS_FILE).is_file()
+    item = {"verdict": "yes", "rank": None, "note": "kerb", "reviewer": "Ana"}
+    doc, taken = store.merge(
+        "candidates", IDENT, {"2": {**item, "time": "2026-11-25T01:00:00.000Z"}}
+    )
+    assert taken == ["2"]
+    assert doc["items"]["2"]["verdict"] == "yes"
+    # an older verdict does not replace a newer one; as new or newer does
+    older = {**item, "verdict": "no", "time": "2026-11-25T00:59:59.999Z"}
+    _doc, taken = store.merge("candidates", IDENT, {"2": older})
+    assert taken == []
+    newer = {**item, "verdict": None, "reviewer": "Bo", "time": "2026-11-25T01:00:00.001Z"}
+    doc, taken = store.merge("candidates", IDENT, {"2": newer})
+    assert taken == ["2"]
+    assert doc["items"]["2"] == {
+        "verdict": None,
+        "rank": None,
+        "note": "kerb",
+        "reviewer": "Bo",
+        "time": "2026-11-25T01:00:00.001Z",
+    }
+    # other pages are apart; the store holds at most max_rows
+    assert store.page("summary", IDENT)["items"] == {}
+    store.merge("summary", IDENT, {"c0": {**item, "time": "2026-11-25T02:00:00.000Z"}})
+    with pytest.raises(LimitError, match="at most 3 verdicts"):
+        store.merge("summary", IDENT, {"c1": {**item, "time": "t"}, "c2": {**item, "time": "t"}})
+    assert [p["page"] for p in store.pages()] == ["summary", "candidates"]
+    assert [p["verdicts"] for p in store.pages()] == [1, 0]
+
+
+def test_verdict_item_time_rules() -> None:
+    from datetime import datetime, timezone
+
+    now = datetime(2026, 11, 25, 2, 0, tzinfo=timezone.utc)
+    given = VerdictItem.model_validate({"verdict": "no", "time": "2026-11-25T03:00:00+02:00"})
+    assert given.stored(now)["time"] == "2026-11-25T01:00:00.000Z"
+    naive = VerdictItem.model_validate({"verdict": "no", "time": "2026-11-25T01:30:00"})
+    assert naive.stored(now)["time"] == "2026-11-25T01:30:00.000Z"
+    future = VerdictItem.model_validate({"verdict": "no", "time": "2027-01-01T00:00:00Z"})
+    assert future.stored(now)["time"] == utc_text(now)  # a clock far ahead: taken as now
+    assert VerdictItem.model_validate({}).stored(now)["time"] == "2026-11-25T02:00:00.000Z"
+
+
+# ----------------------------------------------------------------------------- the API
+def test_verdicts_endpoints_share_and_persist(vserver: Server, vclient: httpx.Client) -> None:
+    r = vclient.get(URL)
+    assert r.status_code == 200, r.text
+    assert r.json() == {"page": "candidates", "identity": IDENT, "items": {}}
+    body = {
+        "items": {
+            "1": {
+                "verdict": "no",
+                "note": "wrong street",
+                "reviewer": "Ana",
+                "time": "2026-11-25T01:00:00.000Z",
+            },
+            "2": {"verdict": "yes", "reviewer": "Ana", "time": "2026-11-25T01:00:01.000Z"},
+        }
+    }
+    r = vclient.post(URL, json=body)
+    assert r.status_code == 200, r.text
+    assert sorted(r.json()["taken"]) == ["1", "2"]
+    # another reviewer, later: withdraws 2; an out-of-date copy of 1 is not taken
+    r = vclient.post(
+        URL,
+        json={
+            "items": {
+                "2": {"verdict": None, "reviewer": "Bo", "time": "2026-11-25T01:05:00Z"},
+                "1": {"verdict": "unsure", "reviewer": "Bo", "time": "2026-11-25T00:00:00Z"},
+            }
+        },
+    )
+    assert r.status_code == 200, r.text
+    assert r.json()["taken"] == ["2"]
+    items = vclient.get(URL).json()["items"]
+    assert {k: (v["verdict"], v["reviewer"], v["note"]) for k, v in items.items()} == {
+        "1": ("no", "Ana", "wrong street"),
+        "2": (None, "Bo", ""),
+    }
+    assert items["2"]["time"] == "2026-11-25T01:05:00.000Z"
+    pages = vclient.get("/v1/verdicts").json()["pages"]
+    assert {
+        "page": "candidates",
+        "identity": IDENT,
+        "verdicts": 1,
+        "latest": "2026-11-25T01:05:00.000Z",
+    } in pages
+    # kept in the folder named by CAMLOC_VERDICT_DIR, and across a restart
+    folder = Path(vserver.env["CAMLOC_VERDICT_DIR"])
+    assert (folder / VERDICTS_FILE).is_file()
+    vserver.stop()
+    vserver.start()
+    with httpx.Client(base_url=vserver.url, timeout=60.0) as again:
+        assert again.get(URL).json()["items"] == items
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "body", "field"),
+    [
+        ("GET", "/v1/verdicts/review/0123456789abcdef", None, "page"),
+        ("GET", "/v1/verdicts/candidates/0123", None, "identity"),
+        ("GET", "/v1/verdicts/candidates/0123456789ABCDEF", None, "identity"),
+        ("POST", URL, {"items": {"rank2": {"verdict": "yes"}}}, "items.rank2.[key]"),
+        ("POST", URL, {"items": {"2": {"verdict": "maybe"}}}, "items.2.verdict"),
+        ("POST", URL, {"items": {"2": {"verdict": "yes", "note": "x" * 201}}}, "items.2.note"),
+        ("POST", URL, {"items": {"2": {"verdict": "yes", "mood": "ok"}}}, "items.2.mood"),
+        ("POST", URL, {"items": {"2": {"time": "yesterday"}}}, "items.2.time"),
+        ("POST", URL, {"items": {"2": {"rank": 0}}}, "items.2.rank"),
+        ("POST", URL, {"items": {"2": {"note": "\ud800"}}}, "items.2.note"),
+        ("POST", URL, {"items": []}, "items"),
+        ("POST", URL, [1, 2], "request"),
+        ("GET", "/v1/verdicts?limit=0", None, "limit"),
+    ],
+)
+def test_verdicts_bad_input_is_a_clear_422(
+    vclient: httpx.Client, method: str, path: str, body: Any, field: str
+) -> None:
+    # (ASCII JSON: a lone surrogate goes as its escape, as a browser may send it)
+    content = None if body is None else json.dumps(body, ensure_ascii=True).encode()
+    r = vclient.request(method, path, content=content, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["type"] == "invalid_input"
+    assert err["field"] == field, err
+
+
+def test_verdicts_bad_bodies(vclient: httpx.Client) -> None:
+    r = vclient.post(URL, content=b"{not json", headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    assert "JSON" in r.json()["error"]["message"]
+    r = vclient.post(URL, content=b"items", headers={"content-type": "text/plain"})
+    assert 400 <= r.status_code < 500, r.text
+    r = vclient.put(URL, json={"items": {}})
+    assert r.status_code == 405
+    assert r.json()["error"]["type"] == "method_not_allowed"
+
+
+def test_serve_verdict_dir_option(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from camloc_geo.cli import main
+
+    afile = tmp_path / "a-file"
+    afile.write_text("x", encoding="utf-8")
+    assert main(["serve", "--verdict-dir", str(afile)]) == 2
+    assert f"--verdict-dir {afile}: not a folder" in capsys.readouterr().err
+    assert main(["serve", "--verdict-dir", str(tmp_path / "no" / "such")]) == 2
+    assert "its parent folder does not exist" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- browser
+needs_browser = pytest.mark.skipif(
+    not Path("/usr/bin/chromium").exists(), reason="Debian chromium is not installed"
+)
+
+
+class _Reviewer:
+    """One reviewer's browser (own storage) on a page served at the service's origin; any
+    request to another origin is aborted and recorded."""
+
+    def __init__(self, browser: Any, origin: str, html_text: str, name: str) -> None:
+        self.context = browser.new_context(viewport={"width": 1400, "height": 900})
+        self.page = self.context.new_page()
+        self.origin = origin
+        self.url = origin + "/review-page-test"
+        self.html = html_text
+        self.blocked: list[str] = []
+        self.errors: list[str] = []
+        self.sent: list[str] = []
+        self.page.route("**/*", self._route)
+        self.page.on("pageerror", lambda exc: self.errors.append(f"pageerror: {exc}"))
+        self.page.on("request", lambda req: self.sent.append(f"{req.method} {req.url}"))
+        self.name = name
+
+    def _route(self, route: Any) -> None:
+        url = route.request.url
+        if url == self.url:  # the page as the service served it (POST /v1/maps)
+            route.fulfill(status=200, body=self.html, content_type="text/html; charset=utf-8")
+        elif url.startswith((self.origin + "/", "data:")):
+            route.continue_()
+        else:
+            self.blocked.append(url)
+            route.abort()
+
+    def open(self) -> None:
+        self.page.goto(self.url, wait_until="load")
+        self.page.wait_for_selector(".camloc-verdicts .camloc-vshare", timeout=5000)
+        self.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent.startsWith('shared')",
+            timeout=5000,
+        )
+
+    def close(self) -> None:
+        self.context.close()
+
+
+@pytest.fixture(scope="module")
+def served_page(vclient: httpx.Client) -> str:
+    r = vclient.post("/v1/maps", json=SCENE)
+    assert r.status_code == 200, r.text
+    assert '"service": "/v1/verdicts"' in r.text
+    return r.text
+
+
+@pytest.mark.browser
+@needs_browser
+def test_served_page_shares_verdicts_between_reviewers(
+    browser: Any, vserver: Server, vclient: httpx.Client, served_page: str, tmp_path: Path
+) -> None:
+    found = re.search(r"var cfg = (\{.*?\});\n", served_page)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    ana = _Reviewer(browser, vserver.url, served_page, "Ana")
+    bo = _Reviewer(browser, vserver.url, served_page, "Bo")
+    try:
+        ana.open()
+        page = ana.page
+        page.locator(".camloc-verdicts button.camloc-vfold").click()  # unfold if folded
+        if not page.locator(".camloc-verdicts input").is_visible():
+            page.locator(".camloc-verdicts button.camloc-vfold").click()
+        page.locator(".camloc-verdicts input").fill("Ana")
+        page.locator('.camloc-candidate [data-rank="2"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="yes"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="yes"]').click()
+        box.locator("input").fill("lamp post")
+        page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (1 there)'",
+            timeout=5000,
+        )
+        deadline_items: dict[str, Any] = {}
+        for _ in range(50):  # the note goes 600 ms after the last key
+            deadline_items = vclient.get(url).json()["items"]
+            if deadline_items.get("2", {}).get("note") == "lamp post":
+                break
+            page.wait_for_timeout(100)
+        assert deadline_items["2"]["verdict"] == "yes"
+        assert deadline_items["2"]["reviewer"] == "Ana"
+        assert deadline_items["2"]["note"] == "lamp post"
+        # Bo's browser (no storage of Ana's) sees it; his "no" on 1 reaches the service
+        bo.open()
+        n = len(cfg["order"])
+        bo.page.wait_for_function(
+            f"document.querySelector('.camloc-vcount').textContent === '1 of {n} candidates "
+            "reviewed'",
+            timeout=5000,
+        )
+        assert (
+            bo.page.locator('.camloc-candidate [data-verdict-mark="2"]').get_attribute(
+                "data-verdict"
+            )
+            == "yes"
+        )
+        bo.page.locator('.camloc-candidate [data-rank="1"]').click()
+        bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
+        bbox.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        bbox.locator('button[data-verdict="no"]').click()
+        bo.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (2 there)'",
+            timeout=5000,
+        )
+        assert vclient.get(url).json()["items"]["1"]["verdict"] == "no"
+        # Ana's page takes Bo's verdict when she comes back to it
+        page.evaluate("window.dispatchEvent(new Event('focus'))")
+        page.wait_for_function(
+            "document.querySelector('[data-verdict-mark=\"1\"]').getAttribute('data-verdict')"
+            " === 'no'",
+            timeout=5000,
+        )
+        page.screenshot(path=str(tmp_path / "shared.png"))
+        for r in (ana, bo):
+            assert r.blocked == []
+            assert r.errors == []
+            assert all(
+                s.startswith(("GET " + vserver.url, "POST " + vserver.url)) for s in r.sent
+            ), r.sent
+    finally:
+        ana.close()
+        bo.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_served_page_saved_as_a_file_makes_no_request(
+    browser: Any, served_page: str, tmp_path: Path
+) -> None:
+    from test_browser_maps import _Page
+
+    path = tmp_path / "review.html"
+    path.write_text(served_page, encoding="utf-8")
+    t = _Page(browser)
+    try:
+        t.open(path, ".camloc-verdicts .camloc-vcount")
+        page = t.page
+        page.locator('.camloc-candidate [data-rank="1"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="no"]').click()
+        page.wait_for_timeout(300)
+        assert page.locator(".camloc-vcount").inner_text().startswith("1 of ")
+        assert page.locator(".camloc-vshare").count() == 0
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
