@@ -1643,7 +1643,9 @@ def build_summary_map(
     if cluster and not offline:
         from folium.plugins import MarkerCluster
 
-        parent = MarkerCluster(name="Cameras (best candidate)")
+        parent = MarkerCluster(
+            name="Cameras (best candidate)", icon_create_function=_CLUSTER_ICON_JS
+        )
     else:
         parent = folium.FeatureGroup(name="Cameras (best candidate)")
     order = sorted(range(len(rows)), key=lambda i: rows[i][1]["properties"].get("score", 0.0))
@@ -1845,8 +1847,61 @@ _VERDICT_CSS = """
 .camloc-verdicts input { width: 8em; margin: 0; }
 .camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
 .camloc-verdicts .camloc-vshare { flex-basis: 100%; color: #1b5e20; }
+.camloc-cluster .camloc-cbadge { position: absolute; top: 34px; left: 50%;
+  transform: translateX(-50%); display: flex; gap: 1px; white-space: nowrap;
+  pointer-events: none; }
+.camloc-cluster .camloc-cv { font: bold 11px/14px sans-serif; color: #fff; padding: 0 3px;
+  border-radius: 7px; border: 1px solid #fff; box-shadow: 0 0 0 1px #111; }
+.camloc-cluster .camloc-cv-yes { background: #1b7f3b; }
+.camloc-cluster .camloc-cv-no { background: #b00020; }
+.camloc-cluster .camloc-cv-unsure { background: #555; }
+.camloc-sr { position: absolute; width: 1px; height: 1px; overflow: hidden;
+  clip: rect(0 0 0 0); white-space: nowrap; }
 .camloc-verdicts .camloc-vshare.bad { color: #b00020; }
 """
+
+
+_CLUSTER_ICON_JS = """
+function (cluster) {
+    // Leaflet.markercluster's own icon (its CSS classes and size steps) with the verdicts
+    // inside the cluster counted under it: "✓2 ✗1 ?1" (the page's verdicts script tells a
+    // camera's verdict through window.camlocVerdictOf; before it runs, none)
+    var n = cluster.getChildCount();
+    var size = n < 10 ? "small" : (n < 100 ? "medium" : "large");
+    var of = window.camlocVerdictOf;
+    var counts = {yes: 0, no: 0, unsure: 0};
+    if (typeof of === "function") {
+        cluster.getAllChildMarkers().forEach(function (m) {
+            var o = m.options.icon && m.options.icon.options;
+            var key = /data-verdict-mark="([^"]*)"/.exec((o && o.html) || "");
+            var v = key ? of(key[1]) : null;
+            if (v && counts.hasOwnProperty(v)) { counts[v]++; }
+        });
+    }
+    var sym = {yes: "\\u2713", no: "\\u2717", unsure: "?"};
+    var words = {yes: "confirmed", no: "rejected", unsure: "unsure"};
+    var badge = "", said = [];
+    ["yes", "no", "unsure"].forEach(function (v) {
+        if (counts[v]) {
+            badge += '<span class="camloc-cv camloc-cv-' + v + '" data-verdict="' + v + '">' +
+                sym[v] + counts[v] + "</span>";
+            said.push(counts[v] + " " + words[v]);
+        }
+    });
+    var left = n - counts.yes - counts.no - counts.unsure;
+    var label = n + " cameras: " + (said.length ? said.join(", ") + ", " + left +
+        " not reviewed" : "none reviewed");
+    return L.divIcon({
+        html: '<div><span>' + n + '</span></div>' +
+            (badge ? '<span class="camloc-cbadge" aria-hidden="true">' + badge + '</span>' : '') +
+            '<span class="camloc-sr">' + label + '</span>',
+        className: "marker-cluster marker-cluster-" + size + " camloc-cluster",
+        iconSize: new L.Point(40, 40)
+    });
+}
+"""
+"""The summary page's cluster icon: markercluster's own, with a badge counting the verdicts
+of the cameras inside (and the counts as text for screen readers)."""
 
 
 class _Verdicts(MacroElement):
@@ -1909,7 +1964,21 @@ class _Verdicts(MacroElement):
     }
     var count, warnBox;
     function warn(text) { if (warnBox) { warnBox.textContent = text; } }
+    window.camlocVerdictOf = function (k) {
+        return (state.items[k] && state.items[k].verdict) || null;
+    };
+    var reclusterTimer = null;
+    function reclusters() {  // the cluster icons count the verdicts inside: made again
+        if (reclusterTimer !== null) { return; }
+        reclusterTimer = setTimeout(function () {
+            reclusterTimer = null;
+            map.eachLayer(function (l) {
+                if (typeof l.refreshClusters === "function") { l.refreshClusters(); }
+            });
+        }, 0);
+    }
     function counted() {
+        reclusters();
         var n = 0;
         cfg.order.forEach(function (k) { if (state.items[k] && state.items[k].verdict) { n++; } });
         if (count) {

@@ -697,3 +697,103 @@ def test_review_page_shows_given_verdicts(tab: Any, tied: Any, tmp_path: Path) -
     page.screenshot(path=str(tmp_path / "given.png"))
     assert tab.blocked == []
     assert tab.errors == []
+
+
+# --------------------------------------------------------------- cluster verdict badges
+def _clustered_page(path: Path, verdicts: list[dict[str, Any]]) -> Path:
+    """A summary page clustered as ``camloc batch --map`` writes it offline (the cluster
+    plug-in inlined from its xstatic package): cameras a0-a3 7 m apart on a line, b0 and b1
+    2 km off."""
+    from camloc_geo.batch._run import _markercluster_assets
+
+    near = [(f"a{i}", 51.5, -0.1 + i * 1e-4) for i in range(4)]
+    far = [("b0", 51.518, -0.1), ("b1", 51.518, -0.1001)]
+    items = [(name, _gj(name, [(1, lat, lon)])) for name, lat, lon in near + far]
+    fmap = maps.build_summary_map(items, offline=False, tiles=None, verdicts=verdicts)
+    page = fmap.get_root().render()
+    js, css = _markercluster_assets()
+    page = re.sub(
+        r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
+        lambda _m: "<script>" + js + "</script>",
+        page,
+    )
+    page = re.sub(
+        r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
+        lambda _m: "<style>" + css + "</style>",
+        page,
+    )
+    page = re.sub(
+        r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
+    )
+    path.write_text(maps.inline_assets(page), encoding="utf-8")
+    return path
+
+
+def test_summary_clusters_use_the_verdict_icon() -> None:
+    fmap = maps.build_summary_map(
+        [("a", _gj("a", [(1, 51.5, -0.1)])), ("b", _gj("b", [(1, 51.6, -0.2)]))]
+    )
+    page = fmap.get_root().render()
+    assert "options.iconCreateFunction" in page
+    assert "window.camlocVerdictOf" in page
+    assert "camloc-cbadge" in page
+
+
+@pytest.mark.browser
+@needs_browser
+def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> None:
+    rows = [
+        {**ROW, "camera": "a0", "rank": 1, "verdict": "yes"},
+        {**ROW, "camera": "a1", "rank": 1, "verdict": "no"},
+        {**ROW, "camera": "a2", "rank": 1, "verdict": "no"},
+        {**ROW, "camera": "b0", "rank": 1, "verdict": "unsure"},
+    ]
+    path = _clustered_page(tmp_path / "clustered.html", rows)
+    tab.open(path, ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent === '4 of 6 cameras reviewed'",
+        timeout=3000,
+    )
+    read = """() => Array.from(document.querySelectorAll('.camloc-cluster')).map(c => [
+        c.querySelector('div span').textContent,
+        Array.from(c.querySelectorAll('.camloc-cv')).map(b => b.textContent).join(' '),
+        c.querySelector('.camloc-sr').textContent]).sort()"""
+    page.wait_for_function(
+        "document.querySelectorAll('.camloc-cluster .camloc-cv').length === 3", timeout=3000
+    )
+    assert page.evaluate(read) == [
+        ["2", "?1", "2 cameras: 1 unsure, 1 not reviewed"],
+        ["4", "✓1 ✗2", "4 cameras: 1 confirmed, 2 rejected, 1 not reviewed"],
+    ]
+    badge = page.locator(".camloc-cluster .camloc-cv-no")
+    assert badge.evaluate("b => getComputedStyle(b).backgroundColor") == "rgb(176, 0, 32)"
+    big = page.locator(".camloc-cluster", has_text="4 cameras")
+    box, bbox = big.bounding_box(), big.locator(".camloc-cbadge").bounding_box()
+    assert box is not None
+    assert bbox is not None
+    assert bbox["y"] >= box["y"] + box["height"] - 8  # under the bubble, not over its count
+    page.screenshot(path=str(tmp_path / "clusters.png"))
+    # a verdict given on a camera inside a cluster: the cluster's badge follows
+    page.evaluate(
+        """() => { const m = Object.keys(window).filter(k => /^map_[0-9a-f]+$/.test(k))
+                   .map(k => window[k])[0]; m.setView([51.5, -0.09985], 22, {animate: false}); }"""
+    )
+    marker = page.locator(
+        ".camloc-summary-marker:has([data-verdict-mark]):not(:has([data-verdict]))"
+    )
+    marker.first.wait_for(timeout=3000)
+    box_v = _open_popup(tab, marker.first)
+    box_v.locator('button[data-verdict="yes"]').click()
+    _close_popup(page)
+    page.evaluate(
+        """() => { const m = Object.keys(window).filter(k => /^map_[0-9a-f]+$/.test(k))
+                   .map(k => window[k])[0]; m.setView([51.509, -0.1], 14, {animate: false}); }"""
+    )
+    page.wait_for_function(
+        "Array.from(document.querySelectorAll('.camloc-cluster .camloc-sr'))"
+        ".some(s => s.textContent === '4 cameras: 2 confirmed, 2 rejected, 0 not reviewed')",
+        timeout=3000,
+    )
+    assert tab.blocked == []
+    assert tab.errors == []
