@@ -2015,11 +2015,16 @@ class _Verdicts(MacroElement):
         shareBox.textContent = text;
         shareBox.className = "camloc-vshare" + (bad ? " bad" : "");
     }
-    function wire(k) {
-        var v = state.items[k] || {};
-        return {verdict: v.verdict || null, rank: v.rank || null,
+    function wire(k) {  // an item as the service keeps it: with the export's camera and point
+        var v = state.items[k] || {}, it = cfg.items[k];
+        var c = v.verdict ? chosen(k) : {rank: it.rank, lat: it.lat, lon: it.lon};
+        return {verdict: v.verdict || null,
+                rank: cfg.kind === "summary" ? (v.rank || it.rank || null) : null,
                 note: (v.note || "").slice(0, cfg.note_chars),
                 reviewer: (typeof v.reviewer === "string" ? v.reviewer : reviewer()).slice(0, 80),
+                camera: String(it.camera).slice(0, 300),
+                lat: typeof c.lat === "number" ? c.lat : null,
+                lon: typeof c.lon === "number" ? c.lon : null,
                 time: v.time || null};
     }
     function failed(what) {
@@ -2070,7 +2075,13 @@ class _Verdicts(MacroElement):
         }
         cfg.order.forEach(function (k) {
             var v = state.items[k], s = server[k];
-            if (v && v.time && (!s || !s.time || v.time > s.time)) { newer.push(k); }
+            // (the same verdict, rank and note there is not sent again: a clock ahead of the
+            // server's, whose times the server takes as its now, sent it on every reading)
+            if (!v || !v.time) { return; }
+            var w = wire(k);
+            var same = s && (s.verdict || null) === w.verdict &&
+                (s.rank || null) === w.rank && (s.note || "") === w.note;
+            if (!same && (!s || !s.time || v.time > s.time)) { newer.push(k); }
         });
         save(); cfg.order.forEach(mark); counted(); rerender();
         var n = 0;

@@ -60,6 +60,9 @@ def test_store_merge_latest_wins_and_limit(tmp_path: Path) -> None:
         "note": "kerb",
         "reviewer": "Bo",
         "time": "2026-11-25T01:00:00.001Z",
+        "camera": "",
+        "lat": None,
+        "lon": None,
     }
     # other pages are apart; the store holds at most max_rows
     assert store.page("summary", IDENT)["items"] == {}
@@ -136,6 +139,51 @@ def test_verdicts_endpoints_share_and_persist(vserver: Server, vclient: httpx.Cl
         assert again.get(URL).json()["items"] == items
 
 
+def test_verdicts_export_reads_back(vclient: httpx.Client, tmp_path: Path) -> None:
+    """``?format=csv|geojson``: the page's own export, which read_verdicts (and so
+    summary-map/locate --verdicts) takes."""
+    from camloc_geo import maps
+
+    url = "/v1/verdicts/summary/00000000000000aa"
+    item = {"reviewer": "Ana", "camera": "=cam 7", "lat": -32.05, "lon": 115.74}
+    r = vclient.post(
+        url,
+        json={
+            "items": {
+                "c10": {**item, "verdict": "yes", "rank": 3, "note": 'kerb, "the" tree'},
+                "c2": {**item, "verdict": "no", "rank": 1, "camera": "cam 2", "lat": None},
+                "c3": {**item, "verdict": None, "camera": "cam 3"},
+            }
+        },
+    )
+    assert r.status_code == 200, r.text
+    r = vclient.get(url, params={"format": "csv"})
+    assert r.status_code == 200, r.text
+    assert r.headers["content-type"].startswith("text/csv")
+    assert 'filename="verdicts-summary-00000000.csv"' in r.headers["content-disposition"]
+    assert r.content.startswith(b"\xef\xbb\xbf")  # a BOM, as the pages write
+    assert "'=cam 7" in r.text  # the formula guard
+    path = tmp_path / "server.csv"
+    path.write_bytes(r.content)
+    rows = maps.read_verdicts(path)
+    assert [(x["camera"], x["rank"], x["verdict"], x["lat"]) for x in rows] == [
+        ("cam 2", 1, "no", None),  # key order c2, c10; the withdrawn c3 left out
+        ("=cam 7", 3, "yes", -32.05),
+    ]
+    assert rows[1]["note"] == 'kerb, "the" tree'
+    assert rows[1]["page"] == "summary"
+    assert rows[1]["identity"] == "00000000000000aa"
+    r = vclient.get(url, params={"format": "geojson"})
+    assert r.status_code == 200, r.text
+    doc = r.json()
+    assert doc["properties"]["format"] == "camloc-verdicts/1"
+    assert doc["features"][0]["geometry"] is None
+    assert doc["features"][1]["geometry"]["coordinates"] == [115.74, -32.05]
+    gpath = tmp_path / "server.geojson"
+    gpath.write_bytes(r.content)
+    assert maps.read_verdicts(gpath) == rows
+
+
 @pytest.mark.parametrize(
     ("method", "path", "body", "field"),
     [
@@ -152,6 +200,9 @@ def test_verdicts_endpoints_share_and_persist(vserver: Server, vclient: httpx.Cl
         ("POST", URL, {"items": []}, "items"),
         ("POST", URL, [1, 2], "request"),
         ("GET", "/v1/verdicts?limit=0", None, "limit"),
+        ("GET", URL + "?format=xml", None, "format"),
+        ("POST", URL, {"items": {"2": {"lat": 95}}}, "items.2.lat"),
+        ("POST", URL, {"items": {"2": {"camera": "x" * 301}}}, "items.2.camera"),
     ],
 )
 def test_verdicts_bad_input_is_a_clear_422(
@@ -167,6 +218,11 @@ def test_verdicts_bad_input_is_a_clear_422(
 
 
 def test_verdicts_bad_bodies(vclient: httpx.Client) -> None:
+    r = vclient.post(
+        URL, content=b'{"items": {"2": {"lat": NaN}}}', headers={"content-type": "application/json"}
+    )
+    assert r.status_code == 422, r.text
+    assert r.json()["error"]["field"] == "items.2.lat"
     r = vclient.post(URL, content=b"{not json", headers={"content-type": "application/json"})
     assert r.status_code == 422, r.text
     assert "JSON" in r.json()["error"]["message"]
@@ -303,6 +359,18 @@ def test_served_page_shares_verdicts_between_reviewers(
             timeout=5000,
         )
         assert vclient.get(url).json()["items"]["1"]["verdict"] == "no"
+        # the service's export is the page's: the camera and the candidates' points came along
+        from camloc_geo import maps
+
+        csv_path = tmp_path / "team.csv"
+        csv_path.write_bytes(vclient.get(url, params={"format": "csv"}).content)
+        rows = maps.read_verdicts(csv_path)
+        assert [(r["camera"], r["rank"], r["verdict"], r["reviewer"]) for r in rows] == [
+            (cfg["items"]["1"]["camera"], 1, "no", ""),
+            (cfg["items"]["2"]["camera"], 2, "yes", "Ana"),
+        ]
+        assert rows[1]["lat"] == pytest.approx(cfg["items"]["2"]["lat"], abs=1e-9)
+        assert rows[1]["lon"] == pytest.approx(cfg["items"]["2"]["lon"], abs=1e-9)
         # Ana's page takes Bo's verdict when she comes back to it
         page.evaluate("window.dispatchEvent(new Event('focus'))")
         page.wait_for_function(

@@ -28,6 +28,7 @@ __all__ = [
     "VerdictItem",
     "VerdictPage",
     "VerdictPost",
+    "VerdictsQuery",
     "utc_text",
 ]
 
@@ -142,12 +143,19 @@ class VerdictItem(BaseModel):
     )
     note: str = Field(default="", max_length=200, description="the reviewer's note")
     reviewer: str = Field(default="", max_length=80, description="the reviewer's name")
+    camera: str = Field(default="", max_length=300, description="the camera's id on the page")
+    lat: float | None = Field(
+        default=None, ge=-90.0, le=90.0, allow_inf_nan=False, description="the chosen candidate"
+    )
+    lon: float | None = Field(
+        default=None, ge=-180.0, le=180.0, allow_inf_nan=False, description="its longitude"
+    )
     time: datetime | None = Field(
         default=None,
         description="when it was given (ISO 8601; default: now); the latest wins",
     )
 
-    @field_validator("note", "reviewer")
+    @field_validator("note", "reviewer", "camera")
     @classmethod
     def _text(cls, value: str) -> str:
         return _encodable(value)
@@ -167,6 +175,9 @@ class VerdictItem(BaseModel):
             "note": self.note,
             "reviewer": self.reviewer,
             "time": text,
+            "camera": self.camera,
+            "lat": self.lat,
+            "lon": self.lon,
         }
 
 
@@ -179,6 +190,13 @@ class VerdictPost(BaseModel):
         max_length=MAX_VERDICTS_PER_POST,
         description='key: the candidate\'s rank ("3", review page) or "c<index>" (summary page)',
     )
+
+
+class VerdictsQuery(BaseModel):
+    """``GET /v1/verdicts/{page}/{identity}``: as JSON (the page's items), or as the page's
+    own export (CSV or GeoJSON, read by ``camloc_geo.maps.read_verdicts``)."""
+
+    format: Literal["json", "csv", "geojson"] = "json"
 
 
 class ErrorDetail(BaseModel):

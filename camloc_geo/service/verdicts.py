@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["VERDICTS_FILE", "VerdictStore"]
+__all__ = ["VERDICTS_FILE", "VerdictStore", "export_csv", "export_geojson", "export_rows"]
 
 VERDICTS_FILE = "camloc-verdicts.sqlite"
 """The file's name in the verdicts folder (``CAMLOC_VERDICT_DIR``, else ``CAMLOC_DATA_DIR``)."""
@@ -27,12 +27,14 @@ _SCHEMA = """
 CREATE TABLE IF NOT EXISTS verdicts (
     page TEXT NOT NULL, identity TEXT NOT NULL, key TEXT NOT NULL,
     verdict TEXT, rank INTEGER, note TEXT NOT NULL, reviewer TEXT NOT NULL,
-    time TEXT NOT NULL, received REAL NOT NULL,
+    time TEXT NOT NULL, camera TEXT NOT NULL DEFAULT '', lat REAL, lon REAL,
+    received REAL NOT NULL,
     PRIMARY KEY (page, identity, key)
 );
 """
 
-_FIELDS = ("verdict", "rank", "note", "reviewer", "time")
+_FIELDS = ("verdict", "rank", "note", "reviewer", "time", "camera", "lat", "lon")
+_DEFAULTS = {"note": "", "reviewer": "", "camera": ""}
 
 
 class VerdictStore:
@@ -76,11 +78,12 @@ class VerdictStore:
         db.execute("COMMIT")
 
     def page(self, page: str, identity: str) -> dict[str, Any]:
-        """``{"page", "identity", "items": {key: {verdict, rank, note, reviewer, time}}}``;
+        """``{"page", "identity", "items": {key: {verdict, rank, note, reviewer, time,
+        camera, lat, lon}}}``;
         an item whose ``verdict`` is None was withdrawn (kept so that the withdrawal reaches
         the other reviewers' pages)."""
         rows = self._db().execute(
-            "SELECT key, verdict, rank, note, reviewer, time FROM verdicts "
+            "SELECT key, verdict, rank, note, reviewer, time, camera, lat, lon FROM verdicts "
             "WHERE page = ? AND identity = ? ORDER BY key",
             (page, identity),
         )
@@ -95,9 +98,10 @@ class VerdictStore:
         Parameters
         ----------
         items
-            ``key → {verdict, rank, note, reviewer, time}``, ``time`` an ISO 8601 UTC string
-            as :func:`camloc_geo.service.routers.verdicts.utc_text` writes it (they compare
-            as text).
+            ``key → {verdict, rank, note, reviewer, time, camera, lat, lon}``, ``time`` an
+            ISO 8601 UTC string
+            as :func:`camloc_geo.service.models.utc_text` writes it (they compare as
+            text).
 
         Returns
         -------
@@ -135,9 +139,9 @@ class VerdictStore:
                     continue  # an older verdict than the stored one: the stored stays
                 db.execute(
                     "INSERT OR REPLACE INTO verdicts "
-                    "(page, identity, key, verdict, rank, note, reviewer, time, received) "
-                    "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    (page, identity, key, *(it[f] for f in _FIELDS), now),
+                    "(page, identity, key, verdict, rank, note, reviewer, time, camera, lat, "
+                    "lon, received) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    (page, identity, key, *(it.get(f, _DEFAULTS.get(f)) for f in _FIELDS), now),
                 )
                 taken.append(key)
         return self.page(page, identity), taken
@@ -159,3 +163,79 @@ class VerdictStore:
             }
             for r in rows
         ]
+
+
+def _cell(value: Any) -> str:
+    """A CSV cell as the pages write it: a text starting ``= + - @`` (or a tab or CR) gets a
+    leading ``'`` so that a spreadsheet does not run it as a formula."""
+    if value is None:
+        return ""
+    text = str(value)
+    if isinstance(value, str) and text[:1] in ("=", "+", "-", "@", "\t", "\r"):
+        text = "'" + text
+    return text
+
+
+def export_rows(doc: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """A page's verdicts (:meth:`VerdictStore.page`) as the rows of the page's own export,
+    in key order; withdrawn ones left out. ``rank`` is the stored one, else (review page) the
+    key's."""
+    from camloc_geo.maps import VERDICT_FIELDS
+
+    def order(key: str) -> tuple[int, str]:
+        digits = key.lstrip("c")
+        return (int(digits) if digits.isdigit() else 0, key)
+
+    rows = []
+    for key in sorted(doc["items"], key=order):
+        it = doc["items"][key]
+        if not it.get("verdict"):
+            continue
+        rank = it.get("rank")
+        if rank is None and doc["page"] == "candidates" and key.isdigit():
+            rank = int(key)
+        row = {
+            **it,
+            "rank": rank,
+            "page": doc["page"],
+            "identity": doc["identity"],
+        }
+        rows.append({f: row.get(f) for f in VERDICT_FIELDS})
+    return rows
+
+
+def export_csv(doc: Mapping[str, Any]) -> str:
+    """The page's export as CSV: UTF-8 with a BOM, CRLF, the formula guard (as the pages)."""
+    import csv
+    import io
+
+    from camloc_geo.maps import VERDICT_FIELDS
+
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\r\n")
+    writer.writerow(VERDICT_FIELDS)
+    for row in export_rows(doc):
+        writer.writerow([_cell(row[f]) for f in VERDICT_FIELDS])
+    return "\ufeff" + buf.getvalue()
+
+
+def export_geojson(doc: Mapping[str, Any]) -> dict[str, Any]:
+    """The page's export as GeoJSON (``format: camloc-verdicts/1``), as the pages write it."""
+    import datetime
+
+    feats = []
+    for row in export_rows(doc):
+        lat, lon = row.get("lat"), row.get("lon")
+        geom = None if lat is None or lon is None else {"type": "Point", "coordinates": [lon, lat]}
+        feats.append({"type": "Feature", "properties": row, "geometry": geom})
+    exported = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="milliseconds")
+    return {
+        "type": "FeatureCollection",
+        "properties": {
+            "format": "camloc-verdicts/1",
+            "page": doc["page"],
+            "identity": doc["identity"],
+            "exported": exported.replace("+00:00", "Z"),
+        },
+        "features": feats,
+    }

@@ -10,9 +10,10 @@ from datetime import datetime, timezone
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, Query, Request
+from fastapi.responses import JSONResponse, Response
 
-from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost
-from camloc_geo.service.verdicts import VerdictStore
+from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
+from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
 
 __all__ = ["VERDICTS_PATH", "router"]
 
@@ -39,12 +40,43 @@ async def list_pages(
     return {"pages": store.pages(limit)}
 
 
-@router.get(VERDICTS_PATH + "/{page}/{identity}")
+_EXPORT_DOC: dict[int | str, dict[str, Any]] = {
+    200: {
+        "description": "the page's verdicts (format=json), or its export (csv, geojson)",
+        "content": {
+            "application/json": {},
+            "text/csv": {"schema": {"type": "string"}},
+            "application/geo+json": {},
+        },
+    }
+}
+
+
+@router.get(VERDICTS_PATH + "/{page}/{identity}", response_model=None, responses=_EXPORT_DOC)
 async def page_verdicts(
-    page: VerdictPage, identity: VerdictIdentity, store: Verdicts
-) -> dict[str, Any]:
-    """A page's verdicts (none yet: an empty ``items``)."""
-    return store.page(page, identity)
+    page: VerdictPage,
+    identity: VerdictIdentity,
+    store: Verdicts,
+    q: Annotated[VerdictsQuery, Query()],
+) -> Response:
+    """A page's verdicts (none yet: an empty ``items``); ``format=csv`` or ``geojson``: the
+    export the page itself writes, which ``camloc summary-map --verdicts`` and ``camloc
+    locate --map ... --verdicts`` read."""
+    doc = store.page(page, identity)
+    if q.format == "json":
+        return JSONResponse(doc)
+    name = f"verdicts-{page}-{identity[:8]}"
+    if q.format == "csv":
+        return Response(
+            export_csv(doc),
+            media_type="text/csv; charset=utf-8",
+            headers={"Content-Disposition": f'attachment; filename="{name}.csv"'},
+        )
+    return JSONResponse(
+        export_geojson(doc),
+        media_type="application/geo+json",
+        headers={"Content-Disposition": f'attachment; filename="{name}.geojson"'},
+    )
 
 
 @router.post(VERDICTS_PATH + "/{page}/{identity}")
