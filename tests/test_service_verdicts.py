@@ -414,3 +414,54 @@ def test_served_page_saved_as_a_file_makes_no_request(
         assert t.errors == []
     finally:
         t.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_verdicts_given_before_the_service_was_reached_are_sent(
+    browser: Any, vserver: Server, vclient: httpx.Client, served_page: str
+) -> None:
+    """A browser that already holds verdicts of the page (given while the service was not
+    reachable) sends them when it reads the service's; an older one the service has newer
+    is taken from the service instead."""
+    found = re.search(r"var cfg = (\{.*?\});\n", served_page)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    r = vclient.post(
+        url,
+        json={"items": {"5": {"verdict": "no", "reviewer": "Bo", "time": "2026-11-25T01:00:00Z"}}},
+    )
+    assert r.status_code == 200, r.text
+    key = f"camloc-verdicts/v1/candidates/{cfg['identity']}"
+    local = {
+        "items": {
+            "4": {"verdict": "unsure", "note": "offline", "time": "2026-11-25T01:30:00.000Z"},
+            "5": {"verdict": "yes", "time": "2026-11-24T00:00:00.000Z"},  # older than Bo's
+        }
+    }
+    cy = _Reviewer(browser, vserver.url, served_page, "Cy")
+    try:
+        cy.page.add_init_script(
+            f"window.localStorage.setItem({json.dumps(key)}, {json.dumps(json.dumps(local))});"
+        )
+        cy.open()
+        items: dict[str, Any] = {}
+        for _ in range(50):
+            items = vclient.get(url).json()["items"]
+            if "4" in items:
+                break
+            cy.page.wait_for_timeout(100)
+        assert items["4"]["verdict"] == "unsure"
+        assert items["4"]["note"] == "offline"
+        assert items["4"]["time"] == "2026-11-25T01:30:00.000Z"
+        assert items["5"]["verdict"] == "no"  # the service's newer one stays
+        cy.page.wait_for_function(
+            "document.querySelector('[data-verdict-mark=\"5\"]').getAttribute('data-verdict')"
+            " === 'no'",
+            timeout=5000,
+        )
+        assert cy.blocked == []
+        assert cy.errors == []
+    finally:
+        cy.close()
