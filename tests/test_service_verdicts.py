@@ -465,3 +465,97 @@ def test_verdicts_given_before_the_service_was_reached_are_sent(
         assert cy.errors == []
     finally:
         cy.close()
+
+
+# ------------------------------------------------------------- a job's summary page
+@pytest.fixture(scope="module")
+def job_page(vclient: httpx.Client) -> dict[str, Any]:
+    import time
+
+    cams = [
+        {"id": "good", "scene": SCENE},
+        {"id": "c1", "title": "Eastern Ave & S Broadway", "lat": 39.2856, "lon": -76.5935},
+        {"id": "nothing"},
+    ]
+    r = vclient.post("/v1/jobs", json={"cameras": cams})
+    assert r.status_code == 202, r.text
+    job_id = r.json()["id"]
+    deadline = time.monotonic() + 90
+    st: dict[str, Any] = {}
+    while time.monotonic() < deadline:
+        st = vclient.get(f"/v1/jobs/{job_id}").json()
+        if st["status"] == "done":
+            break
+        time.sleep(0.3)
+    assert st["status"] == "done", st
+    assert st["map_url"] == f"/v1/jobs/{job_id}/map"
+    r = vclient.get(st["map_url"])
+    assert r.status_code == 200, r.text
+    assert r.headers["content-type"].startswith("text/html")
+    found = re.search(r"var cfg = (\{.*?\});\n", r.text)
+    assert found is not None
+    return {"html": r.text, "cfg": json.loads(found.group(1)), "job": job_id}
+
+
+def test_job_map_is_a_shared_summary_page(vclient: httpx.Client, job_page: dict[str, Any]) -> None:
+    cfg = job_page["cfg"]
+    assert cfg["kind"] == "summary"
+    assert cfg["service"] == "/v1/verdicts"
+    cameras = {it["camera"]: it for it in cfg["items"].values()}
+    assert set(cameras) == {"good", "c1 Eastern Ave & S Broadway"}  # 'nothing' has no point
+    assert cameras["good"]["others"]  # the good camera's other candidates to pick from
+    assert "1 without candidates" in job_page["html"]
+    from test_maps import remote_references
+
+    assert remote_references(job_page["html"]) == []  # an offline page
+    r = vclient.get("/v1/jobs/" + "0" * 32 + "/map")
+    assert r.status_code == 404
+    assert r.json()["error"]["type"] == "not_found"
+
+
+@pytest.mark.browser
+@needs_browser
+def test_job_map_reviewers_share_a_pick(
+    browser: Any, vserver: Server, vclient: httpx.Client, job_page: dict[str, Any], tmp_path: Path
+) -> None:
+    cfg = job_page["cfg"]
+    key = next(k for k, it in cfg["items"].items() if it["camera"] == "good")
+    third = next(o for o in cfg["items"][key]["others"] if o[0] == 3)
+    ana = _Reviewer(browser, vserver.url, job_page["html"], "Ana")
+    bo = _Reviewer(browser, vserver.url, job_page["html"], "Bo")
+    try:
+        ana.open()
+        marker = ana.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]')
+        marker.click()
+        box = ana.page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator("select").wait_for(timeout=3000)
+        box.locator("select").select_option("3")
+        ana.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (1 there)'",
+            timeout=5000,
+        )
+        bo.open()
+        bo.page.wait_for_function(
+            "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
+            timeout=5000,
+        )
+        bo.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
+        bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
+        bbox.locator("select").wait_for(timeout=3000)
+        assert bbox.locator("select").input_value() == "3"  # Ana's pick, on Bo's page
+        csv_path = tmp_path / "job.csv"
+        url = f"/v1/verdicts/summary/{cfg['identity']}"
+        csv_path.write_bytes(vclient.get(url, params={"format": "csv"}).content)
+        from camloc_geo import maps
+
+        rows = maps.read_verdicts(csv_path)
+        assert [(r["camera"], r["rank"], r["verdict"]) for r in rows] == [("good", 3, "yes")]
+        assert rows[0]["lat"] == pytest.approx(third[1], abs=1e-9)
+        assert rows[0]["lon"] == pytest.approx(third[2], abs=1e-9)
+        for r in (ana, bo):
+            assert r.blocked == []
+            assert r.errors == []
+    finally:
+        ana.close()
+        bo.close()
