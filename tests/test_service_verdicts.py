@@ -544,6 +544,8 @@ def test_job_map_reviewers_share_a_pick(
         bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
         bbox.locator("select").wait_for(timeout=3000)
         assert bbox.locator("select").input_value() == "3"  # Ana's pick, on Bo's page
+        bo.page.wait_for_timeout(600)  # (the popup's fade-in and pan, for the screenshot)
+        bo.page.screenshot(path=str(tmp_path / "job-map.png"))
         csv_path = tmp_path / "job.csv"
         url = f"/v1/verdicts/summary/{cfg['identity']}"
         csv_path.write_bytes(vclient.get(url, params={"format": "csv"}).content)
