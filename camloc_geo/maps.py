@@ -1003,6 +1003,8 @@ def build_candidates_map(
     tiles: str | None = "OpenStreetMap",
     overlay_images: Mapping[int, str] | None = None,
     overlay_links: Mapping[int, str] | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> folium.Map:
     """The review map of one scene's candidates, as a :class:`folium.Map`.
 
@@ -1022,6 +1024,14 @@ def build_candidates_map(
         ``rank → img src`` (a data URI or a relative path) shown in the candidate's popup.
     overlay_links
         ``rank → href`` of the full-size overlay (the thumbnail links to it).
+    verdicts
+        Rows of :func:`read_verdicts`: those of this scene shown again on its candidates (a
+        browser that has verdicts of its own for this page keeps those; see
+        docs/candidates.md).
+    verdict_service
+        Path (or URL) of a camloc service's verdicts endpoint (``/v1/verdicts``): the page,
+        when opened over HTTP(S), shares its verdicts there (docs/service.md, "Verdicts");
+        opened from a file it keeps them in the browser only. None: never.
 
     Returns
     -------
@@ -1202,7 +1212,11 @@ def build_candidates_map(
         ],
     ]
     if cand_props:
-        _Verdicts(_verdict_config("candidates", v_items, v_identity, scene_name)).add_to(fmap)
+        config = _verdict_config("candidates", v_items, v_identity, scene_name)
+        config["service"] = verdict_service
+        if verdicts:
+            config["given"] = _given_candidate_verdicts(scene_name, v_items, verdicts)
+        _Verdicts(config).add_to(fmap)
 
     folium.LayerControl(collapsed=False, position="topright").add_to(fmap)
     _SmallScreenFolds().add_to(fmap)
@@ -1302,6 +1316,8 @@ def candidates_map(
     overlay_top: int = _OVERLAY_TOP,
     thumbnail_width: int = 480,
     max_bytes: int = MAX_PAGE_BYTES,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> Path:
     """Write the review map of one scene's candidates as an HTML page.
 
@@ -1331,6 +1347,12 @@ def candidates_map(
         cut, until the page fits ``max_bytes``).
     max_bytes
         Size budget of a page with embedded overlays.
+    verdicts
+        Rows of :func:`read_verdicts` shown again on the page (see
+        :func:`build_candidates_map`).
+    verdict_service
+        The service's verdicts endpoint the page shares its verdicts with when opened over
+        HTTP (see :func:`build_candidates_map`).
 
     Returns
     -------
@@ -1354,6 +1376,8 @@ def candidates_map(
             tiles=tiles,
             overlay_images=links,
             overlay_links=links,
+            verdicts=verdicts,
+            verdict_service=verdict_service,
         )
         page = _render(fmap, offline)
     else:
@@ -1373,6 +1397,8 @@ def candidates_map(
                 tiles=tiles,
                 overlay_images=srcs,
                 overlay_links=links,
+                verdicts=verdicts,
+                verdict_service=verdict_service,
             )
             page = _render(fmap, offline)
             size = len(page.encode("utf-8"))
@@ -1564,6 +1590,7 @@ def build_summary_map(
     cluster: bool = True,
     map_data: MapData | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -1584,6 +1611,9 @@ def build_summary_map(
     verdicts
         Rows of :func:`read_verdicts`: shown again on the page (a browser that has verdicts
         of its own for this page keeps those; see docs/candidates.md).
+    verdict_service
+        A camloc service's verdicts endpoint, shared when the page is opened over HTTP (see
+        :func:`build_candidates_map`).
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
@@ -1613,7 +1643,9 @@ def build_summary_map(
     if cluster and not offline:
         from folium.plugins import MarkerCluster
 
-        parent = MarkerCluster(name="Cameras (best candidate)")
+        parent = MarkerCluster(
+            name="Cameras (best candidate)", icon_create_function=_CLUSTER_ICON_JS
+        )
     else:
         parent = folium.FeatureGroup(name="Cameras (best candidate)")
     order = sorted(range(len(rows)), key=lambda i: rows[i][1]["properties"].get("score", 0.0))
@@ -1687,6 +1719,7 @@ def build_summary_map(
             for it in v_items.values()
         ]
         config = _verdict_config("summary", v_items, v_identity, "summary")
+        config["service"] = verdict_service
         if verdicts:
             config["given"] = _given_verdicts(v_items, verdicts)
         _Verdicts(config).add_to(fmap)
@@ -1728,6 +1761,7 @@ def summary_map(
     cluster: bool = True,
     map_data: MapData | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    verdict_service: str | None = None,
 ) -> Path:
     """Write the summary map of many cameras; see :func:`build_summary_map`.
 
@@ -1745,6 +1779,7 @@ def summary_map(
         cluster=cluster,
         map_data=map_data,
         verdicts=verdicts,
+        verdict_service=verdict_service,
     )
     page = _render(fmap, offline)
     from camloc_geo._io import write_text_atomic
@@ -1811,7 +1846,62 @@ _VERDICT_CSS = """
   align-items: center; }
 .camloc-verdicts input { width: 8em; margin: 0; }
 .camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
+.camloc-verdicts .camloc-vshare { flex-basis: 100%; color: #1b5e20; }
+.camloc-cluster .camloc-cbadge { position: absolute; top: 34px; left: 50%;
+  transform: translateX(-50%); display: flex; gap: 1px; white-space: nowrap;
+  pointer-events: none; }
+.camloc-cluster .camloc-cv { font: bold 11px/14px sans-serif; color: #fff; padding: 0 3px;
+  border-radius: 7px; border: 1px solid #fff; box-shadow: 0 0 0 1px #111; }
+.camloc-cluster .camloc-cv-yes { background: #1b7f3b; }
+.camloc-cluster .camloc-cv-no { background: #b00020; }
+.camloc-cluster .camloc-cv-unsure { background: #555; }
+.camloc-sr { position: absolute; width: 1px; height: 1px; overflow: hidden;
+  clip: rect(0 0 0 0); white-space: nowrap; }
+.camloc-verdicts .camloc-vshare.bad { color: #b00020; }
 """
+
+
+_CLUSTER_ICON_JS = """
+function (cluster) {
+    // Leaflet.markercluster's own icon (its CSS classes and size steps) with the verdicts
+    // inside the cluster counted under it: "✓2 ✗1 ?1" (the page's verdicts script tells a
+    // camera's verdict through window.camlocVerdictOf; before it runs, none)
+    var n = cluster.getChildCount();
+    var size = n < 10 ? "small" : (n < 100 ? "medium" : "large");
+    var of = window.camlocVerdictOf;
+    var counts = {yes: 0, no: 0, unsure: 0};
+    if (typeof of === "function") {
+        cluster.getAllChildMarkers().forEach(function (m) {
+            var o = m.options.icon && m.options.icon.options;
+            var key = /data-verdict-mark="([^"]*)"/.exec((o && o.html) || "");
+            var v = key ? of(key[1]) : null;
+            if (v && counts.hasOwnProperty(v)) { counts[v]++; }
+        });
+    }
+    var sym = {yes: "\\u2713", no: "\\u2717", unsure: "?"};
+    var words = {yes: "confirmed", no: "rejected", unsure: "unsure"};
+    var badge = "", said = [];
+    ["yes", "no", "unsure"].forEach(function (v) {
+        if (counts[v]) {
+            badge += '<span class="camloc-cv camloc-cv-' + v + '" data-verdict="' + v + '">' +
+                sym[v] + counts[v] + "</span>";
+            said.push(counts[v] + " " + words[v]);
+        }
+    });
+    var left = n - counts.yes - counts.no - counts.unsure;
+    var label = n + " cameras: " + (said.length ? said.join(", ") + ", " + left +
+        " not reviewed" : "none reviewed");
+    return L.divIcon({
+        html: '<div><span>' + n + '</span></div>' +
+            (badge ? '<span class="camloc-cbadge" aria-hidden="true">' + badge + '</span>' : '') +
+            '<span class="camloc-sr">' + label + '</span>',
+        className: "marker-cluster marker-cluster-" + size + " camloc-cluster",
+        iconSize: new L.Point(40, 40)
+    });
+}
+"""
+"""The summary page's cluster icon: markercluster's own, with a badge counting the verdicts
+of the cameras inside (and the counts as text for screen readers)."""
 
 
 class _Verdicts(MacroElement):
@@ -1836,6 +1926,11 @@ class _Verdicts(MacroElement):
     var store = null;
     try { store = window.localStorage; store.getItem(WHO); } catch (e) { store = null; }
     var state = {items: {}};
+    // served by a camloc service (over HTTP): verdicts shared there too; from a file: none
+    var remote = null;
+    if (cfg.service && /^https?:$/.test(window.location.protocol)) {
+        remote = cfg.service.replace(/\\/+$/, "") + "/" + cfg.kind + "/" + cfg.identity;
+    }
     function load() {
         state = {items: {}};
         if (!store) { return; }
@@ -1869,7 +1964,21 @@ class _Verdicts(MacroElement):
     }
     var count, warnBox;
     function warn(text) { if (warnBox) { warnBox.textContent = text; } }
+    window.camlocVerdictOf = function (k) {
+        return (state.items[k] && state.items[k].verdict) || null;
+    };
+    var reclusterTimer = null;
+    function reclusters() {  // the cluster icons count the verdicts inside: made again
+        if (reclusterTimer !== null) { return; }
+        reclusterTimer = setTimeout(function () {
+            reclusterTimer = null;
+            map.eachLayer(function (l) {
+                if (typeof l.refreshClusters === "function") { l.refreshClusters(); }
+            });
+        }, 0);
+    }
     function counted() {
+        reclusters();
         var n = 0;
         cfg.order.forEach(function (k) { if (state.items[k] && state.items[k].verdict) { n++; } });
         if (count) {
@@ -1877,6 +1986,7 @@ class _Verdicts(MacroElement):
         }
     }
     function set(k, verdict, rank) {
+        var changed = [k];
         var v = state.items[k] || {};
         var same = v.verdict === verdict && (rank === null || v.rank === rank);
         if (same) { delete v.verdict; delete v.rank; }
@@ -1892,10 +2002,105 @@ class _Verdicts(MacroElement):
                     delete w.verdict;
                     w.time = v.time;
                     mark(o);
+                    changed.push(o);
                 }
             });
         }
-        save(); mark(k); counted();
+        save(); mark(k); counted(); share(changed);
+    }
+    // ---- sharing with the service (remote): the latest time of a key wins
+    var shareBox = null, noteTimer = null;
+    function shared(text, bad) {
+        if (!shareBox) { return; }
+        shareBox.textContent = text;
+        shareBox.className = "camloc-vshare" + (bad ? " bad" : "");
+    }
+    function wire(k) {  // an item as the service keeps it: with the export's camera and point
+        var v = state.items[k] || {}, it = cfg.items[k];
+        var c = v.verdict ? chosen(k) : {rank: it.rank, lat: it.lat, lon: it.lon};
+        return {verdict: v.verdict || null,
+                rank: cfg.kind === "summary" ? (v.rank || it.rank || null) : null,
+                note: (v.note || "").slice(0, cfg.note_chars),
+                reviewer: (typeof v.reviewer === "string" ? v.reviewer : reviewer()).slice(0, 80),
+                camera: String(it.camera).slice(0, 300),
+                lat: typeof c.lat === "number" ? c.lat : null,
+                lon: typeof c.lon === "number" ? c.lon : null,
+                time: v.time || null};
+    }
+    function failed(what) {
+        return function (e) {
+            shared("not shared with the service (" + what + ": " + e + ")", true);
+        };
+    }
+    function answer(r) {
+        if (r.ok) { return r.json(); }
+        return r.json().then(function (b) {
+            throw (b && b.error && b.error.message) || ("HTTP " + r.status);
+        }, function () { throw "HTTP " + r.status; });
+    }
+    function share(keys) {
+        if (!remote || !keys.length) { return; }
+        var body = {items: {}};
+        keys.forEach(function (k) { if (cfg.items[k]) { body.items[k] = wire(k); } });
+        shared("sharing\u2026", false);
+        fetch(remote, {method: "POST", headers: {"Content-Type": "application/json"},
+                       body: JSON.stringify(body), credentials: "same-origin"})
+            .then(answer).then(function (doc) { adopt(doc, false); }, failed("sending"));
+    }
+    function adopt(doc, pushBack) {
+        // the service's items newer than this browser's are taken; this browser's newer
+        // ones (given offline, or handed in with the page) are sent
+        var server = (doc && doc.items) || {}, newer = [];
+        Object.keys(server).forEach(function (k) {
+            var s = server[k], v = state.items[k];
+            if (!cfg.items[k] || !s) { return; }
+            if (!v || !v.time || (s.time && s.time > v.time)) {
+                var w = {time: s.time || "", note: s.note || "", reviewer: s.reviewer || ""};
+                if (s.verdict) { w.verdict = s.verdict; }
+                if (s.verdict && s.rank) { w.rank = s.rank; }
+                state.items[k] = w;
+            }
+        });
+        if (cfg.kind === "candidates") {  // one candidate is the camera: the latest "yes"
+            var yes = cfg.order.filter(function (k) {
+                return state.items[k] && state.items[k].verdict === "yes";
+            });
+            yes.sort(function (a, b) {
+                return (state.items[a].time || "") < (state.items[b].time || "") ? 1 : -1;
+            });
+            yes.slice(1).forEach(function (k) {
+                delete state.items[k].verdict;
+                state.items[k].time = state.items[yes[0]].time;
+            });
+        }
+        cfg.order.forEach(function (k) {
+            var v = state.items[k], s = server[k];
+            // (the same verdict, rank and note there is not sent again: a clock ahead of the
+            // server's, whose times the server takes as its now, sent it on every reading)
+            if (!v || !v.time) { return; }
+            var w = wire(k);
+            var same = s && (s.verdict || null) === w.verdict &&
+                (s.rank || null) === w.rank && (s.note || "") === w.note;
+            if (!same && (!s || !s.time || v.time > s.time)) { newer.push(k); }
+        });
+        save(); cfg.order.forEach(mark); counted(); rerender();
+        var n = 0;
+        Object.keys(server).forEach(function (k) { if (server[k] && server[k].verdict) { n++; } });
+        shared("shared with the service (" + n + " there)", false);
+        if (pushBack && newer.length) { share(newer); }
+    }
+    function pull() {
+        if (!remote) { return; }
+        fetch(remote, {credentials: "same-origin", cache: "no-store"})
+            .then(answer).then(function (doc) { adopt(doc, true); }, failed("reading"));
+    }
+    function rerender() {  // an open popup's controls follow a verdict that came in
+        document.querySelectorAll(".leaflet-popup .camloc-verdict[data-verdict-key]")
+            .forEach(function (box) {
+                if (box.contains(document.activeElement) &&
+                    document.activeElement.tagName === "INPUT") { return; }
+                render(box, box.getAttribute("data-verdict-key"));
+            });
     }
     function render(box, k) {
         var it = cfg.items[k];
@@ -1955,9 +2160,12 @@ class _Verdicts(MacroElement):
         note.addEventListener("input", function () {
             var w = state.items[k] || {};
             w.note = note.value;
+            w.time = new Date().toISOString();
             delete w.reviewer;
             state.items[k] = w;
             save();
+            if (noteTimer !== null) { clearTimeout(noteTimer); }
+            noteTimer = setTimeout(function () { noteTimer = null; share([k]); }, 600);
         });
         L.DomEvent.on(note, "keydown keypress keyup", L.DomEvent.stopPropagation);
         box.appendChild(note);
@@ -2079,6 +2287,11 @@ class _Verdicts(MacroElement):
                 });
                 tools.appendChild(b);
             });
+        if (remote) {
+            shareBox = el("small", "camloc-vshare", "sharing\u2026");
+            shareBox.setAttribute("aria-live", "polite");
+            tools.appendChild(shareBox);
+        }
         div.appendChild(tools);
         warnBox = el("small", "camloc-vwarn");
         div.appendChild(warnBox);
@@ -2088,11 +2301,17 @@ class _Verdicts(MacroElement):
         return div;
     };
     panel.addTo(map);
-    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); }
-    function seed() {  // verdicts handed in with the page (summary-map --verdicts), once
+    function refresh() { load(); seed(); cfg.order.forEach(mark); counted(); pull(); }
+    function seed() {  // verdicts handed in with the page (--verdicts FILE), once
         if (!cfg.given || state.seeded) { return; }
+        var hasYes = cfg.kind === "candidates" && cfg.order.some(function (k) {
+            return state.items[k] && state.items[k].verdict === "yes";
+        });
         Object.keys(cfg.given).forEach(function (k) {
-            if (!state.items[k] && cfg.items[k]) { state.items[k] = cfg.given[k]; }
+            var g = cfg.given[k];
+            // one candidate is the camera: a handed-in "yes" does not add a second one
+            if (hasYes && g.verdict === "yes") { return; }
+            if (!state.items[k] && cfg.items[k]) { state.items[k] = g; }
         });
         state.seeded = true;
         save();
@@ -2107,6 +2326,12 @@ class _Verdicts(MacroElement):
     });
     window.addEventListener("pageshow", refresh);  // back button (a page from the bfcache)
     window.addEventListener("storage", function (e) { if (e.key === KEY) { refresh(); } });
+    if (remote) {  // the other reviewers' verdicts: on coming back to the page, and every 30 s
+        window.addEventListener("focus", pull);
+        setInterval(function () {
+            if (document.visibilityState !== "hidden") { pull(); }
+        }, 30000);
+    }
 })();
 {% endmacro %}
 """
@@ -2202,6 +2427,78 @@ def _given_verdicts(
     if unused:
         log.warning("%d verdict row(s) name no camera or candidate of this page: left out", unused)
     return {key: item for key, (_level, item) in given.items()}
+
+
+_GIVEN_MOVED_M = 30.0
+"""A handed-in verdict on a review page's candidate is left out when its position (as
+exported) lies farther than this from the candidate of the same rank on the page: the scene
+was located again and the ranks moved."""
+
+
+def _given_candidate_verdicts(
+    scene_name: str,
+    items: Mapping[str, Mapping[str, Any]],
+    verdicts: Sequence[Mapping[str, Any]],
+) -> dict[str, dict[str, Any]]:
+    """The review page's stored form (key ``str(rank)``) of exported verdict rows of its
+    camera: a review page's row of a candidate first, else a summary page's row naming the
+    candidate's rank (its "confirm" is "this is the camera"); the last such row wins. Rows of
+    other cameras, of ranks the page does not have, or whose position is more than
+    :data:`_GIVEN_MOVED_M` from the page's candidate are left out (counted in a warning). At
+    most one candidate keeps "yes" (the latest by time)."""
+    given: dict[str, tuple[int, dict[str, Any]]] = {}
+    unused = moved = 0
+    for row in verdicts:
+        rank = row.get("rank")
+        key = str(rank)
+        it = items.get(key)
+        if str(row.get("camera")) != scene_name or rank is None or it is None:
+            unused += 1
+            continue
+        lat, lon = row.get("lat"), row.get("lon")
+        if (
+            lat is not None
+            and lon is not None
+            and it.get("lat") is not None
+            and it.get("lon") is not None
+            and _distance_m({"lat": lat, "lon": lon}, it) > _GIVEN_MOVED_M
+        ):
+            moved += 1
+            continue
+        level = 2 if row.get("page") == "candidates" else 1
+        item = {
+            "verdict": row.get("verdict"),
+            "note": row.get("note") or "",
+            "time": row.get("time") or "",
+            "reviewer": row.get("reviewer") or "",
+        }
+        if level >= given.get(key, (0, {}))[0]:
+            given[key] = (level, item)
+    out = {key: item for key, (_level, item) in given.items()}
+    yes = [k for k, v in out.items() if v["verdict"] == "yes"]
+    if len(yes) > 1:  # one candidate is the camera: the latest "yes" stays
+        keep = max(yes, key=lambda k: str(out[k]["time"]))
+        for k in yes:
+            if k != keep:
+                del out[k]
+        log.warning(
+            "verdicts: %d candidates of %s given 'yes': kept candidate %s (the latest)",
+            len(yes),
+            scene_name,
+            keep,
+        )
+    if unused:
+        log.warning(
+            "%d verdict row(s) name another camera or a rank not on this page: left out", unused
+        )
+    if moved:
+        log.warning(
+            "%d verdict row(s) lie more than %.0f m from this page's candidate of their rank "
+            "(the scene was located again): left out",
+            moved,
+            _GIVEN_MOVED_M,
+        )
+    return out
 
 
 def _verdict_box(key: str) -> str:

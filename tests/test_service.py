@@ -491,3 +491,6 @@ def test_schemathesis_finds_no_server_error(server: Server, tmp_path: Path) -> N
     )
     assert proc.returncode == 0, proc.stdout[-4000:] + proc.stderr[-2000:]
     assert "/v1/locate" in proc.stdout  # the scene endpoints were exercised
+    tested = re.search(r"Tested: (\d+)", proc.stdout)
+    assert tested is not None, proc.stdout[-2000:]
+    assert int(tested.group(1)) >= 17  # 14 before the 3 /v1/verdicts operations

@@ -588,3 +588,212 @@ def test_page_identity_is_the_candidates(vpages: dict[str, Any]) -> None:
         base["identity"] != _config(maps.build_summary_map([("b", gj)], offline=True))["identity"]
     )
     assert base["noun"] == "cameras"
+
+
+# ----------------------------------------------------------------- locate --map --verdicts
+SAMPLES = Path(__file__).resolve().parents[1] / "sample_maps"
+
+
+@pytest.fixture(scope="module")
+def tied() -> Any:
+    """The sample scene located on the Baltimore extract (12 candidates, 1 and 2 tied)."""
+    from camloc_geo.api import locate_scene
+
+    return locate_scene(SAMPLES / "sample_scene.json", map_source=SAMPLES / "baltimore.osm.pbf")
+
+
+def _cand_row(tied: Any, rank: int, **change: Any) -> dict[str, Any]:
+    c = tied.result.candidates[rank - 1]
+    row = {**ROW, "camera": str(tied.result.scene_id), "rank": rank, "lat": c.lat, "lon": c.lon}
+    row["page"] = "candidates"
+    return {**row, **change}
+
+
+def test_given_candidate_verdicts_pick_the_row_per_rank(tied: Any) -> None:
+    fmap = maps.build_candidates_map(
+        tied.result,
+        tied.map_data,
+        offline=True,
+        verdicts=[
+            _cand_row(tied, 1, verdict="no", note="wrong kerb"),
+            _cand_row(tied, 2, verdict="unsure", page="summary"),
+            _cand_row(tied, 2, verdict="yes", time="2026-11-25T01:00:00.000Z"),  # page row wins
+            _cand_row(tied, 3, verdict="yes", time="2026-11-25T01:30:00.000Z"),  # latest yes
+            _cand_row(tied, 4, verdict="no", lat=tied.result.candidates[3].lat + 0.001),  # moved
+            _cand_row(tied, 5, verdict="no", camera="another camera"),  # not this scene: out
+            {**_cand_row(tied, 7, verdict="no"), "rank": 99},  # no such rank: out
+            {**_cand_row(tied, 6, verdict="unsure"), "lat": None, "lon": None},  # no position
+        ],
+    )
+    given = _config(fmap)["given"]
+    assert {k: (v["verdict"], v["note"]) for k, v in given.items()} == {
+        "1": ("no", "wrong kerb"),
+        "3": ("yes", ROW["note"]),
+        "6": ("unsure", ROW["note"]),
+    }
+    assert given["3"]["reviewer"] == "Ana"
+    assert given["3"]["time"] == "2026-11-25T01:30:00.000Z"
+    # without verdicts the page hands in none
+    assert "given" not in _config(maps.build_candidates_map(tied.result, None, offline=True))
+
+
+def test_locate_map_cli_verdicts(
+    tied: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    good = _write_csv(tmp_path / "v.csv", [_cand_row(tied, 2, verdict="no", note="tree")])
+    out = tmp_path / "m.html"
+    scene, osm = str(SAMPLES / "sample_scene.json"), str(SAMPLES / "baltimore.osm.pbf")
+    args = ["locate", scene, "--osm", osm, "-o", str(tmp_path / "c.geojson"), "--offline"]
+    assert main([*args, "--map", str(out), "--verdicts", str(good)]) == 0
+    found = re.search(r"var cfg = (\{.*?\});\n", out.read_text(encoding="utf-8"))
+    assert found is not None
+    given = json.loads(found.group(1))["given"]
+    assert {k: (v["verdict"], v["note"]) for k, v in given.items()} == {"2": ("no", "tree")}
+    capsys.readouterr()
+    assert main([*args, "--verdicts", str(good)]) == 2
+    assert "--verdicts needs --map OUT.html" in capsys.readouterr().err
+    bad = _write_csv(tmp_path / "bad.csv", [{**ROW, "rank": "two"}])
+    assert main([*args, "--map", str(tmp_path / "n.html"), "--verdicts", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "line 2: rank 'two' is not a whole number" in err
+    assert not (tmp_path / "n.html").exists()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_review_page_shows_given_verdicts(tab: Any, tied: Any, tmp_path: Path) -> None:
+    page_path = maps.candidates_map(
+        tied.result,
+        tied.map_data,
+        tmp_path / "given.html",
+        offline=True,
+        overlay_top=0,
+        verdicts=[
+            _cand_row(tied, 2, verdict="yes", note="the lamp post"),
+            _cand_row(tied, 1, verdict="no"),
+        ],
+    )
+    tab.open(page_path, ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    n = len(tied.result.candidates)
+    page.wait_for_function(
+        f"document.querySelector('.camloc-vcount').textContent === '2 of {n} candidates reviewed'",
+        timeout=3000,
+    )
+    marks = page.evaluate(
+        """() => Object.fromEntries(Array.from(
+            document.querySelectorAll('.camloc-candidate [data-verdict-mark]'))
+            .map(m => [m.getAttribute('data-verdict-mark'), m.getAttribute('data-verdict')]))"""
+    )
+    assert marks["1"] == "no"
+    assert marks["2"] == "yes"
+    assert sorted(k for k, v in marks.items() if v) == ["1", "2"]
+    box = _open_popup(tab, page.locator('.camloc-candidate [data-rank="2"]'))
+    assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "true"
+    assert box.locator("input").input_value() == "the lamp post"
+    page.screenshot(path=str(tmp_path / "given.png"))
+    assert tab.blocked == []
+    assert tab.errors == []
+
+
+# --------------------------------------------------------------- cluster verdict badges
+def _clustered_page(path: Path, verdicts: list[dict[str, Any]]) -> Path:
+    """A summary page clustered as ``camloc batch --map`` writes it offline (the cluster
+    plug-in inlined from its xstatic package): cameras a0-a3 7 m apart on a line, b0 and b1
+    2 km off."""
+    from camloc_geo.batch._run import _markercluster_assets
+
+    near = [(f"a{i}", 51.5, -0.1 + i * 1e-4) for i in range(4)]
+    far = [("b0", 51.518, -0.1), ("b1", 51.518, -0.1001)]
+    items = [(name, _gj(name, [(1, lat, lon)])) for name, lat, lon in near + far]
+    fmap = maps.build_summary_map(items, offline=False, tiles=None, verdicts=verdicts)
+    page = fmap.get_root().render()
+    js, css = _markercluster_assets()
+    page = re.sub(
+        r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
+        lambda _m: "<script>" + js + "</script>",
+        page,
+    )
+    page = re.sub(
+        r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
+        lambda _m: "<style>" + css + "</style>",
+        page,
+    )
+    page = re.sub(
+        r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
+    )
+    path.write_text(maps.inline_assets(page), encoding="utf-8")
+    return path
+
+
+def test_summary_clusters_use_the_verdict_icon() -> None:
+    fmap = maps.build_summary_map(
+        [("a", _gj("a", [(1, 51.5, -0.1)])), ("b", _gj("b", [(1, 51.6, -0.2)]))]
+    )
+    page = fmap.get_root().render()
+    assert "options.iconCreateFunction" in page
+    assert "window.camlocVerdictOf" in page
+    assert "camloc-cbadge" in page
+
+
+@pytest.mark.browser
+@needs_browser
+def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> None:
+    rows = [
+        {**ROW, "camera": "a0", "rank": 1, "verdict": "yes"},
+        {**ROW, "camera": "a1", "rank": 1, "verdict": "no"},
+        {**ROW, "camera": "a2", "rank": 1, "verdict": "no"},
+        {**ROW, "camera": "b0", "rank": 1, "verdict": "unsure"},
+    ]
+    path = _clustered_page(tmp_path / "clustered.html", rows)
+    tab.open(path, ".camloc-verdicts .camloc-vcount")
+    page = tab.page
+    page.wait_for_function(
+        "document.querySelector('.camloc-vcount').textContent === '4 of 6 cameras reviewed'",
+        timeout=3000,
+    )
+    read = """() => Array.from(document.querySelectorAll('.camloc-cluster')).map(c => [
+        c.querySelector('div span').textContent,
+        Array.from(c.querySelectorAll('.camloc-cv')).map(b => b.textContent).join(' '),
+        c.querySelector('.camloc-sr').textContent]).sort()"""
+    page.wait_for_function(
+        "document.querySelectorAll('.camloc-cluster .camloc-cv').length === 3", timeout=3000
+    )
+    assert page.evaluate(read) == [
+        ["2", "?1", "2 cameras: 1 unsure, 1 not reviewed"],
+        ["4", "✓1 ✗2", "4 cameras: 1 confirmed, 2 rejected, 1 not reviewed"],
+    ]
+    badge = page.locator(".camloc-cluster .camloc-cv-no")
+    assert badge.evaluate("b => getComputedStyle(b).backgroundColor") == "rgb(176, 0, 32)"
+    big = page.locator(".camloc-cluster", has_text="4 cameras")
+    box, bbox = big.bounding_box(), big.locator(".camloc-cbadge").bounding_box()
+    assert box is not None
+    assert bbox is not None
+    assert bbox["y"] >= box["y"] + box["height"] - 8  # under the bubble, not over its count
+    page.screenshot(path=str(tmp_path / "clusters.png"))
+    # a verdict given on a camera inside a cluster: the cluster's badge follows
+    page.evaluate(
+        """() => { const m = Object.keys(window).filter(k => /^map_[0-9a-f]+$/.test(k))
+                   .map(k => window[k])[0]; m.setView([51.5, -0.09985], 22, {animate: false}); }"""
+    )
+    marker = page.locator(
+        ".camloc-summary-marker:has([data-verdict-mark]):not(:has([data-verdict]))"
+    )
+    marker.first.wait_for(timeout=3000)
+    box_v = _open_popup(tab, marker.first)
+    box_v.locator('button[data-verdict="yes"]').click()
+    _close_popup(page)
+    page.evaluate(
+        """() => { const m = Object.keys(window).filter(k => /^map_[0-9a-f]+$/.test(k))
+                   .map(k => window[k])[0]; m.setView([51.509, -0.1], 14, {animate: false}); }"""
+    )
+    page.wait_for_function(
+        "Array.from(document.querySelectorAll('.camloc-cluster .camloc-sr'))"
+        ".some(s => s.textContent === '4 cameras: 2 confirmed, 2 rejected, 0 not reviewed')",
+        timeout=3000,
+    )
+    assert tab.blocked == []
+    assert tab.errors == []

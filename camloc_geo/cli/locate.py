@@ -51,6 +51,14 @@ def register(subparsers: Any) -> None:
         default=None,
         help="with --map: write candidate image overlays (PNG) into this existing folder",
     )
+    p.add_argument(
+        "--verdicts",
+        metavar="FILE",
+        help=(
+            "with --map: show the verdicts a reviewer exported from a review or summary page "
+            "(.csv or .geojson) on this scene's candidates again (see docs/candidates.md)"
+        ),
+    )
     p.set_defaults(func=run)
 
 
@@ -59,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo._errors import InputError
     from camloc_geo.api import locate_scene
 
-    inputs = [args.scene, args.osm]
+    inputs = [args.scene, args.osm, args.verdicts]
     out_path = output_path(args.output, inputs=inputs)
     map_path = output_path(args.map, inputs=inputs, option="--map")
     distinct_outputs(("-o", out_path), ("--map", map_path))
@@ -67,6 +75,13 @@ def run(args: argparse.Namespace) -> int:
         if map_path is None:
             raise InputError("--overlays needs --map OUT.html")
         output_path(args.overlays, option="--overlays", directory=True)
+    verdicts = None
+    if args.verdicts is not None:
+        if map_path is None:
+            raise InputError("--verdicts needs --map OUT.html (the verdicts are shown on it)")
+        from camloc_geo.maps import read_verdicts
+
+        verdicts = read_verdicts(args.verdicts)  # a bad file stops before the locating
     out = locate_scene(
         args.scene,
         map_source=args.osm,
@@ -90,6 +105,7 @@ def run(args: argparse.Namespace) -> int:
                 offline=inline_of(args),
                 scene=out.scene,
                 overlay_dir=args.overlays,
+                verdicts=verdicts,
             )
     if not out.result.candidates:
         log.warning("no candidates: %s", out.result.reason)

@@ -15,7 +15,8 @@ def register(subparsers: Any) -> None:
             "Serve the camloc HTTP API. Configuration comes from environment variables: "
             "CAMLOC_MAP_DIR (folder of OSM extracts), CAMLOC_API_KEY (key for write endpoints), "
             "CAMLOC_DATA_DIR (jobs and tasks database; default: the user's data folder, e.g. "
-            "~/.local/share/camloc/service), CAMLOC_NETWORK (allow Overpass), and the limits "
+            "~/.local/share/camloc/service), CAMLOC_VERDICT_DIR (reviewers' verdicts; default: "
+            "CAMLOC_DATA_DIR), CAMLOC_NETWORK (allow Overpass), and the limits "
             "documented in docs/service.md. Interactive API docs at /docs (offline)."
         ),
     )
@@ -28,6 +29,15 @@ def register(subparsers: Any) -> None:
         help=(
             "worker processes for the CPU work (1); one process serves HTTP and hands every "
             "request to a free worker (sets CAMLOC_WORKERS)"
+        ),
+    )
+    p.add_argument(
+        "--verdict-dir",
+        metavar="DIR",
+        default=None,
+        help=(
+            "folder of the reviewers' shared verdicts (camloc-verdicts.sqlite, made if "
+            "missing; sets CAMLOC_VERDICT_DIR; default: CAMLOC_DATA_DIR)"
         ),
     )
     p.add_argument("--log-level", default="info", help="uvicorn log level")
@@ -77,6 +87,15 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.service.settings import Settings
 
     os.environ["CAMLOC_WORKERS"] = str(args.workers)
+    if args.verdict_dir is not None:
+        from pathlib import Path
+
+        folder = Path(args.verdict_dir).expanduser()
+        if folder.exists() and not folder.is_dir():
+            raise InputError(f"--verdict-dir {folder}: not a folder")
+        if not folder.exists() and not folder.parent.is_dir():
+            raise InputError(f"--verdict-dir {folder}: its parent folder does not exist")
+        os.environ["CAMLOC_VERDICT_DIR"] = str(folder.resolve())
     try:
         Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable

@@ -25,6 +25,7 @@ from camloc_geo.service.routers.meta import install_docs
 from camloc_geo.service.routers.scenes import FAST_ROUTES
 from camloc_geo.service.settings import Settings
 from camloc_geo.service.store import Store
+from camloc_geo.service.verdicts import VerdictStore
 
 __all__ = ["ERROR_STATUS", "create_app"]
 
@@ -68,6 +69,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings, app.state.maps, app.state.store = settings, maps, store
     app.state.compute = compute
+    app.state.verdicts = VerdictStore(
+        settings.verdict_dir or settings.data_dir, max_rows=settings.max_verdicts
+    )
     for router in ROUTERS:
         app.include_router(router, responses=ERROR_RESPONSES)
     install_error_handlers(app)

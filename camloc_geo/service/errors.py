@@ -8,6 +8,7 @@ else is a 500 logged with its request id, whose details never reach the client.
 from __future__ import annotations
 
 import logging
+import math
 from typing import Any
 
 from fastapi import FastAPI, Request
@@ -147,13 +148,29 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
     return "; ".join(parts) or "invalid request", field
 
 
+def _json_safe(value: Any) -> Any:
+    """``value`` as JSON can carry it: a lone surrogate (``"\\ud800"`` in a JSON body) and a
+    NaN or infinity (``NaN`` is read by FastAPI's JSON parser) echoed back in a validation
+    error's ``input`` made the answer fail to encode, a 500 instead of the 422. Strings are
+    made valid UTF-8 (``?`` for a surrogate), such numbers their text (``"nan"``)."""
+    if isinstance(value, str):
+        return value.encode("utf-8", "replace").decode("utf-8")
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, list):
+        return [_json_safe(v) for v in value]
+    if isinstance(value, dict):
+        return {_json_safe(k): _json_safe(v) for k, v in value.items()}
+    return value
+
+
 _HTTP_KINDS = {404: "not_found", 405: "method_not_allowed", 401: "unauthorized"}
 
 
 async def _invalid_request(request: Request, exc: Exception) -> JSONResponse:
     """A query or path value FastAPI refused: the service's error shape, FastAPI's ``detail``
     kept alongside for clients that read it (before, only ``{"detail": [...]}``)."""
-    errors = jsonable_encoder(getattr(exc, "errors", list)())
+    errors = _json_safe(jsonable_encoder(getattr(exc, "errors", list)()))
     message, field = _validation_message(errors)
     body = error_body("invalid_input", message, field, request_id(request))
     body["detail"] = errors

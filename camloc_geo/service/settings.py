@@ -47,6 +47,16 @@ class Settings(BaseSettings):
             "the user's data folder, e.g. ~/.local/share/camloc/service)"
         ),
     )
+    verdict_dir: Path | None = Field(
+        default=None,
+        description=(
+            "folder of the reviewers' shared verdicts (camloc-verdicts.sqlite; default: "
+            "data_dir); camloc serve --verdict-dir sets it"
+        ),
+    )
+    max_verdicts: int = Field(
+        default=1_000_000, ge=1, description="most verdicts kept over all review pages"
+    )
     max_request_bytes: int = Field(
         default=2_000_000, ge=1_000, description="largest JSON body accepted"
     )

@@ -26,6 +26,7 @@ from qgis.core import (
     QgsProperty,
     QgsVectorLayer,
 )
+from qgis.PyQt import sip
 
 from .layers import (
     TIE_WORDS,
@@ -214,7 +215,12 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         n = write_to_sink(sink, desc, fields)
         del sink
         if context.willLoadLayerOnCompletion(dest):
-            styler = _post_processors.setdefault(dest, _Styler(kind))
+            # QGIS deletes a post-processor once it has run: a second run into the same
+            # output (Run again in the dialog, the file kept) reused the deleted one and
+            # failed with "wrapped C/C++ object of type _Styler has been deleted"
+            styler = _post_processors.get(dest)
+            if styler is None or sip.isdeleted(styler):
+                styler = _post_processors[dest] = _Styler(kind)
             styler.kind = kind
             of = self.__dict__.get("_layers_of", "")
             param = self.parameterDefinition(name)

@@ -23,6 +23,7 @@ from qgis.core import (
     Qgis,
     QgsApplication,
     QgsCoordinateTransform,
+    QgsMessageLog,
     QgsProject,
     QgsTask,
     QgsVectorLayer,
@@ -54,7 +55,14 @@ from qgis.PyQt.QtWidgets import (
 
 from .annotation import GUIDANCE, STEPS, Annotation
 from .imagefile import SnapshotError, check_regular_file, read_snapshot
-from .layers import DRAW_ORDER, apply_style, wgs84, write_gpkg_layer
+from .layers import (
+    DRAW_ORDER,
+    apply_style,
+    style_qml,
+    wgs84,
+    write_gpkg_layer,
+    write_gpkg_styles,
+)
 from .runner import WorkerCanceledError, WorkerError, run_worker
 
 AXIS_COLOURS = {
@@ -262,6 +270,7 @@ class LocateTask(QgsTask):
         self.gpkg = gpkg
         self.prefix = prefix
         self.uris: dict[str, str] = {}
+        self.shapes: dict[str, dict[str, Any]] = {}  # kind -> its fields and geometry
         self.error: str | None = None
         self.warnings: list[str] = []
         self.info: dict[str, Any] = {}
@@ -279,6 +288,7 @@ class LocateTask(QgsTask):
                 desc = res["layers"].get(kind)
                 if desc is not None:
                     self.uris[kind] = write_gpkg_layer(self.gpkg, f"{self.prefix}_{kind}", desc)
+                    self.shapes[kind] = {"fields": desc["fields"], "geometry": desc["geometry"]}
             self.warnings = [str(w) for w in res.get("warnings") or []]
             self.info = dict(res.get("info") or {})
         except WorkerCanceledError:
@@ -340,6 +350,7 @@ class CamlocDock(QDockWidget):
         self.result_layers: list[QgsVectorLayer] = []
         self._result_key: tuple[str, str] | None = None  # (GeoPackage, table prefix) shown
         self._restore: tuple[str, dict[str, str]] | None = None  # (group, uris) to put back
+        self._qml: dict[tuple[str, str], str] = {}  # (kind, fields and geometry) -> style
         self._result_group = ""
         self._result_uris: dict[str, str] = {}
         self.map_tool: QgsMapToolEmitPoint | None = None
@@ -1048,10 +1059,28 @@ class CamlocDock(QDockWidget):
         self._load_results(task)
 
     def _load_results(self, task: LocateTask) -> None:
-        """Load the task's layers, then report and zoom."""
+        """Store the layers' default styles in the GeoPackage, load the layers, then report
+        and zoom."""
         self._restore = None
         self._result_key = (os.path.abspath(task.gpkg), task.prefix)
+        self._store_styles(task)
         self._load_layers(f"camloc: {self.annotation.scene_id}", task.uris, task)
+
+    def _store_styles(self, task: LocateTask) -> None:
+        """The default style of each table the run wrote, into the GeoPackage's
+        ``layer_styles`` (Layer › Add Layer, the Browser and another project then draw them
+        styled), before any of them is opened (see :func:`layers.write_gpkg_styles`). A
+        failure is logged; the layers are styled in the project anyway."""
+        styles = {}
+        for kind, shape in task.shapes.items():
+            key = (kind, json.dumps(shape, sort_keys=True))
+            if key not in self._qml:
+                self._qml[key] = style_qml(kind, shape)
+            if self._qml[key]:
+                styles[f"{task.prefix}_{kind}"] = (kind, self._qml[key])
+        error = write_gpkg_styles(task.gpkg, styles)
+        if error:
+            QgsMessageLog.logMessage(f"the styles were not stored: {error}", "camloc", Qgis.Warning)
 
     def _load_layers(self, name: str, uris: dict[str, str], task: LocateTask | None) -> None:
         """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never

@@ -432,6 +432,131 @@ def store_default_style(layer: QgsVectorLayer, kind: str) -> str:
     return str(layer.saveStyleToDatabase(STYLE_NAME, f"camloc {kind}", True, "") or "")
 
 
+def style_qml(kind: str, desc: dict[str, Any]) -> str:
+    """The QML of ``kind``'s default style for a layer of ``desc``'s fields and geometry.
+
+    Made on a memory layer (main thread only: symbols and fonts), so that no layer of the
+    GeoPackage is opened for it. Empty when QGIS cannot export it.
+    """
+    from qgis.PyQt.QtXml import QDomDocument
+
+    geometry = {"Point": "Point", "LineString": "MultiLineString", "Polygon": "MultiPolygon"}
+    uri = geometry.get(str(desc.get("geometry")), "None") + f"?crs={WGS84}"
+    layer = QgsVectorLayer(uri, kind, "memory")
+    if not layer.isValid():
+        return ""
+    layer.dataProvider().addAttributes(fields_of(desc).toList())
+    layer.updateFields()
+    apply_style(layer, kind)
+    doc = QDomDocument()
+    error = layer.exportNamedStyle(doc)
+    return "" if error else str(doc.toString())
+
+
+_STYLE_FIELDS = (
+    ("f_table_catalog", "String", 256),
+    ("f_table_schema", "String", 256),
+    ("f_table_name", "String", 256),
+    ("f_geometry_column", "String", 256),
+    ("styleName", "String", 30),
+    ("styleQML", "String", 0),
+    ("styleSLD", "String", 0),
+    ("useAsDefault", "Integer", 0),
+    ("description", "String", 0),
+    ("owner", "String", 30),
+    ("ui", "String", 30),
+    ("update_time", "DateTime", 0),
+)
+"""The ``layer_styles`` table as QGIS makes it in a GeoPackage (QgsOgrProviderUtils)."""
+
+
+def write_gpkg_styles(gpkg: str, styles: dict[str, tuple[str, str]]) -> str:
+    """Store default styles in a GeoPackage's ``layer_styles`` table, as QGIS's "Save as
+    Default" does, through a GDAL handle of its own that is closed on return.
+
+    ``styles`` maps a table name to ``(kind, QML)``. Each table's earlier camloc style is
+    replaced and any other default of it unset. Returns an error message, empty if none.
+
+    Why not ``QgsVectorLayer.saveStyleToDatabase`` on the loaded layers: it opens the
+    GeoPackage in update mode through the OGR provider's shared dataset, which stays open
+    with the layers; the next run's writer (another handle, in the task's thread) then
+    replaced the tables under it, and saving the next style hung QGIS (seen in
+    test_dock's background run: "unable to open database file", then no return). Here the
+    GeoPackage is written only while none of the run's layers is open.
+    """
+    from osgeo import gdal, ogr
+
+    if not styles:
+        return ""
+    try:  # (GDAL raises RuntimeError when a plugin turned its exceptions on)
+        ds = ogr.Open(gpkg, 1)
+        if ds is None:
+            return f"cannot open {gpkg} to store the styles: {gdal.GetLastErrorMsg()}"
+        try:
+            return _write_styles(ds, gpkg, styles)
+        finally:
+            ds = None  # closes the file
+    except RuntimeError as exc:
+        return f"cannot store the styles in {gpkg}: {exc}"
+
+
+def _write_styles(ds: Any, gpkg: str, styles: dict[str, tuple[str, str]]) -> str:
+    import datetime
+
+    from osgeo import gdal, ogr
+
+    table = ds.GetLayerByName("layer_styles")
+    if table is None:
+        table = ds.CreateLayer("layer_styles", geom_type=ogr.wkbNone)
+        if table is None:
+            return f"cannot make layer_styles in {gpkg}: {gdal.GetLastErrorMsg()}"
+        for name, kind_name, width in _STYLE_FIELDS:
+            field = ogr.FieldDefn(name, getattr(ogr, "OFT" + kind_name))
+            if width:
+                field.SetWidth(width)
+            if name == "useAsDefault":
+                field.SetSubType(ogr.OFSTBoolean)
+            table.CreateField(field)
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y/%m/%d %H:%M:%S")
+    ds.StartTransaction()
+    for name, (kind, qml) in styles.items():
+        src = ds.GetLayerByName(name)
+        geom_col = src.GetGeometryColumn() if src is not None else ""
+        quoted = name.replace("'", "''")
+        table.SetAttributeFilter(f"f_table_name = '{quoted}'")
+        old = [(f.GetFID(), f.GetField("styleName")) for f in table]
+        table.SetAttributeFilter(None)
+        for fid, style_name in old:
+            if style_name == STYLE_NAME:
+                table.DeleteFeature(fid)
+            else:  # another style of the table stays, no longer the default
+                other = table.GetFeature(fid)
+                other.SetField("useAsDefault", 0)
+                table.SetFeature(other)
+        f = ogr.Feature(table.GetLayerDefn())
+        for key, value in (
+            ("f_table_catalog", ""),
+            ("f_table_schema", ""),
+            ("f_table_name", name),
+            ("f_geometry_column", geom_col),
+            ("styleName", STYLE_NAME),
+            ("styleQML", qml),
+            ("styleSLD", ""),
+            ("useAsDefault", 1),
+            ("description", f"camloc {kind}"),
+            ("owner", ""),
+            ("ui", ""),
+            ("update_time", now),
+        ):
+            f.SetField(key, value)
+        if table.CreateFeature(f) != 0:
+            ds.RollbackTransaction()
+            return f"cannot store the style of {name}: {gdal.GetLastErrorMsg()}"
+    if ds.CommitTransaction() != 0:
+        return f"cannot store the styles in {gpkg}: {gdal.GetLastErrorMsg()}"
+    return ""
+
+
 def _score_columns(layer: QgsVectorLayer) -> None:
     """The attribute table shows ``score_text`` next to ``score``, wide enough for 1.2e-15."""
     fields = layer.fields()

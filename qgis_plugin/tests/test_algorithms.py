@@ -447,3 +447,28 @@ def test_geocodelist_layers_loaded_name_their_list(provider, tmp_path):
     names = [n.layer().name() for n in project.layerTreeRoot().findLayers()]
     assert names == ["Cameras (harbour.csv)"]
     project.clear()
+
+
+def test_run_and_load_again_into_the_same_geopackage(provider, tmp_path):
+    # the second run into the same output (the dialog's Run again, the file kept) failed:
+    # "wrapped C/C++ object of type _Styler has been deleted" (QGIS deletes a post-processor
+    # once it has run; the plugin reused it)
+    import processing
+    from qgis.core import QgsProject, QgsRuleBasedRenderer
+
+    project = QgsProject.instance()
+    project.clear()
+    params = {
+        "SCENE": str(SAMPLE_SCENE),
+        "OSM": str(SAMPLE_OSM),
+        "CANDIDATES": str(tmp_path / "out.gpkg"),
+    }
+    for _ in range(3):
+        res = processing.runAndLoadResults("camloc:locate", params)
+        assert res["N_CANDIDATES"] == 12
+    assert any(lyr.source().startswith(str(tmp_path)) for lyr in project.mapLayers().values())
+    fresh = QgsVectorLayer(res["CANDIDATES"], "fresh", "ogr")  # its default style, once more
+    assert isinstance(fresh.renderer(), QgsRuleBasedRenderer)
+    assert fresh.customProperty("camloc/kind") == "candidates"
+    assert fresh.featureCount() == 12
+    project.clear()

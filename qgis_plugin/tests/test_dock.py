@@ -208,6 +208,27 @@ def test_dock_run_in_background_writes_a_geopackage_and_loads_it(
     assert dock.wait()
     assert len(group.findLayers()) == 6
     cands = dock.result_layers[0]
+    # the GeoPackage carries each table's default style (once, after two runs): a layer
+    # opened from it as Layer > Add Layer does is drawn by camloc's rules
+    from osgeo import ogr
+    from qgis.core import QgsVectorLayer
+
+    ds = ogr.Open(str(gpkg))
+    styles = ds.GetLayerByName("layer_styles")
+    assert styles is not None
+    rows = sorted(
+        (f.GetField("f_table_name"), f.GetField("styleName"), f.GetField("useAsDefault"))
+        for f in styles
+    )
+    ds = None
+    assert rows == sorted((f"snapshot_{k}", "camloc", 1) for k in kinds)
+    fresh = QgsVectorLayer(f"{gpkg}|layername=snapshot_candidates", "fresh", "ogr")
+    assert fresh.isValid()
+    assert fresh.renderer().type() == "RuleRenderer"
+    labels = [r.label() for r in fresh.renderer().rootRule().children()]
+    assert labels[1] == "best candidate (#1)"
+    assert fresh.labelsEnabled()
+    del fresh
     # the canvas (Web Mercator) shows the candidates with their styles, over the map model
     settings = QgsMapSettings()
     settings.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:3857"))
@@ -920,3 +941,12 @@ def test_a_second_camera_leaves_the_first_cameras_layers(dock, qgis_iface, tmp_p
     assert len(second) == 4
     assert first[0].featureCount() > 0
     assert {lyr.id() for lyr in first}.isdisjoint(lyr.id() for lyr in dock.result_layers)
+    # both cameras' tables carry their default style in the GeoPackage
+    from osgeo import ogr
+
+    ds = ogr.Open(str(gpkg))
+    names = sorted(f.GetField("f_table_name") for f in ds.GetLayerByName("layer_styles"))
+    ds = None
+    assert len(names) == 8
+    assert sum(n.startswith("first_") for n in names) == 4
+    assert "second_candidates" in names

@@ -14,7 +14,7 @@ from dataclasses import asdict
 from typing import Annotated, Any
 
 from fastapi import APIRouter, Query, Request
-from fastapi.responses import Response
+from fastapi.responses import HTMLResponse, Response
 from pydantic import ValidationError
 
 from camloc_geo import SceneError
@@ -30,7 +30,7 @@ from camloc_geo.service.deps import (
 )
 from camloc_geo.service.errors import LimitError, NotFoundError
 from camloc_geo.service.mapstore import MapStore
-from camloc_geo.service.models import JobId, JobList, ResultQuery
+from camloc_geo.service.models import HTML_ROUTE_ERRORS, JobId, JobList, ResultQuery
 from camloc_geo.service.settings import Settings
 from camloc_geo.service.store import Store
 from camloc_geo.service.work import process_camera
@@ -140,6 +140,7 @@ async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
     if job is None:
         raise NotFoundError(f"no job {job_id}")
     job["result_url"] = f"/v1/jobs/{job_id}/result"
+    job["map_url"] = f"/v1/jobs/{job_id}/map"
     return job
 
 
@@ -162,6 +163,61 @@ async def job_result(
         media_type="application/geopackage+sqlite3",
         headers={"Content-Disposition": f'attachment; filename="camloc-{job_id}.gpkg"'},
     )
+
+
+def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, Any]]]:
+    """A job's cameras as the summary page takes them: each camera's candidates (a
+    title-only camera: its point as its one candidate; none placed: its status and reason),
+    named ``id title`` as ``camloc batch --map`` names them."""
+    items = []
+    for r in results:
+        label = f"{r.get('id') or ''} {r.get('title') or ''}".strip() or "(no id)"
+        feats = list(r.get("candidates") or [])
+        if not feats and r.get("lat") is not None and r.get("lon") is not None:
+            feats = [
+                {
+                    "type": "Feature",
+                    "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
+                    "properties": {
+                        "kind": "candidate",
+                        "rank": 1,
+                        "lat": r["lat"],
+                        "lon": r["lon"],
+                        "score": r.get("score") or 0.0,
+                        "method": f"{r.get('method')} ({r.get('status')})",
+                        "heading_deg": r.get("heading_deg"),
+                        "height_m": r.get("height_m"),
+                        "sigma_m": r.get("uncertainty_m"),
+                        "flags": [r.get("status")],
+                    },
+                }
+            ]
+        reason = r.get("reason") if feats else f"{r.get('status')}: {r.get('reason') or ''}"
+        gj = {"type": "FeatureCollection", "features": feats, "properties": {"reason": reason}}
+        items.append((label, gj))
+    return items
+
+
+def job_summary_page(results: list[dict[str, Any]]) -> str:
+    """The offline summary page of a job's finished cameras, sharing its reviewers' verdicts
+    through ``/v1/verdicts`` when opened from the server (runs in the thread pool)."""
+    from camloc_geo.maps import build_summary_map, inline_assets
+    from camloc_geo.service.routers.verdicts import VERDICTS_PATH
+
+    fmap = build_summary_map(
+        _summary_items(results), offline=True, tiles=None, verdict_service=VERDICTS_PATH
+    )
+    return inline_assets(fmap.get_root().render())
+
+
+@router.get("/v1/jobs/{job_id}/map", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
+async def job_map(request: Request, job_id: JobId, store: ServiceStore) -> HTMLResponse:
+    """The summary page of the job's finished cameras (best candidate each, the others to
+    pick from): one offline HTML file whose reviewers share their verdicts here."""
+    if store.job(job_id) is None:
+        raise NotFoundError(f"no job {job_id}")
+    results = store.job_results(job_id)
+    return HTMLResponse(await run_cpu(request, lambda: job_summary_page(results)))
 
 
 def camera_work(maps: MapStore, camera: Any, settings: Settings) -> dict[str, Any]:

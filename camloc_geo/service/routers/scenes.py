@@ -59,13 +59,22 @@ def locate_work(maps: MapStore, scene: Scene | bytes, max_candidates: int | None
 
 
 def review_work(maps: MapStore, scene: Scene | bytes) -> str:
-    """The offline review page of a scene or a raw scene body (runs on a worker)."""
+    """The offline review page of a scene or a raw scene body (runs on a worker); opened
+    from this server, it shares its verdicts through ``/v1/verdicts``."""
     from camloc_geo.maps import candidates_map
+    from camloc_geo.service.routers.verdicts import VERDICTS_PATH
 
     out, m = locate_body(cast(Any, _scene(maps, scene)), maps)
     with tempfile.TemporaryDirectory(prefix="camloc-map-") as tmp:
         path = Path(tmp) / "review.html"
-        candidates_map(out.result, m, path, offline=True, scene=out.scene)
+        candidates_map(
+            out.result,
+            m,
+            path,
+            offline=True,
+            scene=out.scene,
+            verdict_service=VERDICTS_PATH,
+        )
         return path.read_text(encoding="utf-8")
 
 

@@ -1,0 +1,91 @@
+"""Verdict endpoints: reviewers of one page share their verdicts through the service.
+
+Open like the annotation pages' submissions (a reviewer's browser has no API key): the
+pages served by the service post here; see docs/service.md, "Verdicts".
+"""
+
+from __future__ import annotations
+
+from datetime import datetime, timezone
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Depends, Query, Request
+from fastapi.responses import JSONResponse, Response
+
+from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
+from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
+
+__all__ = ["VERDICTS_PATH", "router"]
+
+VERDICTS_PATH = "/v1/verdicts"
+"""Where a page served by the service sends its verdicts (``<path>/<page>/<identity>``)."""
+
+router = APIRouter(tags=["verdicts"])
+
+
+async def _verdicts(request: Request) -> VerdictStore:
+    store: VerdictStore = request.app.state.verdicts
+    return store
+
+
+Verdicts = Annotated[VerdictStore, Depends(_verdicts)]
+
+
+@router.get(VERDICTS_PATH)
+async def list_pages(
+    store: Verdicts,
+    limit: Annotated[int, Query(ge=1, le=10_000, description="at most this many pages")] = 1000,
+) -> dict[str, Any]:
+    """The pages that have verdicts, latest change first."""
+    return {"pages": store.pages(limit)}
+
+
+_EXPORT_DOC: dict[int | str, dict[str, Any]] = {
+    200: {
+        "description": "the page's verdicts (format=json), or its export (csv, geojson)",
+        "content": {
+            "application/json": {},
+            "text/csv": {"schema": {"type": "string"}},
+            "application/geo+json": {},
+        },
+    }
+}
+
+
+@router.get(VERDICTS_PATH + "/{page}/{identity}", response_model=None, responses=_EXPORT_DOC)
+async def page_verdicts(
+    page: VerdictPage,
+    identity: VerdictIdentity,
+    store: Verdicts,
+    q: Annotated[VerdictsQuery, Query()],
+) -> Response:
+    """A page's verdicts (none yet: an empty ``items``); ``format=csv`` or ``geojson``: the
+    export the page itself writes, which ``camloc summary-map --verdicts`` and ``camloc
+    locate --map ... --verdicts`` read."""
+    doc = store.page(page, identity)
+    if q.format == "json":
+        return JSONResponse(doc)
+    name = f"verdicts-{page}-{identity[:8]}"
+    if q.format == "csv":
+        return Response(
+            export_csv(doc),
+            media_type="text/csv; charset=utf-8",
+            headers={"Content-Disposition": f'attachment; filename="{name}.csv"'},
+        )
+    return JSONResponse(
+        export_geojson(doc),
+        media_type="application/geo+json",
+        headers={"Content-Disposition": f'attachment; filename="{name}.geojson"'},
+    )
+
+
+@router.post(VERDICTS_PATH + "/{page}/{identity}")
+async def post_verdicts(
+    page: VerdictPage, identity: VerdictIdentity, body: VerdictPost, store: Verdicts
+) -> dict[str, Any]:
+    """Add or change verdicts on a page: each item replaces the stored one of its key unless
+    that one is newer. Answers the page's verdicts after the change and the keys taken."""
+    now = datetime.now(timezone.utc)
+    items = {key: item.stored(now) for key, item in body.items.items()}
+    doc, taken = store.merge(page, identity, items)
+    return {**doc, "taken": taken}

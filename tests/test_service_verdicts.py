@@ -1,0 +1,563 @@
+"""Reviewers' verdicts shared through the service: ``/v1/verdicts`` on a real ``camloc
+serve`` process (loopback, httpx), the store's merge rule, and in headless Chromium a review
+page served by the service sharing one reviewer's verdicts with another's browser."""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+from test_service import SCENE, Server
+
+from camloc_geo.service.models import VerdictItem, utc_text
+from camloc_geo.service.verdicts import VERDICTS_FILE, VerdictStore
+from camloc_geo.service.work import LimitError
+
+IDENT = "0123456789abcdef"
+URL = f"/v1/verdicts/candidates/{IDENT}"
+
+
+@pytest.fixture(scope="module")
+def vserver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    tmp = tmp_path_factory.mktemp("vservice")
+    srv = Server(tmp, CAMLOC_VERDICT_DIR=str(tmp / "shared-verdicts"))
+    srv.start()
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture(scope="module")
+def vclient(vserver: Server) -> Iterator[httpx.Client]:
+    with httpx.Client(base_url=vserver.url, timeout=60.0) as c:
+        yield c
+
+
+# ---------------------------------------------------------------------------- the store
+def test_store_merge_latest_wins_and_limit(tmp_path: Path) -> None:
+    store = VerdictStore(tmp_path / "v", max_rows=3)
+    assert (tmp_path / "v" / VERDICTS_FILE).is_file()
+    item = {"verdict": "yes", "rank": None, "note": "kerb", "reviewer": "Ana"}
+    doc, taken = store.merge(
+        "candidates", IDENT, {"2": {**item, "time": "2026-11-25T01:00:00.000Z"}}
+    )
+    assert taken == ["2"]
+    assert doc["items"]["2"]["verdict"] == "yes"
+    # an older verdict does not replace a newer one; as new or newer does
+    older = {**item, "verdict": "no", "time": "2026-11-25T00:59:59.999Z"}
+    _doc, taken = store.merge("candidates", IDENT, {"2": older})
+    assert taken == []
+    newer = {**item, "verdict": None, "reviewer": "Bo", "time": "2026-11-25T01:00:00.001Z"}
+    doc, taken = store.merge("candidates", IDENT, {"2": newer})
+    assert taken == ["2"]
+    assert doc["items"]["2"] == {
+        "verdict": None,
+        "rank": None,
+        "note": "kerb",
+        "reviewer": "Bo",
+        "time": "2026-11-25T01:00:00.001Z",
+        "camera": "",
+        "lat": None,
+        "lon": None,
+    }
+    # other pages are apart; the store holds at most max_rows
+    assert store.page("summary", IDENT)["items"] == {}
+    store.merge("summary", IDENT, {"c0": {**item, "time": "2026-11-25T02:00:00.000Z"}})
+    with pytest.raises(LimitError, match="at most 3 verdicts"):
+        store.merge("summary", IDENT, {"c1": {**item, "time": "t"}, "c2": {**item, "time": "t"}})
+    assert [p["page"] for p in store.pages()] == ["summary", "candidates"]
+    assert [p["verdicts"] for p in store.pages()] == [1, 0]
+
+
+def test_verdict_item_time_rules() -> None:
+    from datetime import datetime, timezone
+
+    now = datetime(2026, 11, 25, 2, 0, tzinfo=timezone.utc)
+    given = VerdictItem.model_validate({"verdict": "no", "time": "2026-11-25T03:00:00+02:00"})
+    assert given.stored(now)["time"] == "2026-11-25T01:00:00.000Z"
+    naive = VerdictItem.model_validate({"verdict": "no", "time": "2026-11-25T01:30:00"})
+    assert naive.stored(now)["time"] == "2026-11-25T01:30:00.000Z"
+    future = VerdictItem.model_validate({"verdict": "no", "time": "2027-01-01T00:00:00Z"})
+    assert future.stored(now)["time"] == utc_text(now)  # a clock far ahead: taken as now
+    assert VerdictItem.model_validate({}).stored(now)["time"] == "2026-11-25T02:00:00.000Z"
+
+
+# ----------------------------------------------------------------------------- the API
+def test_verdicts_endpoints_share_and_persist(vserver: Server, vclient: httpx.Client) -> None:
+    r = vclient.get(URL)
+    assert r.status_code == 200, r.text
+    assert r.json() == {"page": "candidates", "identity": IDENT, "items": {}}
+    body = {
+        "items": {
+            "1": {
+                "verdict": "no",
+                "note": "wrong street",
+                "reviewer": "Ana",
+                "time": "2026-11-25T01:00:00.000Z",
+            },
+            "2": {"verdict": "yes", "reviewer": "Ana", "time": "2026-11-25T01:00:01.000Z"},
+        }
+    }
+    r = vclient.post(URL, json=body)
+    assert r.status_code == 200, r.text
+    assert sorted(r.json()["taken"]) == ["1", "2"]
+    # another reviewer, later: withdraws 2; an out-of-date copy of 1 is not taken
+    r = vclient.post(
+        URL,
+        json={
+            "items": {
+                "2": {"verdict": None, "reviewer": "Bo", "time": "2026-11-25T01:05:00Z"},
+                "1": {"verdict": "unsure", "reviewer": "Bo", "time": "2026-11-25T00:00:00Z"},
+            }
+        },
+    )
+    assert r.status_code == 200, r.text
+    assert r.json()["taken"] == ["2"]
+    items = vclient.get(URL).json()["items"]
+    assert {k: (v["verdict"], v["reviewer"], v["note"]) for k, v in items.items()} == {
+        "1": ("no", "Ana", "wrong street"),
+        "2": (None, "Bo", ""),
+    }
+    assert items["2"]["time"] == "2026-11-25T01:05:00.000Z"
+    pages = vclient.get("/v1/verdicts").json()["pages"]
+    assert {
+        "page": "candidates",
+        "identity": IDENT,
+        "verdicts": 1,
+        "latest": "2026-11-25T01:05:00.000Z",
+    } in pages
+    # kept in the folder named by CAMLOC_VERDICT_DIR, and across a restart
+    folder = Path(vserver.env["CAMLOC_VERDICT_DIR"])
+    assert (folder / VERDICTS_FILE).is_file()
+    vserver.stop()
+    vserver.start()
+    with httpx.Client(base_url=vserver.url, timeout=60.0) as again:
+        assert again.get(URL).json()["items"] == items
+
+
+def test_verdicts_export_reads_back(vclient: httpx.Client, tmp_path: Path) -> None:
+    """``?format=csv|geojson``: the page's own export, which read_verdicts (and so
+    summary-map/locate --verdicts) takes."""
+    from camloc_geo import maps
+
+    url = "/v1/verdicts/summary/00000000000000aa"
+    item = {"reviewer": "Ana", "camera": "=cam 7", "lat": -32.05, "lon": 115.74}
+    r = vclient.post(
+        url,
+        json={
+            "items": {
+                "c10": {**item, "verdict": "yes", "rank": 3, "note": 'kerb, "the" tree'},
+                "c2": {**item, "verdict": "no", "rank": 1, "camera": "cam 2", "lat": None},
+                "c3": {**item, "verdict": None, "camera": "cam 3"},
+            }
+        },
+    )
+    assert r.status_code == 200, r.text
+    r = vclient.get(url, params={"format": "csv"})
+    assert r.status_code == 200, r.text
+    assert r.headers["content-type"].startswith("text/csv")
+    assert 'filename="verdicts-summary-00000000.csv"' in r.headers["content-disposition"]
+    assert r.content.startswith(b"\xef\xbb\xbf")  # a BOM, as the pages write
+    assert "'=cam 7" in r.text  # the formula guard
+    path = tmp_path / "server.csv"
+    path.write_bytes(r.content)
+    rows = maps.read_verdicts(path)
+    assert [(x["camera"], x["rank"], x["verdict"], x["lat"]) for x in rows] == [
+        ("cam 2", 1, "no", None),  # key order c2, c10; the withdrawn c3 left out
+        ("=cam 7", 3, "yes", -32.05),
+    ]
+    assert rows[1]["note"] == 'kerb, "the" tree'
+    assert rows[1]["page"] == "summary"
+    assert rows[1]["identity"] == "00000000000000aa"
+    r = vclient.get(url, params={"format": "geojson"})
+    assert r.status_code == 200, r.text
+    doc = r.json()
+    assert doc["properties"]["format"] == "camloc-verdicts/1"
+    assert doc["features"][0]["geometry"] is None
+    assert doc["features"][1]["geometry"]["coordinates"] == [115.74, -32.05]
+    gpath = tmp_path / "server.geojson"
+    gpath.write_bytes(r.content)
+    assert maps.read_verdicts(gpath) == rows
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "body", "field"),
+    [
+        ("GET", "/v1/verdicts/review/0123456789abcdef", None, "page"),
+        ("GET", "/v1/verdicts/candidates/0123", None, "identity"),
+        ("GET", "/v1/verdicts/candidates/0123456789ABCDEF", None, "identity"),
+        ("POST", URL, {"items": {"rank2": {"verdict": "yes"}}}, "items.rank2.[key]"),
+        ("POST", URL, {"items": {"2": {"verdict": "maybe"}}}, "items.2.verdict"),
+        ("POST", URL, {"items": {"2": {"verdict": "yes", "note": "x" * 201}}}, "items.2.note"),
+        ("POST", URL, {"items": {"2": {"verdict": "yes", "mood": "ok"}}}, "items.2.mood"),
+        ("POST", URL, {"items": {"2": {"time": "yesterday"}}}, "items.2.time"),
+        ("POST", URL, {"items": {"2": {"rank": 0}}}, "items.2.rank"),
+        ("POST", URL, {"items": {"2": {"note": "\ud800"}}}, "items.2.note"),
+        ("POST", URL, {"items": []}, "items"),
+        ("POST", URL, [1, 2], "request"),
+        ("GET", "/v1/verdicts?limit=0", None, "limit"),
+        ("GET", URL + "?format=xml", None, "format"),
+        ("POST", URL, {"items": {"2": {"lat": 95}}}, "items.2.lat"),
+        ("POST", URL, {"items": {"2": {"camera": "x" * 301}}}, "items.2.camera"),
+    ],
+)
+def test_verdicts_bad_input_is_a_clear_422(
+    vclient: httpx.Client, method: str, path: str, body: Any, field: str
+) -> None:
+    # (ASCII JSON: a lone surrogate goes as its escape, as a browser may send it)
+    content = None if body is None else json.dumps(body, ensure_ascii=True).encode()
+    r = vclient.request(method, path, content=content, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["type"] == "invalid_input"
+    assert err["field"] == field, err
+
+
+def test_verdicts_bad_bodies(vclient: httpx.Client) -> None:
+    r = vclient.post(
+        URL, content=b'{"items": {"2": {"lat": NaN}}}', headers={"content-type": "application/json"}
+    )
+    assert r.status_code == 422, r.text
+    assert r.json()["error"]["field"] == "items.2.lat"
+    r = vclient.post(URL, content=b"{not json", headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    assert "JSON" in r.json()["error"]["message"]
+    r = vclient.post(URL, content=b"items", headers={"content-type": "text/plain"})
+    assert 400 <= r.status_code < 500, r.text
+    r = vclient.put(URL, json={"items": {}})
+    assert r.status_code == 405
+    assert r.json()["error"]["type"] == "method_not_allowed"
+
+
+def test_serve_verdict_dir_option(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from camloc_geo.cli import main
+
+    afile = tmp_path / "a-file"
+    afile.write_text("x", encoding="utf-8")
+    assert main(["serve", "--verdict-dir", str(afile)]) == 2
+    assert f"--verdict-dir {afile}: not a folder" in capsys.readouterr().err
+    assert main(["serve", "--verdict-dir", str(tmp_path / "no" / "such")]) == 2
+    assert "its parent folder does not exist" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- browser
+needs_browser = pytest.mark.skipif(
+    not Path("/usr/bin/chromium").exists(), reason="Debian chromium is not installed"
+)
+
+
+class _Reviewer:
+    """One reviewer's browser (own storage) on a page served at the service's origin; any
+    request to another origin is aborted and recorded."""
+
+    def __init__(self, browser: Any, origin: str, html_text: str, name: str) -> None:
+        self.context = browser.new_context(viewport={"width": 1400, "height": 900})
+        self.page = self.context.new_page()
+        self.origin = origin
+        self.url = origin + "/review-page-test"
+        self.html = html_text
+        self.blocked: list[str] = []
+        self.errors: list[str] = []
+        self.sent: list[str] = []
+        self.page.route("**/*", self._route)
+        self.page.on("pageerror", lambda exc: self.errors.append(f"pageerror: {exc}"))
+        self.page.on("request", lambda req: self.sent.append(f"{req.method} {req.url}"))
+        self.name = name
+
+    def _route(self, route: Any) -> None:
+        url = route.request.url
+        if url == self.url:  # the page as the service served it (POST /v1/maps)
+            route.fulfill(status=200, body=self.html, content_type="text/html; charset=utf-8")
+        elif url.startswith((self.origin + "/", "data:")):
+            route.continue_()
+        else:
+            self.blocked.append(url)
+            route.abort()
+
+    def open(self) -> None:
+        self.page.goto(self.url, wait_until="load")
+        self.page.wait_for_selector(".camloc-verdicts .camloc-vshare", timeout=5000)
+        self.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent.startsWith('shared')",
+            timeout=5000,
+        )
+
+    def close(self) -> None:
+        self.context.close()
+
+
+@pytest.fixture(scope="module")
+def served_page(vclient: httpx.Client) -> str:
+    r = vclient.post("/v1/maps", json=SCENE)
+    assert r.status_code == 200, r.text
+    assert '"service": "/v1/verdicts"' in r.text
+    return r.text
+
+
+@pytest.mark.browser
+@needs_browser
+def test_served_page_shares_verdicts_between_reviewers(
+    browser: Any, vserver: Server, vclient: httpx.Client, served_page: str, tmp_path: Path
+) -> None:
+    found = re.search(r"var cfg = (\{.*?\});\n", served_page)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    ana = _Reviewer(browser, vserver.url, served_page, "Ana")
+    bo = _Reviewer(browser, vserver.url, served_page, "Bo")
+    try:
+        ana.open()
+        page = ana.page
+        page.locator(".camloc-verdicts button.camloc-vfold").click()  # unfold if folded
+        if not page.locator(".camloc-verdicts input").is_visible():
+            page.locator(".camloc-verdicts button.camloc-vfold").click()
+        page.locator(".camloc-verdicts input").fill("Ana")
+        page.locator('.camloc-candidate [data-rank="2"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="yes"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="yes"]').click()
+        box.locator("input").fill("lamp post")
+        page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (1 there)'",
+            timeout=5000,
+        )
+        deadline_items: dict[str, Any] = {}
+        for _ in range(50):  # the note goes 600 ms after the last key
+            deadline_items = vclient.get(url).json()["items"]
+            if deadline_items.get("2", {}).get("note") == "lamp post":
+                break
+            page.wait_for_timeout(100)
+        assert deadline_items["2"]["verdict"] == "yes"
+        assert deadline_items["2"]["reviewer"] == "Ana"
+        assert deadline_items["2"]["note"] == "lamp post"
+        # Bo's browser (no storage of Ana's) sees it; his "no" on 1 reaches the service
+        bo.open()
+        n = len(cfg["order"])
+        bo.page.wait_for_function(
+            f"document.querySelector('.camloc-vcount').textContent === '1 of {n} candidates "
+            "reviewed'",
+            timeout=5000,
+        )
+        assert (
+            bo.page.locator('.camloc-candidate [data-verdict-mark="2"]').get_attribute(
+                "data-verdict"
+            )
+            == "yes"
+        )
+        bo.page.locator('.camloc-candidate [data-rank="1"]').click()
+        bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
+        bbox.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        bbox.locator('button[data-verdict="no"]').click()
+        bo.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (2 there)'",
+            timeout=5000,
+        )
+        assert vclient.get(url).json()["items"]["1"]["verdict"] == "no"
+        # the service's export is the page's: the camera and the candidates' points came along
+        from camloc_geo import maps
+
+        csv_path = tmp_path / "team.csv"
+        csv_path.write_bytes(vclient.get(url, params={"format": "csv"}).content)
+        rows = maps.read_verdicts(csv_path)
+        assert [(r["camera"], r["rank"], r["verdict"], r["reviewer"]) for r in rows] == [
+            (cfg["items"]["1"]["camera"], 1, "no", ""),
+            (cfg["items"]["2"]["camera"], 2, "yes", "Ana"),
+        ]
+        assert rows[1]["lat"] == pytest.approx(cfg["items"]["2"]["lat"], abs=1e-9)
+        assert rows[1]["lon"] == pytest.approx(cfg["items"]["2"]["lon"], abs=1e-9)
+        # Ana's page takes Bo's verdict when she comes back to it
+        page.evaluate("window.dispatchEvent(new Event('focus'))")
+        page.wait_for_function(
+            "document.querySelector('[data-verdict-mark=\"1\"]').getAttribute('data-verdict')"
+            " === 'no'",
+            timeout=5000,
+        )
+        page.screenshot(path=str(tmp_path / "shared.png"))
+        for r in (ana, bo):
+            assert r.blocked == []
+            assert r.errors == []
+            assert all(
+                s.startswith(("GET " + vserver.url, "POST " + vserver.url)) for s in r.sent
+            ), r.sent
+    finally:
+        ana.close()
+        bo.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_served_page_saved_as_a_file_makes_no_request(
+    browser: Any, served_page: str, tmp_path: Path
+) -> None:
+    from test_browser_maps import _Page
+
+    path = tmp_path / "review.html"
+    path.write_text(served_page, encoding="utf-8")
+    t = _Page(browser)
+    try:
+        t.open(path, ".camloc-verdicts .camloc-vcount")
+        page = t.page
+        page.locator('.camloc-candidate [data-rank="1"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="no"]').click()
+        page.wait_for_timeout(300)
+        assert page.locator(".camloc-vcount").inner_text().startswith("1 of ")
+        assert page.locator(".camloc-vshare").count() == 0
+        assert t.blocked == []
+        assert t.errors == []
+    finally:
+        t.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_verdicts_given_before_the_service_was_reached_are_sent(
+    browser: Any, vserver: Server, vclient: httpx.Client, served_page: str
+) -> None:
+    """A browser that already holds verdicts of the page (given while the service was not
+    reachable) sends them when it reads the service's; an older one the service has newer
+    is taken from the service instead."""
+    found = re.search(r"var cfg = (\{.*?\});\n", served_page)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    r = vclient.post(
+        url,
+        json={"items": {"5": {"verdict": "no", "reviewer": "Bo", "time": "2026-11-25T01:00:00Z"}}},
+    )
+    assert r.status_code == 200, r.text
+    key = f"camloc-verdicts/v1/candidates/{cfg['identity']}"
+    local = {
+        "items": {
+            "4": {"verdict": "unsure", "note": "offline", "time": "2026-11-25T01:30:00.000Z"},
+            "5": {"verdict": "yes", "time": "2026-11-24T00:00:00.000Z"},  # older than Bo's
+        }
+    }
+    cy = _Reviewer(browser, vserver.url, served_page, "Cy")
+    try:
+        cy.page.add_init_script(
+            f"window.localStorage.setItem({json.dumps(key)}, {json.dumps(json.dumps(local))});"
+        )
+        cy.open()
+        items: dict[str, Any] = {}
+        for _ in range(50):
+            items = vclient.get(url).json()["items"]
+            if "4" in items:
+                break
+            cy.page.wait_for_timeout(100)
+        assert items["4"]["verdict"] == "unsure"
+        assert items["4"]["note"] == "offline"
+        assert items["4"]["time"] == "2026-11-25T01:30:00.000Z"
+        assert items["5"]["verdict"] == "no"  # the service's newer one stays
+        cy.page.wait_for_function(
+            "document.querySelector('[data-verdict-mark=\"5\"]').getAttribute('data-verdict')"
+            " === 'no'",
+            timeout=5000,
+        )
+        assert cy.blocked == []
+        assert cy.errors == []
+    finally:
+        cy.close()
+
+
+# ------------------------------------------------------------- a job's summary page
+@pytest.fixture(scope="module")
+def job_page(vclient: httpx.Client) -> dict[str, Any]:
+    import time
+
+    cams = [
+        {"id": "good", "scene": SCENE},
+        {"id": "c1", "title": "Eastern Ave & S Broadway", "lat": 39.2856, "lon": -76.5935},
+        {"id": "nothing"},
+    ]
+    r = vclient.post("/v1/jobs", json={"cameras": cams})
+    assert r.status_code == 202, r.text
+    job_id = r.json()["id"]
+    deadline = time.monotonic() + 90
+    st: dict[str, Any] = {}
+    while time.monotonic() < deadline:
+        st = vclient.get(f"/v1/jobs/{job_id}").json()
+        if st["status"] == "done":
+            break
+        time.sleep(0.3)
+    assert st["status"] == "done", st
+    assert st["map_url"] == f"/v1/jobs/{job_id}/map"
+    r = vclient.get(st["map_url"])
+    assert r.status_code == 200, r.text
+    assert r.headers["content-type"].startswith("text/html")
+    found = re.search(r"var cfg = (\{.*?\});\n", r.text)
+    assert found is not None
+    return {"html": r.text, "cfg": json.loads(found.group(1)), "job": job_id}
+
+
+def test_job_map_is_a_shared_summary_page(vclient: httpx.Client, job_page: dict[str, Any]) -> None:
+    cfg = job_page["cfg"]
+    assert cfg["kind"] == "summary"
+    assert cfg["service"] == "/v1/verdicts"
+    cameras = {it["camera"]: it for it in cfg["items"].values()}
+    assert set(cameras) == {"good", "c1 Eastern Ave & S Broadway"}  # 'nothing' has no point
+    assert cameras["good"]["others"]  # the good camera's other candidates to pick from
+    assert "1 without candidates" in job_page["html"]
+    from test_maps import remote_references
+
+    assert remote_references(job_page["html"]) == []  # an offline page
+    r = vclient.get("/v1/jobs/" + "0" * 32 + "/map")
+    assert r.status_code == 404
+    assert r.json()["error"]["type"] == "not_found"
+
+
+@pytest.mark.browser
+@needs_browser
+def test_job_map_reviewers_share_a_pick(
+    browser: Any, vserver: Server, vclient: httpx.Client, job_page: dict[str, Any], tmp_path: Path
+) -> None:
+    cfg = job_page["cfg"]
+    key = next(k for k, it in cfg["items"].items() if it["camera"] == "good")
+    third = next(o for o in cfg["items"][key]["others"] if o[0] == 3)
+    ana = _Reviewer(browser, vserver.url, job_page["html"], "Ana")
+    bo = _Reviewer(browser, vserver.url, job_page["html"], "Bo")
+    try:
+        ana.open()
+        marker = ana.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]')
+        marker.click()
+        box = ana.page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator("select").wait_for(timeout=3000)
+        box.locator("select").select_option("3")
+        ana.page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (1 there)'",
+            timeout=5000,
+        )
+        bo.open()
+        bo.page.wait_for_function(
+            "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
+            timeout=5000,
+        )
+        bo.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
+        bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
+        bbox.locator("select").wait_for(timeout=3000)
+        assert bbox.locator("select").input_value() == "3"  # Ana's pick, on Bo's page
+        bo.page.wait_for_timeout(600)  # (the popup's fade-in and pan, for the screenshot)
+        bo.page.screenshot(path=str(tmp_path / "job-map.png"))
+        csv_path = tmp_path / "job.csv"
+        url = f"/v1/verdicts/summary/{cfg['identity']}"
+        csv_path.write_bytes(vclient.get(url, params={"format": "csv"}).content)
+        from camloc_geo import maps
+
+        rows = maps.read_verdicts(csv_path)
+        assert [(r["camera"], r["rank"], r["verdict"]) for r in rows] == [("good", 3, "yes")]
+        assert rows[0]["lat"] == pytest.approx(third[1], abs=1e-9)
+        assert rows[0]["lon"] == pytest.approx(third[2], abs=1e-9)
+        for r in (ana, bo):
+            assert r.blocked == []
+            assert r.errors == []
+    finally:
+        ana.close()
+        bo.close()
