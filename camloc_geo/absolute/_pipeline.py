@@ -347,6 +347,8 @@ def _other_junction_candidates(
     candidates; tried only when no named candidate was plausible, they found a tenth of the
     wrong cross streets.
     """
+    if ev.junction_search:
+        return _searched_junction_candidates(map_data, world_cam, ev, settings, result)
     others = other_junctions(scene, map_data, ev)
     if not others:
         return []
@@ -385,6 +387,59 @@ def _other_junction_candidates(
             "to fix the junction"
         )
     return out
+
+
+def _searched_junction_candidates(
+    map_data: MapData | None,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+) -> list[Candidate]:
+    """Corner hypotheses at the junctions searched around a stated lat/lon that matched
+    none (:func:`~camloc_geo.absolute._evidence.latlon_search`), each at its prior odds
+    (falling with its distance from the stated point); the most likely one is ``ev``'s own,
+    scored already. All are kept: the corners' fit and the map decide among them."""
+    assert map_data is not None
+    out: list[Candidate] = []
+    for inter, _d, log_prior in ev.junction_search:
+        if ev.intersection is not None and inter.id == ev.intersection.id:
+            continue
+        ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
+        hyps = corner_hypotheses(ev_j, settings)
+        for h in hyps:
+            h.log_prior += log_prior
+        out += score_hypotheses(hyps, world_cam, ev_j, settings)
+    return out
+
+
+def _warn_searched_junction(scene: Scene, ev: Evidence, result: LocateResult) -> None:
+    """Name the junction the best candidate stands at, and its distance from the stated
+    intersection lat/lon, when that point matched no junction and the junctions around it
+    were searched."""
+    hint = scene.intersection
+    if not ev.junction_search or hint is None or hint.lat is None or hint.lon is None:
+        return
+    from camloc_geo.absolute._evidence import LATLON_MATCH_M, LATLON_SEARCH_M
+
+    said = f"lat={hint.lat:.6f}, lon={hint.lon:.6f}"
+    n = len(ev.junction_search)
+    head = (
+        f"intersection: no modelled junction within {LATLON_MATCH_M:.0f} m of the scene's "
+        f"intersection ({said}); the corners were matched at the {n} junction"
+        f"{'s' if n > 1 else ''} with kerb corners within {LATLON_SEARCH_M:.0f} m of it"
+    )
+    top = result.candidates[0] if result.candidates else None
+    where = {x.id: (x, d) for x, d, _lp in ev.junction_search}
+    if top is None or top.intersection_id not in where:
+        result.warnings.append(f"{head}; check the intersection's lat/lon")
+        return
+    inter, d = where[top.intersection_id]
+    result.warnings.append(
+        f"{head}: the best candidate stands at junction {inter.id} "
+        f"({' & '.join(inter.street_names)}), {d:.0f} m from the stated point; check the "
+        "intersection's lat/lon"
+    )
 
 
 def _weight(c: Candidate) -> float:
@@ -455,6 +510,9 @@ def _warn_other_junction(
 ) -> None:
     """Warn when the best candidate stands at a junction the scene did not name."""
     named = named_junctions(scene, map_data, ev)
+    if ev.junction_search:
+        _warn_searched_junction(scene, ev, result)
+        return
     if named is None or not result.candidates:
         return
     top = result.candidates[0]
