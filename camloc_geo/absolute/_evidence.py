@@ -41,6 +41,7 @@ class Evidence:
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
     substitution: str | None = None  # a landmark read as a neighbouring building's
+    reference_substitution: str | None = None  # a corner reference read as another corner
     stated_bearing: float | None = None  # the scene's street_bearing_deg
     map_bearings: list[float] = field(default_factory=list)  # the map's others, with one
     intersection: Intersection | None = None  # the junction whose corners these are
@@ -483,6 +484,52 @@ def landmark_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
             lms = list(ev.landmarks)
             lms[k] = (lms[k][0], pts)
             out.append((replace(ev, landmarks=lms), f"landmarks[{i}] as {b.name!r}"))
+    return out
+
+
+CORNER_REFERENCE_M = 3.0
+"""A reference this near a modelled kerb corner stands on that corner: it may be another
+corner's lat/lon (:func:`reference_corner_alternatives`)."""
+
+
+def reference_corner_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
+    """``ev`` with one reference on a modelled kerb corner moved to each other kerb corner of
+    that junction, each with a note (``references[0] as corner 2 of junction n123 (A &
+    B)``).
+
+    Crowds click a kerb corner in the picture and give the lat/lon of another corner of the
+    junction (``benchmarks/absolute_slips.py``'s ``reference_other_corner``): two references
+    fix a camera exactly whatever their lat/lon, so the wrong corner's answer carries no
+    misfit. Only scenes whose evidence is exactly two references; a reference lies on a
+    corner when it is within :data:`CORNER_REFERENCE_M` of it.
+    """
+    map_data, frame = ev.map_data, ev.frame
+    if map_data is None or frame is None or len(ev.refs) != 2 or ev.corners or ev.landmarks:
+        return []
+    from dataclasses import replace
+
+    out = []
+    for k, (obs, q) in enumerate(ev.refs):
+        lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
+        # a kerb corner lies within a junction's reach of its centre (or a member node)
+        near = map_data.intersections_within(lat=float(lat), lon=float(lon), radius_m=60.0)
+        for inter, _d in near:
+            if len(inter.corners) < 2:
+                continue
+            corners = _corners_enu(inter, frame)
+            gap = np.hypot(corners[:, 0] - q[0], corners[:, 1] - q[1])
+            on = int(np.argmin(gap))
+            if gap[on] > CORNER_REFERENCE_M:
+                continue
+            streets = " & ".join(inter.street_names)
+            for j, c in enumerate(inter.corners):
+                if j == on:
+                    continue
+                refs = list(ev.refs)
+                refs[k] = (obs, corners[j].copy())
+                note = f"{obs.label} as corner {c.order} of junction {inter.id} ({streets})"
+                out.append((replace(ev, refs=refs), note))
+            break
     return out
 
 

@@ -25,10 +25,12 @@ from camloc_geo.absolute._evidence import (
     landmark_alternatives,
     named_junctions,
     other_junctions,
+    reference_corner_alternatives,
 )
 from camloc_geo.absolute._hypotheses import (
     Hypothesis,
     NoCandidatesError,
+    _gen_references,
     bearing_hypotheses,
     corner_hypotheses,
     generate_hypotheses,
@@ -132,6 +134,7 @@ def locate(
         cands += _references_alone(cands, world_cam, ev, settings)
         cands += _map_bearing_candidates(cands, world_cam, ev, settings)
         cands += _neighbour_building_candidates(cands, world_cam, ev, settings)
+        cands += _reference_corner_candidates(world_cam, ev, settings)
         cands += _other_junction_candidates(scene, map_data, world_cam, ev, settings, result, cands)
         cands = prior_gate(cands, ev, settings, result)
         cands = normalise_and_merge(cands, settings)
@@ -146,6 +149,7 @@ def locate(
         _warn_reversed_corners(result)
         _warn_corner_outlier(result)
         _warn_substituted_landmark(result)
+        _warn_reference_corner(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -248,6 +252,43 @@ def _neighbour_building_candidates(
             # landmark closest < 10 m 91 -> 88 %).
             out.append(max(scored, key=lambda c: c.log_likelihood + math.log(max(c.prior, 1e-300))))
     return out
+
+
+REFERENCE_CORNER_PRIOR = 0.2
+"""The prior odds of a reference on a kerb corner being another corner of its junction."""
+
+
+def _reference_corner_candidates(
+    world_cam: Camera, ev: Evidence, settings: LocateSettings
+) -> list[Candidate]:
+    """Two references, one on a modelled kerb corner read as each other corner of its
+    junction (odds :data:`REFERENCE_CORNER_PRIOR`;
+    :func:`~camloc_geo.absolute._evidence.reference_corner_alternatives`). Kept always: the
+    pair's scale and the map (the car on its street, along it) weigh them against the
+    stated corner; one that fits as well ties with it instead of the stated one being
+    answered alone."""
+    odds = math.log(REFERENCE_CORNER_PRIOR)
+    out: list[Candidate] = []
+    for ev_alt, note in reference_corner_alternatives(ev):
+        ev_alt.reference_substitution = note
+        hyps = _gen_references(ev_alt, settings)
+        for h in hyps:
+            h.log_prior += odds
+        out += _keep_odds(score_hypotheses(hyps, world_cam, ev_alt, settings), odds)
+    return out
+
+
+def _warn_reference_corner(result: LocateResult) -> None:
+    """Warn when the best candidate reads a reference as another kerb corner."""
+    if not result.candidates:
+        return
+    ev = result.candidates[0].evidence
+    if ev is None or ev.reference_substitution is None:
+        return
+    result.warnings.append(
+        f"references: the best candidate reads {ev.reference_substitution}: the pair fits "
+        "the picture and the map better so; is the stated lat/lon another corner's? Check it"
+    )
 
 
 def _warn_substituted_landmark(result: LocateResult) -> None:
@@ -409,8 +450,23 @@ def _searched_junction_candidates(
         hyps = corner_hypotheses(ev_j, settings)
         for h in hyps:
             h.log_prior += log_prior
-        out += score_hypotheses(hyps, world_cam, ev_j, settings)
+        out += _keep_odds(score_hypotheses(hyps, world_cam, ev_j, settings), log_prior)
     return out
+
+
+def _keep_odds(cands: list[Candidate], log_prior: float) -> list[Candidate]:
+    """``cands`` whose prior odds stay in their score once refined
+    (:func:`refine_leaders`).
+
+    Only the junctions searched around a stated point and the other-corner readings of a
+    reference keep them: kept for every alternative reading, the map's other street
+    bearings (``bearing_cross_street``) lost their right top answers (60 -> 17 %) and
+    neighbouring buildings theirs (23 -> 7 %), their odds having been set with refinement
+    dropping them (``benchmarks/absolute_slips.py --n 120``).
+    """
+    for c in cands:
+        c.log_prior_odds = log_prior
+    return cands
 
 
 def _warn_searched_junction(scene: Scene, ev: Evidence, result: LocateResult) -> None:
@@ -833,7 +889,11 @@ def refine_leaders(
     plausibility averaged over their refined uncertainty)."""
     leaders = cands[: settings.refine_top]
     top = refine_many(leaders, world_cam, [c.evidence or ev for c in leaders], settings)
-    top = _rescore_many(top, world_cam, ev, settings, [0.0] * len(top), expected=True)
+    # The prior odds a reading keeps once refined (_keep_odds: a searched junction's, another
+    # corner's reading of a reference); the other alternatives compete at even odds here.
+    top = _rescore_many(
+        top, world_cam, ev, settings, [c.log_prior_odds for c in top], expected=True
+    )
     return top + cands[settings.refine_top :]
 
 
