@@ -326,3 +326,38 @@ def test_one_street_name_and_a_prior_try_that_streets_junctions(baltimore: MapDa
     it["streets"] = ["No Such Street"]
     with pytest.raises(MapDataError, match="'No Such Street' meets no other street"):
         locate(parse_scene(scene), baltimore)
+
+
+@pytest.mark.parametrize(
+    ("inter_id", "seed"), [("c49537218", 10), ("c49493745", 10), ("c49531205", 5)]
+)
+def test_two_references_with_the_car_beside_its_street_stay_quiet(
+    baltimore: MapData, inter_id: str, seed: int
+) -> None:
+    # Clean two-reference scenes whose car stands 2.5-6 m beyond the modelled carriageway,
+    # along it (street widths are estimates). Old code: "references: the two references put
+    # the car off any street ..." on a right answer (8 of 117 clean scenes in
+    # absolute_slips). Now a car beside its street, along it, is no contradiction.
+    from camloc_geo.absolute._model import FlagKind
+    from camloc_geo.absolute._pipeline import car_beside_street
+    from camloc_geo.absolute._similarity import Similarity2D
+
+    ls = _located(baltimore, inter_id, seed, n_references=2, min_corners=1)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    res = locate(parse_scene(scene), baltimore)
+    top = res.candidates[0]
+    assert _errors(res, ls)[0] < 2.0
+    assert FlagKind.CAR_OFF_STREET in {f.kind for f in top.flags}  # still flagged...
+    assert car_beside_street(top, top.evidence)
+    assert not [w for w in res.warnings if w.startswith("references")]  # ...not warned
+    # The same car turned 45 degrees about its centre is across, not beside, its street.
+    sim = top.enu_from_world
+    centre = sim.apply(np.asarray(top.evidence.car_center_world, dtype=float))
+    turned = Similarity2D(sim.rotation_rad + np.pi / 4, np.zeros(2), sim.scale)
+    shift = centre - turned.apply(np.asarray(top.evidence.car_center_world, dtype=float))
+    turned = Similarity2D(sim.rotation_rad + np.pi / 4, shift, sim.scale)
+    assert np.allclose(turned.apply(top.evidence.car_center_world), centre)
+    from dataclasses import replace
+
+    assert not car_beside_street(replace(top, enu_from_world=turned), top.evidence)
