@@ -336,7 +336,7 @@ def test_two_references_with_the_car_beside_its_street_stay_quiet(
 ) -> None:
     # Clean two-reference scenes whose car stands 2.5-6 m beyond the modelled carriageway,
     # along it (street widths are estimates). Old code: "references: the two references put
-    # the car off any street ..." on a right answer (8 of 117 clean scenes in
+    # the car off any street ..." on a right answer (7 of the 8 clean scenes warned in
     # absolute_slips). Now a car beside its street, along it, is no contradiction.
     from camloc_geo.absolute._model import FlagKind
     from camloc_geo.absolute._pipeline import car_beside_street

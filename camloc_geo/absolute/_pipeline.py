@@ -333,10 +333,10 @@ def car_beside_street(cand: Candidate, ev: Evidence) -> bool:
     """The candidate's car, off every modelled carriageway, stands beside one, along it.
 
     Clean two-reference scenes were warned of a car "off any street" for cars 2.5-5 m beyond
-    the modelled carriageway and parallel to it (8 of 117, ``benchmarks/absolute_slips.py``):
+    the modelled carriageway and parallel to it (7 of 117, ``benchmarks/absolute_slips.py``):
     street widths are estimates and cars park at the kerb. A wrong reference moves the car
-    tens of metres and turns it (28-89 degrees off the nearest street in 20 of 22 such
-    slips).
+    tens of metres and turns it (28-89 degrees off the nearest street in 25 of the 26 wrong
+    tops flagged so).
     """
     streets = ev.streets
     if streets is None or streets.tree is None:
@@ -370,9 +370,9 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
     Two references fix a camera exactly whatever their lat/lon, so a wrong one (another
     point's, rounded to 4 decimals) moves the answer tens of metres with a small sigma and
     no misfit. The map is the only witness left: the car of a real camera stands on a street,
-    along it. Measured (``benchmarks/absolute_slips.py --n 120``): 8 of 117 clean
-    two-reference scenes get a reference warning (their car off the map's street: street
-    widths are estimates), 38 % of those with one reference on another kerb corner.
+    along it. A car beside its street, along it, is no contradiction
+    (:func:`car_beside_street`). Measured (``benchmarks/absolute_slips.py --n 120``): 1 of 117
+    clean two-reference scenes gets a reference warning (8 before the beside-street test).
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not cands:
         return
