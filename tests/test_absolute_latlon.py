@@ -132,3 +132,21 @@ def test_search_odds_fall_with_distance(baltimore: MapData) -> None:
     others = {x.id: lp for x, _d, lp in found}
     for y, _d, lp in named[1:]:
         assert lp == pytest.approx(others[y.id] - others["c49531205"] + math.log(0.2))
+
+
+def test_tie_across_searched_junctions_says_why(baltimore: MapData) -> None:
+    # Aliceanna & South Bethel, the point 60 m south-west: its candidates tie with those of
+    # n49489908 (and a third junction's); the tie names the junction search, not a
+    # symmetric junction.
+    ls = _located(baltimore, "n49494688", 4)
+    res = locate(parse_scene(_moved(ls.scene, -45.0, -40.0)), baltimore)
+    tie = next(t for t in res.ties if 1 in t.ranks)
+    ids = {res.candidates[r - 1].intersection_id for r in tie.ranks}
+    assert {"n49494688", "n49489908"} <= ids
+    assert tie.why.startswith("the junctions around the scene's intersection lat/lon")
+    # a tie within one junction keeps the usual reason
+    ls = _located(baltimore, "c49531205", 9)
+    res = locate(parse_scene(_moved(ls.scene, 0.0, 60.0)), baltimore)
+    tie = next(t for t in res.ties if 1 in t.ranks)
+    assert {res.candidates[r - 1].intersection_id for r in tie.ranks} == {"c49531205"}
+    assert tie.why.startswith("a symmetric junction cannot tell them apart")

@@ -110,7 +110,13 @@ def test_reference_on_its_own_corner_is_taken_at_its_word(baltimore: MapData) ->
         assert _errors(res, ls)[0] < 1.0
         assert res.candidates[0].evidence is not None
         assert res.candidates[0].evidence.reference_substitution is None
+        assert not res.candidates[0].ambiguous_with
         assert not [w for w in res.warnings if w.startswith("references")]
+        # the other readings that tie among themselves say why
+        for tie in res.ties:
+            assert tie.why.startswith("references[0] read as different kerb corners")
+        if inter_id == "n49471323":
+            assert res.ties
 
 
 def test_two_consistent_references_stay_quiet(baltimore: MapData) -> None:

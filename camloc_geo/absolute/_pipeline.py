@@ -1092,7 +1092,7 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
         c.ambiguous_with.sort()
     result.warnings = [w for w in result.warnings if not w.startswith("ambiguous:")]
     result.leaders_tie = len(cands) >= 2 and _tie(cands[0], cands[1], settings, positions)
-    why = (
+    why_default = (
         "even with the scene's cues"
         if result.cues_applied
         else "a symmetric junction cannot tell them apart: more evidence (a reference "
@@ -1100,7 +1100,9 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
         "a tighter prior decides"
     )
     result.ties = []
+    by_rank = {c.rank: c for c in cands}
     for group in _tie_groups(cands):
+        why = _tie_why([by_rank[r] for r in group if r in by_rank], why_default)
         if result.leaders_tie and group[:2] == [cands[0].rank, cands[1].rank]:
             gap = float(np.linalg.norm(cands[0].east_north - cands[1].east_north))
             odds = cands[0].score / max(cands[1].score, 1e-300)
@@ -1117,6 +1119,27 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
                 f"{1.0 / settings.tie_score_ratio:g} to 1 but stand apart; {why}"
             )
         result.ties.append(Tie(ranks=group, text=text, why=why))
+
+
+def _tie_why(group: list[Candidate], default: str) -> str:
+    """Why the candidates of a tie group cannot be told apart: a reference read on its stated
+    kerb corner and on another, or the junctions searched around a rough point, when that
+    is what sets them apart; else ``default``."""
+    evs = [c.evidence for c in group if c.evidence is not None]
+    notes = sorted({e.reference_substitution for e in evs if e.reference_substitution})
+    if notes and len({e.reference_substitution for e in evs}) > 1:
+        label = notes[0].split(" as ")[0]
+        return (
+            f"{label} read as different kerb corners of its junction (at its stated lat/lon "
+            "or another corner's) fit alike: check that reference's lat/lon, or add a third "
+            "reference, a corner or a landmark"
+        )
+    if any(e.junction_search for e in evs) and len({c.intersection_id for c in group}) > 1:
+        return (
+            "the junctions around the scene's intersection lat/lon (no junction within 25 m "
+            "of it) fit alike: give the junction's own lat/lon or its street names"
+        )
+    return default
 
 
 def _tie_groups(cands: list[Candidate]) -> list[list[int]]:
