@@ -150,3 +150,19 @@ def test_tie_across_searched_junctions_says_why(baltimore: MapData) -> None:
     tie = next(t for t in res.ties if 1 in t.ranks)
     assert {res.candidates[r - 1].intersection_id for r in tie.ranks} == {"c49531205"}
     assert tie.why.startswith("a symmetric junction cannot tell them apart")
+
+
+def test_rough_point_with_street_names_prefers_the_named_junction(baltimore: MapData) -> None:
+    # Aliceanna Street & South Broadway, its point 90 m east and its streets named. Old code:
+    # MapDataError ("the scene's intersection ... is 90 m from its lat/lon, more than 25 m").
+    # Now the search keeps the named junction at even odds and the others at 0.2 more.
+    ls = _located(baltimore, "c49531205", 9)
+    scene = _moved(ls.scene, 90.0, 0.0)
+    scene["intersection"]["streets"] = ["Aliceanna Street", "South Broadway"]
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert errs[0] < 1.0
+    assert res.candidates[0].intersection_id == "c49531205"
+    warned = [w for w in res.warnings if "were matched at the" in w]
+    assert len(warned) == 1
+    assert "junction c49531205 (Aliceanna Street & South Broadway)" in warned[0]
