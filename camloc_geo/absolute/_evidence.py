@@ -700,8 +700,10 @@ def other_junctions(
     where they all meet keep log prior 0, and those within the prior where only some of them
     meet (the cross street a block away) are tried at :data:`NEIGHBOUR_JUNCTION_PRIOR` (at
     most :data:`MAX_NEIGHBOUR_JUNCTIONS`). A scene that states a lat/lon is taken at its
-    word (its neighbours tried at odds of 0.03 cost the absolute benchmark's corner scenes
-    3 % of their right top candidates and four times the time).
+    word when a junction lies within 25 m of it (its neighbours tried at odds of 0.03 cost
+    the absolute benchmark's corner scenes 3 % of their right top candidates and four times
+    the time); when none does, the junctions searched around it
+    (:func:`latlon_search`, ``Evidence.junction_search``) are scored instead of these.
     """
     hint = scene.intersection
     if map_data is None or hint is None or not ev.corners:
