@@ -32,6 +32,9 @@ annotation page make them:
     a reference's lat/lon with 4 decimals (~11 m steps);
 ``reference_other_corner``
     a reference on a visible kerb corner with the lat/lon of another corner of the junction;
+``control_reference_corner``
+    no slip: a reference on a visible kerb corner with that corner's lat/lon (the control
+    of ``reference_other_corner``);
 ``bearing_cross_street``
     one reference with ``street_bearing_deg`` of the cross street (the car in the other one);
 ``control_bearing``
@@ -286,6 +289,20 @@ def slip_ref_other_corner(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | Non
     return scene
 
 
+def control_ref_corner(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    """No slip: a reference on a visible kerb corner with that corner's own lat/lon (the
+    control of ``reference_other_corner``)."""
+    refs = scene.get("references") or []
+    clicks = _corners(c.ls.scene)
+    if not refs or not clicks or len(c.inter.corners) < 2:
+        return None
+    k = int(c.rng.integers(len(clicks)))
+    order = c.ls.visible_corner_orders[k]
+    right = next(x for x in c.inter.corners if x.order == order)
+    refs[0] = {"pixel": clicks[k], "lat": right.lat, "lon": right.lon}
+    return scene
+
+
 def slip_bearing_cross(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     car = c.car_bearing_deg()
     for s in c.inter.streets:
@@ -345,6 +362,7 @@ SLIPS: dict[str, tuple[str, Slip]] = {
     "reference_swapped": ("two_references", slip_ref_swapped),
     "reference_4_decimals": ("two_references", slip_ref_4_decimals),
     "reference_other_corner": ("two_references", slip_ref_other_corner),
+    "control_reference_corner": ("two_references", control_ref_corner),
     "bearing_cross_street": ("one_reference", slip_bearing_cross),
     "control_bearing": ("one_reference", control_bearing),
     "landmark_neighbour": ("landmark", slip_landmark_neighbour),

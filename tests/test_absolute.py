@@ -598,8 +598,10 @@ def test_evidence_above_the_calibrated_horizon_is_explained(maps: dict[str, MapD
     assert "above the calibrated camera's horizon" in result.reason
 
 
-def test_intersection_point_matching_no_junction_is_refused_naming_the_nearest() -> None:
-    """A scene's intersection 150 m from any modelled junction never moves to another one."""
+def test_intersection_point_matching_no_junction_is_searched_around_with_a_warning() -> None:
+    """A scene's intersection 42 m from the nearest modelled junction: the junctions within
+    200 m are searched and the warning names the one the answer stands at (it used to be
+    refused); nothing moves silently to another junction."""
     import json
 
     from camloc_geo.api import locate_scene
@@ -609,5 +611,28 @@ def test_intersection_point_matching_no_junction_is_refused_naming_the_nearest()
     scene["intersection"]["lat"] = 39.28698  # 42 m from Bank Street & South Broadway
     scene["intersection"]["lon"] = -76.59348
     scene["intersection"].pop("streets", None)
-    with pytest.raises(MapDataError, match=r"no modelled junction matches.*nearest"):
+    res = locate_scene(scene, map_source=root / "baltimore.osm.pbf").result
+    assert res.candidates
+    warned = [w for w in res.warnings if "were matched at the" in w]
+    assert len(warned) == 1
+    top = res.candidates[0].intersection_id
+    assert f"junction {top} " in warned[0]
+    assert "Bank Street & South Broadway), 42 m from the stated point" in warned[0]
+
+
+def test_intersection_point_far_from_every_junction_is_refused_naming_the_nearest() -> None:
+    """A scene's intersection farther than the 200 m search from any junction with kerb
+    corners is refused, naming the nearest junctions."""
+    import json
+
+    from camloc_geo.api import locate_scene
+
+    root = Path(__file__).resolve().parents[1] / "sample_maps"
+    scene = json.loads((root / "sample_scene.json").read_text())
+    scene["intersection"]["lat"] = 39.2795  # in the harbour, 630 m south
+    scene["intersection"]["lon"] = -76.59348
+    scene["intersection"].pop("streets", None)
+    with pytest.raises(
+        MapDataError, match=r"no modelled junction matches.*nearest.*none with kerb corners"
+    ):
         locate_scene(scene, map_source=root / "baltimore.osm.pbf")

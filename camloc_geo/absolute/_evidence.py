@@ -41,9 +41,14 @@ class Evidence:
     car_center_world: FloatArray = field(default_factory=lambda: np.zeros(2))
     worst_reference: str | None = None
     substitution: str | None = None  # a landmark read as a neighbouring building's
+    reference_substitution: str | None = None  # a corner reference read as another corner
     stated_bearing: float | None = None  # the scene's street_bearing_deg
     map_bearings: list[float] = field(default_factory=list)  # the map's others, with one
     intersection: Intersection | None = None  # the junction whose corners these are
+    # A stated intersection lat/lon with no junction within 25 m: the junctions searched
+    # around it (junction, distance from the stated point m, log prior odds against the
+    # nearest), nearest first (choose_intersection); empty otherwise.
+    junction_search: list[tuple[Intersection, float, float]] = field(default_factory=list)
     scene: Scene | None = None  # for the cues (view hint, the car's street, its front)
     map_data: MapData | None = None
     frame: LocalFrame | None = None
@@ -211,29 +216,95 @@ def _check_distinct_corners(scene: Scene) -> None:
                 )
 
 
-def choose_intersection(scene: Scene, map_data: MapData, frame: LocalFrame) -> Intersection:
+LATLON_MATCH_M = 25.0
+"""A stated intersection lat/lon names the junction (centre or member node) this near."""
+
+LATLON_SEARCH_M = 200.0
+"""With no junction within :data:`LATLON_MATCH_M` of a stated intersection lat/lon, the
+junctions with kerb corners this near are searched (webcam listings give a rough point:
+``benchmarks/absolute_slips.py``'s ``intersection_latlon_off``, 50-150 m off)."""
+
+LATLON_SEARCH_SCALE_M = 100.0
+"""The searched junctions' prior odds fall by e for each this many metres they lie farther
+from the stated point than the nearest one."""
+
+MAX_SEARCH_JUNCTIONS = 8
+"""At most this many junctions (nearest the stated point first) are searched."""
+
+
+def latlon_search(
+    map_data: MapData, lat: float, lon: float, streets: Sequence[str] | None
+) -> list[tuple[Intersection, float, float]]:
+    """The junctions with kerb corners within :data:`LATLON_SEARCH_M` of a stated point,
+    nearest first: ``(junction, distance_m, log prior odds against the nearest)``.
+
+    The odds fall with the distance (e per :data:`LATLON_SEARCH_SCALE_M` beyond the nearest
+    one's); with stated street names, a junction where they do not all meet is at
+    :data:`NEIGHBOUR_JUNCTION_PRIOR` more. At most :data:`MAX_SEARCH_JUNCTIONS`.
+    """
+    near = [
+        (x, d)
+        for x, d in map_data.intersections_within(lat=lat, lon=lon, radius_m=LATLON_SEARCH_M)
+        if x.corners
+    ][:MAX_SEARCH_JUNCTIONS]
+    if not near:
+        return []
+    named = {x.id for x in map_data.street_junctions(list(streets))} if streets else None
+    out = []
+    for x, d in near:
+        log_prior = -(d - near[0][1]) / LATLON_SEARCH_SCALE_M
+        if named is not None and x.id not in named:
+            log_prior += math.log(NEIGHBOUR_JUNCTION_PRIOR)
+        out.append((x, d, log_prior))
+    best = max(lp for _x, _d, lp in out)
+    out = [(x, d, lp - best) for x, d, lp in out]
+    # the most likely first: it is the evidence's own junction (log prior 0)
+    out.sort(key=lambda t: -t[2])
+    return out
+
+
+def choose_intersection(
+    scene: Scene,
+    map_data: MapData,
+    frame: LocalFrame,
+    search: list[tuple[Intersection, float, float]] | None = None,
+) -> Intersection:
     """The map intersection the scene's corners belong to.
 
-    A stated lat/lon must match a modelled junction (its centre or one of its member nodes)
-    within 25 m, with the stated street names if any: otherwise a :class:`MapDataError`
-    names the nearest junctions and their distances. Nothing moves silently to another one.
+    A stated lat/lon matches a modelled junction (its centre or one of its member nodes)
+    within 25 m, with the stated street names if any. When none does, the junctions with
+    kerb corners within :data:`LATLON_SEARCH_M` of it are searched
+    (:func:`latlon_search`): the most likely is returned and all of them are appended to
+    ``search`` (the caller scores them all and warns which one the answer stands at).
+    Without ``search``, or with no such junction, a :class:`MapDataError` names the nearest
+    junctions and their distances.
     """
     hint = scene.intersection
     assert hint is not None
     near = (scene.prior.lat, scene.prior.lon) if scene.prior is not None else None
     if hint.lat is not None and hint.lon is not None:
+        streets = list(hint.streets or []) or None
         inter, warnings = map_data.match_intersection(
-            lat=hint.lat, lon=hint.lon, streets=list(hint.streets or []) or None
+            lat=hint.lat, lon=hint.lon, streets=streets, max_distance_m=LATLON_MATCH_M
         )
-        if inter is None:
-            raise MapDataError(
-                "intersection: no modelled junction matches the scene's intersection "
-                f"(lat={hint.lat:.6f}, lon={hint.lon:.6f}"
-                + (f", streets {' & '.join(hint.streets)}" if hint.streets else "")
-                + "): "
-                + "; ".join(warnings)
+        if inter is not None:
+            return inter
+        found = latlon_search(map_data, hint.lat, hint.lon, streets) if search is not None else []
+        if found and search is not None:
+            search.extend(found)
+            return found[0][0]
+        raise MapDataError(
+            "intersection: no modelled junction matches the scene's intersection "
+            f"(lat={hint.lat:.6f}, lon={hint.lon:.6f}"
+            + (f", streets {' & '.join(hint.streets)}" if hint.streets else "")
+            + "): "
+            + "; ".join(warnings)
+            + (
+                f"; and none with kerb corners within {LATLON_SEARCH_M:.0f} m to search"
+                if search is not None
+                else ""
             )
-        return inter
+        )
     if hint.streets:
         names = split_street_query(list(hint.streets))
         if len(names) == 1:  # "(some of) its streets": the junctions along that one street
@@ -268,6 +339,7 @@ class _CornerEvidence:
     map_corner_ids: list[str] = field(default_factory=list)
     intersection: Intersection | None = None
     bearings: list[float] = field(default_factory=list)
+    search: list[tuple[Intersection, float, float]] = field(default_factory=list)
 
 
 def _corners(
@@ -284,7 +356,7 @@ def _corners(
             out.corners.append(c_obs)
     if map_data is None:
         raise MapDataError("the scene lists intersection corners but no map was given")
-    inter = choose_intersection(scene, map_data, frame)
+    inter = choose_intersection(scene, map_data, frame, out.search)
     out.intersection = inter
     if inter.kind != "junction":
         observe.warnings.append(
@@ -415,6 +487,52 @@ def landmark_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
     return out
 
 
+CORNER_REFERENCE_M = 3.0
+"""A reference this near a modelled kerb corner stands on that corner: it may be another
+corner's lat/lon (:func:`reference_corner_alternatives`)."""
+
+
+def reference_corner_alternatives(ev: Evidence) -> list[tuple[Evidence, str]]:
+    """``ev`` with one reference on a modelled kerb corner moved to each other kerb corner of
+    that junction, each with a note (``references[0] as corner 2 of junction n123 (A &
+    B)``).
+
+    Crowds click a kerb corner in the picture and give the lat/lon of another corner of the
+    junction (``benchmarks/absolute_slips.py``'s ``reference_other_corner``): two references
+    fix a camera exactly whatever their lat/lon, so the wrong corner's answer carries no
+    misfit. Only scenes whose evidence is exactly two references; a reference lies on a
+    corner when it is within :data:`CORNER_REFERENCE_M` of it.
+    """
+    map_data, frame = ev.map_data, ev.frame
+    if map_data is None or frame is None or len(ev.refs) != 2 or ev.corners or ev.landmarks:
+        return []
+    from dataclasses import replace
+
+    out = []
+    for k, (obs, q) in enumerate(ev.refs):
+        lon, lat = frame.geographic_from_enu(float(q[0]), float(q[1]))
+        # a kerb corner lies within a junction's reach of its centre (or a member node)
+        near = map_data.intersections_within(lat=float(lat), lon=float(lon), radius_m=60.0)
+        for inter, _d in near:
+            if len(inter.corners) < 2:
+                continue
+            corners = _corners_enu(inter, frame)
+            gap = np.hypot(corners[:, 0] - q[0], corners[:, 1] - q[1])
+            on = int(np.argmin(gap))
+            if gap[on] > CORNER_REFERENCE_M:
+                continue
+            streets = " & ".join(inter.street_names)
+            for j, c in enumerate(inter.corners):
+                if j == on:
+                    continue
+                refs = list(ev.refs)
+                refs[k] = (obs, corners[j].copy())
+                note = f"{obs.label} as corner {c.order} of junction {inter.id} ({streets})"
+                out.append((replace(ev, refs=refs), note))
+            break
+    return out
+
+
 def unique_bearings(bearings: Iterable[float]) -> list[float]:
     """Bearings folded into [0, 180), those within 5° of an earlier one dropped."""
     out: list[float] = []
@@ -524,6 +642,7 @@ def gather_evidence(
         unique_bearings(bearings),
     )
     ev.intersection = ce.intersection
+    ev.junction_search = ce.search
     ev.stated_bearing = scene.street_bearing_deg
     ev.map_bearings = map_bearings
     ev.scene, ev.map_data, ev.frame = scene, map_data, frame
@@ -581,8 +700,10 @@ def other_junctions(
     where they all meet keep log prior 0, and those within the prior where only some of them
     meet (the cross street a block away) are tried at :data:`NEIGHBOUR_JUNCTION_PRIOR` (at
     most :data:`MAX_NEIGHBOUR_JUNCTIONS`). A scene that states a lat/lon is taken at its
-    word (its neighbours tried at odds of 0.03 cost the absolute benchmark's corner scenes
-    3 % of their right top candidates and four times the time).
+    word when a junction lies within 25 m of it (its neighbours tried at odds of 0.03 cost
+    the absolute benchmark's corner scenes 3 % of their right top candidates and four times
+    the time); when none does, the junctions searched around it
+    (:func:`latlon_search`, ``Evidence.junction_search``) are scored instead of these.
     """
     hint = scene.intersection
     if map_data is None or hint is None or not ev.corners:

@@ -266,6 +266,8 @@ class Candidate:
     corner_assignment: tuple[int, ...] | None = None  # map corner per visible corner, -1 = none
     ambiguous_with: list[int] = field(default_factory=list)
     intersection_id: str | None = None  # the junction a corners hypothesis stands at
+    log_prior_odds: float = 0.0  # the hypothesis' prior odds (an alternative reading), in
+    # log_likelihood: kept when the candidate is refined and scored again
     evidence: Any = field(default=None, repr=False, compare=False)  # what it was scored on
 
     @property
