@@ -25,7 +25,10 @@ URL = f"/v1/verdicts/candidates/{IDENT}"
 @pytest.fixture(scope="module")
 def vserver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     tmp = tmp_path_factory.mktemp("vservice")
-    srv = Server(tmp, CAMLOC_VERDICT_DIR=str(tmp / "shared-verdicts"))
+    # a busy machine: the first page request loads the map and locates (20 s by default)
+    srv = Server(
+        tmp, CAMLOC_VERDICT_DIR=str(tmp / "shared-verdicts"), CAMLOC_REQUEST_TIMEOUT_S="300"
+    )
     srv.start()
     yield srv
     srv.stop()
