@@ -126,7 +126,7 @@ def test_qgis_process_geocodelist_takes_a_folder_of_extracts(profile_home, tmp_p
         "id,title\n"
         "foo,Foo St & Bar Ave\n"
         "milton,N Milton Ave & E Biddle St\n"
-        "main,Main St\n"
+        "main,Quenthorpe Lane\n"
         "berlin,Karl-Liebknecht-Str. / Wadzeckstr.\n"
     )
     out = tmp_path / "cams.gpkg"
