@@ -84,6 +84,11 @@ class CalibrationSettings:
         Annotation noise, as fractions of the image diagonal.
     size_sigma_rel
         Relative error of a preset object size (added to the uncertainty).
+    preset_shape
+        Where the size is a preset's, its length, width and height are each off by
+        ``size_sigma_rel``, the same for every annotator: the focal length's, principal
+        point's and rotation's move under each (:func:`_size_shape_sensitivity`) enters
+        their sigmas as a consider covariance. False: not (the old sigmas).
     focal_prior_width, focal_prior_sigma_log
         A weak log-normal prior on the focal length: median ``focal_prior_width`` image
         widths (0.75: a 67° horizontal field of view), ``focal_prior_sigma_log`` its spread
@@ -175,6 +180,7 @@ class CalibrationSettings:
     sigma_point_rel: float = 0.0015
     sigma_line_rel: float = 0.0010
     size_sigma_rel: float = 0.05
+    preset_shape: bool = True
     focal_prior_width: float = 0.75
     focal_prior_sigma_log: float = 0.5
     focal_prior_when_sigma_log: float = 0.1
@@ -786,6 +792,59 @@ def _ground_corner_sensitivity(
         D = -factor * np.linalg.solve(H, cols.T)
     except np.linalg.LinAlgError:
         return None
+    if not np.all(np.isfinite(D)):
+        return None
+    return np.asarray(D, dtype=np.float64)
+
+
+def _size_shape_sensitivity(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+    size_sigma_rel: float,
+) -> FloatArray | None:
+    """How the focal length, principal point and rotation move with a preset's size error:
+    ``D`` ``(len(x), 3)``, one column per dimension (length, width, height).
+
+    A preset's length, width and height are each off by ``size_sigma_rel`` (1-sigma),
+    independently, and that error is the *same car's* for every annotator: their edge-end
+    clicks all meet the same wrong box. Where the vanishing points leave the focal length
+    loose (a low camera, a direction near the image plane), the box's proportions decide
+    it, and a wrong proportion moves the answer by far more than the per-click share
+    (``_JointProblem``'s point sigmas, averaged over the annotators) or the jackknife (which
+    cannot see an error every annotator shares) state. Each column is the fit's move
+    ``−H⁻¹ Jᵀ W dr`` when one dimension is ``1 + size_sigma_rel`` times the preset's (the
+    world points scaled along that axis; robust Gauss-Newton at the solution). The camera
+    centre's rows are zero: the distance's share of the size error is stated separately
+    (``size_rel`` of :func:`_output_covariance`). None when off or singular.
+    """
+    if size_sigma_rel <= 0.0:
+        return None
+    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    JW = J * w[:, None]
+    H = J.T @ JW
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    f, pp, R, C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    cam = Camera.from_center(f, pp, R, C)
+    base = cam.project(prob.pt_world)
+    ju = JW[n_seg : n_seg + n_pt] * prob._pt_scale[:, None]  # (n_pt, n)
+    jv = JW[n_seg + n_pt : n_seg + 2 * n_pt] * prob._pt_scale[:, None]
+    cols = np.zeros((3, len(x)))
+    for d in range(3):
+        pts = prob.pt_world.copy()
+        pts[:, d] *= 1.0 + size_sigma_rel
+        dp = cam.project(pts) - base  # a click meeting the bigger box: residual + scale·dp
+        if not np.all(np.isfinite(dp)):
+            return None
+        cols[d] = dp[:, 0] @ ju + dp[:, 1] @ jv
+    try:
+        D = -np.linalg.solve(H, cols.T)
+    except np.linalg.LinAlgError:
+        return None
+    D[-3:] = 0.0  # the centre: size_rel's term
     if not np.all(np.isfinite(D)):
         return None
     return np.asarray(D, dtype=np.float64)
@@ -4075,6 +4134,7 @@ def _joint(
         sigma_pp_assumed,
         size_rel,
         car_lines.D,
+        size_shape_rel=size_sigma if settings.preset_shape else 0.0,
     )
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
@@ -4455,6 +4515,7 @@ def _output_covariance(
     sigma_pp_px: float,
     size_rel: float,
     car_lines: FloatArray | None = None,
+    size_shape_rel: float = 0.0,
 ) -> FloatArray | None:
     """Joint covariance ``(9, 9)`` of the answer, see ``CalibrationResult.parameter_covariance``.
 
@@ -4493,6 +4554,9 @@ def _output_covariance(
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
         A[block] += D @ D.T
+    D_size = _size_shape_sensitivity(prob, x, R0, pp_model, f_fixed, size_shape_rel)
+    if D_size is not None:
+        A[block] += D_size @ D_size.T
     if car_lines is not None:
         A[block] += car_lines @ car_lines.T
     if pp_model is not None and sigma_pp_px > 0.0:
