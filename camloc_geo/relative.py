@@ -84,6 +84,17 @@ class CalibrationSettings:
         Annotation noise, as fractions of the image diagonal.
     size_sigma_rel
         Relative error of a preset object size (added to the uncertainty).
+    preset_shape
+        Where the size is a preset's, its length, width and height are each off by
+        ``size_sigma_rel``, the same for every annotator: the focal length's, principal
+        point's and rotation's move under each (:func:`_size_shape_sensitivity`) enters
+        their sigmas as a consider covariance. False: not (the old sigmas).
+    focal_profile_flat
+        The fit is always repeated with the focal length held 2 sigmas either side
+        (:func:`_focal_profile_widening`); where that fits the annotations *better* (a local
+        minimum) the focal sigma is widened x3 and a warning says so. True: also where the
+        cost rises less than a 2-sigma step should (a flat side), the sigma is widened to
+        that side's log-normal half-width (off by default: it changes other terms' tests).
     focal_prior_width, focal_prior_sigma_log
         A weak log-normal prior on the focal length: median ``focal_prior_width`` image
         widths (0.75: a 67° horizontal field of view), ``focal_prior_sigma_log`` its spread
@@ -175,6 +186,8 @@ class CalibrationSettings:
     sigma_point_rel: float = 0.0015
     sigma_line_rel: float = 0.0010
     size_sigma_rel: float = 0.05
+    preset_shape: bool = True
+    focal_profile_flat: bool = False
     focal_prior_width: float = 0.75
     focal_prior_sigma_log: float = 0.5
     focal_prior_when_sigma_log: float = 0.1
@@ -786,6 +799,59 @@ def _ground_corner_sensitivity(
         D = -factor * np.linalg.solve(H, cols.T)
     except np.linalg.LinAlgError:
         return None
+    if not np.all(np.isfinite(D)):
+        return None
+    return np.asarray(D, dtype=np.float64)
+
+
+def _size_shape_sensitivity(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+    size_sigma_rel: float,
+) -> FloatArray | None:
+    """How the focal length, principal point and rotation move with a preset's size error:
+    ``D`` ``(len(x), 3)``, one column per dimension (length, width, height).
+
+    A preset's length, width and height are each off by ``size_sigma_rel`` (1-sigma),
+    independently, and that error is the *same car's* for every annotator: their edge-end
+    clicks all meet the same wrong box. Where the vanishing points leave the focal length
+    loose (a low camera, a direction near the image plane), the box's proportions decide
+    it, and a wrong proportion moves the answer by far more than the per-click share
+    (``_JointProblem``'s point sigmas, averaged over the annotators) or the jackknife (which
+    cannot see an error every annotator shares) state. Each column is the fit's move
+    ``−H⁻¹ Jᵀ W dr`` when one dimension is ``1 + size_sigma_rel`` times the preset's (the
+    world points scaled along that axis; robust Gauss-Newton at the solution). The camera
+    centre's rows are zero: the distance's share of the size error is stated separately
+    (``size_rel`` of :func:`_output_covariance`). None when off or singular.
+    """
+    if size_sigma_rel <= 0.0:
+        return None
+    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    JW = J * w[:, None]
+    H = J.T @ JW
+    n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
+    f, pp, R, C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    cam = Camera.from_center(f, pp, R, C)
+    base = cam.project(prob.pt_world)
+    ju = JW[n_seg : n_seg + n_pt] * prob._pt_scale[:, None]  # (n_pt, n)
+    jv = JW[n_seg + n_pt : n_seg + 2 * n_pt] * prob._pt_scale[:, None]
+    cols = np.zeros((3, len(x)))
+    for d in range(3):
+        pts = prob.pt_world.copy()
+        pts[:, d] *= 1.0 + size_sigma_rel
+        dp = cam.project(pts) - base  # a click meeting the bigger box: residual + scale·dp
+        if not np.all(np.isfinite(dp)):
+            return None
+        cols[d] = dp[:, 0] @ ju + dp[:, 1] @ jv
+    try:
+        D = -np.linalg.solve(H, cols.T)
+    except np.linalg.LinAlgError:
+        return None
+    D[-3:] = 0.0  # the centre: size_rel's term
     if not np.all(np.isfinite(D)):
         return None
     return np.asarray(D, dtype=np.float64)
@@ -2598,6 +2664,20 @@ def _calibrate_annotations(
         if not quiet:
             log.warning("%s", msg)
         result.warnings.append(msg)
+    profile = _focal_profile_widening(result, settings.focal_profile_flat)
+    if profile is not None:
+        factor, msg = profile
+        assert result.focal_sigma_px is not None
+        result.focal_sigma_px *= factor
+        if result.parameter_covariance is not None:
+            cov = np.array(result.parameter_covariance, dtype=float)
+            cov[0, :] *= factor
+            cov[:, 0] *= factor
+            result.parameter_covariance = cov
+        if msg:
+            if not quiet:
+                log.warning("%s", msg)
+            result.warnings.append(msg)
     widen = _photo_focal_widening(scene, result)
     if widen is not None:
         factor, msg = widen
@@ -2902,6 +2982,97 @@ def _photo_focal_widening(scene: Scene, result: CalibrationResult) -> tuple[floa
         f"widened {factor:.1f}x so that both lie within two of them (one of the two is off: "
         "check the car's far corners and its shortest edges against the photo)"
     )
+
+
+FOCAL_PROFILE_STEPS = 2.0
+"""The profile check's focal lengths: this many stated sigmas either side (log scale)."""
+FOCAL_PROFILE_MAX_WIDEN = 3.0
+FOCAL_PROFILE_MIN_WIDEN = 1.1
+"""A widening below this (10 %) is left out: the linearised sigma's own slack."""
+
+
+def _focal_profile_widening(
+    result: CalibrationResult, widen_flat: bool = False
+) -> tuple[float, str] | None:
+    """Widen ``focal_sigma_px`` where the fit's cost is flatter than its sigma says.
+
+    The stated focal sigma is a linearised one, symmetric in pixels; the focal length's
+    likelihood is not (a low camera, a vanishing point near infinity: a longer focal length
+    costs the fit less than a shorter one). The fit is repeated with the focal length held
+    at ``exp(±FOCAL_PROFILE_STEPS σ)`` times the answer (σ the stated sigma, relative); the
+    rise of its cost (``2·Δcost / s²``, ``s²`` the residual variance factor) should be at
+    least ``FOCAL_PROFILE_STEPS²`` (4) if the stated sigma held on that side. Where it is
+    less, the sigma of that side in log units is taken as ``FOCAL_PROFILE_STEPS / √rise``
+    times the stated one, and the stated pixel sigma widened to that side's half-width
+    ``f·|exp(±2σ') − 1| / 2`` (at most ``FOCAL_PROFILE_MAX_WIDEN`` times; less than
+    ``FOCAL_PROFILE_MIN_WIDEN``: left as it is); where the held fit
+    is *better* than the answer (the fit found a local minimum), the widening is the most
+    and a warning says so. The flat sides' widening (no better fit, a rise below 4) only
+    with ``widen_flat`` (``CalibrationSettings.focal_profile_flat``, default off). Only for the
+    joint fit with a fitted focal length. Returns (factor, warning or "") or None.
+    """
+    state = result.joint_state
+    f = result.camera.focal_px
+    if (
+        state is None
+        or state.focal_px is not None
+        or result.focal_sigma_px is None
+        or not 0.0 < result.focal_sigma_px < f
+    ):
+        return None
+    prob = state.problem
+    saved = prob.weights
+    prob.weights = state.weights
+    try:
+        x = np.asarray(state.x, dtype=float)
+        f0 = math.exp(float(x[0]))
+        base = _fit(prob, x, state.rotation0, state.principal_point, None)
+        fun0 = np.asarray(base.fun, dtype=float)
+        cost0 = soft_l1_cost(fun0, _F_SCALE)
+        s2 = max(2.0 * cost0 / max(len(fun0) - len(x), 1), 1e-12)
+        sig_log = result.focal_sigma_px / f
+        rises = []
+        for side in (-1.0, 1.0):
+            f_held = f0 * math.exp(side * FOCAL_PROFILE_STEPS * sig_log)
+            held = _fit(prob, x[1:].copy(), state.rotation0, state.principal_point, f_held)
+            fun = np.asarray(held.fun, dtype=float)
+            if prob.log_f_prior_sigma > 0.0:  # the focal prior's row, as the free fit has it
+                prior = (math.log(f_held) - prob.log_f_prior) / prob.log_f_prior_sigma
+                fun = np.append(fun, prior)
+            rises.append(2.0 * (soft_l1_cost(fun, _F_SCALE) - cost0) / s2)
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    finally:
+        prob.weights = saved
+    rise = min(rises)
+    want = FOCAL_PROFILE_STEPS**2
+    if not math.isfinite(rise) or rise >= want:
+        return None
+    # Per side: the log-sigma that side's rise implies, as a half-width in pixels (the
+    # longer side's exp(2σ) - 1 is wider than 2σ: the stated sigma is symmetric in pixels).
+    factor = 1.0
+    for side, r in zip((-1.0, 1.0), rises, strict=True):
+        k = (
+            FOCAL_PROFILE_MAX_WIDEN
+            if r <= 0.0
+            else min(max(FOCAL_PROFILE_STEPS / math.sqrt(r), 1.0), FOCAL_PROFILE_MAX_WIDEN)
+        )
+        half = abs(math.expm1(side * FOCAL_PROFILE_STEPS * sig_log * k)) / FOCAL_PROFILE_STEPS
+        factor = max(factor, half / sig_log)
+    factor = min(factor, FOCAL_PROFILE_MAX_WIDEN)
+    if rise >= 0.0 and (not widen_flat or factor < FOCAL_PROFILE_MIN_WIDEN):
+        return None  # no better fit elsewhere; flat sides only when asked
+    msg = ""
+    if rise < 0.0:
+        longer = rises[1] < rises[0]
+        f_alt = f * math.exp((1.0 if longer else -1.0) * FOCAL_PROFILE_STEPS * sig_log)
+        msg = (
+            f"the focal length is not well determined: a fit holding it at {f_alt:.0f} px "
+            f"({'longer' if longer else 'shorter'} than the answer's {f:.0f} px) fits the "
+            "annotations better; the focal sigma is widened "
+            f"x{factor:.1f}; add lines along another direction (a kerb, a building edge)"
+        )
+    return factor, msg
 
 
 def _widen_sigmas(result: CalibrationResult, factor: float) -> None:
@@ -4075,6 +4246,7 @@ def _joint(
         sigma_pp_assumed,
         size_rel,
         car_lines.D,
+        size_shape_rel=size_sigma if settings.preset_shape else 0.0,
     )
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
@@ -4455,6 +4627,7 @@ def _output_covariance(
     sigma_pp_px: float,
     size_rel: float,
     car_lines: FloatArray | None = None,
+    size_shape_rel: float = 0.0,
 ) -> FloatArray | None:
     """Joint covariance ``(9, 9)`` of the answer, see ``CalibrationResult.parameter_covariance``.
 
@@ -4493,6 +4666,9 @@ def _output_covariance(
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
         A[block] += D @ D.T
+    D_size = _size_shape_sensitivity(prob, x, R0, pp_model, f_fixed, size_shape_rel)
+    if D_size is not None:
+        A[block] += D_size @ D_size.T
     if car_lines is not None:
         A[block] += car_lines @ car_lines.T
     if pp_model is not None and sigma_pp_px > 0.0:

@@ -285,6 +285,7 @@ def make_located_scene(
     n_landmarks: int = 0,
     landmark_kind: str = "building_corner",
     landmark_sigma_m: float = 1.0,
+    state_preset: bool = False,
 ) -> LocatedScene | None:
     """A camera near a real intersection of ``map_data`` looking at a car and kerb corners.
 
@@ -299,6 +300,12 @@ def make_located_scene(
     ``building_corner`` or ``face_midpoint`` of the map's footprint, the real one off by
     ``landmark_sigma_m``; in view, below the horizon, not hidden by a building, within 80 m)
     are listed by name; a placement without them is rejected (None when none has them).
+
+    The car is a sedan drawn ``noise.size_rel`` off the preset per dimension. By default the
+    scene states the preset's numbers (``object.length_m`` ...), which ``calibrate`` takes
+    as the car's known size (no size term in its sigmas: the scene then claims more than it
+    knows); ``state_preset`` states ``{"preset": "sedan"}`` instead, as a user who does not
+    know the car would (``benchmarks/relative.py``'s scenes do).
     """
     noise = noise or NoiseModel()
     frame = map_data.frame
@@ -457,6 +464,8 @@ def make_located_scene(
         ):
             continue
         scene = syn.scene
+        if state_preset:
+            scene["object"] = {"preset": "sedan"}
         lon, lat = frame.geographic_from_enu(float(cam_xy[0]), float(cam_xy[1]))
         clicks = corner_pix[vis] + rng.normal(0.0, noise.point_px, (len(vis), 2))
         scene["intersection"] = {"corners": np.clip(clicks, 0, [w, h]).tolist()}
