@@ -73,6 +73,15 @@ def _gpkg_path(dest: str) -> str | None:
     return path if path.lower().endswith(".gpkg") and os.path.isfile(path) else None
 
 
+def _dest_text(value: Any, context: QgsProcessingContext) -> str:
+    """An output parameter's destination as text (a path or a URI), without side effects."""
+    if isinstance(value, QgsProcessingOutputLayerDefinition):
+        value = value.sink
+    if isinstance(value, QgsProperty):
+        return str(value.valueAsString(context.expressionContext())[0] or "")
+    return str(value or "")
+
+
 def _scene_id(candidates: dict[str, Any], scene_path: str) -> str:
     """The scene's id as its candidates carry it, else the scene file's name."""
     try:
@@ -246,10 +255,11 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             value = parameters.get(param.name())
             if not isinstance(param, QgsProcessingParameterFeatureSink) or value in (None, ""):
                 continue
-            try:
-                dest = self.parameterAsOutputLayer(parameters, param.name(), context)
-            except Exception:  # QGIS reports a bad destination itself
-                continue
+            # not parameterAsOutputLayer: with a destination project it registers the output
+            # to load on completion afresh, dropping the post-processor (the style) an earlier
+            # sink of this run had set: of four outputs into named .gpkg/.shp/.geojson files,
+            # only the last came up styled in runAndLoadResults and the Toolbox dialog
+            dest = _dest_text(value, context)
             if dest and dest.lower().endswith(".gpkg") and "'" not in dest:
                 paths.setdefault(os.path.abspath(dest), []).append(param.name())
         shared = {n: p for p, names in paths.items() if len(names) > 1 for n in names}

@@ -472,3 +472,36 @@ def test_run_and_load_again_into_the_same_geopackage(provider, tmp_path):
     assert fresh.customProperty("camloc/kind") == "candidates"
     assert fresh.featureCount() == 12
     project.clear()
+
+
+_LOCATE_OUTPUTS = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION")
+
+
+@pytest.mark.parametrize("ext", ["gpkg", "shp", "geojson"])
+def test_run_and_load_into_named_files_styles_every_layer(provider, tmp_path, ext):
+    # runAndLoadResults (and the Toolbox dialog) into named files loaded only the last output
+    # styled: each sink's parameterAsOutputLayer re-registered the earlier outputs to load,
+    # dropping their post-processors: grey dots, no labels, the name without its camera
+    import processing
+    from qgis.core import QgsProject, QgsRuleBasedRenderer
+
+    project = QgsProject.instance()
+    project.clear()
+    params = {"SCENE": str(SAMPLE_SCENE), "OSM": str(SAMPLE_OSM)}
+    params.update({k: str(tmp_path / f"{k.lower()}.{ext}") for k in _LOCATE_OUTPUTS})
+    res = processing.runAndLoadResults("camloc:locate", params)
+    assert res["N_CANDIDATES"] == 12
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    loaded = {lyr.customProperty("camloc/kind"): lyr for lyr in project.mapLayers().values()}
+    assert set(loaded) == {"candidates", "view_cones", "matched_corners", "intersection"}
+    for kind, lyr in loaded.items():
+        assert lyr.source().startswith(str(tmp_path)), lyr.source()
+        assert isinstance(lyr.renderer(), QgsRuleBasedRenderer), kind
+        assert lyr.name().endswith(f"({sid})"), lyr.name()
+    cands = loaded["candidates"]
+    assert cands.featureCount() == 12
+    assert cands.labelsEnabled()
+    assert cands.renderer().rootRule().children()[0].filterExpression() == '"tie"'
+    order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
+    assert order.index("candidates") < order.index("view_cones"), order
+    project.clear()
