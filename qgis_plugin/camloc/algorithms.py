@@ -53,10 +53,13 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
         super().__init__()
         self.kind = kind
         self.title = ""
+        self.default_name = ""
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
-        if self.title:  # which camera (scene) or list the layer is of
+        # which camera (scene) or list the layer is of; only over the name QGIS gives an output
+        # by default (its description): a model's output keeps the name its author gave it
+        if self.title and layer.name() in ("", self.default_name):
             layer.setName(self.title)
         # Processing adds each output on top as it loads it: re-stack the camloc layers so
         # candidates are drawn above cones whatever the loading order
@@ -234,6 +237,7 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             of = self.__dict__.get("_layers_of", "")
             param = self.parameterDefinition(name)
             styler.title = f"{param.description()} ({of})" if of and param is not None else ""
+            styler.default_name = param.description() if param is not None else ""
             context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
         results[name] = dest
         if kind and _gpkg_path(dest):
