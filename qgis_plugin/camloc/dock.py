@@ -570,6 +570,15 @@ class CamlocDock(QDockWidget):
             self._show_guidance()
 
     def _show_guidance(self) -> None:
+        if not self.view.has_image() and self._ready_note:
+            # a complete scene loaded without its snapshot (the bundled sample names none): the
+            # guidance said "Start: open a snapshot" beside "Run when ready" and eight ticks
+            self.guidance.setText(
+                "<b>Everything needed is marked: Run</b> (at the bottom of the dock).<br>The "
+                "snapshot is not open (the scene names none, or it was not found beside the "
+                "scene): Open snapshot… to see or change the marks."
+            )
+            return
         if not self.view.has_image():
             self.guidance.setText(
                 "<b>Start:</b> open a snapshot. The steps below mark the car (its corner and "

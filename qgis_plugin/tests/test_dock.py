@@ -950,3 +950,17 @@ def test_a_second_camera_leaves_the_first_cameras_layers(dock, qgis_iface, tmp_p
     assert len(names) == 8
     assert sum(n.startswith("first_") for n in names) == 4
     assert "second_candidates" in names
+
+
+def test_a_complete_scene_without_its_snapshot_says_run_not_open_a_snapshot(dock):
+    # the bundled sample names no image: the guidance read "Start: open a snapshot" beside the
+    # status "Run when ready" and every step ticked (seen on the desktop's screenshot)
+    assert not dock.view.has_image()
+    assert dock.load_scene(str(SAMPLE_SCENE))
+    assert "Run when ready" in dock.status.text()
+    text = dock.guidance.text()
+    assert text.startswith("<b>Everything needed is marked: Run</b>")
+    assert "Start:" not in text
+    assert "snapshot is not open" in text
+    dock.set_step("corners")  # the analyst picks a step: its own guidance
+    assert dock.guidance.text().startswith("<b>Start:</b>")
