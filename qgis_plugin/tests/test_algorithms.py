@@ -505,3 +505,33 @@ def test_run_and_load_into_named_files_styles_every_layer(provider, tmp_path, ex
     order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
     assert order.index("candidates") < order.index("view_cones"), order
     project.clear()
+
+
+@pytest.mark.parametrize("size_px", [600, 800])
+def test_the_intersection_keeps_its_streets_label_among_the_others(provider, tmp_path, size_px):
+    # at the zoom the dock sets after a run (the candidates + 0.0006 degrees) the green
+    # square's 'Eastern Avenue & South Broadway' lost to the corners' labels: not drawn
+    from qgis.core import (
+        QgsCoordinateReferenceSystem,
+        QgsMapRendererSequentialJob,
+        QgsMapSettings,
+    )
+    from qgis.PyQt.QtCore import QSize
+
+    res = _locate(tmp_path)
+    layers = [
+        _layer(res[k]) for k in ("CANDIDATES", "MATCHED_CORNERS", "INTERSECTION", "VIEW_CONES")
+    ]  # each with the default style stored in its GeoPackage
+    settings = QgsMapSettings()
+    settings.setLayers(layers)
+    settings.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:4326"))
+    extent = layers[0].extent()
+    extent.grow(0.0006)
+    settings.setExtent(extent)
+    settings.setOutputSize(QSize(size_px, size_px))
+    job = QgsMapRendererSequentialJob(settings)
+    job.start()
+    job.waitForFinished()
+    texts = [lab.labelText for lab in job.takeLabelingResults().allLabels()]
+    assert "Eastern Avenue & South Broadway" in texts, texts
+    assert any(t.startswith("#1 ") for t in texts), texts
