@@ -17,6 +17,7 @@ from qgis.core import (
     QgsProcessingLayerPostProcessorInterface,
     QgsProcessingOutputLayerDefinition,
     QgsProcessingParameterBoolean,
+    QgsProcessingParameterDefinition,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
@@ -221,8 +222,17 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         parameters = self._own_gpkg_tables(parameters, context)
         sink, dest = self.parameterAsSink(parameters, name, context, fields, wkb_of(desc), wgs84())
         if sink is None:
-            if parameters.get(name) is None:
-                return 0  # optional output skipped
+            # optional output skipped: None from the dialog and qgis_process; an output
+            # definition with an empty destination from the batch dialog's empty cell (each
+            # such row failed: "Could not create destination layer for VIEW_CONES")
+            param = self.parameterDefinition(name)
+            optional = param is not None and bool(
+                param.flags() & QgsProcessingParameterDefinition.FlagOptional
+            )
+            if parameters.get(name) is None or (
+                optional and not _dest_text(parameters.get(name), context)
+            ):
+                return 0
             raise QgsProcessingException(self.invalidSinkError(parameters, name))
         n = write_to_sink(sink, desc, fields)
         del sink

@@ -40,11 +40,17 @@ def test_batch_rows_load_styled_layers_named_after_their_scene(provider, tmp_pat
         for out in ("CANDIDATES", "VIEW_CONES"):
             dest = str(tmp_path / f"row{i}_{out.lower()}.gpkg")
             params[out] = QgsProcessingOutputLayerDefinition(dest, project)
+        # the batch panel's cells left empty: an output definition with an empty destination
+        # (BatchPanel.parametersForRow); each row failed "Could not create destination layer
+        # for MATCHED_CORNERS: invalid value"
+        for out in ("MATCHED_CORNERS", "INTERSECTION", "CONTEXT_STREETS", "CONTEXT_BUILDINGS"):
+            params[out] = QgsProcessingOutputLayerDefinition("", project)
         params = alg.preprocessParameters(params)
         context = dataobjects.createContext(feedback)
         results, ok = alg.run(params, context, feedback)
         assert ok, results
         assert results["N_CANDIDATES"] == 12
+        assert "MATCHED_CORNERS" not in results
         assert handleAlgorithmResults(alg, context, feedback, False, params)
     layers = {lyr.name(): lyr for lyr in project.mapLayers().values()}
     assert sorted(layers) == sorted(
