@@ -54,13 +54,13 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
         super().__init__()
         self.kind = kind
         self.title = ""
-        self.default_name = ""
+        self.rename = True
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
-        # which camera (scene) or list the layer is of; only over the name QGIS gives an output
-        # by default (its description): a model's output keeps the name its author gave it
-        if self.title and layer.name() in ("", self.default_name):
+        # which camera (scene) or list the layer is of; not over a model's output, which keeps
+        # the name its author gave it
+        if self.title and self.rename:
             layer.setName(self.title)
         # Processing adds each output on top as it loads it: re-stack the camloc layers so
         # candidates are drawn above cones whatever the loading order
@@ -247,8 +247,12 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             of = self.__dict__.get("_layers_of", "")
             param = self.parameterDefinition(name)
             styler.title = f"{param.description()} ({of})" if of and param is not None else ""
-            styler.default_name = param.description() if param is not None else ""
-            context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
+            details = context.layerToLoadOnCompletionDetails(dest)
+            # a direct run (Toolbox, batch, runAndLoadResults) names the output after the
+            # parameter, a model after its output ('candidates'); QGIS then uses the file's
+            # name instead when "prefer output filename" is set (its default on the desktop)
+            styler.rename = param is not None and details.name in ("", param.description())
+            details.setPostProcessor(styler)
         results[name] = dest
         if kind and _gpkg_path(dest):
             self.__dict__.setdefault("_style_later", []).append((dest, kind))

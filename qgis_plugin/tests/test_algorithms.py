@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -478,18 +479,32 @@ _LOCATE_OUTPUTS = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION"
 
 
 @pytest.mark.parametrize("ext", ["gpkg", "shp", "geojson"])
-def test_run_and_load_into_named_files_styles_every_layer(provider, tmp_path, ext):
+def test_run_and_load_into_named_files_styles_every_layer(provider, artifacts, ext):
     # runAndLoadResults (and the Toolbox dialog) into named files loaded only the last output
     # styled: each sink's parameterAsOutputLayer re-registered the earlier outputs to load,
     # dropping their post-processors: grey dots, no labels, the name without its camera
     import processing
-    from qgis.core import QgsProject, QgsRuleBasedRenderer
+    from qgis.core import QgsProject, QgsRuleBasedRenderer, QgsSettings
 
     project = QgsProject.instance()
     project.clear()
     params = {"SCENE": str(SAMPLE_SCENE), "OSM": str(SAMPLE_OSM)}
+    # not under /tmp: QGIS takes a file there for a temporary layer and never names it after
+    # the file, as it does the analyst's files
+    tmp_path = artifacts / f"named_outputs_{ext}"
+    shutil.rmtree(tmp_path, ignore_errors=True)
+    tmp_path.mkdir()
     params.update({k: str(tmp_path / f"{k.lower()}.{ext}") for k in _LOCATE_OUTPUTS})
-    res = processing.runAndLoadResults("camloc:locate", params)
+    # as on the desktop, where "Prefer output filename for layer names" is on by default: the
+    # layers came up named 'candidates' (the file's name), whatever camera they were of
+    settings = QgsSettings()
+    key = "Processing/Configuration/PREFER_FILENAME_AS_LAYER_NAME"  # read by QGIS's C++
+    before = settings.value(key)
+    settings.setValue(key, True)
+    try:
+        res = processing.runAndLoadResults("camloc:locate", params)
+    finally:
+        settings.setValue(key, before) if before is not None else settings.remove(key)
     assert res["N_CANDIDATES"] == 12
     sid = json.loads(SAMPLE_SCENE.read_text())["id"]
     loaded = {lyr.customProperty("camloc/kind"): lyr for lyr in project.mapLayers().values()}
