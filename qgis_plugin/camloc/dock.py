@@ -75,14 +75,15 @@ AXIS_COLOURS = {
 PRESETS = ["sedan", "bus", "hatchback", "minivan", "pickup", "suv", "taxi_ny", "van"]
 """The library's object presets (``camloc_geo.objects.PRESETS``; the worker's probe wins)."""
 LAYER_TITLES = {
-    "candidates": "camera candidates",
-    "matched_corners": "matched map points",
-    "intersection": "intersection and kerb corners",
-    "view_cones": "view cones (leading candidates)",
-    "context_buildings": "map model: buildings",
-    "context_streets": "map model: streets",
+    "candidates": "Camera candidates",
+    "matched_corners": "Matched map points",
+    "intersection": "Intersection and kerb corners",
+    "view_cones": "View cones (leading candidates)",
+    "context_buildings": "Map model: buildings",
+    "context_streets": "Map model: streets",
 }
-"""The dock's names for its result layers."""
+"""The dock's names for its result layers, capitalised as the Processing outputs' names (the
+dock's 'camera candidates' sat beside the Toolbox's 'Camera candidates (...)')."""
 RESULTS_NAME = "camloc_results.gpkg"
 MARKER_PX = 6.0
 """Click markers' radius on screen (pixels, at any zoom)."""

@@ -978,6 +978,9 @@ def test_the_candidates_are_listed_best_first_and_a_click_shows_one(dock, qgis_i
     assert dock.wait(), dock.status.text()
     cands = dock.result_layers[0]
     assert cands.customProperty("camloc/kind") == "candidates"
+    names = [lyr.name() for lyr in dock.result_layers]
+    assert names[0] == "Camera candidates"  # as the Toolbox's outputs, not 'camera candidates'
+    assert all(n[0].isupper() for n in names), names
     rows = [dock.candidate_list.item(i).text() for i in range(dock.candidate_list.count())]
     assert dock.candidate_list.isVisible()
     assert len(rows) == cands.featureCount() == 12
