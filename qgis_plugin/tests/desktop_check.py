@@ -7,7 +7,8 @@ Not a pytest module (the suite runs headless); run it by hand under Xvfb::
         --profiles-path /tmp/camloc-profile --code qgis_plugin/tests/desktop_check.py
 
 It runs, on the bundled sample: camloc:locate from the Toolbox's code path
-(``processing.runAndLoadResults``) into named GeoPackages, the Processing batch dialog with two
+(``processing.runAndLoadResults``) into named GeoPackages, the Toolbox's algorithm dialog (a
+background task) into named shapefiles, the Processing batch dialog with two
 scenes (outputs per row, optional outputs left empty, layers loaded), and the dock (Load
 scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features) to
 ``tests/artifacts/qgis/desktop/summary.json`` and screenshots (``*.png``) beside it; QGIS exits
@@ -86,13 +87,39 @@ def step_toolbox() -> None:
     processing.runAndLoadResults("camloc:locate", params)
     summary["toolbox"] = _layers()
     _zoom_to_candidates()
-    QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_batch)()))
+    QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_dialog)()))
+
+
+def step_dialog() -> None:
+    """The Toolbox's own dialog (its run is a background task) into named shapefiles."""
+    from processing.gui.AlgorithmDialog import AlgorithmDialog
+
+    QgsProject.instance().clear()
+    alg = QgsApplication.processingRegistry().createAlgorithmById("camloc:locate")
+    dlg = AlgorithmDialog(alg, parent=iface.mainWindow())
+    state["dialog"] = dlg
+    dlg.show()
+    outs = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION")
+    params = {"SCENE": str(SCENE), "OSM": str(OSM)}
+    params.update({k: str(OUT / f"dialog_{k.lower()}.shp") for k in outs})
+    dlg.setParameters(params)
+
+    def finished(ok: bool, results: dict[str, Any]) -> None:
+        summary["dialog_shp"] = {"ok": ok, "layers": _layers()}
+        QTimer.singleShot(
+            1500, lambda: (dlg.grab().save(str(OUT / "dialog.png")), guarded(step_batch)())
+        )
+
+    dlg.algorithmFinished.connect(finished)
+    dlg.runAlgorithm()
 
 
 def step_batch() -> None:
     from processing.gui.BatchAlgorithmDialog import BatchAlgorithmDialog
     from processing.tools import dataobjects
 
+    if "dialog" in state:
+        state["dialog"].close()
     QgsProject.instance().clear()
     second = json.loads(SCENE.read_text())
     second["id"] = "second-camera"
