@@ -17,6 +17,7 @@ from qgis.core import (
     QgsProcessingLayerPostProcessorInterface,
     QgsProcessingOutputLayerDefinition,
     QgsProcessingParameterBoolean,
+    QgsProcessingParameterDefinition,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
@@ -53,10 +54,13 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
         super().__init__()
         self.kind = kind
         self.title = ""
+        self.rename = True
 
     def postProcessLayer(self, layer, context, feedback):
         apply_style(layer, self.kind)
-        if self.title:  # which camera (scene) or list the layer is of
+        # which camera (scene) or list the layer is of; not over a model's output, which keeps
+        # the name its author gave it
+        if self.title and self.rename:
             layer.setName(self.title)
         # Processing adds each output on top as it loads it: re-stack the camloc layers so
         # candidates are drawn above cones whatever the loading order
@@ -71,6 +75,15 @@ def _gpkg_path(dest: str) -> str | None:
     """The GeoPackage file of an output destination (``x.gpkg|layername=t``), else None."""
     path = str(dest).split("|")[0]
     return path if path.lower().endswith(".gpkg") and os.path.isfile(path) else None
+
+
+def _dest_text(value: Any, context: QgsProcessingContext) -> str:
+    """An output parameter's destination as text (a path or a URI), without side effects."""
+    if isinstance(value, QgsProcessingOutputLayerDefinition):
+        value = value.sink
+    if isinstance(value, QgsProperty):
+        return str(value.valueAsString(context.expressionContext())[0] or "")
+    return str(value or "")
 
 
 def _scene_id(candidates: dict[str, Any], scene_path: str) -> str:
@@ -209,8 +222,17 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
         parameters = self._own_gpkg_tables(parameters, context)
         sink, dest = self.parameterAsSink(parameters, name, context, fields, wkb_of(desc), wgs84())
         if sink is None:
-            if parameters.get(name) is None:
-                return 0  # optional output skipped
+            # optional output skipped: None from the dialog and qgis_process; an output
+            # definition with an empty destination from the batch dialog's empty cell (each
+            # such row failed: "Could not create destination layer for VIEW_CONES")
+            param = self.parameterDefinition(name)
+            optional = param is not None and bool(
+                param.flags() & QgsProcessingParameterDefinition.FlagOptional
+            )
+            if parameters.get(name) is None or (
+                optional and not _dest_text(parameters.get(name), context)
+            ):
+                return 0
             raise QgsProcessingException(self.invalidSinkError(parameters, name))
         n = write_to_sink(sink, desc, fields)
         del sink
@@ -225,7 +247,12 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             of = self.__dict__.get("_layers_of", "")
             param = self.parameterDefinition(name)
             styler.title = f"{param.description()} ({of})" if of and param is not None else ""
-            context.layerToLoadOnCompletionDetails(dest).setPostProcessor(styler)
+            details = context.layerToLoadOnCompletionDetails(dest)
+            # a direct run (Toolbox, batch, runAndLoadResults) names the output after the
+            # parameter, a model after its output ('candidates'); QGIS then uses the file's
+            # name instead when "prefer output filename" is set (its default on the desktop)
+            styler.rename = param is not None and details.name in ("", param.description())
+            details.setPostProcessor(styler)
         results[name] = dest
         if kind and _gpkg_path(dest):
             self.__dict__.setdefault("_style_later", []).append((dest, kind))
@@ -246,10 +273,11 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
             value = parameters.get(param.name())
             if not isinstance(param, QgsProcessingParameterFeatureSink) or value in (None, ""):
                 continue
-            try:
-                dest = self.parameterAsOutputLayer(parameters, param.name(), context)
-            except Exception:  # QGIS reports a bad destination itself
-                continue
+            # not parameterAsOutputLayer: with a destination project it registers the output
+            # to load on completion afresh, dropping the post-processor (the style) an earlier
+            # sink of this run had set: of four outputs into named .gpkg/.shp/.geojson files,
+            # only the last came up styled in runAndLoadResults and the Toolbox dialog
+            dest = _dest_text(value, context)
             if dest and dest.lower().endswith(".gpkg") and "'" not in dest:
                 paths.setdefault(os.path.abspath(dest), []).append(param.name())
         shared = {n: p for p, names in paths.items() if len(names) > 1 for n in names}

@@ -75,14 +75,15 @@ AXIS_COLOURS = {
 PRESETS = ["sedan", "bus", "hatchback", "minivan", "pickup", "suv", "taxi_ny", "van"]
 """The library's object presets (``camloc_geo.objects.PRESETS``; the worker's probe wins)."""
 LAYER_TITLES = {
-    "candidates": "camera candidates",
-    "matched_corners": "matched map points",
-    "intersection": "intersection and kerb corners",
-    "view_cones": "view cones (leading candidates)",
-    "context_buildings": "map model: buildings",
-    "context_streets": "map model: streets",
+    "candidates": "Camera candidates",
+    "matched_corners": "Matched map points",
+    "intersection": "Intersection and kerb corners",
+    "view_cones": "View cones (leading candidates)",
+    "context_buildings": "Map model: buildings",
+    "context_streets": "Map model: streets",
 }
-"""The dock's names for its result layers."""
+"""The dock's names for its result layers, capitalised as the Processing outputs' names (the
+dock's 'camera candidates' sat beside the Toolbox's 'Camera candidates (...)')."""
 RESULTS_NAME = "camloc_results.gpkg"
 MARKER_PX = 6.0
 """Click markers' radius on screen (pixels, at any zoom)."""
@@ -336,6 +337,51 @@ class _SceneInbox(QObject):
     received = pyqtSignal(dict)
 
 
+def _number(value: Any) -> float | None:
+    """``value`` as a float, None for NULL or text."""
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        return None
+    return out if out == out else None  # NaN is no number to show
+
+
+def candidate_line(feat: Any) -> str:
+    """One candidate as the dock lists it: ``#1  0.37  ★ tie with #2, #4 · 9.6 m up, facing
+    334° (NNW)``."""
+    score = feat["score_text"] if feat["score_text"] not in (None, "") else feat["score"]
+    line = f"#{feat['rank']}  {score}"
+    if feat["tie"] and feat["tie"] not in ("0", "false"):
+        others = [p.strip() for p in str(feat["ambiguous_with"] or "").split(",") if p.strip()]
+        line += "  ★ tie" + (" with " + ", ".join(f"#{o}" for o in others) if others else "")
+    bits = []
+    height = _number(feat["height_m"])
+    if height is not None:
+        bits.append(f"{height:.1f} m up")
+    heading = _number(feat["heading_deg"])
+    if heading is not None:
+        points = [
+            "N",
+            "NNE",
+            "NE",
+            "ENE",
+            "E",
+            "ESE",
+            "SE",
+            "SSE",
+            "S",
+            "SSW",
+            "SW",
+            "WSW",
+            "W",
+            "WNW",
+            "NW",
+            "NNW",
+        ]
+        bits.append(f"facing {heading % 360:.0f}° ({points[round(heading % 360 / 22.5) % 16]})")
+    return line + (" · " + ", ".join(bits) if bits else "")
+
+
 class CamlocDock(QDockWidget):
     """Annotate a snapshot for camloc and locate the camera."""
 
@@ -502,6 +548,21 @@ class CamlocDock(QDockWidget):
         self.status.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         self.status.setTextInteractionFlags(Qt.TextSelectableByMouse)
         foot.addWidget(self.status)
+        # the candidates of the last run, best first: the analyst read them only from map
+        # labels (the leading ones) or the attribute table; a click shows one on the map
+        self.candidate_list = QListWidget()
+        self.candidate_list.setToolTip(
+            "The last run's candidates, best first (★: a tie). Click one to select it on the "
+            "map and centre the map on it."
+        )
+        self.candidate_list.setVisible(False)
+        # five rows in sight (sizeHintForRow is -1 while the list is empty: the list came up
+        # 3 px high, a line under the status)
+        rows_px = (self.candidate_list.fontMetrics().height() + 4) * 5 + 8
+        self.candidate_list.setMinimumHeight(rows_px)
+        self.candidate_list.setMaximumHeight(rows_px)
+        self.candidate_list.currentRowChanged.connect(self.show_candidate)
+        foot.addWidget(self.candidate_list)
         scroll = QScrollArea()
         scroll.setWidgetResizable(True)
         scroll.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)  # wrap, never cut
@@ -570,6 +631,15 @@ class CamlocDock(QDockWidget):
             self._show_guidance()
 
     def _show_guidance(self) -> None:
+        if not self.view.has_image() and self._ready_note:
+            # a complete scene loaded without its snapshot (the bundled sample names none): the
+            # guidance said "Start: open a snapshot" beside "Run when ready" and eight ticks
+            self.guidance.setText(
+                "<b>Everything needed is marked: Run</b> (at the bottom of the dock).<br>The "
+                "snapshot is not open (the scene names none, or it was not found beside the "
+                "scene): Open snapshot… to see or change the marks."
+            )
+            return
         if not self.view.has_image():
             self.guidance.setText(
                 "<b>Start:</b> open a snapshot. The steps below mark the car (its corner and "
@@ -988,6 +1058,7 @@ class CamlocDock(QDockWidget):
                 self.set_status(problem)
                 return None
         prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id) or "scene"
+        self._fill_candidates(None)
         self._restore = None
         if self._result_key == (os.path.abspath(gpkg), prefix):
             # their GeoPackage tables are about to be replaced; put back if the run fails
@@ -1129,6 +1200,7 @@ class CamlocDock(QDockWidget):
             msg = f"No candidate: {task.info['reason']}"
         self.set_status(msg)
         self.status.setToolTip(task.gpkg)
+        self._fill_candidates(cands)
         if self.iface is not None and cands is not None and n:
             canvas = self.iface.mapCanvas()
             project = QgsProject.instance()
@@ -1141,6 +1213,39 @@ class CamlocDock(QDockWidget):
             # the first layers of an empty project make QGIS zoom to their full extent once
             # the event loop runs: zoom again after that
             QTimer.singleShot(0, lambda: (canvas.setExtent(ext), canvas.refresh()))
+
+    def _fill_candidates(self, cands: QgsVectorLayer | None) -> None:
+        """List ``cands`` best first (None: empty and hidden)."""
+        self.candidate_list.blockSignals(True)
+        self.candidate_list.clear()
+        self._candidate_fids: list[int] = []
+        feats = sorted(cands.getFeatures(), key=lambda f: f["rank"]) if cands is not None else []
+        for f in feats:
+            self.candidate_list.addItem(candidate_line(f))
+            self._candidate_fids.append(f.id())
+        self._candidate_layer = cands
+        self.candidate_list.setCurrentRow(-1)
+        self.candidate_list.blockSignals(False)
+        self.candidate_list.setVisible(bool(feats))
+
+    def show_candidate(self, row: int) -> None:
+        """Select the candidate of list row ``row`` on its layer and centre the map on it."""
+        layer = getattr(self, "_candidate_layer", None)
+        if layer is None or not 0 <= row < len(self._candidate_fids):
+            return
+        try:
+            feat = layer.getFeature(self._candidate_fids[row])
+            layer.selectByIds([feat.id()])
+        except RuntimeError:  # the layer was removed with its project
+            return
+        if self.iface is None or not feat.hasGeometry():
+            return
+        canvas = self.iface.mapCanvas()
+        xform = QgsCoordinateTransform(
+            layer.crs(), canvas.mapSettings().destinationCrs(), QgsProject.instance()
+        )
+        canvas.setCenter(xform.transform(feat.geometry().asPoint()))
+        canvas.refresh()
 
     def wait(self, timeout_s: float = 120.0) -> bool:
         """Process events until the run (and the page task) ends; True if it did in time."""

@@ -306,6 +306,18 @@ def style_corners(layer: QgsVectorLayer) -> None:
         'CASE WHEN "kind" = \'corner\' THEN \'corner \' || "order" ELSE "streets" END',
         priority=3,
     )
+    # the intersection's streets win over every other label: at the zoom the dock sets after a
+    # run its long label lost to the kerb corners' and matched points' and was not drawn (seen
+    # on the desktop's screenshot; the green square unnamed)
+    labeling = layer.labeling()
+    pal = QgsPalLayerSettings(labeling.settings())
+    props = pal.dataDefinedProperties()
+    props.setProperty(
+        QgsPalLayerSettings.Priority,
+        QgsProperty.fromExpression("CASE WHEN \"kind\" = 'intersection' THEN 10 ELSE 3 END"),
+    )
+    pal.setDataDefinedProperties(props)
+    layer.setLabeling(QgsVectorLayerSimpleLabeling(pal))
     layer.triggerRepaint()
 
 

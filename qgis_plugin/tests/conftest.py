@@ -59,3 +59,74 @@ def provider(qgis_processing):
     yield prov
     if added is not None and reg.providerById("camloc") is not None:
         reg.removeProvider(reg.providerById("camloc"))
+
+
+def chain_model():
+    """A model as the designer builds it: camloc:locate's candidates feed camloc:corners (its
+    extent) and native:extractbyattribute (rank = 1); outputs ``locate:candidates``,
+    ``corners:corners``, ``best:best``; inputs ``scene`` and ``osm``."""
+    from qgis.core import (
+        QgsProcessingModelAlgorithm,
+        QgsProcessingModelChildAlgorithm,
+        QgsProcessingModelChildParameterSource,
+        QgsProcessingModelOutput,
+        QgsProcessingModelParameter,
+        QgsProcessingParameterFile,
+    )
+
+    src = QgsProcessingModelChildParameterSource
+    model = QgsProcessingModelAlgorithm("camloc chain", "camloc tests")
+    for name in ("scene", "osm"):
+        model.addModelParameter(
+            QgsProcessingParameterFile(name, name), QgsProcessingModelParameter(name)
+        )
+
+    def child(alg_id, child_id, sources, output, model_output):
+        c = QgsProcessingModelChildAlgorithm(alg_id)
+        c.setChildId(child_id)
+        for param, source in sources.items():
+            c.addParameterSources(param, [source])
+        out = QgsProcessingModelOutput(model_output, model_output)
+        out.setChildId(child_id)
+        out.setChildOutputName(output)
+        c.setModelOutputs({model_output: out})
+        model.addChildAlgorithm(c)
+
+    child(
+        "camloc:locate",
+        "locate",
+        {
+            "SCENE": src.fromModelParameter("scene"),
+            "OSM": src.fromModelParameter("osm"),
+            "NETWORK": src.fromStaticValue(False),
+            "CONTEXT": src.fromStaticValue(False),
+        },
+        "CANDIDATES",
+        "candidates",
+    )
+    child(
+        "camloc:corners",
+        "corners",
+        {
+            "EXTENT": src.fromChildOutput("locate", "CANDIDATES"),
+            "OSM": src.fromModelParameter("osm"),
+            "RADIUS_M": src.fromStaticValue(150.0),
+            "NETWORK": src.fromStaticValue(False),
+        },
+        "CORNERS",
+        "corners",
+    )
+    child(
+        "native:extractbyattribute",
+        "best",
+        {
+            "INPUT": src.fromChildOutput("locate", "CANDIDATES"),
+            "FIELD": src.fromStaticValue("rank"),
+            "OPERATOR": src.fromStaticValue(0),
+            "VALUE": src.fromStaticValue("1"),
+        },
+        "OUTPUT",
+        "best",
+    )
+    model.updateDestinationParameters()
+    return model

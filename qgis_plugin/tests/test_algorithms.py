@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -472,3 +473,80 @@ def test_run_and_load_again_into_the_same_geopackage(provider, tmp_path):
     assert fresh.customProperty("camloc/kind") == "candidates"
     assert fresh.featureCount() == 12
     project.clear()
+
+
+_LOCATE_OUTPUTS = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION")
+
+
+@pytest.mark.parametrize("ext", ["gpkg", "shp", "geojson"])
+def test_run_and_load_into_named_files_styles_every_layer(provider, artifacts, ext):
+    # runAndLoadResults (and the Toolbox dialog) into named files loaded only the last output
+    # styled: each sink's parameterAsOutputLayer re-registered the earlier outputs to load,
+    # dropping their post-processors: grey dots, no labels, the name without its camera
+    import processing
+    from qgis.core import QgsProject, QgsRuleBasedRenderer, QgsSettings
+
+    project = QgsProject.instance()
+    project.clear()
+    params = {"SCENE": str(SAMPLE_SCENE), "OSM": str(SAMPLE_OSM)}
+    # not under /tmp: QGIS takes a file there for a temporary layer and never names it after
+    # the file, as it does the analyst's files
+    tmp_path = artifacts / f"named_outputs_{ext}"
+    shutil.rmtree(tmp_path, ignore_errors=True)
+    tmp_path.mkdir()
+    params.update({k: str(tmp_path / f"{k.lower()}.{ext}") for k in _LOCATE_OUTPUTS})
+    # as on the desktop, where "Prefer output filename for layer names" is on by default: the
+    # layers came up named 'candidates' (the file's name), whatever camera they were of
+    settings = QgsSettings()
+    key = "Processing/Configuration/PREFER_FILENAME_AS_LAYER_NAME"  # read by QGIS's C++
+    before = settings.value(key)
+    settings.setValue(key, True)
+    try:
+        res = processing.runAndLoadResults("camloc:locate", params)
+    finally:
+        settings.setValue(key, before) if before is not None else settings.remove(key)
+    assert res["N_CANDIDATES"] == 12
+    sid = json.loads(SAMPLE_SCENE.read_text())["id"]
+    loaded = {lyr.customProperty("camloc/kind"): lyr for lyr in project.mapLayers().values()}
+    assert set(loaded) == {"candidates", "view_cones", "matched_corners", "intersection"}
+    for kind, lyr in loaded.items():
+        assert lyr.source().startswith(str(tmp_path)), lyr.source()
+        assert isinstance(lyr.renderer(), QgsRuleBasedRenderer), kind
+        assert lyr.name().endswith(f"({sid})"), lyr.name()
+    cands = loaded["candidates"]
+    assert cands.featureCount() == 12
+    assert cands.labelsEnabled()
+    assert cands.renderer().rootRule().children()[0].filterExpression() == '"tie"'
+    order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]
+    assert order.index("candidates") < order.index("view_cones"), order
+    project.clear()
+
+
+@pytest.mark.parametrize("size_px", [600, 800])
+def test_the_intersection_keeps_its_streets_label_among_the_others(provider, tmp_path, size_px):
+    # at the zoom the dock sets after a run (the candidates + 0.0006 degrees) the green
+    # square's 'Eastern Avenue & South Broadway' lost to the corners' labels: not drawn
+    from qgis.core import (
+        QgsCoordinateReferenceSystem,
+        QgsMapRendererSequentialJob,
+        QgsMapSettings,
+    )
+    from qgis.PyQt.QtCore import QSize
+
+    res = _locate(tmp_path)
+    layers = [
+        _layer(res[k]) for k in ("CANDIDATES", "MATCHED_CORNERS", "INTERSECTION", "VIEW_CONES")
+    ]  # each with the default style stored in its GeoPackage
+    settings = QgsMapSettings()
+    settings.setLayers(layers)
+    settings.setDestinationCrs(QgsCoordinateReferenceSystem("EPSG:4326"))
+    extent = layers[0].extent()
+    extent.grow(0.0006)
+    settings.setExtent(extent)
+    settings.setOutputSize(QSize(size_px, size_px))
+    job = QgsMapRendererSequentialJob(settings)
+    job.start()
+    job.waitForFinished()
+    texts = [lab.labelText for lab in job.takeLabelingResults().allLabels()]
+    assert "Eastern Avenue & South Broadway" in texts, texts
+    assert any(t.startswith("#1 ") for t in texts), texts

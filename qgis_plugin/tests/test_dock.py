@@ -950,3 +950,62 @@ def test_a_second_camera_leaves_the_first_cameras_layers(dock, qgis_iface, tmp_p
     assert len(names) == 8
     assert sum(n.startswith("first_") for n in names) == 4
     assert "second_candidates" in names
+
+
+def test_a_complete_scene_without_its_snapshot_says_run_not_open_a_snapshot(dock):
+    # the bundled sample names no image: the guidance read "Start: open a snapshot" beside the
+    # status "Run when ready" and every step ticked (seen on the desktop's screenshot)
+    assert not dock.view.has_image()
+    assert dock.load_scene(str(SAMPLE_SCENE))
+    assert "Run when ready" in dock.status.text()
+    text = dock.guidance.text()
+    assert text.startswith("<b>Everything needed is marked: Run</b>")
+    assert "Start:" not in text
+    assert "snapshot is not open" in text
+    dock.set_step("corners")  # the analyst picks a step: its own guidance
+    assert dock.guidance.text().startswith("<b>Start:</b>")
+
+
+def test_the_candidates_are_listed_best_first_and_a_click_shows_one(dock, qgis_iface, tmp_path):
+    # after a run the dock said only "12 candidate(s) in ...": the analyst read the candidates
+    # from the map's labels (the leading ones) or the attribute table
+    assert not dock.candidate_list.isVisible()
+    assert dock.load_scene(str(SAMPLE_SCENE))
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "results.gpkg"))
+    assert dock.run() is not None
+    assert not dock.candidate_list.isVisible()  # emptied while the run goes on
+    assert dock.wait(), dock.status.text()
+    cands = dock.result_layers[0]
+    assert cands.customProperty("camloc/kind") == "candidates"
+    names = [lyr.name() for lyr in dock.result_layers]
+    assert names[0] == "Camera candidates"  # as the Toolbox's outputs, not 'camera candidates'
+    assert all(n[0].isupper() for n in names), names
+    rows = [dock.candidate_list.item(i).text() for i in range(dock.candidate_list.count())]
+    assert dock.candidate_list.isVisible()
+    assert len(rows) == cands.featureCount() == 12
+    QApplication.processEvents()
+    shown = dock.candidate_list.visibleRegion().boundingRect().height()
+    assert shown >= 4 * dock.candidate_list.sizeHintForRow(0), shown  # it came up 3 px high
+    assert [int(r.split()[0][1:]) for r in rows] == list(range(1, 13))
+    by_rank = {f["rank"]: f for f in cands.getFeatures()}
+    first = by_rank[1]
+    others = ", ".join(f"#{o.strip()}" for o in first["ambiguous_with"].split(","))
+    assert rows[0].startswith(f"#1  {first['score_text']}  ★ tie with {others} · ")
+    assert f"{first['height_m']:.1f} m up" in rows[0]
+    assert f"facing {first['heading_deg'] % 360:.0f}°" in rows[0]
+    untied = [r for r, k in zip(rows, sorted(by_rank), strict=True) if not by_rank[k]["tie"]]
+    assert untied
+    assert all("★" not in r for r in untied)
+    dock.candidate_list.setCurrentRow(2)  # the analyst clicks #3
+    third = by_rank[3]
+    assert cands.selectedFeatureIds() == [third.id()]
+    centre = qgis_iface.mapCanvas().center()
+    point = third.geometry().asPoint()
+    from qgis.core import QgsCoordinateTransform
+
+    canvas_crs = qgis_iface.mapCanvas().mapSettings().destinationCrs()
+    want = QgsCoordinateTransform(cands.crs(), canvas_crs, QgsProject.instance()).transform(point)
+    tol = 1e-6 if canvas_crs.isGeographic() else 0.1
+    assert abs(centre.x() - want.x()) < tol
+    assert abs(centre.y() - want.y()) < tol

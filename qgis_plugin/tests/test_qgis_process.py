@@ -193,3 +193,43 @@ def test_qgis_process_reads_relative_paths_from_the_shell_folder(profile_home, t
     assert cand_ds.GetLayer(0).GetFeatureCount() == 12
     cams_ds = ogr.Open(str(tmp_path / "cams.gpkg"))
     assert [f.GetField("status") for f in cams_ds.GetLayer(0)] == ["title_only"]
+
+
+def test_qgis_process_runs_a_model_chaining_camloc_algorithms(profile_home, provider, tmp_path):
+    # the designer's use: locate's candidates feed corners (their extent) and a native filter
+    from conftest import chain_model
+
+    model = tmp_path / "chain.model3"
+    assert chain_model().toFile(str(model))
+    r = subprocess.run(
+        [
+            QGIS_PROCESS,
+            "run",
+            str(model),
+            f"--scene={SAMPLE_SCENE}",
+            f"--osm={SAMPLE_OSM}",
+            f"--locate:candidates={tmp_path / 'c.gpkg'}",
+            f"--corners:corners={tmp_path / 'k.gpkg'}",
+            f"--best:best={tmp_path / 'b.gpkg'}",
+        ],
+        capture_output=True,
+        text=True,
+        env=_env(profile_home),
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "Executed 3 algorithms" in r.stdout
+    from osgeo import ogr
+
+    def rows(name):
+        ds = ogr.Open(str(tmp_path / name))
+        return [f.items() for f in ds.GetLayer(0)], ds
+
+    cands, ds = rows("c.gpkg")
+    assert len(cands) == 12
+    assert ds.GetLayerByName("layer_styles").GetFeatureCount() == 1  # camloc's default style
+    best, _ = rows("b.gpkg")
+    first = next(c for c in cands if c["rank"] == 1)
+    assert [(b["rank"], b["lat"], b["lon"]) for b in best] == [(1, first["lat"], first["lon"])]
+    corners, _ = rows("k.gpkg")
+    assert [c["kind"] for c in corners].count("intersection") >= 1

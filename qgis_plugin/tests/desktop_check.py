@@ -1,0 +1,207 @@
+"""The QGIS desktop, driven as an analyst would, with screenshots: a script for ``qgis --code``.
+
+Not a pytest module (the suite runs headless); run it by hand under Xvfb::
+
+    CAMLOC_PYTHON=$PWD/.venv-qgis/bin/python PYTHONPATH=$PWD \\
+    xvfb-run -a -s "-screen 0 1400x900x24" qgis --nologo --noversioncheck \\
+        --profiles-path /tmp/camloc-profile --code qgis_plugin/tests/desktop_check.py
+
+It runs, on the bundled sample: camloc:locate from the Toolbox's code path
+(``processing.runAndLoadResults``) into named GeoPackages, the Toolbox's algorithm dialog (a
+background task) into named shapefiles, the Processing batch dialog with two
+scenes (outputs per row, optional outputs left empty, layers loaded), and the dock (Load
+scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features) to
+``tests/artifacts/qgis/desktop/summary.json`` and screenshots (``*.png``) beside it; QGIS exits
+with the project cleared first (``QgsApplication.exit()`` with layers still loaded crashed QGIS
+3.22 in its own teardown: ``QgisApp::setMapStyleDockLayer`` on a destroyed widget).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Any
+
+from qgis.core import QgsApplication, QgsProject
+from qgis.PyQt.QtCore import QTimer
+from qgis.utils import iface
+
+REPO = Path(os.environ.get("CAMLOC_REPO", Path.cwd()))
+SCENE = REPO / "sample_maps" / "sample_scene.json"
+OSM = REPO / "sample_maps" / "baltimore.osm.pbf"
+OUT = REPO / "tests" / "artifacts" / "qgis" / "desktop"
+OUT.mkdir(parents=True, exist_ok=True)
+sys.path.insert(0, str(REPO / "qgis_plugin"))
+summary: dict[str, Any] = {}
+state: dict[str, Any] = {}
+
+
+def _layers() -> list[dict[str, Any]]:
+    out = []
+    for node in QgsProject.instance().layerTreeRoot().findLayers():
+        lyr = node.layer()
+        out.append(
+            {
+                "name": lyr.name(),
+                "renderer": type(lyr.renderer()).__name__,
+                "kind": lyr.customProperty("camloc/kind"),
+                "features": lyr.featureCount(),
+                "labels": lyr.labelsEnabled(),
+            }
+        )
+    return out
+
+
+def _shot(name: str) -> None:
+    iface.mapCanvas().saveAsImage(str(OUT / f"{name}_canvas.png"))
+    iface.mainWindow().grab().save(str(OUT / f"{name}_window.png"))
+
+
+def _zoom_to_candidates() -> None:
+    for lyr in QgsProject.instance().mapLayers().values():
+        if lyr.customProperty("camloc/kind") == "candidates":
+            ext = lyr.extent()
+            ext.grow(0.0006)
+            iface.mapCanvas().setExtent(ext)
+            iface.mapCanvas().refresh()
+            return
+
+
+def step_toolbox() -> None:
+    import processing
+    from processing.core.Processing import Processing
+
+    Processing.initialize()
+    import camloc
+
+    plugin = camloc.classFactory(iface)
+    plugin.initProcessing()
+    plugin.initGui()
+    state["plugin"] = plugin
+    outs = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION")
+    params = {"SCENE": str(SCENE), "OSM": str(OSM)}
+    params.update({k: str(OUT / f"toolbox_{k.lower()}.gpkg") for k in outs})
+    processing.runAndLoadResults("camloc:locate", params)
+    summary["toolbox"] = _layers()
+    _zoom_to_candidates()
+    QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_dialog)()))
+
+
+def step_dialog() -> None:
+    """The Toolbox's own dialog (its run is a background task) into named shapefiles."""
+    from processing.gui.AlgorithmDialog import AlgorithmDialog
+
+    QgsProject.instance().clear()
+    alg = QgsApplication.processingRegistry().createAlgorithmById("camloc:locate")
+    dlg = AlgorithmDialog(alg, parent=iface.mainWindow())
+    state["dialog"] = dlg
+    dlg.show()
+    outs = ("CANDIDATES", "VIEW_CONES", "MATCHED_CORNERS", "INTERSECTION")
+    params = {"SCENE": str(SCENE), "OSM": str(OSM)}
+    params.update({k: str(OUT / f"dialog_{k.lower()}.shp") for k in outs})
+    dlg.setParameters(params)
+
+    def finished(ok: bool, results: dict[str, Any]) -> None:
+        summary["dialog_shp"] = {"ok": ok, "layers": _layers()}
+        QTimer.singleShot(
+            1500, lambda: (dlg.grab().save(str(OUT / "dialog.png")), guarded(step_batch)())
+        )
+
+    dlg.algorithmFinished.connect(finished)
+    dlg.runAlgorithm()
+
+
+def step_batch() -> None:
+    from processing.gui.BatchAlgorithmDialog import BatchAlgorithmDialog
+    from processing.tools import dataobjects
+
+    if "dialog" in state:
+        state["dialog"].close()
+    QgsProject.instance().clear()
+    second = json.loads(SCENE.read_text())
+    second["id"] = "second-camera"
+    (OUT / "second-camera.json").write_text(json.dumps(second))
+    alg = QgsApplication.processingRegistry().createAlgorithmById("camloc:locate")
+    dlg = BatchAlgorithmDialog(alg, parent=iface.mainWindow())
+    state["batch"] = dlg
+    dlg.resize(1300, 500)
+    dlg.show()
+    panel = dlg.mainWidget()
+    scenes = [SCENE, OUT / "second-camera.json"]
+    while panel.batchRowCount() < len(scenes):
+        panel.addRow()
+    context = dataobjects.createContext()
+    col = panel.parameter_to_column
+    for row, scene in enumerate(scenes):
+        panel.wrappers[row][col["SCENE"]].setParameterValue(str(scene), context)
+        panel.wrappers[row][col["OSM"]].setParameterValue(str(OSM), context)
+        for out in ("CANDIDATES", "VIEW_CONES"):  # the other outputs left empty
+            cell = panel.tblParameters.cellWidget(row + 1, col[out])
+            cell.setValue(str(OUT / f"batch_row{row}_{out.lower()}.gpkg"))
+    panel.checkLoadLayersOnCompletion.setChecked(True)
+    dlg.runAlgorithm()
+    summary["batch"] = _layers()
+    _zoom_to_candidates()
+    QTimer.singleShot(
+        1500, lambda: (dlg.grab().save(str(OUT / "batch_dialog.png")), guarded(step_dock)())
+    )
+
+
+def step_dock() -> None:
+    state["batch"].close()
+    QgsProject.instance().clear()
+    plugin = state["plugin"]
+    plugin.action.setChecked(True)
+    dock = plugin.dock
+    dock.load_scene(str(SCENE))
+    dock.osm_edit.setText(str(OSM))
+    dock.gpkg_edit.setText(str(OUT / "dock_results.gpkg"))
+    dock.run()
+
+    def poll(n: list[int] = [0]) -> None:  # noqa: B006 - a counter kept between calls
+        n[0] += 1
+        if (dock.task is not None or dock._loading) and n[0] < 240:
+            QTimer.singleShot(500, poll)
+            return
+        QTimer.singleShot(2500, guarded(finish))
+
+    QTimer.singleShot(500, poll)
+
+
+def finish() -> None:
+    dock = state["plugin"].dock
+    summary["dock"] = {
+        "status": dock.status.text(),
+        "guidance": dock.guidance.text(),
+        "candidates": [
+            dock.candidate_list.item(i).text() for i in range(dock.candidate_list.count())
+        ],
+        "layers": _layers(),
+    }
+    _shot("dock")
+    dock.grab().save(str(OUT / "dock.png"))
+    iface.layerTreeView().grab().save(str(OUT / "dock_legend.png"))
+    done()
+
+
+def done() -> None:
+    (OUT / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False))
+    QgsProject.instance().clear()  # before exit: see the module's docstring
+    QTimer.singleShot(300, QgsApplication.exit)
+
+
+def guarded(step: Any) -> Any:
+    def run() -> None:
+        try:
+            step()
+        except Exception:
+            summary["error"] = traceback.format_exc()
+            done()
+
+    return run
+
+
+QTimer.singleShot(500, guarded(step_toolbox))
