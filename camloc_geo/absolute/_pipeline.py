@@ -47,7 +47,12 @@ from camloc_geo.absolute._model import (
     Match,
     Tie,
 )
-from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine_many
+from camloc_geo.absolute._refine import (
+    calibration_sigmas_m,
+    position_sigma_m,
+    position_sigmas_m,
+    refine_many,
+)
 from camloc_geo.absolute._scoring import (
     car_bearing_deg,
     plausibility_at,
@@ -1175,13 +1180,40 @@ def bundle_leaders(
     camera and ``sigma_m`` become the bundle's (:mod:`camloc_geo.absolute._bundle`). The
     leaders are fitted together (each its own fit, evaluated in one batch per step).
     """
-    if not settings.bundle_adjust:
-        return cands
     top = cands[: settings.refine_top]
     evs = [c.evidence or ev for c in top]
-    adjusted = bundle_adjust_many(top, calibration, evs, settings, result.image_size)
-    _place([a for a, c in zip(adjusted, top, strict=True) if a is not c], result)
+    if settings.bundle_adjust:
+        adjusted = bundle_adjust_many(top, calibration, evs, settings, result.image_size)
+        _place([a for a, c in zip(adjusted, top, strict=True) if a is not c], result)
+    else:
+        adjusted = list(top)
+    held = [k for k, (a, c) in enumerate(zip(adjusted, top, strict=True)) if a is c]
+    _add_calibration_sigma(
+        [adjusted[k] for k in held], calibration, [evs[k] for k in held], settings
+    )
     return adjusted + cands[settings.refine_top :]
+
+
+def _add_calibration_sigma(
+    cands: list[Candidate],
+    calibration: CalibrationResult,
+    evs: list[Evidence],
+    settings: LocateSettings,
+) -> None:
+    """The calibration's own uncertainty added to the ``sigma_m`` of refined candidates that
+    kept the calibrated camera (not re-fitted by the bundle), in place: the refinement's
+    sigma carries the clicks and the map only (:func:`~camloc_geo.absolute._refine.
+    calibration_sigmas_m`). The two add in quadrature."""
+    todo = [k for k, c in enumerate(cands) if c.refined and c.sigma_m is not None]
+    if not todo:
+        return
+    extra = calibration_sigmas_m(
+        [cands[k] for k in todo], calibration, [evs[k] for k in todo], settings
+    )
+    for k, sig_cal in zip(todo, extra, strict=True):
+        sig = cands[k].sigma_m
+        if sig_cal is not None and sig is not None and math.isfinite(sig_cal):
+            cands[k].sigma_m = math.hypot(sig, sig_cal)
 
 
 def apply_cues(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -19,7 +20,10 @@ from camloc_geo.absolute._scoring import (
     street_angle_under_car,
 )
 from camloc_geo.absolute._similarity import Similarity2D
-from camloc_geo.camera import Camera
+from camloc_geo.camera import Camera, rotation_from_rotvec
+
+if TYPE_CHECKING:
+    from camloc_geo.relative import CalibrationResult
 
 FloatArray = npt.NDArray[np.float64]
 ResidualJacobian = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
@@ -307,4 +311,141 @@ def refine_many(
             sigma_m=sigma,
             refined=True,
         )
+    return out
+
+
+CALIBRATION_PARAMETERS = (0, 1, 2, 3, 4, 5, 8)
+"""The rows of ``CalibrationResult.parameter_covariance`` that move a placement: focal length,
+principal point x, y, the rotation about the camera's three axes and the centre's height.
+The centre's x and y carry the camera and every ground point it casts together, so the
+similarity to the map absorbs them."""
+
+
+def calibration_covariance(cal: CalibrationResult) -> FloatArray | None:
+    """The calibration's covariance ``(7, 7)`` over :data:`CALIBRATION_PARAMETERS`, each
+    marginal widened to the stated sigma where that is larger, None when it states none.
+
+    ``parameter_covariance`` is the fit's alone (before the annotators' jackknife); the stated
+    ``focal_sigma_px``, ``rotation_sigma_deg`` and ``position_sigma_m`` include the jackknife.
+    Each row and column is scaled by ``max(1, stated / fitted)``: the marginals become the
+    stated sigmas and the fit's correlations are kept. Without a joint covariance, the stated
+    sigmas alone (uncorrelated).
+    """
+    stated = np.zeros(7)
+    if cal.focal_sigma_px is not None:
+        stated[0] = float(cal.focal_sigma_px)
+    if cal.principal_point_sigma_px is not None:
+        stated[1:3] = np.asarray(cal.principal_point_sigma_px, dtype=float)[:2]
+    if cal.rotation_sigma_deg is not None:
+        stated[3:6] = np.radians(np.asarray(cal.rotation_sigma_deg, dtype=float)[:3])
+    if cal.position_sigma_m is not None:
+        stated[6] = float(np.asarray(cal.position_sigma_m, dtype=float)[2])
+    stated = np.where(np.isfinite(stated), stated, 0.0)
+    cov_full = cal.parameter_covariance
+    if cov_full is None or np.shape(cov_full) != (9, 9) or not np.all(np.isfinite(cov_full)):
+        cov = np.diag(stated**2)
+    else:
+        idx = np.array(CALIBRATION_PARAMETERS)
+        cov = np.asarray(cov_full, dtype=float)[np.ix_(idx, idx)]
+        fitted = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        widen = np.where(fitted > 0.0, np.maximum(1.0, stated / np.where(fitted > 0, fitted, 1)), 0)
+        cov = widen[:, None] * cov * widen[None, :]
+        # a stated sigma where the fit has none (a held parameter): uncorrelated
+        held = fitted <= 0.0
+        cov[held, held] = stated[held] ** 2
+    if not np.any(cov):
+        return None
+    return np.asarray(0.5 * (cov + cov.T), dtype=np.float64)
+
+
+def _perturbed_cameras(cam: Camera, cov: FloatArray) -> list[tuple[Camera, Camera]]:
+    """The calibration's sigma points: the camera moved by ``±`` each column of a square root
+    of ``cov`` (:data:`CALIBRATION_PARAMETERS`), as (plus, minus) pairs; a pair with a
+    non-physical camera (focal length or height not positive) is left out."""
+    lam, vec = np.linalg.eigh(cov)
+    R0 = np.asarray(cam.cam_from_world_rotation, dtype=float)
+    C0 = np.asarray(cam.center_in_world, dtype=float)
+    pp0 = np.asarray(cam.principal_point, dtype=float)
+    out = []
+    for k in range(len(lam)):
+        if lam[k] <= 0.0:
+            continue
+        step = math.sqrt(float(lam[k])) * vec[:, k]
+        pair = []
+        for sign in (1.0, -1.0):
+            d = sign * step
+            f = float(cam.focal_px) + float(d[0])
+            C = C0 + np.array([0.0, 0.0, float(d[6])])
+            if f <= 0.0 or C[2] <= 0.0:
+                break
+            R = rotation_from_rotvec(d[3:6]) @ R0
+            pp = (float(pp0[0] + d[1]), float(pp0[1] + d[2]))
+            pair.append(Camera(f, pp, R, -R @ C, distortion=cam.distortion))
+        if len(pair) == 2:
+            out.append((pair[0], pair[1]))
+    return out
+
+
+def calibration_sigmas_m(
+    cands: Sequence[Candidate],
+    cal: CalibrationResult,
+    evs: Sequence[Evidence],
+    settings: LocateSettings,
+) -> list[float | None]:
+    """How far each candidate's camera moves with the calibration (1-sigma, metres).
+
+    The refinement fits ``enu_from_world`` with the calibrated camera held: its sigma
+    (:func:`refine`) carries the clicks' and the map's noise, not the calibration's. With
+    two references the camera is fixed by the two pixels and the calibration's rays, so a
+    focal length 30 % off moves it by tens of metres while the fit stays exact. Here the
+    calibration's covariance (:func:`calibration_covariance`) is carried through the same
+    fit by its sigma points (the unscented transform without a centre term: each of the
+    seven directions ``±`` one square-root column): the matched pixels are cast again through
+    each moved camera, the similarity fitted again from the candidate's, and the camera's
+    position compared with the unmoved camera's. A sigma point that casts a matched pixel
+    above the horizon counts as the farthest of the others, doubled.
+
+    Returns the 1-sigma (root of the trace of the position covariance) per candidate, None
+    where it cannot be computed (no match, no calibration covariance).
+    """
+    out: list[float | None] = [None] * len(cands)
+    cov = calibration_covariance(cal)
+    if cov is None:
+        return out
+    cam0 = cal.camera
+    pairs = _perturbed_cameras(cam0, cov)
+    if not pairs:
+        return out
+    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        obs_q = _matched_points(cand, ev)
+        if not obs_q:
+            continue
+        street_brg = _street_bearing_prior(cand, ev, settings)
+        pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
+        x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
+
+        def placed(cam: Camera) -> FloatArray | None:
+            ground = cam.ground_from_pixels(pixels)[:, :2]  # noqa: B023
+            if not np.all(np.isfinite(ground)):
+                return None
+            moved = [(replace(o, world_xy=g), q) for (o, q), g in zip(obs_q, ground, strict=True)]  # noqa: B023
+            rj = _residuals(moved, cand.enu_from_world, settings, street_brg)  # noqa: B023
+            x, _J = gauss_newton(rj, x0, max_iter=4, sigma_tol=_SIGMA_TOL)  # noqa: B023
+            if not np.all(np.isfinite(x)):
+                return None
+            sim = Similarity2D(float(x[0]), np.array([x[1], x[2]]), math.exp(float(x[3])))
+            return np.asarray(sim.apply(cam.center_in_world[:2]), dtype=np.float64)
+
+        p0 = placed(cam0)
+        if p0 is None:
+            continue
+        moves: list[FloatArray | None] = []
+        for plus, minus in pairs:
+            for cam in (plus, minus):
+                p = placed(cam)
+                moves.append(None if p is None else p - p0)
+        known = [float(d @ d) for d in moves if d is not None]
+        far = 4.0 * max(known) if known else 0.0
+        var = 0.5 * sum(far if d is None else float(d @ d) for d in moves)
+        out[k] = math.sqrt(var)
     return out
