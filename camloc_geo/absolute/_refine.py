@@ -20,7 +20,7 @@ from camloc_geo.absolute._scoring import (
     street_angle_under_car,
 )
 from camloc_geo.absolute._similarity import Similarity2D
-from camloc_geo.camera import Camera, rotation_from_rotvec
+from camloc_geo.camera import Camera, rotation_from_rotvec, undistort_points_px
 
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult
@@ -182,6 +182,15 @@ def _normal_matrix_at_start(
     Jacobian in (θ, tx, ty, ln s), ``Λ_k`` its precision) plus the scale prior's and the
     bearing prior's rows; the refinement's whitened ``J`` gives the same matrix up to
     rounding (``Λ = L Lᵀ``), without its Cholesky factors and closure."""
+    parts = _normal_parts(cand, ev, settings)
+    return None if parts is None else parts[3]
+
+
+def _normal_parts(
+    cand: Candidate, ev: Evidence, settings: LocateSettings
+) -> tuple[list[tuple[Observation, FloatArray]], FloatArray, FloatArray, FloatArray] | None:
+    """The parts of :func:`_normal_matrix_at_start`: the matched points, their Jacobians
+    ``D`` ``(n, 2, 4)``, precisions ``(n, 2, 2)`` and ``JᵀJ`` ``(4, 4)``; None with no match."""
     obs_q = _matched_points(cand, ev)
     if not obs_q:
         return None
@@ -204,7 +213,7 @@ def _normal_matrix_at_start(
     JtJ[3, 3] += (1.0 / max(settings.scale_sigma_rel, 1e-6)) ** 2
     if street_brg is not None:
         JtJ[0, 0] += (math.degrees(1.0) / settings.bearing_sigma_deg) ** 2
-    return np.asarray(JtJ, dtype=np.float64)
+    return obs_q, D, prec, np.asarray(JtJ, dtype=np.float64)
 
 
 def position_sigmas_m(
@@ -358,32 +367,39 @@ def calibration_covariance(cal: CalibrationResult) -> FloatArray | None:
     return np.asarray(0.5 * (cov + cov.T), dtype=np.float64)
 
 
-def _perturbed_cameras(cam: Camera, cov: FloatArray) -> list[tuple[Camera, Camera]]:
+def _calibration_sigma_points(
+    cam: Camera, cov: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The calibration's sigma points: the camera moved by ``±`` each column of a square root
-    of ``cov`` (:data:`CALIBRATION_PARAMETERS`), as (plus, minus) pairs; a pair with a
-    non-physical camera (focal length or height not positive) is left out."""
+    of ``cov`` (:data:`CALIBRATION_PARAMETERS`), those with a positive focal length and
+    height kept, as arrays: focal lengths ``(m,)``, principal points ``(m, 2)``,
+    ``cam_from_world`` rotations ``(m, 3, 3)`` and centres ``(m, 3)``."""
     lam, vec = np.linalg.eigh(cov)
+    steps = [math.sqrt(float(lam[k])) * vec[:, k] for k in range(len(lam)) if lam[k] > 0.0]
+    deltas = np.array([sign * d for d in steps for sign in (1.0, -1.0)]).reshape(-1, 7)
+    f = float(cam.focal_px) + deltas[:, 0]
+    C = np.asarray(cam.center_in_world, dtype=float)[None, :] + np.outer(deltas[:, 6], [0, 0, 1])
+    ok = (f > 0.0) & (C[:, 2] > 0.0)
     R0 = np.asarray(cam.cam_from_world_rotation, dtype=float)
-    C0 = np.asarray(cam.center_in_world, dtype=float)
-    pp0 = np.asarray(cam.principal_point, dtype=float)
-    out = []
-    for k in range(len(lam)):
-        if lam[k] <= 0.0:
-            continue
-        step = math.sqrt(float(lam[k])) * vec[:, k]
-        pair = []
-        for sign in (1.0, -1.0):
-            d = sign * step
-            f = float(cam.focal_px) + float(d[0])
-            C = C0 + np.array([0.0, 0.0, float(d[6])])
-            if f <= 0.0 or C[2] <= 0.0:
-                break
-            R = rotation_from_rotvec(d[3:6]) @ R0
-            pp = (float(pp0[0] + d[1]), float(pp0[1] + d[2]))
-            pair.append(Camera(f, pp, R, -R @ C, distortion=cam.distortion))
-        if len(pair) == 2:
-            out.append((pair[0], pair[1]))
-    return out
+    R = np.array([rotation_from_rotvec(d[3:6]) @ R0 for d in deltas[ok]]).reshape(-1, 3, 3)
+    pp = np.asarray(cam.principal_point, dtype=float)[None, :] + deltas[ok, 1:3]
+    return f[ok], pp, R, C[ok]
+
+
+def _cast(
+    pixels: FloatArray, f: FloatArray, pp: FloatArray, R: FloatArray, C: FloatArray
+) -> FloatArray:
+    """Pinhole pixels ``(n, 2)`` cast onto the ground ``z = 0`` through ``m`` cameras at once
+    (the arrays of :func:`_calibration_sigma_points`): ``(m, n, 2)``, NaN where a ray does
+    not reach the ground in front of its camera."""
+    d = np.empty((len(f), len(pixels), 3))
+    d[:, :, :2] = (pixels[None, :, :] - pp[:, None, :]) / f[:, None, None]
+    d[:, :, 2] = 1.0
+    rays = np.einsum("mji,mnj->mni", R, d)  # Rᵀ of each camera on each direction
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = -C[:, None, 2] / rays[:, :, 2]
+    t = np.where(t > 0.0, t, np.nan)
+    return np.asarray(C[:, None, :2] + t[:, :, None] * rays[:, :, :2], dtype=np.float64)
 
 
 def calibration_sigmas_m(
@@ -401,9 +417,12 @@ def calibration_sigmas_m(
     calibration's covariance (:func:`calibration_covariance`) is carried through the same
     fit by its sigma points (the unscented transform without a centre term: each of the
     seven directions ``±`` one square-root column): the matched pixels are cast again through
-    each moved camera, the similarity fitted again from the candidate's, and the camera's
-    position compared with the unmoved camera's. A sigma point that casts a matched pixel
-    above the horizon counts as the farthest of the others, doubled.
+    each moved camera (exactly: the casting is where a focal length far off bends the
+    answer), and the similarity's least-squares fit, linearised at the candidate's (its
+    normal matrix, :func:`_normal_matrix_at_start`), moves with the cast points. A lens
+    distortion is undone at the calibrated principal point for every sigma point. A sigma
+    point that casts a matched pixel above the horizon counts as the farthest of the
+    others, doubled.
 
     Returns the 1-sigma (root of the trace of the position covariance) per candidate, None
     where it cannot be computed (no match, no calibration covariance).
@@ -413,39 +432,41 @@ def calibration_sigmas_m(
     if cov is None:
         return out
     cam0 = cal.camera
-    pairs = _perturbed_cameras(cam0, cov)
-    if not pairs:
+    f, pp, R, C = _calibration_sigma_points(cam0, cov)
+    if not len(f):
         return out
+    R0 = np.asarray(cam0.cam_from_world_rotation, dtype=float)
+    base = (
+        np.array([float(cam0.focal_px)]),
+        np.asarray(cam0.principal_point, dtype=float)[None, :],
+        R0[None, :, :],
+        np.asarray(cam0.center_in_world, dtype=float)[None, :],
+    )
     for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
-        obs_q = _matched_points(cand, ev)
-        if not obs_q:
+        parts = _normal_parts(cand, ev, settings)
+        if parts is None:
             continue
-        street_brg = _street_bearing_prior(cand, ev, settings)
+        obs_q, D, prec, JtJ = parts
         pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
-        x0 = np.array([cand.theta_rad, *cand.translation_en, math.log(cand.scale)])
-
-        def placed(cam: Camera) -> FloatArray | None:
-            ground = cam.ground_from_pixels(pixels)[:, :2]  # noqa: B023
-            if not np.all(np.isfinite(ground)):
-                return None
-            moved = [(replace(o, world_xy=g), q) for (o, q), g in zip(obs_q, ground, strict=True)]  # noqa: B023
-            rj = _residuals(moved, cand.enu_from_world, settings, street_brg)  # noqa: B023
-            x, _J = gauss_newton(rj, x0, max_iter=4, sigma_tol=_SIGMA_TOL)  # noqa: B023
-            if not np.all(np.isfinite(x)):
-                return None
-            sim = Similarity2D(float(x[0]), np.array([x[1], x[2]]), math.exp(float(x[3])))
-            return np.asarray(sim.apply(cam.center_in_world[:2]), dtype=np.float64)
-
-        p0 = placed(cam0)
-        if p0 is None:
+        if cam0.distortion is not None:
+            pixels = undistort_points_px(pixels, cam0.distortion, cam0.principal_point)
+        g0 = _cast(pixels, *base)[0]
+        if not np.all(np.isfinite(g0)):
             continue
-        moves: list[FloatArray | None] = []
-        for plus, minus in pairs:
-            for cam in (plus, minus):
-                p = placed(cam)
-                moves.append(None if p is None else p - p0)
-        known = [float(d @ d) for d in moves if d is not None]
-        far = 4.0 * max(known) if known else 0.0
-        var = 0.5 * sum(far if d is None else float(d @ d) for d in moves)
-        out[k] = math.sqrt(var)
+        moved = _cast(pixels, f, pp, R, C) - g0[None]  # (m, n, 2) in the world frame
+        sim = cand.enu_from_world
+        A = sim.scale * sim.rotation  # a world displacement in ENU
+        de = np.einsum("ij,mnj->mni", A, np.nan_to_num(moved))
+        # the fit's step that absorbs them: JᵀJ Δx = -Σ D_kᵀ Λ_k δe_k
+        grad = np.einsum("nia,nij,mnj->ma", D, prec, de)
+        try:
+            dx = -np.linalg.solve(JtJ, grad.T).T
+        except np.linalg.LinAlgError:
+            dx = -(np.linalg.pinv(JtJ) @ grad.T).T
+        Jp = _position_jacobian(sim, cam0.center_in_world[:2])
+        dpos = dx @ Jp.T  # (m, 2); the centre's own height moves no horizontal position
+        d2 = np.einsum("mi,mi->m", dpos, dpos)
+        lost = ~np.all(np.isfinite(moved), axis=(1, 2)) | ~np.isfinite(d2)
+        far = 4.0 * float(np.max(d2[~lost])) if np.any(~lost) else 0.0
+        out[k] = math.sqrt(0.5 * float(np.sum(np.where(lost, far, d2))))
     return out
