@@ -158,3 +158,14 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
     res = locate(scene, m, calibration=cal)
     assert _top_error(res, ls) < 5.0
     assert not any(w.startswith("calibration:") for w in res.warnings)
+
+
+def test_sigma_point_rotations_match_rodrigues() -> None:
+    from camloc_geo.absolute._refine import _rotations
+    from camloc_geo.camera import rotation_from_rotvec
+
+    v = np.random.default_rng(3).normal(size=(6, 3)) * 0.05
+    v[0] = 0.0
+    got = _rotations(v)
+    for i in range(6):
+        np.testing.assert_allclose(got[i], rotation_from_rotvec(v[i]), atol=1e-14)

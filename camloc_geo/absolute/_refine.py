@@ -20,7 +20,7 @@ from camloc_geo.absolute._scoring import (
     street_angle_under_car,
 )
 from camloc_geo.absolute._similarity import Similarity2D
-from camloc_geo.camera import Camera, rotation_from_rotvec, undistort_points_px
+from camloc_geo.camera import Camera, undistort_points_px
 
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult
@@ -367,6 +367,20 @@ def calibration_covariance(cal: CalibrationResult) -> FloatArray | None:
     return np.asarray(0.5 * (cov + cov.T), dtype=np.float64)
 
 
+def _rotations(rotvecs: FloatArray) -> FloatArray:
+    """Rotation matrices ``(m, 3, 3)`` of rotation vectors ``(m, 3)`` (radians), Rodrigues'
+    formula at once (:func:`camloc_geo.camera.rotation_from_rotvec` of each)."""
+    theta = np.linalg.norm(rotvecs, axis=1)
+    safe = np.where(theta > 1e-12, theta, 1.0)
+    k = rotvecs / safe[:, None]
+    K = np.zeros((len(rotvecs), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = k[:, 2], -k[:, 1], k[:, 0]
+    sin = np.where(theta > 1e-12, np.sin(theta), 0.0)[:, None, None]
+    cos1 = np.where(theta > 1e-12, 1.0 - np.cos(theta), 0.0)[:, None, None]
+    return np.asarray(np.eye(3)[None] + sin * K + cos1 * (K @ K), dtype=np.float64)
+
+
 def _calibration_sigma_points(
     cam: Camera, cov: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -381,7 +395,7 @@ def _calibration_sigma_points(
     C = np.asarray(cam.center_in_world, dtype=float)[None, :] + np.outer(deltas[:, 6], [0, 0, 1])
     ok = (f > 0.0) & (C[:, 2] > 0.0)
     R0 = np.asarray(cam.cam_from_world_rotation, dtype=float)
-    R = np.array([rotation_from_rotvec(d[3:6]) @ R0 for d in deltas[ok]]).reshape(-1, 3, 3)
+    R = _rotations(deltas[ok, 3:6]) @ R0
     pp = np.asarray(cam.principal_point, dtype=float)[None, :] + deltas[ok, 1:3]
     return f[ok], pp, R, C[ok]
 
