@@ -218,6 +218,37 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
             )
             for m in METHODS
         },
+        "sigma": {m: _sigma_summary(rows, m) for m in METHODS},
+    }
+
+
+def _sigma_summary(rows: list[dict[str, Any]], method: str) -> dict[str, Any]:
+    """How honest the top candidate's ``sigma_m`` is: the share whose two sigmas reach the
+    truth (all tops, and those within :data:`CONFIDENT_M`: a wrong junction is a tie's
+    business, not the sigma's), the median error over sigma and the median sigma."""
+    tops = [
+        (e["top"], e["top_sigma_m"])
+        for r in rows
+        for e in [r.get("methods", {}).get(method, {})]
+        if e.get("n") and e.get("top_sigma_m")
+    ]
+    if not tops:
+        return {"n": 0}
+    right = [(t, s) for t, s in tops if t < CONFIDENT_M]
+    return {
+        "n": len(tops),
+        "covered_2sigma": round(sum(SIGMA_COVER * s >= t for t, s in tops) / len(tops), 4),
+        "right_covered_2sigma": round(
+            sum(SIGMA_COVER * s >= t for t, s in right) / max(len(right), 1), 4
+        ),
+        "median_error_over_sigma": round(float(np.median([t / s for t, s in tops])), 3),
+        "median_sigma_m": round(float(np.median([s for _t, s in tops])), 2),
+        "warned": sum(
+            1
+            for r in rows
+            if r.get("methods", {}).get(method, {}).get("n")
+            and r["methods"][method].get("warnings")
+        ),
     }
 
 

@@ -47,7 +47,12 @@ from camloc_geo.absolute._model import (
     Match,
     Tie,
 )
-from camloc_geo.absolute._refine import position_sigma_m, position_sigmas_m, refine_many
+from camloc_geo.absolute._refine import (
+    calibration_sigmas_m,
+    position_sigma_m,
+    position_sigmas_m,
+    refine_many,
+)
 from camloc_geo.absolute._scoring import (
     car_bearing_deg,
     plausibility_at,
@@ -1175,13 +1180,77 @@ def bundle_leaders(
     camera and ``sigma_m`` become the bundle's (:mod:`camloc_geo.absolute._bundle`). The
     leaders are fitted together (each its own fit, evaluated in one batch per step).
     """
-    if not settings.bundle_adjust:
-        return cands
     top = cands[: settings.refine_top]
     evs = [c.evidence or ev for c in top]
-    adjusted = bundle_adjust_many(top, calibration, evs, settings, result.image_size)
-    _place([a for a, c in zip(adjusted, top, strict=True) if a is not c], result)
+    if settings.bundle_adjust:
+        adjusted = bundle_adjust_many(top, calibration, evs, settings, result.image_size)
+        _place([a for a, c in zip(adjusted, top, strict=True) if a is not c], result)
+    else:
+        adjusted = list(top)
+    held = [k for k, (a, c) in enumerate(zip(adjusted, top, strict=True)) if a is c]
+    extra = _add_calibration_sigma(
+        [adjusted[k] for k in held], calibration, [evs[k] for k in held], settings
+    )
+    if held and held[0] == 0:
+        _warn_loose_calibration(adjusted[0], extra[0], calibration, result)
     return adjusted + cands[settings.refine_top :]
+
+
+def _add_calibration_sigma(
+    cands: list[Candidate],
+    calibration: CalibrationResult,
+    evs: list[Evidence],
+    settings: LocateSettings,
+) -> list[float | None]:
+    """The calibration's own uncertainty added to the ``sigma_m`` of refined candidates that
+    kept the calibrated camera (not re-fitted by the bundle), in place: the refinement's
+    sigma carries the clicks and the map only (:func:`~camloc_geo.absolute._refine.
+    calibration_sigmas_m`). The two add in quadrature."""
+    out: list[float | None] = [None] * len(cands)
+    todo = [k for k, c in enumerate(cands) if c.refined and c.sigma_m is not None]
+    if not todo:
+        return out
+    extra = calibration_sigmas_m(
+        [cands[k] for k in todo], calibration, [evs[k] for k in todo], settings
+    )
+    for k, sig_cal in zip(todo, extra, strict=True):
+        sig = cands[k].sigma_m
+        if sig_cal is not None and sig is not None and math.isfinite(sig_cal):
+            cands[k].sigma_m = math.hypot(sig, sig_cal)
+            out[k] = sig_cal
+    return out
+
+
+LOOSE_FOCAL_REL = 0.15
+"""A calibration whose focal length's stated 1-sigma exceeds this fraction is loose
+(:func:`_warn_loose_calibration`). ``benchmarks/unseen_cities.py --n 30``: the four
+calibrations 32-62 % off in focal length stated 16-35 %; 13 of the 124 two-reference scenes
+state over 15 % (and move their top candidate at least 5 m)."""
+
+LOOSE_CALIBRATION_M = 5.0
+"""... and the calibration alone moves the top candidate by at least this much (1-sigma)."""
+
+
+def _warn_loose_calibration(
+    top: Candidate, sig_cal: float | None, calibration: CalibrationResult, result: LocateResult
+) -> None:
+    """A warning when the top candidate kept a loose calibration's camera (its focal length
+    over :data:`LOOSE_FOCAL_REL` uncertain) that alone moves it by :data:`LOOSE_CALIBRATION_M`
+    or more: with two references (or two corners) the map cannot correct the focal length,
+    and a focal length two sigmas off puts the camera twice as far (``unseen_cities.py``:
+    Stretford's Lacy Street 26.6 m off, Andorra 21.5 m)."""
+    f_sig = calibration.focal_sigma_px
+    if sig_cal is None or f_sig is None or top.sigma_m is None:
+        return
+    rel = float(f_sig) / float(calibration.camera.focal_px)
+    if rel <= LOOSE_FOCAL_REL or sig_cal < LOOSE_CALIBRATION_M:
+        return
+    result.warnings.append(
+        f"calibration: the focal length is uncertain by {100.0 * rel:.0f} % (1 sigma) and "
+        f"alone moves the top candidate by {sig_cal:.0f} m (its sigma_m {top.sigma_m:.0f} m "
+        f"includes it); {top.method.replace('_', ' ')} cannot correct it: more vanishing "
+        "lines, another reference or kerb corners would"
+    )
 
 
 def apply_cues(

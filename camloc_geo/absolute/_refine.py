@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -19,7 +20,10 @@ from camloc_geo.absolute._scoring import (
     street_angle_under_car,
 )
 from camloc_geo.absolute._similarity import Similarity2D
-from camloc_geo.camera import Camera
+from camloc_geo.camera import Camera, undistort_points_px
+
+if TYPE_CHECKING:
+    from camloc_geo.relative import CalibrationResult
 
 FloatArray = npt.NDArray[np.float64]
 ResidualJacobian = Callable[[FloatArray], tuple[FloatArray, FloatArray]]
@@ -178,6 +182,15 @@ def _normal_matrix_at_start(
     Jacobian in (θ, tx, ty, ln s), ``Λ_k`` its precision) plus the scale prior's and the
     bearing prior's rows; the refinement's whitened ``J`` gives the same matrix up to
     rounding (``Λ = L Lᵀ``), without its Cholesky factors and closure."""
+    parts = _normal_parts(cand, ev, settings)
+    return None if parts is None else parts[3]
+
+
+def _normal_parts(
+    cand: Candidate, ev: Evidence, settings: LocateSettings
+) -> tuple[list[tuple[Observation, FloatArray]], FloatArray, FloatArray, FloatArray] | None:
+    """The parts of :func:`_normal_matrix_at_start`: the matched points, their Jacobians
+    ``D`` ``(n, 2, 4)``, precisions ``(n, 2, 2)`` and ``JᵀJ`` ``(4, 4)``; None with no match."""
     obs_q = _matched_points(cand, ev)
     if not obs_q:
         return None
@@ -200,7 +213,7 @@ def _normal_matrix_at_start(
     JtJ[3, 3] += (1.0 / max(settings.scale_sigma_rel, 1e-6)) ** 2
     if street_brg is not None:
         JtJ[0, 0] += (math.degrees(1.0) / settings.bearing_sigma_deg) ** 2
-    return np.asarray(JtJ, dtype=np.float64)
+    return obs_q, D, prec, np.asarray(JtJ, dtype=np.float64)
 
 
 def position_sigmas_m(
@@ -307,4 +320,167 @@ def refine_many(
             sigma_m=sigma,
             refined=True,
         )
+    return out
+
+
+CALIBRATION_PARAMETERS = (0, 1, 2, 3, 4, 5, 8)
+"""The rows of ``CalibrationResult.parameter_covariance`` that move a placement: focal length,
+principal point x, y, the rotation about the camera's three axes and the centre's height.
+The centre's x and y carry the camera and every ground point it casts together, so the
+similarity to the map absorbs them."""
+
+
+def calibration_covariance(cal: CalibrationResult) -> FloatArray | None:
+    """The calibration's covariance ``(7, 7)`` over :data:`CALIBRATION_PARAMETERS`, each
+    marginal widened to the stated sigma where that is larger, None when it states none.
+
+    ``parameter_covariance`` is the fit's alone (before the annotators' jackknife); the stated
+    ``focal_sigma_px``, ``rotation_sigma_deg`` and ``position_sigma_m`` include the jackknife.
+    Each row and column is scaled by ``max(1, stated / fitted)``: the marginals become the
+    stated sigmas and the fit's correlations are kept. Without a joint covariance, the stated
+    sigmas alone (uncorrelated).
+    """
+    stated = np.zeros(7)
+    if cal.focal_sigma_px is not None:
+        stated[0] = float(cal.focal_sigma_px)
+    if cal.principal_point_sigma_px is not None:
+        stated[1:3] = np.asarray(cal.principal_point_sigma_px, dtype=float)[:2]
+    if cal.rotation_sigma_deg is not None:
+        stated[3:6] = np.radians(np.asarray(cal.rotation_sigma_deg, dtype=float)[:3])
+    if cal.position_sigma_m is not None:
+        stated[6] = float(np.asarray(cal.position_sigma_m, dtype=float)[2])
+    stated = np.where(np.isfinite(stated), stated, 0.0)
+    cov_full = cal.parameter_covariance
+    if cov_full is None or np.shape(cov_full) != (9, 9) or not np.all(np.isfinite(cov_full)):
+        cov = np.diag(stated**2)
+    else:
+        idx = np.array(CALIBRATION_PARAMETERS)
+        cov = np.asarray(cov_full, dtype=float)[np.ix_(idx, idx)]
+        fitted = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        widen = np.where(fitted > 0.0, np.maximum(1.0, stated / np.where(fitted > 0, fitted, 1)), 0)
+        cov = widen[:, None] * cov * widen[None, :]
+        # a stated sigma where the fit has none (a held parameter): uncorrelated
+        held = fitted <= 0.0
+        cov[held, held] = stated[held] ** 2
+    if not np.any(cov):
+        return None
+    return np.asarray(0.5 * (cov + cov.T), dtype=np.float64)
+
+
+def _rotations(rotvecs: FloatArray) -> FloatArray:
+    """Rotation matrices ``(m, 3, 3)`` of rotation vectors ``(m, 3)`` (radians), Rodrigues'
+    formula at once (:func:`camloc_geo.camera.rotation_from_rotvec` of each)."""
+    theta = np.linalg.norm(rotvecs, axis=1)
+    safe = np.where(theta > 1e-12, theta, 1.0)
+    k = rotvecs / safe[:, None]
+    K = np.zeros((len(rotvecs), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = k[:, 2], -k[:, 1], k[:, 0]
+    sin = np.where(theta > 1e-12, np.sin(theta), 0.0)[:, None, None]
+    cos1 = np.where(theta > 1e-12, 1.0 - np.cos(theta), 0.0)[:, None, None]
+    return np.asarray(np.eye(3)[None] + sin * K + cos1 * (K @ K), dtype=np.float64)
+
+
+def _calibration_sigma_points(
+    cam: Camera, cov: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The calibration's sigma points: the camera moved by ``±`` each column of a square root
+    of ``cov`` (:data:`CALIBRATION_PARAMETERS`), those with a positive focal length and
+    height kept, as arrays: focal lengths ``(m,)``, principal points ``(m, 2)``,
+    ``cam_from_world`` rotations ``(m, 3, 3)`` and centres ``(m, 3)``."""
+    lam, vec = np.linalg.eigh(cov)
+    steps = [math.sqrt(float(lam[k])) * vec[:, k] for k in range(len(lam)) if lam[k] > 0.0]
+    deltas = np.array([sign * d for d in steps for sign in (1.0, -1.0)]).reshape(-1, 7)
+    f = float(cam.focal_px) + deltas[:, 0]
+    C = np.asarray(cam.center_in_world, dtype=float)[None, :] + np.outer(deltas[:, 6], [0, 0, 1])
+    ok = (f > 0.0) & (C[:, 2] > 0.0)
+    R0 = np.asarray(cam.cam_from_world_rotation, dtype=float)
+    R = _rotations(deltas[ok, 3:6]) @ R0
+    pp = np.asarray(cam.principal_point, dtype=float)[None, :] + deltas[ok, 1:3]
+    return f[ok], pp, R, C[ok]
+
+
+def _cast(
+    pixels: FloatArray, f: FloatArray, pp: FloatArray, R: FloatArray, C: FloatArray
+) -> FloatArray:
+    """Pinhole pixels ``(n, 2)`` cast onto the ground ``z = 0`` through ``m`` cameras at once
+    (the arrays of :func:`_calibration_sigma_points`): ``(m, n, 2)``, NaN where a ray does
+    not reach the ground in front of its camera."""
+    d = np.empty((len(f), len(pixels), 3))
+    d[:, :, :2] = (pixels[None, :, :] - pp[:, None, :]) / f[:, None, None]
+    d[:, :, 2] = 1.0
+    rays = np.einsum("mji,mnj->mni", R, d)  # Rᵀ of each camera on each direction
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = -C[:, None, 2] / rays[:, :, 2]
+    t = np.where(t > 0.0, t, np.nan)
+    return np.asarray(C[:, None, :2] + t[:, :, None] * rays[:, :, :2], dtype=np.float64)
+
+
+def calibration_sigmas_m(
+    cands: Sequence[Candidate],
+    cal: CalibrationResult,
+    evs: Sequence[Evidence],
+    settings: LocateSettings,
+) -> list[float | None]:
+    """How far each candidate's camera moves with the calibration (1-sigma, metres).
+
+    The refinement fits ``enu_from_world`` with the calibrated camera held: its sigma
+    (:func:`refine`) carries the clicks' and the map's noise, not the calibration's. With
+    two references the camera is fixed by the two pixels and the calibration's rays, so a
+    focal length 30 % off moves it by tens of metres while the fit stays exact. Here the
+    calibration's covariance (:func:`calibration_covariance`) is carried through the same
+    fit by its sigma points (the unscented transform without a centre term: each of the
+    seven directions ``±`` one square-root column): the matched pixels are cast again through
+    each moved camera (exactly: the casting is where a focal length far off bends the
+    answer), and the similarity's least-squares fit, linearised at the candidate's (its
+    normal matrix, :func:`_normal_matrix_at_start`), moves with the cast points. A lens
+    distortion is undone at the calibrated principal point for every sigma point. A sigma
+    point that casts a matched pixel above the horizon counts as the farthest of the
+    others, doubled.
+
+    Returns the 1-sigma (root of the trace of the position covariance) per candidate, None
+    where it cannot be computed (no match, no calibration covariance).
+    """
+    out: list[float | None] = [None] * len(cands)
+    cov = calibration_covariance(cal)
+    if cov is None:
+        return out
+    cam0 = cal.camera
+    f, pp, R, C = _calibration_sigma_points(cam0, cov)
+    if not len(f):
+        return out
+    R0 = np.asarray(cam0.cam_from_world_rotation, dtype=float)
+    base = (
+        np.array([float(cam0.focal_px)]),
+        np.asarray(cam0.principal_point, dtype=float)[None, :],
+        R0[None, :, :],
+        np.asarray(cam0.center_in_world, dtype=float)[None, :],
+    )
+    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        parts = _normal_parts(cand, ev, settings)
+        if parts is None:
+            continue
+        obs_q, D, prec, JtJ = parts
+        pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
+        if cam0.distortion is not None:
+            pixels = undistort_points_px(pixels, cam0.distortion, cam0.principal_point)
+        g0 = _cast(pixels, *base)[0]
+        if not np.all(np.isfinite(g0)):
+            continue
+        moved = _cast(pixels, f, pp, R, C) - g0[None]  # (m, n, 2) in the world frame
+        sim = cand.enu_from_world
+        A = sim.scale * sim.rotation  # a world displacement in ENU
+        de = np.einsum("ij,mnj->mni", A, np.nan_to_num(moved))
+        # the fit's step that absorbs them: JᵀJ Δx = -Σ D_kᵀ Λ_k δe_k
+        grad = np.einsum("nia,nij,mnj->ma", D, prec, de)
+        try:
+            dx = -np.linalg.solve(JtJ, grad.T).T
+        except np.linalg.LinAlgError:
+            dx = -(np.linalg.pinv(JtJ) @ grad.T).T
+        Jp = _position_jacobian(sim, cam0.center_in_world[:2])
+        dpos = dx @ Jp.T  # (m, 2); the centre's own height moves no horizontal position
+        d2 = np.einsum("mi,mi->m", dpos, dpos)
+        lost = ~np.all(np.isfinite(moved), axis=(1, 2)) | ~np.isfinite(d2)
+        far = 4.0 * float(np.max(d2[~lost])) if np.any(~lost) else 0.0
+        out[k] = math.sqrt(0.5 * float(np.sum(np.where(lost, far, d2))))
     return out
