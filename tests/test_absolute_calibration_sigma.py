@@ -68,7 +68,9 @@ def test_two_references_sigma_carries_the_calibration(lacy_street) -> None:  # t
     scene, m, cal, ls = lacy_street
     # the calibration is far off, and says it is loose
     assert cal.camera.focal_px / ls.camera_enu.focal_px - 1.0 == pytest.approx(-0.62, abs=0.02)
-    assert cal.focal_sigma_px / cal.camera.focal_px == pytest.approx(0.28, abs=0.02)
+    # (28 % as the linearised sigma; widened x3 since calibrate's profile finds a better fit
+    # at a longer focal length: the fit stopped in a local minimum)
+    assert cal.focal_sigma_px / cal.camera.focal_px == pytest.approx(0.85, abs=0.03)
     res = locate(scene, m, calibration=cal)
     top = res.candidates[0]
     assert top.method == "two_references"
@@ -77,7 +79,7 @@ def test_two_references_sigma_carries_the_calibration(lacy_street) -> None:  # t
     # was 8.4 m: the truth lay 3.2 sigma away
     assert top.sigma_m is not None
     assert 2.0 * top.sigma_m >= err
-    assert top.sigma_m == pytest.approx(18.0, abs=1.5)
+    assert top.sigma_m == pytest.approx(28.4, abs=2.0)
 
 
 def test_calibration_sigma_follows_the_focal_sigma(lacy_street) -> None:  # type: ignore[no-untyped-def]
@@ -134,7 +136,7 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
     """Andorra's Av. Consell d'Europa x Av. Doctor Mitjavila: focal length 32 % short at a
     stated 17 %, the top candidate 21.5 m off; its sigma (7.0 m before, 9.5 m with the
     calibration's) still falls short of the truth, so only a warning keeps it from looking
-    sure. Lacy Street (28 %) is warned too; a Stretford camera with a tight calibration
+    sure. Lacy Street (85 %) is warned too; a Stretford camera with a tight calibration
     (8 %) is not."""
     from camloc_geo.absolute import locate
 
@@ -151,7 +153,7 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
 
     scene, m, cal, ls = lacy_street
     res = locate(scene, m, calibration=cal)
-    assert any("uncertain by 28 %" in w for w in res.warnings)
+    assert any("uncertain by 85 %" in w for w in res.warnings)
 
     scene, m, cal, ls = _two_reference_scene(*STRETFORD, (53.4461281, -2.3075311), 0)
     assert cal.focal_sigma_px / cal.camera.focal_px < 0.1
