@@ -196,7 +196,12 @@ def test_cli_radar_says_which_witnesses_calibrated_it(
     assert main([*args, "--video-lines"]) == 0
     used = json.loads(capsys.readouterr().out)["calibration"]
     assert used["witnesses"] == ["annotators", "video"]
-    assert set(used["video_segments"]) == {"length", "width", "height"}
+    # --max-frames 60 bounds the video's lines too: those of the first 60 frames only (the
+    # street's and across points; too few uprights in 60 frames for the vertical one)
+    first_60 = video_lines(video.path, image_size=video.image_size, max_frames=60)
+    assert first_60.n_frames == 60
+    assert used["video_segments"] == {"length": 156, "width": 29}
+    assert used["video_segments"]["length"] == first_60.counts["street"]
     f_true = video.camera.focal_px
     assert abs(used["focal_px"] / f_true - 1.0) < 0.03
     assert abs(plain["focal_px"] / f_true - 1.0) > 0.05
@@ -226,3 +231,103 @@ def test_photo_and_video_are_two_witness_groups_of_the_jackknife(
     assert photo_only.focal_sigma_px is not None
     assert one.focal_sigma_px is not None
     assert photo_only.focal_sigma_px > 2.0 * one.focal_sigma_px
+
+
+def test_video_lines_reads_no_more_than_max_frames(
+    street: tuple[RenderedVideo, VideoLines],
+) -> None:
+    video, lines = street
+    assert lines.n_frames == 240  # the whole 12 s video at 20 fps (under the 600 default)
+    first = video_lines(video.path, image_size=video.image_size, max_frames=30)
+    assert first.n_frames == 30
+    assert first.counts["tracks"] < lines.counts["tracks"] / 4
+    for bad in (0, -5):
+        with pytest.raises(InputError, match=f"max_frames must be >= 1, not {bad}"):
+            video_lines(video.path, max_frames=bad)
+    with pytest.raises(InputError, match="whole number"):
+        video_lines(video.path, max_frames=2.5)  # type: ignore[arg-type]
+
+
+def _write_video(path: Path, n_frames: int, size: tuple[int, int] = (960, 540)) -> Path:
+    import cv2
+
+    fourcc = cv2.VideoWriter_fourcc(*"MJPG")  # type: ignore[attr-defined]
+    out = cv2.VideoWriter(str(path), fourcc, 20.0, size)
+    for i in range(n_frames):
+        out.write(np.full((size[1], size[0], 3), 60 + i, dtype=np.uint8))
+    out.release()
+    return path
+
+
+def test_bad_videos_for_calibrate_exit_2_with_one_line(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import cv2
+
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    photo = tmp_path / "frame.jpg"
+    cv2.imwrite(str(photo), np.full((540, 960, 3), 90, dtype=np.uint8))
+    cases = {
+        # a still image: not "speeds need ..." (calibrate measures no speed)
+        str(photo): "has a single frame (a still image?): its lines need a video",
+        # a file OpenCV opens but of no frame: it was silently ignored (exit 0)
+        str(_write_video(tmp_path / "zero.avi", 0)): "cannot decode any frame of video",
+        str(tmp_path): "is not a regular file",
+    }
+    for path, message in cases.items():
+        assert main(["calibrate", str(scene_path), "--video", path]) == 2, path
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, (path, err)
+        assert message in err[0], (path, err)
+    for args, message in (
+        (["--max-frames", "0", "--video", str(video.path)], "--max-frames must be >= 1, not 0"),
+        (["--max-frames", "5"], "--max-frames needs --video VIDEO"),
+    ):
+        assert main(["calibrate", str(scene_path), *args]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, (args, err)
+        assert message in err[0], (args, err)
+
+
+def test_a_video_without_lines_is_warned_and_the_scene_calibrates_alone(
+    street: tuple[RenderedVideo, VideoLines],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    short = _write_video(tmp_path / "short.avi", 5)  # too short for a background
+    assert main(["calibrate", str(scene_path)]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert main(["calibrate", str(scene_path), "--video", str(short)]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert "video_segments" not in out
+    assert out["focal_px"] == pytest.approx(plain["focal_px"], rel=1e-9)
+    warned = [w for w in out["warnings"] if w.startswith(f"video {short}: no lines")]
+    assert len(warned) == 1, out["warnings"]
+    assert "calibrated from the scene alone" in warned[0]
+    logged = [r for r in caplog.records if "no lines of moving vehicles" in r.getMessage()]
+    assert len(logged) == 1  # on stderr once (the CLI's log handler)
+
+
+def test_radar_refuses_max_frames_under_1_before_calibrating(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    code = main(["radar", str(video.path), "--scene", str(scene_path), "--max-frames", "0"])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["camloc radar: error: max_frames must be a whole number >= 1, not 0"]
