@@ -971,7 +971,7 @@ def radar_scene(
         video=video if video_lines else None,
         video_max_frames=max_frames,  # the lines from the frames measured, no more
     )
-    return measure_speeds(
+    result = measure_speeds(
         calibration,
         video,
         fps=fps,
@@ -981,6 +981,10 @@ def radar_scene(
         max_frames=max_frames,
         progress=progress,
     )
+    # the calibration's warnings about the video's lines (none found, a group that
+    # disagrees) are the radar's too: calibration.witnesses alone left them unsaid
+    result.warnings.extend(w for w in calibration.warnings if w.startswith("video"))
+    return result
 
 
 def guide_scene(

@@ -331,3 +331,17 @@ def test_radar_refuses_max_frames_under_1_before_calibrating(
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["camloc radar: error: max_frames must be a whole number >= 1, not 0"]
+
+
+def test_radar_says_when_the_video_gave_no_lines(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    from camloc_geo.api import radar_scene
+
+    video, _lines = street
+    still = _write_video(tmp_path / "still.avi", 12)  # nothing moves: no lines
+    boxes = {1: {i: (100.0 + 10 * i, 300.0, 200.0 + 10 * i, 350.0) for i in range(12)}}
+    res = radar_scene(_car_only_scene(video.camera), still, tracks=boxes, min_track_s=0.1)
+    assert res.calibration["witnesses"] == ["annotators"]
+    warned = [w for w in res.warnings if w.startswith(f"video {still}: no lines")]
+    assert len(warned) == 1, res.warnings
