@@ -345,3 +345,23 @@ def test_radar_says_when_the_video_gave_no_lines(
     assert res.calibration["witnesses"] == ["annotators"]
     warned = [w for w in res.warnings if w.startswith(f"video {still}: no lines")]
     assert len(warned) == 1, res.warnings
+
+
+def test_a_truncated_video_still_gives_its_lines(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    # a recording cut off: the file states 240 frames, about a third decode. The median
+    # background was sampled over the stated 240, failed past the cut, and the video gave
+    # no lines at all ("no lines of moving vehicles").
+    video, _lines = street
+    data = Path(video.path).read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) // 3])
+    lines = video_lines(cut, image_size=video.image_size)
+    assert 40 < lines.n_frames < 120
+    assert lines.has_groups()
+    assert lines.counts["street"] >= 100
+    res = calibrate_scene(_car_only_scene(video.camera), video=cut)
+    assert set(res.video_segments) >= {"length", "width"}
+    assert abs(res.camera.focal_px / video.camera.focal_px - 1.0) < 0.03
+    assert not [w for w in res.warnings if "no lines" in w]

@@ -610,15 +610,23 @@ def _background_init(cap: Any, n_frames: int, scale: float, max_frames: int) -> 
 
     if n_frames < 10:
         return None
-    idx = np.unique(np.linspace(0, min(n_frames, max_frames) - 1, _BG_SAMPLES).astype(int))
-    frames = []
-    for i in idx:
-        if not cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)):
+    last = min(n_frames, max_frames) - 1
+    frames: list[Any] = []
+    for _attempt in range(2):
+        idx = np.unique(np.linspace(0, last, _BG_SAMPLES).astype(int))
+        frames, failed_at = [], None
+        for i in idx:
+            ok = bool(cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)))
+            frame = cap.read()[1] if ok else None
+            if frame is None:
+                failed_at = int(i)
+                break
+            frames.append(_reduce(frame, scale))
+        if len(frames) >= 5 or failed_at is None or failed_at < 10:
             break
-        ok, frame = cap.read()
-        if not ok:
-            break
-        frames.append(_reduce(frame, scale))
+        # a truncated file states more frames than it holds: sample before the first that
+        # failed (the video's lines had no background at all, the radar its first frame)
+        last = failed_at - 1
     cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
     if len(frames) < 5:
         return None
