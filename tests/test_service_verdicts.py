@@ -580,6 +580,13 @@ def test_verdict_folder_that_cannot_hold_the_file_is_one_clear_error(
     (clash / VERDICTS_FILE).mkdir(parents=True)
     with pytest.raises(InputError, match=f"{VERDICTS_FILE} in it is not a file"):
         VerdictStore(clash, max_rows=10)
+    # a read-only folder (as root every folder is writable: os.access says what a user sees)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    with monkeypatch.context() as m:
+        m.setattr("os.access", lambda path, mode: False)
+        with pytest.raises(InputError, match=r"ro: cannot write there \(read-only\)"):
+            VerdictStore(ro, max_rows=10)
     # camloc serve: exit 2 with one line naming the variable (was exit 1, 'failed: FileExists')
     monkeypatch.setenv("CAMLOC_VERDICT_DIR", str(afile))
     assert main(["serve", "--port", "1"]) == 2
