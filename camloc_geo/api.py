@@ -933,7 +933,8 @@ def radar_scene(
     min_track_s
         Shorter tracks are not measured, seconds.
     max_frames
-        Read at most this many frames (the video's lines for the calibration too).
+        Read at most this many frames (the video's lines for the calibration: at most the
+        first ``min(max_frames, 600)``).
     progress
         Show a tqdm progress bar on stderr.
     video_lines
@@ -953,6 +954,7 @@ def radar_scene(
         The scene does not calibrate, ``video`` is not a path, the video is unreadable or not
         the scene's size, no frame rate, malformed tracks (each a one-line message).
     """
+    from camloc_geo.sensors._video_lines import _MAX_FRAMES as _VIDEO_LINES_FRAMES
     from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
     sc = scene_from(scene)
@@ -969,7 +971,8 @@ def radar_scene(
     calibration = calibrate_scene(
         sc,
         video=video if video_lines else None,
-        video_max_frames=max_frames,  # the lines from the frames measured, no more
+        # the lines from the frames measured, and never more than their default 600
+        video_max_frames=None if max_frames is None else min(max_frames, _VIDEO_LINES_FRAMES),
     )
     result = measure_speeds(
         calibration,

@@ -365,3 +365,24 @@ def test_a_truncated_video_still_gives_its_lines(
     assert set(res.video_segments) >= {"length", "width"}
     assert abs(res.camera.focal_px / video.camera.focal_px - 1.0) < 0.03
     assert not [w for w in res.warnings if "no lines" in w]
+
+
+def test_radar_bounds_the_video_lines_by_max_frames_and_600(
+    street: tuple[RenderedVideo, VideoLines], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import camloc_geo.sensors._video_lines as vl
+    from camloc_geo.api import radar_scene
+
+    video, lines = street
+    asked: list[int] = []
+
+    def recorded(path: Any, *, image_size: Any = None, max_frames: int = 600) -> VideoLines:
+        asked.append(max_frames)
+        return lines  # (the fixture's: the reading itself is tested above)
+
+    monkeypatch.setattr(vl, "video_lines", recorded)
+    scene = _car_only_scene(video.camera)
+    boxes = {1: {i: (100.0 + 10 * i, 300.0, 200.0 + 10 * i, 350.0) for i in range(12)}}
+    for max_frames, expected in ((None, 600), (12, 12), (5000, 600)):
+        radar_scene(scene, video.path, tracks=boxes, max_frames=max_frames, min_track_s=0.1)
+        assert asked[-1] == expected, (max_frames, asked)

@@ -44,8 +44,8 @@ def register(subparsers: Any) -> None:
         type=int,
         metavar="N",
         help=(
-            "process only the first N frames (the video's lines for the calibration too; "
-            "without it they read the first 600)"
+            "process only the first N frames (the video's lines for the calibration too, "
+            "at most 600 of them: the first 600 without it)"
         ),
     )
     p.add_argument(
