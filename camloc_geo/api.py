@@ -146,6 +146,7 @@ def calibrate_scene(
     joint_fit: bool = True,
     principal_point: str = "auto",
     video: str | os.PathLike[str] | None = None,
+    video_max_frames: int | None = None,
 ) -> CalibrationResult:
     """Relative pose of the camera from the scene's annotations.
 
@@ -167,7 +168,11 @@ def calibrate_scene(
         and edges join the fit as one more witness group
         (:func:`camloc_geo.sensors._video_lines.video_lines`,
         ``CalibrationSettings.video_lines``; ``video_segments`` in the result says how many
-        per axis). Overrides ``settings.video_lines``.
+        per axis). Overrides ``settings.video_lines``. A video that gives no lines (too
+        short, no moving vehicle) adds a warning and the fit is the scene's alone.
+    video_max_frames
+        Read at most this many of the video's first frames (default 600; the cost is about
+        linear in the frames read).
 
     Returns
     -------
@@ -205,8 +210,17 @@ def calibrate_scene(
 
         if not isinstance(video, (str, os.PathLike)):
             raise InputError(f"video must be a file path, not {type(video).__name__}")
-        lines = video_lines(video, image_size=(sc.image.width, sc.image.height))
+        kw: dict[str, Any] = {} if video_max_frames is None else {"max_frames": video_max_frames}
+        lines = video_lines(video, image_size=(sc.image.width, sc.image.height), **kw)
         settings = replace(settings, video_lines=lines)
+        result = calibrate(sc, settings)
+        if not lines.has_groups():
+            result.warnings.append(
+                f"video {video}: no lines of moving vehicles ({lines.n_frames} frame(s) read: "
+                "a video under 10 frames, a truncated file, or no vehicle moves); calibrated "
+                "from the scene alone"
+            )
+        return result
     return calibrate(sc, settings)
 
 
@@ -919,7 +933,8 @@ def radar_scene(
     min_track_s
         Shorter tracks are not measured, seconds.
     max_frames
-        Read at most this many frames.
+        Read at most this many frames (the video's lines for the calibration: at most the
+        first ``min(max_frames, 600)``).
     progress
         Show a tqdm progress bar on stderr.
     video_lines
@@ -939,17 +954,27 @@ def radar_scene(
         The scene does not calibrate, ``video`` is not a path, the video is unreadable or not
         the scene's size, no frame rate, malformed tracks (each a one-line message).
     """
+    from camloc_geo.sensors._video_lines import _MAX_FRAMES as _VIDEO_LINES_FRAMES
     from camloc_geo.sensors.radar import measure_speeds, probe_video, read_tracks
 
     sc = scene_from(scene)
     if not isinstance(video, (str, os.PathLike)):
         raise InputError(f"video must be a file path, not {type(video).__name__}")
     size = (sc.image.width, sc.image.height)
+    if max_frames is not None and (
+        isinstance(max_frames, bool) or not isinstance(max_frames, SupportsIndex) or max_frames < 1
+    ):  # refused before the calibration (which reads the video's lines) too
+        raise InputError(f"max_frames must be a whole number >= 1, not {max_frames!r}")
     probe_video(video, image_size=size)  # a bad video or tracks file fails before calibrating
     if isinstance(tracks, (str, os.PathLike)):
         tracks = read_tracks(tracks)
-    calibration = calibrate_scene(sc, video=video if video_lines else None)
-    return measure_speeds(
+    calibration = calibrate_scene(
+        sc,
+        video=video if video_lines else None,
+        # the lines from the frames measured, and never more than their default 600
+        video_max_frames=None if max_frames is None else min(max_frames, _VIDEO_LINES_FRAMES),
+    )
+    result = measure_speeds(
         calibration,
         video,
         fps=fps,
@@ -959,6 +984,10 @@ def radar_scene(
         max_frames=max_frames,
         progress=progress,
     )
+    # the calibration's warnings about the video's lines (none found, a group that
+    # disagrees) are the radar's too: calibration.witnesses alone left them unsaid
+    result.warnings.extend(w for w in calibration.warnings if w.startswith("video"))
+    return result
 
 
 def guide_scene(

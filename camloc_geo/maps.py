@@ -2546,14 +2546,19 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{p}: cannot read the verdicts file: {exc}") from None
     raw: list[tuple[str, Mapping[str, Any]]] = []
-    if text.lstrip().startswith("{"):
+    if not text.strip():
+        raise InputError(
+            f"{p}: the verdicts file is empty (export the page's verdicts as CSV or GeoJSON)"
+        )
+    if text.lstrip().startswith(("{", "[")):
         try:
             data = json.loads(text)
         except json.JSONDecodeError as exc:
             raise InputError(f"{p}: not valid JSON: {exc}") from None
         feats = data.get("features") if isinstance(data, dict) else None
         if not isinstance(feats, list):
-            raise InputError(f"{p}: not a verdicts GeoJSON (no 'features' list)")
+            what = "no 'features' list" if isinstance(data, dict) else "not a JSON object"
+            raise InputError(f"{p}: not a verdicts GeoJSON ({what})")
         for i, f in enumerate(feats):
             props = f.get("properties") if isinstance(f, dict) else None
             if not isinstance(props, dict):

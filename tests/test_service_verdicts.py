@@ -564,3 +564,77 @@ def test_job_map_reviewers_share_a_pick(
     finally:
         ana.close()
         bo.close()
+
+
+# ------------------------------------------------------- session 36 QA: the store's failures
+def test_verdict_folder_that_cannot_hold_the_file_is_one_clear_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo import InputError
+    from camloc_geo.cli import main
+
+    afile = tmp_path / "a-file"
+    afile.write_text("x", encoding="utf-8")
+    with pytest.raises(InputError, match="not a folder"):
+        VerdictStore(afile, max_rows=10)  # was FileExistsError: [Errno 17] at start-up
+    with pytest.raises(InputError, match=f"{afile} is a file, not a folder"):
+        VerdictStore(afile / "sub", max_rows=10)
+    clash = tmp_path / "clash"
+    (clash / VERDICTS_FILE).mkdir(parents=True)
+    with pytest.raises(InputError, match=f"{VERDICTS_FILE} in it is not a file"):
+        VerdictStore(clash, max_rows=10)
+    # a read-only folder (as root every folder is writable: os.access says what a user sees)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    with monkeypatch.context() as m:
+        m.setattr("os.access", lambda path, mode: False)
+        with pytest.raises(InputError, match=r"ro: cannot write there \(read-only\)"):
+            VerdictStore(ro, max_rows=10)
+    # camloc serve: exit 2 with one line naming the variable (was exit 1, 'failed: FileExists')
+    monkeypatch.setenv("CAMLOC_VERDICT_DIR", str(afile))
+    assert main(["serve", "--port", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"camloc serve: error: CAMLOC_VERDICT_DIR {afile}: not a folder (the reviewers' "
+        "verdicts go there)"
+    ]
+
+
+def test_a_store_that_cannot_write_answers_verdicts_unavailable(tmp_path: Path) -> None:
+    import sqlite3
+
+    from camloc_geo.service.errors import error_response_for
+    from camloc_geo.service.verdicts import VerdictStoreError
+
+    store = VerdictStore(tmp_path / "v", max_rows=10)
+    item = {"verdict": "yes", "rank": None, "note": "", "reviewer": "Ana"}
+    store.merge("candidates", IDENT, {"1": {**item, "time": "2026-11-25T01:00:00.000Z"}})
+    # the file read-only (as root, chmod does not stop a write: a read-only connection does)
+    ro = sqlite3.connect(f"file:{store.path}?mode=ro", uri=True, isolation_level=None)
+    ro.row_factory = sqlite3.Row
+    store._local.db = ro
+    with pytest.raises(VerdictStoreError, match=r"cannot use its verdicts file.*readonly"):
+        store.merge("candidates", IDENT, {"2": {**item, "time": "2026-11-25T01:00:01.000Z"}})
+    assert not ro.in_transaction  # the connection is not left inside a transaction
+    assert list(store.page("candidates", IDENT)["items"]) == ["1"]  # reads still work
+    answer = error_response_for(VerdictStoreError("the server cannot use ..."), "rid")
+    assert answer.status_code == 503
+    assert json.loads(bytes(answer.body))["error"]["type"] == "verdicts_unavailable"
+
+
+def test_concurrent_merges_from_threads_all_land(tmp_path: Path) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    store = VerdictStore(tmp_path / "v", max_rows=1000)
+
+    def post(i: int) -> list[str]:
+        item = {"verdict": "yes", "rank": None, "note": "", "reviewer": f"r{i}"}
+        when = f"2026-11-25T01:00:{i:02d}.000Z"
+        return store.merge("candidates", IDENT, {str(i + 1): {**item, "time": when}})[1]
+
+    with ThreadPoolExecutor(8) as pool:
+        taken = list(pool.map(post, range(64)))
+    assert taken == [[str(i + 1)] for i in range(64)]
+    items = store.page("candidates", IDENT)["items"]
+    assert len(items) == 64
+    assert {it["reviewer"] for it in items.values()} == {f"r{i}" for i in range(64)}

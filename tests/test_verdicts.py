@@ -122,6 +122,16 @@ def test_read_verdicts_bad_files(tmp_path: Path) -> None:
     nofeat.write_text('{"type": "Feature"}', encoding="utf-8")
     with pytest.raises(InputError, match="no 'features' list"):
         maps.read_verdicts(nofeat)
+    # session 36 QA: an empty file and a JSON list were 'not a verdicts CSV: no column ...'
+    empty = tmp_path / "empty.csv"
+    empty.write_text(" \n", encoding="utf-8")
+    with pytest.raises(InputError, match="the verdicts file is empty"):
+        maps.read_verdicts(empty)
+    listed = tmp_path / "list.json"
+    listed.write_text('[{"camera": "a", "verdict": "yes"}]', encoding="utf-8")
+    with pytest.raises(InputError) as info:
+        maps.read_verdicts(listed)
+    assert str(info.value) == f"{listed}: not a verdicts GeoJSON (not a JSON object)"
 
 
 # ----------------------------------------------------------------------------- browser

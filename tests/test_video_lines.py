@@ -196,7 +196,12 @@ def test_cli_radar_says_which_witnesses_calibrated_it(
     assert main([*args, "--video-lines"]) == 0
     used = json.loads(capsys.readouterr().out)["calibration"]
     assert used["witnesses"] == ["annotators", "video"]
-    assert set(used["video_segments"]) == {"length", "width", "height"}
+    # --max-frames 60 bounds the video's lines too: those of the first 60 frames only (the
+    # street's and across points; too few uprights in 60 frames for the vertical one)
+    first_60 = video_lines(video.path, image_size=video.image_size, max_frames=60)
+    assert first_60.n_frames == 60
+    assert used["video_segments"] == {"length": 156, "width": 29}
+    assert used["video_segments"]["length"] == first_60.counts["street"]
     f_true = video.camera.focal_px
     assert abs(used["focal_px"] / f_true - 1.0) < 0.03
     assert abs(plain["focal_px"] / f_true - 1.0) > 0.05
@@ -226,3 +231,158 @@ def test_photo_and_video_are_two_witness_groups_of_the_jackknife(
     assert photo_only.focal_sigma_px is not None
     assert one.focal_sigma_px is not None
     assert photo_only.focal_sigma_px > 2.0 * one.focal_sigma_px
+
+
+def test_video_lines_reads_no_more_than_max_frames(
+    street: tuple[RenderedVideo, VideoLines],
+) -> None:
+    video, lines = street
+    assert lines.n_frames == 240  # the whole 12 s video at 20 fps (under the 600 default)
+    first = video_lines(video.path, image_size=video.image_size, max_frames=30)
+    assert first.n_frames == 30
+    assert first.counts["tracks"] < lines.counts["tracks"] / 4
+    for bad in (0, -5):
+        with pytest.raises(InputError, match=f"max_frames must be >= 1, not {bad}"):
+            video_lines(video.path, max_frames=bad)
+    with pytest.raises(InputError, match="whole number"):
+        video_lines(video.path, max_frames=2.5)  # type: ignore[arg-type]
+
+
+def _write_video(path: Path, n_frames: int, size: tuple[int, int] = (960, 540)) -> Path:
+    import cv2
+
+    fourcc = cv2.VideoWriter_fourcc(*"MJPG")  # type: ignore[attr-defined]
+    out = cv2.VideoWriter(str(path), fourcc, 20.0, size)
+    for i in range(n_frames):
+        out.write(np.full((size[1], size[0], 3), 60 + i, dtype=np.uint8))
+    out.release()
+    return path
+
+
+def test_bad_videos_for_calibrate_exit_2_with_one_line(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import cv2
+
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    photo = tmp_path / "frame.jpg"
+    cv2.imwrite(str(photo), np.full((540, 960, 3), 90, dtype=np.uint8))
+    cases = {
+        # a still image: not "speeds need ..." (calibrate measures no speed)
+        str(photo): "has a single frame (a still image?): its lines need a video",
+        # a file OpenCV opens but of no frame: it was silently ignored (exit 0)
+        str(_write_video(tmp_path / "zero.avi", 0)): "cannot decode any frame of video",
+        str(tmp_path): "is not a regular file",
+    }
+    for path, message in cases.items():
+        assert main(["calibrate", str(scene_path), "--video", path]) == 2, path
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, (path, err)
+        assert message in err[0], (path, err)
+    for args, message in (
+        (["--max-frames", "0", "--video", str(video.path)], "--max-frames must be >= 1, not 0"),
+        (["--max-frames", "5"], "--max-frames needs --video VIDEO"),
+    ):
+        assert main(["calibrate", str(scene_path), *args]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1, (args, err)
+        assert message in err[0], (args, err)
+
+
+def test_a_video_without_lines_is_warned_and_the_scene_calibrates_alone(
+    street: tuple[RenderedVideo, VideoLines],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    short = _write_video(tmp_path / "short.avi", 5)  # too short for a background
+    assert main(["calibrate", str(scene_path)]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert main(["calibrate", str(scene_path), "--video", str(short)]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert "video_segments" not in out
+    assert out["focal_px"] == pytest.approx(plain["focal_px"], rel=1e-9)
+    warned = [w for w in out["warnings"] if w.startswith(f"video {short}: no lines")]
+    assert len(warned) == 1, out["warnings"]
+    assert "calibrated from the scene alone" in warned[0]
+    logged = [r for r in caplog.records if "no lines of moving vehicles" in r.getMessage()]
+    assert len(logged) == 1  # on stderr once (the CLI's log handler)
+
+
+def test_radar_refuses_max_frames_under_1_before_calibrating(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    video, _lines = street
+    scene_path = tmp_path / "scene.json"
+    scene_path.write_text(json.dumps(_car_only_scene(video.camera)))
+    code = main(["radar", str(video.path), "--scene", str(scene_path), "--max-frames", "0"])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["camloc radar: error: max_frames must be a whole number >= 1, not 0"]
+
+
+def test_radar_says_when_the_video_gave_no_lines(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    from camloc_geo.api import radar_scene
+
+    video, _lines = street
+    still = _write_video(tmp_path / "still.avi", 12)  # nothing moves: no lines
+    boxes = {1: {i: (100.0 + 10 * i, 300.0, 200.0 + 10 * i, 350.0) for i in range(12)}}
+    res = radar_scene(_car_only_scene(video.camera), still, tracks=boxes, min_track_s=0.1)
+    assert res.calibration["witnesses"] == ["annotators"]
+    warned = [w for w in res.warnings if w.startswith(f"video {still}: no lines")]
+    assert len(warned) == 1, res.warnings
+
+
+def test_a_truncated_video_still_gives_its_lines(
+    street: tuple[RenderedVideo, VideoLines], tmp_path: Path
+) -> None:
+    # a recording cut off: the file states 240 frames, about a third decode. The median
+    # background was sampled over the stated 240, failed past the cut, and the video gave
+    # no lines at all ("no lines of moving vehicles").
+    video, _lines = street
+    data = Path(video.path).read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) // 3])
+    lines = video_lines(cut, image_size=video.image_size)
+    assert 40 < lines.n_frames < 120
+    assert lines.has_groups()
+    assert lines.counts["street"] >= 100
+    res = calibrate_scene(_car_only_scene(video.camera), video=cut)
+    assert set(res.video_segments) >= {"length", "width"}
+    assert abs(res.camera.focal_px / video.camera.focal_px - 1.0) < 0.03
+    assert not [w for w in res.warnings if "no lines" in w]
+
+
+def test_radar_bounds_the_video_lines_by_max_frames_and_600(
+    street: tuple[RenderedVideo, VideoLines], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import camloc_geo.sensors._video_lines as vl
+    from camloc_geo.api import radar_scene
+
+    video, lines = street
+    asked: list[int] = []
+
+    def recorded(path: Any, *, image_size: Any = None, max_frames: int = 600) -> VideoLines:
+        asked.append(max_frames)
+        return lines  # (the fixture's: the reading itself is tested above)
+
+    monkeypatch.setattr(vl, "video_lines", recorded)
+    scene = _car_only_scene(video.camera)
+    boxes = {1: {i: (100.0 + 10 * i, 300.0, 200.0 + 10 * i, 350.0) for i in range(12)}}
+    for max_frames, expected in ((None, 600), (12, 12), (5000, 600)):
+        radar_scene(scene, video.path, tracks=boxes, max_frames=max_frames, min_track_s=0.1)
+        assert asked[-1] == expected, (max_frames, asked)

@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import os
 from collections.abc import Iterator
 from typing import Any
 
+from camloc_geo._errors import InputError
 from camloc_geo.cli import write_json
 
 log = logging.getLogger(__name__)
@@ -46,6 +48,13 @@ def register(subparsers: Any) -> None:
             "edges join the fit as one more witness (video_segments in the JSON)"
         ),
     )
+    p.add_argument(
+        "--max-frames",
+        type=int,
+        metavar="N",
+        help="with --video: read at most its first N frames (default 600; the cost is about "
+        "linear in N)",
+    )
     p.set_defaults(func=run)
 
 
@@ -55,17 +64,28 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.cli import output_path
 
     output_path(args.output, inputs=[args.scene, args.video])
+    if args.max_frames is not None:
+        if args.video is None:
+            raise InputError("--max-frames needs --video VIDEO (the frames read of it)")
+        if args.max_frames < 1:
+            raise InputError(f"--max-frames must be >= 1, not {args.max_frames}")
+    if args.video is not None and not (args.verbose or args.debug):
+        # FFmpeg, under OpenCV, prints its own lines ("[mjpeg @ 0x...] overread 8") next to
+        # our one-line error: silenced, read before the first VideoCapture (as camloc radar)
+        os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
     with _logged_warnings() as logged:
         scene = scene_from(args.scene)
         if args.video is not None:
+            from camloc_geo.sensors._video_lines import _NEED
             from camloc_geo.sensors.radar import probe_video
 
-            probe_video(args.video, image_size=(scene.image.width, scene.image.height))
+            probe_video(args.video, image_size=(scene.image.width, scene.image.height), need=_NEED)
         result = calibrate_scene(
             scene,
             joint_fit=not args.no_joint_fit,
             principal_point=args.principal_point,
             video=args.video,
+            video_max_frames=args.max_frames,
         )
     # Every warning of the answer also on stderr, once: those the library logged while
     # reading and screening the scene are there already; the fit's own (a loose focal

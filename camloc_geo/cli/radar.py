@@ -39,7 +39,15 @@ def register(subparsers: Any) -> None:
         default=0.5,
         help="shorter tracks are skipped with a reason (default 0.5 s)",
     )
-    p.add_argument("--max-frames", type=int, help="process only the first N frames")
+    p.add_argument(
+        "--max-frames",
+        type=int,
+        metavar="N",
+        help=(
+            "process only the first N frames (the video's lines for the calibration too, "
+            "at most 600 of them: the first 600 without it)"
+        ),
+    )
     p.add_argument(
         "--video-lines",
         action=argparse.BooleanOptionalAction,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any
 
 
@@ -88,8 +89,6 @@ def run(args: argparse.Namespace) -> int:
 
     os.environ["CAMLOC_WORKERS"] = str(args.workers)
     if args.verdict_dir is not None:
-        from pathlib import Path
-
         folder = Path(args.verdict_dir).expanduser()
         if folder.exists() and not folder.is_dir():
             raise InputError(f"--verdict-dir {folder}: not a folder")
@@ -97,9 +96,18 @@ def run(args: argparse.Namespace) -> int:
             raise InputError(f"--verdict-dir {folder}: its parent folder does not exist")
         os.environ["CAMLOC_VERDICT_DIR"] = str(folder.resolve())
     try:
-        Settings()
+        settings = Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
         raise InputError(f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}") from None
+    from camloc_geo.service.verdicts import check_verdict_folder
+
+    # a verdicts folder that is a file or read-only: one line now, not a traceback at start-up
+    if args.verdict_dir is not None:
+        check_verdict_folder(Path(args.verdict_dir), "--verdict-dir")
+    elif settings.verdict_dir is not None:
+        check_verdict_folder(settings.verdict_dir, "CAMLOC_VERDICT_DIR")
+    else:
+        check_verdict_folder(settings.data_dir, "CAMLOC_DATA_DIR")
     _check_listen(args.host, args.port)
     try:
         uvicorn.run(

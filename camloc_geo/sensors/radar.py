@@ -525,12 +525,11 @@ def _check_tracks(tracks: Mapping[int, Mapping[int, Any]]) -> TrackBoxes:
 
 
 # --------------------------------------------------------------------------- video
-def _single_frame(path: str | os.PathLike[str]) -> InputError:
-    """The error for a video of one frame (a still image): speeds need two or more."""
-    return InputError(
-        f"video {path} has a single frame (a still image?): speeds need a video of the moving "
-        "vehicles"
-    )
+def _single_frame(
+    path: str | os.PathLike[str], need: str = "speeds need a video of the moving vehicles"
+) -> InputError:
+    """The error for a video of one frame (a still image): ``need`` says what needs more."""
+    return InputError(f"video {path} has a single frame (a still image?): {need}")
 
 
 def _check_path(path: object, what: str) -> None:
@@ -539,7 +538,9 @@ def _check_path(path: object, what: str) -> None:
         raise InputError(f"{what}: give a file path, not {type(path).__name__}")
 
 
-def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | None, int]:
+def _open_video(
+    path: str | os.PathLike[str], need: str | None = None
+) -> tuple[Any, int, int, float | None, int]:
     import cv2
 
     _check_path(path, "video")
@@ -558,7 +559,7 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
         raise InputError(f"cannot read video {p}: it states no frame size")
     if n == 1:  # OpenCV reads a photo as a video of one frame
         cap.release()
-        raise _single_frame(p)
+        raise _single_frame(p) if need is None else _single_frame(p, need)
     if w * h > MAX_VIDEO_PIXELS:
         cap.release()
         raise InputError(
@@ -569,12 +570,16 @@ def _open_video(path: str | os.PathLike[str]) -> tuple[Any, int, int, float | No
 
 
 def probe_video(
-    video_path: str | os.PathLike[str], *, image_size: tuple[int, int] | None = None
+    video_path: str | os.PathLike[str],
+    *,
+    image_size: tuple[int, int] | None = None,
+    need: str | None = None,
 ) -> tuple[int, int, float | None, int]:
     """Width, height, stated frame rate (None: none usable) and frame count of a video.
 
     Cheap (reads the header only): front ends call it before calibrating, to refuse a bad
-    video at once.
+    video at once. ``need``: what a still image's error says needs a video (default: the
+    speeds).
 
     Raises
     ------
@@ -582,7 +587,7 @@ def probe_video(
         Missing or unreadable video, too large frames, or (with ``image_size``) frames of
         another size than the scene's image.
     """
-    cap, w, h, fps, n = _open_video(video_path)
+    cap, w, h, fps, n = _open_video(video_path, need)
     cap.release()
     if image_size is not None:
         _check_size(video_path, (w, h), image_size)
@@ -605,15 +610,23 @@ def _background_init(cap: Any, n_frames: int, scale: float, max_frames: int) -> 
 
     if n_frames < 10:
         return None
-    idx = np.unique(np.linspace(0, min(n_frames, max_frames) - 1, _BG_SAMPLES).astype(int))
-    frames = []
-    for i in idx:
-        if not cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)):
+    last = min(n_frames, max_frames) - 1
+    frames: list[Any] = []
+    for _attempt in range(2):
+        idx = np.unique(np.linspace(0, last, _BG_SAMPLES).astype(int))
+        frames, failed_at = [], None
+        for i in idx:
+            ok = bool(cap.set(cv2.CAP_PROP_POS_FRAMES, int(i)))
+            frame = cap.read()[1] if ok else None
+            if frame is None:
+                failed_at = int(i)
+                break
+            frames.append(_reduce(frame, scale))
+        if len(frames) >= 5 or failed_at is None or failed_at < 10:
             break
-        ok, frame = cap.read()
-        if not ok:
-            break
-        frames.append(_reduce(frame, scale))
+        # a truncated file states more frames than it holds: sample before the first that
+        # failed (the video's lines had no background at all, the radar its first frame)
+        last = failed_at - 1
     cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
     if len(frames) < 5:
         return None

@@ -26,6 +26,7 @@ from camloc_geo import (
     NotEnoughStructureError,
     SceneError,
 )
+from camloc_geo.service.verdicts import VerdictStoreError
 from camloc_geo.service.work import LimitError
 
 __all__ = [
@@ -87,6 +88,7 @@ ERROR_STATUS: tuple[tuple[type[BaseException], int, str], ...] = (
     (MapDataError, 422, "map_data"),
     (InputError, 422, "invalid_input"),
     (MapSourceError, 503, "map_source_unavailable"),
+    (VerdictStoreError, 503, "verdicts_unavailable"),
 )
 """Exception → HTTP status and error type; the first matching row wins."""
 

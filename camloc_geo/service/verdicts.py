@@ -18,7 +18,15 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["VERDICTS_FILE", "VerdictStore", "export_csv", "export_geojson", "export_rows"]
+__all__ = [
+    "VERDICTS_FILE",
+    "VerdictStore",
+    "VerdictStoreError",
+    "check_verdict_folder",
+    "export_csv",
+    "export_geojson",
+    "export_rows",
+]
 
 VERDICTS_FILE = "camloc-verdicts.sqlite"
 """The file's name in the verdicts folder (``CAMLOC_VERDICT_DIR``, else ``CAMLOC_DATA_DIR``)."""
@@ -37,6 +45,48 @@ _FIELDS = ("verdict", "rank", "note", "reviewer", "time", "camera", "lat", "lon"
 _DEFAULTS = {"note": "", "reviewer": "", "camera": ""}
 
 
+class VerdictStoreError(Exception):
+    """The verdicts file cannot be read or written (a read-only folder, a full disk, a file
+    another process holds locked): the service answers 503 ``verdicts_unavailable``."""
+
+
+def check_verdict_folder(folder: Path, name: str = "CAMLOC_VERDICT_DIR") -> Path:
+    """The verdicts folder, refused at once where it cannot hold the verdicts file.
+
+    Parameters
+    ----------
+    folder
+        The folder (made later if missing).
+    name
+        What set it (``CAMLOC_VERDICT_DIR``, ``--verdict-dir``...), for the message.
+
+    Raises
+    ------
+    InputError
+        ``folder`` (or the verdicts file in it) is not a folder (a file), its parent is not a
+        folder, or it exists and cannot be written.
+    """
+    import os
+
+    from camloc_geo._errors import InputError
+
+    folder = Path(folder).expanduser()
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{name} {folder}: not a folder (the reviewers' verdicts go there)")
+    if folder.is_dir():
+        target = folder / VERDICTS_FILE
+        if target.exists() and not target.is_file():
+            raise InputError(f"{name} {folder}: {VERDICTS_FILE} in it is not a file")
+        writable = os.access(target if target.exists() else folder, os.W_OK)
+        if not writable:
+            raise InputError(f"{name} {folder}: cannot write there (read-only)")
+    else:
+        parent = next((p for p in folder.parents if p.exists()), None)
+        if parent is not None and not parent.is_dir():
+            raise InputError(f"{name} {folder}: {parent} is a file, not a folder")
+    return folder
+
+
 class VerdictStore:
     """The verdicts of every page the service's reviewers marked (thread-safe; WAL mode).
 
@@ -49,12 +99,17 @@ class VerdictStore:
     """
 
     def __init__(self, folder: Path, max_rows: int) -> None:
-        self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
+        from camloc_geo._errors import InputError
+
+        self.folder = check_verdict_folder(Path(folder), "verdicts folder")
         self.path = self.folder / VERDICTS_FILE
         self.max_rows = int(max_rows)
         self._local = threading.local()
-        self._db().executescript(_SCHEMA)
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self._db().executescript(_SCHEMA)
+        except (OSError, sqlite3.Error) as exc:
+            raise InputError(f"verdicts folder {self.folder}: cannot use it: {exc}") from None
 
     def _db(self) -> sqlite3.Connection:
         db = getattr(self._local, "db", None)
@@ -72,22 +127,34 @@ class VerdictStore:
         db.execute("BEGIN IMMEDIATE")
         try:
             yield db
+            db.execute("COMMIT")
         except BaseException:
-            db.execute("ROLLBACK")
+            if db.in_transaction:  # (a failed COMMIT too: the connection is reused)
+                db.execute("ROLLBACK")
             raise
-        db.execute("COMMIT")
+
+    @contextmanager
+    def _unavailable(self) -> Iterator[None]:
+        """An SQLite or OS failure as a :class:`VerdictStoreError` naming the file."""
+        try:
+            yield
+        except (sqlite3.Error, OSError) as exc:
+            raise VerdictStoreError(
+                f"the server cannot use its verdicts file {self.path.name}: {exc}"
+            ) from None
 
     def page(self, page: str, identity: str) -> dict[str, Any]:
         """``{"page", "identity", "items": {key: {verdict, rank, note, reviewer, time,
         camera, lat, lon}}}``;
         an item whose ``verdict`` is None was withdrawn (kept so that the withdrawal reaches
         the other reviewers' pages)."""
-        rows = self._db().execute(
-            "SELECT key, verdict, rank, note, reviewer, time, camera, lat, lon FROM verdicts "
-            "WHERE page = ? AND identity = ? ORDER BY key",
-            (page, identity),
-        )
-        items = {str(r["key"]): {f: r[f] for f in _FIELDS} for r in rows}
+        with self._unavailable():
+            rows = self._db().execute(
+                "SELECT key, verdict, rank, note, reviewer, time, camera, lat, lon FROM verdicts "
+                "WHERE page = ? AND identity = ? ORDER BY key",
+                (page, identity),
+            )
+            items = {str(r["key"]): {f: r[f] for f in _FIELDS} for r in rows}
         return {"page": page, "identity": identity, "items": items}
 
     def merge(
@@ -112,12 +179,14 @@ class VerdictStore:
         ------
         LimitError
             The store would hold more than ``max_rows`` verdicts.
+        VerdictStoreError
+            The file cannot be written (read-only, full disk, locked over 30 s).
         """
         from camloc_geo.service.work import LimitError
 
         taken: list[str] = []
         now = time.time()
-        with self._tx() as db:
+        with self._unavailable(), self._tx() as db:
             stored = {
                 str(r["key"]): str(r["time"])
                 for r in db.execute(
@@ -149,11 +218,16 @@ class VerdictStore:
     def pages(self, limit: int = 1000) -> list[dict[str, Any]]:
         """The pages with verdicts, latest first: ``page``, ``identity``, ``verdicts`` (how many
         candidates or cameras have one), ``latest`` (time of the latest change)."""
-        rows = self._db().execute(
-            "SELECT page, identity, SUM(verdict IS NOT NULL) AS n, MAX(time) AS latest "
-            "FROM verdicts GROUP BY page, identity ORDER BY latest DESC LIMIT ?",
-            (int(limit),),
-        )
+        with self._unavailable():
+            rows = (
+                self._db()
+                .execute(
+                    "SELECT page, identity, SUM(verdict IS NOT NULL) AS n, MAX(time) AS latest "
+                    "FROM verdicts GROUP BY page, identity ORDER BY latest DESC LIMIT ?",
+                    (int(limit),),
+                )
+                .fetchall()
+            )
         return [
             {
                 "page": str(r["page"]),

@@ -11,6 +11,7 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
+from starlette.concurrency import run_in_threadpool
 
 from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
 from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
@@ -37,7 +38,7 @@ async def list_pages(
     limit: Annotated[int, Query(ge=1, le=10_000, description="at most this many pages")] = 1000,
 ) -> dict[str, Any]:
     """The pages that have verdicts, latest change first."""
-    return {"pages": store.pages(limit)}
+    return {"pages": await run_in_threadpool(store.pages, limit)}
 
 
 _EXPORT_DOC: dict[int | str, dict[str, Any]] = {
@@ -62,7 +63,7 @@ async def page_verdicts(
     """A page's verdicts (none yet: an empty ``items``); ``format=csv`` or ``geojson``: the
     export the page itself writes, which ``camloc summary-map --verdicts`` and ``camloc
     locate --map ... --verdicts`` read."""
-    doc = store.page(page, identity)
+    doc = await run_in_threadpool(store.page, page, identity)
     if q.format == "json":
         return JSONResponse(doc)
     name = f"verdicts-{page}-{identity[:8]}"
@@ -87,5 +88,7 @@ async def post_verdicts(
     that one is newer. Answers the page's verdicts after the change and the keys taken."""
     now = datetime.now(timezone.utc)
     items = {key: item.stored(now) for key, item in body.items.items()}
-    doc, taken = store.merge(page, identity, items)
+    # (in the thread pool: SQLite may wait up to 30 s for another process's lock, which
+    # blocked every other request of the event loop)
+    doc, taken = await run_in_threadpool(store.merge, page, identity, items)
     return {**doc, "taken": taken}
