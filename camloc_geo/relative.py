@@ -3089,6 +3089,11 @@ def _focal_profile_widening(
     and a warning says so. The flat sides' widening (no better fit, a rise below 4) only
     with ``widen_flat`` (``CalibrationSettings.focal_profile_flat``, default off). Only for the
     joint fit with a fitted focal length. Returns (factor, warning or "") or None.
+
+    The answer's cost is its residuals (no re-fit). Without ``widen_flat`` only whether a
+    held fit gets below it matters: :func:`_held_focal_fit_drops` stops each held fit as
+    soon as that is decided, and only where one does get below are the full held fits run
+    (the widening and the warning as before).
     """
     state = result.joint_state
     f = result.camera.focal_px
