@@ -12,7 +12,10 @@ turn call by call) of
 - ``default``: ``calibrate(scene)``, the joint fit with its uncertainty (the one-step
   jackknife);
 - ``refit_jackknife``: the uncertainty by full refits (``jackknife_method="refit"``), the
-  reference the one-step jackknife is checked against.
+  reference the one-step jackknife is checked against;
+- with ``--no-focal-check``, also ``default_no_focal_check``: the default with the focal
+  local-minimum check (``camloc_geo.relative._focal_profile_widening``) switched off, what
+  the check costs (calibrate before it, commit 4d58b77).
 
 It also compares the two jackknives' sigmas (the camera position's leave-one-out spread in x,
 y, z and the rotation sigma about the camera's x, y, z) and the annotators they flag
@@ -28,7 +31,7 @@ y, z and the rotation sigma about the camera's x, y, z) and the annotators they 
 
 Usage::
 
-    python benchmarks/calibrate_speed.py --n 30 [--profile]
+    python benchmarks/calibrate_speed.py --n 30 [--profile] [--no-focal-check]
 """
 
 from __future__ import annotations
@@ -64,6 +67,7 @@ METHODS = {
     "default": CalibrationSettings(),
     "refit_jackknife": CalibrationSettings(jackknife_method="refit"),
 }
+NO_FOCAL_CHECK = "default_no_focal_check"
 TARGET_RATIO = 1.5
 SIGMA_TOLERANCE = 0.10
 
@@ -87,20 +91,39 @@ def cpu_ms(scene: Scene, settings: CalibrationSettings, repeats: int) -> float:
     return float(np.median(times))
 
 
-def interleaved_cpu_ms(scene: Scene, repeats: int) -> dict[str, float]:
+def cpu_ms_no_focal_check(scene: Scene) -> float:
+    """CPU milliseconds of one default ``calibrate(scene)`` without the focal check."""
+    import camloc_geo.relative as rel
+
+    check = rel._focal_profile_widening
+    rel._focal_profile_widening = lambda result, widen_flat=False: None
+    try:
+        return cpu_ms(scene, METHODS["default"], 1)
+    finally:
+        rel._focal_profile_widening = check
+
+
+def interleaved_cpu_ms(
+    scene: Scene, repeats: int, no_focal_check: bool = False
+) -> dict[str, float]:
     """Median CPU milliseconds of each method on one scene, the methods taken in turn.
 
     ``repeats`` rounds of one call of each fast method (the closed form, the joint fit, the
     default), then one refit call: the methods compared meet the same state of the machine
     (a drift of its speed, a collection of the garbage another call left) instead of one
     method's calls running back to back. The garbage is collected before the scene.
+    ``no_focal_check``: the default without the focal check joins the fast methods.
     """
     gc.collect()
     fast = [m for m in METHODS if m != "refit_jackknife"]
     times: dict[str, list[float]] = {m: [] for m in METHODS}
+    if no_focal_check:
+        times[NO_FOCAL_CHECK] = []
     for _ in range(repeats):
         for method in fast:
             times[method].append(cpu_ms(scene, METHODS[method], 1))
+        if no_focal_check:
+            times[NO_FOCAL_CHECK].append(cpu_ms_no_focal_check(scene))
     times["refit_jackknife"].append(cpu_ms(scene, METHODS["refit_jackknife"], 1))
     return {m: float(np.median(t)) for m, t in times.items()}
 
@@ -209,6 +232,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=20261124, help="random seed")
     parser.add_argument("--repeats", type=int, default=3, help="timed calls per scene")
     parser.add_argument("--profile", action="store_true", help="add a cProfile table")
+    parser.add_argument(
+        "--no-focal-check",
+        action="store_true",
+        help="also time the default without the focal local-minimum check",
+    )
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)
@@ -219,7 +247,7 @@ def main(argv: list[str] | None = None) -> int:
     rows: list[dict[str, Any]] = []
     for i, scene in enumerate(scenes):
         row: dict[str, Any] = {"index": i, "cpu_ms": {}}
-        row["cpu_ms"] = interleaved_cpu_ms(scene, args.repeats)
+        row["cpu_ms"] = interleaved_cpu_ms(scene, args.repeats, args.no_focal_check)
         fast = calibrate(scene)
         slow = calibrate(scene, METHODS["refit_jackknife"])
         row["sigma_one_step"] = sigmas(fast)
@@ -228,17 +256,18 @@ def main(argv: list[str] | None = None) -> int:
         row["flagged_refit"] = flagged(slow.annotator_influence_m)
         rows.append(row)
     load_after = os.getloadavg()
-    med = {m: float(np.median([r["cpu_ms"][m] for r in rows])) for m in METHODS}
+    timed = [*METHODS, *([NO_FOCAL_CHECK] if args.no_focal_check else [])]
+    med = {m: float(np.median([r["cpu_ms"][m] for r in rows])) for m in timed}
     both = [r for r in rows if r["sigma_one_step"] and r["sigma_refit"]]
     ratio = np.array([np.divide(r["sigma_one_step"], r["sigma_refit"]) for r in both])
     within = np.abs(ratio - 1.0) <= SIGMA_TOLERANCE
     summary: dict[str, Any] = {
         "median_cpu_ms": med,
-        "ratio_to_closed_form": {m: med[m] / med["closed_form"] for m in METHODS},
+        "ratio_to_closed_form": {m: med[m] / med["closed_form"] for m in timed},
         # the same per scene, then its median over the scenes (paired: robust to drift)
         "ratio_to_closed_form_per_scene_median": {
             m: float(np.median([r["cpu_ms"][m] / r["cpu_ms"]["closed_form"] for r in rows]))
-            for m in METHODS
+            for m in timed
         },
         "target_ratio": TARGET_RATIO,
         "sigma_components": [
@@ -279,8 +308,9 @@ def main(argv: list[str] | None = None) -> int:
         f"calibrate speed, {len(rows)} scenes, seed {args.seed}, load "
         f"{load_before[0]:.2f} -> {load_after[0]:.2f} on {os.cpu_count()} CPUs\n"
         + "\n".join(
-            f"  {m:16s} median CPU {med[m]:7.1f} ms  ({summary['ratio_to_closed_form'][m]:.2f}x)"
-            for m in METHODS
+            f"  {m:22s} median CPU {med[m]:7.1f} ms  ({summary['ratio_to_closed_form'][m]:.2f}x,"
+            f" per scene {summary['ratio_to_closed_form_per_scene_median'][m]:.2f}x)"
+            for m in timed
         )
         + f"\n  one-step vs refit sigmas: median ratio "
         f"{np.round(summary['sigma_ratio_median'], 3).tolist()}, within 10 % "

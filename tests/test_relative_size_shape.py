@@ -95,3 +95,46 @@ def test_a_well_determined_focal_length_is_not_widened() -> None:
     assert res.joint_state is not None
     assert rel._focal_profile_widening(res) is None
     assert not any("not well determined" in w for w in res.warnings)
+
+
+@pytest.mark.parametrize("seed", [2, 6])
+def test_the_held_fits_early_stop_agrees_with_the_full_held_fit(seed: int) -> None:
+    """The profile check's held fits stop early (below the answer's cost, or clearly above
+    it); on both sides the verdict is the full fit's (seed 6: the longer side is better)."""
+    import math
+
+    import camloc_geo.relative as rel
+    from camloc_geo._optimize import soft_l1_cost
+
+    scene, _f = _low_camera_scene(seed)
+    res = calibrate(parse_scene(scene))
+    state = res.joint_state
+    assert state is not None
+    assert state.focal_px is None
+    assert res.focal_sigma_px is not None
+    prob = state.problem
+    saved = prob.weights
+    prob.weights = state.weights
+    try:
+        x = np.asarray(state.x, dtype=float)
+        fun0 = prob.residuals(x, state.rotation0, state.principal_point, None)
+        cost0 = soft_l1_cost(fun0, rel._F_SCALE)
+        s2 = 2.0 * cost0 / (len(fun0) - len(x))
+        sig_log = res.focal_sigma_px / res.camera.focal_px
+        verdicts = []
+        for side in (-1.0, 1.0):
+            f_held = math.exp(float(x[0]) + side * 2.0 * sig_log)
+            pc = 0.0
+            if prob.log_f_prior_sigma > 0.0:
+                z = (math.log(f_held) - prob.log_f_prior) / prob.log_f_prior_sigma
+                pc = soft_l1_cost(np.array([z]), rel._F_SCALE)
+            full = rel._fit(prob, x[1:].copy(), state.rotation0, state.principal_point, f_held)
+            full_below = soft_l1_cost(full.fun, rel._F_SCALE) + pc < cost0
+            quick = rel._held_focal_fit_drops(
+                prob, x[1:], state.rotation0, state.principal_point, f_held, cost0 - pc, s2
+            )
+            assert quick == full_below
+            verdicts.append(quick)
+    finally:
+        prob.weights = saved
+    assert verdicts == ([False, True] if seed == 6 else [False, False])
