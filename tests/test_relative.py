@@ -605,7 +605,8 @@ def test_one_step_jackknife_matches_the_refits(seed: int) -> None:
         fast.position_sigma_jackknife_m, slow.position_sigma_jackknife_m, rtol=0.10
     )
     assert fast.rotation_sigma_fit_deg is not None
-    assert np.all(fast.rotation_sigma_deg > fast.rotation_sigma_fit_deg)
+    # the larger of the fit's and the annotators' spread (_add_jackknife_spread)
+    assert np.all(fast.rotation_sigma_deg >= fast.rotation_sigma_fit_deg)
     assert _flagged(fast.annotator_influence_m) == _flagged(slow.annotator_influence_m)
     for a, b in zip(fast.annotator_influence_m, slow.annotator_influence_m, strict=True):
         if a is not None and b is not None:
