@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Store"]
+__all__ = ["SqliteFile", "Store"]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
@@ -42,17 +42,15 @@ CREATE TABLE IF NOT EXISTS annotations (
 _STALE_CLAIM_S = 300.0
 
 
-class Store:
-    """The service's SQLite database under ``data_dir`` (one file, WAL mode)."""
+class SqliteFile:
+    """One SQLite file (WAL mode), a connection per thread, ``BEGIN IMMEDIATE`` transactions.
 
-    def __init__(self, data_dir: Path) -> None:
-        self.data_dir = Path(data_dir)
-        self.data_dir.mkdir(parents=True, exist_ok=True)
-        (self.data_dir / "snapshots").mkdir(exist_ok=True)
-        self.path = self.data_dir / "camloc-service.sqlite"
-        self._local = threading.local()
-        self.worker_id = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
-        self._db().executescript(_SCHEMA)
+    Subclasses set ``path`` and ``_local`` (a :class:`threading.local`) before the first
+    :meth:`_db` call.
+    """
+
+    path: Path
+    _local: threading.local
 
     def _db(self) -> sqlite3.Connection:
         db = getattr(self._local, "db", None)
@@ -70,10 +68,24 @@ class Store:
         db.execute("BEGIN IMMEDIATE")
         try:
             yield db
+            db.execute("COMMIT")
         except BaseException:
-            db.execute("ROLLBACK")
+            if db.in_transaction:  # (a failed COMMIT too: the connection is reused)
+                db.execute("ROLLBACK")
             raise
-        db.execute("COMMIT")
+
+
+class Store(SqliteFile):
+    """The service's SQLite database under ``data_dir`` (one file, WAL mode)."""
+
+    def __init__(self, data_dir: Path) -> None:
+        self.data_dir = Path(data_dir)
+        self.data_dir.mkdir(parents=True, exist_ok=True)
+        (self.data_dir / "snapshots").mkdir(exist_ok=True)
+        self.path = self.data_dir / "camloc-service.sqlite"
+        self._local = threading.local()
+        self.worker_id = f"{os.getpid()}-{uuid.uuid4().hex[:8]}"
+        self._db().executescript(_SCHEMA)
 
     # --- jobs ----------------------------------------------------------------------------
     def create_job(self, cameras: list[dict[str, Any]]) -> str:

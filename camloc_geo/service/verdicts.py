@@ -18,6 +18,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from camloc_geo.service.store import SqliteFile
+
 __all__ = [
     "VERDICTS_FILE",
     "VerdictStore",
@@ -87,7 +89,7 @@ def check_verdict_folder(folder: Path, name: str = "CAMLOC_VERDICT_DIR") -> Path
     return folder
 
 
-class VerdictStore:
+class VerdictStore(SqliteFile):
     """The verdicts of every page the service's reviewers marked (thread-safe; WAL mode).
 
     Parameters
@@ -110,28 +112,6 @@ class VerdictStore:
             self._db().executescript(_SCHEMA)
         except (OSError, sqlite3.Error) as exc:
             raise InputError(f"verdicts folder {self.folder}: cannot use it: {exc}") from None
-
-    def _db(self) -> sqlite3.Connection:
-        db = getattr(self._local, "db", None)
-        if db is None:
-            db = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
-            db.execute("PRAGMA journal_mode=WAL")
-            db.execute("PRAGMA synchronous=NORMAL")
-            db.row_factory = sqlite3.Row
-            self._local.db = db
-        return db
-
-    @contextmanager
-    def _tx(self) -> Iterator[sqlite3.Connection]:
-        db = self._db()
-        db.execute("BEGIN IMMEDIATE")
-        try:
-            yield db
-            db.execute("COMMIT")
-        except BaseException:
-            if db.in_transaction:  # (a failed COMMIT too: the connection is reused)
-                db.execute("ROLLBACK")
-            raise
 
     @contextmanager
     def _unavailable(self) -> Iterator[None]:
