@@ -214,6 +214,39 @@ def _errors(result: LocateResult, ls: LocatedScene) -> list[float]:
     ]
 
 
+def oracle_scene(
+    m: MapData, oj: dict[str, Any], rng: np.random.Generator, noise: NoiseModel
+) -> tuple[Any | None, LocatedScene | None, str]:
+    """The synthetic camera at oracle junction ``oj`` (``lat``, ``lon``): (the modelled
+    intersection matched to it or None, the located scene or None, why there is none).
+
+    The scene states the oracle's point as its intersection, as a user would; a junction
+    without kerb corners, or where no camera placement is found, gets no scene.
+    """
+    inter, warnings = m.match_intersection(
+        lat=oj["lat"], lon=oj["lon"], max_distance_m=ORACLE_MATCH_M
+    )
+    if inter is None:
+        return None, None, "no modelled junction: " + warnings[0]
+    if not inter.corners:
+        return inter, None, f"{inter.kind} junction without kerb corners"
+    ls = make_located_scene(
+        m,
+        inter,
+        rng,
+        noise=noise,
+        corner_sigma_m=1.5,
+        n_references=2,
+        min_corners=1,
+        max_corners=4,
+    )
+    if ls is None:
+        return inter, None, "no camera placement found"
+    ls.scene["intersection"]["lat"] = oj["lat"]  # what the user states: the oracle's point
+    ls.scene["intersection"]["lon"] = oj["lon"]
+    return inter, ls, ""
+
+
 def run_scenes(
     n: int, seed: int, maps: dict[str, MapData]
 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
@@ -232,34 +265,13 @@ def run_scenes(
     for i, (name, oj) in enumerate(order):
         m = maps[name]
         base = {"place": name, "oracle": [oj["lat"], oj["lon"]], "oracle_streets": oj["streets"]}
-        inter, warnings = m.match_intersection(
-            lat=oj["lat"], lon=oj["lon"], max_distance_m=ORACLE_MATCH_M
-        )
-        if inter is None:
-            rows.append({**base, "placed": False, "reason": "no modelled junction: " + warnings[0]})
-            continue
-        base["intersection"] = inter.id
-        if not inter.corners:
-            rows.append(
-                {**base, "placed": False, "reason": f"{inter.kind} junction without kerb corners"}
-            )
-            continue
-        rng = np.random.default_rng([seed, i])
-        ls = make_located_scene(
-            m,
-            inter,
-            rng,
-            noise=noise,
-            corner_sigma_m=1.5,
-            n_references=2,
-            min_corners=1,
-            max_corners=4,
-        )
+        inter, ls, reason = oracle_scene(m, oj, np.random.default_rng([seed, i]), noise)
+        if inter is not None:
+            base["intersection"] = inter.id
         if ls is None:
-            rows.append({**base, "placed": False, "reason": "no camera placement found"})
+            rows.append({**base, "placed": False, "reason": reason})
             continue
-        ls.scene["intersection"]["lat"] = oj["lat"]  # what the user states: the oracle's point
-        ls.scene["intersection"]["lon"] = oj["lon"]
+        assert inter is not None  # a scene stands at a matched junction
         scene = parse_scene(ls.scene)
         t0 = time.perf_counter()
         try:

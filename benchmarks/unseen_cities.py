@@ -66,7 +66,6 @@ CONFIDENT_M = 15.0
 """A top candidate farther than this from the truth is wrong."""
 SIGMA_COVER = 2.0
 """A wrong top candidate whose ``SIGMA_COVER * sigma_m`` reaches the truth is not confident."""
-ORACLE_MATCH_M = 15.0
 
 
 def _entry(res: Any, lat: float, lon: float) -> dict[str, Any]:
@@ -107,11 +106,13 @@ def locate_city(
     name: str, lat: float, lon: float, radius_m: float, junctions: list[dict[str, Any]], n: int
 ) -> dict[str, Any]:
     """Synthetic cameras at up to ``n`` oracle junctions of one city, located two ways."""
+    from absolute import oracle_scene  # benchmarks/absolute.py: its cameras, made alike
+
     from camloc_geo.absolute import apply_cues, locate
     from camloc_geo.osm import load_map
     from camloc_geo.relative import calibrate
     from camloc_geo.scene import parse_scene
-    from camloc_geo.testing.synthetic import NoiseModel, make_located_scene
+    from camloc_geo.testing.synthetic import NoiseModel
 
     m = load_map(OSM / name, lat, lon, radius_m)
     chosen = _oracle_near(junctions, m)[:n]
@@ -119,34 +120,13 @@ def locate_city(
     rows: list[dict[str, Any]] = []
     for i, oj in enumerate(chosen):
         base = {"oracle": [round(oj["lat"], 7), round(oj["lon"], 7)], "streets": oj["streets"]}
-        inter, warnings = m.match_intersection(
-            lat=oj["lat"], lon=oj["lon"], max_distance_m=ORACLE_MATCH_M
-        )
-        if inter is None:
-            rows.append({**base, "placed": False, "reason": "no modelled junction: " + warnings[0]})
-            continue
-        base["intersection"] = inter.id
-        base["kind"] = inter.kind
-        if not inter.corners:
-            rows.append(
-                {**base, "placed": False, "reason": f"{inter.kind} junction without kerb corners"}
-            )
-            continue
-        ls = make_located_scene(
-            m,
-            inter,
-            np.random.default_rng([0, i]),
-            noise=noise,
-            corner_sigma_m=1.5,
-            n_references=2,
-            min_corners=1,
-            max_corners=4,
-        )
+        inter, ls, reason = oracle_scene(m, oj, np.random.default_rng([0, i]), noise)
+        if inter is not None:
+            base["intersection"] = inter.id
+            base["kind"] = inter.kind
         if ls is None:
-            rows.append({**base, "placed": False, "reason": "no camera placement found"})
+            rows.append({**base, "placed": False, "reason": reason})
             continue
-        ls.scene["intersection"]["lat"] = oj["lat"]
-        ls.scene["intersection"]["lon"] = oj["lon"]
         row: dict[str, Any] = {**base, "placed": True, "methods": {}}
         try:
             cal = calibrate(parse_scene(ls.scene))
