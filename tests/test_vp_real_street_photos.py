@@ -13,16 +13,7 @@ PIL_Image = pytest.importorskip("PIL.Image")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 vp_real = pytest.importorskip("vp_real")
 
-
-def _jpeg(path: Path, size: tuple[int, int], sub_tags: dict[int, object]) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    im = PIL_Image.new("RGB", size, (128, 128, 128))
-    exif = PIL_Image.Exif()
-    sub = exif.get_ifd(0x8769)
-    for k, v in sub_tags.items():
-        sub[k] = v
-    im.save(path, exif=exif)
-    return path
+from test_vp_real_loader import _jpeg  # noqa: E402  (an EXIF-tagged JPEG)
 
 
 def _sha(path: Path) -> str:
