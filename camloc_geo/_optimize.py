@@ -277,6 +277,7 @@ def soft_l1_least_squares_small(
     max_nfev: int = 200,
     damping: float = 1e-3,
     sigma_tol: float | None = None,
+    stop: Callable[[float, FloatArray, FloatArray], bool] | None = None,
 ) -> LeastSquaresResult:
     """:func:`soft_l1_least_squares` (``method="lm"``, with ``fun_and_jac``), step for step.
 
@@ -292,6 +293,10 @@ def soft_l1_least_squares_small(
         The residuals ``(m,)`` and their Jacobian ``(m, n)`` at ``x`` from one call.
     x0, f_scale, project, tol, max_nfev, damping, sigma_tol
         As :func:`soft_l1_least_squares`.
+    stop
+        Called at each step's start with the cost, the normal matrix ``Jᵀ W J`` and the
+        gradient ``Jᵀ W r`` at ``x``; True ends the fit there (``success`` False), for a
+        caller that needs only to know whether the cost gets below some level.
     """
     x = np.asarray(x0, dtype=np.float64).copy()
     if project is not None:
@@ -312,6 +317,8 @@ def soft_l1_least_squares_small(
         Jw = J * w[:, None]
         A = J.T @ Jw
         g = Jw.T @ r
+        if stop is not None and stop(cost, A, g):
+            break
         if np.max(np.abs(g)) * max(1.0, float(np.max(np.abs(x)))) < tol * max(cost, 1e-300):
             success = True
             break
