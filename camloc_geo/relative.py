@@ -760,6 +760,21 @@ def _cluster(
 
 
 # ----------------------------------------------------------------------------- joint fit
+def _robust_normal_matrix(
+    prob: _JointProblem,
+    x: FloatArray,
+    R0: FloatArray,
+    pp_fixed: tuple[float, float] | None,
+    f_fixed: float | None,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """At ``x``: the residuals ``r``, the soft-L1-weighted Jacobian ``W J`` and the robust
+    Gauss-Newton normal matrix ``H = Jᵀ W J`` (the sensitivities' ``−H⁻¹ Jᵀ W dr``)."""
+    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
+    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
+    JW = J * w[:, None]
+    return r, JW, J.T @ JW
+
+
 def _ground_corner_sensitivity(
     prob: _JointProblem,
     x: FloatArray,
@@ -782,10 +797,7 @@ def _ground_corner_sensitivity(
     rel = prob.ground_corner_sigma_rel
     if rel <= 0.0:
         return None
-    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
-    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
-    JW = J * w[:, None]
-    H = J.T @ JW
+    r, JW, H = _robust_normal_matrix(prob, x, R0, pp_fixed, f_fixed)
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
     steps, live = prob.ground_corner_steps()
     if not np.any(live):
@@ -830,10 +842,7 @@ def _size_shape_sensitivity(
     """
     if size_sigma_rel <= 0.0:
         return None
-    r, J = prob.residuals_and_jacobian(x, R0, pp_fixed, f_fixed)
-    w = 1.0 / np.sqrt(1.0 + (r / _F_SCALE) ** 2)
-    JW = J * w[:, None]
-    H = J.T @ JW
+    _r, JW, H = _robust_normal_matrix(prob, x, R0, pp_fixed, f_fixed)
     n_seg, n_pt = len(prob.segments), len(prob.pt_pix)
     f, pp, R, C = prob.unpack(x, R0, pp_fixed, f_fixed)
     cam = Camera.from_center(f, pp, R, C)
@@ -3013,8 +3022,8 @@ def _held_focal_fit_drops(
 
     :func:`_fit`'s steps (:func:`camloc_geo._optimize.soft_l1_least_squares_small`'s
     Levenberg-Marquardt, the same damping), from ``x0``, but only as far as the answer
-    needs (its ``stop``): True as soon as a step's cost is below ``target_cost``; False once the cost
-    stands above it by more than ``FOCAL_PROFILE_STOP_GAIN`` times the undamped
+    needs (its ``stop``): True as soon as a step's cost is below ``target_cost``; False
+    once the cost stands above it by more than ``FOCAL_PROFILE_STOP_GAIN`` times the undamped
     Gauss-Newton step's predicted gain plus a hundredth of ``s2`` (the residual variance
     factor), or where the full fit would have stopped. A full fit ends below
     ``target_cost`` only through a step below it, so True matches it wherever the stop
