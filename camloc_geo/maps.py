@@ -1847,6 +1847,10 @@ _VERDICT_CSS = """
 .camloc-verdicts input { width: 8em; margin: 0; }
 .camloc-verdicts .camloc-vwarn { color: #b00020; display: block; }
 .camloc-verdicts .camloc-vshare { flex-basis: 100%; color: #1b5e20; }
+.camloc-verdicts .camloc-vkey { flex-basis: 100%; margin: 2px 0 0; }
+.camloc-verdicts .camloc-vkey[hidden] { display: none; }
+.camloc-verdicts .camloc-vkey span { display: block; }
+.camloc-verdicts .camloc-vkey input { width: 12em; margin-right: 4px; }
 .camloc-cluster .camloc-cbadge { position: absolute; top: 34px; left: 50%;
   transform: translateX(-50%); display: flex; gap: 1px; white-space: nowrap;
   pointer-events: none; }
@@ -1921,6 +1925,9 @@ class _Verdicts(MacroElement):
     var map = {{ this._parent.get_name() }};
     var KEY = {{ this.store|tojson }} + cfg.kind + "/" + cfg.identity;
     var WHO = {{ this.store|tojson }} + "reviewer";
+    // the service's API key, when it wants one for changes: asked once (on the first 401),
+    // kept for this tab's session only (sessionStorage), sent as X-API-Key
+    var APIKEY = {{ this.store|tojson }} + "service-key";
     var SYM = {yes: "\\u2713", no: "\\u2717", unsure: "?"};
     var LABEL = cfg.labels;
     var store = null;
@@ -2034,18 +2041,75 @@ class _Verdicts(MacroElement):
     }
     function answer(r) {
         if (r.ok) { return r.json(); }
+        function refused(text) {
+            var e = new Error(text);
+            e.status = r.status;
+            throw e;
+        }
         return r.json().then(function (b) {
-            throw (b && b.error && b.error.message) || ("HTTP " + r.status);
-        }, function () { throw "HTTP " + r.status; });
+            refused((b && b.error && b.error.message) || ("HTTP " + r.status));
+        }, function () { refused("HTTP " + r.status); });
+    }
+    var keyBox = null, keyInput = null, keyText = null, keyHost = null, panelDiv = null;
+    function apiKey() {
+        try { return window.sessionStorage.getItem(APIKEY) || ""; } catch (e) { return ""; }
+    }
+    function askKey(message, hadKey) {  // a change refused for its key: say so, ask for it
+        try { window.sessionStorage.removeItem(APIKEY); } catch (e) { /* no storage */ }
+        shared("not shared with the service: the change was refused (401: " + message +
+               "); kept in this browser only", true);
+        if (!keyHost) { return; }
+        if (!keyBox) { makeKeyBox(); }
+        keyText.textContent = hadKey
+            ? "The service refused that key. Enter its API key again:"
+            : "The service needs its API key for changes. Enter it (asked once a session):";
+        keyBox.hidden = false;
+        if (panelDiv) {  // a folded panel would hide the question
+            L.DomUtil.removeClass(panelDiv, "folded");
+        }
+    }
+    function makeKeyBox() {
+        keyBox = el("form", "camloc-vkey");
+        var keyLabel = el("label");
+        keyText = el("span");
+        keyInput = el("input");
+        keyInput.type = "password";
+        keyInput.autocomplete = "off";
+        keyInput.setAttribute("aria-label", "the service's API key");
+        keyLabel.appendChild(keyText);
+        keyLabel.appendChild(keyInput);
+        keyBox.appendChild(keyLabel);
+        var keySend = el("button", "camloc-vkeysend", "Send");
+        keySend.type = "submit";
+        keyBox.appendChild(keySend);
+        keyBox.addEventListener("submit", function (ev) {
+            ev.preventDefault();
+            var key = keyInput.value.trim();
+            if (!key) { return; }
+            try { window.sessionStorage.setItem(APIKEY, key); } catch (e) { /* none */ }
+            keyInput.value = "";
+            keyBox.hidden = true;
+            pull();  // reads the service's and sends this browser's newer verdicts
+        });
+        L.DomEvent.on(keyInput, "keydown keypress keyup", L.DomEvent.stopPropagation);
+        keyHost.appendChild(keyBox);
+    }
+    function sending(hadKey) {
+        return function (e) {
+            if (e && e.status === 401) { askKey(e.message, hadKey); return; }
+            failed("sending")(e && e.message ? e.message : e);
+        };
     }
     function share(keys) {
         if (!remote || !keys.length) { return; }
         var body = {items: {}};
         keys.forEach(function (k) { if (cfg.items[k]) { body.items[k] = wire(k); } });
         shared("sharing\u2026", false);
-        fetch(remote, {method: "POST", headers: {"Content-Type": "application/json"},
+        var headers = {"Content-Type": "application/json"}, key = apiKey();
+        if (key) { headers["X-API-Key"] = key; }
+        fetch(remote, {method: "POST", headers: headers,
                        body: JSON.stringify(body), credentials: "same-origin"})
-            .then(answer).then(function (doc) { adopt(doc, false); }, failed("sending"));
+            .then(answer).then(function (doc) { adopt(doc, false); }, sending(!!key));
     }
     function adopt(doc, pushBack) {
         // the service's items newer than this browser's are taken; this browser's newer
@@ -2092,7 +2156,9 @@ class _Verdicts(MacroElement):
     function pull() {
         if (!remote) { return; }
         fetch(remote, {credentials: "same-origin", cache: "no-store"})
-            .then(answer).then(function (doc) { adopt(doc, true); }, failed("reading"));
+            .then(answer).then(function (doc) { adopt(doc, true); }, function (e) {
+                failed("reading")(e && e.message ? e.message : e);
+            });
     }
     function rerender() {  // an open popup's controls follow a verdict that came in
         document.querySelectorAll(".leaflet-popup .camloc-verdict[data-verdict-key]")
@@ -2244,6 +2310,7 @@ class _Verdicts(MacroElement):
     var panel = L.control({position: small ? "topright" : "bottomright"});
     panel.onAdd = function () {
         var div = L.DomUtil.create("div", "camloc-verdicts" + (folded ? " folded" : ""));
+        panelDiv = div;
         div.setAttribute("role", "region");
         div.setAttribute("aria-label", "verdicts");
         var head = el("div", "camloc-vhead");
@@ -2291,6 +2358,7 @@ class _Verdicts(MacroElement):
             shareBox = el("small", "camloc-vshare", "sharing\u2026");
             shareBox.setAttribute("aria-live", "polite");
             tools.appendChild(shareBox);
+            keyHost = tools;  // the key field is made on the first refusal
         }
         div.appendChild(tools);
         warnBox = el("small", "camloc-vwarn");

@@ -566,6 +566,119 @@ def test_job_map_reviewers_share_a_pick(
         bo.close()
 
 
+# ------------------------------------------------------ session 37: changes need the key
+KEY = "s3cret-key"
+
+
+@pytest.fixture(scope="module")
+def kserver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    """A server with ``CAMLOC_API_KEY``: verdict changes need ``X-API-Key``."""
+    tmp = tmp_path_factory.mktemp("kservice")
+    srv = Server(tmp, CAMLOC_API_KEY=KEY, CAMLOC_REQUEST_TIMEOUT_S="300")
+    srv.start()
+    yield srv
+    srv.stop()
+
+
+def test_verdict_changes_need_the_key_reads_stay_open(kserver: Server) -> None:
+    body = {"items": {"3": {"verdict": "yes", "reviewer": "Ana"}}}
+    with httpx.Client(base_url=kserver.url, timeout=60.0) as c:
+        for headers in ({}, {"X-API-Key": "wrong"}, {"X-API-Key": ""}):
+            r = c.post(URL, json=body, headers=headers)
+            assert r.status_code == 401, (headers, r.text)
+            assert r.json()["error"] == {
+                "type": "unauthorized",
+                "message": "missing or wrong X-API-Key",
+                "field": "X-API-Key",
+            }
+        assert c.get(URL).json()["items"] == {}  # nothing was stored
+        r = c.post(URL, json=body, headers={"X-API-Key": KEY})
+        assert r.status_code == 200, r.text
+        assert r.json()["taken"] == ["3"]
+        # reads need no key: the page, its export, the list
+        assert c.get(URL).json()["items"]["3"]["verdict"] == "yes"
+        assert c.get(URL, params={"format": "csv"}).status_code == 200
+        assert c.get("/v1/verdicts").status_code == 200
+        # the refusal comes before the body is looked at: a bad body without the key is 401
+        assert c.post(URL, json={"items": {"x": 1}}).status_code == 401
+        spec = c.get("/openapi.json").json()
+        op = spec["paths"]["/v1/verdicts/{page}/{identity}"]["post"]
+        assert any(p["name"].lower() == "x-api-key" for p in op["parameters"])
+        assert "401" in op["responses"]
+
+
+@pytest.mark.browser
+@needs_browser
+def test_served_page_asks_for_the_key_once_and_says_a_refusal(
+    browser: Any, kserver: Server, served_page: str, tmp_path: Path
+) -> None:
+    """A reviewer on a server with a key: the first change is refused (401) and the page
+    says so and asks for the key; with a wrong key it asks again; with the right one the
+    verdict given before reaches the service, and the next change goes without asking."""
+    found = re.search(r"var cfg = (\{.*?\});\n", served_page)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    client = httpx.Client(base_url=kserver.url, timeout=60.0)
+    ana = _Reviewer(browser, kserver.url, served_page, "Ana")
+    try:
+        ana.open()
+        page = ana.page
+        share = page.locator(".camloc-vshare")
+        keybox = page.locator(".camloc-verdicts form.camloc-vkey")
+        assert not keybox.is_visible()  # not asked before a change is refused
+        page.locator('.camloc-candidate [data-rank="2"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="yes"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="yes"]').click()
+        keybox.wait_for(state="visible", timeout=5000)
+        text = share.inner_text()
+        assert "refused (401: missing or wrong X-API-Key)" in text, text
+        assert "kept in this browser only" in text
+        assert share.get_attribute("class") == "camloc-vshare bad"
+        assert "needs its API key" in keybox.inner_text()
+        assert client.get(url).json()["items"] == {}
+        page.screenshot(path=str(tmp_path / "asks-key.png"))
+        # a wrong key: refused again, asked again
+        keybox.locator("input").fill("nope")
+        keybox.locator("button").click()
+        page.wait_for_function(
+            "document.querySelector('.camloc-vkey').textContent.includes('refused that key')",
+            timeout=5000,
+        )
+        assert keybox.is_visible()
+        assert client.get(url).json()["items"] == {}
+        # the right key: the verdict given before is sent
+        keybox.locator("input").fill(KEY)
+        keybox.locator("button").click()
+        page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (1 there)'",
+            timeout=5000,
+        )
+        assert not keybox.is_visible()
+        assert client.get(url).json()["items"]["2"]["verdict"] == "yes"
+        # the next change goes at once, with the key kept for the session
+        page.locator('.camloc-candidate [data-rank="1"]').click()
+        box1 = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="1"]')
+        box1.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box1.locator('button[data-verdict="no"]').click()
+        page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent === "
+            "'shared with the service (2 there)'",
+            timeout=5000,
+        )
+        assert not keybox.is_visible()
+        assert client.get(url).json()["items"]["1"]["verdict"] == "no"
+        stored = "window.localStorage.getItem('camloc-verdicts/v1/service-key')"
+        assert page.evaluate(stored) is None  # the session's only
+        assert ana.blocked == []
+        assert ana.errors == []
+    finally:
+        ana.close()
+        client.close()
+
+
 # ------------------------------------------------------- session 36 QA: the store's failures
 def test_verdict_folder_that_cannot_hold_the_file_is_one_clear_error(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]

@@ -1,6 +1,7 @@
 """Verdict endpoints: reviewers of one page share their verdicts through the service.
 
-Open like the annotation pages' submissions (a reviewer's browser has no API key): the
+Reads are open; with ``CAMLOC_API_KEY`` set, a change (``POST``) needs ``X-API-Key`` like the
+other write endpoints (the served pages ask the reviewer for it once, on the first 401): the
 pages served by the service post here; see docs/service.md, "Verdicts".
 """
 
@@ -13,6 +14,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
 from starlette.concurrency import run_in_threadpool
 
+from camloc_geo.service.deps import ApiKey
 from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
 from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
 
@@ -80,12 +82,13 @@ async def page_verdicts(
     )
 
 
-@router.post(VERDICTS_PATH + "/{page}/{identity}")
+@router.post(VERDICTS_PATH + "/{page}/{identity}", dependencies=[ApiKey])
 async def post_verdicts(
     page: VerdictPage, identity: VerdictIdentity, body: VerdictPost, store: Verdicts
 ) -> dict[str, Any]:
     """Add or change verdicts on a page: each item replaces the stored one of its key unless
-    that one is newer. Answers the page's verdicts after the change and the keys taken."""
+    that one is newer. Answers the page's verdicts after the change and the keys taken.
+    With ``CAMLOC_API_KEY`` set: ``X-API-Key`` is needed (401 without it)."""
     now = datetime.now(timezone.utc)
     items = {key: item.stored(now) for key, item in body.items.items()}
     # (in the thread pool: SQLite may wait up to 30 s for another process's lock, which
