@@ -1591,6 +1591,7 @@ def build_summary_map(
     map_data: MapData | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
     verdict_service: str | None = None,
+    tiles_attribution: str | None = None,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -1614,6 +1615,9 @@ def build_summary_map(
     verdict_service
         A camloc service's verdicts endpoint, shared when the page is opened over HTTP (see
         :func:`build_candidates_map`).
+    tiles_attribution
+        With ``tiles`` a tile URL template (``https://.../{z}/{x}/{y}.png``): its attribution
+        (plain text), the layer named "Basemap". Without it ``tiles`` is taken as before.
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
@@ -1635,7 +1639,17 @@ def build_summary_map(
         location = (float(lats.mean()), float(lons.mean()))
     else:
         location = (0.0, 0.0)
-    fmap = _new_map(offline, None if offline else tiles, location)
+    if tiles_attribution is not None and tiles and not offline:
+        fmap = _new_map(offline, None, location)
+        folium.TileLayer(
+            tiles,
+            name="Basemap",
+            attr=html.escape(tiles_attribution),
+            max_zoom=22,
+            max_native_zoom=19,
+        ).add_to(fmap)
+    else:
+        fmap = _new_map(offline, None if offline else tiles, location)
     if map_data is not None:
         radius = float(min(getattr(map_data, "radius_m", 400.0) or 400.0, 500.0))
         _map_layers(fmap, map_data, map_data.frame, np.zeros(2), radius)
@@ -1750,6 +1764,89 @@ def build_summary_map(
             max_zoom=18,
         )
     return fmap
+
+
+@lru_cache(maxsize=1)
+def markercluster_assets() -> tuple[str, str]:
+    """Leaflet.markercluster's JS and CSS (its two stylesheets) from the xstatic package."""
+    import xstatic.pkg.leaflet_markercluster as xmc
+
+    base = Path(xmc.BASE_DIR)
+    js = (base / "leaflet.markercluster.js").read_text(encoding="utf-8")
+    js = re.sub(r"//# sourceMappingURL=\S+", "", js)
+    css = (base / "MarkerCluster.css").read_text(encoding="utf-8") + (
+        base / "MarkerCluster.Default.css"
+    ).read_text(encoding="utf-8")
+    if "</script" in js.lower() or "</style" in css.lower():
+        raise ValueError("leaflet.markercluster cannot be inlined")
+    return js, css
+
+
+def summary_page(
+    items: Iterable[tuple[str, Any]],
+    *,
+    tiles: str | None = None,
+    tiles_attribution: str | None = None,
+    verdict_service: str | None = None,
+    verdicts: Sequence[Mapping[str, Any]] | None = None,
+) -> str:
+    """The summary page as one self-contained HTML text, with clusters.
+
+    Leaflet, jQuery and Leaflet.markercluster are inlined (no CDN), so the markers are
+    clustered with the verdict counts under each cluster (as ``camloc batch --map``'s page);
+    a basemap only when ``tiles`` is given: then its tiles are the page's only requests
+    (besides ``verdict_service``'s, opened over HTTP).
+
+    Parameters
+    ----------
+    items, verdicts, verdict_service
+        As :func:`build_summary_map`.
+    tiles
+        A tile URL template (``https://tiles.example.org/{z}/{x}/{y}.png``), or None: no
+        basemap, the page makes no request of its own.
+    tiles_attribution
+        The basemap's attribution (plain text; default ``basemap: <host>``).
+
+    Returns
+    -------
+    str
+        The page.
+    """
+    attribution = None
+    if tiles:
+        from urllib.parse import urlsplit
+
+        attribution = tiles_attribution or f"basemap: {urlsplit(tiles).hostname or tiles}"
+    fmap = build_summary_map(
+        items,
+        offline=False,
+        tiles=tiles or None,
+        tiles_attribution=attribution,
+        cluster=True,
+        verdicts=verdicts,
+        verdict_service=verdict_service,
+    )
+    page = fmap.get_root().render()
+    page = re.sub(
+        r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
+        lambda _m: "<!--camloc:markercluster_js-->",
+        page,
+    )
+    page = re.sub(
+        r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
+        lambda _m: "<!--camloc:markercluster_css-->",
+        page,
+    )
+    if not tiles:  # without a tile layer the map has no maxZoom, which the clusters need
+        page = re.sub(
+            r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
+        )
+    page = inline_assets(page, tiles=bool(tiles))
+    js, css = markercluster_assets()
+    page = page.replace("<!--camloc:markercluster_css-->", "<style>" + css + "</style>", 1)
+    page = page.replace("<!--camloc:markercluster_css-->", "")
+    page = page.replace("<!--camloc:markercluster_js-->", "<script>" + js + "</script>", 1)
+    return page.replace("<!--camloc:markercluster_js-->", "")
 
 
 def summary_map(
@@ -2719,13 +2816,16 @@ _SCRIPT_SRC = re.compile(r"<script\b[^>]*\bsrc=\"([^\"]+)\"[^>]*>\s*</script>", 
 _CSS_LINK = re.compile(r"<link\b[^>]*\bhref=\"([^\"]+)\"[^>]*/?>", re.IGNORECASE)
 
 
-def inline_assets(page: str) -> str:
+def inline_assets(page: str, *, tiles: bool = False) -> str:
     """Make a folium page self-contained: inline Leaflet and jQuery, drop other remote assets.
 
     Parameters
     ----------
     page
         HTML rendered by folium.
+    tiles
+        Keep the page's tile layers (a basemap configured on purpose, :func:`summary_page`):
+        its tiles are then the page's only remote requests. Default: a tile layer is an error.
 
     Returns
     -------
@@ -2773,7 +2873,7 @@ def inline_assets(page: str) -> str:
         flags=re.IGNORECASE,
     )
     leftovers += re.findall(r"url\(\s*[\"']?(?:https?:)?//[^)]*\)", out, flags=re.IGNORECASE)
-    if re.search(r"L\.tileLayer\(", out):
+    if not tiles and re.search(r"L\.tileLayer\(", out):
         leftovers.append("L.tileLayer(...)")
     if leftovers:
         raise ValueError(f"offline page still references remote resources: {leftovers[:3]}")

@@ -511,9 +511,36 @@ def test_job_map_is_a_shared_summary_page(vclient: httpx.Client, job_page: dict[
     from test_maps import remote_references
 
     assert remote_references(job_page["html"]) == []  # an offline page
+    # clustered (session 37): the cluster plug-in is inlined, not fetched; no basemap
+    html_text = job_page["html"]
+    assert "L.markerClusterGroup(" in html_text
+    assert "markercluster" not in " ".join(re.findall(r'(?:src|href)="([^"]+)"', html_text))
+    assert "MarkerClusterGroup" in html_text.split("L.markerClusterGroup(")[0]  # inlined JS
+    assert "marker-cluster-small" in html_text  # its stylesheet too
+    assert "maxZoom: 22" in html_text  # (the cluster plug-in needs one without tiles)
+    assert "L.tileLayer(" not in html_text
     r = vclient.get("/v1/jobs/" + "0" * 32 + "/map")
     assert r.status_code == 404
     assert r.json()["error"]["type"] == "not_found"
+
+
+def _show_marker(page: Any, key: str) -> None:
+    """Zoom the summary page's cluster layer until camera ``key``'s marker is out of its
+    cluster (its cameras are clustered at the page's first view when they lie close)."""
+    page.evaluate(
+        """(key) => new Promise((done) => {
+            const name = Object.keys(window).find(
+                (k) => k.startsWith("map_") && window[k] instanceof L.Map);
+            window[name].eachLayer((group) => {
+                if (typeof group.zoomToShowLayer !== "function") { return; }
+                const m = group.getLayers().find((l) => (l.options.icon.options.html || "")
+                    .includes('data-verdict-mark="' + key + '"'));
+                if (m) { group.zoomToShowLayer(m, done); }
+            });
+        })""",
+        key,
+    )
+    page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').wait_for(timeout=5000)
 
 
 @pytest.mark.browser
@@ -528,6 +555,7 @@ def test_job_map_reviewers_share_a_pick(
     bo = _Reviewer(browser, vserver.url, job_page["html"], "Bo")
     try:
         ana.open()
+        _show_marker(ana.page, key)
         marker = ana.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]')
         marker.click()
         box = ana.page.locator(".leaflet-popup-content .camloc-verdict")
@@ -543,6 +571,7 @@ def test_job_map_reviewers_share_a_pick(
             "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
             timeout=5000,
         )
+        _show_marker(bo.page, key)
         bo.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
         bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
         bbox.locator("select").wait_for(timeout=3000)
@@ -564,6 +593,152 @@ def test_job_map_reviewers_share_a_pick(
     finally:
         ana.close()
         bo.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_job_map_clusters_count_the_verdicts(
+    browser: Any, vserver: Server, vclient: httpx.Client, job_page: dict[str, Any], tmp_path: Path
+) -> None:
+    """The served job page clusters its cameras, the cluster icon counting the verdicts
+    inside (as ``camloc batch --map``'s page), with no request but the service's."""
+    cfg = job_page["cfg"]
+    key = next(k for k, it in cfg["items"].items() if it["camera"].startswith("c1 "))
+    mapvar = re.search(r"var (map_[0-9a-f]+) = L\.map\(", job_page["html"])
+    assert mapvar is not None
+    ana = _Reviewer(browser, vserver.url, job_page["html"], "Ana")
+    try:
+        ana.open()
+        page = ana.page
+        # close together, the two cameras are one cluster at the page's first view
+        cluster = page.locator(".marker-cluster.camloc-cluster")
+        assert cluster.count() == 1
+        assert cluster.locator("div > span").inner_text() == "2"
+        _show_marker(page, key)
+        page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
+        box = page.locator(f'.leaflet-popup-content .camloc-verdict[data-verdict-key="{key}"]')
+        box.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="no"]').click()
+        page.wait_for_function(
+            "document.querySelector('.camloc-vshare').textContent.startsWith("
+            "'shared with the service')",
+            timeout=5000,
+        )
+        page.evaluate(f"{mapvar.group(1)}.closePopup(); {mapvar.group(1)}.setZoom(11)")
+        cluster.first.wait_for(timeout=5000)
+        assert cluster.count() == 1
+        assert cluster.locator("div > span").inner_text() == "2"
+        badge = cluster.locator(".camloc-cbadge")
+        page.wait_for_function(
+            "(document.querySelector('.camloc-cluster .camloc-cbadge') || {}).textContent"
+            " && document.querySelector('.camloc-cluster .camloc-cbadge').textContent"
+            ".includes('\u27171')",
+            timeout=5000,
+        )
+        assert "\u27171" in badge.inner_text()  # c1's "no"
+        # (inside the cluster: gone once the zoom's animation is over)
+        page.locator(".camloc-summary-marker").first.wait_for(state="detached", timeout=5000)
+        page.screenshot(path=str(tmp_path / "job-clusters.png"))
+        # zoomed in again, the marker comes back with its badge
+        _show_marker(page, key)
+        mark = page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]')
+        assert mark.get_attribute("data-verdict") == "no"
+        assert ana.blocked == []
+        assert ana.errors == []
+    finally:
+        ana.close()
+
+
+TILES = "https://tiles.example.test/{z}/{x}/{y}.png"
+_CAMS = [
+    {
+        "id": f"t{i}",
+        "title": f"title {i}",
+        "lat": 39.2856 + 0.0004 * i,
+        "lon": -76.5935,
+        "status": "title_only",
+        "method": "title",
+        "score": 0.4,
+    }
+    for i in range(4)
+] + [{"id": "none", "status": "no_candidates", "reason": "no junction"}]
+
+
+def test_job_summary_page_basemap_only_when_configured(monkeypatch: pytest.MonkeyPatch) -> None:
+    from camloc_geo.service.routers.jobs import job_summary_page
+    from camloc_geo.service.settings import Settings
+
+    plain = job_summary_page(_CAMS)
+    assert "L.tileLayer(" not in plain
+    assert "tiles.example" not in plain
+    page = job_summary_page(_CAMS, TILES, "© Tiles & Co <b>")
+    assert page.count("L.tileLayer(") == 1
+    assert json.dumps(TILES) in page
+    # the attribution is text, not markup (escaped, then written as JSON)
+    assert '"attribution": "\\u00a9 Tiles \\u0026amp; Co \\u0026lt;b\\u0026gt;"' in page
+    assert "L.markerClusterGroup(" in page
+    srcs = re.findall(r'<(?:script|link)\b[^>]*(?:src|href)="([^"]+)"', page)
+    assert srcs == []  # Leaflet and the cluster plug-in inlined: the tiles are the requests
+    assert "basemap: tiles.example.test" in job_summary_page(_CAMS, TILES)  # default credit
+    monkeypatch.setenv("CAMLOC_TILE_URL", TILES)
+    assert Settings().tile_url == TILES
+    monkeypatch.delenv("CAMLOC_TILE_URL")
+    assert Settings().tile_url is None  # the default: no basemap
+    for bad, said in (
+        ("tiles.example.test/{z}/{x}/{y}.png", "must start with https://"),
+        ("https://tiles.example.test/{z}/{x}.png", "missing {y}"),
+        ('https://t.example/{z}/{x}/{y}.png"', "not a URL template"),
+    ):
+        monkeypatch.setenv("CAMLOC_TILE_URL", bad)
+        with pytest.raises(ValueError, match=re.escape(said)):
+            Settings()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_job_summary_page_basemap_in_chromium(browser: Any, tmp_path: Path) -> None:
+    """With a tile URL the page asks for its tiles there, and for nothing else."""
+    import base64
+
+    from camloc_geo.service.routers.jobs import job_summary_page
+
+    png = base64.b64decode(
+        "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg=="
+    )
+    path = tmp_path / "job.html"
+    path.write_text(job_summary_page(_CAMS, TILES), encoding="utf-8")
+    context = browser.new_context(viewport={"width": 1000, "height": 700})
+    page = context.new_page()
+    tiles: list[str] = []
+    other: list[str] = []
+    errors: list[str] = []
+
+    def route(r: Any) -> None:
+        url = r.request.url
+        if url.startswith("https://tiles.example.test/"):
+            tiles.append(url)
+            r.fulfill(status=200, body=png, content_type="image/png")
+        elif url.startswith(("file:", "data:")):
+            r.continue_()
+        else:
+            other.append(url)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    try:
+        page.goto(path.as_uri(), wait_until="load")
+        page.wait_for_selector(".leaflet-tile-loaded", timeout=5000)
+        assert tiles
+        assert all(re.fullmatch(r"https://tiles\.example\.test/\d+/\d+/\d+\.png", u) for u in tiles)
+        assert (
+            "basemap: tiles.example.test"
+            in page.locator(".leaflet-control-attribution").inner_text()
+        )
+        assert other == []
+        assert errors == []
+    finally:
+        context.close()
 
 
 # ------------------------------------------------------ session 37: changes need the key

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pydantic import Field, SecretStr
+from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 __all__ = ["Settings", "default_data_dir"]
@@ -88,3 +88,33 @@ class Settings(BaseSettings):
         default=3, ge=1, le=50, description="default annotations collected before a task is located"
     )
     max_radius_m: float = Field(default=2_000.0, gt=0, description="largest corners/streets radius")
+    tile_url: str | None = Field(
+        default=None,
+        description=(
+            "basemap tile URL template (https://.../{z}/{x}/{y}.png) under a job's summary "
+            "page; none (default): no basemap, the page makes no request of its own"
+        ),
+    )
+    tile_attribution: str | None = Field(
+        default=None,
+        max_length=300,
+        description="the basemap's attribution, plain text (default: 'basemap: <host>')",
+    )
+
+    @field_validator("tile_url")
+    @classmethod
+    def _tile_template(cls, value: str | None) -> str | None:
+        if value is None or not value.strip():
+            return None
+        value = value.strip()
+        if not value.startswith(("https://", "http://")):
+            raise ValueError(f"CAMLOC_TILE_URL must start with https:// or http:// (got {value!r})")
+        missing = [p for p in ("{z}", "{x}", "{y}") if p not in value]
+        if missing:
+            raise ValueError(
+                f"CAMLOC_TILE_URL needs the placeholders {{z}}, {{x}} and {{y}} "
+                f"(missing {', '.join(missing)} in {value!r})"
+            )
+        if len(value) > 2000 or any(c in value for c in "\"'<>` \\"):
+            raise ValueError(f"CAMLOC_TILE_URL is not a URL template: {value!r}")
+        return value

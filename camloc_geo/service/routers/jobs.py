@@ -198,26 +198,40 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
     return items
 
 
-def job_summary_page(results: list[dict[str, Any]]) -> str:
-    """The offline summary page of a job's finished cameras, sharing its reviewers' verdicts
-    through ``/v1/verdicts`` when opened from the server (runs in the thread pool)."""
-    from camloc_geo.maps import build_summary_map, inline_assets
+def job_summary_page(
+    results: list[dict[str, Any]],
+    tile_url: str | None = None,
+    tile_attribution: str | None = None,
+) -> str:
+    """The summary page of a job's finished cameras, clustered (Leaflet and its cluster
+    plug-in inlined), sharing its reviewers' verdicts through ``/v1/verdicts`` when opened
+    from the server; a basemap only with ``tile_url`` (``CAMLOC_TILE_URL``). Runs in the
+    thread pool."""
+    from camloc_geo.maps import summary_page
     from camloc_geo.service.routers.verdicts import VERDICTS_PATH
 
-    fmap = build_summary_map(
-        _summary_items(results), offline=True, tiles=None, verdict_service=VERDICTS_PATH
+    return summary_page(
+        _summary_items(results),
+        tiles=tile_url,
+        tiles_attribution=tile_attribution,
+        verdict_service=VERDICTS_PATH,
     )
-    return inline_assets(fmap.get_root().render())
 
 
 @router.get("/v1/jobs/{job_id}/map", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
-async def job_map(request: Request, job_id: JobId, store: ServiceStore) -> HTMLResponse:
+async def job_map(
+    request: Request, job_id: JobId, store: ServiceStore, settings: ServiceSettings
+) -> HTMLResponse:
     """The summary page of the job's finished cameras (best candidate each, the others to
-    pick from): one offline HTML file whose reviewers share their verdicts here."""
+    pick from, clustered with their verdicts counted): one self-contained HTML file whose
+    reviewers share their verdicts here; a basemap only when ``CAMLOC_TILE_URL`` is set."""
     if store.job(job_id) is None:
         raise NotFoundError(f"no job {job_id}")
     results = store.job_results(job_id)
-    return HTMLResponse(await run_cpu(request, lambda: job_summary_page(results)))
+    tiles, attribution = settings.tile_url, settings.tile_attribution
+    return HTMLResponse(
+        await run_cpu(request, lambda: job_summary_page(results, tiles, attribution))
+    )
 
 
 def camera_work(maps: MapStore, camera: Any, settings: Settings) -> dict[str, Any]:
