@@ -2030,9 +2030,12 @@ class _Verdicts(MacroElement):
     var store = null;
     try { store = window.localStorage; store.getItem(WHO); } catch (e) { store = null; }
     var state = {items: {}};
-    // served by a camloc service (over HTTP): verdicts shared there too; from a file: none
+    // served by a camloc service (over HTTP, cfg.service a path): verdicts shared there too,
+    // from a file none; a page pointed at a service (cfg.service a URL, --verdict-url): there,
+    // from a file too (the service allows the page's origin: CAMLOC_CORS_ORIGINS)
     var remote = null;
-    if (cfg.service && /^https?:$/.test(window.location.protocol)) {
+    var elsewhere = !!cfg.service && /^https?:\\/\\//i.test(cfg.service);
+    if (cfg.service && (elsewhere || /^https?:$/.test(window.location.protocol))) {
         remote = cfg.service.replace(/\\/+$/, "") + "/" + cfg.kind + "/" + cfg.identity;
     }
     function load() {
@@ -2133,7 +2136,12 @@ class _Verdicts(MacroElement):
     }
     function failed(what) {
         return function (e) {
-            shared("not shared with the service (" + what + ": " + e + ")", true);
+            var hint = "";
+            if (elsewhere && /fetch|network/i.test(String(e))) {  // CORS refusals say no more
+                hint = "; is the service up, and this page's origin (" +
+                    window.location.origin + ") in its CAMLOC_CORS_ORIGINS?";
+            }
+            shared("not shared with the service (" + what + ": " + e + hint + ")", true);
         };
     }
     function answer(r) {

@@ -743,13 +743,19 @@ def test_job_summary_page_basemap_in_chromium(browser: Any, tmp_path: Path) -> N
 
 # ------------------------------------------------------ session 37: changes need the key
 KEY = "s3cret-key"
+PAGES = "http://localhost:8765"  # the origin kserver lets share verdicts (and null: files)
 
 
 @pytest.fixture(scope="module")
 def kserver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     """A server with ``CAMLOC_API_KEY``: verdict changes need ``X-API-Key``."""
     tmp = tmp_path_factory.mktemp("kservice")
-    srv = Server(tmp, CAMLOC_API_KEY=KEY, CAMLOC_REQUEST_TIMEOUT_S="300")
+    srv = Server(
+        tmp,
+        CAMLOC_API_KEY=KEY,
+        CAMLOC_REQUEST_TIMEOUT_S="300",
+        CAMLOC_CORS_ORIGINS=f"{PAGES},null",
+    )
     srv.start()
     yield srv
     srv.stop()
@@ -851,6 +857,170 @@ def test_served_page_asks_for_the_key_once_and_says_a_refusal(
         assert ana.errors == []
     finally:
         ana.close()
+        client.close()
+
+
+# ------------------------------------------- session 37: a CLI page pointed at a service
+def test_cors_for_the_configured_origins_on_the_verdict_paths_only(
+    kserver: Server, vserver: Server
+) -> None:
+    pre = {
+        "Access-Control-Request-Method": "POST",
+        "Access-Control-Request-Headers": "content-type,x-api-key",
+    }
+    with httpx.Client(base_url=kserver.url, timeout=60.0) as c:
+        for origin in (PAGES, "null"):
+            r = c.options(URL, headers={"Origin": origin, **pre})
+            assert r.status_code == 200, r.text
+            assert r.headers["access-control-allow-origin"] == origin
+            assert "x-api-key" in r.headers["access-control-allow-headers"].lower()
+            assert "POST" in r.headers["access-control-allow-methods"]
+            r = c.get(URL, headers={"Origin": origin})
+            assert r.headers["access-control-allow-origin"] == origin
+            r = c.post(URL, json={"items": {}}, headers={"Origin": origin})
+            assert r.status_code == 401  # the key is still needed, and the page can read why
+            assert r.headers["access-control-allow-origin"] == origin
+        # another origin: refused preflight, no CORS header
+        r = c.options(URL, headers={"Origin": "http://evil.example", **pre})
+        assert r.status_code == 400
+        assert "access-control-allow-origin" not in r.headers
+        assert (
+            "access-control-allow-origin"
+            not in c.get(URL, headers={"Origin": "http://evil.example"}).headers
+        )
+        # the other endpoints have no CORS, from the allowed origin either
+        r = c.get("/healthz", headers={"Origin": PAGES})
+        assert r.status_code == 200
+        assert "access-control-allow-origin" not in r.headers
+        r = c.options("/v1/locate", headers={"Origin": PAGES, **pre})
+        assert "access-control-allow-origin" not in r.headers
+    # a server without CAMLOC_CORS_ORIGINS: none anywhere
+    with httpx.Client(base_url=vserver.url, timeout=60.0) as c:
+        r = c.get(URL, headers={"Origin": PAGES})
+        assert r.status_code == 200
+        assert "access-control-allow-origin" not in r.headers
+
+
+def test_cors_origins_setting_is_checked(monkeypatch: pytest.MonkeyPatch) -> None:
+    from camloc_geo.service.settings import Settings
+
+    monkeypatch.setenv("CAMLOC_CORS_ORIGINS", " https://r.example , null,http://[::1]:8080")
+    assert Settings().cors_origin_list == ["https://r.example", "null", "http://[::1]:8080"]
+    for bad, said in (
+        ("*", "name the origins"),
+        ("https://r.example/", "is not an origin"),
+        ("r.example", "is not an origin"),
+    ):
+        monkeypatch.setenv("CAMLOC_CORS_ORIGINS", bad)
+        with pytest.raises(ValueError, match=re.escape(said)):
+            Settings()
+
+
+@pytest.fixture(scope="module")
+def cli_page(kserver: Server, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A review page written by ``camloc locate --map ... --verdict-url`` (not served)."""
+    from camloc_geo.cli import main
+
+    tmp = tmp_path_factory.mktemp("cli-page")
+    scene = tmp / "scene.json"
+    scene.write_text(json.dumps(SCENE), encoding="utf-8")
+    out = tmp / "review.html"
+    maps_dir = Path(kserver.env["CAMLOC_MAP_DIR"])
+    args = ["locate", str(scene), "--osm", str(maps_dir / "baltimore.osm.pbf"), "--map", str(out)]
+    assert main([*args, "--inline", "--verdict-url", kserver.url + "/"]) == 0
+    return out
+
+
+def test_locate_map_verdict_url_option(
+    kserver: Server, cli_page: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from camloc_geo.cli import main
+
+    page = cli_page.read_text(encoding="utf-8")
+    found = re.search(r"var cfg = (\{.*?\});\n", page)
+    assert found is not None
+    assert json.loads(found.group(1))["service"] == kserver.url + "/v1/verdicts"
+    capsys.readouterr()
+    scene = cli_page.parent / "scene.json"
+    for url, said in (
+        ("ftp://h", "give the service's http:// or https:// address"),
+        ("http://h:99999", "not a URL"),
+        ("http://h/?x=1", "no query"),
+    ):
+        code = main(["locate", str(scene), "--map", str(tmp_path / "x.html"), "--verdict-url", url])
+        assert code == 2
+        assert f"--verdict-url {url!r}: {said}" in capsys.readouterr().err
+    assert main(["locate", str(scene), "--verdict-url", "http://h"]) == 2
+    assert "--verdict-url needs --map" in capsys.readouterr().err
+    assert not (tmp_path / "x.html").exists()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_cli_page_from_a_file_shares_with_the_service(
+    browser: Any, kserver: Server, cli_page: Path
+) -> None:
+    """The CLI's page opened from a file (origin null) reads and, with the key, changes the
+    service's verdicts; served from an origin the service does not allow, it says so."""
+    page_html = cli_page.read_text(encoding="utf-8")
+    found = re.search(r"var cfg = (\{.*?\});\n", page_html)
+    assert found is not None
+    cfg = json.loads(found.group(1))
+    url = f"/v1/verdicts/candidates/{cfg['identity']}"
+    client = httpx.Client(base_url=kserver.url, timeout=60.0)
+    other = "http://localhost:8766"
+    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    page = context.new_page()
+    sent: list[str] = []
+    blocked: list[str] = []
+    errors: list[str] = []
+
+    def route(r: Any) -> None:
+        u = r.request.url
+        if u == other + "/review.html":
+            r.fulfill(status=200, body=page_html, content_type="text/html; charset=utf-8")
+        elif u.startswith(("file:", "data:")):
+            r.continue_()
+        elif u.startswith(kserver.url + "/"):
+            sent.append(f"{r.request.method} {u}")
+            r.continue_()
+        else:
+            blocked.append(u)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    share = ".camloc-vshare"
+    try:
+        page.goto(cli_page.as_uri(), wait_until="load")
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=5000
+        )
+        page.locator('.camloc-candidate [data-rank="3"]').click()
+        box = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="3"]')
+        box.locator('button[data-verdict="unsure"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="unsure"]').click()
+        keybox = page.locator(".camloc-verdicts form.camloc-vkey")
+        keybox.wait_for(state="visible", timeout=5000)  # the 401 reached the page
+        keybox.locator("input").fill(KEY)
+        keybox.locator("button").click()
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=5000
+        )
+        assert client.get(url).json()["items"]["3"]["verdict"] == "unsure"
+        assert any(s.startswith("POST ") for s in sent)
+        # the same page from an origin the service does not allow: refused, and said
+        page.goto(other + "/review.html", wait_until="load")
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('not shared')",
+            timeout=5000,
+        )
+        text = page.locator(share).inner_text()
+        assert f"this page's origin ({other}) in its CAMLOC_CORS_ORIGINS?" in text, text
+        assert blocked == []
+        assert errors == []
+    finally:
+        context.close()
         client.close()
 
 

@@ -17,7 +17,7 @@ from camloc_geo.cli import (
     write_json,
 )
 
-__all__ = ["register", "run"]
+__all__ = ["register", "run", "verdict_url"]
 
 log = logging.getLogger(__name__)
 
@@ -59,7 +59,58 @@ def register(subparsers: Any) -> None:
             "(.csv or .geojson) on this scene's candidates again (see docs/candidates.md)"
         ),
     )
+    p.add_argument(
+        "--verdict-url",
+        metavar="URL",
+        help=(
+            "with --map: the page shares its reviewers' verdicts with this camloc service "
+            "(http(s)://host[:port], /v1/verdicts added), from a file too; the service must "
+            "allow the page's origin (CAMLOC_CORS_ORIGINS; null for a file), see docs/service.md"
+        ),
+    )
     p.set_defaults(func=run)
+
+
+def verdict_url(url: str) -> str:
+    """The verdicts endpoint of a service named by ``--verdict-url``.
+
+    Parameters
+    ----------
+    url
+        ``http(s)://host[:port]`` with or without a path prefix (``/camloc``) or the
+        ``/v1/verdicts`` endpoint itself.
+
+    Returns
+    -------
+    str
+        ``<url>/v1/verdicts``, without a trailing slash.
+
+    Raises
+    ------
+    InputError
+        Not an http(s) URL with a host, or with a query, fragment or user name.
+    """
+    from urllib.parse import urlsplit
+
+    from camloc_geo._errors import InputError
+
+    text = url.strip()
+    try:
+        parts = urlsplit(text)
+        parts.port  # noqa: B018 (a bad port raises here)
+    except ValueError as exc:
+        raise InputError(f"--verdict-url {url!r}: not a URL ({exc})") from None
+    if parts.scheme not in ("http", "https") or not parts.hostname:
+        raise InputError(
+            f"--verdict-url {url!r}: give the service's http:// or https:// address "
+            "(e.g. http://reviews.example.org:8000)"
+        )
+    if parts.query or parts.fragment or parts.username or parts.password:
+        raise InputError(f"--verdict-url {url!r}: no query, fragment or user name, please")
+    if any(c in text for c in "\"'<>` \\"):
+        raise InputError(f"--verdict-url {url!r}: not a URL")
+    base = text.split("?")[0].rstrip("/")
+    return base if base.endswith("/v1/verdicts") else base + "/v1/verdicts"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -82,6 +133,11 @@ def run(args: argparse.Namespace) -> int:
         from camloc_geo.maps import read_verdicts
 
         verdicts = read_verdicts(args.verdicts)  # a bad file stops before the locating
+    service = None
+    if args.verdict_url is not None:
+        if map_path is None:
+            raise InputError("--verdict-url needs --map OUT.html (the page shares verdicts)")
+        service = verdict_url(args.verdict_url)
     out = locate_scene(
         args.scene,
         map_source=args.osm,
@@ -106,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
                 scene=out.scene,
                 overlay_dir=args.overlays,
                 verdicts=verdicts,
+                verdict_service=service,
             )
     if not out.result.candidates:
         log.warning("no candidates: %s", out.result.reason)

@@ -17,7 +17,7 @@ from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import ERROR_STATUS, install_error_handlers
 from camloc_geo.service.fastpath import SceneFastPath
 from camloc_geo.service.mapstore import MapStore
-from camloc_geo.service.middleware import RequestLimits
+from camloc_geo.service.middleware import RequestLimits, VerdictCors
 from camloc_geo.service.models import ERROR_RESPONSES
 from camloc_geo.service.routers import ROUTERS
 from camloc_geo.service.routers.jobs import JobRunner
@@ -84,4 +84,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         upload_paths=("/v1/tasks",),
         max_upload_bytes=settings.max_upload_bytes,
     )
+    if settings.cors_origin_list:  # pages of other origins share verdicts (--verdict-url)
+        app.add_middleware(VerdictCors, origins=settings.cors_origin_list)
     return app

@@ -1,4 +1,5 @@
-"""The service's one middleware (plain ASGI): a request id, and the body size limits.
+"""The service's middleware (plain ASGI): a request id, the body size limits, and CORS for
+the verdict endpoints when ``CAMLOC_CORS_ORIGINS`` names origins.
 
 Plain ASGI rather than ``@app.middleware("http")``: no extra task and no response copy per
 request. A body over its limit is refused from ``Content-Length`` before it is read, and a
@@ -15,7 +16,49 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from camloc_geo.service.work import LimitError
 
-__all__ = ["RequestLimits"]
+__all__ = ["RequestLimits", "VerdictCors"]
+
+
+class VerdictCors:
+    """CORS for the verdict endpoints only, for the configured origins only.
+
+    A review page written by ``camloc locate --map ... --verdict-url`` (opened from a file:
+    origin ``null``, or from another web server) reads and changes its verdicts here; every
+    other path answers as without CORS. A preflight from another origin is refused (400),
+    and the answers to its requests carry no ``Access-Control-Allow-Origin``.
+
+    Parameters
+    ----------
+    app
+        The wrapped ASGI app.
+    origins
+        The allowed origins (``https://host[:port]``, or ``null``).
+    paths
+        The path prefixes CORS applies to.
+    """
+
+    def __init__(
+        self, app: ASGIApp, *, origins: list[str], paths: tuple[str, ...] = ("/v1/verdicts",)
+    ) -> None:
+        from starlette.middleware.cors import CORSMiddleware
+
+        self.app = app
+        self.paths = paths
+        self.cors = CORSMiddleware(
+            app,
+            allow_origins=list(origins),
+            allow_methods=["GET", "POST"],
+            allow_headers=["Content-Type", "X-API-Key"],
+            expose_headers=["X-Request-ID"],
+            max_age=600,
+        )
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        path = scope.get("path", "") if scope["type"] == "http" else ""
+        if any(path == p or path.startswith(p + "/") for p in self.paths):
+            await self.cors(scope, receive, send)
+        else:
+            await self.app(scope, receive, send)
 
 
 class RequestLimits:

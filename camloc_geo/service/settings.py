@@ -101,6 +101,44 @@ class Settings(BaseSettings):
         description="the basemap's attribution, plain text (default: 'basemap: <host>')",
     )
 
+    cors_origins: str | None = Field(
+        default=None,
+        description=(
+            "origins (comma-separated: https://review.example.org, http://localhost:8080, "
+            "null for pages opened from files) whose pages may read and change verdicts "
+            "(/v1/verdicts) from another origin; none (default): no CORS"
+        ),
+    )
+
+    @property
+    def cors_origin_list(self) -> list[str]:
+        """``cors_origins`` as a list (empty: no CORS)."""
+        return [o.strip() for o in (self.cors_origins or "").split(",") if o.strip()]
+
+    @field_validator("cors_origins")
+    @classmethod
+    def _origins(cls, value: str | None) -> str | None:
+        import re
+
+        if value is None:
+            return None
+        origins = [o.strip() for o in value.split(",") if o.strip()]
+        for origin in origins:
+            if origin == "*":
+                raise ValueError(
+                    "CAMLOC_CORS_ORIGINS: name the origins, '*' is not taken "
+                    "(e.g. https://review.example.org)"
+                )
+            if origin != "null" and not re.fullmatch(
+                r"https?://[A-Za-z0-9.\-]+(:[0-9]{1,5})?|https?://\[[0-9A-Fa-f:.]+\](:[0-9]{1,5})?",
+                origin,
+            ):
+                raise ValueError(
+                    f"CAMLOC_CORS_ORIGINS: {origin!r} is not an origin (scheme://host[:port], "
+                    "no path, no trailing slash; or null for pages opened from files)"
+                )
+        return ",".join(origins) or None
+
     @field_validator("tile_url")
     @classmethod
     def _tile_template(cls, value: str | None) -> str | None:
