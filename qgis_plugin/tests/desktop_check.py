@@ -1,8 +1,8 @@
 """The QGIS desktop, driven as an analyst would, with screenshots: a script for ``qgis --code``.
 
-Not a pytest module (the suite runs headless); run it by hand under Xvfb::
+The suite runs it (test_desktop.py, under Xvfb, a fresh profile, a time limit); by hand::
 
-    CAMLOC_PYTHON=$PWD/.venv-qgis/bin/python PYTHONPATH=$PWD \\
+    CAMLOC_PYTHON=$PWD/.venv-qgis/bin/python \\
     xvfb-run -a -s "-screen 0 1400x900x24" qgis --nologo --noversioncheck \\
         --profiles-path /tmp/camloc-profile --code qgis_plugin/tests/desktop_check.py
 
@@ -10,10 +10,14 @@ It runs, on the bundled sample: camloc:locate from the Toolbox's code path
 (``processing.runAndLoadResults``) into named GeoPackages, the Toolbox's algorithm dialog (a
 background task) into named shapefiles, the Processing batch dialog with two
 scenes (outputs per row, optional outputs left empty, layers loaded), and the dock (Load
-scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features) to
-``tests/artifacts/qgis/desktop/summary.json`` and screenshots (``*.png``) beside it; QGIS exits
-with the project cleared first (``QgsApplication.exit()`` with layers still loaded crashed QGIS
-3.22 in its own teardown: ``QgisApp::setMapStyleDockLayer`` on a destroyed widget).
+scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features, the
+candidates' ranks), the labels the canvas drew (text, layer, inside the visible map or cut by
+its edge) and where the canvas sits in the window's screenshot to ``summary.json`` in
+``$CAMLOC_DESKTOP_OUT`` (default ``tests/artifacts/qgis/desktop``), with screenshots
+(``*.png``) beside it. QGIS exits with the project cleared first (``QgsApplication.exit()``
+with layers still loaded crashed QGIS 3.22 in its own teardown:
+``QgisApp::setMapStyleDockLayer`` on a destroyed widget); a watchdog ends it after
+``$CAMLOC_DESKTOP_WATCHDOG_S`` seconds (default 240) with ``error`` in the summary.
 """
 
 from __future__ import annotations
@@ -26,13 +30,13 @@ from pathlib import Path
 from typing import Any
 
 from qgis.core import QgsApplication, QgsProject
-from qgis.PyQt.QtCore import QTimer
+from qgis.PyQt.QtCore import QPoint, QTimer
 from qgis.utils import iface
 
 REPO = Path(os.environ.get("CAMLOC_REPO", Path.cwd()))
 SCENE = REPO / "sample_maps" / "sample_scene.json"
 OSM = REPO / "sample_maps" / "baltimore.osm.pbf"
-OUT = REPO / "tests" / "artifacts" / "qgis" / "desktop"
+OUT = Path(os.environ.get("CAMLOC_DESKTOP_OUT", REPO / "tests" / "artifacts" / "qgis" / "desktop"))
 OUT.mkdir(parents=True, exist_ok=True)
 sys.path.insert(0, str(REPO / "qgis_plugin"))
 summary: dict[str, Any] = {}
@@ -40,24 +44,54 @@ state: dict[str, Any] = {}
 
 
 def _layers() -> list[dict[str, Any]]:
+    """The layers in the legend, top first."""
     out = []
     for node in QgsProject.instance().layerTreeRoot().findLayers():
         lyr = node.layer()
-        out.append(
-            {
-                "name": lyr.name(),
-                "renderer": type(lyr.renderer()).__name__,
-                "kind": lyr.customProperty("camloc/kind"),
-                "features": lyr.featureCount(),
-                "labels": lyr.labelsEnabled(),
-            }
-        )
+        row = {
+            "name": lyr.name(),
+            "renderer": type(lyr.renderer()).__name__,
+            "kind": lyr.customProperty("camloc/kind"),
+            "features": lyr.featureCount(),
+            "labels": lyr.labelsEnabled(),
+        }
+        if row["kind"] == "candidates":
+            feats = list(lyr.getFeatures())
+            row["ranks"] = [f["rank"] for f in feats]
+            row["tie_ranks"] = sorted(f["rank"] for f in feats if f["tie"])
+        out.append(row)
     return out
 
 
+def _labels() -> list[dict[str, Any]]:
+    """The labels of the canvas's last render: text, layer and whether the visible map holds
+    the whole of it (False: cut by the canvas's edge)."""
+    canvas = iface.mapCanvas()
+    results = canvas.labelingResults()
+    if results is None or not hasattr(results, "allLabels"):
+        return []
+    extent = canvas.mapSettings().visibleExtent()
+    names = {lid: lyr.name() for lid, lyr in QgsProject.instance().mapLayers().items()}
+    return [
+        {
+            "layer": names.get(lp.layerID, lp.layerID),
+            "text": lp.labelText,
+            "inside": extent.contains(lp.labelRect),
+            "unplaced": lp.isUnplaced,
+        }
+        for lp in results.allLabels()
+    ]
+
+
 def _shot(name: str) -> None:
-    iface.mapCanvas().saveAsImage(str(OUT / f"{name}_canvas.png"))
+    canvas = iface.mapCanvas()
+    canvas.saveAsImage(str(OUT / f"{name}_canvas.png"))
     iface.mainWindow().grab().save(str(OUT / f"{name}_window.png"))
+    corner = canvas.mapTo(iface.mainWindow(), QPoint(0, 0))
+    summary.setdefault("canvas", {})[name] = {
+        "rect": [corner.x(), corner.y(), canvas.width(), canvas.height()],
+        "labels": _labels(),
+    }
 
 
 def _zoom_to_candidates() -> None:
@@ -188,6 +222,9 @@ def finish() -> None:
 
 
 def done() -> None:
+    if summary.get("done"):
+        return
+    summary["done"] = True
     (OUT / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False))
     QgsProject.instance().clear()  # before exit: see the module's docstring
     QTimer.singleShot(300, QgsApplication.exit)
@@ -204,4 +241,21 @@ def guarded(step: Any) -> Any:
     return run
 
 
-QTimer.singleShot(500, guarded(step_toolbox))
+def start() -> None:
+    # the window as large as the screen (Xvfb has no window manager to maximise it): the
+    # canvas beside the dock as an analyst's screen shows it
+    screen = QgsApplication.primaryScreen()
+    if screen is not None:
+        iface.mainWindow().setGeometry(screen.availableGeometry())
+    step_toolbox()
+
+
+def watchdog() -> None:
+    if not summary.get("done"):
+        summary["error"] = f"watchdog: the steps did not end within {WATCHDOG_S} s"
+        done()
+
+
+WATCHDOG_S = float(os.environ.get("CAMLOC_DESKTOP_WATCHDOG_S", "240"))
+QTimer.singleShot(int(WATCHDOG_S * 1000), watchdog)
+QTimer.singleShot(500, guarded(start))
