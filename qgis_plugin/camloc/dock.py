@@ -58,6 +58,8 @@ from .imagefile import SnapshotError, check_regular_file, read_snapshot
 from .layers import (
     DRAW_ORDER,
     apply_style,
+    extent_with_room,
+    label_room_px,
     style_qml,
     wgs84,
     write_gpkg_layer,
@@ -1206,8 +1208,15 @@ class CamlocDock(QDockWidget):
             project = QgsProject.instance()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
             ext84 = cands.extent()
-            ext84.grow(0.0006)  # degrees (the layer is EPSG:4326): about 60 m around them
-            ext = xform.transformBoundingBox(ext84)
+            ext84.grow(0.0002)  # degrees (the layer is EPSG:4326): about 20 m around them
+            # room beside them for the leading candidates' labels: at a fixed 60 m the canvas
+            # beside the dock (460 px) cut '#4 0.05 (tie with #1, #3)' at its left edge
+            ext = extent_with_room(
+                xform.transformBoundingBox(ext84),
+                canvas.width(),
+                canvas.height(),
+                label_room_px(cands, canvas.mapSettings().outputDpi()),
+            )
             canvas.setExtent(ext)
             canvas.refresh()
             # the first layers of an empty project make QGIS zoom to their full extent once

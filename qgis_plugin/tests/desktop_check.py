@@ -95,12 +95,17 @@ def _shot(name: str) -> None:
 
 
 def _zoom_to_candidates() -> None:
+    """As the dock zooms after a run: the candidates with room for their labels."""
+    from camloc.layers import extent_with_room, label_room_px
+
+    canvas = iface.mapCanvas()
     for lyr in QgsProject.instance().mapLayers().values():
         if lyr.customProperty("camloc/kind") == "candidates":
             ext = lyr.extent()
-            ext.grow(0.0006)
-            iface.mapCanvas().setExtent(ext)
-            iface.mapCanvas().refresh()
+            ext.grow(0.0002)
+            room = label_room_px(lyr, canvas.mapSettings().outputDpi())
+            canvas.setExtent(extent_with_room(ext, canvas.width(), canvas.height(), room))
+            canvas.refresh()
             return
 
 
@@ -120,7 +125,7 @@ def step_toolbox() -> None:
     params.update({k: str(OUT / f"toolbox_{k.lower()}.gpkg") for k in outs})
     processing.runAndLoadResults("camloc:locate", params)
     summary["toolbox"] = _layers()
-    _zoom_to_candidates()
+    QTimer.singleShot(300, _zoom_to_candidates)  # after QGIS zooms to its first layers
     QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_dialog)()))
 
 
@@ -178,7 +183,7 @@ def step_batch() -> None:
     panel.checkLoadLayersOnCompletion.setChecked(True)
     dlg.runAlgorithm()
     summary["batch"] = _layers()
-    _zoom_to_candidates()
+    QTimer.singleShot(300, _zoom_to_candidates)
     QTimer.singleShot(
         1500, lambda: (dlg.grab().save(str(OUT / "batch_dialog.png")), guarded(step_dock)())
     )

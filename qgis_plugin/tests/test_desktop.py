@@ -3,7 +3,8 @@
 One QGIS desktop (a fresh profile, this checkout's plugin, the bundled sample) runs the Toolbox's
 code path, the algorithm dialog, the batch dialog and the dock, and writes summary.json and
 screenshots into tests/artifacts/qgis/desktop/; the tests read them. Skipped when ``xvfb-run``
-or ``qgis`` is missing. The run has a time limit: past it the whole process group (xvfb-run,
+or ``qgis`` is missing. The screen is 1400x900 (``CAMLOC_DESKTOP_SCREEN``, e.g. ``1120x720``, to
+try another). The run has a time limit: past it the whole process group (xvfb-run,
 Xvfb, QGIS, the worker) is killed and the test fails with the log's tail, never hangs.
 """
 
@@ -66,7 +67,7 @@ def desktop(tmp_path_factory) -> dict[str, Any]:
         str(XVFB_RUN),
         "-a",
         "-s",
-        "-screen 0 1400x900x24",
+        f"-screen 0 {os.environ.get('CAMLOC_DESKTOP_SCREEN', '1400x900')}x24",
         str(QGIS),
         "--nologo",
         "--noversioncheck",
@@ -208,7 +209,7 @@ def test_screenshots_show_the_map(desktop, step):
 @pytest.mark.parametrize("name", ["dialog.png", "batch_dialog.png", "dock.png", "dock_legend.png"])
 def test_widget_screenshots_are_not_blank(desktop, name):
     rgb = _pixels(desktop["out"] / name)
-    assert min(rgb.shape[:2]) > 150, (name, rgb.shape)
+    assert min(rgb.shape[:2]) > 100, (name, rgb.shape)
     assert float(rgb.std()) > 15.0, (name, "nearly one colour", float(rgb.std()))
     dark = (rgb.max(axis=2) < 90).mean()  # text
     assert 0.005 < dark < 0.5, (name, "no text, or mostly black", float(dark))
