@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import os
+import traceback
 from typing import Any
 
 from qgis.core import (
@@ -300,12 +301,22 @@ class LocateTask(QgsTask):
         except (WorkerError, OSError) as exc:
             self.error = str(exc)
             return False
+        except Exception as exc:  # an exception out of a task would be a Python error
+            self.error = _unexpected(exc)
+            return False
         self.setProgress(100)
         return True
 
     def finished(self, ok: bool) -> None:
         if self.on_done is not None:
             self.on_done(self, ok)
+
+
+def _unexpected(exc: BaseException) -> str:
+    """One line for an error the plugin did not foresee in a background task; its traceback
+    goes to the message log (tab camloc), not to a Python error dialog."""
+    QgsMessageLog.logMessage(traceback.format_exc(), "camloc", Qgis.Critical)
+    return f"unexpected error ({type(exc).__name__}: {exc}); details in the message log, tab camloc"
 
 
 class WorkerTask(QgsTask):
@@ -325,6 +336,9 @@ class WorkerTask(QgsTask):
             )
         except WorkerError as exc:
             self.error = str(exc)
+            return False
+        except Exception as exc:  # as LocateTask.run
+            self.error = _unexpected(exc)
             return False
         return True
 
@@ -599,11 +613,11 @@ class CamlocDock(QDockWidget):
         try:
             image, turned = read_snapshot(path)
         except SnapshotError as exc:
-            self.set_status(str(exc))
+            self.refuse(str(exc))
             return False
         pix = QPixmap.fromImage(image)
         if pix.isNull():  # out of memory for the pixmap
-            self.set_status(f"cannot show the image {path}: not enough memory for it")
+            self.refuse(f"cannot show the image {path}: not enough memory for it")
             return False
         self._stop_page()
         scene_id = os.path.splitext(os.path.basename(path))[0]
@@ -792,7 +806,7 @@ class CamlocDock(QDockWidget):
         if self.page_server is None:
             return
         if not ok:
-            self.set_status(f"annotation page: {task.error or 'canceled'}")
+            self.refuse(f"annotation page: {task.error or 'canceled'}")
             self._stop_page()
             return
         self.page_server.html = task.result["info"]["html"]
@@ -873,7 +887,7 @@ class CamlocDock(QDockWidget):
         """Load a scene file (for example one saved by the annotation page)."""
         problem = check_regular_file(path, "scene")  # a FIFO would block QGIS on open()
         if problem:
-            self.set_status(problem)
+            self.refuse(problem)
             return False
         try:
             if os.path.getsize(path) > MAX_SCENE_BYTES:
@@ -886,7 +900,7 @@ class CamlocDock(QDockWidget):
             if not isinstance(scene, dict):
                 raise ValueError("not a JSON object")
         except (OSError, ValueError, RecursionError) as exc:
-            self.set_status(f"cannot read the scene {path}: {exc}")
+            self.refuse(f"cannot read the scene {path}: {exc}")
             return False
         name = os.path.basename(path)
         # the library's own check, at load (it used to come only at Run or Save): the analyst
@@ -895,7 +909,7 @@ class CamlocDock(QDockWidget):
         try:
             Annotation.from_scene(scene)  # a wrong shape ("annotations": 5) cannot be shown
         except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
-            self.set_status(f"cannot load the scene {name}: {invalid or exc}")
+            self.refuse(f"cannot load the scene {name}: {invalid or exc}")
             return False
         image = (scene.get("image") or {}).get("path")
         refused = ""
@@ -985,7 +999,7 @@ class CamlocDock(QDockWidget):
         if problem is None and _same_file(path, self.osm_edit.text().strip()):
             problem = f"{path} is the map extract; give the scene its own .json file"
         if problem:
-            self.set_status(f"not saved: {problem}")
+            self.refuse(f"not saved: {problem}")
             return False
         scene = self.scene()
         if self.image_file:  # the scene names its photo from its own folder, where it is saved
@@ -993,7 +1007,7 @@ class CamlocDock(QDockWidget):
         try:
             run_worker({"task": "check_scene", "scene": scene, "save_to": path})
         except WorkerError as exc:
-            self.set_status(f"not saved: {exc}")
+            self.refuse(f"not saved: {exc}")
             return False
         self.set_status(f"saved {path}")
         return True
@@ -1043,7 +1057,7 @@ class CamlocDock(QDockWidget):
             return None
         problems = self.annotation.problems()
         if problems:
-            self.set_status("Not ready: " + "; ".join(problems))
+            self.refuse("Not ready: " + "; ".join(problems))
             return None
         osm = self.osm_edit.text().strip()
         gpkg = self.results_path()
@@ -1052,12 +1066,12 @@ class CamlocDock(QDockWidget):
             if problem is None and _same_file(gpkg, other):
                 problem = f"{gpkg} is {what}"  # found only after the run, as an OGR error
         if problem:
-            self.set_status(f"cannot write results: {problem}; pick another GeoPackage")
+            self.refuse(f"cannot write results: {problem}; pick another GeoPackage")
             return None
         if osm:
             problem = _extract_problem(osm)
             if problem:
-                self.set_status(problem)
+                self.refuse(problem)
                 return None
         prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id) or "scene"
         self._fill_candidates(None)
@@ -1282,6 +1296,14 @@ class CamlocDock(QDockWidget):
             if project.mapLayer(layer_id) is not None:
                 project.removeMapLayer(layer_id)
         self.result_layers = []
+
+    def refuse(self, text: str) -> None:
+        """Say why an action was refused: the status line, and QGIS's message bar (a warning,
+        10 s; the analyst may be looking at the map, not at the dock)."""
+        self.set_status(text)
+        if self.iface is not None:
+            line = " ".join(text.split())
+            self.iface.messageBar().pushMessage("camloc", line, Qgis.Warning, 10)
 
     def set_status(self, text: str) -> None:
         self.status.setText(text)
