@@ -412,6 +412,7 @@ class CamlocDock(QDockWidget):
         self.result_layers: list[QgsVectorLayer] = []
         self._result_key: tuple[str, str] | None = None  # (GeoPackage, table prefix) shown
         self._restore: tuple[str, dict[str, str]] | None = None  # (group, uris) to put back
+        self._restore_extent: Any = None  # the canvas's extent at that Run
         self._qml: dict[tuple[str, str], str] = {}  # (kind, fields and geometry) -> style
         self._result_group = ""
         self._result_uris: dict[str, str] = {}
@@ -1079,6 +1080,11 @@ class CamlocDock(QDockWidget):
         if self._result_key == (os.path.abspath(gpkg), prefix):
             # their GeoPackage tables are about to be replaced; put back if the run fails
             self._restore = (self._result_group, dict(self._result_uris))
+            # and the map where the analyst left it: put back into a project left empty, QGIS
+            # zoomed to the layers' full extent (the cones; seen in the desktop check)
+            self._restore_extent = (
+                self.iface.mapCanvas().extent() if self.iface is not None else None
+            )
             self._remove_results()
         else:
             # another camera's (or GeoPackage's) layers: they stay in the project as they are
@@ -1112,9 +1118,12 @@ class CamlocDock(QDockWidget):
 
     def cancel(self) -> None:
         """Cancel the run (the worker process is stopped)."""
-        if self.task is not None:
-            self.task.cancel()
+        task = self.task
+        if task is not None:
+            # said before cancel(): a task canceled before it started ends inside cancel()
+            # (its finished(False) runs at once), and "Canceling…" stayed after "Canceled."
             self.set_status("Canceling…")
+            task.cancel()
 
     def _task_progress(self, value: float) -> None:
         self.progress.setValue(int(value))
@@ -1130,7 +1139,7 @@ class CamlocDock(QDockWidget):
         if not ok:
             restore, self._restore = self._restore, None
             if restore is not None:  # the tables were not replaced: the last results come back
-                self._load_layers(restore[0], restore[1], None)
+                self._load_layers(restore[0], restore[1], None, self._restore_extent)
                 self._result_key = (os.path.abspath(task.gpkg), task.prefix)
             if task.error in (None, "canceled"):
                 self.set_status("Canceled.")
@@ -1169,10 +1178,17 @@ class CamlocDock(QDockWidget):
         if error:
             QgsMessageLog.logMessage(f"the styles were not stored: {error}", "camloc", Qgis.Warning)
 
-    def _load_layers(self, name: str, uris: dict[str, str], task: LocateTask | None) -> None:
+    def _load_layers(
+        self,
+        name: str,
+        uris: dict[str, str],
+        task: LocateTask | None,
+        extent: Any = None,
+    ) -> None:
         """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never
         stalls for the whole batch) into the group ``name``, candidates on top; then report
-        ``task`` (None: layers put back after a failed run, nothing to report)."""
+        ``task`` (None: layers put back after a failed run, nothing to report) or set the
+        canvas back to ``extent`` (a QgsRectangle, None: left as it is)."""
         from qgis.PyQt.QtCore import QTimer
 
         root = QgsProject.instance().layerTreeRoot()
@@ -1188,6 +1204,12 @@ class CamlocDock(QDockWidget):
                 self._loading = False
                 if task is not None:
                     self._report(task)
+                elif extent is not None and self.iface is not None:
+                    canvas = self.iface.mapCanvas()
+                    canvas.setExtent(extent)
+                    canvas.refresh()
+                    # after QGIS's own zoom to the first layers of an empty project
+                    QTimer.singleShot(0, lambda: (canvas.setExtent(extent), canvas.refresh()))
                 return
             kind = todo.pop(0)
             opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan

@@ -8,11 +8,12 @@ The suite runs it (test_desktop.py, under Xvfb, a fresh profile, a time limit); 
 
 It runs, on the bundled sample: camloc:locate from the Toolbox's code path
 (``processing.runAndLoadResults``) into named GeoPackages, the Toolbox's algorithm dialog (a
-background task) into named shapefiles, the Processing batch dialog with two
-scenes (outputs per row, optional outputs left empty, layers loaded), and the dock (Load
-scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features, the
-candidates' ranks), the labels the canvas drew (text, layer, inside the visible map or cut by
-its edge) and where the canvas sits in the window's screenshot to ``summary.json`` in
+background task) into named shapefiles, the Processing batch dialog with two scenes (outputs per
+row, optional outputs left empty, layers loaded), and the dock (Load scene…, Run; then Run on a
+cut extract, and a Run canceled at once). Each step writes the loaded layers (name, renderer,
+camloc kind, features, the candidates' ranks), the labels the canvas drew (text, layer, inside
+the visible map or cut by its edge), where the canvas sits in the window's screenshot, the
+message bar's lines and the message log's Python errors and camloc messages to ``summary.json`` in
 ``$CAMLOC_DESKTOP_OUT`` (default ``tests/artifacts/qgis/desktop``), with screenshots
 (``*.png``) beside it. QGIS exits with the project cleared first (``QgsApplication.exit()``
 with layers still loaded crashed QGIS 3.22 in its own teardown:
@@ -219,11 +220,75 @@ def finish() -> None:
             dock.candidate_list.item(i).text() for i in range(dock.candidate_list.count())
         ],
         "layers": _layers(),
+        "extent": _extent(),
     }
     _shot("dock")
     dock.grab().save(str(OUT / "dock.png"))
     iface.layerTreeView().grab().save(str(OUT / "dock_legend.png"))
-    done()
+    step_dock_errors()
+
+
+def _extent() -> list[float]:
+    """The canvas's extent, [xmin, ymin, xmax, ymax] in the project's CRS."""
+    ext = iface.mapCanvas().extent()
+    return [ext.xMinimum(), ext.yMinimum(), ext.xMaximum(), ext.yMaximum()]
+
+
+def _bar() -> list[str]:
+    """The message bar's items, 'title: text', newest last."""
+    out = []
+    for item in iface.messageBar().items():
+        out.append(f"{item.title()}: {item.text()}")
+    return out
+
+
+def _when_idle(then: Any) -> None:
+    """Call ``then`` once the dock's run and its layer loading have ended (at most 120 s)."""
+    dock = state["plugin"].dock
+
+    def poll(n: list[int] = [0]) -> None:  # noqa: B006 - a counter kept between calls
+        n[0] += 1
+        if (dock.task is not None or dock._loading) and n[0] < 240:
+            QTimer.singleShot(500, poll)
+            return
+        QTimer.singleShot(500, guarded(then))
+
+    QTimer.singleShot(300, poll)
+
+
+def step_dock_errors() -> None:
+    """What the analyst sees when the extract is broken, and when a run is canceled: the
+    message bar's line (no Python error), the last results kept."""
+    dock = state["plugin"].dock
+    cut = OUT / "cut.osm.pbf"
+    cut.write_bytes(OSM.read_bytes()[:4000])
+    iface.messageBar().clearWidgets()
+    dock.osm_edit.setText(str(cut))
+    dock.run()
+
+    def broken_done() -> None:
+        summary["dock_broken_extract"] = {
+            "status": dock.status.text(),
+            "bar": _bar(),
+            "layers": _layers(),
+            "extent": _extent(),
+        }
+        iface.mainWindow().grab().save(str(OUT / "dock_error_window.png"))
+        iface.messageBar().clearWidgets()
+        dock.osm_edit.setText(str(OSM))
+        dock.run()
+        dock.cancel()  # at once: the worker is stopped
+        _when_idle(canceled)
+
+    def canceled() -> None:
+        summary["dock_canceled"] = {
+            "status": dock.status.text(),
+            "layers": _layers(),
+            "extent": _extent(),
+        }
+        done()
+
+    _when_idle(broken_done)
 
 
 def done() -> None:
@@ -244,6 +309,14 @@ def guarded(step: Any) -> Any:
             done()
 
     return run
+
+
+def _log(message: str, tag: str, level: Any) -> None:
+    if tag in ("Python error", "Python warning", "camloc") or "Traceback" in message:
+        summary.setdefault("log", []).append({"tag": tag, "message": message})
+
+
+QgsApplication.messageLog().messageReceived.connect(_log)
 
 
 def start() -> None:

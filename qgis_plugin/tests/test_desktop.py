@@ -213,3 +213,38 @@ def test_widget_screenshots_are_not_blank(desktop, name):
     assert float(rgb.std()) > 15.0, (name, "nearly one colour", float(rgb.std()))
     dark = (rgb.max(axis=2) < 90).mean()  # text
     assert 0.005 < dark < 0.5, (name, "no text, or mostly black", float(dark))
+
+
+def test_dock_run_on_a_cut_extract_is_one_line_in_the_message_bar(desktop):
+    broken = desktop["dock_broken_extract"]
+    bar = broken["bar"]
+    assert len(bar) == 1, bar
+    assert bar[0].startswith(
+        "camloc: the camera was not located: cannot read OSM extract cut.osm.pbf: "
+    ), bar
+    assert "\n" not in bar[0]
+    assert broken["status"].startswith("camloc: cannot read OSM extract cut.osm.pbf")
+    # the failed run replaced nothing: the sample's layers are still there
+    kinds = {lyr["kind"]: lyr["features"] for lyr in broken["layers"]}
+    assert kinds == LOCATE_KINDS
+    # and the map stays where it was (it jumped to the cones' extent, 1:701 to 1:229, when the
+    # layers were put back into the emptied project)
+    assert broken["extent"] == pytest.approx(desktop["dock"]["extent"], abs=1e-9)
+    _map_drawn(_pixels(desktop["out"] / "dock_error_window.png"), "dock_error_window.png")
+
+
+def test_dock_run_canceled_at_once_keeps_the_last_results(desktop):
+    canceled = desktop["dock_canceled"]
+    assert canceled["status"] == "Canceled."
+    kinds = {lyr["kind"]: lyr["features"] for lyr in canceled["layers"]}
+    assert kinds == LOCATE_KINDS
+    assert canceled["extent"] == pytest.approx(desktop["dock"]["extent"], abs=1e-9)
+
+
+def test_no_python_error_in_the_whole_session(desktop):
+    errors = [
+        entry
+        for entry in desktop.get("log", [])
+        if entry["tag"].startswith("Python") or "Traceback" in entry["message"]
+    ]
+    assert errors == []
