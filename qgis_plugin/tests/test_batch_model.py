@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from conftest import SAMPLE_OSM, SAMPLE_SCENE, chain_model
 from qgis.core import QgsProject, QgsRuleBasedRenderer, QgsVectorLayer
 
@@ -169,3 +170,35 @@ def test_unset_options_read_as_their_defaults(provider):
                 assert alg.parameterAsBool({}, name, context) is False
             else:
                 assert alg.parameterAsDouble({}, name, context) == default
+
+
+@pytest.mark.parametrize("alg_id", ["camloc:locate", "camloc:corners", "camloc:geocodelist"])
+def test_the_designers_child_dialog_left_as_it_opens_gives_a_valid_child(
+    provider, qgis_iface, alg_id
+):
+    # the graphical modeler's path: add the algorithm, set only its required input, press OK
+    from processing.modeler.ModelerParametersDialog import ModelerParametersDialog
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingModelAlgorithm,
+        QgsProcessingModelChildParameterSource,
+        QgsProcessingModelParameter,
+        QgsProcessingParameterFile,
+    )
+
+    model = QgsProcessingModelAlgorithm("designer", "camloc tests")
+    model.addModelParameter(
+        QgsProcessingParameterFile("input", "input"), QgsProcessingModelParameter("input")
+    )
+    alg = QgsApplication.processingRegistry().algorithmById(alg_id)
+    dlg = ModelerParametersDialog(alg, model)
+    wrappers = dlg.widget.widget.wrappers
+    required = {"camloc:locate": "SCENE", "camloc:geocodelist": "LIST"}.get(alg_id)
+    if required:
+        wrappers[required].setWidgetValue(
+            QgsProcessingModelChildParameterSource.fromModelParameter("input")
+        )
+    child = dlg.createAlgorithm()
+    model.addChildAlgorithm(child)
+    assert model.validateChildAlgorithm(child.childId()) == (True, [])
+    dlg.deleteLater()
