@@ -114,6 +114,18 @@ def _helped(param: Any, text: str) -> Any:
     return param
 
 
+def _option_bool(name: str, label: str) -> QgsProcessingParameterBoolean:
+    """A yes/no option, default no, that a model may leave unset.
+
+    QGIS 3.22's model validation (``QgsProcessingModelAlgorithm.validateChildAlgorithm``) calls
+    every parameter of a child algorithm that is not optional and has no value source in the
+    model "mandatory", whatever its default: a model built in Python or saved before an option
+    existed was refused ("Parameter NETWORK is mandatory"), native:buffer's DISSOLVE likewise.
+    Optional, it reads as its default (no) when unset, in a model, ``qgis_process`` and Python.
+    """
+    return QgsProcessingParameterBoolean(name, label, defaultValue=False, optional=True)
+
+
 class _CamlocAlgorithm(QgsProcessingAlgorithm):
     """Shared parts: group, help, the worker call and the typed sinks."""
 
@@ -183,8 +195,10 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
                 )
             )
         self.addParameter(
-            QgsProcessingParameterBoolean(
-                "NETWORK", "Allow fetching OpenStreetMap data from Overpass", defaultValue=False
+            _helped(
+                _option_bool("NETWORK", "Allow fetching OSM data from Overpass"),
+                "Download the map from the Overpass API when no extract covers the place; "
+                "unticked or unset (in a model): no network",
             )
         )
 
@@ -374,12 +388,9 @@ class LocateAlgorithm(_CamlocAlgorithm):
         )
         self.addParameter(
             _helped(
-                QgsProcessingParameterBoolean(
-                    "CONTEXT",
-                    "Also output the map model (streets, buildings)",
-                    defaultValue=False,
-                ),
-                "The streets and buildings locate matched the scene against",
+                _option_bool("CONTEXT", "Also output the map model"),
+                "The streets and buildings locate matched the scene against "
+                "(CONTEXT_STREETS, CONTEXT_BUILDINGS); unticked or unset (in a model): not written",
             )
         )
         self.addParameter(
@@ -494,12 +505,16 @@ class CornersAlgorithm(_CamlocAlgorithm):
             )
         )
         self.addParameter(
-            QgsProcessingParameterNumber(
-                "RADIUS_M",
-                "Radius around the point (m)",
-                type=QgsProcessingParameterNumber.Double,
-                defaultValue=150.0,
-                minValue=1.0,
+            _helped(
+                QgsProcessingParameterNumber(
+                    "RADIUS_M",
+                    "Radius around the point (m)",
+                    type=QgsProcessingParameterNumber.Double,
+                    defaultValue=150.0,
+                    minValue=1.0,
+                    optional=True,  # unset in a model: 150 m (see _option_bool)
+                ),
+                "Used with POINT; empty: 150 m",
             )
         )
         self.addParameter(

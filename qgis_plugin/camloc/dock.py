@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import os
+import traceback
 from typing import Any
 
 from qgis.core import (
@@ -58,6 +59,8 @@ from .imagefile import SnapshotError, check_regular_file, read_snapshot
 from .layers import (
     DRAW_ORDER,
     apply_style,
+    extent_with_room,
+    label_room_px,
     style_qml,
     wgs84,
     write_gpkg_layer,
@@ -298,12 +301,22 @@ class LocateTask(QgsTask):
         except (WorkerError, OSError) as exc:
             self.error = str(exc)
             return False
+        except Exception as exc:  # an exception out of a task would be a Python error
+            self.error = _unexpected(exc)
+            return False
         self.setProgress(100)
         return True
 
     def finished(self, ok: bool) -> None:
         if self.on_done is not None:
             self.on_done(self, ok)
+
+
+def _unexpected(exc: BaseException) -> str:
+    """One line for an error the plugin did not foresee in a background task; its traceback
+    goes to the message log (tab camloc), not to a Python error dialog."""
+    QgsMessageLog.logMessage(traceback.format_exc(), "camloc", Qgis.Critical)
+    return f"unexpected error ({type(exc).__name__}: {exc}); details in the message log, tab camloc"
 
 
 class WorkerTask(QgsTask):
@@ -323,6 +336,9 @@ class WorkerTask(QgsTask):
             )
         except WorkerError as exc:
             self.error = str(exc)
+            return False
+        except Exception as exc:  # as LocateTask.run
+            self.error = _unexpected(exc)
             return False
         return True
 
@@ -396,6 +412,7 @@ class CamlocDock(QDockWidget):
         self.result_layers: list[QgsVectorLayer] = []
         self._result_key: tuple[str, str] | None = None  # (GeoPackage, table prefix) shown
         self._restore: tuple[str, dict[str, str]] | None = None  # (group, uris) to put back
+        self._restore_extent: Any = None  # the canvas's extent at that Run
         self._qml: dict[tuple[str, str], str] = {}  # (kind, fields and geometry) -> style
         self._result_group = ""
         self._result_uris: dict[str, str] = {}
@@ -597,11 +614,11 @@ class CamlocDock(QDockWidget):
         try:
             image, turned = read_snapshot(path)
         except SnapshotError as exc:
-            self.set_status(str(exc))
+            self.refuse(str(exc))
             return False
         pix = QPixmap.fromImage(image)
         if pix.isNull():  # out of memory for the pixmap
-            self.set_status(f"cannot show the image {path}: not enough memory for it")
+            self.refuse(f"cannot show the image {path}: not enough memory for it")
             return False
         self._stop_page()
         scene_id = os.path.splitext(os.path.basename(path))[0]
@@ -790,7 +807,7 @@ class CamlocDock(QDockWidget):
         if self.page_server is None:
             return
         if not ok:
-            self.set_status(f"annotation page: {task.error or 'canceled'}")
+            self.refuse(f"annotation page: {task.error or 'canceled'}")
             self._stop_page()
             return
         self.page_server.html = task.result["info"]["html"]
@@ -871,7 +888,7 @@ class CamlocDock(QDockWidget):
         """Load a scene file (for example one saved by the annotation page)."""
         problem = check_regular_file(path, "scene")  # a FIFO would block QGIS on open()
         if problem:
-            self.set_status(problem)
+            self.refuse(problem)
             return False
         try:
             if os.path.getsize(path) > MAX_SCENE_BYTES:
@@ -884,7 +901,7 @@ class CamlocDock(QDockWidget):
             if not isinstance(scene, dict):
                 raise ValueError("not a JSON object")
         except (OSError, ValueError, RecursionError) as exc:
-            self.set_status(f"cannot read the scene {path}: {exc}")
+            self.refuse(f"cannot read the scene {path}: {exc}")
             return False
         name = os.path.basename(path)
         # the library's own check, at load (it used to come only at Run or Save): the analyst
@@ -893,7 +910,7 @@ class CamlocDock(QDockWidget):
         try:
             Annotation.from_scene(scene)  # a wrong shape ("annotations": 5) cannot be shown
         except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
-            self.set_status(f"cannot load the scene {name}: {invalid or exc}")
+            self.refuse(f"cannot load the scene {name}: {invalid or exc}")
             return False
         image = (scene.get("image") or {}).get("path")
         refused = ""
@@ -983,7 +1000,7 @@ class CamlocDock(QDockWidget):
         if problem is None and _same_file(path, self.osm_edit.text().strip()):
             problem = f"{path} is the map extract; give the scene its own .json file"
         if problem:
-            self.set_status(f"not saved: {problem}")
+            self.refuse(f"not saved: {problem}")
             return False
         scene = self.scene()
         if self.image_file:  # the scene names its photo from its own folder, where it is saved
@@ -991,7 +1008,7 @@ class CamlocDock(QDockWidget):
         try:
             run_worker({"task": "check_scene", "scene": scene, "save_to": path})
         except WorkerError as exc:
-            self.set_status(f"not saved: {exc}")
+            self.refuse(f"not saved: {exc}")
             return False
         self.set_status(f"saved {path}")
         return True
@@ -1041,7 +1058,7 @@ class CamlocDock(QDockWidget):
             return None
         problems = self.annotation.problems()
         if problems:
-            self.set_status("Not ready: " + "; ".join(problems))
+            self.refuse("Not ready: " + "; ".join(problems))
             return None
         osm = self.osm_edit.text().strip()
         gpkg = self.results_path()
@@ -1050,12 +1067,12 @@ class CamlocDock(QDockWidget):
             if problem is None and _same_file(gpkg, other):
                 problem = f"{gpkg} is {what}"  # found only after the run, as an OGR error
         if problem:
-            self.set_status(f"cannot write results: {problem}; pick another GeoPackage")
+            self.refuse(f"cannot write results: {problem}; pick another GeoPackage")
             return None
         if osm:
             problem = _extract_problem(osm)
             if problem:
-                self.set_status(problem)
+                self.refuse(problem)
                 return None
         prefix = "".join(c if c.isalnum() else "_" for c in self.annotation.scene_id) or "scene"
         self._fill_candidates(None)
@@ -1063,6 +1080,11 @@ class CamlocDock(QDockWidget):
         if self._result_key == (os.path.abspath(gpkg), prefix):
             # their GeoPackage tables are about to be replaced; put back if the run fails
             self._restore = (self._result_group, dict(self._result_uris))
+            # and the map where the analyst left it: put back into a project left empty, QGIS
+            # zoomed to the layers' full extent (the cones; seen in the desktop check)
+            self._restore_extent = (
+                self.iface.mapCanvas().extent() if self.iface is not None else None
+            )
             self._remove_results()
         else:
             # another camera's (or GeoPackage's) layers: they stay in the project as they are
@@ -1096,9 +1118,12 @@ class CamlocDock(QDockWidget):
 
     def cancel(self) -> None:
         """Cancel the run (the worker process is stopped)."""
-        if self.task is not None:
-            self.task.cancel()
+        task = self.task
+        if task is not None:
+            # said before cancel(): a task canceled before it started ends inside cancel()
+            # (its finished(False) runs at once), and "Canceling…" stayed after "Canceled."
             self.set_status("Canceling…")
+            task.cancel()
 
     def _task_progress(self, value: float) -> None:
         self.progress.setValue(int(value))
@@ -1114,7 +1139,7 @@ class CamlocDock(QDockWidget):
         if not ok:
             restore, self._restore = self._restore, None
             if restore is not None:  # the tables were not replaced: the last results come back
-                self._load_layers(restore[0], restore[1], None)
+                self._load_layers(restore[0], restore[1], None, self._restore_extent)
                 self._result_key = (os.path.abspath(task.gpkg), task.prefix)
             if task.error in (None, "canceled"):
                 self.set_status("Canceled.")
@@ -1153,10 +1178,17 @@ class CamlocDock(QDockWidget):
         if error:
             QgsMessageLog.logMessage(f"the styles were not stored: {error}", "camloc", Qgis.Warning)
 
-    def _load_layers(self, name: str, uris: dict[str, str], task: LocateTask | None) -> None:
+    def _load_layers(
+        self,
+        name: str,
+        uris: dict[str, str],
+        task: LocateTask | None,
+        extent: Any = None,
+    ) -> None:
         """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never
         stalls for the whole batch) into the group ``name``, candidates on top; then report
-        ``task`` (None: layers put back after a failed run, nothing to report)."""
+        ``task`` (None: layers put back after a failed run, nothing to report) or set the
+        canvas back to ``extent`` (a QgsRectangle, None: left as it is)."""
         from qgis.PyQt.QtCore import QTimer
 
         root = QgsProject.instance().layerTreeRoot()
@@ -1172,6 +1204,12 @@ class CamlocDock(QDockWidget):
                 self._loading = False
                 if task is not None:
                     self._report(task)
+                elif extent is not None and self.iface is not None:
+                    canvas = self.iface.mapCanvas()
+                    canvas.setExtent(extent)
+                    canvas.refresh()
+                    # after QGIS's own zoom to the first layers of an empty project
+                    QTimer.singleShot(0, lambda: (canvas.setExtent(extent), canvas.refresh()))
                 return
             kind = todo.pop(0)
             opts = QgsVectorLayer.LayerOptions(False, False)  # no default style, no extent scan
@@ -1206,8 +1244,15 @@ class CamlocDock(QDockWidget):
             project = QgsProject.instance()
             xform = QgsCoordinateTransform(wgs84(), canvas.mapSettings().destinationCrs(), project)
             ext84 = cands.extent()
-            ext84.grow(0.0006)  # degrees (the layer is EPSG:4326): about 60 m around them
-            ext = xform.transformBoundingBox(ext84)
+            ext84.grow(0.0002)  # degrees (the layer is EPSG:4326): about 20 m around them
+            # room beside them for the leading candidates' labels: at a fixed 60 m the canvas
+            # beside the dock (460 px) cut '#4 0.05 (tie with #1, #3)' at its left edge
+            ext = extent_with_room(
+                xform.transformBoundingBox(ext84),
+                canvas.width(),
+                canvas.height(),
+                label_room_px(cands, canvas.mapSettings().outputDpi()),
+            )
             canvas.setExtent(ext)
             canvas.refresh()
             # the first layers of an empty project make QGIS zoom to their full extent once
@@ -1273,6 +1318,14 @@ class CamlocDock(QDockWidget):
             if project.mapLayer(layer_id) is not None:
                 project.removeMapLayer(layer_id)
         self.result_layers = []
+
+    def refuse(self, text: str) -> None:
+        """Say why an action was refused: the status line, and QGIS's message bar (a warning,
+        10 s; the analyst may be looking at the map, not at the dock)."""
+        self.set_status(text)
+        if self.iface is not None:
+            line = " ".join(text.split())
+            self.iface.messageBar().pushMessage("camloc", line, Qgis.Warning, 10)
 
     def set_status(self, text: str) -> None:
         self.status.setText(text)

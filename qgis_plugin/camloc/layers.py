@@ -6,8 +6,12 @@ import json
 from typing import Any
 
 from qgis.core import (
+    NULL,
     QgsCoordinateReferenceSystem,
     QgsCoordinateTransformContext,
+    QgsExpression,
+    QgsExpressionContext,
+    QgsExpressionContextUtils,
     QgsFeature,
     QgsFeatureSink,
     QgsField,
@@ -18,6 +22,7 @@ from qgis.core import (
     QgsPalLayerSettings,
     QgsPointXY,
     QgsProperty,
+    QgsRectangle,
     QgsRuleBasedRenderer,
     QgsSymbol,
     QgsSymbolLayer,
@@ -29,7 +34,7 @@ from qgis.core import (
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QVariant
-from qgis.PyQt.QtGui import QColor
+from qgis.PyQt.QtGui import QColor, QFontMetricsF
 
 WGS84 = "EPSG:4326"
 
@@ -406,6 +411,63 @@ STYLES = {
     "context_streets": style_context_streets,
     "context_buildings": style_context_buildings,
 }
+
+
+CANDIDATE_MARKER_MM = 7.0
+"""The largest candidate marker (the tie star), for the room its labels need."""
+
+
+def label_room_px(layer: QgsVectorLayer, dpi: float) -> tuple[float, float]:
+    """Room (x, y in pixels at ``dpi``) the layer's point labels take beside their markers.
+
+    x: the widest label the layer draws (its label expression evaluated on each feature; NULL
+    draws nothing) plus the gap from the marker's edge and half the largest marker; y: a
+    label's height plus half the marker. (0, 0) when the layer draws no labels.
+    """
+    labeling = layer.labeling()
+    if not layer.labelsEnabled() or labeling is None or not hasattr(labeling, "settings"):
+        return 0.0, 0.0
+    settings = labeling.settings()
+    fmt = settings.format()
+    font = fmt.toQFont()
+    font.setPixelSize(max(1, round(fmt.size() * dpi / 72.0)))  # the format's size is in points
+    metrics = QFontMetricsF(font)
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    expr = QgsExpression(settings.fieldName if settings.isExpression else f'"{settings.fieldName}"')
+    expr.prepare(ctx)
+    widest = 0.0
+    for feature in layer.getFeatures():
+        ctx.setFeature(feature)
+        text = expr.evaluate(ctx)
+        if text is not None and text != NULL and str(text):
+            widest = max(widest, metrics.boundingRect(str(text)).width())
+    if widest == 0.0:
+        return 0.0, 0.0
+    mm = dpi / 25.4
+    marker = 0.5 * CANDIDATE_MARKER_MM * mm
+    buffer = 2 * fmt.buffer().size() * mm if fmt.buffer().enabled() else 0.0
+    return widest + settings.dist * mm + marker + buffer, metrics.height() + marker + buffer
+
+
+def extent_with_room(
+    extent: QgsRectangle, width_px: int, height_px: int, room_px: tuple[float, float]
+) -> QgsRectangle:
+    """An extent of the canvas's shape around ``extent`` leaving ``room_px`` (x, y) on each
+    side for labels (at most 35 % of the canvas each side, so a narrow canvas still shows the
+    points)."""
+    room_x = min(room_px[0], 0.35 * width_px)
+    room_y = min(room_px[1], 0.35 * height_px)
+    per_px = max(
+        extent.width() / max(1.0, width_px - 2 * room_x),
+        extent.height() / max(1.0, height_px - 2 * room_y),
+    )
+    if per_px <= 0:
+        return QgsRectangle(extent)
+    centre = extent.center()
+    half_w, half_h = 0.5 * per_px * width_px, 0.5 * per_px * height_px
+    return QgsRectangle(
+        centre.x() - half_w, centre.y() - half_h, centre.x() + half_w, centre.y() + half_h
+    )
 
 
 def apply_style(layer: QgsVectorLayer, kind: str) -> None:

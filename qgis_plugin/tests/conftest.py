@@ -61,10 +61,14 @@ def provider(qgis_processing):
         reg.removeProvider(reg.providerById("camloc"))
 
 
-def chain_model():
+def chain_model(options: bool = True):
     """A model as the designer builds it: camloc:locate's candidates feed camloc:corners (its
     extent) and native:extractbyattribute (rank = 1); outputs ``locate:candidates``,
-    ``corners:corners``, ``best:best``; inputs ``scene`` and ``osm``."""
+    ``corners:corners``, ``best:best``; inputs ``scene`` and ``osm``.
+
+    ``options=False`` leaves camloc's options with a default (the yes/no ``NETWORK`` and
+    ``CONTEXT``, corners' ``RADIUS_M``) unset, as a model written in Python or saved before an
+    option existed does."""
     from qgis.core import (
         QgsProcessingModelAlgorithm,
         QgsProcessingModelChildAlgorithm,
@@ -92,14 +96,18 @@ def chain_model():
         c.setModelOutputs({model_output: out})
         model.addChildAlgorithm(c)
 
+    locate_options = {"NETWORK": src.fromStaticValue(False), "CONTEXT": src.fromStaticValue(False)}
+    corners_options = {
+        "RADIUS_M": src.fromStaticValue(150.0),
+        "NETWORK": src.fromStaticValue(False),
+    }
     child(
         "camloc:locate",
         "locate",
         {
             "SCENE": src.fromModelParameter("scene"),
             "OSM": src.fromModelParameter("osm"),
-            "NETWORK": src.fromStaticValue(False),
-            "CONTEXT": src.fromStaticValue(False),
+            **(locate_options if options else {}),
         },
         "CANDIDATES",
         "candidates",
@@ -110,8 +118,7 @@ def chain_model():
         {
             "EXTENT": src.fromChildOutput("locate", "CANDIDATES"),
             "OSM": src.fromModelParameter("osm"),
-            "RADIUS_M": src.fromStaticValue(150.0),
-            "NETWORK": src.fromStaticValue(False),
+            **(corners_options if options else {}),
         },
         "CORNERS",
         "corners",

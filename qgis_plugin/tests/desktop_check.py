@@ -1,19 +1,24 @@
 """The QGIS desktop, driven as an analyst would, with screenshots: a script for ``qgis --code``.
 
-Not a pytest module (the suite runs headless); run it by hand under Xvfb::
+The suite runs it (test_desktop.py, under Xvfb, a fresh profile, a time limit); by hand::
 
-    CAMLOC_PYTHON=$PWD/.venv-qgis/bin/python PYTHONPATH=$PWD \\
+    CAMLOC_PYTHON=$PWD/.venv-qgis/bin/python \\
     xvfb-run -a -s "-screen 0 1400x900x24" qgis --nologo --noversioncheck \\
         --profiles-path /tmp/camloc-profile --code qgis_plugin/tests/desktop_check.py
 
 It runs, on the bundled sample: camloc:locate from the Toolbox's code path
 (``processing.runAndLoadResults``) into named GeoPackages, the Toolbox's algorithm dialog (a
-background task) into named shapefiles, the Processing batch dialog with two
-scenes (outputs per row, optional outputs left empty, layers loaded), and the dock (Load
-scene…, Run). Each step writes the loaded layers (name, renderer, camloc kind, features) to
-``tests/artifacts/qgis/desktop/summary.json`` and screenshots (``*.png``) beside it; QGIS exits
-with the project cleared first (``QgsApplication.exit()`` with layers still loaded crashed QGIS
-3.22 in its own teardown: ``QgisApp::setMapStyleDockLayer`` on a destroyed widget).
+background task) into named shapefiles, the Processing batch dialog with two scenes (outputs per
+row, optional outputs left empty, layers loaded), and the dock (Load scene…, Run; then Run on a
+cut extract, and a Run canceled at once). Each step writes the loaded layers (name, renderer,
+camloc kind, features, the candidates' ranks), the labels the canvas drew (text, layer, inside
+the visible map or cut by its edge), where the canvas sits in the window's screenshot, the
+message bar's lines and the message log's Python errors and camloc messages to ``summary.json`` in
+``$CAMLOC_DESKTOP_OUT`` (default ``tests/artifacts/qgis/desktop``), with screenshots
+(``*.png``) beside it. QGIS exits with the project cleared first (``QgsApplication.exit()``
+with layers still loaded crashed QGIS 3.22 in its own teardown:
+``QgisApp::setMapStyleDockLayer`` on a destroyed widget); a watchdog ends it after
+``$CAMLOC_DESKTOP_WATCHDOG_S`` seconds (default 240) with ``error`` in the summary.
 """
 
 from __future__ import annotations
@@ -26,13 +31,13 @@ from pathlib import Path
 from typing import Any
 
 from qgis.core import QgsApplication, QgsProject
-from qgis.PyQt.QtCore import QTimer
+from qgis.PyQt.QtCore import QPoint, QTimer
 from qgis.utils import iface
 
 REPO = Path(os.environ.get("CAMLOC_REPO", Path.cwd()))
 SCENE = REPO / "sample_maps" / "sample_scene.json"
 OSM = REPO / "sample_maps" / "baltimore.osm.pbf"
-OUT = REPO / "tests" / "artifacts" / "qgis" / "desktop"
+OUT = Path(os.environ.get("CAMLOC_DESKTOP_OUT", REPO / "tests" / "artifacts" / "qgis" / "desktop"))
 OUT.mkdir(parents=True, exist_ok=True)
 sys.path.insert(0, str(REPO / "qgis_plugin"))
 summary: dict[str, Any] = {}
@@ -40,33 +45,68 @@ state: dict[str, Any] = {}
 
 
 def _layers() -> list[dict[str, Any]]:
+    """The layers in the legend, top first."""
     out = []
     for node in QgsProject.instance().layerTreeRoot().findLayers():
         lyr = node.layer()
-        out.append(
-            {
-                "name": lyr.name(),
-                "renderer": type(lyr.renderer()).__name__,
-                "kind": lyr.customProperty("camloc/kind"),
-                "features": lyr.featureCount(),
-                "labels": lyr.labelsEnabled(),
-            }
-        )
+        row = {
+            "name": lyr.name(),
+            "renderer": type(lyr.renderer()).__name__,
+            "kind": lyr.customProperty("camloc/kind"),
+            "features": lyr.featureCount(),
+            "labels": lyr.labelsEnabled(),
+        }
+        if row["kind"] == "candidates":
+            feats = list(lyr.getFeatures())
+            row["ranks"] = [f["rank"] for f in feats]
+            row["tie_ranks"] = sorted(f["rank"] for f in feats if f["tie"])
+        out.append(row)
     return out
 
 
+def _labels() -> list[dict[str, Any]]:
+    """The labels of the canvas's last render: text, layer and whether the visible map holds
+    the whole of it (False: cut by the canvas's edge)."""
+    canvas = iface.mapCanvas()
+    results = canvas.labelingResults()
+    if results is None or not hasattr(results, "allLabels"):
+        return []
+    extent = canvas.mapSettings().visibleExtent()
+    names = {lid: lyr.name() for lid, lyr in QgsProject.instance().mapLayers().items()}
+    return [
+        {
+            "layer": names.get(lp.layerID, lp.layerID),
+            "text": lp.labelText,
+            "inside": extent.contains(lp.labelRect),
+            "unplaced": lp.isUnplaced,
+        }
+        for lp in results.allLabels()
+    ]
+
+
 def _shot(name: str) -> None:
-    iface.mapCanvas().saveAsImage(str(OUT / f"{name}_canvas.png"))
+    canvas = iface.mapCanvas()
+    canvas.saveAsImage(str(OUT / f"{name}_canvas.png"))
     iface.mainWindow().grab().save(str(OUT / f"{name}_window.png"))
+    corner = canvas.mapTo(iface.mainWindow(), QPoint(0, 0))
+    summary.setdefault("canvas", {})[name] = {
+        "rect": [corner.x(), corner.y(), canvas.width(), canvas.height()],
+        "labels": _labels(),
+    }
 
 
 def _zoom_to_candidates() -> None:
+    """As the dock zooms after a run: the candidates with room for their labels."""
+    from camloc.layers import extent_with_room, label_room_px
+
+    canvas = iface.mapCanvas()
     for lyr in QgsProject.instance().mapLayers().values():
         if lyr.customProperty("camloc/kind") == "candidates":
             ext = lyr.extent()
-            ext.grow(0.0006)
-            iface.mapCanvas().setExtent(ext)
-            iface.mapCanvas().refresh()
+            ext.grow(0.0002)
+            room = label_room_px(lyr, canvas.mapSettings().outputDpi())
+            canvas.setExtent(extent_with_room(ext, canvas.width(), canvas.height(), room))
+            canvas.refresh()
             return
 
 
@@ -86,7 +126,7 @@ def step_toolbox() -> None:
     params.update({k: str(OUT / f"toolbox_{k.lower()}.gpkg") for k in outs})
     processing.runAndLoadResults("camloc:locate", params)
     summary["toolbox"] = _layers()
-    _zoom_to_candidates()
+    QTimer.singleShot(300, _zoom_to_candidates)  # after QGIS zooms to its first layers
     QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_dialog)()))
 
 
@@ -144,7 +184,7 @@ def step_batch() -> None:
     panel.checkLoadLayersOnCompletion.setChecked(True)
     dlg.runAlgorithm()
     summary["batch"] = _layers()
-    _zoom_to_candidates()
+    QTimer.singleShot(300, _zoom_to_candidates)
     QTimer.singleShot(
         1500, lambda: (dlg.grab().save(str(OUT / "batch_dialog.png")), guarded(step_dock)())
     )
@@ -180,14 +220,81 @@ def finish() -> None:
             dock.candidate_list.item(i).text() for i in range(dock.candidate_list.count())
         ],
         "layers": _layers(),
+        "extent": _extent(),
     }
     _shot("dock")
     dock.grab().save(str(OUT / "dock.png"))
     iface.layerTreeView().grab().save(str(OUT / "dock_legend.png"))
-    done()
+    step_dock_errors()
+
+
+def _extent() -> list[float]:
+    """The canvas's extent, [xmin, ymin, xmax, ymax] in the project's CRS."""
+    ext = iface.mapCanvas().extent()
+    return [ext.xMinimum(), ext.yMinimum(), ext.xMaximum(), ext.yMaximum()]
+
+
+def _bar() -> list[str]:
+    """The message bar's items, 'title: text', newest last."""
+    out = []
+    for item in iface.messageBar().items():
+        out.append(f"{item.title()}: {item.text()}")
+    return out
+
+
+def _when_idle(then: Any) -> None:
+    """Call ``then`` once the dock's run and its layer loading have ended (at most 120 s)."""
+    dock = state["plugin"].dock
+
+    def poll(n: list[int] = [0]) -> None:  # noqa: B006 - a counter kept between calls
+        n[0] += 1
+        if (dock.task is not None or dock._loading) and n[0] < 240:
+            QTimer.singleShot(500, poll)
+            return
+        QTimer.singleShot(500, guarded(then))
+
+    QTimer.singleShot(300, poll)
+
+
+def step_dock_errors() -> None:
+    """What the analyst sees when the extract is broken, and when a run is canceled: the
+    message bar's line (no Python error), the last results kept."""
+    dock = state["plugin"].dock
+    cut = OUT / "cut.osm.pbf"
+    cut.write_bytes(OSM.read_bytes()[:4000])
+    iface.messageBar().clearWidgets()
+    dock.osm_edit.setText(str(cut))
+    dock.run()
+
+    def broken_done() -> None:
+        summary["dock_broken_extract"] = {
+            "status": dock.status.text(),
+            "bar": _bar(),
+            "layers": _layers(),
+            "extent": _extent(),
+        }
+        iface.mainWindow().grab().save(str(OUT / "dock_error_window.png"))
+        iface.messageBar().clearWidgets()
+        dock.osm_edit.setText(str(OSM))
+        dock.run()
+        dock.cancel()  # at once: the worker is stopped
+        _when_idle(canceled)
+
+    def canceled() -> None:
+        summary["dock_canceled"] = {
+            "status": dock.status.text(),
+            "layers": _layers(),
+            "extent": _extent(),
+        }
+        done()
+
+    _when_idle(broken_done)
 
 
 def done() -> None:
+    if summary.get("done"):
+        return
+    summary["done"] = True
     (OUT / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False))
     QgsProject.instance().clear()  # before exit: see the module's docstring
     QTimer.singleShot(300, QgsApplication.exit)
@@ -204,4 +311,29 @@ def guarded(step: Any) -> Any:
     return run
 
 
-QTimer.singleShot(500, guarded(step_toolbox))
+def _log(message: str, tag: str, level: Any) -> None:
+    if tag in ("Python error", "Python warning", "camloc") or "Traceback" in message:
+        summary.setdefault("log", []).append({"tag": tag, "message": message})
+
+
+QgsApplication.messageLog().messageReceived.connect(_log)
+
+
+def start() -> None:
+    # the window as large as the screen (Xvfb has no window manager to maximise it): the
+    # canvas beside the dock as an analyst's screen shows it
+    screen = QgsApplication.primaryScreen()
+    if screen is not None:
+        iface.mainWindow().setGeometry(screen.availableGeometry())
+    step_toolbox()
+
+
+def watchdog() -> None:
+    if not summary.get("done"):
+        summary["error"] = f"watchdog: the steps did not end within {WATCHDOG_S} s"
+        done()
+
+
+WATCHDOG_S = float(os.environ.get("CAMLOC_DESKTOP_WATCHDOG_S", "240"))
+QTimer.singleShot(int(WATCHDOG_S * 1000), watchdog)
+QTimer.singleShot(500, guarded(start))

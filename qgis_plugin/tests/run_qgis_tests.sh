@@ -5,7 +5,8 @@
 # --system-site-packages, so that it sees qgis, PyQt5 and osgeo, with numpy 1.24.2 (numpy 2
 # breaks osgeo on bookworm), pytest-qgis and this repository (editable). The plugin's worker runs
 # camloc_geo in that venv's Python, outside the QGIS process (docs/qgis.md).
-# Usage: qgis_plugin/tests/run_qgis_tests.sh [pytest args]   (venv: $CAMLOC_QGIS_VENV or .venv-qgis)
+# Usage: qgis_plugin/tests/run_qgis_tests.sh [pytest args] [test files]   (venv: $CAMLOC_QGIS_VENV
+# or .venv-qgis); with no test file among the arguments it runs the whole of qgis_plugin/tests.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 VENV="${CAMLOC_QGIS_VENV:-.venv-qgis}"
@@ -19,4 +20,12 @@ fi
 "$VENV/bin/python" -m pip install -q "numpy==1.24.2" "pytest>=8" "pytest-qgis>=2" -e .
 export QT_QPA_PLATFORM=offscreen
 unset PYTHONPATH
-exec "$VENV/bin/python" -m pytest -q qgis_plugin/tests "$@"
+# Test files or node ids among the arguments run alone; otherwise the whole folder.
+TARGETS=(qgis_plugin/tests)
+for arg in "$@"; do
+  case "$arg" in
+    -*) ;;
+    *) if [ -e "${arg%%::*}" ]; then TARGETS=(); break; fi ;;
+  esac
+done
+exec "$VENV/bin/python" -m pytest -q "${TARGETS[@]}" "$@"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from conftest import SAMPLE_OSM, SAMPLE_SCENE, chain_model
 from qgis.core import QgsProject, QgsRuleBasedRenderer, QgsVectorLayer
 
@@ -127,3 +128,77 @@ def test_model_outputs_loaded_keep_the_model_names_and_camloc_styles(provider, t
     assert layers["corners"].customProperty("camloc/kind") == "corners"
     assert layers["best"].featureCount() == 1
     project.clear()
+
+
+def test_model_with_camloc_options_left_unset_validates_and_runs(provider, tmp_path):
+    # QGIS 3.22 refused such a model: "Parameter NETWORK is mandatory", "Parameter CONTEXT is
+    # mandatory" (every non-optional parameter without a source, whatever its default)
+    import processing
+
+    model = chain_model(options=False)
+    assert model.validate() == (True, [])
+    for child in ("locate", "corners"):
+        assert model.validateChildAlgorithm(child) == (True, [])
+    res = processing.run(
+        model,
+        {
+            "scene": str(SAMPLE_SCENE),
+            "osm": str(SAMPLE_OSM),
+            "locate:candidates": str(tmp_path / "candidates.gpkg"),
+            "corners:corners": str(tmp_path / "corners.gpkg"),
+            "best:best": str(tmp_path / "best.gpkg"),
+        },
+    )
+    assert QgsVectorLayer(res["locate:candidates"], "c", "ogr").featureCount() == 12
+    assert QgsVectorLayer(res["best:best"], "b", "ogr").featureCount() == 1
+    corners = QgsVectorLayer(res["corners:corners"], "k", "ogr")
+    assert [f["kind"] for f in corners.getFeatures()].count("intersection") >= 1
+
+
+def test_unset_options_read_as_their_defaults(provider):
+    from qgis.core import QgsProcessingContext, QgsProcessingParameterDefinition
+
+    context = QgsProcessingContext()
+    for alg in provider.algorithms():
+        for name, default in (("NETWORK", False), ("CONTEXT", False), ("RADIUS_M", 150.0)):
+            param = alg.parameterDefinition(name)
+            if param is None or param.defaultValue() is None:
+                continue
+            assert param.flags() & QgsProcessingParameterDefinition.FlagOptional, (alg.id(), name)
+            assert param.defaultValue() == default
+            if param.type() == "boolean":
+                assert alg.parameterAsBool({}, name, context) is False
+            else:
+                assert alg.parameterAsDouble({}, name, context) == default
+
+
+@pytest.mark.parametrize("alg_id", ["camloc:locate", "camloc:corners", "camloc:geocodelist"])
+def test_the_designers_child_dialog_left_as_it_opens_gives_a_valid_child(
+    provider, qgis_iface, alg_id
+):
+    # the graphical modeler's path: add the algorithm, set only its required input, press OK
+    from processing.modeler.ModelerParametersDialog import ModelerParametersDialog
+    from qgis.core import (
+        QgsApplication,
+        QgsProcessingModelAlgorithm,
+        QgsProcessingModelChildParameterSource,
+        QgsProcessingModelParameter,
+        QgsProcessingParameterFile,
+    )
+
+    model = QgsProcessingModelAlgorithm("designer", "camloc tests")
+    model.addModelParameter(
+        QgsProcessingParameterFile("input", "input"), QgsProcessingModelParameter("input")
+    )
+    alg = QgsApplication.processingRegistry().algorithmById(alg_id)
+    dlg = ModelerParametersDialog(alg, model)
+    wrappers = dlg.widget.widget.wrappers
+    required = {"camloc:locate": "SCENE", "camloc:geocodelist": "LIST"}.get(alg_id)
+    if required:
+        wrappers[required].setWidgetValue(
+            QgsProcessingModelChildParameterSource.fromModelParameter("input")
+        )
+    child = dlg.createAlgorithm()
+    model.addChildAlgorithm(child)
+    assert model.validateChildAlgorithm(child.childId()) == (True, [])
+    dlg.deleteLater()

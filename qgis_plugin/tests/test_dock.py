@@ -260,7 +260,9 @@ def test_dock_cancel_stops_the_run(dock, qgis_iface, tmp_path):
     assert dock.wait()
     assert dock.result_layers == []
     assert dock.run_button.isEnabled()
-    assert "Cancel" in dock.status.text() or "candidate" in dock.status.text()
+    # "Canceling…" stayed when the task was canceled before it started (seen in the desktop
+    # check): its end ran inside cancel(), before the dock said "Canceling…"
+    assert dock.status.text() == "Canceled." or "candidate" in dock.status.text()
 
 
 def test_reopening_a_snapshot_after_clicks_does_not_crash(dock, tmp_path):
@@ -1009,3 +1011,89 @@ def test_the_candidates_are_listed_best_first_and_a_click_shows_one(dock, qgis_i
     tol = 1e-6 if canvas_crs.isGeographic() else 0.1
     assert abs(centre.x() - want.x()) < tol
     assert abs(centre.y() - want.y()) < tol
+
+
+def test_bad_scenes_and_extracts_are_told_in_the_message_bar_without_traceback(
+    dock, qgis_iface, tmp_path
+):
+    # a refusal at Run or Load scene… (an empty extract, a broken scene file) was said only in
+    # the dock's status line; a run on a file that is no OSM extract ends in one Critical line
+    from qgis.core import Qgis, QgsApplication
+
+    logged: list[str] = []
+    log = QgsApplication.messageLog()
+    log.messageReceived.connect(lambda msg, tag, _level: logged.append(f"{tag}: {msg}"))
+    bar = qgis_iface.messageBar()
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    empty = tmp_path / "empty.osm"
+    empty.write_bytes(b"")
+    dock.osm_edit.setText(str(empty))
+    bar.clear_messages()
+    _no_run(dock)
+    warned = bar.get_messages(Qgis.Warning)
+    assert len(warned) == 1, warned
+    assert "empty (0 bytes)" in warned[0]
+    assert "empty.osm" in warned[0]
+    cut = tmp_path / "cut.osm.pbf"  # an extract cut short, and a text file named .osm
+    cut.write_bytes(SAMPLE_OSM.read_bytes()[:4000])
+    text = tmp_path / "notes.osm"
+    text.write_text("these are my notes, not OpenStreetMap\n")
+    for bad in (cut, text):
+        bar.clear_messages()
+        dock.osm_edit.setText(str(bad))
+        assert dock.run() is not None
+        assert dock.wait()
+        said = bar.get_messages(Qgis.Critical)
+        assert len(said) == 1, (bad.name, said)
+        # e.g. "the camera was not located: cannot read OSM extract cut.osm.pbf: PBF error:
+        # unexpected EOF" (notes.osm: "XML parsing error at line 1, column 0: syntax error")
+        assert f"the camera was not located: cannot read OSM extract {bad.name}: " in said[0]
+        assert "\n" not in said[0]
+        assert "Traceback" not in said[0]
+        assert "Traceback" not in dock.status.text()
+    broken = tmp_path / "broken.json"
+    broken.write_text('{"format": "camloc-scene/1", "annotations": [')
+    bar.clear_messages()
+    assert not dock.load_scene(str(broken))
+    warned = bar.get_messages(Qgis.Warning)
+    assert len(warned) == 1, warned
+    assert "cannot read the scene" in warned[0]
+    assert "broken.json" in warned[0]
+    assert [m for m in logged if "Traceback" in m or m.startswith("Python")] == []
+
+
+def test_an_unforeseen_error_in_the_run_is_one_line_and_a_logged_traceback(
+    dock, qgis_iface, tmp_path, monkeypatch
+):
+    # an exception other than the worker's or the file system's escaped the background task
+    from camloc import dock as dock_module
+    from qgis.core import Qgis, QgsApplication
+
+    def broken(*_args, **_kwargs):
+        raise RuntimeError("OGR said no")
+
+    monkeypatch.setattr(dock_module, "write_gpkg_layer", broken)
+    logged: list[tuple[str, str]] = []
+    QgsApplication.messageLog().messageReceived.connect(
+        lambda msg, tag, _level: logged.append((tag, msg))
+    )
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    bar = qgis_iface.messageBar()
+    bar.clear_messages()
+    assert dock.run() is not None
+    assert dock.wait()
+    said = bar.get_messages(Qgis.Critical)
+    assert len(said) == 1, said
+    assert "unexpected error (RuntimeError: OGR said no)" in said[0]
+    assert "\n" not in said[0]
+    tracebacks = [msg for tag, msg in logged if tag == "camloc" and "Traceback" in msg]
+    assert len(tracebacks) == 1
+    assert "OGR said no" in tracebacks[0]
+    assert dock.run_button.isEnabled()

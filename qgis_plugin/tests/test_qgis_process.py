@@ -195,12 +195,17 @@ def test_qgis_process_reads_relative_paths_from_the_shell_folder(profile_home, t
     assert [f.GetField("status") for f in cams_ds.GetLayer(0)] == ["title_only"]
 
 
-def test_qgis_process_runs_a_model_chaining_camloc_algorithms(profile_home, provider, tmp_path):
-    # the designer's use: locate's candidates feed corners (their extent) and a native filter
+@pytest.mark.parametrize("options", [True, False], ids=["options-set", "options-unset"])
+def test_qgis_process_runs_a_model_chaining_camloc_algorithms(
+    profile_home, provider, tmp_path, options
+):
+    # the designer's use: locate's candidates feed corners (their extent) and a native filter;
+    # options-unset: camloc's yes/no options and corners' radius have no value in the model
+    # (QGIS 3.22 refused it: "Parameter NETWORK is mandatory")
     from conftest import chain_model
 
     model = tmp_path / "chain.model3"
-    assert chain_model().toFile(str(model))
+    assert chain_model(options=options).toFile(str(model))
     r = subprocess.run(
         [
             QGIS_PROCESS,
