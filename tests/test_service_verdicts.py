@@ -283,10 +283,10 @@ class _Reviewer:
 
     def open(self) -> None:
         self.page.goto(self.url, wait_until="load")
-        self.page.wait_for_selector(".camloc-verdicts .camloc-vshare", timeout=5000)
+        self.page.wait_for_selector(".camloc-verdicts .camloc-vshare", timeout=30000)
         self.page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent.startsWith('shared')",
-            timeout=5000,
+            timeout=30000,
         )
 
     def close(self) -> None:
@@ -321,13 +321,13 @@ def test_served_page_shares_verdicts_between_reviewers(
         page.locator(".camloc-verdicts input").fill("Ana")
         page.locator('.camloc-candidate [data-rank="2"]').click()
         box = page.locator(".leaflet-popup-content .camloc-verdict")
-        box.locator('button[data-verdict="yes"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="yes"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="yes"]').click()
         box.locator("input").fill("lamp post")
         page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent === "
             "'shared with the service (1 there)'",
-            timeout=5000,
+            timeout=30000,
         )
         deadline_items: dict[str, Any] = {}
         for _ in range(50):  # the note goes 600 ms after the last key
@@ -344,7 +344,7 @@ def test_served_page_shares_verdicts_between_reviewers(
         bo.page.wait_for_function(
             f"document.querySelector('.camloc-vcount').textContent === '1 of {n} candidates "
             "reviewed'",
-            timeout=5000,
+            timeout=30000,
         )
         assert (
             bo.page.locator('.camloc-candidate [data-verdict-mark="2"]').get_attribute(
@@ -354,12 +354,12 @@ def test_served_page_shares_verdicts_between_reviewers(
         )
         bo.page.locator('.camloc-candidate [data-rank="1"]').click()
         bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
-        bbox.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        bbox.locator('button[data-verdict="no"]').wait_for(timeout=30000)
         bbox.locator('button[data-verdict="no"]').click()
         bo.page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent === "
             "'shared with the service (2 there)'",
-            timeout=5000,
+            timeout=30000,
         )
         assert vclient.get(url).json()["items"]["1"]["verdict"] == "no"
         # the service's export is the page's: the camera and the candidates' points came along
@@ -379,7 +379,7 @@ def test_served_page_shares_verdicts_between_reviewers(
         page.wait_for_function(
             "document.querySelector('[data-verdict-mark=\"1\"]').getAttribute('data-verdict')"
             " === 'no'",
-            timeout=5000,
+            timeout=30000,
         )
         page.screenshot(path=str(tmp_path / "shared.png"))
         for r in (ana, bo):
@@ -408,7 +408,7 @@ def test_served_page_saved_as_a_file_makes_no_request(
         page = t.page
         page.locator('.camloc-candidate [data-rank="1"]').click()
         box = page.locator(".leaflet-popup-content .camloc-verdict")
-        box.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="no"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="no"]').click()
         page.wait_for_timeout(300)
         assert page.locator(".camloc-vcount").inner_text().startswith("1 of ")
@@ -462,7 +462,7 @@ def test_verdicts_given_before_the_service_was_reached_are_sent(
         cy.page.wait_for_function(
             "document.querySelector('[data-verdict-mark=\"5\"]').getAttribute('data-verdict')"
             " === 'no'",
-            timeout=5000,
+            timeout=30000,
         )
         assert cy.blocked == []
         assert cy.errors == []
@@ -540,7 +540,7 @@ def _show_marker(page: Any, key: str) -> None:
         })""",
         key,
     )
-    page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').wait_for(timeout=5000)
+    page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').wait_for(timeout=30000)
 
 
 @pytest.mark.browser
@@ -559,22 +559,22 @@ def test_job_map_reviewers_share_a_pick(
         marker = ana.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]')
         marker.click()
         box = ana.page.locator(".leaflet-popup-content .camloc-verdict")
-        box.locator("select").wait_for(timeout=3000)
+        box.locator("select").wait_for(timeout=30000)
         box.locator("select").select_option("3")
         ana.page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent === "
             "'shared with the service (1 there)'",
-            timeout=5000,
+            timeout=30000,
         )
         bo.open()
         bo.page.wait_for_function(
             "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
-            timeout=5000,
+            timeout=30000,
         )
         _show_marker(bo.page, key)
         bo.page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
         bbox = bo.page.locator(".leaflet-popup-content .camloc-verdict")
-        bbox.locator("select").wait_for(timeout=3000)
+        bbox.locator("select").wait_for(timeout=30000)
         assert bbox.locator("select").input_value() == "3"  # Ana's pick, on Bo's page
         bo.page.wait_for_timeout(600)  # (the popup's fade-in and pan, for the screenshot)
         bo.page.screenshot(path=str(tmp_path / "job-map.png"))
@@ -617,15 +617,15 @@ def test_job_map_clusters_count_the_verdicts(
         _show_marker(page, key)
         page.locator(f'.camloc-summary-marker [data-verdict-mark="{key}"]').click()
         box = page.locator(f'.leaflet-popup-content .camloc-verdict[data-verdict-key="{key}"]')
-        box.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="no"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="no"]').click()
         page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent.startsWith("
             "'shared with the service')",
-            timeout=5000,
+            timeout=30000,
         )
         page.evaluate(f"{mapvar.group(1)}.closePopup(); {mapvar.group(1)}.setZoom(11)")
-        cluster.first.wait_for(timeout=5000)
+        cluster.first.wait_for(timeout=30000)
         assert cluster.count() == 1
         assert cluster.locator("div > span").inner_text() == "2"
         badge = cluster.locator(".camloc-cbadge")
@@ -633,11 +633,11 @@ def test_job_map_clusters_count_the_verdicts(
             "(document.querySelector('.camloc-cluster .camloc-cbadge') || {}).textContent"
             " && document.querySelector('.camloc-cluster .camloc-cbadge').textContent"
             ".includes('\u27171')",
-            timeout=5000,
+            timeout=30000,
         )
         assert "\u27171" in badge.inner_text()  # c1's "no"
         # (inside the cluster: gone once the zoom's animation is over)
-        page.locator(".camloc-summary-marker").first.wait_for(state="detached", timeout=5000)
+        page.locator(".camloc-summary-marker").first.wait_for(state="detached", timeout=30000)
         page.screenshot(path=str(tmp_path / "job-clusters.png"))
         # zoomed in again, the marker comes back with its badge
         _show_marker(page, key)
@@ -728,7 +728,7 @@ def test_job_summary_page_basemap_in_chromium(browser: Any, tmp_path: Path) -> N
     page.on("pageerror", lambda exc: errors.append(str(exc)))
     try:
         page.goto(path.as_uri(), wait_until="load")
-        page.wait_for_selector(".leaflet-tile-loaded", timeout=5000)
+        page.wait_for_selector(".leaflet-tile-loaded", timeout=30000)
         assert tiles
         assert all(re.fullmatch(r"https://tiles\.example\.test/\d+/\d+/\d+\.png", u) for u in tiles)
         assert (
@@ -810,9 +810,9 @@ def test_served_page_asks_for_the_key_once_and_says_a_refusal(
         assert not keybox.is_visible()  # not asked before a change is refused
         page.locator('.camloc-candidate [data-rank="2"]').click()
         box = page.locator(".leaflet-popup-content .camloc-verdict")
-        box.locator('button[data-verdict="yes"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="yes"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="yes"]').click()
-        keybox.wait_for(state="visible", timeout=5000)
+        keybox.wait_for(state="visible", timeout=30000)
         text = share.inner_text()
         assert "refused (401: missing or wrong X-API-Key)" in text, text
         assert "kept in this browser only" in text
@@ -825,7 +825,7 @@ def test_served_page_asks_for_the_key_once_and_says_a_refusal(
         keybox.locator("button").click()
         page.wait_for_function(
             "document.querySelector('.camloc-vkey').textContent.includes('refused that key')",
-            timeout=5000,
+            timeout=30000,
         )
         assert keybox.is_visible()
         assert client.get(url).json()["items"] == {}
@@ -835,19 +835,19 @@ def test_served_page_asks_for_the_key_once_and_says_a_refusal(
         page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent === "
             "'shared with the service (1 there)'",
-            timeout=5000,
+            timeout=30000,
         )
         assert not keybox.is_visible()
         assert client.get(url).json()["items"]["2"]["verdict"] == "yes"
         # the next change goes at once, with the key kept for the session
         page.locator('.camloc-candidate [data-rank="1"]').click()
         box1 = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="1"]')
-        box1.locator('button[data-verdict="no"]').wait_for(timeout=3000)
+        box1.locator('button[data-verdict="no"]').wait_for(timeout=30000)
         box1.locator('button[data-verdict="no"]').click()
         page.wait_for_function(
             "document.querySelector('.camloc-vshare').textContent === "
             "'shared with the service (2 there)'",
-            timeout=5000,
+            timeout=30000,
         )
         assert not keybox.is_visible()
         assert client.get(url).json()["items"]["1"]["verdict"] == "no"
@@ -994,18 +994,18 @@ def test_cli_page_from_a_file_shares_with_the_service(
     try:
         page.goto(cli_page.as_uri(), wait_until="load")
         page.wait_for_function(
-            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=5000
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
         )
         page.locator('.camloc-candidate [data-rank="3"]').click()
         box = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="3"]')
-        box.locator('button[data-verdict="unsure"]').wait_for(timeout=3000)
+        box.locator('button[data-verdict="unsure"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="unsure"]').click()
         keybox = page.locator(".camloc-verdicts form.camloc-vkey")
-        keybox.wait_for(state="visible", timeout=5000)  # the 401 reached the page
+        keybox.wait_for(state="visible", timeout=30000)  # the 401 reached the page
         keybox.locator("input").fill(KEY)
         keybox.locator("button").click()
         page.wait_for_function(
-            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=5000
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
         )
         assert client.get(url).json()["items"]["3"]["verdict"] == "unsure"
         assert any(s.startswith("POST ") for s in sent)
@@ -1013,7 +1013,7 @@ def test_cli_page_from_a_file_shares_with_the_service(
         page.goto(other + "/review.html", wait_until="load")
         page.wait_for_function(
             f"document.querySelector('{share}').textContent.startsWith('not shared')",
-            timeout=5000,
+            timeout=30000,
         )
         text = page.locator(share).inner_text()
         assert f"this page's origin ({other}) in its CAMLOC_CORS_ORIGINS?" in text, text
