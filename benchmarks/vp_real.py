@@ -470,13 +470,16 @@ def load_street_set(n_frames: int) -> list[dict[str, Any]]:
 STREET_SYNTH_HALVES = ("dev", "held-out")
 
 
-def load_street_synth(halves: tuple[str, ...], n_per_half: int) -> list[dict[str, Any]]:
+def load_street_synth(
+    halves: tuple[str, ...], n_per_half: int, focal_rel: float | None = None
+) -> list[dict[str, Any]]:
     """Synthetic handheld street photos (:mod:`camloc_geo.testing.street_photo_render`).
 
     A level-ish phone camera 1.4-1.8 m up looking down a street between two rows of
     facades, with exact truth (focal length, principal point, gravity). ``halves`` picks
     the development seeds (0, 1, ...) and/or the held-out ones (5000, 5001, ...), the first
-    ``n_per_half`` of each.
+    ``n_per_half`` of each. ``focal_rel``: every photo's focal length that many times the
+    longer side (0.97: issue 24's phone) instead of the seed's 0.7-1.3.
     """
     from camloc_geo.testing import street_photo_render as spr
 
@@ -484,7 +487,7 @@ def load_street_synth(halves: tuple[str, ...], n_per_half: int) -> list[dict[str
     for half in halves:
         seeds = spr.DEV_SEEDS if half == "dev" else spr.HELD_OUT_SEEDS
         for seed in list(seeds)[:n_per_half]:
-            ph = spr.render_street_photo(seed)
+            ph = spr.render_street_photo(seed, focal_rel)
             up = ph.up_in_cam
             out.append(
                 {
@@ -1053,6 +1056,13 @@ def main(argv: list[str] | None = None) -> int:
         help="synthetic street photos per half in 'street-synth' (not run unless --sets has it)",
     )
     ap.add_argument(
+        "--synth-focal-rel",
+        type=float,
+        default=None,
+        help="the synthetic street photos' focal length in longer sides (0.97: issue 24's "
+        "phone) instead of each seed's 0.7-1.3",
+    )
+    ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
     ap.add_argument(
@@ -1105,7 +1115,7 @@ def main(argv: list[str] | None = None) -> int:
         h for h in STREET_SYNTH_HALVES if {"street-synth", f"street-synth-{h}"} & wanted
     )
     if synth_halves:
-        data.extend(load_street_synth(synth_halves, args.synth_photos))
+        data.extend(load_street_synth(synth_halves, args.synth_photos, args.synth_focal_rel))
     street_halves = tuple(
         h for h in STREET_PHOTO_HALVES if {"street-photos", f"street-photos-{h}"} & wanted
     )

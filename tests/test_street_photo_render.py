@@ -64,3 +64,14 @@ def test_a_turned_camera_is_calibrated_from_its_photo() -> None:
     assert abs(err) < 2 * res.focal_std_rel
     assert abs(res.pitch_deg + ph.pitch_up_deg) < 1.5
     assert res.distortion == pytest.approx(ph.k1, abs=0.02)
+
+
+def test_focal_rel_sets_the_focal_length_and_keeps_the_rest() -> None:
+    a, b = render_street_photo(7), render_street_photo(7, focal_rel=0.97)
+    assert b.focal_px == pytest.approx(0.97 * max(b.size))
+    assert a.size == b.size
+    assert a.principal_point == b.principal_point
+    assert a.yaw_deg == b.yaw_deg
+    assert a.k1 == b.k1
+    with pytest.raises(ValueError, match="focal_rel"):
+        render_street_photo(7, focal_rel=float("nan"))

@@ -302,13 +302,16 @@ def _draw_facade_row(
     return calls
 
 
-def render_street_photo(seed: int) -> StreetPhoto:
+def render_street_photo(seed: int, focal_rel: float | None = None) -> StreetPhoto:
     """Draw the street photo of ``seed`` (the same seed gives the same photo).
 
     Parameters
     ----------
     seed
         Seed of the photo's random generator.
+    focal_rel
+        If given, the focal length in longer sides (e.g. 0.97 for issue 24's phone),
+        instead of the seed's draw; everything else stays the seed's.
 
     Returns
     -------
@@ -321,6 +324,10 @@ def render_street_photo(seed: int) -> StreetPhoto:
     w, h = _SIZES[int(rng.integers(len(_SIZES)))]
     long_px = max(w, h)
     f = long_px * float(math.exp(rng.uniform(math.log(0.7), math.log(1.3))))
+    if focal_rel is not None:
+        if not (math.isfinite(focal_rel) and 0.2 <= focal_rel <= 5.0):
+            raise ValueError(f"focal_rel must be within 0.2-5 longer sides, got {focal_rel}")
+        f = long_px * float(focal_rel)
     pp = (
         w / 2 + float(rng.uniform(-0.015, 0.015)) * w,
         h / 2 + float(rng.uniform(-0.015, 0.015)) * h,
