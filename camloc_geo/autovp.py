@@ -2576,10 +2576,18 @@ def _finish(
             focal_source = "prior"
         else:
             focal_source = "estimated"
+        n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
+        one_finite = n_finite < 2 and abs(float(dirs[0, 2])) < 0.15
         if focal_source in ("bound", "prior"):
+            why_default = (
+                " (only one horizontal vanishing point is finite and the vertical one lies "
+                "far off: a level camera looking along a street or at a facade)"
+                if one_finite
+                else " (its vanishing points leave it loose: far outside the photo, or few lines)"
+            )
             warnings.append(
-                "the photo does not fix the focal length: a default was used; give --focal-px "
-                "or a photo with EXIF"
+                f"the photo does not fix the focal length{why_default}: a default was used; "
+                "give --focal-px or a photo with EXIF"
             )
         elif (
             math.isfinite(data_std)
@@ -2588,10 +2596,9 @@ def _finish(
             and not m.rests_on_few
             and not m.thin_only
         ):
-            n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
             why = (
                 "only one horizontal vanishing point is finite and the vertical one lies far off"
-                if n_finite < 2 and abs(float(dirs[0, 2])) < 0.15
+                if one_finite
                 else "the vanishing points leave it loose"
             )
             warnings.append(

@@ -47,7 +47,12 @@ def test_level_camera_down_the_street_is_not_confidently_wrong(
     assert err < 1.0 * res.focal_std_rel
     assert res.focal_std_rel > 0.2
     assert res.confidence < 0.5
-    assert res.warnings
+    # the warning names why: a level camera looking along the street
+    assert res.focal_source == "prior"
+    assert any(
+        "does not fix the focal length (only one horizontal vanishing point is finite" in w
+        for w in res.warnings
+    )
 
 
 def test_given_principal_point_has_no_such_term(monkeypatch: pytest.MonkeyPatch) -> None:
