@@ -10,6 +10,7 @@ Usage::
                                   the handheld street photos;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
+    python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
 
 The photos (none of them is in this repository; their licences keep them out):
 
@@ -73,6 +74,14 @@ The photos (none of them is in this repository; their licences keep them out):
     separated): each is a set named by its folder, truth from EXIF as for ``perrot``,
     run with and without it. Photos without a usable EXIF focal length are skipped
     (counted in the log).
+``street-synth`` (``street-synth-dev``, ``street-synth-held-out``; not photographs, only
+when ``--sets`` names it)
+    ``--synth-photos`` (40) synthetic handheld street photos per half
+    (:mod:`camloc_geo.testing.street_photo_render`: a phone 1.4-1.8 m up looking down a
+    street between two rows of facades, yaw 0-25 degrees, pitch -5..+10, roll within 2,
+    focal length 0.7-1.3 times the longer side, principal point up to 1.5 % off centre,
+    division-model k1 in [-0.06, 0.02], JPEG). Development seeds 0-39, held-out seeds
+    5000-5039, fixed before any result. Truth: focal length, principal point, gravity.
 ``street`` (not photographs; only when ``--sets`` names it)
     ``--street-frames`` (30) rendered traffic frames
     (:mod:`camloc_geo.testing.traffic_render`: a pole camera 6-9 m up looking down 15-23
@@ -453,6 +462,46 @@ def load_street_set(n_frames: int) -> list[dict[str, Any]]:
                 "size": (w, h),
             }
         )
+    return out
+
+
+#: The halves of the synthetic handheld street photos (set ``street-synth``): their seeds,
+#: fixed before any result was read (:mod:`camloc_geo.testing.street_photo_render`).
+STREET_SYNTH_HALVES = ("dev", "held-out")
+
+
+def load_street_synth(
+    halves: tuple[str, ...], n_per_half: int, focal_rel: float | None = None
+) -> list[dict[str, Any]]:
+    """Synthetic handheld street photos (:mod:`camloc_geo.testing.street_photo_render`).
+
+    A level-ish phone camera 1.4-1.8 m up looking down a street between two rows of
+    facades, with exact truth (focal length, principal point, gravity). ``halves`` picks
+    the development seeds (0, 1, ...) and/or the held-out ones (5000, 5001, ...), the first
+    ``n_per_half`` of each. ``focal_rel``: every photo's focal length that many times the
+    longer side (0.97: issue 24's phone) instead of the seed's 0.7-1.3.
+    """
+    from camloc_geo.testing import street_photo_render as spr
+
+    out = []
+    for half in halves:
+        seeds = spr.DEV_SEEDS if half == "dev" else spr.HELD_OUT_SEEDS
+        for seed in list(seeds)[:n_per_half]:
+            ph = spr.render_street_photo(seed, focal_rel)
+            up = ph.up_in_cam
+            out.append(
+                {
+                    "set": "street-synth",
+                    "name": f"street-synth/seed{seed}",
+                    "half": half,
+                    "path": ph.image,
+                    "f": ph.focal_px,
+                    "pp": ph.principal_point,
+                    "up": up if up[1] < 0 else -up,
+                    "size": ph.size,
+                    "k1_true": ph.k1,
+                }
+            )
     return out
 
 
@@ -1001,6 +1050,19 @@ def main(argv: list[str] | None = None) -> int:
         help="rendered traffic frames in the 'street' set (not run unless --sets has it)",
     )
     ap.add_argument(
+        "--synth-photos",
+        type=int,
+        default=40,
+        help="synthetic street photos per half in 'street-synth' (not run unless --sets has it)",
+    )
+    ap.add_argument(
+        "--synth-focal-rel",
+        type=float,
+        default=None,
+        help="the synthetic street photos' focal length in longer sides (0.97: issue 24's "
+        "phone) instead of each seed's 0.7-1.3",
+    )
+    ap.add_argument(
         "--no-distortion", action="store_true", help="do not fit the lens distortion k1"
     )
     ap.add_argument(
@@ -1049,6 +1111,11 @@ def main(argv: list[str] | None = None) -> int:
                 args.drive_photos,
             )
         data.extend(drive[: args.limit])
+    synth_halves = tuple(
+        h for h in STREET_SYNTH_HALVES if {"street-synth", f"street-synth-{h}"} & wanted
+    )
+    if synth_halves:
+        data.extend(load_street_synth(synth_halves, args.synth_photos, args.synth_focal_rel))
     street_halves = tuple(
         h for h in STREET_PHOTO_HALVES if {"street-photos", f"street-photos-{h}"} & wanted
     )
@@ -1088,7 +1155,7 @@ def main(argv: list[str] | None = None) -> int:
                     part = [r for r in rows if r["set"] == s and r.get("half") == half]
                     if part:
                         summary[tag][f"{s} {half}"] = summarise(part)
-            if s == "street-photos":  # the development and the held-out halves
+            if s in ("street-photos", "street-synth"):  # development and held-out halves
                 for half in STREET_PHOTO_HALVES:
                     part = [r for r in rows if r["set"] == s and r.get("half") == half]
                     if part:
@@ -1102,7 +1169,7 @@ def main(argv: list[str] | None = None) -> int:
             part = [r for r in rows if r["set"] in DRIVE_SETS and r.get("half") == half]
             if part:
                 summary[tag][f"drive {half} (all driving sets)"] = summarise(part)
-        outdoor = [r for r in rows if r["set"] not in ("yud", "street")]
+        outdoor = [r for r in rows if r["set"] not in ("yud", "street", "street-synth")]
         if outdoor and len(outdoor) != len(rows):
             summary[tag]["outdoor (all but yud)"] = summarise(outdoor)
         # photos looking up at a building, where the truth gives gravity
@@ -1114,7 +1181,7 @@ def main(argv: list[str] | None = None) -> int:
     exif_sets = {d.name for d in args.exif_dir} if "exif" in wanted else set()
     bars = {}
     for key in sorted(summary.get("no EXIF", {})):
-        if key.startswith("street-photos") or key in exif_sets:
+        if key.startswith(("street-photos", "street-synth")) or key in exif_sets:
             bars[key] = issue24_bars(
                 summary["no EXIF"].get(key), summary.get("EXIF prior", {}).get(key)
             )

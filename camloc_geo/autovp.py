@@ -132,6 +132,10 @@ _PP_SIGMA_REL = 0.03
 #: Uncertainty of an assumed (image-centre) principal point, relative to the longer side,
 #: put into the pitch sigma (York Urban's lies 2.7 % from the centre, Strecha's 0.6 %).
 _PP_TILT_SIGMA_REL = 0.015
+#: Uncertainty of an assumed (image-centre) principal point, relative to the longer side,
+#: put into the focal length's sigma (``_pp_logf_std``): phones and compact cameras lie
+#: within about 1 % of the centre, York Urban's camera 2.7 %, Strecha's 0.6 %.
+_PP_FOCAL_SIGMA_REL = 0.01
 #: Number of distinct best hypotheses refined.
 _N_REFINED = 3
 #: Inlier distance (px per 800 px of image diagonal) of segment end points.
@@ -892,6 +896,62 @@ def _systematic_logf_std(
             p1, r1 = pitch_roll_from_up(_up_sign(R[:, kv]))
             tilt2 += np.array([(p1 - p0) ** 2, (r1 - r0) ** 2])
     m.tilt_sys_deg = (float(math.sqrt(tilt2[0])), float(math.sqrt(tilt2[1])))
+    return math.sqrt(total)
+
+
+def _shifted_segs(s: _Segs, delta_n: FloatArray) -> _Segs:
+    """Segments as seen from a principal point moved by ``delta_n`` (normalised)."""
+    mid = s.mid - delta_n
+    nrm = s.lines[:, :2]
+    lines = np.column_stack([nrm, -np.sum(nrm * mid, axis=1)])
+    return _Segs(mid=mid, dirn=s.dirn, length_px=s.length_px, lines=lines, weight=s.weight)
+
+
+def _pp_logf_std(
+    m: _Model,
+    s: _Segs,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    pp_sigma_n: float,
+) -> float:
+    """How far an unknown principal point moves ``log(focal)``.
+
+    The principal point is assumed at the image centre; a real one lies up to a few per
+    cent of the longer side off it. The principal point is moved by ``pp_sigma_n``
+    (relative to the longer side) each way along each image axis, the focal length
+    refitted (labels kept), and the root mean square of the two moves per axis summed
+    in quadrature. Small where three vanishing points are finite; large for a level camera
+    looking down a street, where the focal length is the square root of the horizon's
+    offset from the principal point times the vertical vanishing point's distance: a
+    principal point as far off as the horizon's offset moves it by a factor of 1.4 or
+    more (rendered street photos, ``benchmarks/vp_real.py --sets street-synth-dev``).
+    Finite differences, not the least-squares covariance: the response is far from linear
+    there.
+    """
+    if not pp_sigma_n > 0.0:
+        return 0.0
+    total = 0.0
+    for axis in (0, 1):
+        moves2 = 0.0
+        for sign in (1.0, -1.0):
+            delta = np.zeros(2)
+            delta[axis] = sign * pp_sigma_n
+            _, f, _, _ = _refine(
+                m.R,
+                m.f_n,
+                _shifted_segs(s, delta),
+                m.labels,
+                tau_px,
+                True,
+                f_prior,
+                f_bounds,
+                prior_w=prior_w,
+                max_nfev=20,
+            )
+            moves2 += math.log(f / m.f_n) ** 2
+        total += 0.5 * moves2
     return math.sqrt(total)
 
 
@@ -2065,10 +2125,15 @@ def detect_vanishing_points(
         jack_std = _line_jackknife_logf_std(
             best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w
         )
+        pp_std = (
+            _pp_logf_std(best, s, tau, f_prior, f_bounds, prior_w, _PP_FOCAL_SIGMA_REL)
+            if principal_point is None and not estimate_principal_point
+            else 0.0
+        )
         # the jackknife measures the same sampling spread as the least-squares sigma,
         # outliers that pose as lines included: the larger of the two
         stat_std = max(best.logf_std, jack_std)
-        own_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2)
+        own_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2 + pp_std**2)
         rival_std = _rival_spread(rival_modes, own_std)[0]
         best.logf_std = math.sqrt(own_std**2 + rival_std**2)
         if best.weak_only or best.thin_only:
@@ -2511,10 +2576,18 @@ def _finish(
             focal_source = "prior"
         else:
             focal_source = "estimated"
+        n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
+        one_finite = n_finite < 2 and abs(float(dirs[0, 2])) < 0.15
         if focal_source in ("bound", "prior"):
+            why_default = (
+                " (only one horizontal vanishing point is finite and the vertical one lies "
+                "far off: a level camera looking along a street or at a facade)"
+                if one_finite
+                else " (its vanishing points leave it loose: far outside the photo, or few lines)"
+            )
             warnings.append(
-                "the photo does not fix the focal length: a default was used; give --focal-px "
-                "or a photo with EXIF"
+                f"the photo does not fix the focal length{why_default}: a default was used; "
+                "give --focal-px or a photo with EXIF"
             )
         elif (
             math.isfinite(data_std)
@@ -2523,10 +2596,9 @@ def _finish(
             and not m.rests_on_few
             and not m.thin_only
         ):
-            n_finite = sum(abs(float(d[2])) > 0.05 for d in dirs[1:])
             why = (
                 "only one horizontal vanishing point is finite and the vertical one lies far off"
-                if n_finite < 2 and abs(float(dirs[0, 2])) < 0.15
+                if one_finite
                 else "the vanishing points leave it loose"
             )
             warnings.append(
