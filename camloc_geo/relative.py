@@ -39,7 +39,7 @@ import numpy.typing as npt
 from camloc_geo._errors import DegenerateGeometryError, InputError, SceneError
 from camloc_geo._optimize import soft_l1_cost
 from camloc_geo.camera import Camera, rotvec_from_rotation
-from camloc_geo.objects import ObjectSize
+from camloc_geo.objects import PRESETS, ObjectSize
 from camloc_geo.scene import Annotation, Scene, line_photo, pixel_problem
 from camloc_geo.vanishing import (
     AXES,
@@ -4395,6 +4395,15 @@ def _joint(
         # The clicked box is not the stated car: the answer's scale is off by up to the
         # spread of its edges' scales (half of it at one sigma; benchmarks/crowd_slips.py).
         size_rel = math.hypot(size_rel, 0.5 * props.spread)
+    other_class = (
+        _likely_class(props, size)
+        if props is not None and size_sigma > 0.0 and not props.disagrees
+        else None
+    )
+    if other_class is not None:
+        # Another class's proportions fit the clicked box better: were it that car, the
+        # answer's scale would be off by their mean log ratio (at one sigma).
+        size_rel = math.hypot(size_rel, other_class[2])
     car_lines = _car_line_sensitivity(
         prob,
         np.asarray(res.x, dtype=float),
@@ -4506,6 +4515,8 @@ def _joint(
         result.object_proportions = props.to_dict([a.annotator for a in scene.annotations])
         if props.disagrees:
             result.warnings.append(_proportion_warning(props, size))
+        if other_class is not None:
+            result.warnings.append(_class_warning(props, size, other_class, scene.object.preset))
         for slot, axis, ratio in props.odd:
             result.warnings.append(
                 f"annotator {scene.annotations[slot].annotator!r} (annotations[{slot}]): their "
@@ -4538,6 +4549,28 @@ class _Proportions:
     n_annotators: int
     # (slot, axis, ratio): an annotator whose edge is ``ratio`` x the others' (median)
     odd: tuple[tuple[int, str, float], ...] = ()
+    # per axis: the median log scale and its variance (the clicks' and the preset's)
+    log_scale: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    log_var: tuple[float, float, float] = (1.0, 1.0, 1.0)
+
+    def class_fit(self, stated: ObjectSize, other: ObjectSize) -> float:
+        """How much better ``other``'s proportions fit the clicked box than ``stated``'s:
+        the drop of the chi-square (2 degrees of freedom, the common scale free)."""
+        med = np.asarray(self.log_scale)
+        w = 1.0 / np.asarray(self.log_var)
+        shift = np.log(
+            [
+                other.length_m / stated.length_m,
+                other.width_m / stated.width_m,
+                other.height_m / stated.height_m,
+            ]
+        )
+
+        def chi2(v: FloatArray) -> float:
+            mean = float(np.sum(w * v) / np.sum(w))
+            return float(np.sum(w * (v - mean) ** 2))
+
+        return chi2(med) - chi2(med - shift)
 
     @property
     def disagrees(self) -> bool:
@@ -4625,7 +4658,15 @@ def _box_proportions(
             j = int(np.argmax(np.abs(dev) / sd))
             if abs(dev[j]) > PROPORTION_ODD_LOG and abs(dev[j]) > PROPORTION_ODD_Z * sd[j]:
                 odd.append((slots[k], AXES[j], float(math.exp(dev[j]))))
-    return _Proportions(scale, chi2, float(np.ptp(med)), n, tuple(odd))
+    return _Proportions(
+        scale,
+        chi2,
+        float(np.ptp(med)),
+        n,
+        tuple(odd),
+        (float(med[0]), float(med[1]), float(med[2])),
+        (float(var[0]), float(var[1]), float(var[2])),
+    )
 
 
 def _clicked_box(camera: Camera, clicks: FloatArray) -> FloatArray | None:
@@ -4655,6 +4696,60 @@ def _clicked_box(camera: Camera, clicks: FloatArray) -> FloatArray | None:
     if not np.all(np.isfinite(out) & (out > 0.0)):
         return None
     return np.asarray(out, dtype=np.float64)
+
+
+CLASS_DELTA_CHI2 = 2.5  # another preset fits the clicked proportions this much better
+
+
+def _likely_class(props: _Proportions, size: ObjectSize) -> tuple[str, ObjectSize, float] | None:
+    """The car preset whose proportions fit the clicked box clearly better than ``size``'s.
+
+    A car of a neighbouring class (an SUV called a sedan: height x1.17, length x1.02, width
+    x1.04) has proportions within a few of the preset's own 5 % sigmas, so the proportion
+    test (:attr:`_Proportions.disagrees`) does not see it, yet every annotator clicks the
+    same taller box and the answer's scale is off by the classes' mean ratio, which no
+    jackknife sees. Each other preset of :data:`~camloc_geo.objects.PRESETS` is compared by
+    its chi-square drop
+    (:meth:`_Proportions.class_fit`, the common scale free); the best one whose drop exceeds
+    ``CLASS_DELTA_CHI2`` (2.5: a likelihood ratio of e^1.25, the other class's proportions
+    ~3.5x as likely as the stated one's) is returned as (name, size, the mean absolute log
+    ratio of its edges to the stated ones). None: the stated class fits as well as any.
+    The threshold trades the clean crowd's false alarms against the slips caught
+    (``benchmarks/README.md``, crowd_slips: 2.0, 2.5, 3.0, 4.0 warn on 7, 4, 3.5, 2 % of
+    clean crowd scenes). Not used where the proportions already disagree (their own
+    warning and widening) or the size is stated in numbers.
+    """
+    stated = np.array([size.length_m, size.width_m, size.height_m])
+    best: tuple[float, str, ObjectSize, float] | None = None
+    for name, other in PRESETS.items():
+        shift = np.log(np.array([other.length_m, other.width_m, other.height_m]) / stated)
+        if not np.any(shift):  # the stated size itself
+            continue
+        drop = props.class_fit(size, other)
+        if drop > CLASS_DELTA_CHI2 and (best is None or drop > best[0]):
+            best = (drop, name, other, abs(float(np.mean(shift))))
+    if best is None:
+        return None
+    return best[1], best[2], best[3]
+
+
+def _class_warning(
+    props: _Proportions,
+    size: ObjectSize,
+    other_class: tuple[str, ObjectSize, float],
+    preset: str | None,
+) -> str:
+    """The warning naming the car class whose proportions fit the clicked box better."""
+    name, other, shift = other_class
+    parts = ", ".join(f"{axis} x{props.scale[axis]:.2f}" for axis in AXES)
+    stated = f"the stated {preset}'s" if preset else "the stated size's"
+    return (
+        f"object: the clicked car's proportions ({parts} of {size.length_m:.2f} x "
+        f"{size.width_m:.2f} x {size.height_m:.2f} m) fit a {name}'s ({other.length_m:.2f} x "
+        f"{other.width_m:.2f} x {other.height_m:.2f} m) better than {stated}: is the car a "
+        f"{name}? The camera's distance is uncertain by their difference ({100.0 * shift:.0f} "
+        "%, included in the position sigmas); check object.preset"
+    )
 
 
 def _proportion_warning(props: _Proportions, size: ObjectSize) -> str:

@@ -196,3 +196,35 @@ def test_leverage_option_never_widens_the_jackknife() -> None:
     assert on.position_sigma_jackknife_m is not None
     assert np.all(on.position_sigma_jackknife_m <= off.position_sigma_jackknife_m + 1e-12)
     assert np.any(on.position_sigma_jackknife_m < 0.99 * off.position_sigma_jackknife_m)
+
+
+def _class_scene(true: ObjectSize, seed: int) -> tuple[dict, float]:
+    rng = np.random.default_rng(seed)
+    cam = random_camera(rng, height_m=(6.0, 12.0))
+    syn = make_scene(cam, rng, noise=NoiseModel.exact(), true_size=true)
+    syn.scene["object"] = {"preset": "sedan"}
+    return syn.scene, cam.height_m
+
+
+@pytest.mark.parametrize("seed", [1, 2, 5, 7])
+def test_an_suv_called_a_sedan_is_named(seed: int) -> None:
+    """Exact clicks on an SUV (1.70 m roof) stated as a sedan: its proportions (height
+    x1.17) are within the sedan's 5 % sigmas' reach, so the proportion test is silent; the
+    class comparison names the SUV and widens the position sigmas to cover the height.
+    Not every SUV: of seeds 1-11 the comparison names 6 (these four among them), the older
+    proportion test one more (seed 3); the other four look like a sedan within the clicks'
+    and the preset's noise (old code: none named)."""
+    scene, true_h = _class_scene(PRESETS["suv"], seed)
+    res = calibrate(parse_scene(scene))
+    named = [w for w in res.warnings if "better than the stated sedan's" in w]
+    assert len(named) == 1, res.warnings
+    assert "fit a suv's (4.70 x 1.88 x 1.70 m)" in named[0]
+    assert res.position_sigma_m is not None
+    assert abs(res.camera.height_m - true_h) < 2.0 * float(res.position_sigma_m[2])
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_sedan_is_not_called_another_class(seed: int) -> None:
+    scene, _h = _class_scene(SEDAN, seed)
+    res = calibrate(parse_scene(scene))
+    assert not [w for w in res.warnings if "better than the stated" in w], res.warnings
