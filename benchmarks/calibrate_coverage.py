@@ -30,9 +30,11 @@ the focal length's 1σ / 2σ coverage and median error/σ, the share more than 1
 those the share outside 2σ and outside 2σ with no warning (the note that annotators marked
 different corners does not count as one).
 
+``--jackknife-leverage`` calibrates with ``CalibrationSettings(jackknife_leverage=True)``.
+
 Usage::
 
-    python benchmarks/calibrate_coverage.py --n 60 [--located 400]
+    python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--jackknife-leverage]
 """
 
 from __future__ import annotations
@@ -74,12 +76,14 @@ PP_PRIOR = {"noise_free_pp_prior": CalibrationSettings().principal_point_sigma_r
 SIZE_GIVEN = {"noise_free_size_given"}
 QUANTITIES = ("focal", "pp_x", "pp_y", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
+# calibrate's settings for every scene (``--jackknife-leverage`` turns that option on).
+SETTINGS = CalibrationSettings()
 
 
 def scene_errors(syn: Any) -> dict[str, Any] | None:
     """Errors and stated sigmas of one scene, or None when ``calibrate`` refuses it."""
     try:
-        res = calibrate(parse_scene(syn.scene))
+        res = calibrate(parse_scene(syn.scene), SETTINGS)
     except InputError:
         return None
     truth = syn.camera
@@ -261,7 +265,7 @@ def located_coverage(n: int, seed: int) -> dict[str, Any]:
             if variant == "preset":
                 scene["object"] = {"preset": "sedan"}
             try:
-                res = calibrate(parse_scene(scene))
+                res = calibrate(parse_scene(scene), SETTINGS)
             except InputError:
                 continue
             if res.focal_sigma_px is None:
@@ -316,7 +320,14 @@ def main(argv: list[str] | None = None) -> int:
         default=0,
         help="also N scenes of absolute.py's scene maker (focal coverage; default 0: none)",
     )
+    parser.add_argument(
+        "--jackknife-leverage",
+        action="store_true",
+        help="calibrate with CalibrationSettings(jackknife_leverage=True) (default off)",
+    )
     args = parser.parse_args(argv)
+    global SETTINGS
+    SETTINGS = CalibrationSettings(jackknife_leverage=args.jackknife_leverage)
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -358,6 +369,7 @@ def main(argv: list[str] | None = None) -> int:
         "n_per_set": args.n,
         "want": WANT,
         "sigmas": "main fields (with the principal point's uncertainty)",
+        "jackknife_leverage": args.jackknife_leverage,
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),
