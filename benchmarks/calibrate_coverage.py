@@ -30,9 +30,15 @@ the focal length's 1σ / 2σ coverage and median error/σ, the share more than 1
 those the share outside 2σ and outside 2σ with no warning (the note that annotators marked
 different corners does not count as one).
 
+``--jackknife-leverage`` calibrates with ``CalibrationSettings(jackknife_leverage=True)``.
+``--terms`` files each scene under the term that decides each of its sigmas (the fit's
+covariance, the ground-corner, preset-shape, car-line, principal-point or size term, or the
+jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
+JSON).
+
 Usage::
 
-    python benchmarks/calibrate_coverage.py --n 60 [--located 400]
+    python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--jackknife-leverage]
 """
 
 from __future__ import annotations
@@ -74,12 +80,85 @@ PP_PRIOR = {"noise_free_pp_prior": CalibrationSettings().principal_point_sigma_r
 SIZE_GIVEN = {"noise_free_size_given"}
 QUANTITIES = ("focal", "pp_x", "pp_y", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
+# calibrate's settings for every scene (``--jackknife-leverage`` turns that option on).
+SETTINGS = CalibrationSettings()
+
+
+# ``--terms``: each sigma's terms, recorded by wrapping two of calibrate's private helpers
+# (a diagnostic: the library does not report them). Index in the 9-vector of
+# ``parameter_covariance``: focal 0, rotation 3-5 (rad), centre 6-8.
+TERM_NAMES = ("fit", "ground_corner", "preset_shape", "car_lines", "principal_point", "size")
+TERM_QUANTITIES = {"focal": 0, "rot_x": 3, "rot_y": 4, "rot_z": 5, "x": 6, "y": 7, "z": 8}
+_TERMS: dict[int, dict[str, list[float]]] = {}
+
+
+def _record_terms() -> None:
+    """Wrap ``_output_covariance`` to record each term's variances (its diagonal)."""
+    from camloc_geo import relative as rel
+
+    out_cov: Any = rel._output_covariance
+    gc_sens: Any = rel._ground_corner_sensitivity
+
+    def output_covariance(*args: Any, **kwargs: Any) -> Any:
+        full = out_cov(*args, **kwargs)
+        if full is None:
+            return full
+        names = ("sigma_pp_px", "size_rel", "car_lines", "size_shape_rel")
+        given = dict(zip(names, args[8:], strict=False)) | kwargs
+        off = {"sigma_pp_px": 0.0, "size_rel": 0.0, "car_lines": None, "size_shape_rel": 0.0}
+
+        def diag(on: str | None) -> Any:
+            keep: dict[str, Any] = {
+                k: (given.get(k, off[k]) if k == on else v) for k, v in off.items()
+            }
+            rel._ground_corner_sensitivity = gc_sens if on == "gc" else (lambda *a, **k: None)
+            try:
+                return np.diag(out_cov(*args[:8], **keep))
+            finally:
+                rel._ground_corner_sensitivity = gc_sens
+
+        fit = diag(None)
+        on = ("gc", "size_shape_rel", "car_lines", "sigma_pp_px", "size_rel")
+        terms = {"fit": fit} | {
+            name: diag(k) - fit for name, k in zip(TERM_NAMES[1:], on, strict=True)
+        }
+        _TERMS[id(full)] = {k: v.tolist() for k, v in terms.items()}
+        return full
+
+    rel._output_covariance = output_covariance
+
+
+def _dominant_terms(res: Any) -> dict[str, str] | None:
+    """Per quantity of ``TERM_QUANTITIES``: the term that decides its stated sigma."""
+    terms = _TERMS.get(id(res.parameter_covariance))
+    if terms is None:
+        return None
+    pos_jack = res.position_sigma_jackknife_m
+    rot_fits = res.rotation_sigma_fit_deg
+    out: dict[str, str] = {}
+    for q, k in TERM_QUANTITIES.items():
+        var = {t: max(terms[t][k], 0.0) for t in TERM_NAMES}
+        name = max(var, key=lambda t: var[t])
+        cov_sd = math.sqrt(sum(var.values()))
+        # The jackknife decided where the stated sigma exceeds the covariance's.
+        stated: float | None = None
+        cov = 0.0
+        if q == "focal":
+            stated, cov = res.focal_sigma_px, cov_sd
+        elif q in ("x", "y", "z") and pos_jack is not None:
+            stated, cov = float(pos_jack[k - 6]), cov_sd
+        elif q.startswith("rot") and rot_fits is not None and res.rotation_sigma_deg is not None:
+            stated, cov = float(res.rotation_sigma_deg[k - 3]), float(rot_fits[k - 3])
+        if stated is not None and stated > 1.0001 * cov:
+            name = "jackknife"
+        out[q] = name
+    return out
 
 
 def scene_errors(syn: Any) -> dict[str, Any] | None:
     """Errors and stated sigmas of one scene, or None when ``calibrate`` refuses it."""
     try:
-        res = calibrate(parse_scene(syn.scene))
+        res = calibrate(parse_scene(syn.scene), SETTINGS)
     except InputError:
         return None
     truth = syn.camera
@@ -114,6 +193,9 @@ def scene_errors(syn: Any) -> dict[str, Any] | None:
     sig["pp_y"] = None if pp_sigma is None else float(pp_sigma[1])
     out["error"] = {k: float(v) for k, v in err.items()}
     out["sigma"] = sig
+    if _TERMS:
+        out["dominant_term"] = _dominant_terms(res)
+        _TERMS.clear()
     out["principal_point_error_px"] = float(np.hypot(*pp_err))
     return out
 
@@ -148,6 +230,28 @@ def coverage(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "p50": float(np.median(pp)),
         "p90": float(np.percentile(pp, 90)),
     }
+    return out
+
+
+def coverage_by_term(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Per quantity and deciding term (``--terms``): scenes, 1σ / 2σ coverage, median."""
+    out: dict[str, Any] = {}
+    for q in TERM_QUANTITIES:
+        groups: dict[str, list[float]] = {}
+        for r in rows:
+            term = (r.get("dominant_term") or {}).get(q)
+            if term is None or not r["sigma"].get(q):
+                continue
+            groups.setdefault(term, []).append(abs(r["error"][q]) / r["sigma"][q])
+        out[q] = {
+            t: {
+                "n": len(z),
+                "cover_1sigma": float(np.mean(np.array(z) <= 1.0)),
+                "cover_2sigma": float(np.mean(np.array(z) <= 2.0)),
+                "median_z": float(np.median(z)),
+            }
+            for t, z in sorted(groups.items())
+        }
     return out
 
 
@@ -261,7 +365,7 @@ def located_coverage(n: int, seed: int) -> dict[str, Any]:
             if variant == "preset":
                 scene["object"] = {"preset": "sedan"}
             try:
-                res = calibrate(parse_scene(scene))
+                res = calibrate(parse_scene(scene), SETTINGS)
             except InputError:
                 continue
             if res.focal_sigma_px is None:
@@ -316,7 +420,23 @@ def main(argv: list[str] | None = None) -> int:
         default=0,
         help="also N scenes of absolute.py's scene maker (focal coverage; default 0: none)",
     )
+    parser.add_argument(
+        "--jackknife-leverage",
+        action="store_true",
+        help="calibrate with CalibrationSettings(jackknife_leverage=True) (default off)",
+    )
+    parser.add_argument(
+        "--terms",
+        action="store_true",
+        help="also file each scene under the term that decides each sigma (fit, ground "
+        "corner, preset shape, car lines, principal point, size, jackknife) and report the "
+        "coverage per term (a diagnostic: wraps a private helper of calibrate)",
+    )
     args = parser.parse_args(argv)
+    if args.terms:
+        _record_terms()
+    global SETTINGS
+    SETTINGS = CalibrationSettings(jackknife_leverage=args.jackknife_leverage)
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -358,12 +478,15 @@ def main(argv: list[str] | None = None) -> int:
         "n_per_set": args.n,
         "want": WANT,
         "sigmas": "main fields (with the principal point's uncertainty)",
+        "jackknife_leverage": args.jackknife_leverage,
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),
         "cpu_count": os.cpu_count(),
         "rows": by_set,
     }
+    if args.terms:
+        result["by_term"] = {name: coverage_by_term(rows) for name, rows in by_set.items()}
     if args.located > 0:
         result["located"] = located_coverage(args.located, args.seed)
     (args.out / "calibrate_coverage.json").write_text(json.dumps(result, indent=1))
@@ -388,6 +511,15 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  {q:8s} {cells[0]}   {cells[1]}")
         pp = cov["principal_point_error_px"]
         print(f"  principal point error p50 {pp['p50']:.1f} px, p90 {pp['p90']:.1f} px")
+    for name, per_q in result.get("by_term", {}).items():
+        print(f"{name}: error/sigma by the term that decides the sigma (n, 1σ, 2σ, median)")
+        for q, groups in per_q.items():
+            line = "; ".join(
+                f"{t} {g['n']}, {g['cover_1sigma']:.0%} / {g['cover_2sigma']:.0%}, "
+                f"{g['median_z']:.2f}"
+                for t, g in groups.items()
+            )
+            print(f"  {q:6s} {line}")
     for variant in ("as_made", "preset"):
         if "located" not in result:
             break

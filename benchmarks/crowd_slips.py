@@ -43,7 +43,7 @@ from relative import _has_lines, draw_scene
 
 from camloc_geo import InputError
 from camloc_geo.objects import PRESETS
-from camloc_geo.relative import calibrate
+from camloc_geo.relative import CalibrationSettings, calibrate
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import NoiseModel, SyntheticScene
 
@@ -367,7 +367,7 @@ def classify(syn: SyntheticScene, slipped: int | None) -> dict[str, Any]:
     """Calibrate the slipped scene and sort the outcome (see the module docstring)."""
     names = [a.get("annotator", "anonymous") for a in syn.scene["annotations"]]
     try:
-        res = calibrate(parse_scene(syn.scene))
+        res = calibrate(parse_scene(syn.scene), SETTINGS)
     except InputError as exc:
         return {"outcome": "flagged", "refused": True, "message": str(exc)[:200]}
     truth = syn.camera
@@ -450,6 +450,8 @@ def run(slips: list[str], n: int, seed: int) -> dict[str, Any]:
 
 
 OUTCOMES = ("ok", "flagged", "confidently_wrong")
+# calibrate's settings for every scene (``--jackknife-leverage`` turns that option on).
+SETTINGS = CalibrationSettings()
 
 
 def plot(result: dict[str, Any], path: Path) -> None:
@@ -487,7 +489,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=20261124, help="random seed")
     parser.add_argument("--slips", default="", help="comma-separated slips (default: all)")
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
+    parser.add_argument(
+        "--jackknife-leverage",
+        action="store_true",
+        help="calibrate with CalibrationSettings(jackknife_leverage=True) (default off)",
+    )
     args = parser.parse_args(argv)
+    global SETTINGS
+    SETTINGS = CalibrationSettings(jackknife_leverage=args.jackknife_leverage)
     logging.basicConfig(level=logging.CRITICAL)
     logging.getLogger("camloc_geo").setLevel(logging.CRITICAL)
     slips = [s for s in args.slips.split(",") if s] or list(SLIPS)

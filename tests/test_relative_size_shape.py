@@ -138,3 +138,93 @@ def test_the_held_fits_early_stop_agrees_with_the_full_held_fit(seed: int) -> No
     finally:
         prob.weights = saved
     assert verdicts == ([False, True] if seed == 6 else [False, False])
+
+
+def _equal_annotators(n: int, seed: int) -> dict:
+    """``n`` annotators who drew the same lines and clicks (0.5 px apart): equal leverage."""
+    rng = np.random.default_rng(seed)
+    cam = random_camera(rng, height_m=(6.0, 8.0))
+    syn = make_scene(cam, rng, noise=NoiseModel.exact(), n_annotators=1)
+    base = syn.scene["annotations"][0]
+    anns = []
+    for k in range(n):
+        axes = {
+            name: (np.asarray(p) + rng.normal(0.0, 0.5, 2)).tolist()
+            for name, p in base["axes"].items()
+        }
+        lines = {
+            axis: [(np.asarray(s) + rng.normal(0.0, 0.5, 4)).tolist() for s in segs]
+            for axis, segs in base["vp_lines"].items()
+        }
+        anns.append({"annotator": f"a{k}", "axes": axes, "vp_lines": lines})
+    syn.scene["annotations"] = anns
+    syn.scene["object"] = {"preset": "sedan"}
+    return syn.scene
+
+
+def test_leverage_of_equal_annotators_is_one_over_n() -> None:
+    """Annotators doing the same work each hold 1/n of every quantity: the jackknife's moves
+    are scaled by √(1 − 1/n) (the delete-one jackknife is then unbiased as it stands)."""
+    from camloc_geo.relative import _leverage_factors
+
+    n = 4
+    res = calibrate(parse_scene(_equal_annotators(n, 5)))
+    assert res.joint_state is not None
+    lev = _leverage_factors(res.joint_state, list(range(n)))
+    assert lev is not None
+    assert lev.shape == (n, 7)
+    np.testing.assert_allclose(lev, np.sqrt(1.0 - 1.0 / n), atol=0.03)
+
+
+def test_leverage_option_never_widens_the_jackknife() -> None:
+    """With ``jackknife_leverage`` each leave-out's move shrinks (factors in (0, 1]), so the
+    stated sigmas (the larger of the fit's and the jackknife's) do not grow; off (the
+    default) they are as before."""
+    from camloc_geo.relative import CalibrationSettings
+
+    rng = np.random.default_rng(11)
+    cam = random_camera(rng)
+    syn = make_scene(cam, rng, noise=NoiseModel(), n_annotators=5)
+    syn.scene["object"] = {"preset": "sedan"}
+    scene = parse_scene(syn.scene)
+    off = calibrate(scene)
+    on = calibrate(scene, CalibrationSettings(jackknife_leverage=True))
+    assert off.focal_sigma_px is not None
+    assert on.focal_sigma_px is not None
+    assert on.focal_sigma_px <= off.focal_sigma_px * (1.0 + 1e-9)
+    assert off.position_sigma_jackknife_m is not None
+    assert on.position_sigma_jackknife_m is not None
+    assert np.all(on.position_sigma_jackknife_m <= off.position_sigma_jackknife_m + 1e-12)
+    assert np.any(on.position_sigma_jackknife_m < 0.99 * off.position_sigma_jackknife_m)
+
+
+def _class_scene(true: ObjectSize, seed: int) -> tuple[dict, float]:
+    rng = np.random.default_rng(seed)
+    cam = random_camera(rng, height_m=(6.0, 12.0))
+    syn = make_scene(cam, rng, noise=NoiseModel.exact(), true_size=true)
+    syn.scene["object"] = {"preset": "sedan"}
+    return syn.scene, cam.height_m
+
+
+@pytest.mark.parametrize("seed", [1, 2, 5, 7])
+def test_an_suv_called_a_sedan_is_named(seed: int) -> None:
+    """Exact clicks on an SUV (1.70 m roof) stated as a sedan: its proportions (height
+    x1.17) are within the sedan's 5 % sigmas' reach, so the proportion test is silent; the
+    class comparison names the SUV and widens the position sigmas to cover the height.
+    Not every SUV: of seeds 1-11 the comparison names 6 (these four among them), the older
+    proportion test one more (seed 3); the other four look like a sedan within the clicks'
+    and the preset's noise (old code: none named)."""
+    scene, true_h = _class_scene(PRESETS["suv"], seed)
+    res = calibrate(parse_scene(scene))
+    named = [w for w in res.warnings if "better than the stated sedan's" in w]
+    assert len(named) == 1, res.warnings
+    assert "fit a suv's (4.70 x 1.88 x 1.70 m)" in named[0]
+    assert res.position_sigma_m is not None
+    assert abs(res.camera.height_m - true_h) < 2.0 * float(res.position_sigma_m[2])
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_sedan_is_not_called_another_class(seed: int) -> None:
+    scene, _h = _class_scene(SEDAN, seed)
+    res = calibrate(parse_scene(scene))
+    assert not [w for w in res.warnings if "better than the stated" in w], res.warnings
