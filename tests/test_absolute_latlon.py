@@ -181,8 +181,8 @@ def test_rough_point_at_a_junction_that_fits_badly_tries_the_junctions_around_it
     # The stated lat/lon is another junction's (a rough point that lands within 25 m of the
     # wrong junction). Old code took it at its word: every candidate stood at that junction,
     # none within 15 m of the camera. That junction fits the image badly (its best candidate
-    # is implausible on the map, or leaves a visible corner unmatched), so the junctions
-    # within 200 m are tried too, and the warning names the one the answer stands at.
+    # is implausible on the map), so the junctions within 200 m are tried too, and the
+    # warning names the one the answer stands at.
     ls = _located(baltimore, inter_id, seed)
     scene = json.loads(json.dumps(ls.scene))
     stated = baltimore.intersection(stated_id)

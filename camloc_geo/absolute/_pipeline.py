@@ -516,21 +516,22 @@ within 25 m of it (:func:`_rough_point_candidates`), before the fall with distan
 
 ROUGH_POINT_GATE = 0.5
 """The stated junction fits badly when its best candidate's map plausibility (the factor of
-:func:`~camloc_geo.absolute._scoring.plausibility_at`) is under this, when its matched points
-misfit (``poor_fit``) or when a visible corner matches none of its corners (``unmatched``)."""
+:func:`~camloc_geo.absolute._scoring.plausibility_at`) is under this, or when its matched
+points misfit (``poor_fit``). A visible corner left ``unmatched`` does not count: it is what a
+corner of a neighbouring junction clicked too gives (``absolute_slips.py``'s
+``corner_extra``), and counted, it cost that slip 3 of 84 right top candidates for 3 of 120
+rough points."""
 
 
 def fits_badly(cands: list[Candidate]) -> bool:
     """Whether the best of ``cands`` (by weight) fits the image evidence badly: implausible
     on the map (its car off or across its street, its camera in a building, its corners seen
-    through one: plausibility under :data:`ROUGH_POINT_GATE`), its matched points misfit
-    (``poor_fit``) or a visible corner left unmatched (``unmatched``: more corners in view
-    than the junction has). No candidate at all fits badly too."""
+    through one: plausibility under :data:`ROUGH_POINT_GATE`) or its matched points misfit
+    (``poor_fit``). No candidate at all fits badly too."""
     if not cands:
         return True
     best = max(cands, key=_weight)
-    kinds = {f.kind for f in best.flags}
-    return best.prior < ROUGH_POINT_GATE or bool(kinds & {FlagKind.POOR_FIT, FlagKind.UNMATCHED})
+    return best.prior < ROUGH_POINT_GATE or FlagKind.POOR_FIT in {f.kind for f in best.flags}
 
 
 def _rough_point_candidates(
