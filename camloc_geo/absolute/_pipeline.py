@@ -49,6 +49,7 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import (
     calibration_sigmas_m,
+    focal_moves_m,
     position_sigma_m,
     position_sigmas_m,
     refine_many,
@@ -1330,7 +1331,7 @@ def bundle_leaders(
         [adjusted[k] for k in held], calibration, [evs[k] for k in held], settings
     )
     if held and held[0] == 0:
-        _warn_loose_calibration(adjusted[0], extra[0], calibration, result)
+        _warn_loose_calibration(adjusted[0], extra[0], calibration, evs[0], settings, result)
     return adjusted + cands[settings.refine_top :]
 
 
@@ -1368,26 +1369,58 @@ state over 15 % (and move their top candidate at least 5 m)."""
 LOOSE_CALIBRATION_M = 5.0
 """... and the calibration alone moves the top candidate by at least this much (1-sigma)."""
 
+LOOSE_FOCAL_SIGMAS = 2.0
+"""... and a focal length this many sigmas shorter or longer (the other parameters moved
+with it as the calibration's covariance correlates them, the pixels cast exactly) moves the
+top candidate farther than its ``sigma_m``: the warning says how far."""
+
 
 def _warn_loose_calibration(
-    top: Candidate, sig_cal: float | None, calibration: CalibrationResult, result: LocateResult
+    top: Candidate,
+    sig_cal: float | None,
+    calibration: CalibrationResult,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
 ) -> None:
-    """A warning when the top candidate kept a loose calibration's camera (its focal length
-    over :data:`LOOSE_FOCAL_REL` uncertain) that alone moves it by :data:`LOOSE_CALIBRATION_M`
-    or more: with two references (or two corners) the map cannot correct the focal length,
-    and a focal length two sigmas off puts the camera twice as far (``unseen_cities.py``:
-    Stretford's Lacy Street 26.6 m off, Andorra 21.5 m)."""
+    """A warning when the top candidate kept a loose calibration's camera: its focal length
+    over :data:`LOOSE_FOCAL_REL` uncertain, alone moving the candidate by
+    :data:`LOOSE_CALIBRATION_M` or more (1 sigma), and a focal length
+    :data:`LOOSE_FOCAL_SIGMAS` sigmas off moving it farther than its ``sigma_m``
+    (:func:`~camloc_geo.absolute._refine.focal_moves_m`). With two references (or two corners)
+    the map cannot correct the focal length (``unseen_cities.py``: Stretford's Lacy Street
+    26.6 m off, Andorra 21.5 m at a sigma of 9.5 m). The warning names the focal length that
+    far off and how far it moves the candidate."""
     f_sig = calibration.focal_sigma_px
     if sig_cal is None or f_sig is None or top.sigma_m is None:
         return
-    rel = float(f_sig) / float(calibration.camera.focal_px)
+    focal = float(calibration.camera.focal_px)
+    rel = float(f_sig) / focal
     if rel <= LOOSE_FOCAL_REL or sig_cal < LOOSE_CALIBRATION_M:
         return
+    k = LOOSE_FOCAL_SIGMAS
+    moves = focal_moves_m(top, calibration, ev, settings, k)
+    if moves is None or max(moves) <= top.sigma_m:
+        return
+    short = moves[0] >= moves[1]
+    far = max(moves)
+    moved_px = focal - k * float(f_sig) if short else focal + k * float(f_sig)
+    which = (
+        f"{k:g} sigma {'shorter' if short else 'longer'} ({moved_px:.0f} px against {focal:.0f} px)"
+        if moved_px > 0.0
+        else f"{k:g} sigma shorter (at or below zero)"
+    )
+    how = (
+        "leaves no camera that casts every matched pixel onto the ground"
+        if math.isinf(far)
+        else f"moves it {far:.0f} m"
+    )
     result.warnings.append(
         f"calibration: the focal length is uncertain by {100.0 * rel:.0f} % (1 sigma) and "
-        f"alone moves the top candidate by {sig_cal:.0f} m (its sigma_m {top.sigma_m:.0f} m "
-        f"includes it); {top.method.replace('_', ' ')} cannot correct it: more vanishing "
-        "lines, another reference or kerb corners would"
+        f"alone moves the top candidate by {sig_cal:.0f} m (1 sigma; its sigma_m "
+        f"{top.sigma_m:.0f} m includes it); a focal length {which} {how}; "
+        f"{top.method.replace('_', ' ')} cannot correct it: more vanishing lines, another "
+        "reference or kerb corners would"
     )
 
 
