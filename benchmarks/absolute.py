@@ -198,6 +198,11 @@ def _entry(res: LocateResult, ls: LocatedScene) -> dict[str, Any]:
             top_sigma_m=res.candidates[0].sigma_m,
             top_residual_m=round(res.candidates[0].residual_m, 3),
             top_tied=bool(res.candidates[0].ambiguous_with),
+            # What the answer says besides its ranks (ties aside), and whether it is a
+            # confidently wrong one: top more than CONFIDENT_M off, not tied, no warning,
+            # SIGMA_COVER sigmas short of the truth.
+            warnings=[w[:200] for w in res.warnings if not w.startswith("ambiguous:")],
+            confidently_wrong=_confidently_wrong(res, errs),
             # Every candidate's error and score (to study ties and ranking offline).
             errors_m=[round(e, 2) for e in errs],
             scores=[round(c.score, 5) for c in res.candidates],
@@ -205,6 +210,23 @@ def _entry(res: LocateResult, ls: LocatedScene) -> dict[str, Any]:
     else:
         entry["reason"] = res.reason
     return entry
+
+
+CONFIDENT_M = 15.0
+"""A top candidate farther than this from the truth is wrong (``absolute_slips.py``'s and
+``unseen_cities.py``'s rule)."""
+
+SIGMA_COVER = 2.0
+"""A wrong top candidate whose ``SIGMA_COVER * sigma_m`` reaches the truth is not confident."""
+
+
+def _confidently_wrong(res: LocateResult, errs: list[float]) -> bool:
+    """The top candidate more than :data:`CONFIDENT_M` off, not tied, with no warning (but
+    a tie's) and a ``sigma_m`` whose :data:`SIGMA_COVER` sigmas do not reach the truth."""
+    top = res.candidates[0]
+    warned = [w for w in res.warnings if not w.startswith("ambiguous:")]
+    covered = top.sigma_m is not None and SIGMA_COVER * top.sigma_m >= errs[0]
+    return bool(errs[0] > CONFIDENT_M and not top.ambiguous_with and not warned and not covered)
 
 
 def _errors(result: LocateResult, ls: LocatedScene) -> list[float]:
@@ -377,6 +399,8 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         s["right_top_named_tied"] = (
             sum(bool(e.get("top_tied")) for e in right_top) / len(right_top) if right_top else None
         )
+        s["confidently_wrong"] = sum(bool(e.get("confidently_wrong")) for e in found)
+        s["any_warning"] = sum(bool(e.get("warnings")) for e in found)
         wrong_any = [e for e in found if e["top"] >= 10.0]
         s["wrong_top_named_tied"] = (
             sum(bool(e.get("top_tied")) for e in wrong_any) / len(wrong_any) if wrong_any else None

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -150,6 +151,17 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
     assert len(loose) == 1
     assert "uncertain by 17 %" in loose[0]
     assert "two references cannot correct it" in loose[0]
+    # how far: a focal length 2 sigma shorter moves it 13 m, beyond its sigma_m of 9.5 m
+    moved = re.search(
+        r"2 sigma (shorter|longer) \((\d+) px against (\d+) px\) moves it (\d+) m", loose[0]
+    )
+    assert moved is not None
+    assert moved.group(1) == "shorter"
+    f_px = float(cal.camera.focal_px)
+    assert int(moved.group(3)) == round(f_px)
+    assert int(moved.group(2)) == round(f_px - 2.0 * float(cal.focal_sigma_px))
+    assert res.candidates[0].sigma_m == pytest.approx(9.5, abs=0.5)
+    assert int(moved.group(4)) == pytest.approx(13.0, abs=1.5)
 
     scene, m, cal, ls = lacy_street
     res = locate(scene, m, calibration=cal)
@@ -171,3 +183,34 @@ def test_sigma_point_rotations_match_rodrigues() -> None:
     got = _rotations(v)
     for i in range(6):
         np.testing.assert_allclose(got[i], rotation_from_rotvec(v[i]), atol=1e-14)
+
+
+def test_focal_moves_grow_with_the_focal_lengths_distance() -> None:
+    """:func:`focal_moves_m` on Andorra's loose calibration (17 %): no move at 0 sigma, about
+    twice the 1-sigma move at 2 sigmas, a shorter focal length moving the camera farther
+    (the casting's nonlinearity), and the 1-sigma moves near the calibration's sigma."""
+    from camloc_geo.absolute import LocateSettings
+    from camloc_geo.absolute._refine import calibration_sigmas_m, focal_moves_m
+
+    scene, m, cal, _ls = _two_reference_scene(
+        "andorra.osm.pbf", (42.5075, 1.5300, 1500.0), (42.5090898, 1.5295354), 29
+    )
+    from camloc_geo.absolute import locate
+
+    res = locate(scene, m, calibration=cal)
+    top = res.candidates[0]
+    ev = top.evidence
+    settings = LocateSettings()
+    zero = focal_moves_m(top, cal, ev, settings, 0.0)
+    one = focal_moves_m(top, cal, ev, settings, 1.0)
+    two = focal_moves_m(top, cal, ev, settings, 2.0)
+    assert zero is not None
+    assert one is not None
+    assert two is not None
+    assert max(zero) < 1e-6
+    assert two[0] > one[0] > 3.0
+    assert two[0] / one[0] == pytest.approx(2.0, abs=0.2)
+    assert two[0] > two[1]  # shorter moves farther
+    (sig_cal,) = calibration_sigmas_m([top], cal, [ev], settings)
+    assert sig_cal is not None
+    assert max(one) <= sig_cal * 1.5

@@ -166,3 +166,50 @@ def test_rough_point_with_street_names_prefers_the_named_junction(baltimore: Map
     warned = [w for w in res.warnings if "were matched at the" in w]
     assert len(warned) == 1
     assert "junction c49531205 (Aliceanna Street & South Broadway)" in warned[0]
+
+
+@pytest.mark.parametrize(
+    ("inter_id", "seed", "stated_id"),
+    [
+        ("c49489906", 1, "n49489907"),  # the stated point at a junction 114 m away
+        ("n998949631", 1, "c49493751"),  # 65 m away
+    ],
+)
+def test_rough_point_at_a_junction_that_fits_badly_tries_the_junctions_around_it(
+    baltimore: MapData, inter_id: str, seed: int, stated_id: str
+) -> None:
+    # The stated lat/lon is another junction's (a rough point that lands within 25 m of the
+    # wrong junction). Old code took it at its word: every candidate stood at that junction,
+    # none within 15 m of the camera. That junction fits the image badly (its best candidate
+    # is implausible on the map), so the junctions within 200 m are tried too, and the
+    # warning names the one the answer stands at.
+    ls = _located(baltimore, inter_id, seed)
+    scene = json.loads(json.dumps(ls.scene))
+    stated = baltimore.intersection(stated_id)
+    scene["intersection"]["lat"], scene["intersection"]["lon"] = stated.lat, stated.lon
+    res = locate(parse_scene(scene), baltimore)
+    errs = _errors(res, ls)
+    assert errs[0] < 1.0
+    assert res.candidates[0].intersection_id == inter_id
+    assert res.intersection is not None
+    assert res.intersection.id == inter_id
+    warned = [w for w in res.warnings if "fits the image badly" in w]
+    assert len(warned) == 1
+    d = baltimore.distance_to_m(baltimore.intersection(inter_id), lat=stated.lat, lon=stated.lon)
+    assert f"{stated_id} (" in warned[0]
+    assert f"stands at junction {inter_id} " in warned[0]
+    assert f"{d:.0f} m from the stated point" in warned[0]
+    assert not [w for w in res.warnings if w.startswith("corners: the scene lists")]
+
+
+def test_stated_junction_that_fits_well_is_taken_at_its_word(baltimore: MapData) -> None:
+    # A clean scene's junction fits: its neighbours are not tried (no candidate elsewhere,
+    # no junction warning), however well they would fit.
+    from camloc_geo.absolute._pipeline import fits_badly
+
+    ls = _located(baltimore, "c49531205", 9)
+    res = locate(parse_scene(ls.scene), baltimore)
+    assert not fits_badly(res.candidates)
+    assert {c.intersection_id for c in res.candidates} == {"c49531205"}
+    assert not [w for w in res.warnings if "fits the image badly" in w]
+    assert fits_badly([])

@@ -49,6 +49,7 @@ from camloc_geo.absolute._model import (
 )
 from camloc_geo.absolute._refine import (
     calibration_sigmas_m,
+    focal_moves_m,
     position_sigma_m,
     position_sigmas_m,
     refine_many,
@@ -446,7 +447,9 @@ def _other_junction_candidates(
         return _searched_junction_candidates(map_data, world_cam, ev, settings, result)
     others = other_junctions(scene, map_data, ev)
     if not others:
-        return []
+        return _rough_point_candidates(
+            scene, map_data, world_cam, ev, settings, result, named_cands
+        )
     assert map_data is not None
     out: list[Candidate] = []
     # The junctions as likely as the scene's own first; then the neighbours (where only
@@ -505,6 +508,124 @@ def _searched_junction_candidates(
         for h in hyps:
             h.log_prior += log_prior
         out += _keep_odds(score_hypotheses(hyps, world_cam, ev_j, settings), log_prior)
+    return out
+
+
+ROUGH_POINT_PRIOR = 0.1
+"""The prior odds of a junction near a stated intersection lat/lon against the junction
+within 25 m of it (:func:`_rough_point_candidates`), before the fall with distance."""
+
+ROUGH_POINT_GATE = 0.5
+"""The stated junction fits badly when its best candidate's map plausibility (the factor of
+:func:`~camloc_geo.absolute._scoring.plausibility_at`) is under this, or when its matched
+points misfit (``poor_fit``). A visible corner left ``unmatched`` does not count: it is what a
+corner of a neighbouring junction clicked too gives (``absolute_slips.py``'s
+``corner_extra``), and counted, it cost that slip 3 of 84 right top candidates for 3 of 120
+rough points."""
+
+
+def fits_badly(cands: list[Candidate]) -> bool:
+    """Whether the best of ``cands`` (by weight) fits the image evidence badly: implausible
+    on the map (its car off or across its street, its camera in a building, its corners seen
+    through one: plausibility under :data:`ROUGH_POINT_GATE`) or its matched points misfit
+    (``poor_fit``). No candidate at all fits badly too."""
+    if not cands:
+        return True
+    best = max(cands, key=_weight)
+    return best.prior < ROUGH_POINT_GATE or FlagKind.POOR_FIT in {f.kind for f in best.flags}
+
+
+def _rough_point_candidates(
+    scene: Scene,
+    map_data: MapData | None,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+    named_cands: list[Candidate],
+) -> list[Candidate]:
+    """Corner hypotheses at the junctions around a stated intersection lat/lon that did
+    match a junction within 25 m, when that junction fits the image evidence badly
+    (:func:`fits_badly`).
+
+    A webcam listing's rough point lands within 25 m of the wrong junction about one time in
+    four (``benchmarks/absolute_slips.py``'s ``intersection_latlon_off``). The junctions
+    with kerb corners within :data:`~camloc_geo.absolute._evidence.LATLON_SEARCH_M` of the
+    point (:func:`~camloc_geo.absolute._evidence.latlon_search`, at most
+    :data:`~camloc_geo.absolute._evidence.MAX_SEARCH_JUNCTIONS`) are tried at prior odds
+    :data:`ROUGH_POINT_PRIOR`, falling by e per
+    :data:`~camloc_geo.absolute._evidence.LATLON_SEARCH_SCALE_M` beyond the stated
+    junction's distance; they are kept only when one of them outweighs every candidate at
+    the stated junction (their odds included); where no hypothesis fits at the stated
+    junction at all (every one ``poor_fit``), only when their best fits well itself (else
+    the empty answer and its reason stand: a junction that fits badly too is no answer). A
+    warning names the junction used
+    (:func:`_warn_other_junction`). A stated junction that fits well is taken at its word,
+    as before (``absolute_slips.py``: 11 of 120 clean corner scenes fit their junction
+    badly and pay the search; none changes).
+    """
+    hint = scene.intersection
+    if (
+        map_data is None
+        or hint is None
+        or hint.lat is None
+        or hint.lon is None
+        or ev.intersection is None
+        or not ev.corners
+        or not fits_badly(named_cands)
+    ):
+        return []
+    out = _rough_point_alternatives(scene, map_data, world_cam, ev, settings, result)
+    if not out:
+        return []
+    if all(FlagKind.POOR_FIT in {f.kind for f in c.flags} for c in named_cands):
+        # nothing fits at the stated junction: its empty answer and reason stand unless a
+        # junction around fits well
+        return [] if fits_badly(out) else out
+    if max(map(_weight, out)) > max(map(_weight, named_cands)):
+        return out
+    return []
+
+
+def _rough_point_alternatives(
+    scene: Scene,
+    map_data: MapData,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+) -> list[Candidate]:
+    """The scored corner hypotheses of :func:`_rough_point_candidates` at every junction
+    searched around the stated point but the stated one, each at its prior odds."""
+    from camloc_geo.absolute._evidence import (
+        LATLON_SEARCH_SCALE_M,
+        NEIGHBOUR_JUNCTION_PRIOR,
+        latlon_search,
+    )
+
+    hint = scene.intersection
+    assert hint is not None
+    assert hint.lat is not None
+    assert hint.lon is not None
+    assert ev.intersection is not None
+    streets = list(hint.streets or []) or None
+    found = latlon_search(map_data, hint.lat, hint.lon, streets)
+    if not found:
+        return []
+    own = map_data.distance_to_m(ev.intersection, lat=hint.lat, lon=hint.lon)
+    named = {x.id for x in map_data.street_junctions(streets)} if streets else None
+    out: list[Candidate] = []
+    for inter, d, _lp in found:
+        if inter.id == ev.intersection.id:
+            continue
+        lp = math.log(ROUGH_POINT_PRIOR) - max(0.0, d - own) / LATLON_SEARCH_SCALE_M
+        if named is not None and inter.id not in named:
+            lp += math.log(NEIGHBOUR_JUNCTION_PRIOR)
+        ev_j = evidence_at(ev, inter, map_data, result.frame, settings)
+        hyps = corner_hypotheses(ev_j, settings)
+        for h in hyps:
+            h.log_prior += lp
+        out += _keep_odds(score_hypotheses(hyps, world_cam, ev_j, settings), lp)
     return out
 
 
@@ -619,6 +740,8 @@ def _warn_other_junction(
     scene: Scene, map_data: MapData | None, ev: Evidence, result: LocateResult
 ) -> None:
     """Warn when the best candidate stands at a junction the scene did not name."""
+    from camloc_geo.absolute._evidence import LATLON_SEARCH_M
+
     named = named_junctions(scene, map_data, ev)
     if ev.junction_search:
         _warn_searched_junction(scene, ev, result)
@@ -632,11 +755,27 @@ def _warn_other_junction(
     there = map_data.intersection(top.intersection_id)
     hint = scene.intersection
     assert hint is not None
-    said = (
-        f"lat={hint.lat:.6f}, lon={hint.lon:.6f}"
-        if hint.lat is not None and hint.lon is not None
-        else " & ".join(hint.streets or [])
-    )
+    if hint.lat is not None and hint.lon is not None and ev.intersection is not None:
+        own = ev.intersection
+        d_top = map_data.distance_to_m(there, lat=hint.lat, lon=hint.lon)
+        d_own = map_data.distance_to_m(own, lat=hint.lat, lon=hint.lon)
+        k, n = len(ev.corners), len(ev.map_corners)
+        why = f" (it has {n} kerb corners, the image shows {k})" if k > n else ""
+        if why:  # the count warning spoke of every hypothesis; the best stands elsewhere
+            result.warnings[:] = [
+                w for w in result.warnings if not w.startswith("corners: the scene lists")
+            ]
+        result.warnings.append(
+            f"intersection: the junction at the scene's intersection lat/lon (lat={hint.lat:.6f}, "
+            f"lon={hint.lon:.6f}), {own.id} ({' & '.join(own.street_names)}) {d_own:.0f} m "
+            f"from it, fits the image badly{why}; the junctions with kerb corners within "
+            f"{LATLON_SEARCH_M:.0f} m were tried: the best candidate stands at junction "
+            f"{there.id} ({' & '.join(there.street_names)}), {d_top:.0f} m from the stated "
+            "point. Is the lat/lon a rough point (a webcam listing's)? Check the best "
+            "candidate's junction"
+        )
+        return
+    said = " & ".join(hint.streets or [])
     result.warnings.append(
         f"intersection: the corners fit junction {there.id} ({' & '.join(there.street_names)}) "
         f"better than the scene's own ({said}): is the cross street or the lat/lon of "
@@ -1192,7 +1331,7 @@ def bundle_leaders(
         [adjusted[k] for k in held], calibration, [evs[k] for k in held], settings
     )
     if held and held[0] == 0:
-        _warn_loose_calibration(adjusted[0], extra[0], calibration, result)
+        _warn_loose_calibration(adjusted[0], extra[0], calibration, evs[0], settings, result)
     return adjusted + cands[settings.refine_top :]
 
 
@@ -1230,26 +1369,58 @@ state over 15 % (and move their top candidate at least 5 m)."""
 LOOSE_CALIBRATION_M = 5.0
 """... and the calibration alone moves the top candidate by at least this much (1-sigma)."""
 
+LOOSE_FOCAL_SIGMAS = 2.0
+"""... and a focal length this many sigmas shorter or longer (the other parameters moved
+with it as the calibration's covariance correlates them, the pixels cast exactly) moves the
+top candidate farther than its ``sigma_m``: the warning says how far."""
+
 
 def _warn_loose_calibration(
-    top: Candidate, sig_cal: float | None, calibration: CalibrationResult, result: LocateResult
+    top: Candidate,
+    sig_cal: float | None,
+    calibration: CalibrationResult,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
 ) -> None:
-    """A warning when the top candidate kept a loose calibration's camera (its focal length
-    over :data:`LOOSE_FOCAL_REL` uncertain) that alone moves it by :data:`LOOSE_CALIBRATION_M`
-    or more: with two references (or two corners) the map cannot correct the focal length,
-    and a focal length two sigmas off puts the camera twice as far (``unseen_cities.py``:
-    Stretford's Lacy Street 26.6 m off, Andorra 21.5 m)."""
+    """A warning when the top candidate kept a loose calibration's camera: its focal length
+    over :data:`LOOSE_FOCAL_REL` uncertain, alone moving the candidate by
+    :data:`LOOSE_CALIBRATION_M` or more (1 sigma), and a focal length
+    :data:`LOOSE_FOCAL_SIGMAS` sigmas off moving it farther than its ``sigma_m``
+    (:func:`~camloc_geo.absolute._refine.focal_moves_m`). With two references (or two corners)
+    the map cannot correct the focal length (``unseen_cities.py``: Stretford's Lacy Street
+    26.6 m off, Andorra 21.5 m at a sigma of 9.5 m). The warning names the focal length that
+    far off and how far it moves the candidate."""
     f_sig = calibration.focal_sigma_px
     if sig_cal is None or f_sig is None or top.sigma_m is None:
         return
-    rel = float(f_sig) / float(calibration.camera.focal_px)
+    focal = float(calibration.camera.focal_px)
+    rel = float(f_sig) / focal
     if rel <= LOOSE_FOCAL_REL or sig_cal < LOOSE_CALIBRATION_M:
         return
+    k = LOOSE_FOCAL_SIGMAS
+    moves = focal_moves_m(top, calibration, ev, settings, k)
+    if moves is None or max(moves) <= top.sigma_m:
+        return
+    short = moves[0] >= moves[1]
+    far = max(moves)
+    moved_px = focal - k * float(f_sig) if short else focal + k * float(f_sig)
+    which = (
+        f"{k:g} sigma {'shorter' if short else 'longer'} ({moved_px:.0f} px against {focal:.0f} px)"
+        if moved_px > 0.0
+        else f"{k:g} sigma shorter (at or below zero)"
+    )
+    how = (
+        "leaves no camera that casts every matched pixel onto the ground"
+        if math.isinf(far)
+        else f"moves it {far:.0f} m"
+    )
     result.warnings.append(
         f"calibration: the focal length is uncertain by {100.0 * rel:.0f} % (1 sigma) and "
-        f"alone moves the top candidate by {sig_cal:.0f} m (its sigma_m {top.sigma_m:.0f} m "
-        f"includes it); {top.method.replace('_', ' ')} cannot correct it: more vanishing "
-        "lines, another reference or kerb corners would"
+        f"alone moves the top candidate by {sig_cal:.0f} m (1 sigma; its sigma_m "
+        f"{top.sigma_m:.0f} m includes it); a focal length {which} {how}; "
+        f"{top.method.replace('_', ' ')} cannot correct it: more vanishing lines, another "
+        "reference or kerb corners would"
     )
 
 

@@ -391,6 +391,15 @@ def _calibration_sigma_points(
     lam, vec = np.linalg.eigh(cov)
     steps = [math.sqrt(float(lam[k])) * vec[:, k] for k in range(len(lam)) if lam[k] > 0.0]
     deltas = np.array([sign * d for d in steps for sign in (1.0, -1.0)]).reshape(-1, 7)
+    return _moved_cameras(cam, deltas)
+
+
+def _moved_cameras(
+    cam: Camera, deltas: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The camera moved by each row of ``deltas`` ``(m, 7)`` (:data:`CALIBRATION_PARAMETERS`),
+    those with a positive focal length and height kept, as the arrays of
+    :func:`_calibration_sigma_points`."""
     f = float(cam.focal_px) + deltas[:, 0]
     C = np.asarray(cam.center_in_world, dtype=float)[None, :] + np.outer(deltas[:, 6], [0, 0, 1])
     ok = (f > 0.0) & (C[:, 2] > 0.0)
@@ -449,6 +458,34 @@ def calibration_sigmas_m(
     f, pp, R, C = _calibration_sigma_points(cam0, cov)
     if not len(f):
         return out
+    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
+        d2 = _squared_moves(cand, ev, settings, cam0, (f, pp, R, C))
+        if d2 is None:
+            continue
+        lost = ~np.isfinite(d2)
+        far = 4.0 * float(np.max(d2[~lost])) if np.any(~lost) else 0.0
+        out[k] = math.sqrt(0.5 * float(np.sum(np.where(lost, far, d2))))
+    return out
+
+
+def _squared_moves(
+    cand: Candidate,
+    ev: Evidence,
+    settings: LocateSettings,
+    cam0: Camera,
+    moved_cams: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+) -> FloatArray | None:
+    """How far (squared, metres²) the candidate's camera moves on the map with each moved
+    camera (the arrays of :func:`_moved_cameras`): the matched pixels cast again through it
+    exactly, the similarity's fit linearised at the candidate. ``inf`` where a moved camera
+    casts a matched pixel above its horizon; None where nothing can be computed."""
+    parts = _normal_parts(cand, ev, settings)
+    if parts is None:
+        return None
+    obs_q, D, prec, JtJ = parts
+    pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
+    if cam0.distortion is not None:
+        pixels = undistort_points_px(pixels, cam0.distortion, cam0.principal_point)
     R0 = np.asarray(cam0.cam_from_world_rotation, dtype=float)
     base = (
         np.array([float(cam0.focal_px)]),
@@ -456,31 +493,55 @@ def calibration_sigmas_m(
         R0[None, :, :],
         np.asarray(cam0.center_in_world, dtype=float)[None, :],
     )
-    for k, (cand, ev) in enumerate(zip(cands, evs, strict=True)):
-        parts = _normal_parts(cand, ev, settings)
-        if parts is None:
+    g0 = _cast(pixels, *base)[0]
+    if not np.all(np.isfinite(g0)):
+        return None
+    moved = _cast(pixels, *moved_cams) - g0[None]  # (m, n, 2) in the world frame
+    sim = cand.enu_from_world
+    A = sim.scale * sim.rotation  # a world displacement in ENU
+    de = np.einsum("ij,mnj->mni", A, np.nan_to_num(moved))
+    # the fit's step that absorbs them: JᵀJ Δx = -Σ D_kᵀ Λ_k δe_k
+    grad = np.einsum("nia,nij,mnj->ma", D, prec, de)
+    try:
+        dx = -np.linalg.solve(JtJ, grad.T).T
+    except np.linalg.LinAlgError:
+        dx = -(np.linalg.pinv(JtJ) @ grad.T).T
+    Jp = _position_jacobian(sim, cam0.center_in_world[:2])
+    dpos = dx @ Jp.T  # (m, 2); the centre's own height moves no horizontal position
+    d2 = np.einsum("mi,mi->m", dpos, dpos)
+    lost = ~np.all(np.isfinite(moved), axis=(1, 2)) | ~np.isfinite(d2)
+    return np.asarray(np.where(lost, np.inf, d2), dtype=np.float64)
+
+
+def focal_moves_m(
+    cand: Candidate,
+    cal: CalibrationResult,
+    ev: Evidence,
+    settings: LocateSettings,
+    k_sigma: float = 2.0,
+) -> tuple[float, float] | None:
+    """How far the candidate's camera moves on the map when the calibration's focal length
+    is ``k_sigma`` sigmas shorter and longer (metres; ``inf`` where a matched pixel would
+    cast above the horizon), the other parameters moved with it along the covariance's
+    regression on the focal length (:func:`calibration_covariance`), the matched pixels cast
+    exactly (the camera moves faster than linearly with a focal length far off: the
+    1-sigma of :func:`calibration_sigmas_m` understates a 2-sigma focal length's move).
+
+    None where it cannot be computed (no focal sigma, no match).
+    """
+    cov = calibration_covariance(cal)
+    if cov is None or cov[0, 0] <= 0.0:
+        return None
+    step = k_sigma * cov[:, 0] / math.sqrt(float(cov[0, 0]))
+    cam0 = cal.camera
+    out = []
+    for delta in (-step, step):
+        moved = _moved_cameras(cam0, delta[None, :])
+        if not len(moved[0]):  # a focal length or height at or below zero: no camera
+            out.append(math.inf)
             continue
-        obs_q, D, prec, JtJ = parts
-        pixels = np.array([o.pixel for o, _q in obs_q], dtype=float)
-        if cam0.distortion is not None:
-            pixels = undistort_points_px(pixels, cam0.distortion, cam0.principal_point)
-        g0 = _cast(pixels, *base)[0]
-        if not np.all(np.isfinite(g0)):
-            continue
-        moved = _cast(pixels, f, pp, R, C) - g0[None]  # (m, n, 2) in the world frame
-        sim = cand.enu_from_world
-        A = sim.scale * sim.rotation  # a world displacement in ENU
-        de = np.einsum("ij,mnj->mni", A, np.nan_to_num(moved))
-        # the fit's step that absorbs them: JᵀJ Δx = -Σ D_kᵀ Λ_k δe_k
-        grad = np.einsum("nia,nij,mnj->ma", D, prec, de)
-        try:
-            dx = -np.linalg.solve(JtJ, grad.T).T
-        except np.linalg.LinAlgError:
-            dx = -(np.linalg.pinv(JtJ) @ grad.T).T
-        Jp = _position_jacobian(sim, cam0.center_in_world[:2])
-        dpos = dx @ Jp.T  # (m, 2); the centre's own height moves no horizontal position
-        d2 = np.einsum("mi,mi->m", dpos, dpos)
-        lost = ~np.all(np.isfinite(moved), axis=(1, 2)) | ~np.isfinite(d2)
-        far = 4.0 * float(np.max(d2[~lost])) if np.any(~lost) else 0.0
-        out[k] = math.sqrt(0.5 * float(np.sum(np.where(lost, far, d2))))
-    return out
+        d2 = _squared_moves(cand, ev, settings, cam0, moved)
+        if d2 is None:
+            return None
+        out.append(math.sqrt(float(d2[0])))
+    return (out[0], out[1])
