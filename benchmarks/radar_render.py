@@ -39,6 +39,7 @@ Usage::
 
     python benchmarks/radar_render.py              # 7 seeds, about 10 min on one core
     python benchmarks/radar_render.py --seeds 2 --duration 10
+    python benchmarks/radar_render.py --video-dir /tmp/videos   # render once, reuse after
 """
 
 from __future__ import annotations
@@ -74,6 +75,31 @@ BRNO = {  # BrnoCompSpeed state of the art, km/h
 TARGETS = {"rel_p90": 0.05, "rel_max": 0.10, "mean_signed_abs": 0.015, "coverage_2sigma": 0.90}
 
 
+def street_video(seed: int, duration_s: float, video_dir: Path) -> RenderedVideo:
+    """``render_street``'s video for ``random_street(seed)``, rendered into ``video_dir`` once.
+
+    The video is ``s{seed}.avi`` (the name ``calibrate_traffic.py --video-dir`` reads too) and
+    its truth (vehicles, boxes, scene) ``s{seed}_{duration}s.pkl`` beside it; both are reused
+    when present, so a second run (or the other benchmark) skips the rendering.
+    """
+    import pickle
+
+    video_dir.mkdir(parents=True, exist_ok=True)
+    path = video_dir / f"s{seed}.avi"
+    truth = video_dir / f"s{seed}_{duration_s:g}s.pkl"
+    if path.is_file() and truth.is_file():
+        video = pickle.loads(truth.read_bytes())
+        if isinstance(video, RenderedVideo) and Path(video.path) == path:
+            return video
+    n_veh = max(1, round(10 * duration_s / 20.0))
+    cam, vehicles = random_street(
+        np.random.default_rng(seed), n_vehicles=n_veh, duration_s=duration_s
+    )
+    video = render_street(path, cam, vehicles, duration_s=duration_s, seed=seed)
+    truth.write_bytes(pickle.dumps(video))
+    return video
+
+
 def true_calibration(cal: CalibrationResult, camera: Camera) -> CalibrationResult:
     """``cal`` with the true camera and no calibration uncertainty (the radar's own error)."""
     return replace(
@@ -82,6 +108,7 @@ def true_calibration(cal: CalibrationResult, camera: Camera) -> CalibrationResul
         position_sigma_m=np.zeros(3),
         focal_sigma_px=0.0,
         rotation_sigma_deg=None,
+        principal_point_sigma_px=None,
     )
 
 
@@ -264,6 +291,11 @@ def main(argv: list[str] | None = None) -> int:
         default=True,
         help="calibrate with the video's own lines too (camloc radar's default)",
     )
+    ap.add_argument(
+        "--video-dir",
+        type=Path,
+        help="render the videos here once and reuse them (default: a temporary directory)",
+    )
     args = ap.parse_args(argv)
     runs = [r for r in args.runs.split(",") if r]
     unknown = set(runs) - set(RUNS) - set(EXTRA_RUNS)
@@ -281,12 +313,8 @@ def main(argv: list[str] | None = None) -> int:
     seconds: dict[str, float] = dict.fromkeys(runs, 0.0)
     with tempfile.TemporaryDirectory(prefix="camloc-radar-render-") as tmp:
         for seed in range(args.first_seed, args.first_seed + args.seeds):
-            rng = np.random.default_rng(seed)
-            n_veh = max(1, round(10 * args.duration / 20.0))
-            cam, vehicles = random_street(rng, n_vehicles=n_veh, duration_s=args.duration)
-            video = render_street(
-                Path(tmp) / f"s{seed}.avi", cam, vehicles, duration_s=args.duration, seed=seed
-            )
+            video = street_video(seed, args.duration, args.video_dir or Path(tmp))
+            cam = video.camera
             n_true += sum(1 for per in video.boxes.values() if len(per) / video.fps >= 0.5)
             try:
                 cal: CalibrationResult | None = calibrate_scene(

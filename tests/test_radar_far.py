@@ -29,7 +29,12 @@ def calibration() -> CalibrationResult:
     cam = street_camera(7.5)
     cal = calibrate_scene(street_scene(cam, 3, click_px=0.0).scene)
     return replace(
-        cal, camera=cam, position_sigma_m=np.zeros(3), focal_sigma_px=0.0, rotation_sigma_deg=None
+        cal,
+        camera=cam,
+        position_sigma_m=np.zeros(3),
+        focal_sigma_px=0.0,
+        rotation_sigma_deg=None,
+        principal_point_sigma_px=None,
     )
 
 

@@ -52,6 +52,7 @@ def true_calibration(video: RenderedVideo) -> CalibrationResult:
         position_sigma_m=np.zeros(3),
         focal_sigma_px=0.0,
         rotation_sigma_deg=None,
+        principal_point_sigma_px=None,
     )
 
 

@@ -389,3 +389,35 @@ def test_radar_bounds_the_video_lines_by_max_frames_and_600(
     for max_frames, expected in ((None, 600), (12, 12), (5000, 600)):
         radar_scene(scene, video.path, tracks=boxes, max_frames=max_frames, min_track_s=0.1)
         assert asked[-1] == expected, (max_frames, asked)
+
+
+def test_the_street_group_is_capped_by_information_the_edges_by_count() -> None:
+    from types import SimpleNamespace
+
+    from camloc_geo.relative import VIDEO_GROUP_CAP, _line_information, _video_group_widening
+
+    # 3 annotators, 2 length lines of 100 px each; the line sigma 1 px
+    ann = np.array([[0.0, 0.0, 100.0, 0.0]] * 6)
+    prob = SimpleNamespace(
+        segments=ann,
+        seg_axis=np.zeros(6, dtype=int),
+        n_annotators=3,
+        sigma_line=1.0,
+        image_wh=(960.0, 540.0),
+    )
+    assert _line_information(ann, 1.0) == pytest.approx(6 * 100.0**2)
+    # 900 tracks of 20 px: 900 * 400 = 360,000 against a cap of 3 annotators' 20,000 each
+    tracks = np.array([[0.0, 0.0, 20.0, 0.0]] * 900)
+    sigma = np.ones(900)
+    factor = _video_group_widening(prob, tracks, sigma, 0, True)
+    assert factor == pytest.approx(360_000.0 / (VIDEO_GROUP_CAP * 20_000.0))
+    # counted, the same group was held to 3 x 2 segments: 25 times less than its information
+    assert _video_group_widening(prob, tracks, sigma, 0, False) == pytest.approx(900 / 6.0)
+    # a group saying less than the cap keeps its own sigmas
+    few = np.array([[0.0, 0.0, 20.0, 0.0]] * 40)
+    assert _video_group_widening(prob, few, np.ones(40), 0, True) == 1.0
+    assert _video_group_widening(prob, few, np.ones(40), 0, False) == pytest.approx(40 / 6.0)
+    # an axis the annotators barely drew: at least 2 lines of 5 % of the diagonal each
+    floor = 2.0 * (0.05 * math.hypot(960.0, 540.0)) ** 2
+    factor = _video_group_widening(prob, tracks, sigma, 2, True)
+    assert factor == pytest.approx(360_000.0 / (VIDEO_GROUP_CAP * floor))

@@ -91,7 +91,7 @@ from camloc_geo._limits import (
     MAX_VIDEO_PIXELS,
     check_regular_file,
 )
-from camloc_geo.sensors import _draws, _ground, _rays
+from camloc_geo.sensors import _draws_posed, _ground, _rays
 
 if TYPE_CHECKING:
     from camloc_geo.relative import CalibrationResult
@@ -1174,8 +1174,12 @@ def _fit_track(
     pixels = np.array([t.contacts[i] for i in use], dtype=np.float64)
     frames = np.array([t.frames[i] for i in use])
     cam = calibration.camera
-    centres, focals, px = _draws(calibration, pixels, n_samples, 0.0, seed)
-    rays = _rays(px, focals, cam.principal_point, cam.cam_from_world_rotation)
+    # the camera drawn as a whole (focal length, principal point, orientation and centre with
+    # the fit's correlations, as `camloc measure` draws it): before session 37 the rotation
+    # and principal point were held while the centre and focal length moved, and the
+    # draws lost the tilt that compensates them
+    centres, focals, rotations, px = _draws_posed(calibration, pixels, n_samples, 0.0, seed)
+    rays = _rays(px, focals, cam.principal_point, rotations)
     ground = _ground(centres, rays)[..., :2]
     ok = np.all(np.isfinite(ground[0]), axis=1)
     if ok.sum() < 3:
