@@ -1001,7 +1001,11 @@ def test_cli_page_from_a_file_shares_with_the_service(
         box.locator('button[data-verdict="unsure"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="unsure"]').click()
         keybox = page.locator(".camloc-verdicts form.camloc-vkey")
-        keybox.wait_for(state="visible", timeout=30000)  # the 401 reached the page
+        try:
+            keybox.wait_for(state="visible", timeout=60000)  # the 401 reached the page
+        except Exception as exc:  # say what the page sent and showed, for a rare miss
+            status = page.locator(share).inner_text()
+            raise AssertionError(f"no key field: sent={sent} share={status!r}") from exc
         keybox.locator("input").fill(KEY)
         keybox.locator("button").click()
         page.wait_for_function(
