@@ -143,6 +143,8 @@ def step_dialog() -> None:
     params = {"SCENE": str(SCENE), "OSM": str(OSM)}
     params.update({k: str(OUT / f"dialog_{k.lower()}.shp") for k in outs})
     dlg.setParameters(params)
+    dlg.resize(900, 640)
+    dlg.grab().save(str(OUT / "dialog_parameters.png"))  # the form as the analyst fills it
 
     def finished(ok: bool, results: dict[str, Any]) -> None:
         summary["dialog_shp"] = {"ok": ok, "layers": _layers()}

@@ -206,7 +206,10 @@ def test_screenshots_show_the_map(desktop, step):
     _map_drawn(window[y : y + h, x : x + w], f"{step}_window.png's canvas")
 
 
-@pytest.mark.parametrize("name", ["dialog.png", "batch_dialog.png", "dock.png", "dock_legend.png"])
+@pytest.mark.parametrize(
+    "name",
+    ["dialog_parameters.png", "dialog.png", "batch_dialog.png", "dock.png", "dock_legend.png"],
+)
 def test_widget_screenshots_are_not_blank(desktop, name):
     rgb = _pixels(desktop["out"] / name)
     assert min(rgb.shape[:2]) > 100, (name, rgb.shape)
