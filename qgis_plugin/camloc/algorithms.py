@@ -102,6 +102,9 @@ def _scene_id(candidates: dict[str, Any], scene_path: str) -> str:
     return os.path.basename(scene_path)
 
 
+CANCELED_TEXT = "camloc: canceled; the worker was stopped, no output was written"
+"""What a canceled run says in the Processing log (before QGIS's "Execution failed")."""
+
 LABEL_MAX_CHARS = 48
 """A parameter's label fits the Processing dialog as QGIS first opens it (688 px): longer ones
 widened the form past it, hiding the file pickers' browse buttons; details go in the help."""
@@ -213,7 +216,8 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
                 job, progress=progress, canceled=feedback.isCanceled, log=feedback.pushDebugInfo
             )
         except WorkerCanceledError:
-            feedback.reportError("canceled", fatalError=False)
+            # the log said only "canceled", then QGIS's "Execution failed"
+            feedback.reportError(CANCELED_TEXT, fatalError=False)
             return None
         except WorkerError as exc:
             raise QgsProcessingException(f"camloc: {exc}") from None

@@ -184,6 +184,21 @@ class ImageView(QGraphicsView):
     def has_image(self) -> bool:
         return self._pixmap_item is not None
 
+    EMPTY_TEXT = (
+        "No snapshot open.\nOpen snapshot… to annotate a photo; Load scene… for a saved scene "
+        "(its marks show once its photo is open)."
+    )
+
+    def paintEvent(self, event: Any) -> None:
+        """The view; with no snapshot, a line saying so (it was a blank white box)."""
+        super().paintEvent(event)
+        if self._pixmap_item is None:
+            painter = QPainter(self.viewport())
+            painter.setPen(QColor("#6b6b6b"))
+            box = self.viewport().rect().adjusted(16, 16, -16, -16)
+            painter.drawText(box, int(Qt.AlignCenter | Qt.TextWordWrap), self.EMPTY_TEXT)
+            painter.end()
+
     def clear_overlays(self) -> None:
         """Remove the click markers (each once)."""
         sc = self.scene()

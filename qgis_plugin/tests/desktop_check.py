@@ -32,6 +32,7 @@ from typing import Any
 
 from qgis.core import QgsApplication, QgsProject
 from qgis.PyQt.QtCore import QPoint, QTimer
+from qgis.PyQt.QtWidgets import QTextEdit
 from qgis.utils import iface
 
 REPO = Path(os.environ.get("CAMLOC_REPO", Path.cwd()))
@@ -126,8 +127,12 @@ def step_toolbox() -> None:
     params.update({k: str(OUT / f"toolbox_{k.lower()}.gpkg") for k in outs})
     processing.runAndLoadResults("camloc:locate", params)
     summary["toolbox"] = _layers()
-    QTimer.singleShot(300, _zoom_to_candidates)  # after QGIS zooms to its first layers
-    QTimer.singleShot(1500, lambda: (_shot("toolbox"), guarded(step_dialog)()))
+
+    def zoomed() -> None:  # after QGIS's own zoom to its first layers
+        _zoom_to_candidates()
+        _after_render(lambda: (_shot("toolbox"), step_dialog()))
+
+    QTimer.singleShot(300, guarded(zoomed))
 
 
 def step_dialog() -> None:
@@ -143,15 +148,50 @@ def step_dialog() -> None:
     params = {"SCENE": str(SCENE), "OSM": str(OSM)}
     params.update({k: str(OUT / f"dialog_{k.lower()}.shp") for k in outs})
     dlg.setParameters(params)
+    dlg.resize(900, 640)
+    dlg.grab().save(str(OUT / "dialog_parameters.png"))  # the form as the analyst fills it
 
     def finished(ok: bool, results: dict[str, Any]) -> None:
         summary["dialog_shp"] = {"ok": ok, "layers": _layers()}
+        dlg.algorithmFinished.disconnect(finished)
         QTimer.singleShot(
-            1500, lambda: (dlg.grab().save(str(OUT / "dialog.png")), guarded(step_batch)())
+            1500, lambda: (dlg.grab().save(str(OUT / "dialog.png")), guarded(cancel_run)())
+        )
+
+    def cancel_run() -> None:
+        """Run again into other files and press Cancel at once, as for a long run."""
+        QgsProject.instance().clear()
+        again = {"SCENE": str(SCENE), "OSM": str(OSM)}
+        again.update({k: str(OUT / f"dialog_canceled_{k.lower()}.gpkg") for k in outs})
+        dlg.setParameters(again)
+        dlg.algorithmFinished.connect(canceled)
+        dlg.runAlgorithm()
+        state["cancel_enabled"] = dlg.cancelButton().isEnabled()
+        dlg.cancelButton().click()
+
+    def canceled(ok: bool, results: dict[str, Any]) -> None:
+        summary["dialog_canceled"] = {
+            "ok": ok,
+            "cancel_enabled": state.get("cancel_enabled"),
+            "layers": _layers(),
+            "files": sorted(p.name for p in OUT.glob("dialog_canceled_*")),
+            "log": _dialog_log(dlg),
+        }
+        QTimer.singleShot(
+            1000,
+            lambda: (dlg.grab().save(str(OUT / "dialog_canceled.png")), guarded(step_batch)()),
         )
 
     dlg.algorithmFinished.connect(finished)
     dlg.runAlgorithm()
+
+
+def _dialog_log(dlg: Any) -> str | None:
+    """The text of a Processing dialog's log (the text box that lists the input parameters)."""
+    for box in dlg.findChildren(QTextEdit):
+        if "Input parameters" in box.toPlainText():
+            return box.toPlainText()
+    return None
 
 
 def step_batch() -> None:
@@ -222,10 +262,31 @@ def finish() -> None:
         "layers": _layers(),
         "extent": _extent(),
     }
-    _shot("dock")
-    dock.grab().save(str(OUT / "dock.png"))
-    iface.layerTreeView().grab().save(str(OUT / "dock_legend.png"))
-    step_dock_errors()
+
+    def shots() -> None:
+        _shot("dock")
+        dock.grab().save(str(OUT / "dock.png"))
+        iface.layerTreeView().grab().save(str(OUT / "dock_legend.png"))
+        step_dock_errors()
+
+    _after_render(shots)
+
+
+def _after_render(then: Any) -> None:
+    """Refresh the canvas and call ``then`` once it has drawn (its labels known): a fixed
+    wait took the screenshot before the labels on a busy machine."""
+    canvas = iface.mapCanvas()
+    fired: list[bool] = []
+
+    def drawn() -> None:
+        if fired:
+            return
+        fired.append(True)
+        canvas.mapCanvasRefreshed.disconnect(drawn)
+        QTimer.singleShot(300, guarded(then))
+
+    canvas.mapCanvasRefreshed.connect(drawn)
+    canvas.refresh()
 
 
 def _extent() -> list[float]:

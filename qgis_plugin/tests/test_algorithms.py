@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -550,3 +551,64 @@ def test_the_intersection_keeps_its_streets_label_among_the_others(provider, tmp
     texts = [lab.labelText for lab in job.takeLabelingResults().allLabels()]
     assert "Eastern Avenue & South Broadway" in texts, texts
     assert any(t.startswith("#1 ") for t in texts), texts
+
+
+def _files_an_analyst_picks_by_mistake(tmp_path: Path) -> dict[str, tuple[Path, Path]]:
+    """name: (scene, extract), one of them wrong."""
+    broken = tmp_path / "broken.json"
+    broken.write_text('{"format": "camloc-scene/1", "annotations": [')
+    cut = tmp_path / "cut.osm.pbf"
+    cut.write_bytes(SAMPLE_OSM.read_bytes()[:4000])
+    notes = tmp_path / "notes.osm"
+    notes.write_text("these are my notes, not OpenStreetMap\n")
+    folder = tmp_path / "a folder.json"
+    folder.mkdir()
+    fifo = tmp_path / "pipe.json"
+    os.mkfifo(fifo)
+    return {
+        "broken.json": (broken, SAMPLE_OSM),
+        "a folder.json": (folder, SAMPLE_OSM),
+        "pipe.json": (fifo, SAMPLE_OSM),
+        "missing.json": (tmp_path / "missing.json", SAMPLE_OSM),
+        "cut.osm.pbf": (SAMPLE_SCENE, cut),
+        "notes.osm": (SAMPLE_SCENE, notes),
+        "the scene as extract": (SAMPLE_SCENE, SAMPLE_SCENE),
+    }
+
+
+class _ErrorsSaid(QgsProcessingFeedback):
+    """The lines an algorithm reports as errors (the dialog's log shows them in red)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.errors: list[str] = []
+
+    def reportError(self, error: str, fatalError: bool = False) -> None:
+        self.errors.append(error)
+
+
+def test_a_wrong_file_is_one_processing_error_line_naming_it(provider, tmp_path):
+    # the Toolbox dialog shows a QgsProcessingException's text in its log; any other exception
+    # would be a Python traceback there. A FIFO must not block (the worker refuses it).
+    import processing
+    from test_dock import _Unblocker
+
+    said = {}
+    cases = _files_an_analyst_picks_by_mistake(tmp_path)
+    with _Unblocker(cases["pipe.json"][0]) as unblocker:
+        for name, (scene, osm) in cases.items():
+            feedback = _ErrorsSaid()
+            with pytest.raises(QgsProcessingException) as err:
+                processing.run(
+                    "camloc:locate",
+                    {"SCENE": str(scene), "OSM": str(osm), "CANDIDATES": "TEMPORARY_OUTPUT"},
+                    feedback=feedback,
+                )
+            text = " ".join([*feedback.errors, str(err.value)])
+            said[name] = text
+            assert "Traceback" not in text, (name, text)
+            assert "camloc:" in text, (name, text)
+            file_name = scene.name if osm == SAMPLE_OSM else osm.name
+            assert file_name in text, (name, text)
+    assert not unblocker.used  # nothing opened the FIFO
+    assert len(said) == 7

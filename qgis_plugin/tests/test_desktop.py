@@ -154,6 +154,17 @@ def test_algorithm_dialog_into_shapefiles_loads_four_styled_layers(desktop):
     _check_locate_layers(desktop["dialog_shp"]["layers"], SCENE_ID, "dialog")
 
 
+def test_algorithm_dialog_cancel_stops_the_run_and_loads_nothing(desktop):
+    canceled = desktop["dialog_canceled"]
+    assert canceled["cancel_enabled"] is True  # the Cancel button works during the run
+    assert canceled["ok"] is False
+    assert canceled["layers"] == []
+    assert canceled["files"] == []  # the worker was stopped before anything was written
+    # the dialog's log said only "canceled" before QGIS's "Execution failed"
+    assert "camloc: canceled; the worker was stopped, no output was written" in canceled["log"]
+    assert "Traceback" not in canceled["log"]
+
+
 def test_batch_dialog_loads_each_rows_layers_named_after_its_scene(desktop):
     layers = desktop["batch"]
     assert sorted(lyr["name"] for lyr in layers) == sorted(
@@ -206,7 +217,17 @@ def test_screenshots_show_the_map(desktop, step):
     _map_drawn(window[y : y + h, x : x + w], f"{step}_window.png's canvas")
 
 
-@pytest.mark.parametrize("name", ["dialog.png", "batch_dialog.png", "dock.png", "dock_legend.png"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "dialog_parameters.png",
+        "dialog.png",
+        "dialog_canceled.png",
+        "batch_dialog.png",
+        "dock.png",
+        "dock_legend.png",
+    ],
+)
 def test_widget_screenshots_are_not_blank(desktop, name):
     rgb = _pixels(desktop["out"] / name)
     assert min(rgb.shape[:2]) > 100, (name, rgb.shape)

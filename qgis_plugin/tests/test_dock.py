@@ -1097,3 +1097,28 @@ def test_an_unforeseen_error_in_the_run_is_one_line_and_a_logged_traceback(
     assert len(tracebacks) == 1
     assert "OGR said no" in tracebacks[0]
     assert dock.run_button.isEnabled()
+
+
+def test_the_empty_snapshot_view_says_what_to_open(dock, tmp_path):
+    # with no snapshot the view was a blank white box under the step list (seen in the
+    # desktop check's dock screenshot after Load scene… of the bundled sample)
+    def ink(view) -> int:
+        view.resize(420, 300)
+        view.viewport().resize(420, 300)
+        img = view.viewport().grab().toImage()
+        return sum(
+            1
+            for y in range(0, img.height(), 2)
+            for x in range(0, img.width(), 2)
+            if QColor(img.pixel(x, y)).lightness() < 160
+        )
+
+    assert not dock.view.has_image()
+    assert ink(dock.view) > 40  # the words
+    assert "Open snapshot…" in dock.view.EMPTY_TEXT
+    blank = tmp_path / "white.png"
+    img = QImage(640, 480, QImage.Format_RGB32)
+    img.fill(QColor("white"))
+    assert img.save(str(blank))
+    assert dock.open_snapshot(str(blank))
+    assert ink(dock.view) == 0  # a white photo: no words over it
