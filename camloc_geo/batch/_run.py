@@ -927,50 +927,29 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
 
 
 def _markercluster_assets() -> tuple[str, str]:
-    import xstatic.pkg.leaflet_markercluster as xmc
+    """Kept for callers of the old private copy: :func:`camloc_geo.maps.markercluster_assets`."""
+    from camloc_geo.maps import markercluster_assets
 
-    base = Path(xmc.BASE_DIR)
-    js = (base / "leaflet.markercluster.js").read_text(encoding="utf-8")
-    js = js.replace("//# sourceMappingURL=leaflet.markercluster.js.map", "")
-    css = (base / "MarkerCluster.css").read_text(encoding="utf-8") + (
-        base / "MarkerCluster.Default.css"
-    ).read_text(encoding="utf-8")
-    return js, css
+    return markercluster_assets()
 
 
 def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
-    """The summary map: one marker per placed camera, clustered (offline: inlined plug-in)."""
-    import re
+    """The summary map: one marker per placed camera, clustered (offline: inlined plug-in).
 
-    from camloc_geo.maps import build_summary_map, inline_assets
+    The offline page is :func:`camloc_geo.maps.summary_page`'s (the service's job page without
+    a basemap): the same bytes this module used to assemble with its own copy of the
+    cluster-inlining code.
+    """
+    from camloc_geo._io import write_text_atomic
+    from camloc_geo.maps import build_summary_map, summary_page
 
-    fmap = build_summary_map(
-        _summary_items(journal), offline=False, tiles=None if offline else "OpenStreetMap"
-    )
-    page = fmap.get_root().render()
     if offline:
-        js, css = _markercluster_assets()
-        page = re.sub(
-            r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
-            lambda _m: "<!--camloc:markercluster_js-->",
-            page,
-        )
-        page = re.sub(
-            r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
-            lambda _m: "<!--camloc:markercluster_css-->",
-            page,
-        )
-        # without a tile layer the map has no maxZoom, which the cluster plug-in needs
-        page = re.sub(
-            r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
-        )
-        page = inline_assets(page)
-        page = page.replace("<!--camloc:markercluster_css-->", "<style>" + css + "</style>", 1)
-        page = page.replace("<!--camloc:markercluster_css-->", "")
-        page = page.replace("<!--camloc:markercluster_js-->", "<script>" + js + "</script>", 1)
-        page = page.replace("<!--camloc:markercluster_js-->", "")
+        page = summary_page(_summary_items(journal))
+    else:
+        fmap = build_summary_map(_summary_items(journal), offline=False, tiles="OpenStreetMap")
+        page = fmap.get_root().render()
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(page, encoding="utf-8")
+    write_text_atomic(path, page)
     return path
 
 
