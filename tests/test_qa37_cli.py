@@ -32,3 +32,32 @@ def test_geocode_title_not_utf8_to_file(tmp_path: Path) -> None:
     features = json.loads(out.read_text(encoding="utf-8"))["features"]
     assert features[0]["properties"]["title"] == "Eastern Ave \u00e9& S Broadway"
     assert features[0]["properties"]["status"] == "junction"
+
+
+def test_job_camera_names_its_bad_row(tmp_path: Path) -> None:
+    """An HTTP job camera whose lat is not a number was ``not_found`` with only the title's
+    reason: the row's problem (which ``camloc batch`` keeps in its ``errors`` layer) was lost,
+    a job's result having no such layer. It is now in the reason."""
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.settings import Settings
+    from camloc_geo.service.work import process_camera
+
+    folder = tmp_path / "maps"
+    folder.mkdir()
+    (folder / BALTIMORE.name).symlink_to(BALTIMORE)
+    settings = Settings(map_dir=folder, network=False, data_dir=tmp_path / "data")
+    maps = MapStore(settings)
+    bad = process_camera({"id": "a", "title": "Nonsense title", "lat": "x"}, maps, settings)
+    assert bad["status"] == "not_found"
+    assert "list row: lat 'x' is not a number" in bad["reason"]
+    placed = process_camera(
+        {"id": "b", "title": "Eastern Ave & S Broadway", "lat": 39.2851, "lon": "x"},
+        maps,
+        settings,
+    )
+    assert placed["status"] == "title_only"
+    # said once (the engine already notes a placed camera's problems)
+    assert placed["reason"].count("lon 'x' is not a number") == 1
+    none = process_camera({"id": "c", "lat": "x"}, maps, settings)
+    assert none["status"] == "no_evidence"
+    assert none["reason"].count("lat 'x' is not a number") == 1
