@@ -61,3 +61,33 @@ def test_job_camera_names_its_bad_row(tmp_path: Path) -> None:
     none = process_camera({"id": "c", "lat": "x"}, maps, settings)
     assert none["status"] == "no_evidence"
     assert none["reason"].count("lat 'x' is not a number") == 1
+
+
+def test_batch_refuses_an_unusable_extract_before_work(tmp_path: Path) -> None:
+    """``camloc batch --osm`` naming an empty extract or a file of another kind ran the whole
+    list (every camera ``map_error``/``no_map``, the warning once per camera) and exited 0;
+    ``locate`` and ``geocode`` refuse it. It is refused before any work (exit 2), no
+    GeoPackage or journal written."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title,lat,lon\nc1,Eastern Ave & S Broadway,39.2851,-76.5930\n")
+    (tmp_path / "empty.osm.pbf").write_bytes(b"")
+    (tmp_path / "cams.json").write_text("{}")
+    for extract, says in [
+        ("empty.osm.pbf", "OSM extract is empty"),
+        ("cams.json", "unsupported OSM extract 'cams.json'"),
+    ]:
+        proc = _camloc(
+            ["batch", str(lst), "-o", "out.gpkg", "--osm", extract, "--no-progress"], tmp_path
+        )
+        assert proc.returncode == 2, proc.stderr
+        assert says in proc.stderr
+        assert "Traceback" not in proc.stderr
+        assert not (tmp_path / "out.gpkg").exists()
+        assert not (tmp_path / "out.camloc-batch.sqlite").exists()
+
+
+def test_batch_list_that_is_a_folder(tmp_path: Path) -> None:
+    """``camloc batch FOLDER`` said "camera list not found" of a folder that exists."""
+    proc = _camloc(["batch", str(tmp_path), "-o", "out.gpkg", "--no-progress"], tmp_path)
+    assert proc.returncode == 2
+    assert f"camera list {tmp_path} is a folder" in proc.stderr

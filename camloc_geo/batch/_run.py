@@ -461,11 +461,19 @@ def run_batch(
     t_start = time.perf_counter()
     list_p = Path(list_path).expanduser()
     out = Path(out_gpkg).expanduser()
+    if list_p.is_dir():
+        raise InputError(f"camera list {list_p} is a folder; give the list's file (CSV or GeoJSON)")
     if not list_p.is_file():
         raise InputError(f"camera list not found: {list_p}")
     if chunk_size < 1:
         raise InputError("chunk_size must be at least 1")
     _check_has_cameras(list_p)
+    if map_source is not None and Path(map_source).expanduser().is_file():
+        # one extract named: one that cannot be a map (another suffix, empty) is the user's
+        # mistake, refused before any work; it used to end every camera as map_error/no_map
+        from camloc_geo.osm._load import _check_extract_path
+
+        _check_extract_path(Path(map_source).expanduser())
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
     counts: dict[str, int] = defaultdict(int)
