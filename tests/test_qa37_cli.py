@@ -91,3 +91,30 @@ def test_batch_list_that_is_a_folder(tmp_path: Path) -> None:
     proc = _camloc(["batch", str(tmp_path), "-o", "out.gpkg", "--no-progress"], tmp_path)
     assert proc.returncode == 2
     assert f"camera list {tmp_path} is a folder" in proc.stderr
+
+
+def test_batch_refuses_a_list_without_a_placing_column(tmp_path: Path) -> None:
+    """A file of titles without a header row (its first title taken as the header) or a
+    table of other columns ran: every camera ``no_evidence``, exit 0. It is refused, naming
+    the header row; a list with a street pair but no title still runs."""
+    titles = tmp_path / "titles.txt"
+    titles.write_text("Eastern Ave & S Broadway\nFleet St & S Broadway\n", encoding="utf-8")
+    other = tmp_path / "other.csv"
+    other.write_text("foo,lat,lon\n1,39.2851,-76.593\n", encoding="utf-8")
+    for lst, header in [(titles, "'Eastern Ave & S Broadway'"), (other, "'foo,lat,lon'")]:
+        proc = _camloc(
+            ["batch", str(lst), "-o", "out.gpkg", "--osm", str(BALTIMORE), "--no-progress"],
+            tmp_path,
+        )
+        assert proc.returncode == 2, proc.stderr
+        assert "has no column a camera can be placed by" in proc.stderr
+        assert f"its header row is {header}" in proc.stderr
+        assert not (tmp_path / "out.gpkg").exists()
+    pairs = tmp_path / "pairs.csv"
+    pairs.write_text("id,street1,street2\na,Eastern Ave,S Broadway\n", encoding="utf-8")
+    proc = _camloc(
+        ["batch", str(pairs), "-o", "out.gpkg", "--osm", str(BALTIMORE), "--no-progress"],
+        tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "1 title_only" in proc.stderr

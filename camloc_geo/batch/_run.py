@@ -402,6 +402,37 @@ def _check_has_cameras(list_p: Path) -> None:
             f"the camera list {list_p.name} holds no camera ({what}); a list is CSV with a "
             "header (id,title and optional lat,lon,radius_m,streets,scene) or GeoJSON"
         )
+    if any(p.startswith("the list has no title column") for p in first.problems):
+        _check_has_evidence_columns(list_p)
+
+
+#: How many rows of a CSV without a title column are looked at for a street pair or a scene.
+_EVIDENCE_ROWS = 1000
+
+
+def _check_has_evidence_columns(list_p: Path) -> None:
+    """Refuse a CSV none of whose columns can place a camera (no title, street pair or scene
+    column): a file of titles without a header row (its first title read as the header),
+    another table. Every camera of it was ``no_evidence``, exit 0."""
+    import itertools
+
+    rows = read_camera_list(list_p)
+    try:
+        for row in itertools.islice(rows, _EVIDENCE_ROWS):
+            if row.title or row.streets or row.scene or row.scene_data is not None:
+                return
+    finally:
+        close = getattr(rows, "close", None)
+        if close is not None:
+            close()
+    with open(list_p, "rb") as fh:
+        header = fh.readline(400).decode("utf-8", "replace").strip()
+    raise InputError(
+        f"the camera list {list_p.name} has no column a camera can be placed by (title, "
+        f"name, streets, street1+street2, scene, ...): its header row is {header[:80]!r}; "
+        "a list is CSV with a header row (id,title and optional lat,lon,radius_m,streets,"
+        "scene) or GeoJSON"
+    )
 
 
 def run_batch(
