@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[1]
 BALTIMORE = REPO / "sample_maps" / "baltimore.osm.pbf"
 
@@ -118,3 +120,76 @@ def test_batch_refuses_a_list_without_a_placing_column(tmp_path: Path) -> None:
     )
     assert proc.returncode == 0, proc.stderr
     assert "1 title_only" in proc.stderr
+
+
+def test_device_inputs_are_refused_not_read_for_ever(tmp_path: Path) -> None:
+    """``/dev/zero`` as a GeoJSON, verdicts or list file was read whole: memory grew until
+    ``MemoryError`` (exit 1; without a memory limit the machine swapped), and ``geocode
+    --list /dev/zero`` never ended. Each is refused at once (exit 2, naming the file)."""
+    loc = tmp_path / "loc.geojson"
+    loc.write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "features": [
+                    {
+                        "type": "Feature",
+                        "geometry": {"type": "Point", "coordinates": [-76.593, 39.2851]},
+                        "properties": {
+                            "kind": "candidate",
+                            "rank": 1,
+                            "score": 1.0,
+                            "lat": 39.2851,
+                            "lon": -76.593,
+                        },
+                    }
+                ],
+            }
+        ),
+        encoding="utf-8",
+    )
+    cases = [
+        (["summary-map", "/dev/zero", "-o", "a.html"], "GeoJSON file"),
+        (["summary-map", str(loc), "-o", "b.html", "--verdicts", "/dev/zero"], "verdicts file"),
+        (["geocode", "--list", "/dev/zero", "--osm", str(BALTIMORE)], "list of titles"),
+        (["batch", "/dev/zero", "-o", "c.gpkg"], "camera list /dev/zero is not a regular file"),
+    ]
+    for args, says in cases:
+        proc = _camloc(args, tmp_path)  # the timeout of 600 s is the hang's test
+        assert proc.returncode == 2, (args, proc.stderr)
+        assert "/dev/zero" in proc.stderr, proc.stderr
+        assert says in proc.stderr, proc.stderr
+    # a pipe (bash's <(camloc locate ...)) is still read, bounded
+    read_fd, write_fd = os.pipe()
+    os.write(write_fd, loc.read_bytes())
+    os.close(write_fd)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    cmd = [sys.executable, "-m", "camloc_geo.cli", "summary-map", f"/dev/fd/{read_fd}"]
+    proc2 = subprocess.run(
+        [*cmd, "-o", "d.html"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+        env=env,
+        pass_fds=(read_fd,),
+    )
+    os.close(read_fd)
+    assert proc2.returncode == 0, proc2.stderr
+    assert (tmp_path / "d.html").stat().st_size > 1000
+
+
+def test_read_json_file_bounds_its_read(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A JSON file over ``MAX_JSON_BYTES`` is refused by its size (regular file) or after
+    reading that much (a pipe), never read whole."""
+    from camloc_geo import _io
+    from camloc_geo._errors import InputError
+
+    big = tmp_path / "big.json"
+    big.write_text("[" + "0," * 600 + "0]", encoding="utf-8")
+    monkeypatch.setattr(_io, "MAX_JSON_BYTES", 1000)
+    with pytest.raises(InputError, match=r"big\.json: .*camloc reads \(0 MB at most\)"):
+        _io.read_json_file(big)
+    small = tmp_path / "small.json"
+    small.write_text("[1, 2]", encoding="utf-8")
+    assert _io.read_json_file(small) == [1, 2]

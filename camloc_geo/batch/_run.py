@@ -494,6 +494,8 @@ def run_batch(
     out = Path(out_gpkg).expanduser()
     if list_p.is_dir():
         raise InputError(f"camera list {list_p} is a folder; give the list's file (CSV or GeoJSON)")
+    if list_p.exists() and not list_p.is_file():
+        raise InputError(f"camera list {list_p} is not a regular file (a device or a pipe)")
     if not list_p.is_file():
         raise InputError(f"camera list not found: {list_p}")
     if chunk_size < 1:

@@ -102,8 +102,11 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
     so a missing or headless list fails before any output is written.
     """
     from camloc_geo._errors import InputError
+    from camloc_geo._io import check_input_file
     from camloc_geo.cameras._list import _list_kind, _text_encoding
 
+    # a device or a pipe (/dev/zero) was read for ever; a list may be large (streamed)
+    check_input_file(path, what="list of titles", max_bytes=None)
     csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
     try:
         kind = _list_kind(path)
