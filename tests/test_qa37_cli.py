@@ -193,3 +193,31 @@ def test_read_json_file_bounds_its_read(tmp_path: Path, monkeypatch: pytest.Monk
     small = tmp_path / "small.json"
     small.write_text("[1, 2]", encoding="utf-8")
     assert _io.read_json_file(small) == [1, 2]
+
+
+def test_serve_names_the_bad_variable(tmp_path: Path) -> None:
+    """A bad ``CAMLOC_*`` value stopped ``camloc serve`` with pydantic's text, which names the
+    field (``max_request_bytes``), a type code and a pydantic URL; the line names the
+    variable and its value now (exit 2, no server started)."""
+    pytest.importorskip("uvicorn")
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(REPO),
+        "CAMLOC_DATA_DIR": str(tmp_path),
+        "CAMLOC_MAX_REQUEST_BYTES": "-5",
+        "CAMLOC_NETWORK": "maybe",
+    }
+    proc = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", "serve", "--port", "1"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert proc.returncode == 2, proc.stderr
+    line = proc.stderr.strip()
+    assert "\n" not in line
+    assert "CAMLOC_MAX_REQUEST_BYTES='-5': Input should be greater than or equal to 1000" in line
+    assert "CAMLOC_NETWORK='maybe'" in line
+    assert "errors.pydantic.dev" not in line
