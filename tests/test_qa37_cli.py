@@ -221,3 +221,14 @@ def test_serve_names_the_bad_variable(tmp_path: Path) -> None:
     assert "CAMLOC_MAX_REQUEST_BYTES='-5': Input should be greater than or equal to 1000" in line
     assert "CAMLOC_NETWORK='maybe'" in line
     assert "errors.pydantic.dev" not in line
+
+
+@pytest.mark.parametrize("near", ["nan", "-3", "inf"])
+def test_streets_near_m_must_be_a_distance(tmp_path: Path, near: str) -> None:
+    """``camloc streets --near-m nan`` loaded the map and failed with "ValueError: Out of
+    range float values are not JSON compliant" (exit 1); ``-3`` listed nothing near without
+    a word. Both are refused (exit 2) before the map is read."""
+    args = ["streets", "--osm", str(BALTIMORE), "--lat", "39.2851", "--lon", "-76.593"]
+    proc = _camloc([*args, f"--near-m={near}"], tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert f"--near-m must be a number of metres, 0 or more, got {float(near)}" in proc.stderr
