@@ -30,8 +30,10 @@ __all__ = [
     "EXIF_TURNED_QUARTER",
     "MAX_IMAGE_BYTES_PER_PIXEL",
     "MAX_IMAGE_EXTRA_BYTES",
+    "MAX_JSON_BYTES",
     "MIN_IMAGE_SIDE_PX",
     "atomic_path",
+    "check_input_file",
     "check_output_path",
     "displayed_size",
     "image_data_complete",
@@ -41,6 +43,10 @@ __all__ = [
 ]
 
 PathLike = str | os.PathLike[str]
+
+MAX_JSON_BYTES = 200_000_000
+"""Largest JSON, GeoJSON or verdicts file the command line reads whole (bytes): a candidate
+file of one scene is kilobytes, a verdict export of 10 000 cameras about 2 MB."""
 
 MIN_IMAGE_SIDE_PX = 8
 """Smallest image side (pixels) worth looking for lines in."""
@@ -164,17 +170,82 @@ def write_text_atomic(path: PathLike, text: str) -> Path:
     return Path(path)
 
 
+def check_input_file(
+    path: PathLike,
+    *,
+    what: str = "file",
+    max_bytes: int | None = -1,
+    pipes: bool = False,
+) -> Path:
+    """``path`` if it is a regular file of at most ``max_bytes``; never opens it.
+
+    A device (``/dev/zero``) or a file of gigabytes read whole grew memory until the process
+    died (``MemoryError``, exit 1) or hung; they are refused with a clear error.
+
+    Parameters
+    ----------
+    path
+        The input file.
+    what
+        What it should be, for the messages ("GeoJSON file", "verdicts file").
+    max_bytes
+        Largest size accepted (None: any; default :data:`MAX_JSON_BYTES`).
+    pipes
+        Accept a pipe (``<(camloc locate ...)``; its size is unknown: the reader bounds it).
+
+    Returns
+    -------
+    Path
+        The path.
+
+    Raises
+    ------
+    InputError
+        Missing, a directory, not a regular file, or too large.
+    """
+    import stat
+
+    if max_bytes == -1:
+        max_bytes = MAX_JSON_BYTES
+    p = Path(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise InputError(f"{p}: no such file") from None
+    except OSError as exc:
+        raise InputError(f"{p}: cannot read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{p}: is a directory, expected a {what}")
+    if pipes and stat.S_ISFIFO(st.st_mode):
+        return p
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{p}: not a regular file (a device or a pipe), expected a {what}")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise InputError(
+            f"{p}: {st.st_size / 1e6:.0f} MB is more than a {what} camloc reads "
+            f"({max_bytes / 1e6:.0f} MB at most)"
+        )
+    return p
+
+
 def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
     """Parse a JSON file; every failure is an :class:`InputError` naming the file.
 
     Raises
     ------
     InputError
-        Missing, unreadable, not UTF-8 or not JSON (the message gives line and column).
+        Missing, unreadable, not a regular file, over :data:`MAX_JSON_BYTES`, not UTF-8 or
+        not JSON (the message gives line and column).
     """
-    p = Path(path)
+    p = check_input_file(path, what=what, pipes=True)
     try:
-        text = p.read_text(encoding="utf-8")
+        with open(p, "rb") as fh:
+            raw = fh.read(MAX_JSON_BYTES + 1)  # bounded: a pipe's size is not known
+        if len(raw) > MAX_JSON_BYTES:
+            raise InputError(
+                f"{p}: more than a {what} camloc reads ({MAX_JSON_BYTES / 1e6:.0f} MB at most)"
+            )
+        text = raw.decode("utf-8")
     except FileNotFoundError as exc:
         raise InputError(f"{p}: no such file") from exc
     except IsADirectoryError as exc:

@@ -38,6 +38,7 @@ from pydantic import (
     Field,
     PrivateAttr,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -89,8 +90,32 @@ Segment = tuple[float, float, float, float]
 _PIXEL_DOC = "image pixel [x, y]: origin at the image's top-left corner, x right, y down"
 
 
+def _holds_bool(value: Any, depth: int = 0) -> bool:
+    """Whether a JSON value is, or holds (in nested lists), a ``true``/``false``."""
+    if isinstance(value, bool):
+        return True
+    if isinstance(value, (list, tuple)) and depth < 3:
+        return any(_holds_bool(v, depth + 1) for v in value)
+    return False
+
+
 class _Model(BaseModel):
     model_config = ConfigDict(extra="allow", frozen=True, populate_by_name=True)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_bool_numbers(cls, value: Any, info: ValidationInfo) -> Any:
+        """Refuse ``true``/``false`` where a number is expected.
+
+        pydantic reads ``true`` as 1 in a number field: ``"focal_px": true`` became a 1 px
+        focal length (then "implausible, ignored"), ``"width": true`` a 1-pixel image.
+        """
+        if info.field_name is None or not _holds_bool(value):
+            return value
+        kind = str(cls.model_fields[info.field_name].annotation)
+        if ("float" in kind or "int" in kind) and "bool" not in kind and "Any" not in kind:
+            raise ValueError("true/false is not a number")
+        return value
 
 
 class ImageInfo(_Model):

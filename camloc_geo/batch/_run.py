@@ -402,6 +402,37 @@ def _check_has_cameras(list_p: Path) -> None:
             f"the camera list {list_p.name} holds no camera ({what}); a list is CSV with a "
             "header (id,title and optional lat,lon,radius_m,streets,scene) or GeoJSON"
         )
+    if any(p.startswith("the list has no title column") for p in first.problems):
+        _check_has_evidence_columns(list_p)
+
+
+#: How many rows of a CSV without a title column are looked at for a street pair or a scene.
+_EVIDENCE_ROWS = 1000
+
+
+def _check_has_evidence_columns(list_p: Path) -> None:
+    """Refuse a CSV none of whose columns can place a camera (no title, street pair or scene
+    column): a file of titles without a header row (its first title read as the header),
+    another table. Every camera of it was ``no_evidence``, exit 0."""
+    import itertools
+
+    rows = read_camera_list(list_p)
+    try:
+        for row in itertools.islice(rows, _EVIDENCE_ROWS):
+            if row.title or row.streets or row.scene or row.scene_data is not None:
+                return
+    finally:
+        close = getattr(rows, "close", None)
+        if close is not None:
+            close()
+    with open(list_p, "rb") as fh:
+        header = fh.readline(400).decode("utf-8", "replace").strip()
+    raise InputError(
+        f"the camera list {list_p.name} has no column a camera can be placed by (title, "
+        f"name, streets, street1+street2, scene, ...): its header row is {header[:80]!r}; "
+        "a list is CSV with a header row (id,title and optional lat,lon,radius_m,streets,"
+        "scene) or GeoJSON"
+    )
 
 
 def run_batch(
@@ -461,11 +492,21 @@ def run_batch(
     t_start = time.perf_counter()
     list_p = Path(list_path).expanduser()
     out = Path(out_gpkg).expanduser()
+    if list_p.is_dir():
+        raise InputError(f"camera list {list_p} is a folder; give the list's file (CSV or GeoJSON)")
+    if list_p.exists() and not list_p.is_file():
+        raise InputError(f"camera list {list_p} is not a regular file (a device or a pipe)")
     if not list_p.is_file():
         raise InputError(f"camera list not found: {list_p}")
     if chunk_size < 1:
         raise InputError("chunk_size must be at least 1")
     _check_has_cameras(list_p)
+    if map_source is not None and Path(map_source).expanduser().is_file():
+        # one extract named: one that cannot be a map (another suffix, empty) is the user's
+        # mistake, refused before any work; it used to end every camera as map_error/no_map
+        from camloc_geo.osm._load import _check_extract_path
+
+        _check_extract_path(Path(map_source).expanduser())
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
     counts: dict[str, int] = defaultdict(int)
@@ -927,50 +968,29 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
 
 
 def _markercluster_assets() -> tuple[str, str]:
-    import xstatic.pkg.leaflet_markercluster as xmc
+    """Kept for callers of the old private copy: :func:`camloc_geo.maps.markercluster_assets`."""
+    from camloc_geo.maps import markercluster_assets
 
-    base = Path(xmc.BASE_DIR)
-    js = (base / "leaflet.markercluster.js").read_text(encoding="utf-8")
-    js = js.replace("//# sourceMappingURL=leaflet.markercluster.js.map", "")
-    css = (base / "MarkerCluster.css").read_text(encoding="utf-8") + (
-        base / "MarkerCluster.Default.css"
-    ).read_text(encoding="utf-8")
-    return js, css
+    return markercluster_assets()
 
 
 def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
-    """The summary map: one marker per placed camera, clustered (offline: inlined plug-in)."""
-    import re
+    """The summary map: one marker per placed camera, clustered (offline: inlined plug-in).
 
-    from camloc_geo.maps import build_summary_map, inline_assets
+    The offline page is :func:`camloc_geo.maps.summary_page`'s (the service's job page without
+    a basemap): the same bytes this module used to assemble with its own copy of the
+    cluster-inlining code.
+    """
+    from camloc_geo._io import write_text_atomic
+    from camloc_geo.maps import build_summary_map, summary_page
 
-    fmap = build_summary_map(
-        _summary_items(journal), offline=False, tiles=None if offline else "OpenStreetMap"
-    )
-    page = fmap.get_root().render()
     if offline:
-        js, css = _markercluster_assets()
-        page = re.sub(
-            r"<script\b[^>]*src=\"[^\"]*leaflet\.markercluster[^\"]*\.js\"[^>]*>\s*</script>",
-            lambda _m: "<!--camloc:markercluster_js-->",
-            page,
-        )
-        page = re.sub(
-            r"<link\b[^>]*href=\"[^\"]*MarkerCluster[^\"]*\.css\"[^>]*/?>",
-            lambda _m: "<!--camloc:markercluster_css-->",
-            page,
-        )
-        # without a tile layer the map has no maxZoom, which the cluster plug-in needs
-        page = re.sub(
-            r"(L\.map\(\s*\"[^\"]+\",\s*\{)", lambda m: m.group(1) + " maxZoom: 22,", page, count=1
-        )
-        page = inline_assets(page)
-        page = page.replace("<!--camloc:markercluster_css-->", "<style>" + css + "</style>", 1)
-        page = page.replace("<!--camloc:markercluster_css-->", "")
-        page = page.replace("<!--camloc:markercluster_js-->", "<script>" + js + "</script>", 1)
-        page = page.replace("<!--camloc:markercluster_js-->", "")
+        page = summary_page(_summary_items(journal))
+    else:
+        fmap = build_summary_map(_summary_items(journal), offline=False, tiles="OpenStreetMap")
+        page = fmap.get_root().render()
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(page, encoding="utf-8")
+    write_text_atomic(path, page)
     return path
 
 

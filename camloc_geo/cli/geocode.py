@@ -102,8 +102,11 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
     so a missing or headless list fails before any output is written.
     """
     from camloc_geo._errors import InputError
+    from camloc_geo._io import check_input_file
     from camloc_geo.cameras._list import _list_kind, _text_encoding
 
+    # a device or a pipe (/dev/zero) was read for ever; a list may be large (streamed)
+    check_input_file(path, what="list of titles", max_bytes=None)
     csv.field_size_limit(max(csv.field_size_limit(), 1 << 20))
     try:
         kind = _list_kind(path)
@@ -272,6 +275,35 @@ def _features_to(fh: IO[str]) -> Iterator[Any]:
         fh.flush()
 
 
+def _title_text(title: str, number: int) -> str:
+    """A title from the command line as text.
+
+    Python reads arguments that are not UTF-8 into lone surrogates, which no UTF-8 file can
+    hold: ``-o`` then failed with a ``UnicodeEncodeError`` (exit 1) after the work. Such a
+    title is read as Windows-1252 (Latin-1 where even that fails), as ``--list`` reads a
+    list that is not UTF-8, with a warning.
+    """
+    import logging
+    import os
+
+    try:
+        title.encode("utf-8")
+    except UnicodeEncodeError:
+        raw = os.fsencode(title)
+        try:
+            text, encoding = raw.decode("cp1252"), "Windows-1252"
+        except UnicodeDecodeError:
+            text, encoding = raw.decode("latin-1"), "Latin-1"
+        logging.getLogger("camloc_geo.cli").warning(
+            "title %d is not UTF-8 text: read as %s (%r); check accented names",
+            number,
+            encoding,
+            text,
+        )
+        return text
+    return title
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc geocode``."""
     from camloc_geo._errors import InputError
@@ -298,7 +330,8 @@ def run(args: argparse.Namespace) -> int:
         return [m.to_feature() for m in found]
 
     with _feature_writer(out) as write:
-        for title in args.titles:
+        for number, arg in enumerate(args.titles, start=1):
+            title = _title_text(arg, number)
             for rank, feature in enumerate(matches_of(title, None)):
                 feature["properties"]["rank"] = rank
                 write(feature)

@@ -130,8 +130,10 @@ def run(args: argparse.Namespace) -> int:
     if args.verdicts is not None:
         if map_path is None:
             raise InputError("--verdicts needs --map OUT.html (the verdicts are shown on it)")
+        from camloc_geo._io import check_input_file
         from camloc_geo.maps import read_verdicts
 
+        check_input_file(args.verdicts, what="verdicts file", pipes=True)  # no /dev/zero
         verdicts = read_verdicts(args.verdicts)  # a bad file stops before the locating
     service = None
     if args.verdict_url is not None:

@@ -63,6 +63,29 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _settings_error(exc: Exception) -> str:
+    """One line naming each bad ``CAMLOC_*`` variable, its value and what is wrong.
+
+    pydantic's own text ("1 validation error for Settings / max_request_bytes / Input
+    should be ... [type=..., input_value=..., input_type=str] / For further information
+    visit https://errors.pydantic.dev/...") named the field, not the variable.
+    """
+    errors = getattr(exc, "errors", None)
+    if not callable(errors):
+        return f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}"
+    parts = []
+    for err in errors():
+        loc = err.get("loc") or ()
+        name = f"CAMLOC_{str(loc[0]).upper()}" if loc else "CAMLOC_*"
+        msg = str(err.get("msg", "invalid"))
+        msg = msg.removeprefix("Value error, ")
+        if name in msg:  # the service's own checks already name the variable
+            parts.append(msg)
+        else:
+            parts.append(f"{name}={str(err.get('input', ''))[:60]!r}: {msg}")
+    return "; ".join(parts) or f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo._errors import InputError
@@ -98,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         settings = Settings()
     except Exception as exc:  # pydantic ValidationError: a bad CAMLOC_* variable
-        raise InputError(f"invalid CAMLOC_* setting: {' '.join(str(exc).split())}") from None
+        raise InputError(_settings_error(exc)) from None
     from camloc_geo.service.verdicts import check_verdict_folder
 
     # a verdicts folder that is a file or read-only: one line now, not a traceback at start-up

@@ -33,10 +33,17 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc streets``."""
+    import math
+
+    from camloc_geo._errors import InputError
     from camloc_geo.api import streets_near
     from camloc_geo.cli import output_path
     from camloc_geo.results import streets_json
 
+    if not (math.isfinite(args.near_m) and args.near_m >= 0):
+        # nan ended in "failed: ValueError: Out of range float values..." (exit 1) after
+        # loading the map; a negative value listed nothing near, without a word
+        raise InputError(f"--near-m must be a number of metres, 0 or more, got {args.near_m}")
     output_path(args.output, inputs=[args.osm])
     m = streets_near(
         lat=args.lat,

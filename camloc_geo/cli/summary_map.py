@@ -131,8 +131,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("no usable camera position in the inputs (every candidate was skipped)")
     verdicts = None
     if args.verdicts:
+        from camloc_geo._io import check_input_file
         from camloc_geo.maps import read_verdicts
 
+        check_input_file(args.verdicts, what="verdicts file", pipes=True)  # no /dev/zero
         verdicts = read_verdicts(args.verdicts)
     map_data = None
     if args.osm:

@@ -110,6 +110,11 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
         if not cam_id:
             row = dataclasses.replace(row, id="")
         res = locate_camera(row, map_source=maps.catalogue)
+        problems = "; ".join(row.problems)
+        if problems and problems not in (res.reason or ""):
+            # batch keeps them in its errors layer; a job's result has only the reason
+            note = "list row: " + problems
+            res.reason = f"{res.reason}; {note}" if res.reason else note
     except CamlocError as exc:
         res = CameraResult(row=1, id=cam_id).fail(
             "scene_error" if isinstance(exc, (SceneError, LimitError)) else "failed",

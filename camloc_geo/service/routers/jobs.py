@@ -66,6 +66,41 @@ def _record(row: Any, scene: Any = None) -> dict[str, Any]:
     return out
 
 
+def csv_text(raw: bytes) -> str:
+    """A CSV body as text: UTF-8 (a byte-order mark is fine), else Windows-1252 (Latin-1 where
+    even that fails), as ``camloc batch`` reads a spreadsheet's export (``docs/batch.md``).
+
+    Such a body was refused (422 "the CSV list is not UTF-8 text"), though the service reads
+    its lists "with camloc batch's reader"; the job's answer now says how it was read
+    (:func:`csv_encoding_warning`).
+    """
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        pass
+    try:
+        return raw.decode("cp1252")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def csv_encoding_warning(raw: bytes) -> str | None:
+    """The warning for a CSV body that is not UTF-8, or None."""
+    try:
+        raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        try:
+            raw.decode("cp1252")
+            encoding = "Windows-1252"
+        except UnicodeDecodeError:
+            encoding = "Latin-1"
+        return (
+            f"the CSV list is not UTF-8 text: read as {encoding} (a spreadsheet's export); "
+            "check accented names, and send UTF-8 to be sure"
+        )
+    return None
+
+
 def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
     """The cameras of a list body, as the job store keeps them (at most ``max_cameras + 1``).
 
@@ -77,10 +112,7 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
     from camloc_geo.batch import read_camera_csv, row_from_mapping
 
     if ctype == "text/csv":
-        try:
-            text = raw.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise SceneError("the CSV list is not UTF-8 text", "body") from None
+        text = csv_text(raw)
         out: list[Any] = []
         for row in read_camera_csv(io.StringIO(text)):
             if row.scene is not None:
@@ -128,6 +160,10 @@ async def create_job(
     from camloc_geo.batch._run import duplicate_id_warnings
 
     warnings = duplicate_id_warnings(c.get("id") if isinstance(c, dict) else None for c in cameras)
+    if content_type(request) == "text/csv":
+        encoding_warning = csv_encoding_warning(raw)
+        if encoding_warning:
+            warnings = [encoding_warning, *warnings]
     if warnings:  # accepted, as camloc batch accepts it, but named
         answer["warnings"] = warnings
     return answer
