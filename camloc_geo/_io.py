@@ -211,9 +211,9 @@ def check_input_file(
     try:
         st = p.stat()
     except FileNotFoundError:
-        raise InputError(f"{p}: no such file") from None
+        raise InputError(f"cannot read the {what} {p}: no such file") from None
     except OSError as exc:
-        raise InputError(f"{p}: cannot read ({exc.strerror or exc})") from None
+        raise InputError(f"cannot read the {what} {p}: {exc.strerror or exc}") from None
     if stat.S_ISDIR(st.st_mode):
         raise InputError(f"{p}: is a directory, expected a {what}")
     if pipes and stat.S_ISFIFO(st.st_mode):
