@@ -4607,21 +4607,20 @@ class _Proportions:
     def class_fit(self, stated: ObjectSize, other: ObjectSize) -> float:
         """How much better ``other``'s proportions fit the clicked box than ``stated``'s:
         the drop of the chi-square (2 degrees of freedom, the common scale free)."""
+        return float(self.class_fits(stated, [other])[0])
+
+    def class_fits(self, stated: ObjectSize, others: list[ObjectSize]) -> FloatArray:
+        """:meth:`class_fit` of each of ``others`` at once, ``(len(others),)``."""
         med = np.asarray(self.log_scale)
         w = 1.0 / np.asarray(self.log_var)
-        shift = np.log(
-            [
-                other.length_m / stated.length_m,
-                other.width_m / stated.width_m,
-                other.height_m / stated.height_m,
-            ]
-        )
-
-        def chi2(v: FloatArray) -> float:
-            mean = float(np.sum(w * v) / np.sum(w))
-            return float(np.sum(w * (v - mean) ** 2))
-
-        return chi2(med) - chi2(med - shift)
+        dims = np.array([[o.length_m, o.width_m, o.height_m] for o in others], dtype=float)
+        shift = np.log(dims / np.array([stated.length_m, stated.width_m, stated.height_m]))
+        v = med[None, :] - shift
+        mean = np.sum(w * v, axis=1) / np.sum(w)
+        chi2_others = np.sum(w * (v - mean[:, None]) ** 2, axis=1)
+        mean0 = float(np.sum(w * med) / np.sum(w))
+        chi2_stated = float(np.sum(w * (med - mean0) ** 2))
+        return np.asarray(chi2_stated - chi2_others, dtype=np.float64)
 
     @property
     def disagrees(self) -> bool:
@@ -4784,12 +4783,17 @@ def _likely_class(props: _Proportions, size: ObjectSize) -> tuple[str, ObjectSiz
     warning and widening) or the size is stated in numbers.
     """
     stated = np.array([size.length_m, size.width_m, size.height_m])
+    names = list(PRESETS)
+    others = [PRESETS[name] for name in names]
+    dims = np.array([[o.length_m, o.width_m, o.height_m] for o in others], dtype=float)
+    shifts = np.log(dims / stated)  # every preset at once
+    drops = props.class_fits(size, others).tolist()
     best: tuple[float, str, ObjectSize, float] | None = None
-    for name, other in PRESETS.items():
-        shift = np.log(np.array([other.length_m, other.width_m, other.height_m]) / stated)
+    for k, (name, other) in enumerate(zip(names, others, strict=True)):
+        shift = shifts[k]
         if not np.any(shift):  # the stated size itself
             continue
-        drop = props.class_fit(size, other)
+        drop = drops[k]
         if drop > CLASS_DELTA_CHI2 and (best is None or drop > best[0]):
             best = (drop, name, other, abs(float(np.mean(shift))))
     if best is None:
