@@ -1421,7 +1421,7 @@ class _JointProblem:
         self._seg_nT = np.ascontiguousarray(self._seg_n.T)
         self._mid_x, self._mid_y = self._mid[:, 0].copy(), self._mid[:, 1].copy()
         self._seg_op = self._segment_operator()
-        self.weights = self._weights  # the scales of all segment rows
+        self._set_weights(self._weights)  # the scales of all segment rows
         self._memo.clear()
 
     def set_corners(self, corners: npt.ArrayLike) -> None:
@@ -1667,7 +1667,17 @@ class _JointProblem:
 
     @weights.setter
     def weights(self, value: FloatArray) -> None:
-        self._weights = np.array(value, dtype=float)  # a copy: the version below holds
+        new = np.array(value, dtype=float)  # a copy: the version below holds
+        old = getattr(self, "_weights", None)
+        if old is not None and old.shape == new.shape and bool(np.array_equal(old, new)):
+            # The same weights (a save-and-restore around a step at the fit's own weights):
+            # every scale below, and the memo's weighted copies, hold as they are.
+            return
+        self._set_weights(new)
+
+    def _set_weights(self, new: FloatArray) -> None:
+        """The weights and every row scale derived from them (a new weights version)."""
+        self._weights = new
         self._w_seg = np.sqrt(self._weights[self.seg_ann])
         self._w_pt = np.sqrt(self._weights[self.pt_ann])
         self._seg_scale = np.concatenate([self._w_seg / self.sigma_line, self._photo_scale])
