@@ -3562,8 +3562,8 @@ def _leave_one_out_steps(
                 if live:
                     _leave_one_out_step(prob, args, xs_d, live, mask_d, h)
                     live = [a for a in live if xs_d[a] is not None]
-                if live:
-                    last = _leave_one_out_step(prob, args, list(xs_d), live, mask_d, h)
+                if live:  # the normal equations there only: no step is taken
+                    last = _leave_one_out_step(prob, args, xs_d, live, mask_d, h, step=False)
                     last_has_prior = False
                 prob.log_f_prior_sigma = saved_prior
             switch = _prior_switches(
@@ -3644,13 +3644,16 @@ def _leave_one_out_step(
     live: list[int],
     mask: FloatArray,
     h: FloatArray,
+    *,
+    step: bool = True,
 ) -> tuple[list[int], FloatArray, FloatArray, FloatArray]:
     """One Gauss-Newton step of each ``live`` leave-out (``xs`` updated in place).
 
     Every annotator's next step from one batched evaluation: each point and its forward
     differences (steps ``h``), ``len(live) × (n + 1)`` parameter vectors at once; each
     annotator's own rows (``mask``) get zero weight. Returns the live annotators, and at
-    their points the Jacobians, residuals and row weights the step used.
+    their points the Jacobians, residuals and row weights the step used. ``step=False``:
+    only those (``xs`` unchanged, no Newton solve): the normal equations at the points.
     """
     pts = np.array([xs[a] for a in live])
     n = pts.shape[1]
@@ -3659,6 +3662,8 @@ def _leave_one_out_step(
     r_k = Rb[:, 0, :]  # (L, m)
     J_k = np.swapaxes((Rb[:, 1:, :] - r_k[:, None, :]) / h[None, :, None], 1, 2)
     w_k = (1.0 - mask[live]) / np.sqrt(1.0 + (r_k / _F_SCALE) ** 2)
+    if not step:
+        return live, J_k, r_k, w_k
     Jw_k = J_k * w_k[:, :, None]  # (L, m, n)
     Hs = np.swapaxes(J_k, 1, 2) @ Jw_k
     gs = (np.swapaxes(Jw_k, 1, 2) @ r_k[:, :, None])[:, :, 0]
