@@ -29,19 +29,29 @@ y, z and the rotation sigma about the camera's x, y, z) and the annotators they 
 - ``benchmarks/out/calibrate_speed.png``: the CPU time per scene of each method, and the
   one-step sigmas against the refits' with the ±10 % band.
 
+With ``--dump PATH`` it only writes every output of the default and the refit ``calibrate``
+on the scenes (the camera, every sigma, the covariance, influences, proportions, warnings)
+to ``PATH`` (JSON), and with ``--compare PATH`` it compares them with such a dump, field by
+field, to ``1e-9`` relative: the check that a speed change left the answers as they were
+(run it on the tree before the change, then after).
+
 Usage::
 
     python benchmarks/calibrate_speed.py --n 30 [--profile] [--no-focal-check]
+    python benchmarks/calibrate_speed.py --n 40 --dump before.json   # on the old tree
+    python benchmarks/calibrate_speed.py --n 40 --compare before.json  # on the new one
 """
 
 from __future__ import annotations
 
 import argparse
 import cProfile
+import dataclasses
 import gc
 import io
 import json
 import logging
+import math
 import os
 import pstats
 import sys
@@ -155,6 +165,75 @@ def draw_scenes(seed: int, n: int) -> list[Scene]:
     return scenes
 
 
+COMPARE_REL_TOL = 1e-9
+
+
+def to_record(value: Any, depth: int = 0) -> Any:
+    """JSON-ready copy of a result: dataclasses field by field, arrays as lists."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return to_record(value.tolist(), depth + 1)
+    if isinstance(value, dict):
+        return {str(k): to_record(v, depth + 1) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [to_record(v, depth + 1) for v in value]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type) and depth < 5:
+        return {
+            f.name: to_record(getattr(value, f.name), depth + 1)
+            for f in dataclasses.fields(value)
+            if f.name != "joint_state"  # the fit's internals, not an output
+        }
+    return repr(value)
+
+
+def dump_outputs(scenes: list[Scene]) -> list[dict[str, Any]]:
+    """Every output of the default and the refit ``calibrate`` on each scene."""
+    rows = []
+    for scene in scenes:
+        row = {}
+        for method in ("default", "refit_jackknife"):
+            result = calibrate(scene, METHODS[method])
+            record = to_record(result)
+            record["parameter_covariance"] = to_record(result.parameter_covariance)
+            row[method] = record
+        rows.append(row)
+    return rows
+
+
+def differences(before: Any, after: Any, path: str = "") -> list[str]:
+    """Where two dumps differ: numbers beyond ``COMPARE_REL_TOL`` relative (and 1e-12
+    absolute), anything else unequal."""
+    if isinstance(before, dict) and isinstance(after, dict):
+        if set(before) != set(after):
+            return [f"{path}: keys {sorted(set(before) ^ set(after))}"]
+        return [d for k in before for d in differences(before[k], after[k], f"{path}.{k}")]
+    if isinstance(before, list) and isinstance(after, list):
+        if len(before) != len(after):
+            return [f"{path}: length {len(before)} -> {len(after)}"]
+        return [
+            d
+            for i, (b, a) in enumerate(zip(before, after, strict=True))
+            for d in differences(b, a, f"{path}[{i}]")
+        ]
+    numbers = (int, float)
+    if (
+        isinstance(before, numbers)
+        and isinstance(after, numbers)
+        and not isinstance(before, bool)
+        and not isinstance(after, bool)
+    ):
+        if before == after or (math.isnan(before) and math.isnan(after)):
+            return []
+        gap = abs(before - after)
+        if gap <= 1e-12 or gap <= COMPARE_REL_TOL * max(abs(before), abs(after)):
+            return []
+        return [f"{path}: {before!r} -> {after!r}"]
+    return [] if before == after else [f"{path}: {before!r} -> {after!r}"]
+
+
 def profile_default(scenes: list[Scene], top: int = 25) -> str:
     """The cumulative-time table of a cProfile of the default ``calibrate``."""
     prof = cProfile.Profile()
@@ -238,12 +317,35 @@ def main(argv: list[str] | None = None) -> int:
         help="also time the default without the focal local-minimum check",
     )
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
+    parser.add_argument(
+        "--dump", type=Path, help="only write every output of calibrate to this JSON file"
+    )
+    parser.add_argument(
+        "--compare",
+        type=Path,
+        help="only compare every output of calibrate with a --dump file (exit 1 if any differs)",
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
     load_before = os.getloadavg()
     scenes = draw_scenes(args.seed, args.n)
+    if args.dump is not None or args.compare is not None:
+        outputs = dump_outputs(scenes)
+        if args.dump is not None:
+            args.dump.write_text(json.dumps(outputs))
+            print(f"{len(outputs)} scenes' outputs written to {args.dump}")
+        if args.compare is not None:
+            diffs = differences(json.loads(args.compare.read_text()), outputs)
+            print(
+                f"{len(outputs)} scenes against {args.compare}: {len(diffs)} differences "
+                f"beyond {COMPARE_REL_TOL:g} relative"
+            )
+            for line in diffs[:20]:
+                print("  " + line)
+            return 1 if diffs else 0
+        return 0
     rows: list[dict[str, Any]] = []
     for i, scene in enumerate(scenes):
         row: dict[str, Any] = {"index": i, "cpu_ms": {}}
