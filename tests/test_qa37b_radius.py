@@ -10,7 +10,7 @@ import json
 from pathlib import Path
 
 import pytest
-from annotate_synthetic import located_case
+from annotate_synthetic import located_case, render_snapshot
 
 from camloc_geo._errors import MapDataError
 from camloc_geo.api import MAX_MAP_RADIUS_M, corners_near, scene_map_radius_m, streets_near
@@ -59,3 +59,16 @@ def test_library_refuses_a_radius_over_the_bound() -> None:
     with pytest.raises(MapDataError, match="largest map radius"):
         scene_map_radius_m(scene, 50_001.0)
     assert scene_map_radius_m(scene, 50_000.0) == 50_000.0
+
+
+def test_annotate_refuses_a_radius_over_the_bound(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    snap = tmp_path / "cam.jpg"
+    snap.write_bytes(render_snapshot(located_case()))
+    out = tmp_path / "page.html"
+    args = ["annotate", str(snap), "-o", str(out), "--osm", BALTIMORE]
+    code = main([*args, "--lat", "39.2851", "--lon", "-76.5934", "--radius-m", "30000000"])
+    assert code == 2
+    assert "--radius-m 3e+07 m is over the largest map radius, 50000 m" in error_line(capsys)
+    assert not out.exists()
