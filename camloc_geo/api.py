@@ -40,6 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DEFAULT_MIN_RADIUS_M",
+    "MAX_MAP_RADIUS_M",
     "LocateOutput",
     "MapSource",
     "SceneLike",
@@ -72,6 +73,11 @@ DEFAULT_MIN_RADIUS_M = 300.0
 
 _PRIOR_MARGIN_M = 200.0
 
+MAX_MAP_RADIUS_M = 50_000.0
+"""The largest map radius a caller may give (metres): the largest prior radius a scene may
+have. Beyond it the map's local frame no longer holds (a radius of 30 000 km loaded the
+extract and said it "holds buildings but no streets")."""
+
 
 def _degrees(value: object, name: str) -> float:
     """``value`` as a float of degrees, or a :class:`MapDataError` naming ``name``."""
@@ -94,6 +100,35 @@ def _metres(value: object, name: str) -> float:
     if isinstance(value, bool) or not (math.isfinite(out) and out > 0):
         raise MapDataError(f"{name} must be a positive number of metres, got {value!r}")
     return out
+
+
+def check_map_radius_m(value: object, name: str = "radius_m") -> float:
+    """``value`` as a map radius in metres: positive, finite, at most :data:`MAX_MAP_RADIUS_M`.
+
+    Parameters
+    ----------
+    value
+        The radius given.
+    name
+        How the caller calls it in the message (``radius_m``, ``--radius-m``).
+
+    Returns
+    -------
+    float
+        The radius, metres.
+
+    Raises
+    ------
+    MapDataError
+        Not a positive finite number, or over the bound (the message names the bound).
+    """
+    radius_m = _metres(value, name)
+    if radius_m > MAX_MAP_RADIUS_M:
+        raise MapDataError(
+            f"{name} {radius_m:g} m is over the largest map radius, {MAX_MAP_RADIUS_M:g} m "
+            f"({MAX_MAP_RADIUS_M / 1000:g} km): give a point nearer the camera"
+        )
+    return radius_m
 
 
 def _whole(value: object, name: str, error: type[InputError] = InputError) -> int:
@@ -247,7 +282,7 @@ def scene_anchor(scene: Scene) -> tuple[float, float] | None:
 def scene_map_radius_m(scene: Scene, radius_m: float | None = None) -> float:
     """The map radius for a scene: ``radius_m``, or the prior's radius + 200 m (≥ 300 m)."""
     if radius_m is not None:
-        return _metres(radius_m, "radius_m")
+        return check_map_radius_m(radius_m)
     return max(
         DEFAULT_MIN_RADIUS_M, (scene.prior.radius_m if scene.prior else 0.0) + _PRIOR_MARGIN_M
     )
@@ -629,7 +664,7 @@ def corners_near(
         Overpass could not be reached or failed.
     """
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
-    radius_m = _metres(radius_m, "radius_m")
+    radius_m = check_map_radius_m(radius_m)
     if streets is not None and (
         not isinstance(streets, (str, list, tuple))
         or not all(isinstance(n, str) for n in ([] if isinstance(streets, str) else streets))
@@ -722,7 +757,7 @@ def streets_near(
         Overpass could not be reached (within a few seconds) or failed.
     """
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
-    radius_m = _metres(radius_m, "radius_m")
+    radius_m = check_map_radius_m(radius_m)
     _require_source(map_source, network)
     catalogue = _catalogue_of(map_source)
     if catalogue is not None:
@@ -1167,7 +1202,7 @@ def streets_within(
     from camloc_geo.results import streets_json
 
     lat, lon = _degrees(lat, "lat"), _degrees(lon, "lon")
-    radius_m = _metres(radius_m, "radius_m")
+    radius_m = check_map_radius_m(radius_m)
     m = streets_near(
         lat=lat,
         lon=lon,

@@ -51,6 +51,13 @@ def _size(data: dict[str, Any]) -> tuple[float, float, float]:
     return (s.length_m, s.width_m, s.height_m)
 
 
+def _image_size(data: dict[str, Any]) -> tuple[int, int]:
+    """The image size as parsed numbers (a scene may give ``"width": "1920"`` as text)."""
+    from camloc_geo.scene import parse_scene
+
+    return parse_scene(data).image_size
+
+
 def _car_box(ann: dict[str, Any]) -> tuple[float, float, float, float]:
     pts = [ann["axes"][k] for k in ("origin", "length", "width", "height")]
     o, ln, w = pts[0], pts[1], pts[2]
@@ -163,7 +170,8 @@ def merge_scenes(scenes: Sequence[Any], *, scene_id: str | None = None) -> dict[
     out.pop("base_dir", None)
     if scene_id:
         out["id"] = scene_id
-    w, h = first["image"]["width"], first["image"]["height"]
+    w, h = _image_size(first)
+    out["image"]["width"], out["image"]["height"] = w, h
     diag = math.hypot(w, h)
     size0 = _size(first)
     ref_ann = (first.get("annotations") or [None])[0]
@@ -176,10 +184,10 @@ def merge_scenes(scenes: Sequence[Any], *, scene_id: str | None = None) -> dict[
     landmarks: list[dict[str, Any]] = []
     for label, data in loaded:
         img = data["image"]
-        if (img["width"], img["height"]) != (w, h):
+        wi, hi = _image_size(data)
+        if (wi, hi) != (w, h):
             raise SceneError(
-                f"{label} is for a {img['width']}x{img['height']} image, {label0} for "
-                f"{w}x{h}: not the same snapshot"
+                f"{label} is for a {wi}x{hi} image, {label0} for {w}x{h}: not the same snapshot"
             )
         p0, p1 = first["image"].get("path"), img.get("path")
         if p0 and p1 and PurePath(p0).name != PurePath(p1).name:

@@ -92,6 +92,10 @@ def run(args: argparse.Namespace) -> int:
 
     if (args.lat is None) != (args.lon is None):
         raise InputError("give --lat and --lon together")
+    if args.osm:
+        from camloc_geo.api import check_map_radius_m
+
+        check_map_radius_m(args.radius_m, "--radius-m")  # before the map is read
     out = args.output or (Path(args.image).stem + ".annotate.html")
     # before any work; never over the photo, the scene or the extract (-o cam.jpg replaced
     # the photo with the page)

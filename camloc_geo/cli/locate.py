@@ -116,8 +116,10 @@ def verdict_url(url: str) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo._errors import InputError
-    from camloc_geo.api import locate_scene
+    from camloc_geo.api import check_map_radius_m, locate_scene
 
+    if args.radius_m is not None:  # 30000000 loaded the extract, then "no streets"
+        check_map_radius_m(args.radius_m, "--radius-m")
     inputs = [args.scene, args.osm, args.verdicts]
     out_path = output_path(args.output, inputs=inputs)
     map_path = output_path(args.map, inputs=inputs, option="--map")

@@ -3,22 +3,39 @@
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 from camloc_geo._errors import InputError
 
 
-def _pixel(text: str) -> tuple[float, float]:
+def _pixel(text: str, option: str = "pixel") -> tuple[float, float]:
     parts = text.split(",")
     try:
         if len(parts) != 2:
             raise ValueError
         u, v = float(parts[0]), float(parts[1])
     except ValueError:
-        raise InputError(f"pixel {text!r} is not U,V (two numbers separated by a comma)") from None
-    if not (u == u and v == v) or abs(u) == float("inf") or abs(v) == float("inf"):
-        raise InputError(f"pixel {text!r} is not finite")
+        raise InputError(
+            f"{option}: pixel {text!r} is not U,V (two numbers separated by a comma)"
+        ) from None
+    if not (math.isfinite(u) and math.isfinite(v)):
+        raise InputError(f"{option}: pixel {text!r} is not a finite number pair")
     return u, v
+
+
+def _in_image(
+    pixels: list[tuple[float, float]], texts: list[str], option: str, size: tuple[int, int]
+) -> None:
+    """Refuse a pixel more than one image size outside the image, naming the option
+    (``--ground 1e308,2 3,4`` exited 0 with 762 m ± 50 km)."""
+    width, height = size
+    for (u, v), text in zip(pixels, texts, strict=True):
+        if not (-width <= u <= 2 * width and -height <= v <= 2 * height):
+            raise InputError(
+                f"{option}: pixel {text!r} is far outside the {width}x{height} image (more "
+                "than one image size beyond its edge)"
+            )
 
 
 def register(subparsers: Any) -> None:
@@ -53,19 +70,22 @@ def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.api import calibrate_scene
     from camloc_geo.cli import output_path, write_json
+    from camloc_geo.scene import load_scene
     from camloc_geo.sensors import ground_distance, point_height
 
     output_path(args.output, inputs=[args.scene])  # before the work; never over the scene
     if not (args.click_sigma_px >= 0.0 and args.click_sigma_px < float("inf")):
         raise InputError(f"--click-sigma-px must be >= 0, not {args.click_sigma_px}")
     if args.ground is not None:
-        pixels = [_pixel(t) for t in args.ground]
+        pixels = [_pixel(t, "--ground") for t in args.ground]
         if len(pixels) < 2:
             raise InputError("--ground needs at least two pixels")
+        _in_image(pixels, args.ground, "--ground", load_scene(args.scene).image_size)
         calibration = calibrate_scene(args.scene)
         m = ground_distance(calibration, pixels, click_sigma_px=args.click_sigma_px)
     else:
-        base, top = (_pixel(t) for t in args.height)
+        base, top = (_pixel(t, "--height") for t in args.height)
+        _in_image([base, top], list(args.height), "--height", load_scene(args.scene).image_size)
         calibration = calibrate_scene(args.scene)
         m = point_height(calibration, base, top, click_sigma_px=args.click_sigma_px)
     out = m.to_dict()

@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     import math
 
     from camloc_geo._errors import InputError
-    from camloc_geo.api import streets_near
+    from camloc_geo.api import check_map_radius_m, streets_near
     from camloc_geo.cli import output_path
     from camloc_geo.results import streets_json
 
@@ -44,6 +44,7 @@ def run(args: argparse.Namespace) -> int:
         # nan ended in "failed: ValueError: Out of range float values..." (exit 1) after
         # loading the map; a negative value listed nothing near, without a word
         raise InputError(f"--near-m must be a number of metres, 0 or more, got {args.near_m}")
+    check_map_radius_m(args.radius_m, "--radius-m")  # before the map is read
     output_path(args.output, inputs=[args.osm])
     m = streets_near(
         lat=args.lat,

@@ -745,12 +745,28 @@ def geocode_title(
     title_text = title if isinstance(title, str) else str(title)
     names = parsed.streets
     if not names:
-        why = parsed.notes[-1] if parsed.notes else "empty title"
+        why = _why_no_street(parsed, title)
         return [_not_found(parsed, title_text, map_data, f"no street name in the title ({why})")]
     hits = [match_name(n, index) for n in names]
     if len(names) >= 2:
         return _two_names(parsed, title_text, names, hits, index, map_data, near, radius_m)
     return _one_name(parsed, title_text, names[0], hits[0], index, map_data, near, radius_m)
+
+
+def _why_no_street(parsed: ParsedTitle, title: Any) -> str:
+    """Why a title gave no street name: said for what the title holds (a title ``5`` said
+    "empty title" though it is not empty)."""
+    if parsed.notes:
+        return parsed.notes[-1]
+    raw = parsed.raw.strip()
+    if not raw:
+        return "empty title"
+    kind = "" if isinstance(title, str) else f"the title is not text ({type(title).__name__}); "
+    if parsed.camera_number and raw == parsed.camera_number:
+        return f"{kind}it holds only a number, {raw!r}, read as a camera number"
+    if parsed.compass_text:
+        return f"{kind}it holds only a view direction, {parsed.compass_text!r}"
+    return f"{kind}nothing name-like in {raw!r}"
 
 
 def _filter_rank(

@@ -96,6 +96,22 @@ def _pixels(pixels_px: npt.ArrayLike, what: str) -> FloatArray:
     return px
 
 
+def _check_in_view(pixels: FloatArray, calibration: object, what: str) -> None:
+    """Refuse a pixel more than one image size outside the image (``--ground 1e308,2 3,4``
+    measured 762 m ± 50 km). The image is taken as twice the principal point, which is its
+    centre unless the scene gave another."""
+    cx, cy = (float(c) for c in calibration.camera.principal_point)  # type: ignore[attr-defined]
+    width, height = 2.0 * cx, 2.0 * cy
+    if not (width > 0 and height > 0):
+        return
+    for u, v in pixels:
+        if not (-width <= u <= 2.0 * width and -height <= v <= 2.0 * height):
+            raise InputError(
+                f"{what}: pixel ({u:g}, {v:g}) is far outside the {width:g}x{height:g} image "
+                "(more than one image size beyond its edge)"
+            )
+
+
 def _options(
     calibration: object, click_sigma_px: object, n_samples: object, seed: object
 ) -> tuple[float, int, int]:
@@ -311,7 +327,8 @@ def ground_distance(
     Raises
     ------
     InputError
-        Fewer than two pixels, or a pixel at or above the horizon (named in the message); a
+        Fewer than two pixels, a pixel not finite or more than one image size outside the
+        image, or a pixel at or above the horizon (named in the message); a
         ``calibration`` that is not one, ``click_sigma_px`` < 0, ``n_samples`` < 2, a
         ``seed`` that is not a whole number >= 0.
     """
@@ -319,6 +336,7 @@ def ground_distance(
     pixels = _pixels(pixels_px, "ground")
     if len(pixels) < 2:
         raise InputError("ground: give at least two pixels")
+    _check_in_view(pixels, calibration, "ground")
     cam = calibration.camera
     centres, focals, rotations, px = _draws_posed(
         calibration, pixels, n_samples, click_sigma_px, seed
@@ -364,6 +382,7 @@ def point_height(
     ------
     InputError
         The base pixel is at or above the horizon, or the top pixel is below its base; a
+        pixel not finite or more than one image size outside the image; a
         ``calibration`` that is not one, ``click_sigma_px`` < 0, ``n_samples`` < 2, a
         ``seed`` that is not a whole number >= 0.
     """
@@ -372,6 +391,8 @@ def point_height(
     top = _pixels(top_px, "height top")
     if len(base) != 1 or len(top) != 1:
         raise InputError("height: give one base pixel and one top pixel")
+    _check_in_view(base, calibration, "height base")
+    _check_in_view(top, calibration, "height top")
     pixels = np.vstack([base, top])
     cam = calibration.camera
     centres, focals, rotations, px = _draws_posed(

@@ -54,8 +54,15 @@ MAX_VERDICTS_PER_POST = 10_000
 """Most items in one ``POST /v1/verdicts/...`` (a summary page has one per camera)."""
 _FUTURE_SLACK = timedelta(minutes=5)
 
-Lat = Annotated[float, Field(ge=-90.0, le=90.0, description="latitude, degrees WGS 84")]
-Lon = Annotated[float, Field(ge=-180.0, le=180.0, description="longitude, degrees WGS 84")]
+# allow_inf_nan=False: lat=nan was refused "should be less than or equal to 90"; it now says
+# it is not a finite number
+Lat = Annotated[
+    float, Field(ge=-90.0, le=90.0, allow_inf_nan=False, description="latitude, degrees WGS 84")
+]
+Lon = Annotated[
+    float,
+    Field(ge=-180.0, le=180.0, allow_inf_nan=False, description="longitude, degrees WGS 84"),
+]
 
 
 class PointQuery(BaseModel):
@@ -64,7 +71,10 @@ class PointQuery(BaseModel):
     lat: Lat
     lon: Lon
     radius_m: float = Field(
-        default=150.0, gt=0.0, description="search radius, metres (at most CAMLOC_MAX_RADIUS_M)"
+        default=150.0,
+        gt=0.0,
+        allow_inf_nan=False,
+        description="search radius, metres (at most CAMLOC_MAX_RADIUS_M)",
     )
 
 
@@ -92,9 +102,9 @@ class TaskQuery(BaseModel):
     """``POST /v1/tasks``: how many annotations to collect, and the rough point if known."""
 
     annotations: int | None = Field(default=None, ge=1, le=50)
-    lat: float | None = Field(default=None, ge=-90.0, le=90.0)
-    lon: float | None = Field(default=None, ge=-180.0, le=180.0)
-    radius_m: float = Field(default=150.0, gt=0.0, le=5_000.0)
+    lat: float | None = Field(default=None, ge=-90.0, le=90.0, allow_inf_nan=False)
+    lon: float | None = Field(default=None, ge=-180.0, le=180.0, allow_inf_nan=False)
+    radius_m: float = Field(default=150.0, gt=0.0, le=5_000.0, allow_inf_nan=False)
 
 
 class JobList(BaseModel):
