@@ -79,6 +79,8 @@ def test_rendered_box_edges_match_camera_projection() -> None:
     checked = 0
     for col in range(int(lo[0]) + 3, int(hi[0]) - 3, 5):
         u = col + 0.5
+        if np.min(np.abs(hull[:, 0] - u)) < 1.5:
+            continue  # a vertex inside the column: the outline bends within it
         ys = []  # the hull's outline crossings at the column's centre
         for a, b in zip(hull, np.roll(hull, -1, axis=0), strict=True):
             if (a[0] - u) * (b[0] - u) < 0:
@@ -102,3 +104,36 @@ def test_shadow_darkens_its_area_only() -> None:
     assert lost == pytest.approx(50 * 100.0, rel=0.03)
     assert img[12, 9].min() == 200
     assert img[12, 20].min() == 200
+
+
+def test_first_generator_cuboid_edges_match_camera_projection() -> None:
+    """``synthetic_video`` (the radar's own cuboids) draws in the same convention: its
+    outline per column within 0.2 px of the projected hull (opacity read from the same
+    cuboid drawn on black and on white)."""
+    import cv2
+
+    from camloc_geo.testing.synthetic_video import SyntheticVehicle, _draw_vehicle, traffic_camera
+
+    camera = traffic_camera()
+    corners = SyntheticVehicle((6.0, 3.0), 30.0, 0.0).corners_at(0.0)
+    black = np.zeros((360, 640, 3), np.uint8)
+    white = np.full((360, 640, 3), 255, np.uint8)
+    assert _draw_vehicle(black, camera, corners, (200, 180, 160))
+    assert _draw_vehicle(white, camera, corners, (200, 180, 160))
+    alpha = 1.0 - (white.astype(float) - black.astype(float)).mean(axis=2) / 255.0
+    hull = cv2.convexHull(camera.project(corners).astype(np.float32)).reshape(-1, 2)
+    lo, hi = hull.min(axis=0), hull.max(axis=0)
+    checked = 0
+    for col in range(int(lo[0]) + 3, int(hi[0]) - 3, 4):
+        u = col + 0.5
+        if np.min(np.abs(hull[:, 0] - u)) < 1.5:
+            continue  # a vertex inside the column: the outline bends within it
+        ys = []
+        for a, b in zip(hull, np.roll(hull, -1, axis=0), strict=True):
+            if (a[0] - u) * (b[0] - u) < 0:
+                ys.append(a[1] + (u - a[0]) / (b[0] - a[0]) * (b[1] - a[1]))
+        top, bottom = _column_extent(alpha, col)
+        assert top == pytest.approx(min(ys), abs=0.2)
+        assert bottom == pytest.approx(max(ys), abs=0.2)
+        checked += 1
+    assert checked >= 10

@@ -374,7 +374,15 @@ class _Layer:
     would let the background show through the seam by up to a quarter).
     """
 
-    def __init__(self, polygons: list[tuple[FloatArray, FloatArray]], size: tuple[int, int]):
+    def __init__(
+        self,
+        polygons: list[tuple[FloatArray, FloatArray]],
+        size: tuple[int, int],
+        decals: list[tuple[FloatArray, FloatArray]] | None = None,
+    ):
+        """``polygons``: ``(image polygon, BGR)`` in painter's order; ``decals``: painted on
+        them afterwards (windows, wheels drawn on a face), colour only: where a decal's edge
+        lies on its face's edge it must not add to the layer's opacity."""
         w, h = size
         allpx = np.vstack([p for p, _ in polygons])
         lo = np.clip(np.floor(allpx.min(axis=0)).astype(int) - 1, 0, [w, h])
@@ -389,6 +397,11 @@ class _Layer:
             self.colour = self.colour * (1.0 - c[..., None]) + c[..., None] * colour
             self.over = self.over * (1.0 - c) + c
             self.alpha = np.minimum(1.0, self.alpha + c)
+        for px, colour in decals or []:
+            c = _coverage(px, self.x0, self.y0, self.w, self.h) * (self.over > 0)
+            self.colour = (
+                self.colour * (1.0 - c[..., None]) + c[..., None] * colour * self.over[..., None]
+            )
 
     def paint(self, img: Any) -> None:
         """Lay the layer over ``img`` (BGR uint8, in place)."""
