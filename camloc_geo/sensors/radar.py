@@ -49,9 +49,9 @@ the reported one (a cuboid is not a car: on two-box cars with ground clearance i
 it ends, so a long video holds only the active tracks in memory.
 
 Uncertainty (``sigma_kmh``), combined in quadrature: the fit's standard error (from its
-residuals); the contact's unknown height (a tyre on the road or the body's lower edge, up
-to 0.25 m up, not corrected: the root mean square of a height uniform over that range,
-0.144 m, over the camera's height ``H`` moves the speed by ``0.144 / H``; 0.6 m for a
+residuals); the contact's unknown height, not corrected: its root mean square over the
+camera's height ``H`` (given boxes: a tyre on the road or the body's lower edge up to 0.2 m
+up, uniform, 0.115 m; a detected silhouette's lowest corner: 0.03 m, measured; 0.6 m for a
 silhouette lower than 1.5 m, a piece of a vehicle); model error: half the disagreement
 of the track's two halves in time beyond their noise (a contact that followed another
 vehicle through a merge, a corner sliding along the body); the
@@ -146,8 +146,20 @@ _SHADOW_NCC = 0.4  # ... which a shadow keeps: correlation of frame and backgrou
 _BG_SAMPLES = 9  # frames sampled over the video for the initial background (median)
 _CONTACT_PX = 1.5  # pixels: noise of the contact pixel (sub-pixel hinge at reduced scale)
 _CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in every frame
-_CLEARANCE_MAX_M = 0.25  # the lowest silhouette point: a tyre (0) up to a body's lower edge
+# The contact's height is not corrected; its root mean square over the camera's height is
+# a relative speed error. With given boxes the box's bottom cuts the silhouette at a tyre
+# (0) or at the body's lower edge, up to a car's clearance (0.2 m) up: uniform, RMS 0.115 m
+# (measured on development seeds 0-5 with the exact boxes, session 38: RMS 0.115 m of the
+# height h = H e / (1 + e) the speed error e implies, mean +0.07 m). A detected
+# silhouette's lowest corner, where the tyres, the body's edge and the contact shadow's
+# boundary meet, stands lower: its implied height on the same seeds (detection, true
+# camera) had mean +0.001 m, RMS 0.024 m, 5-95 % -0.03 ... +0.035 m; the term takes 0.03 m.
+# (Until session 38 both took 0.144 m, a height uniform over 0-0.25 m: measured on videos
+# whose renderer drew every polygon half a pixel low and 0.7 px too large, which read
+# detected speeds -0.8 % slow.)
+_CLEARANCE_MAX_M = 0.2  # given boxes: a tyre (0) up to a car's body's lower edge
 _CONTACT_HEIGHT_SIGMA_M = _CLEARANCE_MAX_M / math.sqrt(3.0)  # RMS of an uncorrected height
+_DETECTED_CONTACT_SIGMA_M = 0.03  # a detected silhouette's lowest corner (measured)
 _MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is a piece
 _PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
 _MAX_GROUND_PER_PX_M = 1.0  # metres of road per detection pixel: farther frames not used
@@ -1141,6 +1153,7 @@ def _fit_track(
     n_samples: int,
     seed: int,
     detect_scale: float = 1.0,
+    given: bool = False,
 ) -> VehicleSpeed:
     first, last = t.frames[0], t.frames[-1]
     kinds = set(t.kinds)
@@ -1250,7 +1263,8 @@ def _fit_track(
     # silhouette's lowest point is often its shadow on the road); its error is one-sided,
     # and the term is its root mean square for a height uniform over the range
     height_m = max(1.0, float(cam.center_in_world[2]))
-    sigma_contact = speed * _CONTACT_HEIGHT_SIGMA_M / height_m
+    contact_sigma_m = _CONTACT_HEIGHT_SIGMA_M if given else _DETECTED_CONTACT_SIGMA_M
+    sigma_contact = speed * contact_sigma_m / height_m
     # a silhouette lower than any vehicle standing on its contact is a piece of one (a
     # road-grey car's cabin and roof): its lowest corner may be the body's top edge, up
     # to a metre above the road
@@ -1746,7 +1760,16 @@ def _run(
         for piece in _split_reversals(t) if given is None else [t]:
             vehicles.append(
                 _fit_track(
-                    piece, calibration, fps, width, height, min_track_s, n_samples, seed, scale
+                    piece,
+                    calibration,
+                    fps,
+                    width,
+                    height,
+                    min_track_s,
+                    n_samples,
+                    seed,
+                    scale,
+                    given=given is not None,
                 )
             )
 

@@ -168,7 +168,10 @@ def _background(
     tex, world_from_tex = _ground_texture(rng, (-60.0, 80.0, -60.0, 40.0), 0.03)
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     img_from_ground = camera.img_from_cam @ np.column_stack([R[:, 0], R[:, 1], t])
-    img_from_tex = img_from_ground @ world_from_tex
+    # OpenCV indexes pixels by their centres, Camera puts the first one's at 0.5 (session 38)
+    cv_from_img = np.array([[1.0, 0.0, -0.5], [0.0, 1.0, -0.5], [0.0, 0.0, 1.0]])
+    tex_centres = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])
+    img_from_tex = cv_from_img @ img_from_ground @ world_from_tex @ tex_centres
     img = cv2.warpPerspective(tex, img_from_tex, (w, h), flags=cv2.INTER_AREA, borderValue=_SKY)
     # Pixels at or above the horizon (and the far haze) are sky.
     a, b, c = camera.horizon_line()
@@ -181,7 +184,7 @@ def _draw_shadow(
     img: npt.NDArray[np.uint8], camera: Camera, corners: FloatArray, shadow: tuple[float, float]
 ) -> None:
     """Darken the ground under a cuboid's shadow (sun direction: ``shadow`` m per m height)."""
-    import cv2
+    from camloc_geo.testing.traffic_render import _darken
 
     top = corners[4:]
     cast = top[:, :2] + np.outer(top[:, 2], shadow)
@@ -189,21 +192,19 @@ def _draw_shadow(
     px = camera.project(np.column_stack([ground, np.zeros(len(ground))]))
     if not np.all(np.isfinite(px)):
         return
-    hull = cv2.convexHull(np.round(px * 16).astype(np.int32))
-    mask = np.zeros(img.shape[:2], np.uint8)
-    cv2.fillConvexPoly(mask, hull, 255, cv2.LINE_AA, 4)
-    x, y, w, h = cv2.boundingRect(mask)
-    if w and h:
-        roi = img[y : y + h, x : x + w]
-        a = mask[y : y + h, x : x + w, None].astype(np.float32) / 255.0
-        roi[:] = (roi * (1.0 - 0.5 * a)).astype(np.uint8)
+    _darken(img, px, 0.5)
 
 
 def _draw_vehicle(
     img: npt.NDArray[np.uint8], camera: Camera, corners: FloatArray, colour: tuple[int, int, int]
 ) -> bool:
-    """Draw a cuboid (back faces culled); False when part of it is behind the camera."""
-    import cv2
+    """Draw a cuboid (back faces culled); False when part of it is behind the camera.
+
+    Drawn in :class:`~camloc_geo.camera.Camera`'s pixel convention with exact coverage
+    (:func:`camloc_geo.testing.traffic_render._coverage`); before session 38 OpenCV's
+    anti-aliased fill drew it half a pixel right of and below its projection, 0.7 px larger.
+    """
+    from camloc_geo.testing.traffic_render import _Layer
 
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     if np.any((corners @ R.T + t)[:, 2] < 0.5):
@@ -212,6 +213,8 @@ def _draw_vehicle(
     centre = corners.mean(axis=0)
     eye = camera.center_in_world
     base = np.array(colour, float)
+    polygons: list[tuple[FloatArray, FloatArray]] = []
+    decals: list[tuple[FloatArray, FloatArray]] = []  # on the side faces
     for face in _FACES:
         q = corners[list(face)]
         fc = q.mean(axis=0)
@@ -219,8 +222,7 @@ def _draw_vehicle(
         if normal @ (eye - fc) <= 0:
             continue
         shade = 0.55 + 0.45 * abs(normal[2]) / (np.linalg.norm(normal) + 1e-9)
-        poly = np.round(px[list(face)] * 16).astype(np.int32)
-        cv2.fillConvexPoly(img, poly, tuple(float(v) for v in base * shade), cv2.LINE_AA, 4)
+        polygons.append((px[list(face)], base * shade))
         if abs(normal[2]) < 1e-6:
             # A window in the upper part of each side face and two dark wheels at the bottom.
             p0, p1, _p2, p3 = q  # bottom a, bottom b, top b, top a (see _FACES order)
@@ -229,13 +231,13 @@ def _draw_vehicle(
                 p0 + 0.85 * (p1 - p0) + 0.55 * (p3 - p0),
             ]
             win += [win[1] + 0.3 * (p3 - p0), win[0] + 0.3 * (p3 - p0)]
-            wpx = np.round(camera.project(np.array(win)) * 16).astype(np.int32)
-            cv2.fillConvexPoly(img, wpx, (70.0, 60.0, 50.0), cv2.LINE_AA, 4)
+            decals.append((camera.project(np.array(win)), np.array([70.0, 60.0, 50.0])))
             for s in (0.15, 0.7):
                 wh = [p0 + s * (p1 - p0), p0 + (s + 0.15) * (p1 - p0)]
                 wh += [wh[1] + 0.3 * (p3 - p0), wh[0] + 0.3 * (p3 - p0)]
-                hpx = np.round(camera.project(np.array(wh)) * 16).astype(np.int32)
-                cv2.fillConvexPoly(img, hpx, (25.0, 25.0, 25.0), cv2.LINE_AA, 4)
+                decals.append((camera.project(np.array(wh)), np.array([25.0, 25.0, 25.0])))
+    if polygons:
+        _Layer(polygons, (img.shape[1], img.shape[0]), decals).paint(img)
     return True
 
 

@@ -307,8 +307,16 @@ def _background(
     tex, world_from_tex = _texture(rng, m_per_px)
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     img_from_ground = camera.img_from_cam @ np.column_stack([R[:, 0], R[:, 1], t])
+    # OpenCV indexes pixels by their centres; Camera puts the first pixel's centre at 0.5
+    # (both in the image and in the texture, whose pixel c covers world x0 + [c, c + 1] m/px)
+    cv_from_img = np.array([[1.0, 0.0, -0.5], [0.0, 1.0, -0.5], [0.0, 0.0, 1.0]])
+    tex_centres = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])
     img = cv2.warpPerspective(
-        tex, img_from_ground @ world_from_tex, (w, h), flags=cv2.INTER_AREA, borderValue=_SKY
+        tex,
+        cv_from_img @ img_from_ground @ world_from_tex @ tex_centres,
+        (w, h),
+        flags=cv2.INTER_AREA,
+        borderValue=_SKY,
     )
     a, b, c = camera.horizon_line()
     uu, vv = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
@@ -316,25 +324,104 @@ def _background(
     return np.asarray(img, np.uint8)
 
 
-def _poly(img: Any, px: FloatArray, colour: Any) -> None:
+def _coverage(px: FloatArray, x0: int, y0: int, w: int, h: int) -> FloatArray:
+    """How much of each pixel of the window ``[x0, x0 + w) x [y0, y0 + h)`` the convex hull
+    of ``px`` covers, 0-1 ``(h, w)``.
+
+    In :class:`~camloc_geo.camera.Camera`'s convention: pixel ``(x, y)`` is the unit square
+    ``[x, x + 1] x [y, y + 1]``, its centre at ``(x + 0.5, y + 0.5)``. Each edge covers a
+    pixel by ``clip(0.5 + d)`` for the signed distance ``d`` (px) of its centre inside the
+    edge's line (exact for edges along the pixel grid, unbiased for slanted ones), the
+    polygon by the product over its edges; a polygon thinner than a pixel (its summed
+    coverage above its area) is scaled down to its area. So a drawn edge stands where the
+    camera projects it (within a few hundredths of a pixel) and a polygon keeps its area;
+    OpenCV's anti-aliased fill put every edge half a pixel right of and below its
+    projection and grew it by about 0.7 px on every side (before session 38).
+    """
     import cv2
 
-    cv2.fillConvexPoly(
-        img, np.round(px * 16).astype(np.int32), tuple(float(v) for v in colour), cv2.LINE_AA, 4
-    )
+    out = np.zeros((h, w))
+    hull = cv2.convexHull(np.asarray(px, np.float32)).reshape(-1, 2).astype(np.float64)
+    if len(hull) < 3 or w <= 0 or h <= 0:
+        return out
+    x, y = hull[:, 0], hull[:, 1]
+    area2 = float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+    if abs(area2) < 1e-9:
+        return out
+    lo = np.maximum(np.floor(hull.min(axis=0)).astype(int) - 1, [x0, y0])
+    hi = np.minimum(np.ceil(hull.max(axis=0)).astype(int) + 1, [x0 + w, y0 + h])
+    if np.any(hi <= lo):
+        return out
+    uu, vv = np.meshgrid(np.arange(lo[0], hi[0]) + 0.5, np.arange(lo[1], hi[1]) + 0.5)
+    cov = np.ones(uu.shape)
+    sign = 1.0 if area2 > 0 else -1.0
+    for a, b in zip(hull, np.roll(hull, -1, axis=0), strict=True):
+        e = b - a
+        n = sign * np.array([-e[1], e[0]]) / (np.hypot(e[0], e[1]) + 1e-12)  # inward
+        cov *= np.clip(0.5 + (uu - a[0]) * n[0] + (vv - a[1]) * n[1], 0.0, 1.0)
+    total = float(cov.sum())
+    if total > abs(area2) / 2 / 0.95:  # thinner than a pixel: keep its area
+        cov *= abs(area2) / 2 / total
+    out[lo[1] - y0 : hi[1] - y0, lo[0] - x0 : hi[0] - x0] = cov
+    return out
+
+
+class _Layer:
+    """A vehicle drawn apart, then laid over the frame at once (painter's order inside it).
+
+    Colours blend face over face; the layer's opacity adds the faces' coverages (capped at
+    1), so two faces sharing an edge cover its pixels wholly (blending them over each other
+    would let the background show through the seam by up to a quarter).
+    """
+
+    def __init__(
+        self,
+        polygons: list[tuple[FloatArray, FloatArray]],
+        size: tuple[int, int],
+        decals: list[tuple[FloatArray, FloatArray]] | None = None,
+    ):
+        """``polygons``: ``(image polygon, BGR)`` in painter's order; ``decals``: painted on
+        them afterwards (windows, wheels drawn on a face), colour only: where a decal's edge
+        lies on its face's edge it must not add to the layer's opacity."""
+        w, h = size
+        allpx = np.vstack([p for p, _ in polygons])
+        lo = np.clip(np.floor(allpx.min(axis=0)).astype(int) - 1, 0, [w, h])
+        hi = np.clip(np.ceil(allpx.max(axis=0)).astype(int) + 1, 0, [w, h])
+        self.x0, self.y0 = int(lo[0]), int(lo[1])
+        self.w, self.h = int(hi[0] - lo[0]), int(hi[1] - lo[1])
+        self.colour = np.zeros((self.h, self.w, 3))
+        self.over = np.zeros((self.h, self.w))
+        self.alpha = np.zeros((self.h, self.w))
+        for px, colour in polygons:
+            c = _coverage(px, self.x0, self.y0, self.w, self.h)
+            self.colour = self.colour * (1.0 - c[..., None]) + c[..., None] * colour
+            self.over = self.over * (1.0 - c) + c
+            self.alpha = np.minimum(1.0, self.alpha + c)
+        for px, colour in decals or []:
+            c = _coverage(px, self.x0, self.y0, self.w, self.h) * (self.over > 0)
+            self.colour = (
+                self.colour * (1.0 - c[..., None]) + c[..., None] * colour * self.over[..., None]
+            )
+
+    def paint(self, img: Any) -> None:
+        """Lay the layer over ``img`` (BGR uint8, in place)."""
+        if self.w <= 0 or self.h <= 0:
+            return
+        roi = img[self.y0 : self.y0 + self.h, self.x0 : self.x0 + self.w]
+        colour = self.colour / np.maximum(self.over, 1e-9)[..., None]
+        a = self.alpha[..., None]
+        roi[:] = np.clip(roi * (1.0 - a) + colour * a + 0.5, 0, 255).astype(np.uint8)
 
 
 def _darken(img: Any, px: FloatArray, factor: float) -> None:
-    import cv2
-
-    hull = cv2.convexHull(np.round(px * 16).astype(np.int32))
-    mask = np.zeros(img.shape[:2], np.uint8)
-    cv2.fillConvexPoly(mask, hull, 255, cv2.LINE_AA, 4)
-    x, y, w, h = cv2.boundingRect(mask)
-    if w and h:
-        roi = img[y : y + h, x : x + w]
-        a = mask[y : y + h, x : x + w, None].astype(np.float32) / 255.0
-        roi[:] = (roi * (1.0 - (1.0 - factor) * a)).astype(np.uint8)
+    h, w = img.shape[:2]
+    lo = np.clip(np.floor(px.min(axis=0)).astype(int) - 1, 0, [w, h])
+    hi = np.clip(np.ceil(px.max(axis=0)).astype(int) + 1, 0, [w, h])
+    if np.any(hi <= lo):
+        return
+    a = _coverage(px, int(lo[0]), int(lo[1]), int(hi[0] - lo[0]), int(hi[1] - lo[1]))
+    roi = img[lo[1] : hi[1], lo[0] : hi[0]]
+    roi[:] = (roi * (1.0 - (1.0 - factor) * a[..., None]) + 0.5).astype(np.uint8)
 
 
 _FACES = ((0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7))
@@ -345,9 +432,11 @@ def _shade(normal: FloatArray) -> float:
     return 0.5 + 0.5 * max(0.0, float(n @ _SUN))
 
 
-def _draw_box(
-    img: Any, camera: Camera, corners: FloatArray, colour: FloatArray, glass: bool
-) -> None:
+def _box_faces(
+    camera: Camera, corners: FloatArray, colour: FloatArray, glass: bool
+) -> list[tuple[FloatArray, FloatArray]]:
+    """The visible faces of a box: ``(image polygon, shaded BGR colour)`` each."""
+    out = []
     eye = camera.center_in_world
     centre = corners.mean(axis=0)
     px = camera.project(corners)
@@ -361,7 +450,8 @@ def _draw_box(
             continue
         side = k >= 2
         base = np.array([55.0, 48.0, 42.0]) if glass and side else colour
-        _poly(img, px[list(face)], base * _shade(normal))
+        out.append((px[list(face)], base * _shade(normal)))
+    return out
 
 
 def _draw(img: Any, camera: Camera, veh: StreetVehicle, t_s: float, sun: bool) -> None:
@@ -386,15 +476,19 @@ def _draw(img: Any, camera: Camera, veh: StreetVehicle, t_s: float, sun: bool) -
     near = [
         (w[:, :2].mean(axis=0) - centre[:2]) @ (eye[:2] - centre[:2]) > 0 for w in parts["wheels"]
     ]
-    for wheel, n in zip(parts["wheels"], near, strict=True):
-        if not n:
-            _poly(img, camera.project(wheel), _TYRE)
-    _draw_box(img, camera, body, colour, glass=False)
-    for wheel, n in zip(parts["wheels"], near, strict=True):
-        if n:
-            _poly(img, camera.project(wheel), _TYRE)
+    tyre = np.array(_TYRE)
+    polygons = [
+        (camera.project(wheel), tyre)
+        for wheel, n in zip(parts["wheels"], near, strict=True)
+        if not n
+    ]
+    polygons += _box_faces(camera, body, colour, glass=False)
+    polygons += [
+        (camera.project(wheel), tyre) for wheel, n in zip(parts["wheels"], near, strict=True) if n
+    ]
     if cabin is not None:
-        _draw_box(img, camera, cabin, colour, glass=True)
+        polygons += _box_faces(camera, cabin, colour, glass=True)
+    _Layer(polygons, (img.shape[1], img.shape[0])).paint(img)
 
 
 def _truth(
