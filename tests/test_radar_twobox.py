@@ -112,7 +112,7 @@ def test_given_true_boxes(video: RenderedVideo, true_calibration: CalibrationRes
 def test_contact_term_by_source(
     video: RenderedVideo, true_calibration: CalibrationResult, detected: RadarResult
 ) -> None:
-    """The contact's height term (session 38): given boxes cut the silhouette at a tyre or
+    """The contact's height term (session 37): given boxes cut the silhouette at a tyre or
     the body's edge up to 0.2 m up (RMS 0.115 m over the 7.5 m camera height, 1.54 %); a
     detected silhouette's lowest corner was measured within a few centimetres (0.03 m: 0.4 %)
     on renders drawn where the camera projects. With the true camera, the given boxes'

@@ -149,12 +149,12 @@ _CONTACT_FLOOR_M = 0.05  # metres: the contact's own wander on the vehicle, in e
 # The contact's height is not corrected; its root mean square over the camera's height is
 # a relative speed error. With given boxes the box's bottom cuts the silhouette at a tyre
 # (0) or at the body's lower edge, up to a car's clearance (0.2 m) up: uniform, RMS 0.115 m
-# (measured on development seeds 0-5 with the exact boxes, session 38: RMS 0.115 m of the
+# (measured on development seeds 0-5 with the exact boxes, session 37: RMS 0.115 m of the
 # height h = H e / (1 + e) the speed error e implies, mean +0.07 m). A detected
 # silhouette's lowest corner, where the tyres, the body's edge and the contact shadow's
 # boundary meet, stands lower: its implied height on the same seeds (detection, true
 # camera) had mean +0.001 m, RMS 0.024 m, 5-95 % -0.03 ... +0.035 m; the term takes 0.03 m.
-# (Until session 38 both took 0.144 m, a height uniform over 0-0.25 m: measured on videos
+# (Until session 37 both took 0.144 m, a height uniform over 0-0.25 m: measured on videos
 # whose renderer drew every polygon half a pixel low and 0.7 px too large, which read
 # detected speeds -0.8 % slow.)
 _CLEARANCE_MAX_M = 0.2  # given boxes: a tyre (0) up to a car's body's lower edge

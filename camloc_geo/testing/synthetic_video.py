@@ -168,7 +168,7 @@ def _background(
     tex, world_from_tex = _ground_texture(rng, (-60.0, 80.0, -60.0, 40.0), 0.03)
     R, t = camera.cam_from_world_rotation, camera.cam_from_world_translation
     img_from_ground = camera.img_from_cam @ np.column_stack([R[:, 0], R[:, 1], t])
-    # OpenCV indexes pixels by their centres, Camera puts the first one's at 0.5 (session 38)
+    # OpenCV indexes pixels by their centres, Camera puts the first one's at 0.5 (session 37)
     cv_from_img = np.array([[1.0, 0.0, -0.5], [0.0, 1.0, -0.5], [0.0, 0.0, 1.0]])
     tex_centres = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])
     img_from_tex = cv_from_img @ img_from_ground @ world_from_tex @ tex_centres
@@ -201,7 +201,7 @@ def _draw_vehicle(
     """Draw a cuboid (back faces culled); False when part of it is behind the camera.
 
     Drawn in :class:`~camloc_geo.camera.Camera`'s pixel convention with exact coverage
-    (:func:`camloc_geo.testing.traffic_render._coverage`); before session 38 OpenCV's
+    (:func:`camloc_geo.testing.traffic_render._coverage`); before session 37 OpenCV's
     anti-aliased fill drew it half a pixel right of and below its projection, 0.7 px larger.
     """
     from camloc_geo.testing.traffic_render import _Layer

@@ -336,7 +336,7 @@ def _coverage(px: FloatArray, x0: int, y0: int, w: int, h: int) -> FloatArray:
     coverage above its area) is scaled down to its area. So a drawn edge stands where the
     camera projects it (within a few hundredths of a pixel) and a polygon keeps its area;
     OpenCV's anti-aliased fill put every edge half a pixel right of and below its
-    projection and grew it by about 0.7 px on every side (before session 38).
+    projection and grew it by about 0.7 px on every side (before session 37).
     """
     import cv2
 
