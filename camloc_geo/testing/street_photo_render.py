@@ -29,6 +29,13 @@ to 1.5 % of each side off the centre, barrel to mild pincushion distortion (divi
 :class:`camloc_geo.camera.RadialDistortion`), Gaussian noise and a JPEG round trip
 (quality 75-92). Sizes 1024x768 (half of the photos), 1024x576 (16:9), 800x600, 1280x720.
 
+Drawn where :class:`camloc_geo.camera.Camera` projects (pixel ``(x, y)`` is the square
+``[x, x + 1] x [y, y + 1]``): polygons with exact coverage
+(:func:`camloc_geo.testing.traffic_render._coverage`), lines and tree crowns with OpenCV
+half a pixel up and left (OpenCV centres pixel ``(x, y)`` at ``(x, y)``). Before session 37
+everything was drawn in OpenCV's convention: half a pixel right and low, fills ~0.7 px
+larger on every side.
+
 Shortcuts (name them where the figures are quoted): painter's algorithm by distance (no
 depth buffer; a car or tree is drawn whole over what lies behind it), no perspective
 texture on the surfaces (flat colours with per-pixel noise), tree crowns are drawn as
@@ -129,7 +136,7 @@ class _Canvas:
         return np.asarray(self.f * pc[:, :2] / pc[:, 2:3] + self.pp, np.float64)
 
     def poly(self, pts_w: Any, colour: Any) -> None:
-        import cv2
+        from camloc_geo.testing.traffic_render import _coverage
 
         pc = self._clip(self.cam(np.asarray(pts_w, float)))
         if len(pc) < 3:
@@ -137,8 +144,16 @@ class _Canvas:
         px = self._px(pc)
         if not np.all(np.isfinite(px)) or np.abs(px).max() > 1e6:
             return
-        pts = np.round(px * 16).astype(np.int32)
-        cv2.fillPoly(self.img, [pts], tuple(float(c) for c in colour), cv2.LINE_AA, shift=4)
+        # exact coverage in Camera's pixel convention (pixel (x, y) is [x, x+1] x [y, y+1])
+        h, w = self.img.shape[:2]
+        lo = np.clip(np.floor(px.min(axis=0)).astype(int) - 1, 0, [w, h])
+        hi = np.clip(np.ceil(px.max(axis=0)).astype(int) + 1, 0, [w, h])
+        if np.any(hi <= lo):
+            return
+        x0, y0 = int(lo[0]), int(lo[1])
+        cov = _coverage(px, x0, y0, int(hi[0] - x0), int(hi[1] - y0))[..., None]
+        roi = self.img[y0 : int(hi[1]), x0 : int(hi[0])]
+        roi[:] = roi * (1.0 - cov) + cov * np.asarray(colour, float)
 
     def line(self, a_w: Any, b_w: Any, colour: Any, width_m: float) -> None:
         import cv2
@@ -155,7 +170,8 @@ class _Canvas:
         z = float(pc[:, 2].min())
         thick = max(1, round(self.f * width_m / max(z, 0.5)))
         thick = min(thick, 6)
-        p = np.round(px * 16).astype(np.int64)
+        # OpenCV puts pixel (x, y)'s centre at (x, y), Camera at (x + 0.5, y + 0.5)
+        p = np.round((px - 0.5) * 16).astype(np.int64)
         if np.abs(p).max() > 2**30:
             return
         cv2.line(
@@ -178,8 +194,11 @@ class _Canvas:
         r = self.f * radius_m / pc[0, 2]
         if r < 1 or np.abs(px).max() > 1e5:
             return
-        axes = (int(r), int(0.85 * r))
-        cv2.ellipse(self.img, (int(px[0]), int(px[1])), axes, 0, 0, 360, colour, -1, cv2.LINE_AA)
+        centre = np.round((px - 0.5) * 16).astype(int)  # OpenCV's pixel centres, 4 bits
+        axes = (round(16 * r), round(16 * 0.85 * r))
+        cv2.ellipse(
+            self.img, (int(centre[0]), int(centre[1])), axes, 0, 0, 360, colour, -1, cv2.LINE_AA, 4
+        )
 
 
 def _box(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> list[FloatArray]:
