@@ -92,7 +92,7 @@ def _canvas_and_camera() -> tuple[Any, Camera]:
 def test_storey_line_is_drawn_where_the_camera_projects() -> None:
     # A storey line on the left facade (y = 8 m, 6 m up), white on black: in each column its
     # drawn centre (intensity-weighted, pixel (x, y) centred at (x + 0.5, y + 0.5)) lies on
-    # Camera.project's line. OpenCV's own convention drew it 0.5 px low (session 37).
+    # Camera.project's line. OpenCV's line drew it 0.2-0.5 px low (session 37).
     cv, camera = _canvas_and_camera()
     a, b = np.array([12.0, 8.0, 6.0]), np.array([40.0, 8.0, 6.0])
     cv.line(a, b, (255.0, 255.0, 255.0), 0.15)
@@ -108,12 +108,11 @@ def test_storey_line_is_drawn_where_the_camera_projects() -> None:
         centre = float(np.sum((np.arange(y0, y1) + 0.5) * col) / np.sum(col))
         errs.append(centre - v)
     assert len(errs) >= 20
-    # the line fitted through the centres (as a line detector sees it) within 0.3 px of the
-    # projection along its whole length; single columns wobble by OpenCV's rasterisation
+    # every column within 0.3 px (0.03 measured; OpenCV's LINE_AA wobbled by up to 0.35 px
+    # even shifted into Camera's convention), and the line fitted through them within 0.1 px
+    assert np.max(np.abs(errs)) < 0.3
     slope, offset = np.polyfit(us, errs, 1)
-    assert np.max(np.abs(slope * np.array([us[0], us[-1]]) + offset)) < 0.3
-    assert abs(float(np.mean(errs))) < 0.1
-    assert np.max(np.abs(errs)) < 0.45
+    assert np.max(np.abs(slope * np.array([us[0], us[-1]]) + offset)) < 0.1
 
 
 def test_facade_edges_are_drawn_where_the_camera_projects() -> None:
