@@ -32,8 +32,8 @@ to 1.5 % of each side off the centre, barrel to mild pincushion distortion (divi
 Drawn where :class:`camloc_geo.camera.Camera` projects (pixel ``(x, y)`` is the square
 ``[x, x + 1] x [y, y + 1]``): polygons with exact coverage
 (:func:`camloc_geo.testing.traffic_render._coverage`; lines as bands 1-6 px wide with
-square ends), tree crowns with OpenCV half a pixel up and left (OpenCV centres pixel
-``(x, y)`` at ``(x, y)``). Before session 37 everything was drawn in OpenCV's convention:
+square ends, tree crowns as 64-gons). Before session 37 everything was drawn in OpenCV's
+convention (which centres pixel ``(x, y)`` at ``(x, y)``):
 half a pixel right and low, fills ~0.7 px larger on every side, lines 0.2-0.5 px low.
 
 Shortcuts (name them where the figures are quoted): painter's algorithm by distance (no
@@ -199,8 +199,8 @@ class _Canvas:
         self._fill(np.array([a + n, b + n, b - n, a - n]), colour)
 
     def ellipse(self, centre_w: Any, radius_m: float, colour: Any) -> None:
-        import cv2
-
+        """An upright image ellipse (a 64-gon) about the projected centre, ``radius_m``
+        wide and 0.85 of that high at its depth, drawn by :meth:`_fill`."""
         pc = self.cam(np.array([centre_w], float))
         if pc[0, 2] < 1.0:
             return
@@ -208,11 +208,8 @@ class _Canvas:
         r = self.f * radius_m / pc[0, 2]
         if r < 1 or np.abs(px).max() > 1e5:
             return
-        centre = np.round((px - 0.5) * 16).astype(int)  # OpenCV's pixel centres, 4 bits
-        axes = (round(16 * r), round(16 * 0.85 * r))
-        cv2.ellipse(
-            self.img, (int(centre[0]), int(centre[1])), axes, 0, 0, 360, colour, -1, cv2.LINE_AA, 4
-        )
+        t = np.linspace(0.0, 2.0 * np.pi, 64, endpoint=False)
+        self._fill(px + np.column_stack([r * np.cos(t), 0.85 * r * np.sin(t)]), colour)
 
 
 def _box(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> list[FloatArray]:
