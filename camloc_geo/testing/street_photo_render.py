@@ -1,8 +1,8 @@
 """Synthetic handheld street photos with known calibration (issue 24's scene class).
 
 A person stands on a street between two rows of facades and takes a photo down it with a
-phone. Drawn with OpenCV (no other dependency), with exact truth: focal length, principal
-point, gravity in the camera frame and the lens distortion.
+phone. Drawn with numpy and OpenCV (no other dependency), with exact truth: focal length,
+principal point, gravity in the camera frame and the lens distortion.
 
 The street (world frame: x along the street, y to its left, z up, metres):
 
