@@ -1,8 +1,8 @@
 """Synthetic handheld street photos with known calibration (issue 24's scene class).
 
 A person stands on a street between two rows of facades and takes a photo down it with a
-phone. Drawn with OpenCV (no other dependency), with exact truth: focal length, principal
-point, gravity in the camera frame and the lens distortion.
+phone. Drawn with numpy and OpenCV (no other dependency), with exact truth: focal length,
+principal point, gravity in the camera frame and the lens distortion.
 
 The street (world frame: x along the street, y to its left, z up, metres):
 
@@ -28,6 +28,13 @@ to 1.5 % of each side off the centre, barrel to mild pincushion distortion (divi
 ``k1`` in [-0.06, 0.02], radius half the image diagonal about the principal point, as
 :class:`camloc_geo.camera.RadialDistortion`), Gaussian noise and a JPEG round trip
 (quality 75-92). Sizes 1024x768 (half of the photos), 1024x576 (16:9), 800x600, 1280x720.
+
+Drawn where :class:`camloc_geo.camera.Camera` projects (pixel ``(x, y)`` is the square
+``[x, x + 1] x [y, y + 1]``): polygons with exact coverage
+(:func:`camloc_geo.testing.traffic_render._coverage`; lines as bands 1-6 px wide with
+square ends, tree crowns as 64-gons). Before session 37 everything was drawn in OpenCV's
+convention (which centres pixel ``(x, y)`` at ``(x, y)``):
+half a pixel right and low, fills ~0.7 px larger on every side, lines 0.2-0.5 px low.
 
 Shortcuts (name them where the figures are quoted): painter's algorithm by distance (no
 depth buffer; a car or tree is drawn whole over what lies behind it), no perspective
@@ -129,20 +136,32 @@ class _Canvas:
         return np.asarray(self.f * pc[:, :2] / pc[:, 2:3] + self.pp, np.float64)
 
     def poly(self, pts_w: Any, colour: Any) -> None:
-        import cv2
-
         pc = self._clip(self.cam(np.asarray(pts_w, float)))
         if len(pc) < 3:
             return
         px = self._px(pc)
         if not np.all(np.isfinite(px)) or np.abs(px).max() > 1e6:
             return
-        pts = np.round(px * 16).astype(np.int32)
-        cv2.fillPoly(self.img, [pts], tuple(float(c) for c in colour), cv2.LINE_AA, shift=4)
+        self._fill(px, colour)
+
+    def _fill(self, px: FloatArray, colour: Any) -> None:
+        """Blend a convex image polygon in with its exact coverage, Camera's pixel
+        convention (pixel ``(x, y)`` is ``[x, x + 1] x [y, y + 1]``)."""
+        from camloc_geo.testing.traffic_render import _coverage
+
+        h, w = self.img.shape[:2]
+        lo = np.clip(np.floor(px.min(axis=0)).astype(int) - 1, 0, [w, h])
+        hi = np.clip(np.ceil(px.max(axis=0)).astype(int) + 1, 0, [w, h])
+        if np.any(hi <= lo):
+            return
+        x0, y0 = int(lo[0]), int(lo[1])
+        cov = _coverage(px, x0, y0, int(hi[0] - x0), int(hi[1] - y0))[..., None]
+        roi = self.img[y0 : int(hi[1]), x0 : int(hi[0])]
+        roi[:] = roi * (1.0 - cov) + cov * np.asarray(colour, float)
 
     def line(self, a_w: Any, b_w: Any, colour: Any, width_m: float) -> None:
-        import cv2
-
+        """A straight band ``thick`` px wide (1-6, from ``width_m`` at its nearest end)
+        about the projected segment, square ends, drawn by :meth:`_fill`."""
         pc = self.cam(np.array([a_w, b_w], float))
         if pc[0, 2] < _NEAR_M and pc[1, 2] < _NEAR_M:
             return
@@ -152,25 +171,36 @@ class _Canvas:
                 t = (_NEAR_M - o[2]) / (pc[i, 2] - o[2])
                 pc[i] = o + t * (pc[i] - o)
         px = self._px(pc)
+        if not np.all(np.isfinite(px)):
+            return
         z = float(pc[:, 2].min())
         thick = max(1, round(self.f * width_m / max(z, 0.5)))
         thick = min(thick, 6)
-        p = np.round(px * 16).astype(np.int64)
-        if np.abs(p).max() > 2**30:
+        # clip the segment to the image and a margin (Liang-Barsky)
+        h, w = self.img.shape[:2]
+        a, d = px[0], px[1] - px[0]
+        t0, t1 = 0.0, 1.0
+        for k, lim in ((0, w), (1, h)):
+            for p_k, q_k in ((-d[k], a[k] + 8.0), (d[k], lim + 8.0 - a[k])):
+                if abs(p_k) < 1e-12:
+                    if q_k < 0:
+                        return
+                    continue
+                r = q_k / p_k
+                if p_k < 0:
+                    t0 = max(t0, r)
+                else:
+                    t1 = min(t1, r)
+        length = float(np.hypot(d[0], d[1]))
+        if t1 <= t0 or length < 1e-9:
             return
-        cv2.line(
-            self.img,
-            (int(p[0, 0]), int(p[0, 1])),
-            (int(p[1, 0]), int(p[1, 1])),
-            tuple(float(c) for c in colour),
-            thick,
-            cv2.LINE_AA,
-            shift=4,
-        )
+        a, b = a + t0 * d, a + t1 * d
+        n = np.array([-d[1], d[0]]) / length * (thick / 2)
+        self._fill(np.array([a + n, b + n, b - n, a - n]), colour)
 
     def ellipse(self, centre_w: Any, radius_m: float, colour: Any) -> None:
-        import cv2
-
+        """An upright image ellipse (a 64-gon) about the projected centre, ``radius_m``
+        wide and 0.85 of that high at its depth, drawn by :meth:`_fill`."""
         pc = self.cam(np.array([centre_w], float))
         if pc[0, 2] < 1.0:
             return
@@ -178,8 +208,8 @@ class _Canvas:
         r = self.f * radius_m / pc[0, 2]
         if r < 1 or np.abs(px).max() > 1e5:
             return
-        axes = (int(r), int(0.85 * r))
-        cv2.ellipse(self.img, (int(px[0]), int(px[1])), axes, 0, 0, 360, colour, -1, cv2.LINE_AA)
+        t = np.linspace(0.0, 2.0 * np.pi, 64, endpoint=False)
+        self._fill(px + np.column_stack([r * np.cos(t), 0.85 * r * np.sin(t)]), colour)
 
 
 def _box(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> list[FloatArray]:
