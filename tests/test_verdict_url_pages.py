@@ -10,7 +10,10 @@ import re
 from pathlib import Path
 from typing import Any
 
+import httpx
 import pytest
+from test_service import Server
+from test_service_verdicts import KEY, kserver, needs_browser  # noqa: F401 (a fixture)
 
 CANDS = {
     "type": "FeatureCollection",
@@ -130,3 +133,92 @@ def test_batch_page_carries_the_service(tmp_path: Path) -> None:
             )
     finally:
         _run._summary_items = orig  # type: ignore[assignment]
+
+
+@pytest.mark.browser
+@needs_browser
+@pytest.mark.parametrize("command", ["summary-map", "batch"])
+def test_summary_page_from_a_file_shares_with_the_service(
+    browser: Any,
+    kserver: Server,  # noqa: F811 (the fixture imported above)
+    cands: Path,
+    tmp_path: Path,
+    command: str,
+) -> None:
+    """``camloc summary-map --verdict-url``'s and ``camloc batch --map --verdict-url``'s page
+    (a real one-camera batch on the sample extract) opened from a file (origin null) reads the
+    service's verdicts, asks for the key on the 401 and lands the verdict with it; served from
+    an origin the service does not allow, it says so."""
+    from camloc_geo.cli import main
+
+    out = tmp_path / "summary.html"
+    if command == "summary-map":
+        args = ["summary-map", str(cands), "-o", str(out), "--inline", "--no-cluster"]
+    else:
+        listing = tmp_path / "list.csv"
+        listing.write_text(
+            "id,title,lat,lon\na,Eastern Ave & S Broadway,39.2848,-76.5934\n", encoding="utf-8"
+        )
+        extract = Path(kserver.env["CAMLOC_MAP_DIR"]) / "baltimore.osm.pbf"
+        args = ["batch", str(listing), "-o", str(tmp_path / "out.gpkg"), "--osm", str(extract)]
+        args += ["--workers", "1", "--no-progress", "--map", str(out)]
+    assert main([*args, "--verdict-url", kserver.url]) == 0
+    page_html = out.read_text(encoding="utf-8")
+    cfg = _cfg(page_html)
+    assert cfg["service"] == kserver.url + "/v1/verdicts"
+    client = httpx.Client(base_url=kserver.url, timeout=60.0)
+    other = "http://localhost:8766"
+    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    page = context.new_page()
+    sent: list[str] = []
+    blocked: list[str] = []
+    errors: list[str] = []
+
+    def route(r: Any) -> None:
+        u = r.request.url
+        if u == other + "/summary.html":
+            r.fulfill(status=200, body=page_html, content_type="text/html; charset=utf-8")
+        elif u.startswith(("file:", "data:")):
+            r.continue_()
+        elif u.startswith(kserver.url + "/"):
+            sent.append(f"{r.request.method} {u}")
+            r.continue_()
+        else:
+            blocked.append(u)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("pageerror", lambda exc: errors.append(str(exc)))
+    share = ".camloc-vshare"
+    try:
+        page.goto(out.as_uri(), wait_until="load")
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
+        )
+        assert any(s.startswith("GET ") and "/v1/verdicts/summary/" in s for s in sent), sent
+        page.locator('.camloc-summary-marker [data-verdict-mark="c0"]').click()
+        box = page.locator(".leaflet-popup-content .camloc-verdict")
+        box.locator('button[data-verdict="no"]').wait_for(timeout=30000)
+        box.locator('button[data-verdict="no"]').click()
+        keybox = page.locator(".camloc-verdicts form.camloc-vkey")
+        keybox.wait_for(state="visible", timeout=60000)  # the 401 reached the page
+        keybox.locator("input").fill(KEY)
+        keybox.locator("button").click()
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
+        )
+        items = client.get(f"/v1/verdicts/summary/{cfg['identity']}").json()["items"]
+        assert [(k, v["verdict"]) for k, v in items.items()] == [("c0", "no")]
+        # the same page from an origin the service does not allow: refused, and said
+        page.goto(other + "/summary.html", wait_until="load")
+        page.wait_for_function(
+            f"document.querySelector('{share}').textContent.startsWith('not shared')",
+            timeout=30000,
+        )
+        text = page.locator(share).inner_text()
+        assert f"this page's origin ({other}) in its CAMLOC_CORS_ORIGINS?" in text, text
+        assert blocked == []
+        assert errors == []
+    finally:
+        context.close()
+        client.close()
