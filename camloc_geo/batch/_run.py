@@ -450,6 +450,7 @@ def run_batch(
     restart: bool = False,
     offline_map: bool = True,
     on_chunk: Callable[[int], None] | None = None,
+    verdict_service: str | None = None,
 ) -> BatchSummary:
     """Geocode every camera of a list into a GeoPackage (resumable).
 
@@ -483,6 +484,10 @@ def run_batch(
         Forget the journal and compute every camera again.
     on_chunk
         Called with the number of cameras done after each journal write.
+    verdict_service
+        With ``summary_map``: the verdicts endpoint (``.../v1/verdicts``, see
+        :func:`camloc_geo.cli.locate.verdict_url`) the page shares its verdicts with, from a
+        file too (docs/service.md, "Verdicts").
 
     Raises
     ------
@@ -574,7 +579,9 @@ def run_batch(
         map_path = None
         if summary_map is not None:
             t = time.perf_counter()
-            map_path = _write_summary_map(journal, Path(summary_map), offline=offline_map)
+            map_path = _write_summary_map(
+                journal, Path(summary_map), offline=offline_map, verdict_service=verdict_service
+            )
             stage["summary_map"] += time.perf_counter() - t
         statuses = journal.status_counts()
     finally:
@@ -974,7 +981,9 @@ def _markercluster_assets() -> tuple[str, str]:
     return markercluster_assets()
 
 
-def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
+def _write_summary_map(
+    journal: Journal, path: Path, *, offline: bool, verdict_service: str | None = None
+) -> Path:
     """The summary map: one marker per placed camera, clustered (offline: inlined plug-in).
 
     The offline page is :func:`camloc_geo.maps.summary_page`'s (the service's job page without
@@ -985,9 +994,14 @@ def _write_summary_map(journal: Journal, path: Path, *, offline: bool) -> Path:
     from camloc_geo.maps import build_summary_map, summary_page
 
     if offline:
-        page = summary_page(_summary_items(journal))
+        page = summary_page(_summary_items(journal), verdict_service=verdict_service)
     else:
-        fmap = build_summary_map(_summary_items(journal), offline=False, tiles="OpenStreetMap")
+        fmap = build_summary_map(
+            _summary_items(journal),
+            offline=False,
+            tiles="OpenStreetMap",
+            verdict_service=verdict_service,
+        )
         page = fmap.get_root().render()
     path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, page)

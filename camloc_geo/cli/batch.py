@@ -60,6 +60,15 @@ def register(subparsers: Any) -> None:
         "--online-map", action="store_true", help="summary map with web tiles (not self-contained)"
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--verdict-url",
+        metavar="URL",
+        help=(
+            "with --map: the page shares its reviewers' verdicts with this camloc service "
+            "(http(s)://host[:port], /v1/verdicts added), from a file too; the service must "
+            "allow the page's origin (CAMLOC_CORS_ORIGINS; null for a file), see docs/service.md"
+        ),
+    )
     p.set_defaults(func=run)
 
 
@@ -81,6 +90,13 @@ def run(args: argparse.Namespace) -> int:
         page = output_path(args.map, inputs=inputs, option="--map")
         if page is not None and out is not None and page.resolve() == out.resolve():
             raise InputError(f"--map {args.map}: the same file as -o; give the page its own name")
+    service = None
+    if args.verdict_url is not None:
+        from camloc_geo.cli.locate import verdict_url
+
+        if args.map is None:
+            raise InputError("--verdict-url needs --map SUMMARY.html (the page shares verdicts)")
+        service = verdict_url(args.verdict_url)
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers must be at least 1")
     if args.scheduler is not None and not args.scheduler.strip():
@@ -99,6 +115,7 @@ def run(args: argparse.Namespace) -> int:
             chunk_size=args.chunk_size,
             restart=args.restart,
             offline_map=not args.online_map,
+            verdict_service=service,
         )
     except KeyboardInterrupt:
         from camloc_geo.batch import journal_path

@@ -53,6 +53,15 @@ def register(subparsers: Any) -> None:
             ".geojson) again on this page (see docs/candidates.md)"
         ),
     )
+    p.add_argument(
+        "--verdict-url",
+        metavar="URL",
+        help=(
+            "the page shares its reviewers' verdicts with this camloc service "
+            "(http(s)://host[:port], /v1/verdicts added), from a file too; the service must "
+            "allow the page's origin (CAMLOC_CORS_ORIGINS; null for a file), see docs/service.md"
+        ),
+    )
     p.set_defaults(func=run)
 
 
@@ -114,6 +123,10 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
     from camloc_geo.cli import atomic_output, output_path, read_json_file
+    from camloc_geo.cli.locate import verdict_url
+
+    # a bad URL stops before any reading
+    service = None if args.verdict_url is None else verdict_url(args.verdict_url)
 
     out = output_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
     if out is None:
@@ -151,6 +164,7 @@ def run(args: argparse.Namespace) -> int:
             cluster=not args.no_cluster,
             map_data=map_data,
             verdicts=verdicts,
+            verdict_service=service,
         )
     return 0
 
