@@ -144,8 +144,14 @@ def _oracle_points(name: str, m: MapData) -> list[dict[str, Any]]:
     from junctions import oracle_junctions
 
     found, _G = oracle_junctions(OSM / name)
+    return oracle_near(found, m)
+
+
+def oracle_near(junctions: list[dict[str, Any]], m: MapData) -> list[dict[str, Any]]:
+    """``junctions`` (dicts with ``lat``/``lon``) at least 30 m inside the map's radius, each
+    with its distance ``d`` (m) from the map's centre, nearest first."""
     out = []
-    for j in found:
+    for j in junctions:
         e, n = m.frame.enu_from_geographic(lat=j["lat"], lon=j["lon"])
         d = float(np.hypot(e, n))
         if m.radius_m is None or d <= m.radius_m - 30.0:

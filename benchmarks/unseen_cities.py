@@ -91,22 +91,11 @@ def _entry(res: Any, lat: float, lon: float) -> dict[str, Any]:
     }
 
 
-def _oracle_near(junctions: list[dict[str, Any]], m: Any) -> list[dict[str, Any]]:
-    out = []
-    for j in junctions:
-        e, n = m.frame.enu_from_geographic(lat=j["lat"], lon=j["lon"])
-        d = float(np.hypot(e, n))
-        if m.radius_m is None or d <= m.radius_m - 30.0:
-            out.append({**j, "d": d})
-    out.sort(key=lambda j: j["d"])
-    return out
-
-
 def locate_city(
     name: str, lat: float, lon: float, radius_m: float, junctions: list[dict[str, Any]], n: int
 ) -> dict[str, Any]:
     """Synthetic cameras at up to ``n`` oracle junctions of one city, located two ways."""
-    from absolute import oracle_scene  # benchmarks/absolute.py: its cameras, made alike
+    from absolute import oracle_near, oracle_scene  # benchmarks/absolute.py: made alike
 
     from camloc_geo.absolute import apply_cues, locate
     from camloc_geo.osm import load_map
@@ -115,7 +104,7 @@ def locate_city(
     from camloc_geo.testing.synthetic import NoiseModel
 
     m = load_map(OSM / name, lat, lon, radius_m)
-    chosen = _oracle_near(junctions, m)[:n]
+    chosen = oracle_near(junctions, m)[:n]
     noise = NoiseModel()
     rows: list[dict[str, Any]] = []
     for i, oj in enumerate(chosen):
