@@ -95,7 +95,7 @@ class Tab:
     def open(self, path: Path) -> float:
         t0 = time.perf_counter()
         self.page.goto(path.resolve().as_uri(), wait_until="load")
-        self.page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        self.page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
         return time.perf_counter() - t0
 
     def screen(self, x: float, y: float) -> tuple[float, float]:
@@ -687,7 +687,7 @@ def test_a_reload_keeps_the_work_until_it_is_saved(tab: Tab, files: dict[str, An
     assert clicked["origin"] is not None
     assert clicked["length"] is not None
     page.reload(wait_until="load")
-    page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+    page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
     restored = tab.state()["axes"]
     assert restored["origin"] == pytest.approx(clicked["origin"])
     assert restored["length"] == pytest.approx(clicked["length"])
@@ -706,7 +706,7 @@ def test_a_reload_keeps_the_work_until_it_is_saved(tab: Tab, files: dict[str, An
     assert tab.state()["axes"]["origin"] == pytest.approx(clicked["origin"])
     tab.save()  # saved: nothing to restore any more
     page.reload(wait_until="load")
-    page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+    page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
     assert tab.state()["axes"]["origin"] is None
     assert "unsaved work" not in page.inner_text("#save-status")
     # leaving with unsaved clicks asks first (the browser's "Leave site?")
@@ -737,7 +737,7 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
     )
     try:
         page.goto(files["page"].resolve().as_uri(), wait_until="load")
-        page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
         box = page.locator("#canvas").bounding_box()
         assert box is not None
         assert box["width"] == pytest.approx(390, abs=1)
@@ -783,7 +783,7 @@ def test_next_is_in_sight_on_a_laptop_screen(
     )
     try:
         page.goto(files["page"].resolve().as_uri(), wait_until="load")
-        page.wait_for_selector("body[data-ready]", state="attached", timeout=5000)
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
         for step in range(4):
             page.keyboard.press(str(step + 1))
             box = page.locator("#btn-next").bounding_box()

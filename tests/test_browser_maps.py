@@ -80,7 +80,7 @@ class _Page:
         How long that takes is measured by ``benchmarks/page_render.py``, not here.
         """
         self.page.goto(path.resolve().as_uri(), wait_until="load")
-        self.page.wait_for_selector(selector, state="attached", timeout=5000)
+        self.page.wait_for_selector(selector, state="attached", timeout=30000)
 
     def click_for_popup(self, locator: Any) -> None:
         """Click a marker to open its popup; click once more if no popup came.
@@ -101,10 +101,10 @@ class _Page:
     def popup_text(self) -> str:
         """Text of the open popup, once its fade-in animation has finished."""
         popup = self.page.locator(".leaflet-popup-content")
-        popup.wait_for(timeout=3000)
+        popup.wait_for(timeout=30000)
         self.page.wait_for_function(
             "getComputedStyle(document.querySelector('.leaflet-popup')).opacity === '1'",
-            timeout=3000,
+            timeout=30000,
         )
         return str(popup.inner_text())
 
@@ -236,7 +236,7 @@ def test_tied_candidates_are_marked_and_explained(
     page.screenshot(path=str(ARTIFACTS / "tied_map_popup.png"))
     page.locator(".leaflet-popup-close-button").click()
     page.wait_for_function(
-        "!document.querySelector('.camloc-banner').classList.contains('folded')", timeout=3000
+        "!document.querySelector('.camloc-banner').classList.contains('folded')", timeout=30000
     )
     assert banner.locator(".camloc-banner-body").is_visible()
     assert tab.blocked == []
@@ -302,7 +302,7 @@ def test_phone_sees_the_candidates_not_the_controls(browser: Any, pages: dict[st
         t.page.set_viewport_size({"width": 390, "height": 844})
         t.open(pages["tied"], ".camloc-candidate")
         page = t.page
-        page.wait_for_selector(".camloc-legend.folded", timeout=5000)
+        page.wait_for_selector(".camloc-legend.folded", timeout=30000)
         layers = page.locator(".leaflet-control-layers")
         assert "leaflet-control-layers-expanded" not in (layers.get_attribute("class") or "")
         legend = _box(page, ".camloc-legend")
@@ -335,7 +335,7 @@ def test_phone_popup_is_not_under_the_title_box(browser: Any, pages: dict[str, A
         t.page.set_viewport_size({"width": 390, "height": 844})
         t.open(pages["candidates"], ".camloc-candidate")
         page = t.page
-        page.wait_for_selector(".camloc-legend.folded", timeout=5000)
+        page.wait_for_selector(".camloc-legend.folded", timeout=30000)
         assert page.locator(".camloc-title").is_visible()
         t.click_for_popup(page.locator('.camloc-candidate [data-rank="1"]'))
         t.popup_text()
@@ -349,7 +349,7 @@ def test_phone_popup_is_not_under_the_title_box(browser: Any, pages: dict[str, A
         ARTIFACTS.mkdir(exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / "candidates_map_phone_popup.png"))
         page.locator(".leaflet-popup-close-button").click()
-        page.wait_for_selector(".leaflet-popup", state="detached", timeout=3000)
+        page.wait_for_selector(".leaflet-popup", state="detached", timeout=30000)
         assert page.locator(".camloc-title").is_visible()
         assert t.blocked == []
         assert t.errors == []

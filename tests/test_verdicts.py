@@ -174,13 +174,13 @@ def tab(browser: Any) -> Iterator[Any]:
 def _open_popup(tab: Any, locator: Any) -> Any:
     tab.click_for_popup(locator)
     buttons = tab.page.locator(".leaflet-popup-content .camloc-verdict button")
-    buttons.first.wait_for(timeout=3000)
+    buttons.first.wait_for(timeout=30000)
     return tab.page.locator(".leaflet-popup-content .camloc-verdict")
 
 
 def _close_popup(page: Any) -> None:
     page.locator(".leaflet-popup-close-button").dispatch_event("click")
-    page.wait_for_function("!document.querySelector('.leaflet-popup')", timeout=3000)
+    page.wait_for_function("!document.querySelector('.leaflet-popup')", timeout=30000)
 
 
 def _download(page: Any, which: str) -> tuple[str, str]:
@@ -226,7 +226,7 @@ def test_candidate_verdict_survives_reload_and_exports(
     page.reload(wait_until="load")
     page.wait_for_selector(".camloc-vcount")
     page.wait_for_function(
-        "document.querySelector('.camloc-vcount').textContent.startsWith('2 of')", timeout=3000
+        "document.querySelector('.camloc-vcount').textContent.startsWith('2 of')", timeout=30000
     )
     assert (
         page.locator('.camloc-candidate [data-verdict-mark="2"]').get_attribute("data-verdict")
@@ -286,7 +286,7 @@ def test_summary_verdicts_pick_another_rank_and_keep_apart(
     assert box.locator('button[data-verdict="yes"]').get_attribute("aria-pressed") == "false"
     page.reload(wait_until="load")
     page.wait_for_function(
-        "document.querySelector('.camloc-vcount').textContent.startsWith('1 of')", timeout=3000
+        "document.querySelector('.camloc-vcount').textContent.startsWith('1 of')", timeout=30000
     )
     page.locator(".camloc-verdicts input").fill("")
     name, text = _download(page, "csv")
@@ -345,7 +345,7 @@ def test_verdicts_on_a_phone(browser: Any, vpages: dict[str, Any]) -> None:
         page.locator('.leaflet-marker-icon:has([data-rank="1"])').focus()
         page.keyboard.press("Enter")
         box = page.locator(".leaflet-popup-content .camloc-verdict")
-        box.locator("button").first.wait_for(timeout=3000)
+        box.locator("button").first.wait_for(timeout=30000)
         box.locator('button[data-verdict="no"]').focus()
         page.keyboard.press("Tab")
         page.keyboard.press("Enter")
@@ -448,7 +448,7 @@ def test_summary_page_shows_given_verdicts(
     page = tab.page
     page.wait_for_function(
         "document.querySelector('.camloc-vcount').textContent === '1 of 2 cameras reviewed'",
-        timeout=3000,
+        timeout=30000,
     )
     marks = page.evaluate(
         """() => Array.from(document.querySelectorAll('[data-verdict-mark]'))
@@ -470,7 +470,7 @@ def test_summary_page_shows_given_verdicts(
     label.locator("input").check()
     page.wait_for_function(
         "document.querySelectorAll('[data-verdict-mark][data-verdict=\"no\"]').length === 1",
-        timeout=3000,
+        timeout=30000,
     )
     assert tab.errors == []
 
@@ -546,7 +546,7 @@ def test_verdicts_kept_apart_and_back_button(tab: Any, vpages: dict[str, Any]) -
     page.go_back(wait_until="load")
     page.wait_for_function(
         "document.querySelector('.camloc-vcount').textContent.startsWith('1 of ')",
-        timeout=3000,
+        timeout=30000,
     )
     mark = page.locator('.camloc-candidate [data-verdict-mark="3"]')
     assert mark.get_attribute("data-verdict") == "unsure"
@@ -691,7 +691,7 @@ def test_review_page_shows_given_verdicts(tab: Any, tied: Any, tmp_path: Path) -
     n = len(tied.result.candidates)
     page.wait_for_function(
         f"document.querySelector('.camloc-vcount').textContent === '2 of {n} candidates reviewed'",
-        timeout=3000,
+        timeout=30000,
     )
     marks = page.evaluate(
         """() => Object.fromEntries(Array.from(
@@ -763,14 +763,14 @@ def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> N
     page = tab.page
     page.wait_for_function(
         "document.querySelector('.camloc-vcount').textContent === '4 of 6 cameras reviewed'",
-        timeout=3000,
+        timeout=30000,
     )
     read = """() => Array.from(document.querySelectorAll('.camloc-cluster')).map(c => [
         c.querySelector('div span').textContent,
         Array.from(c.querySelectorAll('.camloc-cv')).map(b => b.textContent).join(' '),
         c.querySelector('.camloc-sr').textContent]).sort()"""
     page.wait_for_function(
-        "document.querySelectorAll('.camloc-cluster .camloc-cv').length === 3", timeout=3000
+        "document.querySelectorAll('.camloc-cluster .camloc-cv').length === 3", timeout=30000
     )
     assert page.evaluate(read) == [
         ["2", "?1", "2 cameras: 1 unsure, 1 not reviewed"],
@@ -792,7 +792,7 @@ def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> N
     marker = page.locator(
         ".camloc-summary-marker:has([data-verdict-mark]):not(:has([data-verdict]))"
     )
-    marker.first.wait_for(timeout=3000)
+    marker.first.wait_for(timeout=30000)
     box_v = _open_popup(tab, marker.first)
     box_v.locator('button[data-verdict="yes"]').click()
     _close_popup(page)
@@ -803,7 +803,7 @@ def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> N
     page.wait_for_function(
         "Array.from(document.querySelectorAll('.camloc-cluster .camloc-sr'))"
         ".some(s => s.textContent === '4 cameras: 2 confirmed, 2 rejected, 0 not reviewed')",
-        timeout=3000,
+        timeout=30000,
     )
     assert tab.blocked == []
     assert tab.errors == []
