@@ -219,7 +219,9 @@ def test_sensor_numbers_unchanged(calibration: Any) -> None:
     from camloc_geo.sensors import ground_distance
 
     m = ground_distance(calibration, np.array([(900, 700), (1000, 700)]), n_samples=np.int64(400))
-    assert m.value_m == pytest.approx(1.2938980364696304, rel=1e-9)
+    # rel 1e-7: another CPU or BLAS moves the last digits (1.7e-9 seen on a fresh machine);
+    # a change of the sensor's numbers moves them by far more.
+    assert m.value_m == pytest.approx(1.2938980364696304, rel=1e-7)
     assert m.n_samples == 400
     assert all(type(v) in (int, float) for v in m.to_dict().values())
 
