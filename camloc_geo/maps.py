@@ -66,12 +66,22 @@ if TYPE_CHECKING:
     from camloc_geo.scene import Scene
 
 __all__ = [
+    "BASEMAP_MAX_AREAS",
+    "BASEMAP_MAX_BUILDINGS",
+    "BASEMAP_MAX_ROADS",
+    "CLUSTER_NEAR_PX",
+    "CLUSTER_OPEN_MAX_MARKERS",
+    "CLUSTER_STREET_ZOOM",
     "MAX_PAGE_BYTES",
     "RANK_OTHER",
     "RANK_PALETTE",
     "SCORE_SCALE",
+    "SUMMARY_BASEMAP_RADIUS_M",
     "VERDICTS",
     "VERDICT_FIELDS",
+    "Basemap",
+    "basemap_features",
+    "basemap_maps",
     "build_candidates_map",
     "build_summary_map",
     "candidates_map",
@@ -82,6 +92,7 @@ __all__ = [
     "read_verdicts",
     "score_colour",
     "summary_map",
+    "summary_page",
 ]
 
 log = logging.getLogger(__name__)
@@ -2103,12 +2114,24 @@ CLUSTER_NEAR_PX = 4
 stand within this many pixels of each other (all but on top of each other: two cameras
 placed at one junction's point) share a cluster, which a click spreads out (markercluster's
 spiderfy); zoomed out farther, markercluster's own 80 px clusters. Cameras tens of metres
-apart are never hidden in a cluster at the opening zoom: a reviewer sees each marker."""
+apart are never hidden in a cluster at the opening zoom: a reviewer sees each marker (a page
+of more than :data:`CLUSTER_OPEN_MAX_MARKERS` cameras: from :data:`CLUSTER_STREET_ZOOM`)."""
+
+CLUSTER_OPEN_MAX_MARKERS = 300
+"""A summary page with more cameras than this opens clustered as markercluster clusters
+(80 px) and drops to :data:`CLUSTER_NEAR_PX` only from :data:`CLUSTER_STREET_ZOOM` on: a
+city's thousands of cameras as single markers at a city's zoom would be slow and cover
+each other."""
+
+CLUSTER_STREET_ZOOM = 16
+"""The zoom (about 2 m a pixel) from which a large summary page clusters only markers all
+but on top of each other."""
 
 
 class _OpenUnclustered(MacroElement):
     """Fit a clustered summary page to its cameras (no animation), then cluster only markers
-    all but on top of each other (:data:`CLUSTER_NEAR_PX`) at that zoom and closer."""
+    all but on top of each other (:data:`CLUSTER_NEAR_PX`) at that zoom and closer (a large
+    page: from :data:`CLUSTER_STREET_ZOOM`)."""
 
     _template = Template(
         """
@@ -2120,13 +2143,16 @@ class _OpenUnclustered(MacroElement):
     map.fitBounds({{ this.bounds|tojson }}, {padding: [30, 30], maxZoom: 18, animate: false});
     {% endif %}
     var open = map.getZoom();
+    var markers = group.getLayers();
+    var from = markers.length <= {{ this.max_markers }} ? open
+        : Math.max(open, {{ this.street_zoom }});
     group.options.maxClusterRadius = function (zoom) {
-        return zoom >= open ? {{ this.near_px }} : 80;
+        return zoom >= from ? {{ this.near_px }} : 80;
     };
-    var markers = group.getLayers();  // clustered again under the new radius
-    group.clearLayers();
+    group.clearLayers();  // clustered again under the new radius
     group.addLayers(markers);
     map.getContainer().setAttribute("data-camloc-open-zoom", String(open));
+    map.getContainer().setAttribute("data-camloc-unclustered-from", String(from));
 })();
 {% endmacro %}
 """
@@ -2138,6 +2164,8 @@ class _OpenUnclustered(MacroElement):
         self.group = group.get_name()
         self.bounds = bounds
         self.near_px = CLUSTER_NEAR_PX
+        self.max_markers = CLUSTER_OPEN_MAX_MARKERS
+        self.street_zoom = CLUSTER_STREET_ZOOM
 
 
 @lru_cache(maxsize=1)
