@@ -145,7 +145,6 @@ _STYLE: dict[str, Any] = {
 _OVERLAY_TOP = 5
 _MATCH_LAYERS = 5
 _CONES_SHOWN = 3
-_BANNER_PX = 150  # about the height of the tie banner: the candidates are fitted below it
 _BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
 BANNER_FOLD_BELOW_PX = (1200, 800)
 """A map narrower or lower than this (pixels) opens with the banner folded to its headline."""
@@ -388,6 +387,8 @@ _PAGE_CSS = """
 .camloc-legend.folded { max-height: 1.45em; overflow: hidden; }
 .camloc-popup-open .leaflet-top .leaflet-control { visibility: hidden; }
 @media (max-width: 719px) {
+  .leaflet-control-attribution { font-size: 10px; max-width: calc(100vw - 110px);
+    white-space: normal; text-align: right; }
   .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
     width: calc(100% - 40px); }
   .leaflet-popup-content { max-width: calc(100vw - 70px) !important; max-height: 62vh;
@@ -1579,11 +1580,7 @@ def build_candidates_map(
         pts.append([f["geometry"]["coordinates"][1], f["geometry"]["coordinates"][0]])
     if len(pts) >= 2:
         arr = np.asarray(pts)
-        fmap.fit_bounds(
-            [arr.min(axis=0).tolist(), arr.max(axis=0).tolist()],
-            padding_top_left=(40, 40 if banner is None else _BANNER_PX + 20),
-            padding_bottom_right=(40, 40),
-        )
+        _FitClear([arr.min(axis=0).tolist(), arr.max(axis=0).tolist()]).add_to(fmap)
     return fmap
 
 
@@ -2103,10 +2100,79 @@ def build_summary_map(
     )
     if isinstance(parent, folium.FeatureGroup) or not rows:
         if bounds is not None:
-            fmap.fit_bounds(bounds, padding=(30, 30), max_zoom=18)
+            _FitClear(bounds, max_zoom=18).add_to(fmap)
     else:
         _OpenUnclustered(parent, bounds).add_to(fmap)
     return fmap
+
+
+_FIT_CLEAR_JS = """
+function camlocFitClear(map, bounds, maxZoom) {
+    // fit the markers into the part of the map no box covers: a box along the top or the
+    // bottom (title, banner, scale, the verdicts' counter) pads that edge, a tall one
+    // (a long legend or layer list) pads its side; on a phone the legend and the layer list
+    // are folded (SmallScreenFolds), so they count folded
+    var size = map.getSize();
+    var box = map.getContainer().getBoundingClientRect();
+    var small = size.x < SMALL_PX;
+    var pad = {l: 30, t: 30, r: 30, b: 30};
+    var boxes = map.getContainer().querySelectorAll(".leaflet-control, .camloc-banner");
+    Array.prototype.forEach.call(boxes, function (el) {
+        var r = el.getBoundingClientRect();
+        if (!r.width || !r.height) { return; }
+        var x0 = r.left - box.left, y0 = r.top - box.top;
+        var x1 = x0 + r.width, y1 = y0 + r.height;
+        if (small && el.classList.contains("camloc-legend")) { y0 = Math.max(y0, y1 - 30); }
+        if (small && el.classList.contains("leaflet-control-layers")) {
+            y1 = Math.min(y1, y0 + 50);
+            x0 = Math.max(x0, x1 - 50);
+        }
+        if (y1 - y0 > 0.35 * size.y) {
+            if (x0 < size.x / 2) { pad.l = Math.max(pad.l, x1 + 10); }
+            else { pad.r = Math.max(pad.r, size.x - x0 + 10); }
+        } else if (y0 < size.y / 2) { pad.t = Math.max(pad.t, y1 + 10); }
+        else { pad.b = Math.max(pad.b, size.y - y0 + 10); }
+    });
+    // at least 40 % of the map's width and height stay for the markers
+    if (pad.l + pad.r > 0.6 * size.x) {
+        var kx = 0.6 * size.x / (pad.l + pad.r); pad.l *= kx; pad.r *= kx;
+    }
+    if (pad.t + pad.b > 0.6 * size.y) {
+        var ky = 0.6 * size.y / (pad.t + pad.b); pad.t *= ky; pad.b *= ky;
+    }
+    var options = {paddingTopLeft: [pad.l, pad.t], paddingBottomRight: [pad.r, pad.b],
+                   animate: false};
+    if (maxZoom) { options.maxZoom = maxZoom; }
+    map.fitBounds(bounds, options);
+    map.getContainer().setAttribute("data-camloc-fit-padding",
+        [pad.l, pad.t, pad.r, pad.b].map(Math.round).join(" "));
+}
+""".replace("SMALL_PX", str(SMALL_SCREEN_PX))
+"""A page's first view: its markers fitted clear of the boxes over the map (a legend at the
+bottom left covered the candidates there)."""
+
+
+class _FitClear(MacroElement):
+    """Fit the map to ``bounds`` clear of its boxes (:data:`_FIT_CLEAR_JS`); added last."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    {{ this.js }}
+    camlocFitClear({{ this._parent.get_name() }}, {{ this.bounds|tojson }},
+                   {{ this.max_zoom|tojson }});
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, bounds: list[list[float]], max_zoom: int | None = None) -> None:
+        super().__init__()
+        self._name = "CamlocFitClear"
+        self.js = _FIT_CLEAR_JS
+        self.bounds = bounds
+        self.max_zoom = max_zoom
 
 
 CLUSTER_NEAR_PX = 4
@@ -2137,10 +2203,11 @@ class _OpenUnclustered(MacroElement):
         """
 {% macro script(this, kwargs) %}
 (function () {
+    {{ this.js }}
     var map = {{ this._parent.get_name() }};
     var group = {{ this.group }};
     {% if this.bounds %}
-    map.fitBounds({{ this.bounds|tojson }}, {padding: [30, 30], maxZoom: 18, animate: false});
+    camlocFitClear(map, {{ this.bounds|tojson }}, 18);
     {% endif %}
     var open = map.getZoom();
     var markers = group.getLayers();
@@ -2164,6 +2231,7 @@ class _OpenUnclustered(MacroElement):
         self.group = group.get_name()
         self.bounds = bounds
         self.near_px = CLUSTER_NEAR_PX
+        self.js = _FIT_CLEAR_JS
         self.max_markers = CLUSTER_OPEN_MAX_MARKERS
         self.street_zoom = CLUSTER_STREET_ZOOM
 
