@@ -2107,7 +2107,7 @@ def build_summary_map(
 
 
 _FIT_CLEAR_JS = """
-function camlocFitClear(map, bounds, maxZoom) {
+function camlocFitClear(map, bounds, maxZoom, beforeFit) {
     // fit the markers into the part of the map no box covers: a box along the top or the
     // bottom (title, banner, scale, the verdicts' counter) pads that edge, a tall one
     // (a long legend or layer list) pads its side; on a phone the legend and the layer list
@@ -2143,6 +2143,11 @@ function camlocFitClear(map, bounds, maxZoom) {
     var options = {paddingTopLeft: [pad.l, pad.t], paddingBottomRight: [pad.r, pad.b],
                    animate: false};
     if (maxZoom) { options.maxZoom = maxZoom; }
+    if (beforeFit) {  // the zoom fitBounds will choose (Leaflet's own rule)
+        var zoom = map.getBoundsZoom(L.latLngBounds(bounds), false,
+                                     L.point(pad.l + pad.r, pad.t + pad.b));
+        beforeFit(maxZoom ? Math.min(maxZoom, zoom) : zoom);
+    }
     map.fitBounds(bounds, options);
     map.getContainer().setAttribute("data-camloc-fit-padding",
         [pad.l, pad.t, pad.r, pad.b].map(Math.round).join(" "));
@@ -2206,20 +2211,23 @@ class _OpenUnclustered(MacroElement):
     {{ this.js }}
     var map = {{ this._parent.get_name() }};
     var group = {{ this.group }};
+    function recluster(open) {  // before the view moves: the group then shows the new view
+        var markers = group.getLayers();
+        var from = markers.length <= {{ this.max_markers }} ? open
+            : Math.max(open, {{ this.street_zoom }});
+        group.options.maxClusterRadius = function (zoom) {
+            return zoom >= from ? {{ this.near_px }} : 80;
+        };
+        group.clearLayers();  // clustered again under the new radius
+        group.addLayers(markers);
+        map.getContainer().setAttribute("data-camloc-open-zoom", String(open));
+        map.getContainer().setAttribute("data-camloc-unclustered-from", String(from));
+    }
     {% if this.bounds %}
-    camlocFitClear(map, {{ this.bounds|tojson }}, 18);
+    camlocFitClear(map, {{ this.bounds|tojson }}, 18, recluster);
+    {% else %}
+    recluster(map.getZoom());
     {% endif %}
-    var open = map.getZoom();
-    var markers = group.getLayers();
-    var from = markers.length <= {{ this.max_markers }} ? open
-        : Math.max(open, {{ this.street_zoom }});
-    group.options.maxClusterRadius = function (zoom) {
-        return zoom >= from ? {{ this.near_px }} : 80;
-    };
-    group.clearLayers();  // clustered again under the new radius
-    group.addLayers(markers);
-    map.getContainer().setAttribute("data-camloc-open-zoom", String(open));
-    map.getContainer().setAttribute("data-camloc-unclustered-from", String(from));
 })();
 {% endmacro %}
 """

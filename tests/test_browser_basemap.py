@@ -125,6 +125,30 @@ def test_junction_cameras_open_as_markers_not_a_cluster(browser: Any, tmp_path: 
 
 @pytest.mark.browser
 @needs_browser
+def test_cameras_kilometres_apart_all_show(browser: Any, tmp_path: Path) -> None:
+    """Cameras far outside the view a page is built at (zoom 18 on their centre), a city's
+    grid 5 by 9 km, are all on the fitted page: the clusters are made again before the view
+    moves (made after it, the page showed 2 of 40 cameras over Monaco, 0 of these 42)."""
+    items = [
+        (f"k{i}{j}", _camera(LAT0 + 0.008 * i, LON0 + 0.0162 * j, 45.0))
+        for i in range(6)
+        for j in range(7)
+    ]
+    path = tmp_path / "far.html"
+    path.write_text(maps.summary_page(items), encoding="utf-8")
+    context, page, blocked, errors = _open(browser, path)
+    try:
+        page.wait_for_selector(".camloc-summary-marker", timeout=30000)
+        assert page.locator(".marker-cluster").count() == 0
+        assert page.locator(".camloc-summary-marker").count() == 42
+        assert blocked == []
+        assert errors == []
+    finally:
+        context.close()
+
+
+@pytest.mark.browser
+@needs_browser
 def test_cameras_at_one_point_share_a_cluster_a_click_spreads(browser: Any, tmp_path: Path) -> None:
     """Two cameras placed at one junction's point would hide each other as markers: they
     share a cluster, and one click spreads them out (spiderfy)."""
