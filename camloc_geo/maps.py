@@ -733,6 +733,7 @@ _ROAD_WEIGHT = {
 _BASEMAP_ROAD = {"color": "#ffffff", "opacity": 1.0, "lineCap": "round", "lineJoin": "round"}
 _BASEMAP_CASING = {"color": "#9a9a92", "opacity": 1.0, "lineCap": "round", "lineJoin": "round"}
 _BASEMAP_BACKGROUND = "#efeee9"
+_BASEMAP_FULL_ZOOM = 18
 _BASEMAP_BUILDING = {"color": "#a1887f", "weight": 1, "fillColor": "#e4dcd6", "fillOpacity": 0.8}
 
 
@@ -795,6 +796,15 @@ def _lonlat_geojson(geom: Any) -> dict[str, Any] | None:
     return None
 
 
+_SIMPLIFY_DEG = 3e-6
+"""Outlines are simplified to about 0.3 m (degrees) before they are written: a page's
+basemap is for telling a street from a building, not for surveying."""
+
+
+def _simplified(geom: Any) -> Any:
+    return geom.simplify(_SIMPLIFY_DEG, preserve_topology=True) if not geom.is_empty else geom
+
+
 def _metres_to(points_lonlat: np.ndarray, lon: float, lat: float) -> float:
     """Approximate metres from (lon, lat) to the nearest of the points (equirectangular)."""
     dlon = (points_lonlat[:, 0] - lon) * math.cos(math.radians(lat))
@@ -846,7 +856,7 @@ def basemap_features(
             if key in seen_roads or not prepared.intersects(st.geometry):
                 continue
             seen_roads.add(key)
-            geom = _lonlat_geojson(st.geometry.intersection(clip_lonlat))
+            geom = _lonlat_geojson(_simplified(st.geometry.intersection(clip_lonlat)))
             if geom is None:
                 continue
             mid = st.geometry.interpolate(0.5, normalized=True)
@@ -868,7 +878,7 @@ def basemap_features(
             if b.id in seen_buildings or not prepared.intersects(b.footprint):
                 continue
             seen_buildings.add(b.id)
-            geom = _lonlat_geojson(b.footprint.intersection(clip_lonlat))
+            geom = _lonlat_geojson(_simplified(b.footprint.intersection(clip_lonlat)))
             if geom is None:
                 continue
             c = b.footprint.centroid
@@ -1000,6 +1010,54 @@ class _OsmAttribution(MacroElement):
         )
 
 
+class _StreetCasing(MacroElement):
+    """The white streets' grey casing, made in the page from the streets' own layer (the
+    features are not written twice), and both scaled with the zoom: from
+    :data:`_BASEMAP_FULL_ZOOM` on at their full width (a class's width in pixels), thinner
+    farther out, and below zoom 15 thin grey lines without casing (at a city's zoom the
+    wide white streets merged into blobs)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    var map = {{ this._parent.get_name() }};
+    var group = {{ this.group }}, streets = {{ this.streets }};
+    var widths = {{ this.widths|tojson }};
+    function width(f) { return widths[f.properties.highway] || {{ this.default_width }}; }
+    var casing = L.geoJSON(streets.toGeoJSON(), {interactive: false,
+                                                 style: {{ this.casing|tojson }}});
+    group.addLayer(casing);
+    casing.bringToBack();
+    function restyle() {
+        var z = map.getZoom();
+        var k = Math.min(1.25, Math.max(0.2, Math.pow(2, (z - {{ this.full_zoom }}) / 2)));
+        var far = z < 15;
+        streets.setStyle(function (f) {
+            return {weight: Math.max(1, width(f) * k), color: far ? "#bdbab0" : "#ffffff"};
+        });
+        casing.setStyle(function (f) {
+            return {weight: Math.max(1, width(f) * k) + 2, opacity: far ? 0 : 1};
+        });
+    }
+    map.on("zoomend", restyle);
+    restyle();
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, group: Any, streets: Any) -> None:
+        super().__init__()
+        self._name = "CamlocStreetCasing"
+        self.group = group.get_name()
+        self.streets = streets.get_name()
+        self.widths = _ROAD_WEIGHT
+        self.default_width = 4
+        self.casing = _BASEMAP_CASING
+        self.full_zoom = _BASEMAP_FULL_ZOOM
+
+
 def _draw_basemap(
     fmap: folium.Map, bm: Basemap, *, road_style: Mapping[str, Any] | None = None
 ) -> None:
@@ -1038,17 +1096,14 @@ def _draw_basemap(
                 return _ROAD_WEIGHT.get(str(f["properties"].get("highway")), 4)
 
             group = folium.FeatureGroup(name="Streets (OpenStreetMap)", show=True)
-            folium.GeoJson(  # a grey casing under the white streets
-                roads,
-                style_function=lambda f: {**_BASEMAP_CASING, "weight": weight(f) + 2},
-                interactive=False,
-            ).add_to(group)
-            folium.GeoJson(
+            streets = folium.GeoJson(
                 roads,
                 style_function=lambda f: {**_BASEMAP_ROAD, "weight": weight(f)},
                 tooltip=tooltip,
-            ).add_to(group)
+            )
+            streets.add_to(group)
             group.add_to(fmap)
+            _StreetCasing(group, streets).add_to(fmap)
     _OsmAttribution().add_to(fmap)
 
 
