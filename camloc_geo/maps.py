@@ -25,6 +25,14 @@ The summary map colours each camera's best candidate by score (:data:`SCORE_SCAL
 whose best candidate is tied gets a dashed ring and an "≈" badge, and its popup says which
 candidate it is tied with.
 
+Pages without tiles draw the OpenStreetMap streets (names on hover) and buildings as an
+inlined vector basemap (:func:`basemap_features`): the review page within its disc, the
+summary pages within :data:`SUMMARY_BASEMAP_RADIUS_M` of each camera; capped at
+:data:`BASEMAP_MAX_ROADS` and :data:`BASEMAP_MAX_BUILDINGS` features, nearest first (the page
+says so when capped), with OSM's attribution in the map's corner. A clustered summary page
+clusters only markers all but on top of each other (:data:`CLUSTER_NEAR_PX`) at the zoom it
+opens at and closer; both pages open fitted clear of the boxes over the map.
+
 Offline pages (``offline=True``) are one self-contained HTML file: Leaflet's JS and CSS
 and jQuery (which folium's popups use) are inlined from the ``xstatic-leaflet`` and
 ``xstatic-jquery`` packages, Leaflet's images become data URIs, every other asset folium
