@@ -378,3 +378,109 @@ def test_job_map_draws_the_servers_extracts_unless_tiles(tmp_path: Path) -> None
     tiled = job_summary_page(results, "https://tiles.example.test/{z}/{x}/{y}.png", maps=store)
     assert "Streets (OpenStreetMap)" not in tiled
     assert '"highway": ' not in tiled
+
+
+# ----------------------------------------------------------------------- the first view
+@pytest.fixture(scope="module")
+def tied_page(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The bundled sample's offline review page (four tied candidates, 1 and 3 3.4 m apart)."""
+    from camloc_geo.api import locate_scene
+
+    out = locate_scene(REPO / "sample_maps" / "sample_scene.json", map_source=BALTIMORE)
+    path = tmp_path_factory.mktemp("tied") / "tied.html"
+    return maps.candidates_map(out.result, out.map_data, path, offline=True, scene=out.scene)
+
+
+_BOXES = (
+    "Array.from(document.querySelectorAll('.leaflet-control, .camloc-banner'))"
+    ".filter(e => e.offsetWidth > 0).map(e => { const r = e.getBoundingClientRect();"
+    " return {x: r.left, y: r.top, w: r.width, h: r.height, c: e.className}; })"
+)
+
+
+def _under_a_box(page: Any, selector: str) -> list[str]:
+    """The markers (their text) whose centre lies under a box over the map."""
+    boxes = page.evaluate(f"() => {_BOXES}")
+    hidden = []
+    markers = page.locator(selector)
+    for i in range(markers.count()):
+        m = markers.nth(i).bounding_box()
+        assert m is not None
+        cx, cy = m["x"] + m["width"] / 2, m["y"] + m["height"] / 2
+        for b in boxes:
+            if b["x"] <= cx <= b["x"] + b["w"] and b["y"] <= cy <= b["y"] + b["h"]:
+                hidden.append(f"{markers.nth(i).inner_text().strip()} under {b['c']}")
+    return hidden
+
+
+@pytest.mark.browser
+@needs_browser
+@pytest.mark.parametrize("size", [(1400, 900), (1024, 640), (390, 844)])
+def test_first_view_keeps_markers_clear_of_the_boxes(
+    browser: Any, tied_page: Path, tmp_path: Path, size: tuple[int, int]
+) -> None:
+    """No candidate of the sample (12, spread 70 m) and no camera of a summary page whose
+    cameras sit at the corners of their bounds opens under the legend, the title box, the
+    banner, the layer list or the verdicts' counter."""
+    corners = [
+        ("sw", _camera(LAT0, LON0, 0.0)),
+        ("ne", _camera(LAT0 + 0.004, LON0 + 0.006, 0.0)),
+        ("nw", _camera(LAT0 + 0.004, LON0, 0.0)),
+        ("se", _camera(LAT0, LON0 + 0.006, 0.0)),
+    ]
+    summary = tmp_path / "corners.html"
+    summary.write_text(maps.summary_page(corners), encoding="utf-8")
+    for path, selector in ((tied_page, ".camloc-candidate"), (summary, ".camloc-summary-marker")):
+        context = browser.new_context(viewport={"width": size[0], "height": size[1]})
+        page = context.new_page()
+        blocked: list[str] = []
+
+        def route(r: Any, blocked: list[str] = blocked) -> None:
+            if r.request.url.startswith(("file:", "data:")):
+                r.continue_()
+            else:
+                blocked.append(r.request.url)
+                r.abort()
+
+        page.route("**/*", route)
+        try:
+            page.goto(path.resolve().as_uri(), wait_until="load")
+            page.wait_for_selector(selector, timeout=30000)
+            page.wait_for_timeout(300)  # the phone's folds run after the page's script
+            assert page.locator(selector).count() == (12 if path == tied_page else 4)
+            assert _under_a_box(page, selector) == []
+            assert blocked == []
+        finally:
+            context.close()
+
+
+@pytest.mark.browser
+@needs_browser
+def test_a_candidate_under_a_better_one_rises_on_hover(browser: Any, tied_page: Path) -> None:
+    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    page = context.new_page()
+    try:
+        page.goto(tied_page.resolve().as_uri(), wait_until="load")
+        page.wait_for_selector(".camloc-candidate", timeout=30000)
+        one = page.locator(".camloc-candidate", has=page.locator('[data-rank="1"]'))
+        three = page.locator(".camloc-candidate", has=page.locator('[data-rank="3"]'))
+        b1, b3 = one.bounding_box(), three.bounding_box()
+        assert b1 is not None
+        assert b3 is not None
+        z = "e => Number(getComputedStyle(e).zIndex)"
+        assert three.evaluate(z) < one.evaluate(z)  # drawn under candidate 1
+        # the point of 3's disc farthest from 1's centre
+        c1 = (b1["x"] + b1["width"] / 2, b1["y"] + b1["height"] / 2)
+        c3 = (b3["x"] + b3["width"] / 2, b3["y"] + b3["height"] / 2)
+        d = math.hypot(c3[0] - c1[0], c3[1] - c1[1]) or 1.0
+        r3 = b3["width"] / 2 - 3
+        x, y = c3[0] + (c3[0] - c1[0]) / d * r3, c3[1] + (c3[1] - c1[1]) / d * r3
+        assert math.hypot(x - c1[0], y - c1[1]) > b1["width"] / 2 + 6  # off candidate 1
+        page.mouse.move(x, y)
+        page.wait_for_function(
+            "([a, b]) => Number(getComputedStyle(a).zIndex) > Number(getComputedStyle(b).zIndex)",
+            arg=[three.element_handle(), one.element_handle()],
+            timeout=30000,
+        )
+    finally:
+        context.close()
