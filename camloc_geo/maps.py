@@ -2116,6 +2116,7 @@ def build_summary_map(
             ),
             tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})"
             + (f" ≈ {html.escape(tie)}" if tie else ""),
+            rise_on_hover=True,  # a camera drawn under another comes on top under the mouse
         ).add_to(parent)
     parent.add_to(fmap)
     v_items = {}
