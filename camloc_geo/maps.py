@@ -139,8 +139,10 @@ TIE_RING = "#111111"
 
 OSM_ATTRIBUTION = ATTRIBUTION
 _OSM_TILES_ATTR = (
-    '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors'
+    '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors, ODbL'
 )
+"""OSM's credit in the map's attribution line: the OSM tile layer's and the vector
+basemap's (one text, so Leaflet shows it once when both are on a page)."""
 
 _STYLE: dict[str, Any] = {
     "building": {"color": "#8d6e63", "weight": 1, "fillColor": "#d7ccc8", "fillOpacity": 0.7},
@@ -1012,10 +1014,7 @@ class _OsmAttribution(MacroElement):
     def __init__(self) -> None:
         super().__init__()
         self._name = "CamlocOsmAttribution"
-        self.text = (
-            '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> '
-            "contributors, ODbL"
-        )
+        self.text = _OSM_TILES_ATTR
 
 
 class _StreetCasing(MacroElement):
