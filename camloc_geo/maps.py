@@ -815,11 +815,25 @@ def _simplified(geom: Any) -> Any:
     return geom.simplify(_SIMPLIFY_DEG, preserve_topology=True) if not geom.is_empty else geom
 
 
-def _metres_to(points_lonlat: np.ndarray, lon: float, lat: float) -> float:
-    """Approximate metres from (lon, lat) to the nearest of the points (equirectangular)."""
-    dlon = (points_lonlat[:, 0] - lon) * math.cos(math.radians(lat))
-    dlat = points_lonlat[:, 1] - lat
-    return float(np.sqrt(np.min(dlon * dlon + dlat * dlat))) * 111_320.0
+def _unit_vectors(lonlat: npt.ArrayLike) -> np.ndarray:
+    """(lon, lat) degrees → unit vectors (N, 3): their chord distance times the earth's
+    radius is the distance apart in metres, for points a few km apart or closer."""
+    arr = np.radians(np.asarray(lonlat, dtype=float).reshape(-1, 2))
+    cos_lat = np.cos(arr[:, 1])
+    return np.column_stack(
+        [cos_lat * np.cos(arr[:, 0]), cos_lat * np.sin(arr[:, 0]), np.sin(arr[:, 1])]
+    )
+
+
+def _nearest_m(near_lonlat: np.ndarray, refs_lonlat: list[tuple[float, float]]) -> np.ndarray:
+    """Metres from each reference point to the nearest of ``near_lonlat`` (a k-d tree: a
+    batch's page has up to 50,000 cameras)."""
+    if not refs_lonlat:
+        return np.zeros(0)
+    from scipy.spatial import cKDTree
+
+    dist, _idx = cKDTree(_unit_vectors(near_lonlat)).query(_unit_vectors(refs_lonlat))
+    return np.asarray(dist, dtype=float) * 6_371_008.8
 
 
 def basemap_features(
@@ -856,8 +870,8 @@ def basemap_features(
         c = clip_lonlat.centroid
         near = np.array([[c.x, c.y]])
     prepared = shapely.prepared.prep(clip_lonlat)
-    roads: list[tuple[float, dict[str, Any]]] = []
-    buildings: list[tuple[float, dict[str, Any]]] = []
+    roads: list[tuple[tuple[float, float], dict[str, Any]]] = []
+    buildings: list[tuple[tuple[float, float], dict[str, Any]]] = []
     seen_roads: set[Any] = set()
     seen_buildings: set[str] = set()
     for md in maps_data:
@@ -872,7 +886,7 @@ def basemap_features(
             mid = st.geometry.interpolate(0.5, normalized=True)
             roads.append(
                 (
-                    _metres_to(near, mid.x, mid.y),
+                    (mid.x, mid.y),
                     {
                         "type": "Feature",
                         "geometry": geom,
@@ -895,7 +909,7 @@ def basemap_features(
             h = _overlay.building_height_m(b)
             buildings.append(
                 (
-                    _metres_to(near, c.x, c.y),
+                    (c.x, c.y),
                     {
                         "type": "Feature",
                         "geometry": geom,
@@ -907,8 +921,10 @@ def basemap_features(
                     },
                 )
             )
-    roads.sort(key=lambda t: t[0])
-    buildings.sort(key=lambda t: t[0])
+    road_m = _nearest_m(near, [ref for ref, _f in roads])
+    building_m = _nearest_m(near, [ref for ref, _f in buildings])
+    roads = [roads[k] for k in np.argsort(road_m, kind="stable")]
+    buildings = [buildings[k] for k in np.argsort(building_m, kind="stable")]
     n_roads = BASEMAP_MAX_ROADS if max_roads is None else max(int(max_roads), 0)
     n_buildings = BASEMAP_MAX_BUILDINGS if max_buildings is None else max(int(max_buildings), 0)
     return Basemap(
