@@ -25,6 +25,14 @@ The summary map colours each camera's best candidate by score (:data:`SCORE_SCAL
 whose best candidate is tied gets a dashed ring and an "≈" badge, and its popup says which
 candidate it is tied with.
 
+Pages without tiles draw the OpenStreetMap streets (names on hover) and buildings as an
+inlined vector basemap (:func:`basemap_features`): the review page within its disc, the
+summary pages within :data:`SUMMARY_BASEMAP_RADIUS_M` of each camera; capped at
+:data:`BASEMAP_MAX_ROADS` and :data:`BASEMAP_MAX_BUILDINGS` features, nearest first (the page
+says so when capped), with OSM's attribution in the map's corner. A clustered summary page
+clusters only markers all but on top of each other (:data:`CLUSTER_NEAR_PX`) at the zoom it
+opens at and closer; both pages open fitted clear of the boxes over the map.
+
 Offline pages (``offline=True``) are one self-contained HTML file: Leaflet's JS and CSS
 and jQuery (which folium's popups use) are inlined from the ``xstatic-leaflet`` and
 ``xstatic-jquery`` packages, Leaflet's images become data URIs, every other asset folium
@@ -41,12 +49,17 @@ import logging
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import folium
 import numpy as np
+import numpy.typing as npt
+import shapely
+import shapely.affinity
+import shapely.prepared
 from branca.element import Figure, MacroElement
 from jinja2 import Template
 from shapely.geometry import LineString, Point, Polygon
@@ -61,12 +74,22 @@ if TYPE_CHECKING:
     from camloc_geo.scene import Scene
 
 __all__ = [
+    "BASEMAP_MAX_AREAS",
+    "BASEMAP_MAX_BUILDINGS",
+    "BASEMAP_MAX_ROADS",
+    "CLUSTER_NEAR_PX",
+    "CLUSTER_OPEN_MAX_MARKERS",
+    "CLUSTER_STREET_ZOOM",
     "MAX_PAGE_BYTES",
     "RANK_OTHER",
     "RANK_PALETTE",
     "SCORE_SCALE",
+    "SUMMARY_BASEMAP_RADIUS_M",
     "VERDICTS",
     "VERDICT_FIELDS",
+    "Basemap",
+    "basemap_features",
+    "basemap_maps",
     "build_candidates_map",
     "build_summary_map",
     "candidates_map",
@@ -77,6 +100,7 @@ __all__ = [
     "read_verdicts",
     "score_colour",
     "summary_map",
+    "summary_page",
 ]
 
 log = logging.getLogger(__name__)
@@ -115,8 +139,10 @@ TIE_RING = "#111111"
 
 OSM_ATTRIBUTION = ATTRIBUTION
 _OSM_TILES_ATTR = (
-    '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors'
+    '&copy; <a href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors, ODbL'
 )
+"""OSM's credit in the map's attribution line: the OSM tile layer's and the vector
+basemap's (one text, so Leaflet shows it once when both are on a page)."""
 
 _STYLE: dict[str, Any] = {
     "building": {"color": "#8d6e63", "weight": 1, "fillColor": "#d7ccc8", "fillOpacity": 0.7},
@@ -129,7 +155,6 @@ _STYLE: dict[str, Any] = {
 _OVERLAY_TOP = 5
 _MATCH_LAYERS = 5
 _CONES_SHOWN = 3
-_BANNER_PX = 150  # about the height of the tie banner: the candidates are fitted below it
 _BANNER_FOLDED_PX = 60  # the banner folded to its headline while a popup is open
 BANNER_FOLD_BELOW_PX = (1200, 800)
 """A map narrower or lower than this (pixels) opens with the banner folded to its headline."""
@@ -372,6 +397,8 @@ _PAGE_CSS = """
 .camloc-legend.folded { max-height: 1.45em; overflow: hidden; }
 .camloc-popup-open .leaflet-top .leaflet-control { visibility: hidden; }
 @media (max-width: 719px) {
+  .leaflet-control-attribution { font-size: 10px; max-width: calc(100vw - 110px);
+    white-space: normal; text-align: right; }
   .camloc-banner { top: auto; bottom: 100px; min-width: 0; max-width: calc(100% - 40px);
     width: calc(100% - 40px); }
   .leaflet-popup-content { max-width: calc(100vw - 70px) !important; max-height: 62vh;
@@ -692,6 +719,417 @@ def _tie_note(
     )
 
 
+# ----------------------------------------------------------------------- vector basemap
+BASEMAP_MAX_ROADS = 1500
+"""At most this many street pieces are drawn on one page's vector basemap (nearest the
+cameras first; the page says so when more were in reach)."""
+BASEMAP_MAX_BUILDINGS = 1500
+"""At most this many building outlines are drawn on one page's vector basemap (nearest
+first; the page says so when more were in reach)."""
+SUMMARY_BASEMAP_RADIUS_M = 250.0
+"""A summary page's vector basemap covers this many metres around each camera."""
+
+_ROAD_WEIGHT = {
+    "motorway": 9,
+    "trunk": 9,
+    "primary": 8,
+    "secondary": 8,
+    "tertiary": 7,
+    "residential": 6,
+    "unclassified": 6,
+    "living_street": 5,
+    "service": 4,
+}
+_BASEMAP_ROAD = {"color": "#ffffff", "opacity": 1.0, "lineCap": "round", "lineJoin": "round"}
+_BASEMAP_CASING = {"color": "#9a9a92", "opacity": 1.0, "lineCap": "round", "lineJoin": "round"}
+_BASEMAP_BACKGROUND = "#efeee9"
+_BASEMAP_FULL_ZOOM = 18
+_BASEMAP_BUILDING = {"color": "#a1887f", "weight": 1, "fillColor": "#e4dcd6", "fillOpacity": 0.8}
+
+
+@dataclass(frozen=True)
+class Basemap:
+    """The OSM streets and buildings a page draws under its markers (lon/lat GeoJSON).
+
+    Attributes
+    ----------
+    roads, buildings
+        GeoJSON features, nearest the page's points first, at most the caps.
+    roads_in_reach, buildings_in_reach
+        How many were inside the clip before the caps.
+    """
+
+    roads: list[dict[str, Any]]
+    buildings: list[dict[str, Any]]
+    roads_in_reach: int
+    buildings_in_reach: int
+
+    @property
+    def capped(self) -> bool:
+        """More features were in reach than are drawn."""
+        roads_left = self.roads_in_reach > len(self.roads)
+        return roads_left or self.buildings_in_reach > len(self.buildings)
+
+    @property
+    def empty(self) -> bool:
+        """Nothing to draw."""
+        return not self.roads and not self.buildings
+
+
+def _lonlat_geojson(geom: Any) -> dict[str, Any] | None:
+    """A clipped shapely geometry in lon/lat → a GeoJSON geometry (lines or polygons only),
+    coordinates rounded to 6 decimals (about 0.1 m)."""
+    if geom.is_empty:
+        return None
+    lines: list[Any] = []
+    polys: list[Any] = []
+    for g in getattr(geom, "geoms", [geom]):
+        if g.is_empty:
+            continue
+        if isinstance(g, LineString) and len(g.coords) >= 2:
+            lines.append([list(c[:2]) for c in g.coords])
+        elif isinstance(g, Polygon):
+            polys.append(
+                [[list(c[:2]) for c in g.exterior.coords]]
+                + [[list(c[:2]) for c in r.coords] for r in g.interiors]
+            )
+        elif hasattr(g, "geoms"):
+            sub = _lonlat_geojson(g)
+            if sub is not None and sub["type"] == "MultiLineString":
+                lines.extend(sub["coordinates"])
+            elif sub is not None:
+                polys.extend(sub["coordinates"])
+    if polys:
+        return {"type": "MultiPolygon", "coordinates": _round_coords(polys)}
+    if lines:
+        return {"type": "MultiLineString", "coordinates": _round_coords(lines)}
+    return None
+
+
+_SIMPLIFY_DEG = 3e-6
+"""Outlines are simplified to about 0.3 m (degrees) before they are written: a page's
+basemap is for telling a street from a building, not for surveying."""
+
+
+def _simplified(geom: Any) -> Any:
+    return geom.simplify(_SIMPLIFY_DEG, preserve_topology=True) if not geom.is_empty else geom
+
+
+def _unit_vectors(lonlat: npt.ArrayLike) -> np.ndarray:
+    """(lon, lat) degrees → unit vectors (N, 3): their chord distance times the earth's
+    radius is the distance apart in metres, for points a few km apart or closer."""
+    arr = np.radians(np.asarray(lonlat, dtype=float).reshape(-1, 2))
+    cos_lat = np.cos(arr[:, 1])
+    return np.column_stack(
+        [cos_lat * np.cos(arr[:, 0]), cos_lat * np.sin(arr[:, 0]), np.sin(arr[:, 1])]
+    )
+
+
+def _nearest_m(near_lonlat: np.ndarray, refs_lonlat: list[tuple[float, float]]) -> np.ndarray:
+    """Metres from each reference point to the nearest of ``near_lonlat`` (a k-d tree: a
+    batch's page has up to 50,000 cameras)."""
+    if not refs_lonlat:
+        return np.zeros(0)
+    from scipy.spatial import cKDTree
+
+    dist, _idx = cKDTree(_unit_vectors(near_lonlat)).query(_unit_vectors(refs_lonlat))
+    return np.asarray(dist, dtype=float) * 6_371_008.8
+
+
+def basemap_features(
+    maps_data: Sequence[MapData],
+    clip_lonlat: Any,
+    near_lonlat: npt.ArrayLike,
+    *,
+    max_roads: int | None = None,
+    max_buildings: int | None = None,
+) -> Basemap:
+    """The streets and buildings of some maps inside a clip area, nearest some points first.
+
+    Parameters
+    ----------
+    maps_data
+        The maps (a street piece or building in two of them is drawn once: by its geometry,
+        by its OSM id).
+    clip_lonlat
+        A shapely geometry in (lon, lat) degrees: features are cut to it.
+    near_lonlat
+        ``(N, 2)`` (lon, lat) of the page's points (cameras, candidates): the features
+        nearest them are kept first when a cap is reached.
+    max_roads, max_buildings
+        Caps on the features kept (>= 0); default :data:`BASEMAP_MAX_ROADS` and
+        :data:`BASEMAP_MAX_BUILDINGS`.
+
+    Returns
+    -------
+    Basemap
+        The features kept and how many were in reach.
+    """
+    near = np.asarray(near_lonlat, dtype=float).reshape(-1, 2)
+    if near.shape[0] == 0:
+        c = clip_lonlat.centroid
+        near = np.array([[c.x, c.y]])
+    prepared = shapely.prepared.prep(clip_lonlat)
+    roads: list[tuple[tuple[float, float], dict[str, Any]]] = []
+    buildings: list[tuple[tuple[float, float], dict[str, Any]]] = []
+    seen_roads: set[Any] = set()
+    seen_buildings: set[str] = set()
+    for md in maps_data:
+        for st in md.streets:
+            key = st.geometry.wkb  # one piece of street in two maps: drawn once
+            if key in seen_roads or not prepared.intersects(st.geometry):
+                continue
+            seen_roads.add(key)
+            geom = _lonlat_geojson(_simplified(st.geometry.intersection(clip_lonlat)))
+            if geom is None:
+                continue
+            mid = st.geometry.interpolate(0.5, normalized=True)
+            roads.append(
+                (
+                    (mid.x, mid.y),
+                    {
+                        "type": "Feature",
+                        "geometry": geom,
+                        "properties": {
+                            "name": st.name or "(unnamed)",
+                            "highway": st.highway,
+                            "width_m": round(float(st.width_m), 1),
+                        },
+                    },
+                )
+            )
+        for b in md.buildings:
+            if b.id in seen_buildings or not prepared.intersects(b.footprint):
+                continue
+            seen_buildings.add(b.id)
+            geom = _lonlat_geojson(_simplified(b.footprint.intersection(clip_lonlat)))
+            if geom is None:
+                continue
+            c = b.footprint.centroid
+            h = _overlay.building_height_m(b)
+            buildings.append(
+                (
+                    (c.x, c.y),
+                    {
+                        "type": "Feature",
+                        "geometry": geom,
+                        "properties": {
+                            "name": b.name or "(building)",
+                            "building": b.building,
+                            "height_m": "unknown" if h is None else f"{h:.0f}",
+                        },
+                    },
+                )
+            )
+    road_m = _nearest_m(near, [ref for ref, _f in roads])
+    building_m = _nearest_m(near, [ref for ref, _f in buildings])
+    roads = [roads[k] for k in np.argsort(road_m, kind="stable")]
+    buildings = [buildings[k] for k in np.argsort(building_m, kind="stable")]
+    n_roads = BASEMAP_MAX_ROADS if max_roads is None else max(int(max_roads), 0)
+    n_buildings = BASEMAP_MAX_BUILDINGS if max_buildings is None else max(int(max_buildings), 0)
+    return Basemap(
+        roads=[f for _d, f in roads[:n_roads]],
+        buildings=[f for _d, f in buildings[:n_buildings]],
+        roads_in_reach=len(roads),
+        buildings_in_reach=len(buildings),
+    )
+
+
+BASEMAP_MAX_AREAS = 8
+"""A summary page's basemap loads the maps of at most this many extract areas (the ones
+serving the most cameras); cameras elsewhere have no streets drawn under them."""
+
+
+def basemap_maps(
+    points_latlon: Iterable[tuple[float, float]], source: Any
+) -> tuple[list[MapData], int]:
+    """The maps of the extract areas serving some cameras, for a summary page's basemap.
+
+    Only extracts are read, never the network (a page is built from what is on disk): the
+    catalogue's rule picks each camera's area (:class:`camloc_geo.osm.MapCatalogue`), and
+    the maps of at most :data:`BASEMAP_MAX_AREAS` areas (those serving the most cameras)
+    are loaded, once per process. An area whose map cannot be read is skipped (logged).
+
+    Parameters
+    ----------
+    points_latlon
+        The cameras' ``(lat, lon)``, degrees.
+    source
+        A :class:`~camloc_geo.osm.MapCatalogue`, an extract or a folder of extracts, or None.
+
+    Returns
+    -------
+    list of MapData, int
+        The maps, and how many cameras no loaded map serves.
+    """
+    from camloc_geo._errors import MapDataError, MapSourceError
+    from camloc_geo.osm import MapCatalogue, area_map
+
+    if source is None:
+        return [], 0
+    catalogue = MapCatalogue.from_source(source)
+    served: dict[tuple[Any, ...], int] = {}
+    unserved = 0
+    for lat, lon in points_latlon:
+        area = catalogue.area_for_point(float(lat), float(lon)) if catalogue.files else ("none",)
+        if area[0] in ("file", "cell"):
+            served[tuple(area)] = served.get(tuple(area), 0) + 1
+        else:
+            unserved += 1
+    maps_data = []
+    ranked = sorted(served.items(), key=lambda kv: -kv[1])
+    for area, n in ranked[:BASEMAP_MAX_AREAS]:
+        try:
+            maps_data.append(area_map(area))
+        except (MapDataError, MapSourceError, OSError) as exc:  # a page without its streets
+            log.warning("basemap: the map of %s could not be read: %s", area[1], exc)
+            unserved += n
+    unserved += sum(n for _a, n in ranked[BASEMAP_MAX_AREAS:])
+    return maps_data, unserved
+
+
+def _discs_lonlat(points_latlon: Sequence[tuple[float, float]], radius_m: float) -> Any:
+    """The union of discs of ``radius_m`` around (lat, lon) points, in (lon, lat) degrees."""
+    parts = []
+    for lat, lon in points_latlon:
+        k = math.cos(math.radians(lat))
+        disc = Point(0.0, 0.0).buffer(radius_m / 111_320.0, quad_segs=8)
+        parts.append(
+            shapely.affinity.affine_transform(disc, [1.0 / max(k, 1e-6), 0.0, 0.0, 1.0, lon, lat])
+        )
+    return shapely.union_all(parts) if parts else Polygon()
+
+
+def _basemap_note(bm: Basemap) -> str:
+    """The page's line saying the basemap was capped (empty when it was not)."""
+    if not bm.capped:
+        return ""
+    parts = []
+    if bm.roads_in_reach > len(bm.roads):
+        parts.append(f"{len(bm.roads)} of {bm.roads_in_reach} street pieces")
+    if bm.buildings_in_reach > len(bm.buildings):
+        parts.append(f"{len(bm.buildings)} of {bm.buildings_in_reach} buildings")
+    return (
+        '<small class="camloc-basemap-capped" style="display:block">basemap capped: '
+        + html.escape(" and ".join(parts))
+        + " drawn, nearest first</small>"
+    )
+
+
+class _OsmAttribution(MacroElement):
+    """OpenStreetMap's attribution in the map's attribution control (bottom right)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+{{ this._parent.get_name() }}.attributionControl.addAttribution({{ this.text|tojson }});
+{% endmacro %}
+"""
+    )
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._name = "CamlocOsmAttribution"
+        self.text = _OSM_TILES_ATTR
+
+
+class _StreetCasing(MacroElement):
+    """The white streets' grey casing, made in the page from the streets' own layer (the
+    features are not written twice), and both scaled with the zoom: from
+    :data:`_BASEMAP_FULL_ZOOM` on at their full width (a class's width in pixels), thinner
+    farther out, and below zoom 15 thin grey lines without casing (at a city's zoom the
+    wide white streets merged into blobs)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    var map = {{ this._parent.get_name() }};
+    var group = {{ this.group }}, streets = {{ this.streets }};
+    var widths = {{ this.widths|tojson }};
+    function width(f) { return widths[f.properties.highway] || {{ this.default_width }}; }
+    var casing = L.geoJSON(streets.toGeoJSON(), {interactive: false,
+                                                 style: {{ this.casing|tojson }}});
+    group.addLayer(casing);
+    casing.bringToBack();
+    function restyle() {
+        var z = map.getZoom();
+        var k = Math.min(1.25, Math.max(0.2, Math.pow(2, (z - {{ this.full_zoom }}) / 2)));
+        var far = z < 15;
+        streets.setStyle(function (f) {
+            return {weight: Math.max(1, width(f) * k), color: far ? "#bdbab0" : "#ffffff"};
+        });
+        casing.setStyle(function (f) {
+            return {weight: Math.max(1, width(f) * k) + 2, opacity: far ? 0 : 1};
+        });
+    }
+    map.on("zoomend", restyle);
+    restyle();
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, group: Any, streets: Any) -> None:
+        super().__init__()
+        self._name = "CamlocStreetCasing"
+        self.group = group.get_name()
+        self.streets = streets.get_name()
+        self.widths = _ROAD_WEIGHT
+        self.default_width = 4
+        self.casing = _BASEMAP_CASING
+        self.full_zoom = _BASEMAP_FULL_ZOOM
+
+
+def _draw_basemap(
+    fmap: folium.Map, bm: Basemap, *, road_style: Mapping[str, Any] | None = None
+) -> None:
+    """The basemap's layers (streets with their names on hover, building outlines) and OSM's
+    attribution; nothing when it is empty. ``road_style``: one style for every street
+    (the candidates map's dashed centre lines over its carriageways); default white streets
+    in a grey casing, wider by class."""
+    if bm.empty:
+        return
+    if bm.buildings:
+        folium.GeoJson(
+            {"type": "FeatureCollection", "features": bm.buildings},
+            name="Buildings",
+            style_function=lambda _f: _STYLE["building"] if road_style else _BASEMAP_BUILDING,
+            tooltip=folium.GeoJsonTooltip(
+                fields=["name", "building", "height_m"], aliases=["name", "building", "height (m)"]
+            ),
+        ).add_to(fmap)
+    if bm.roads:
+        roads = {"type": "FeatureCollection", "features": bm.roads}
+        tooltip = folium.GeoJsonTooltip(
+            fields=["name", "highway", "width_m"],
+            aliases=["street", "highway", "width (m)"],
+            sticky=True,
+        )
+        if road_style:
+            folium.GeoJson(
+                roads,
+                name="Street centre lines",
+                style_function=lambda _f: dict(road_style),
+                tooltip=tooltip,
+            ).add_to(fmap)
+        else:
+
+            def weight(f: Mapping[str, Any]) -> int:
+                return _ROAD_WEIGHT.get(str(f["properties"].get("highway")), 4)
+
+            group = folium.FeatureGroup(name="Streets (OpenStreetMap)", show=True)
+            streets = folium.GeoJson(
+                roads,
+                style_function=lambda f: {**_BASEMAP_ROAD, "weight": weight(f)},
+                tooltip=tooltip,
+            )
+            streets.add_to(group)
+            group.add_to(fmap)
+            _StreetCasing(group, streets).add_to(fmap)
+    _OsmAttribution().add_to(fmap)
+
+
 # ---------------------------------------------------------------------------- geometry
 def _round_coords(coords: Any, nd: int = 6) -> Any:
     if isinstance(coords, (list, tuple)):
@@ -751,9 +1189,16 @@ def _focus(result: LocateResult, candidates: list[dict[str, Any]]) -> tuple[np.n
 
 
 def _map_layers(
-    fmap: folium.Map, map_data: MapData, frame: LocalFrame, centre: np.ndarray, radius: float
-) -> None:
-    """Carriageways, street centre lines and buildings within ``radius`` of ``centre``."""
+    fmap: folium.Map,
+    map_data: MapData,
+    frame: LocalFrame,
+    centre: np.ndarray,
+    radius: float,
+    near_lonlat: npt.ArrayLike,
+) -> Basemap:
+    """Carriageways, street centre lines and buildings within ``radius`` of ``centre`` (the
+    centre lines and buildings capped at :data:`BASEMAP_MAX_ROADS` and
+    :data:`BASEMAP_MAX_BUILDINGS`, nearest ``near_lonlat`` first)."""
     disc = Point(float(centre[0]), float(centre[1])).buffer(radius, quad_segs=16)
     carriage = _overlay.carriageways_enu(map_data.streets, frame, centre, radius)
     geom = _geom_lonlat(carriage, frame)
@@ -764,66 +1209,16 @@ def _map_layers(
             style_function=lambda _f: _STYLE["carriageway"],
             interactive=False,
         ).add_to(fmap)
-    lines = []
-    for st in map_data.streets:
-        coords = np.asarray(st.geometry.coords, dtype=float)
-        en = frame.points_enu_from_geographic(coords[:, :2])
-        line = LineString(en)
-        if not line.intersects(disc):
-            continue
-        g = _geom_lonlat(line.intersection(disc), frame)
-        if g is None:
-            continue
-        lines.append(
-            {
-                "type": "Feature",
-                "geometry": g,
-                "properties": {
-                    "name": st.name or "(unnamed)",
-                    "highway": st.highway,
-                    "width_m": round(float(st.width_m), 1),
-                },
-            }
-        )
-    if lines:
-        folium.GeoJson(
-            {"type": "FeatureCollection", "features": lines},
-            name="Street centre lines",
-            style_function=lambda _f: _STYLE["centre"],
-            tooltip=folium.GeoJsonTooltip(
-                fields=["name", "highway", "width_m"], aliases=["street", "highway", "width (m)"]
-            ),
-        ).add_to(fmap)
-    blds = []
-    for b in map_data.buildings:
-        ring = np.asarray(b.footprint.exterior.coords, dtype=float)
-        en = frame.points_enu_from_geographic(ring[:, :2])
-        if not Polygon(en).intersects(disc):
-            continue
-        h = _overlay.building_height_m(b)
-        blds.append(
-            {
-                "type": "Feature",
-                "geometry": {
-                    "type": "Polygon",
-                    "coordinates": [_round_coords(ring[:, :2].tolist())],
-                },
-                "properties": {
-                    "name": b.name or "(building)",
-                    "building": b.building,
-                    "height_m": "unknown" if h is None else f"{h:.0f}",
-                },
-            }
-        )
-    if blds:
-        folium.GeoJson(
-            {"type": "FeatureCollection", "features": blds},
-            name="Buildings",
-            style_function=lambda _f: _STYLE["building"],
-            tooltip=folium.GeoJsonTooltip(
-                fields=["name", "building", "height_m"], aliases=["name", "building", "height (m)"]
-            ),
-        ).add_to(fmap)
+    clip = Polygon(frame.points_geographic_from_enu(np.asarray(disc.exterior.coords)))
+    bm = basemap_features(
+        [map_data],
+        clip,
+        near_lonlat,
+        max_roads=BASEMAP_MAX_ROADS,
+        max_buildings=BASEMAP_MAX_BUILDINGS,
+    )
+    _draw_basemap(fmap, bm, road_style=_STYLE["centre"])
+    return bm
 
 
 def _candidate_popup(
@@ -963,7 +1358,11 @@ def _new_map(offline: bool, tiles: str | None, location: Sequence[float]) -> fol
         folium.Element(
             "<style>"
             + _PAGE_CSS
-            + (".leaflet-container { background: #eef0ea; }" if offline or not tiles else "")
+            + (
+                f".leaflet-container.leaflet-container {{ background: {_BASEMAP_BACKGROUND}; }}"
+                if offline or not tiles
+                else ""
+            )
             + "</style>"
         ),
         name="camloc_css",
@@ -1050,8 +1449,13 @@ def build_candidates_map(
     lon0, lat0 = frame.geographic_from_enu(float(centre_en[0]), float(centre_en[1]))
     fmap = _new_map(offline, None if offline else tiles, (float(lat0), float(lon0)))
 
+    basemap_note = ""
     if map_data is not None:
-        _map_layers(fmap, map_data, result.frame, centre_en, radius)
+        near = [[f["properties"]["lon"], f["properties"]["lat"]] for f in cands[:8]]
+        if result.intersection is not None:
+            near.append([result.intersection.lon, result.intersection.lat])
+        bm = _map_layers(fmap, map_data, result.frame, centre_en, radius, near)
+        basemap_note = _basemap_note(bm)
 
     if scene is not None and scene.prior is not None and scene.prior.radius_m:
         fg_prior = folium.FeatureGroup(name="Prior area", show=True)
@@ -1191,6 +1595,10 @@ def build_candidates_map(
             popup=popup,
             tooltip=tip,
             z_index_offset=z,
+            # a candidate under a better one (3.4 m apart at the sample's junction: rank 3
+            # under rank 1) comes on top while the mouse is on what shows of it
+            rise_on_hover=True,
+            rise_offset=20_000,
         ).add_to(fg_cands)
     fg_cands.add_to(fmap)
     scene_name = str(result.scene_id)
@@ -1243,6 +1651,7 @@ def build_candidates_map(
         f"{_fmt(cal['height_m'], ' m', 1)} ({html.escape(str(cal['method']))})</small>"
     )
     title += _left_out_html(cal, collection)
+    title += basemap_note
     if not cands:
         why = str(result.reason or "").strip() or "the locate result gives no reason"
         title += f"<br><b>no candidates</b>: {html.escape(why)}"
@@ -1253,11 +1662,7 @@ def build_candidates_map(
         pts.append([f["geometry"]["coordinates"][1], f["geometry"]["coordinates"][0]])
     if len(pts) >= 2:
         arr = np.asarray(pts)
-        fmap.fit_bounds(
-            [arr.min(axis=0).tolist(), arr.max(axis=0).tolist()],
-            padding_top_left=(40, 40 if banner is None else _BANNER_PX + 20),
-            padding_bottom_right=(40, 40),
-        )
+        _FitClear([arr.min(axis=0).tolist(), arr.max(axis=0).tolist()]).add_to(fmap)
     return fmap
 
 
@@ -1588,7 +1993,7 @@ def build_summary_map(
     offline: bool = False,
     tiles: str | None = "OpenStreetMap",
     cluster: bool = True,
-    map_data: MapData | None = None,
+    map_data: MapData | Sequence[MapData] | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
     verdict_service: str | None = None,
     tiles_attribution: str | None = None,
@@ -1607,8 +2012,12 @@ def build_summary_map(
     cluster
         Cluster markers (online pages only; ``leaflet.markercluster`` from its CDN).
     map_data
-        A map to draw under the cameras (its streets and buildings within 500 m of its
-        centre): the only context an offline page has.
+        A map, or several (the areas of a batch), to draw under the cameras as a light
+        vector basemap: their streets (names on hover) and building outlines within
+        :data:`SUMMARY_BASEMAP_RADIUS_M` of each camera, at most :data:`BASEMAP_MAX_ROADS`
+        and :data:`BASEMAP_MAX_BUILDINGS` of them (nearest the cameras first; the page says
+        so when capped), with OpenStreetMap's attribution: the only context a page without
+        tiles has.
     verdicts
         Rows of :func:`read_verdicts`: shown again on the page (a browser that has verdicts
         of its own for this page keeps those; see docs/candidates.md).
@@ -1650,9 +2059,17 @@ def build_summary_map(
         ).add_to(fmap)
     else:
         fmap = _new_map(offline, None if offline else tiles, location)
-    if map_data is not None:
-        radius = float(min(getattr(map_data, "radius_m", 400.0) or 400.0, 500.0))
-        _map_layers(fmap, map_data, map_data.frame, np.zeros(2), radius)
+    basemap_note = ""
+    if map_data is not None and rows:
+        maps_data: list[MapData] = list(map_data) if isinstance(map_data, Sequence) else [map_data]
+        cams = [(float(f["properties"]["lat"]), float(f["properties"]["lon"])) for _s, f in rows]
+        bm = basemap_features(
+            maps_data,
+            _discs_lonlat(cams, SUMMARY_BASEMAP_RADIUS_M),
+            [(lon, lat) for lat, lon in cams],
+        )
+        _draw_basemap(fmap, bm)
+        basemap_note = _basemap_note(bm)
     parent: Any
     if cluster and not offline:
         from folium.plugins import MarkerCluster
@@ -1714,6 +2131,7 @@ def build_summary_map(
             ),
             tooltip=f"{html.escape(str(scene_id))} ({p.get('score', 0.0):.2f})"
             + (f" ≈ {html.escape(tie)}" if tie else ""),
+            rise_on_hover=True,  # a camera drawn under another comes on top under the mouse
         ).add_to(parent)
     parent.add_to(fmap)
     v_items = {}
@@ -1756,14 +2174,157 @@ def build_summary_map(
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
         title += _missing_html(missing)
+    title += basemap_note
     _Control(title, position="topleft", css_class="camloc-title camloc-summary-title").add_to(fmap)
-    if len(rows) >= 2:
-        fmap.fit_bounds(
-            [[float(lats.min()), float(lons.min())], [float(lats.max()), float(lons.max())]],
-            padding=(30, 30),
-            max_zoom=18,
-        )
+    bounds = (
+        [[float(lats.min()), float(lons.min())], [float(lats.max()), float(lons.max())]]
+        if len(rows) >= 2
+        else None
+    )
+    if isinstance(parent, folium.FeatureGroup) or not rows:
+        if bounds is not None:
+            _FitClear(bounds, max_zoom=18).add_to(fmap)
+    else:
+        _OpenUnclustered(parent, bounds).add_to(fmap)
     return fmap
+
+
+_FIT_CLEAR_JS = """
+function camlocFitClear(map, bounds, maxZoom, beforeFit) {
+    // fit the markers into the part of the map no box covers: a box along the top or the
+    // bottom (title, banner, scale, the verdicts' counter) pads that edge, a tall one
+    // (a long legend or layer list) pads its side; on a phone the legend and the layer list
+    // are folded (SmallScreenFolds), so they count folded
+    var size = map.getSize();
+    var box = map.getContainer().getBoundingClientRect();
+    var small = size.x < SMALL_PX;
+    var pad = {l: 30, t: 30, r: 30, b: 30};
+    var boxes = map.getContainer().querySelectorAll(".leaflet-control, .camloc-banner");
+    Array.prototype.forEach.call(boxes, function (el) {
+        var r = el.getBoundingClientRect();
+        if (!r.width || !r.height) { return; }
+        var x0 = r.left - box.left, y0 = r.top - box.top;
+        var x1 = x0 + r.width, y1 = y0 + r.height;
+        if (small && el.classList.contains("camloc-legend")) { y0 = Math.max(y0, y1 - 30); }
+        if (small && el.classList.contains("leaflet-control-layers")) {
+            y1 = Math.min(y1, y0 + 50);
+            x0 = Math.max(x0, x1 - 50);
+        }
+        if (y1 - y0 > 0.35 * size.y) {
+            if (x0 < size.x / 2) { pad.l = Math.max(pad.l, x1 + 10); }
+            else { pad.r = Math.max(pad.r, size.x - x0 + 10); }
+        } else if (y0 < size.y / 2) { pad.t = Math.max(pad.t, y1 + 10); }
+        else { pad.b = Math.max(pad.b, size.y - y0 + 10); }
+    });
+    // at least 40 % of the map's width and height stay for the markers
+    if (pad.l + pad.r > 0.6 * size.x) {
+        var kx = 0.6 * size.x / (pad.l + pad.r); pad.l *= kx; pad.r *= kx;
+    }
+    if (pad.t + pad.b > 0.6 * size.y) {
+        var ky = 0.6 * size.y / (pad.t + pad.b); pad.t *= ky; pad.b *= ky;
+    }
+    var options = {paddingTopLeft: [pad.l, pad.t], paddingBottomRight: [pad.r, pad.b],
+                   animate: false};
+    if (maxZoom) { options.maxZoom = maxZoom; }
+    if (beforeFit) {  // the zoom fitBounds will choose (Leaflet's own rule)
+        var zoom = map.getBoundsZoom(L.latLngBounds(bounds), false,
+                                     L.point(pad.l + pad.r, pad.t + pad.b));
+        beforeFit(maxZoom ? Math.min(maxZoom, zoom) : zoom);
+    }
+    map.fitBounds(bounds, options);
+    map.getContainer().setAttribute("data-camloc-fit-padding",
+        [pad.l, pad.t, pad.r, pad.b].map(Math.round).join(" "));
+}
+""".replace("SMALL_PX", str(SMALL_SCREEN_PX))
+"""A page's first view: its markers fitted clear of the boxes over the map (a legend at the
+bottom left covered the candidates there)."""
+
+
+class _FitClear(MacroElement):
+    """Fit the map to ``bounds`` clear of its boxes (:data:`_FIT_CLEAR_JS`); added last."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    {{ this.js }}
+    camlocFitClear({{ this._parent.get_name() }}, {{ this.bounds|tojson }},
+                   {{ this.max_zoom|tojson }});
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, bounds: list[list[float]], max_zoom: int | None = None) -> None:
+        super().__init__()
+        self._name = "CamlocFitClear"
+        self.js = _FIT_CLEAR_JS
+        self.bounds = bounds
+        self.max_zoom = max_zoom
+
+
+CLUSTER_NEAR_PX = 4
+"""At the zoom a clustered summary page opens at, and closer, only cameras whose markers
+stand within this many pixels of each other (all but on top of each other: two cameras
+placed at one junction's point) share a cluster, which a click spreads out (markercluster's
+spiderfy); zoomed out farther, markercluster's own 80 px clusters. Cameras tens of metres
+apart are never hidden in a cluster at the opening zoom: a reviewer sees each marker (a page
+of more than :data:`CLUSTER_OPEN_MAX_MARKERS` cameras: from :data:`CLUSTER_STREET_ZOOM`)."""
+
+CLUSTER_OPEN_MAX_MARKERS = 300
+"""A summary page with more cameras than this opens clustered as markercluster clusters
+(80 px) and drops to :data:`CLUSTER_NEAR_PX` only from :data:`CLUSTER_STREET_ZOOM` on: a
+city's thousands of cameras as single markers at a city's zoom would be slow and cover
+each other."""
+
+CLUSTER_STREET_ZOOM = 16
+"""The zoom (about 2 m a pixel) from which a large summary page clusters only markers all
+but on top of each other."""
+
+
+class _OpenUnclustered(MacroElement):
+    """Fit a clustered summary page to its cameras (no animation), then cluster only markers
+    all but on top of each other (:data:`CLUSTER_NEAR_PX`) at that zoom and closer (a large
+    page: from :data:`CLUSTER_STREET_ZOOM`)."""
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    {{ this.js }}
+    var map = {{ this._parent.get_name() }};
+    var group = {{ this.group }};
+    function recluster(open) {  // before the view moves: the group then shows the new view
+        var markers = group.getLayers();
+        var from = markers.length <= {{ this.max_markers }} ? open
+            : Math.max(open, {{ this.street_zoom }});
+        group.options.maxClusterRadius = function (zoom) {
+            return zoom >= from ? {{ this.near_px }} : 80;
+        };
+        group.clearLayers();  // clustered again under the new radius
+        group.addLayers(markers);
+        map.getContainer().setAttribute("data-camloc-open-zoom", String(open));
+        map.getContainer().setAttribute("data-camloc-unclustered-from", String(from));
+    }
+    {% if this.bounds %}
+    camlocFitClear(map, {{ this.bounds|tojson }}, 18, recluster);
+    {% else %}
+    recluster(map.getZoom());
+    {% endif %}
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, group: Any, bounds: list[list[float]] | None) -> None:
+        super().__init__()
+        self._name = "CamlocOpenUnclustered"
+        self.group = group.get_name()
+        self.bounds = bounds
+        self.near_px = CLUSTER_NEAR_PX
+        self.js = _FIT_CLEAR_JS
+        self.max_markers = CLUSTER_OPEN_MAX_MARKERS
+        self.street_zoom = CLUSTER_STREET_ZOOM
 
 
 @lru_cache(maxsize=1)
@@ -1789,6 +2350,7 @@ def summary_page(
     tiles_attribution: str | None = None,
     verdict_service: str | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
+    map_source: Any = None,
 ) -> str:
     """The summary page as one self-contained HTML text, with clusters.
 
@@ -1806,12 +2368,28 @@ def summary_page(
         basemap, the page makes no request of its own.
     tiles_attribution
         The basemap's attribution (plain text; default ``basemap: <host>``).
+    map_source
+        Without ``tiles``: the extracts (a :class:`~camloc_geo.osm.MapCatalogue`, an extract
+        or a folder) whose streets and buildings around the cameras are drawn as a light
+        vector basemap, inlined (:func:`basemap_maps`, :func:`build_summary_map`'s
+        ``map_data``); never the network. None: no basemap.
 
     Returns
     -------
     str
         The page.
     """
+    items = list(items)
+    map_data: list[MapData] | None = None
+    if map_source is not None and not tiles:
+        points = []
+        for _scene_id, item in items:
+            best, _reason = _best_feature(item)
+            if best is not None:
+                points.append((float(best["properties"]["lat"]), float(best["properties"]["lon"])))
+        map_data, unserved = basemap_maps(points, map_source)
+        if unserved:
+            log.info("basemap: %d camera(s) outside the extracts' areas loaded", unserved)
     attribution = None
     if tiles:
         from urllib.parse import urlsplit
@@ -1823,6 +2401,7 @@ def summary_page(
         tiles=tiles or None,
         tiles_attribution=attribution,
         cluster=True,
+        map_data=map_data or None,
         verdicts=verdicts,
         verdict_service=verdict_service,
     )

@@ -61,7 +61,8 @@ def test_batch_page_is_summary_page(batch_page: dict[str, Path]) -> None:
 
     journal = Journal(batch_page["out"].with_suffix(".camloc-batch.sqlite"))
     try:
-        expected = maps.summary_page(_summary_items(journal))
+        # session 38: the batch's extract is drawn under the cameras as a vector basemap
+        expected = maps.summary_page(_summary_items(journal), map_source=BALTIMORE)
     finally:
         journal.close()
     written = batch_page["page"].read_text(encoding="utf-8")

@@ -761,6 +761,12 @@ def test_cluster_badge_counts_the_verdicts_inside(tab: Any, tmp_path: Path) -> N
     path = _clustered_page(tmp_path / "clustered.html", rows)
     tab.open(path, ".camloc-verdicts .camloc-vcount")
     page = tab.page
+    # session 38: at the zoom the page opens at only markers all but on top of each other
+    # cluster (a0-a3, 2.3 px apart, would be pairs): two levels out, markercluster's own
+    page.evaluate(
+        """() => { const m = Object.keys(window).filter(k => /^map_[0-9a-f]+$/.test(k))
+                   .map(k => window[k])[0]; m.setZoom(m.getZoom() - 2, {animate: false}); }"""
+    )
     page.wait_for_function(
         "document.querySelector('.camloc-vcount').textContent === '4 of 6 cameras reviewed'",
         timeout=30000,

@@ -580,7 +580,11 @@ def run_batch(
         if summary_map is not None:
             t = time.perf_counter()
             map_path = _write_summary_map(
-                journal, Path(summary_map), offline=offline_map, verdict_service=verdict_service
+                journal,
+                Path(summary_map),
+                offline=offline_map,
+                verdict_service=verdict_service,
+                map_source=plan,
             )
             stage["summary_map"] += time.perf_counter() - t
         statuses = journal.status_counts()
@@ -982,19 +986,27 @@ def _markercluster_assets() -> tuple[str, str]:
 
 
 def _write_summary_map(
-    journal: Journal, path: Path, *, offline: bool, verdict_service: str | None = None
+    journal: Journal,
+    path: Path,
+    *,
+    offline: bool,
+    verdict_service: str | None = None,
+    map_source: Any = None,
 ) -> Path:
     """The summary map: one marker per placed camera, clustered (offline: inlined plug-in).
 
     The offline page is :func:`camloc_geo.maps.summary_page`'s (the service's job page without
     a basemap): the same bytes this module used to assemble with its own copy of the
-    cluster-inlining code.
+    cluster-inlining code. With ``map_source`` (the run's catalogue) its extracts' streets
+    and buildings around the cameras are drawn under them (never the network).
     """
     from camloc_geo._io import write_text_atomic
     from camloc_geo.maps import build_summary_map, summary_page
 
     if offline:
-        page = summary_page(_summary_items(journal), verdict_service=verdict_service)
+        page = summary_page(
+            _summary_items(journal), verdict_service=verdict_service, map_source=map_source
+        )
     else:
         fmap = build_summary_map(
             _summary_items(journal),

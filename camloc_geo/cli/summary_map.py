@@ -41,7 +41,7 @@ def register(subparsers: Any) -> None:
         metavar="EXTRACT",
         help=(
             "draw this extract's (or this folder's covering extract's) streets and buildings "
-            "(within 500 m of the cameras' centre)"
+            "(within 250 m of each camera, at most 1500 of each; the page says when capped)"
         ),
     )
     p.add_argument("--no-cluster", action="store_true", help="plain markers on online pages too")

@@ -21,6 +21,7 @@ from camloc_geo import SceneError
 from camloc_geo.service.compute import Compute
 from camloc_geo.service.deps import (
     ApiKey,
+    Maps,
     ServiceSettings,
     ServiceStore,
     content_type,
@@ -238,11 +239,14 @@ def job_summary_page(
     results: list[dict[str, Any]],
     tile_url: str | None = None,
     tile_attribution: str | None = None,
+    *,
+    maps: MapStore | None = None,
 ) -> str:
     """The summary page of a job's finished cameras, clustered (Leaflet and its cluster
     plug-in inlined), sharing its reviewers' verdicts through ``/v1/verdicts`` when opened
-    from the server; a basemap only with ``tile_url`` (``CAMLOC_TILE_URL``). Runs in the
-    thread pool."""
+    from the server; a tile basemap only with ``tile_url`` (``CAMLOC_TILE_URL``), otherwise,
+    with ``maps``, the streets and buildings of the server's extracts around the cameras
+    drawn inline (never the network). Runs in the thread pool."""
     from camloc_geo.maps import summary_page
     from camloc_geo.service.routers.verdicts import VERDICTS_PATH
 
@@ -251,22 +255,24 @@ def job_summary_page(
         tiles=tile_url,
         tiles_attribution=tile_attribution,
         verdict_service=VERDICTS_PATH,
+        map_source=None if maps is None or tile_url else maps.catalogue,
     )
 
 
 @router.get("/v1/jobs/{job_id}/map", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
 async def job_map(
-    request: Request, job_id: JobId, store: ServiceStore, settings: ServiceSettings
+    request: Request, job_id: JobId, store: ServiceStore, settings: ServiceSettings, maps: Maps
 ) -> HTMLResponse:
     """The summary page of the job's finished cameras (best candidate each, the others to
     pick from, clustered with their verdicts counted): one self-contained HTML file whose
-    reviewers share their verdicts here; a basemap only when ``CAMLOC_TILE_URL`` is set."""
+    reviewers share their verdicts here; a tile basemap only when ``CAMLOC_TILE_URL`` is
+    set, otherwise the server's extracts' streets and buildings around the cameras."""
     if store.job(job_id) is None:
         raise NotFoundError(f"no job {job_id}")
     results = store.job_results(job_id)
     tiles, attribution = settings.tile_url, settings.tile_attribution
     return HTMLResponse(
-        await run_cpu(request, lambda: job_summary_page(results, tiles, attribution))
+        await run_cpu(request, lambda: job_summary_page(results, tiles, attribution, maps=maps))
     )
 
 
