@@ -810,6 +810,8 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             roll_std_deg=res.roll_std_deg,
             rivals=rec.modes,
             own_logf_std=rec.own_logf_std,
+            focal_std_parts=dict(getattr(res, "focal_std_parts", {}) or {}),
+            line_residual_rms_px=getattr(res, "line_residual_rms_px", math.nan),
         )
         if t["up"] is not None:
             p_true, r_true = pitch_roll_from_up(t["up"])
@@ -897,6 +899,43 @@ def issue24_bars(stripped: dict[str, Any] | None, kept: dict[str, Any] | None) -
     }
 
 
+def sigma_terms(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """Which term decides the photos' own focal sigma (``AutoVPResult.focal_std_parts``).
+
+    Returns
+    -------
+    dict or None
+        ``median``: the median of each term (standard deviations of ``log(focal)``);
+        ``decides``: on how many photos each term is the largest (``least_squares`` and
+        ``jackknife`` counted as one, ``statistical``: the larger of the two is taken);
+        ``share_of_variance``: each term's share of the summed variance over the photos.
+        None when no photo has the terms (the focal length given, or an EXIF prior).
+    """
+    parts = [r["focal_std_parts"] for r in rows if r.get("focal_std_parts")]
+    if not parts:
+        return None
+    names = [k for k in parts[0] if k not in ("least_squares", "jackknife")]
+    table = {
+        "statistical": [max(p["least_squares"], p["jackknife"]) for p in parts],
+        **{k: [p.get(k, 0.0) for p in parts] for k in names},
+    }
+    arr = {
+        k: np.nan_to_num(np.array(v, dtype=float), nan=0.0, posinf=1.0) for k, v in table.items()
+    }
+    keys = list(arr)
+    stacked = np.vstack([arr[k] for k in keys])
+    largest = np.argmax(stacked, axis=0)
+    var = (stacked**2).sum(axis=1)
+    return {
+        "n": len(parts),
+        "median": {k: float(np.median(arr[k])) for k in keys},
+        "decides": {k: int(np.sum(largest == i)) for i, k in enumerate(keys)},
+        "share_of_variance": {
+            k: float(var[i] / var.sum()) if var.sum() > 0 else 0.0 for i, k in enumerate(keys)
+        },
+    }
+
+
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     ok = [r for r in rows if "f" in r]
     n = len(rows)
@@ -949,6 +988,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         ),
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
         "rival_calibration": rival_calibration(rows),
+        "sigma_terms": sigma_terms(ok),
     }
     return out
 
@@ -1041,6 +1081,13 @@ def main(argv: list[str] | None = None) -> int:
         help="a folder of outdoor photos whose EXIF gives the focal length (repeatable)",
     )
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
+    ap.add_argument(
+        "--bias-deg",
+        type=float,
+        default=None,
+        help="the systematic line bias of the focal sigma (degrees; default autovp.BIAS_DEG): "
+        "how far the sigma's size rests on it",
+    )
     ap.add_argument("--sets", default="strecha,sceaux,perrot,lund,street-photos,exif,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
@@ -1135,7 +1182,9 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    opts = {"estimate_distortion": False} if args.no_distortion else {}
+    opts: dict[str, Any] = {"estimate_distortion": False} if args.no_distortion else {}
+    if args.bias_deg is not None:
+        opts["bias_deg"] = args.bias_deg
     runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:
@@ -1222,6 +1271,15 @@ def main(argv: list[str] | None = None) -> int:
                 v = sm.get(k)
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
             lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
+    for s, sm in summary.get("no EXIF", {}).items():
+        st = sm.get("sigma_terms")
+        if st:
+            lines.append(
+                f"sigma terms / {s}: largest on "
+                + ", ".join(f"{k} {v}" for k, v in st["decides"].items() if v)
+                + "; median "
+                + ", ".join(f"{k} {v:.3f}" for k, v in st["median"].items())
+            )
     for key, judged in bars.items():
         for name, b in judged.items():
             if b["value"] is None:

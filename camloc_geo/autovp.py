@@ -643,6 +643,9 @@ class _Model:
     # the photo's own estimate (normalised) and sigma of log(focal), before the default prior
     f_data_n: float = float("nan")
     data_logf_std: float = float("nan")
+    # the terms of the focal sigma (``log(focal)``), by name: see AutoVPResult.focal_std_parts
+    sigma_parts: dict[str, float] = field(default_factory=dict)
+    residual_rms_px: float = float("nan")  # inliers' end-point residual (detection pixels)
 
 
 def _label_scores(
@@ -1528,6 +1531,18 @@ class AutoVPResult:
         Share of the total segment length that supports one of the vanishing points.
     image_size
         ``(width, height)`` in pixels.
+    focal_std_parts
+        The terms of the photo's own ``focal_std_rel`` (standard deviations of
+        ``log(focal)``, by name: ``least_squares``, ``jackknife`` (the larger of the two is
+        taken), ``systematic`` (segments turned by :data:`BIAS_DEG`), ``split_horizon``,
+        ``few_lines``, ``principal_point``, ``rival``), before a default or EXIF prior
+        joins; empty when the focal length was given. For diagnosis
+        (``benchmarks/vp_real.py`` reports which term decides the sigma, set by set); not
+        in the command line's JSON.
+    line_residual_rms_px
+        Root mean square distance of the inlier segments' end points to the lines through
+        their midpoints and vanishing points, in the detection image's pixels (at most
+        1024 px on the longer side); NaN when the focal length was given. For diagnosis.
     """
 
     vanishing_points: FloatArray
@@ -1552,6 +1567,8 @@ class AutoVPResult:
     distortion_std: float = float("nan")
     pitch_std_deg: float = float("nan")
     roll_std_deg: float = float("nan")
+    focal_std_parts: dict[str, float] = field(default_factory=dict)
+    line_residual_rms_px: float = float("nan")
 
     @property
     def street_index(self) -> int:
@@ -2135,6 +2152,21 @@ def detect_vanishing_points(
         stat_std = max(best.logf_std, jack_std)
         own_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2 + pp_std**2)
         rival_std = _rival_spread(rival_modes, own_std)[0]
+        inl = best.labels >= 0
+        if np.any(inl):
+            res_px = _endpoint_residual(_vps_from_rotation(best.R, best.f_n), s)
+            res_in = res_px[best.labels[inl], np.flatnonzero(inl)]
+            # in the detection image's pixels (detect_segments works at most 1024 px wide)
+            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * min(1.0, 1024.0 / scale)
+        best.sigma_parts = {
+            "least_squares": float(best.logf_std),
+            "jackknife": float(jack_std),
+            "systematic": float(sys_std),
+            "split_horizon": float(split_std),
+            "few_lines": float(best.few_shift),
+            "principal_point": float(pp_std),
+            "rival": float(rival_std),
+        }
         best.logf_std = math.sqrt(own_std**2 + rival_std**2)
         if best.weak_only or best.thin_only:
             best.logf_std = min(best.logf_std, _MAX_STATED_STD)
@@ -2200,6 +2232,8 @@ def detect_vanishing_points(
     )
     result.distortion_std = k1_std
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
+    result.focal_std_parts = dict(best.sigma_parts)
+    result.line_residual_rms_px = best.residual_rms_px
     if best.horizon_rests_on:
         result.warnings.append(
             f"no vertical line: the horizon rests on {best.horizon_rests_on} lines of one "
