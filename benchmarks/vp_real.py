@@ -721,6 +721,63 @@ def horizon_err(
     return max(e) / h
 
 
+def vertical_bias_deg(res: Any, t: dict[str, Any]) -> tuple[float, float] | None:
+    """The coherent bias of the photo's vertical lines against the true vertical vanishing
+    point: what ``autovp``'s systematic sigma term (:data:`camloc_geo.autovp.BIAS_DEG`)
+    stands for, measured where the truth gives gravity.
+
+    Each vertical inlier segment (undistorted with the run's ``k1``) is compared with the
+    line from its midpoint to the true vertical vanishing point ``K up`` (true focal length
+    and principal point): its signed angle, in degrees.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(turn, convergence)``: the length-weighted mean angle (all the lines turned the
+        same way: a roll of the lines) and half the difference of the means right and left
+        of their centroid (a change of their lean, which moves the vertical vanishing point
+        and, for a level camera, the focal length); None without gravity truth or with
+        fewer than 4 vertical segments (2 a side for the convergence: NaN).
+    """
+    if t.get("up") is None:
+        return None
+    from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+    segs = np.asarray(res.segments, dtype=float)[np.asarray(res.labels) == 0]
+    if len(segs) < 4:
+        return None
+    if res.distortion:
+        w, h = res.image_size
+        dist = RadialDistortion.for_image(res.distortion, w, h)
+        pts = undistort_points_px(segs.reshape(-1, 2), dist, res.principal_point)
+        segs = pts.reshape(-1, 4)
+        segs = segs[np.all(np.isfinite(segs), axis=1)]
+        if len(segs) < 4:
+            return None
+    f, (cx, cy) = float(t["f"]), t["pp"]
+    up = np.asarray(t["up"], dtype=float)
+    vp = np.array([f * up[0] + cx * up[2], f * up[1] + cy * up[2], up[2]])
+    mid = 0.5 * (segs[:, :2] + segs[:, 2:])
+    d = segs[:, 2:] - segs[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    d = d / np.maximum(length, 1e-12)[:, None]
+    to_vp = vp[None, :2] - vp[2] * mid
+    to_vp = to_vp / np.maximum(np.linalg.norm(to_vp, axis=1, keepdims=True), 1e-12)
+    d = d * np.where(np.sum(d * to_vp, axis=1) < 0, -1.0, 1.0)[:, None]
+    ang = np.degrees(
+        np.arctan2(d[:, 0] * to_vp[:, 1] - d[:, 1] * to_vp[:, 0], np.sum(d * to_vp, axis=1))
+    )
+    turn = float(np.average(ang, weights=length))
+    right = mid[:, 0] > np.average(mid[:, 0], weights=length)
+    conv = math.nan
+    if right.sum() >= 2 and (~right).sum() >= 2:
+        conv = 0.5 * float(
+            np.average(ang[right], weights=length[right])
+            - np.average(ang[~right], weights=length[~right])
+        )
+    return turn, conv
+
+
 class _RivalRecorder:
     """Records the rival frames of one ``detect_vanishing_points`` call (weight and log
     focal ratio of each, and the kept frame's own sigma) by wrapping ``autovp``'s
@@ -816,6 +873,9 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
         if t["up"] is not None:
             p_true, r_true = pitch_roll_from_up(t["up"])
             row.update(pitch_err_deg=res.pitch_deg - p_true, roll_err_deg=res.roll_deg - r_true)
+            vb = vertical_bias_deg(res, t)
+            if vb is not None:
+                row.update(vertical_turn_deg=vb[0], vertical_convergence_deg=vb[1])
         rows.append(row)
     return rows
 
@@ -989,8 +1049,25 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
         "rival_calibration": rival_calibration(rows),
         "sigma_terms": sigma_terms(ok),
+        **_vertical_bias_rms(ok),
     }
     return out
+
+
+def _vertical_bias_rms(ok: list[dict[str, Any]]) -> dict[str, Any]:
+    """Root mean square of :func:`vertical_bias_deg`'s turn and convergence over the photos
+    with gravity truth (degrees; against ``autovp.BIAS_DEG``, which the sigma assumes for
+    both), and how many photos had them."""
+    turn = np.array([r["vertical_turn_deg"] for r in ok if "vertical_turn_deg" in r])
+    conv = np.array([r.get("vertical_convergence_deg", math.nan) for r in ok])
+    conv = conv[np.isfinite(conv)]
+    if not len(turn):
+        return {}
+    return {
+        "n_vertical_bias": len(turn),
+        "vertical_turn_rms_deg": float(np.sqrt(np.mean(turn**2))),
+        "vertical_convergence_rms_deg": float(np.sqrt(np.mean(conv**2))) if len(conv) else None,
+    }
 
 
 def plots(runs: dict[str, list[dict[str, Any]]], out_dir: Path) -> None:
@@ -1272,6 +1349,13 @@ def main(argv: list[str] | None = None) -> int:
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
             lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
     for s, sm in summary.get("no EXIF", {}).items():
+        if sm.get("n_vertical_bias"):
+            conv_rms = sm.get("vertical_convergence_rms_deg")
+            lines.append(
+                f"vertical lines' bias / {s}: turn rms {sm['vertical_turn_rms_deg']:.3f} deg, "
+                f"convergence rms {'-' if conv_rms is None else f'{conv_rms:.3f}'} deg "
+                f"({sm['n_vertical_bias']} photos; the sigma assumes {autovp.BIAS_DEG} for both)"
+            )
         st = sm.get("sigma_terms")
         if st:
             lines.append(
