@@ -57,16 +57,21 @@ The photos (none of them is in this repository; their licences keep them out):
 ``street-photos`` (``street-photos-dev``, ``street-photos-held-out``)
     Ordinary handheld photos taken standing on a street or square (a street receding,
     facades, a church front on a square, a phone box on a pavement), compact cameras and
-    phones, EXIF kept: 12 photos listed in ``benchmarks/street_photos.json`` (file,
-    sha256, repository, commit, path, camera, what it shows, half), from the public
-    repositories ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo,
-    Nikon Coolpix P6000, 640x480; one Nikon D70s photo between apartment blocks) and
+    phones, EXIF kept: 27 photos listed in ``benchmarks/street_photos.json`` (file,
+    sha256, repository, commit, path, camera, what it shows, batch, half). Batch 1 (12):
+    ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo, Nikon Coolpix
+    P6000, 640x480; one Nikon D70s photo between apartment blocks) and
     ``drewnoakes/metadata-extractor-images`` (BlackBerry Z10, Samsung SM-J327T1, Nikon
-    D40, Panasonic DMC-LX3, Canon PowerShot S30), both EXIF test collections, so no
-    licence is given for the photos themselves: kept out, copied by
-    ``benchmarks/fetch_real_photos.sh`` (from a local mirror, else GitHub's raw files).
-    Chosen by what they show before any result on them was read; the halves by a rule
-    fixed then: sorted by sha256, every other one dev. Truth: the EXIF focal length as for
+    D40, Panasonic DMC-LX3, Canon PowerShot S30). Batch 2 (14, stop 38): the test data of
+    ``Exiv2/exiv2``, ``MikeKovarik/exifr``, ``hMatoba/Piexif``, ``photoprism/photoprism``,
+    ``h2non/bimg`` and more of ``drewnoakes/metadata-extractor-images`` (phones: Samsung
+    Galaxy S5, S7, S7 edge, Note 3, Huawei P30, Xiaomi Mi A1, iPhone XS; compacts and
+    DSLRs). Batch 3 (1): a church front from ``ethanhe42/3D-reconstruction`` (Casio
+    EX-Z55). EXIF test collections and library test data, so no licence is given for the
+    photos themselves: kept out, copied by ``benchmarks/fetch_real_photos.sh`` (from a
+    local mirror, else GitHub's raw files). Chosen by what they show before any result on
+    them was read; the halves by a rule fixed then, batch by batch: sorted by sha256,
+    every other one dev (14 dev, 13 held out). Truth: the EXIF focal length as for
     ``perrot``; no gravity truth. Run with and without the EXIF.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
@@ -148,7 +153,14 @@ row says so):
   roll on the road are not in it), how often the stated ``pitch_std_deg`` and
   ``roll_std_deg`` cover the error at 1 and 2 sigma and the median error / sigma
   (``pitch_sigma_cover_1`` ... ``roll_median_err_over_sigma``, and the median absolute
-  errors ``pitch_abs_err_median_deg``, ``roll_abs_err_median_deg``).
+  errors ``pitch_abs_err_median_deg``, ``roll_abs_err_median_deg``);
+- which term decides the photos' own focal sigma (``sigma_terms``, from
+  ``AutoVPResult.focal_std_parts``: on how many photos each term is the largest, each
+  term's median and share of the variance);
+- where the truth gives gravity, the coherent bias of the vertical lines against the true
+  vertical vanishing point (``vertical_turn_rms_deg``, ``vertical_convergence_rms_deg``,
+  :func:`vertical_bias_deg`): what the sigma's systematic term assumes to be
+  ``autovp.BIAS_DEG`` (0.3 degrees). ``--bias-deg`` runs with another value.
 
 Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 """
