@@ -27,8 +27,8 @@
 #                                    CC BY-NC-SA 4.0, so kept out; about 190 MB
 #   ianare/exif-samples, drewnoakes/metadata-extractor-images, Exiv2/exiv2,
 #   MikeKovarik/exifr, hMatoba/Piexif, photoprism/photoprism, h2non/bimg,
-#   ethanhe42/3D-reconstruction, beauwoods/photo-portfolio, Megu09mi/megu
-#                                    33 handheld street photos
+#   ethanhe42/3D-reconstruction, beauwoods/photo-portfolio, Megu09mi/megu, saryCast/grafital
+#                                    37 handheld street photos
 #                                    (benchmarks/street_photos.json: compact cameras and phones,
 #                                    EXIF kept), copied one by one (commit and path pinned, the
 #                                    content checked against its sha256); EXIF test data of
@@ -90,7 +90,7 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of ten repositories (some of them large),
+# The handheld street photos: single files of eleven repositories (some of them large),
 # from the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
 if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
   manifest="$(dirname "$0")/street_photos.json"
