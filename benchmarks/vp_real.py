@@ -57,7 +57,7 @@ The photos (none of them is in this repository; their licences keep them out):
 ``street-photos`` (``street-photos-dev``, ``street-photos-held-out``)
     Ordinary handheld photos taken standing on a street or square (a street receding,
     facades, a church front on a square, a phone box on a pavement), compact cameras and
-    phones, EXIF kept: 37 photos listed in ``benchmarks/street_photos.json`` (file,
+    phones, EXIF kept: 40 photos listed in ``benchmarks/street_photos.json`` (file,
     sha256, repository, commit, path, camera, what it shows, batch, half). Batch 1 (12):
     ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo, Nikon Coolpix
     P6000, 640x480; one Nikon D70s photo between apartment blocks) and
@@ -70,11 +70,12 @@ The photos (none of them is in this repository; their licences keep them out):
     EX-Z55). Batch 4 (3): ``beauwoods/photo-portfolio`` (photos at their camera's full
     native size only: not cropped). Batch 5 (3): ``Megu09mi/megu`` (a builder's website:
     resized, not cropped). Batch 6 (4): ``saryCast/grafital`` (iPhone 4S photos of an
-    apartment complex). EXIF test collections, library test data, a portfolio and a
+    apartment complex). Batch 7 (3): ``BrendanJohn/backbayfens`` (iPhone 6) and one more
+    of ``saryCast/grafital``. EXIF test collections, library test data, a portfolio and a
     website, so no licence is given for the photos themselves: kept out, copied by
     ``benchmarks/fetch_real_photos.sh`` (from a local mirror, else GitHub's raw files).
     Chosen by what they show before any result on them was read; the halves by a rule
-    fixed then, batch by batch: sorted by sha256, every other one dev (20 dev, 17 held
+    fixed then, batch by batch: sorted by sha256, every other one dev (22 dev, 18 held
     out). Truth: the EXIF focal length as for
     ``perrot``; no gravity truth. Run with and without the EXIF.
 ``exif``
