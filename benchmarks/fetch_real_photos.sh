@@ -25,11 +25,16 @@
 #                                    centre, right; 1920x1080) and the dataset's reference
 #                                    calibrations (results/*/system_dubska_optimal_calib.json);
 #                                    CC BY-NC-SA 4.0, so kept out; about 190 MB
-#   ianare/exif-samples, drewnoakes/metadata-extractor-images  12 handheld street photos
+#   ianare/exif-samples, drewnoakes/metadata-extractor-images, Exiv2/exiv2,
+#   MikeKovarik/exifr, hMatoba/Piexif, photoprism/photoprism, h2non/bimg,
+#   ethanhe42/3D-reconstruction, beauwoods/photo-portfolio, Megu09mi/megu, saryCast/grafital,
+#   BrendanJohn/backbayfens
+#                                    40 handheld street photos
 #                                    (benchmarks/street_photos.json: compact cameras and phones,
 #                                    EXIF kept), copied one by one (commit and path pinned, the
-#                                    content checked against its sha256); EXIF test collections
-#                                    without a licence for the photos, so kept out
+#                                    content checked against its sha256); EXIF test data of
+#                                    libraries and photos of public websites, no licence
+#                                    given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -87,7 +92,7 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of two repositories (one of them about 400 MB),
+# The handheld street photos: single files of twelve repositories (some of them large),
 # from the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
 if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
   manifest="$(dirname "$0")/street_photos.json"

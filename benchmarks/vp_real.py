@@ -57,16 +57,26 @@ The photos (none of them is in this repository; their licences keep them out):
 ``street-photos`` (``street-photos-dev``, ``street-photos-held-out``)
     Ordinary handheld photos taken standing on a street or square (a street receding,
     facades, a church front on a square, a phone box on a pavement), compact cameras and
-    phones, EXIF kept: 12 photos listed in ``benchmarks/street_photos.json`` (file,
-    sha256, repository, commit, path, camera, what it shows, half), from the public
-    repositories ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo,
-    Nikon Coolpix P6000, 640x480; one Nikon D70s photo between apartment blocks) and
+    phones, EXIF kept: 40 photos listed in ``benchmarks/street_photos.json`` (file,
+    sha256, repository, commit, path, camera, what it shows, batch, half). Batch 1 (12):
+    ``ianare/exif-samples`` (6 photos of the streets and squares of Arezzo, Nikon Coolpix
+    P6000, 640x480; one Nikon D70s photo between apartment blocks) and
     ``drewnoakes/metadata-extractor-images`` (BlackBerry Z10, Samsung SM-J327T1, Nikon
-    D40, Panasonic DMC-LX3, Canon PowerShot S30), both EXIF test collections, so no
-    licence is given for the photos themselves: kept out, copied by
+    D40, Panasonic DMC-LX3, Canon PowerShot S30). Batch 2 (14, stop 38): the test data of
+    ``Exiv2/exiv2``, ``MikeKovarik/exifr``, ``hMatoba/Piexif``, ``photoprism/photoprism``,
+    ``h2non/bimg`` and more of ``drewnoakes/metadata-extractor-images`` (phones: Samsung
+    Galaxy S5, S7, S7 edge, Note 3, Huawei P30, Xiaomi Mi A1, iPhone XS; compacts and
+    DSLRs). Batch 3 (1): a church front from ``ethanhe42/3D-reconstruction`` (Casio
+    EX-Z55). Batch 4 (3): ``beauwoods/photo-portfolio`` (photos at their camera's full
+    native size only: not cropped). Batch 5 (3): ``Megu09mi/megu`` (a builder's website:
+    resized, not cropped). Batch 6 (4): ``saryCast/grafital`` (iPhone 4S photos of an
+    apartment complex). Batch 7 (3): ``BrendanJohn/backbayfens`` (iPhone 6) and one more
+    of ``saryCast/grafital``. EXIF test collections, library test data, a portfolio and a
+    website, so no licence is given for the photos themselves: kept out, copied by
     ``benchmarks/fetch_real_photos.sh`` (from a local mirror, else GitHub's raw files).
     Chosen by what they show before any result on them was read; the halves by a rule
-    fixed then: sorted by sha256, every other one dev. Truth: the EXIF focal length as for
+    fixed then, batch by batch: sorted by sha256, every other one dev (22 dev, 18 held
+    out). Truth: the EXIF focal length as for
     ``perrot``; no gravity truth. Run with and without the EXIF.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
@@ -148,7 +158,14 @@ row says so):
   roll on the road are not in it), how often the stated ``pitch_std_deg`` and
   ``roll_std_deg`` cover the error at 1 and 2 sigma and the median error / sigma
   (``pitch_sigma_cover_1`` ... ``roll_median_err_over_sigma``, and the median absolute
-  errors ``pitch_abs_err_median_deg``, ``roll_abs_err_median_deg``).
+  errors ``pitch_abs_err_median_deg``, ``roll_abs_err_median_deg``);
+- which term decides the photos' own focal sigma (``sigma_terms``, from
+  ``AutoVPResult.focal_std_parts``: on how many photos each term is the largest, each
+  term's median and share of the variance);
+- where the truth gives gravity, the coherent bias of the vertical lines against the true
+  vertical vanishing point (``vertical_turn_rms_deg``, ``vertical_convergence_rms_deg``,
+  :func:`vertical_bias_deg`): what the sigma's systematic term assumes to be
+  ``autovp.BIAS_DEG`` (0.3 degrees). ``--bias-deg`` runs with another value.
 
 Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 """
@@ -721,6 +738,63 @@ def horizon_err(
     return max(e) / h
 
 
+def vertical_bias_deg(res: Any, t: dict[str, Any]) -> tuple[float, float] | None:
+    """The coherent bias of the photo's vertical lines against the true vertical vanishing
+    point: what ``autovp``'s systematic sigma term (:data:`camloc_geo.autovp.BIAS_DEG`)
+    stands for, measured where the truth gives gravity.
+
+    Each vertical inlier segment (undistorted with the run's ``k1``) is compared with the
+    line from its midpoint to the true vertical vanishing point ``K up`` (true focal length
+    and principal point): its signed angle, in degrees.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(turn, convergence)``: the length-weighted mean angle (all the lines turned the
+        same way: a roll of the lines) and half the difference of the means right and left
+        of their centroid (a change of their lean, which moves the vertical vanishing point
+        and, for a level camera, the focal length); None without gravity truth or with
+        fewer than 4 vertical segments (2 a side for the convergence: NaN).
+    """
+    if t.get("up") is None:
+        return None
+    from camloc_geo.camera import RadialDistortion, undistort_points_px
+
+    segs = np.asarray(res.segments, dtype=float)[np.asarray(res.labels) == 0]
+    if len(segs) < 4:
+        return None
+    if res.distortion:
+        w, h = res.image_size
+        dist = RadialDistortion.for_image(res.distortion, w, h)
+        pts = undistort_points_px(segs.reshape(-1, 2), dist, res.principal_point)
+        segs = pts.reshape(-1, 4)
+        segs = segs[np.all(np.isfinite(segs), axis=1)]
+        if len(segs) < 4:
+            return None
+    f, (cx, cy) = float(t["f"]), t["pp"]
+    up = np.asarray(t["up"], dtype=float)
+    vp = np.array([f * up[0] + cx * up[2], f * up[1] + cy * up[2], up[2]])
+    mid = 0.5 * (segs[:, :2] + segs[:, 2:])
+    d = segs[:, 2:] - segs[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    d = d / np.maximum(length, 1e-12)[:, None]
+    to_vp = vp[None, :2] - vp[2] * mid
+    to_vp = to_vp / np.maximum(np.linalg.norm(to_vp, axis=1, keepdims=True), 1e-12)
+    d = d * np.where(np.sum(d * to_vp, axis=1) < 0, -1.0, 1.0)[:, None]
+    ang = np.degrees(
+        np.arctan2(d[:, 0] * to_vp[:, 1] - d[:, 1] * to_vp[:, 0], np.sum(d * to_vp, axis=1))
+    )
+    turn = float(np.average(ang, weights=length))
+    right = mid[:, 0] > np.average(mid[:, 0], weights=length)
+    conv = math.nan
+    if right.sum() >= 2 and (~right).sum() >= 2:
+        conv = 0.5 * float(
+            np.average(ang[right], weights=length[right])
+            - np.average(ang[~right], weights=length[~right])
+        )
+    return turn, conv
+
+
 class _RivalRecorder:
     """Records the rival frames of one ``detect_vanishing_points`` call (weight and log
     focal ratio of each, and the kept frame's own sigma) by wrapping ``autovp``'s
@@ -810,10 +884,15 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             roll_std_deg=res.roll_std_deg,
             rivals=rec.modes,
             own_logf_std=rec.own_logf_std,
+            focal_std_parts=dict(getattr(res, "focal_std_parts", {}) or {}),
+            line_residual_rms_px=getattr(res, "line_residual_rms_px", math.nan),
         )
         if t["up"] is not None:
             p_true, r_true = pitch_roll_from_up(t["up"])
             row.update(pitch_err_deg=res.pitch_deg - p_true, roll_err_deg=res.roll_deg - r_true)
+            vb = vertical_bias_deg(res, t)
+            if vb is not None:
+                row.update(vertical_turn_deg=vb[0], vertical_convergence_deg=vb[1])
         rows.append(row)
     return rows
 
@@ -897,6 +976,43 @@ def issue24_bars(stripped: dict[str, Any] | None, kept: dict[str, Any] | None) -
     }
 
 
+def sigma_terms(rows: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """Which term decides the photos' own focal sigma (``AutoVPResult.focal_std_parts``).
+
+    Returns
+    -------
+    dict or None
+        ``median``: the median of each term (standard deviations of ``log(focal)``);
+        ``decides``: on how many photos each term is the largest (``least_squares`` and
+        ``jackknife`` counted as one, ``statistical``: the larger of the two is taken);
+        ``share_of_variance``: each term's share of the summed variance over the photos.
+        None when no photo has the terms (the focal length given, or an EXIF prior).
+    """
+    parts = [r["focal_std_parts"] for r in rows if r.get("focal_std_parts")]
+    if not parts:
+        return None
+    names = [k for k in parts[0] if k not in ("least_squares", "jackknife")]
+    table = {
+        "statistical": [max(p["least_squares"], p["jackknife"]) for p in parts],
+        **{k: [p.get(k, 0.0) for p in parts] for k in names},
+    }
+    arr = {
+        k: np.nan_to_num(np.array(v, dtype=float), nan=0.0, posinf=1.0) for k, v in table.items()
+    }
+    keys = list(arr)
+    stacked = np.vstack([arr[k] for k in keys])
+    largest = np.argmax(stacked, axis=0)
+    var = (stacked**2).sum(axis=1)
+    return {
+        "n": len(parts),
+        "median": {k: float(np.median(arr[k])) for k in keys},
+        "decides": {k: int(np.sum(largest == i)) for i, k in enumerate(keys)},
+        "share_of_variance": {
+            k: float(var[i] / var.sum()) if var.sum() > 0 else 0.0 for i, k in enumerate(keys)
+        },
+    }
+
+
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
     ok = [r for r in rows if "f" in r]
     n = len(rows)
@@ -949,8 +1065,26 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         ),
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
         "rival_calibration": rival_calibration(rows),
+        "sigma_terms": sigma_terms(ok),
+        **_vertical_bias_rms(ok),
     }
     return out
+
+
+def _vertical_bias_rms(ok: list[dict[str, Any]]) -> dict[str, Any]:
+    """Root mean square of :func:`vertical_bias_deg`'s turn and convergence over the photos
+    with gravity truth (degrees; against ``autovp.BIAS_DEG``, which the sigma assumes for
+    both), and how many photos had them."""
+    turn = np.array([r["vertical_turn_deg"] for r in ok if "vertical_turn_deg" in r])
+    conv = np.array([r.get("vertical_convergence_deg", math.nan) for r in ok])
+    conv = conv[np.isfinite(conv)]
+    if not len(turn):
+        return {}
+    return {
+        "n_vertical_bias": len(turn),
+        "vertical_turn_rms_deg": float(np.sqrt(np.mean(turn**2))),
+        "vertical_convergence_rms_deg": float(np.sqrt(np.mean(conv**2))) if len(conv) else None,
+    }
 
 
 def plots(runs: dict[str, list[dict[str, Any]]], out_dir: Path) -> None:
@@ -1041,6 +1175,13 @@ def main(argv: list[str] | None = None) -> int:
         help="a folder of outdoor photos whose EXIF gives the focal length (repeatable)",
     )
     ap.add_argument("--limit", type=int, default=None, help="at most N photos per set")
+    ap.add_argument(
+        "--bias-deg",
+        type=float,
+        default=None,
+        help="the systematic line bias of the focal sigma (degrees; default autovp.BIAS_DEG): "
+        "how far the sigma's size rests on it",
+    )
     ap.add_argument("--sets", default="strecha,sceaux,perrot,lund,street-photos,exif,yud")
     ap.add_argument("--out", type=Path, default=HERE / "out")
     ap.add_argument(
@@ -1135,7 +1276,9 @@ def main(argv: list[str] | None = None) -> int:
     if not data:
         log.error("no photos found: %s", HOW_TO_GET)
         return 2
-    opts = {"estimate_distortion": False} if args.no_distortion else {}
+    opts: dict[str, Any] = {"estimate_distortion": False} if args.no_distortion else {}
+    if args.bias_deg is not None:
+        opts["bias_deg"] = args.bias_deg
     runs = {"no EXIF": run(data, use_exif=False, **opts)}
     exif_data = [t for t in data if t.get("exif")]
     if exif_data:
@@ -1222,6 +1365,22 @@ def main(argv: list[str] | None = None) -> int:
                 v = sm.get(k)
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
             lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
+    for s, sm in summary.get("no EXIF", {}).items():
+        if sm.get("n_vertical_bias"):
+            conv_rms = sm.get("vertical_convergence_rms_deg")
+            lines.append(
+                f"vertical lines' bias / {s}: turn rms {sm['vertical_turn_rms_deg']:.3f} deg, "
+                f"convergence rms {'-' if conv_rms is None else f'{conv_rms:.3f}'} deg "
+                f"({sm['n_vertical_bias']} photos; the sigma assumes {autovp.BIAS_DEG} for both)"
+            )
+        st = sm.get("sigma_terms")
+        if st:
+            lines.append(
+                f"sigma terms / {s}: largest on "
+                + ", ".join(f"{k} {v}" for k, v in st["decides"].items() if v)
+                + "; median "
+                + ", ".join(f"{k} {v:.3f}" for k, v in st["median"].items())
+            )
     for key, judged in bars.items():
         for name, b in judged.items():
             if b["value"] is None:

@@ -643,6 +643,9 @@ class _Model:
     # the photo's own estimate (normalised) and sigma of log(focal), before the default prior
     f_data_n: float = float("nan")
     data_logf_std: float = float("nan")
+    # the terms of the focal sigma (``log(focal)``), by name: see AutoVPResult.focal_std_parts
+    sigma_parts: dict[str, float] = field(default_factory=dict)
+    residual_rms_px: float = float("nan")  # inliers' end-point residual (detection pixels)
 
 
 def _label_scores(
@@ -1528,6 +1531,18 @@ class AutoVPResult:
         Share of the total segment length that supports one of the vanishing points.
     image_size
         ``(width, height)`` in pixels.
+    focal_std_parts
+        The terms of the photo's own ``focal_std_rel`` (standard deviations of
+        ``log(focal)``, by name: ``least_squares``, ``jackknife`` (the larger of the two is
+        taken), ``systematic`` (segments turned by :data:`BIAS_DEG`), ``split_horizon``,
+        ``few_lines``, ``principal_point``, ``rival``), before a default or EXIF prior
+        joins; empty when the focal length was given. For diagnosis
+        (``benchmarks/vp_real.py`` reports which term decides the sigma, set by set); not
+        in the command line's JSON.
+    line_residual_rms_px
+        Root mean square distance of the inlier segments' end points to the lines through
+        their midpoints and vanishing points, in the detection image's pixels (at most
+        1024 px on the longer side); NaN when the focal length was given. For diagnosis.
     """
 
     vanishing_points: FloatArray
@@ -1552,6 +1567,8 @@ class AutoVPResult:
     distortion_std: float = float("nan")
     pitch_std_deg: float = float("nan")
     roll_std_deg: float = float("nan")
+    focal_std_parts: dict[str, float] = field(default_factory=dict)
+    line_residual_rms_px: float = float("nan")
 
     @property
     def street_index(self) -> int:
@@ -2135,6 +2152,21 @@ def detect_vanishing_points(
         stat_std = max(best.logf_std, jack_std)
         own_std = math.sqrt(stat_std**2 + sys_std**2 + split_std**2 + best.few_shift**2 + pp_std**2)
         rival_std = _rival_spread(rival_modes, own_std)[0]
+        inl = best.labels >= 0
+        if np.any(inl):
+            res_px = _endpoint_residual(_vps_from_rotation(best.R, best.f_n), s)
+            res_in = res_px[best.labels[inl], np.flatnonzero(inl)]
+            # in the detection image's pixels (detect_segments works at most 1024 px wide)
+            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * min(1.0, 1024.0 / scale)
+        best.sigma_parts = {
+            "least_squares": float(best.logf_std),
+            "jackknife": float(jack_std),
+            "systematic": float(sys_std),
+            "split_horizon": float(split_std),
+            "few_lines": float(best.few_shift),
+            "principal_point": float(pp_std),
+            "rival": float(rival_std),
+        }
         best.logf_std = math.sqrt(own_std**2 + rival_std**2)
         if best.weak_only or best.thin_only:
             best.logf_std = min(best.logf_std, _MAX_STATED_STD)
@@ -2144,6 +2176,21 @@ def detect_vanishing_points(
             best, s, segs_px, merge_px, tau, f_prior, f_bounds, prior_w, f_free=False
         )
     best.f_data_n, best.data_logf_std = best.f_n, best.logf_std
+    if (
+        has_prior
+        and math.isfinite(best.logf_std)
+        and best.logf_std > prior_sigma
+        and not best.weak_only
+        and not best.thin_only
+    ):
+        # The prior (EXIF, or given) enters the fit as one residual against hundreds of
+        # segments whose noise the fit takes as independent, so a loose photo (a ramp's
+        # railings taken for the street, reflections on a wet road) can pull the focal length
+        # far from it (+21 % at a stated 17 % from a 35 mm tag). The photo's estimate, with
+        # the sigma it states (systematic terms included), and the prior are combined as two
+        # Gaussians in log(focal) instead, as for the default prior. Shortcut: the photo's
+        # estimate is the fit with the prior, which counts the prior a little twice.
+        best = _with_default_prior(best, s, tau, f_bounds, prior_w, (f_prior, prior_sigma))
     if (
         default_focal_prior
         and f_fixed is None
@@ -2200,6 +2247,8 @@ def detect_vanishing_points(
     )
     result.distortion_std = k1_std
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
+    result.focal_std_parts = dict(best.sigma_parts)
+    result.line_residual_rms_px = best.residual_rms_px
     if best.horizon_rests_on:
         result.warnings.append(
             f"no vertical line: the horizon rests on {best.horizon_rests_on} lines of one "
@@ -2601,10 +2650,18 @@ def _finish(
                 if one_finite
                 else "the vanishing points leave it loose"
             )
-            warnings.append(
-                f"the focal length is uncertain (+/- {100 * logf_std:.0f} %): {why}; give "
-                "--focal-px if it is known"
-            )
+            if prior_source is not None and logf_std < data_std:
+                # the prior (EXIF) decides: the photo's lines alone would leave it loose
+                warnings.append(
+                    f"the photo's lines leave the focal length loose (+/- {100 * data_std:.0f} % "
+                    f"on their own: {why}); the {prior_source} focal length decides "
+                    f"(+/- {100 * logf_std:.0f} %)"
+                )
+            else:
+                warnings.append(
+                    f"the focal length is uncertain (+/- {100 * logf_std:.0f} %): {why}; give "
+                    "--focal-px if it is known"
+                )
     if m.thin_only and f_free:
         warnings.append(
             f"the focal length rests on a direction of {m.thin_only} lines that are pieces of "
