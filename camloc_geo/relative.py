@@ -845,6 +845,8 @@ def _size_shape_sensitivity(
     pp_fixed: tuple[float, float] | None,
     f_fixed: float | None,
     size_sigma_rel: float,
+    *,
+    centre: bool = False,
 ) -> FloatArray | None:
     """How the focal length, principal point and rotation move with a preset's size error:
     ``D`` ``(len(x), 3)``, one column per dimension (length, width, height).
@@ -859,7 +861,8 @@ def _size_shape_sensitivity(
     ``−H⁻¹ Jᵀ W dr`` when one dimension is ``1 + size_sigma_rel`` times the preset's (the
     world points scaled along that axis; robust Gauss-Newton at the solution). The camera
     centre's rows are zero: the distance's share of the size error is stated separately
-    (``size_rel`` of :func:`_output_covariance`). None when off or singular.
+    (``size_rel`` of :func:`_output_covariance`); ``centre``: they are kept (the car-class
+    mixture's moves). None when off or singular.
     """
     if size_sigma_rel <= 0.0:
         return None
@@ -882,7 +885,8 @@ def _size_shape_sensitivity(
         D = -np.linalg.solve(H, cols.T)
     except np.linalg.LinAlgError:
         return None
-    D[-3:] = 0.0  # the centre: size_rel's term
+    if not centre:
+        D[-3:] = 0.0  # the centre: size_rel's term
     if not np.all(np.isfinite(D)):
         return None
     return np.asarray(D, dtype=np.float64)
@@ -5054,8 +5058,9 @@ def _output_covariance(
     columns (``car_lines``, :func:`_car_line_sensitivity`); the car-class mixture
     (``class_shifts``, :func:`_class_mixture`: per other preset its posterior weight ``π``
     and log size ratio ``s``, adding ``π m mᵀ`` with ``m`` the answer's move were the car
-    that preset: the shape sensitivity's columns times ``s / size_shape_rel``, the
-    distance times the mean of ``s``). Order: focal length (px),
+    that preset: the shape sensitivity's columns, the centre's rows included, times
+    ``s / size_shape_rel``; without them, ``preset_shape`` off, the distance times the
+    mean of ``s``). Order: focal length (px),
     principal point x, y (px), small rotation about the camera's x, y, z axes (rad, on the left of
     ``cam_from_world_rotation``), camera centre x, y, z (m, output frame). None when the
     normal equations are singular.
@@ -5085,11 +5090,17 @@ def _output_covariance(
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
         A[block] += D @ D.T
-    D_size = _size_shape_sensitivity(prob, x, R0, pp_model, f_fixed, size_shape_rel)
-    if D_size is not None:
+    D_full = _size_shape_sensitivity(
+        prob, x, R0, pp_model, f_fixed, size_shape_rel, centre=bool(class_shifts)
+    )
+    D_size = None
+    if D_full is not None:
+        D_size = D_full.copy()
+        D_size[-3:] = 0.0  # the centre: size_rel's term
         A[block] += D_size @ D_size.T
         for weight, shift in class_shifts or []:
-            move = D_size @ (np.asarray(shift, dtype=float) / size_shape_rel)
+            # The whole answer's move were the car that preset, the centre's included.
+            move = D_full @ (np.asarray(shift, dtype=float) / size_shape_rel)
             A[block] += weight * np.outer(move, move)
     if car_lines is not None:
         A[block] += car_lines @ car_lines.T
@@ -5111,7 +5122,8 @@ def _output_covariance(
     out = T @ A @ T.T
     if size_rel > 0.0:
         out[6:9, 6:9] += size_rel**2 * np.outer(c_out, c_out)
-    for weight, shift in class_shifts or []:
+    for weight, shift in class_shifts or [] if D_full is None else []:
+        # Without the shape columns (``preset_shape`` off): the distance by the mean ratio.
         out[6:9, 6:9] += weight * float(np.mean(shift)) ** 2 * np.outer(c_out, c_out)
     out = 0.5 * (out + out.T)
     if not np.all(np.isfinite(out)):
