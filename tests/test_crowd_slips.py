@@ -289,10 +289,11 @@ def test_slips_stay_said_or_covered_with_the_leverage_correction(key: str) -> No
     """The jackknife's leverage correction (CR2, default since stop 38) shrinks the spread an
     unevenly loaded crowd had over-stated; the over-stated spread had also covered, by
     accident, slips no jackknife is built to see. Four scenes of ``benchmarks/crowd_slips.py``
-    (every corner at the tyre contacts, a height line 9 deg off, two SUVs called sedans)
-    that the plain correction leaves confidently wrong: the default keeps them covered or
-    said, by the leave-outs beyond the linearisation keeping their move
-    (``jackknife_leverage_max_move``) and by the car-class mixture (``car_class_prior``)."""
+    (every corner at the tyre contacts; three SUVs called sedans, two of them confidently
+    wrong with stop 37's sigmas as well) that the plain correction leaves confidently wrong:
+    the default keeps them covered, by the leave-outs beyond the linearisation keeping their
+    move (``jackknife_leverage_max_move``: the tyre contacts) and by the car-class mixture
+    (``car_class_prior``: the SUVs)."""
     case = LEVERAGE[key]
     scene = parse_scene(case["scene"])
     plain = calibrate(
