@@ -131,15 +131,16 @@ class CalibrationSettings:
         leave-out that moves the focal length or the camera's distance from the car by more
         than ``jackknife_leverage_max_move`` (10 %) is beyond that linearisation and keeps its
         whole move. Crowd set (seed 7, 240 scenes): focal 1 sigma 82 -> 80 %, median
-        error/sigma 0.50 -> 0.55; ``benchmarks/README.md``, calibrate_coverage.
+        error/sigma 0.50 -> 0.56; ``benchmarks/README.md``, calibrate_coverage.
     car_class_prior
         Where the size is a car preset's, the prior odds (per other preset) that the car is of
-        that class instead; each class's posterior weight from the clicked proportions
-        (:func:`_class_mixture`) puts the answer's move were it that car into the stated
-        sigmas (the mixture's second moment). An SUV whose clicks look like a sedan's within
-        their noise is then no longer stated with a sedan's sigmas (``crowd_slips``
-        ``roof_suv``, 4 seeds x 40 scenes: confidently wrong 10 -> 6). 0 turns it off (stop
-        37's sigmas); a clearly better class is still warned by name (``_likely_class``).
+        that class instead. Each class whose proportions fit the clicked box better than the
+        stated one's gets its posterior weight (:func:`_class_mixture`), and the answer's
+        move were it that car enters the stated sigmas with that weight. An SUV whose clicks
+        look like a sedan's within their noise is then no longer stated with a sedan's
+        sigmas (``crowd_slips`` ``roof_suv``, 4 development seeds x 40 scenes: confidently
+        wrong 10 -> 3). 0 turns it off (stop 37's sigmas); a clearly better class is still
+        warned by name (``_likely_class``).
     ground_corner_sigma_rel
         Where on a rounded body the car's clicks fall: the ground corner is the ground under
         the body's corner (bumper), but annotators also click the tyre contact, 0.5-1 m
