@@ -30,15 +30,18 @@ the focal length's 1σ / 2σ coverage and median error/σ, the share more than 1
 those the share outside 2σ and outside 2σ with no warning (the note that annotators marked
 different corners does not count as one).
 
-``--jackknife-leverage`` calibrates with ``CalibrationSettings(jackknife_leverage=True)``.
+``--no-jackknife-leverage`` calibrates with ``CalibrationSettings(jackknife_leverage=False)``
+and ``--class-prior 0`` with ``car_class_prior=0`` (both together: stop 37's sigmas; the
+leverage correction and the car-class mixture are on by default since stop 38;
+``--jackknife-leverage`` is accepted, the default).
 ``--terms`` files each scene under the term that decides each of its sigmas (the fit's
-covariance, the ground-corner, preset-shape, car-line, principal-point or size term, or the
-jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
+covariance, the ground-corner, preset-shape, car-line, principal-point, size or car-class
+term, or the jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
 JSON).
 
 Usage::
 
-    python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--jackknife-leverage]
+    python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--no-jackknife-leverage]
 """
 
 from __future__ import annotations
@@ -80,14 +83,22 @@ PP_PRIOR = {"noise_free_pp_prior": CalibrationSettings().principal_point_sigma_r
 SIZE_GIVEN = {"noise_free_size_given"}
 QUANTITIES = ("focal", "pp_x", "pp_y", "x", "y", "z", "height", "rot_x", "rot_y", "rot_z")
 WANT = {"cover_1sigma": (0.55, 0.80), "cover_2sigma": (0.90, 0.98), "median_z": (0.5, 1.0)}
-# calibrate's settings for every scene (``--jackknife-leverage`` turns that option on).
+# calibrate's settings for every scene (``--no-jackknife-leverage``, ``--class-prior``).
 SETTINGS = CalibrationSettings()
 
 
 # ``--terms``: each sigma's terms, recorded by wrapping two of calibrate's private helpers
 # (a diagnostic: the library does not report them). Index in the 9-vector of
 # ``parameter_covariance``: focal 0, rotation 3-5 (rad), centre 6-8.
-TERM_NAMES = ("fit", "ground_corner", "preset_shape", "car_lines", "principal_point", "size")
+TERM_NAMES = (
+    "fit",
+    "ground_corner",
+    "preset_shape",
+    "car_lines",
+    "principal_point",
+    "size",
+    "car_class",
+)
 TERM_QUANTITIES = {"focal": 0, "rot_x": 3, "rot_y": 4, "rot_z": 5, "x": 6, "y": 7, "z": 8}
 _TERMS: dict[int, dict[str, list[float]]] = {}
 
@@ -103,14 +114,22 @@ def _record_terms() -> None:
         full = out_cov(*args, **kwargs)
         if full is None:
             return full
-        names = ("sigma_pp_px", "size_rel", "car_lines", "size_shape_rel")
+        names = ("sigma_pp_px", "size_rel", "car_lines", "size_shape_rel", "class_shifts")
         given = dict(zip(names, args[8:], strict=False)) | kwargs
-        off = {"sigma_pp_px": 0.0, "size_rel": 0.0, "car_lines": None, "size_shape_rel": 0.0}
+        off = {
+            "sigma_pp_px": 0.0,
+            "size_rel": 0.0,
+            "car_lines": None,
+            "size_shape_rel": 0.0,
+            "class_shifts": None,
+        }
 
         def diag(on: str | None) -> Any:
             keep: dict[str, Any] = {
                 k: (given.get(k, off[k]) if k == on else v) for k, v in off.items()
             }
+            if on == "class_shifts":  # the class mixture moves through the shape columns
+                keep["size_shape_rel"] = given.get("size_shape_rel", 0.0)
             rel._ground_corner_sensitivity = gc_sens if on == "gc" else (lambda *a, **k: None)
             try:
                 return np.diag(out_cov(*args[:8], **keep))
@@ -118,10 +137,12 @@ def _record_terms() -> None:
                 rel._ground_corner_sensitivity = gc_sens
 
         fit = diag(None)
-        on = ("gc", "size_shape_rel", "car_lines", "sigma_pp_px", "size_rel")
+        on = ("gc", "size_shape_rel", "car_lines", "sigma_pp_px", "size_rel", "class_shifts")
         terms = {"fit": fit} | {
             name: diag(k) - fit for name, k in zip(TERM_NAMES[1:], on, strict=True)
         }
+        # The class term alone: with the shape columns on, less the shape term itself.
+        terms["car_class"] = terms["car_class"] - terms["preset_shape"]
         _TERMS[id(full)] = {k: v.tolist() for k, v in terms.items()}
         return full
 
@@ -422,8 +443,17 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument(
         "--jackknife-leverage",
-        action="store_true",
-        help="calibrate with CalibrationSettings(jackknife_leverage=True) (default off)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="the jackknife's leverage correction, CalibrationSettings.jackknife_leverage "
+        "(default on since stop 38; --no-jackknife-leverage: stop 37's default)",
+    )
+    parser.add_argument(
+        "--class-prior",
+        type=float,
+        default=CalibrationSettings().car_class_prior,
+        help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
+        "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
     )
     parser.add_argument(
         "--terms",
@@ -436,7 +466,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.terms:
         _record_terms()
     global SETTINGS
-    SETTINGS = CalibrationSettings(jackknife_leverage=args.jackknife_leverage)
+    SETTINGS = CalibrationSettings(
+        jackknife_leverage=args.jackknife_leverage, car_class_prior=args.class_prior
+    )
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
@@ -479,6 +511,7 @@ def main(argv: list[str] | None = None) -> int:
         "want": WANT,
         "sigmas": "main fields (with the principal point's uncertainty)",
         "jackknife_leverage": args.jackknife_leverage,
+        "car_class_prior": args.class_prior,
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),

@@ -450,7 +450,7 @@ def run(slips: list[str], n: int, seed: int) -> dict[str, Any]:
 
 
 OUTCOMES = ("ok", "flagged", "confidently_wrong")
-# calibrate's settings for every scene (``--jackknife-leverage`` turns that option on).
+# calibrate's settings for every scene (``--no-jackknife-leverage``, ``--class-prior``).
 SETTINGS = CalibrationSettings()
 
 
@@ -491,12 +491,23 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
     parser.add_argument(
         "--jackknife-leverage",
-        action="store_true",
-        help="calibrate with CalibrationSettings(jackknife_leverage=True) (default off)",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="the jackknife's leverage correction, CalibrationSettings.jackknife_leverage "
+        "(default on since stop 38; --no-jackknife-leverage: stop 37's default)",
+    )
+    parser.add_argument(
+        "--class-prior",
+        type=float,
+        default=CalibrationSettings().car_class_prior,
+        help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
+        "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
     )
     args = parser.parse_args(argv)
     global SETTINGS
-    SETTINGS = CalibrationSettings(jackknife_leverage=args.jackknife_leverage)
+    SETTINGS = CalibrationSettings(
+        jackknife_leverage=args.jackknife_leverage, car_class_prior=args.class_prior
+    )
     logging.basicConfig(level=logging.CRITICAL)
     logging.getLogger("camloc_geo").setLevel(logging.CRITICAL)
     slips = [s for s in args.slips.split(",") if s] or list(SLIPS)
@@ -510,6 +521,8 @@ def main(argv: list[str] | None = None) -> int:
         "seed": args.seed,
         "n_per_slip": args.n,
         "bars": BARS,
+        "jackknife_leverage": args.jackknife_leverage,
+        "car_class_prior": args.class_prior,
         "wall_time_s": round(time.perf_counter() - t0, 1),
         "slips": per_slip,
     }

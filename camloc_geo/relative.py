@@ -123,15 +123,24 @@ class CalibrationSettings:
         residuals and Jacobian (no refits; ~2 ms; within 10 % of the refits' sigmas in
         80-95 % of crowd scenes, ``benchmarks/calibrate_speed.py``); ``refit``: the whole
         calibration repeated without each annotator (the reference, ~5x one fit).
-    jackknife_leverage
+    jackknife_leverage, jackknife_leverage_max_move
         ``one_step`` only: scale each leave-out's move by its annotator's leverage
         (:func:`_leverage_factors`, the "CR2" correction of the delete-one jackknife, which
-        over-states the spread of an answer resting unevenly on its annotators). Brings the
-        crowd set's bulk into issue 24's band (seed 7, 240 scenes: focal 1 sigma 82 -> 79 %,
-        median error/sigma 0.50 -> 0.58; position 74 -> 69-72 %), but off by default: the
-        inflated spread was also covering errors no jackknife sees (``crowd_slips`` ``--n
-        40``: roof_suv confidently wrong 2 -> 8 %, nonparallel_line 8 -> 10 %,
-        tyre_contact_all 5 -> 8 %); ``benchmarks/README.md``, calibrate_coverage.
+        over-states the spread of an answer resting unevenly on its annotators); on by
+        default since stop 38. The factor is the normal equations' at the joint solution: a
+        leave-out that moves the focal length or the camera's distance from the car by more
+        than ``jackknife_leverage_max_move`` (10 %) is beyond that linearisation and keeps its
+        whole move. Crowd set (seed 7, 240 scenes): focal 1 sigma 82 -> 80 %, median
+        error/sigma 0.50 -> 0.56; ``benchmarks/README.md``, calibrate_coverage.
+    car_class_prior
+        Where the size is a car preset's, the prior odds (per other preset) that the car is of
+        that class instead. Each class whose proportions fit the clicked box better than the
+        stated one's gets its posterior weight (:func:`_class_mixture`), and the answer's
+        move were it that car enters the stated sigmas with that weight. An SUV whose clicks
+        look like a sedan's within their noise is then no longer stated with a sedan's
+        sigmas (``crowd_slips`` ``roof_suv``, 4 development seeds x 40 scenes: confidently
+        wrong 10 -> 3). 0 turns it off (stop 37's sigmas); a clearly better class is still
+        warned by name (``_likely_class``).
     ground_corner_sigma_rel
         Where on a rounded body the car's clicks fall: the ground corner is the ground under
         the body's corner (bumper), but annotators also click the tyre contact, 0.5-1 m
@@ -215,7 +224,9 @@ class CalibrationSettings:
     car_line_axes: tuple[str, ...] = ("length", "width")
     jackknife: bool = True
     jackknife_method: Literal["one_step", "refit"] = "one_step"
-    jackknife_leverage: bool = False
+    jackknife_leverage: bool = True
+    jackknife_leverage_max_move: float = 0.1
+    car_class_prior: float = 0.05
     photo_lines: bool = True
     video_lines: Any = None
 
@@ -835,6 +846,8 @@ def _size_shape_sensitivity(
     pp_fixed: tuple[float, float] | None,
     f_fixed: float | None,
     size_sigma_rel: float,
+    *,
+    centre: bool = False,
 ) -> FloatArray | None:
     """How the focal length, principal point and rotation move with a preset's size error:
     ``D`` ``(len(x), 3)``, one column per dimension (length, width, height).
@@ -849,7 +862,8 @@ def _size_shape_sensitivity(
     ``−H⁻¹ Jᵀ W dr`` when one dimension is ``1 + size_sigma_rel`` times the preset's (the
     world points scaled along that axis; robust Gauss-Newton at the solution). The camera
     centre's rows are zero: the distance's share of the size error is stated separately
-    (``size_rel`` of :func:`_output_covariance`). None when off or singular.
+    (``size_rel`` of :func:`_output_covariance`); ``centre``: they are kept (the car-class
+    mixture's moves). None when off or singular.
     """
     if size_sigma_rel <= 0.0:
         return None
@@ -872,7 +886,8 @@ def _size_shape_sensitivity(
         D = -np.linalg.solve(H, cols.T)
     except np.linalg.LinAlgError:
         return None
-    D[-3:] = 0.0  # the centre: size_rel's term
+    if not centre:
+        D[-3:] = 0.0  # the centre: size_rel's term
     if not np.all(np.isfinite(D)):
         return None
     return np.asarray(D, dtype=np.float64)
@@ -3811,6 +3826,17 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     if settings.jackknife_leverage:  # each leave-out's move shrunk by its group's leverage
         kept_groups = [a for a in range(len(xs)) if a in answers and answers[a][1][2] > 0.0]
         lev = _leverage_factors(state, kept_groups)
+        if lev is not None:
+            # The leverage is the normal equations' at the joint solution: a leave-out that
+            # moves the answer far (focal length or distance by more than
+            # jackknife_leverage_max_move) is beyond that linearisation, and keeps its move.
+            f0 = result.camera.focal_px
+            dist = max(float(np.linalg.norm(c)), 1e-9)
+            for k, a in enumerate(kept_groups):
+                f_a, c_a, _t = answers[a]
+                move = max(abs(f_a / f0 - 1.0), float(np.linalg.norm(c_a - c)) / dist)
+                if move > settings.jackknife_leverage_max_move:
+                    lev[k] = 1.0
     _add_jackknife_spread(result, centres, turns, focals, lev)
     return True
 
@@ -4480,6 +4506,15 @@ def _joint(
         settings.car_line_share_warn,
         settings.car_line_axes,
     )
+    class_shifts = (
+        _class_mixture(props, size, settings.car_class_prior)
+        if props is not None
+        and size_sigma > 0.0
+        and not props.disagrees
+        and other_class is None
+        and settings.car_class_prior > 0.0
+        else []
+    )
     cov_out = _output_covariance(
         prob,
         res,
@@ -4493,6 +4528,7 @@ def _joint(
         size_rel,
         car_lines.D,
         size_shape_rel=size_sigma if settings.preset_shape else 0.0,
+        class_shifts=class_shifts,
     )
     sigma_c: FloatArray | None = None
     sigma_f: float | None = None
@@ -4816,6 +4852,45 @@ def _likely_class(props: _Proportions, size: ObjectSize) -> tuple[str, ObjectSiz
     return best[1], best[2], best[3]
 
 
+def _class_mixture(
+    props: _Proportions, size: ObjectSize, prior: float
+) -> list[tuple[float, FloatArray]]:
+    """The car classes the clicked box may be, short of a warning: ``[(π, s), ...]``.
+
+    :func:`_likely_class` names another preset only where its proportions fit clearly
+    better (``CLASS_DELTA_CHI2``); an SUV whose clicked box looks like a sedan's within the
+    clicks' noise is then called a sedan with the sedan's sigmas, and its height's 17 %
+    moves the focal length and the distance (``benchmarks/crowd_slips.py`` ``roof_suv``:
+    focal 5-37 % low, camera height 1.2-2.2 m off) by more than the preset's own 5 % per
+    dimension covers. Each other preset whose proportions fit the clicked box better than
+    the stated one's (a chi-square drop above 0, :meth:`_Proportions.class_fits`) gets its
+    posterior weight: the prior odds ``prior`` (per preset, that the stated one is that
+    class instead) times the likelihood ratio of its proportions, ``exp(drop / 2)``,
+    normalised with the stated class's 1 (the sum over every other preset); ``s`` is its
+    log size ratio per dimension (length, width, height). The stated sigmas then hold
+    those classes' share of the mixture's second moment about the answer
+    (:func:`_output_covariance`). A class the clicks do not favour adds nothing: with the
+    whole prior mixture a noise-free sedan's position sigma grew 1.5-3x (a pickup's 20-30 %
+    at 1-3 % weight) where its clicks show nothing of another class. Presets whose weight
+    is below 1e-3 are left out too.
+    """
+    stated = np.array([size.length_m, size.width_m, size.height_m])
+    others = [
+        o for o in PRESETS.values() if not np.allclose([o.length_m, o.width_m, o.height_m], stated)
+    ]
+    if not others or prior <= 0.0:
+        return []
+    drops = np.clip(props.class_fits(size, others), -60.0, 60.0)
+    odds = prior * np.exp(0.5 * drops)
+    weights = odds / (1.0 + float(np.sum(odds)))
+    out = []
+    for o, weight, drop in zip(others, weights.tolist(), drops.tolist(), strict=True):
+        if weight >= 1e-3 and drop > 0.0:  # only a class the clicks favour over the stated
+            shift = np.log(np.array([o.length_m, o.width_m, o.height_m]) / stated)
+            out.append((float(weight), shift))
+    return out
+
+
 def _class_warning(
     props: _Proportions,
     size: ObjectSize,
@@ -4977,6 +5052,7 @@ def _output_covariance(
     size_rel: float,
     car_lines: FloatArray | None = None,
     size_shape_rel: float = 0.0,
+    class_shifts: list[tuple[float, FloatArray]] | None = None,
 ) -> FloatArray | None:
     """Joint covariance ``(9, 9)`` of the answer, see ``CalibrationResult.parameter_covariance``.
 
@@ -4985,7 +5061,12 @@ def _output_covariance(
     ``sigma_pp_px``, its consider covariance (:func:`_pinned_pp_sensitivity`) and its
     correlation with the rest; a preset's size error (``size_rel`` of the distance, along
     the camera's position vector ``c_out``); the ground-corner and the car lines' consider
-    columns (``car_lines``, :func:`_car_line_sensitivity`). Order: focal length (px),
+    columns (``car_lines``, :func:`_car_line_sensitivity`); the car-class mixture
+    (``class_shifts``, :func:`_class_mixture`: per other preset its posterior weight ``π``
+    and log size ratio ``s``, adding ``π m mᵀ`` with ``m`` the answer's move were the car
+    that preset: the shape sensitivity's columns, the centre's rows included, times
+    ``s / size_shape_rel``; without them, ``preset_shape`` off, the distance times the
+    mean of ``s``). Order: focal length (px),
     principal point x, y (px), small rotation about the camera's x, y, z axes (rad, on the left of
     ``cam_from_world_rotation``), camera centre x, y, z (m, output frame). None when the
     normal equations are singular.
@@ -5015,9 +5096,18 @@ def _output_covariance(
     D = _ground_corner_sensitivity(prob, x, R0, pp_model, f_fixed)
     if D is not None:
         A[block] += D @ D.T
-    D_size = _size_shape_sensitivity(prob, x, R0, pp_model, f_fixed, size_shape_rel)
-    if D_size is not None:
+    D_full = _size_shape_sensitivity(
+        prob, x, R0, pp_model, f_fixed, size_shape_rel, centre=bool(class_shifts)
+    )
+    D_size = None
+    if D_full is not None:
+        D_size = D_full.copy()
+        D_size[-3:] = 0.0  # the centre: size_rel's term
         A[block] += D_size @ D_size.T
+        for weight, shift in class_shifts or []:
+            # The whole answer's move were the car that preset, the centre's included.
+            move = D_full @ (np.asarray(shift, dtype=float) / size_shape_rel)
+            A[block] += weight * np.outer(move, move)
     if car_lines is not None:
         A[block] += car_lines @ car_lines.T
     if pp_model is not None and sigma_pp_px > 0.0:
@@ -5038,6 +5128,9 @@ def _output_covariance(
     out = T @ A @ T.T
     if size_rel > 0.0:
         out[6:9, 6:9] += size_rel**2 * np.outer(c_out, c_out)
+    for weight, shift in class_shifts or [] if D_full is None else []:
+        # Without the shape columns (``preset_shape`` off): the distance by the mean ratio.
+        out[6:9, 6:9] += weight * float(np.mean(shift)) ** 2 * np.outer(c_out, c_out)
     out = 0.5 * (out + out.T)
     if not np.all(np.isfinite(out)):
         return None

@@ -589,7 +589,8 @@ def test_one_step_jackknife_matches_the_refits(seed: int) -> None:
     one-step jackknife makes the same choice (before: 0.8x, 1.3-1.4x and 2.2-3.1x the
     refits' position spread)."""
     scene = parse_scene(_crowd_scene(seed))
-    fast = calibrate(scene)
+    # The refits' spread has no leverage correction: the one step's own moves are compared.
+    fast = calibrate(scene, CalibrationSettings(jackknife_leverage=False))
     slow = calibrate(scene, CalibrationSettings(jackknife_method="refit"))
     assert fast.position_sigma_m is not None
     assert slow.position_sigma_m is not None
@@ -665,16 +666,22 @@ def test_a_given_principal_point_has_no_principal_point_sigma() -> None:
 
 
 def test_the_jackknife_widens_the_focal_sigma() -> None:
-    """The annotators' leave-one-out spread of the focal length enters focal_sigma_px."""
+    """The annotators' leave-one-out spread of the focal length enters focal_sigma_px (its
+    raw moves, ``jackknife_leverage`` off; the default's leverage-scaled spread lies between
+    the fit's sigma and that)."""
     cam = camera_aimed_at_car(height_m=6.0, distance_m=20.0, roll_deg=2.0)
     widened = 0
     for seed in range(3):
         scene = parse_scene(make_scene(cam, np.random.default_rng(seed), noise=NoiseModel()).scene)
-        with_jack = calibrate(scene)
+        with_jack = calibrate(scene, CalibrationSettings(jackknife_leverage=False))
         without = calibrate(scene, CalibrationSettings(jackknife=False))
+        default = calibrate(scene)
         assert with_jack.focal_sigma_px is not None
         assert without.focal_sigma_px is not None
+        assert default.focal_sigma_px is not None
         assert with_jack.focal_sigma_px >= without.focal_sigma_px - 1e-9
+        assert without.focal_sigma_px - 1e-9 <= default.focal_sigma_px
+        assert default.focal_sigma_px <= with_jack.focal_sigma_px + 1e-9
         widened += with_jack.focal_sigma_px > 1.01 * without.focal_sigma_px
     assert widened >= 1
 
