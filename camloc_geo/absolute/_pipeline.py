@@ -119,6 +119,38 @@ def locate(
     """
     settings = settings or LocateSettings()
     cal = calibration or calibrate(scene, calibration_settings)
+    scene, spelling = _spelled(scene, map_data)
+    result = _locate_once(scene, map_data, cal, settings, frozenset())
+    if not result.candidates and _corner_misfit(scene, result):
+        result = _leave_one_corner_out(scene, map_data, cal, settings, result)
+    result.warnings[:0] = spelling
+    return result
+
+
+def _spelled(scene: Scene, map_data: MapData | None) -> tuple[Scene, list[str]]:
+    """The scene with ``intersection.streets`` that meet nowhere on the map read as the map's
+    names they misspell (:meth:`~camloc_geo.osm.MapData.spell_streets`: only when exactly
+    one reading meets), and a warning per corrected name."""
+    hint = scene.intersection
+    if map_data is None or hint is None or not hint.streets or len(hint.streets) < 2:
+        return scene, []
+    names, notes = map_data.spell_streets(list(hint.streets))
+    if not notes:
+        return scene, []
+    fixed = hint.model_copy(update={"streets": names})
+    return scene.model_copy(update={"intersection": fixed}), [
+        f"intersection.streets: {n}" for n in notes
+    ]
+
+
+def _locate_once(
+    scene: Scene,
+    map_data: MapData | None,
+    cal: CalibrationResult,
+    settings: LocateSettings,
+    skip_corners: frozenset[int],
+) -> LocateResult:
+    """One run of the pipeline, the listed corners ``skip_corners`` (indices) left out."""
     frame = frame_anchor(scene, map_data)
     width, height = scene.image_size
     result = LocateResult(
@@ -131,7 +163,7 @@ def locate(
         view_cone_range_m=settings.view_cone_range_m,
     )
     world_cam = cal.camera
-    ev = gather_evidence(scene, map_data, world_cam, settings, result)
+    ev = gather_evidence(scene, map_data, world_cam, settings, result, skip_corners=skip_corners)
     result.cues_applied = ev.has_cues
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
@@ -163,6 +195,92 @@ def locate(
         result.reason = str(exc)
     finally:
         _forget_placements(ev, result.candidates)
+    return result
+
+
+NO_FIT_REASON = "no hypothesis fits"
+"""How :func:`rank`'s refusal begins when every candidate misfits (``poor_fit``)."""
+
+
+def _corner_misfit(scene: Scene, result: LocateResult) -> bool:
+    """Whether an empty answer is every hypothesis misfitting a scene that lists two or more
+    kerb corners (one of them may be another junction's, or no kerb corner at all)."""
+    return (
+        (result.reason or "").startswith(NO_FIT_REASON)
+        and scene.intersection is not None
+        and len(scene.intersection.corners) >= 2
+    )
+
+
+def _leave_one_corner_out(
+    scene: Scene,
+    map_data: MapData | None,
+    cal: CalibrationResult,
+    settings: LocateSettings,
+    empty: LocateResult,
+) -> LocateResult:
+    """The scene located again with each listed corner left out in turn, where no hypothesis
+    fits them all (``empty``: the answer so far).
+
+    A corner of a neighbouring junction in view, clicked too, or a point that is no kerb
+    corner (a T junction's straight far kerb read as a crossroads' corner), leaves every
+    reading of the junction misfitting: the answer was empty. Only then (a scene with an
+    answer is never changed) each corner is left out once; the candidates of every run that
+    fits are pooled by their weight (log likelihood with prior odds, and plausibility: each
+    run has the same evidence but one corner), near-duplicates merged, ranked and their ties
+    named, and a warning names the corner the best candidate leaves out. When no run fits,
+    ``empty`` is returned as it was.
+    """
+    assert scene.intersection is not None
+    runs: list[tuple[int, LocateResult]] = []
+    for k in range(len(scene.intersection.corners)):
+        got = _locate_once(scene, map_data, cal, settings, frozenset({k}))
+        if got.candidates:
+            runs.append((k, got))
+    if not runs:
+        return empty
+    pool = sorted(
+        ((_weight(c), k, c) for k, got in runs for c in got.candidates), key=lambda t: -t[0]
+    )
+    kept: list[tuple[float, int, Candidate]] = []
+    for w, k, c in pool:
+        if len(kept) >= settings.max_candidates:
+            break
+        dup = any(
+            float(np.linalg.norm(c.east_north - o.east_north)) < settings.merge_distance_m
+            and abs((c.heading_deg - o.heading_deg + 180.0) % 360.0 - 180.0)
+            < settings.merge_heading_deg
+            for _w, _k, o in kept
+        )
+        if not dup:
+            kept.append((w, k, c))
+    w0, k0, _c0 = kept[0]
+    result = next(got for k, got in runs if k == k0)
+    total = sum(math.exp(w - w0) for w, _k, _c in kept)
+    cands = []
+    for i, (w, _k, c) in enumerate(kept, start=1):
+        c.score = math.exp(w - w0) / total
+        c.rank = i
+        cands.append(c)
+    result.candidates = cands
+    mark_ties(cands, settings, result)
+    inter = result.intersection
+    where = f"junction {inter.id} ({' & '.join(inter.street_names)})" if inter else "the map"
+    others = sorted({k for _w, k, _c in kept[1:] if k != k0})
+    misfit = (empty.reason or "").partition(": ")[2].partition(", more than")[0]
+    result.warnings.append(
+        f"intersection.corners[{k0}]: no reading of the junction fits all the listed corners "
+        f"({misfit}); without corners[{k0}] they fit {where}: a corner of another "
+        "junction, or no kerb corner (a T junction's straight far kerb)? The answer leaves it "
+        "out; check it"
+        + (
+            "; leaving out "
+            + ", ".join(f"corners[{k}]" for k in others)
+            + " instead gives other candidates in this list"
+            if others
+            else ""
+        )
+    )
     return result
 
 

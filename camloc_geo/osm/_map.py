@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import os
@@ -40,7 +41,12 @@ from camloc_geo.osm._local import (
     street_index,
 )
 from camloc_geo.osm._model import Building, Intersection, Street
-from camloc_geo.osm._names import close_matches, normalize_name, split_street_query
+from camloc_geo.osm._names import (
+    close_matches,
+    misspelling_matches,
+    normalize_name,
+    split_street_query,
+)
 from camloc_geo.osm._widths import in_north_america, parse_lanes, resolve_width_m
 
 __all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
@@ -263,6 +269,54 @@ class MapData:
         names = {n for s in self._streets for n in (s.names or (s.name,))}
         names.update(s.name for x in self._intersections for s in x.streets)
         return sorted(names)
+
+    def spell_streets(self, streets: str | Sequence[str]) -> tuple[list[str], list[str]]:
+        """Street names that meet nowhere on this map, read as the map's names they misspell.
+
+        Parameters
+        ----------
+        streets
+            Two or more names (``"A & B"`` or a list), as :meth:`find_intersection` takes.
+
+        Returns
+        -------
+        ``(names, notes)``. When the named streets meet somewhere, or fewer than two are
+        given, the names as split and no note. Otherwise each name the map lacks is
+        replaced by a map name it may misspell (:func:`~camloc_geo.osm._names.
+        misspelling_matches`: one or two letters off, the same numbers); the names are
+        returned corrected, with a note per corrected name, only when exactly one
+        reading makes the streets meet on this map. Ambiguous or no reading: unchanged
+        (:meth:`find_intersection` then refuses with close matches).
+
+        Examples
+        --------
+        ``["Eastrn Avenue", "South Broadway"]`` -> ``(["Eastern Avenue", "South Broadway"],
+        ["'Eastrn Avenue' is no street of this map: read as 'Eastern Avenue' ..."])``.
+        """
+        wanted = split_street_query(streets)
+        if len(wanted) < 2 or self._street_hits(wanted):
+            return wanted, []
+        all_names = self.street_names()
+        options: list[list[str]] = []
+        for w in wanted:
+            alt = misspelling_matches(w, all_names) if not self._street_hits([w]) else []
+            options.append(alt or [w])
+        if all(len(o) == 1 and o[0] == w for o, w in zip(options, wanted, strict=True)):
+            return wanted, []
+        readings = [
+            list(r)
+            for r in itertools.islice(itertools.product(*options), 27)
+            if self._street_hits(list(r))
+        ]
+        if len(readings) != 1:
+            return wanted, []
+        notes = [
+            f"{w!r} is no street of this map: read as {r!r} (the one close name that meets "
+            f"the other named street{'s' if len(wanted) > 2 else ''}); check the spelling"
+            for w, r in zip(wanted, readings[0], strict=True)
+            if w != r
+        ]
+        return readings[0], notes
 
     def find_intersection(
         self, streets: str | Sequence[str], near: tuple[float, float] | None = None
