@@ -495,3 +495,57 @@ def test_misspelling_matches_keep_numbers() -> None:
     assert misspelling_matches("Eastrn Ave", ["Easton Road"]) == []
     assert misspelling_matches("1st Street", ["2nd Street", "1st Streat"]) == ["1st Streat"]
     assert misspelling_matches("Eastern Avenue", ["Eastern Ave"]) == []
+
+
+def _landmark_scene(m: MapData, inter_id: str, seed: int) -> tuple[dict, LocatedScene]:
+    ls = make_located_scene(
+        m,
+        m.intersection(inter_id),
+        np.random.default_rng(seed),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        n_landmarks=2,
+        landmark_sigma_m=0.0,
+        max_tries=150,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene.pop("references", None)
+    return scene, ls
+
+
+def test_landmarks_that_put_the_car_off_the_street_are_warned(baltimore: MapData) -> None:
+    # Two landmarks, the first named by its nearest named neighbour. The best candidate
+    # stands 120 m off with its car off any street (flagged car_off_street, sigma 6-12 m).
+    # Old code: no word on the car (absolute_slips dev-classes landmark_neighbour: 6 of 47
+    # confidently wrong, 4 of them with the car off its street). Now the map's witness is a
+    # warning, as for two references.
+    scene, ls = _landmark_scene(baltimore, "c49471330", 0)
+    inter = baltimore.intersection("c49471330")
+    named = baltimore.find_building(scene["landmarks"][0]["name"], near=(inter.lat, inter.lon))
+    taken = {lm["name"] for lm in scene["landmarks"]}
+    neighbour = min(
+        (b for b in baltimore.buildings if b.name and b.name not in taken),
+        key=lambda b: distance_m(
+            lat1=named.centroid[1], lon1=named.centroid[0], lat2=b.centroid[1], lon2=b.centroid[0]
+        ),
+    )
+    scene["landmarks"][0]["name"] = neighbour.name
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] > 50.0
+    assert "car_off_street" in res.candidates[0].flags
+    warned = [w for w in res.warnings if w.startswith("landmarks: the best candidate puts")]
+    assert warned == [
+        "landmarks: the best candidate puts the car off any street; if the car does stand on "
+        "a street, along it, a landmark is named wrong (the building next to it, a name that "
+        "moved) or its pixel is not that building's corner: check the names, or add a "
+        "reference"
+    ]
+
+
+def test_landmarks_named_right_are_not_warned_of_the_car(baltimore: MapData) -> None:
+    scene, ls = _landmark_scene(baltimore, "c49471330", 0)
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 2.0
+    assert not [w for w in res.warnings if w.startswith("landmarks: the best candidate puts")]

@@ -187,6 +187,7 @@ def _locate_once(
         _warn_reversed_corners(result)
         _warn_corner_outlier(result)
         _warn_substituted_landmark(result)
+        _warn_landmarks_off_street(ev, result)
         _warn_reference_corner(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
@@ -530,6 +531,38 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
         "street, along it, one reference's lat/lon is wrong (another point's, rounded, "
         "swapped): check both, or add a third; the one_reference candidates trust each "
         "alone"
+    )
+
+
+def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
+    """Warn when landmarks alone put the best candidate's car off or across its street.
+
+    A landmark named by the wrong building (its neighbour's name, a shop that moved) is
+    matched at its word: the camera lands where that building stands, tens of metres off,
+    with a small sigma. The map is the witness, as for two references
+    (:func:`_warn_references_off_street`): a real car stands on a street, along it; one
+    beside its street, along it, is no contradiction (:func:`car_beside_street`). Measured
+    on ``benchmarks/absolute_slips.py`` (session 38, dev runs): of 37 landmark tops whose car
+    stands off or across its street, 33 were more than 15 m off.
+    """
+    if not ev.landmarks or ev.refs or ev.corners or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.method not in ("landmark", "one_landmark"):
+        return
+    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
+    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
+        return
+    if not kinds:
+        return
+    where = (
+        "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
+    )
+    result.warnings.append(
+        f"landmarks: the best candidate puts the car {where}; if the car does stand on a "
+        "street, along it, a landmark is named wrong (the building next to it, a name that "
+        "moved) or its pixel is not that building's corner: check the names, or add a "
+        "reference"
     )
 
 
