@@ -433,6 +433,22 @@ def slip_street_misspelt_only(scene: dict[str, Any], c: Ctx) -> dict[str, Any] |
     return scene
 
 
+def slip_street_other_language(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
+    """The intersection named by its streets' names in another language (or an old or
+    alternative name the map holds: ``name:<lang>``, ``old_name``...), no lat/lon."""
+    names = sorted({s.name for s in c.inter.streets if s.name and not s.name.startswith("unnamed")})
+    if len(names) < 2:
+        return None
+    other = [next(iter(c.m.other_names(n)), None) for n in names[:2]]
+    if all(o is None for o in other):
+        return None
+    it = scene["intersection"]
+    it.pop("lat", None)
+    it.pop("lon", None)
+    it["streets"] = [o or n for o, n in zip(other, names[:2], strict=True)]
+    return scene
+
+
 def control_latlon_streets(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     """No slip: the intersection's lat/lon and two of its own streets (the control of
     ``street_misspelt``)."""
@@ -536,6 +552,7 @@ SLIPS: dict[str, tuple[str, Slip]] = {
     "street_misspelt": ("corners", slip_street_misspelt),
     "street_misspelt_only": ("corners", slip_street_misspelt_only),
     "control_latlon_streets": ("corners", control_latlon_streets),
+    "street_other_language": ("corners", slip_street_other_language),
     "t_as_crossroads": ("corners", slip_t_as_crossroads),
     "reference_kerb": ("two_references", slip_ref_kerb),
 }
@@ -731,6 +748,7 @@ def _fig(entries: list[dict[str, Any]]) -> dict[str, Any]:
         "refused": sum(1 for e in entries if "refused" in e),
         "empty": sum(1 for e in entries if "empty" in e),
         "top_lt_10m": frac(lambda e: e["top"] < 10),
+        "top_lt_12m": frac(lambda e: e["top"] < 12),
         "top_lt_15m": frac(lambda e: e["top"] < 15),
         "closest_lt_10m": frac(lambda e: e["closest"] < 10),
         "closest_lt_15m": frac(lambda e: e["closest"] < 15),

@@ -549,3 +549,53 @@ def test_landmarks_named_right_are_not_warned_of_the_car(baltimore: MapData) -> 
     res = locate(parse_scene(scene), baltimore)
     assert _errors(res, ls)[0] < 2.0
     assert not [w for w in res.warnings if w.startswith("landmarks: the best candidate puts")]
+
+
+@pytest.fixture(scope="module")
+def helsinki() -> MapData:
+    return load_map(OSM / "helsinki.osm.pbf", 60.171635, 24.944295, radius_m=600)
+
+
+def test_streets_named_in_the_other_language_find_their_junction(helsinki: MapData) -> None:
+    # Kaivokatu & Keskuskatu in Swedish (Brunnsgatan & Centralgatan: the ways' name:sv).
+    # Old code: refused, "streets 'Brunnsgatan' & 'Centralgatan' do not meet" (the map kept
+    # only `name`). Now a street's name:<language>, alt_name, old_name... are its names too,
+    # after its own names (the own names' matches are unchanged).
+    assert "Brunnsgatan" in helsinki.other_names("Kaivokatu")
+    assert "Centralgatan" in helsinki.other_names("Keskuskatu")
+    own = helsinki.find_intersection(["Kaivokatu", "Keskuskatu"])
+    assert helsinki.find_intersection(["Brunnsgatan", "Centralgatan"]).id == own.id
+    assert "Brunnsgatan" in helsinki.street_names()
+    inter = helsinki.intersection(own.id)
+    ls = make_located_scene(
+        helsinki,
+        inter,
+        np.random.default_rng(1),
+        noise=NoiseModel.exact(),
+        corner_sigma_m=0.0,
+        min_corners=2,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene["intersection"].pop("lat", None)
+    scene["intersection"].pop("lon", None)
+    scene["intersection"]["streets"] = ["Brunnsgatan", "Centralgatan"]
+    res = locate(parse_scene(scene), helsinki)
+    assert res.intersection is not None
+    assert res.intersection.id == own.id
+    assert min(_errors(res, ls)) < 1.0
+
+
+def test_alt_names_of_way_tags() -> None:
+    from camloc_geo.osm._graph import alt_names_of
+
+    tags = {
+        "name": "Kaivokatu",
+        "name:sv": "Brunnsgatan",
+        "name:fi": "Kaivokatu",
+        "old_name": "Brunnsgatan;Kaivogatan",
+        "name:etymology:wikidata": "Q1",
+        "highway": "primary",
+    }
+    assert alt_names_of(tags) == "Brunnsgatan;Kaivogatan;Kaivokatu"
+    assert alt_names_of({"name": "A", "highway": "residential"}) is None

@@ -160,6 +160,9 @@ class MapData:
             )
         )
         self._streets = tuple(_streets_of(raw.graph, north_america))
+        self._alt_names = dict(getattr(raw, "alt_names", None) or {})
+        """``{street name: its other names}`` (``name:<language>``, ``alt_name``, ``old_name``...):
+        a scene or query may name a street by any of them."""
         self._buildings = tuple(raw.buildings)
         self._cache: dict[str, Any] = {}
         self._cache_lock = threading.RLock()
@@ -265,10 +268,18 @@ class MapData:
         raise MapDataError(f"no intersection with id {ident!r}")
 
     def street_names(self) -> list[str]:
-        """Every street name of the map, sorted."""
+        """Every street name of the map, sorted, other names (``name:<language>``,
+        ``alt_name``, ``old_name``...) included."""
         names = {n for s in self._streets for n in (s.names or (s.name,))}
         names.update(s.name for x in self._intersections for s in x.streets)
+        alt = getattr(self, "_alt_names", {})
+        names.update(a for n in list(names) for a in alt.get(n, ()))
         return sorted(names)
+
+    def other_names(self, name: str) -> tuple[str, ...]:
+        """The other names of the street named ``name`` (``name:<language>``, ``alt_name``,
+        ``old_name``, ``official_name``...), sorted; empty when it has none."""
+        return getattr(self, "_alt_names", {}).get(name, ())
 
     def spell_streets(self, streets: str | Sequence[str]) -> tuple[list[str], list[str]]:
         """Street names that meet nowhere on this map, read as the map's names they misspell.
@@ -431,10 +442,28 @@ class MapData:
         return self._street_hits(split_street_query(streets))
 
     def _street_hits(self, wanted: list[str]) -> list[Intersection]:
+        """Intersections where every wanted name meets: by the streets' own names (exactly,
+        else loosely: a name holding all the query's words), else with their other names
+        too (``name:<language>``, ``old_name``...), exactly, else loosely."""
         norms = [normalize_name(w) for w in wanted]
-        table, by_token = self.cached("intersection_street_names", self._street_name_table)
+        for key, with_alt in (
+            ("intersection_street_names", False),
+            ("intersection_street_names_alt", True),
+        ):
+            for loose in (False, True):
+                hits = self._street_hits_in(norms, key, with_alt, loose=loose)
+                if hits:
+                    return hits
+        return []
 
-        def matches(sets: list[frozenset[str]], loose: bool) -> bool:
+    def _street_hits_in(
+        self, norms: list[str], key: str, with_alt: bool, *, loose: bool
+    ) -> list[Intersection]:
+        table, by_token = self.cached(key, lambda: self._street_name_table(with_alt))
+        if with_alt and table is None:
+            return []
+
+        def matches(sets: list[frozenset[str]]) -> bool:
             for q in norms:
                 q_tokens = set(q.split())
                 ok = any(q in names for names in sets) or (
@@ -451,17 +480,24 @@ class MapData:
                 hit = by_token.get(tok, set())
                 maybe = set(hit) if maybe is None else maybe & hit
         order = sorted(maybe) if maybe is not None else range(len(table))
-        for loose in (False, True):
-            hits = [self._intersections[i] for i in order if matches(table[i], loose)]
-            if hits:
-                return hits
-        return []
+        return [self._intersections[i] for i in order if matches(table[i])]
 
-    def _street_name_table(self) -> tuple[list[list[frozenset[str]]], dict[str, set[int]]]:
+    def _street_name_table(self, with_alt: bool = False) -> tuple[Any, dict[str, set[int]]]:
         """Every intersection's normalised street names (per street) and a token index, once
-        per map (normalising them per call cost 30 ms on a city's extract, twice per locate)."""
+        per map (normalising them per call cost 30 ms on a city's extract, twice per locate).
+        ``with_alt``: each street's other names too (None when the map has none)."""
+        alt = getattr(self, "_alt_names", {}) if with_alt else {}
+        if with_alt and not alt:
+            return None, {}
         table = [
-            [frozenset(normalize_name(n) for n in (s.names or (s.name,))) for s in x.streets]
+            [
+                frozenset(
+                    normalize_name(n)
+                    for own in (s.names or (s.name,))
+                    for n in (own, *alt.get(own, ()))
+                )
+                for s in x.streets
+            ]
             for x in self._intersections
         ]
         by_token: dict[str, set[int]] = {}
