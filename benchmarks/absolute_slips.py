@@ -433,13 +433,48 @@ def slip_street_misspelt_only(scene: dict[str, Any], c: Ctx) -> dict[str, Any] |
     return scene
 
 
+_OTHER_NAMES: dict[str, dict[str, list[str]]] = {}
+_OTHER_NAME_KEYS = ("alt_name", "old_name", "official_name", "int_name", "loc_name")
+
+
+def other_names_of_extract(path: str) -> dict[str, list[str]]:
+    """``{name: other names}`` of the extract's named highway ways, read with pyosmium
+    (``name:<language>`` and the alternative-name keys), independently of camloc's map."""
+    if path not in _OTHER_NAMES:
+        import osmium
+
+        found: dict[str, set[str]] = {}
+
+        class _Ways(osmium.SimpleHandler):  # type: ignore[misc]
+            def way(self, w: Any) -> None:
+                tags = {t.k: t.v for t in w.tags}
+                if "highway" not in tags or not tags.get("name"):
+                    return None
+                own = {n.strip() for n in tags["name"].split(";") if n.strip()}
+                alts = {
+                    v.strip()
+                    for k, val in tags.items()
+                    if k in _OTHER_NAME_KEYS or re.match(r"^name:[a-z]{2,3}$", k)
+                    for v in val.split(";")
+                    if v.strip()
+                } - own
+                for n in own:
+                    found.setdefault(n, set()).update(alts)
+                return None
+
+        _Ways().apply_file(path)
+        _OTHER_NAMES[path] = {n: sorted(a) for n, a in found.items() if a}
+    return _OTHER_NAMES[path]
+
+
 def slip_street_other_language(scene: dict[str, Any], c: Ctx) -> dict[str, Any] | None:
     """The intersection named by its streets' names in another language (or an old or
-    alternative name the map holds: ``name:<lang>``, ``old_name``...), no lat/lon."""
+    alternative name the extract holds: ``name:<lang>``, ``old_name``...), no lat/lon."""
     names = sorted({s.name for s in c.inter.streets if s.name and not s.name.startswith("unnamed")})
     if len(names) < 2:
         return None
-    other = [next(iter(c.m.other_names(n)), None) for n in names[:2]]
+    table = other_names_of_extract(c.m.source)
+    other = [next(iter(table.get(n, [])), None) for n in names[:2]]
     if all(o is None for o in other):
         return None
     it = scene["intersection"]
