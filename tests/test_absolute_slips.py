@@ -599,3 +599,42 @@ def test_alt_names_of_way_tags() -> None:
     }
     assert alt_names_of(tags) == "Brunnsgatan;Kaivogatan;Kaivokatu"
     assert alt_names_of({"name": "A", "highway": "residential"}) is None
+
+
+def _two_refs(m: MapData, ls: LocatedScene, apart_m: float) -> dict:
+    """Two references on the ground 20 m in front of the true camera, ``apart_m`` apart
+    across the view, with their true lat/lon (noise-free)."""
+    cam = ls.camera_enu
+    centre = np.asarray(cam.center_in_world[:2], dtype=float)
+    fwd = np.asarray(cam.cam_from_world_rotation, dtype=float)[2, :2]
+    fwd = fwd / np.linalg.norm(fwd)
+    side = np.array([fwd[1], -fwd[0]])
+    refs = []
+    for k in (-0.5, 0.5):
+        g = centre + 20.0 * fwd + k * apart_m * side
+        px = np.asarray(cam.project([float(g[0]), float(g[1]), 0.0]), dtype=float)
+        lon, lat = m.frame.geographic_from_enu(float(g[0]), float(g[1]))
+        refs.append({"pixel": [float(px[0]), float(px[1])], "lat": float(lat), "lon": float(lon)})
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene["references"] = refs
+    return scene
+
+
+def test_two_references_close_together_far_from_the_camera_are_warned(
+    baltimore: MapData,
+) -> None:
+    # Two references 1.5 m apart, the camera 20 m beyond them: a lat/lon 3 m off across them
+    # would turn the camera 40 m away, beyond its sigma. Old code: a right answer with no
+    # word, and with the slip (absolute_slips reference_kerb, reference_4_decimals) answers
+    # 18-74 m off at sigmas of 4-10 m, no word. Now the fragility is a warning.
+    ls = _located(baltimore, "n49471327", 0, min_corners=1)
+    res = locate(parse_scene(_two_refs(baltimore, ls, 1.5)), baltimore)
+    assert _errors(res, ls)[0] < 1.0
+    warned = [w for w in res.warnings if w.startswith("references: the two references are")]
+    assert len(warned) == 1
+    assert "3 m off across them" in warned[0]
+    # 12 m apart: the same slip moves the camera about 3 x 22 / 12 = 6 m: no warning
+    res = locate(parse_scene(_two_refs(baltimore, ls, 12.0)), baltimore)
+    assert _errors(res, ls)[0] < 1.0
+    assert not [w for w in res.warnings if w.startswith("references: the two references are")]

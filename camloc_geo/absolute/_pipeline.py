@@ -188,6 +188,7 @@ def _locate_once(
         _warn_corner_outlier(result)
         _warn_substituted_landmark(result)
         _warn_landmarks_off_street(ev, result)
+        _warn_fragile_references(ev, result)
         _warn_reference_corner(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
@@ -531,6 +532,53 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
         "street, along it, one reference's lat/lon is wrong (another point's, rounded, "
         "swapped): check both, or add a third; the one_reference candidates trust each "
         "alone"
+    )
+
+
+REFERENCE_SLIP_M = 3.0
+"""A reference's lat/lon this far off is an ordinary slip (a click on the kerb for a point on
+the centre line, half a lane, a lat/lon rounded to 4 decimals): what the fragile-references
+warning moves a reference by."""
+WRONG_M = 15.0
+"""A camera moved farther than this stands somewhere else (the benchmarks' wrong answer)."""
+
+
+def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
+    """Warn when two references alone leave the answer fragile: one reference's lat/lon
+    :data:`REFERENCE_SLIP_M` off across their baseline would move the camera farther than
+    :data:`WRONG_M` and than two of its ``sigma_m``.
+
+    Two references fix the camera exactly; their distance apart is the only check on them
+    (``references[0] and references[1] disagree``), and it cannot see a slip across their
+    baseline. Such a slip turns the camera about the other reference by slip / baseline, so
+    the camera moves by about slip x (its distance from that reference) / baseline: a lever
+    of 5-13 turned 3-8 m slips (a pixel on the kerb for a lat/lon on the centre line, four
+    decimals) into answers 18-74 m off with sigmas of 4-10 m (``benchmarks/absolute_slips.py``,
+    session 38). The warning says how far and what would hold the answer.
+    """
+    if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.method != "two_references":
+        return
+    (_o0, q0), (_o1, q1) = ev.refs
+    a, b = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+    baseline = float(np.linalg.norm(a - b))
+    if not math.isfinite(baseline) or baseline <= 0.0:
+        return
+    cam = top.east_north
+    lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
+    move = REFERENCE_SLIP_M * lever
+    sigma = top.sigma_m if top.sigma_m is not None else 0.0
+    if move <= max(WRONG_M, 2.0 * sigma):
+        return
+    result.warnings.append(
+        f"references: the two references are {baseline:.0f} m apart and the camera "
+        f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
+        f"{REFERENCE_SLIP_M:.0f} m off across them (a pixel on the kerb for a point on the "
+        f"centre line, a rounded lat/lon) would move the camera about {move:.0f} m, beyond "
+        "its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
+        "landmark"
     )
 
 
