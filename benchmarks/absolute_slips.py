@@ -629,6 +629,14 @@ def _entry(res: LocateResult | None, err: str, ls: LocatedScene, clean_keys: set
         "new_warnings": [w[:240] for w in new],
         "warnings": [w[:160] for w in res.warnings if not w.startswith("ambiguous:")],
         "confidently_wrong": bool(errs[0] > CONFIDENT_M and not tied and not new and not covered),
+        # the same with no warning at all (a warning the clean run gives too counts: the
+        # user sees it; a scene's geometry warning is the same with and without the slip)
+        "wrong_unwarned": bool(
+            errs[0] > CONFIDENT_M
+            and not tied
+            and not covered
+            and not [w for w in res.warnings if not w.startswith("ambiguous:")]
+        ),
         "wrong_uncovered": bool(errs[0] > CONFIDENT_M and not covered),
         "silently_lost": bool(min(errs) > CONFIDENT_M and not new),
     }
@@ -792,6 +800,7 @@ def _fig(entries: list[dict[str, Any]]) -> dict[str, Any]:
         "wrong_uncovered": frac(lambda e: e["wrong_uncovered"]),
         "confidently_wrong": frac(lambda e: e["confidently_wrong"]),
         "confidently_wrong_n": sum(1 for e in found if e["confidently_wrong"]),
+        "wrong_unwarned_n": sum(1 for e in found if e.get("wrong_unwarned")),
         "silently_lost": frac(lambda e: e["silently_lost"]),
     }
 
