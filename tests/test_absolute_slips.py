@@ -64,6 +64,22 @@ def _refs_on_wrong_corner(m: MapData, inter_id: str, seed: int) -> tuple[dict, L
     return scene, ls
 
 
+def _name_by_neighbour(m: MapData, scene: dict, inter_id: str) -> Any:
+    """Name the scene's first landmark by its nearest other named building; the building it
+    was named by before."""
+    inter = m.intersection(inter_id)
+    named = m.find_building(scene["landmarks"][0]["name"], near=(inter.lat, inter.lon))
+    taken = {lm["name"] for lm in scene["landmarks"]}
+    neighbour = min(
+        (b for b in m.buildings if b.name and b.name not in taken),
+        key=lambda b: distance_m(
+            lat1=named.centroid[1], lon1=named.centroid[0], lat2=b.centroid[1], lon2=b.centroid[0]
+        ),
+    )
+    scene["landmarks"][0]["name"] = neighbour.name
+    return named
+
+
 @pytest.mark.parametrize(("inter_id", "seed"), [("c49531205", 9), ("n49471323", 10)])
 def test_reference_on_another_corner_is_read_on_its_corner_with_a_warning(
     baltimore: MapData, inter_id: str, seed: int
@@ -296,16 +312,7 @@ def test_landmark_named_by_its_neighbour(baltimore: MapData, inter_id: str, seed
     scene = json.loads(json.dumps(ls.scene))
     scene.pop("intersection")
     scene.pop("references", None)
-    inter = baltimore.intersection(inter_id)
-    named = baltimore.find_building(scene["landmarks"][0]["name"], near=(inter.lat, inter.lon))
-    taken = {lm["name"] for lm in scene["landmarks"]}
-    neighbour = min(
-        (b for b in baltimore.buildings if b.name and b.name not in taken),
-        key=lambda b: distance_m(
-            lat1=named.centroid[1], lon1=named.centroid[0], lat2=b.centroid[1], lon2=b.centroid[0]
-        ),
-    )
-    scene["landmarks"][0]["name"] = neighbour.name
+    named = _name_by_neighbour(baltimore, scene, inter_id)
     res = locate(parse_scene(scene), baltimore)
     assert _errors(res, ls)[0] < 2.0
     warned = [w for w in res.warnings if w.startswith("landmarks: the best candidate reads")]
@@ -522,16 +529,7 @@ def test_landmarks_that_put_the_car_off_the_street_are_warned(baltimore: MapData
     # confidently wrong, 4 of them with the car off its street). Now the map's witness is a
     # warning, as for two references.
     scene, ls = _landmark_scene(baltimore, "c49471330", 0)
-    inter = baltimore.intersection("c49471330")
-    named = baltimore.find_building(scene["landmarks"][0]["name"], near=(inter.lat, inter.lon))
-    taken = {lm["name"] for lm in scene["landmarks"]}
-    neighbour = min(
-        (b for b in baltimore.buildings if b.name and b.name not in taken),
-        key=lambda b: distance_m(
-            lat1=named.centroid[1], lon1=named.centroid[0], lat2=b.centroid[1], lon2=b.centroid[0]
-        ),
-    )
-    scene["landmarks"][0]["name"] = neighbour.name
+    _name_by_neighbour(baltimore, scene, "c49471330")
     res = locate(parse_scene(scene), baltimore)
     assert _errors(res, ls)[0] > 50.0
     assert "car_off_street" in res.candidates[0].flags

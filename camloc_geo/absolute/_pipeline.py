@@ -490,6 +490,14 @@ def car_beside_street(cand: Candidate, ev: Evidence) -> bool:
     return bool(np.any(diff <= BESIDE_STREET_DEG))
 
 
+def _car_where(kinds: set[FlagKind]) -> str | None:
+    """Where the car flags put the car, for a warning: ``across its street``, ``off any
+    street``, or None without a car flag."""
+    if not kinds:
+        return None
+    return "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
+
+
 def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: LocateResult) -> None:
     """Warn when two references alone put the car off or across its street.
 
@@ -522,11 +530,9 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
                 "swapped?)"
             )
         return
-    if not kinds:
+    where = _car_where(kinds)
+    if where is None:
         return
-    where = (
-        "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
-    )
     result.warnings.append(
         f"references: the two references put the car {where}; if the car does stand on a "
         "street, along it, one reference's lat/lon is wrong (another point's, rounded, "
@@ -601,11 +607,9 @@ def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
     kinds = {f.kind for f in top.flags} & _CAR_FLAGS
     if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
         return
-    if not kinds:
+    where = _car_where(kinds)
+    if where is None:
         return
-    where = (
-        "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
-    )
     result.warnings.append(
         f"landmarks: the best candidate puts the car {where}; if the car does stand on a "
         "street, along it, a landmark is named wrong (the building next to it, a name that "
