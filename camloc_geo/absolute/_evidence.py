@@ -343,13 +343,19 @@ class _CornerEvidence:
 
 
 def _corners(
-    scene: Scene, map_data: MapData | None, frame: LocalFrame, observe: _Observer
+    scene: Scene,
+    map_data: MapData | None,
+    frame: LocalFrame,
+    observe: _Observer,
+    skip: frozenset[int] = frozenset(),
 ) -> _CornerEvidence:
     out = _CornerEvidence()
     if scene.intersection is None:
         return out
     _check_distinct_corners(scene)
     for i, px in enumerate(scene.intersection.corners):
+        if i in skip:
+            continue
         label = f"intersection.corners[{i}]"
         c_obs = observe(px, "corner", label, observe.settings.sigma_corner_m)
         if c_obs is not None:
@@ -604,13 +610,17 @@ def gather_evidence(
     world_cam: Camera,
     settings: LocateSettings,
     result: LocateResult,
+    skip_corners: frozenset[int] = frozenset(),
 ) -> Evidence:
-    """Stage 1: every ground pixel of the scene with the map points it may match (ENU)."""
+    """Stage 1: every ground pixel of the scene with the map points it may match (ENU).
+
+    ``skip_corners``: indices of listed kerb corners left out (the pipeline's
+    leave-one-corner-out run, where no reading fits them all)."""
     frame = result.frame
     observe = _Observer(world_cam, settings, scene)
     observe.warnings = result.warnings
     refs = _references(scene, frame, observe, map_data is not None or scene.prior is not None)
-    ce = _corners(scene, map_data, frame, observe)
+    ce = _corners(scene, map_data, frame, observe, skip_corners)
     result.intersection = ce.intersection
     landmarks = _landmarks(scene, map_data, frame, observe)
     bearings = ce.bearings

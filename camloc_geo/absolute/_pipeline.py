@@ -119,6 +119,38 @@ def locate(
     """
     settings = settings or LocateSettings()
     cal = calibration or calibrate(scene, calibration_settings)
+    scene, spelling = _spelled(scene, map_data)
+    result = _locate_once(scene, map_data, cal, settings, frozenset())
+    if not result.candidates and _corner_misfit(scene, result):
+        result = _leave_one_corner_out(scene, map_data, cal, settings, result)
+    result.warnings[:0] = spelling
+    return result
+
+
+def _spelled(scene: Scene, map_data: MapData | None) -> tuple[Scene, list[str]]:
+    """The scene with ``intersection.streets`` that meet nowhere on the map read as the map's
+    names they misspell (:meth:`~camloc_geo.osm.MapData.spell_streets`: only when exactly
+    one reading meets), and a warning per corrected name."""
+    hint = scene.intersection
+    if map_data is None or hint is None or not hint.streets or len(hint.streets) < 2:
+        return scene, []
+    names, notes = map_data.spell_streets(list(hint.streets))
+    if not notes:
+        return scene, []
+    fixed = hint.model_copy(update={"streets": names})
+    return scene.model_copy(update={"intersection": fixed}), [
+        f"intersection.streets: {n}" for n in notes
+    ]
+
+
+def _locate_once(
+    scene: Scene,
+    map_data: MapData | None,
+    cal: CalibrationResult,
+    settings: LocateSettings,
+    skip_corners: frozenset[int],
+) -> LocateResult:
+    """One run of the pipeline, the listed corners ``skip_corners`` (indices) left out."""
     frame = frame_anchor(scene, map_data)
     width, height = scene.image_size
     result = LocateResult(
@@ -131,7 +163,7 @@ def locate(
         view_cone_range_m=settings.view_cone_range_m,
     )
     world_cam = cal.camera
-    ev = gather_evidence(scene, map_data, world_cam, settings, result)
+    ev = gather_evidence(scene, map_data, world_cam, settings, result, skip_corners=skip_corners)
     result.cues_applied = ev.has_cues
     try:
         hyps = generate_hypotheses(scene, ev, settings, result)
@@ -155,6 +187,8 @@ def locate(
         _warn_reversed_corners(result)
         _warn_corner_outlier(result)
         _warn_substituted_landmark(result)
+        _warn_landmarks_off_street(ev, result)
+        _warn_fragile_references(ev, result)
         _warn_reference_corner(result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
@@ -163,6 +197,92 @@ def locate(
         result.reason = str(exc)
     finally:
         _forget_placements(ev, result.candidates)
+    return result
+
+
+NO_FIT_REASON = "no hypothesis fits"
+"""How :func:`rank`'s refusal begins when every candidate misfits (``poor_fit``)."""
+
+
+def _corner_misfit(scene: Scene, result: LocateResult) -> bool:
+    """Whether an empty answer is every hypothesis misfitting a scene that lists two or more
+    kerb corners (one of them may be another junction's, or no kerb corner at all)."""
+    return (
+        (result.reason or "").startswith(NO_FIT_REASON)
+        and scene.intersection is not None
+        and len(scene.intersection.corners) >= 2
+    )
+
+
+def _leave_one_corner_out(
+    scene: Scene,
+    map_data: MapData | None,
+    cal: CalibrationResult,
+    settings: LocateSettings,
+    empty: LocateResult,
+) -> LocateResult:
+    """The scene located again with each listed corner left out in turn, where no hypothesis
+    fits them all (``empty``: the answer so far).
+
+    A corner of a neighbouring junction in view, clicked too, or a point that is no kerb
+    corner (a T junction's straight far kerb read as a crossroads' corner), leaves every
+    reading of the junction misfitting: the answer was empty. Only then (a scene with an
+    answer is never changed) each corner is left out once; the candidates of every run that
+    fits are pooled by their weight (log likelihood with prior odds, and plausibility: each
+    run has the same evidence but one corner), near-duplicates merged, ranked and their ties
+    named, and a warning names the corner the best candidate leaves out. When no run fits,
+    ``empty`` is returned as it was.
+    """
+    assert scene.intersection is not None
+    runs: list[tuple[int, LocateResult]] = []
+    for k in range(len(scene.intersection.corners)):
+        got = _locate_once(scene, map_data, cal, settings, frozenset({k}))
+        if got.candidates:
+            runs.append((k, got))
+    if not runs:
+        return empty
+    pool = sorted(
+        ((_weight(c), k, c) for k, got in runs for c in got.candidates), key=lambda t: -t[0]
+    )
+    kept: list[tuple[float, int, Candidate]] = []
+    for w, k, c in pool:
+        if len(kept) >= settings.max_candidates:
+            break
+        dup = any(
+            float(np.linalg.norm(c.east_north - o.east_north)) < settings.merge_distance_m
+            and abs((c.heading_deg - o.heading_deg + 180.0) % 360.0 - 180.0)
+            < settings.merge_heading_deg
+            for _w, _k, o in kept
+        )
+        if not dup:
+            kept.append((w, k, c))
+    w0, k0, _c0 = kept[0]
+    result = next(got for k, got in runs if k == k0)
+    total = sum(math.exp(w - w0) for w, _k, _c in kept)
+    cands = []
+    for i, (w, _k, c) in enumerate(kept, start=1):
+        c.score = math.exp(w - w0) / total
+        c.rank = i
+        cands.append(c)
+    result.candidates = cands
+    mark_ties(cands, settings, result)
+    inter = result.intersection
+    where = f"junction {inter.id} ({' & '.join(inter.street_names)})" if inter else "the map"
+    others = sorted({k for _w, k, _c in kept[1:] if k != k0})
+    misfit = (empty.reason or "").partition(": ")[2].partition(", more than")[0]
+    result.warnings.append(
+        f"intersection.corners[{k0}]: no reading of the junction fits all the listed corners "
+        f"({misfit}); without corners[{k0}] they fit {where}: a corner of another "
+        "junction, or no kerb corner (a T junction's straight far kerb)? The answer leaves it "
+        "out; check it"
+        + (
+            "; leaving out "
+            + ", ".join(f"corners[{k}]" for k in others)
+            + " instead gives other candidates in this list"
+            if others
+            else ""
+        )
+    )
     return result
 
 
@@ -370,6 +490,14 @@ def car_beside_street(cand: Candidate, ev: Evidence) -> bool:
     return bool(np.any(diff <= BESIDE_STREET_DEG))
 
 
+def _car_where(kinds: set[FlagKind]) -> str | None:
+    """Where the car flags put the car, for a warning: ``across its street``, ``off any
+    street``, or None without a car flag."""
+    if not kinds:
+        return None
+    return "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
+
+
 def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: LocateResult) -> None:
     """Warn when two references alone put the car off or across its street.
 
@@ -402,16 +530,91 @@ def _warn_references_off_street(cands: list[Candidate], ev: Evidence, result: Lo
                 "swapped?)"
             )
         return
-    if not kinds:
+    where = _car_where(kinds)
+    if where is None:
         return
-    where = (
-        "across its street" if FlagKind.CAR_NOT_PARALLEL_TO_STREET in kinds else "off any street"
-    )
     result.warnings.append(
         f"references: the two references put the car {where}; if the car does stand on a "
         "street, along it, one reference's lat/lon is wrong (another point's, rounded, "
         "swapped): check both, or add a third; the one_reference candidates trust each "
         "alone"
+    )
+
+
+REFERENCE_SLIP_M = 3.0
+"""A reference's lat/lon this far off is an ordinary slip (a click on the kerb for a point on
+the centre line, half a lane, a lat/lon rounded to 4 decimals): what the fragile-references
+warning moves a reference by."""
+WRONG_M = 15.0
+"""A camera moved farther than this stands somewhere else (the benchmarks' wrong answer)."""
+
+
+def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
+    """Warn when two references alone leave the answer fragile: one reference's lat/lon
+    :data:`REFERENCE_SLIP_M` off across their baseline would move the camera farther than
+    :data:`WRONG_M` and than two of its ``sigma_m``.
+
+    Two references fix the camera exactly; their distance apart is the only check on them
+    (``references[0] and references[1] disagree``), and it cannot see a slip across their
+    baseline. Such a slip turns the camera about the other reference by slip / baseline, so
+    the camera moves by about slip x (its distance from that reference) / baseline: a lever
+    of 5-13 turned 3-8 m slips (a pixel on the kerb for a lat/lon on the centre line, four
+    decimals) into answers 18-74 m off with sigmas of 4-10 m (``benchmarks/absolute_slips.py``,
+    session 38). The warning says how far and what would hold the answer.
+    """
+    if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.method != "two_references":
+        return
+    (_o0, q0), (_o1, q1) = ev.refs
+    a, b = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+    baseline = float(np.linalg.norm(a - b))
+    if not math.isfinite(baseline) or baseline <= 0.0:
+        return
+    cam = top.east_north
+    lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
+    move = REFERENCE_SLIP_M * lever
+    sigma = top.sigma_m if top.sigma_m is not None else 0.0
+    if move <= max(WRONG_M, 2.0 * sigma):
+        return
+    result.warnings.append(
+        f"references: the two references are {baseline:.0f} m apart and the camera "
+        f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
+        f"{REFERENCE_SLIP_M:.0f} m off across them (a pixel on the kerb for a point on the "
+        f"centre line, a rounded lat/lon) would move the camera about {move:.0f} m, beyond "
+        "its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
+        "landmark"
+    )
+
+
+def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
+    """Warn when landmarks alone put the best candidate's car off or across its street.
+
+    A landmark named by the wrong building (its neighbour's name, a shop that moved) is
+    matched at its word: the camera lands where that building stands, tens of metres off,
+    with a small sigma. The map is the witness, as for two references
+    (:func:`_warn_references_off_street`): a real car stands on a street, along it; one
+    beside its street, along it, is no contradiction (:func:`car_beside_street`). Measured
+    on ``benchmarks/absolute_slips.py`` (session 38, dev runs): of 37 landmark tops whose car
+    stands off or across its street, 33 were more than 15 m off.
+    """
+    if not ev.landmarks or ev.refs or ev.corners or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.method not in ("landmark", "one_landmark"):
+        return
+    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
+    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
+        return
+    where = _car_where(kinds)
+    if where is None:
+        return
+    result.warnings.append(
+        f"landmarks: the best candidate puts the car {where}; if the car does stand on a "
+        "street, along it, a landmark is named wrong (the building next to it, a name that "
+        "moved) or its pixel is not that building's corner: check the names, or add a "
+        "reference"
     )
 
 

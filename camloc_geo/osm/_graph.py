@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import itertools
 import logging
-from collections.abc import Iterable, Iterator, Sequence
+import re
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from typing import Any
 
 import networkx as nx
@@ -24,7 +25,14 @@ from shapely.geometry import LineString
 
 from camloc_geo.geodesy import great_circle_m
 
-__all__ = ["USEFUL_TAGS_WAY", "graph_from_ways", "simplify_graph"]
+__all__ = [
+    "ALT_NAME_TAGS",
+    "USEFUL_TAGS_WAY",
+    "alt_names_by_name",
+    "alt_names_of",
+    "graph_from_ways",
+    "simplify_graph",
+]
 
 log = logging.getLogger(__name__)
 
@@ -46,6 +54,26 @@ USEFUL_TAGS_WAY = (
     "width",
 )
 """Way tags kept as edge attributes (osmnx's ``settings.useful_tags_way``)."""
+
+ALT_NAME_TAGS = ("alt_name", "old_name", "official_name", "int_name", "loc_name", "short_name")
+"""Way tags whose values are other names of a street (also every ``name:<language>``)."""
+
+_LANG_NAME_RE = re.compile(r"^name:[a-z]{2,3}(?:[-_][A-Za-z]{2,8})?$")
+
+
+def alt_names_of(tags: Mapping[str, str]) -> str | None:
+    """A way's other names (:data:`ALT_NAME_TAGS`, ``name:<language>``), ``;``-joined and
+    sorted, or None. Not kept on the graph (osmnx keeps none of them): the map keeps them
+    by street name (:attr:`RawMap.alt_names <camloc_geo.osm._load.RawMap>`)."""
+    found = {
+        v.strip()
+        for k, value in tags.items()
+        if k in ALT_NAME_TAGS or _LANG_NAME_RE.match(k)
+        for v in str(value).split(";")
+        if v.strip()
+    }
+    return ";".join(sorted(found)) if found else None
+
 
 _ONEWAY_VALUES = {"yes", "true", "1", "-1", "reverse", "T", "F"}
 _REVERSED_VALUES = {"-1", "reverse", "T"}
@@ -189,3 +217,20 @@ def simplify_graph(G: nx.MultiDiGraph, *, edge_attrs_differ: Sequence[str] = ())
     G.remove_nodes_from(ring_nodes)
     G.graph["simplified"] = True
     return G
+
+
+def alt_names_by_name(
+    ways: Iterable[tuple[int, Mapping[str, str], Any]],
+) -> dict[str, tuple[str, ...]]:
+    """``{street name: its other names}`` over street ways (:func:`alt_names_of`), each
+    sorted; a way's own names (``name``, split at ``;``) left out."""
+    found: dict[str, set[str]] = {}
+    for _way_id, tags, _nodes in ways:
+        alt = alt_names_of(tags)
+        own = {n.strip() for n in str(tags.get("name") or "").split(";") if n.strip()}
+        if alt is None or not own:
+            continue
+        alts = set(alt.split(";")) - own
+        for n in own:
+            found.setdefault(n, set()).update(alts)
+    return {n: tuple(sorted(a)) for n, a in found.items() if a}

@@ -40,7 +40,7 @@ import shapely
 
 from camloc_geo._errors import MapDataError, MapSourceError
 from camloc_geo.geodesy import GEOD
-from camloc_geo.osm._graph import graph_from_ways, simplify_graph
+from camloc_geo.osm._graph import alt_names_by_name, graph_from_ways, simplify_graph
 from camloc_geo.osm._model import Building, polygon_from_lonlat
 from camloc_geo.osm._widths import parse_lanes, parse_width_m
 
@@ -102,6 +102,8 @@ class RawMap:
     bounds: tuple[float, float, float, float] | None = None  # (south, west, north, east)
     source: str = ""
     warnings: list[str] = field(default_factory=list)
+    alt_names: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """``{street name: its other names}`` (``name:<language>``, ``alt_name``, ``old_name``...)."""
 
 
 _SETTINGS_LOCK = threading.RLock()
@@ -340,7 +342,12 @@ def read_extract(
         )
     graph = _graph_from_ways(street_ways)
     return RawMap(
-        graph=graph, buildings=buildings, bounds=bounds, source=str(path), warnings=warnings
+        graph=graph,
+        buildings=buildings,
+        bounds=bounds,
+        source=str(path),
+        warnings=warnings,
+        alt_names=alt_names_by_name(street_ways),
     )
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
 import os
@@ -40,7 +41,12 @@ from camloc_geo.osm._local import (
     street_index,
 )
 from camloc_geo.osm._model import Building, Intersection, Street
-from camloc_geo.osm._names import close_matches, normalize_name, split_street_query
+from camloc_geo.osm._names import (
+    close_matches,
+    misspelling_matches,
+    normalize_name,
+    split_street_query,
+)
 from camloc_geo.osm._widths import in_north_america, parse_lanes, resolve_width_m
 
 __all__ = ["DEFAULT_TOLERANCE_M", "MapData", "load_map"]
@@ -154,6 +160,9 @@ class MapData:
             )
         )
         self._streets = tuple(_streets_of(raw.graph, north_america))
+        self._alt_names = dict(getattr(raw, "alt_names", None) or {})
+        """``{street name: its other names}`` (``name:<language>``, ``alt_name``, ``old_name``...):
+        a scene or query may name a street by any of them."""
         self._buildings = tuple(raw.buildings)
         self._cache: dict[str, Any] = {}
         self._cache_lock = threading.RLock()
@@ -259,10 +268,66 @@ class MapData:
         raise MapDataError(f"no intersection with id {ident!r}")
 
     def street_names(self) -> list[str]:
-        """Every street name of the map, sorted."""
+        """Every street name of the map, sorted, other names (``name:<language>``,
+        ``alt_name``, ``old_name``...) included."""
         names = {n for s in self._streets for n in (s.names or (s.name,))}
         names.update(s.name for x in self._intersections for s in x.streets)
+        alt = getattr(self, "_alt_names", {})
+        names.update(a for n in list(names) for a in alt.get(n, ()))
         return sorted(names)
+
+    def other_names(self, name: str) -> tuple[str, ...]:
+        """The other names of the street named ``name`` (``name:<language>``, ``alt_name``,
+        ``old_name``, ``official_name``...), sorted; empty when it has none."""
+        return getattr(self, "_alt_names", {}).get(name, ())
+
+    def spell_streets(self, streets: str | Sequence[str]) -> tuple[list[str], list[str]]:
+        """Street names that meet nowhere on this map, read as the map's names they misspell.
+
+        Parameters
+        ----------
+        streets
+            Two or more names (``"A & B"`` or a list), as :meth:`find_intersection` takes.
+
+        Returns
+        -------
+        ``(names, notes)``. When the named streets meet somewhere, or fewer than two are
+        given, the names as split and no note. Otherwise each name the map lacks is
+        replaced by a map name it may misspell (:func:`~camloc_geo.osm._names.
+        misspelling_matches`: one or two letters off, the same numbers); the names are
+        returned corrected, with a note per corrected name, only when exactly one
+        reading makes the streets meet on this map. Ambiguous or no reading: unchanged
+        (:meth:`find_intersection` then refuses with close matches).
+
+        Examples
+        --------
+        ``["Eastrn Avenue", "South Broadway"]`` -> ``(["Eastern Avenue", "South Broadway"],
+        ["'Eastrn Avenue' is no street of this map: read as 'Eastern Avenue' ..."])``.
+        """
+        wanted = split_street_query(streets)
+        if len(wanted) < 2 or self._street_hits(wanted):
+            return wanted, []
+        all_names = self.street_names()
+        options: list[list[str]] = []
+        for w in wanted:
+            alt = misspelling_matches(w, all_names) if not self._street_hits([w]) else []
+            options.append(alt or [w])
+        if all(len(o) == 1 and o[0] == w for o, w in zip(options, wanted, strict=True)):
+            return wanted, []
+        readings = [
+            list(r)
+            for r in itertools.islice(itertools.product(*options), 27)
+            if self._street_hits(list(r))
+        ]
+        if len(readings) != 1:
+            return wanted, []
+        notes = [
+            f"{w!r} is no street of this map: read as {r!r} (the one close name that meets "
+            f"the other named street{'s' if len(wanted) > 2 else ''}); check the spelling"
+            for w, r in zip(wanted, readings[0], strict=True)
+            if w != r
+        ]
+        return readings[0], notes
 
     def find_intersection(
         self, streets: str | Sequence[str], near: tuple[float, float] | None = None
@@ -377,10 +442,28 @@ class MapData:
         return self._street_hits(split_street_query(streets))
 
     def _street_hits(self, wanted: list[str]) -> list[Intersection]:
+        """Intersections where every wanted name meets: by the streets' own names (exactly,
+        else loosely: a name holding all the query's words), else with their other names
+        too (``name:<language>``, ``old_name``...), exactly, else loosely."""
         norms = [normalize_name(w) for w in wanted]
-        table, by_token = self.cached("intersection_street_names", self._street_name_table)
+        for key, with_alt in (
+            ("intersection_street_names", False),
+            ("intersection_street_names_alt", True),
+        ):
+            for loose in (False, True):
+                hits = self._street_hits_in(norms, key, with_alt, loose=loose)
+                if hits:
+                    return hits
+        return []
 
-        def matches(sets: list[frozenset[str]], loose: bool) -> bool:
+    def _street_hits_in(
+        self, norms: list[str], key: str, with_alt: bool, *, loose: bool
+    ) -> list[Intersection]:
+        table, by_token = self.cached(key, lambda: self._street_name_table(with_alt))
+        if with_alt and table is None:
+            return []
+
+        def matches(sets: list[frozenset[str]]) -> bool:
             for q in norms:
                 q_tokens = set(q.split())
                 ok = any(q in names for names in sets) or (
@@ -397,17 +480,24 @@ class MapData:
                 hit = by_token.get(tok, set())
                 maybe = set(hit) if maybe is None else maybe & hit
         order = sorted(maybe) if maybe is not None else range(len(table))
-        for loose in (False, True):
-            hits = [self._intersections[i] for i in order if matches(table[i], loose)]
-            if hits:
-                return hits
-        return []
+        return [self._intersections[i] for i in order if matches(table[i])]
 
-    def _street_name_table(self) -> tuple[list[list[frozenset[str]]], dict[str, set[int]]]:
+    def _street_name_table(self, with_alt: bool = False) -> tuple[Any, dict[str, set[int]]]:
         """Every intersection's normalised street names (per street) and a token index, once
-        per map (normalising them per call cost 30 ms on a city's extract, twice per locate)."""
+        per map (normalising them per call cost 30 ms on a city's extract, twice per locate).
+        ``with_alt``: each street's other names too (None when the map has none)."""
+        alt = getattr(self, "_alt_names", {}) if with_alt else {}
+        if with_alt and not alt:
+            return None, {}
         table = [
-            [frozenset(normalize_name(n) for n in (s.names or (s.name,))) for s in x.streets]
+            [
+                frozenset(
+                    normalize_name(n)
+                    for own in (s.names or (s.name,))
+                    for n in (own, *alt.get(own, ()))
+                )
+                for s in x.streets
+            ]
             for x in self._intersections
         ]
         by_token: dict[str, set[int]] = {}

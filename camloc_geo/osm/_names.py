@@ -16,7 +16,13 @@ from collections.abc import Iterable, Sequence
 
 from camloc_geo.osm._tokens import name_tokens
 
-__all__ = ["close_matches", "names_match", "normalize_name", "split_street_query"]
+__all__ = [
+    "close_matches",
+    "misspelling_matches",
+    "names_match",
+    "normalize_name",
+    "split_street_query",
+]
 
 _SPLIT_RE = re.compile(r"\s*(?:&|/|×|\+|\s+and\s+|\s+x\s+|\s+at\s+)\s*", re.IGNORECASE)
 
@@ -82,3 +88,40 @@ def close_matches(query: str, candidates: Iterable[str], n: int = 5) -> list[str
         if q_tokens and q_tokens <= set(norm.split()) and norm not in hits:
             hits.append(norm)
     return [by_norm[h] for h in hits]
+
+
+MISSPELLING_MIN_RATIO = 85.0
+"""rapidfuzz's ``fuzz.ratio`` (0-100) of two normalised names at least this for one to be
+read as a misspelling of the other: one letter dropped, added or two swapped in a name of
+ten letters scores 90-95, in one of six 85-90."""
+
+
+def misspelling_matches(query: str, candidates: Iterable[str], n: int = 3) -> list[str]:
+    """Candidates the query may be a misspelling of: normalised names within
+    :data:`MISSPELLING_MIN_RATIO` of it with the same numbers (``1st`` is never read as
+    ``2nd``), best first; empty when the query is itself one of them.
+
+    Examples
+    --------
+    >>> misspelling_matches("Eastrn Ave", ["Eastern Avenue", "Western Avenue", "Easton Road"])
+    ['Eastern Avenue', 'Western Avenue']
+    >>> misspelling_matches("1st Street", ["2nd Street"])
+    []
+    """
+    by_norm: dict[str, str] = {}
+    for cand in candidates:
+        by_norm.setdefault(normalize_name(cand), cand)
+    q = normalize_name(query)
+    if not q or q in by_norm:
+        return []
+    from rapidfuzz import fuzz, process
+
+    digits = [t for t in q.split() if any(ch.isdigit() for ch in t)]
+    found = process.extract(
+        q, list(by_norm), scorer=fuzz.ratio, limit=None, score_cutoff=MISSPELLING_MIN_RATIO
+    )
+    out = []
+    for norm, _score, _i in found:
+        if [t for t in norm.split() if any(ch.isdigit() for ch in t)] == digits:
+            out.append(by_norm[norm])
+    return out[:n]
