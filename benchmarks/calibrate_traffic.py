@@ -343,7 +343,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     for name, s in result["summary"].items():
         if not s["n"]:
-            print(f"{name:14s} all failed")
+            print(f"{name:14s} " + ("all failed" if s.get("failed") else "no scenes"))
             continue
         print(
             f"{name:14s} {s['n']:4d} {100 * s['median_signed']:+6.2f}% "
