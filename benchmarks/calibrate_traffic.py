@@ -115,7 +115,7 @@ def street_video_lines(seed: int, video_dir: Path) -> Any:
     beside it as ``s{seed}_lines.npz`` and read from there when it is newer than the video
     and the code that finds them, so a second run skips both passes)."""
     from camloc_geo.sensors import _video_lines as vl_mod
-    from camloc_geo.sensors._video_lines import VideoLines, video_lines
+    from camloc_geo.sensors._video_lines import video_lines
 
     path = video_dir / f"s{seed}.avi"
     if not path.is_file():
@@ -124,18 +124,16 @@ def street_video_lines(seed: int, video_dir: Path) -> Any:
     kept = video_dir / f"s{seed}_lines.npz"
     newest = max(path.stat().st_mtime, Path(vl_mod.__file__).stat().st_mtime)
     if kept.is_file() and kept.stat().st_mtime > newest:
-        with np.load(kept) as z:
-            return VideoLines(
-                (int(z["size"][0]), int(z["size"][1])),
-                z["segments"],
-                z["labels"],
-                z["vanishing_points"],
-                int(z["n_frames"]),
-                json.loads(str(z["counts"])),
-            )
+        return load_lines(kept)
     lines = video_lines(path, image_size=IMAGE_SIZE)
+    save_lines(kept, lines)
+    return lines
+
+
+def save_lines(path: Path, lines: Any) -> None:
+    """Keep a :class:`~camloc_geo.sensors._video_lines.VideoLines` as ``.npz`` (no pickle)."""
     np.savez(
-        kept,
+        path,
         size=np.array(lines.image_size),
         segments=lines.segments,
         labels=lines.labels,
@@ -143,7 +141,21 @@ def street_video_lines(seed: int, video_dir: Path) -> Any:
         n_frames=lines.n_frames,
         counts=json.dumps(lines.counts),
     )
-    return lines
+
+
+def load_lines(path: Path) -> Any:
+    """The :class:`~camloc_geo.sensors._video_lines.VideoLines` :func:`save_lines` kept."""
+    from camloc_geo.sensors._video_lines import VideoLines
+
+    with np.load(path) as z:
+        return VideoLines(
+            (int(z["size"][0]), int(z["size"][1])),
+            z["segments"],
+            z["labels"],
+            z["vanishing_points"],
+            int(z["n_frames"]),
+            json.loads(str(z["counts"])),
+        )
 
 
 def focal_row(
