@@ -23,11 +23,15 @@ not depend on the frames). The sets per seed:
   ``car_only`` scenes calibrated with the video's own lines too
   (:func:`camloc_geo.sensors._video_lines.video_lines` on the street video
   ``render_street`` makes for the seed: 10 vehicles, 20 s; what ``camloc radar`` does by
-  default). Rendering and reading a video take ~30 s of CPU each.
+  default), and with ``--draws`` also ``traffic_video_draws`` and
+  ``car_only_video_draws`` (the same video, ``--draws`` more noise draws of the
+  annotators). Rendering and reading a video take ~30 s of CPU each; with ``--video-dir``
+  both are kept (``s{seed}.avi``, ``s{seed}_lines.npz``) and reused.
 
 Per scene: the focal error ``f / f_true - 1``, the stated ``focal_sigma_px`` and ``z`` =
-error / sigma; per set also the 2-sigma coverage and the median ``|z|`` (a Gaussian: 95 %,
-0.67). Writes ``benchmarks/out/calibrate_traffic.json`` and
+error / sigma, and the same for the camera's height (``height_error``,
+``height_sigma_rel``, ``height_z``); per set also the 1- and 2-sigma coverage and the
+median ``|z|`` (a Gaussian: 68 %, 95 %, 0.67). Writes ``benchmarks/out/calibrate_traffic.json`` and
 ``benchmarks/out/calibrate_traffic.png`` (focal error per seed with the stated 2-sigma).
 
 Usage: ``python benchmarks/calibrate_traffic.py [--first-seed 300] [--seeds 20] [--draws 5]
@@ -107,20 +111,58 @@ def traffic_scene(
 
 def street_video_lines(seed: int, video_dir: Path) -> Any:
     """The video witness lines of ``render_street``'s video for ``random_street(seed)``
-    (rendered into ``video_dir`` unless ``s{seed}.avi`` is there already)."""
+    (rendered into ``video_dir`` unless ``s{seed}.avi`` is there already; the lines are kept
+    beside it as ``s{seed}_lines.npz`` and read from there when it is newer than the video
+    and the code that finds them, so a second run skips both passes)."""
+    from camloc_geo.sensors import _video_lines as vl_mod
     from camloc_geo.sensors._video_lines import video_lines
 
     path = video_dir / f"s{seed}.avi"
     if not path.is_file():
         cam, vehicles = random_street(np.random.default_rng(seed), n_vehicles=10, duration_s=20.0)
         render_street(path, cam, vehicles, duration_s=20.0, seed=seed)
-    return video_lines(path, image_size=IMAGE_SIZE)
+    kept = video_dir / f"s{seed}_lines.npz"
+    newest = max(path.stat().st_mtime, Path(vl_mod.__file__).stat().st_mtime)
+    if kept.is_file() and kept.stat().st_mtime > newest:
+        return load_lines(kept)
+    lines = video_lines(path, image_size=IMAGE_SIZE)
+    save_lines(kept, lines)
+    return lines
+
+
+def save_lines(path: Path, lines: Any) -> None:
+    """Keep a :class:`~camloc_geo.sensors._video_lines.VideoLines` as ``.npz`` (no pickle)."""
+    np.savez(
+        path,
+        size=np.array(lines.image_size),
+        segments=lines.segments,
+        labels=lines.labels,
+        vanishing_points=lines.vanishing_points,
+        n_frames=lines.n_frames,
+        counts=json.dumps(lines.counts),
+    )
+
+
+def load_lines(path: Path) -> Any:
+    """The :class:`~camloc_geo.sensors._video_lines.VideoLines` :func:`save_lines` kept."""
+    from camloc_geo.sensors._video_lines import VideoLines
+
+    with np.load(path) as z:
+        return VideoLines(
+            (int(z["size"][0]), int(z["size"][1])),
+            z["segments"],
+            z["labels"],
+            z["vanishing_points"],
+            int(z["n_frames"]),
+            json.loads(str(z["counts"])),
+        )
 
 
 def focal_row(
     scene: dict[str, Any], truth: Camera, settings: CalibrationSettings | None = None
 ) -> dict[str, Any] | None:
-    """Focal error, stated sigma and z of one scene, or None when ``calibrate`` refuses it."""
+    """Focal and camera-height errors, their stated sigmas and z (error / sigma) of one
+    scene, or None when ``calibrate`` refuses it."""
     try:
         res = calibrate_scene(scene, settings=settings)
     except InputError:
@@ -128,11 +170,17 @@ def focal_row(
     f_true = truth.focal_px
     err = res.camera.focal_px / f_true - 1.0
     sigma = (res.focal_sigma_px or float("nan")) / f_true
+    h_true = float(truth.center_in_world[2])
+    h_err = float(res.camera.center_in_world[2]) / h_true - 1.0
+    h_sigma = float(res.position_sigma_m[2]) / h_true if res.position_sigma_m is not None else 0.0
     return {
         "focal_error": round(float(err), 5),
         "focal_sigma_rel": round(float(sigma), 5),
         "z": round(float(err / sigma), 3) if sigma > 0 else None,
-        "height_m": round(float(truth.center_in_world[2]), 2),
+        "height_m": round(h_true, 2),
+        "height_error": round(h_err, 5),
+        "height_sigma_rel": round(h_sigma, 5),
+        "height_z": round(h_err / h_sigma, 3) if h_sigma > 0 else None,
         "warnings": len(res.warnings),
         **({"video_segments": res.video_segments} if settings is not None else {}),
     }
@@ -159,6 +207,25 @@ def summary(rows: list[dict[str, Any] | None]) -> dict[str, Any]:
         "cover_2sigma": round(float(np.mean(np.abs(z) < 2.0)), 3) if z.size else None,
         "median_abs_z": round(float(np.median(np.abs(z))), 3) if z.size else None,
         "lines_left_out": int(sum(r["warnings"] for r in ok)),
+        **_height_summary(ok),
+    }
+
+
+def _height_summary(ok: list[dict[str, Any]]) -> dict[str, Any]:
+    """The camera height's error and its stated sigma over a set's rows (as the focal's)."""
+    e = np.array([r["height_error"] for r in ok if "height_error" in r])
+    z = np.array([r["height_z"] for r in ok if r.get("height_z") is not None])
+    if e.size == 0:
+        return {}
+    return {
+        "height_median_abs": round(float(np.median(np.abs(e))), 4),
+        "height_max_abs": round(float(np.abs(e).max()), 4),
+        "height_cover_1sigma": round(float(np.mean(np.abs(z) < 1.0)), 3) if z.size else None,
+        "height_cover_2sigma": round(float(np.mean(np.abs(z) < 2.0)), 3) if z.size else None,
+        "height_median_abs_z": round(float(np.median(np.abs(z))), 3) if z.size else None,
+        "cover_1sigma": round(
+            float(np.mean([abs(r["z"]) < 1.0 for r in ok if r["z"] is not None])), 3
+        ),
     }
 
 
@@ -229,6 +296,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.video:
         scenes["traffic_video"] = []
         scenes["car_only_video"] = []
+        if args.draws:
+            scenes["traffic_video_draws"] = []
+            scenes["car_only_video_draws"] = []
     empty = {"focal_error": None, "focal_sigma_rel": None, "z": None}
     photo_dir = Path(tempfile.mkdtemp(prefix="camloc-calibrate-traffic-"))
     for seed in range(args.first_seed, args.first_seed + args.seeds):
@@ -258,6 +328,11 @@ def main(argv: list[str] | None = None) -> int:
             for name, base in (("traffic_video", syn), ("car_only_video", car)):
                 row = focal_row(base.scene, base.camera, with_video) or empty
                 scenes[name].append({"seed": seed, **row})
+            for k in range(args.draws):  # the same video, other annotators' noise
+                for name, lanes in (("traffic_video_draws", True), ("car_only_video_draws", False)):
+                    draw = traffic_scene(seed, noise_seed=10_000 * seed + k, lane_lines=lanes)
+                    row = focal_row(draw.scene, draw.camera, with_video) or empty
+                    scenes[name].append({"seed": seed, "draw": k, **row})
     shutil.rmtree(photo_dir, ignore_errors=True)
     result: dict[str, Any] = {
         "seeds": [args.first_seed, args.first_seed + args.seeds - 1],
@@ -276,11 +351,11 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"{'set':14s} {'n':>4s} {'median':>7s} {'mean':>7s} {'sd':>6s} {'med|e|':>7s} "
         f"{'max|e|':>7s} {'<3%':>5s} {'<6%':>5s} {'sigma':>6s} {'2σcov':>6s} {'|z|':>5s} "
-        f"{'drop':>4s}"
+        f"{'drop':>4s} {'h max':>6s} {'h 2σ':>5s} {'h|z|':>5s}"
     )
     for name, s in result["summary"].items():
         if not s["n"]:
-            print(f"{name:14s} all failed")
+            print(f"{name:14s} " + ("all failed" if s.get("failed") else "no scenes"))
             continue
         print(
             f"{name:14s} {s['n']:4d} {100 * s['median_signed']:+6.2f}% "
@@ -288,7 +363,10 @@ def main(argv: list[str] | None = None) -> int:
             f"{100 * s['sd']:5.2f}% {100 * s['median_abs']:6.2f}% {100 * s['max_abs']:6.2f}% "
             f"{100 * s['within_3pct']:4.0f}% {100 * s['within_6pct']:4.0f}% "
             f"{100 * s['median_sigma_rel']:5.2f}% {100 * (s['cover_2sigma'] or 0):5.0f}% "
-            f"{s['median_abs_z'] or 0:5.2f} {s['lines_left_out']:4d}"
+            f"{s['median_abs_z'] or 0:5.2f} {s['lines_left_out']:4d} "
+            f"{100 * s.get('height_max_abs', 0):5.2f}% "
+            f"{100 * (s.get('height_cover_2sigma') or 0):4.0f}% "
+            f"{s.get('height_median_abs_z') or 0:5.2f}"
         )
     return 0
 

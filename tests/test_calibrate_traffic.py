@@ -245,3 +245,58 @@ def test_the_one_step_jackknife_selects_the_photo_lines_again_without_each_annot
     assert abs(fast.camera.focal_px / cam.focal_px - 1.0) < 0.005
     assert slow.focal_sigma_px / cam.focal_px > 0.08  # the refits' spread
     assert fast.focal_sigma_px == pytest.approx(slow.focal_sigma_px, rel=0.15)  # was 0.27x
+
+
+def _benchmark() -> Any:
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "calibrate_traffic.py"
+    spec = importlib.util.spec_from_file_location("calibrate_traffic_bench", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_benchmark_rows_carry_the_camera_height_and_its_sigma() -> None:
+    bench = _benchmark()
+    exact = bench.traffic_scene(106, click_px=0.0)
+    row = bench.focal_row(exact.scene, exact.camera)
+    assert row["height_error"] == pytest.approx(0.0, abs=1e-6)
+    noisy = bench.traffic_scene(106, lane_lines=False)
+    row = bench.focal_row(noisy.scene, noisy.camera)
+    res = calibrate_scene(noisy.scene)
+    h_true = float(noisy.camera.center_in_world[2])
+    assert row["height_error"] == pytest.approx(float(res.camera.height_m) / h_true - 1.0, abs=1e-5)
+    assert row["height_sigma_rel"] == pytest.approx(
+        float(res.position_sigma_m[2]) / h_true, abs=1e-5
+    )
+    assert row["height_z"] == pytest.approx(row["height_error"] / row["height_sigma_rel"], rel=1e-2)
+    summary = bench.summary([row, row])
+    assert summary["height_max_abs"] == pytest.approx(abs(row["height_error"]), abs=1e-4)
+    assert summary["height_cover_2sigma"] == (1.0 if abs(row["height_z"]) < 2 else 0.0)
+
+
+def test_the_benchmark_keeps_video_lines_without_pickle(tmp_path: Any) -> None:
+    from camloc_geo.sensors._video_lines import VideoLines
+
+    bench = _benchmark()
+    vps = np.array([[1.0, 0.0, 0.0], [np.nan] * 3, [0.0, 1.0, 1e-3]])
+    lines = VideoLines(
+        (960, 540),
+        np.array([[1.0, 2.0, 30.0, 4.0], [5.0, 6.0, 7.0, 80.0]]),
+        np.array([0, 2]),
+        vps / np.linalg.norm(np.nan_to_num(vps), axis=1, keepdims=True).clip(1e-12),
+        400,
+        {"street": 1, "vertical": 1},
+    )
+    bench.save_lines(tmp_path / "s1_lines.npz", lines)
+    back = bench.load_lines(tmp_path / "s1_lines.npz")
+    assert back.image_size == (960, 540)
+    assert np.array_equal(back.segments, lines.segments)
+    assert np.array_equal(back.labels, lines.labels)
+    assert np.array_equal(back.vanishing_points, lines.vanishing_points, equal_nan=True)
+    assert back.n_frames == 400
+    assert back.counts == lines.counts
