@@ -24,7 +24,8 @@ def write_video(
     """Write ``n_frames`` frames ``frame_at(t_s)`` (BGR uint8, ``size`` = (w, h)) to ``path``.
 
     Each frame gets Gaussian sensor noise of ``noise_sigma`` grey levels (OpenCV's RNG, as the
-    generators always used). Raises RuntimeError when OpenCV cannot write ``fourcc`` there.
+    generators always used, reset to a fresh process's state first: the same video whatever
+    was rendered before it). Raises RuntimeError when OpenCV cannot write ``fourcc`` there.
     """
     import cv2
 
@@ -33,6 +34,10 @@ def write_video(
     if not writer.isOpened():
         raise RuntimeError(f"OpenCV cannot write {fourcc} video to {path}")
     noise = np.empty((h, w, 3), np.float32)
+    # OpenCV's RNG is one per thread for the whole process: reset it to the state a fresh
+    # process starts with (seed 0 is that state), so a video's noise does not depend on what
+    # was rendered before it (a test's video differed with the tests run before it).
+    cv2.setRNGSeed(0)
     try:
         for i in range(n_frames):
             frame = frame_at(i / fps)
