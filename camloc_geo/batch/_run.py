@@ -213,10 +213,27 @@ def _local_executor(workers: int) -> Executor:
 
 def _worker_signals() -> None:
     """A worker ends on SIGTERM (a forked worker inherited the CLI's handler, which turns
-    SIGTERM into an exception that the pool's task loop catches: the worker lived on)."""
+    SIGTERM into an exception that the pool's task loop catches: the worker lived on), and
+    when the process that started it is gone (``kill -9`` of ``camloc batch``, the OOM
+    killer): the pool's queue never closes then, and its workers waited on it for ever,
+    each holding its maps and the journal's file handles."""
     import signal
 
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # the batch process's sentinel: readable once it is gone, whatever the start method (a
+    # forkserver's worker is the forkserver's child, and the forkserver lives as long as its
+    # workers do, so the worker's own parent never changes)
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        from multiprocessing.connection import wait
+
+        wait([parent.sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="camloc-parent-watch", daemon=True).start()
 
 
 class _DaskRunner:
