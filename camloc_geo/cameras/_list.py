@@ -243,15 +243,47 @@ def row_from_mapping(
     )
 
 
+# the binary files a camera list is mistaken for, by their first bytes
+_BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
+    (b"SQLite format 3\x00", "a GeoPackage or SQLite database"),
+    (b"PK\x03\x04", "a ZIP archive (an Excel or LibreOffice workbook, a zipped shapefile?)"),
+    (b"\xd0\xcf\x11\xe0", "an old Excel (.xls) workbook"),
+    (b"\x00\x00\x27\x0a", "a shapefile's geometry (.shp)"),
+    (b"%PDF", "a PDF document"),
+)
+
+
+_UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+
+
+def _check_text_list(path: Path, head: bytes) -> None:
+    """Refuse a binary file as a list, naming what it looks like.
+
+    A GeoPackage given as the list was read as Latin-1 "text": the error quoted its SQLite
+    header's bytes as the list's header row. Text lists (CSV, GeoJSON; UTF-8, UTF-8 with a
+    byte-order mark, Windows-1252) never hold a NUL byte.
+    """
+    if b"\x00" not in head or head.startswith(_UTF16_BOMS):
+        return  # UTF-16 with its byte-order mark (Excel's "Unicode Text") is read as such
+    what = next((kind for magic, kind in _BINARY_KINDS if head.startswith(magic)), None)
+    raise InputError(
+        f"the camera list {path.name} is {what or 'not a text file (it holds NUL bytes)'}, "
+        "not a CSV or GeoJSON list: save the cameras as CSV or GeoJSON (QGIS: Export > "
+        "Save Features As...; GDAL: ogr2ogr -f GeoJSON cameras.geojson "
+        f"{path.name}) and give that file"
+    )
+
+
 def _list_kind(path: Path) -> str:
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    _check_text_list(path, head)
     name = path.name.lower()
     if name.endswith((".geojson", ".json", ".geojsonl", ".geojsons", ".ndjson", ".jsonl")):
         return "geojson"
     if name.endswith((".csv", ".tsv", ".txt")):
         return "csv"
-    with open(path, "rb") as fh:
-        head = fh.read(64).lstrip()
-    return "geojson" if head.startswith((b"{", b"[")) else "csv"
+    return "geojson" if head.lstrip()[:64].startswith((b"{", b"[")) else "csv"
 
 
 def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
@@ -267,7 +299,8 @@ def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
 
 
 def _text_encoding(path: Path) -> str:
-    """``utf-8-sig`` for UTF-8 text (with or without a byte-order mark), else the
+    """``utf-8-sig`` for UTF-8 text (with or without a byte-order mark), ``utf-16`` for text
+    that starts with a UTF-16 byte-order mark (Excel's "Unicode Text"), else the
     Windows-1252 that spreadsheets export on Western systems (``latin-1`` where even that
     does not decode), with a warning: a list saved so is read, not refused.
 
@@ -275,6 +308,9 @@ def _text_encoding(path: Path) -> str:
     """
     decoder: codecs.IncrementalDecoder = codecs.getincrementaldecoder("utf-8")()
     with open(path, "rb") as fh:
+        if fh.read(2) in _UTF16_BOMS:  # Excel's "Unicode Text" export (tab-separated)
+            return "utf-16"
+        fh.seek(0)
         try:
             while chunk := fh.read(1 << 20):
                 decoder.decode(chunk)
@@ -515,7 +551,8 @@ def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
         else:
             yield from _read_csv(p)
     except UnicodeDecodeError as exc:
-        raise InputError(f"camera list {p.name} is not UTF-8 text: {exc.reason}") from None
+        enc = "UTF-8" if exc.encoding.lower().startswith("utf-8") else exc.encoding.upper()
+        raise InputError(f"camera list {p.name} is not {enc} text: {exc.reason}") from None
     except csv.Error as exc:
         raise InputError(f"malformed CSV in {p.name}: {exc}") from None
     except OSError as exc:
