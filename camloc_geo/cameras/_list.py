@@ -263,15 +263,26 @@ def _check_text_list(path: Path, head: bytes) -> None:
     header's bytes as the list's header row. Text lists (CSV, GeoJSON; UTF-8, UTF-8 with a
     byte-order mark, Windows-1252) never hold a NUL byte.
     """
-    if b"\x00" not in head or head.startswith(_UTF16_BOMS):
-        return  # UTF-16 with its byte-order mark (Excel's "Unicode Text") is read as such
-    what = next((kind for magic, kind in _BINARY_KINDS if head.startswith(magic)), None)
+    what = binary_list_kind(head)
+    if what is None:
+        return
     raise InputError(
-        f"the camera list {path.name} is {what or 'not a text file (it holds NUL bytes)'}, "
-        "not a CSV or GeoJSON list: save the cameras as CSV or GeoJSON (QGIS: Export > "
-        "Save Features As...; GDAL: ogr2ogr -f GeoJSON cameras.geojson "
-        f"{path.name}) and give that file"
+        f"the camera list {path.name} is {what}, not a CSV or GeoJSON list: save the cameras "
+        "as CSV or GeoJSON (QGIS: Export > Save Features As...; GDAL: ogr2ogr -f GeoJSON "
+        f"cameras.geojson {path.name}) and give that file"
     )
+
+
+def binary_list_kind(head: bytes) -> str | None:
+    """What a list's first bytes say it is when it is no text (None: text, maybe UTF-16).
+
+    A NUL byte never occurs in a UTF-8 or Windows-1252 list; UTF-16 with its byte-order mark
+    (Excel's "Unicode Text") is text.
+    """
+    if b"\x00" not in head or head.startswith(_UTF16_BOMS):
+        return None
+    what = next((kind for magic, kind in _BINARY_KINDS if head.startswith(magic)), None)
+    return what or "not a text file (it holds NUL bytes)"
 
 
 def _list_kind(path: Path) -> str:

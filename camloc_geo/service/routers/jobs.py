@@ -7,6 +7,8 @@ the store, so a job survives a restart.
 
 from __future__ import annotations
 
+import codecs
+import csv
 import io
 import logging
 import threading
@@ -74,6 +76,11 @@ def csv_text(raw: bytes) -> str:
     its lists "with camloc batch's reader"; the job's answer now says how it was read
     (:func:`csv_encoding_warning`).
     """
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        try:  # Excel's "Unicode Text", as camloc batch reads it
+            return raw.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise SceneError(f"the CSV list is not UTF-16 text: {exc.reason}", "body") from None
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -85,7 +92,9 @@ def csv_text(raw: bytes) -> str:
 
 
 def csv_encoding_warning(raw: bytes) -> str | None:
-    """The warning for a CSV body that is not UTF-8, or None."""
+    """The warning for a CSV body that is not UTF-8 (or UTF-16 with its mark), or None."""
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return None
     try:
         raw.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -110,20 +119,29 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
         Not UTF-8, not ``{"cameras": [...]}``, or a CSV naming scene files.
     """
     from camloc_geo.batch import read_camera_csv, row_from_mapping
+    from camloc_geo.cameras import binary_list_kind
 
     if ctype == "text/csv":
+        what = binary_list_kind(raw[:4096])
+        if what is not None:  # a GeoPackage sent as the list was a 500
+            raise SceneError(f"the CSV list is {what}: send CSV text (UTF-8)", "body")
         text = csv_text(raw)
         out: list[Any] = []
-        for row in read_camera_csv(io.StringIO(text)):
-            if row.scene is not None:
-                raise SceneError(
-                    "a list sent over HTTP cannot name scene files: send it as JSON with each "
-                    "camera's scene inline",
-                    "scene",
-                )
-            out.append(_record(row))
-            if len(out) > max_cameras:
-                break
+        try:
+            # newline="": rows ended by a bare CR (a Mac spreadsheet's CSV) are rows, as
+            # camloc batch reads them; the csv module refused them (a 500)
+            for row in read_camera_csv(io.StringIO(text, newline="")):
+                if row.scene is not None:
+                    raise SceneError(
+                        "a list sent over HTTP cannot name scene files: send it as JSON with "
+                        "each camera's scene inline",
+                        "scene",
+                    )
+                out.append(_record(row))
+                if len(out) > max_cameras:
+                    break
+        except csv.Error as exc:
+            raise SceneError(f"malformed CSV list: {exc}", "body") from None
         return out
     try:
         cameras = JobList.model_validate(parse_json(raw)).cameras
