@@ -33,6 +33,7 @@ from camloc_geo.cameras import (
     geocode_camera,
     read_camera_list,
 )
+from camloc_geo.cameras._camera import area_of_row
 from camloc_geo.cameras._list import count_camera_rows
 from camloc_geo.osm import Area, MapPlan, area_map, map_plan
 
@@ -379,6 +380,8 @@ def _chunks(
     for row in rows:
         if row.has_point:
             area = plan.area_of(row)
+        elif row.has_scene:  # at its scene's point (one scene read per such row)
+            area = area_of_row(plan, row)
         else:
             area = search_areas.get(row.area) or search_areas.setdefault(
                 row.area, plan.area_of(row)

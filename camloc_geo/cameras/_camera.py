@@ -556,6 +556,10 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     from camloc_geo.geocode._maps import miss_rank, one_place
     from camloc_geo.osm import area_map
 
+    if not (row.title or row.streets) and row.has_scene:
+        # a scene naming no point on any map (or that cannot be read): located without a
+        # map, which says what it lacks (scene_error, or a scene that needs a map)
+        return _with_map(row, res, None)
     if not (row.title or row.streets):
         res.status = "no_evidence"
         res.reason = "no point, no title and no street pair: nothing to search the maps with"
@@ -619,6 +623,20 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     )
 
 
+def area_of_row(plan: MapPlan, row: CameraRow) -> Area:
+    """The row's area; a row without a point but with a scene: the area at the scene's
+    point (its intersection or prior), when a map covers it (else as before: its title is
+    searched in every extract)."""
+    from camloc_geo.cameras._list import area_row
+
+    at_scene = area_row(row)
+    if at_scene is not row:
+        area = plan.area_of(at_scene)
+        if area[0] != "none":
+            return area
+    return plan.area_of(row)
+
+
 def geocode_camera(
     row: CameraRow,
     *,
@@ -680,7 +698,7 @@ def _geocode(
             else map_plan(None, network=network)
         )
     if area is None:
-        area = plan.area_of(row)
+        area = area_of_row(plan, row)
     kind = area[0]
     if kind == "none":
         if row.has_scene and not (row.title or row.streets):

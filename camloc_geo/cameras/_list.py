@@ -34,11 +34,12 @@ import math
 import os
 import re
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
+from camloc_geo._limits import MAX_SCENE_BYTES
 
 log = logging.getLogger(__name__)
 
@@ -133,6 +134,60 @@ class CameraRow:
     def has_scene(self) -> bool:
         """True when the row gives a scene (a file or inline)."""
         return bool(self.scene) or self.scene_data is not None
+
+
+def scene_point(row: CameraRow) -> tuple[float, float] | None:
+    """Where a row's scene says the camera is: its intersection's lat/lon, else its prior's.
+
+    Only for choosing the map (the extract of a folder, a network cell) of a row that gives
+    no point itself; None where the row has no scene or the scene names no valid point (a
+    broken scene is reported when it is located, not here). Reads at most
+    :data:`~camloc_geo._limits.MAX_SCENE_BYTES` of a scene file, as plain JSON.
+    """
+    data: Any = row.scene_data
+    if data is None and row.scene:
+        try:
+            p = Path(row.scene)
+            if not p.is_file() or p.stat().st_size > MAX_SCENE_BYTES:
+                return None
+            with open(p, encoding="utf-8-sig") as fh:
+                data = json.load(fh)
+        except (OSError, ValueError):
+            return None
+    if not isinstance(data, dict):
+        return None
+    for key in ("intersection", "prior"):
+        part = data.get(key)
+        if not isinstance(part, dict):
+            continue
+        lat, lon = part.get("lat"), part.get("lon")
+        if (
+            isinstance(lat, (int, float))
+            and isinstance(lon, (int, float))
+            and not isinstance(lat, bool)
+            and not isinstance(lon, bool)
+            and math.isfinite(lat)
+            and math.isfinite(lon)
+            and -90 <= lat <= 90
+            and -180 <= lon <= 180
+        ):
+            return float(lat), float(lon)
+    return None
+
+
+def area_row(row: CameraRow) -> CameraRow:
+    """The row as its map is chosen: a row without a point takes its scene's point.
+
+    A camera given only a scene (``id,scene``; an HTTP job's inline scene) was searched by
+    its title in every extract of a folder, found no title, and ended ``no_evidence``
+    although its scene names where it is (located with one extract given).
+    """
+    if row.has_point or not row.has_scene:
+        return row
+    point = scene_point(row)
+    if point is None:
+        return row
+    return replace(row, lat=point[0], lon=point[1])
 
 
 def _clean(value: Any) -> str:
