@@ -89,3 +89,32 @@ def test_job_camera_with_only_an_inline_scene_is_located(tmp_path: Path, maps: P
     (scene_cam,) = camera_records(body, "application/json", 10)
     located = process_camera(scene_cam, MapStore(settings), settings)
     assert located["status"] == "located", located["reason"]
+
+
+def test_job_row_problems_survive_the_stored_list(tmp_path: Path, maps: Path) -> None:
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.routers.jobs import camera_records
+    from camloc_geo.service.settings import Settings
+    from camloc_geo.service.work import process_camera
+
+    settings = Settings(map_dir=maps, network=False, data_dir=tmp_path / "data")
+    store = MapStore(settings)
+    body = json.dumps(
+        {
+            "cameras": [
+                {"id": "c", "title": "Eastern Ave & S Broadway", "lat": "abc", "lon": -76.59},
+                {"id": "e", "title": "Nowhere & Fake", "lat": 95, "lon": -76.59},
+            ]
+        }
+    ).encode()
+    bad_lat, off_earth = camera_records(body, "application/json", 10)
+    placed = process_camera(bad_lat, store, settings)
+    assert placed["status"] == "title_only"
+    assert placed["reason"].count("list row: lat 'abc' is not a number") == 1
+    missed = process_camera(off_earth, store, settings)
+    assert missed["status"] == "not_found"
+    assert "lat=95.0, lon=-76.59 is not a point on Earth" in missed["reason"]
+    csv_cam = camera_records(
+        b"id,title,lat,lon\nc,Eastern Ave & S Broadway,abc,-76.59\n", "text/csv", 10
+    )[0]
+    assert "lat 'abc' is not a number" in process_camera(csv_cam, store, settings)["reason"]
