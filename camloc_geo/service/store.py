@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SqliteFile", "Store"]
+__all__ = ["SqliteFile", "Store", "TaskFullError"]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
@@ -73,6 +73,10 @@ class SqliteFile:
             if db.in_transaction:  # (a failed COMMIT too: the connection is reused)
                 db.execute("ROLLBACK")
             raise
+
+
+class TaskFullError(Exception):
+    """A crowd task has all the annotations it needs."""
 
 
 class Store(SqliteFile):
@@ -252,11 +256,20 @@ class Store(SqliteFile):
             )
         return int(n) + 1
 
-    def add_annotation_once(self, task_id: str, scene: dict[str, Any]) -> tuple[int, bool]:
+    def add_annotation_once(
+        self, task_id: str, scene: dict[str, Any], *, needed: int | None = None
+    ) -> tuple[int, bool]:
         """Store one annotator's scene unless the task has the very same one already.
 
         Returns how many the task has now and whether this one was new: a client's retry
         (a lost answer, a double click on Submit) must not count as another annotator.
+
+        Raises
+        ------
+        TaskFullError
+            The task has ``needed`` annotations already (checked in the same transaction:
+            submissions racing the one that completed the task, while it was being
+            located, were all stored and counted).
         """
         with self._tx() as db:
             rows = db.execute(
@@ -264,6 +277,8 @@ class Store(SqliteFile):
             ).fetchall()
             if any(json.loads(r["scene"]) == scene for r in rows):
                 return len(rows), False
+            if needed is not None and len(rows) >= needed:
+                raise TaskFullError(task_id)
             db.execute(
                 "INSERT INTO annotations (task_id, n, created, scene) VALUES (?, ?, ?, ?)",
                 (task_id, len(rows), time.time(), json.dumps(scene)),
