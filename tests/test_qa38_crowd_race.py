@@ -74,3 +74,54 @@ def test_a_task_takes_only_the_annotations_it_needs(tmp_path: Path) -> None:
     assert state["annotations"] == 3
     assert state["status"] == "located"
     assert len(state["result"]["scene"]["annotations"]) == 3
+
+
+def test_a_completing_submission_that_fails_can_be_sent_again(
+    tmp_path: Path, monkeypatch: Any
+) -> None:
+    """The submission that completes a task is taken back when locating fails outside the
+    library (a time limit, a lost worker): the task would otherwise be full for ever and
+    never located, every later submission refused."""
+    import camloc_geo.service.routers.crowd as crowd
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "baltimore.osm.pbf").symlink_to(REPO / "sample_maps" / "baltimore.osm.pbf")
+    app = create_app(Settings(data_dir=tmp_path / "d", map_dir=maps, workers=0))
+    photo = cv2.imencode(".png", np.full((1080, 1920, 3), 128, np.uint8))[1].tobytes()
+    real = crowd.crowd_work
+    calls = {"n": 0}
+
+    def flaky(*args: Any) -> Any:
+        calls["n"] += 1
+        if calls["n"] == 1:
+            raise TimeoutError("a worker was lost")
+        return real(*args)
+
+    monkeypatch.setattr(crowd, "crowd_work", flaky)
+
+    async def run() -> list[Any]:
+        transport = httpx.ASGITransport(app=app, raise_app_exceptions=False)
+        async with httpx.AsyncClient(
+            transport=transport, base_url="http://t", timeout=120
+        ) as client:
+            task = await client.post(
+                "/v1/tasks?annotations=2", content=photo, headers={"content-type": "image/png"}
+            )
+            url = f"/v1/tasks/{task.json()['id']}"
+            first = await client.post(f"{url}/annotations", json=_annotator(0))
+            failed = await client.post(f"{url}/annotations", json=_annotator(1))
+            between = (await client.get(url)).json()
+            again = await client.post(f"{url}/annotations", json=_annotator(1))
+            return [first, failed, between, again, (await client.get(url)).json()]
+
+    try:
+        first, failed, between, again, state = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert first.status_code == 200
+    assert failed.status_code >= 500
+    assert (between["annotations"], between["status"]) == (1, "collecting")
+    assert again.status_code == 200, again.text
+    assert again.json()["status"] == "located"
+    assert (state["annotations"], state["status"]) == (2, "located")

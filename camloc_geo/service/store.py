@@ -285,6 +285,13 @@ class Store(SqliteFile):
             )
         return len(rows) + 1, True
 
+    def remove_annotation(self, task_id: str, n: int) -> None:
+        """Take back the ``n``-th annotation (from 1) of a task: the submission that
+        completed the task failed to locate it (a time limit, a worker lost), so it may be
+        sent again rather than leave the task full and never located."""
+        with self._tx() as db:
+            db.execute("DELETE FROM annotations WHERE task_id = ? AND n = ?", (task_id, n - 1))
+
     def annotations(self, task_id: str) -> list[dict[str, Any]]:
         """Every annotator's scene of a task, in arrival order."""
         rows = self._db().execute(

@@ -223,7 +223,13 @@ async def submit(
         raise SceneError("this task has all its annotations already", "task") from None
     if new and n >= task["needed"]:
         prior = task["base_scene"].get("prior")
-        status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        try:
+            status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        except BaseException:
+            # not located (the time limit, a lost worker): the submission is taken back,
+            # so that sending it again locates the task (a full task is refused otherwise)
+            store.remove_annotation(task_id, n)
+            raise
         store.set_task_result(task_id, status, result)
     got = cast(dict[str, Any], store.task(task_id))
     answer = {"annotations": n, "needed": task["needed"], "status": got["status"]}
