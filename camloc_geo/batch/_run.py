@@ -10,6 +10,8 @@ output does not depend on where or in which order the work ran.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import multiprocessing
 import os
@@ -172,6 +174,32 @@ def _memo_key(plan: MapPlan, area: Area, row: CameraRow) -> tuple[Any, ...] | No
         row.area,
         row.problems,
     )
+
+
+def row_fingerprint(row: CameraRow) -> str:
+    """What the list says of a camera, as a short digest: its fields, and for a scene file
+    its size and modification time (a scene annotated again under the same name)."""
+    parts: list[Any] = [
+        row.id,
+        row.title,
+        row.lat,
+        row.lon,
+        row.radius_m,
+        row.streets,
+        row.scene,
+        row.view,
+        row.area,
+        row.problems,
+        row.scene_data,
+    ]
+    if row.scene:
+        try:
+            st = os.stat(row.scene)
+            parts.append([st.st_size, st.st_mtime_ns])
+        except OSError:
+            parts.append(None)
+    text = json.dumps(parts, sort_keys=True, default=str)
+    return hashlib.blake2b(text.encode("utf-8"), digest_size=12).hexdigest()
 
 
 def _memoizable(rec: dict[str, Any]) -> bool:
@@ -552,8 +580,10 @@ def run_batch(
         # the list and the journal are both in row order: walk them side by side, keeping
         # one bit per row done (125 kB per million rows), never a row-to-id dict
         done = _RowBits()
-        recorded = journal.iter_done(retry=RETRY_STATUSES)
+        recorded = journal.iter_done_fingerprints(retry=RETRY_STATUSES)
         nxt = next(recorded, None)
+        changed: list[tuple[int, str]] = []  # the first few rows the list changed
+        n_changed = 0
         # nothing to resume: no first pass over the list (the rows are counted as they are
         # computed; the progress bar alone needs the count up front, and counts lines)
         first_pass = nxt is not None
@@ -569,6 +599,13 @@ def run_batch(
                         f"row {row.row} of {list_p.name} is camera {row.id!r} but the journal "
                         f"recorded {nxt[1]!r}: the list changed; use --restart"
                     )
+                if nxt[2] is not None and nxt[2] != row_fingerprint(row):
+                    # the same camera, another listing (a title corrected, a scene file
+                    # edited): computed again, never its old answer under the new title
+                    n_changed += 1
+                    if len(changed) < _NAMED_DUPLICATE_IDS:
+                        changed.append((row.row, row.id))
+                    continue
                 done.add(row.row)
                 skipped += 1
         del recorded
@@ -593,6 +630,13 @@ def run_batch(
             total = counted.n
         dups = journal.duplicate_ids(limit=_MAX_DUPLICATE_IDS)
         warnings = _duplicate_warnings(dups, journal.n_duplicate_ids(), list_p.name)
+        if n_changed:
+            named = ", ".join(f"row {r} ({i!r})" for r, i in changed)
+            more = f" and {n_changed - len(changed)} more" if n_changed > len(changed) else ""
+            warnings.append(
+                f"{list_p.name}: {n_changed} row(s) changed since {journal.path.name} recorded "
+                f"them, computed again: {named}{more}"
+            )
         t = time.perf_counter()
         _write_gpkg(journal, out, duplicates=dups)
         stage["gpkg"] += time.perf_counter() - t
@@ -685,6 +729,7 @@ def _run_chunks(
     computed = 0
     done_count = initial
     inflight: set[Any] = set()
+    fingerprints: dict[Any, dict[int, str]] = {}
 
     def collect(futs: set[Any]) -> None:
         nonlocal computed, done_count
@@ -696,7 +741,7 @@ def _run_chunks(
                 else:
                     stage[k] += v
             t = time.perf_counter()
-            n = journal.write(records)
+            n = journal.write(records, fingerprints.pop(fut, None))
             stage["journal"] += time.perf_counter() - t
             computed += n
             done_count += n
@@ -709,7 +754,9 @@ def _run_chunks(
         t_read = time.perf_counter()
         for area, rows in _chunks(todo, plan, chunk_size):
             stage["read_list"] += time.perf_counter() - t_read
-            inflight.add(runner.submit(process_chunk, plan, area, rows))
+            fut = runner.submit(process_chunk, plan, area, rows)
+            fingerprints[fut] = {r.row: row_fingerprint(r) for r in rows}
+            inflight.add(fut)
             while len(inflight) >= max_inflight:
                 finished = runner.wait_one(inflight)
                 inflight -= finished
