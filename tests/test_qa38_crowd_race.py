@@ -125,3 +125,46 @@ def test_a_completing_submission_that_fails_can_be_sent_again(
     assert again.status_code == 200, again.text
     assert again.json()["status"] == "located"
     assert (state["annotations"], state["status"]) == (2, "located")
+
+
+def test_a_task_full_but_not_located_at_start_up_is_reopened(tmp_path: Path) -> None:
+    """The server died while locating the submission that completed a task: at the next
+    start the task takes its last annotation back, so that a retry locates it (every
+    submission was refused as full, the task never located)."""
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "baltimore.osm.pbf").symlink_to(REPO / "sample_maps" / "baltimore.osm.pbf")
+    settings = Settings(data_dir=tmp_path / "d", map_dir=maps, workers=0)
+    photo = cv2.imencode(".png", np.full((1080, 1920, 3), 128, np.uint8))[1].tobytes()
+
+    async def crashed() -> str:
+        app = create_app(settings)
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            task = await client.post(
+                "/v1/tasks?annotations=2", content=photo, headers={"content-type": "image/png"}
+            )
+        task_id = str(task.json()["id"])
+        store = app.state.store
+        for i in range(2):  # stored, then the process died before the task's result
+            store.add_annotation_once(task_id, _annotator(i), needed=2)
+        app.state.compute.shutdown()
+        return task_id
+
+    async def restarted(task_id: str) -> list[Any]:
+        app = create_app(settings)
+        async with app.router.lifespan_context(app):
+            transport = httpx.ASGITransport(app=app)
+            async with httpx.AsyncClient(
+                transport=transport, base_url="http://t", timeout=120
+            ) as client:
+                url = f"/v1/tasks/{task_id}"
+                before = (await client.get(url)).json()
+                retry = await client.post(f"{url}/annotations", json=_annotator(1))
+                return [before, retry, (await client.get(url)).json()]
+
+    task_id = asyncio.run(crashed())
+    before, retry, after = asyncio.run(restarted(task_id))
+    assert (before["annotations"], before["status"]) == (1, "collecting")
+    assert retry.status_code == 200, retry.text
+    assert (after["annotations"], after["status"]) == (2, "located")

@@ -136,6 +136,23 @@ class Store(SqliteFile):
                 (f"{os.getpid()}-%",),
             )
 
+    def reopen_full_tasks(self) -> int:
+        """At start-up: a crowd task that has its annotations but no result (the server
+        died while locating it) takes its last one back, so that the annotator's retry
+        locates it; otherwise every submission was refused as full and the task never
+        located. Returns how many tasks were reopened."""
+        with self._tx() as db:
+            full = db.execute(
+                "SELECT t.id, t.needed FROM tasks t WHERE t.status = 'collecting' AND "
+                "(SELECT COUNT(*) FROM annotations a WHERE a.task_id = t.id) >= t.needed"
+            ).fetchall()
+            for task_id, needed in full:
+                db.execute(
+                    "DELETE FROM annotations WHERE task_id = ? AND n >= ?",
+                    (task_id, max(int(needed) - 1, 0)),
+                )
+        return len(full)
+
     def finish_camera(self, job_id: str, idx: int, result: dict[str, Any]) -> None:
         """Commit one camera's result (exactly once)."""
         with self._tx() as db:

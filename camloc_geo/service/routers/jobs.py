@@ -304,6 +304,13 @@ class JobRunner:
     def start(self) -> None:
         """Release what a dead process had claimed, then start working."""
         self.store.release_own_claims()
+        reopened = self.store.reopen_full_tasks()
+        if reopened:
+            log.warning(
+                "%d crowd task(s) had all their annotations but no result (the server "
+                "stopped while locating them): each took its last annotation back",
+                reopened,
+            )
         self._thread = threading.Thread(target=self._run, name="camloc-jobs", daemon=True)
         self._thread.start()
 
