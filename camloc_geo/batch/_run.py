@@ -970,23 +970,30 @@ def _write_gpkg(
             started.add(name)
         buf.clear()
 
-    for rec in journal.records():
-        buf.append(rec)
-        if len(buf) >= page:
-            flush(False)
-    flush(False)
-    for name in ("cameras", "candidates", "view_cones", "errors"):
-        if name not in started:
-            buf.clear()
-            df = _layers_of([])[name]
-            kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
-            if name in _GEOM_TYPES:
-                kwargs["geometry_type"] = _GEOM_TYPES[name]
-            if not started:  # no camera at all: this layer creates the file
-                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
-            pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
-            started.add(name)
-    os.replace(tmp, out)
+    try:
+        for rec in journal.records():
+            buf.append(rec)
+            if len(buf) >= page:
+                flush(False)
+        flush(False)
+        for name in ("cameras", "candidates", "view_cones", "errors"):
+            if name not in started:
+                buf.clear()
+                df = _layers_of([])[name]
+                kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
+                if name in _GEOM_TYPES:
+                    kwargs["geometry_type"] = _GEOM_TYPES[name]
+                if not started:  # no camera at all: this layer creates the file
+                    kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
+                pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
+                started.add(name)
+        os.replace(tmp, out)
+    except BaseException:
+        # Ctrl-C, SIGTERM or a failure while writing: the previous GeoPackage stays, and no
+        # half-written OUT.part.gpkg is left behind (it was)
+        for left in (tmp, *(tmp.with_name(tmp.name + x) for x in ("-journal", "-wal", "-shm"))):
+            left.unlink(missing_ok=True)
+        raise
 
 
 # ------------------------------------------------------------------------ summary map
