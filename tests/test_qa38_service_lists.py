@@ -79,3 +79,27 @@ def test_excel_unicode_text_body_is_read(tmp_path: Path) -> None:
     assert cam["title"] == "Straße & Blücherplatz"
     assert (cam["lat"], cam["lon"]) == (52.5, 13.4)
     assert csv_encoding_warning(body) is None
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        b"foo,bar\n1,2\n3,4\n",
+        b"Eastern Ave & S Broadway\nFleet St & S Broadway\n",  # titles without a header
+        b"id,lat,lon\nc1,39.28,-76.59\n",
+    ],
+)
+def test_a_csv_no_camera_can_be_placed_by_is_refused(tmp_path: Path, body: bytes) -> None:
+    """As ``camloc batch`` refuses it (session 37): the job was accepted and every camera
+    ended ``no_evidence``."""
+    r = _post_jobs(tmp_path, body)
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["field"] == "body"
+    assert "no column a camera can be placed by" in err["message"]
+    assert body.decode().splitlines()[0][:20] in err["message"]
+
+
+def test_a_csv_with_one_placeable_row_is_taken(tmp_path: Path) -> None:
+    body = b"id,title\nc1,\nc2,Eastern Ave & S Broadway\n"
+    assert [c["id"] for c in camera_records(body, "text/csv", 10)] == ["c1", "c2"]

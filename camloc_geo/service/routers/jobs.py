@@ -127,6 +127,7 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
             raise SceneError(f"the CSV list is {what}: send CSV text (UTF-8)", "body")
         text = csv_text(raw)
         out: list[Any] = []
+        placeable = False
         try:
             # newline="": rows ended by a bare CR (a Mac spreadsheet's CSV) are rows, as
             # camloc batch reads them; the csv module refused them (a 500)
@@ -138,10 +139,20 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
                         "scene",
                     )
                 out.append(_record(row))
+                placeable = placeable or bool(row.title or row.streets)
                 if len(out) > max_cameras:
                     break
         except csv.Error as exc:
             raise SceneError(f"malformed CSV list: {exc}", "body") from None
+        if out and not placeable and len(out) <= max_cameras:  # (over it: the limit's 413)
+            # as camloc batch refuses it: a list of titles without a header row (its first
+            # title read as the header), another table; every camera was no_evidence
+            header = text.lstrip("\ufeff").splitlines()[0][:80] if text.strip() else ""
+            raise SceneError(
+                "the CSV list has no column a camera can be placed by (title, name, streets, "
+                f"street1+street2, ...): its header row is {header!r}",
+                "body",
+            )
         return out
     try:
         cameras = JobList.model_validate(parse_json(raw)).cameras
