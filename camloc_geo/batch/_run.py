@@ -270,7 +270,13 @@ class _DaskRunner:
         from distributed import Client
 
         if isinstance(scheduler, str):
-            self.client = Client(scheduler, set_as_default=False)
+            try:
+                self.client = Client(scheduler, set_as_default=False)
+            except ValueError as exc:  # an address Dask cannot parse: the user's input
+                raise InputError(
+                    f"--scheduler {scheduler!r} is not a Dask scheduler address "
+                    f"(tcp://HOST:PORT): {exc}"
+                ) from None
             self.own = True
         else:
             self.client = scheduler
