@@ -38,6 +38,7 @@ __all__ = [
     "TimeLimitError",
     "UnauthorizedError",
     "UnsupportedMediaError",
+    "WorkerLostError",
     "error_body",
     "error_response",
     "error_response_for",
@@ -75,11 +76,17 @@ class QueryError(ServiceError):
     """A query parameter is outside what this server accepts."""
 
 
+class WorkerLostError(ServiceError):
+    """The worker process computing the request stopped (killed, out of memory); the
+    server starts another: the same request may be sent again."""
+
+
 ERROR_STATUS: tuple[tuple[type[BaseException], int, str], ...] = (
     (UnauthorizedError, 401, "unauthorized"),
     (NotFoundError, 404, "not_found"),
     (UnsupportedMediaError, 415, "unsupported_media_type"),
     (TimeLimitError, 503, "time_limit"),
+    (WorkerLostError, 503, "worker_lost"),
     (QueryError, 422, "invalid_input"),
     (LimitError, 413, "limit_exceeded"),
     (SceneError, 422, "invalid_scene"),
