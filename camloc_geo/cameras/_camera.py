@@ -523,6 +523,9 @@ def _with_map(
             res.reason = f"scene not located ({locate_reason}); placed from the title"
         elif res.status == "scene_error" and title_status not in ("failed",):
             res.match_status = res.match_status or title_status
+            # no point is given (the scene could not be read): nor the spread of one; the
+            # title's junction, with its own, stays in the candidates
+            res.uncertainty_m = None
             if title_reason and res.reason:
                 res.reason = f"{res.reason}; title: {title_reason}"
         return res
