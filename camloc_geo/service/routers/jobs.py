@@ -12,6 +12,7 @@ import csv
 import io
 import logging
 import threading
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict
 from typing import Annotated, Any
 
@@ -344,8 +345,14 @@ class JobRunner:
                 continue
             job_id, idx, camera = claimed
             try:
-                result = self.compute.submit(camera_work, camera, self.settings).result()
-            except Exception as exc:  # a worker died or the pool is shutting down
+                try:
+                    result = self.compute.submit(camera_work, camera, self.settings).result()
+                except BrokenProcessPool:
+                    # the worker died (killed, out of memory): once more on a new one, as a
+                    # restart does the cameras in flight again (it was "failed" for good)
+                    log.warning("camera %d of job %s: its worker died; computed again", idx, job_id)
+                    result = self.compute.submit(camera_work, camera, self.settings).result()
+            except Exception as exc:  # a worker died again or the pool is shutting down
                 if self._stop.is_set():
                     return  # the claim goes back to pending at the next start
                 log.exception("camera %d of job %s failed", idx, job_id)
