@@ -565,7 +565,9 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         return _with_map(row, res, None)
     if not (row.title or row.streets):
         res.status = "no_evidence"
-        res.reason = "no point, no title and no street pair: nothing to search the maps with"
+        res.reason = "no point, no title and no street pair: nothing to search the maps with" + (
+            " (" + "; ".join(row.problems) + ")" if row.problems else ""
+        )
         res.errors.append({"stage": "input", "message": res.reason})
         return res
     found: list[tuple[Any, list[Any], str]] = []
@@ -623,6 +625,28 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     )
     return res.fail(
         "not_found", reason or "the title names no street found in any extract", "title"
+    )
+
+
+def _swapped_hint(plan: MapPlan, row: CameraRow) -> str:
+    """A hint when the row's point, outside every map, lies in one with lat and lon swapped
+    (a list exported as x=lat, y=lon: the camera was only ``no_map``)."""
+    from dataclasses import replace
+
+    lat, lon = row.lat, row.lon
+    if lat is None or lon is None or not (-90 <= lon <= 90):
+        return ""
+    try:
+        area = plan.area_of(replace(row, lat=lon, lon=lat))
+    except Exception:  # a hint only
+        return ""
+    if area[0] in ("none", "net"):
+        return ""
+    name = plan.source_name(area) if hasattr(plan, "source_name") else None
+    where = f" (in {name})" if name else ""
+    return (
+        f"; with lat and lon swapped, lat={lon:.6f}, lon={lat:.6f} lies in a map{where}: "
+        "are the list's lat and lon columns the other way round?"
     )
 
 
@@ -712,7 +736,7 @@ def _geocode(
             near_res = _at_the_edge(row, res, plan, *edge)
             if near_res is not None:
                 return near_res
-        return res.fail("no_map", str(area[1]), "map")
+        return res.fail("no_map", str(area[1]) + _swapped_hint(plan, row), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
     from camloc_geo.osm import area_map

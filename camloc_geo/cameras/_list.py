@@ -249,7 +249,13 @@ def row_from_mapping(
         problems.append("give both lat and lon, or neither")
         lat = lon = None
     if lat is not None and lon is not None and not (-90 <= lat <= 90 and -180 <= lon <= 180):
-        problems.append(f"lat={lat}, lon={lon} is not a point on Earth")
+        hint = ""
+        if max(abs(lat), abs(lon)) > 1000:  # metres of a projected CRS (Web Mercator, UTM)
+            hint = (
+                " (projected coordinates, in metres? a list gives WGS 84 degrees: export it "
+                "in EPSG:4326, as GeoJSON requires)"
+            )
+        problems.append(f"lat={lat}, lon={lon} is not a point on Earth{hint}")
         lat = lon = None
     radius = _number(_pick(lower, "radius_m"), "radius_m", problems)
     if radius is not None and radius <= 0:
