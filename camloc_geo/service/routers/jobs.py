@@ -210,7 +210,18 @@ async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
     return job
 
 
-@router.get("/v1/jobs/{job_id}/result", response_model=None)
+_RESULT_CONTENT: dict[int | str, dict[str, Any]] = {
+    200: {
+        "description": "GeoJSON (format=geojson) or a GeoPackage (format=gpkg)",
+        "content": {
+            "application/json": {"schema": {"type": "object"}},
+            "application/geopackage+sqlite3": {"schema": {"type": "string", "format": "binary"}},
+        },
+    }
+}
+
+
+@router.get("/v1/jobs/{job_id}/result", response_model=None, responses=_RESULT_CONTENT)
 async def job_result(
     request: Request, job_id: JobId, q: Annotated[ResultQuery, Query()], store: ServiceStore
 ) -> Response | dict[str, Any]:
