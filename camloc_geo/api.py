@@ -827,7 +827,12 @@ def vanishing_points(
     from camloc_geo.autovp import detect_vanishing_points, load_image
 
     if focal_px is not None:
-        focal = _finite_numbers([focal_px], 1, "focal_px must be a positive number of pixels")
+        try:
+            focal = _finite_numbers([focal_px], 1, "focal_px must be a positive number of pixels")
+        except InputError:  # named as given ('got nan', it said 'got [nan]')
+            raise InputError(
+                f"focal_px must be a positive number of pixels, got {focal_px!r}"
+            ) from None
         if isinstance(focal_px, bool) or not focal[0] > 0:
             raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
         focal_px = focal[0]

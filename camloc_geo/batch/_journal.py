@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 import sqlite3
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +46,11 @@ class Journal:
             self.db.execute("PRAGMA journal_mode=WAL")
             self.db.execute("PRAGMA synchronous=NORMAL")
             self.db.executescript(_SCHEMA)
+            # each row's fingerprint (what the list said): a journal of an older release
+            # has none, and its rows are taken as they are
+            cols = {str(r[1]) for r in self.db.execute("PRAGMA table_info(done)")}
+            if "fp" not in cols:
+                self.db.execute("ALTER TABLE done ADD COLUMN fp TEXT")
         except sqlite3.DatabaseError as exc:
             raise InputError(
                 f"cannot use the batch journal {path}: {exc} (delete it to start again)"
@@ -102,15 +107,52 @@ class Journal:
                 yield int(r), str(i)
             last = int(rows[-1][0])
 
-    def write(self, records: Iterable[dict[str, Any]]) -> int:
-        """Record finished cameras in one transaction; returns how many."""
+    def iter_done_fingerprints(
+        self, retry: Iterable[str] = (), page: int = 10_000
+    ) -> Iterator[tuple[int, str, str | None]]:
+        """``(row, id, fingerprint)`` of the cameras finished, in row order, a page at a time
+        (:meth:`iter_done` with each row's fingerprint as written; None from older runs)."""
+        retry = tuple(retry)
+        q = "SELECT row, id, fp FROM done WHERE row > ?"
+        if retry:
+            q += " AND status NOT IN (" + ",".join("?" * len(retry)) + ")"
+        q += " ORDER BY row LIMIT ?"
+        last = -(1 << 62)
+        while True:
+            rows = self.db.execute(q, (last, *retry, page)).fetchall()
+            if not rows:
+                return
+            for r, i, fp in rows:
+                yield int(r), str(i), None if fp is None else str(fp)
+            last = int(rows[-1][0])
+
+    def write(
+        self,
+        records: Iterable[dict[str, Any]],
+        fingerprints: Mapping[int, str] | None = None,
+    ) -> int:
+        """Record finished cameras in one transaction; returns how many.
+
+        ``fingerprints``: each row's fingerprint of what the list said (``{row: text}``), so
+        that a rerun computes a row the list changed again.
+        """
+        fps = fingerprints or {}
         rows = [
-            (int(r["row"]), str(r["id"]), str(r["status"]), json.dumps(r, allow_nan=False))
+            (
+                int(r["row"]),
+                str(r["id"]),
+                str(r["status"]),
+                json.dumps(r, allow_nan=False),
+                fps.get(int(r["row"])),
+            )
             for r in records
         ]
         self.db.execute("BEGIN IMMEDIATE")
         try:
-            self.db.executemany("INSERT OR REPLACE INTO done VALUES (?, ?, ?, ?)", rows)
+            self.db.executemany(
+                "INSERT OR REPLACE INTO done (row, id, status, record, fp) VALUES (?, ?, ?, ?, ?)",
+                rows,
+            )
             self.db.execute("COMMIT")
         except BaseException:
             self.db.execute("ROLLBACK")

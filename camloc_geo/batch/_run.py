@@ -10,6 +10,8 @@ output does not depend on where or in which order the work ran.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import multiprocessing
 import os
@@ -33,6 +35,7 @@ from camloc_geo.cameras import (
     geocode_camera,
     read_camera_list,
 )
+from camloc_geo.cameras._camera import area_of_row
 from camloc_geo.cameras._list import count_camera_rows
 from camloc_geo.osm import Area, MapPlan, area_map, map_plan
 
@@ -173,6 +176,32 @@ def _memo_key(plan: MapPlan, area: Area, row: CameraRow) -> tuple[Any, ...] | No
     )
 
 
+def row_fingerprint(row: CameraRow) -> str:
+    """What the list says of a camera, as a short digest: its fields, and for a scene file
+    its size and modification time (a scene annotated again under the same name)."""
+    parts: list[Any] = [
+        row.id,
+        row.title,
+        row.lat,
+        row.lon,
+        row.radius_m,
+        row.streets,
+        row.scene,
+        row.view,
+        row.area,
+        row.problems,
+        row.scene_data,
+    ]
+    if row.scene:
+        try:
+            st = os.stat(row.scene)
+            parts.append([st.st_size, st.st_mtime_ns])
+        except OSError:
+            parts.append(None)
+    text = json.dumps(parts, sort_keys=True, default=str)
+    return hashlib.blake2b(text.encode("utf-8"), digest_size=12).hexdigest()
+
+
 def _memoizable(rec: dict[str, Any]) -> bool:
     """False for answers a rerun computes again (a map that failed may load next time)."""
     if rec.get("status") in RETRY_STATUSES:
@@ -213,10 +242,27 @@ def _local_executor(workers: int) -> Executor:
 
 def _worker_signals() -> None:
     """A worker ends on SIGTERM (a forked worker inherited the CLI's handler, which turns
-    SIGTERM into an exception that the pool's task loop catches: the worker lived on)."""
+    SIGTERM into an exception that the pool's task loop catches: the worker lived on), and
+    when the process that started it is gone (``kill -9`` of ``camloc batch``, the OOM
+    killer): the pool's queue never closes then, and its workers waited on it for ever,
+    each holding its maps and the journal's file handles."""
     import signal
 
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # the batch process's sentinel: readable once it is gone, whatever the start method (a
+    # forkserver's worker is the forkserver's child, and the forkserver lives as long as its
+    # workers do, so the worker's own parent never changes)
+    parent = multiprocessing.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        from multiprocessing.connection import wait
+
+        wait([parent.sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="camloc-parent-watch", daemon=True).start()
 
 
 class _DaskRunner:
@@ -224,7 +270,13 @@ class _DaskRunner:
         from distributed import Client
 
         if isinstance(scheduler, str):
-            self.client = Client(scheduler, set_as_default=False)
+            try:
+                self.client = Client(scheduler, set_as_default=False)
+            except ValueError as exc:  # an address Dask cannot parse: the user's input
+                raise InputError(
+                    f"--scheduler {scheduler!r} is not a Dask scheduler address "
+                    f"(tcp://HOST:PORT): {exc}"
+                ) from None
             self.own = True
         else:
             self.client = scheduler
@@ -362,6 +414,8 @@ def _chunks(
     for row in rows:
         if row.has_point:
             area = plan.area_of(row)
+        elif row.has_scene:  # at its scene's point (one scene read per such row)
+            area = area_of_row(plan, row)
         else:
             area = search_areas.get(row.area) or search_areas.setdefault(
                 row.area, plan.area_of(row)
@@ -532,8 +586,10 @@ def run_batch(
         # the list and the journal are both in row order: walk them side by side, keeping
         # one bit per row done (125 kB per million rows), never a row-to-id dict
         done = _RowBits()
-        recorded = journal.iter_done(retry=RETRY_STATUSES)
+        recorded = journal.iter_done_fingerprints(retry=RETRY_STATUSES)
         nxt = next(recorded, None)
+        changed: list[tuple[int, str]] = []  # the first few rows the list changed
+        n_changed = 0
         # nothing to resume: no first pass over the list (the rows are counted as they are
         # computed; the progress bar alone needs the count up front, and counts lines)
         first_pass = nxt is not None
@@ -549,6 +605,13 @@ def run_batch(
                         f"row {row.row} of {list_p.name} is camera {row.id!r} but the journal "
                         f"recorded {nxt[1]!r}: the list changed; use --restart"
                     )
+                if nxt[2] is not None and nxt[2] != row_fingerprint(row):
+                    # the same camera, another listing (a title corrected, a scene file
+                    # edited): computed again, never its old answer under the new title
+                    n_changed += 1
+                    if len(changed) < _NAMED_DUPLICATE_IDS:
+                        changed.append((row.row, row.id))
+                    continue
                 done.add(row.row)
                 skipped += 1
         del recorded
@@ -573,6 +636,13 @@ def run_batch(
             total = counted.n
         dups = journal.duplicate_ids(limit=_MAX_DUPLICATE_IDS)
         warnings = _duplicate_warnings(dups, journal.n_duplicate_ids(), list_p.name)
+        if n_changed:
+            named = ", ".join(f"row {r} ({i!r})" for r, i in changed)
+            more = f" and {n_changed - len(changed)} more" if n_changed > len(changed) else ""
+            warnings.append(
+                f"{list_p.name}: {n_changed} row(s) changed since {journal.path.name} recorded "
+                f"them, computed again: {named}{more}"
+            )
         t = time.perf_counter()
         _write_gpkg(journal, out, duplicates=dups)
         stage["gpkg"] += time.perf_counter() - t
@@ -669,6 +739,7 @@ def _run_chunks(
     computed = 0
     done_count = initial
     inflight: set[Any] = set()
+    fingerprints: dict[Any, dict[int, str]] = {}
 
     def collect(futs: set[Any]) -> None:
         nonlocal computed, done_count
@@ -680,7 +751,7 @@ def _run_chunks(
                 else:
                     stage[k] += v
             t = time.perf_counter()
-            n = journal.write(records)
+            n = journal.write(records, fingerprints.pop(fut, None))
             stage["journal"] += time.perf_counter() - t
             computed += n
             done_count += n
@@ -693,7 +764,9 @@ def _run_chunks(
         t_read = time.perf_counter()
         for area, rows in _chunks(todo, plan, chunk_size):
             stage["read_list"] += time.perf_counter() - t_read
-            inflight.add(runner.submit(process_chunk, plan, area, rows))
+            fut = runner.submit(process_chunk, plan, area, rows)
+            fingerprints[fut] = {r.row: row_fingerprint(r) for r in rows}
+            inflight.add(fut)
             while len(inflight) >= max_inflight:
                 finished = runner.wait_one(inflight)
                 inflight -= finished
@@ -907,23 +980,30 @@ def _write_gpkg(
             started.add(name)
         buf.clear()
 
-    for rec in journal.records():
-        buf.append(rec)
-        if len(buf) >= page:
-            flush(False)
-    flush(False)
-    for name in ("cameras", "candidates", "view_cones", "errors"):
-        if name not in started:
-            buf.clear()
-            df = _layers_of([])[name]
-            kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
-            if name in _GEOM_TYPES:
-                kwargs["geometry_type"] = _GEOM_TYPES[name]
-            if not started:  # no camera at all: this layer creates the file
-                kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
-            pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
-            started.add(name)
-    os.replace(tmp, out)
+    try:
+        for rec in journal.records():
+            buf.append(rec)
+            if len(buf) >= page:
+                flush(False)
+        flush(False)
+        for name in ("cameras", "candidates", "view_cones", "errors"):
+            if name not in started:
+                buf.clear()
+                df = _layers_of([])[name]
+                kwargs: dict[str, Any] = {"driver": "GPKG", "layer": name}
+                if name in _GEOM_TYPES:
+                    kwargs["geometry_type"] = _GEOM_TYPES[name]
+                if not started:  # no camera at all: this layer creates the file
+                    kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
+                pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
+                started.add(name)
+        os.replace(tmp, out)
+    except BaseException:
+        # Ctrl-C, SIGTERM or a failure while writing: the previous GeoPackage stays, and no
+        # half-written OUT.part.gpkg is left behind (it was)
+        for left in (tmp, *(tmp.with_name(tmp.name + x) for x in ("-journal", "-wal", "-shm"))):
+            left.unlink(missing_ok=True)
+        raise
 
 
 # ------------------------------------------------------------------------ summary map

@@ -22,6 +22,7 @@ from camloc_geo.cameras._camera import (
 from camloc_geo.cameras._list import (
     COLUMN_VARIANTS,
     CameraRow,
+    binary_list_kind,
     read_camera_csv,
     read_camera_list,
     row_from_mapping,
@@ -35,6 +36,7 @@ __all__ = [
     "STATUS_ALIASES",
     "CameraResult",
     "CameraRow",
+    "binary_list_kind",
     "geocode_camera",
     "normalize_status",
     "read_camera_csv",

@@ -523,6 +523,9 @@ def _with_map(
             res.reason = f"scene not located ({locate_reason}); placed from the title"
         elif res.status == "scene_error" and title_status not in ("failed",):
             res.match_status = res.match_status or title_status
+            # no point is given (the scene could not be read): nor the spread of one; the
+            # title's junction, with its own, stays in the candidates
+            res.uncertainty_m = None
             if title_reason and res.reason:
                 res.reason = f"{res.reason}; title: {title_reason}"
         return res
@@ -556,9 +559,15 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     from camloc_geo.geocode._maps import miss_rank, one_place
     from camloc_geo.osm import area_map
 
+    if not (row.title or row.streets) and row.has_scene:
+        # a scene naming no point on any map (or that cannot be read): located without a
+        # map, which says what it lacks (scene_error, or a scene that needs a map)
+        return _with_map(row, res, None)
     if not (row.title or row.streets):
         res.status = "no_evidence"
-        res.reason = "no point, no title and no street pair: nothing to search the maps with"
+        res.reason = "no point, no title and no street pair: nothing to search the maps with" + (
+            " (" + "; ".join(row.problems) + ")" if row.problems else ""
+        )
         res.errors.append({"stage": "input", "message": res.reason})
         return res
     found: list[tuple[Any, list[Any], str]] = []
@@ -617,6 +626,42 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     return res.fail(
         "not_found", reason or "the title names no street found in any extract", "title"
     )
+
+
+def _swapped_hint(plan: MapPlan, row: CameraRow) -> str:
+    """A hint when the row's point, outside every map, lies in one with lat and lon swapped
+    (a list exported as x=lat, y=lon: the camera was only ``no_map``)."""
+    from dataclasses import replace
+
+    lat, lon = row.lat, row.lon
+    if lat is None or lon is None or not (-90 <= lon <= 90):
+        return ""
+    try:
+        area = plan.area_of(replace(row, lat=lon, lon=lat))
+    except Exception:  # a hint only
+        return ""
+    if area[0] in ("none", "net"):
+        return ""
+    name = plan.source_name(area) if hasattr(plan, "source_name") else None
+    where = f" (in {name})" if name else ""
+    return (
+        f"; with lat and lon swapped, lat={lon:.6f}, lon={lat:.6f} lies in a map{where}: "
+        "are the list's lat and lon columns the other way round?"
+    )
+
+
+def area_of_row(plan: MapPlan, row: CameraRow) -> Area:
+    """The row's area; a row without a point but with a scene: the area at the scene's
+    point (its intersection or prior), when a map covers it (else as before: its title is
+    searched in every extract)."""
+    from camloc_geo.cameras._list import area_row
+
+    at_scene = area_row(row)
+    if at_scene is not row:
+        area = plan.area_of(at_scene)
+        if area[0] != "none":
+            return area
+    return plan.area_of(row)
 
 
 def geocode_camera(
@@ -680,7 +725,7 @@ def _geocode(
             else map_plan(None, network=network)
         )
     if area is None:
-        area = plan.area_of(row)
+        area = area_of_row(plan, row)
     kind = area[0]
     if kind == "none":
         if row.has_scene and not (row.title or row.streets):
@@ -691,7 +736,7 @@ def _geocode(
             near_res = _at_the_edge(row, res, plan, *edge)
             if near_res is not None:
                 return near_res
-        return res.fail("no_map", str(area[1]), "map")
+        return res.fail("no_map", str(area[1]) + _swapped_hint(plan, row), "map")
     if kind == "search":
         return _search(row, res, tuple(area[1]))
     from camloc_geo.osm import area_map

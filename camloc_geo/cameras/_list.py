@@ -34,11 +34,12 @@ import math
 import os
 import re
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
+from camloc_geo._limits import MAX_SCENE_BYTES
 
 log = logging.getLogger(__name__)
 
@@ -135,6 +136,60 @@ class CameraRow:
         return bool(self.scene) or self.scene_data is not None
 
 
+def scene_point(row: CameraRow) -> tuple[float, float] | None:
+    """Where a row's scene says the camera is: its intersection's lat/lon, else its prior's.
+
+    Only for choosing the map (the extract of a folder, a network cell) of a row that gives
+    no point itself; None where the row has no scene or the scene names no valid point (a
+    broken scene is reported when it is located, not here). Reads at most
+    :data:`~camloc_geo._limits.MAX_SCENE_BYTES` of a scene file, as plain JSON.
+    """
+    data: Any = row.scene_data
+    if data is None and row.scene:
+        try:
+            p = Path(row.scene)
+            if not p.is_file() or p.stat().st_size > MAX_SCENE_BYTES:
+                return None
+            with open(p, encoding="utf-8-sig") as fh:
+                data = json.load(fh)
+        except (OSError, ValueError):
+            return None
+    if not isinstance(data, dict):
+        return None
+    for key in ("intersection", "prior"):
+        part = data.get(key)
+        if not isinstance(part, dict):
+            continue
+        lat, lon = part.get("lat"), part.get("lon")
+        if (
+            isinstance(lat, (int, float))
+            and isinstance(lon, (int, float))
+            and not isinstance(lat, bool)
+            and not isinstance(lon, bool)
+            and math.isfinite(lat)
+            and math.isfinite(lon)
+            and -90 <= lat <= 90
+            and -180 <= lon <= 180
+        ):
+            return float(lat), float(lon)
+    return None
+
+
+def area_row(row: CameraRow) -> CameraRow:
+    """The row as its map is chosen: a row without a point takes its scene's point.
+
+    A camera given only a scene (``id,scene``; an HTTP job's inline scene) was searched by
+    its title in every extract of a folder, found no title, and ended ``no_evidence``
+    although its scene names where it is (located with one extract given).
+    """
+    if row.has_point or not row.has_scene:
+        return row
+    point = scene_point(row)
+    if point is None:
+        return row
+    return replace(row, lat=point[0], lon=point[1])
+
+
 def _clean(value: Any) -> str:
     if value is None:
         return ""
@@ -194,7 +249,13 @@ def row_from_mapping(
         problems.append("give both lat and lon, or neither")
         lat = lon = None
     if lat is not None and lon is not None and not (-90 <= lat <= 90 and -180 <= lon <= 180):
-        problems.append(f"lat={lat}, lon={lon} is not a point on Earth")
+        hint = ""
+        if max(abs(lat), abs(lon)) > 1000:  # metres of a projected CRS (Web Mercator, UTM)
+            hint = (
+                " (projected coordinates, in metres? a list gives WGS 84 degrees: export it "
+                "in EPSG:4326, as GeoJSON requires)"
+            )
+        problems.append(f"lat={lat}, lon={lon} is not a point on Earth{hint}")
         lat = lon = None
     radius = _number(_pick(lower, "radius_m"), "radius_m", problems)
     if radius is not None and radius <= 0:
@@ -243,15 +304,58 @@ def row_from_mapping(
     )
 
 
+# the binary files a camera list is mistaken for, by their first bytes
+_BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
+    (b"SQLite format 3\x00", "a GeoPackage or SQLite database"),
+    (b"PK\x03\x04", "a ZIP archive (an Excel or LibreOffice workbook, a zipped shapefile?)"),
+    (b"\xd0\xcf\x11\xe0", "an old Excel (.xls) workbook"),
+    (b"\x00\x00\x27\x0a", "a shapefile's geometry (.shp)"),
+    (b"%PDF", "a PDF document"),
+)
+
+
+_UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+
+
+def _check_text_list(path: Path, head: bytes) -> None:
+    """Refuse a binary file as a list, naming what it looks like.
+
+    A GeoPackage given as the list was read as Latin-1 "text": the error quoted its SQLite
+    header's bytes as the list's header row. Text lists (CSV, GeoJSON; UTF-8, UTF-8 with a
+    byte-order mark, Windows-1252) never hold a NUL byte.
+    """
+    what = binary_list_kind(head)
+    if what is None:
+        return
+    raise InputError(
+        f"the camera list {path.name} is {what}, not a CSV or GeoJSON list: save the cameras "
+        "as CSV or GeoJSON (QGIS: Export > Save Features As...; GDAL: ogr2ogr -f GeoJSON "
+        f"cameras.geojson {path.name}) and give that file"
+    )
+
+
+def binary_list_kind(head: bytes) -> str | None:
+    """What a list's first bytes say it is when it is no text (None: text, maybe UTF-16).
+
+    A NUL byte never occurs in a UTF-8 or Windows-1252 list; UTF-16 with its byte-order mark
+    (Excel's "Unicode Text") is text.
+    """
+    if b"\x00" not in head or head.startswith(_UTF16_BOMS):
+        return None
+    what = next((kind for magic, kind in _BINARY_KINDS if head.startswith(magic)), None)
+    return what or "not a text file (it holds NUL bytes)"
+
+
 def _list_kind(path: Path) -> str:
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    _check_text_list(path, head)
     name = path.name.lower()
     if name.endswith((".geojson", ".json", ".geojsonl", ".geojsons", ".ndjson", ".jsonl")):
         return "geojson"
     if name.endswith((".csv", ".tsv", ".txt")):
         return "csv"
-    with open(path, "rb") as fh:
-        head = fh.read(64).lstrip()
-    return "geojson" if head.startswith((b"{", b"[")) else "csv"
+    return "geojson" if head.lstrip()[:64].startswith((b"{", b"[")) else "csv"
 
 
 def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
@@ -267,7 +371,8 @@ def _missing_column_problems(columns: list[str]) -> tuple[str, ...]:
 
 
 def _text_encoding(path: Path) -> str:
-    """``utf-8-sig`` for UTF-8 text (with or without a byte-order mark), else the
+    """``utf-8-sig`` for UTF-8 text (with or without a byte-order mark), ``utf-16`` for text
+    that starts with a UTF-16 byte-order mark (Excel's "Unicode Text"), else the
     Windows-1252 that spreadsheets export on Western systems (``latin-1`` where even that
     does not decode), with a warning: a list saved so is read, not refused.
 
@@ -275,6 +380,9 @@ def _text_encoding(path: Path) -> str:
     """
     decoder: codecs.IncrementalDecoder = codecs.getincrementaldecoder("utf-8")()
     with open(path, "rb") as fh:
+        if fh.read(2) in _UTF16_BOMS:  # Excel's "Unicode Text" export (tab-separated)
+            return "utf-16"
+        fh.seek(0)
         try:
             while chunk := fh.read(1 << 20):
                 decoder.decode(chunk)
@@ -515,7 +623,8 @@ def read_camera_list(path: str | os.PathLike[str]) -> Iterator[CameraRow]:
         else:
             yield from _read_csv(p)
     except UnicodeDecodeError as exc:
-        raise InputError(f"camera list {p.name} is not UTF-8 text: {exc.reason}") from None
+        enc = "UTF-8" if exc.encoding.lower().startswith("utf-8") else exc.encoding.upper()
+        raise InputError(f"camera list {p.name} is not {enc} text: {exc.reason}") from None
     except csv.Error as exc:
         raise InputError(f"malformed CSV in {p.name}: {exc}") from None
     except OSError as exc:

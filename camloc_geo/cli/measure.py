@@ -80,13 +80,15 @@ def run(args: argparse.Namespace) -> int:
         pixels = [_pixel(t, "--ground") for t in args.ground]
         if len(pixels) < 2:
             raise InputError("--ground needs at least two pixels")
-        _in_image(pixels, args.ground, "--ground", load_scene(args.scene).image_size)
-        calibration = calibrate_scene(args.scene)
+        scene = load_scene(args.scene)  # read once: its warnings said once
+        _in_image(pixels, args.ground, "--ground", scene.image_size)
+        calibration = calibrate_scene(scene)
         m = ground_distance(calibration, pixels, click_sigma_px=args.click_sigma_px)
     else:
         base, top = (_pixel(t, "--height") for t in args.height)
-        _in_image([base, top], list(args.height), "--height", load_scene(args.scene).image_size)
-        calibration = calibrate_scene(args.scene)
+        scene = load_scene(args.scene)
+        _in_image([base, top], list(args.height), "--height", scene.image_size)
+        calibration = calibrate_scene(scene)
         m = point_height(calibration, base, top, click_sigma_px=args.click_sigma_px)
     out = m.to_dict()
     out["click_sigma_px"] = args.click_sigma_px

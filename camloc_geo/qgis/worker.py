@@ -660,7 +660,9 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     ]
     return {
         "layers": {"measurements": _write_layer(out_dir, "measurements", "None", fields, rows)},
-        "warnings": [],
+        # the calibration's (a missing photo, an annotator left out, a loose focal length):
+        # what the measurements rest on; the Processing log had none of them
+        "warnings": list(cal.warnings),
         "info": {},
     }
 

@@ -31,7 +31,7 @@ from typing import Any, TypeVar
 
 from starlette.responses import Response
 
-from camloc_geo.service.errors import TimeLimitError
+from camloc_geo.service.errors import TimeLimitError, WorkerLostError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.settings import Settings
 
@@ -166,7 +166,11 @@ class Compute:
         except BrokenProcessPool:
             with self._lock:
                 self._processes = None
-            raise
+            # a 503 the client may retry (it was a logged 500 "internal error", as for a bug)
+            raise WorkerLostError(
+                "the worker process computing this request stopped (killed or out of "
+                "memory); a new one is started: send the request again"
+            ) from None
 
     async def run_bytes(self, fn: Callable[..., Any], *args: Any) -> bytes:
         """:meth:`run`, the answer written as JSON by the worker (the serving process only

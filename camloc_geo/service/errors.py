@@ -38,6 +38,7 @@ __all__ = [
     "TimeLimitError",
     "UnauthorizedError",
     "UnsupportedMediaError",
+    "WorkerLostError",
     "error_body",
     "error_response",
     "error_response_for",
@@ -75,11 +76,17 @@ class QueryError(ServiceError):
     """A query parameter is outside what this server accepts."""
 
 
+class WorkerLostError(ServiceError):
+    """The worker process computing the request stopped (killed, out of memory); the
+    server starts another: the same request may be sent again."""
+
+
 ERROR_STATUS: tuple[tuple[type[BaseException], int, str], ...] = (
     (UnauthorizedError, 401, "unauthorized"),
     (NotFoundError, 404, "not_found"),
     (UnsupportedMediaError, 415, "unsupported_media_type"),
     (TimeLimitError, 503, "time_limit"),
+    (WorkerLostError, 503, "worker_lost"),
     (QueryError, 422, "invalid_input"),
     (LimitError, 413, "limit_exceeded"),
     (SceneError, 422, "invalid_scene"),
@@ -141,6 +148,12 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
     parts = []
     field = None
     for err in errors:
+        if err.get("type") == "json_invalid":  # the body is no JSON: its loc is a position
+            field = field or "body"
+            ctx = err.get("ctx") or {}
+            why = f": {ctx['error']}" if isinstance(ctx, dict) and ctx.get("error") else ""
+            parts.append(f"body: the body is not valid JSON{why}")
+            continue
         loc = [str(x) for x in err.get("loc", ()) if x not in ("query", "path", "body", "header")]
         name = ".".join(loc) or "request"
         field = field or name
@@ -184,6 +197,17 @@ async def _http_error(request: Request, exc: Exception) -> JSONResponse:
     shape, ``detail`` kept."""
     status = int(getattr(exc, "status_code", 500))
     detail = getattr(exc, "detail", None)
+    if status == 400 and detail == "There was an error parsing the body":
+        # FastAPI's answer to a JSON body that is no text (a GeoPackage, UTF-16 without a
+        # mark): bad input, 422 naming the body, as every other body the service refuses
+        body = error_body(
+            "invalid_input",
+            "body: the body is not valid JSON (not UTF-8 text)",
+            "body",
+            request_id(request),
+        )
+        body["detail"] = detail
+        return JSONResponse(body, status_code=422)
     kind = _HTTP_KINDS.get(status, "http_error")
     message = str(detail) if detail else kind.replace("_", " ")
     body = error_body(kind, message, None, request_id(request))

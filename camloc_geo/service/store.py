@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SqliteFile", "Store"]
+__all__ = ["SqliteFile", "Store", "TaskFullError"]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
@@ -73,6 +73,10 @@ class SqliteFile:
             if db.in_transaction:  # (a failed COMMIT too: the connection is reused)
                 db.execute("ROLLBACK")
             raise
+
+
+class TaskFullError(Exception):
+    """A crowd task has all the annotations it needs."""
 
 
 class Store(SqliteFile):
@@ -131,6 +135,23 @@ class Store(SqliteFile):
                 "WHERE state = 'running' AND (claimed_by IS NULL OR claimed_by NOT LIKE ?)",
                 (f"{os.getpid()}-%",),
             )
+
+    def reopen_full_tasks(self) -> int:
+        """At start-up: a crowd task that has its annotations but no result (the server
+        died while locating it) takes its last one back, so that the annotator's retry
+        locates it; otherwise every submission was refused as full and the task never
+        located. Returns how many tasks were reopened."""
+        with self._tx() as db:
+            full = db.execute(
+                "SELECT t.id, t.needed FROM tasks t WHERE t.status = 'collecting' AND "
+                "(SELECT COUNT(*) FROM annotations a WHERE a.task_id = t.id) >= t.needed"
+            ).fetchall()
+            for task_id, needed in full:
+                db.execute(
+                    "DELETE FROM annotations WHERE task_id = ? AND n >= ?",
+                    (task_id, max(int(needed) - 1, 0)),
+                )
+        return len(full)
 
     def finish_camera(self, job_id: str, idx: int, result: dict[str, Any]) -> None:
         """Commit one camera's result (exactly once)."""
@@ -252,11 +273,20 @@ class Store(SqliteFile):
             )
         return int(n) + 1
 
-    def add_annotation_once(self, task_id: str, scene: dict[str, Any]) -> tuple[int, bool]:
+    def add_annotation_once(
+        self, task_id: str, scene: dict[str, Any], *, needed: int | None = None
+    ) -> tuple[int, bool]:
         """Store one annotator's scene unless the task has the very same one already.
 
         Returns how many the task has now and whether this one was new: a client's retry
         (a lost answer, a double click on Submit) must not count as another annotator.
+
+        Raises
+        ------
+        TaskFullError
+            The task has ``needed`` annotations already (checked in the same transaction:
+            submissions racing the one that completed the task, while it was being
+            located, were all stored and counted).
         """
         with self._tx() as db:
             rows = db.execute(
@@ -264,11 +294,20 @@ class Store(SqliteFile):
             ).fetchall()
             if any(json.loads(r["scene"]) == scene for r in rows):
                 return len(rows), False
+            if needed is not None and len(rows) >= needed:
+                raise TaskFullError(task_id)
             db.execute(
                 "INSERT INTO annotations (task_id, n, created, scene) VALUES (?, ?, ?, ?)",
                 (task_id, len(rows), time.time(), json.dumps(scene)),
             )
         return len(rows) + 1, True
+
+    def remove_annotation(self, task_id: str, n: int) -> None:
+        """Take back the ``n``-th annotation (from 1) of a task: the submission that
+        completed the task failed to locate it (a time limit, a worker lost), so it may be
+        sent again rather than leave the task full and never located."""
+        with self._tx() as db:
+            db.execute("DELETE FROM annotations WHERE task_id = ? AND n = ?", (task_id, n - 1))
 
     def annotations(self, task_id: str) -> list[dict[str, Any]]:
         """Every annotator's scene of a task, in arrival order."""

@@ -107,6 +107,12 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
         if scene is not None:
             check_scene_body(scene, settings, where="scene")
         row = row_from_mapping(camera, 1, scene_paths=False)
+        # the problems the list's first reading found (POST /v1/jobs keeps the parsed row:
+        # a lat of 'x' is gone from it, and only its problem says it was there)
+        first = camera.get("problems")
+        if isinstance(first, (list, tuple)) and first:
+            kept = [str(p) for p in first if isinstance(p, str)]
+            row = dataclasses.replace(row, problems=tuple(dict.fromkeys([*kept, *row.problems])))
         if not cam_id:
             row = dataclasses.replace(row, id="")
         res = locate_camera(row, map_source=maps.catalogue)

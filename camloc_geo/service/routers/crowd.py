@@ -28,7 +28,7 @@ from camloc_geo.service.errors import LimitError, NotFoundError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.models import HTML_ROUTE_ERRORS, TaskId, TaskQuery
 from camloc_geo.service.routers.scenes import review_work, scene_body_doc
-from camloc_geo.service.store import Store
+from camloc_geo.service.store import Store, TaskFullError
 from camloc_geo.service.work import locate_body
 
 __all__ = ["router"]
@@ -217,10 +217,19 @@ async def submit(
         }
     if task["status"] != "collecting":
         raise SceneError("this task has all its annotations already", "task")
-    n, new = store.add_annotation_once(task_id, body.data)
+    try:
+        n, new = store.add_annotation_once(task_id, body.data, needed=task["needed"])
+    except TaskFullError:  # another submission completed the task meanwhile
+        raise SceneError("this task has all its annotations already", "task") from None
     if new and n >= task["needed"]:
         prior = task["base_scene"].get("prior")
-        status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        try:
+            status, result = await workers.run(crowd_work, store.annotations(task_id), prior)
+        except BaseException:
+            # not located (the time limit, a lost worker): the submission is taken back,
+            # so that sending it again locates the task (a full task is refused otherwise)
+            store.remove_annotation(task_id, n)
+            raise
         store.set_task_result(task_id, status, result)
     got = cast(dict[str, Any], store.task(task_id))
     answer = {"annotations": n, "needed": task["needed"], "status": got["status"]}

@@ -7,9 +7,12 @@ the store, so a job survives a restart.
 
 from __future__ import annotations
 
+import codecs
+import csv
 import io
 import logging
 import threading
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict
 from typing import Annotated, Any
 
@@ -75,6 +78,11 @@ def csv_text(raw: bytes) -> str:
     its lists "with camloc batch's reader"; the job's answer now says how it was read
     (:func:`csv_encoding_warning`).
     """
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        try:  # Excel's "Unicode Text", as camloc batch reads it
+            return raw.decode("utf-16")
+        except UnicodeDecodeError as exc:
+            raise SceneError(f"the CSV list is not UTF-16 text: {exc.reason}", "body") from None
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -86,7 +94,9 @@ def csv_text(raw: bytes) -> str:
 
 
 def csv_encoding_warning(raw: bytes) -> str | None:
-    """The warning for a CSV body that is not UTF-8, or None."""
+    """The warning for a CSV body that is not UTF-8 (or UTF-16 with its mark), or None."""
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return None
     try:
         raw.decode("utf-8-sig")
     except UnicodeDecodeError:
@@ -111,20 +121,40 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
         Not UTF-8, not ``{"cameras": [...]}``, or a CSV naming scene files.
     """
     from camloc_geo.batch import read_camera_csv, row_from_mapping
+    from camloc_geo.cameras import binary_list_kind
 
     if ctype == "text/csv":
+        what = binary_list_kind(raw[:4096])
+        if what is not None:  # a GeoPackage sent as the list was a 500
+            raise SceneError(f"the CSV list is {what}: send CSV text (UTF-8)", "body")
         text = csv_text(raw)
         out: list[Any] = []
-        for row in read_camera_csv(io.StringIO(text)):
-            if row.scene is not None:
-                raise SceneError(
-                    "a list sent over HTTP cannot name scene files: send it as JSON with each "
-                    "camera's scene inline",
-                    "scene",
-                )
-            out.append(_record(row))
-            if len(out) > max_cameras:
-                break
+        placeable = False
+        try:
+            # newline="": rows ended by a bare CR (a Mac spreadsheet's CSV) are rows, as
+            # camloc batch reads them; the csv module refused them (a 500)
+            for row in read_camera_csv(io.StringIO(text, newline="")):
+                if row.scene is not None:
+                    raise SceneError(
+                        "a list sent over HTTP cannot name scene files: send it as JSON with "
+                        "each camera's scene inline",
+                        "scene",
+                    )
+                out.append(_record(row))
+                placeable = placeable or bool(row.title or row.streets)
+                if len(out) > max_cameras:
+                    break
+        except csv.Error as exc:
+            raise SceneError(f"malformed CSV list: {exc}", "body") from None
+        if out and not placeable and len(out) <= max_cameras:  # (over it: the limit's 413)
+            # as camloc batch refuses it: a list of titles without a header row (its first
+            # title read as the header), another table; every camera was no_evidence
+            header = text.lstrip("\ufeff").splitlines()[0][:80] if text.strip() else ""
+            raise SceneError(
+                "the CSV list has no column a camera can be placed by (title, name, streets, "
+                f"street1+street2, ...): its header row is {header!r}",
+                "body",
+            )
         return out
     try:
         cameras = JobList.model_validate(parse_json(raw)).cameras
@@ -181,7 +211,18 @@ async def job_status(job_id: JobId, store: ServiceStore) -> dict[str, Any]:
     return job
 
 
-@router.get("/v1/jobs/{job_id}/result", response_model=None)
+_RESULT_CONTENT: dict[int | str, dict[str, Any]] = {
+    200: {
+        "description": "GeoJSON (format=geojson) or a GeoPackage (format=gpkg)",
+        "content": {
+            "application/json": {"schema": {"type": "object"}},
+            "application/geopackage+sqlite3": {"schema": {"type": "string", "format": "binary"}},
+        },
+    }
+}
+
+
+@router.get("/v1/jobs/{job_id}/result", response_model=None, responses=_RESULT_CONTENT)
 async def job_result(
     request: Request, job_id: JobId, q: Annotated[ResultQuery, Query()], store: ServiceStore
 ) -> Response | dict[str, Any]:
@@ -292,6 +333,13 @@ class JobRunner:
     def start(self) -> None:
         """Release what a dead process had claimed, then start working."""
         self.store.release_own_claims()
+        reopened = self.store.reopen_full_tasks()
+        if reopened:
+            log.warning(
+                "%d crowd task(s) had all their annotations but no result (the server "
+                "stopped while locating them): each took its last annotation back",
+                reopened,
+            )
         self._thread = threading.Thread(target=self._run, name="camloc-jobs", daemon=True)
         self._thread.start()
 
@@ -314,8 +362,14 @@ class JobRunner:
                 continue
             job_id, idx, camera = claimed
             try:
-                result = self.compute.submit(camera_work, camera, self.settings).result()
-            except Exception as exc:  # a worker died or the pool is shutting down
+                try:
+                    result = self.compute.submit(camera_work, camera, self.settings).result()
+                except BrokenProcessPool:
+                    # the worker died (killed, out of memory): once more on a new one, as a
+                    # restart does the cameras in flight again (it was "failed" for good)
+                    log.warning("camera %d of job %s: its worker died; computed again", idx, job_id)
+                    result = self.compute.submit(camera_work, camera, self.settings).result()
+            except Exception as exc:  # a worker died again or the pool is shutting down
                 if self._stop.is_set():
                     return  # the claim goes back to pending at the next start
                 log.exception("camera %d of job %s failed", idx, job_id)

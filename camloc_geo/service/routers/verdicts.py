@@ -14,7 +14,8 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
 from starlette.concurrency import run_in_threadpool
 
-from camloc_geo.service.deps import ApiKey
+from camloc_geo.service.deps import ApiKey, content_type
+from camloc_geo.service.errors import UnsupportedMediaError
 from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
 from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
 
@@ -82,7 +83,18 @@ async def page_verdicts(
     )
 
 
-@router.post(VERDICTS_PATH + "/{page}/{identity}", dependencies=[ApiKey])
+async def _json_body(request: Request) -> None:
+    """A verdicts post is JSON: another content type is a 415 naming it, as for the other
+    write endpoints (a CSV body was a 422 "Input should be a valid dictionary")."""
+    ctype = content_type(request)
+    if ctype != "application/json" and not ctype.endswith("+json"):
+        raise UnsupportedMediaError(
+            f"content type {ctype or 'none'!r} not supported here; send application/json",
+            "content-type",
+        )
+
+
+@router.post(VERDICTS_PATH + "/{page}/{identity}", dependencies=[ApiKey, Depends(_json_body)])
 async def post_verdicts(
     page: VerdictPage, identity: VerdictIdentity, body: VerdictPost, store: Verdicts
 ) -> dict[str, Any]:
