@@ -1332,6 +1332,12 @@ def _corner_icon(text: str, colour: str, *, above: bool = False) -> folium.DivIc
     )
 
 
+def _set_page_title(fmap: folium.Map, title: str) -> None:
+    """The page's ``<title>`` (the browser tab, bookmarks, a screen reader's first words),
+    escaped: scene ids are the user's text."""
+    fmap.get_root().title = html.escape(title)  # type: ignore[attr-defined]
+
+
 def _new_map(offline: bool, tiles: str | None, location: Sequence[float]) -> folium.Map:
     fmap = folium.Map(
         location=list(location),
@@ -1448,6 +1454,8 @@ def build_candidates_map(
     centre_en, radius = _focus(result, cands)
     lon0, lat0 = frame.geographic_from_enu(float(centre_en[0]), float(centre_en[1]))
     fmap = _new_map(offline, None if offline else tiles, (float(lat0), float(lon0)))
+    scene_name = (gj.get("properties") or {}).get("scene")
+    _set_page_title(fmap, f"camloc review: {scene_name}" if scene_name else "camloc review")
 
     basemap_note = ""
     if map_data is not None:
@@ -2059,6 +2067,11 @@ def build_summary_map(
         ).add_to(fmap)
     else:
         fmap = _new_map(offline, None if offline else tiles, location)
+    n_cameras = len(rows) + len(missing)
+    _set_page_title(
+        fmap,
+        f"camloc summary: {len(rows)} of {n_cameras} camera{'s' * (n_cameras != 1)} on the map",
+    )
     basemap_note = ""
     if map_data is not None and rows:
         maps_data: list[MapData] = list(map_data) if isinstance(map_data, Sequence) else [map_data]
@@ -3295,7 +3308,16 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
         text = p.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise InputError(f"{p}: no such verdicts file") from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError:
+        from camloc_geo.cameras import binary_list_kind
+
+        with open(p, "rb") as fh:
+            kind = binary_list_kind(fh.read(4096)) or "not UTF-8 text"
+        raise InputError(
+            f"{p}: not a verdicts file ({kind}): give the .csv or .geojson a review or "
+            "summary page exported (its Export button)"
+        ) from None
+    except OSError as exc:
         raise InputError(f"{p}: cannot read the verdicts file: {exc}") from None
     raw: list[tuple[str, Mapping[str, Any]]] = []
     if not text.strip():

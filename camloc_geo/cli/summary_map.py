@@ -142,6 +142,12 @@ def run(args: argparse.Namespace) -> int:
     pts = [p for p in best if p is not None]
     if not pts and any(n > 0 for _s, _g, n in cleaned):
         raise InputError("no usable camera position in the inputs (every candidate was skipped)")
+    if not pts:
+        log.warning(
+            "no camera in the inputs has a candidate: the page lists %d camera(s) without "
+            "a position on the map",
+            len(items),
+        )
     verdicts = None
     if args.verdicts:
         from camloc_geo._io import check_input_file
