@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 from typing import Any
 
 from camloc_geo._errors import InputError
+
+log = logging.getLogger(__name__)
 
 
 def _pixel(text: str, option: str = "pixel") -> tuple[float, float]:
@@ -90,6 +93,8 @@ def run(args: argparse.Namespace) -> int:
         _in_image([base, top], list(args.height), "--height", scene.image_size)
         calibration = calibrate_scene(scene)
         m = point_height(calibration, base, top, click_sigma_px=args.click_sigma_px)
+    for w in m.warnings:
+        log.warning("%s", w)
     out = m.to_dict()
     out["click_sigma_px"] = args.click_sigma_px
     write_json(out, args.output, inputs=[args.scene])

@@ -66,20 +66,28 @@ class Measurement:
         1-sigma uncertainty, metres (model in the module docstring).
     n_samples
         Monte Carlo draws that reached the ground.
+    warnings
+        What makes the sigma doubtful: draws lost beyond the horizon (their distance is
+        unbounded, so the spread of the others is a lower bound).
     """
 
     quantity: str
     value_m: float
     sigma_m: float
     n_samples: int
+    warnings: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: ``{"distance_m"|"height_m": ..., "sigma_m": ..., "n_samples": ...}``."""
-        return {
+        """JSON-ready: ``{"distance_m"|"height_m": ..., "sigma_m": ..., "n_samples": ...}``,
+        and ``"warnings"`` when there are any."""
+        out: dict[str, Any] = {
             f"{self.quantity}_m": self.value_m,
             "sigma_m": self.sigma_m,
             "n_samples": self.n_samples,
         }
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
+        return out
 
 
 def _pixels(pixels_px: npt.ArrayLike, what: str) -> FloatArray:
@@ -295,7 +303,14 @@ def _summary(quantity: str, values: FloatArray) -> Measurement:
             f"the {quantity} is too close to the horizon to measure: most perturbed cameras "
             "see the clicked pixels above it"
         )
-    return Measurement(quantity, nominal, float(np.std(ok, ddof=1)), len(ok))
+    warnings: tuple[str, ...] = ()
+    if len(ok) < len(draws):
+        warnings = (
+            f"{len(draws) - len(ok)} of {len(draws)} perturbed cameras see the clicked pixels "
+            f"at or above the horizon: the {quantity} may be far larger than stated, and "
+            "sigma_m (the spread of the other draws) is a lower bound",
+        )
+    return Measurement(quantity, nominal, float(np.std(ok, ddof=1)), len(ok), warnings)
 
 
 def ground_distance(
