@@ -632,12 +632,15 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     pairs = _measure_pairs(job.get("pairs"))
     cal = calibrate_scene(job["scene"])
     rows: list[tuple[dict[str, Any] | None, dict[str, Any]]] = []
+    pair_warnings: list[str] = []
     for i, item in enumerate(pairs):
         a, b = item["a"], item["b"]
         if item["kind"] == "height":
             m = sensors.point_height(cal, a, b)
         else:
             m = sensors.ground_distance(cal, [a, b])
+        # a pair near the horizon: its sigma is a lower bound (Measurement.warnings)
+        pair_warnings += [f"PAIRS item {i}: {w}" for w in getattr(m, "warnings", ())]
         # the library's Measurement holds ``value_m`` (``to_dict`` names it distance_m or
         # height_m); reading those names as attributes gave a null value in every row
         value = m.value_m
@@ -662,7 +665,7 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
         "layers": {"measurements": _write_layer(out_dir, "measurements", "None", fields, rows)},
         # the calibration's (a missing photo, an annotator left out, a loose focal length):
         # what the measurements rest on; the Processing log had none of them
-        "warnings": list(cal.warnings),
+        "warnings": [*cal.warnings, *pair_warnings],
         "info": {},
     }
 
