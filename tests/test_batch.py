@@ -124,6 +124,12 @@ def test_every_row_once_with_status(world: dict[str, Path], local_run: dict[str,
     assert len(placed) >= 20
     assert placed["lat"].notna().all()
     assert local_run["summary"].statuses["title_only"] >= 10
+    # the candidates layer holds places only: a not_found title gave a row with no point
+    # and score 0 (session 38 QA), which a GeoPackage reader counted as a candidate
+    cands = local_run["layers"]["candidates"]
+    assert cands["wkb"].notna().all()
+    assert cands["lat"].notna().all()
+    assert "bad_unknown_streets" not in set(cands["id"])
 
 
 def test_positions_against_truth(world: dict[str, Path], local_run: dict[str, Any]) -> None:

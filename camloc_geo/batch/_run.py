@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import math
 import multiprocessing
 import os
 import sys
@@ -921,6 +922,11 @@ def _layers_of(
         cams.append(cam)
         cam_xy.append((r.get("lon"), r.get("lat")))
         for c in r.get("candidates") or []:
+            if not _is_position(c.get("lat"), c.get("lon")):
+                # a title that names no place in the map (not_found): the camera's row says
+                # so; a point layer's row without a point read as a candidate (QGIS and the
+                # service give none)
+                continue
             ties = c.get("ambiguous_with") or []
             cands.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": _ranks_text(ties)})
             cand_xy.append((c.get("lon"), c.get("lat")))
@@ -936,6 +942,14 @@ def _layers_of(
         "view_cones": _frame(cones, _CONE_COLUMNS, cone_g),
         "errors": _frame(errs, _ERROR_COLUMNS, None),
     }
+
+
+def _is_position(lat: Any, lon: Any) -> bool:
+    """Both finite numbers (a candidate with a place on the map)."""
+    return all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+        for v in (lat, lon)
+    )
 
 
 _GEOM_TYPES = {"cameras": "Point", "candidates": "Point", "view_cones": "Polygon"}
