@@ -1756,6 +1756,7 @@ def _run(
     background = None if bg_init is None else bg_init.astype(np.float32)
     max_coast = max(5, round(_MAX_COAST_S * fps))
     hidden: set[int] = set()
+    near = _near_mask(calibration, sw, sh, scale) if given is None else None
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     kernel_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
     active: list[_Track] = []
@@ -1814,7 +1815,7 @@ def _run(
                 level = diff
             fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
             cv2.accumulateWeighted(small, background, _BG_RATE, mask=cv2.bitwise_not(fg))
-            fg = _foreground(small, background, level, fg)
+            fg = _foreground(small, background, level, fg, near)
             fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
             fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
             if given is None:
@@ -1989,7 +1990,29 @@ def _weak_threshold(level: Any) -> float:
     return float(min(_FG_THRESHOLD, max(_FG_WEAK_MIN, _FG_WEAK_NOISE * noise)))
 
 
-def _foreground(small: Any, background: Any, level: Any, strong: Any) -> Any:
+def _near_mask(calibration: CalibrationResult, sw: int, sh: int, scale: float) -> Any:
+    """Mask (255) of the reduced pixels whose ray meets the road at most
+    ``_MAX_GROUND_PER_PX_M`` of road per detection pixel away (what the fit uses, see
+    :func:`_fit_track`); 0 farther and above the horizon."""
+    cam = calibration.camera
+    cols, rows = np.meshgrid(np.arange(sw), np.arange(sh))
+    px = np.stack([(cols.ravel() + 0.5) / scale, (rows.ravel() + 0.5) / scale], axis=1)
+    centre = np.asarray(cam.center_in_world, dtype=np.float64)[None]
+    focal = np.array([cam.focal_px], dtype=np.float64)
+    rot = cam.cam_from_world_rotation
+    ground = _ground(centre, _rays(px[None], focal, cam.principal_point, rot))[0, :, :2]
+    foot = np.zeros(len(px))
+    for step in ((1.0, 0.0), (0.0, 1.0)):
+        moved = _ground(centre, _rays((px + step)[None], focal, cam.principal_point, rot))
+        foot += np.sum((moved[0, :, :2] - ground) ** 2, axis=1)
+    with np.errstate(invalid="ignore"):
+        near = np.isfinite(foot) & (
+            np.sqrt(np.where(np.isfinite(foot), foot, 0.0)) / scale <= _MAX_GROUND_PER_PX_M
+        )
+    return near.reshape(sh, sw).astype(np.uint8) * 255
+
+
+def _foreground(small: Any, background: Any, level: Any, strong: Any, near: Any = None) -> Any:
     """Foreground mask (255) before morphology: ``strong`` (above ``_FG_THRESHOLD``) and
     its weak bridges.
 
@@ -2000,7 +2023,9 @@ def _foreground(small: Any, background: Any, level: Any, strong: Any) -> Any:
     and contact shadow instead of losing its lower body (whose loss put the contact on the
     body and read the speed fast). Bridges stay inside the strong silhouette's extent, so
     they never move its outline outward. Cast shadows (:func:`_shadows`) are removed from
-    both layers first.
+    both layers first. ``near`` (:func:`_near_mask`, optional): bridges only there; far
+    away, where a detection pixel covers more than ``_MAX_GROUND_PER_PX_M`` of road and
+    no contact is used, they joined vehicles stacked in the image near the horizon.
     """
     import cv2
 
@@ -2019,6 +2044,8 @@ def _foreground(small: Any, background: Any, level: Any, strong: Any) -> Any:
     below = cv2.dilate(strong, col, anchor=(0, 0))
     above = cv2.dilate(strong, col, anchor=(0, n - 1))
     bridge = cv2.bitwise_and(below, above)
+    if near is not None:  # far away: stacked vehicles would be bridged, and not measured
+        bridge = cv2.bitwise_and(bridge, near)
     return cv2.bitwise_or(strong, cv2.bitwise_and(weak, bridge))
 
 
