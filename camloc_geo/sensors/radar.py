@@ -10,8 +10,9 @@ radar (see ``docs/radar.md``):
    levels away in some channel are foreground, except cast shadows (the background dimmed
    by the same ratio, 0.35-0.9, in every channel); pixels above a weak threshold (6 levels,
    or more in a noisy video) between two foreground pixels of their column are
-   foreground too (a silver or road-grey body's lit face near the road's grey keeps the
-   vehicle whole down to its wheels, :func:`_foreground`); morphology and connected components
+   foreground too, where a detection pixel covers at most 1 m of road (a silver or
+   road-grey body's lit face near the road's grey keeps the vehicle whole down to its
+   wheels, :func:`_foreground`); morphology and connected components
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
    The pieces of one vehicle (a road-grey car falls apart under the threshold) inside its
