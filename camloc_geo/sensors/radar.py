@@ -8,7 +8,11 @@ radar (see ``docs/radar.md``):
    the road's grey level): the background starts as the median of 9 frames sampled over
    the video and is updated (running average) where no vehicle is; pixels more than 30
    levels away in some channel are foreground, except cast shadows (the background dimmed
-   by the same ratio, 0.35-0.9, in every channel); morphology and connected components
+   by the same ratio, 0.35-0.9, in every channel); pixels above a weak threshold (6 levels,
+   or more in a noisy video) between two foreground pixels of their column are
+   foreground too, where a detection pixel covers at most 1 m of road (a silver or
+   road-grey body's lit face near the road's grey keeps the vehicle whole down to its
+   wheels, :func:`_foreground`); morphology and connected components
    give blobs; blobs are associated frame to frame by IoU with the track's
    predicted box (Hungarian assignment, :func:`scipy.optimize.linear_sum_assignment`).
    The pieces of one vehicle (a road-grey car falls apart under the threshold) inside its
@@ -138,6 +142,17 @@ _MIN_DETECTED_FRAMES = 3  # shorter detections are noise, not vehicles
 _MAX_FEATURES = 40
 _MIN_PIECE_PX = 6  # reduced pixels: smaller foreground pieces are noise, never joined
 _FG_THRESHOLD = 30  # grey levels (largest channel) from the background: foreground
+# Bridges: pixels above a weak threshold lying between two foreground (above _FG_THRESHOLD)
+# pixels of one column, each at most _FG_BRIDGE_PX away, are foreground too (a silver or
+# road-grey body's lit face is 5-15 levels from the road's grey: the body fell apart, its
+# lower part lost, its contact read high and the speed fast). A bridge never grows the
+# silhouette's outline outward (a halo of a pixel round every vehicle reads it slow), and
+# is vertical only (rows bridged too joined vehicles side by side on development seeds). The
+# weak threshold follows the frame's noise: _FG_WEAK_NOISE times the median level (the
+# background's pixels), at least _FG_WEAK_MIN, at most _FG_THRESHOLD.
+_FG_WEAK_MIN = 6  # grey levels
+_FG_WEAK_NOISE = 5.0  # times the frame's median level (about 6 noise sigmas)
+_FG_BRIDGE_PX = 32  # reduced pixels: longest vertical gap bridged
 _BG_RATE = 0.02  # background update rate per frame, where no foreground
 _SHADOW_RATIO = (0.35, 0.9)  # a shadow dims every channel of the background by this much
 _SHADOW_SPREAD = 0.1  # ... by nearly the same ratio (a colour change is a vehicle)
@@ -1742,6 +1757,7 @@ def _run(
     background = None if bg_init is None else bg_init.astype(np.float32)
     max_coast = max(5, round(_MAX_COAST_S * fps))
     hidden: set[int] = set()
+    near = _near_mask(calibration, sw, sh, scale) if given is None else None
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     kernel_close = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (7, 7))
     active: list[_Track] = []
@@ -1800,8 +1816,7 @@ def _run(
                 level = diff
             fg = cv2.threshold(level, _FG_THRESHOLD, 255, cv2.THRESH_BINARY)[1]
             cv2.accumulateWeighted(small, background, _BG_RATE, mask=cv2.bitwise_not(fg))
-            if small.ndim == 3:
-                fg = cv2.bitwise_and(fg, cv2.bitwise_not(_shadows(small, background)))
+            fg = _foreground(small, background, level, fg, near)
             fg = cv2.morphologyEx(fg, cv2.MORPH_OPEN, kernel)
             fg = cv2.morphologyEx(fg, cv2.MORPH_CLOSE, kernel_close)
             if given is None:
@@ -1963,6 +1978,76 @@ def _identity_switches(t: _Track) -> list[int]:
                 cuts.append(i)
         last = (dx, dy)
     return cuts
+
+
+def _weak_threshold(level: Any) -> float:
+    """Weak foreground threshold (grey levels) of a frame's difference image ``level``.
+
+    ``_FG_WEAK_NOISE`` times its median (most pixels are background: their difference is
+    the noise), clipped to ``[_FG_WEAK_MIN, _FG_THRESHOLD]``: a noisy video keeps the
+    strong threshold alone.
+    """
+    noise = float(np.median(level))
+    return float(min(_FG_THRESHOLD, max(_FG_WEAK_MIN, _FG_WEAK_NOISE * noise)))
+
+
+def _near_mask(calibration: CalibrationResult, sw: int, sh: int, scale: float) -> Any:
+    """Mask (255) of the reduced pixels whose ray meets the road at most
+    ``_MAX_GROUND_PER_PX_M`` of road per detection pixel away (what the fit uses, see
+    :func:`_fit_track`); 0 farther and above the horizon."""
+    cam = calibration.camera
+    cols, rows = np.meshgrid(np.arange(sw), np.arange(sh))
+    px = np.stack([(cols.ravel() + 0.5) / scale, (rows.ravel() + 0.5) / scale], axis=1)
+    centre = np.asarray(cam.center_in_world, dtype=np.float64)[None]
+    focal = np.array([cam.focal_px], dtype=np.float64)
+    rot = cam.cam_from_world_rotation
+    ground = _ground(centre, _rays(px[None], focal, cam.principal_point, rot))[0, :, :2]
+    foot = np.zeros(len(px))
+    for step in ((1.0, 0.0), (0.0, 1.0)):
+        moved = _ground(centre, _rays((px + step)[None], focal, cam.principal_point, rot))
+        foot += np.sum((moved[0, :, :2] - ground) ** 2, axis=1)
+    with np.errstate(invalid="ignore"):
+        near = np.isfinite(foot) & (
+            np.sqrt(np.where(np.isfinite(foot), foot, 0.0)) / scale <= _MAX_GROUND_PER_PX_M
+        )
+    return near.reshape(sh, sw).astype(np.uint8) * 255
+
+
+def _foreground(small: Any, background: Any, level: Any, strong: Any, near: Any = None) -> Any:
+    """Foreground mask (255) before morphology: ``strong`` (above ``_FG_THRESHOLD``) and
+    its weak bridges.
+
+    Pixels above the weak threshold (:func:`_weak_threshold`) with strong foreground both
+    above and below them in their column, each within ``_FG_BRIDGE_PX``, are foreground
+    too: a vehicle whose colour is near the road's
+    (silver, road-grey: its lit face 5-15 levels away) stays one blob down to its wheels
+    and contact shadow instead of losing its lower body (whose loss put the contact on the
+    body and read the speed fast). Bridges stay inside the strong silhouette's extent, so
+    they never move its outline outward. Cast shadows (:func:`_shadows`) are removed from
+    both layers first. ``near`` (:func:`_near_mask`, optional): bridges only there; far
+    away, where a detection pixel covers more than ``_MAX_GROUND_PER_PX_M`` of road and
+    no contact is used, they joined vehicles stacked in the image near the horizon.
+    """
+    import cv2
+
+    if small.ndim == 3:
+        not_shadow = cv2.bitwise_not(_shadows(small, background))
+        strong = cv2.bitwise_and(strong, not_shadow)
+    weak_level = _weak_threshold(level)
+    if weak_level >= _FG_THRESHOLD or not strong.any():
+        return strong
+    weak = cv2.threshold(level, weak_level, 255, cv2.THRESH_BINARY)[1]
+    if small.ndim == 3:
+        weak = cv2.bitwise_and(weak, not_shadow)
+    n = _FG_BRIDGE_PX
+    # dilation with a one-sided vertical line: strong within n pixels below / above
+    col = np.ones((n, 1), np.uint8)
+    below = cv2.dilate(strong, col, anchor=(0, 0))
+    above = cv2.dilate(strong, col, anchor=(0, n - 1))
+    bridge = cv2.bitwise_and(below, above)
+    if near is not None:  # far away: stacked vehicles would be bridged, and not measured
+        bridge = cv2.bitwise_and(bridge, near)
+    return cv2.bitwise_or(strong, cv2.bitwise_and(weak, bridge))
 
 
 def _shadows(frame: Any, background: Any) -> Any:
