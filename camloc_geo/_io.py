@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import math
 import os
 import tempfile
 import threading
@@ -37,12 +38,28 @@ __all__ = [
     "check_output_path",
     "displayed_size",
     "image_data_complete",
+    "is_lat_lon",
     "read_image_gray",
     "read_json_file",
     "write_text_atomic",
 ]
 
 PathLike = str | os.PathLike[str]
+
+
+def is_lat_lon(lat: Any, lon: Any) -> bool:
+    """Both finite numbers (not booleans) within ±90 and ±180 degrees: a place on the map."""
+    return (
+        isinstance(lat, (int, float))
+        and isinstance(lon, (int, float))
+        and not isinstance(lat, bool)
+        and not isinstance(lon, bool)
+        and math.isfinite(lat)
+        and math.isfinite(lon)
+        and -90.0 <= lat <= 90.0
+        and -180.0 <= lon <= 180.0
+    )
+
 
 MAX_JSON_BYTES = 200_000_000
 """Largest JSON, GeoJSON or verdicts file the command line reads whole (bytes): a candidate

@@ -93,19 +93,8 @@ class Journal:
         The streaming form of :meth:`done_rows`: memory stays one page whatever the length of
         the journal (a million rows as a dict held about 150 MB).
         """
-        retry = tuple(retry)
-        q = "SELECT row, id FROM done WHERE row > ?"
-        if retry:
-            q += " AND status NOT IN (" + ",".join("?" * len(retry)) + ")"
-        q += " ORDER BY row LIMIT ?"
-        last = -(1 << 62)
-        while True:
-            rows = self.db.execute(q, (last, *retry, page)).fetchall()
-            if not rows:
-                return
-            for r, i in rows:
-                yield int(r), str(i)
-            last = int(rows[-1][0])
+        for r, i, _fp in self.iter_done_fingerprints(retry, page):
+            yield r, i
 
     def iter_done_fingerprints(
         self, retry: Iterable[str] = (), page: int = 10_000

@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
-import math
 import multiprocessing
 import os
 import sys
@@ -28,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from camloc_geo._errors import InputError
+from camloc_geo._io import is_lat_lon
 from camloc_geo.batch._journal import Journal, journal_path
 from camloc_geo.cameras import (
     RETRY_STATUSES,
@@ -922,7 +922,7 @@ def _layers_of(
         cams.append(cam)
         cam_xy.append((r.get("lon"), r.get("lat")))
         for c in r.get("candidates") or []:
-            if not _is_position(c.get("lat"), c.get("lon")):
+            if not is_lat_lon(c.get("lat"), c.get("lon")):
                 # a title that names no place in the map (not_found): the camera's row says
                 # so; a point layer's row without a point read as a candidate (QGIS and the
                 # service give none)
@@ -942,14 +942,6 @@ def _layers_of(
         "view_cones": _frame(cones, _CONE_COLUMNS, cone_g),
         "errors": _frame(errs, _ERROR_COLUMNS, None),
     }
-
-
-def _is_position(lat: Any, lon: Any) -> bool:
-    """Both finite numbers (a candidate with a place on the map)."""
-    return all(
-        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-        for v in (lat, lon)
-    )
 
 
 _GEOM_TYPES = {"cameras": "Point", "candidates": "Point", "view_cones": "Polygon"}

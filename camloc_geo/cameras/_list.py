@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
+from camloc_geo._io import is_lat_lon
 from camloc_geo._limits import MAX_SCENE_BYTES
 
 log = logging.getLogger(__name__)
@@ -160,17 +161,9 @@ def scene_point(row: CameraRow) -> tuple[float, float] | None:
         part = data.get(key)
         if not isinstance(part, dict):
             continue
-        lat, lon = part.get("lat"), part.get("lon")
-        if (
-            isinstance(lat, (int, float))
-            and isinstance(lon, (int, float))
-            and not isinstance(lat, bool)
-            and not isinstance(lon, bool)
-            and math.isfinite(lat)
-            and math.isfinite(lon)
-            and -90 <= lat <= 90
-            and -180 <= lon <= 180
-        ):
+        lat: Any = part.get("lat")
+        lon: Any = part.get("lon")
+        if is_lat_lon(lat, lon):
             return float(lat), float(lon)
     return None
 

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 import logging
-import math
 from pathlib import Path
 from typing import Any
 
 from camloc_geo._errors import InputError
+from camloc_geo._io import is_lat_lon
 
 __all__ = ["register", "run"]
 
@@ -65,19 +65,6 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _finite_lat_lon(lat: Any, lon: Any) -> bool:
-    return (
-        isinstance(lat, (int, float))
-        and isinstance(lon, (int, float))
-        and not isinstance(lat, bool)
-        and not isinstance(lon, bool)
-        and math.isfinite(lat)
-        and math.isfinite(lon)
-        and -90.0 <= lat <= 90.0
-        and -180.0 <= lon <= 180.0
-    )
-
-
 def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
     """Validate one candidate GeoJSON; drop (with a warning) features that cannot be drawn.
 
@@ -105,7 +92,7 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
             log.warning("%s: feature %d has no properties: skipped", path, i)
             skipped += 1
             continue
-        if fp.get("kind") == "candidate" and not _finite_lat_lon(fp.get("lat"), fp.get("lon")):
+        if fp.get("kind") == "candidate" and not is_lat_lon(fp.get("lat"), fp.get("lon")):
             log.warning(
                 "%s: feature %d: lat=%r, lon=%r is not a position: skipped",
                 path,
