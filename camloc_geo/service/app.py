@@ -11,6 +11,7 @@ from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 
 from fastapi import FastAPI
+from fastapi.routing import APIRoute
 
 from camloc_geo import __version__
 from camloc_geo.service.compute import Compute
@@ -74,6 +75,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     for router in ROUTERS:
         app.include_router(router, responses=ERROR_RESPONSES)
+    # every route's methods by path, for a 405's Allow (Starlette names the first route's only)
+    app.state.route_methods = [
+        (route.path_regex, frozenset(route.methods))
+        for router in ROUTERS
+        for route in router.routes
+        if isinstance(route, APIRoute) and route.methods
+    ]
     install_error_handlers(app)
     install_docs(app)
     # (the last added is the outermost: a request's id and body limit come first)

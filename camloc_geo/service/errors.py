@@ -212,7 +212,44 @@ async def _http_error(request: Request, exc: Exception) -> JSONResponse:
     message = str(detail) if detail else kind.replace("_", " ")
     body = error_body(kind, message, None, request_id(request))
     body["detail"] = detail
-    return JSONResponse(body, status_code=status, headers=getattr(exc, "headers", None))
+    headers = dict(getattr(exc, "headers", None) or {})
+    if status == 405:
+        allowed = allowed_methods(request.app, request.scope.get("path", ""))
+        if allowed:
+            # (Starlette names the first matching route's methods only: OPTIONS or PUT on
+            # /v1/verdicts/{page}/{identity} said "Allow: GET", though it takes POST)
+            headers["Allow"] = ", ".join(allowed)
+            body["error"]["message"] = f"method {request.method} not allowed here; allowed: " + (
+                ", ".join(allowed)
+            )
+    return JSONResponse(body, status_code=status, headers=headers or None)
+
+
+_METHOD_ORDER = ("GET", "HEAD", "POST", "PUT", "PATCH", "DELETE", "OPTIONS")
+
+
+def allowed_methods(app: FastAPI, path: str) -> list[str]:
+    """The methods some route of ``app`` takes at ``path`` (every route, not the first).
+
+    Parameters
+    ----------
+    app
+        The service; its routes are read from ``app.state.route_methods``, a list of
+        ``(path regex, methods)`` that :func:`camloc_geo.service.app.create_app` sets.
+    path
+        The request's path.
+
+    Returns
+    -------
+    list of str
+        The methods in the usual order (``GET, HEAD, POST, ...``); empty when no route matches.
+    """
+    methods: set[str] = set()
+    for regex, route_methods in getattr(app.state, "route_methods", ()):
+        if regex.match(path):
+            methods |= set(route_methods)
+    known = [m for m in _METHOD_ORDER if m in methods]
+    return known + sorted(methods - set(known))
 
 
 def install_error_handlers(app: FastAPI) -> None:
