@@ -308,6 +308,15 @@ def _image_format(path: Path, head: bytes) -> str | None:
                     return str(im.format)
     except Exception:  # any failure: try the first bytes
         pass
+    return magic_format(head)
+
+
+def magic_format(head: bytes) -> str | None:
+    """The image format its first bytes announce (``JPEG``, ``PNG``, ``WEBP``...), or None.
+
+    For a file Pillow cannot open: a JPEG cut off inside its header is still a JPEG, and the
+    error should say "truncated or corrupt JPEG", not "not an image".
+    """
     if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
         return "WEBP"
     return next((name for magic, name in _MAGIC if head.startswith(magic)), None)

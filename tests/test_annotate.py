@@ -108,7 +108,7 @@ def test_cli_writes_page_with_prior_and_map(
             lambda p: p.write_bytes(
                 bytes(cv2.imencode(".png", np.zeros((8, 8, 3), np.uint8))[1])[:40]
             ),
-            "JPEG, PNG or WebP",
+            "truncated or corrupt PNG file",  # (session 39; it said "give a JPEG, PNG or WebP")
         ),
     ],
 )

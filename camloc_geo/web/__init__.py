@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from camloc_geo._errors import InputError, SceneError
-from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete
+from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete, magic_format
 
 __all__ = [
     "MAX_IMAGE_BYTES",
@@ -132,6 +132,9 @@ def read_image(image: bytes | str | os.PathLike[str], *, name: str | None = None
             f"{MAX_IMAGE_PIXELS / 1e6:.0f} megapixels (scale it down first)"
         ) from None
     except (UnidentifiedImageError, OSError, ValueError):
+        cut = magic_format(data[:16])
+        if cut in SUPPORTED_FORMATS:  # cut off inside its header: it is one, broken
+            raise InputError(f"{label} is a truncated or corrupt {cut} file") from None
         raise InputError(
             f"{label} is not an image this page can show; give a {_SUPPORTED_WORDS} file"
         ) from None

@@ -14,7 +14,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse
 
 from camloc_geo import CamlocError, MapDataError, SceneError
-from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete
+from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete, magic_format
 from camloc_geo.service.deps import (
     ApiKey,
     SceneBody,
@@ -64,6 +64,9 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
                 fmt = img.format or ""
                 width, height = displayed_size(img)  # as the annotators' browsers show it
     except (UnidentifiedImageError, OSError, ValueError):
+        cut = magic_format(raw[:16])
+        if cut in IMAGE_TYPES:  # cut off inside its header (an upload interrupted early)
+            raise SceneError(f"the snapshot is a truncated or corrupt {cut} file", "body") from None
         raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
     except Image.DecompressionBombError:
         raise LimitError("the snapshot has too many pixels", "body") from None
