@@ -270,10 +270,27 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
                     },
                 }
             ]
+        if r.get("status") in _PLACED_BY_TITLE:
+            # the status leads the flags, as in camloc batch --map's page: the heading then
+            # says "on the map: 1 title_only (at the junction its title names)", not "1
+            # camera(s) located" (a title's candidates carried no status: located, they read)
+            feats = [_status_first(f, str(r["status"])) for f in feats]
         reason = r.get("reason") if feats else f"{r.get('status')}: {r.get('reason') or ''}"
         gj = {"type": "FeatureCollection", "features": feats, "properties": {"reason": reason}}
         items.append((label, gj))
     return items
+
+
+_PLACED_BY_TITLE = ("title_only", "street_only")
+"""Statuses of cameras placed where their title points, not located from a scene."""
+
+
+def _status_first(feature: dict[str, Any], status: str) -> dict[str, Any]:
+    """A copy of a candidate feature whose ``flags`` start with the camera's ``status``."""
+    props = dict(feature.get("properties") or {})
+    flags = [f for f in props.get("flags") or [] if f != status]
+    props["flags"] = [status, *flags]
+    return {**feature, "properties": props}
 
 
 def job_summary_page(
