@@ -3342,9 +3342,12 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
         reader = csv.DictReader(text.splitlines())
         missing = [f for f in ("camera", "verdict") if f not in (reader.fieldnames or [])]
         if missing:
+            # (it listed the export's columns as "columns: camera, ...", which read as the
+            # file's own: a camera list was "no column camera, verdict (columns: camera, ...")
+            found = ", ".join(str(c) for c in (reader.fieldnames or [])[:12]) or "none"
             raise InputError(
-                f"{p}: not a verdicts CSV: no column {', '.join(missing)} "
-                f"(columns: {', '.join(VERDICT_FIELDS)})"
+                f"{p}: not a verdicts CSV: no column {', '.join(missing)} (its columns: "
+                f"{found[:200]}; a page's export has {', '.join(VERDICT_FIELDS)})"
             )
         for i, row in enumerate(reader, start=2):
             raw.append((f"line {i}", row))
