@@ -32,3 +32,41 @@ def test_a_verdicts_csv_without_verdicts_names_the_one_missing(tmp_path: Path) -
     half.write_text("camera,rank,lat,lon\nc1,1,39.28,-76.59\n", encoding="utf-8")
     with pytest.raises(InputError, match=r"no column verdict \(its columns: camera, rank, lat"):
         maps.read_verdicts(half)
+
+
+def test_summary_map_draws_a_file_given_twice_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """``camloc summary-map cam-*.geojson cam-1.geojson`` drew cam-1 twice: two markers on
+    one spot, both named "cam-1 (cam-1.geojson)"."""
+    import json
+    import re
+
+    from camloc_geo.cli import main
+
+    cam = {
+        "type": "FeatureCollection",
+        "properties": {"scene": "cam-1"},
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [-76.5934, 39.2851]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": 1,
+                    "score": 1.0,
+                    "lat": 39.2851,
+                    "lon": -76.5934,
+                    "scene": "cam-1",
+                },
+            }
+        ],
+    }
+    (tmp_path / "cam-1.geojson").write_text(json.dumps(cam), encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    args = ["summary-map", "cam-1.geojson", "./cam-1.geojson", "-o", "s.html", "--inline"]
+    assert main(args) == 0
+    page = (tmp_path / "s.html").read_text(encoding="utf-8")
+    assert len(re.findall(r"L\.marker\(", page)) == 1
+    assert "cam-1 (cam-1.geojson)" not in page
+    assert "./cam-1.geojson is given twice (also as cam-1.geojson): shown once" in caplog.text

@@ -118,12 +118,13 @@ def run(args: argparse.Namespace) -> int:
     out = output_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
     if out is None:
         raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
+    inputs = _once_each(args.inputs)
     cleaned = [
         clean_candidates(p, read_json_file(p, what="GeoJSON file (camloc locate output)"))
-        for p in args.inputs
+        for p in inputs
     ]
     items = _named_apart(
-        [(scene_id, gj) for scene_id, gj, _n in cleaned], [Path(p).name for p in args.inputs]
+        [(scene_id, gj) for scene_id, gj, _n in cleaned], [Path(p).name for p in inputs]
     )
     best = [_best_lat_lon(gj) for _s, gj in items]
     pts = [p for p in best if p is not None]
@@ -160,6 +161,24 @@ def run(args: argparse.Namespace) -> int:
             verdict_service=service,
         )
     return 0
+
+
+def _once_each(paths: list[str]) -> list[str]:
+    """The input files, a file given again (``cam-*.geojson cam-3.geojson``) dropped with a
+    warning: it was drawn twice, two markers on one spot under one name."""
+    seen: dict[Path, str] = {}
+    kept = []
+    for name in paths:
+        try:
+            key = Path(name).resolve()
+        except (OSError, RuntimeError):  # a loop of links: reading it says what is wrong
+            key = Path(name).absolute()
+        if key in seen:
+            log.warning("%s is given twice (also as %s): shown once", name, seen[key])
+            continue
+        seen[key] = name
+        kept.append(name)
+    return kept
 
 
 def _named_apart(
