@@ -245,6 +245,52 @@ def check_input_file(
     return p
 
 
+BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
+    (b"SQLite format 3\x00", "a GeoPackage or SQLite database"),
+    (b"PK\x03\x04", "a ZIP archive (an Excel or LibreOffice workbook, a zipped shapefile?)"),
+    (b"\xd0\xcf\x11\xe0", "an old Excel (.xls) workbook"),
+    (b"\x00\x00\x27\x0a", "a shapefile's geometry (.shp)"),
+    (b"%PDF", "a PDF document"),
+)
+"""What a file's first bytes say it is when it is no text (a camera list, a scene, JSON)."""
+
+
+class NotTextError(ValueError):
+    """Bytes that are no text a JSON reader takes; the message says what they look like."""
+
+
+def json_text(raw: bytes) -> str:
+    """The text of a JSON file's or body's bytes.
+
+    UTF-8, a leading byte-order mark dropped (Windows Notepad and PowerShell's ``Out-File
+    -Encoding utf8`` write one; ``json.loads`` refused it, "Unexpected UTF-8 BOM"); UTF-16
+    with its mark (Notepad's "Unicode") decoded.
+
+    Raises
+    ------
+    NotTextError
+        Not such text; the message completes "X is ...": ``a GeoPackage or SQLite
+        database``, ``a JPEG image``, ``not UTF-8 text (byte 0xd8 at position 63)``.
+    """
+    import codecs
+
+    try:
+        if raw.startswith(codecs.BOM_UTF8):
+            return raw[len(codecs.BOM_UTF8) :].decode("utf-8")
+        if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+            return raw.decode("utf-16")
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        kind = next((k for magic, k in BINARY_KINDS if raw.startswith(magic)), None)
+        image = magic_format(raw[:16])
+        if kind is None and image is not None:
+            kind = f"a {image} image"
+        if kind is None:
+            bad = raw[exc.start : exc.start + 1].hex()
+            kind = f"not UTF-8 text (byte 0x{bad} at position {exc.start})"
+        raise NotTextError(kind) from None
+
+
 def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
     """Parse a JSON file; every failure is an :class:`InputError` naming the file.
 
@@ -262,13 +308,13 @@ def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
             raise InputError(
                 f"{p}: more than a {what} camloc reads ({MAX_JSON_BYTES / 1e6:.0f} MB at most)"
             )
-        text = raw.decode("utf-8")
+        text = json_text(raw)
     except FileNotFoundError as exc:
         raise InputError(f"{p}: no such file") from exc
     except IsADirectoryError as exc:
         raise InputError(f"{p}: is a directory, expected a {what}") from exc
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{p}: not a {what} (not UTF-8 text)") from exc
+    except NotTextError as exc:
+        raise InputError(f"{p}: not a {what} ({exc})") from exc
     except OSError as exc:
         raise InputError(f"{p}: cannot read ({exc.strerror or exc})") from exc
     try:

@@ -44,6 +44,7 @@ from pydantic import (
 )
 
 from camloc_geo._errors import InputError, SceneError
+from camloc_geo._io import NotTextError, json_text
 from camloc_geo._limits import (
     MAX_ANNOTATORS,
     MAX_LANDMARKS,
@@ -879,12 +880,18 @@ def load_scene(path: str | Path) -> Scene:
             raise SceneError(
                 f"scene file {p} is {size / 1e6:.1f} MB; the limit is {MAX_SCENE_BYTES / 1e6:g} MB"
             )
-        text = p.read_text(encoding="utf-8")
+        text = json_text(p.read_bytes())
     except SceneError:
         raise
     except InputError as exc:
         raise SceneError(str(exc)) from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except NotTextError as exc:
+        # (it was the codec's "'utf-8' codec can't decode byte 0xd8 in position 63", and a
+        # file Notepad saved with a byte-order mark was "Unexpected UTF-8 BOM")
+        raise SceneError(
+            f"cannot read scene file {p}: it is {exc}; a scene is camloc-scene/1 JSON text"
+        ) from None
+    except OSError as exc:
         raise SceneError(f"cannot read scene file {p}: {exc}") from None
     try:
         data = json.loads(text, parse_constant=_reject_constant)

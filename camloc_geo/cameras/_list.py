@@ -39,7 +39,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from camloc_geo._errors import InputError
-from camloc_geo._io import is_lat_lon
+from camloc_geo._io import BINARY_KINDS, is_lat_lon
 from camloc_geo._limits import MAX_SCENE_BYTES
 
 log = logging.getLogger(__name__)
@@ -298,13 +298,7 @@ def row_from_mapping(
 
 
 # the binary files a camera list is mistaken for, by their first bytes
-_BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
-    (b"SQLite format 3\x00", "a GeoPackage or SQLite database"),
-    (b"PK\x03\x04", "a ZIP archive (an Excel or LibreOffice workbook, a zipped shapefile?)"),
-    (b"\xd0\xcf\x11\xe0", "an old Excel (.xls) workbook"),
-    (b"\x00\x00\x27\x0a", "a shapefile's geometry (.shp)"),
-    (b"%PDF", "a PDF document"),
-)
+_BINARY_KINDS = BINARY_KINDS
 
 
 _UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)

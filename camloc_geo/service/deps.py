@@ -138,11 +138,16 @@ def _reject_constant(name: str) -> float:
 
 def parse_json(raw: bytes) -> Any:
     """Parsed JSON; NaN, Infinity, bad UTF-8 and deep nesting are a :class:`SceneError`."""
+    from camloc_geo._io import NotTextError, json_text
+
     try:
-        return json.loads(raw.decode("utf-8"), parse_constant=_reject_constant)
+        # (a byte-order mark dropped, as from a file Notepad saved: "Unexpected UTF-8 BOM")
+        return json.loads(json_text(raw), parse_constant=_reject_constant)
     except RecursionError:
         raise SceneError("the JSON body is nested too deeply", "body") from None
-    except (ValueError, UnicodeDecodeError) as exc:
+    except NotTextError as exc:
+        raise SceneError(f"the body is not valid JSON: it is {exc}", "body") from None
+    except ValueError as exc:
         raise SceneError(f"the body is not valid JSON: {exc}", "body") from None
 
 
