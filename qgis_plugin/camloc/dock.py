@@ -149,6 +149,28 @@ def _extract_problem(osm: str) -> str | None:
     return None
 
 
+def _json_text(raw: bytes) -> str:
+    """A scene file's text: UTF-8, a byte-order mark dropped (Notepad and PowerShell write
+    one: it was "Expecting value: line 1 column 1"), or UTF-16 with its mark; as the
+    library's ``camloc_geo._io.json_text`` reads it (the plugin does not import the library).
+    A file that is no text raises ``ValueError`` saying so."""
+    import codecs
+
+    try:
+        if raw.startswith(codecs.BOM_UTF8):
+            return raw[len(codecs.BOM_UTF8) :].decode("utf-8")
+        if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+            return raw.decode("utf-16")
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if raw.startswith(b"SQLite format 3\x00"):
+            raise ValueError("it is a GeoPackage or SQLite database, not a scene") from None
+        raise ValueError(
+            f"it is not UTF-8 text (byte 0x{raw[exc.start : exc.start + 1].hex()} at position "
+            f"{exc.start}), not a scene"
+        ) from None
+
+
 class ImageView(QGraphicsView):
     """The snapshot; emits image pixel coordinates of left clicks; zooms and pans.
 
@@ -911,8 +933,8 @@ class CamlocDock(QDockWidget):
                     f"{os.path.getsize(path) / 1e6:.0f} MB, more than the "
                     f"{MAX_SCENE_BYTES / 1e6:g} MB a scene may be"
                 )
-            with open(path, encoding="utf-8") as fh:
-                scene = json.load(fh)
+            with open(path, "rb") as fh:
+                scene = json.loads(_json_text(fh.read()))
             if not isinstance(scene, dict):
                 raise ValueError("not a JSON object")
         except (OSError, ValueError, RecursionError) as exc:

@@ -787,6 +787,24 @@ def test_a_complete_scene_loaded_says_run_not_click_the_car(dock, tmp_path):
     assert "Everything needed" not in dock.guidance.text()
 
 
+def test_a_scene_saved_with_a_byte_order_mark_is_loaded(dock, tmp_path):
+    """A scene saved by Notepad or PowerShell starts with a UTF-8 byte-order mark: Load
+    scene… refused it ("cannot read the scene ...: Unexpected UTF-8 BOM"); UTF-16 with its
+    mark ("'utf-8' codec can't decode byte 0xff") too. Session 39."""
+    text = SAMPLE_SCENE.read_text(encoding="utf-8")
+    for encoding in ("utf-8-sig", "utf-16"):
+        path = tmp_path / f"scene-{encoding}.json"
+        path.write_bytes(text.encode(encoding))
+        assert dock.load_scene(str(path)), dock.status.text()
+        assert dock.guidance.text().startswith("<b>Everything needed is marked: Run</b>")
+    gpkg = tmp_path / "cams.json"
+    gpkg.write_bytes(b"SQLite format 3\x00" + bytes(range(256)) * 4)
+    assert not dock.load_scene(str(gpkg))
+    assert dock.status.text() == (
+        f"cannot read the scene {gpkg}: it is a GeoPackage or SQLite database, not a scene"
+    )
+
+
 def test_scene_and_results_never_go_over_the_snapshot_or_extract(dock, qgis_iface, tmp_path):
     """Save scene… naming the open snapshot wrote the scene's JSON over the photo, and a
     Results GeoPackage naming the snapshot or the extract failed only after the whole run
