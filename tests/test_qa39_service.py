@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import asyncio
+import re
 from pathlib import Path
 
 import httpx
@@ -55,3 +56,19 @@ def test_a_405_names_every_method_the_path_takes(
     err = r.json()["error"]
     assert err["type"] == "method_not_allowed"
     assert err["message"] == f"method {method} not allowed here; allowed: {allow}"
+
+
+def test_redoc_draws_no_image_from_another_site(tmp_path: Path) -> None:
+    """ReDoc's bundle loads its maker's logo from https://cdn.redoc.ly: the offline docs
+    page made a request to another site (Chromium: net::ERR_NAME_NOT_RESOLVED offline)."""
+    pytest.importorskip("fastapi_offline")
+    (r,) = _calls(tmp_path, [("GET", "/redoc")])
+    assert r.status_code == 200
+    assert r.headers["content-security-policy"] == "img-src 'self' data: blob:"
+    assert "cdn.redoc.ly" not in r.text
+    (script,) = [s for s in re.findall(r'<script src="([^"]+)"', r.text) if "redoc" in s]
+    (js,) = _calls(tmp_path / "js", [("GET", script)])
+    assert js.status_code == 200
+    assert len(js.content) > 500_000  # the whole bundle
+    assert b"https://cdn.redoc.ly" not in js.content
+    assert b'src:"/favicon.ico"' in js.content

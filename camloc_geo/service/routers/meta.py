@@ -28,6 +28,11 @@ log = logging.getLogger(__name__)
 router = APIRouter(tags=["meta"])
 
 ASSETS = "/docs/assets"
+REDOC_JS = "/docs/redoc.js"
+"""ReDoc's script as served (:func:`_redoc_bundle`): outside the static mount."""
+
+REDOC_CSP = "img-src 'self' data: blob:"
+"""The ``/redoc`` page's Content-Security-Policy: images from the server only."""
 
 FAVICON_SVG = (
     b'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 16 16">'
@@ -57,6 +62,17 @@ async def healthz_head(maps: Maps) -> dict[str, Any]:
     """``HEAD /healthz`` (``curl -I``, load balancers' probes) answers as ``GET`` without a
     body; it was a 405."""
     return await healthz(maps)
+
+
+REDOC_LOGO = b"https://cdn.redoc.ly/redoc/logo-mini.svg"
+"""Where ReDoc's bundle draws its maker's logo from (no option turns it off)."""
+
+
+def _redoc_bundle(path: Path) -> bytes:
+    """ReDoc's script with its logo taken from this server (the service's icon): the offline
+    ``/redoc`` page made one request to another site, cdn.redoc.ly, which failed offline
+    (a console error) and told that site who reads the docs."""
+    return path.read_bytes().replace(REDOC_LOGO, b"/favicon.ico")
 
 
 def _assets_dir() -> Path | None:
@@ -106,7 +122,7 @@ def install_docs(app: FastAPI) -> None:
             "swagger_favicon_url": f"{ASSETS}/favicon.png",
         }
         redoc = {
-            "redoc_js_url": f"{ASSETS}/redoc.standalone.js",
+            "redoc_js_url": REDOC_JS,
             "redoc_favicon_url": f"{ASSETS}/favicon.png",
             "with_google_fonts": False,
         }
@@ -117,7 +133,25 @@ def install_docs(app: FastAPI) -> None:
         )
 
     async def redoc_page(request: Request) -> HTMLResponse:
-        return get_redoc_html(openapi_url="/openapi.json", title=f"{app.title} - API", **redoc)
+        page = get_redoc_html(openapi_url="/openapi.json", title=f"{app.title} - API", **redoc)
+        if folder is not None:  # images from this server only (see _redoc_bundle)
+            page.headers["Content-Security-Policy"] = REDOC_CSP
+        return page
+
+    bundle: list[bytes] = []
+
+    async def redoc_js() -> Response:
+        if folder is None:
+            return Response(status_code=404)
+        if not bundle:
+            bundle.append(_redoc_bundle(folder / "redoc.standalone.js"))
+        return Response(
+            bundle[0],
+            media_type="text/javascript; charset=utf-8",
+            headers={"Cache-Control": "public, max-age=86400"},
+        )
+
+    app.add_api_route(REDOC_JS, redoc_js, include_in_schema=False)
 
     app.add_api_route("/docs", docs, include_in_schema=False)
     app.add_api_route("/redoc", redoc_page, include_in_schema=False)
