@@ -10,6 +10,7 @@ output does not depend on where or in which order the work ran.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import logging
@@ -570,7 +571,12 @@ def run_batch(
     plan = map_plan(map_source, network=network, area=area)
     stage: dict[str, float] = defaultdict(float)
     counts: dict[str, int] = defaultdict(int)
-    journal = Journal(journal_path(out))
+    lock = OutputLock(out)  # one run per output: a second one is refused at once
+    try:
+        journal = Journal(journal_path(out))
+    except BaseException:
+        lock.release()
+        raise
     try:
         journal.check_options(
             {
@@ -661,6 +667,7 @@ def run_batch(
         statuses = journal.status_counts()
     finally:
         journal.close()
+        lock.release()
     return BatchSummary(
         total=total,
         computed=computed,
@@ -950,6 +957,62 @@ GPKG_VERSION = "1.2"
 """The GeoPackage version written. pyogrio's GDAL (3.7+) writes 1.4 by default, which the GDAL
 3.6 of QGIS 3.22 on Debian bookworm (and its ``ogrinfo``) reads with a warning on every open
 ("user_version ... v1.4.0 may only be partially supported"); 1.2 is what that QGIS writes."""
+
+
+class OutputLock:
+    """An exclusive hold on a batch output while a run writes it (``OUT.camloc-batch.lock``).
+
+    Two ``camloc batch`` runs with one ``-o`` computed every camera twice, and the first to
+    finish lost its GeoPackage to the other's temporary file ("failed: FileNotFoundError:
+    'cams.part.gpkg' -> 'cams.gpkg'", exit 1). The second is now refused at once. The lock is
+    the operating system's (``flock``; ``msvcrt.locking`` on Windows), so a run killed with
+    ``kill -9`` holds nothing; the file is removed when the run ends.
+
+    Parameters
+    ----------
+    out
+        The output GeoPackage.
+
+    Raises
+    ------
+    InputError
+        Another run holds the output.
+    """
+
+    def __init__(self, out: Path) -> None:
+        self.path = out.with_name(out.stem + ".camloc-batch.lock")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        self._fd: int | None = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            _lock_fd(self._fd)
+        except OSError:
+            os.close(self._fd)
+            self._fd = None
+            raise InputError(
+                f"another camloc batch is writing {out} (it holds {self.path.name}): wait for "
+                "it to end, or give another -o"
+            ) from None
+
+    def release(self) -> None:
+        """Remove the lock file and let go (again: nothing)."""
+        if self._fd is None:
+            return
+        with contextlib.suppress(OSError):
+            self.path.unlink()
+        os.close(self._fd)  # closing the descriptor releases the lock
+        self._fd = None
+
+
+def _lock_fd(fd: int) -> None:
+    """Lock ``fd`` for this process without waiting; ``OSError`` when another holds it."""
+    if sys.platform == "win32":
+        import msvcrt
+
+        msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+    else:
+        import fcntl
+
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
 
 
 def _write_gpkg(
