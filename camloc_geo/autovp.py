@@ -494,6 +494,10 @@ _CURVE_TURN_DEG = (1.5, 25.0)
 _CURVE_MIN_PIECE_PX = 6.0
 #: How many pieces a curve is followed beyond its chords, each way.
 _CURVE_FOLLOW = 8
+#: Segments at least this long (detection pixels), and at least this many, measure a
+#: photo's line scatter (:func:`_line_scatter_deg`).
+_SCATTER_MIN_PX = 60.0
+_SCATTER_MIN_N = 8
 
 
 def _curve_pieces(segs: FloatArray, noise_px: float, gap_px: float) -> npt.NDArray[np.bool_]:
@@ -625,6 +629,23 @@ def _curve_directions(labels: npt.NDArray[np.int64], chords: npt.NDArray[np.bool
         if n_chords >= _CURVE_MIN_CHORDS and n_chords >= _CURVE_CHORD_SHARE * np.count_nonzero(sel):
             out.append(k)
     return out
+
+
+def _line_scatter_deg(res_px: FloatArray, length_px: FloatArray) -> float:
+    """How far the long inliers turn about their vanishing points beyond their noise.
+
+    ``res_px`` are the end points' distances to the line through the midpoint and the
+    vanishing point, ``length_px`` the segments' lengths (detection pixels); a segment's
+    turn is ``res / (L / 2)``, its noise ``_CURVE_NOISE_PX / (L / 2)``. Root mean square
+    of the excess over segments at least :data:`_SCATTER_MIN_PX` long, in degrees (NaN
+    with fewer than :data:`_SCATTER_MIN_N`).
+    """
+    long_ = length_px >= _SCATTER_MIN_PX
+    if np.count_nonzero(long_) < _SCATTER_MIN_N:
+        return float("nan")
+    half = 0.5 * length_px[long_]
+    turn2 = (res_px[long_] / half) ** 2 - (_CURVE_NOISE_PX / half) ** 2
+    return float(np.degrees(math.sqrt(max(0.0, float(np.mean(turn2))))))
 
 
 def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
@@ -827,6 +848,7 @@ class _Model:
     # the terms of the focal sigma (``log(focal)``), by name: see AutoVPResult.focal_std_parts
     sigma_parts: dict[str, float] = field(default_factory=dict)
     residual_rms_px: float = float("nan")  # inliers' end-point residual (detection pixels)
+    scatter_deg: float = float("nan")  # long inliers' turn about their VPs beyond noise
 
 
 def _label_scores(
@@ -1724,6 +1746,11 @@ class AutoVPResult:
         Root mean square distance of the inlier segments' end points to the lines through
         their midpoints and vanishing points, in the detection image's pixels (at most
         1024 px on the longer side); NaN when the focal length was given. For diagnosis.
+    line_scatter_deg
+        How far the long inliers (60 detection pixels or more) turn about their vanishing
+        points beyond their end points' noise, root mean square in degrees; NaN with fewer
+        than 8 of them or when the focal length was given. For diagnosis: it does not
+        tell a photo's coherent line bias (``benchmarks/README.md``, vp_real, stop 39).
     """
 
     vanishing_points: FloatArray
@@ -1750,6 +1777,7 @@ class AutoVPResult:
     roll_std_deg: float = float("nan")
     focal_std_parts: dict[str, float] = field(default_factory=dict)
     line_residual_rms_px: float = float("nan")
+    line_scatter_deg: float = float("nan")
 
     @property
     def street_index(self) -> int:
@@ -2384,7 +2412,9 @@ def detect_vanishing_points(
             res_px = _endpoint_residual(_vps_from_rotation(best.R, best.f_n), s)
             res_in = res_px[best.labels[inl], np.flatnonzero(inl)]
             # in the detection image's pixels (detect_segments works at most 1024 px wide)
-            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * min(1.0, 1024.0 / scale)
+            det = min(1.0, 1024.0 / scale)  # detection pixels per photo pixel
+            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * det
+            best.scatter_deg = _line_scatter_deg(res_in * det, s.length_px[inl] * det)
         best.sigma_parts = {
             "least_squares": float(best.logf_std),
             "jackknife": float(jack_std),
@@ -2476,6 +2506,7 @@ def detect_vanishing_points(
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
     result.focal_std_parts = dict(best.sigma_parts)
     result.line_residual_rms_px = best.residual_rms_px
+    result.line_scatter_deg = best.scatter_deg
     if best.horizon_rests_on:
         result.warnings.append(
             f"no vertical line: the horizon rests on {best.horizon_rests_on} lines of one "
