@@ -2098,6 +2098,7 @@ def detect_vanishing_points(
         und = undistort_points_px(segs_px.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
         ok = np.all(np.isfinite(und), axis=1)
         segs_px, segs_photo = und[ok], segs_px[ok]
+        segs_detected, curve = segs_detected[ok], curve[ok]
     hints = _prepare_hints(axes_hint, pp, scale)
     if axes_hint:
         # An annotated axis is a straight line of the image too: fit it with the segments

@@ -182,3 +182,21 @@ def test_curve_directions_needs_enough_chords_and_share() -> None:
     chords[30:35] = False
     chords[30:33] = True  # three of 30: 10 %
     assert autovp._curve_directions(labels, chords) == [1]
+
+
+def test_read_again_with_a_given_distortion_and_annotated_axes() -> None:
+    # the chords stay aligned with the segments when a given k1 undistorts them and
+    # annotated axes are fitted with them
+    img = _rotunda_photo(-20.0)
+    segs, chords = autovp._detect_segments(img)
+    axes = [((100.0, 700.0), (100.0, 600.0)), ((100.0, 700.0), (300.0, 705.0))]
+    res = autovp.detect_vanishing_points(img, distortion_k1=-0.02)
+    assert not _chords_in(res, segs, chords).any()
+    assert res.distortion == -0.02
+    # with the axes the chords are needed for a second direction: the reading with them
+    # stands, said to rest on curves (the axes are the result's first segments)
+    res = autovp.detect_vanishing_points(img, distortion_k1=-0.02, axes_hint=axes)
+    assert len(res.segments) == len(segs) + len(axes)
+    assert _chords_in(res, segs, chords)[len(axes) :].sum() == chords.sum()
+    assert any("pieces of curves" in w_ for w_ in res.warnings)
+    assert res.focal_std_rel >= 0.2
