@@ -79,9 +79,9 @@ def test_a_kinked_edge_is_not_a_curve() -> None:
     assert not autovp._curve_pieces(segs, 0.25, 6.0).any()
 
 
-def test_the_pieces_of_a_curve_in_an_image_are_not_fitted() -> None:
+def test_the_pieces_of_a_ring_drawn_in_an_image_are_found() -> None:
     # A rotunda's ring drawn as a band: the detector's chords of its edges are found and
-    # left out of the fit, so none is among the result's segments.
+    # told from the straight lines of a window grid beside it.
     cv2 = pytest.importorskip("cv2")
     img = np.full((768, 1024), 200, np.uint8)
     outer = _ellipse_arc_px((512.0, 420.0), 430.0, 70.0, 15.0, 165.0)
