@@ -886,6 +886,7 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             own_logf_std=rec.own_logf_std,
             focal_std_parts=dict(getattr(res, "focal_std_parts", {}) or {}),
             line_residual_rms_px=getattr(res, "line_residual_rms_px", math.nan),
+            line_scatter_deg=getattr(res, "line_scatter_deg", math.nan),
         )
         if t["up"] is not None:
             p_true, r_true = pitch_roll_from_up(t["up"])
@@ -1066,9 +1067,34 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "time_median_s": float(np.median([r["time_s"] for r in rows])) if rows else None,
         "rival_calibration": rival_calibration(rows),
         "sigma_terms": sigma_terms(ok),
+        "line_scatter": line_scatter(ok, z),
         **_vertical_bias_rms(ok),
     }
     return out
+
+
+def line_scatter(ok: list[dict[str, Any]], z: np.ndarray) -> dict[str, Any] | None:
+    """The photos' line scatter (``AutoVPResult.line_scatter_deg``) and the median
+    error/sigma of the focal length by its terciles: would the scatter tell the photos whose
+    sigma is too wide or too narrow (issue 24 item 4)?
+
+    Returns
+    -------
+    dict or None
+        ``median_deg``, ``tercile_edges_deg`` and ``median_err_over_sigma_by_tercile``
+        (low, middle, high); None with fewer than 6 photos that have it.
+    """
+    sc = np.array([r.get("line_scatter_deg", math.nan) for r in ok], dtype=float)
+    has = np.isfinite(sc) & np.isfinite(z)
+    if np.count_nonzero(has) < 6:
+        return None
+    lo, hi = np.percentile(sc[has], [100.0 / 3.0, 200.0 / 3.0])
+    bins = [has & (sc <= lo), has & (sc > lo) & (sc <= hi), has & (sc > hi)]
+    return {
+        "median_deg": float(np.median(sc[has])),
+        "tercile_edges_deg": [float(lo), float(hi)],
+        "median_err_over_sigma_by_tercile": [float(np.median(z[b])) for b in bins],
+    }
 
 
 def _vertical_bias_rms(ok: list[dict[str, Any]]) -> dict[str, Any]:
@@ -1372,6 +1398,13 @@ def main(argv: list[str] | None = None) -> int:
                 f"vertical lines' bias / {s}: turn rms {sm['vertical_turn_rms_deg']:.3f} deg, "
                 f"convergence rms {'-' if conv_rms is None else f'{conv_rms:.3f}'} deg "
                 f"({sm['n_vertical_bias']} photos; the sigma assumes {autovp.BIAS_DEG} for both)"
+            )
+        ls = sm.get("line_scatter")
+        if ls:
+            zt = ls["median_err_over_sigma_by_tercile"]
+            lines.append(
+                f"line scatter / {s}: median {ls['median_deg']:.3f} deg; median err/sigma by "
+                f"tercile {zt[0]:.2f} / {zt[1]:.2f} / {zt[2]:.2f}"
             )
         st = sm.get("sigma_terms")
         if st:

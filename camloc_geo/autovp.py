@@ -344,6 +344,30 @@ def detect_segments(
         ``(N, 4)`` rows ``x1, y1, x2, y2`` in continuous pixel coordinates (the centre of
         the top-left pixel is ``(0.5, 0.5)``), longest first. Possibly empty.
     """
+    return _detect_segments(
+        image,
+        min_length_px=min_length_px,
+        max_segments=max_segments,
+        max_side_px=max_side_px,
+        method=method,
+        mask=mask,
+        trim_borders=trim_borders,
+    )[0]
+
+
+def _detect_segments(
+    image: str | os.PathLike[str] | npt.NDArray[Any],
+    *,
+    min_length_px: float | None = None,
+    max_segments: int = 500,
+    max_side_px: int = 1024,
+    method: str = "auto",
+    mask: npt.NDArray[Any] | None = None,
+    trim_borders: bool = True,
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """:func:`detect_segments`, and which of the segments are pieces of a curve
+    (:func:`_curve_pieces`, looked for among all the detector's pieces, short ones
+    included)."""
     import cv2
 
     gray = load_image(image)
@@ -393,9 +417,10 @@ def detect_segments(
     # top-left pixel at 0, 0): shift to the continuous convention, then undo the shrink.
     segs = (segs + 0.5) / scale + np.array([x0, y0, x0, y0], dtype=np.float64)
     if len(segs) == 0:
-        return np.zeros((0, 4))
+        return np.zeros((0, 4)), np.zeros(0, dtype=bool)
     if trim_borders:
         segs = segs[~_along_border(segs, (x0, y0, x1, y1), _BORDER_EDGE_PX / scale)]
+    curve = _curve_pieces(segs, _CURVE_NOISE_PX / scale, _CURVE_GAP_PX / scale)
     if mask is not None:
         pts = [segs[:, 0:2], segs[:, 2:4], 0.5 * (segs[:, 0:2] + segs[:, 2:4])]
         inside = np.ones(len(segs), dtype=bool)
@@ -403,12 +428,12 @@ def detect_segments(
             ix = np.clip(np.floor(p[:, 0]).astype(np.int64), 0, full_w - 1)
             iy = np.clip(np.floor(p[:, 1]).astype(np.int64), 0, full_h - 1)
             inside &= mask[iy, ix]
-        segs = segs[inside]
+        segs, curve = segs[inside], curve[inside]
     lengths = np.hypot(segs[:, 2] - segs[:, 0], segs[:, 3] - segs[:, 1])
     keep = lengths >= min_length_px
-    segs, lengths = segs[keep], lengths[keep]
+    segs, lengths, curve = segs[keep], lengths[keep], curve[keep]
     order = np.argsort(-lengths, kind="stable")[:max_segments]
-    return np.ascontiguousarray(segs[order])
+    return np.ascontiguousarray(segs[order]), np.ascontiguousarray(curve[order])
 
 
 #: Segments whose two end points lie this close (pixels of the detection image) to the
@@ -444,6 +469,183 @@ def _along_border(
         | np.all(ys - y0 <= edge_px, axis=1)
         | np.all(y1 - ys <= edge_px, axis=1)
     )
+
+
+#: Pieces of curves (:func:`_curve_pieces`): a detected segment continued at both of its
+#: ends by another piece of the detector, each turned the same way (a convex outline) by
+#: at least twice the turn's noise and :data:`_CURVE_TURN_DEG`\\ [0] degrees, at most
+#: :data:`_CURVE_TURN_DEG`\\ [1], is a chord of a curve; so are the pieces that continue
+#: it bending its way (the curve's flatter stretch and its ends). End point scatter of a
+#: piece across its line (pixels of the detection image), and the largest gap between two
+#: pieces' ends.
+_CURVE_NOISE_PX = 0.25
+#: What :func:`detect_vanishing_points` does with the chords of curves it detects:
+#: ``"refit"`` (read the photo again without them where a direction leans on them,
+#: :func:`_curve_directions`), ``"drop"`` (always leave them out: moves many photos by
+#: chance, as any change of the segments moves RANSAC) or ``"keep"`` (before stop 39).
+_CURVE_MODE = "refit"
+#: A direction with at least this many chords of curves among its segments, making at
+#: least this share of them, leans on curves (:func:`_curve_directions`).
+_CURVE_MIN_CHORDS = 3
+_CURVE_CHORD_SHARE = 0.15
+_CURVE_GAP_PX = 6.0
+_CURVE_TURN_DEG = (1.5, 25.0)
+#: Pieces shorter than this (pixels of the detection image) are too noisy to be links.
+_CURVE_MIN_PIECE_PX = 6.0
+#: How many pieces a curve is followed beyond its chords, each way.
+_CURVE_FOLLOW = 8
+#: Segments at least this long (detection pixels), and at least this many, measure a
+#: photo's line scatter (:func:`_line_scatter_deg`).
+_SCATTER_MIN_PX = 60.0
+_SCATTER_MIN_N = 8
+
+
+def _curve_pieces(segs: FloatArray, noise_px: float, gap_px: float) -> npt.NDArray[np.bool_]:
+    """Which segments are chords of a curved outline (a ring, a dome, a basin's rim).
+
+    A line detector cuts a curve into straight pieces; near where the curve runs along a
+    vanishing direction its pieces point at that vanishing point and pose as lines of it
+    (the rings of a rotunda as both horizontal directions: a confidently wrong focal
+    length). A straight edge cut into pieces continues straight; a corner turns by more
+    than :data:`_CURVE_TURN_DEG`\\ [1]. So a piece continued end to end at *both* its ends,
+    turned the same way at each by a few degrees (see :data:`_CURVE_TURN_DEG`), is a
+    chord of a curve. The curve is then followed piece by piece (up to
+    :data:`_CURVE_FOLLOW` each way) while each next piece turns its way, however little:
+    the flat front of a ring seen from below, where the turns are under their noise, and
+    the curve's ends.
+
+    Parameters
+    ----------
+    segs
+        ``(N, 4)`` segments ``x1, y1, x2, y2`` (all the detector's pieces).
+    noise_px
+        Scatter of the end points across a piece's line, in the same pixels.
+    gap_px
+        Largest distance between two pieces' ends that still continue each other.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` booleans, True for the chords of a curve.
+    """
+    from scipy.spatial import cKDTree
+
+    n = len(segs)
+    out = np.zeros(n, dtype=bool)
+    if n < 3:
+        return out
+    p = np.asarray(segs, dtype=np.float64).reshape(n, 2, 2)
+    d = p[:, 1] - p[:, 0]
+    length = np.hypot(d[:, 0], d[:, 1])
+    u = d / np.where(length > 0, length, 1.0)[:, None]
+    ends = np.concatenate([p[:, 0], p[:, 1]])  # row k: segment k % n, its end k // n
+    pairs = cKDTree(ends).query_pairs(gap_px, output_type="ndarray")
+    if len(pairs) == 0:
+        return out
+    a, b = pairs[:, 0], pairs[:, 1]
+    si, sj, ei, ej = a % n, b % n, a // n, b // n
+    ok = (si != sj) & (length[si] >= _CURVE_MIN_PIECE_PX) & (length[sj] >= _CURVE_MIN_PIECE_PX)
+    a, b, si, sj, ei, ej = a[ok], b[ok], si[ok], sj[ok], ei[ok], ej[ok]
+    # walking out of i through end a, then along j away from end b
+    out_i = np.where((ei == 1)[:, None], u[si], -u[si])
+    along_j = np.where((ej == 0)[:, None], u[sj], -u[sj])
+    turn = np.arctan2(
+        out_i[:, 0] * along_j[:, 1] - out_i[:, 1] * along_j[:, 0], np.sum(out_i * along_j, axis=1)
+    )
+    gap = np.hypot(*(ends[a] - ends[b]).T)
+    # end to end, not overlapping or side by side: the far ends lie further apart than
+    # either piece is long, and j starts on i's line (up to the turn over the gap)
+    far = np.hypot(*(ends[(a + n) % (2 * n)] - ends[(b + n) % (2 * n)]).T)
+    step = ends[b] - ends[a]
+    lateral = np.abs(out_i[:, 0] * step[:, 1] - out_i[:, 1] * step[:, 0])
+    sigma = math.sqrt(2.0) * noise_px * np.hypot(1.0 / length[si], 1.0 / length[sj])
+    lo = np.maximum(math.radians(_CURVE_TURN_DEG[0]), 2.0 * sigma)
+    ok = (
+        (np.abs(turn) >= lo)
+        & (np.abs(turn) <= math.radians(_CURVE_TURN_DEG[1]))
+        & (far > np.maximum(length[si], length[sj]))
+        & (lateral <= 4.0 * noise_px + gap * np.abs(np.sin(turn)))
+    )
+    cont = (
+        (np.abs(turn) <= math.radians(_CURVE_TURN_DEG[1]))
+        & (far > np.maximum(length[si], length[sj]))
+        & (lateral <= 4.0 * noise_px + gap * np.abs(np.sin(turn)))
+    )
+    # the sense of the bend in each piece's own forward direction: walking forward out of
+    # end 1 it is the turn's; walking backward out of end 0, a curve bending the same way
+    # turns the other way round
+    sense_i = np.where(ei == 1, 1.0, -1.0) * np.sign(turn)
+    sense_j = np.where(ej == 1, -1.0, 1.0) * np.sign(turn)
+    # the nearest continuation at each end decides that end
+    bent = np.zeros((n, 2))  # sense of a significant bend at end 0 and end 1, else 0
+    sense = np.zeros((n, 2))  # sense of the turn into the continuation, however small
+    nbr = np.full((n, 2), -1, dtype=np.int64)
+    nbr_end = np.zeros((n, 2), dtype=np.int64)
+    for k in np.argsort(gap, kind="stable"):
+        if not cont[k]:
+            continue
+        for s_, e_, sn, other, other_e in (
+            (si[k], ei[k], sense_i[k], sj[k], ej[k]),
+            (sj[k], ej[k], sense_j[k], si[k], ei[k]),
+        ):
+            if nbr[s_, e_] >= 0:
+                continue
+            nbr[s_, e_], nbr_end[s_, e_], sense[s_, e_] = other, other_e, sn
+            if ok[k]:
+                bent[s_, e_] = sn
+    out = (bent[:, 0] != 0) & (bent[:, 0] == bent[:, 1])
+    curl = np.where(out, bent[:, 1], 0.0)  # each chord's sense of bending
+    # follow each curve beyond its chords: a piece continuing a chord where the chord bends
+    # its way, and bending the same way into the chord, belongs to the curve (its flatter
+    # stretch, where the turns are under their noise, and its ends)
+    frontier = np.flatnonzero(out)
+    for _ in range(_CURVE_FOLLOW):
+        nxt = []
+        for i in frontier:
+            for e_ in range(2):
+                j = nbr[i, e_]
+                if j < 0 or out[j] or sense[i, e_] != curl[i]:
+                    continue
+                ej_ = nbr_end[i, e_]
+                if nbr[j, ej_] != i:
+                    continue
+                # (the same turn, seen from j: its sense of bending in its own direction)
+                out[j], curl[j] = True, sense[j, ej_]
+                nxt.append(j)
+        if not nxt:
+            break
+        frontier = np.array(nxt)
+    return out
+
+
+def _curve_directions(labels: npt.NDArray[np.int64], chords: npt.NDArray[np.bool_]) -> list[int]:
+    """The directions (0..2) that lean on chords of curves: at least
+    :data:`_CURVE_MIN_CHORDS` of their segments, and :data:`_CURVE_CHORD_SHARE` of them, are
+    chords (:func:`_curve_pieces`)."""
+    out = []
+    for k in range(3):
+        sel = labels == k
+        n_chords = int(np.count_nonzero(chords & sel))
+        if n_chords >= _CURVE_MIN_CHORDS and n_chords >= _CURVE_CHORD_SHARE * np.count_nonzero(sel):
+            out.append(k)
+    return out
+
+
+def _line_scatter_deg(res_px: FloatArray, length_px: FloatArray) -> float:
+    """How far the long inliers turn about their vanishing points beyond their noise.
+
+    ``res_px`` are the end points' distances to the line through the midpoint and the
+    vanishing point, ``length_px`` the segments' lengths (detection pixels); a segment's
+    turn is ``res / (L / 2)``, its noise ``_CURVE_NOISE_PX / (L / 2)``. Root mean square
+    of the excess over segments at least :data:`_SCATTER_MIN_PX` long, in degrees (NaN
+    with fewer than :data:`_SCATTER_MIN_N`).
+    """
+    long_ = length_px >= _SCATTER_MIN_PX
+    if np.count_nonzero(long_) < _SCATTER_MIN_N:
+        return float("nan")
+    half = 0.5 * length_px[long_]
+    turn2 = (res_px[long_] / half) ** 2 - (_CURVE_NOISE_PX / half) ** 2
+    return float(np.degrees(math.sqrt(max(0.0, float(np.mean(turn2))))))
 
 
 def _content_box(gray: npt.NDArray[np.uint8], tol: float = 3.0) -> tuple[int, int, int, int]:
@@ -646,6 +848,7 @@ class _Model:
     # the terms of the focal sigma (``log(focal)``), by name: see AutoVPResult.focal_std_parts
     sigma_parts: dict[str, float] = field(default_factory=dict)
     residual_rms_px: float = float("nan")  # inliers' end-point residual (detection pixels)
+    scatter_deg: float = float("nan")  # long inliers' turn about their VPs beyond noise
 
 
 def _label_scores(
@@ -1514,7 +1717,8 @@ class AutoVPResult:
         ``a, b, c`` of the horizon ``a x + b y + c = 0`` with ``a^2 + b^2 = 1``.
     segments, labels
         ``(N, 4)`` detected segments and the index (0..2) of the VP each supports, -1
-        for outliers.
+        for outliers. Where a direction leaned on chords of curves and the photo was read
+        again without them (:func:`_curve_directions`), the chords are not among them.
     confidence
         0..1: roughly the probability that the focal length is within 10 % (when it is
         estimated): that of the stated Gaussian ``focal_std_rel``, times the chance that
@@ -1543,6 +1747,11 @@ class AutoVPResult:
         Root mean square distance of the inlier segments' end points to the lines through
         their midpoints and vanishing points, in the detection image's pixels (at most
         1024 px on the longer side); NaN when the focal length was given. For diagnosis.
+    line_scatter_deg
+        How far the long inliers (60 detection pixels or more) turn about their vanishing
+        points beyond their end points' noise, root mean square in degrees; NaN with fewer
+        than 8 of them or when the focal length was given. For diagnosis: it does not
+        tell a photo's coherent line bias (``benchmarks/README.md``, vp_real, stop 39).
     """
 
     vanishing_points: FloatArray
@@ -1569,6 +1778,7 @@ class AutoVPResult:
     roll_std_deg: float = float("nan")
     focal_std_parts: dict[str, float] = field(default_factory=dict)
     line_residual_rms_px: float = float("nan")
+    line_scatter_deg: float = float("nan")
 
     @property
     def street_index(self) -> int:
@@ -1859,11 +2069,16 @@ def detect_vanishing_points(
         raise InputError(f"max_iterations must be positive, got {max_iterations}")
     if segments is None:
         assert gray is not None
-        segs_px = detect_segments(gray, mask=mask)
+        segs_px, curve = _detect_segments(gray, mask=mask)
+        segs_detected = segs_px
+        if _CURVE_MODE == "drop" and np.any(curve) and np.count_nonzero(~curve) >= _MIN_SEGMENTS:
+            segs_px, curve = segs_px[~curve], curve[~curve]
+            segs_detected = segs_px
     else:
         segs_px = np.asarray(segments, dtype=np.float64).reshape(-1, 4)
         ln = np.hypot(segs_px[:, 2] - segs_px[:, 0], segs_px[:, 3] - segs_px[:, 1])
         segs_px = segs_px[np.isfinite(ln) & (ln > 1e-6)]
+        segs_detected, curve = segs_px, np.zeros(len(segs_px), dtype=bool)
     if len(segs_px) < _MIN_SEGMENTS:
         raise NotEnoughStructureError(
             f"not enough structure: {len(segs_px)} straight line segments found "
@@ -1883,6 +2098,7 @@ def detect_vanishing_points(
         und = undistort_points_px(segs_px.reshape(-1, 2), dist, pp_t).reshape(-1, 4)
         ok = np.all(np.isfinite(und), axis=1)
         segs_px, segs_photo = und[ok], segs_px[ok]
+        segs_detected, curve = segs_detected[ok], curve[ok]
     hints = _prepare_hints(axes_hint, pp, scale)
     if axes_hint:
         # An annotated axis is a straight line of the image too: fit it with the segments
@@ -1972,6 +2188,41 @@ def detect_vanishing_points(
         labels0=best.labels,
         prior_w=prior_w,
     )
+    n_axes = len(segs_px) - len(segs_detected)  # annotated axes, first
+    chords = np.r_[np.zeros(n_axes, dtype=bool), curve]
+    curve_dirs = _curve_directions(best.labels, chords) if _CURVE_MODE == "refit" else []
+    curve_only = False
+    if curve_dirs:
+        # A direction of the frame leans on chords of curves (a rotunda's rings, a dome:
+        # _curve_pieces): they are not lines of the scene. The photo is read again
+        # without them (once: given segments are not looked at for curves).
+        log.debug("%d segments are chords of curves: read again without them", int(curve.sum()))
+        try:
+            return detect_vanishing_points(
+                None,
+                focal_px=focal_px,
+                principal_point=principal_point,
+                seed=seed,
+                max_iterations=max_iterations,
+                segments=segs_detected[~curve],
+                image_size=(w, h),
+                inlier_px=inlier_px,
+                focal_bounds_rel=focal_bounds_rel,
+                estimate_principal_point=estimate_principal_point,
+                min_inlier_share=min_inlier_share,
+                axes_hint=axes_hint,
+                focal_prior_px=focal_prior_px,
+                focal_prior_sigma_rel=focal_prior_sigma_rel,
+                focal_prior_source=focal_prior_source,
+                bias_deg=bias_deg,
+                distortion_k1=distortion_k1,
+                estimate_distortion=estimate_distortion,
+                default_focal_prior=default_focal_prior,
+            )
+        except NotEnoughStructureError:
+            # too little is left without them: this reading stands, but its focal length
+            # rests on the curves (said below)
+            curve_only = True
     rival_tilt = (0.0, 0.0)
     rival_modes: list[tuple[float, float, FloatArray]] = []
     if f_fixed is None and rivals:
@@ -2115,6 +2366,12 @@ def detect_vanishing_points(
             )
     if f_fixed is None and not has_prior and not best.weak_only:
         best = _curve_direction(best, s, segs_px, n_lines, tau, f_prior, f_bounds, prior_w)
+    if curve_only and f_fixed is None and not has_prior and not best.weak_only:
+        # without the chords of curves the photo has too few lines to fix anything
+        k_curve = max(range(3), key=lambda k: int(np.count_nonzero(chords & (best.labels == k))))
+        best.thin_only = max(1, _n_distinct_lines(segs_px[best.labels == k_curve], merge_px))
+        best.logf_std = _MAX_STATED_STD
+        log.debug("focal length rests on direction %d, chords of curves", k_curve)
     nl = [_n_distinct_lines(segs_px[best.labels == k], merge_px) for k in range(3)]
     best.n_lines = (nl[0], nl[1], nl[2])
     # With no line left in one direction (no building over a highway: no vertical; or a
@@ -2157,7 +2414,9 @@ def detect_vanishing_points(
             res_px = _endpoint_residual(_vps_from_rotation(best.R, best.f_n), s)
             res_in = res_px[best.labels[inl], np.flatnonzero(inl)]
             # in the detection image's pixels (detect_segments works at most 1024 px wide)
-            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * min(1.0, 1024.0 / scale)
+            det = min(1.0, 1024.0 / scale)  # detection pixels per photo pixel
+            best.residual_rms_px = float(np.sqrt(np.mean(res_in**2))) * det
+            best.scatter_deg = _line_scatter_deg(res_in * det, s.length_px[inl] * det)
         best.sigma_parts = {
             "least_squares": float(best.logf_std),
             "jackknife": float(jack_std),
@@ -2249,6 +2508,7 @@ def detect_vanishing_points(
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
     result.focal_std_parts = dict(best.sigma_parts)
     result.line_residual_rms_px = best.residual_rms_px
+    result.line_scatter_deg = best.scatter_deg
     if best.horizon_rests_on:
         result.warnings.append(
             f"no vertical line: the horizon rests on {best.horizon_rests_on} lines of one "

@@ -763,7 +763,9 @@ def test_real_frontal_gate_focal_is_the_default_and_said_so() -> None:
 def test_real_photo_third_direction_of_a_few_lines_is_jackknifed() -> None:
     """Strecha fountain-P11/0000: +10 % at a stated 3.9 % (confidently wrong). Leaving the
     lines of its thinly supported directions out one at a time moves the focal length
-    enough to widen the sigma to about 5 %: the error is within 2 sigma."""
+    enough to widen the sigma to about 5 %: the error is within 2 sigma. (Stop 39: its
+    basin's rim leans on chords of a curve, so it is read again without them: +14 % at a
+    stated 7.5 %, still within 2 sigma.)"""
     vals = [
         [float(x) for x in ln.split()]
         for ln in (STRECHA / "fountain-P11" / "gt_dense_cameras" / "0000.jpg.camera")
@@ -774,7 +776,7 @@ def test_real_photo_third_direction_of_a_few_lines_is_jackknifed() -> None:
     f_true = 0.5 * (vals[0][0] + vals[1][1])
     res = detect_vanishing_points(str(STRECHA / "fountain-P11" / "images" / "0000.jpg"))
     err = abs(math.log(res.focal_px / f_true))
-    assert 0.07 < err < 0.12
+    assert 0.07 < err < 0.16
     assert res.focal_std_rel > 0.045
     assert err < 2.0 * res.focal_std_rel
 
