@@ -40,8 +40,8 @@
 #   RuoyuX-2018/Panorama-Stitching, hsiaoyi0504/vfx-image-stitching, shsiung/16822hw2,
 #   aayush-k/Local-Feature-Matching, Jiarui-Xu-Gatech/Camera-Calibration-and-Fundamental-
 #   Matrix-Estimation-with-RANSAC, liuxianming/cs543_hw, zukun/cs543_2011,
-#   polimi-ispl/prnu-python, kernelmurton/prnu
-#                                    30 more (batch 8, set street-photos-held-out-2, into
+#   polimi-ispl/prnu-python, kernelmurton/prnu, bojunyang24/CS6476
+#                                    42 more (batch 8, set street-photos-held-out-2, into
 #                                    street-photos-held-out-2/): course and test data, no
 #                                    licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
@@ -102,7 +102,7 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of 25 repositories (some of them large), from
+# The handheld street photos: single files of 26 repositories (some of them large), from
 # the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
 # "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder).
 street_only=""

@@ -80,7 +80,7 @@ The photos (none of them is in this repository; their licences keep them out):
     out). Truth: the EXIF focal length as for
     ``perrot``; no gravity truth. Run with and without the EXIF.
 ``street-photos-held-out-2`` (only when ``--sets`` names it; ``street-photos`` never loads it)
-    Batch 8 of ``benchmarks/street_photos.json`` (stop 39): 30 more photos of streets,
+    Batch 8 of ``benchmarks/street_photos.json`` (stop 39): 42 more photos of streets,
     squares and buildings that no one had run ``camloc vp`` on, all held out, to be
     measured once (files under ``street-photos-held-out-2/``). Each has a ``view`` read
     from the photo before any result ("level", "looking-up", "looking-down"); the run
@@ -640,7 +640,7 @@ STREET_PHOTOS = HERE / "street_photos.json"
 #: before any result was read.
 STREET_PHOTO_HALVES = ("dev", "held-out")
 #: Fresh held-out batches, each its own set (``street-photos-<half>``), loaded only when
-#: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 30 photos no
+#: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
 #: one had run ``camloc vp`` on, to be measured once.
 STREET_PHOTO_FRESH_HALVES = ("held-out-2",)
 
