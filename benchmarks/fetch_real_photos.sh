@@ -35,6 +35,15 @@
 #                                    content checked against its sha256); EXIF test data of
 #                                    libraries and photos of public websites, no licence
 #                                    given for the photos, so kept out
+#   praveenVnktsh/Panorama-Stitching, fantashi099/Panorama-Stitching,
+#   jammychiou1/panorama-stitching, kyeongjin0110/Panorama-Stitching,
+#   RuoyuX-2018/Panorama-Stitching, hsiaoyi0504/vfx-image-stitching, shsiung/16822hw2,
+#   aayush-k/Local-Feature-Matching, Jiarui-Xu-Gatech/Camera-Calibration-and-Fundamental-
+#   Matrix-Estimation-with-RANSAC, liuxianming/cs543_hw, zukun/cs543_2011,
+#   polimi-ispl/prnu-python, kernelmurton/prnu, bojunyang24/CS6476
+#                                    42 more (batch 8, set street-photos-held-out-2, into
+#                                    street-photos-held-out-2/): course and test data, no
+#                                    licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -42,7 +51,8 @@
 # A mirror that lacks some blobs (large files left out) gives the photos it does hold (its JPEG
 # files are copied out one by one, blob by blob); with none of them, GitHub is tried.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
-# "street-photos" for the handheld street photos) to fetch fewer.
+# "street-photos" for all the handheld street photos of benchmarks/street_photos.json, or
+# "street-photos-held-out-2" for batch 8 alone) to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
@@ -92,9 +102,16 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of twelve repositories (some of them large),
-# from the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
-if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
+# The handheld street photos: single files of 26 repositories (some of them large), from
+# the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
+# "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder).
+street_only=""
+if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]] \
+  && [[ " $CAMLOC_PHOTO_SETS " == *" street-photos-held-out-2 "* ]]; then
+  street_only="street-photos-held-out-2"
+fi
+if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [ -n "$street_only" ] \
+  || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
   manifest="$(dirname "$0")/street_photos.json"
   got=0 failed=0
   while IFS=$'\t' read -r file repo commit path sha; do
@@ -117,8 +134,11 @@ if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [[ " $CAMLOC_PHOTO_SETS " == *" street-pho
     fi
   done < <(python3 -c 'import json, sys
 for p in json.load(open(sys.argv[1]))["photos"]:
-    print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' "$manifest")
-  echo "street-photos: $got photos in $dest/street-photos"
+    if sys.argv[2] and not p["file"].startswith(sys.argv[2] + "/"):
+        continue
+    print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' \
+    "$manifest" "$street_only")
+  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/)"
   [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
 fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"

@@ -7,7 +7,8 @@ Usage::
                                  [--sets strecha,sceaux,perrot,lund,street-photos,exif,yud]
                                  (lund-dev, lund-held-out: one half of the Lund scenes;
                                   street-photos-dev, street-photos-held-out: one half of
-                                  the handheld street photos;
+                                  the handheld street photos; street-photos-held-out-2:
+                                  the fresh batch 8, only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
     python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
@@ -78,6 +79,12 @@ The photos (none of them is in this repository; their licences keep them out):
     fixed then, batch by batch: sorted by sha256, every other one dev (22 dev, 18 held
     out). Truth: the EXIF focal length as for
     ``perrot``; no gravity truth. Run with and without the EXIF.
+``street-photos-held-out-2`` (only when ``--sets`` names it; ``street-photos`` never loads it)
+    Batch 8 of ``benchmarks/street_photos.json`` (stop 39): 42 more photos of streets,
+    squares and buildings that no one had run ``camloc vp`` on, all held out, to be
+    measured once (files under ``street-photos-held-out-2/``). Each has a ``view`` read
+    from the photo before any result ("level", "looking-up", "looking-down"); the run
+    also summarises each view (``street-photos-held-out-2 / looking-up``).
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
     (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
@@ -367,7 +374,7 @@ LUND_SCENES = {
     7: "heidelberg-castle",
 }
 #: Sets summarised by scene too (the second part of a photo's name).
-SCENE_SETS = ("lund",)
+SCENE_SETS = ("lund", "street-photos-held-out-2")  # and the fresh street photos by view
 #: The Lund scenes split by building, so that a change tuned on some is checked on others:
 #: the development half (looked at, its debug drawings read) and the held-out half (only
 #: its summary figures are read). Each half has one scene where the focal length is loose
@@ -626,10 +633,45 @@ def load_drive_set(
 
 
 #: Handheld street photos (sets ``street-photos``, ``street-photos-dev``,
-#: ``street-photos-held-out``): file, sha256, source, half; truth from their EXIF.
+#: ``street-photos-held-out``, ``street-photos-held-out-2``): file, sha256, source, half;
+#: truth from their EXIF.
 STREET_PHOTOS = HERE / "street_photos.json"
-#: The halves of the street photos, fixed by a rule before any result was read.
+#: The halves of the street photos of batches 1-7 (set ``street-photos``), fixed by a rule
+#: before any result was read.
 STREET_PHOTO_HALVES = ("dev", "held-out")
+#: Fresh held-out batches, each its own set (``street-photos-<half>``), loaded only when
+#: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
+#: one had run ``camloc vp`` on, to be measured once.
+STREET_PHOTO_FRESH_HALVES = ("held-out-2",)
+
+
+def street_photo_set(half: str) -> str:
+    """The set a street photo of this half belongs to.
+
+    Parameters
+    ----------
+    half
+        The manifest's ``half`` (``"dev"``, ``"held-out"``, ``"held-out-2"``, ...).
+
+    Returns
+    -------
+    str
+        ``"street-photos"`` for the halves of :data:`STREET_PHOTO_HALVES`, else
+        ``"street-photos-<half>"`` (a fresh batch is a set of its own).
+    """
+    return "street-photos" if half in STREET_PHOTO_HALVES else f"street-photos-{half}"
+
+
+def street_photo_halves(wanted: set[str]) -> tuple[str, ...]:
+    """The street-photo halves the names in ``--sets`` ask for.
+
+    ``street-photos`` means both halves of :data:`STREET_PHOTO_HALVES`;
+    ``street-photos-<half>`` that half, a fresh one of :data:`STREET_PHOTO_FRESH_HALVES`
+    included (which ``street-photos`` never loads).
+    """
+    both = tuple(h for h in STREET_PHOTO_HALVES if {"street-photos", f"street-photos-{h}"} & wanted)
+    fresh = tuple(h for h in STREET_PHOTO_FRESH_HALVES if f"street-photos-{h}" in wanted)
+    return both + fresh
 
 
 def load_street_photos(
@@ -648,14 +690,17 @@ def load_street_photos(
         :data:`STREET_PHOTOS`: ``photos`` (file, sha256, repository, commit, path,
         camera, scene, ``half``).
     halves
-        Which halves to load (``"dev"``, ``"held-out"``).
+        Which halves to load (``"dev"``, ``"held-out"``, ``"held-out-2"``).
 
     Returns
     -------
     list of dict
         One truth record a photo present with the content the manifest pins (set
-        ``"street-photos"``, ``half`` kept); a photo missing, with another content or
-        without a usable EXIF focal length is skipped and counted in the log.
+        :func:`street_photo_set` of its half, ``half`` kept; a photo with a ``view`` tag,
+        "level", "looking-up" or "looking-down", keeps it, and in a fresh set its name
+        carries it: ``street-photos-held-out-2/looking-up/IMG_8729.JPG``, so the run
+        summarises each view); a photo missing, with another content or without a usable
+        EXIF focal length is skipped and counted in the log.
     """
     import hashlib
 
@@ -677,20 +722,26 @@ def load_street_photos(
             no_exif += 1
             continue
         ex, (w, h) = got
-        out.append(
-            {
-                "set": "street-photos",
-                "name": f"street-photos/{Path(ph['file']).name}",
-                "path": str(path),
-                "f": ex.focal_px,
-                "f_source": ex.source,
-                "pp": (w / 2.0, h / 2.0),
-                "up": None,
-                "size": (w, h),
-                "exif": True,
-                "half": ph["half"],
-            }
-        )
+        set_name = street_photo_set(ph["half"])
+        view = ph.get("view")
+        fresh = set_name != "street-photos" and view
+        rec: dict[str, Any] = {
+            "set": set_name,
+            "name": f"{set_name}/{view}/{Path(ph['file']).name}"
+            if fresh
+            else f"{set_name}/{Path(ph['file']).name}",
+            "path": str(path),
+            "f": ex.focal_px,
+            "f_source": ex.source,
+            "pp": (w / 2.0, h / 2.0),
+            "up": None,
+            "size": (w, h),
+            "exif": True,
+            "half": ph["half"],
+        }
+        if view:
+            rec["view"] = view
+        out.append(rec)
     if missing or changed or no_exif:
         log.info(
             "street-photos: %d missing, %d with another content than the manifest pins, "
@@ -1283,9 +1334,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     if synth_halves:
         data.extend(load_street_synth(synth_halves, args.synth_photos, args.synth_focal_rel))
-    street_halves = tuple(
-        h for h in STREET_PHOTO_HALVES if {"street-photos", f"street-photos-{h}"} & wanted
-    )
+    street_halves = street_photo_halves(wanted)
     if street_halves:
         street = load_street_photos(args.drive_photos, args.street_photos, street_halves)
         if not street:

@@ -25,21 +25,47 @@ def test_manifest_halves_follow_the_fixed_rule() -> None:
     # (1st, 3rd, ...) dev (a later batch leaves the halves of the earlier ones as they were)
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
     photos = doc["photos"]
-    assert len(photos) >= 40
+    assert len(photos) >= 70
     shas = [p["sha256"] for p in photos]
     assert len(set(shas)) == len(shas)
     assert len({p["file"] for p in photos}) == len(photos)
     assert len({Path(p["file"]).name for p in photos}) == len(photos)  # the run's names
     batches = sorted({p["batch"] for p in photos})
-    assert batches == [1, 2, 3, 4, 5, 6, 7]
-    for batch in batches:
+    assert batches == [1, 2, 3, 4, 5, 6, 7, 8]
+    for batch in batches[:-1]:
         ordered = sorted((p for p in photos if p["batch"] == batch), key=lambda p: p["sha256"])
         assert [p["half"] for p in ordered] == [
             "dev" if i % 2 == 0 else "held-out" for i in range(len(ordered))
         ]
     for p in photos:
         assert len(p["commit"]) == 40
-        assert p["file"].startswith("street-photos/")
+        folder = "street-photos/" if p["batch"] < 8 else "street-photos-held-out-2/"
+        assert p["file"].startswith(folder)
+
+
+def test_fresh_batch_is_held_out_whole_in_a_set_of_its_own() -> None:
+    # batch 8 (stop 39): all held out, in its own folder, each with the view read from it
+    doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
+    fresh = [p for p in doc["photos"] if p["batch"] == 8]
+    assert len(fresh) >= 30
+    assert {p["half"] for p in fresh} == {"held-out-2"}
+    assert {p["view"] for p in fresh} <= {"level", "looking-up", "looking-down"}
+    assert sum(p["view"] == "looking-up" for p in fresh) >= 3
+    # a dozen sources, none of them more than 12 photos (at most 3 or so of one place)
+    per_repo: dict[str, int] = {}
+    for p in fresh:
+        per_repo[p["repo"]] = per_repo.get(p["repo"], 0) + 1
+    assert len(per_repo) >= 10
+    assert max(per_repo.values()) <= 12
+    assert vp_real.street_photo_set("held-out-2") == "street-photos-held-out-2"
+    assert vp_real.street_photo_set("dev") == "street-photos"
+    # "street-photos" (and so the default --sets) never loads it: only its own name does
+    assert vp_real.street_photo_halves({"street-photos"}) == ("dev", "held-out")
+    assert vp_real.street_photo_halves({"street-photos-held-out"}) == ("held-out",)
+    assert vp_real.street_photo_halves({"street-photos-held-out-2"}) == ("held-out-2",)
+    assert vp_real.street_photo_halves({"yud", "lund"}) == ()
+    default_sets = {"strecha", "sceaux", "perrot", "lund", "street-photos", "exif", "yud"}
+    assert "held-out-2" not in vp_real.street_photo_halves(default_sets)
 
 
 def test_loader_pins_content_and_reads_the_exif_truth(tmp_path: Path) -> None:
@@ -73,6 +99,118 @@ def test_loader_pins_content_and_reads_the_exif_truth(tmp_path: Path) -> None:
     assert [t["f"] for t in held] == [pytest.approx(50.0 * 800.0 / 43.267, rel=1e-3)]
 
 
+def test_loader_serves_a_fresh_half_as_its_own_set_named_by_view(tmp_path: Path) -> None:
+    photos = tmp_path / "photos"
+    a = _jpeg(photos / "street-photos" / "x" / "a.jpg", (640, 480), {0xA405: 28})
+    u = _jpeg(photos / "street-photos-held-out-2" / "y" / "u.jpg", (480, 640), {0xA405: 26})
+    v = _jpeg(photos / "street-photos-held-out-2" / "y" / "v.jpg", (640, 480), {0xA405: 35})
+    entries = [
+        {"file": "street-photos/x/a.jpg", "sha256": _sha(a), "half": "dev", "view": "level"},
+        {
+            "file": "street-photos-held-out-2/y/u.jpg",
+            "sha256": _sha(u),
+            "half": "held-out-2",
+            "view": "looking-up",
+        },
+        {"file": "street-photos-held-out-2/y/v.jpg", "sha256": _sha(v), "half": "held-out-2"},
+    ]
+    manifest = tmp_path / "m.json"
+    manifest.write_text(json.dumps({"photos": entries}), encoding="utf-8")
+    # the default halves leave the fresh batch alone
+    assert [t["name"] for t in vp_real.load_street_photos(photos, manifest)] == [
+        "street-photos/a.jpg"
+    ]
+    fresh = vp_real.load_street_photos(photos, manifest, ("held-out-2",))
+    assert [(t["set"], t["name"], t["half"]) for t in fresh] == [
+        ("street-photos-held-out-2", "street-photos-held-out-2/looking-up/u.jpg", "held-out-2"),
+        ("street-photos-held-out-2", "street-photos-held-out-2/v.jpg", "held-out-2"),
+    ]
+    assert fresh[0]["view"] == "looking-up"
+    assert "view" not in fresh[1]
+    assert fresh[0]["f"] == pytest.approx(26.0 * 800.0 / 43.267, rel=1e-3)
+    assert fresh[0]["size"] == (480, 640)
+    # the fresh set is summarised by view, as Lund is by scene
+    assert "street-photos-held-out-2" in vp_real.SCENE_SETS
+
+
+def test_fetch_script_copies_the_fresh_batch_alone_from_a_mirror(tmp_path: Path) -> None:
+    # benchmarks/fetch_real_photos.sh with CAMLOC_PHOTO_SETS=street-photos-held-out-2: the
+    # manifest's batch-8 files, from a local mirror's blobs at the pinned commit, sha256
+    # checked; nothing else (curl is stubbed to fail: a test never reaches the internet)
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or shutil.which("bash") is None:
+        pytest.skip("git and bash are needed")
+    work = tmp_path / "src"
+    good = _jpeg(work / "pics" / "good.jpg", (64, 48), {0xA405: 28})
+    _jpeg(work / "pics" / "old.jpg", (64, 48), {0xA405: 50})
+    env = {
+        "PATH": f"{tmp_path / 'bin'}:/usr/bin:/bin",
+        "HOME": str(tmp_path),
+        "GIT_AUTHOR_NAME": "t",
+        "GIT_AUTHOR_EMAIL": "t@t",
+        "GIT_COMMITTER_NAME": "t",
+        "GIT_COMMITTER_EMAIL": "t@t",
+    }
+    (tmp_path / "bin").mkdir()
+    (tmp_path / "bin" / "curl").write_text("#!/bin/sh\nexit 22\n", encoding="utf-8")
+    (tmp_path / "bin" / "curl").chmod(0o755)
+    for cmd in (["init", "-q"], ["add", "-A"], ["commit", "-qm", "photos"]):
+        subprocess.run(["git", *cmd], cwd=work, env=env, check=True)
+    commit = subprocess.run(
+        ["git", "rev-parse", "HEAD"], cwd=work, env=env, check=True, capture_output=True, text=True
+    ).stdout.strip()
+    mirror = tmp_path / "mirror"
+    subprocess.run(
+        ["git", "clone", "-q", "--bare", str(work), str(mirror / "me+pics" / "repo")],
+        env=env,
+        check=True,
+    )
+    bench = tmp_path / "bench"
+    bench.mkdir()
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "fetch_real_photos.sh"
+    shutil.copy(script, bench / "fetch_real_photos.sh")
+    entry = {"repo": "me/pics", "commit": commit, "half": "held-out-2", "batch": 8}
+    photos = [
+        dict(
+            entry,
+            file="street-photos-held-out-2/me/good.jpg",
+            path="pics/good.jpg",
+            sha256=_sha(good),
+        ),
+        dict(
+            entry, file="street-photos-held-out-2/me/bad.jpg", path="pics/old.jpg", sha256="0" * 64
+        ),  # another content than pinned: not kept
+        dict(
+            entry,
+            file="street-photos/me/old.jpg",
+            path="pics/old.jpg",
+            half="dev",
+            batch=1,
+            sha256=_sha(work / "pics" / "old.jpg"),
+        ),
+    ]
+    (bench / "street_photos.json").write_text(json.dumps({"photos": photos}), encoding="utf-8")
+    dest = tmp_path / "dest"
+    run = subprocess.run(
+        ["bash", str(bench / "fetch_real_photos.sh")],
+        env=dict(
+            env,
+            CAMLOC_PHOTOS_DIR=str(dest),
+            CAMLOC_MIRROR_DIR=str(mirror),
+            CAMLOC_PHOTO_SETS="street-photos-held-out-2",
+        ),
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    got = sorted(p.relative_to(dest).as_posix() for p in dest.rglob("*") if p.is_file())
+    assert got == ["street-photos-held-out-2/me/good.jpg"]
+    assert _sha(dest / got[0]) == _sha(good)
+    assert "1 not fetched" in run.stderr
+
+
 def test_fetched_street_photos_match_the_manifest() -> None:
     # where benchmarks/fetch_real_photos.sh has copied them: every one loads, with a truth
     photos = vp_real.PHOTOS
@@ -83,7 +221,12 @@ def test_fetched_street_photos_match_the_manifest() -> None:
         )
     rows = vp_real.load_street_photos(photos)
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
-    assert len(rows) == len(doc["photos"])
+    pinned = [p for p in doc["photos"] if p["half"] in vp_real.STREET_PHOTO_HALVES]
+    assert len(rows) == len(pinned)
+    if (photos / "street-photos-held-out-2").is_dir():  # the fresh batch: its EXIF only
+        fresh = vp_real.load_street_photos(photos, halves=vp_real.STREET_PHOTO_FRESH_HALVES)
+        assert len(fresh) == len(doc["photos"]) - len(pinned)
+        rows = rows + fresh
     for t in rows:
         w, h = t["size"]
         assert 0.4 < t["f"] / max(w, h) < 5.0
@@ -102,3 +245,40 @@ def test_issue24_bars_judge_the_three_figures() -> None:
     assert bars["stripped_confidently_wrong_share"]["met"] is False
     assert bars["stripped_within_10pct"]["met"] is False
     assert bars["kept_within_10pct"] == {"value": None, "bar": 0.95, "met": None}
+
+
+def test_run_loads_the_fresh_set_only_when_named(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # vp_real.main: "--sets street-photos-held-out-2" hands exactly batch 8's photos to the
+    # estimation (stubbed here: nothing is estimated), "--sets street-photos" none of them
+    photos = tmp_path / "photos"
+    a = _jpeg(photos / "street-photos" / "x" / "a.jpg", (640, 480), {0xA405: 28})
+    u = _jpeg(photos / "street-photos-held-out-2" / "y" / "u.jpg", (640, 480), {0xA405: 26})
+    entries = [
+        {"file": "street-photos/x/a.jpg", "sha256": _sha(a), "half": "held-out"},
+        {
+            "file": "street-photos-held-out-2/y/u.jpg",
+            "sha256": _sha(u),
+            "half": "held-out-2",
+            "view": "looking-up",
+        },
+    ]
+    manifest = tmp_path / "m.json"
+    manifest.write_text(json.dumps({"photos": entries}), encoding="utf-8")
+
+    class LoadedError(Exception):
+        pass
+
+    def stub(data: list[dict[str, object]], use_exif: bool, **_: object) -> None:
+        raise LoadedError([str(t["name"]) for t in data])
+
+    monkeypatch.setattr(vp_real, "run", stub)
+    args = ["--drive-photos", str(photos), "--street-photos", str(manifest)]
+    args += ["--out", str(tmp_path / "out")]
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", "street-photos-held-out-2"])
+    assert got.value.args[0] == ["street-photos-held-out-2/looking-up/u.jpg"]
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", "street-photos"])
+    assert got.value.args[0] == ["street-photos/a.jpg"]
