@@ -119,6 +119,22 @@ HELD_OUT_SKIP = 24
 """Oracle junctions nearest each development place's centre that held-out runs skip."""
 HELD_OUT_SEED = 38
 """The held-out runs' seed (the dev runs use 0)."""
+HELD_OUT_2_SKIP = 30
+"""``--set held-out-2``: oracle junctions nearest each unseen city's centre that it skips
+(``unseen_cities.py --n 30`` locates the 30 nearest)."""
+HELD_OUT_2_SEED = 39
+"""The second held-out set's seed."""
+
+
+def held_out_2_places() -> list[tuple[str, float, float, float]]:
+    """``--set held-out-2``: fixed (stop 39) before any result on it. The six unseen cities of
+    ``benchmarks/unseen_cities.py`` (no absolute slip benchmark ever sampled them), only the
+    oracle junctions beyond the :data:`HELD_OUT_2_SKIP` nearest each centre, by junction class,
+    seed :data:`HELD_OUT_2_SEED`."""
+    from unseen_cities import CITIES
+
+    return list(CITIES)
+
 
 CONFIDENT_M = 15.0
 """A top candidate farther than this from the truth is wrong."""
@@ -672,6 +688,8 @@ def _order_dev(n: int, maps: dict[str, MapData]) -> list[tuple[str, Any]]:
 def _order_held_out(
     n: int, maps: dict[str, MapData], skip: int | None = None
 ) -> list[tuple[str, Any]]:
+    # skip: the nearest junctions every place skips (None: HELD_OUT_SKIP, Campo Grande and
+    # Bristol whole)
     """Held-out junctions: per place, skip the :data:`HELD_OUT_SKIP` nearest the centre (the
     ones ``absolute.py`` and the dev runs sample), class them (:func:`junction_class`) and
     take them round-robin over (place, class) cells, so that rare types (roundabouts, dual
@@ -701,6 +719,8 @@ def run(
 ) -> list[dict[str, Any]]:
     if which == "held-out":
         order = _order_held_out(n, maps)
+    elif which == "held-out-2":
+        order = _order_held_out(n, maps, skip=HELD_OUT_2_SKIP)
     elif which == "dev-classes":
         order = _order_held_out(n, maps, skip=0)
     else:
@@ -873,13 +893,17 @@ def plot(summary: dict[str, Any], path: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=60, help="number of junction cameras")
-    ap.add_argument("--seed", type=int, default=None, help="default 0 (dev), 38 (held-out)")
+    ap.add_argument(
+        "--seed", type=int, default=None, help="default 0 (dev), 38 (held-out), 39 (held-out-2)"
+    )
     ap.add_argument(
         "--set",
-        choices=("dev", "dev-classes", "held-out"),
+        choices=("dev", "dev-classes", "held-out", "held-out-2"),
         default="dev",
         help="dev: absolute.py's junctions; dev-classes: DEV_CLASS_PLACES by junction "
-        "class; held-out: HELD_OUT_PLACES by junction class (measure once, at the end)",
+        "class; held-out: HELD_OUT_PLACES by junction class (stop 38's; read since: "
+        "development now); held-out-2: the unseen cities beyond their 30 nearest "
+        "junctions, by class (measure once, at the end)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -891,12 +915,15 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [s for s in slips if s not in SLIPS]
     if unknown:
         ap.error(f"unknown slips {unknown}; known: {', '.join(SLIPS)}")
-    held_out = args.set == "held-out"
     if args.seed is None:
-        args.seed = HELD_OUT_SEED if held_out else 0
+        args.seed = {"held-out": HELD_OUT_SEED, "held-out-2": HELD_OUT_2_SEED}.get(args.set, 0)
     t0 = time.perf_counter()
     maps = {}
-    places = {"held-out": HELD_OUT_PLACES, "dev-classes": DEV_CLASS_PLACES}.get(args.set, PLACES)
+    places = {
+        "held-out": HELD_OUT_PLACES,
+        "dev-classes": DEV_CLASS_PLACES,
+        "held-out-2": held_out_2_places(),
+    }.get(args.set, PLACES)
     for name, lat, lon, r in places:
         try:
             maps[name] = load_map(OSM / name, lat, lon, radius_m=r)

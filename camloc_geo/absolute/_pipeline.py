@@ -28,6 +28,7 @@ from camloc_geo.absolute._evidence import (
     reference_corner_alternatives,
 )
 from camloc_geo.absolute._hypotheses import (
+    REVERSED_ORDER_PRIOR,
     Hypothesis,
     NoCandidatesError,
     _gen_references,
@@ -55,6 +56,7 @@ from camloc_geo.absolute._refine import (
     refine_many,
 )
 from camloc_geo.absolute._scoring import (
+    OUTLIER_M2,
     car_bearing_deg,
     plausibility_at,
     score,
@@ -186,6 +188,7 @@ def _locate_once(
         _warn_stated_bearing(ev, result)
         _warn_reversed_corners(result)
         _warn_corner_outlier(result)
+        _warn_one_corner_decides(ev, settings, result)
         _warn_substituted_landmark(result)
         _warn_landmarks_off_street(ev, result)
         _warn_fragile_references(ev, result)
@@ -289,9 +292,20 @@ def _leave_one_corner_out(
 def _counter_clockwise_candidates(
     cands: list[Candidate], world_cam: Camera, ev: Evidence, settings: LocateSettings
 ) -> list[Candidate]:
-    """The visible corners read counter-clockwise (odds 0.1), kept only when one of those
-    readings outweighs every clockwise corner candidate (kept always, they nearly doubled
-    the candidates of every corner scene, to no gain where the order was right)."""
+    """The visible corners read counter-clockwise (odds
+    :data:`~camloc_geo.absolute._hypotheses.REVERSED_ORDER_PRIOR`), kept when one of those
+    readings fits better than every clockwise corner candidate, its prior odds left out (kept
+    always, they nearly doubled the candidates of every corner scene, to no gain where the
+    order was right).
+
+    Before stop 39 they were kept only when they outweighed the clockwise ones with their
+    odds in: a reversed list (three or more corners) whose clockwise misreading fitted
+    another placement nearly as well was answered there with no warning (5 of 131
+    ``corners_ccw`` scenes of ``benchmarks/absolute_slips.py --set held-out``, 23-103 m off).
+    Kept, a better-fitting reversed reading ties with the clockwise top or is warned
+    (:func:`_warn_reversed_fits`). Two corners have no reversed reading of their own: every
+    ordered pair of a junction's corners is a clockwise reading too.
+    """
     if len(ev.corners) < 2 or len(ev.map_corners) < 2:
         return []
     hyps = corner_hypotheses(ev, settings, counter_clockwise=True)
@@ -299,7 +313,8 @@ def _counter_clockwise_candidates(
         return []
     back = score_hypotheses(hyps, world_cam, ev, settings)
     ahead = [c for c in cands if c.method == "corners"]
-    if ahead and max(map(_weight, back)) <= max(map(_weight, ahead)):
+    odds = math.log(REVERSED_ORDER_PRIOR)
+    if ahead and max(map(_weight, back)) - odds <= max(map(_weight, ahead)):
         return []
     return back
 
@@ -574,18 +589,41 @@ def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
         return
     cam = top.east_north
     lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
-    move = REFERENCE_SLIP_M * lever
+    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b))
+    move = slip * lever
     sigma = top.sigma_m if top.sigma_m is not None else 0.0
     if move <= max(WRONG_M, 2.0 * sigma):
         return
     result.warnings.append(
         f"references: the two references are {baseline:.0f} m apart and the camera "
         f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
-        f"{REFERENCE_SLIP_M:.0f} m off across them (a pixel on the kerb for a point on the "
+        f"{slip:.0f} m off across them (a pixel on the kerb for a point on the "
         f"centre line, a rounded lat/lon) would move the camera about {move:.0f} m, beyond "
         "its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
         "landmark"
     )
+
+
+def _half_carriageway_m(ev: Evidence, point_en: FloatArray) -> float:
+    """Half the widest carriageway (the map's, metres) whose centre line ``point_en`` lies
+    on (within a quarter of the carriageway's width), 0 where none: how far a pixel on the
+    kerb lies from a lat/lon taken on that street's centre line, as maps draw streets. A
+    wide avenue's carriageway is wider than the 3 m of :data:`REFERENCE_SLIP_M` (stop 39: a
+    reference at a dual carriageway's junction 3.3 m across its street put the camera 33 m
+    off, unwarned, on ``benchmarks/absolute_slips.py --set held-out``'s ``reference_kerb``).
+    A lat/lon near a kerb (a kerb corner's) is no centre-line point: 0."""
+    if ev.streets is None or ev.street_tree is None:
+        return 0.0
+    import shapely
+
+    pt = shapely.Point(float(point_en[0]), float(point_en[1]))
+    idx = ev.street_tree.query(pt.buffer(30.0))
+    if not len(idx):
+        return 0.0
+    half = ev.streets.values_array[idx]
+    d = shapely.distance(ev.street_tree.geometries[idx], pt)
+    inside = half[d <= 0.5 * half]
+    return float(inside.max()) if len(inside) else 0.0
 
 
 def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
@@ -905,18 +943,103 @@ def _warn_corner_outlier(result: LocateResult) -> None:
     )
 
 
+MISCLICK_ODDS = 0.05
+"""The prior odds of one listed kerb corner being misclicked (where the centre lines cross,
+across a wide pavement, another junction's corner, a T junction's straight far kerb): what
+:func:`_warn_one_corner_decides` charges for reading a corner so."""
+
+
+def _misclick_weight(c: Candidate) -> tuple[float, str | None]:
+    """A corners candidate's log weight with its worst-fitting listed corner read as
+    misclicked when that fits better (at :data:`MISCLICK_ODDS`), and that corner's label
+    (None when reading none so fits better).
+
+    The corner's term is taken out of the weight as it stands (the placement is not refitted
+    without it: a lower bound of the leave-one-out fit). A corner left unmatched already
+    costs an outlier's share (``OUTLIER_M2``)."""
+    w = _weight(c)
+    terms = [
+        (0.5 * min(m.mahalanobis2, OUTLIER_M2), m.label) for m in c.matches if m.kind == "corner"
+    ]
+    unmatched = sum(1 for j in (c.corner_assignment or ()) if j < 0)
+    if unmatched:
+        terms.append((0.5 * OUTLIER_M2, "an unmatched corner"))
+    if not terms:
+        return w, None
+    gain, label = max(terms, key=lambda t: t[0])
+    gain += math.log(MISCLICK_ODDS)
+    return (w + gain, label) if gain > 0.0 else (w, None)
+
+
+def _warn_one_corner_decides(ev: Evidence, settings: LocateSettings, result: LocateResult) -> None:
+    """Warn when one listed corner decides the answer: read as misclicked, the other corners
+    fit a candidate more than :data:`WRONG_M` from the best about as well (within the tie
+    ratio, at :data:`MISCLICK_ODDS`).
+
+    Scenes with three or more listed corners only (two leave one: it fits anywhere). At a
+    dual carriageway's junction (two corners per side a median apart) a corner clicked where
+    the centre lines cross, or across a wide pavement, fits another reading of the junction
+    well, 40-60 m off: those answers had no warning (``benchmarks/absolute_slips.py --set
+    held-out``, stop 38's `corner_centreline` and `corner_far_pavement` rows)."""
+    if len(ev.corners) < 3 or len(result.candidates) < 2:
+        return
+    top = result.candidates[0]
+    if top.method != "corners":
+        return
+    w_top, _label = _misclick_weight(top)
+    floor = w_top + math.log(settings.tie_score_ratio)
+    for c in result.candidates[1:]:
+        if c.method != "corners":
+            continue
+        gap = float(np.linalg.norm(c.east_north - top.east_north))
+        if gap <= WRONG_M:
+            continue
+        w, label = _misclick_weight(c)
+        if label is None or w < floor:
+            continue
+        result.warnings.append(
+            f"{label}: the answer rests on it: read as misclicked (where the centre lines "
+            "cross, across a wide pavement, another junction's corner), the other corners fit "
+            f"candidate {c.rank}, {gap:.0f} m from the best, about as well; check it"
+        )
+        return
+
+
 def _warn_reversed_corners(result: LocateResult) -> None:
-    """Warn when the best candidate reads the visible corners counter-clockwise."""
+    """Warn when the best candidate reads the visible corners counter-clockwise, or when it
+    reads them clockwise but a counter-clockwise reading that fits better (its prior odds
+    left out: :func:`_counter_clockwise_candidates` keeps only those) stands elsewhere."""
     if not result.candidates:
         return
     top = result.candidates[0]
     ev = top.evidence
-    if ev is None or not is_reversed(top.corner_assignment, len(ev.map_corners)):
+    if ev is None:
         return
+    n_map = len(ev.map_corners)
+    if is_reversed(top.corner_assignment, n_map):
+        result.warnings.append(
+            "intersection.corners: the best candidate reads the listed corners "
+            "counter-clockwise (they fit the map better that way): the scene lists them "
+            "clockwise as seen on screen; check their order"
+        )
+        return
+    if top.method != "corners":
+        return
+    back = [
+        c
+        for c in result.candidates[1:]
+        if c.evidence is not None
+        and is_reversed(c.corner_assignment, len(c.evidence.map_corners))
+        and float(np.linalg.norm(c.east_north - top.east_north)) > WRONG_M
+    ]
+    if not back:
+        return
+    alt = back[0]
+    gap = float(np.linalg.norm(alt.east_north - top.east_north))
     result.warnings.append(
-        "intersection.corners: the best candidate reads the listed corners counter-clockwise "
-        "(they fit the map better that way): the scene lists them clockwise as seen on "
-        "screen; check their order"
+        "intersection.corners: the listed corners fit the map better read counter-clockwise "
+        f"(candidate {alt.rank}, {gap:.0f} m from the best); the best reads them clockwise, as "
+        "the scene lists them. Check their order (clockwise as seen on screen)"
     )
 
 
