@@ -50,8 +50,9 @@ _LIST_DOC = {
         "required": True,
         "description": (
             'A webcam list: JSON {"cameras": [{"id", "title", "lat", "lon", "radius_m", '
-            '"scene"}, ...]} or CSV with columns id,title,lat,lon,radius_m (the column '
-            "variants of camloc batch are accepted)"
+            '"scene"}, ...]}, a GeoJSON FeatureCollection of cameras (properties as columns, '
+            "a Point as the camera's point, scenes inline) or CSV with columns "
+            "id,title,lat,lon,radius_m (the column variants of camloc batch are accepted)"
         ),
         "content": {
             "application/json": {"schema": JobList.model_json_schema()},
