@@ -66,3 +66,27 @@ def test_a_second_run_on_the_same_output_is_refused(
     # the first run over, the output is free again
     again = run_batch(lst, out_gpkg=out, map_source=OSM, progress=False, workers=1)
     assert (again.computed, again.skipped) == (0, 2)
+
+
+def test_rows_cut_from_the_end_of_the_list_leave_the_output(tmp_path: Path) -> None:
+    """A rerun after the list's last row was deleted kept that camera in the GeoPackage,
+    and said "2 cameras (0 computed, 2 already done): 3 title_only"."""
+    lst = tmp_path / "cams.csv"
+    out = tmp_path / "cams.gpkg"
+    rows = ["c1,Eastern Ave & S Broadway", "c2,Fleet St & S Broadway", "c3,Thames St & S Broadway"]
+    lst.write_text("id,title\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    first = run_batch(lst, out_gpkg=out, map_source=OSM, progress=False, workers=1)
+    assert first.computed == 3
+    lst.write_text("id,title\n" + "\n".join(rows[:2]) + "\n", encoding="utf-8")
+    again = run_batch(lst, out_gpkg=out, map_source=OSM, progress=False, workers=1)
+    assert (again.total, again.computed, again.skipped) == (2, 0, 2)
+    assert sum(again.statuses.values()) == 2
+    assert (
+        "cams.csv: 1 camera(s) cams.camloc-batch.sqlite recorded are no longer in the list, "
+        "left out of the output: row 3 ('c3')"
+    ) in again.warnings
+    assert list(pyogrio.read_dataframe(out, layer="cameras")["id"]) == ["c1", "c2"]
+    # the list grows back: the row is computed again, not taken from the old journal
+    lst.write_text("id,title\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    grown = run_batch(lst, out_gpkg=out, map_source=OSM, progress=False, workers=1)
+    assert (grown.computed, grown.skipped) == (1, 2)

@@ -38,13 +38,13 @@ def _calls(tmp_path: Path, calls: list[tuple[str, str]]) -> list[httpx.Response]
 @pytest.mark.parametrize(
     ("method", "url", "allow"),
     [
-        ("OPTIONS", PAGE, "GET, POST"),
-        ("PUT", PAGE, "GET, POST"),
-        ("DELETE", PAGE, "GET, POST"),
+        ("OPTIONS", PAGE, "GET, HEAD, POST"),
+        ("PUT", PAGE, "GET, HEAD, POST"),
+        ("DELETE", PAGE, "GET, HEAD, POST"),
         ("DELETE", "/healthz", "GET, HEAD"),
-        ("OPTIONS", "/v1/verdicts", "GET"),
+        ("OPTIONS", "/v1/verdicts", "GET, HEAD"),
         ("GET", "/v1/locate", "POST"),
-        ("OPTIONS", "/v1/jobs/abc", "GET"),
+        ("OPTIONS", "/v1/jobs/abc", "GET, HEAD"),
     ],
 )
 def test_a_405_names_every_method_the_path_takes(
@@ -72,3 +72,21 @@ def test_redoc_draws_no_image_from_another_site(tmp_path: Path) -> None:
     assert len(js.content) > 500_000  # the whole bundle
     assert b"https://cdn.redoc.ly" not in js.content
     assert b'src:"/favicon.ico"' in js.content
+
+
+@pytest.mark.parametrize("url", ["/v1/verdicts", PAGE, "/docs", "/openapi.json", "/favicon.ico"])
+def test_head_answers_as_get_without_a_body(tmp_path: Path, url: str) -> None:
+    """``curl -I`` (link checkers, uptime probes) got a 405 from every page but /healthz."""
+    head, get = _calls(tmp_path, [("HEAD", url), ("GET", url)])
+    assert get.status_code == 200, get.text
+    assert head.status_code == 200
+    assert head.content == b""
+    assert head.headers["content-type"] == get.headers["content-type"]
+    assert head.headers["content-length"] == get.headers["content-length"]
+    assert "x-request-id" in head.headers
+
+
+def test_head_of_a_missing_job_is_its_404(tmp_path: Path) -> None:
+    (r,) = _calls(tmp_path, [("HEAD", "/v1/jobs/" + "0" * 32 + "/map")])
+    assert r.status_code == 404
+    assert r.content == b""

@@ -70,3 +70,19 @@ def test_summary_map_draws_a_file_given_twice_once(
     assert len(re.findall(r"L\.marker\(", page)) == 1
     assert "cam-1 (cam-1.geojson)" not in page
     assert "./cam-1.geojson is given twice (also as cam-1.geojson): shown once" in caplog.text
+
+
+@pytest.mark.parametrize("value", ["0", "-5"])
+def test_locate_max_candidates_below_one_names_the_option(
+    value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``camloc locate --max-candidates -5`` said "max_candidates: max_candidates must be at
+    least 1", after reading the map."""
+    from camloc_geo.cli import main
+
+    repo = Path(__file__).resolve().parents[1]
+    scene = repo / "sample_maps" / "sample_scene.json"
+    osm = repo / "sample_maps" / "baltimore.osm.pbf"
+    assert main(["locate", str(scene), "--osm", str(osm), "--max-candidates", value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"camloc locate: error: --max-candidates must be at least 1 (got {value})"]

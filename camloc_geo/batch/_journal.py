@@ -148,6 +148,31 @@ class Journal:
             raise
         return len(rows)
 
+    def drop_after(self, last_row: int, limit: int = 20) -> tuple[int, list[tuple[int, str]]]:
+        """Forget the cameras recorded past ``last_row`` (rows the list no longer has).
+
+        Returns
+        -------
+        tuple
+            How many were dropped, and the first ``limit`` of them as ``(row, id)``.
+        """
+        named = [
+            (int(r), str(i))
+            for r, i in self.db.execute(
+                "SELECT row, id FROM done WHERE row > ? ORDER BY row LIMIT ?", (last_row, limit)
+            )
+        ]
+        if not named:
+            return 0, []
+        self.db.execute("BEGIN IMMEDIATE")
+        try:
+            n = self.db.execute("DELETE FROM done WHERE row > ?", (last_row,)).rowcount
+            self.db.execute("COMMIT")
+        except BaseException:
+            self.db.execute("ROLLBACK")
+            raise
+        return int(n), named
+
     def duplicate_ids(self, limit: int = 20) -> dict[str, list[int]]:
         """Camera ids recorded on more than one row: ``{id: [row, ...]}``, at most ``limit`` ids.
 

@@ -356,10 +356,12 @@ class _Counted:
     def __init__(self, rows: Iterable[CameraRow]) -> None:
         self.rows = rows
         self.n = 0
+        self.last = 0  # the last row number handed out
 
     def __iter__(self) -> Iterator[CameraRow]:
         for row in self.rows:
             self.n += 1
+            self.last = max(self.last, row.row)
             yield row
 
 
@@ -602,8 +604,10 @@ def run_batch(
         first_pass = nxt is not None
         if not first_pass and progress:
             total = _count_rows(list_p)
+        last_row = 0  # the list's last row: the journal's rows past it left the list
         for row in read_camera_list(list_p) if first_pass else ():
             total += 1
+            last_row = max(last_row, row.row)
             while nxt is not None and nxt[0] < row.row:
                 nxt = next(recorded, None)
             if nxt is not None and nxt[0] == row.row:
@@ -641,8 +645,18 @@ def run_batch(
         )
         if not first_pass:
             total = counted.n
+        # rows cut from the end of the list: their cameras stayed in the GeoPackage, and the
+        # summary said "2 cameras ... 3 title_only" (session 39)
+        n_gone, gone = journal.drop_after(max(last_row, counted.last))
         dups = journal.duplicate_ids(limit=_MAX_DUPLICATE_IDS)
         warnings = _duplicate_warnings(dups, journal.n_duplicate_ids(), list_p.name)
+        if n_gone:
+            named = ", ".join(f"row {r} ({i!r})" for r, i in gone)
+            more = f" and {n_gone - len(gone)} more" if n_gone > len(gone) else ""
+            warnings.append(
+                f"{list_p.name}: {n_gone} camera(s) {journal.path.name} recorded are no longer "
+                f"in the list, left out of the output: {named}{more}"
+            )
         if n_changed:
             named = ", ".join(f"row {r} ({i!r})" for r, i in changed)
             more = f" and {n_changed - len(changed)} more" if n_changed > len(changed) else ""

@@ -440,7 +440,7 @@ def read_camera_csv(
         yield row_from_mapping(rec, n, base_dir=base_dir, list_problems=list_problems)
 
 
-def _feature_row(feat: Any, n: int, base: Path) -> CameraRow:
+def _feature_row(feat: Any, n: int, base: Path, *, scene_paths: bool = True) -> CameraRow:
     if not isinstance(feat, dict):
         return CameraRow(row=n, id=f"row-{n}", problems=("not a GeoJSON feature",))
     props = feat.get("properties") or {}
@@ -461,7 +461,9 @@ def _feature_row(feat: Any, n: int, base: Path) -> CameraRow:
         problems = (f"geometry {geom.get('type') if isinstance(geom, dict) else geom!r} ignored",)
     if not any(k.lower() in COLUMN_VARIANTS["title"] for k in props):
         problems = (*problems, "the feature has no title property")
-    return row_from_mapping(props, n, base_dir=base, point=point, list_problems=problems)
+    return row_from_mapping(
+        props, n, base_dir=base, point=point, list_problems=problems, scene_paths=scene_paths
+    )
 
 
 def _iter_json_features(fh: TextIO, name: str) -> Iterator[Any]:

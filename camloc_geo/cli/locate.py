@@ -120,6 +120,10 @@ def run(args: argparse.Namespace) -> int:
 
     if args.radius_m is not None:  # 30000000 loaded the extract, then "no streets"
         check_map_radius_m(args.radius_m, "--radius-m")
+    if args.max_candidates is not None and args.max_candidates < 1:
+        # before the locating, in the option's name (it came after the map was read, as
+        # "max_candidates: max_candidates must be at least 1")
+        raise InputError(f"--max-candidates must be at least 1 (got {args.max_candidates})")
     inputs = [args.scene, args.osm, args.verdicts]
     out_path = output_path(args.output, inputs=inputs)
     map_path = output_path(args.map, inputs=inputs, option="--map")

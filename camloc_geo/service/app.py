@@ -18,7 +18,7 @@ from camloc_geo.service.compute import Compute
 from camloc_geo.service.errors import ERROR_STATUS, install_error_handlers
 from camloc_geo.service.fastpath import SceneFastPath
 from camloc_geo.service.mapstore import MapStore
-from camloc_geo.service.middleware import RequestLimits, VerdictCors
+from camloc_geo.service.middleware import HeadAsGet, RequestLimits, VerdictCors
 from camloc_geo.service.models import ERROR_RESPONSES
 from camloc_geo.service.routers import ROUTERS
 from camloc_geo.service.routers.jobs import JobRunner
@@ -86,6 +86,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     install_docs(app)
     # (the last added is the outermost: a request's id and body limit come first)
     app.add_middleware(SceneFastPath, compute=compute, settings=settings, routes=FAST_ROUTES)
+    app.add_middleware(HeadAsGet)  # HEAD on every GET path (after the id and the limits)
     app.add_middleware(
         RequestLimits,
         max_bytes=settings.max_request_bytes,

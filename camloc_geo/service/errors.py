@@ -248,6 +248,8 @@ def allowed_methods(app: FastAPI, path: str) -> list[str]:
     for regex, route_methods in getattr(app.state, "route_methods", ()):
         if regex.match(path):
             methods |= set(route_methods)
+    if "GET" in methods:  # (HeadAsGet answers HEAD wherever GET is taken)
+        methods.add("HEAD")
     known = [m for m in _METHOD_ORDER if m in methods]
     return known + sorted(methods - set(known))
 

@@ -16,7 +16,39 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from camloc_geo.service.work import LimitError
 
-__all__ = ["RequestLimits", "VerdictCors"]
+__all__ = ["HeadAsGet", "RequestLimits", "VerdictCors"]
+
+
+class HeadAsGet:
+    """``HEAD`` answered as ``GET`` without its body, on every path that takes ``GET``.
+
+    FastAPI's routes take only the methods they name: ``curl -I``, link checkers and
+    uptime probes got a 405 from every page (``/v1/jobs/{id}/map``, ``/docs``,
+    ``/v1/verdicts``...) but ``/healthz``. The headers (``Content-Length`` included) are
+    the ``GET``'s, as HTTP asks.
+
+    Parameters
+    ----------
+    app
+        The wrapped ASGI app.
+    """
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or scope["method"] != "HEAD":
+            await self.app(scope, receive, send)
+            return
+
+        async def headers_only(message: Message) -> None:
+            if message["type"] == "http.response.body":
+                if not message.get("more_body", False):
+                    await send({"type": "http.response.body", "body": b""})
+                return
+            await send(message)
+
+        await self.app({**scope, "method": "GET"}, receive, headers_only)
 
 
 class VerdictCors:

@@ -505,7 +505,8 @@ class CornersAlgorithm(_CamlocAlgorithm):
         self.addParameter(
             _helped(
                 QgsProcessingParameterExtent("EXTENT", "Or in this extent (canvas)", optional=True),
-                "Used when POINT is empty; at most 10 km across",
+                "Used when POINT is empty; at most 10 km across. The extent of one point "
+                "(a layer of one feature) is that point with RADIUS_M",
             )
         )
         self.addParameter(
@@ -518,7 +519,7 @@ class CornersAlgorithm(_CamlocAlgorithm):
                     minValue=1.0,
                     optional=True,  # unset in a model: 150 m (see _option_bool)
                 ),
-                "Used with POINT; empty: 150 m",
+                "Used with POINT, or an extent of one point; empty: 150 m",
             )
         )
         self.addParameter(
@@ -544,8 +545,11 @@ class CornersAlgorithm(_CamlocAlgorithm):
             radius = self.parameterAsDouble(parameters, "RADIUS_M", context)
         elif parameters.get("EXTENT") not in (None, ""):
             ext = self.parameterAsExtent(parameters, "EXTENT", context, crs)
-            if ext.isEmpty():
-                raise QgsProcessingException("camloc: the extent is empty")
+            if ext.isNull():
+                raise QgsProcessingException(
+                    "camloc: the extent is empty (a layer without features, or none with a "
+                    "geometry): give a layer with features, an extent, or a point"
+                )
             pt = ext.center()
             da = QgsDistanceArea()
             da.setEllipsoid("WGS84")
@@ -553,6 +557,11 @@ class CornersAlgorithm(_CamlocAlgorithm):
                 QgsPointXY(ext.xMinimum(), ext.yMinimum()),
                 QgsPointXY(ext.xMaximum(), ext.yMaximum()),
             )
+            if ext.isEmpty():
+                # one point (a layer of one feature: the best candidate kept by a filter, a
+                # one-camera list) or points in a line: that point with RADIUS_M (it was
+                # refused, "the extent is empty"); a wider extent keeps its own size
+                radius = max(radius, self.parameterAsDouble(parameters, "RADIUS_M", context))
             if radius > 5000:
                 raise QgsProcessingException(
                     f"camloc: the extent is {2 * radius / 1000:.1f} km across; zoom in "

@@ -302,6 +302,56 @@ def test_corners_in_a_canvas_extent(provider, tmp_path):
     assert n_inter >= 2
 
 
+def test_corners_in_the_extent_of_one_point(provider, tmp_path):
+    """The extent of a layer of one point (the best candidate a filter kept, a one-camera
+    list; docs/qgis.md's model feeds locate's candidates to EXTENT) was refused, "the
+    extent is empty": it is that point with RADIUS_M (session 39)."""
+    import processing
+
+    one = tmp_path / "one.geojson"
+    one.write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "features": [
+                    {
+                        "type": "Feature",
+                        "geometry": {"type": "Point", "coordinates": [-76.5935, 39.2856]},
+                        "properties": {"rank": 1},
+                    }
+                ],
+            }
+        )
+    )
+    res = processing.run(
+        "camloc:corners",
+        {
+            "EXTENT": str(one),
+            "RADIUS_M": 60,
+            "OSM": str(SAMPLE_OSM),
+            "CORNERS": str(tmp_path / "corners.gpkg"),
+        },
+    )
+    layer = _layer(res["CORNERS"])
+    streets = [f["streets"] for f in layer.getFeatures() if f["kind"] == "intersection"]
+    assert "Eastern Avenue & South Broadway" in streets
+    for f in layer.getFeatures():
+        pt = f.geometry().asPoint()
+        assert metres_between(pt.y(), pt.x(), 39.2856, -76.5935) < 90  # within 60 m, + corners
+
+
+def test_corners_in_the_extent_of_no_feature_says_so(provider, tmp_path):
+    import processing
+
+    none = tmp_path / "none.geojson"
+    none.write_text(json.dumps({"type": "FeatureCollection", "features": []}))
+    with pytest.raises(QgsProcessingException, match="the extent is empty \\(a layer without"):
+        processing.run(
+            "camloc:corners",
+            {"EXTENT": str(none), "OSM": str(SAMPLE_OSM), "CORNERS": "TEMPORARY_OUTPUT"},
+        )
+
+
 def test_corners_needs_a_point_or_an_extent(provider):
     # (a test of its own: a layer kept alive by an exception's frames until QGIS exits
     # crashes the interpreter at exit)

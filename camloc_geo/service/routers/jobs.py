@@ -50,8 +50,9 @@ _LIST_DOC = {
         "required": True,
         "description": (
             'A webcam list: JSON {"cameras": [{"id", "title", "lat", "lon", "radius_m", '
-            '"scene"}, ...]} or CSV with columns id,title,lat,lon,radius_m (the column '
-            "variants of camloc batch are accepted)"
+            '"scene"}, ...]}, a GeoJSON FeatureCollection of cameras (properties as columns, '
+            "a Point as the camera's point, scenes inline) or CSV with columns "
+            "id,title,lat,lon,radius_m (the column variants of camloc batch are accepted)"
         ),
         "content": {
             "application/json": {"schema": JobList.model_json_schema()},
@@ -112,6 +113,27 @@ def csv_encoding_warning(raw: bytes) -> str | None:
     return None
 
 
+def _feature_records(data: dict[str, Any], max_cameras: int) -> list[Any]:
+    """The cameras of a GeoJSON list body (a QGIS or GDAL export, as ``camloc batch`` reads
+    it: properties as columns, a Point as the camera's point), at most ``max_cameras + 1``.
+    Scenes only inline (a ``scene`` object); a scene file path is the row's problem. It was
+    refused, 'the body must be {"cameras": [...]}' (session 39)."""
+    from pathlib import Path
+
+    from camloc_geo.cameras._list import _feature_row
+
+    feats = data.get("features")
+    if not isinstance(feats, list):
+        raise SceneError("a GeoJSON camera list needs a 'features' list", "features")
+    out = []
+    for n, feat in enumerate(feats[: max_cameras + 1], start=1):
+        props = feat.get("properties") if isinstance(feat, dict) else None
+        scene = props.get("scene") if isinstance(props, dict) else None
+        row = _feature_row(feat, n, Path("."), scene_paths=False)
+        out.append(_record(row, scene if isinstance(scene, dict) else None))
+    return out
+
+
 def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
     """The cameras of a list body, as the job store keeps them (at most ``max_cameras + 1``).
 
@@ -156,10 +178,16 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
                 "body",
             )
         return out
+    data = parse_json(raw)
+    if isinstance(data, dict) and data.get("type") == "FeatureCollection":
+        return _feature_records(data, max_cameras)
     try:
-        cameras = JobList.model_validate(parse_json(raw)).cameras
+        cameras = JobList.model_validate(data).cameras
     except ValidationError:
-        raise SceneError('the body must be {"cameras": [...]}', "cameras") from None
+        raise SceneError(
+            'the body must be {"cameras": [...]} or a GeoJSON FeatureCollection of cameras',
+            "cameras",
+        ) from None
     return [
         _record(row_from_mapping({k: v for k, v in c.items() if k != "scene"}, n), c.get("scene"))
         if isinstance(c, dict)
