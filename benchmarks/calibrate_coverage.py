@@ -465,10 +465,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--variance-groups",
         action=argparse.BooleanOptionalAction,
-        default=True,
+        default=CalibrationSettings().variance_groups,
         help="CalibrationSettings.variance_groups: the fit's covariance with one residual "
-        "variance factor per group of rows (segments, corner clicks, edge-end clicks; "
-        "default since stop 39; --no-variance-groups: one pooled factor, stop 38's)",
+        "variance factor per group of rows (segments, corner clicks, edge-end clicks; off "
+        "by default: one pooled factor)",
     )
     parser.add_argument(
         "--settings",
