@@ -39,9 +39,15 @@ covariance, the ground-corner, preset-shape, car-line, principal-point, size or 
 term, or the jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
 JSON).
 
+``--sets crowd`` runs only the named sets (comma-separated); ``--variance-groups`` turns on
+``CalibrationSettings.variance_groups`` (one residual variance factor per row group, off by
+default); ``--settings NAME=VALUE,...`` sets any other ``CalibrationSettings`` field (a
+diagnostic, e.g. ``discordant_line_t=0`` for stop 38's sigmas).
+
 Usage::
 
     python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--no-jackknife-leverage]
+    python benchmarks/calibrate_coverage.py --n 60 --sets crowd --settings discordant_line_t=0
 """
 
 from __future__ import annotations

@@ -20,6 +20,9 @@ Usage::
 
     python benchmarks/crowd_slips.py --n 40            # 40 scenes per slip
     python benchmarks/crowd_slips.py --n 20 --slips tyre_contact_all,swap_edges
+    python benchmarks/crowd_slips.py --n 40 --settings discordant_line_t=0   # stop 38's sigmas
+
+``--settings NAME=VALUE,...`` sets any ``CalibrationSettings`` field (a diagnostic).
 """
 
 from __future__ import annotations
