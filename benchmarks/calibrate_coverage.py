@@ -39,9 +39,15 @@ covariance, the ground-corner, preset-shape, car-line, principal-point, size or 
 term, or the jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
 JSON).
 
+``--sets crowd`` runs only the named sets (comma-separated); ``--variance-groups`` turns on
+``CalibrationSettings.variance_groups`` (one residual variance factor per row group, off by
+default); ``--settings NAME=VALUE,...`` sets any other ``CalibrationSettings`` field (a
+diagnostic, e.g. ``discordant_line_t=0`` for stop 38's sigmas).
+
 Usage::
 
     python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--no-jackknife-leverage]
+    python benchmarks/calibrate_coverage.py --n 60 --sets crowd --settings discordant_line_t=0
 """
 
 from __future__ import annotations
@@ -60,7 +66,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from relative import _has_lines, draw_scene
+from relative import _has_lines, draw_scene, parse_settings
 from scipy.spatial.transform import Rotation
 
 from camloc_geo import InputError
@@ -462,19 +468,48 @@ def main(argv: list[str] | None = None) -> int:
         "corner, preset shape, car lines, principal point, size, jackknife) and report the "
         "coverage per term (a diagnostic: wraps a private helper of calibrate)",
     )
+    parser.add_argument(
+        "--variance-groups",
+        action=argparse.BooleanOptionalAction,
+        default=CalibrationSettings().variance_groups,
+        help="CalibrationSettings.variance_groups: the fit's covariance with one residual "
+        "variance factor per group of rows (segments, corner clicks, edge-end clicks; off "
+        "by default: one pooled factor)",
+    )
+    parser.add_argument(
+        "--settings",
+        default="",
+        help="extra CalibrationSettings fields, NAME=VALUE[,NAME=VALUE] (a diagnostic: "
+        "e.g. jackknife_leverage_max_move=inf)",
+    )
+    parser.add_argument(
+        "--sets",
+        default=",".join(SETS),
+        help="comma-separated sets to run (default: all, %(default)s)",
+    )
     args = parser.parse_args(argv)
+    sets = [s.strip() for s in args.sets.split(",") if s.strip()]
+    unknown = sorted(set(sets) - set(SETS))
+    if unknown:
+        parser.error(f"unknown set(s) {', '.join(unknown)}; known: {', '.join(SETS)}")
     if args.terms:
         _record_terms()
     global SETTINGS
     SETTINGS = CalibrationSettings(
-        jackknife_leverage=args.jackknife_leverage, car_class_prior=args.class_prior
+        **{
+            "jackknife_leverage": args.jackknife_leverage,
+            "car_class_prior": args.class_prior,
+            "variance_groups": args.variance_groups,
+        }
+        | parse_settings(args.settings)
     )
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     by_set: dict[str, list[dict[str, Any]]] = {}
     refused: dict[str, int] = {}
-    for name, noise in SETS.items():
+    for name in sets:
+        noise = SETS[name]
         rng = np.random.default_rng(args.seed)
         rows: list[dict[str, Any]] = []
         refused[name] = 0
@@ -512,6 +547,8 @@ def main(argv: list[str] | None = None) -> int:
         "sigmas": "main fields (with the principal point's uncertainty)",
         "jackknife_leverage": args.jackknife_leverage,
         "car_class_prior": args.class_prior,
+        "variance_groups": args.variance_groups,
+        "settings": args.settings,
         "refused": refused,
         "summary": summary,
         "wall_time_s": round(time.perf_counter() - t0, 1),

@@ -20,6 +20,9 @@ Usage::
 
     python benchmarks/crowd_slips.py --n 40            # 40 scenes per slip
     python benchmarks/crowd_slips.py --n 20 --slips tyre_contact_all,swap_edges
+    python benchmarks/crowd_slips.py --n 40 --settings discordant_line_t=0   # stop 38's sigmas
+
+``--settings NAME=VALUE,...`` sets any ``CalibrationSettings`` field (a diagnostic).
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from relative import _has_lines, draw_scene
+from relative import _has_lines, draw_scene, parse_settings
 
 from camloc_geo import InputError
 from camloc_geo.objects import PRESETS
@@ -503,10 +506,17 @@ def main(argv: list[str] | None = None) -> int:
         help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
         "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
     )
+    parser.add_argument(
+        "--settings",
+        default="",
+        help="more CalibrationSettings fields, NAME=VALUE[,NAME=VALUE] (a diagnostic: e.g. "
+        "jackknife_leverage_max_move=inf)",
+    )
     args = parser.parse_args(argv)
     global SETTINGS
     SETTINGS = CalibrationSettings(
-        jackknife_leverage=args.jackknife_leverage, car_class_prior=args.class_prior
+        **{"jackknife_leverage": args.jackknife_leverage, "car_class_prior": args.class_prior}
+        | parse_settings(args.settings)
     )
     logging.basicConfig(level=logging.CRITICAL)
     logging.getLogger("camloc_geo").setLevel(logging.CRITICAL)
@@ -523,6 +533,7 @@ def main(argv: list[str] | None = None) -> int:
         "bars": BARS,
         "jackknife_leverage": args.jackknife_leverage,
         "car_class_prior": args.class_prior,
+        "settings": args.settings,
         "wall_time_s": round(time.perf_counter() - t0, 1),
         "slips": per_slip,
     }

@@ -93,6 +93,20 @@ def draw_scene(
     return syn, size, n_ann
 
 
+def parse_settings(text: str) -> dict[str, Any]:
+    """``NAME=VALUE[,NAME=VALUE]`` (a benchmark's ``--settings``): CalibrationSettings fields,
+    each value read as its default's type (``inf`` for a float; ``true``/``false``)."""
+    defaults = CalibrationSettings()
+    out: dict[str, Any] = {}
+    for item in filter(None, (t.strip() for t in text.split(","))):
+        name, _, value = item.partition("=")
+        if not hasattr(defaults, name):
+            raise SystemExit(f"--settings: CalibrationSettings has no field {name!r}")
+        kind = type(getattr(defaults, name))
+        out[name] = value.lower() in ("1", "true", "yes") if kind is bool else kind(value)
+    return out
+
+
 def _has_lines(scene: dict[str, Any]) -> bool:
     """At least one annotator drew two or more segments of every axis."""
     return any(

@@ -70,8 +70,11 @@ def test_two_references_sigma_carries_the_calibration(lacy_street) -> None:  # t
     # the calibration is far off, and says it is loose
     assert cal.camera.focal_px / ls.camera_enu.focal_px - 1.0 == pytest.approx(-0.62, abs=0.02)
     # (28 % as the linearised sigma; widened x3 since calibrate's profile finds a better fit
-    # at a longer focal length: the fit stopped in a local minimum)
-    assert cal.focal_sigma_px / cal.camera.focal_px == pytest.approx(0.85, abs=0.03)
+    # at a longer focal length: the fit stopped in a local minimum; 85 % until stop 39, now
+    # 181 %: one annotator's 91 px width line carries the answer and disagrees with the other
+    # lines, and the refit without it moves the focal length +160 %, onto the truth's +163 %)
+    assert cal.focal_sigma_px / cal.camera.focal_px == pytest.approx(1.81, abs=0.05)
+    assert any("carries the answer" in w for w in cal.warnings)
     res = locate(scene, m, calibration=cal)
     top = res.candidates[0]
     assert top.method == "two_references"
@@ -80,15 +83,20 @@ def test_two_references_sigma_carries_the_calibration(lacy_street) -> None:  # t
     # was 8.4 m: the truth lay 3.2 sigma away
     assert top.sigma_m is not None
     assert 2.0 * top.sigma_m >= err
-    assert top.sigma_m == pytest.approx(28.4, abs=2.0)
+    assert top.sigma_m == pytest.approx(23.9, abs=2.0)  # 28.4 m with the 85 % focal sigma
 
 
 def test_calibration_sigma_follows_the_focal_sigma(lacy_street) -> None:  # type: ignore[no-untyped-def]
     from camloc_geo.absolute import locate
     from camloc_geo.absolute._model import LocateSettings
     from camloc_geo.absolute._refine import calibration_covariance, calibration_sigmas_m
+    from camloc_geo.relative import CalibrationSettings, calibrate
+    from camloc_geo.scene import parse_scene
 
-    scene, m, cal, _ls = lacy_street
+    scene, m, _cal, ls = lacy_street
+    # The calibration before its discordant line widened it (85 %, not 181 %): the
+    # propagation's scaling is checked where a tenth of the sigma is within its linear reach.
+    cal = calibrate(parse_scene(ls.scene), CalibrationSettings(discordant_line_t=0.0))
     res = locate(scene, m, calibration=cal)
     top = res.candidates[0]
     ev = top.evidence
@@ -137,7 +145,7 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
     """Andorra's Av. Consell d'Europa x Av. Doctor Mitjavila: focal length 32 % short at a
     stated 17 %, the top candidate 21.5 m off; its sigma (7.0 m before, 9.5 m with the
     calibration's) still falls short of the truth, so only a warning keeps it from looking
-    sure. Lacy Street (85 %) is warned too; a Stretford camera with a tight calibration
+    sure. Lacy Street (181 %) is warned too; a Stretford camera with a tight calibration
     (8 %) is not."""
     from camloc_geo.absolute import locate
 
@@ -165,7 +173,7 @@ def test_loose_calibration_is_warned(lacy_street) -> None:  # type: ignore[no-un
 
     scene, m, cal, ls = lacy_street
     res = locate(scene, m, calibration=cal)
-    assert any("uncertain by 85 %" in w for w in res.warnings)
+    assert any("uncertain by 181 %" in w for w in res.warnings)
 
     scene, m, cal, ls = _two_reference_scene(*STRETFORD, (53.4461281, -2.3075311), 0)
     assert cal.focal_sigma_px / cal.camera.focal_px < 0.1
