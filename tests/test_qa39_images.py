@@ -48,3 +48,22 @@ def test_bytes_of_no_image_are_still_not_an_image() -> None:
         read_image(b"<osm version='0.6'></osm>")
     with pytest.raises(SceneError, match="not a readable JPEG, PNG or WebP image"):
         image_info(b"<osm version='0.6'></osm>", 40_000_000)
+
+
+def test_annotate_streets_without_a_map_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``camloc annotate cam.jpg --streets "A & B"`` without ``--osm`` wrote a page without
+    the junction and said nothing (the option was dropped)."""
+    from camloc_geo.cli import main
+
+    snap = tmp_path / "cam.jpg"
+    snap.write_bytes(_encoded("JPEG"))
+    out = tmp_path / "a.html"
+    assert main(["annotate", str(snap), "-o", str(out), "--streets", "Main St & 1st Ave"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "camloc annotate: error: --streets needs --osm EXTRACT (the junction is looked up in "
+        "the map)"
+    ]
+    assert not out.exists()

@@ -86,3 +86,24 @@ def test_locate_max_candidates_below_one_names_the_option(
     assert main(["locate", str(scene), "--osm", str(osm), "--max-candidates", value]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"camloc locate: error: --max-candidates must be at least 1 (got {value})"]
+
+
+def test_geocode_failing_writes_no_collection_to_stdout(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``camloc geocode TITLE --area nowhere`` exited 2 but printed a complete, empty
+    ``{"type": "FeatureCollection", "features": []}``: a pipe's reader took it for "no
+    match"."""
+    from camloc_geo.cli import main
+
+    osm = Path(__file__).resolve().parents[1] / "sample_maps" / "baltimore.osm.pbf"
+    args = ["geocode", "Eastern Ave & S Broadway", "--osm", str(osm), "--area", "nowhere"]
+    assert main(args) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert "area 'nowhere' is not a named place of the map" in captured.err
+    assert main(["geocode", "Eastern Ave & S Broadway", "--osm", str(osm)]) == 0
+    import json
+
+    (feature,) = json.loads(capsys.readouterr().out)["features"]
+    assert feature["properties"]["status"] == "junction"

@@ -92,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
 
     if (args.lat is None) != (args.lon is None):
         raise InputError("give --lat and --lon together")
+    if args.streets and not args.osm:  # it was dropped without a word: a page without them
+        raise InputError("--streets needs --osm EXTRACT (the junction is looked up in the map)")
     if args.osm:
         from camloc_geo.api import check_map_radius_m
 

@@ -259,20 +259,24 @@ def _feature_writer(out: Path | None) -> Iterator[Any]:
 
 @contextmanager
 def _features_to(fh: IO[str]) -> Iterator[Any]:
-    first = [True]
-    fh.write('{"type": "FeatureCollection", "features": [\n')
+    """A FeatureCollection streamed to ``fh``, closed only when the work succeeds.
+
+    On a failure (``--area`` naming no place, an unreadable extract) stdout held a complete,
+    empty ``{"type": "FeatureCollection", "features": []}`` beside exit 2, which a pipe's
+    reader took for "no match" (session 39): now nothing is written before the first feature,
+    and a collection cut by a failure stays unclosed, so no JSON reader takes it as whole.
+    """
+    started = [False]
+    head = '{"type": "FeatureCollection", "features": [\n'
 
     def write(feature: dict[str, Any]) -> None:
-        if not first[0]:
-            fh.write(",\n")
-        first[0] = False
+        fh.write(",\n" if started[0] else head)
+        started[0] = True
         fh.write(json.dumps(feature, allow_nan=False, ensure_ascii=False))
 
-    try:
-        yield write
-    finally:
-        fh.write("\n]}\n")
-        fh.flush()
+    yield write
+    fh.write("\n]}\n" if started[0] else head + "\n]}\n")
+    fh.flush()
 
 
 def _title_text(title: str, number: int) -> str:
