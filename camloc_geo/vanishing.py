@@ -197,7 +197,10 @@ def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:
     DegenerateGeometryError
         When the second singular value is below 1e-9 of the first (all lines one line).
     """
-    _u, s, vt = np.linalg.svd(weighted_lines)
+    # Only the right singular vectors are used: the reduced form keeps U at (n, 3) instead of
+    # (n, n), which grew with the square of the line count (23 GB for a 200-annotator scene).
+    # Two segments still need the full form, whose third row of vt is the null vector.
+    _u, s, vt = np.linalg.svd(weighted_lines, full_matrices=weighted_lines.shape[0] < 3)
     # s[1], not s[-2]: with two segments there are only two singular values.
     if s[1] < 1e-9 * max(s[0], 1e-300):
         raise DegenerateGeometryError(
