@@ -291,6 +291,25 @@ def json_text(raw: bytes) -> str:
         raise NotTextError(kind) from None
 
 
+def read_text_file(path: PathLike, *, what: str) -> str:
+    """The text of a small text input (CSV, GPX, JSON) the caller has checked, decoded as
+    :func:`json_text` decodes (UTF-8, a byte-order mark dropped, UTF-16 with its mark).
+
+    Raises
+    ------
+    InputError
+        Unreadable, or not text: the message names what the file is instead (``cams.gpkg: not
+        a GPS traces file (a GeoPackage or SQLite database)``), never the codec's words.
+    """
+    p = Path(path)
+    try:
+        return json_text(p.read_bytes())
+    except NotTextError as exc:
+        raise InputError(f"{p}: not a {what} ({exc})") from None
+    except OSError as exc:
+        raise InputError(f"cannot read {what} {p}: {exc.strerror or exc}") from None
+
+
 def read_json_file(path: PathLike, *, what: str = "JSON file") -> Any:
     """Parse a JSON file; every failure is an :class:`InputError` naming the file.
 

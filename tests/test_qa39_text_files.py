@@ -21,6 +21,7 @@ import pytest
 from PIL import Image
 
 from camloc_geo import SceneError
+from camloc_geo._errors import InputError
 from camloc_geo.scene import load_scene
 from camloc_geo.service import create_app
 from camloc_geo.service.settings import Settings
@@ -101,3 +102,36 @@ def test_a_geopackage_body_says_what_it_is(tmp_path: Path) -> None:
     assert err["message"] == (
         "body: the body is not valid JSON: it is a GeoPackage or SQLite database"
     )
+
+
+@pytest.mark.parametrize("reader", ["guide.read_gps", "guide.read_tracks", "radar.read_tracks"])
+def test_sensor_inputs_name_a_geopackage_not_the_codec(tmp_path: Path, reader: str) -> None:
+    """``camloc guide --gps cams.gpkg`` / ``--tracks`` and ``camloc radar --tracks cams.gpkg``
+    said "'utf-8' codec can't decode byte 0xd8 ...": they now name what the file is."""
+    import sqlite3
+
+    from camloc_geo.sensors import guide, radar
+
+    gpkg = tmp_path / "cams.gpkg"
+    con = sqlite3.connect(gpkg)
+    con.execute("create table t (x integer)")
+    con.commit()
+    con.close()
+    module, name = reader.split(".")
+    fn = getattr({"guide": guide, "radar": radar}[module], name)
+    with pytest.raises(InputError) as info:
+        fn(gpkg)
+    msg = str(info.value)
+    assert "a GeoPackage or SQLite database" in msg
+    assert "codec" not in msg
+
+
+def test_sensor_csv_with_byte_order_mark_still_reads(tmp_path: Path) -> None:
+    """The GPS CSV saved by Notepad (UTF-8 with a mark) reads as before."""
+    from camloc_geo.sensors.guide import read_gps
+
+    p = tmp_path / "gps.csv"
+    p.write_bytes(b"\xef\xbb\xbfid,time,lat,lon\na,0,52.5,13.4\na,1,52.50001,13.4\n")
+    traces = read_gps(p)
+    assert [t.id for t in traces] == ["a"]
+    assert len(traces[0].times_s) == 2

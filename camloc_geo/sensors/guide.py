@@ -60,6 +60,7 @@ import numpy as np
 import numpy.typing as npt
 
 from camloc_geo._errors import InputError
+from camloc_geo._io import read_text_file
 from camloc_geo.absolute._similarity import Similarity2D, rot2
 from camloc_geo.camera import Camera, rotation_from_angles
 from camloc_geo.geodesy import LocalFrame
@@ -328,10 +329,7 @@ def read_tracks(
     if isinstance(source, (str, Path)):
         path = Path(source)
         name = path.name
-        try:
-            text = path.read_text(encoding="utf-8-sig")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise InputError(f"cannot read tracks {path}: {exc}") from None
+        text = read_text_file(path, what="tracks file")
         if path.suffix.lower() == ".csv":
             rows = list(csv.DictReader(io.StringIO(text)))
             if not rows:
@@ -424,10 +422,7 @@ def read_gps(source: str | Path) -> list[GpsTrace]:
         )
     path = Path(source)
     name = path.name
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read GPS traces {path}: {exc}") from None
+    text = read_text_file(path, what="GPS traces file")
     if path.suffix.lower() == ".csv":
         per: dict[str, list[tuple[float, float, float]]] = {}
         reader = csv.DictReader(io.StringIO(text))

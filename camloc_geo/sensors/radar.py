@@ -88,6 +88,7 @@ import numpy as np
 import numpy.typing as npt
 
 from camloc_geo._errors import InputError
+from camloc_geo._io import read_text_file
 from camloc_geo._limits import (
     MAX_TRACK_BOXES,
     MAX_TRACKS_BYTES,
@@ -523,10 +524,7 @@ def read_tracks(path: str | os.PathLike[str]) -> TrackBoxes:
     size = p.stat().st_size
     if size > MAX_TRACKS_BYTES:
         raise InputError(f"tracks file {p} is {size} bytes; the limit is {MAX_TRACKS_BYTES}")
-    try:
-        text = p.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read tracks file {p}: {exc}") from None
+    text = read_text_file(p, what="tracks file")
     if p.suffix.lower() == ".json" or text.lstrip()[:1] in ("[", "{"):
         try:
             data = json.loads(text)
