@@ -14,6 +14,7 @@ hatchback had two measured tracks (20.4 and 20.5 km/h, frames 0-43 and 110-150).
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -25,8 +26,10 @@ from camloc_geo.relative import CalibrationResult
 from camloc_geo.sensors.radar import (
     RadarResult,
     VehicleSpeed,
+    _as_fragment,
     _fragment_of,
     _joined,
+    _off_motion,
     _Track,
     measure_speeds,
 )
@@ -137,6 +140,37 @@ def test_fragment_of_by_motion() -> None:
     dup = np.column_stack([speed * np.array(during) / fps, np.full(20, -3.0)])
     got = _fragment_of([earlier], vehicles, _records(during), _vehicle(during, dup, 21.0, 1.0), fps)
     assert got == (0, False)
+
+
+def test_fragment_before_the_vehicle() -> None:
+    # a short far fragment first (its own speed 20 % low, sigma 7 %), lost 1.5 s, then the
+    # vehicle's long track: the later track's motion, extrapolated back, finds it
+    fps, speed = 20.0, 15.6
+    early = list(range(80, 100))
+    xy_a = np.column_stack([speed * np.array(early) / fps, np.full(20, -3.0)])
+    frag = _vehicle(early, xy_a, 0.8 * speed * 3.6, 0.07 * 0.8 * speed * 3.6)
+    late = list(range(130, 175))
+    xy_b = np.column_stack([speed * np.array(late) / fps + 0.5, np.full(45, -3.2)])
+    main = _vehicle(late, xy_b, speed * 3.6, 0.6)
+    got = _fragment_of([(_records(early), 0)], [frag], _records(late), main, fps)
+    assert got == (0, True)
+    # the earlier one's own motion alone would not have reached it
+    assert _off_motion(frag, main, fps, forward=True) == math.inf
+    assert _off_motion(main, frag, fps, forward=False) < 1.0
+
+
+def test_fragment_is_reported_without_speed() -> None:
+    frames = list(range(10))
+    xy = np.column_stack([np.arange(10.0), np.zeros(10)])
+    whole = _vehicle(frames, xy, 20.0, 0.3)
+    piece = _as_fragment(_vehicle(frames, xy, 7.0, 3.0), whole)
+    assert not piece.measured
+    assert piece.status == "skipped"
+    assert math.isnan(piece.speed_kmh)
+    assert math.isnan(piece.sigma_kmh)
+    assert piece.reason is not None
+    assert piece.reason.startswith("a fragment of the vehicle")
+    assert piece.to_dict()["speed_kmh"] is None
 
 
 def test_joined_records() -> None:

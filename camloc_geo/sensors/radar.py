@@ -1863,27 +1863,24 @@ def _run(
             if link is not None:
                 k, joinable = link
                 earlier, index = closed[k]
-                first, last = vehicles[index].first_frame, vehicles[index].last_frame
+                v_earlier = vehicles[index]
                 if joinable:
                     both = _joined(earlier, piece)
                     v_both = fit(both)
-                    if v_both.measured and v_both.sigma_kmh <= vehicles[index].sigma_kmh:
+                    if v_both.measured and v_both.sigma_kmh <= min(
+                        v.sigma_kmh, v_earlier.sigma_kmh
+                    ):
                         vehicles[index] = v_both
                         closed[k] = (both, index)
                         continue
-                    # (a short, far fragment whose own pieces disagree can only widen the
-                    # vehicle's sigma: its measurement stays the earlier track's)
-                v = replace(
-                    v,
-                    status="skipped",
-                    speed_kmh=math.nan,
-                    sigma_kmh=math.nan,
-                    reason=(
-                        f"a fragment of the vehicle tracked over frames {first}-{last}: its "
-                        "ground contact moves with that vehicle's (measured there)"
-                    ),
-                    warning=None,
-                )
+                # not joined (the joined fit would be less sure than the better of the
+                # two: a short, far fragment whose own segments disagree; or one repeats
+                # the other's frames): the less sure of the two is the other's fragment
+                if v.sigma_kmh < v_earlier.sigma_kmh:
+                    vehicles[index] = _as_fragment(v_earlier, v)
+                    del closed[k]
+                else:
+                    v = _as_fragment(v, v_earlier)
             vehicles.append(v)
             closed.append((piece, len(vehicles) - 1))
 
@@ -2093,51 +2090,82 @@ def _fragment_of(
     fit: VehicleSpeed,
     fps: float,
 ) -> tuple[int, bool] | None:
-    """The earlier track (index into ``closed``) whose vehicle ``piece`` is a fragment of, and
-    whether the two can be joined into one track; None when it is no fragment.
+    """The earlier track (index into ``closed``) of the vehicle ``piece`` is a fragment of,
+    and whether the two can be joined into one track; None when it is no fragment.
 
-    ``piece`` is a fragment when its ground contacts (``fit.track_world_m``) lie where the
-    earlier vehicle's fitted motion (its speed and heading, from its last frames' offset)
-    puts it at the same times: within ``_LINK_ALONG_M`` along that motion plus twice the
-    extrapolation's sigma (its speed's sigma times the time since its last frame), and
-    ``_LINK_ACROSS_M`` across it (median over the piece's frames); ``piece`` must start
-    after the earlier track did and at most ``_LINK_MAX_GAP_S`` after it ended. The
-    nearest such track is taken. The two are joined when they share at most
-    ``_LINK_MAX_OVERLAP`` frames and the piece goes on for 3 frames past the earlier
-    track's end; otherwise the piece is a duplicate of a vehicle measured already.
+    Two tracks are one vehicle when one's ground contacts (``track_world_m``) lie where the
+    other's fitted motion (its speed and heading, anchored on the offset of its 10 frames
+    nearest the other track in time) puts that vehicle at the same times: within
+    ``_LINK_ALONG_M`` along the motion plus twice the extrapolation's sigma (that track's
+    speed sigma times the time from its anchor), and ``_LINK_ACROSS_M`` across it (medians
+    over the frames). Either track may carry the motion (the earlier forward, the later
+    backward): a short far fragment's own speed is poor, its partner's extrapolates well.
+    ``piece`` must start after the earlier track did and at most ``_LINK_MAX_GAP_S`` after
+    it ended. The nearest such track is taken. The two can be joined when they share at
+    most ``_LINK_MAX_OVERLAP`` frames and ``piece`` goes on for 3 frames past the earlier
+    track's end; otherwise one repeats frames of the other.
     """
     if not fit.track_world_m:
         return None
-    mine = np.array(fit.track_world_m, dtype=np.float64)
     best: tuple[float, int, bool] | None = None
     for k, (earlier, index) in enumerate(closed):
         v = vehicles[index]
         if not v.measured or not v.track_world_m or earlier.frames[0] >= piece.frames[0]:
             continue
-        gap_s = (piece.frames[0] - earlier.frames[-1]) / fps
-        if gap_s > _LINK_MAX_GAP_S:
+        if (piece.frames[0] - earlier.frames[-1]) / fps > _LINK_MAX_GAP_S:
             continue
-        theirs = np.array(v.track_world_m, dtype=np.float64)
-        speed = v.speed_kmh / 3.6
-        head = math.radians(v.heading_deg)
-        unit = np.array([math.sin(head), math.cos(head)])
-        vel = speed * unit
-        tail = theirs[-10:]
-        origin = np.median(tail[:, 1:] - np.outer(tail[:, 0] / fps, vel), axis=0)
-        res = mine[:, 1:] - (origin + np.outer(mine[:, 0] / fps, vel))
-        along = float(np.median(res @ unit))
-        across = float(np.median(res @ np.array([-unit[1], unit[0]])))
-        ahead_s = max(0.0, float(np.median(mine[:, 0]) - theirs[-1, 0]) / fps)
-        tol = _LINK_ALONG_M + 2.0 * (v.sigma_kmh / 3.6) * ahead_s
-        if abs(along) > tol or abs(across) > _LINK_ACROSS_M:
+        off = min(
+            _off_motion(v, fit, fps, forward=True),
+            _off_motion(fit, v, fps, forward=False),
+        )
+        if not math.isfinite(off):
             continue
         overlap = earlier.frames[-1] - piece.frames[0] + 1
         beyond = sum(1 for f in piece.frames if f > earlier.frames[-1])
         joinable = overlap <= _LINK_MAX_OVERLAP and beyond >= 3
-        dist = math.hypot(along, across)
-        if best is None or dist < best[0]:
-            best = (dist, k, joinable)
+        if best is None or off < best[0]:
+            best = (off, k, joinable)
     return None if best is None else (best[1], best[2])
+
+
+def _off_motion(mover: VehicleSpeed, other: VehicleSpeed, fps: float, *, forward: bool) -> float:
+    """How far (metres) ``other``'s ground contacts lie from ``mover``'s fitted motion at the
+    same times, or ``inf`` beyond the bounds of :func:`_fragment_of`.
+
+    ``forward``: ``mover`` is the earlier track, anchored on its last 10 frames; otherwise
+    the later one, anchored on its first 10.
+    """
+    theirs = np.array(mover.track_world_m, dtype=np.float64)
+    mine = np.array(other.track_world_m, dtype=np.float64)
+    head = math.radians(mover.heading_deg)
+    unit = np.array([math.sin(head), math.cos(head)])
+    vel = mover.speed_kmh / 3.6 * unit
+    anchor = theirs[-10:] if forward else theirs[:10]
+    origin = np.median(anchor[:, 1:] - np.outer(anchor[:, 0] / fps, vel), axis=0)
+    res = mine[:, 1:] - (origin + np.outer(mine[:, 0] / fps, vel))
+    along = float(np.median(res @ unit))
+    across = float(np.median(res @ np.array([-unit[1], unit[0]])))
+    span_s = abs(float(np.median(mine[:, 0]) - np.median(anchor[:, 0]))) / fps
+    tol = _LINK_ALONG_M + 2.0 * (mover.sigma_kmh / 3.6) * span_s
+    if abs(along) > tol or abs(across) > _LINK_ACROSS_M:
+        return math.inf
+    return math.hypot(along, across)
+
+
+def _as_fragment(v: VehicleSpeed, whole: VehicleSpeed) -> VehicleSpeed:
+    """``v`` reported as a fragment of the vehicle ``whole`` measured (skipped, no speed)."""
+    return replace(
+        v,
+        status="skipped",
+        speed_kmh=math.nan,
+        sigma_kmh=math.nan,
+        reason=(
+            f"a fragment of the vehicle tracked over frames {whole.first_frame}-"
+            f"{whole.last_frame}: its ground contact moves with that vehicle's (measured "
+            "there)"
+        ),
+        warning=None,
+    )
 
 
 def _joined(earlier: _Track, later: _Track) -> _Track:
