@@ -19,10 +19,11 @@ radar (see ``docs/radar.md``):
    track's predicted box are joined by that motion (:func:`_join_fragments`); a track is
    cut where its features' motion turns back (it came out of a merge on another vehicle).
    A vehicle whose track was lost (hidden behind another for longer than a track may
-   coast) and found again is joined by its motion too: a later track whose ground
-   contacts lie where an earlier track's fitted motion puts its vehicle is refitted with
-   it as one track, or, when it only repeats frames the earlier one measured, reported
-   skipped as its fragment (:func:`_fragment_of`).
+   coast) and found again is joined by its motion too: two tracks whose ground contacts
+   lie where the other's fitted motion puts its vehicle (within 4 s) are refitted as one
+   track, or, where that fit would be less sure than the better of the two (or one
+   repeats the other's frames), the less sure one is reported skipped as the other's
+   fragment (:func:`_fragment_of`).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
 2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
    silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
@@ -200,11 +201,12 @@ _UNCERTAIN_REL = 0.05  # sigma_kmh above this fraction of the speed: a warning (
 # Fragments of one vehicle in time (its track lost while it hid behind or merged with another
 # vehicle, a new track started where it came out; development seed 723's white hatchback,
 # 3 s hidden behind a van, gave a second track reading -67 %) are joined by their motion
-# (:func:`_fragment_of`): a later track whose ground contacts lie where an earlier track's
-# fitted motion puts that vehicle at the same times, within
+# (:func:`_fragment_of`): two tracks whose ground contacts lie where the other's fitted
+# motion (the earlier's carried forward or the later's carried back) puts that vehicle at
+# the same times, within
 _LINK_MAX_GAP_S = 4.0  # ... this long after the earlier track ended,
 _LINK_ALONG_M = 2.0  # ... this far along its motion (the contact on another corner), plus 2
-# sigma of the extrapolation (the earlier speed's sigma times the time since it ended),
+# sigma of the extrapolation (that track's speed sigma times the time from its anchor),
 _LINK_ACROSS_M = 1.2  # ... and this far across it (half a lane: not the next lane's car)
 _LINK_MAX_OVERLAP = 5  # frames both tracks hold: more, and the later one is a duplicate
 
