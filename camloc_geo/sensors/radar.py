@@ -18,6 +18,12 @@ radar (see ``docs/radar.md``):
    The pieces of one vehicle (a road-grey car falls apart under the threshold) inside its
    track's predicted box are joined by that motion (:func:`_join_fragments`); a track is
    cut where its features' motion turns back (it came out of a merge on another vehicle).
+   A vehicle whose track was lost (hidden behind another for longer than a track may
+   coast) and found again is joined by its motion too: two tracks whose ground contacts
+   lie where the other's fitted motion puts its vehicle (within 4 s) are refitted as one
+   track, or, where that fit would be less sure than the better of the two (or one
+   repeats the other's frames), the less sure one is reported skipped as the other's
+   fragment (:func:`_fragment_of`).
    With ``tracks`` (boxes per frame from any detector) the given boxes and ids are used.
 2. **Ground contact.** In each frame, the lowest corner of the vehicle's foreground
    silhouette, to sub-pixel: the bottom outline around its lowest point is fitted with two
@@ -39,7 +45,8 @@ radar (see ``docs/radar.md``):
    velocity over the track). Speed = |velocity| in km/h. Frames where a detection pixel
    at the contact covers more than 1 m of road are not used (far away the contact moves
    in steps of a pixel and stalls; a track left too short is skipped, "too far");
-   segments that fit one offset are merged (:func:`_merge_segments`), segments whose
+   segments that fit one offset, or whose offsets lie within 0.5 m (the contact wandering
+   on its corner, not another corner), are merged (:func:`_merge_segments`), segments whose
    contact stands still while the features move are left out (:func:`_still_segments`),
    and where segments' speeds disagree beyond their noise the standard error of their
    random-effects mean is model error (:func:`_segments_pooled`).
@@ -64,7 +71,9 @@ drawn as in :mod:`camloc_geo.sensors` (camera centre and focal length perturbed 
 calibration's sigmas; rotation fixed), and the spread of the speeds taken.
 
 Tracks shorter than ``min_track_s``, vehicles never wholly inside the frame, stationary
-blobs and contacts above the horizon are reported with ``status="skipped"`` and a reason.
+blobs, contacts above the horizon and fragments of a vehicle measured on another track
+(reason ``a fragment of the vehicle tracked over frames ...``) are reported with
+``status="skipped"`` and a reason: a skipped entry is never a vehicle with a speed.
 A measured speed whose ``sigma_kmh`` exceeds 5 % of it carries a ``warning`` naming the
 main cause (a track that held other vehicles, a piece of a vehicle, ...).
 """
@@ -180,9 +189,27 @@ _MIN_VEHICLE_HEIGHT_M = 1.5  # a silhouette lower than this above its contact is
 _PIECE_CONTACT_SIGMA_M = 0.6  # ... whose contact may be the body's top edge (0.9 m up)
 _MAX_GROUND_PER_PX_M = 1.0  # metres of road per detection pixel: farther frames not used
 _SEGMENT_MERGE_CHI2 = 9.2  # residuals' rise allowed to merge two segments (chi2, 2 dof, 99 %)
+# Two segments adjacent in time whose offsets lie closer than this on the road are one
+# contact wandering on its corner, not another corner (a car's other corners and its tyres'
+# contacts are 0.8 m or more away): with an offset each, the jumps forward between them are
+# thrown away while the slow creeps back within them stay, and the speed reads slow (a
+# receding SUV whose contact crept back 5 cm a frame and jumped 0.3 m forward every 5
+# frames near the camera read -5.7 %, development seed 721)
+_CONTACT_WANDER_M = 0.5
 _STILL_KLT_PX = 3.0  # pixels the features of a segment moved: enough to tell a still contact
 _STILL_RATIO = 0.3  # ... which moved less than this fraction of it along their motion
 _UNCERTAIN_REL = 0.05  # sigma_kmh above this fraction of the speed: a warning (2 sigma > 10 %)
+# Fragments of one vehicle in time (its track lost while it hid behind or merged with another
+# vehicle, a new track started where it came out; development seed 723's white hatchback,
+# 3 s hidden behind a van, gave a second track reading -67 %) are joined by their motion
+# (:func:`_fragment_of`): two tracks whose ground contacts lie where the other's fitted
+# motion (the earlier's carried forward or the later's carried back) puts that vehicle at
+# the same times, within
+_LINK_MAX_GAP_S = 4.0  # ... this long after the earlier track ended,
+_LINK_ALONG_M = 2.0  # ... this far along its motion (the contact on another corner), plus 2
+# sigma of the extrapolation (that track's speed sigma times the time from its anchor),
+_LINK_ACROSS_M = 1.2  # ... and this far across it (half a lane: not the next lane's car)
+_LINK_MAX_OVERLAP = 5  # frames both tracks hold: more, and the later one is a duplicate
 
 
 # --------------------------------------------------------------------------- results
@@ -1153,6 +1180,43 @@ def _merge_segments(
             break
         _rise, keep, gone = best
         labels = [keep if s == gone else s for s in labels]
+    return _merge_wander(times, labels, ground, prior)
+
+
+def _merge_wander(
+    times: FloatArray, labels: list[int], ground: FloatArray, prior: FloatArray
+) -> list[int]:
+    """Segment labels with adjacent segments whose offsets lie within ``_CONTACT_WANDER_M``
+    of each other on the road merged (the closest pair first, refitted after each merge).
+
+    A contact that wanders on its corner (the silhouette's lowest corner creeping back
+    along the rear edge, then snapping forward) is split at every snap, and with an offset
+    per segment only the creeps are left to measure the speed: it reads slow. A jump shorter
+    than the distance to any other corner of a vehicle is that wander, and the time across
+    it measures the speed too. (:func:`_merge_segments` merges by the fit's noise, which near
+    the camera is centimetres: a 0.3 m snap never passed it.)
+    """
+    labels = list(labels)
+    while len(set(labels)) > 1:
+        a = _design(times, labels)
+        if a.shape[0] <= a.shape[1]:
+            break
+        solve, _w, _res = _irls(a, ground, prior)
+        coef = solve @ ground
+        segs = sorted(set(labels))
+        first: dict[int, float] = {}
+        for s, t in zip(labels, times, strict=True):
+            first[s] = min(first.get(s, math.inf), float(t))
+        order = sorted(first, key=lambda s: first[s])
+        best: tuple[float, int, int] | None = None
+        for keep, gone in itertools.pairwise(order):
+            jump = float(np.linalg.norm(coef[1 + segs.index(keep)] - coef[1 + segs.index(gone)]))
+            if best is None or jump < best[0]:
+                best = (jump, keep, gone)
+        if best is None or best[0] >= _CONTACT_WANDER_M:
+            break
+        _jump, keep, gone = best
+        labels = [keep if s == gone else s for s in labels]
     return labels
 
 
@@ -1763,6 +1827,24 @@ def _run(
     noise = [0]
     last_given = {vid: max(per) for vid, per in given.items() if per} if given is not None else {}
 
+    # detected tracks finished lately, with their vehicles' index: a later track of the same
+    # vehicle (its fragment) is joined to them by its motion
+    closed: list[tuple[_Track, int]] = []
+
+    def fit(t: _Track) -> VehicleSpeed:
+        return _fit_track(
+            t,
+            calibration,
+            fps,
+            width,
+            height,
+            min_track_s,
+            n_samples,
+            seed,
+            scale,
+            given=given is not None,
+        )
+
     def finish(t: _Track) -> None:
         if t.absorbed:
             return  # a piece of a vehicle measured by its own track
@@ -1771,21 +1853,42 @@ def _run(
             return
         if not t.frames:
             return
-        for piece in _split_reversals(t) if given is None else [t]:
-            vehicles.append(
-                _fit_track(
-                    piece,
-                    calibration,
-                    fps,
-                    width,
-                    height,
-                    min_track_s,
-                    n_samples,
-                    seed,
-                    scale,
-                    given=given is not None,
-                )
-            )
+        if given is not None:
+            vehicles.append(fit(t))
+            return
+        for piece in _split_reversals(t):
+            piece.points = None
+            v = fit(piece)
+            link = _fragment_of(closed, vehicles, piece, v, fps) if v.measured else None
+            if link is not None:
+                k, joinable = link
+                earlier, index = closed[k]
+                v_earlier = vehicles[index]
+                if joinable:
+                    both = _joined(earlier, piece)
+                    v_both = fit(both)
+                    if v_both.measured and v_both.sigma_kmh <= min(
+                        v.sigma_kmh, v_earlier.sigma_kmh
+                    ):
+                        vehicles[index] = v_both
+                        closed[k] = (both, index)
+                        continue
+                # not joined (the joined fit would be less sure than the better of the
+                # two: a short, far fragment whose own segments disagree; or one repeats
+                # the other's frames): the less sure of the two is the other's fragment
+                if v.sigma_kmh < v_earlier.sigma_kmh:
+                    vehicles[index] = _as_fragment(v_earlier, v)
+                    del closed[k]
+                else:
+                    v = _as_fragment(v, v_earlier)
+            vehicles.append(v)
+            closed.append((piece, len(vehicles) - 1))
+
+    def prune(frame: int) -> None:
+        """Forget closed tracks no active or later track can be a fragment of."""
+        gap = round(_LINK_MAX_GAP_S * fps)
+        start = min([frame, *(t.frames[0] for t in active if t.frames)])
+        closed[:] = [(t, k) for t, k in closed if t.frames[-1] + gap >= start]
 
     by_id: dict[int, _Track] = {}
     next_id = 1
@@ -1905,6 +2008,8 @@ def _run(
                     still.append(t)
             if len(still) != len(active):
                 active = still
+                if given is None:
+                    prune(i)
                 if given is not None:
                     by_id = {t.vid: t for t in active}
             prev_grey = grey
@@ -1976,6 +2081,101 @@ def _identity_switches(t: _Track) -> list[int]:
                 cuts.append(i)
         last = (dx, dy)
     return cuts
+
+
+def _fragment_of(
+    closed: list[tuple[_Track, int]],
+    vehicles: list[VehicleSpeed],
+    piece: _Track,
+    fit: VehicleSpeed,
+    fps: float,
+) -> tuple[int, bool] | None:
+    """The earlier track (index into ``closed``) of the vehicle ``piece`` is a fragment of,
+    and whether the two can be joined into one track; None when it is no fragment.
+
+    Two tracks are one vehicle when one's ground contacts (``track_world_m``) lie where the
+    other's fitted motion (its speed and heading, anchored on the offset of its 10 frames
+    nearest the other track in time) puts that vehicle at the same times: within
+    ``_LINK_ALONG_M`` along the motion plus twice the extrapolation's sigma (that track's
+    speed sigma times the time from its anchor), and ``_LINK_ACROSS_M`` across it (medians
+    over the frames). Either track may carry the motion (the earlier forward, the later
+    backward): a short far fragment's own speed is poor, its partner's extrapolates well.
+    ``piece`` must start after the earlier track did and at most ``_LINK_MAX_GAP_S`` after
+    it ended. The nearest such track is taken. The two can be joined when they share at
+    most ``_LINK_MAX_OVERLAP`` frames and ``piece`` goes on for 3 frames past the earlier
+    track's end; otherwise one repeats frames of the other.
+    """
+    if not fit.track_world_m:
+        return None
+    best: tuple[float, int, bool] | None = None
+    for k, (earlier, index) in enumerate(closed):
+        v = vehicles[index]
+        if not v.measured or not v.track_world_m or earlier.frames[0] >= piece.frames[0]:
+            continue
+        if (piece.frames[0] - earlier.frames[-1]) / fps > _LINK_MAX_GAP_S:
+            continue
+        off = min(
+            _off_motion(v, fit, fps, forward=True),
+            _off_motion(fit, v, fps, forward=False),
+        )
+        if not math.isfinite(off):
+            continue
+        overlap = earlier.frames[-1] - piece.frames[0] + 1
+        beyond = sum(1 for f in piece.frames if f > earlier.frames[-1])
+        joinable = overlap <= _LINK_MAX_OVERLAP and beyond >= 3
+        if best is None or off < best[0]:
+            best = (off, k, joinable)
+    return None if best is None else (best[1], best[2])
+
+
+def _off_motion(mover: VehicleSpeed, other: VehicleSpeed, fps: float, *, forward: bool) -> float:
+    """How far (metres) ``other``'s ground contacts lie from ``mover``'s fitted motion at the
+    same times, or ``inf`` beyond the bounds of :func:`_fragment_of`.
+
+    ``forward``: ``mover`` is the earlier track, anchored on its last 10 frames; otherwise
+    the later one, anchored on its first 10.
+    """
+    theirs = np.array(mover.track_world_m, dtype=np.float64)
+    mine = np.array(other.track_world_m, dtype=np.float64)
+    head = math.radians(mover.heading_deg)
+    unit = np.array([math.sin(head), math.cos(head)])
+    vel = mover.speed_kmh / 3.6 * unit
+    anchor = theirs[-10:] if forward else theirs[:10]
+    origin = np.median(anchor[:, 1:] - np.outer(anchor[:, 0] / fps, vel), axis=0)
+    res = mine[:, 1:] - (origin + np.outer(mine[:, 0] / fps, vel))
+    along = float(np.median(res @ unit))
+    across = float(np.median(res @ np.array([-unit[1], unit[0]])))
+    span_s = abs(float(np.median(mine[:, 0]) - np.median(anchor[:, 0]))) / fps
+    tol = _LINK_ALONG_M + 2.0 * (mover.sigma_kmh / 3.6) * span_s
+    if abs(along) > tol or abs(across) > _LINK_ACROSS_M:
+        return math.inf
+    return math.hypot(along, across)
+
+
+def _as_fragment(v: VehicleSpeed, whole: VehicleSpeed) -> VehicleSpeed:
+    """``v`` reported as a fragment of the vehicle ``whole`` measured (skipped, no speed)."""
+    return replace(
+        v,
+        status="skipped",
+        speed_kmh=math.nan,
+        sigma_kmh=math.nan,
+        reason=(
+            f"a fragment of the vehicle tracked over frames {whole.first_frame}-"
+            f"{whole.last_frame}: its ground contact moves with that vehicle's (measured "
+            "there)"
+        ),
+        warning=None,
+    )
+
+
+def _joined(earlier: _Track, later: _Track) -> _Track:
+    """One track of a vehicle's two fragments: the earlier's records, then the later's past
+    the earlier's last frame (the fit gives each its own offset where the contact jumps)."""
+    keep = [k for k, f in enumerate(later.frames) if f > earlier.frames[-1]]
+    out = _Track(earlier.vid, later.boxes[-1])
+    for name in ("frames", "boxes", "contacts", "kinds", "klt", "border", "occluded"):
+        setattr(out, name, getattr(earlier, name) + [getattr(later, name)[k] for k in keep])
+    return out
 
 
 def _weak_threshold(level: Any) -> float:
