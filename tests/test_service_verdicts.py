@@ -253,6 +253,21 @@ needs_browser = pytest.mark.skipif(
 )
 
 
+def _click_for_popup(marker: Any, popup: Any) -> None:
+    """Click a marker for its popup; once more if that popup did not come within 3 s.
+
+    Under a loaded machine (7 sessions on 2 CPUs) the click on rank 1 while rank 2's popup
+    was open once opened nothing in 30 s (as test_browser_maps' click_for_popup says of
+    freshly loaded pages). What the popup does is asserted as before.
+    """
+    marker.click()
+    try:
+        popup.wait_for(timeout=3000)
+    except Exception:  # playwright's TimeoutError
+        if popup.count() == 0:
+            marker.click()
+
+
 class _Reviewer:
     """One reviewer's browser (own storage) on a page served at the service's origin; any
     request to another origin is aborted and recorded."""
@@ -854,8 +869,8 @@ def test_served_page_asks_for_the_key_once_and_says_a_refusal(
         assert not keybox.is_visible()
         assert client.get(url).json()["items"]["2"]["verdict"] == "yes"
         # the next change goes at once, with the key kept for the session
-        page.locator('.camloc-candidate [data-rank="1"]').click()
         box1 = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="1"]')
+        _click_for_popup(page.locator('.camloc-candidate [data-rank="1"]'), box1)
         box1.locator('button[data-verdict="no"]').wait_for(timeout=30000)
         box1.locator('button[data-verdict="no"]').click()
         page.wait_for_function(
