@@ -2349,7 +2349,9 @@ def detect_vanishing_points(
         wires = _sky_wires(segs_detected, thin, labels_det, kv, (float(w), float(h)), merge_wire)
         wire_dirs = _wire_directions(segs_detected, labels_det, wires, merge_wire)
         if wire_dirs:
-            drop = drop | wires
+            # the wires, and the thin lines of the directions that lean on them (the
+            # wires' pieces in front of facades, nowhere in the sky)
+            drop = drop | wires | (thin & np.isin(labels_det, wire_dirs))
     curve_only = False
     if curve_dirs or wire_dirs:
         # A direction of the frame leans on chords of curves (a rotunda's rings, a dome:

@@ -81,20 +81,23 @@ def test_wire_directions_need_enough_wire_lines_and_share() -> None:
     assert autovp._wire_directions(segs, labels, wires, 4.0) == [1]
 
 
-@pytest.mark.parametrize(("seed", "wrong_rel"), [(1, 0.15), (2, 0.15)])
+@pytest.mark.parametrize("seed", [1, 2, 8])
 def test_wires_over_a_street_photo_do_not_pose_as_a_direction(
-    seed: int, wrong_rel: float, monkeypatch: pytest.MonkeyPatch
+    seed: int, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    # seed 8: two of the wires cross facades only (nowhere in the sky); read again without
+    # the sky's wires alone, they made a direction with car edges (+62 % at a stated 9 %,
+    # no warning): the thin lines of a direction that leans on wires go too
     photo = spr.render_street_photo(seed)
     img = spr.with_overhead_wires(photo)
     res = autovp.detect_vanishing_points(img)
     err = res.focal_px / photo.focal_px - 1.0
     assert abs(err) < 0.05, err
-    assert res.focal_std_rel < 0.08
+    assert abs(err) < 2.0 * res.focal_std_rel
     # without the wires' check the wires make a direction of the frame: far off
     monkeypatch.setattr(autovp, "_WIRE_MIN_LINES", 10**6)
     res_without = autovp.detect_vanishing_points(img)
-    assert abs(res_without.focal_px / photo.focal_px - 1.0) > wrong_rel
+    assert abs(res_without.focal_px / photo.focal_px - 1.0) > 0.15
 
 
 def test_a_street_photo_without_wires_is_not_read_again(monkeypatch: pytest.MonkeyPatch) -> None:
