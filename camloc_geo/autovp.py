@@ -638,6 +638,7 @@ _WIRE_SKYLINE_MARGIN = 0.05
 _WIRE_POINTS = 8
 _WIRE_SKY_SHARE = 0.75
 _WIRE_CLEARANCE = 0.03
+_WIRE_STEP_MARGIN = 0.015
 #: A horizontal direction with at least this many wires among its segments, making at
 #: least this share of them, leans on wires (:func:`_wire_directions`).
 _WIRE_MIN_LINES = 3
@@ -716,8 +717,9 @@ def _sky_wires(
     At :data:`_WIRE_POINTS` places along a segment, the skyline is the topmost end of the
     vertical direction's inliers within :data:`_WIRE_SKYLINE_MARGIN` of the image width;
     the segment is a wire where at least :data:`_WIRE_SKY_SHARE` of the places lie above
-    it by :data:`_WIRE_CLEARANCE` of the image height or more (a place with no vertical
-    line near it is not counted as sky). Shortcut: "above" is
+    it by :data:`_WIRE_CLEARANCE` of the image height or more and no edge but thin or
+    vertical lines lies above it within that margin (a place with no vertical line near it
+    is not counted as sky). Shortcut: "above" is
     along the image's y axis (handheld roll is a few degrees); without a vertical line
     nothing is a wire.
     """
@@ -730,13 +732,23 @@ def _sky_wires(
     vtop = np.minimum(vert[:, 1], vert[:, 3])
     margin = _WIRE_SKYLINE_MARGIN * width_px
     clear_px = _WIRE_CLEARANCE * height_px
+    step_margin = _WIRE_STEP_MARGIN * width_px
     t = np.linspace(0.0, 1.0, _WIRE_POINTS)
+    # points of the edges that are neither thin lines nor vertical (steps: a roof line, a
+    # lamp, a cornice; the vertical ones are the skyline's)
+    steps = segs_px[~thin & (labels != kv)]
+    step_x = (steps[:, None, 0] + t[None, :] * (steps[:, None, 2] - steps[:, None, 0])).ravel()
+    step_y = (steps[:, None, 1] + t[None, :] * (steps[:, None, 3] - steps[:, None, 1])).ravel()
     for i in np.flatnonzero(thin & (labels != kv)):
         x0, y0, x1, y1 = segs_px[i]
         xs, ys = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
         near = np.abs(vx[None, :] - xs[:, None]) <= margin  # (points, verticals)
         top = np.where(near, vtop[None, :], np.inf).min(axis=1)
-        sky = np.isfinite(top) & (ys < top - clear_px)
+        # nothing but thin lines above it: the sky (a ceiling has its lamps, a facade its
+        # top)
+        near_step = np.abs(step_x[None, :] - xs[:, None]) <= step_margin
+        open_above = ~np.any(near_step & (step_y[None, :] < ys[:, None]), axis=1)
+        sky = np.isfinite(top) & (ys < top - clear_px) & open_above
         out[i] = np.count_nonzero(sky) >= _WIRE_SKY_SHARE * len(t)
     if np.any(out):
         cand = np.flatnonzero(thin & (labels != kv))

@@ -69,6 +69,27 @@ def test_a_wire_runs_above_the_skyline_and_a_facade_line_below_it() -> None:
     assert not wires[len(vert)]
 
 
+def test_a_thin_line_under_a_step_edge_is_not_a_wire() -> None:
+    # a ceiling's joint above the walls' verticals, under a lamp's edge (a step, not thin):
+    # not the sky
+    vert = np.array([[x, 100.0, x, 300.0] for x in range(0, 401, 50)], float)
+    segs = np.vstack(
+        [
+            vert,
+            [[0.0, 40.0, 400.0, 60.0]],  # the joint
+            [[0.0, 10.0, 400.0, 30.0]],  # the lamp's edge above it
+        ]
+    )
+    labels = np.r_[np.zeros(len(vert), int), 1, 1]
+    thin = np.r_[np.zeros(len(vert), bool), True, False]
+    wires = autovp._sky_wires(segs, thin, labels, 0, (800.0, 400.0), merge_px=8.0)
+    assert not np.any(wires)
+    # with a thin line above it instead (another wire), both are wires
+    thin[-1] = True
+    wires = autovp._sky_wires(segs, thin, labels, 0, (800.0, 400.0), merge_px=8.0)
+    assert wires[len(vert) :].tolist() == [True, True]
+
+
 def test_wire_directions_need_enough_wire_lines_and_share() -> None:
     segs = np.array([[0.0, 10.0 * i, 300.0, 10.0 * i + 5.0] for i in range(9)], float)
     labels = np.ones(9, dtype=np.int64)

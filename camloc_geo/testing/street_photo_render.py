@@ -39,7 +39,9 @@ half a pixel right and low, fills ~0.7 px larger on every side, lines 0.2-0.5 px
 Shortcuts (name them where the figures are quoted): painter's algorithm by distance (no
 depth buffer; a car or tree is drawn whole over what lies behind it), no perspective
 texture on the surfaces (flat colours with per-pixel noise), tree crowns are drawn as
-image-space ellipses, no sky clutter (wires, lamps, signs), no people.
+image-space ellipses, no sky clutter (wires, lamps, signs), no people. Overhead wires can be
+drawn over a photo afterwards (:func:`with_overhead_wires`, for tests and the wired benchmark
+run).
 """
 
 from __future__ import annotations
