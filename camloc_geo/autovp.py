@@ -1875,8 +1875,9 @@ class AutoVPResult:
         ``a, b, c`` of the horizon ``a x + b y + c = 0`` with ``a^2 + b^2 = 1``.
     segments, labels
         ``(N, 4)`` detected segments and the index (0..2) of the VP each supports, -1
-        for outliers. Where a direction leaned on chords of curves and the photo was read
-        again without them (:func:`_curve_directions`), the chords are not among them.
+        for outliers. Where a direction leaned on chords of curves or on overhead wires
+        and the photo was read again without them (:func:`_curve_directions`,
+        :func:`_wire_directions`), those segments are not among them.
     confidence
         0..1: roughly the probability that the focal length is within 10 % (when it is
         estimated): that of the stated Gaussian ``focal_std_rel``, times the chance that
