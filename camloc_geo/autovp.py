@@ -618,6 +618,164 @@ def _curve_pieces(segs: FloatArray, noise_px: float, gap_px: float) -> npt.NDArr
     return out
 
 
+#: Overhead wires (:func:`_sky_wires`): a thin line is a dark ridge of the grey levels at
+#: most about ``2 * _WIRE_CORE_PX`` wide (pixels of the detection image), its two sides
+#: (sampled :data:`_WIRE_SIDE_PX` away) alike: it is darker than their mean by more than
+#: :data:`_WIRE_CONTRAST` grey levels and by more than :data:`_WIRE_SIDE_RATIO` times
+#: their difference, on at least :data:`_WIRE_SAMPLE_SHARE` of
+#: :data:`_WIRE_SAMPLES` places along it.
+_WIRE_CORE_PX = 2.0
+_WIRE_SIDE_PX = (3.5, 5.5)
+_WIRE_CONTRAST = 8.0
+_WIRE_SIDE_RATIO = 1.5
+_WIRE_SAMPLE_SHARE = 0.6
+_WIRE_SAMPLES = 24
+#: The skyline at a place is the top of the vertical direction's inliers within this share
+#: of the image width; a wire runs above it, by this share of the image height or more
+#: (a line at the foot of a short post is not in the sky), at this many places along it,
+#: this share of them (:func:`_sky_wires`).
+_WIRE_SKYLINE_MARGIN = 0.05
+_WIRE_POINTS = 8
+_WIRE_SKY_SHARE = 0.75
+_WIRE_CLEARANCE = 0.03
+_WIRE_STEP_MARGIN = 0.015
+#: A horizontal direction with at least this many wires among its segments, making at
+#: least this share of them, leans on wires (:func:`_wire_directions`).
+_WIRE_MIN_LINES = 3
+_WIRE_SHARE = 1.0 / 3.0
+
+
+def _thin_lines(gray: npt.NDArray[np.uint8], segs_px: FloatArray) -> npt.NDArray[np.bool_]:
+    """Which segments are thin dark lines: a dark ridge of the grey levels with like sides.
+
+    A wire or a cable against the sky is a dark line a few pixels wide with sky on both
+    sides; a building's edge is a step (its sides differ). Sampled across each segment at
+    :data:`_WIRE_SAMPLES` places along it (see :data:`_WIRE_CORE_PX`).
+
+    Parameters
+    ----------
+    gray
+        The photo, grey levels, full size.
+    segs_px
+        ``(N, 4)`` segments in the photo's pixels (continuous convention).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` booleans.
+    """
+    import cv2
+
+    n = len(segs_px)
+    if n == 0:
+        return np.zeros(0, dtype=bool)
+    h, w = gray.shape
+    px_per_det = max(1.0, max(h, w) / 1024.0)  # detect_segments works at most 1024 px wide
+    t = np.linspace(0.1, 0.9, _WIRE_SAMPLES)
+    side = np.linspace(_WIRE_SIDE_PX[0], _WIRE_SIDE_PX[1], 3)
+    core = np.linspace(-_WIRE_CORE_PX, _WIRE_CORE_PX, 5)
+    offs_px = np.r_[-side[::-1], core, side] * px_per_det
+    d = segs_px[:, 2:4] - segs_px[:, 0:2]
+    u = d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)[:, None]
+    nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    mid = segs_px[:, None, 0:2] + t[None, :, None] * d[:, None, :]  # (N, T, 2)
+    # continuous pixel coordinates -> OpenCV's (pixel centres at integers)
+    map_x = mid[:, :, None, 0] + offs_px[None, None, :] * nrm[:, None, None, 0] - 0.5
+    map_y = mid[:, :, None, 1] + offs_px[None, None, :] * nrm[:, None, None, 1] - 0.5
+    v = cv2.remap(
+        np.ascontiguousarray(gray, dtype=np.float32),
+        map_x.reshape(n, -1).astype(np.float32),
+        map_y.reshape(n, -1).astype(np.float32),
+        cv2.INTER_LINEAR,
+        borderMode=cv2.BORDER_REPLICATE,
+    ).reshape(n, len(t), len(offs_px))
+    side_a = v[:, :, 0:3].mean(axis=2)
+    side_b = v[:, :, 8:11].mean(axis=2)
+    centre = v[:, :, 3:8]
+    mean_side = 0.5 * (side_a + side_b)
+    ridge = mean_side - centre.min(axis=2)  # dark on its sides
+    ok = (ridge > _WIRE_CONTRAST) & (ridge > _WIRE_SIDE_RATIO * np.abs(side_a - side_b))
+    return np.asarray(np.mean(ok, axis=1) >= _WIRE_SAMPLE_SHARE)
+
+
+def _sky_wires(
+    segs_px: FloatArray,
+    thin: npt.NDArray[np.bool_],
+    labels: npt.NDArray[np.int64],
+    kv: int,
+    image_size: tuple[float, float],
+    merge_px: float,
+) -> npt.NDArray[np.bool_]:
+    """Which segments are overhead wires: thin lines (:func:`_thin_lines`) not labelled
+    vertical that run above the skyline, the top of the vertical lines below them, and the
+    thin lines on the same image line (:func:`_line_groups`: the wire's pieces in front of
+    a facade).
+
+    Wires and cables hang over streets; they are nearly straight, nearly horizontal and
+    long, so a line detector finds them and a vanishing-point fit may take them for a
+    principal direction of the street (the catenary's sag also poses as lens distortion).
+    At :data:`_WIRE_POINTS` places along a segment, the skyline is the topmost end of the
+    vertical direction's inliers within :data:`_WIRE_SKYLINE_MARGIN` of the image width;
+    the segment is a wire where at least :data:`_WIRE_SKY_SHARE` of the places lie above
+    it by :data:`_WIRE_CLEARANCE` of the image height or more and no edge but thin or
+    vertical lines lies above it within that margin (a place with no vertical line near it
+    is not counted as sky). Shortcut: "above" is
+    along the image's y axis (handheld roll is a few degrees); without a vertical line
+    nothing is a wire.
+    """
+    width_px, height_px = image_size
+    out = np.zeros(len(segs_px), dtype=bool)
+    vert = segs_px[labels == kv]
+    if len(vert) == 0:
+        return out
+    vx = 0.5 * (vert[:, 0] + vert[:, 2])
+    vtop = np.minimum(vert[:, 1], vert[:, 3])
+    margin = _WIRE_SKYLINE_MARGIN * width_px
+    clear_px = _WIRE_CLEARANCE * height_px
+    step_margin = _WIRE_STEP_MARGIN * width_px
+    t = np.linspace(0.0, 1.0, _WIRE_POINTS)
+    # points of the edges that are neither thin lines nor vertical (steps: a roof line, a
+    # lamp, a cornice; the vertical ones are the skyline's)
+    steps = segs_px[~thin & (labels != kv)]
+    step_x = (steps[:, None, 0] + t[None, :] * (steps[:, None, 2] - steps[:, None, 0])).ravel()
+    step_y = (steps[:, None, 1] + t[None, :] * (steps[:, None, 3] - steps[:, None, 1])).ravel()
+    for i in np.flatnonzero(thin & (labels != kv)):
+        x0, y0, x1, y1 = segs_px[i]
+        xs, ys = x0 + t * (x1 - x0), y0 + t * (y1 - y0)
+        near = np.abs(vx[None, :] - xs[:, None]) <= margin  # (points, verticals)
+        top = np.where(near, vtop[None, :], np.inf).min(axis=1)
+        # nothing but thin lines above it: the sky (a ceiling has its lamps, a facade its
+        # top)
+        near_step = np.abs(step_x[None, :] - xs[:, None]) <= step_margin
+        open_above = ~np.any(near_step & (step_y[None, :] < ys[:, None]), axis=1)
+        sky = np.isfinite(top) & (ys < top - clear_px) & open_above
+        out[i] = np.count_nonzero(sky) >= _WIRE_SKY_SHARE * len(t)
+    if np.any(out):
+        cand = np.flatnonzero(thin & (labels != kv))
+        groups = _line_groups(segs_px[cand], merge_px)
+        out[cand] = np.isin(groups, groups[out[cand]])
+    return out
+
+
+def _wire_directions(
+    segs_px: FloatArray,
+    labels: npt.NDArray[np.int64],
+    wires: npt.NDArray[np.bool_],
+    merge_px: float,
+) -> list[int]:
+    """The directions that lean on overhead wires (:func:`_sky_wires`): at least
+    :data:`_WIRE_MIN_LINES` distinct lines (:func:`_n_distinct_lines`) of their segments
+    are wires, making at least :data:`_WIRE_SHARE` of their segments."""
+    out = []
+    for k in range(3):
+        sel = labels == k
+        n_wire = int(np.count_nonzero(wires & sel))
+        n_wire_lines = _n_distinct_lines(segs_px[wires & sel], merge_px) if n_wire else 0
+        if n_wire_lines >= _WIRE_MIN_LINES and n_wire >= _WIRE_SHARE * np.count_nonzero(sel):
+            out.append(k)
+    return out
+
+
 def _curve_directions(labels: npt.NDArray[np.int64], chords: npt.NDArray[np.bool_]) -> list[int]:
     """The directions (0..2) that lean on chords of curves: at least
     :data:`_CURVE_MIN_CHORDS` of their segments, and :data:`_CURVE_CHORD_SHARE` of them, are
@@ -1717,8 +1875,9 @@ class AutoVPResult:
         ``a, b, c`` of the horizon ``a x + b y + c = 0`` with ``a^2 + b^2 = 1``.
     segments, labels
         ``(N, 4)`` detected segments and the index (0..2) of the VP each supports, -1
-        for outliers. Where a direction leaned on chords of curves and the photo was read
-        again without them (:func:`_curve_directions`), the chords are not among them.
+        for outliers. Where a direction leaned on chords of curves or on overhead wires
+        and the photo was read again without them (:func:`_curve_directions`,
+        :func:`_wire_directions`), those segments are not among them.
     confidence
         0..1: roughly the probability that the focal length is within 10 % (when it is
         estimated): that of the stated Gaussian ``focal_std_rel``, times the chance that
@@ -2191,12 +2350,31 @@ def detect_vanishing_points(
     n_axes = len(segs_px) - len(segs_detected)  # annotated axes, first
     chords = np.r_[np.zeros(n_axes, dtype=bool), curve]
     curve_dirs = _curve_directions(best.labels, chords) if _CURVE_MODE == "refit" else []
+    wire_dirs: list[int] = []
+    drop = curve if curve_dirs else np.zeros(len(segs_detected), dtype=bool)
+    if gray is not None and segments is None and len(segs_detected):
+        # Overhead wires against the sky (_sky_wires): where a direction of the frame
+        # leans on them, they go too.
+        labels_det = best.labels[n_axes:]
+        kv = int(np.argmax(np.abs(best.R[1])))  # the direction nearest the image's vertical
+        merge_wire = max(4.0, 0.01 * diag)
+        thin = _thin_lines(gray, segs_detected)
+        wires = _sky_wires(segs_detected, thin, labels_det, kv, (float(w), float(h)), merge_wire)
+        wire_dirs = _wire_directions(segs_detected, labels_det, wires, merge_wire)
+        if wire_dirs:
+            # the wires, and the thin lines of the directions that lean on them (the
+            # wires' pieces in front of facades, nowhere in the sky)
+            drop = drop | wires | (thin & np.isin(labels_det, wire_dirs))
     curve_only = False
-    if curve_dirs:
+    if curve_dirs or wire_dirs:
         # A direction of the frame leans on chords of curves (a rotunda's rings, a dome:
-        # _curve_pieces): they are not lines of the scene. The photo is read again
-        # without them (once: given segments are not looked at for curves).
-        log.debug("%d segments are chords of curves: read again without them", int(curve.sum()))
+        # _curve_pieces) or on overhead wires: they are not lines of the scene. The photo
+        # is read again without them (once: given segments are not looked at again).
+        log.debug(
+            "%d segments are chords of curves, %d overhead wires: read again without them",
+            int(np.count_nonzero(curve & drop)),
+            int(np.count_nonzero(drop & ~curve)),
+        )
         try:
             return detect_vanishing_points(
                 None,
@@ -2204,7 +2382,7 @@ def detect_vanishing_points(
                 principal_point=principal_point,
                 seed=seed,
                 max_iterations=max_iterations,
-                segments=segs_detected[~curve],
+                segments=segs_detected[~drop],
                 image_size=(w, h),
                 inlier_px=inlier_px,
                 focal_bounds_rel=focal_bounds_rel,
@@ -2222,7 +2400,7 @@ def detect_vanishing_points(
         except NotEnoughStructureError:
             # too little is left without them: this reading stands, but its focal length
             # rests on the curves (said below)
-            curve_only = True
+            curve_only = bool(curve_dirs)
     rival_tilt = (0.0, 0.0)
     rival_modes: list[tuple[float, float, FloatArray]] = []
     if f_fixed is None and rivals:

@@ -39,7 +39,9 @@ half a pixel right and low, fills ~0.7 px larger on every side, lines 0.2-0.5 px
 Shortcuts (name them where the figures are quoted): painter's algorithm by distance (no
 depth buffer; a car or tree is drawn whole over what lies behind it), no perspective
 texture on the surfaces (flat colours with per-pixel noise), tree crowns are drawn as
-image-space ellipses, no sky clutter (wires, lamps, signs), no people.
+image-space ellipses, no sky clutter (wires, lamps, signs), no people. Overhead wires can be
+drawn over a photo afterwards (:func:`with_overhead_wires`, for tests and the wired benchmark
+run).
 """
 
 from __future__ import annotations
@@ -569,3 +571,62 @@ def render_street_photo(seed: int, focal_rel: float | None = None) -> StreetPhot
         roll_deg=roll,
         height_m=height,
     )
+
+
+def with_overhead_wires(
+    photo: StreetPhoto,
+    n_wires: int = 8,
+    vp_offset_rel: float = 1.5,
+    y_range_px: tuple[float, float] = (20.0, 200.0),
+    grey: int = 60,
+    width_px: int = 2,
+) -> npt.NDArray[np.uint8]:
+    """The photo with overhead wires drawn across its top: thin dark lines (``width_px``
+    wide, anti-aliased), horizontal in the world and in no principal direction of the
+    street, so they meet on the true horizon ``vp_offset_rel`` focal lengths right of the
+    principal point.
+
+    The real street photos have them (power and tram lines: issue 24's development photo
+    ``la foto.JPG``, where they posed as a principal direction); :func:`render_street_photo`
+    does not draw them. Shortcut: straight (no sag), drawn over everything from the left
+    edge to the right one, starting at ``y_range_px`` on the left edge, no JPEG round
+    trip after them.
+
+    Parameters
+    ----------
+    photo
+        A rendered photo (:func:`render_street_photo`).
+    n_wires
+        How many wires.
+    vp_offset_rel
+        Where they meet on the horizon, focal lengths right of the principal point.
+    y_range_px
+        Their heights on the left edge, first and last (pixels).
+    grey
+        Their grey level.
+    width_px
+        Their width (pixels).
+
+    Returns
+    -------
+    numpy.ndarray
+        A new ``(H, W, 3)`` BGR image.
+    """
+    import cv2
+
+    img = np.ascontiguousarray(photo.image.copy())
+    w = img.shape[1]
+    cx, cy = photo.principal_point
+    up = photo.up_in_cam
+    vx = cx + vp_offset_rel * photo.focal_px
+    # the horizon: up . (x - cx, y - cy, f) = 0
+    vy = cy - (up[0] * (vx - cx) + up[2] * photo.focal_px) / up[1]
+    sub = 16  # cv2.line's fixed point: 4 fractional bits
+    for k in range(n_wires):
+        ya = y_range_px[0] + (y_range_px[1] - y_range_px[0]) * k / max(n_wires - 1, 1)
+        yb = ya + (vy - ya) * w / vx
+        # OpenCV centres pixel (x, y) at (x, y): shift from the continuous convention
+        a = (round(-0.5 * sub), round((ya - 0.5) * sub))
+        b = (round((w - 0.5) * sub), round((yb - 0.5) * sub))
+        cv2.line(img, a, b, (grey, grey, grey), width_px, cv2.LINE_AA, shift=4)
+    return img
