@@ -215,7 +215,8 @@ def _refine_on_sphere(
     """Damped Gauss-Newton on (theta, phi) of the weighted, conditioned segment residuals.
 
     Two parameters; the residuals and the forward-difference Jacobian come from one
-    evaluation at three points, built from Python floats rather than stacked arrays.
+    evaluation at three points, built from Python floats rather than stacked arrays, one
+    evaluation an iteration (the trial point's with its neighbours).
     """
     sx, sy = seg_c[:, 0], seg_c[:, 1]
     mx_c = (seg_c[:, 0] + seg_c[:, 2]) / 2.0
@@ -234,28 +235,43 @@ def _refine_on_sphere(
         norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
         return np.asarray((la * sx + lb * sy + lc) / norm * weights)
 
+    # Every evaluation is at a point and its two forward-difference neighbours: a trial step
+    # that is taken then already has the next iteration's Jacobian rows (the same floats as
+    # evaluating them afterwards), and a refused one leaves the Jacobian as it was, so each
+    # iteration costs one call instead of two, with the same answer bit for bit.
     th, ph = theta0, phi0
-    r = fun_many([(th, ph)])[0]
+    F = fun_many([(th, ph), (th + h, ph), (th, ph + h)])
+    r = F[0]
     cost = float(r @ r)
     lam = 1e-6
+    normal: tuple[float, float, float, float, FloatArray] | None = None
     for _ in range(10):
-        F = fun_many([(th, ph), (th + h, ph), (th, ph + h)])
-        J = (F[1:] - F[0]) / h  # (2, n): the Jacobian, transposed
-        JtJ = J @ J.T
-        a, b, c = float(JtJ[0, 0]), float(JtJ[0, 1]), float(JtJ[1, 1])
+        if normal is None:
+            J = (F[1:] - F[0]) / h  # (2, n): the Jacobian, transposed
+            JtJ = J @ J.T
+            normal = (
+                float(JtJ[0, 0]),
+                float(JtJ[0, 1]),
+                float(JtJ[1, 0]),
+                float(JtJ[1, 1]),
+                J @ r,
+            )
+        a, b, b10, c, Jr = normal
         # JtJ + lam diag(diag(JtJ) + 1e-12), built from floats with the same roundings.
-        A = np.array([[a + lam * (a + 1e-12), b], [float(JtJ[1, 0]), c + lam * (c + 1e-12)]])
+        A = np.array([[a + lam * (a + 1e-12), b], [b10, c + lam * (c + 1e-12)]])
         try:
             # np.linalg.solve, not Cramer's rule: its rounding is what the answers were
             # frozen with (the stopping rule leaves them converged only to ~1e-8).
-            dth, dph = (-np.linalg.solve(A, J @ r)).tolist()
+            dth, dph = (-np.linalg.solve(A, Jr)).tolist()
         except np.linalg.LinAlgError:
             break
-        r_new = fun_many([(th + dth, ph + dph)])[0]
+        th_new, ph_new = th + dth, ph + dph
+        F_new = fun_many([(th_new, ph_new), (th_new + h, ph_new), (th_new, ph_new + h)])
+        r_new = F_new[0]
         cost_new = float(r_new @ r_new)
         step = max(abs(dth), abs(dph))
         if cost_new < cost:
-            th, ph, r = th + dth, ph + dph, r_new
+            th, ph, r, F, normal = th_new, ph_new, r_new, F_new, None
             done = cost - cost_new <= 1e-12 * cost or step < 1e-10
             cost, lam = cost_new, lam * 0.3
             if done:
