@@ -207,6 +207,9 @@ def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:
 
 
 _FD_STEP = 1e-7  # forward-difference step of the Jacobian, radians
+# Up to this many segments the sphere refinement evaluates its residuals on Python floats
+# (the same bits as numpy's, see _refine_on_sphere; cheaper on a few segments).
+_PYTHON_REFINE_MAX = 12
 
 
 def _refine_on_sphere(
@@ -223,7 +226,7 @@ def _refine_on_sphere(
     my_c = (seg_c[:, 1] + seg_c[:, 3]) / 2.0
     h = _FD_STEP
 
-    def fun_many(points: list[tuple[float, float]]) -> FloatArray:
+    def fun_many_numpy(points: list[tuple[float, float]]) -> FloatArray:
         # segment_residuals_px of the conditioned segments to the unit points (theta, phi),
         # all at once: (P, n).
         unit_pts = np.array(
@@ -234,6 +237,39 @@ def _refine_on_sphere(
         lc = mx_c * py - my_c * px
         norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
         return np.asarray((la * sx + lb * sy + lc) / norm * weights)
+
+    def fun_many_python(points: list[tuple[float, float]]) -> FloatArray:
+        # The same residuals from Python floats: every product, sum, quotient and square
+        # root is the same correctly rounded IEEE operation as numpy's element-wise one (no
+        # fused multiply-add in either), so the bits are the same; on a few segments the
+        # ~14 ufunc calls of an evaluation cost more than the arithmetic.
+        out = []
+        for t, p in points:
+            qx, qy, qw = math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)
+            row = []
+            for ax, ay, mx, my, w in rows_c:
+                la, lb = my * qw - qy, qx - mx * qw
+                norm = math.sqrt(la * la + lb * lb)
+                if not norm >= 1e-300:  # np.maximum(norm, 1e-300), NaN kept
+                    norm = norm if norm != norm else 1e-300
+                row.append((la * ax + lb * ay + (mx * qy - my * qx)) / norm * w)
+            out.append(row)
+        return np.array(out)
+
+    if len(seg_c) <= _PYTHON_REFINE_MAX:
+        rows_c = list(
+            zip(
+                sx.tolist(),
+                sy.tolist(),
+                mx_c.tolist(),
+                my_c.tolist(),
+                np.asarray(weights, dtype=float).tolist(),
+                strict=True,
+            )
+        )
+        fun_many = fun_many_python
+    else:
+        fun_many = fun_many_numpy
 
     # Every evaluation is at a point and its two forward-difference neighbours: a trial step
     # that is taken then already has the next iteration's Jacobian rows (the same floats as
