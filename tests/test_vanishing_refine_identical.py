@@ -1,5 +1,6 @@
-"""``_refine_on_sphere`` (one evaluation an iteration) against a frozen copy of its
-two-evaluation form: the same answer bit for bit, not merely to a tolerance (stop 39).
+"""``_refine_on_sphere`` (one evaluation an iteration, up to 20 segments on Python floats)
+against a frozen copy of its two-evaluation numpy form: the same answer bit for bit, not
+merely to a tolerance (stop 39).
 
 The calibrate answers downstream are loosely converged (the stopping rules leave ~1e-8), so
 anything that changes a vanishing point's last digit moves them; this speed change must not.
@@ -87,6 +88,26 @@ def test_refine_is_bit_identical_to_the_frozen_form(seed: int) -> None:
             assert new == old, (seg.tolist(), theta0, phi0)  # exact, not approximate
             compared += 1
     assert compared > 1000
+
+
+@pytest.mark.parametrize("n_segments", [13, 17, 20, 21, 30])
+def test_refine_of_pooled_sets_is_bit_identical(n_segments: int) -> None:
+    # Pooled segments (the screen's consensus, the pooled seed): both sides of the
+    # Python-float / numpy switch (_PYTHON_REFINE_MAX), noisy and noise-free.
+    rng = np.random.default_rng(n_segments)
+    for k in range(60):
+        vp = rng.uniform([-3000.0, -3000.0], [5000.0, 4000.0])
+        a = rng.uniform([0.0, 0.0], [1920.0, 1080.0], size=(n_segments, 2))
+        toward = (vp - a) / np.linalg.norm(vp - a, axis=1, keepdims=True)
+        seg = np.column_stack([a, a + toward * rng.uniform(15.0, 600.0, size=(n_segments, 1))])
+        seg += rng.normal(0.0, [0.0, 0.5, 2.0][k % 3], size=seg.shape)
+        pts = seg.reshape(-1, 2)
+        seg_c = ((pts - pts.mean(axis=0)) / DIAG_PX).reshape(-1, 4)
+        weights = rng.uniform(0.3, 2.0, n_segments)
+        start = (float(rng.uniform(0.01, 1.5)), float(rng.uniform(-3.0, 3.0)))
+        new = _refine_on_sphere(seg_c, weights, *start)
+        old = _frozen_refine_on_sphere(seg_c, weights, *start)
+        assert new == old, (n_segments, k)
 
 
 def test_refine_moves_from_a_poor_start_and_converges() -> None:
