@@ -159,13 +159,23 @@ def fit_vanishing_point(
     # Conditioned segments and the homogeneous line through each, normalised to unit normals:
     # the cross product of (x1, y1, 1) and (x2, y2, 1), written out (the same rounding as
     # np.cross, without its per-call cost on these tiny arrays).
-    seg_c = (seg - center[[0, 1, 0, 1]]) / scale
-    x1, y1, x2, y2 = seg_c.T
-    lines = np.empty((len(seg), 3))
-    lines[:, 0], lines[:, 1], lines[:, 2] = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
-    lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
-    weights = np.sqrt(lengths / (float(np.add.reduce(lengths)) / len(lengths)))
-    v0 = _linear_estimate(lines * weights[:, None], name)
+    mean_length = float(np.add.reduce(lengths)) / len(lengths)
+    small = (
+        _conditioned_rows(seg, lengths, center, scale, mean_length)
+        if len(seg) <= _PYTHON_REFINE_MAX
+        else None
+    )
+    if small is not None:
+        seg_c, weights, weighted_lines = small
+    else:
+        seg_c = (seg - center[[0, 1, 0, 1]]) / scale
+        x1, y1, x2, y2 = seg_c.T
+        lines = np.empty((len(seg), 3))
+        lines[:, 0], lines[:, 1], lines[:, 2] = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
+        lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
+        weights = np.sqrt(lengths / mean_length)
+        weighted_lines = lines * weights[:, None]
+    v0 = _linear_estimate(weighted_lines, name)
 
     # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
     if v0[2] < 0:
@@ -183,9 +193,49 @@ def fit_vanishing_point(
     hx, hy, hw = vcx * scale + cx * vcw, vcy * scale + cy * vcw, vcw
     norm = math.sqrt(hx * hx + hy * hy + hw * hw)
     vp_h = np.array([hx / norm, hy / norm, hw / norm])
-    residuals = segment_residuals_px(seg, vp_h)
+    if small is not None:
+        residuals = _segment_residuals_small(seg, hx / norm, hy / norm, hw / norm)
+    else:
+        residuals = segment_residuals_px(seg, vp_h)
     diag = float(scale_px) if scale_px else 2.0 * spread
     return VanishingPoint(vp_h, residuals, _is_finite(vp_h, diag))
+
+
+def _conditioned_rows(
+    seg: FloatArray, lengths: FloatArray, center: FloatArray, scale: float, mean_length: float
+) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+    """:func:`fit_vanishing_point`'s conditioned segments, weights and weighted unit lines
+    on Python floats (a few segments): the same correctly rounded operations, one by one, as
+    its array expressions, so the same bits. None where a conditioned segment has no
+    direction (the array expressions then give the NaN that follows)."""
+    cx, cy = center.tolist()
+    seg_rows, weight_list, line_rows = [], [], []
+    for (a1, b1, a2, b2), length in zip(seg.tolist(), lengths.tolist(), strict=True):
+        x1, y1, x2, y2 = (a1 - cx) / scale, (b1 - cy) / scale, (a2 - cx) / scale, (b2 - cy) / scale
+        la, lb, lc = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
+        norm = math.sqrt(la * la + lb * lb)
+        if not norm > 0.0 or norm == math.inf:
+            return None
+        w = math.sqrt(length / mean_length)
+        seg_rows.append([x1, y1, x2, y2])
+        weight_list.append(w)
+        line_rows.append([la / norm * w, lb / norm * w, lc / norm * w])
+    return np.array(seg_rows), np.array(weight_list), np.array(line_rows)
+
+
+def _segment_residuals_small(seg: FloatArray, px: float, py: float, pw: float) -> FloatArray:
+    """:func:`segment_residuals_px` on Python floats, operation for operation (the same
+    bits), for a few segments."""
+    out = []
+    for x1, y1, x2, y2 in seg.tolist():
+        mx, my = (x1 + x2) / 2.0, (y1 + y2) / 2.0
+        la, lb = my * pw - py, px - mx * pw
+        lc = mx * py - my * px
+        norm = math.sqrt(la * la + lb * lb)
+        if norm < 1e-300:  # np.where(norm < 1e-300, 1e-300, norm): NaN kept
+            norm = 1e-300
+        out.append((la * x1 + lb * y1 + lc) / norm)
+    return np.array(out)
 
 
 def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:

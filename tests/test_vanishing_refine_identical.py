@@ -126,3 +126,29 @@ def test_refine_moves_from_a_poor_start_and_converges() -> None:
     fit = fit_vanishing_point(seg_c * 1000.0, scale_px=DIAG_PX)
     assert fit.pixel is not None
     np.testing.assert_allclose(fit.pixel, vp[:2] / vp[2] * 1000.0, rtol=1e-7)
+
+
+@pytest.mark.parametrize("scale_px", [None, DIAG_PX])
+def test_fit_on_python_floats_is_bit_identical_to_the_array_form(
+    scale_px: float | None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # fit_vanishing_point's Python-float paths (conditioning, weights, refinement,
+    # residuals; up to _PYTHON_REFINE_MAX segments) against its array form, which
+    # _PYTHON_REFINE_MAX = 0 selects for every set: the same bytes, the same errors.
+    from camloc_geo import DegenerateGeometryError, vanishing
+
+    sets = [seg for seed in (4, 5) for seg in _segment_sets(seed, 400)]
+    results = []
+    for limit in (vanishing._PYTHON_REFINE_MAX, 0):
+        monkeypatch.setattr(vanishing, "_PYTHON_REFINE_MAX", limit)
+        out: list[tuple[bytes, bytes, bool] | str] = []
+        for seg in sets:
+            try:
+                fit = fit_vanishing_point(seg, scale_px=scale_px, name="s")
+            except DegenerateGeometryError as exc:
+                out.append(str(exc))
+                continue
+            out.append((fit.homogeneous.tobytes(), fit.residuals_px.tobytes(), fit.finite))
+        results.append(out)
+    assert results[0] == results[1]
+    assert sum(isinstance(r, tuple) for r in results[0]) > 600
