@@ -45,6 +45,7 @@ from camloc_geo.vanishing import (
     AXES,
     IntrinsicsEstimate,
     VanishingPoint,
+    _vector_norm,
     direction_sign,
     estimate_intrinsics,
     fit_vanishing_point,
@@ -593,7 +594,7 @@ def _vanishing_directions(
     dirs = {}
     for k, v in vps.items():
         d = cam_from_img @ v.homogeneous
-        dirs[k] = d / np.linalg.norm(d)
+        dirs[k] = d / _vector_norm(d)
     return cam_from_img, dirs
 
 
@@ -619,7 +620,7 @@ def _origin_depth_terms(
     nums, dens = np.zeros(3), np.zeros(3)
     for i, k in enumerate(AXES):
         mk = cam_from_img @ np.array([*getattr(ann.axes, k), 1.0])
-        mk /= np.linalg.norm(mk)
+        mk /= _vector_norm(mk)
         a = _cross3(mk, m0)
         b = _cross3(mk, R @ ends[_AXIS_INDEX[k] + 1])
         nums[i] = -float(a @ b)
@@ -4152,16 +4153,16 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
         centres.append(c_i)
         focals.append(f_i)
         turn = _small_rotvec(turn_matrix)
-        if np.linalg.norm(turn) < math.radians(30.0):
+        if _vector_norm(turn) < math.radians(30.0):
             turns.append(turn)
         if a < n_ann:
-            influence.append(float(np.linalg.norm(c_i - c)))
+            influence.append(float(_vector_norm(c_i - c)))
         else:
             log.info(
                 "without one witness group's lines (photo, video): focal length %+.1f %%, "
                 "camera moved %.2f m",
                 100.0 * (f_i / result.camera.focal_px - 1.0),
-                float(np.linalg.norm(c_i - c)),
+                float(_vector_norm(c_i - c)),
             )
     result.annotator_influence_m = influence
     lev = None
@@ -4173,10 +4174,10 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
             # moves the answer far (focal length or distance by more than
             # jackknife_leverage_max_move) is beyond that linearisation, and keeps its move.
             f0 = result.camera.focal_px
-            dist = max(float(np.linalg.norm(c)), 1e-9)
+            dist = max(float(_vector_norm(c)), 1e-9)
             for k, a in enumerate(kept_groups):
                 f_a, c_a, _t = answers[a]
-                move = max(abs(f_a / f0 - 1.0), float(np.linalg.norm(c_a - c)) / dist)
+                move = max(abs(f_a / f0 - 1.0), float(_vector_norm(c_a - c)) / dist)
                 if move > settings.jackknife_leverage_max_move:
                     lev[k] = 1.0
     _add_jackknife_spread(result, centres, turns, focals, lev)

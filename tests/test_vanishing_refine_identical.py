@@ -152,3 +152,18 @@ def test_fit_on_python_floats_is_bit_identical_to_the_array_form(
         results.append(out)
     assert results[0] == results[1]
     assert sum(isinstance(r, tuple) for r in results[0]) > 600
+
+
+def test_vector_norm_is_np_linalg_norm_bit_for_bit() -> None:
+    from camloc_geo.vanishing import _vector_norm
+
+    rng = np.random.default_rng(3)
+    cases: list[npt.ArrayLike] = [[3, 4], [1.0, 2.0, 2.0], np.zeros(3), [1e-200, 1e-200]]
+    for n in (2, 3, 5, 9, 40):
+        cases += [rng.normal(0.0, 10.0 ** rng.uniform(-8, 8), n) for _ in range(300)]
+    wide = rng.normal(size=(6, 4))
+    cases += [wide, wide.T, wide[::2, 1:3]]  # 2-D and non-contiguous: flattened as norm does
+    for x in cases:
+        got, want = _vector_norm(x), np.linalg.norm(x)
+        assert got.tobytes() == np.float64(want).tobytes(), x
+    assert float(_vector_norm([3, 4])) == 5.0
