@@ -32,14 +32,14 @@ y, z and the rotation sigma about the camera's x, y, z) and the annotators they 
 With ``--dump PATH`` it only writes every output of the default and the refit ``calibrate``
 on the scenes (the camera, every sigma, the covariance, influences, proportions, warnings)
 to ``PATH`` (JSON), and with ``--compare PATH`` it compares them with such a dump, field by
-field, to ``1e-9`` relative: the check that a speed change left the answers as they were
-(run it on the tree before the change, then after).
+field, to ``1e-9`` relative (with ``--exact``, bit for bit): the check that a speed change
+left the answers as they were (run it on the tree before the change, then after).
 
 Usage::
 
     python benchmarks/calibrate_speed.py --n 30 [--profile] [--no-focal-check]
     python benchmarks/calibrate_speed.py --n 40 --dump before.json   # on the old tree
-    python benchmarks/calibrate_speed.py --n 40 --compare before.json  # on the new one
+    python benchmarks/calibrate_speed.py --n 40 --compare before.json --exact  # on the new one
 """
 
 from __future__ import annotations
@@ -203,20 +203,23 @@ def dump_outputs(scenes: list[Scene]) -> list[dict[str, Any]]:
     return rows
 
 
-def differences(before: Any, after: Any, path: str = "") -> list[str]:
+def differences(before: Any, after: Any, path: str = "", *, exact: bool = False) -> list[str]:
     """Where two dumps differ: numbers beyond ``COMPARE_REL_TOL`` relative (and 1e-12
-    absolute), anything else unequal."""
+    absolute), or with ``exact`` any number not equal bit for bit (JSON keeps a float's
+    every digit); anything else unequal."""
     if isinstance(before, dict) and isinstance(after, dict):
         if set(before) != set(after):
             return [f"{path}: keys {sorted(set(before) ^ set(after))}"]
-        return [d for k in before for d in differences(before[k], after[k], f"{path}.{k}")]
+        return [
+            d for k in before for d in differences(before[k], after[k], f"{path}.{k}", exact=exact)
+        ]
     if isinstance(before, list) and isinstance(after, list):
         if len(before) != len(after):
             return [f"{path}: length {len(before)} -> {len(after)}"]
         return [
             d
             for i, (b, a) in enumerate(zip(before, after, strict=True))
-            for d in differences(b, a, f"{path}[{i}]")
+            for d in differences(b, a, f"{path}[{i}]", exact=exact)
         ]
     numbers = (int, float)
     if (
@@ -227,6 +230,8 @@ def differences(before: Any, after: Any, path: str = "") -> list[str]:
     ):
         if before == after or (math.isnan(before) and math.isnan(after)):
             return []
+        if exact:
+            return [f"{path}: {before!r} -> {after!r}"]
         gap = abs(before - after)
         if gap <= 1e-12 or gap <= COMPARE_REL_TOL * max(abs(before), abs(after)):
             return []
@@ -325,6 +330,11 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         help="only compare every output of calibrate with a --dump file (exit 1 if any differs)",
     )
+    parser.add_argument(
+        "--exact",
+        action="store_true",
+        help="with --compare: every number equal bit for bit, not to 1e-9 relative",
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -337,10 +347,10 @@ def main(argv: list[str] | None = None) -> int:
             args.dump.write_text(json.dumps(outputs))
             print(f"{len(outputs)} scenes' outputs written to {args.dump}")
         if args.compare is not None:
-            diffs = differences(json.loads(args.compare.read_text()), outputs)
+            diffs = differences(json.loads(args.compare.read_text()), outputs, exact=args.exact)
+            beyond = "in any digit" if args.exact else f"beyond {COMPARE_REL_TOL:g} relative"
             print(
-                f"{len(outputs)} scenes against {args.compare}: {len(diffs)} differences "
-                f"beyond {COMPARE_REL_TOL:g} relative"
+                f"{len(outputs)} scenes against {args.compare}: {len(diffs)} differences {beyond}"
             )
             for line in diffs[:20]:
                 print("  " + line)

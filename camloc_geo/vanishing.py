@@ -104,8 +104,20 @@ class VanishingPoint:
         return float(np.sqrt(np.mean(self.residuals_px**2)))
 
 
+def _vector_norm(x: npt.ArrayLike) -> np.float64:
+    """``np.linalg.norm(x)`` (no ``ord``, no ``axis``) by its own arithmetic, ``sqrt(x·x)``
+    of the flattened floats (the same bits), without its dispatch (~3 us a call)."""
+    v = np.asarray(x)
+    if not issubclass(v.dtype.type, np.inexact):
+        v = v.astype(float)
+    v = v.ravel(order="K")
+    return np.float64(np.sqrt(v.dot(v)))
+
+
 def _is_finite(vp_h: FloatArray, scale_px: float) -> bool:
-    return bool(abs(vp_h[2]) * _INFINITY_DIAGONALS * scale_px > np.linalg.norm(vp_h[:2]))
+    xy = vp_h[:2]
+    # np.linalg.norm(xy) is sqrt(xy.dot(xy)): the same, without its dispatch.
+    return bool(abs(vp_h[2]) * _INFINITY_DIAGONALS * scale_px > np.sqrt(xy.dot(xy)))
 
 
 def fit_vanishing_point(
@@ -157,13 +169,23 @@ def fit_vanishing_point(
     # Conditioned segments and the homogeneous line through each, normalised to unit normals:
     # the cross product of (x1, y1, 1) and (x2, y2, 1), written out (the same rounding as
     # np.cross, without its per-call cost on these tiny arrays).
-    seg_c = (seg - center[[0, 1, 0, 1]]) / scale
-    x1, y1, x2, y2 = seg_c.T
-    lines = np.empty((len(seg), 3))
-    lines[:, 0], lines[:, 1], lines[:, 2] = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
-    lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
-    weights = np.sqrt(lengths / (float(np.add.reduce(lengths)) / len(lengths)))
-    v0 = _linear_estimate(lines * weights[:, None], name)
+    mean_length = float(np.add.reduce(lengths)) / len(lengths)
+    small = (
+        _conditioned_rows(seg, lengths, center, scale, mean_length)
+        if len(seg) <= _PYTHON_REFINE_MAX
+        else None
+    )
+    if small is not None:
+        seg_c, weights, weighted_lines = small
+    else:
+        seg_c = (seg - center[[0, 1, 0, 1]]) / scale
+        x1, y1, x2, y2 = seg_c.T
+        lines = np.empty((len(seg), 3))
+        lines[:, 0], lines[:, 1], lines[:, 2] = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
+        lines /= np.sqrt(lines[:, 0] * lines[:, 0] + lines[:, 1] * lines[:, 1])[:, None]
+        weights = np.sqrt(lengths / mean_length)
+        weighted_lines = lines * weights[:, None]
+    v0 = _linear_estimate(weighted_lines, name)
 
     # Refine on the sphere in conditioned coordinates (well scaled for any VP, finite or not).
     if v0[2] < 0:
@@ -181,9 +203,49 @@ def fit_vanishing_point(
     hx, hy, hw = vcx * scale + cx * vcw, vcy * scale + cy * vcw, vcw
     norm = math.sqrt(hx * hx + hy * hy + hw * hw)
     vp_h = np.array([hx / norm, hy / norm, hw / norm])
-    residuals = segment_residuals_px(seg, vp_h)
+    if small is not None:
+        residuals = _segment_residuals_small(seg, hx / norm, hy / norm, hw / norm)
+    else:
+        residuals = segment_residuals_px(seg, vp_h)
     diag = float(scale_px) if scale_px else 2.0 * spread
     return VanishingPoint(vp_h, residuals, _is_finite(vp_h, diag))
+
+
+def _conditioned_rows(
+    seg: FloatArray, lengths: FloatArray, center: FloatArray, scale: float, mean_length: float
+) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+    """:func:`fit_vanishing_point`'s conditioned segments, weights and weighted unit lines
+    on Python floats (a few segments): the same correctly rounded operations, one by one, as
+    its array expressions, so the same bits. None where a conditioned segment has no
+    direction (the array expressions then give the NaN that follows)."""
+    cx, cy = center.tolist()
+    seg_rows, weight_list, line_rows = [], [], []
+    for (a1, b1, a2, b2), length in zip(seg.tolist(), lengths.tolist(), strict=True):
+        x1, y1, x2, y2 = (a1 - cx) / scale, (b1 - cy) / scale, (a2 - cx) / scale, (b2 - cy) / scale
+        la, lb, lc = y1 - y2, x2 - x1, x1 * y2 - y1 * x2
+        norm = math.sqrt(la * la + lb * lb)
+        if not norm > 0.0 or norm == math.inf:
+            return None
+        w = math.sqrt(length / mean_length)
+        seg_rows.append([x1, y1, x2, y2])
+        weight_list.append(w)
+        line_rows.append([la / norm * w, lb / norm * w, lc / norm * w])
+    return np.array(seg_rows), np.array(weight_list), np.array(line_rows)
+
+
+def _segment_residuals_small(seg: FloatArray, px: float, py: float, pw: float) -> FloatArray:
+    """:func:`segment_residuals_px` on Python floats, operation for operation (the same
+    bits), for a few segments."""
+    out = []
+    for x1, y1, x2, y2 in seg.tolist():
+        mx, my = (x1 + x2) / 2.0, (y1 + y2) / 2.0
+        la, lb = my * pw - py, px - mx * pw
+        lc = mx * py - my * px
+        norm = math.sqrt(la * la + lb * lb)
+        if norm < 1e-300:  # np.where(norm < 1e-300, 1e-300, norm): NaN kept
+            norm = 1e-300
+        out.append((la * x1 + lb * y1 + lc) / norm)
+    return np.array(out)
 
 
 def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:
@@ -210,6 +272,9 @@ def _linear_estimate(weighted_lines: FloatArray, name: str) -> FloatArray:
 
 
 _FD_STEP = 1e-7  # forward-difference step of the Jacobian, radians
+# Up to this many segments the sphere refinement evaluates its residuals on Python floats
+# (the same bits as numpy's, see _refine_on_sphere; cheaper up to ~20 segments, measured).
+_PYTHON_REFINE_MAX = 20
 
 
 def _refine_on_sphere(
@@ -218,14 +283,15 @@ def _refine_on_sphere(
     """Damped Gauss-Newton on (theta, phi) of the weighted, conditioned segment residuals.
 
     Two parameters; the residuals and the forward-difference Jacobian come from one
-    evaluation at three points, built from Python floats rather than stacked arrays.
+    evaluation at three points, built from Python floats rather than stacked arrays, one
+    evaluation an iteration (the trial point's with its neighbours).
     """
     sx, sy = seg_c[:, 0], seg_c[:, 1]
     mx_c = (seg_c[:, 0] + seg_c[:, 2]) / 2.0
     my_c = (seg_c[:, 1] + seg_c[:, 3]) / 2.0
     h = _FD_STEP
 
-    def fun_many(points: list[tuple[float, float]]) -> FloatArray:
+    def fun_many_numpy(points: list[tuple[float, float]]) -> FloatArray:
         # segment_residuals_px of the conditioned segments to the unit points (theta, phi),
         # all at once: (P, n).
         unit_pts = np.array(
@@ -237,28 +303,76 @@ def _refine_on_sphere(
         norm = np.maximum(np.sqrt(la * la + lb * lb), 1e-300)
         return np.asarray((la * sx + lb * sy + lc) / norm * weights)
 
+    def fun_many_python(points: list[tuple[float, float]]) -> FloatArray:
+        # The same residuals from Python floats: every product, sum, quotient and square
+        # root is the same correctly rounded IEEE operation as numpy's element-wise one (no
+        # fused multiply-add in either), so the bits are the same; on a few segments the
+        # ~14 ufunc calls of an evaluation cost more than the arithmetic.
+        out = []
+        for t, p in points:
+            qx, qy, qw = math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)
+            row = []
+            for ax, ay, mx, my, w in rows_c:
+                la, lb = my * qw - qy, qx - mx * qw
+                norm = math.sqrt(la * la + lb * lb)
+                if not norm >= 1e-300:  # np.maximum(norm, 1e-300), NaN kept
+                    norm = norm if norm != norm else 1e-300
+                row.append((la * ax + lb * ay + (mx * qy - my * qx)) / norm * w)
+            out.append(row)
+        return np.array(out)
+
+    if len(seg_c) <= _PYTHON_REFINE_MAX:
+        rows_c = list(
+            zip(
+                sx.tolist(),
+                sy.tolist(),
+                mx_c.tolist(),
+                my_c.tolist(),
+                np.asarray(weights, dtype=float).tolist(),
+                strict=True,
+            )
+        )
+        fun_many = fun_many_python
+    else:
+        fun_many = fun_many_numpy
+
+    # Every evaluation is at a point and its two forward-difference neighbours: a trial step
+    # that is taken then already has the next iteration's Jacobian rows (the same floats as
+    # evaluating them afterwards), and a refused one leaves the Jacobian as it was, so each
+    # iteration costs one call instead of two, with the same answer bit for bit.
     th, ph = theta0, phi0
-    r = fun_many([(th, ph)])[0]
+    F = fun_many([(th, ph), (th + h, ph), (th, ph + h)])
+    r = F[0]
     cost = float(r @ r)
     lam = 1e-6
+    normal: tuple[float, float, float, float, FloatArray] | None = None
     for _ in range(10):
-        F = fun_many([(th, ph), (th + h, ph), (th, ph + h)])
-        J = (F[1:] - F[0]) / h  # (2, n): the Jacobian, transposed
-        JtJ = J @ J.T
-        a, b, c = float(JtJ[0, 0]), float(JtJ[0, 1]), float(JtJ[1, 1])
+        if normal is None:
+            J = (F[1:] - F[0]) / h  # (2, n): the Jacobian, transposed
+            JtJ = J @ J.T
+            normal = (
+                float(JtJ[0, 0]),
+                float(JtJ[0, 1]),
+                float(JtJ[1, 0]),
+                float(JtJ[1, 1]),
+                J @ r,
+            )
+        a, b, b10, c, Jr = normal
         # JtJ + lam diag(diag(JtJ) + 1e-12), built from floats with the same roundings.
-        A = np.array([[a + lam * (a + 1e-12), b], [float(JtJ[1, 0]), c + lam * (c + 1e-12)]])
+        A = np.array([[a + lam * (a + 1e-12), b], [b10, c + lam * (c + 1e-12)]])
         try:
             # np.linalg.solve, not Cramer's rule: its rounding is what the answers were
             # frozen with (the stopping rule leaves them converged only to ~1e-8).
-            dth, dph = (-np.linalg.solve(A, J @ r)).tolist()
+            dth, dph = (-np.linalg.solve(A, Jr)).tolist()
         except np.linalg.LinAlgError:
             break
-        r_new = fun_many([(th + dth, ph + dph)])[0]
+        th_new, ph_new = th + dth, ph + dph
+        F_new = fun_many([(th_new, ph_new), (th_new + h, ph_new), (th_new, ph_new + h)])
+        r_new = F_new[0]
         cost_new = float(r_new @ r_new)
         step = max(abs(dth), abs(dph))
         if cost_new < cost:
-            th, ph, r = th + dth, ph + dph, r_new
+            th, ph, r, F, normal = th_new, ph_new, r_new, F_new, None
             done = cost - cost_new <= 1e-12 * cost or step < 1e-10
             cost, lam = cost_new, lam * 0.3
             if done:
@@ -310,8 +424,8 @@ def focal_from_vanishing_pair(
     a = np.asarray(v1_h, dtype=float).reshape(3)
     b = np.asarray(v2_h, dtype=float).reshape(3)
     cx, cy = np.asarray(principal_point, dtype=float).reshape(2)
-    a = a / np.linalg.norm(a)
-    b = b / np.linalg.norm(b)
+    a = a / _vector_norm(a)
+    b = b / _vector_norm(b)
     ww = a[2] * b[2]
     dot = (a[0] - cx * a[2]) * (b[0] - cx * b[2]) + (a[1] - cy * a[2]) * (b[1] - cy * b[2])
     scale = math.sqrt(
@@ -387,14 +501,14 @@ def estimate_intrinsics(
         return IntrinsicsEstimate(float(focal_px), (pp[0], pp[1]), "given", "scene gives both")
 
     vps = {k: np.asarray(v, dtype=float) for k, v in vps_h.items() if v is not None}
-    finite = {k: v for k, v in vps.items() if _is_finite(v / np.linalg.norm(v), diag)}
+    finite = {k: v for k, v in vps.items() if _is_finite(v / _vector_norm(v), diag)}
     why = ""
     if focal_px is None and pp is None and len(finite) == 3:
         px = [finite[k][:2] / finite[k][2] for k in AXES]
         try:
             ortho = principal_point_from_orthocentre(*px)
             f = focal_from_vanishing_pair(finite["length"], finite["width"], ortho)
-            if np.linalg.norm(ortho - centre) <= max_pp_offset * diag:
+            if _vector_norm(ortho - centre) <= max_pp_offset * diag:
                 return IntrinsicsEstimate(
                     f,
                     (float(ortho[0]), float(ortho[1])),
@@ -426,8 +540,8 @@ def estimate_intrinsics(
             except DegenerateGeometryError:
                 continue
             # Conditioning: a pair whose points are both far out gives an unstable f.
-            da = np.linalg.norm(a[:2] / a[2] - pp_used)
-            db = np.linalg.norm(b[:2] / b[2] - pp_used)
+            da = _vector_norm(a[:2] / a[2] - pp_used)
+            db = _vector_norm(b[:2] / b[2] - pp_used)
             quality = -float(max(da, db)) / diag
             if best is None or quality > best[0]:
                 best = (quality, f, f"{names[i]}+{names[j]}")
@@ -465,7 +579,8 @@ def direction_sign(
     step = np.asarray(image_step, dtype=float).reshape(2)
     g = d[:2] - m[:2] * d[2]
     dot = float(g @ step)
-    denom = float(np.linalg.norm(g) * np.linalg.norm(step))
+    # np.linalg.norm of a vector is sqrt(x.dot(x)): the same, without its dispatch.
+    denom = float(np.sqrt(g.dot(g)) * np.sqrt(step.dot(step)))
     if denom <= 0 or abs(dot) < 0.05 * denom:
         return 0.0
     return 1.0 if dot > 0 else -1.0
@@ -491,7 +606,7 @@ def rotation_from_vanishing_directions(
     A missing third axis is completed by the right-handed cross product.
     """
     cols = {"length": 0, "width": 1, "height": 2}
-    dirs = {k: np.asarray(v, dtype=float) / np.linalg.norm(v) for k, v in directions_in_cam.items()}
+    dirs = {k: np.asarray(v, dtype=float) / _vector_norm(v) for k, v in directions_in_cam.items()}
     if len(dirs) < 2:
         raise DegenerateGeometryError("at least two axis directions are needed for a rotation")
     w = dict(weights or {})
@@ -505,5 +620,5 @@ def rotation_from_vanishing_directions(
         # e_third = e_i1 × e_i2 up to the cyclic sign.
         sign = 1.0 if (i1, i2, third) in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) else -1.0
         d3 = sign * np.cross(d1, d2)
-        M += np.outer(d3 / np.linalg.norm(d3), np.eye(3)[third])
+        M += np.outer(d3 / _vector_norm(d3), np.eye(3)[third])
     return project_to_rotation(M)
