@@ -344,10 +344,15 @@ def test_one_street_name_and_a_prior_try_that_streets_junctions(baltimore: MapDa
 
 @pytest.fixture(scope="module")
 def baltimore_narrow() -> MapData:
-    """Baltimore with every carriageway modelled 1 m wide (street widths are estimates)."""
+    """Baltimore with every carriageway modelled 1 m wide (street widths are estimates).
+
+    A copy (its own cache): :func:`load_map` shares the loaded map with every other test.
+    """
+    import copy
+
     from camloc_geo.osm._local import LocalIndex
 
-    m = load_map(OSM / "baltimore.osm.pbf", 39.2851, -76.5934, radius_m=300)
+    m = copy.copy(load_map(OSM / "baltimore.osm.pbf", 39.2851, -76.5934, radius_m=300))
     idx = m.street_index
     m._cache["street_index"] = LocalIndex(idx.geometries, (0.5,) * len(idx.values), idx.tree)
     return m
@@ -650,3 +655,61 @@ def test_two_references_close_together_far_from_the_camera_are_warned(
     res = locate(parse_scene(_two_refs(baltimore, ls, 12.0)), baltimore)
     assert _errors(res, ls)[0] < 1.0
     assert not [w for w in res.warnings if w.startswith("references: the two references are")]
+
+
+@pytest.fixture(scope="module")
+def andorra() -> MapData:
+    return load_map(OSM / "andorra.osm.pbf", 42.5075, 1.5324, radius_m=500)
+
+
+def test_a_rough_point_near_another_junction_that_fits_as_well_is_warned(
+    andorra: MapData,
+) -> None:
+    # A webcam listing's rough point 83 m from the camera's junction lands 20 m from another
+    # junction whose corners fit as well (absolute_slips --set held-out-2, scene 15): the
+    # answer stands there, 90 m off, and used to come with no warning.
+    inter = andorra.intersection("c51399278")
+    ls = make_located_scene(
+        andorra,
+        inter,
+        np.random.default_rng([39, 15]),
+        noise=NoiseModel(),
+        corner_sigma_m=1.5,
+        n_references=2,
+        max_corners=4,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("references")
+    right = locate(parse_scene(scene), andorra)
+    assert _errors(right, ls)[0] < 10.0
+    assert not [w for w in right.warnings if "rough point" in w]
+    scene["intersection"]["lat"], scene["intersection"]["lon"] = 42.507576, 1.532421
+    res = locate(parse_scene(scene), andorra)
+    assert res.candidates[0].intersection_id != inter.id  # the stated junction is taken...
+    warned = [w for w in res.warnings if w.startswith("intersection: the scene's intersection")]
+    assert len(warned) == 1, res.warnings  # ...with a warning naming the one that fits
+    assert f"junction {inter.id}" in warned[0]
+    assert "rough point" in warned[0]
+    d_stated = float(re.search(r"stands (\d+) m from junction", warned[0]).group(1))
+    assert 10 <= d_stated <= 25
+
+
+def test_a_best_candidate_beyond_the_prior_is_warned(baltimore: MapData) -> None:
+    # The prior's factor alone left a flag ("outside_prior") and no word to the user.
+    ls = _located(baltimore, "c49537218", 3)
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("references", None)
+    right = locate(parse_scene(scene), baltimore)
+    assert not [w for w in right.warnings if w.startswith("prior:")]
+    # the same prior 180 m north of the camera, radius 120 m: the answer stays right
+    lat, lon = ls.lat + 180.0 / 111_200.0, ls.lon
+    scene["prior"] = {"lat": lat, "lon": lon, "radius_m": 120.0}
+    res = locate(parse_scene(scene), baltimore)
+    assert _errors(res, ls)[0] < 10.0
+    top = res.candidates[0]
+    assert "outside_prior" in {str(f.kind.value) for f in top.flags}
+    warned = [w for w in res.warnings if w.startswith("prior:")]
+    assert len(warned) == 1
+    d = float(re.search(r"stands (\d+) m from", warned[0]).group(1))
+    assert 150 <= d <= 210

@@ -193,6 +193,7 @@ def _locate_once(
         _warn_landmarks_off_street(ev, result)
         _warn_fragile_references(ev, result)
         _warn_reference_corner(result)
+        _warn_outside_prior(ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -813,8 +814,10 @@ def _rough_point_candidates(
         or hint.lon is None
         or ev.intersection is None
         or not ev.corners
-        or not fits_badly(named_cands)
     ):
+        return []
+    if not fits_badly(named_cands):
+        _warn_rough_point(scene, map_data, world_cam, ev, settings, result, named_cands)
         return []
     out = _rough_point_alternatives(scene, map_data, world_cam, ev, settings, result)
     if not out:
@@ -826,6 +829,68 @@ def _rough_point_candidates(
     if max(map(_weight, out)) > max(map(_weight, named_cands)):
         return out
     return []
+
+
+ROUGH_POINT_WARN_M = 10.0
+"""A stated intersection lat/lon this far or farther from every node of the junction it
+names (and from its centre) is read as possibly rough (:func:`_warn_rough_point`). A point
+taken from the map stands on the junction (the benchmarks' clean scenes: 0 m); a webcam
+listing's rough point that happens to land within 25 m of a junction, 0-25 m from it."""
+
+ROUGH_POINT_AS_WELL = math.log(10.0)
+"""Another junction "fits as well" when its best candidate's fit (likelihood and map
+plausibility, its prior odds left out) is within this (log odds of 10 to 1) of the stated
+junction's best, and it does not fit badly itself (:func:`fits_badly`)."""
+
+
+def _warn_rough_point(
+    scene: Scene,
+    map_data: MapData,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+    named_cands: list[Candidate],
+) -> None:
+    """Warn when a stated intersection lat/lon off its junction's nodes could be a rough
+    point that landed near the wrong junction: another junction around fits as well.
+
+    The stated junction fits well, so it is taken at its word (:func:`_rough_point_candidates`);
+    but a rough point (a webcam listing's, 50-150 m off) lands within 25 m of another junction
+    about one time in four, and where that junction has the same shape the corners fit it as
+    well: the answer was wrong by 90-180 m with no warning (``benchmarks/absolute_slips.py
+    --set held-out-2``'s ``intersection_latlon_off``, 4 of 149). Only points at least
+    :data:`ROUGH_POINT_WARN_M` from the junction's nodes pay the search.
+    """
+    hint = scene.intersection
+    assert hint is not None
+    assert hint.lat is not None
+    assert hint.lon is not None
+    assert ev.intersection is not None
+    own = ev.intersection
+    d_own = map_data.distance_to_m(own, lat=hint.lat, lon=hint.lon)
+    if d_own < ROUGH_POINT_WARN_M or not named_cands:
+        return
+    alts = _rough_point_alternatives(scene, map_data, world_cam, ev, settings, result)
+    if not alts or fits_badly(alts):
+        return
+    best_own = max(map(_weight, named_cands))
+    best = max(alts, key=lambda c: _weight(c) - c.log_prior_odds)
+    if _weight(best) - best.log_prior_odds < best_own - ROUGH_POINT_AS_WELL:
+        return
+    if best.intersection_id is None:
+        return
+    there = map_data.intersection(best.intersection_id)
+    d_there = map_data.distance_to_m(there, lat=hint.lat, lon=hint.lon)
+    result.warnings.append(
+        f"intersection: the scene's intersection lat/lon (lat={hint.lat:.6f}, "
+        f"lon={hint.lon:.6f}) stands {d_own:.0f} m from junction {own.id} "
+        f"({' & '.join(own.street_names)}), not on it, and junction {there.id} "
+        f"({' & '.join(there.street_names)}), {d_there:.0f} m from the point, fits the corners "
+        "as well; the answer stands at the stated junction. Is the lat/lon a rough point (a "
+        "webcam listing's)? Check the junction, or give the junction's own lat/lon or its "
+        "street names"
+    )
 
 
 def _rough_point_alternatives(
@@ -911,6 +976,30 @@ def _warn_searched_junction(scene: Scene, ev: Evidence, result: LocateResult) ->
         f"{head}: the best candidate stands at junction {inter.id} "
         f"({' & '.join(inter.street_names)}), {d:.0f} m from the stated point; check the "
         "intersection's lat/lon"
+    )
+
+
+def _warn_outside_prior(ev: Evidence, result: LocateResult) -> None:
+    """Warn when the best candidate stands beyond the scene's prior radius.
+
+    Its score paid for it (the prior's Gaussian factor, flag ``outside_prior``), but a flag
+    alone says nothing to the user: a rough intersection lat/lon that landed on another
+    junction put the answer 148 m off, outside the stated prior, with no warning
+    (``benchmarks/absolute_slips.py --set held-out-2``, ``intersection_latlon_off``). A right
+    answer stands within the prior whenever the prior is right, so it does not fire on them.
+    """
+    if not result.candidates or ev.prior_en is None or not ev.prior_radius_m:
+        return
+    top = result.candidates[0]
+    if FlagKind.OUTSIDE_PRIOR not in {f.kind for f in top.flags}:
+        return
+    d = float(np.linalg.norm(top.east_north - ev.prior_en))
+    if d <= ev.prior_radius_m:
+        return
+    result.warnings.append(
+        f"prior: the best candidate stands {d:.0f} m from the scene's prior, beyond its "
+        f"radius_m ({ev.prior_radius_m:.0f} m): the other evidence outweighed it; check the "
+        "prior, or the evidence that put the camera there (the intersection's lat/lon?)"
     )
 
 
