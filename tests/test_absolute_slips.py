@@ -358,7 +358,7 @@ def baltimore_narrow() -> MapData:
     return m
 
 
-@pytest.mark.parametrize("seed", [1, 4, 9])
+@pytest.mark.parametrize("seed", [1, 8, 9])
 def test_two_references_with_the_car_beside_its_street_stay_quiet(
     baltimore: MapData, baltimore_narrow: MapData, seed: int
 ) -> None:

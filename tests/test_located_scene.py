@@ -74,3 +74,18 @@ def test_cars_at_single_carriageways_stand_in_their_street(baltimore: MapData) -
                 beyond.append(_beyond_nearest_carriageway_m(baltimore, _car_side_midpoint_enu(ls)))
     assert len(beyond) >= 12
     assert max(beyond) < 0.0, sorted(beyond)[-3:]
+
+
+def test_cars_at_a_wide_median_stand_in_a_carriageway() -> None:
+    # Moscow's Academician Korolev Street: two carriageways 23 m apart, each 11 m from the
+    # merged axis; the car is placed on one of them (none was placed with a 10 m reach).
+    m = load_map(OSM / "moscow_ostankino.osm.gz", 55.8215, 37.6038, radius_m=300)
+    inter, _ = m.match_intersection(lat=55.8214925, lon=37.6037556, max_distance_m=15)
+    assert inter is not None
+    assert min(s.carriageways for s in inter.streets) == 2
+    beyond = []
+    for seed in range(4):
+        ls = make_located_scene(m, inter, np.random.default_rng(seed), noise=NoiseModel.exact())
+        assert ls is not None
+        beyond.append(_beyond_nearest_carriageway_m(m, _car_side_midpoint_enu(ls)))
+    assert max(beyond) < 0.0, beyond

@@ -332,7 +332,8 @@ def make_located_scene(
         # In a lane of the street's real centre line (it may bend), parallel to it there: of
         # a dual carriageway, the nearer carriageway's line, within that carriageway's half
         # width (the intersection's street.width_m spans both and the median).
-        on_line = _along_street(lines, street.name, centre + dist * along, along)
+        reach_m = max(10.0, street.width_m / 2) if street.carriageways > 1 else 10.0
+        on_line = _along_street(lines, street.name, centre + dist * along, along, max_m=reach_m)
         half_width_m = (
             on_line[2] if on_line is not None else street.width_m / 2 / street.carriageways
         )
@@ -556,19 +557,25 @@ def _street_lines_enu(
 
 
 def _along_street(
-    lines: list[tuple[str, Any, float]], name: str, point: FloatArray, along: FloatArray
+    lines: list[tuple[str, Any, float]],
+    name: str,
+    point: FloatArray,
+    along: FloatArray,
+    max_m: float = 10.0,
 ) -> tuple[FloatArray, FloatArray, float] | None:
     """The nearest point of the named street's centre line, its direction and half width.
 
     The direction is the chord over ±5 m (as :mod:`camloc_geo.absolute` measures a street
     under the car), oriented like ``along``; the half width (metres) is that centre line's
-    own carriageway's. None when the street is not within 10 m.
+    own carriageway's. None when the street is not within ``max_m`` metres (a dual
+    carriageway's merged axis runs down its median: its carriageways lie within half its
+    outer width).
     """
     from shapely.geometry import Point
 
     pt = Point(float(point[0]), float(point[1]))
     near = [(line.distance(pt), line, hw) for n, line, hw in lines if n == name]
-    near = [x for x in near if x[0] < 10.0]
+    near = [x for x in near if x[0] < max_m]
     if not near:
         return None
     _, line, half_width_m = min(near, key=lambda x: x[0])
