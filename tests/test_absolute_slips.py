@@ -713,3 +713,45 @@ def test_a_best_candidate_beyond_the_prior_is_warned(baltimore: MapData) -> None
     assert len(warned) == 1
     d = float(re.search(r"stands (\d+) m from", warned[0]).group(1))
     assert 150 <= d <= 210
+
+
+def test_rounding_m_reads_a_lat_lon_given_short() -> None:
+    from camloc_geo.absolute._pipeline import rounding_m
+
+    assert rounding_m(17.71025171096887, -64.87857133662945) == 0.0
+    assert rounding_m(17.7103, -64.8786) == pytest.approx(
+        0.5e-4 * 111_320.0 * np.hypot(1.0, np.cos(np.radians(17.7103))), rel=1e-9
+    )
+    assert rounding_m(17.7, -64.88) == pytest.approx(10 * rounding_m(17.7, -64.876), rel=1e-3)
+    assert rounding_m(42.51234, 1.53591) == 0.0  # 5 decimals: 1 m steps, no slip
+
+
+def test_two_references_one_rounded_to_4_decimals_are_warned() -> None:
+    # absolute_slips --set held-out-2 scene 57 (Frederiksted, a T junction): a reference's
+    # lat/lon rounded to 4 decimals (6 m off) put the camera 22 m off with a sigma_m of 4 m
+    # and no warning: the fragile test moved a reference by 3 m, a lever of 2.4 short of 15 m.
+    m = load_map(OSM / "frederiksted.osm.pbf", 17.7125, -64.8820, radius_m=600)
+    inter = m.intersection("n310811180")
+    ls = make_located_scene(
+        m,
+        inter,
+        np.random.default_rng([39, 57]),
+        noise=NoiseModel(),
+        corner_sigma_m=1.5,
+        n_references=2,
+        max_corners=4,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene["references"] = scene["references"][:2]
+    clean = locate(parse_scene(scene), m)
+    assert not [w for w in clean.warnings if "4 decimals" in w]
+    ref = scene["references"][0]
+    ref["lat"], ref["lon"] = round(ref["lat"], 4), round(ref["lon"], 4)
+    res = locate(parse_scene(scene), m)
+    assert _errors(res, ls)[0] > 15.0  # still wrong...
+    warned = [w for w in res.warnings if "4 decimals or fewer" in w]
+    assert len(warned) == 1, res.warnings  # ...and said to rest on the rounded lat/lon
+    moved = float(re.search(r"move the camera about (\d+) m", warned[0]).group(1))
+    assert moved > 15.0

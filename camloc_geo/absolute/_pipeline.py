@@ -191,7 +191,7 @@ def _locate_once(
         _warn_one_corner_decides(ev, settings, result)
         _warn_substituted_landmark(result)
         _warn_landmarks_off_street(ev, result)
-        _warn_fragile_references(ev, result)
+        _warn_fragile_references(scene, ev, result)
         _warn_reference_corner(result)
         _warn_outside_prior(ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
@@ -565,7 +565,24 @@ WRONG_M = 15.0
 """A camera moved farther than this stands somewhere else (the benchmarks' wrong answer)."""
 
 
-def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
+def rounding_m(lat: float, lon: float, max_decimals: int = 4) -> float:
+    """How far a lat/lon given with at most ``max_decimals`` decimals may lie from the point
+    it rounds, metres: half its last step in latitude and in longitude, together (the
+    diagonal); 0 for a lat/lon with more decimals.
+
+    A precise lat/lon has 4 decimals or fewer in both numbers about once in 10^8 draws; a
+    rounded one (copied from a listing, typed short) is up to 5.6 m off in latitude at 4,
+    and 5.6 m times cos(lat) in longitude.
+    """
+    for k in range(max_decimals + 1):
+        scale = 10.0**k
+        if all(abs(v * scale - round(v * scale)) < 1e-6 for v in (lat, lon)):
+            half_m = 0.5 / scale * 111_320.0
+            return float(math.hypot(half_m, half_m * math.cos(math.radians(lat))))
+    return 0.0
+
+
+def _warn_fragile_references(scene: Scene, ev: Evidence, result: LocateResult) -> None:
     """Warn when two references alone leave the answer fragile: one reference's lat/lon
     :data:`REFERENCE_SLIP_M` off across their baseline would move the camera farther than
     :data:`WRONG_M` and than two of its ``sigma_m``.
@@ -577,6 +594,10 @@ def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
     of 5-13 turned 3-8 m slips (a pixel on the kerb for a lat/lon on the centre line, four
     decimals) into answers 18-74 m off with sigmas of 4-10 m (``benchmarks/absolute_slips.py``,
     session 38). The warning says how far and what would hold the answer.
+
+    A reference whose lat/lon has 4 decimals or fewer (:func:`rounding_m`) slips by its
+    rounding's half step, 5.6 m at 4 decimals: the 3 m slip left two rounded references
+    unwarned 17-22 m off (``absolute_slips.py --set held-out-2``, ``reference_4_decimals``).
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
         return
@@ -590,17 +611,25 @@ def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
         return
     cam = top.east_north
     lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
-    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b))
+    rounded = max(
+        (rounding_m(r.lat, r.lon) for r in scene.references[:2]),
+        default=0.0,
+    )
+    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b), rounded)
     move = slip * lever
     sigma = top.sigma_m if top.sigma_m is not None else 0.0
     if move <= max(WRONG_M, 2.0 * sigma):
         return
+    why = (
+        "a lat/lon given with 4 decimals or fewer, rounded"
+        if rounded >= slip
+        else "a pixel on the kerb for a point on the centre line, a rounded lat/lon"
+    )
     result.warnings.append(
         f"references: the two references are {baseline:.0f} m apart and the camera "
         f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
-        f"{slip:.0f} m off across them (a pixel on the kerb for a point on the "
-        f"centre line, a rounded lat/lon) would move the camera about {move:.0f} m, beyond "
-        "its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
+        f"{slip:.0f} m off across them ({why}) would move the camera about {move:.0f} m, "
+        "beyond its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
         "landmark"
     )
 
