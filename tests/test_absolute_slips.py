@@ -755,3 +755,40 @@ def test_two_references_one_rounded_to_4_decimals_are_warned() -> None:
     assert len(warned) == 1, res.warnings  # ...and said to rest on the rounded lat/lon
     moved = float(re.search(r"move the camera about (\d+) m", warned[0]).group(1))
     assert moved > 15.0
+
+
+def test_corners_that_put_the_car_across_its_street_are_warned() -> None:
+    # absolute_slips --n 120 scene 53 (Berlin, a dual carriageway): one corner clicked where
+    # the centre lines cross fits a placement 80 m off whose car stands across its street
+    # (sigma_m 4 m), with no warning. The clean list's answer is right and not warned so.
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from absolute_slips import Ctx, slip_centreline
+
+    m = load_map(OSM / "berlin_alexanderplatz.osm.pbf", 52.521915, 13.413215, radius_m=600)
+    inter = m.intersection("c21432799")
+    ls = make_located_scene(
+        m,
+        inter,
+        np.random.default_rng([0, 53]),
+        noise=NoiseModel(),
+        corner_sigma_m=1.5,
+        n_references=2,
+        max_corners=4,
+    )
+    assert ls is not None
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("references")
+    clean = locate(parse_scene(scene), m)
+    assert _errors(clean, ls)[0] < 10.0
+    assert not [w for w in clean.warnings if w.startswith("corners: the best candidate puts")]
+    rng = np.random.default_rng([0, 53, 7, len("corner_centreline")])
+    slipped = slip_centreline(json.loads(json.dumps(scene)), Ctx(m, inter, ls, rng))
+    assert slipped is not None
+    res = locate(parse_scene(slipped), m)
+    assert _errors(res, ls)[0] > 15.0
+    assert not res.candidates[0].ambiguous_with
+    warned = [w for w in res.warnings if w.startswith("corners: the best candidate puts")]
+    assert len(warned) == 1, res.warnings
+    assert "across its street" in warned[0]
