@@ -289,7 +289,8 @@ def make_located_scene(
 ) -> LocatedScene | None:
     """A camera near a real intersection of ``map_data`` looking at a car and kerb corners.
 
-    The car stands in a lane of one of the intersection's streets, parallel to it; the
+    The car stands in a lane of one of the intersection's streets, parallel to it (at a dual
+    carriageway in one of its two carriageways, within that carriageway's half width); the
     camera, 2.5-14 m high, 12-45 m from the intersection centre, looks towards it. The
     real kerb corners differ from the map's by ``corner_sigma_m`` (the map model's error);
     their pixels (with click noise) are listed clockwise on screen. Returns None when no
