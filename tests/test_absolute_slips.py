@@ -2,7 +2,8 @@
 
 Each test is a slip that used to give a confidently wrong answer (the top candidate far off,
 no warning, no tie); noise-free annotations at real Baltimore junctions, so every figure is
-the slip's alone.
+the slip's alone, but for the benchmark scenes replayed (seeded, with ``NoiseModel()``) in
+Andorra, Frederiksted and Berlin.
 """
 
 from __future__ import annotations
