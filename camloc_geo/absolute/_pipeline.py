@@ -191,8 +191,10 @@ def _locate_once(
         _warn_one_corner_decides(ev, settings, result)
         _warn_substituted_landmark(result)
         _warn_landmarks_off_street(ev, result)
-        _warn_fragile_references(ev, result)
+        _warn_corners_car_off_street(ev, result)
+        _warn_fragile_references(scene, ev, result)
         _warn_reference_corner(result)
+        _warn_outside_prior(ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
         if top_ev is not None and top_ev.intersection is not None:
             result.intersection = top_ev.intersection
@@ -564,7 +566,24 @@ WRONG_M = 15.0
 """A camera moved farther than this stands somewhere else (the benchmarks' wrong answer)."""
 
 
-def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
+def rounding_m(lat: float, lon: float, max_decimals: int = 4) -> float:
+    """How far a lat/lon given with at most ``max_decimals`` decimals may lie from the point
+    it rounds, metres: half its last step in latitude and in longitude, together (the
+    diagonal); 0 for a lat/lon with more decimals.
+
+    A precise lat/lon has 4 decimals or fewer in both numbers about once in 10^8 draws; a
+    rounded one (copied from a listing, typed short) is up to 5.6 m off in latitude at 4,
+    and 5.6 m times cos(lat) in longitude.
+    """
+    for k in range(max_decimals + 1):
+        scale = 10.0**k
+        if all(abs(v * scale - round(v * scale)) < 1e-6 for v in (lat, lon)):
+            half_m = 0.5 / scale * 111_320.0
+            return float(math.hypot(half_m, half_m * math.cos(math.radians(lat))))
+    return 0.0
+
+
+def _warn_fragile_references(scene: Scene, ev: Evidence, result: LocateResult) -> None:
     """Warn when two references alone leave the answer fragile: one reference's lat/lon
     :data:`REFERENCE_SLIP_M` off across their baseline would move the camera farther than
     :data:`WRONG_M` and than two of its ``sigma_m``.
@@ -576,6 +595,10 @@ def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
     of 5-13 turned 3-8 m slips (a pixel on the kerb for a lat/lon on the centre line, four
     decimals) into answers 18-74 m off with sigmas of 4-10 m (``benchmarks/absolute_slips.py``,
     session 38). The warning says how far and what would hold the answer.
+
+    A reference whose lat/lon has 4 decimals or fewer (:func:`rounding_m`) slips by its
+    rounding's half step, 5.6 m at 4 decimals: the 3 m slip left two rounded references
+    unwarned 17-22 m off (``absolute_slips.py --set held-out-2``, ``reference_4_decimals``).
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
         return
@@ -589,17 +612,25 @@ def _warn_fragile_references(ev: Evidence, result: LocateResult) -> None:
         return
     cam = top.east_north
     lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
-    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b))
+    rounded = max(
+        (rounding_m(r.lat, r.lon) for r in scene.references[:2]),
+        default=0.0,
+    )
+    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b), rounded)
     move = slip * lever
     sigma = top.sigma_m if top.sigma_m is not None else 0.0
     if move <= max(WRONG_M, 2.0 * sigma):
         return
+    why = (
+        "a lat/lon given with 4 decimals or fewer, rounded"
+        if rounded >= slip
+        else "a pixel on the kerb for a point on the centre line, a rounded lat/lon"
+    )
     result.warnings.append(
         f"references: the two references are {baseline:.0f} m apart and the camera "
         f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
-        f"{slip:.0f} m off across them (a pixel on the kerb for a point on the "
-        f"centre line, a rounded lat/lon) would move the camera about {move:.0f} m, beyond "
-        "its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
+        f"{slip:.0f} m off across them ({why}) would move the camera about {move:.0f} m, "
+        "beyond its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
         "landmark"
     )
 
@@ -652,6 +683,35 @@ def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
         f"landmarks: the best candidate puts the car {where}; if the car does stand on a "
         "street, along it, a landmark is named wrong (the building next to it, a name that "
         "moved) or its pixel is not that building's corner: check the names, or add a "
+        "reference"
+    )
+
+
+def _warn_corners_car_off_street(ev: Evidence, result: LocateResult) -> None:
+    """Warn when kerb corners alone put the best candidate's car off or across its street.
+
+    The map's witness, as for landmarks (:func:`_warn_landmarks_off_street`): a corner
+    clicked where the centre lines cross can fit a wrong placement whose car stands across
+    its street, 80 m off with a sigma of 4 m, unwarned (``benchmarks/absolute_slips.py
+    --n 120``, ``corner_centreline``). Until stop 39 the scene maker put cars beside dual
+    carriageways, and 6 of 89 right clean answers had their car so flagged; with cars in
+    their carriageway, 1 of 91, and the warning fires on none of the 120 clean corner runs.
+    """
+    if not ev.corners or ev.refs or ev.landmarks or not result.candidates:
+        return
+    top = result.candidates[0]
+    if top.method != "corners" or top.ambiguous_with:
+        return
+    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
+    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
+        return
+    where = _car_where(kinds)
+    if where is None:
+        return
+    result.warnings.append(
+        f"corners: the best candidate puts the car {where}; if the car does stand on a "
+        "street, along it, the corners are read wrong (one clicked off its kerb corner, "
+        "listed in another order, another junction's?): check the corners, or add a "
         "reference"
     )
 
@@ -813,8 +873,10 @@ def _rough_point_candidates(
         or hint.lon is None
         or ev.intersection is None
         or not ev.corners
-        or not fits_badly(named_cands)
     ):
+        return []
+    if not fits_badly(named_cands):
+        _warn_rough_point(scene, map_data, world_cam, ev, settings, result, named_cands)
         return []
     out = _rough_point_alternatives(scene, map_data, world_cam, ev, settings, result)
     if not out:
@@ -826,6 +888,68 @@ def _rough_point_candidates(
     if max(map(_weight, out)) > max(map(_weight, named_cands)):
         return out
     return []
+
+
+ROUGH_POINT_WARN_M = 10.0
+"""A stated intersection lat/lon this far or farther from every node of the junction it
+names (and from its centre) is read as possibly rough (:func:`_warn_rough_point`). A point
+taken from the map stands on the junction (the benchmarks' clean scenes: 0 m); a webcam
+listing's rough point that happens to land within 25 m of a junction, 0-25 m from it."""
+
+ROUGH_POINT_AS_WELL = math.log(10.0)
+"""Another junction "fits as well" when its best candidate's fit (likelihood and map
+plausibility, its prior odds left out) is within this (log odds of 10 to 1) of the stated
+junction's best, and it does not fit badly itself (:func:`fits_badly`)."""
+
+
+def _warn_rough_point(
+    scene: Scene,
+    map_data: MapData,
+    world_cam: Camera,
+    ev: Evidence,
+    settings: LocateSettings,
+    result: LocateResult,
+    named_cands: list[Candidate],
+) -> None:
+    """Warn when a stated intersection lat/lon off its junction's nodes could be a rough
+    point that landed near the wrong junction: another junction around fits as well.
+
+    The stated junction fits well, so it is taken at its word (:func:`_rough_point_candidates`);
+    but a rough point (a webcam listing's, 50-150 m off) lands within 25 m of another junction
+    about one time in four, and where that junction has the same shape the corners fit it as
+    well: the answer was wrong by 90-180 m with no warning (``benchmarks/absolute_slips.py
+    --set held-out-2``'s ``intersection_latlon_off``, 4 of 149). Only points at least
+    :data:`ROUGH_POINT_WARN_M` from the junction's nodes pay the search.
+    """
+    hint = scene.intersection
+    assert hint is not None
+    assert hint.lat is not None
+    assert hint.lon is not None
+    assert ev.intersection is not None
+    own = ev.intersection
+    d_own = map_data.distance_to_m(own, lat=hint.lat, lon=hint.lon)
+    if d_own < ROUGH_POINT_WARN_M or not named_cands:
+        return
+    alts = _rough_point_alternatives(scene, map_data, world_cam, ev, settings, result)
+    if not alts or fits_badly(alts):
+        return
+    best_own = max(map(_weight, named_cands))
+    best = max(alts, key=lambda c: _weight(c) - c.log_prior_odds)
+    if _weight(best) - best.log_prior_odds < best_own - ROUGH_POINT_AS_WELL:
+        return
+    if best.intersection_id is None:
+        return
+    there = map_data.intersection(best.intersection_id)
+    d_there = map_data.distance_to_m(there, lat=hint.lat, lon=hint.lon)
+    result.warnings.append(
+        f"intersection: the scene's intersection lat/lon (lat={hint.lat:.6f}, "
+        f"lon={hint.lon:.6f}) stands {d_own:.0f} m from junction {own.id} "
+        f"({' & '.join(own.street_names)}), not on it, and junction {there.id} "
+        f"({' & '.join(there.street_names)}), {d_there:.0f} m from the point, fits the corners "
+        "as well; the answer stands at the stated junction. Is the lat/lon a rough point (a "
+        "webcam listing's)? Check the junction, or give the junction's own lat/lon or its "
+        "street names"
+    )
 
 
 def _rough_point_alternatives(
@@ -911,6 +1035,30 @@ def _warn_searched_junction(scene: Scene, ev: Evidence, result: LocateResult) ->
         f"{head}: the best candidate stands at junction {inter.id} "
         f"({' & '.join(inter.street_names)}), {d:.0f} m from the stated point; check the "
         "intersection's lat/lon"
+    )
+
+
+def _warn_outside_prior(ev: Evidence, result: LocateResult) -> None:
+    """Warn when the best candidate stands beyond the scene's prior radius.
+
+    Its score paid for it (the prior's Gaussian factor, flag ``outside_prior``), but a flag
+    alone says nothing to the user: a rough intersection lat/lon that landed on another
+    junction put the answer 148 m off, outside the stated prior, with no warning
+    (``benchmarks/absolute_slips.py --set held-out-2``, ``intersection_latlon_off``). A right
+    answer stands within the prior whenever the prior is right, so it does not fire on them.
+    """
+    if not result.candidates or ev.prior_en is None or not ev.prior_radius_m:
+        return
+    top = result.candidates[0]
+    if FlagKind.OUTSIDE_PRIOR not in {f.kind for f in top.flags}:
+        return
+    d = float(np.linalg.norm(top.east_north - ev.prior_en))
+    if d <= ev.prior_radius_m:
+        return
+    result.warnings.append(
+        f"prior: the best candidate stands {d:.0f} m from the scene's prior, beyond its "
+        f"radius_m ({ev.prior_radius_m:.0f} m): the other evidence outweighed it; check the "
+        "prior, or the evidence that put the camera there (the intersection's lat/lon?)"
     )
 
 

@@ -289,7 +289,8 @@ def make_located_scene(
 ) -> LocatedScene | None:
     """A camera near a real intersection of ``map_data`` looking at a car and kerb corners.
 
-    The car stands in a lane of one of the intersection's streets, parallel to it; the
+    The car stands in a lane of one of the intersection's streets, parallel to it (at a dual
+    carriageway in one of its two carriageways, within that carriageway's half width); the
     camera, 2.5-14 m high, 12-45 m from the intersection centre, looks towards it. The
     real kerb corners differ from the map's by ``corner_sigma_m`` (the map model's error);
     their pixels (with click noise) are listed clockwise on screen. Returns None when no
@@ -329,14 +330,20 @@ def make_located_scene(
         along = np.array([math.sin(b), math.cos(b)])
         right = np.array([along[1], -along[0]])
         dist = float(rng.uniform(8.0, 25.0))
-        lateral = float(rng.uniform(1.2, max(1.5, street.width_m / 2 - 1.0))) * rng.choice(
-            [-1.0, 1.0]
+        # In a lane of the street's real centre line (it may bend), parallel to it there: of
+        # a dual carriageway, the nearer carriageway's line, within that carriageway's half
+        # width (the intersection's street.width_m spans both and the median).
+        reach_m = max(10.0, street.width_m / 2) if street.carriageways > 1 else 10.0
+        on_line = _along_street(lines, street.name, centre + dist * along, along, max_m=reach_m)
+        half_width_m = (
+            on_line[2] if on_line is not None else street.width_m / 2 / street.carriageways
         )
+        if on_line is None and street.carriageways > 1:
+            continue  # the merged centre line runs in the median
+        lateral = float(rng.uniform(1.2, max(1.5, half_width_m - 1.0))) * rng.choice([-1.0, 1.0])
         car_centre = centre + dist * along + lateral * right
-        # In a lane of the street's real centre line (it may bend), parallel to it there.
-        on_line = _along_street(lines, street.name, centre + dist * along, along)
         if on_line is not None:
-            base, along = on_line
+            base, along, _ = on_line
             right = np.array([along[1], -along[0]])
             car_centre = base + lateral * right
             on_line = _along_street(lines, street.name, car_centre, along)
@@ -531,8 +538,14 @@ def _projected(map_data: Any, name: str) -> tuple[Any, ...]:
     return tuple(getattr(map_data, name, ()))
 
 
-def _street_lines_enu(map_data: Any, centre: FloatArray, radius_m: float) -> list[tuple[str, Any]]:
-    """Street centre lines (ENU LineStrings) passing within ``radius_m`` of ``centre``."""
+def _street_lines_enu(
+    map_data: Any, centre: FloatArray, radius_m: float
+) -> list[tuple[str, Any, float]]:
+    """Street centre lines (ENU LineStrings) passing within ``radius_m`` of ``centre``.
+
+    Each with its name and its carriageway's half width, metres (``Street.width_m`` / 2:
+    one carriageway of a dual road).
+    """
     from shapely.geometry import Point
 
     around = Point(float(centre[0]), float(centre[1]))
@@ -540,26 +553,33 @@ def _street_lines_enu(map_data: Any, centre: FloatArray, radius_m: float) -> lis
     streets = getattr(map_data, "streets", [])
     for st, line in zip(streets, _projected(map_data, "streets_enu"), strict=True):
         if line.length > 1.0 and line.distance(around) < radius_m:
-            out.append((st.name, line))
+            out.append((st.name, line, float(st.width_m) / 2.0))
     return out
 
 
 def _along_street(
-    lines: list[tuple[str, Any]], name: str, point: FloatArray, along: FloatArray
-) -> tuple[FloatArray, FloatArray] | None:
-    """The nearest point of the named street's centre line and its direction there.
+    lines: list[tuple[str, Any, float]],
+    name: str,
+    point: FloatArray,
+    along: FloatArray,
+    max_m: float = 10.0,
+) -> tuple[FloatArray, FloatArray, float] | None:
+    """The nearest point of the named street's centre line, its direction and half width.
 
     The direction is the chord over ±5 m (as :mod:`camloc_geo.absolute` measures a street
-    under the car), oriented like ``along``; None when the street is not within 10 m.
+    under the car), oriented like ``along``; the half width (metres) is that centre line's
+    own carriageway's. None when the street is not within ``max_m`` metres (a dual
+    carriageway's merged axis runs down its median: its carriageways lie within half its
+    outer width).
     """
     from shapely.geometry import Point
 
     pt = Point(float(point[0]), float(point[1]))
-    near = [(line.distance(pt), line) for n, line in lines if n == name]
-    near = [x for x in near if x[0] < 10.0]
+    near = [(line.distance(pt), line, hw) for n, line, hw in lines if n == name]
+    near = [x for x in near if x[0] < max_m]
     if not near:
         return None
-    line = min(near, key=lambda x: x[0])[1]
+    _, line, half_width_m = min(near, key=lambda x: x[0])
     s = line.project(pt)
     a = line.interpolate(max(0.0, s - 5.0))
     b = line.interpolate(min(line.length, s + 5.0))
@@ -570,7 +590,7 @@ def _along_street(
     if float(d @ along) < 0:
         d = -d
     p = line.interpolate(s)
-    return np.array([p.x, p.y]), d
+    return np.array([p.x, p.y]), d, float(half_width_m)
 
 
 def _landmark_points(
