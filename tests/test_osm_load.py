@@ -158,6 +158,22 @@ def test_unreadable_or_empty_extract(tmp_path: Path, name: str, content: bytes) 
         load_map(tmp_path / name, 39.0, -76.0)
 
 
+@pytest.mark.parametrize("lat", ["999", "abc"])
+def test_a_node_off_the_globe_is_a_map_error(tmp_path: Path, lat: str) -> None:
+    """``<node lat="999">`` (or ``"abc"``) inside a street: osmium's InvalidLocationError was
+    not caught, so ``camloc corners`` ended "failed: InvalidLocationError ...", exit 1 (found
+    by the session-39 client sweep); it is a MapDataError naming the file, exit 2."""
+    xml = (
+        "<?xml version='1.0'?><osm version='0.6'>"
+        f"<node id='1' lat='{lat}' lon='-76.0'/><node id='2' lat='39.001' lon='-76.0'/>"
+        "<way id='5'><nd ref='1'/><nd ref='2'/><tag k='highway' v='residential'/></way>"
+        "</osm>"
+    )
+    (tmp_path / "bad.osm").write_text(xml)
+    with pytest.raises(MapDataError, match=r"bad\.osm: a node"):
+        load_map(tmp_path / "bad.osm", 39.0, -76.0)
+
+
 def test_unsupported_suffix(tmp_path: Path) -> None:
     (tmp_path / "map.txt").write_text("hello")
     with pytest.raises(MapDataError, match="unsupported"):

@@ -308,6 +308,10 @@ def read_extract(
                     buildings.append(_building_from_tags(f"way/{way.id}", tags, poly))
     except RuntimeError as exc:  # osmium's parse errors
         raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
+    except osmium.InvalidLocationError as exc:  # <node lat="999"> or lat="abc"
+        raise MapDataError(
+            f"cannot read OSM extract {path.name}: a node's coordinates are not a location ({exc})"
+        ) from exc
     except (OSError, EOFError, ValueError) as exc:
         raise MapDataError(f"cannot read OSM extract {path.name}: {exc}") from exc
 
