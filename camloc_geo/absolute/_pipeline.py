@@ -673,10 +673,7 @@ def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
     top = result.candidates[0]
     if top.method not in ("landmark", "one_landmark"):
         return
-    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
-    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
-        return
-    where = _car_where(kinds)
+    where = _top_car_where(top, ev)
     if where is None:
         return
     result.warnings.append(
@@ -685,6 +682,15 @@ def _warn_landmarks_off_street(ev: Evidence, result: LocateResult) -> None:
         "moved) or its pixel is not that building's corner: check the names, or add a "
         "reference"
     )
+
+
+def _top_car_where(top: Candidate, ev: Evidence) -> str | None:
+    """Where a candidate's car stands against its street, in words, when the map contradicts
+    it (off or across its street); None when it stands on or beside its street, along it."""
+    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
+    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
+        return None
+    return _car_where(kinds)
 
 
 def _warn_corners_car_off_street(ev: Evidence, result: LocateResult) -> None:
@@ -702,10 +708,7 @@ def _warn_corners_car_off_street(ev: Evidence, result: LocateResult) -> None:
     top = result.candidates[0]
     if top.method != "corners" or top.ambiguous_with:
         return
-    kinds = {f.kind for f in top.flags} & _CAR_FLAGS
-    if kinds == {FlagKind.CAR_OFF_STREET} and car_beside_street(top, top.evidence or ev):
-        return
-    where = _car_where(kinds)
+    where = _top_car_where(top, ev)
     if where is None:
         return
     result.warnings.append(
