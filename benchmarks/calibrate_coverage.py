@@ -66,7 +66,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from relative import _has_lines, draw_scene, parse_settings
+from relative import _has_lines, add_settings_options, draw_scene, settings_from_args
 from scipy.spatial.transform import Rotation
 
 from camloc_geo import InputError
@@ -447,20 +447,7 @@ def main(argv: list[str] | None = None) -> int:
         default=0,
         help="also N scenes of absolute.py's scene maker (focal coverage; default 0: none)",
     )
-    parser.add_argument(
-        "--jackknife-leverage",
-        action=argparse.BooleanOptionalAction,
-        default=True,
-        help="the jackknife's leverage correction, CalibrationSettings.jackknife_leverage "
-        "(default on since stop 38; --no-jackknife-leverage: stop 37's default)",
-    )
-    parser.add_argument(
-        "--class-prior",
-        type=float,
-        default=CalibrationSettings().car_class_prior,
-        help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
-        "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
-    )
+    add_settings_options(parser)
     parser.add_argument(
         "--terms",
         action="store_true",
@@ -477,12 +464,6 @@ def main(argv: list[str] | None = None) -> int:
         "by default: one pooled factor)",
     )
     parser.add_argument(
-        "--settings",
-        default="",
-        help="extra CalibrationSettings fields, NAME=VALUE[,NAME=VALUE] (a diagnostic: "
-        "e.g. jackknife_leverage_max_move=inf)",
-    )
-    parser.add_argument(
         "--sets",
         default=",".join(SETS),
         help="comma-separated sets to run (default: all, %(default)s)",
@@ -495,14 +476,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.terms:
         _record_terms()
     global SETTINGS
-    SETTINGS = CalibrationSettings(
-        **{
-            "jackknife_leverage": args.jackknife_leverage,
-            "car_class_prior": args.class_prior,
-            "variance_groups": args.variance_groups,
-        }
-        | parse_settings(args.settings)
-    )
+    SETTINGS = settings_from_args(args, variance_groups=args.variance_groups)
     logging.basicConfig(level=logging.ERROR)
     args.out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()

@@ -42,7 +42,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from relative import _has_lines, draw_scene, parse_settings
+from relative import _has_lines, add_settings_options, draw_scene, settings_from_args
 
 from camloc_geo import InputError
 from camloc_geo.objects import PRESETS
@@ -492,32 +492,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=20261124, help="random seed")
     parser.add_argument("--slips", default="", help="comma-separated slips (default: all)")
     parser.add_argument("--out", type=Path, default=OUT_DIR, help="output folder")
-    parser.add_argument(
-        "--jackknife-leverage",
-        action=argparse.BooleanOptionalAction,
-        default=True,
-        help="the jackknife's leverage correction, CalibrationSettings.jackknife_leverage "
-        "(default on since stop 38; --no-jackknife-leverage: stop 37's default)",
-    )
-    parser.add_argument(
-        "--class-prior",
-        type=float,
-        default=CalibrationSettings().car_class_prior,
-        help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
-        "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
-    )
-    parser.add_argument(
-        "--settings",
-        default="",
-        help="more CalibrationSettings fields, NAME=VALUE[,NAME=VALUE] (a diagnostic: e.g. "
-        "jackknife_leverage_max_move=inf)",
-    )
+    add_settings_options(parser)
     args = parser.parse_args(argv)
     global SETTINGS
-    SETTINGS = CalibrationSettings(
-        **{"jackknife_leverage": args.jackknife_leverage, "car_class_prior": args.class_prior}
-        | parse_settings(args.settings)
-    )
+    SETTINGS = settings_from_args(args)
     logging.basicConfig(level=logging.CRITICAL)
     logging.getLogger("camloc_geo").setLevel(logging.CRITICAL)
     slips = [s for s in args.slips.split(",") if s] or list(SLIPS)

@@ -107,6 +107,42 @@ def parse_settings(text: str) -> dict[str, Any]:
     return out
 
 
+def add_settings_options(parser: argparse.ArgumentParser) -> None:
+    """The calibrate-settings options the sigma benchmarks share (``calibrate_coverage``,
+    ``crowd_slips``): ``--jackknife-leverage``, ``--class-prior``, ``--settings``; read them
+    back with :func:`settings_from_args`."""
+    parser.add_argument(
+        "--jackknife-leverage",
+        action=argparse.BooleanOptionalAction,
+        default=True,
+        help="the jackknife's leverage correction, CalibrationSettings.jackknife_leverage "
+        "(default on since stop 38; --no-jackknife-leverage: stop 37's default)",
+    )
+    parser.add_argument(
+        "--class-prior",
+        type=float,
+        default=CalibrationSettings().car_class_prior,
+        help="CalibrationSettings.car_class_prior, the prior odds per other car preset "
+        "(default %(default)s; 0: stop 37's sigmas, no class mixture)",
+    )
+    parser.add_argument(
+        "--settings",
+        default="",
+        help="more CalibrationSettings fields, NAME=VALUE[,NAME=VALUE] (a diagnostic: e.g. "
+        "jackknife_leverage_max_move=inf)",
+    )
+
+
+def settings_from_args(args: argparse.Namespace, **fields: Any) -> CalibrationSettings:
+    """The CalibrationSettings of :func:`add_settings_options`' options, with ``fields``
+    (a benchmark's own options) under ``--settings``."""
+    return CalibrationSettings(
+        **{"jackknife_leverage": args.jackknife_leverage, "car_class_prior": args.class_prior}
+        | fields
+        | parse_settings(args.settings)
+    )
+
+
 def _has_lines(scene: dict[str, Any]) -> bool:
     """At least one annotator drew two or more segments of every axis."""
     return any(
