@@ -102,13 +102,17 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of 26 repositories (some of them large), from
+# The handheld street photos: single files of many repositories (some of them large), from
 # the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
-# "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder).
+# "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder),
+# "street-photos-held-out-3" only batch 9 (either or both).
 street_only=""
-if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]] \
-  && [[ " $CAMLOC_PHOTO_SETS " == *" street-photos-held-out-2 "* ]]; then
-  street_only="street-photos-held-out-2"
+if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]]; then
+  for s in $CAMLOC_PHOTO_SETS; do
+    if [[ "$s" =~ ^street-photos-held-out-[0-9]+$ ]]; then
+      street_only="${street_only:+$street_only }$s"
+    fi
+  done
 fi
 if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [ -n "$street_only" ] \
   || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
@@ -133,12 +137,13 @@ if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [ -n "$street_only" ] \
       failed=$((failed + 1))
     fi
   done < <(python3 -c 'import json, sys
+only = sys.argv[2].split()
 for p in json.load(open(sys.argv[1]))["photos"]:
-    if sys.argv[2] and not p["file"].startswith(sys.argv[2] + "/"):
+    if only and not any(p["file"].startswith(f + "/") for f in only):
         continue
     print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' \
     "$manifest" "$street_only")
-  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/)"
+  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/, street-photos-held-out-3/)"
   [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
 fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"
