@@ -44,6 +44,13 @@
 #                                    42 more (batch 8, set street-photos-held-out-2, into
 #                                    street-photos-held-out-2/): course and test data, no
 #                                    licence given for the photos, so kept out
+#   kernelmurton/prnu, Urban-Research-Lab/building-facades-advertising-dataset,
+#   jimlinntu/CS29426, yrlu/image_mosaic_stitching, sim-pez/prnu, nkisel/cs194-26-proj4,
+#   f0bs/Computer_Vision, felixnie/Panoramic-Image-Stitching, muhabgadir/CS194-26,
+#   shsiung/16822hw2
+#                                    16 phone photos (batch 9, set street-photos-held-out-3,
+#                                    into street-photos-held-out-3/): course and test data,
+#                                    no licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -52,7 +59,8 @@
 # files are copied out one by one, blob by blob); with none of them, GitHub is tried.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
 # "street-photos" for all the handheld street photos of benchmarks/street_photos.json, or
-# "street-photos-held-out-2" for batch 8 alone) to fetch fewer.
+# "street-photos-held-out-2" for batch 8 alone, "street-photos-held-out-3" for batch 9 alone)
+# to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""

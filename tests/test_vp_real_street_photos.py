@@ -72,6 +72,41 @@ def test_fresh_batch_is_held_out_whole_in_a_set_of_its_own() -> None:
     assert "held-out-2" not in vp_real.street_photo_halves(default_sets)
 
 
+def test_fresh_batch_9_is_phones_held_out_whole_with_views() -> None:
+    # batch 9 (stop 40): phones only, held out whole in a set of its own, each view read
+    # from the photo before any result, at most two views of one place, a cited truth
+    # wherever the 35 mm tag does not fit the frame
+    doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
+    fresh = [p for p in doc["photos"] if p["batch"] == 9]
+    assert len(fresh) >= 16
+    assert {p["half"] for p in fresh} == {"held-out-3"}
+    assert all(p["file"].startswith("street-photos-held-out-3/") for p in fresh)
+    views = [p["view"] for p in fresh]
+    assert set(views) <= {"level", "looking-up", "looking-down"}
+    assert views.count("level") >= len(fresh) // 2  # the issue's case first
+    phones = ("iPhone", "Pixel", "SM-", "ONEPLUS")
+    assert all(p["camera"].startswith(phones) for p in fresh)
+    per_source: dict[str, int] = {}
+    for p in fresh:
+        per_source[p["repo"]] = per_source.get(p["repo"], 0) + 1
+    assert max(per_source.values()) <= 2
+    for p in fresh:
+        w, h = p["size"]
+        aspect = max(w, h) / min(w, h)
+        if abs(aspect - 4 / 3) > 0.01:  # a 16:9 mode: only with a lens-and-sensor truth
+            assert p.get("truth"), p["file"]
+        if p.get("truth"):
+            t = p["truth"]
+            assert "http" in t["source"]
+            f = vp_real.sensor_focal_truth_px(t["focal_mm"], t["sensor_width_mm"], (w, h))
+            assert 0.6 < f / max(w, h) < 1.0  # a phone's main camera
+    assert vp_real.street_photo_set("held-out-3") == "street-photos-held-out-3"
+    assert "street-photos-held-out-3" in vp_real.SCENE_SETS
+    assert vp_real.street_photo_halves({"street-photos-held-out-3"}) == ("held-out-3",)
+    assert vp_real.street_photo_halves({"street-photos-held-out-2"}) == ("held-out-2",)
+    assert vp_real.street_photo_halves({"street-photos"}) == ("dev", "held-out")
+
+
 def test_loader_pins_content_and_reads_the_exif_truth(tmp_path: Path) -> None:
     photos = tmp_path / "photos"
     a = _jpeg(photos / "street-photos" / "x" / "a.jpg", (640, 480), {0xA405: 28})
@@ -227,10 +262,11 @@ def test_fetched_street_photos_match_the_manifest() -> None:
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
     pinned = [p for p in doc["photos"] if p["half"] in vp_real.STREET_PHOTO_HALVES]
     assert len(rows) == len(pinned)
-    if (photos / "street-photos-held-out-2").is_dir():  # the fresh batch: its EXIF only
-        fresh = vp_real.load_street_photos(photos, halves=vp_real.STREET_PHOTO_FRESH_HALVES)
-        assert len(fresh) == len(doc["photos"]) - len(pinned)
-        rows = rows + fresh
+    for half in vp_real.STREET_PHOTO_FRESH_HALVES:  # the fresh batches: their EXIF only
+        if (photos / vp_real.street_photo_set(half)).is_dir():
+            fresh = vp_real.load_street_photos(photos, halves=(half,))
+            assert len(fresh) == sum(p["half"] == half for p in doc["photos"])
+            rows = rows + fresh
     for t in rows:
         w, h = t["size"]
         assert 0.4 < t["f"] / max(w, h) < 5.0
@@ -331,7 +367,7 @@ def test_batch2_16_9_phone_truths_come_from_the_sensor() -> None:
     # truth is what the lens focal length over the sensor width gives (before -> after:
     # Note 3 0.822 -> 0.893, Mi A1 1.379 -> 1.498, Galaxy S5 0.823 -> 0.807 of the longer side)
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
-    with_truth = {p["camera"]: p for p in doc["photos"] if p.get("truth")}
+    with_truth = {p["camera"]: p for p in doc["photos"] if p.get("truth") and p["batch"] < 9}
     assert set(with_truth) == {"SAMSUNG-SM-N900A", "SM-G900F", "Mi A1"}
     want = {"SAMSUNG-SM-N900A": 0.893, "SM-G900F": 0.807, "Mi A1": 1.498}
     for camera, p in with_truth.items():
