@@ -322,6 +322,23 @@ def test_run_loads_the_fresh_set_only_when_named(
     with pytest.raises(LoadedError) as got:
         vp_real.main([*args, "--sets", "street-photos"])
     assert got.value.args[0] == ["street-photos/a.jpg"]
+    # batch 9's set the same way: only its own name loads it, by view
+    v = _jpeg(photos / "street-photos-held-out-3" / "z" / "v.jpg", (640, 480), {0xA405: 26})
+    entries.append(
+        {
+            "file": "street-photos-held-out-3/z/v.jpg",
+            "sha256": _sha(v),
+            "half": "held-out-3",
+            "view": "level",
+        }
+    )
+    manifest.write_text(json.dumps({"photos": entries}), encoding="utf-8")
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", "street-photos-held-out-3"])
+    assert got.value.args[0] == ["street-photos-held-out-3/level/v.jpg"]
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", "street-photos-held-out-2"])
+    assert got.value.args[0] == ["street-photos-held-out-2/looking-up/u.jpg"]
 
 
 def test_sensor_rule_gives_the_lens_over_the_sensor_width() -> None:
