@@ -743,9 +743,9 @@ def load_street_photos(
         :func:`street_photo_set` of its half, ``half`` kept; a photo with a ``view`` tag,
         "level", "looking-up" or "looking-down", keeps it, and in a fresh set its name
         carries it: ``street-photos-held-out-2/looking-up/IMG_8729.JPG``, so the run
-        summarises each view; ``f_source`` is ``"sensor-width"`` where the manifest
-        gives the truth); a photo missing, with another content or without a usable EXIF
-        focal length is skipped and counted in the log.
+        summarises each view; ``f_source`` is ``"exif-focal-mm+sensor-width"`` where the
+        manifest gives the truth); a photo missing, with another content or without a usable
+        EXIF focal length is skipped and counted in the log.
     """
     import hashlib
 
@@ -771,7 +771,7 @@ def load_street_photos(
         if ph.get("truth"):  # the lens and the sensor, where the 35 mm tag does not fit
             t = ph["truth"]
             f_px = sensor_focal_truth_px(float(t["focal_mm"]), float(t["sensor_width_mm"]), (w, h))
-            f_source = "sensor-width"
+            f_source = "exif-focal-mm+sensor-width"
         set_name = street_photo_set(ph["half"])
         view = ph.get("view")
         fresh = set_name != "street-photos" and view

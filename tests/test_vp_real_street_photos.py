@@ -372,7 +372,7 @@ def test_manifest_truth_replaces_the_exif_truth(tmp_path: Path) -> None:
     got = {t["name"]: t for t in vp_real.load_street_photos(photos, manifest)}
     sensor, tag = got["street-photos/a.jpg"], got["street-photos/b.jpg"]
     assert sensor["f"] == pytest.approx(4.13 / 4.62336 * 640, rel=1e-9)
-    assert sensor["f_source"] == "sensor-width"
+    assert sensor["f_source"] == "exif-focal-mm+sensor-width"
     assert sensor["exif"] is True  # the EXIF-kept run still reads the photo's own tags
     assert tag["f"] == pytest.approx(31.0 * (640**2 + 360**2) ** 0.5 / 43.267, rel=1e-3)
     assert tag["f_source"] == "exif-35mm"
