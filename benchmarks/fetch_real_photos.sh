@@ -44,6 +44,13 @@
 #                                    42 more (batch 8, set street-photos-held-out-2, into
 #                                    street-photos-held-out-2/): course and test data, no
 #                                    licence given for the photos, so kept out
+#   kernelmurton/prnu, Urban-Research-Lab/building-facades-advertising-dataset,
+#   jimlinntu/CS29426, yrlu/image_mosaic_stitching, sim-pez/prnu, nkisel/cs194-26-proj4,
+#   f0bs/Computer_Vision, felixnie/Panoramic-Image-Stitching, muhabgadir/CS194-26,
+#   shsiung/16822hw2, rohana96/ProjectiveGeometry
+#                                    18 phone photos (batch 9, set street-photos-held-out-3,
+#                                    into street-photos-held-out-3/): course and test data,
+#                                    no licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -52,7 +59,8 @@
 # files are copied out one by one, blob by blob); with none of them, GitHub is tried.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
 # "street-photos" for all the handheld street photos of benchmarks/street_photos.json, or
-# "street-photos-held-out-2" for batch 8 alone) to fetch fewer.
+# "street-photos-held-out-2" for batch 8 alone, "street-photos-held-out-3" for batch 9 alone)
+# to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
@@ -102,13 +110,17 @@ for full in $sets; do
   }
 done
 
-# The handheld street photos: single files of 26 repositories (some of them large), from
+# The handheld street photos: single files of many repositories (some of them large), from
 # the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
-# "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder).
+# "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder),
+# "street-photos-held-out-3" only batch 9 (either or both).
 street_only=""
-if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]] \
-  && [[ " $CAMLOC_PHOTO_SETS " == *" street-photos-held-out-2 "* ]]; then
-  street_only="street-photos-held-out-2"
+if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]]; then
+  for s in $CAMLOC_PHOTO_SETS; do
+    if [[ "$s" =~ ^street-photos-held-out-[0-9]+$ ]]; then
+      street_only="${street_only:+$street_only }$s"
+    fi
+  done
 fi
 if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [ -n "$street_only" ] \
   || [[ " $CAMLOC_PHOTO_SETS " == *" street-photos "* ]]; then
@@ -133,12 +145,13 @@ if [ -z "${CAMLOC_PHOTO_SETS:-}" ] || [ -n "$street_only" ] \
       failed=$((failed + 1))
     fi
   done < <(python3 -c 'import json, sys
+only = sys.argv[2].split()
 for p in json.load(open(sys.argv[1]))["photos"]:
-    if sys.argv[2] and not p["file"].startswith(sys.argv[2] + "/"):
+    if only and not any(p["file"].startswith(f + "/") for f in only):
         continue
     print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' \
     "$manifest" "$street_only")
-  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/)"
+  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/, street-photos-held-out-3/)"
   [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
 fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"

@@ -7,8 +7,9 @@ Usage::
                                  [--sets strecha,sceaux,perrot,lund,street-photos,exif,yud]
                                  (lund-dev, lund-held-out: one half of the Lund scenes;
                                   street-photos-dev, street-photos-held-out: one half of
-                                  the handheld street photos; street-photos-held-out-2:
-                                  the fresh batch 8, only when named;
+                                  the handheld street photos; street-photos-held-out-2,
+                                  street-photos-held-out-3: the fresh batches 8 and 9,
+                                  each only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
     python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
@@ -85,6 +86,9 @@ The photos (none of them is in this repository; their licences keep them out):
     measured once (files under ``street-photos-held-out-2/``). Each has a ``view`` read
     from the photo before any result ("level", "looking-up", "looking-down"); the run
     also summarises each view (``street-photos-held-out-2 / looking-up``).
+``street-photos-held-out-3`` (only when ``--sets`` names it)
+    Batch 9 (stop 40): a further fresh batch held out whole in the same way (files under
+    ``street-photos-held-out-3/``), phones first, to be measured once; summarised by view.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
     (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
@@ -374,7 +378,11 @@ LUND_SCENES = {
     7: "heidelberg-castle",
 }
 #: Sets summarised by scene too (the second part of a photo's name).
-SCENE_SETS = ("lund", "street-photos-held-out-2")  # and the fresh street photos by view
+SCENE_SETS = (  # and the fresh street photos by view
+    "lund",
+    "street-photos-held-out-2",
+    "street-photos-held-out-3",
+)
 #: The Lund scenes split by building, so that a change tuned on some is checked on others:
 #: the development half (looked at, its debug drawings read) and the held-out half (only
 #: its summary figures are read). Each half has one scene where the focal length is loose
@@ -633,16 +641,49 @@ def load_drive_set(
 
 
 #: Handheld street photos (sets ``street-photos``, ``street-photos-dev``,
-#: ``street-photos-held-out``, ``street-photos-held-out-2``): file, sha256, source, half;
-#: truth from their EXIF.
+#: ``street-photos-held-out``, ``street-photos-held-out-2``, ``street-photos-held-out-3``):
+#: file, sha256, source, half; truth from their EXIF, or from the lens focal length and the
+#: sensor's published width where the manifest gives a ``truth`` (see
+#: :func:`sensor_focal_truth_px`).
 STREET_PHOTOS = HERE / "street_photos.json"
 #: The halves of the street photos of batches 1-7 (set ``street-photos``), fixed by a rule
 #: before any result was read.
 STREET_PHOTO_HALVES = ("dev", "held-out")
 #: Fresh held-out batches, each its own set (``street-photos-<half>``), loaded only when
 #: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
-#: one had run ``camloc vp`` on, to be measured once.
-STREET_PHOTO_FRESH_HALVES = ("held-out-2",)
+#: one had run ``camloc vp`` on, measured once at the end of stop 39 (development since), and
+#: batch 9 (stop 40, ``held-out-3``), fresh again, to be measured once.
+STREET_PHOTO_FRESH_HALVES = ("held-out-2", "held-out-3")
+
+
+def sensor_focal_truth_px(focal_mm: float, sensor_width_mm: float, size: tuple[int, int]) -> float:
+    """The focal length in pixels from the lens focal length and the sensor's width.
+
+    The truth for a photo whose ``FocalLengthIn35mmFilm`` does not fit its frame: a phone's
+    16:9 mode crops the top and bottom of a 4:3 sensor, while the tag (a 35 mm equivalent
+    on the diagonal) is written for the 4:3 frame, so the diagonal rule
+    (``f35 * diagonal_px / 43.27``) reads it about 8 % low. The photo's longer side spans
+    the sensor's full width either way (a 16:9 crop of a 4:3 sensor, a natively 16:9
+    sensor, a 4:3 photo; resized or not, as long as it is not cropped).
+
+    Parameters
+    ----------
+    focal_mm
+        The lens focal length (EXIF ``FocalLength``), millimetres.
+    sensor_width_mm
+        The width of the sensor area the photo spans (published pixel pitch times the
+        sensor's pixel columns at that width), millimetres.
+    size
+        The photo as stored, ``(width, height)`` in pixels (either orientation).
+
+    Returns
+    -------
+    float
+        Focal length in pixels of the stored photo.
+    """
+    if not (focal_mm > 0.0 and sensor_width_mm > 0.0):
+        raise ValueError(f"focal_mm and sensor_width_mm must be > 0: {focal_mm}, {sensor_width_mm}")
+    return focal_mm / sensor_width_mm * float(max(size))
 
 
 def street_photo_set(half: str) -> str:
@@ -688,9 +729,12 @@ def load_street_photos(
         relative to it).
     manifest
         :data:`STREET_PHOTOS`: ``photos`` (file, sha256, repository, commit, path,
-        camera, scene, ``half``).
+        camera, scene, ``half``; optionally ``truth``: ``focal_mm`` and
+        ``sensor_width_mm`` with their ``source``, which replaces the EXIF truth by
+        :func:`sensor_focal_truth_px`).
     halves
-        Which halves to load (``"dev"``, ``"held-out"``, ``"held-out-2"``).
+        Which halves to load (``"dev"``, ``"held-out"``, ``"held-out-2"``,
+        ``"held-out-3"``).
 
     Returns
     -------
@@ -699,7 +743,8 @@ def load_street_photos(
         :func:`street_photo_set` of its half, ``half`` kept; a photo with a ``view`` tag,
         "level", "looking-up" or "looking-down", keeps it, and in a fresh set its name
         carries it: ``street-photos-held-out-2/looking-up/IMG_8729.JPG``, so the run
-        summarises each view); a photo missing, with another content or without a usable
+        summarises each view; ``f_source`` is ``"exif-focal-mm+sensor-width"`` where the
+        manifest gives the truth); a photo missing, with another content or without a usable
         EXIF focal length is skipped and counted in the log.
     """
     import hashlib
@@ -722,6 +767,11 @@ def load_street_photos(
             no_exif += 1
             continue
         ex, (w, h) = got
+        f_px, f_source = ex.focal_px, ex.source
+        if ph.get("truth"):  # the lens and the sensor, where the 35 mm tag does not fit
+            t = ph["truth"]
+            f_px = sensor_focal_truth_px(float(t["focal_mm"]), float(t["sensor_width_mm"]), (w, h))
+            f_source = "exif-focal-mm+sensor-width"
         set_name = street_photo_set(ph["half"])
         view = ph.get("view")
         fresh = set_name != "street-photos" and view
@@ -731,8 +781,8 @@ def load_street_photos(
             if fresh
             else f"{set_name}/{Path(ph['file']).name}",
             "path": str(path),
-            "f": ex.focal_px,
-            "f_source": ex.source,
+            "f": f_px,
+            "f_source": f_source,
             "pp": (w / 2.0, h / 2.0),
             "up": None,
             "size": (w, h),
