@@ -132,9 +132,14 @@ class CalibrationSettings:
         over-states the spread of an answer resting unevenly on its annotators); on by
         default since stop 38. The factor is the normal equations' at the joint solution: a
         leave-out that moves the focal length or the camera's distance from the car by more
-        than ``jackknife_leverage_max_move`` (10 %) is beyond that linearisation and keeps its
-        whole move. Crowd set (seed 7, 240 scenes): focal 1 sigma 82 -> 80 %, median
-        error/sigma 0.50 -> 0.56; ``benchmarks/README.md``, calibrate_coverage.
+        than ``jackknife_leverage_max_move`` (10 %) keeps its whole move (the guard, for a
+        move beyond that linearisation). Crowd set (seed 7, 240 scenes): focal 1 sigma
+        82 -> 80 %, median error/sigma 0.50 -> 0.56; ``benchmarks/README.md``,
+        calibrate_coverage. Stop 40 measured the factor where such leave-outs land: 1.05x
+        the joint solution's (median), so the guard widens what the correction would state
+        (crowd focal 1 sigma 81 -> 82 %, 4 development seeds); it stays because without it
+        slips whose sigma it widens look sure (crowd_slips confidently wrong 15 -> 19 of
+        3,360; ``inf`` turns it off).
     car_class_prior
         Where the size is a car preset's, the prior odds (per other preset) that the car is of
         that class instead. Each class whose proportions fit the clicked box better than the
@@ -4208,8 +4213,9 @@ def _leverage_for_moves(
 
     The leverage is the normal equations' at the joint solution: a leave-out that moves the
     focal length or the camera's distance from the car by more than ``max_move`` (a
-    fraction) is beyond that linearisation, and keeps its whole move (factor 1). None where
-    :func:`_leverage_factors` is.
+    fraction) keeps its whole move (factor 1; see ``CalibrationSettings``: measured where
+    such leave-outs land, the factor is about the joint solution's, so this widens). None
+    where :func:`_leverage_factors` is.
     """
     lev = _leverage_factors(state, groups)
     if lev is None:
