@@ -121,18 +121,25 @@ class CalibrationSettings:
         photo's lines, where they joined the fit, are left out in turn as one more group).
         ``one_step``: per left-out annotator, the Newton step of the infinitesimal
         jackknife from the joint solution and one Gauss-Newton step more, on the fit's own
-        residuals and Jacobian (no refits; ~2 ms; within 10 % of the refits' sigmas in
-        80-95 % of crowd scenes, ``benchmarks/calibrate_speed.py``); ``refit``: the whole
-        calibration repeated without each annotator (the reference, ~5x one fit).
+        residuals and Jacobian (no refits; ~2 ms; all six of the position's and rotation's
+        sigmas within 10 % of the refits' in 100 % of 20 crowd scenes,
+        ``benchmarks/calibrate_speed.py``); ``refit``: the whole calibration repeated
+        without each annotator (the reference, ~5x one fit). Both scale the moves by the
+        leverage correction below (the refits since stop 40).
     jackknife_leverage, jackknife_leverage_max_move
-        ``one_step`` only: scale each leave-out's move by its annotator's leverage
+        Scale each leave-out's move by its annotator's leverage
         (:func:`_leverage_factors`, the "CR2" correction of the delete-one jackknife, which
         over-states the spread of an answer resting unevenly on its annotators); on by
         default since stop 38. The factor is the normal equations' at the joint solution: a
         leave-out that moves the focal length or the camera's distance from the car by more
-        than ``jackknife_leverage_max_move`` (10 %) is beyond that linearisation and keeps its
-        whole move. Crowd set (seed 7, 240 scenes): focal 1 sigma 82 -> 80 %, median
-        error/sigma 0.50 -> 0.56; ``benchmarks/README.md``, calibrate_coverage.
+        than ``jackknife_leverage_max_move`` (10 %) keeps its whole move (the guard, for a
+        move beyond that linearisation). Crowd set (seed 7, 240 scenes): focal 1 sigma
+        82 -> 80 %, median error/sigma 0.50 -> 0.56; ``benchmarks/README.md``,
+        calibrate_coverage. Stop 40 measured the factor where such leave-outs land: 1.05x
+        the joint solution's (median), so the guard widens what the correction would state
+        (crowd focal 1 sigma 81 -> 82 %, 4 development seeds); it stays because without it
+        slips whose sigma it widens look sure (crowd_slips confidently wrong 15 -> 19 of
+        3,360; ``inf`` turns it off).
     car_class_prior
         Where the size is a car preset's, the prior odds (per other preset) that the car is of
         that class instead. Each class whose proportions fit the clicked box better than the
@@ -3693,6 +3700,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
     influence (how far the camera moves without them) goes to ``annotator_influence_m``.
     Where the fit used lines detected in the scene's photo (``photo_segments``), the photo
     is one more witness: a refit without its lines (``photo_lines`` off) joins the spread.
+    With ``jackknife_leverage`` each refit's move is scaled by its group's leverage, as the
+    one-step jackknife's (:func:`_leverage_for_moves`): the two estimate the same spread.
     """
     n = len(scene.annotations)
     c = result.camera.center_in_world
@@ -3726,7 +3735,8 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
         leave_outs.append((scene, replace(sub_settings, photo_lines=False)))
     if result.video_segments:
         leave_outs.append((scene, replace(sub_settings, video_lines=None)))
-    for sub, sub_set in leave_outs:
+    groups: list[int] = []  # each kept camera's group (as _leverage_factors numbers them)
+    for k, (sub, sub_set) in enumerate(leave_outs):
         try:
             res = _calibrate_usable(sub, sub_set)
         except (InputError, np.linalg.LinAlgError):
@@ -3735,6 +3745,7 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
         if res.width_sign != result.width_sign or implausibility(res, scene.image_size):
             influence.append(None)  # another frame, or no answer without them
             continue
+        groups.append(k)
         centres.append(res.camera.center_in_world)
         focals.append(res.camera.focal_px)
         turn = rotvec_from_rotation(res.camera.cam_from_world_rotation @ R.T)
@@ -3742,7 +3753,16 @@ def _jackknife(result: CalibrationResult, scene: Scene, settings: CalibrationSet
             turns.append(turn)
         influence.append(float(np.linalg.norm(res.camera.center_in_world - c)))
     result.annotator_influence_m = influence[:n]  # the photo's is nobody's
-    _add_jackknife_spread(result, centres, turns, focals)
+    # The same estimator as the one-step jackknife: each refit's move scaled by its group's
+    # leverage (stop 40; before, the refits' spread was the raw delete-one spread, so the
+    # one-step sigmas were compared with another estimator, benchmarks/calibrate_speed.py).
+    state = result.joint_state
+    lev = None
+    if settings.jackknife_leverage and state is not None and state.problem.n_annotators == n:
+        lev = _leverage_for_moves(
+            state, groups, focals, centres, result.camera, settings.jackknife_leverage_max_move
+        )
+    _add_jackknife_spread(result, centres, turns, focals, lev)
 
 
 def _add_jackknife_spread(
@@ -4168,20 +4188,46 @@ def _jackknife_one_step(result: CalibrationResult, settings: CalibrationSettings
     lev = None
     if settings.jackknife_leverage:  # each leave-out's move shrunk by its group's leverage
         kept_groups = [a for a in range(len(xs)) if a in answers and answers[a][1][2] > 0.0]
-        lev = _leverage_factors(state, kept_groups)
-        if lev is not None:
-            # The leverage is the normal equations' at the joint solution: a leave-out that
-            # moves the answer far (focal length or distance by more than
-            # jackknife_leverage_max_move) is beyond that linearisation, and keeps its move.
-            f0 = result.camera.focal_px
-            dist = max(float(_vector_norm(c)), 1e-9)
-            for k, a in enumerate(kept_groups):
-                f_a, c_a, _t = answers[a]
-                move = max(abs(f_a / f0 - 1.0), float(_vector_norm(c_a - c)) / dist)
-                if move > settings.jackknife_leverage_max_move:
-                    lev[k] = 1.0
+        lev = _leverage_for_moves(
+            state,
+            kept_groups,
+            focals,
+            centres,
+            result.camera,
+            settings.jackknife_leverage_max_move,
+        )
     _add_jackknife_spread(result, centres, turns, focals, lev)
     return True
+
+
+def _leverage_for_moves(
+    state: JointState,
+    groups: list[int],
+    focals: list[float],
+    centres: list[FloatArray],
+    camera: Camera,
+    max_move: float,
+) -> FloatArray | None:
+    """:func:`_leverage_factors` of the leave-outs ``groups`` that landed at ``focals`` and
+    ``centres`` (one each, in order), the answer being ``camera``.
+
+    The leverage is the normal equations' at the joint solution: a leave-out that moves the
+    focal length or the camera's distance from the car by more than ``max_move`` (a
+    fraction) keeps its whole move (factor 1; see ``CalibrationSettings``: measured where
+    such leave-outs land, the factor is about the joint solution's, so this widens). None
+    where :func:`_leverage_factors` is.
+    """
+    lev = _leverage_factors(state, groups)
+    if lev is None:
+        return None
+    c = camera.center_in_world
+    f0 = camera.focal_px
+    dist = max(float(_vector_norm(c)), 1e-9)
+    for k, (f_a, c_a) in enumerate(zip(focals, centres, strict=True)):
+        move = max(abs(f_a / f0 - 1.0), float(_vector_norm(c_a - c)) / dist)
+        if move > max_move:
+            lev[k] = 1.0
+    return lev
 
 
 def _leverage_factors(state: JointState, groups: list[int]) -> FloatArray | None:
