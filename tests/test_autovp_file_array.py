@@ -9,6 +9,7 @@ from the array). Both now go through the one conversion.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import cv2
@@ -57,6 +58,12 @@ def test_gray_files_read_as_before(tmp_path: Path, wired_photo: np.ndarray) -> N
     assert np.array_equal(load_image(path), gray)
 
 
+def _photos_dir() -> Path:
+    """Where benchmarks/fetch_real_photos.sh puts the photos (as benchmarks/vp_real.py)."""
+    default = Path.home() / ".cache" / "camloc_geo" / "photos"
+    return Path(os.environ.get("CAMLOC_PHOTOS_DIR", str(default)))
+
+
 _DOME = "street-photos/piexif/L01.jpg"
 
 
@@ -66,7 +73,7 @@ def test_a_grey_level_apart_each_reading_covers_the_other() -> None:
     hypotheses refined, one reading found a rival frame and the other did not: -53 % at a
     stated 23 % and -26 % at 7 %. With six refined for the rival frames, each reading's
     stated 2 sigma covers the other's focal length."""
-    path = Path.home() / ".cache" / "camloc_geo" / "photos" / _DOME
+    path = _photos_dir() / _DOME
     if not path.is_file():
         pytest.skip("the street photos are not fetched: run benchmarks/fetch_real_photos.sh")
     luma = cv2.imdecode(np.fromfile(str(path), dtype=np.uint8), cv2.IMREAD_GRAYSCALE)

@@ -11,6 +11,8 @@ them, is then among the outliers: a third horizontal direction.
 from __future__ import annotations
 
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -151,6 +153,12 @@ def test_a_third_direction_of_few_lines_is_not_counted(seed: int) -> None:
     assert _third(two_buildings_segments(20.0, 24, seed, n_b_rows=5)) is None
 
 
+def _photos_dir() -> Path:
+    """Where benchmarks/fetch_real_photos.sh puts the photos (as benchmarks/vp_real.py)."""
+    default = Path.home() / ".cache" / "camloc_geo" / "photos"
+    return Path(os.environ.get("CAMLOC_PHOTOS_DIR", str(default)))
+
+
 _CAMPUS = "street-photos-held-out-2/praveenVnktsh/I2_2_1.JPG"
 
 
@@ -160,9 +168,7 @@ def test_campus_photo_of_two_buildings_at_an_angle_is_not_confidently_wrong(
     """The development photo that showed it (653 x 490 px, 526 px true focal length from
     its EXIF): +101 % at a stated 8.4 %, confidence 0.73, no warning; now warned, the
     confidence under 0.5 (its estimate is the same)."""
-    from pathlib import Path
-
-    path = Path.home() / ".cache" / "camloc_geo" / "photos" / _CAMPUS
+    path = _photos_dir() / _CAMPUS
     if not path.is_file():
         pytest.skip(
             "the street photos are not fetched: CAMLOC_PHOTO_SETS=street-photos-held-out-2 "
