@@ -396,8 +396,23 @@ _quiet_users = 0
 _loud_level: int | None = None
 
 
+def _gray_from_colour(cv2: Any, buf: Any) -> Any:
+    """Decode in colour (BGR), then to gray with ``cv2.cvtColor``: the one grey conversion
+    that an array the caller decoded itself (``cv2.imread``) goes through too
+    (:func:`camloc_geo.autovp.load_image`). Decoding straight to gray (``IMREAD_GRAYSCALE``:
+    libjpeg's luma, libpng's own weights) differs from it by a grey level on up to half the
+    pixels, and the line detector's segments, and a loose photo's focal length, followed
+    that difference (issue 24: one photo read from a file and from an array, 806 and
+    1211 px)."""
+    arr = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    if arr is None:
+        return None
+    return cv2.cvtColor(arr, cv2.COLOR_BGR2GRAY)
+
+
 def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
-    """``cv2.imdecode`` to 8-bit gray, without OpenCV's own warning and error lines on stderr.
+    """``cv2.imdecode`` to 8-bit gray (:func:`_gray_from_colour`), without OpenCV's own
+    warning and error lines on stderr.
 
     OpenCV's log level is process-wide: it is lowered while any thread decodes here and
     restored by the last one out.
@@ -405,14 +420,14 @@ def _imdecode_quietly(cv2: Any, buf: Any) -> Any:
     global _quiet_users, _loud_level
     logging_ = getattr(getattr(cv2, "utils", None), "logging", None)
     if logging_ is None:  # pragma: no cover - an OpenCV build without cv2.utils.logging
-        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+        return _gray_from_colour(cv2, buf)
     with _QUIET:
         if _quiet_users == 0:
             _loud_level = logging_.getLogLevel()
             logging_.setLogLevel(logging_.LOG_LEVEL_SILENT)  # our message names the fault
         _quiet_users += 1
     try:
-        return cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
+        return _gray_from_colour(cv2, buf)
     finally:
         with _QUIET:
             _quiet_users -= 1
