@@ -3296,7 +3296,14 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
     ------
     InputError
         The file is missing, is neither an exported CSV nor GeoJSON, lacks a column, or a row
-        has a verdict, rank or position that is not one (the message names the row).
+        has a verdict, rank or position that is not one (the message names the row), or no
+        row names a camera.
+
+    Notes
+    -----
+    A row without a camera id (a service export of an item posted without ``camera``) is left
+    out with a warning naming its line or feature; the other rows are read. One such row sank
+    the whole file ("line 3: no camera id", exit 2) though the service had taken it.
     """
     import csv
     import json
@@ -3351,7 +3358,28 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
             )
         for i, row in enumerate(reader, start=2):
             raw.append((f"line {i}", row))
-    return [_verdict_row(p, where, r) for where, r in raw]
+    rows, no_camera = [], []
+    for where, r in raw:
+        if not _unformula(r.get("camera")).strip():
+            no_camera.append(where)
+            continue
+        rows.append(_verdict_row(p, where, r))
+    if no_camera:
+        named = ", ".join(no_camera[:10]) + (" ..." if len(no_camera) > 10 else "")
+        if not rows:
+            raise InputError(
+                f"{p}: {named}: no camera id, in any row: a verdict row names its camera "
+                "(a page's export does; an item posted to the service without 'camera' "
+                "has none)"
+            )
+        log.warning(
+            "%s: %d verdict row(s) without a camera id left out (%s); the other %d read",
+            p,
+            len(no_camera),
+            named,
+            len(rows),
+        )
+    return rows
 
 
 def _unformula(value: Any) -> str:
