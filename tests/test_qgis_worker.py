@@ -449,6 +449,9 @@ def test_measure_job_gives_the_library_values(tmp_path):
         ([{"a": [1, 2], "b": [3, "x"]}], "PAIRS item 0: 'b' must be a pixel"),
         ([[1, 2, 3, 4]], "PAIRS item 0: must be an object"),
         ({"a": [1, 2]}, "PAIRS must be a JSON list"),
+        # session 40: an empty PAIRS wrote an empty table without a word
+        ([], "PAIRS has no pair: nothing to measure"),
+        (None, "PAIRS has no pair: nothing to measure"),
     ],
 )
 def test_measure_job_names_a_bad_pair(tmp_path, pairs, message):

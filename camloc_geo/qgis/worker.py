@@ -589,10 +589,11 @@ _MEASURE_KINDS = ("distance", "height")
 def _measure_pairs(pairs: Any) -> list[dict[str, Any]]:
     """``PAIRS`` checked item by item: a clear one-line error naming the item and the fault."""
     example = '[{"kind": "distance", "a": [x, y], "b": [x, y]}]'
-    if pairs is None:
-        return []
-    if not isinstance(pairs, list):
+    if not isinstance(pairs, list) and pairs is not None:
         raise InputError(f"PAIRS must be a JSON list like {example}")
+    if not pairs:
+        # (an empty PAIRS wrote an empty measurements table without a word)
+        raise InputError(f"PAIRS has no pair: nothing to measure; give a JSON list like {example}")
     out: list[dict[str, Any]] = []
     for i, item in enumerate(pairs):
         if not isinstance(item, dict):
