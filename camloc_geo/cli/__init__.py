@@ -104,6 +104,34 @@ def output_path(
     return check_output_path(path, inputs=inputs, option=option, directory=directory)
 
 
+PAGE_SUFFIXES: tuple[str, ...] = (".html", ".htm")
+"""Names an HTML page (``--map``, ``summary-map -o``, ``annotate -o``) may end with; a name
+without a suffix is taken as it is (``/dev/stdout``)."""
+
+
+def page_path(
+    path: str | Path | None, *, inputs: Iterable[str | Path | None] = (), option: str = "-o"
+) -> Path | None:
+    """:func:`output_path` for an HTML page: a name ending in another suffix is refused.
+
+    ``locate --map x.pdf`` wrote the HTML page under a PDF name, which a PDF viewer then
+    could not open.
+
+    Raises
+    ------
+    InputError
+        As :func:`output_path`, or the name ends in a suffix other than
+        :data:`PAGE_SUFFIXES` (exit 2, one line naming them).
+    """
+    out = output_path(path, inputs=inputs, option=option)
+    if out is not None and out.suffix and out.suffix.lower() not in PAGE_SUFFIXES:
+        raise InputError(
+            f"{option} {path}: writes an HTML page, not {out.suffix}; name it "
+            f"{' or '.join(PAGE_SUFFIXES)} (as {out.stem}.html)"
+        )
+    return out
+
+
 def distinct_outputs(*outputs: tuple[str, Path | None]) -> None:
     """Refuse two outputs of one command naming the same file (``-o x --map x``: the last
     written replaced the other). ``outputs`` are ``(option, path)`` pairs; None is stdout.

@@ -14,6 +14,7 @@ from camloc_geo.cli import (
     inline_of,
     network_of,
     output_path,
+    page_path,
     write_json,
 )
 
@@ -126,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--max-candidates must be at least 1 (got {args.max_candidates})")
     inputs = [args.scene, args.osm, args.verdicts]
     out_path = output_path(args.output, inputs=inputs)
-    map_path = output_path(args.map, inputs=inputs, option="--map")
+    map_path = page_path(args.map, inputs=inputs, option="--map")
     distinct_outputs(("-o", out_path), ("--map", map_path))
     if args.overlays is not None:
         if map_path is None:

@@ -109,13 +109,13 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
-    from camloc_geo.cli import atomic_output, output_path, read_json_file
+    from camloc_geo.cli import atomic_output, page_path, read_json_file
     from camloc_geo.cli.locate import verdict_url
 
     # a bad URL stops before any reading
     service = None if args.verdict_url is None else verdict_url(args.verdict_url)
 
-    out = output_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
+    out = page_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
     if out is None:
         raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
     inputs = _once_each(args.inputs)

@@ -1,0 +1,64 @@
+"""Session 40 QA: a map-writing command wrote its HTML page under any name.
+
+``camloc locate --map x.pdf`` wrote the HTML under a ``.pdf`` name (a PDF viewer then failed
+on it); the same for ``summary-map -o``, ``batch --map`` and ``annotate -o``. A page's name
+must now end in .html or .htm (or have no suffix); another is refused before any work, exit 2,
+naming the suffixes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from camloc_geo.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+SCENE = REPO / "sample_maps" / "sample_scene.json"
+BALTIMORE = REPO / "sample_maps" / "baltimore.osm.pbf"
+
+
+def _refused(argv: list[str], option: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"{option} " in err
+    assert "writes an HTML page, not .pdf; name it .html or .htm" in err
+    assert "Traceback" not in err
+
+
+def test_locate_map_pdf_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    page = tmp_path / "x.pdf"
+    out = tmp_path / "c.geojson"
+    argv = ["locate", str(SCENE), "--osm", str(BALTIMORE), "-o", str(out), "--map", str(page)]
+    _refused(argv, "--map", capsys)
+    assert not page.exists()
+    assert not out.exists()
+
+
+def test_summary_map_batch_and_annotate_pages_are_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cands = tmp_path / "c.geojson"
+    cands.write_text('{"type": "FeatureCollection", "features": []}', encoding="utf-8")
+    page = tmp_path / "s.PDF".lower()
+    _refused(["summary-map", str(cands), "-o", str(page)], "-o", capsys)
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\n1,A & B\n", encoding="utf-8")
+    gpkg = tmp_path / "o.gpkg"
+    argv = ["batch", str(lst), "-o", str(gpkg), "--map", str(page), "--workers", "1"]
+    _refused([*argv, "--no-progress"], "--map", capsys)
+    from PIL import Image
+
+    photo = tmp_path / "photos" / "cam.png"
+    photo.parent.mkdir()
+    Image.new("RGB", (64, 48), (90, 90, 90)).save(photo)
+    _refused(["annotate", str(photo), "-o", str(page)], "-o", capsys)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.geojson", "cams.csv", "photos"]
+
+
+def test_html_htm_and_no_suffix_are_taken(tmp_path: Path) -> None:
+    from camloc_geo.cli import page_path
+
+    for name in ("a.html", "b.HTM", "c"):
+        assert page_path(tmp_path / name, option="--map") == tmp_path / name
