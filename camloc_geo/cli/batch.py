@@ -87,9 +87,10 @@ def run(args: argparse.Namespace) -> int:
             "(its layers: cameras, candidates, view_cones, errors)"
         )
     if args.map is not None:
-        page = page_path(args.map, inputs=inputs, option="--map")
+        page = output_path(args.map, inputs=inputs, option="--map")
         if page is not None and out is not None and page.resolve() == out.resolve():
             raise InputError(f"--map {args.map}: the same file as -o; give the page its own name")
+        page_path(args.map, inputs=inputs, option="--map")  # an .html name
     service = None
     if args.verdict_url is not None:
         from camloc_geo.cli.locate import verdict_url
