@@ -451,6 +451,11 @@ def test_measure_job_gives_the_library_values(tmp_path):
         ({"a": [1, 2]}, "PAIRS must be a JSON list"),
         # session 40: an empty PAIRS wrote an empty table without a word
         ([], "PAIRS has no pair: nothing to measure"),
+        # a pixel the library refuses: which item (it named none)
+        (
+            [{"a": [1, 2], "b": [3, 4]}, {"a": [1e308, 631], "b": [1345, 531]}],
+            "PAIRS item 1: ground: pixel (1e+308, 631) is far outside",
+        ),
         (None, "PAIRS has no pair: nothing to measure"),
     ],
 )

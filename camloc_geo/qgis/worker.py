@@ -636,10 +636,14 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     pair_warnings: list[str] = []
     for i, item in enumerate(pairs):
         a, b = item["a"], item["b"]
-        if item["kind"] == "height":
-            m = sensors.point_height(cal, a, b)
-        else:
-            m = sensors.ground_distance(cal, [a, b])
+        try:
+            if item["kind"] == "height":
+                m = sensors.point_height(cal, a, b)
+            else:
+                m = sensors.ground_distance(cal, [a, b])
+        except InputError as exc:
+            # which pair: "ground: pixel (1e+308, 631) is far outside..." named none
+            raise type(exc)(f"PAIRS item {i}: {exc}") from None
         # a pair near the horizon: its sigma is a lower bound (Measurement.warnings)
         pair_warnings += [f"PAIRS item {i}: {w}" for w in getattr(m, "warnings", ())]
         # the library's Measurement holds ``value_m`` (``to_dict`` names it distance_m or
