@@ -1,0 +1,41 @@
+"""Session 40 QA on a live service: ``GET /v1/corners?streets=`` with fewer than two names.
+
+``streets=Eastern Ave`` (or ``" & "``) was a 422 ``map_data`` with no field, "give at least two
+street names", as if the map were at fault; it is the query's: 422 ``invalid_input`` naming
+``streets``, before any map is read.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from pathlib import Path
+
+import httpx
+import pytest
+
+from camloc_geo.service import create_app
+from camloc_geo.service.settings import Settings
+
+
+def _get(tmp_path: Path, params: dict[str, str]) -> httpx.Response:
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get("/v1/corners", params=params)
+
+    try:
+        return asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+
+
+@pytest.mark.parametrize("streets", ["Eastern Ave", " & ", "Eastern Ave &"])
+def test_one_street_name_is_the_querys_fault(tmp_path: Path, streets: str) -> None:
+    r = _get(tmp_path, {"lat": "39.2855", "lon": "-76.5935", "streets": streets})
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["type"] == "invalid_input"
+    assert err["field"] == "streets"
+    assert "give two street names" in err["message"]
