@@ -39,3 +39,25 @@ def test_one_street_name_is_the_querys_fault(tmp_path: Path, streets: str) -> No
     assert err["type"] == "invalid_input"
     assert err["field"] == "streets"
     assert "give two street names" in err["message"]
+
+
+def test_the_root_address_says_what_the_service_is(tmp_path: Path) -> None:
+    """``GET /`` in a browser was a 404 "Not Found" JSON; it is a page linking the API's
+    description and health."""
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> tuple[httpx.Response, httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get("/"), await client.head("/")
+
+    try:
+        page, head = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert page.status_code == 200
+    assert page.headers["content-type"].startswith("text/html")
+    for link in ('href="/docs"', 'href="/redoc"', 'href="/openapi.json"', 'href="/healthz"'):
+        assert link in page.text
+    assert head.status_code == 200
+    assert head.content == b""
