@@ -62,3 +62,12 @@ def test_html_htm_and_no_suffix_are_taken(tmp_path: Path) -> None:
 
     for name in ("a.html", "b.HTM", "c"):
         assert page_path(tmp_path / name, option="--map") == tmp_path / name
+
+
+def test_an_empty_geocode_title_is_refused(capsys: pytest.CaptureFixture[str]) -> None:
+    """``camloc geocode ""`` (an unset shell variable) printed a ``not_found`` feature and
+    exited 0; it is refused before the map is read, naming the title."""
+    assert main(["geocode", "Eastern Ave & S Broadway", " ", "--osm", str(BALTIMORE)]) == 2
+    captured = capsys.readouterr()
+    assert "title 2 is empty" in captured.err
+    assert captured.out == ""
