@@ -1,11 +1,13 @@
 """Write the QGIS styles ``camloc batch`` stores in its GeoPackage: run with QGIS's Python.
 
 ``/usr/bin/python3 qgis_plugin/make_batch_styles.py`` (``QT_QPA_PLATFORM=offscreen``) writes
-``camloc_geo/batch/styles/<layer>.qml`` and ``.sld`` for the batch GeoPackage's ``cameras``,
-``candidates`` and ``view_cones`` layers: the plugin's own styles (``camloc/layers.py``: the
-list's candidates, its cameras, the view cones) with the batch layers' field names. The batch
-writer (``camloc_geo.batch._run``) copies them into the GeoPackage's ``layer_styles`` table,
-as QGIS's "Save as Default" does, so that the GeoPackage opened in QGIS looks as the
+``camloc_geo/data/qgis_styles/<name>.qml`` and ``.sld``: ``batch_cameras``,
+``batch_candidates`` and ``batch_view_cones`` for ``camloc batch``'s GeoPackage, and
+``job_cameras`` and ``job_candidates`` for the service's job result
+(``/v1/jobs/{id}/result?format=gpkg``): the plugin's own styles (``camloc/layers.py``: the
+list's candidates, its cameras, the view cones) with those layers' field names.
+``camloc_geo.results.write_layer_styles`` copies them into a GeoPackage's ``layer_styles``
+table, as QGIS's "Save as Default" does, so that the GeoPackage opened in QGIS looks as the
 plugin's layers do; camloc_geo itself never needs QGIS. Run it again after changing a style.
 """
 
@@ -15,7 +17,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-OUT = HERE.parent / "camloc_geo" / "batch" / "styles"
+OUT = HERE.parent / "camloc_geo" / "data" / "qgis_styles"
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 
@@ -41,10 +43,8 @@ def main() -> int:
 
     from camloc_geo.batch import _run
 
-    tie = '"ambiguous_with" IS NOT NULL'
-    no_tie = '"ambiguous_with" IS NULL'
-
-    def candidates(layer: QgsVectorLayer) -> None:  # the plugin's style_list_candidates
+    def candidates(layer: QgsVectorLayer, tie: str) -> None:  # style_list_candidates
+        no_tie = f"NOT ({tie})"
         L._rules(
             layer,
             [
@@ -76,10 +76,22 @@ def main() -> int:
         )
         L._rules(layer, [("view cone (faded by score)", None, sym)])
 
+    # the batch's ties: "2,4", NULL without one; the job's: JSON text, "[2, 4]" or "[]"
+    batch_tie = '"ambiguous_with" IS NOT NULL'
+    job_tie = "coalesce(\"ambiguous_with\", '[]') NOT IN ('', '[]')"
+    job_cameras = {"id": "object", "status": "object", "title": "object", "score": "float64"}
+    job_candidates = {
+        "camera_id": "object",
+        "rank": "int64",
+        "score": "float64",
+        "ambiguous_with": "object",
+    }
     jobs = [
-        ("cameras", "Point", _run._CAMERA_COLUMNS, cameras),
-        ("candidates", "Point", _run._CANDIDATE_COLUMNS, candidates),
-        ("view_cones", "MultiPolygon", _run._CONE_COLUMNS, view_cones),
+        ("batch_cameras", "Point", _run._CAMERA_COLUMNS, cameras),
+        ("batch_candidates", "Point", _run._CANDIDATE_COLUMNS, lambda x: candidates(x, batch_tie)),
+        ("batch_view_cones", "MultiPolygon", _run._CONE_COLUMNS, view_cones),
+        ("job_cameras", "Point", job_cameras, cameras),
+        ("job_candidates", "Point", job_candidates, lambda x: candidates(x, job_tie)),
     ]
     OUT.mkdir(parents=True, exist_ok=True)
     for name, geometry, columns, style in jobs:

@@ -3,7 +3,8 @@
 Opened in QGIS it drew every layer in one random colour: ties, ranks and cameras alike. It now
 holds QGIS's ``layer_styles`` table with the plugin's styles (QML and SLD) for ``cameras``,
 ``candidates`` and ``view_cones``, each the layer's default, which QGIS applies when the layer
-is opened (checked in QGIS by qgis_plugin/tests/test_batch_styles.py).
+is opened (checked in QGIS by qgis_plugin/tests/test_batch_styles.py). So does the service's
+job result (``/v1/jobs/{id}/result?format=gpkg``), with the styles of its own columns.
 """
 
 from __future__ import annotations
@@ -52,12 +53,47 @@ def test_the_geopackage_holds_a_default_style_for_each_drawn_layer(gpkg: Path) -
         assert renderer.get("type") == "RuleRenderer"
         ET.fromstring(row["styleSLD"])  # well-formed SLD beside it
         # every field a rule or a label reads is a field of the layer
-        texts = [r.get("filter") or "" for r in renderer.iter("rule")]
-        texts += [s.get("fieldName") or "" for s in qml.iter("text-style")]
-        used = {m for t in texts for m in re.findall(r'"([A-Za-z_]+)"', t)}
+        used = _fields_read(row["styleQML"])
+        assert used, name
         assert used <= set(info["fields"]), (name, used - set(info["fields"]))
     cands = styles.set_index("f_table_name").loc["candidates", "styleQML"]
     assert "ambiguous_with" in cands  # ties drawn as stars, from the batch's own column
+
+
+def _fields_read(qml_text: str) -> set[str]:
+    qml = ET.fromstring(qml_text.split("\n", 1)[1])
+    texts = [r.get("filter") or "" for r in qml.iter("rule")]
+    texts += [s.get("fieldName") or "" for s in qml.iter("text-style")]
+    texts += [o.get("value") or "" for o in qml.iter("Option") if o.get("name") == "expression"]
+    return {m for t in texts for m in re.findall(r'"([A-Za-z_]+)"', t)}
+
+
+def test_a_service_job_geopackage_is_styled_too(tmp_path: Path) -> None:
+    from camloc_geo.results import job_result_geojson, job_result_geopackage
+
+    title_only = {
+        "id": "t1",
+        "row": 1,
+        "status": "title_only",
+        "lat": 39.2855,
+        "lon": -76.5935,
+        "candidates": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [-76.5935, 39.2855]},
+                "properties": {"kind": "candidate", "rank": 1, "score": 0.5},
+            }
+        ],
+    }
+    path = tmp_path / "job.gpkg"
+    path.write_bytes(job_result_geopackage(job_result_geojson("j", [title_only])))
+    styles = pyogrio.read_dataframe(path, layer="layer_styles").set_index("f_table_name")
+    assert sorted(styles.index) == ["cameras", "candidates"]
+    for name in ("cameras", "candidates"):
+        fields = set(pyogrio.read_info(path, layer=name)["fields"])
+        assert _fields_read(styles.loc[name, "styleQML"]) <= fields, name
+    cands = pyogrio.read_dataframe(path, layer="candidates")
+    assert cands["ambiguous_with"].isna().all()  # the column the style reads, empty
 
 
 def test_the_layers_read_as_before(gpkg: Path) -> None:

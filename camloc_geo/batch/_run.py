@@ -1090,57 +1090,18 @@ def _write_gpkg(
         raise
 
 
-STYLE_NAME = "camloc"
-"""Name of the default QGIS style of each layer in the GeoPackage's ``layer_styles`` table
-(the QGIS plugin's name for its own)."""
-
 STYLED_LAYERS = ("cameras", "candidates", "view_cones")
-"""The layers whose QGIS style (``camloc_geo/batch/styles/<layer>.qml`` and ``.sld``, made
-from the plugin's styles by ``qgis_plugin/make_batch_styles.py``) the GeoPackage carries."""
+"""The layers whose default QGIS style the GeoPackage carries (QGIS's ``layer_styles``:
+``camloc_geo/data/qgis_styles/batch_<layer>.qml`` and ``.sld``, made from the plugin's styles
+by ``qgis_plugin/make_batch_styles.py``; :func:`camloc_geo.results.write_layer_styles`)."""
 
 
 def _write_layer_styles(gpkg: Path) -> None:
-    """Add QGIS's ``layer_styles`` table: each styled layer's QML and SLD, the default.
+    """The batch GeoPackage's QGIS styles (it had none: QGIS drew every layer in one random
+    colour, ties and ranks alike)."""
+    from camloc_geo.results import write_layer_styles
 
-    QGIS reads it when the GeoPackage is opened (Add Layer, the Browser, drag and drop) and
-    draws the layers as the plugin does: the candidates by rank with ties as stars, labelled,
-    the cameras as labelled triangles, the cones faded by score. The batch GeoPackage had no
-    style: QGIS drew every layer in one random colour, ties and ranks alike.
-    """
-    import datetime
-
-    import pandas as pd
-    import pyogrio
-
-    folder = Path(__file__).resolve().parent / "styles"
-    now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0, tzinfo=None)
-    rows = []
-    for name in STYLED_LAYERS:
-        qml, sld = folder / f"{name}.qml", folder / f"{name}.sld"
-        if not qml.is_file():  # an install without its styles: the layers stay unstyled
-            log.warning("no QGIS style for the %s layer (%s missing)", name, qml)
-            continue
-        geom_col = pyogrio.read_info(str(gpkg), layer=name).get("geometry_name") or "geom"
-        rows.append(
-            {
-                "f_table_catalog": "",
-                "f_table_schema": "",
-                "f_table_name": name,
-                "f_geometry_column": geom_col,
-                "styleName": STYLE_NAME,
-                "styleQML": qml.read_text(encoding="utf-8"),
-                "styleSLD": sld.read_text(encoding="utf-8") if sld.is_file() else "",
-                "useAsDefault": True,
-                "description": f"camloc batch {name}",
-                "owner": "",
-                "ui": "",
-                "update_time": now,
-            }
-        )
-    if rows:
-        frame = pd.DataFrame(rows)
-        frame["update_time"] = pd.to_datetime(frame["update_time"])
-        pyogrio.write_dataframe(frame, str(gpkg), layer="layer_styles", driver="GPKG", append=True)
+    write_layer_styles(gpkg, {name: f"batch_{name}" for name in STYLED_LAYERS})
 
 
 # ------------------------------------------------------------------------ summary map

@@ -52,3 +52,38 @@ def test_a_batch_geopackage_opens_styled(tmp_path):
         if expr.evaluate(ctx):
             starred.append((f["id"], f["rank"]))
     assert sorted(starred) == [("s1", 1), ("s1", 2), ("s1", 3), ("s1", 4)]
+
+
+def test_a_service_job_geopackage_opens_styled(tmp_path):
+    """The service's job result (``format=gpkg``) carries its own styles: its ties are JSON
+    text (``"[2]"``, ``"[]"`` without one), read by its candidates' star rule."""
+    out = tmp_path / "job.gpkg"
+    code = (
+        "import sys; from camloc_geo.results import job_result_geojson, job_result_geopackage\n"
+        "def c(rank, tie): return {'type': 'Feature', 'geometry': {'type': 'Point', "
+        "'coordinates': [-76.5935 + rank * 1e-4, 39.2855]}, 'properties': {'kind': "
+        "'candidate', 'rank': rank, 'score': 0.4 / rank, 'ambiguous_with': tie}}\n"
+        "cam = {'id': 'k1', 'row': 1, 'status': 'located', 'lat': 39.2855, 'lon': -76.5935,"
+        " 'candidates': [c(1, [2]), c(2, [1]), c(3, [])]}\n"
+        "open(sys.argv[1], 'wb').write(job_result_geopackage(job_result_geojson('j', [cam])))\n"
+    )
+    subprocess.run([sys.executable, "-c", code, str(out)], check=True, timeout=300)
+    layer = QgsVectorLayer(f"{out}|layername=candidates", "c", "ogr")
+    assert layer.isValid()
+    assert isinstance(layer.renderer(), QgsRuleBasedRenderer)
+    rules = layer.renderer().rootRule().children()
+    assert rules[0].label().startswith("★ tie:")
+    from qgis.core import QgsExpression, QgsExpressionContext, QgsExpressionContextUtils
+
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    drawn_by = {}
+    for f in layer.getFeatures():
+        ctx.setFeature(f)
+        for rule in rules:
+            if rule.isElse() or QgsExpression(rule.filterExpression()).evaluate(ctx):
+                drawn_by[f["rank"]] = rule.label()[:12]
+                break
+    assert drawn_by == {1: "★ tie: anoth", 2: "★ tie: anoth", 3: "other candid"}
+    cams = QgsVectorLayer(f"{out}|layername=cameras", "k", "ogr")
+    assert isinstance(cams.renderer(), QgsRuleBasedRenderer)
+    assert cams.labelsEnabled()

@@ -1,43 +1,43 @@
 <!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>
-<qgis maxScale="0" simplifyAlgorithm="0" minScale="100000000" simplifyDrawingTol="1" symbologyReferenceScale="-1" styleCategories="AllStyleCategories" simplifyMaxScale="1" version="3.22.16-Białowieża" simplifyLocal="1" labelsEnabled="0" simplifyDrawingHints="1" hasScaleBasedVisibilityFlag="0" readOnly="0">
+<qgis readOnly="0" simplifyDrawingTol="1" styleCategories="AllStyleCategories" maxScale="0" minScale="100000000" simplifyLocal="1" symbologyReferenceScale="-1" hasScaleBasedVisibilityFlag="0" version="3.22.16-Białowieża" labelsEnabled="0" simplifyMaxScale="1" simplifyAlgorithm="0" simplifyDrawingHints="1">
  <flags>
   <Identifiable>1</Identifiable>
   <Removable>1</Removable>
   <Searchable>1</Searchable>
   <Private>0</Private>
  </flags>
- <temporal enabled="0" limitMode="0" accumulate="0" endField="" endExpression="" startField="" startExpression="" fixedDuration="0" durationUnit="min" mode="0" durationField="">
+ <temporal durationUnit="min" enabled="0" endField="" startExpression="" fixedDuration="0" durationField="" limitMode="0" accumulate="0" endExpression="" mode="0" startField="">
   <fixedRange>
    <start></start>
    <end></end>
   </fixedRange>
  </temporal>
- <renderer-v2 forceraster="0" type="RuleRenderer" referencescale="-1" symbollevels="0" enableorderby="0">
-  <rules key="{88676630-ddc0-4947-a11b-fc8c7d84a91e}">
-   <rule filter="ELSE" key="{e89c4eb3-bbd1-4ca0-b42a-3844c7a0db72}" label="view cone (faded by score)" symbol="0"/>
+ <renderer-v2 referencescale="-1" forceraster="0" enableorderby="0" type="RuleRenderer" symbollevels="0">
+  <rules key="{99f130f4-5456-4301-ab4d-f1d1f17b9264}">
+   <rule symbol="0" label="view cone (faded by score)" key="{b1e0818b-3356-4187-a426-b3aba9b898d7}" filter="ELSE"/>
   </rules>
   <symbols>
-   <symbol name="0" type="fill" force_rhr="0" alpha="1" clip_to_extent="1">
+   <symbol force_rhr="0" name="0" type="fill" alpha="1" clip_to_extent="1">
     <data_defined_properties>
      <Option type="Map">
-      <Option name="name" type="QString" value=""/>
+      <Option value="" name="name" type="QString"/>
       <Option name="properties"/>
-      <Option name="type" type="QString" value="collection"/>
+      <Option value="collection" name="type" type="QString"/>
      </Option>
     </data_defined_properties>
     <layer enabled="1" locked="0" pass="0" class="SimpleFill">
      <Option type="Map">
-      <Option name="border_width_map_unit_scale" type="QString" value="3x:0,0,0,0,0,0"/>
-      <Option name="color" type="QString" value="255,190,0,70"/>
-      <Option name="joinstyle" type="QString" value="bevel"/>
-      <Option name="offset" type="QString" value="0,0"/>
-      <Option name="offset_map_unit_scale" type="QString" value="3x:0,0,0,0,0,0"/>
-      <Option name="offset_unit" type="QString" value="MM"/>
-      <Option name="outline_color" type="QString" value="180,120,0,255"/>
-      <Option name="outline_style" type="QString" value="solid"/>
-      <Option name="outline_width" type="QString" value="0.26"/>
-      <Option name="outline_width_unit" type="QString" value="MM"/>
-      <Option name="style" type="QString" value="solid"/>
+      <Option value="3x:0,0,0,0,0,0" name="border_width_map_unit_scale" type="QString"/>
+      <Option value="255,190,0,70" name="color" type="QString"/>
+      <Option value="bevel" name="joinstyle" type="QString"/>
+      <Option value="0,0" name="offset" type="QString"/>
+      <Option value="3x:0,0,0,0,0,0" name="offset_map_unit_scale" type="QString"/>
+      <Option value="MM" name="offset_unit" type="QString"/>
+      <Option value="180,120,0,255" name="outline_color" type="QString"/>
+      <Option value="solid" name="outline_style" type="QString"/>
+      <Option value="0.26" name="outline_width" type="QString"/>
+      <Option value="MM" name="outline_width_unit" type="QString"/>
+      <Option value="solid" name="style" type="QString"/>
      </Option>
      <prop v="3x:0,0,0,0,0,0" k="border_width_map_unit_scale"/>
      <prop v="255,190,0,70" k="color"/>
@@ -52,15 +52,15 @@
      <prop v="solid" k="style"/>
      <data_defined_properties>
       <Option type="Map">
-       <Option name="name" type="QString" value=""/>
+       <Option value="" name="name" type="QString"/>
        <Option name="properties" type="Map">
         <Option name="fillColor" type="Map">
-         <Option name="active" type="bool" value="true"/>
-         <Option name="expression" type="QString" value="color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce(&quot;score&quot;, 0) / 0.5))"/>
-         <Option name="type" type="int" value="3"/>
+         <Option value="true" name="active" type="bool"/>
+         <Option value="color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce(&quot;score&quot;, 0) / 0.5))" name="expression" type="QString"/>
+         <Option value="3" name="type" type="int"/>
         </Option>
        </Option>
-       <Option name="type" type="QString" value="collection"/>
+       <Option value="collection" name="type" type="QString"/>
       </Option>
      </data_defined_properties>
     </layer>
@@ -73,44 +73,44 @@
  <blendMode>0</blendMode>
  <featureBlendMode>0</featureBlendMode>
  <layerOpacity>1</layerOpacity>
- <geometryOptions geometryPrecision="0" removeDuplicateNodes="0">
+ <geometryOptions removeDuplicateNodes="0" geometryPrecision="0">
   <activeChecks type="StringList">
-   <Option type="QString" value=""/>
+   <Option value="" type="QString"/>
   </activeChecks>
   <checkConfiguration/>
  </geometryOptions>
  <legend type="default-vector" showLabelLegend="0"/>
  <referencedLayers/>
  <fieldConfiguration>
-  <field name="row" configurationFlags="None">
+  <field configurationFlags="None" name="row">
    <editWidget type="">
     <config>
      <Option/>
     </config>
    </editWidget>
   </field>
-  <field name="id" configurationFlags="None">
+  <field configurationFlags="None" name="id">
    <editWidget type="">
     <config>
      <Option/>
     </config>
    </editWidget>
   </field>
-  <field name="rank" configurationFlags="None">
+  <field configurationFlags="None" name="rank">
    <editWidget type="">
     <config>
      <Option/>
     </config>
    </editWidget>
   </field>
-  <field name="source" configurationFlags="None">
+  <field configurationFlags="None" name="source">
    <editWidget type="">
     <config>
      <Option/>
     </config>
    </editWidget>
   </field>
-  <field name="score" configurationFlags="None">
+  <field configurationFlags="None" name="score">
    <editWidget type="">
     <config>
      <Option/>
@@ -119,11 +119,11 @@
   </field>
  </fieldConfiguration>
  <aliases>
-  <alias index="0" name="" field="row"/>
-  <alias index="1" name="" field="id"/>
-  <alias index="2" name="" field="rank"/>
-  <alias index="3" name="" field="source"/>
-  <alias index="4" name="" field="score"/>
+  <alias name="" field="row" index="0"/>
+  <alias name="" field="id" index="1"/>
+  <alias name="" field="rank" index="2"/>
+  <alias name="" field="source" index="3"/>
+  <alias name="" field="score" index="4"/>
  </aliases>
  <defaults>
   <default applyOnUpdate="0" field="row" expression=""/>
@@ -133,11 +133,11 @@
   <default applyOnUpdate="0" field="score" expression=""/>
  </defaults>
  <constraints>
-  <constraint field="row" exp_strength="0" unique_strength="0" notnull_strength="0" constraints="0"/>
-  <constraint field="id" exp_strength="0" unique_strength="0" notnull_strength="0" constraints="0"/>
-  <constraint field="rank" exp_strength="0" unique_strength="0" notnull_strength="0" constraints="0"/>
-  <constraint field="source" exp_strength="0" unique_strength="0" notnull_strength="0" constraints="0"/>
-  <constraint field="score" exp_strength="0" unique_strength="0" notnull_strength="0" constraints="0"/>
+  <constraint field="row" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
+  <constraint field="id" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
+  <constraint field="rank" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
+  <constraint field="source" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
+  <constraint field="score" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
  </constraints>
  <constraintExpressions>
   <constraint field="row" exp="" desc=""/>
@@ -148,7 +148,7 @@
  </constraintExpressions>
  <expressionfields/>
  <attributeactions/>
- <attributetableconfig sortOrder="0" sortExpression="" actionWidgetStyle="dropDown">
+ <attributetableconfig actionWidgetStyle="dropDown" sortExpression="" sortOrder="0">
   <columns/>
  </attributetableconfig>
  <conditionalstyles>

@@ -1,9 +1,9 @@
 <?xml version="1.0" encoding="UTF-8"?>
-<StyledLayerDescriptor xmlns="http://www.opengis.net/sld" xmlns:se="http://www.opengis.net/se" xmlns:ogc="http://www.opengis.net/ogc" xmlns:xlink="http://www.w3.org/1999/xlink" xsi:schemaLocation="http://www.opengis.net/sld http://schemas.opengis.net/sld/1.1.0/StyledLayerDescriptor.xsd" version="1.1.0" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance">
+<StyledLayerDescriptor xmlns="http://www.opengis.net/sld" xmlns:ogc="http://www.opengis.net/ogc" xmlns:se="http://www.opengis.net/se" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xmlns:xlink="http://www.w3.org/1999/xlink" version="1.1.0" xsi:schemaLocation="http://www.opengis.net/sld http://schemas.opengis.net/sld/1.1.0/StyledLayerDescriptor.xsd">
  <NamedLayer>
-  <se:Name>candidates</se:Name>
+  <se:Name>batch_candidates</se:Name>
   <UserStyle>
-   <se:Name>candidates</se:Name>
+   <se:Name>batch_candidates</se:Name>
    <se:FeatureTypeStyle>
     <se:Rule>
      <se:Name>★ tie: another candidate fits the evidence nearly as well (odds under 10 to 1) more than 10 m away; add a viewing direction or a landmark to decide</se:Name>
@@ -40,9 +40,13 @@
      </se:Description>
      <ogc:Filter xmlns:ogc="http://www.opengis.net/ogc">
       <ogc:And>
-       <ogc:PropertyIsNull>
-        <ogc:PropertyName>ambiguous_with</ogc:PropertyName>
-       </ogc:PropertyIsNull>
+       <ogc:Not>
+        <ogc:Not>
+         <ogc:PropertyIsNull>
+          <ogc:PropertyName>ambiguous_with</ogc:PropertyName>
+         </ogc:PropertyIsNull>
+        </ogc:Not>
+       </ogc:Not>
        <ogc:PropertyIsEqualTo>
         <ogc:PropertyName>rank</ogc:PropertyName>
         <ogc:Literal>1</ogc:Literal>
