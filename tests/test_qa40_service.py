@@ -61,3 +61,35 @@ def test_the_root_address_says_what_the_service_is(tmp_path: Path) -> None:
         assert link in page.text
     assert head.status_code == 200
     assert head.content == b""
+
+
+def test_a_job_maps_title_camera_shows_its_uncertainty() -> None:
+    """A title-placed camera's candidate states ``uncertainty_m`` (20 m); the job map's popup
+    read ``sigma_m`` and showed "—" (as ``camloc batch --map``'s page does not)."""
+    from camloc_geo.service.routers.jobs import job_summary_page
+
+    cand = {
+        "type": "Feature",
+        "geometry": {"type": "Point", "coordinates": [-76.5937, 39.2892]},
+        "properties": {
+            "rank": 1,
+            "source": "title",
+            "score": 0.94,
+            "lat": 39.2892,
+            "lon": -76.5937,
+            "uncertainty_m": 20.213,
+            "method": "title:junction",
+            "kind": "candidate",
+        },
+    }
+    camera = {
+        "id": "c1",
+        "title": "E Pratt St & S Broadway",
+        "status": "title_only",
+        "lat": 39.2892,
+        "lon": -76.5937,
+        "uncertainty_m": 20.213,
+        "candidates": [cand],
+    }
+    page = job_summary_page([camera])
+    assert "<th>sigma_m</th><td>20.21 m</td>" in page
