@@ -970,12 +970,18 @@ def basemap_maps(
     catalogue = MapCatalogue.from_source(source)
     served: dict[tuple[Any, ...], int] = {}
     unserved = 0
+    # each distinct point once (a job's title-placed cameras share their junction's point:
+    # 3000 cameras at 10 junctions asked the catalogue 3000 times, 0.7 ms each)
+    counts: dict[tuple[float, float], int] = {}
     for lat, lon in points_latlon:
-        area = catalogue.area_for_point(float(lat), float(lon)) if catalogue.files else ("none",)
+        key = (float(lat), float(lon))
+        counts[key] = counts.get(key, 0) + 1
+    for (lat, lon), n in counts.items():
+        area = catalogue.area_for_point(lat, lon) if catalogue.files else ("none",)
         if area[0] in ("file", "cell"):
-            served[tuple(area)] = served.get(tuple(area), 0) + 1
+            served[tuple(area)] = served.get(tuple(area), 0) + n
         else:
-            unserved += 1
+            unserved += n
     maps_data = []
     ranked = sorted(served.items(), key=lambda kv: -kv[1])
     for area, n in ranked[:BASEMAP_MAX_AREAS]:

@@ -151,3 +151,28 @@ def test_a_large_page_works_in_chromium(browser: Any, tmp_path: Path) -> None:
     assert page.locator(".camloc-cv-yes").all_inner_texts() == ["✓1"]  # the cluster counts it
     assert said == []  # no script error, no request leaving the page
     context.close()
+
+
+def test_the_basemap_asks_the_catalogue_once_per_distinct_point(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A job's title-placed cameras share their junction's point: 3000 cameras at a few
+    junctions asked the catalogue for each camera's area 3000 times (2 s of a 3000-camera
+    job map); each distinct point is asked once now, and the counts are the same."""
+    from camloc_geo.osm import MapCatalogue
+
+    baltimore = Path(__file__).resolve().parents[1] / "sample_maps" / "baltimore.osm.pbf"
+    asked: list[tuple[float, float]] = []
+    original = MapCatalogue.area_for_point
+
+    def spy(self: Any, lat: float, lon: float, **kw: Any) -> Any:
+        asked.append((lat, lon))
+        return original(self, lat, lon, **kw)
+
+    monkeypatch.setattr(MapCatalogue, "area_for_point", spy)
+    points = [(39.2855, -76.5935)] * 1000 + [(39.2905, -76.5937)] * 999 + [(0.0, 0.0)] * 7
+    maps_data, unserved = maps.basemap_maps(points, baltimore)
+    assert sorted(set(asked)) == sorted(set(points))
+    assert len(asked) == 3
+    assert len(maps_data) == 1
+    assert unserved == 7
