@@ -71,3 +71,34 @@ def test_an_empty_geocode_title_is_refused(capsys: pytest.CaptureFixture[str]) -
     captured = capsys.readouterr()
     assert "title 2 is empty" in captured.err
     assert captured.out == ""
+
+
+def test_summary_map_takes_a_candidates_point_from_its_geometry(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A candidate GeoJSON whose lat/lon properties were dropped (columns removed in a GIS,
+    another tool's output) had every candidate skipped, "lat=None ... is not a position",
+    exit 2, though each feature's Point says where it is; the Point is taken now."""
+    import json
+
+    feats = [
+        {
+            "type": "Feature",
+            "geometry": {"type": "Point", "coordinates": [-76.5935 + r * 1e-4, 39.2855]},
+            "properties": {"kind": "candidate", "rank": r, "score": 0.5 / r},
+        }
+        for r in (1, 2)
+    ]
+    feats.append(
+        {"type": "Feature", "geometry": None, "properties": {"kind": "candidate", "rank": 3}}
+    )
+    src = tmp_path / "cam-a.geojson"
+    src.write_text(json.dumps({"type": "FeatureCollection", "features": feats}), "utf-8")
+    page = tmp_path / "s.html"
+    assert main(["summary-map", str(src), "-o", str(page), "--inline"]) == 0
+    err = caplog.text
+    assert "feature 2: lat=None, lon=None is not a position: skipped" in err
+    assert "feature 0" not in err
+    text = page.read_text(encoding="utf-8")
+    assert "39.2855000°" in text  # the best candidate's popup, from its Point
+    assert "<title>camloc summary: 1 of 1 camera on the map</title>" in text
