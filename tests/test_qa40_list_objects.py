@@ -8,6 +8,8 @@ for as ``"['A', 'B']"``. Both are now row problems (in the camera's ``reason``, 
 
 from __future__ import annotations
 
+import pytest
+
 from camloc_geo.cameras import row_from_mapping
 
 
@@ -23,3 +25,27 @@ def test_a_list_title_is_named_and_not_searched_for() -> None:
     assert row.id == "7"  # a number is an id, as before
     assert row.title == ""
     assert row.problems == ('title \'["Eastern Ave", "S Broadway"]\' is not text or a number',)
+
+
+def test_merge_names_a_file_that_adds_nothing(caplog: pytest.LogCaptureFixture) -> None:
+    """An annotator's file saved before any click (no annotation, corner, reference or
+    landmark) was merged without a word; the merge now says which file added nothing."""
+    import copy
+    import json
+    import logging
+    from pathlib import Path
+
+    from camloc_geo.merge import merge_scenes
+
+    sample = Path(__file__).resolve().parents[1] / "sample_maps" / "sample_scene.json"
+    full = json.loads(sample.read_text(encoding="utf-8"))
+    empty = copy.deepcopy(full)
+    empty["annotations"] = []
+    for key in ("intersection", "references", "landmarks"):
+        empty.pop(key, None)
+    with caplog.at_level(logging.WARNING, logger="camloc_geo.merge"):
+        merged = merge_scenes([full, empty])
+    assert len(merged["annotations"]) == len(full["annotations"])
+    said = [r.getMessage() for r in caplog.records]
+    assert len(said) == 1
+    assert said[0].startswith("scene 2 (baltimore-eastern-broadway) adds nothing to the merge")
