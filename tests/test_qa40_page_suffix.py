@@ -102,3 +102,40 @@ def test_summary_map_takes_a_candidates_point_from_its_geometry(
     text = page.read_text(encoding="utf-8")
     assert "39.2855000°" in text  # the best candidate's popup, from its Point
     assert "<title>camloc summary: 1 of 1 camera on the map</title>" in text
+
+
+CORNERS = ["corners", "--osm", str(BALTIMORE), "--lat", "39.2855", "--lon", "-76.5935"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["locate", str(SCENE), "--osm", str(BALTIMORE), "-o", "{tmp}/review.html"],
+            "writes GeoJSON, not .html; name it .geojson (the review page is --map OUT.html)",
+        ),
+        (["locate", str(SCENE), "--osm", str(BALTIMORE), "-o", "{tmp}/c.gpkg"], "not .gpkg"),
+        (["calibrate", str(SCENE), "-o", "{tmp}/cal.pdf"], "writes JSON, not .pdf; name it .json"),
+        (
+            [*CORNERS, "-o", "{tmp}/corners.csv"],
+            "writes GeoJSON, not .csv",
+        ),
+        (["measure", str(SCENE), "--ground", "1,2", "3,4", "-o", "{tmp}/m.xlsx"], "not .xlsx"),
+    ],
+)
+def test_a_json_output_under_another_formats_name_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], message: str
+) -> None:
+    """``locate -o review.html`` wrote GeoJSON under a page's name (``--map`` was meant),
+    ``-o c.gpkg`` GeoJSON under a GeoPackage's; refused before any work, exit 2."""
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_json_names_are_taken(tmp_path: Path) -> None:
+    from camloc_geo.cli import json_path
+
+    for name in ("a.json", "b.geojson", "c", "d.out", "e.JSON"):
+        assert json_path(tmp_path / name) == tmp_path / name

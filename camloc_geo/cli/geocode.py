@@ -321,10 +321,10 @@ def run(args: argparse.Namespace) -> int:
     near = _parse_near(args.near)
     if args.radius_m is not None and not (args.radius_m > 0):
         raise InputError(f"--radius-m must be positive, got {args.radius_m}")
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import json_path
 
     paths = extract_paths(args.osm)
-    out = output_path(args.output, inputs=[args.list, *paths])
+    out = json_path(args.output, inputs=[args.list, *paths], what="GeoJSON")
     rows = _rows(Path(args.list)) if args.list else None
     maps = [whole_map(p) for p in paths]
 
