@@ -121,6 +121,7 @@ CORNERS = ["corners", "--osm", str(BALTIMORE), "--lat", "39.2855", "--lon", "-76
             "writes GeoJSON, not .csv",
         ),
         (["measure", str(SCENE), "--ground", "1,2", "3,4", "-o", "{tmp}/m.xlsx"], "not .xlsx"),
+        (["schema", "scene", "-o", "{tmp}/schema.html"], "writes JSON, not .html"),
     ],
 )
 def test_a_json_output_under_another_formats_name_is_refused(
