@@ -93,3 +93,36 @@ def test_a_job_maps_title_camera_shows_its_uncertainty() -> None:
     }
     page = job_summary_page([camera])
     assert "<th>sigma_m</th><td>20.21 m</td>" in page
+
+
+def test_a_missing_map_is_said_in_the_servers_words(tmp_path: Path) -> None:
+    """A server without map data answered a scene "no map: give --osm EXTRACT_OR_FOLDER or
+    allow --network", options a client of the service does not have; a job's camera said
+    "give --osm EXTRACT_OR_FOLDER" in its reason. Both name the server's map folder now."""
+    import json
+
+    from camloc_geo.service.work import process_camera
+
+    scene = (Path(__file__).resolve().parents[1] / "sample_maps" / "sample_scene.json").read_text()
+    settings = Settings(data_dir=tmp_path / "d", workers=0, map_dir=None, network=False)
+    app = create_app(settings)
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.post("/v1/locate", json=json.loads(scene))
+
+    try:
+        r = asyncio.run(run())
+        maps = app.state.maps
+    finally:
+        app.state.compute.shutdown()
+    assert r.status_code == 422, r.text
+    message = r.json()["error"]["message"]
+    assert "this server has no map data there (its operator adds extracts to CAMLOC_MAP_DIR)" in (
+        message
+    )
+    assert "--osm" not in message
+    res = process_camera({"id": "c1", "title": "Eastern Ave & S Broadway"}, maps, settings)
+    assert "--osm" not in str(res)
+    assert "CAMLOC_MAP_DIR" in str(res)

@@ -43,6 +43,7 @@ __all__ = [
     "error_response",
     "error_response_for",
     "install_error_handlers",
+    "server_words",
 ]
 
 log = logging.getLogger("camloc_geo.service")
@@ -120,13 +121,33 @@ def error_response(
     return JSONResponse(error_body(kind, message, field, rid), status_code=status)
 
 
+_SERVER_HINT = "this server has no map data there (its operator adds extracts to CAMLOC_MAP_DIR)"
+_CLI_HINTS = (
+    "give --osm EXTRACT_OR_FOLDER or allow --network",
+    "give --osm EXTRACT_OR_FOLDER",
+    "give --osm EXTRACT (map_source=...)",
+    "give --osm EXTRACT (a local OSM extract) to work without the network",
+)
+
+
+def server_words(text: str) -> str:
+    """``text`` with the command line's map hints put as a service client can act on them.
+
+    The library's "give --osm EXTRACT_OR_FOLDER or allow --network" reached clients of the
+    service, which have no such option: the server's operator configures the maps.
+    """
+    for hint in _CLI_HINTS:
+        text = text.replace(hint, _SERVER_HINT)
+    return text
+
+
 def error_response_for(exc: BaseException, rid: str) -> JSONResponse:
     """The answer to an exception: its row of :data:`ERROR_STATUS`, or a logged 500."""
     for cls, status, kind in ERROR_STATUS:
         if isinstance(exc, cls):
             if status >= 500:
                 log.warning("request %s: %s", rid, exc)
-            message = " ".join(str(exc).split())
+            message = server_words(" ".join(str(exc).split()))
             return error_response(status, kind, message, getattr(exc, "field", None), rid)
     log.error("request %s failed", rid, exc_info=exc)
     return error_response(500, "internal", f"internal error (request id {rid})", None, rid)

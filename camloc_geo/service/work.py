@@ -98,6 +98,7 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     from camloc_geo.api import locate_camera
     from camloc_geo.cameras import CameraResult, row_from_mapping
     from camloc_geo.results import camera_job_result
+    from camloc_geo.service.errors import server_words
 
     cam_id = str(camera.get("id", "")) if isinstance(camera, dict) else ""
     try:
@@ -116,6 +117,8 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
         if not cam_id:
             row = dataclasses.replace(row, id="")
         res = locate_camera(row, map_source=maps.catalogue)
+        if res.reason:  # the library's hints in the server's words, not the CLI's options
+            res.reason = server_words(res.reason)
         problems = "; ".join(row.problems)
         if problems and problems not in (res.reason or ""):
             # batch keeps them in its errors layer; a job's result has only the reason
@@ -124,7 +127,7 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     except CamlocError as exc:
         res = CameraResult(row=1, id=cam_id).fail(
             "scene_error" if isinstance(exc, (SceneError, LimitError)) else "failed",
-            " ".join(str(exc).split()),
+            server_words(" ".join(str(exc).split())),
             "input",
         )
     except Exception as exc:  # one bad camera never sinks the job
