@@ -27,7 +27,7 @@ from camloc_geo import (
     SceneError,
 )
 from camloc_geo.service.verdicts import VerdictStoreError
-from camloc_geo.service.work import LimitError
+from camloc_geo.service.work import LimitError, server_words
 
 __all__ = [
     "ERROR_STATUS",
@@ -43,7 +43,6 @@ __all__ = [
     "error_response",
     "error_response_for",
     "install_error_handlers",
-    "server_words",
 ]
 
 log = logging.getLogger("camloc_geo.service")
@@ -119,26 +118,6 @@ def error_response(
 ) -> JSONResponse:
     """The JSON error answer."""
     return JSONResponse(error_body(kind, message, field, rid), status_code=status)
-
-
-_SERVER_HINT = "this server has no map data there (its operator adds extracts to CAMLOC_MAP_DIR)"
-_CLI_HINTS = (
-    "give --osm EXTRACT_OR_FOLDER or allow --network",
-    "give --osm EXTRACT_OR_FOLDER",
-    "give --osm EXTRACT (map_source=...)",
-    "give --osm EXTRACT (a local OSM extract) to work without the network",
-)
-
-
-def server_words(text: str) -> str:
-    """``text`` with the command line's map hints put as a service client can act on them.
-
-    The library's "give --osm EXTRACT_OR_FOLDER or allow --network" reached clients of the
-    service, which have no such option: the server's operator configures the maps.
-    """
-    for hint in _CLI_HINTS:
-        text = text.replace(hint, _SERVER_HINT)
-    return text
 
 
 def error_response_for(exc: BaseException, rid: str) -> JSONResponse:

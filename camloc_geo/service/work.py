@@ -12,9 +12,29 @@ if TYPE_CHECKING:
     from camloc_geo.service.mapstore import MapStore
     from camloc_geo.service.settings import Settings
 
-__all__ = ["check_scene_body", "locate_body", "process_camera"]
+__all__ = ["check_scene_body", "locate_body", "process_camera", "server_words"]
 
 log = logging.getLogger(__name__)
+
+
+_SERVER_HINT = "this server has no map data there (its operator adds extracts to CAMLOC_MAP_DIR)"
+_CLI_HINTS = (
+    "give --osm EXTRACT_OR_FOLDER or allow --network",
+    "give --osm EXTRACT_OR_FOLDER",
+    "give --osm EXTRACT (map_source=...)",
+    "give --osm EXTRACT (a local OSM extract) to work without the network",
+)
+
+
+def server_words(text: str) -> str:
+    """``text`` with the command line's map hints put as a service client can act on them.
+
+    The library's "give --osm EXTRACT_OR_FOLDER or allow --network" reached clients of the
+    service, which have no such option: the server's operator configures the maps.
+    """
+    for hint in _CLI_HINTS:
+        text = text.replace(hint, _SERVER_HINT)
+    return text
 
 
 class LimitError(InputError):
@@ -98,7 +118,6 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     from camloc_geo.api import locate_camera
     from camloc_geo.cameras import CameraResult, row_from_mapping
     from camloc_geo.results import camera_job_result
-    from camloc_geo.service.errors import server_words
 
     cam_id = str(camera.get("id", "")) if isinstance(camera, dict) else ""
     try:
