@@ -970,12 +970,18 @@ def basemap_maps(
     catalogue = MapCatalogue.from_source(source)
     served: dict[tuple[Any, ...], int] = {}
     unserved = 0
+    # each distinct point once (a job's title-placed cameras share their junction's point:
+    # 3000 cameras at 10 junctions asked the catalogue 3000 times, 0.7 ms each)
+    counts: dict[tuple[float, float], int] = {}
     for lat, lon in points_latlon:
-        area = catalogue.area_for_point(float(lat), float(lon)) if catalogue.files else ("none",)
+        key = (float(lat), float(lon))
+        counts[key] = counts.get(key, 0) + 1
+    for (lat, lon), n in counts.items():
+        area = catalogue.area_for_point(lat, lon) if catalogue.files else ("none",)
         if area[0] in ("file", "cell"):
-            served[tuple(area)] = served.get(tuple(area), 0) + 1
+            served[tuple(area)] = served.get(tuple(area), 0) + n
         else:
-            unserved += 1
+            unserved += n
     maps_data = []
     ranked = sorted(served.items(), key=lambda kv: -kv[1])
     for area, n in ranked[:BASEMAP_MAX_AREAS]:
@@ -2093,32 +2099,42 @@ def build_summary_map(
     else:
         parent = folium.FeatureGroup(name="Cameras (best candidate)")
     order = sorted(range(len(rows)), key=lambda i: rows[i][1]["properties"].get("score", 0.0))
+    compact = len(rows) > SUMMARY_DATA_MARKERS
+    data_rows: list[list[Any]] = []
+    words = _Words()  # texts many cameras share (colours, methods, flags, reasons), once each
     for i in order:
         scene_id, f = rows[i]
         p = f["properties"]
         tie = ties[i]
-        body = "".join(
-            f"<tr><th>{k}</th><td>{v}</td></tr>"
-            for k, v in (
-                ("camera", html.escape(str(scene_id))),
-                ("score", _score_text(p.get("score"))),
-                ("method", html.escape(str(p.get("method")))),
-                ("rank", _fmt(p.get("rank"))),
-                ("lat", _fmt(p.get("lat"), "°", 7)),
-                ("lon", _fmt(p.get("lon"), "°", 7)),
-                ("height_m", _fmt(p.get("height_m"), " m")),
-                ("heading_deg", _fmt(p.get("heading_deg"), "°", 1)),
-                ("residual_m", _fmt(p.get("residual_m"), " m")),
-                ("sigma_m", _fmt(p.get("sigma_m"), " m")),
-                ("flags", html.escape(_fmt(list(p.get("flags") or [])))),
-            )
-        )
+        fields = _summary_fields(scene_id, p)
         why = " ".join(str(reasons[i] or "").split())
-        if why:
-            # what placed the camera and what was wrong (a camloc batch camera: "junction of
-            # the map's model; list row: lat 'abc' is not a number", "...; 933 km from the
-            # point given"): the popup showed the numbers only
-            short = why if len(why) <= 300 else why[:299] + "…"
+        # what placed the camera and what was wrong (a camloc batch camera: "junction of
+        # the map's model; list row: lat 'abc' is not a number", "...; 933 km from the
+        # point given"): the popup showed the numbers only
+        short = (why if len(why) <= 300 else why[:299] + "…") or None
+        if compact:
+            data_rows.append(
+                [
+                    i,
+                    str(scene_id),
+                    round(float(p["lat"]), 7),
+                    round(float(p["lon"]), 7),
+                    _finite(p.get("heading_deg")),
+                    tie,
+                    _finite(p.get("score")),
+                    words.of(score_colour(p.get("score", 0.0))),
+                    words.of(fields[2][1]),  # the method
+                    p.get("rank") if isinstance(p.get("rank"), int) else None,
+                    _finite(p.get("height_m")),
+                    _finite(p.get("residual_m")),
+                    _finite(p.get("sigma_m")),
+                    words.of(fields[-1][1]),  # the flags
+                    None if short is None else words.of(short),
+                ]
+            )
+            continue
+        body = "".join(f"<tr><th>{k}</th><td>{html.escape(v)}</td></tr>" for k, v in fields)
+        if short:
             body += f"<tr><th>reason</th><td>{html.escape(short)}</td></tr>"
         note = ""
         if tie:
@@ -2147,6 +2163,8 @@ def build_summary_map(
             rise_on_hover=True,  # a camera drawn under another comes on top under the mouse
         ).add_to(parent)
     parent.add_to(fmap)
+    if compact:
+        _DataMarkers(parent, data_rows, words.texts).add_to(fmap)
     v_items = {}
     for i, (scene_id, f) in enumerate(rows):
         p = f["properties"]
@@ -2158,6 +2176,8 @@ def build_summary_map(
             "label": f"camera {scene_id}",
             "others": alternatives[i],
         }
+        if compact:  # the page's script says "camera <id>" itself
+            del v_items[f"c{i}"]["label"]
     if v_items:
         v_identity = [
             [it["camera"], it["rank"], it["lat"], it["lon"], it["others"]]
@@ -2200,6 +2220,155 @@ def build_summary_map(
     else:
         _OpenUnclustered(parent, bounds).add_to(fmap)
     return fmap
+
+
+SUMMARY_DATA_MARKERS = 300
+"""A summary page of more cameras than this carries its markers as one compact data array
+that the browser turns into markers, icons, tooltips and popups (a popup's HTML made only
+when it opens), instead of one folium marker each with its icon and popup HTML: a 3000-camera
+job map was 8 MB and took 10.6 s to build (session 40)."""
+
+
+def _summary_fields(scene_id: Any, p: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """A summary popup's rows as ``(label, plain text)``, in order (escaped where drawn)."""
+    return [
+        ("camera", str(scene_id)),
+        ("score", _score_text(p.get("score"))),
+        ("method", str(p.get("method"))),
+        ("rank", _fmt(p.get("rank"))),
+        ("lat", _fmt(p.get("lat"), "°", 7)),
+        ("lon", _fmt(p.get("lon"), "°", 7)),
+        ("height_m", _fmt(p.get("height_m"), " m")),
+        ("heading_deg", _fmt(p.get("heading_deg"), "°", 1)),
+        ("residual_m", _fmt(p.get("residual_m"), " m")),
+        ("sigma_m", _fmt(p.get("sigma_m"), " m")),
+        ("flags", _fmt(list(p.get("flags") or []))),
+    ]
+
+
+def _finite(value: Any) -> float | None:
+    """A number as the page's data carries it (None when missing or not finite)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        return None
+    return float(value)
+
+
+class _Words:
+    """Texts shared by many rows of a page's data, each kept once; a row holds its index."""
+
+    def __init__(self) -> None:
+        self.texts: list[str] = []
+        self._at: dict[str, int] = {}
+
+    def of(self, text: str) -> int:
+        """The index of ``text`` (added if new)."""
+        at = self._at.get(text)
+        if at is None:
+            at = self._at[text] = len(self.texts)
+            self.texts.append(text)
+        return at
+
+
+class _DataMarkers(MacroElement):
+    """A large summary page's markers, made in the browser from one compact array.
+
+    Each row: ``[index, camera, lat, lon, heading, tie text, score, colour, method, rank,
+    height_m, residual_m, sigma_m, flags, reason]``, the colour, method, flags and reason as
+    indices into ``words`` (texts many cameras share, once each); missing numbers null. The
+    icons are :func:`_arrow_icon`'s (the same HTML, so the verdict badges and the clusters'
+    counts find them), the tooltips and popups :func:`build_summary_map`'s, a popup made when
+    it opens; the markers go into the group in one ``addLayers`` call (markercluster's bulk
+    path).
+    """
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    var group = {{ this.group }};
+    var words = {{ this.words|tojson }};
+    var rows = {{ this.rows|tojson }};
+    var ring = {{ this.ring|tojson }}, odds = {{ this.odds|tojson }};
+    function esc(x) {
+        return String(x).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;")
+            .replace(/"/g, "&quot;").replace(/'/g, "&#x27;");
+    }
+    function num(x, digits, unit) {  // as the Python side's _fmt
+        return x === null ? "\u2014" : x.toFixed(digits) + unit;
+    }
+    function score(x) {  // as _score_text: 0.375, or 1.1e-15 where 0.000 would show
+        if (x === null) { return "\u2014"; }
+        return (x === 0 || Math.abs(x) >= 0.0005) ? x.toFixed(3) : x.toExponential(1);
+    }
+    function icon(r) {
+        var heading = r[4], tied = r[5] !== null, size = tied ? 36 : 26, h = size / 2;
+        var shape = heading === null ? '<circle r="6" />'
+            : '<path transform="rotate(' + heading.toFixed(1) +
+              ')" d="M0,-11 L6,6 L0,2 L-6,6 Z" />';
+        var svg = '<svg xmlns="http://www.w3.org/2000/svg" width="' + size + '" height="' +
+            size + '" viewBox="-' + h + ' -' + h + ' ' + size + ' ' + size + '">' +
+            (tied ? '<circle r="16" fill="rgba(255,255,255,0.7)" stroke="' + ring +
+                    '" stroke-width="2.5" stroke-dasharray="5 3" />' : '') +
+            '<g fill="' + words[r[7]] + '" stroke="#111" stroke-width="1.5">' + shape +
+            '</g></svg>';
+        if (tied) {
+            svg = '<div class="camloc-tied-arrow" data-tied="1">' + svg +
+                '<span class="camloc-badge">\u2248</span></div>';
+        }
+        svg = '<div class="camloc-vmark" data-verdict-mark="c' + r[0] + '">' + svg + '</div>';
+        return L.divIcon({html: svg, iconSize: [size, size], iconAnchor: [h, h],
+                          className: "camloc-summary-marker"});
+    }
+    function popup(r) {
+        var fields = [
+            ["camera", r[1]], ["score", score(r[6])], ["method", words[r[8]]],
+            ["rank", r[9] === null ? "\u2014" : String(r[9])],
+            ["lat", num(r[2], 7, "\u00b0")], ["lon", num(r[3], 7, "\u00b0")],
+            ["height_m", num(r[10], 2, " m")], ["heading_deg", num(r[4], 1, "\u00b0")],
+            ["residual_m", num(r[11], 2, " m")], ["sigma_m", num(r[12], 2, " m")],
+            ["flags", words[r[13]]]
+        ];
+        if (r[14] !== null) { fields.push(["reason", words[r[14]]]); }
+        var body = fields.map(function (f) {
+            return "<tr><th>" + f[0] + "</th><td>" + esc(f[1]) + "</td></tr>";
+        }).join("");
+        var note = r[5] === null ? "" : '<div class="camloc-tie">\u2248 <b>' + esc(r[5]) +
+            "</b>: the evidence does not favour the best candidate firmly (odds under " +
+            odds + " to 1); see the camera's review page</div>";
+        return '<div class="camloc-popup"><b>' + esc(r[1]) + "</b>" + note + "<table>" +
+            body + '</table><div class="camloc-verdict" data-verdict-key="c' + r[0] +
+            '"></div></div>';
+    }
+    var markers = rows.map(function (r) {
+        var m = L.marker([r[2], r[3]], {icon: icon(r), riseOnHover: true});
+        m.bindTooltip(esc(r[1]) + " (" + (r[6] || 0).toFixed(2) + ")" +
+                      (r[5] === null ? "" : " \u2248 " + esc(r[5])), {sticky: true});
+        var content = null;  // made at the first opening, then kept: the verdict controls
+        // drawn into it stay when Leaflet updates the popup (made anew, they went)
+        m.bindPopup(function () {
+            if (content === null) {
+                content = document.createElement("div");
+                content.innerHTML = popup(r);
+            }
+            return content;
+        }, {maxWidth: 320});
+        return m;
+    });
+    if (typeof group.addLayers === "function") { group.addLayers(markers); }
+    else { markers.forEach(function (m) { group.addLayer(m); }); }
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self, group: Any, rows: list[list[Any]], words: list[str]) -> None:
+        super().__init__()
+        self._name = "CamlocDataMarkers"
+        self.group = group.get_name()
+        self.rows = rows
+        self.words = words
+        self.ring = TIE_RING
+        self.odds = f"{1 / TIE_SCORE_RATIO:g}"
 
 
 _FIT_CLEAR_JS = """
@@ -2645,6 +2814,9 @@ class _Verdicts(MacroElement):
     function reviewer() {
         try { return (store && store.getItem(WHO)) || ""; } catch (e) { return ""; }
     }
+    function labelOf(it) {  // a large summary page's items carry no label (its camera's)
+        return it.label || ("camera " + it.camera);
+    }
     function el(tag, cls, text) {
         var e = document.createElement(tag);
         if (cls) { e.className = cls; }
@@ -2658,7 +2830,7 @@ class _Verdicts(MacroElement):
             if (v) { m.setAttribute("data-verdict", v); }
             else { m.removeAttribute("data-verdict"); }
             var icon = m.closest(".leaflet-marker-icon") || m;
-            icon.setAttribute("aria-label", it.label + (v ? ": " + LABEL[v] : ": not reviewed"));
+            icon.setAttribute("aria-label", labelOf(it) + (v ? ": " + LABEL[v] : ": not reviewed"));
         });
     }
     var count, warnBox;
@@ -2885,7 +3057,7 @@ class _Verdicts(MacroElement):
         }
         var group = el("div", "camloc-vbtns");
         group.setAttribute("role", "group");
-        group.setAttribute("aria-label", "verdict on " + it.label);
+        group.setAttribute("aria-label", "verdict on " + labelOf(it));
         cfg.verdicts.forEach(function (val) {
             var b = el("button", "v-" + val, SYM[val] + " " + LABEL[val]);
             b.type = "button";
@@ -2918,7 +3090,7 @@ class _Verdicts(MacroElement):
         note.type = "text";
         note.maxLength = cfg.note_chars;
         note.placeholder = "note (optional)";
-        note.setAttribute("aria-label", "note on " + it.label);
+        note.setAttribute("aria-label", "note on " + labelOf(it));
         note.value = (state.items[k] || {}).note || "";
         note.addEventListener("input", function () {
             var w = state.items[k] || {};
@@ -3296,7 +3468,14 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
     ------
     InputError
         The file is missing, is neither an exported CSV nor GeoJSON, lacks a column, or a row
-        has a verdict, rank or position that is not one (the message names the row).
+        has a verdict, rank or position that is not one (the message names the row), or no
+        row names a camera.
+
+    Notes
+    -----
+    A row without a camera id (a service export of an item posted without ``camera``) is left
+    out with a warning naming its line or feature; the other rows are read. One such row sank
+    the whole file ("line 3: no camera id", exit 2) though the service had taken it.
     """
     import csv
     import json
@@ -3351,7 +3530,28 @@ def read_verdicts(path: str | Path) -> list[dict[str, Any]]:
             )
         for i, row in enumerate(reader, start=2):
             raw.append((f"line {i}", row))
-    return [_verdict_row(p, where, r) for where, r in raw]
+    rows, no_camera = [], []
+    for where, r in raw:
+        if not _unformula(r.get("camera")).strip():
+            no_camera.append(where)
+            continue
+        rows.append(_verdict_row(p, where, r))
+    if no_camera:
+        named = ", ".join(no_camera[:10]) + (" ..." if len(no_camera) > 10 else "")
+        if not rows:
+            raise InputError(
+                f"{p}: {named}: no camera id, in any row: a verdict row names its camera "
+                "(a page's export does; an item posted to the service without 'camera' "
+                "has none)"
+            )
+        log.warning(
+            "%s: %d verdict row(s) without a camera id left out (%s); the other %d read",
+            p,
+            len(no_camera),
+            named,
+            len(rows),
+        )
+    return rows
 
 
 def _unformula(value: Any) -> str:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 import json
+import logging
 import math
 import os
 from collections.abc import Sequence
@@ -17,6 +18,8 @@ from pathlib import Path, PurePath
 from typing import Any
 
 from camloc_geo._errors import SceneError
+
+log = logging.getLogger(__name__)
 
 __all__ = ["merge_scenes"]
 
@@ -231,6 +234,13 @@ def merge_scenes(scenes: Sequence[Any], *, scene_id: str | None = None) -> dict[
             if inter is None:
                 inter_label = label
             inter = _merge_intersection(inter, inter_label, data["intersection"], label, diag)
+        if not any(data.get(k) for k in ("annotations", "intersection", "references", "landmarks")):
+            # (an annotator's file saved before any click was merged without a word)
+            log.warning(
+                "%s adds nothing to the merge: no annotation, kerb corner, reference or "
+                "landmark in it",
+                label,
+            )
         for src, dst in ((data.get("references"), references), (data.get("landmarks"), landmarks)):
             for item in src or []:
                 if item not in dst:

@@ -28,8 +28,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable
+import os
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from camloc_geo._ties import TIE_DISTANCE_M, TIE_SCORE_RATIO
@@ -44,6 +46,8 @@ if TYPE_CHECKING:
 __all__ = [
     "ATTRIBUTION",
     "JOB_LAYERS",
+    "QGIS_STYLES",
+    "QGIS_STYLE_NAME",
     "TIE_DISTANCE_M",
     "TIE_SCORE_RATIO",
     "CalibrationOutput",
@@ -76,6 +80,7 @@ __all__ = [
     "point",
     "streets_json",
     "to_json",
+    "write_layer_styles",
 ]
 
 ATTRIBUTION = "Map data © OpenStreetMap contributors, ODbL 1.0"
@@ -783,12 +788,84 @@ def _numeric_name(name: str) -> bool:
     return name in _NUMERIC_NAMES or name.endswith(("_deg", "_m", "_px"))
 
 
+QGIS_STYLE_NAME = "camloc"
+"""Name of camloc's default QGIS style of a layer in a GeoPackage's ``layer_styles`` table
+(the QGIS plugin's name for its own)."""
+
+QGIS_STYLES = Path(__file__).resolve().parent / "data" / "qgis_styles"
+"""The QGIS styles camloc's GeoPackages carry (``<name>.qml`` and ``.sld``), made from the QGIS
+plugin's by ``qgis_plugin/make_batch_styles.py`` (run it with QGIS's Python)."""
+
+
+def write_layer_styles(gpkg: str | os.PathLike[str], styles: Mapping[str, str]) -> None:
+    """Add QGIS's ``layer_styles`` table to a GeoPackage: each layer's style as its default.
+
+    QGIS reads it when a layer of the file is opened (Add Layer, the Browser, drag and drop)
+    and draws the layer as the QGIS plugin draws its own: candidates by rank with ties as
+    stars, labelled; cameras as labelled triangles; cones faded by score. The table is as
+    QGIS's "Save as Default" writes it (an attribute table: ``f_table_name``,
+    ``f_geometry_column``, ``styleName``, ``styleQML``, ``styleSLD``, ``useAsDefault``...).
+
+    Parameters
+    ----------
+    gpkg
+        The GeoPackage, without a ``layer_styles`` table yet.
+    styles
+        Layer name → style name in :data:`QGIS_STYLES` (``{"cameras": "batch_cameras"}``);
+        a style missing there (an install without its data) is skipped with a warning.
+    """
+    import datetime
+    import logging
+
+    import pandas as pd
+    import pyogrio
+
+    now = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0, tzinfo=None)
+    rows = []
+    for layer, style in styles.items():
+        qml, sld = QGIS_STYLES / f"{style}.qml", QGIS_STYLES / f"{style}.sld"
+        if not qml.is_file():
+            logging.getLogger(__name__).warning("no QGIS style for %s (%s missing)", layer, qml)
+            continue
+        geom_col = pyogrio.read_info(str(gpkg), layer=layer).get("geometry_name") or "geom"
+        rows.append(
+            {
+                "f_table_catalog": "",
+                "f_table_schema": "",
+                "f_table_name": layer,
+                "f_geometry_column": geom_col,
+                "styleName": QGIS_STYLE_NAME,
+                "styleQML": qml.read_text(encoding="utf-8"),
+                "styleSLD": sld.read_text(encoding="utf-8") if sld.is_file() else "",
+                "useAsDefault": True,
+                "description": f"camloc {style.replace('_', ' ')}",
+                "owner": "",
+                "ui": "",
+                "update_time": now,
+            }
+        )
+    if rows:
+        frame = pd.DataFrame(rows)
+        frame["update_time"] = pd.to_datetime(frame["update_time"])
+        pyogrio.write_dataframe(frame, str(gpkg), layer="layer_styles", driver="GPKG")
+
+
+_JOB_STYLED_COLUMNS = {
+    "cameras": ("id", "status"),
+    "candidates": ("camera_id", "rank", "ambiguous_with"),
+}
+"""Columns a job GeoPackage's layer always has once it has features: its QGIS style reads
+them (a job of title-placed cameras has no ``ambiguous_with`` of its own)."""
+
+
 def job_result_geopackage(collection: dict[str, Any]) -> bytes:
     """A job result (:func:`job_result_geojson`) as GeoPackage bytes, EPSG:4326.
 
     Layers ``cameras`` and ``candidates``, both always there (one without features has the
     column ``id`` only: before, it was left out, and a job with no camera done yet gave 0
-    bytes, no GeoPackage at all); list and dict properties are stored as JSON text. Needs
+    bytes, no GeoPackage at all); list and dict properties are stored as JSON text. Since
+    session 40 also QGIS's ``layer_styles`` table (:func:`write_layer_styles`), and the
+    columns those styles read (``ambiguous_with`` empty where no candidate has one). Needs
     geopandas and pyogrio.
     """
     import json
@@ -831,6 +908,9 @@ def job_result_geopackage(collection: dict[str, Any]) -> bytes:
                 geometry=[shape(f["geometry"]) if f["geometry"] else None for f in feats],
                 crs="EPSG:4326",
             )
+            for col in _JOB_STYLED_COLUMNS[layer]:  # what the layer's QGIS style reads
+                if col not in frame.columns:
+                    frame[col] = None
             for col in frame.columns:
                 # a numeric column null in every row (no camera of the job has a heading
                 # yet) was written as a String field, which QGIS then styles and sorts as text
@@ -839,4 +919,6 @@ def job_result_geopackage(collection: dict[str, Any]) -> bytes:
             # GeoPackage 1.2, as QGIS 3.22's GDAL 3.6 reads without a warning (1.4 is
             # pyogrio's default; camloc_geo.batch writes 1.2 for the same reason)
             frame.to_file(path, layer=layer, driver="GPKG", engine="pyogrio", **options)
+        # QGIS draws the layers as the plugin's (session 40: they had no style)
+        write_layer_styles(path, {layer: f"job_{layer}" for layer, _kind in JOB_LAYERS})
         return path.read_bytes()

@@ -179,6 +179,7 @@ def test_layers_and_summary_map(world: dict[str, Path], local_run: dict[str, Any
         "candidates": "Point",
         "view_cones": "Polygon",
         "errors": None,
+        "layer_styles": None,  # QGIS's default styles (session 40)
     }
     cands = layers["candidates"]
     assert set(cands["row"]) <= set(layers["cameras"]["row"])

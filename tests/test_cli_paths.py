@@ -373,7 +373,7 @@ def test_two_outputs_of_one_command_are_distinct(
 ) -> None:
     """``locate -o x --map x`` wrote the GeoJSON and then the page over it (exit 0, no
     GeoJSON left); ``vp -o x.png --draw x.png`` likewise. Both are refused before any work."""
-    out = tmp_path / "same.out"
+    out = tmp_path / "same.html"
     args = ["locate", str(SCENE), "--osm", str(BALTIMORE), "-o", str(out), "--map", str(out)]
     assert main([*args, "--offline"]) == 2
     err = capsys.readouterr().err

@@ -449,6 +449,14 @@ def test_measure_job_gives_the_library_values(tmp_path):
         ([{"a": [1, 2], "b": [3, "x"]}], "PAIRS item 0: 'b' must be a pixel"),
         ([[1, 2, 3, 4]], "PAIRS item 0: must be an object"),
         ({"a": [1, 2]}, "PAIRS must be a JSON list"),
+        # session 40: an empty PAIRS wrote an empty table without a word
+        ([], "PAIRS has no pair: nothing to measure"),
+        # a pixel the library refuses: which item (it named none)
+        (
+            [{"a": [1, 2], "b": [3, 4]}, {"a": [1e308, 631], "b": [1345, 531]}],
+            "PAIRS item 1: ground: pixel (1e+308, 631) is far outside",
+        ),
+        (None, "PAIRS has no pair: nothing to measure"),
     ],
 )
 def test_measure_job_names_a_bad_pair(tmp_path, pairs, message):
@@ -457,3 +465,20 @@ def test_measure_job_names_a_bad_pair(tmp_path, pairs, message):
     with pytest.raises(InputError) as info:
         run_job({"task": "measure", "scene": str(SCENE), "pairs": pairs, "out_dir": str(tmp_path)})
     assert message in str(info.value)
+
+
+def test_worker_errors_name_the_processing_parameters_not_cli_options(tmp_path):
+    """camloc:locate without OSM (the network off) said "give --osm EXTRACT
+    (map_source=...)": options the Processing dialog does not have. It names OSM and NETWORK
+    now (session 40, found through qgis_process.bin)."""
+    r = subprocess.run(
+        [sys.executable, "-m", "camloc_geo.qgis.worker", "-"],
+        input=json.dumps({"task": "locate", "scene": str(SCENE), "out_dir": str(tmp_path)}),
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 2
+    error = json.loads(r.stdout.strip().splitlines()[-1])["error"]
+    assert "give OSM (an OSM extract) or turn NETWORK on" in error
+    assert "--osm" not in error
+    assert "map_source" not in error

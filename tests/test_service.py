@@ -420,6 +420,8 @@ def test_crowd_task_collects_and_locates(client: httpx.Client) -> None:
     # the page of the full task says so before any work (it was served as if open)
     full = client.get(f"/annotate/{task['id']}").text
     assert "This task has all its 2 annotations already: it takes no more work." in full
+    # session 40: and where the answer is (the page named none)
+    assert f"The camera's candidates: /v1/tasks/{task['id']}/map" in full
 
 
 def test_crowd_task_no_map_can_serve_is_refused(client: httpx.Client) -> None:

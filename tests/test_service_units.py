@@ -683,7 +683,7 @@ def test_job_geopackage_of_a_job_with_nothing_done_is_a_geopackage(tmp_path: Pat
     empty = tmp_path / "empty.gpkg"
     empty.write_bytes(job_result_geopackage({"type": "FeatureCollection", "features": []}))
     layers = dict(pyogrio.list_layers(empty))
-    assert layers == {"cameras": "Point", "candidates": "Point"}
+    assert layers == {"cameras": "Point", "candidates": "Point", "layer_styles": None}
     assert len(pyogrio.read_dataframe(empty, layer="cameras")) == 0
 
 

@@ -1080,6 +1080,7 @@ def _write_gpkg(
                     kwargs["dataset_options"] = {"VERSION": GPKG_VERSION}
                 pyogrio.write_dataframe(df, str(tmp), append=name in started, **kwargs)
                 started.add(name)
+        _write_layer_styles(tmp)
         os.replace(tmp, out)
     except BaseException:
         # Ctrl-C, SIGTERM or a failure while writing: the previous GeoPackage stays, and no
@@ -1087,6 +1088,20 @@ def _write_gpkg(
         for left in (tmp, *(tmp.with_name(tmp.name + x) for x in ("-journal", "-wal", "-shm"))):
             left.unlink(missing_ok=True)
         raise
+
+
+STYLED_LAYERS = ("cameras", "candidates", "view_cones")
+"""The layers whose default QGIS style the GeoPackage carries (QGIS's ``layer_styles``:
+``camloc_geo/data/qgis_styles/batch_<layer>.qml`` and ``.sld``, made from the plugin's styles
+by ``qgis_plugin/make_batch_styles.py``; :func:`camloc_geo.results.write_layer_styles`)."""
+
+
+def _write_layer_styles(gpkg: Path) -> None:
+    """The batch GeoPackage's QGIS styles (it had none: QGIS drew every layer in one random
+    colour, ties and ranks alike)."""
+    from camloc_geo.results import write_layer_styles
+
+    write_layer_styles(gpkg, {name: f"batch_{name}" for name in STYLED_LAYERS})
 
 
 # ------------------------------------------------------------------------ summary map

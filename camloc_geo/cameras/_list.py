@@ -192,6 +192,19 @@ def _clean(value: Any) -> str:
     return "".join(ch if ch.isprintable() else " " for ch in text).strip()
 
 
+def _text(value: Any, name: str, problems: list[str]) -> str:
+    """A text column's value; an object or a list (a JSON list's ``"id": {"a": 1}``) is
+    named as a row problem and kept as its JSON text (it became a Python repr, ``{'a': 1}``,
+    without a word; ``"title": ["A", "B"]`` was searched for as ``['A', 'B']``)."""
+    if isinstance(value, (dict, list)):
+        import json
+
+        text = json.dumps(value, ensure_ascii=False, sort_keys=True, default=str)
+        problems.append(f"{name} {text[:40]!r} is not text or a number")
+        return "" if name == "title" else _clean(text)
+    return _clean(value)
+
+
 def _number(value: Any, name: str, problems: list[str]) -> float | None:
     if value is None or (isinstance(value, str) and not value.strip()):
         return None
@@ -232,8 +245,8 @@ def row_from_mapping(
     """
     lower = {str(k).strip().lower(): v for k, v in values.items() if k is not None}
     problems = list(list_problems)
-    ident = _clean(_pick(lower, "id")) or f"row-{row}"
-    title = _clean(_pick(lower, "title"))
+    ident = _text(_pick(lower, "id"), "id", problems) or f"row-{row}"
+    title = _text(_pick(lower, "title"), "title", problems)
     lat = _number(_pick(lower, "lat"), "lat", problems)
     lon = _number(_pick(lower, "lon"), "lon", problems)
     if lat is None and lon is None and point is not None:

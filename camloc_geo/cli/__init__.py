@@ -104,6 +104,71 @@ def output_path(
     return check_output_path(path, inputs=inputs, option=option, directory=directory)
 
 
+PAGE_SUFFIXES: tuple[str, ...] = (".html", ".htm")
+"""Names an HTML page (``--map``, ``summary-map -o``, ``annotate -o``) may end with; a name
+without a suffix is taken as it is (``/dev/stdout``)."""
+
+
+def page_path(
+    path: str | Path | None, *, inputs: Iterable[str | Path | None] = (), option: str = "-o"
+) -> Path | None:
+    """:func:`output_path` for an HTML page: a name ending in another suffix is refused.
+
+    ``locate --map x.pdf`` wrote the HTML page under a PDF name, which a PDF viewer then
+    could not open.
+
+    Raises
+    ------
+    InputError
+        As :func:`output_path`, or the name ends in a suffix other than
+        :data:`PAGE_SUFFIXES` (exit 2, one line naming them).
+    """
+    out = output_path(path, inputs=inputs, option=option)
+    if out is not None and out.suffix and out.suffix.lower() not in PAGE_SUFFIXES:
+        raise InputError(
+            f"{option} {path}: writes an HTML page, not {out.suffix}; name it "
+            f"{' or '.join(PAGE_SUFFIXES)} (as {out.stem}.html)"
+        )
+    return out
+
+
+NOT_JSON_SUFFIXES: frozenset[str] = frozenset(
+    {
+        ".html", ".htm", ".pdf", ".png", ".jpg", ".jpeg", ".gif", ".webp", ".tif", ".tiff",
+        ".gpkg", ".shp", ".kml", ".kmz", ".csv", ".xlsx", ".xls", ".sqlite", ".zip",
+    }
+)  # fmt: skip
+"""Suffixes of other formats that a JSON output (``locate -o``, ``calibrate -o``...) refuses:
+``locate -o review.html`` wrote GeoJSON under a page's name, ``-o cams.gpkg`` GeoJSON under a
+GeoPackage's (a name without a suffix, ``.json``, ``.geojson`` or any other is taken)."""
+
+
+def json_path(
+    path: str | Path | None,
+    *,
+    inputs: Iterable[str | Path | None] = (),
+    what: str = "JSON",
+    hint: str = "",
+) -> Path | None:
+    """:func:`output_path` for ``-o`` of a command that writes JSON or GeoJSON.
+
+    Raises
+    ------
+    InputError
+        As :func:`output_path`, or the name ends in a suffix of another format
+        (:data:`NOT_JSON_SUFFIXES`; exit 2, one line; ``hint`` says where that format comes
+        from, such as "the review page is --map OUT.html").
+    """
+    out = output_path(path, inputs=inputs)
+    if out is not None and out.suffix.lower() in NOT_JSON_SUFFIXES:
+        ext = ".geojson" if what == "GeoJSON" else ".json"
+        raise InputError(
+            f"-o {path}: writes {what}, not {out.suffix}; name it {ext}"
+            + (f" ({hint})" if hint else "")
+        )
+    return out
+
+
 def distinct_outputs(*outputs: tuple[str, Path | None]) -> None:
     """Refuse two outputs of one command naming the same file (``-o x --map x``: the last
     written replaced the other). ``outputs`` are ``(option, path)`` pairs; None is stdout.

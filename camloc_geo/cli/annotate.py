@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo._errors import InputError
     from camloc_geo._io import write_text_atomic
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import page_path
     from camloc_geo.scene import load_scene
     from camloc_geo.web import annotation_page_html
 
@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     out = args.output or (Path(args.image).stem + ".annotate.html")
     # before any work; never over the photo, the scene or the extract (-o cam.jpg replaced
     # the photo with the page)
-    out_path = output_path(out, inputs=[args.image, args.scene, args.osm])
+    out_path = page_path(out, inputs=[args.image, args.scene, args.osm])
     lat, lon = args.lat, args.lon
     scene = load_scene(args.scene) if args.scene else None
     if args.osm and lat is None:

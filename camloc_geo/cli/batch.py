@@ -75,7 +75,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.batch import run_batch
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import output_path, page_path
 
     # before any work: the GeoPackage and the page never land on the list or an extract (the
     # page used to overwrite the list with --map LIST.csv), nor on each other
@@ -90,6 +90,7 @@ def run(args: argparse.Namespace) -> int:
         page = output_path(args.map, inputs=inputs, option="--map")
         if page is not None and out is not None and page.resolve() == out.resolve():
             raise InputError(f"--map {args.map}: the same file as -o; give the page its own name")
+        page_path(args.map, inputs=inputs, option="--map")  # an .html name
     service = None
     if args.verdict_url is not None:
         from camloc_geo.cli.locate import verdict_url

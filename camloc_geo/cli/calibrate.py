@@ -61,9 +61,9 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.api import calibrate_scene, scene_from
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import json_path
 
-    output_path(args.output, inputs=[args.scene, args.video])
+    json_path(args.output, inputs=[args.scene, args.video])
     if args.max_frames is not None:
         if args.video is None:
             raise InputError("--max-frames needs --video VIDEO (the frames read of it)")

@@ -34,10 +34,10 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc corners``."""
     from camloc_geo.api import check_map_radius_m, corners_near
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import json_path
 
     check_map_radius_m(args.radius_m, "--radius-m")  # before the map is read
-    output_path(args.output, inputs=[args.osm])
+    json_path(args.output, inputs=[args.osm], what="GeoJSON")
     gj = corners_near(
         lat=args.lat,
         lon=args.lon,

@@ -315,13 +315,16 @@ def run(args: argparse.Namespace) -> int:
 
     if not args.titles and not args.list:
         raise InputError("give one or more titles, or --list LIST.csv")
+    for number, arg in enumerate(args.titles, start=1):
+        if not arg.strip():  # ("$TITLE" unset: it printed a not_found feature, exit 0)
+            raise InputError(f"title {number} is empty: give the webcam title's text")
     near = _parse_near(args.near)
     if args.radius_m is not None and not (args.radius_m > 0):
         raise InputError(f"--radius-m must be positive, got {args.radius_m}")
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import json_path
 
     paths = extract_paths(args.osm)
-    out = output_path(args.output, inputs=[args.list, *paths])
+    out = json_path(args.output, inputs=[args.list, *paths], what="GeoJSON")
     rows = _rows(Path(args.list)) if args.list else None
     maps = [whole_map(p) for p in paths]
 

@@ -7,7 +7,13 @@ import math
 from typing import Any
 
 from camloc_geo._errors import InputError
-from camloc_geo.cli import NETWORK_HELP, add_map_options, network_of, output_path, write_json
+from camloc_geo.cli import (
+    NETWORK_HELP,
+    add_map_options,
+    json_path,
+    network_of,
+    write_json,
+)
 
 __all__ = ["register", "run"]
 
@@ -92,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     from camloc_geo.sensors.guide import GuideSettings
 
     inputs = [args.scene, args.tracks, args.gps, args.candidates, args.osm]
-    out_path = output_path(args.output, inputs=inputs)
+    out_path = json_path(args.output, inputs=inputs)
     for name in ("gps_sigma_m", "step_s"):
         _positive("--" + name.replace("_", "-"), getattr(args, name))
     if not (math.isfinite(args.click_sigma_px) and args.click_sigma_px >= 0):

@@ -12,8 +12,10 @@ from camloc_geo.cli import (
     atomic_output,
     distinct_outputs,
     inline_of,
+    json_path,
     network_of,
     output_path,
+    page_path,
     write_json,
 )
 
@@ -126,8 +128,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--max-candidates must be at least 1 (got {args.max_candidates})")
     inputs = [args.scene, args.osm, args.verdicts]
     out_path = output_path(args.output, inputs=inputs)
-    map_path = output_path(args.map, inputs=inputs, option="--map")
-    distinct_outputs(("-o", out_path), ("--map", map_path))
+    map_path = page_path(args.map, inputs=inputs, option="--map")
+    distinct_outputs(("-o", out_path), ("--map", map_path))  # said first, as before
+    json_path(args.output, inputs=inputs, what="GeoJSON", hint="the review page is --map OUT.html")
     if args.overlays is not None:
         if map_path is None:
             raise InputError("--overlays needs --map OUT.html")

@@ -72,11 +72,11 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
     from camloc_geo.api import calibrate_scene
-    from camloc_geo.cli import output_path, write_json
+    from camloc_geo.cli import json_path, write_json
     from camloc_geo.scene import load_scene
     from camloc_geo.sensors import ground_distance, point_height
 
-    output_path(args.output, inputs=[args.scene])  # before the work; never over the scene
+    json_path(args.output, inputs=[args.scene])  # before the work; never over the scene
     if not (args.click_sigma_px >= 0.0 and args.click_sigma_px < float("inf")):
         raise InputError(f"--click-sigma-px must be >= 0, not {args.click_sigma_px}")
     if args.ground is not None:

@@ -30,10 +30,10 @@ def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from camloc_geo._errors import InputError
-    from camloc_geo.cli import output_path, write_json
+    from camloc_geo.cli import json_path, write_json
     from camloc_geo.merge import merge_scenes
 
-    out = output_path(args.output, inputs=args.scenes)  # never over an annotator's file
+    out = json_path(args.output, inputs=args.scenes)  # never over an annotator's file
     seen: dict[Path, str] = {}
     for name in args.scenes:
         key = Path(name).resolve()

@@ -32,8 +32,9 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the command."""
-    from camloc_geo.cli import write_json
+    from camloc_geo.cli import json_path, write_json
 
+    json_path(args.output)  # a JSON Schema under a .html or .pdf name is refused
     if args.document == "scene":
         from camloc_geo.scene import scene_json_schema
 

@@ -37,7 +37,7 @@ def run(args: argparse.Namespace) -> int:
 
     from camloc_geo._errors import InputError
     from camloc_geo.api import check_map_radius_m, streets_near
-    from camloc_geo.cli import output_path
+    from camloc_geo.cli import json_path
     from camloc_geo.results import streets_json
 
     if not (math.isfinite(args.near_m) and args.near_m >= 0):
@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
         # loading the map; a negative value listed nothing near, without a word
         raise InputError(f"--near-m must be a number of metres, 0 or more, got {args.near_m}")
     check_map_radius_m(args.radius_m, "--radius-m")  # before the map is read
-    output_path(args.output, inputs=[args.osm])
+    json_path(args.output, inputs=[args.osm])
     m = streets_near(
         lat=args.lat,
         lon=args.lon,

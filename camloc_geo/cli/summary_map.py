@@ -65,8 +65,21 @@ def register(subparsers: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _point_of(geometry: Any) -> tuple[float, float] | None:
+    """``(lon, lat)`` of a GeoJSON Point on Earth, else None."""
+    if not isinstance(geometry, dict) or geometry.get("type") != "Point":
+        return None
+    coords = geometry.get("coordinates")
+    if not isinstance(coords, list) or len(coords) < 2:
+        return None
+    lon, lat = coords[0], coords[1]
+    return (float(lon), float(lat)) if is_lat_lon(lat, lon) else None
+
+
 def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
     """Validate one candidate GeoJSON; drop (with a warning) features that cannot be drawn.
+
+    A candidate without a ``lat``/``lon`` position takes its Point geometry's.
 
     Returns
     -------
@@ -93,6 +106,11 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
             skipped += 1
             continue
         if fp.get("kind") == "candidate" and not is_lat_lon(fp.get("lat"), fp.get("lon")):
+            point = _point_of(f.get("geometry"))
+            if point is not None:  # the feature's own Point (lat/lon columns dropped in
+                # a GIS, or another tool's GeoJSON): every candidate was skipped, exit 2
+                kept.append({**f, "properties": {**fp, "lat": point[1], "lon": point[0]}})
+                continue
             log.warning(
                 "%s: feature %d: lat=%r, lon=%r is not a position: skipped",
                 path,
@@ -109,13 +127,13 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
-    from camloc_geo.cli import atomic_output, output_path, read_json_file
+    from camloc_geo.cli import atomic_output, page_path, read_json_file
     from camloc_geo.cli.locate import verdict_url
 
     # a bad URL stops before any reading
     service = None if args.verdict_url is None else verdict_url(args.verdict_url)
 
-    out = output_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
+    out = page_path(args.output, inputs=[*args.inputs, args.osm, args.verdicts], option="-o")
     if out is None:
         raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
     inputs = _once_each(args.inputs)

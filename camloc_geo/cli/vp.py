@@ -91,11 +91,12 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc vp``."""
     from camloc_geo.autovp import draw_segments
-    from camloc_geo.cli import atomic_output, distinct_outputs, output_path, write_json
+    from camloc_geo.cli import atomic_output, distinct_outputs, json_path, output_path, write_json
 
     out_path = output_path(args.output, inputs=[args.image])
     draw_path = output_path(args.draw, inputs=[args.image], option="--draw")
-    distinct_outputs(("-o", out_path), ("--draw", draw_path))
+    distinct_outputs(("-o", out_path), ("--draw", draw_path))  # said first, as before
+    json_path(args.output, inputs=[args.image], hint="the drawing is --draw OUT.png")
     if draw_path is not None and draw_path.suffix.lower() not in _IMAGE_SUFFIXES:
         raise InputError(f"--draw {draw_path}: give a .png or .jpg file name")
     options: dict[str, Any] = {}

@@ -589,10 +589,11 @@ _MEASURE_KINDS = ("distance", "height")
 def _measure_pairs(pairs: Any) -> list[dict[str, Any]]:
     """``PAIRS`` checked item by item: a clear one-line error naming the item and the fault."""
     example = '[{"kind": "distance", "a": [x, y], "b": [x, y]}]'
-    if pairs is None:
-        return []
-    if not isinstance(pairs, list):
+    if not isinstance(pairs, list) and pairs is not None:
         raise InputError(f"PAIRS must be a JSON list like {example}")
+    if not pairs:
+        # (an empty PAIRS wrote an empty measurements table without a word)
+        raise InputError(f"PAIRS has no pair: nothing to measure; give a JSON list like {example}")
     out: list[dict[str, Any]] = []
     for i, item in enumerate(pairs):
         if not isinstance(item, dict):
@@ -635,10 +636,14 @@ def _task_measure(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     pair_warnings: list[str] = []
     for i, item in enumerate(pairs):
         a, b = item["a"], item["b"]
-        if item["kind"] == "height":
-            m = sensors.point_height(cal, a, b)
-        else:
-            m = sensors.ground_distance(cal, [a, b])
+        try:
+            if item["kind"] == "height":
+                m = sensors.point_height(cal, a, b)
+            else:
+                m = sensors.ground_distance(cal, [a, b])
+        except InputError as exc:
+            # which pair: "ground: pixel (1e+308, 631) is far outside..." named none
+            raise type(exc)(f"PAIRS item {i}: {exc}") from None
         # a pair near the horizon: its sigma is a lower bound (Measurement.warnings)
         pair_warnings += [f"PAIRS item {i}: {w}" for w in getattr(m, "warnings", ())]
         # the library's Measurement holds ``value_m`` (``to_dict`` names it distance_m or
@@ -769,6 +774,27 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
     return {"ok": True, **_TASKS[task](job, out_dir)}
 
 
+_CLI_HINTS = (
+    ("give --osm EXTRACT (map_source=...)", "give OSM (an OSM extract) or turn NETWORK on"),
+    ("give --osm EXTRACT (a local OSM extract)", "give OSM (a local OSM extract)"),
+    (
+        "give --osm EXTRACT_OR_FOLDER or allow --network",
+        "give OSM (an extract or a folder of them) or turn NETWORK on",
+    ),
+    ("give --osm EXTRACT_OR_FOLDER", "give OSM (an extract or a folder of them)"),
+    ("give --osm EXTRACT", "give OSM (an OSM extract)"),
+)
+"""The command line's words in the library's hints, and the Processing parameters' for them:
+QGIS users read "give --osm EXTRACT (map_source=...)", options their dialog does not have."""
+
+
+def processing_words(text: str) -> str:
+    """``text`` with the command line's option names put as the Processing parameters'."""
+    for cli, qgis in _CLI_HINTS:
+        text = text.replace(cli, qgis)
+    return text
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: ``python -m camloc_geo.qgis.worker JOB.json`` (``-`` reads standard input)."""
     args = sys.argv[1:] if argv is None else argv
@@ -784,10 +810,13 @@ def main(argv: list[str] | None = None) -> int:
         _emit({"ok": False, "error": f"cannot read the job: {exc}", "kind": "InputError"})
         return 2
     try:
-        _emit(run_job(job))
+        result = run_job(job)
+        if result.get("warnings"):
+            result["warnings"] = [processing_words(str(w)) for w in result["warnings"]]
+        _emit(result)
     except (InputError, KeyError) as exc:
         msg = f"missing job parameter {exc}" if isinstance(exc, KeyError) else str(exc)
-        _emit({"ok": False, "error": msg, "kind": type(exc).__name__})
+        _emit({"ok": False, "error": processing_words(msg), "kind": type(exc).__name__})
         return 2
     except Exception as exc:
         sys.stderr.write(traceback.format_exc())

@@ -27,7 +27,7 @@ from camloc_geo import (
     SceneError,
 )
 from camloc_geo.service.verdicts import VerdictStoreError
-from camloc_geo.service.work import LimitError
+from camloc_geo.service.work import LimitError, server_words
 
 __all__ = [
     "ERROR_STATUS",
@@ -126,7 +126,7 @@ def error_response_for(exc: BaseException, rid: str) -> JSONResponse:
         if isinstance(exc, cls):
             if status >= 500:
                 log.warning("request %s: %s", rid, exc)
-            message = " ".join(str(exc).split())
+            message = server_words(" ".join(str(exc).split()))
             return error_response(status, kind, message, getattr(exc, "field", None), rid)
     log.error("request %s failed", rid, exc_info=exc)
     return error_response(500, "internal", f"internal error (request id {rid})", None, rid)

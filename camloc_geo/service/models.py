@@ -85,6 +85,19 @@ class CornersQuery(PointQuery):
         default=None, max_length=200, description='"A & B": only where they meet'
     )
 
+    @field_validator("streets")
+    @classmethod
+    def _two_streets(cls, value: str | None) -> str | None:
+        """Fewer than two names is the query's fault: 422 ``invalid_input`` naming
+        ``streets`` (it was ``map_data`` with no field, as if the map were wrong)."""
+        from camloc_geo.osm._names import split_street_query
+
+        if value is not None and value.strip():
+            names = [n for n in split_street_query(value) if n]
+            if len(names) < 2:
+                raise ValueError(f'give two street names, as "A & B" (got {value!r})')
+        return value
+
 
 class LocateQuery(BaseModel):
     """``/v1/locate``."""

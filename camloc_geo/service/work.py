@@ -12,9 +12,29 @@ if TYPE_CHECKING:
     from camloc_geo.service.mapstore import MapStore
     from camloc_geo.service.settings import Settings
 
-__all__ = ["check_scene_body", "locate_body", "process_camera"]
+__all__ = ["check_scene_body", "locate_body", "process_camera", "server_words"]
 
 log = logging.getLogger(__name__)
+
+
+_SERVER_HINT = "this server has no map data there (its operator adds extracts to CAMLOC_MAP_DIR)"
+_CLI_HINTS = (
+    "give --osm EXTRACT_OR_FOLDER or allow --network",
+    "give --osm EXTRACT_OR_FOLDER",
+    "give --osm EXTRACT (map_source=...)",
+    "give --osm EXTRACT (a local OSM extract) to work without the network",
+)
+
+
+def server_words(text: str) -> str:
+    """``text`` with the command line's map hints put as a service client can act on them.
+
+    The library's "give --osm EXTRACT_OR_FOLDER or allow --network" reached clients of the
+    service, which have no such option: the server's operator configures the maps.
+    """
+    for hint in _CLI_HINTS:
+        text = text.replace(hint, _SERVER_HINT)
+    return text
 
 
 class LimitError(InputError):
@@ -116,6 +136,8 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
         if not cam_id:
             row = dataclasses.replace(row, id="")
         res = locate_camera(row, map_source=maps.catalogue)
+        if res.reason:  # the library's hints in the server's words, not the CLI's options
+            res.reason = server_words(res.reason)
         problems = "; ".join(row.problems)
         if problems and problems not in (res.reason or ""):
             # batch keeps them in its errors layer; a job's result has only the reason
@@ -124,7 +146,7 @@ def process_camera(camera: Any, maps: MapStore, settings: Settings) -> dict[str,
     except CamlocError as exc:
         res = CameraResult(row=1, id=cam_id).fail(
             "scene_error" if isinstance(exc, (SceneError, LimitError)) else "failed",
-            " ".join(str(exc).split()),
+            server_words(" ".join(str(exc).split())),
             "input",
         )
     except Exception as exc:  # one bad camera never sinks the job

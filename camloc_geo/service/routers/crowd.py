@@ -164,6 +164,8 @@ async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HT
                 f"This task has all its {task['needed']} annotations already: it takes no "
                 "more work. Thank you!"
             )
+            if task["status"] == "located":  # where its answer is (the page named none)
+                closed += f" The camera's candidates: /v1/tasks/{task_id}/map"
         return annotation_page_html(
             store.task_image(task),
             scene=task["base_scene"],

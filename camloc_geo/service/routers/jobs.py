@@ -303,6 +303,7 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
             # says "on the map: 1 title_only (at the junction its title names)", not "1
             # camera(s) located" (a title's candidates carried no status: located, they read)
             feats = [_status_first(f, str(r["status"])) for f in feats]
+        feats = [_with_sigma(f) for f in feats]
         reason = r.get("reason") if feats else f"{r.get('status')}: {r.get('reason') or ''}"
         gj = {"type": "FeatureCollection", "features": feats, "properties": {"reason": reason}}
         items.append((label, gj))
@@ -311,6 +312,16 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
 
 _PLACED_BY_TITLE = ("title_only", "street_only")
 """Statuses of cameras placed where their title points, not located from a scene."""
+
+
+def _with_sigma(feature: dict[str, Any]) -> dict[str, Any]:
+    """A candidate feature whose uncertainty the page shows: a title's candidate states it
+    as ``uncertainty_m`` (the batch's name), which the page's ``sigma_m`` row left as "—"
+    (a junction placed within 20 m read as of unknown uncertainty)."""
+    props = feature.get("properties") or {}
+    if props.get("sigma_m") is not None or props.get("uncertainty_m") is None:
+        return feature
+    return {**feature, "properties": {**props, "sigma_m": props["uncertainty_m"]}}
 
 
 def _status_first(feature: dict[str, Any], status: str) -> dict[str, Any]:

@@ -57,6 +57,31 @@ async def favicon() -> Response:
     )
 
 
+_INDEX_HTML = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>camloc service {version}</title>
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<link rel="icon" href="/favicon.ico">
+<style>body {{ font: 15px/1.5 sans-serif; margin: 2em auto; max-width: 40em; padding: 0 1em; }}
+</style></head><body>
+<h1>camloc service {version}</h1>
+<p>Finds where a street camera stands from one snapshot. This address serves an HTTP API:</p>
+<ul>
+<li><a href="/docs">/docs</a>: the API, to try in the browser (Swagger UI)</li>
+<li><a href="/redoc">/redoc</a>: the API, to read (ReDoc)</li>
+<li><a href="/openapi.json">/openapi.json</a>: the API's description, for clients</li>
+<li><a href="/healthz">/healthz</a>: health, the version and the extracts configured</li>
+<li><a href="/v1/verdicts">/v1/verdicts</a>: the pages reviewers gave verdicts on</li>
+</ul></body></html>
+"""
+
+
+@router.get("/", include_in_schema=False, response_class=HTMLResponse)
+async def index() -> HTMLResponse:
+    """The service's address opened in a browser: what it is and where its API is described
+    (it was a 404 "Not Found" JSON)."""
+    return HTMLResponse(_INDEX_HTML.format(version=__version__))
+
+
 @router.head("/healthz", include_in_schema=False)
 async def healthz_head(maps: Maps) -> dict[str, Any]:
     """``HEAD /healthz`` (``curl -I``, load balancers' probes) answers as ``GET`` without a

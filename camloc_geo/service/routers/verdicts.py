@@ -99,11 +99,31 @@ async def post_verdicts(
     page: VerdictPage, identity: VerdictIdentity, body: VerdictPost, store: Verdicts
 ) -> dict[str, Any]:
     """Add or change verdicts on a page: each item replaces the stored one of its key unless
-    that one is newer. Answers the page's verdicts after the change and the keys taken.
+    that one is newer. Answers the page's verdicts after the change, the keys taken, and
+    ``warnings``: one per item taken with a verdict but no ``camera`` (kept; an export row
+    without a camera cannot be matched to one, so ``--verdicts`` leaves it out).
     With ``CAMLOC_API_KEY`` set: ``X-API-Key`` is needed (401 without it)."""
     now = datetime.now(timezone.utc)
     items = {key: item.stored(now) for key, item in body.items.items()}
     # (in the thread pool: SQLite may wait up to 30 s for another process's lock, which
     # blocked every other request of the event loop)
     doc, taken = await run_in_threadpool(store.merge, page, identity, items)
-    return {**doc, "taken": taken}
+    return {**doc, "taken": taken, "warnings": no_camera_warnings(items, taken)}
+
+
+def no_camera_warnings(items: dict[str, dict[str, Any]], taken: list[str]) -> list[str]:
+    """One line per taken item that has a verdict but no ``camera``, naming its key.
+
+    Such an item was taken without a word, and ``camloc summary-map --verdicts`` then failed
+    on the whole export ("no camera id"); the export is read without it now, and the poster
+    is told here.
+    """
+    out = []
+    for key in taken:
+        it = items[key]
+        if it.get("verdict") is not None and not str(it.get("camera") or "").strip():
+            out.append(
+                f"item {key!r}: no camera: kept, but the export's row of it names no camera, "
+                "so --verdicts leaves it out (send 'camera', the camera's id on the page)"
+            )
+    return out

@@ -1,0 +1,118 @@
+"""Write the QGIS styles ``camloc batch`` stores in its GeoPackage: run with QGIS's Python.
+
+``/usr/bin/python3 qgis_plugin/make_batch_styles.py`` (``QT_QPA_PLATFORM=offscreen``) writes
+``camloc_geo/data/qgis_styles/<name>.qml`` and ``.sld``: ``batch_cameras``,
+``batch_candidates`` and ``batch_view_cones`` for ``camloc batch``'s GeoPackage, and
+``job_cameras`` and ``job_candidates`` for the service's job result
+(``/v1/jobs/{id}/result?format=gpkg``): the plugin's own styles (``camloc/layers.py``: the
+list's candidates, its cameras, the view cones) with those layers' field names.
+``camloc_geo.results.write_layer_styles`` copies them into a GeoPackage's ``layer_styles``
+table, as QGIS's "Save as Default" does, so that the GeoPackage opened in QGIS looks as the
+plugin's layers do; camloc_geo itself never needs QGIS. Run it again after changing a style.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+OUT = HERE.parent / "camloc_geo" / "data" / "qgis_styles"
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent))
+
+_TYPES = {"int64": "int", "float64": "double", "bool": "bool", "object": "string"}
+
+
+def main() -> int:
+    """Write the styles; 0 on success."""
+    from qgis.core import (
+        QgsApplication,
+        QgsProperty,
+        QgsSymbol,
+        QgsSymbolLayer,
+        QgsVectorLayer,
+        QgsWkbTypes,
+    )
+    from qgis.PyQt.QtGui import QColor
+    from qgis.PyQt.QtXml import QDomDocument
+
+    app = QgsApplication([], False)
+    app.initQgis()
+    from camloc import layers as L  # noqa: N812  (the plugin's styles)
+
+    from camloc_geo.batch import _run
+
+    def candidates(layer: QgsVectorLayer, tie: str) -> None:  # style_list_candidates
+        no_tie = f"NOT ({tie})"
+        L._rules(
+            layer,
+            [
+                ("★ " + L.TIE_WORDS, tie, L._marker("#d7191c", "Star", 5.0)),
+                (
+                    "a camera's best candidate",
+                    no_tie + ' AND "rank" = 1',
+                    L._marker("#fdae61", "Circle", 3.2),
+                ),
+                ("other candidates", None, L._marker("#2c7bb6", "Circle", 2.2, 0.6)),
+            ],
+        )
+        L._label(layer, f'CASE WHEN "rank" > 1 OR {tie} THEN concat(\'#\', "rank") END', 1)
+
+    def cameras(layer: QgsVectorLayer) -> None:  # style_cameras, "id" for "camera_id"
+        L._rules(layer, [("camera placed", None, L._marker("#d7191c", "Triangle", 4.5))])
+        L._label(layer, '"id" || \' \' || "status"', priority=10, size=10)
+
+    def view_cones(layer: QgsVectorLayer) -> None:  # style_view_cones without "tie"
+        sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
+        sym.setColor(QColor(255, 190, 0, 70))
+        sl = sym.symbolLayer(0)
+        sl.setStrokeColor(QColor(180, 120, 0))
+        sl.setDataDefinedProperty(
+            QgsSymbolLayer.PropertyFillColor,
+            QgsProperty.fromExpression(
+                'color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce("score", 0) / 0.5))'
+            ),
+        )
+        L._rules(layer, [("view cone (faded by score)", None, sym)])
+
+    # the batch's ties: "2,4", NULL without one; the job's: JSON text, "[2, 4]" or "[]"
+    batch_tie = '"ambiguous_with" IS NOT NULL'
+    job_tie = "coalesce(\"ambiguous_with\", '[]') NOT IN ('', '[]')"
+    job_cameras = {"id": "object", "status": "object", "title": "object", "score": "float64"}
+    job_candidates = {
+        "camera_id": "object",
+        "rank": "int64",
+        "score": "float64",
+        "ambiguous_with": "object",
+    }
+    jobs = [
+        ("batch_cameras", "Point", _run._CAMERA_COLUMNS, cameras),
+        ("batch_candidates", "Point", _run._CANDIDATE_COLUMNS, lambda x: candidates(x, batch_tie)),
+        ("batch_view_cones", "MultiPolygon", _run._CONE_COLUMNS, view_cones),
+        ("job_cameras", "Point", job_cameras, cameras),
+        ("job_candidates", "Point", job_candidates, lambda x: candidates(x, job_tie)),
+    ]
+    OUT.mkdir(parents=True, exist_ok=True)
+    for name, geometry, columns, style in jobs:
+        layer = QgsVectorLayer(f"{geometry}?crs=EPSG:4326", name, "memory")
+        desc = {"fields": [[c, _TYPES[t]] for c, t in columns.items()]}
+        layer.dataProvider().addAttributes(L.fields_of(desc).toList())
+        layer.updateFields()
+        style(layer)
+        doc = QDomDocument()
+        error = layer.exportNamedStyle(doc)
+        if error:
+            print(f"{name}: {error}", file=sys.stderr)
+            return 1
+        (OUT / f"{name}.qml").write_text(doc.toString(1), encoding="utf-8")
+        sld = QDomDocument()
+        layer.exportSldStyle(sld, "")
+        (OUT / f"{name}.sld").write_text(sld.toString(1), encoding="utf-8")
+        print(OUT / f"{name}.qml")
+    app.exitQgis()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
