@@ -47,8 +47,10 @@
 #   kernelmurton/prnu, Urban-Research-Lab/building-facades-advertising-dataset,
 #   jimlinntu/CS29426, yrlu/image_mosaic_stitching, sim-pez/prnu, nkisel/cs194-26-proj4,
 #   f0bs/Computer_Vision, felixnie/Panoramic-Image-Stitching, muhabgadir/CS194-26,
-#   shsiung/16822hw2, rohana96/ProjectiveGeometry
-#                                    18 phone photos (batch 9, set street-photos-held-out-3,
+#   shsiung/16822hw2, rohana96/ProjectiveGeometry, rushk014/image-autostitch,
+#   dominathan/Photos-for-Calvin, shortstheory/cis581-3a, karahannibal/karahannibal.github.io,
+#   mwomick/computational-photography
+#                                    phone photos (batch 9, set street-photos-held-out-3,
 #                                    into street-photos-held-out-3/): course and test data,
 #                                    no licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set

@@ -78,7 +78,7 @@ def test_fresh_batch_9_is_phones_held_out_whole_with_views() -> None:
     # wherever the 35 mm tag does not fit the frame
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
     fresh = [p for p in doc["photos"] if p["batch"] == 9]
-    assert len(fresh) >= 18
+    assert len(fresh) >= 24  # 18 in stop 40's first round, 6 more in its second
     assert {p["half"] for p in fresh} == {"held-out-3"}
     assert all(p["file"].startswith("street-photos-held-out-3/") for p in fresh)
     views = [p["view"] for p in fresh]
@@ -105,6 +105,40 @@ def test_fresh_batch_9_is_phones_held_out_whole_with_views() -> None:
     assert vp_real.street_photo_halves({"street-photos-held-out-3"}) == ("held-out-3",)
     assert vp_real.street_photo_halves({"street-photos-held-out-2"}) == ("held-out-2",)
     assert vp_real.street_photo_halves({"street-photos"}) == ("dev", "held-out")
+
+
+def test_batch_9_leaves_out_the_xperia_z2_set_whose_truth_is_not_pinned_down() -> None:
+    # The Xperia Z2's 16:9 8 MP photos (3840x2160, EXIF FocalLength 4.9 mm, no 35 mm tag)
+    # resample the sensor's full 5248-column width, so f/W is the 4:3 frame's; but the two
+    # published widths for it disagree by far more than the 3 % a pinned truth needs:
+    # Sony's 27 mm equivalent on the 4:3 diagonal and TechSpot's 1.1 um pixels.
+    size = (3840, 2160)
+    width_27mm = 4.9 * 43.27 / 27.0 * 0.8  # 4:3 diagonal -> width, mm
+    width_pitch = 5248 * 1.1e-3
+    f_a = vp_real.sensor_focal_truth_px(4.9, width_27mm, size) / 3840
+    f_b = vp_real.sensor_focal_truth_px(4.9, width_pitch, size) / 3840
+    assert f_a == pytest.approx(0.780, abs=0.002)
+    assert f_b == pytest.approx(0.849, abs=0.002)
+    assert abs(f_b / f_a - 1.0) > 0.03  # so none of them is pinned
+    doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
+    fresh = [p for p in doc["photos"] if p["batch"] == 9]
+    assert not [p for p in fresh if p["camera"].startswith("D65")]  # the Z2's model codes
+    assert "Xperia Z2" in doc["about"]
+    assert "9 %" in doc["about"]
+    # the second round's photos: a 4:3 main-camera frame each, the 35 mm tag as truth
+    second = {
+        "rushk014/image-autostitch",
+        "dominathan/Photos-for-Calvin",
+        "shortstheory/cis581-3a",
+        "karahannibal/karahannibal.github.io",
+        "mwomick/computational-photography",
+    }
+    added = [p for p in fresh if p["repo"] in second]
+    assert len(added) == 6
+    for p in added:
+        w, h = p["size"]
+        assert max(w, h) / min(w, h) == pytest.approx(4 / 3, abs=0.01)
+        assert "truth" not in p
 
 
 def test_loader_pins_content_and_reads_the_exif_truth(tmp_path: Path) -> None:
