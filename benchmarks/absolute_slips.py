@@ -124,6 +124,18 @@ HELD_OUT_2_SKIP = 30
 (``unseen_cities.py --n 30`` locates the 30 nearest)."""
 HELD_OUT_2_SEED = 39
 """The second held-out set's seed."""
+HELD_OUT_3_PLACES = [
+    ("liechtenstein.osm.pbf", 47.1410, 9.5215, 1500.0),
+    ("leeds_centre.osm.gz", 53.79891, -1.53450, 600.0),
+    ("nyc_manhattan.osm.pbf", 40.73618, -74.00535, 1500.0),
+]
+"""``--set held-out-3``: fixed (stop 40) before any result on it. Three cities no benchmark
+had sampled (Vaduz/Schaan, Leeds centre, Manhattan; ``data/osm/SOURCES.md``), every oracle
+junction within the radius (the centres are the median of Leeds' and Manhattan's oracle
+junctions, and Vaduz's town hall square), by junction class, seed :data:`HELD_OUT_3_SEED`,
+150 cameras, the 22 slips. Measured once, at the end."""
+HELD_OUT_3_SEED = 40
+"""The third held-out set's seed."""
 
 
 def held_out_2_places() -> list[tuple[str, float, float, float]]:
@@ -721,7 +733,7 @@ def run(
         order = _order_held_out(n, maps)
     elif which == "held-out-2":
         order = _order_held_out(n, maps, skip=HELD_OUT_2_SKIP)
-    elif which == "dev-classes":
+    elif which in ("held-out-3", "dev-classes"):
         order = _order_held_out(n, maps, skip=0)
     else:
         order = _order_dev(n, maps)
@@ -894,16 +906,20 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=60, help="number of junction cameras")
     ap.add_argument(
-        "--seed", type=int, default=None, help="default 0 (dev), 38 (held-out), 39 (held-out-2)"
+        "--seed",
+        type=int,
+        default=None,
+        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3)",
     )
     ap.add_argument(
         "--set",
-        choices=("dev", "dev-classes", "held-out", "held-out-2"),
+        choices=("dev", "dev-classes", "held-out", "held-out-2", "held-out-3"),
         default="dev",
         help="dev: absolute.py's junctions; dev-classes: DEV_CLASS_PLACES by junction "
         "class; held-out: HELD_OUT_PLACES by junction class (stop 38's; read since: "
         "development now); held-out-2: the unseen cities beyond their 30 nearest "
-        "junctions, by class (measure once, at the end)",
+        "junctions, by class (stop 39's; read since); held-out-3: Vaduz, Leeds and "
+        "Manhattan, every junction, by class (measure once, at the end)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -916,13 +932,18 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         ap.error(f"unknown slips {unknown}; known: {', '.join(SLIPS)}")
     if args.seed is None:
-        args.seed = {"held-out": HELD_OUT_SEED, "held-out-2": HELD_OUT_2_SEED}.get(args.set, 0)
+        args.seed = {
+            "held-out": HELD_OUT_SEED,
+            "held-out-2": HELD_OUT_2_SEED,
+            "held-out-3": HELD_OUT_3_SEED,
+        }.get(args.set, 0)
     t0 = time.perf_counter()
     maps = {}
     places = {
         "held-out": HELD_OUT_PLACES,
         "dev-classes": DEV_CLASS_PLACES,
         "held-out-2": held_out_2_places(),
+        "held-out-3": HELD_OUT_3_PLACES,
     }.get(args.set, PLACES)
     for name, lat, lon, r in places:
         try:
