@@ -849,6 +849,60 @@ def summarise(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
     return out
 
 
+WARNING_KINDS = [
+    ("rounding", r"4 decimals or fewer"),
+    ("fragile_references", r"^references: the two references are \d+ m apart"),
+    ("references_off_street", r"^references: the two references put the car"),
+    ("one_reference_trusted", r"^references: the best candidate trusts one reference"),
+    ("references_disagree", r"references\[\d+\] and references\[\d+\] disagree"),
+    ("loose_calibration", r"^calibration: the focal length is uncertain"),
+    ("corners_car_off_street", r"^corners: the best candidate puts the car"),
+    ("roundabout", r"is a roundabout"),
+]
+"""Warning kinds the warning-rate summary tells apart (the first pattern that matches);
+any other warning counts under the words before its colon, figures and ids left out."""
+
+
+def warning_kind(w: str) -> str:
+    """The kind of a warning, for :func:`warning_rates`."""
+    for name, pattern in WARNING_KINDS:
+        if re.search(pattern, w):
+            return name
+    head = w.split(":")[0]
+    return re.sub(r"\b[cnw]?\d+\b", "#", re.sub(r"\[\d+\]", "[#]", head)).strip()
+
+
+def warning_rates(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
+    """How often each warning kind fires on right and on wrong answers (top within /
+    beyond :data:`CONFIDENT_M`): per method on the clean runs (one per scene and method),
+    and per slip on the slipped runs. A warning that fires on right answers teaches users to
+    ignore it."""
+
+    def tally(entries: list[dict[str, Any]]) -> dict[str, Any]:
+        out: dict[str, Any] = {"right": 0, "wrong": 0, "right_warned": {}, "wrong_warned": {}}
+        for e in entries:
+            if "n" not in e:
+                continue
+            side = "right" if e["top"] <= CONFIDENT_M else "wrong"
+            out[side] += 1
+            for k in sorted({warning_kind(w) for w in e.get("warnings", [])}):
+                out[f"{side}_warned"][k] = out[f"{side}_warned"].get(k, 0) + 1
+        return out
+
+    clean: dict[str, list[dict[str, Any]]] = {}
+    for r in rows:
+        seen: set[str] = set()
+        for s in slips:
+            meth = SLIPS[s][0]
+            if s in r.get("slips", {}) and meth not in seen:
+                seen.add(meth)
+                clean.setdefault(meth, []).append(r["slips"][s]["clean"])
+    slipped = {
+        s: tally([r["slips"][s]["slipped"] for r in rows if s in r.get("slips", {})]) for s in slips
+    }
+    return {"clean": {m: tally(es) for m, es in clean.items()}, "slipped": slipped}
+
+
 def summarise_by(rows: list[dict[str, Any]], slips: list[str], key: str) -> dict[str, Any]:
     """Per ``place`` or ``class``: every slipped entry pooled, and each method's clean runs
     (one per scene and method)."""
@@ -964,6 +1018,7 @@ def main(argv: list[str] | None = None) -> int:
         "confident_m": CONFIDENT_M,
         "sigma_cover": SIGMA_COVER,
         "summary": summary,
+        "warning_rates": warning_rates(rows, slips),
         "wall_s": time.perf_counter() - t0,
         "scenes": rows,
     }
@@ -991,6 +1046,15 @@ def main(argv: list[str] | None = None) -> int:
             100 * b.get("confidently_wrong", 0),
             b.get("confidently_wrong_n", 0),
             100 * b.get("silently_lost", 0),
+        )
+    for meth, t in doc["warning_rates"]["clean"].items():
+        log.info(
+            "clean %-16s right %3d wrong %3d | warned right: %s | warned wrong: %s",
+            meth,
+            t["right"],
+            t["wrong"],
+            ", ".join(f"{k} {n}" for k, n in sorted(t["right_warned"].items())) or "-",
+            ", ".join(f"{k} {n}" for k, n in sorted(t["wrong_warned"].items())) or "-",
         )
     for key in ("by_place", "by_class"):
         for v, f in doc[key].items():
