@@ -861,3 +861,64 @@ def test_corners_that_put_the_car_across_its_street_are_warned() -> None:
     warned = [w for w in res.warnings if w.startswith("corners: the best candidate puts")]
     assert len(warned) == 1, res.warnings
     assert "across its street" in warned[0]
+
+
+def _bench() -> Any:
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import absolute_slips
+
+    return absolute_slips
+
+
+def test_held_out_3_is_three_cities_no_other_set_samples() -> None:
+    bench = _bench()
+    from unseen_cities import CITIES
+
+    names = [p[0] for p in bench.HELD_OUT_3_PLACES]
+    assert names == ["liechtenstein.osm.pbf", "leeds_centre.osm.gz", "nyc_manhattan.osm.pbf"]
+    used = {p[0] for p in bench.PLACES} | {p[0] for p in bench.HELD_OUT_PLACES}
+    used |= {c[0] for c in CITIES}
+    assert not used & set(names)
+    for name in names:
+        assert (OSM / name).is_file()
+        assert f"`{name}`" in (OSM / "SOURCES.md").read_text(encoding="utf-8")
+    assert bench.HELD_OUT_3_SEED not in (0, bench.HELD_OUT_SEED, bench.HELD_OUT_2_SEED)
+
+
+def test_warning_rates_count_kinds_on_right_and_wrong_answers() -> None:
+    bench = _bench()
+    right = {
+        "n": 1,
+        "top": 3.0,
+        "warnings": ["references: references[0]'s lat/lon has 4 decimals or fewer, a box"],
+    }
+    wrong = {
+        "n": 2,
+        "top": 40.0,
+        "warnings": [
+            "calibration: the focal length is uncertain by 20 % (1 sigma) and ...",
+            "intersection c123 is a roundabout: ...",
+        ],
+    }
+    quiet = {"n": 1, "top": 2.0, "warnings": []}
+    rows = [
+        {"slips": {"reference_4_decimals": {"clean": quiet, "slipped": right}}},
+        {"slips": {"reference_4_decimals": {"clean": quiet, "slipped": wrong}}},
+        {"slips": {"reference_4_decimals": {"clean": {"refused": "x"}, "slipped": {"empty": ""}}}},
+    ]
+    got = bench.warning_rates(rows, ["reference_4_decimals"])
+    assert got["clean"]["two_references"] == {
+        "right": 2,
+        "wrong": 0,
+        "right_warned": {},
+        "wrong_warned": {},
+    }
+    slipped = got["slipped"]["reference_4_decimals"]
+    assert (slipped["right"], slipped["wrong"]) == (1, 1)
+    assert slipped["right_warned"] == {"rounding": 1}
+    assert slipped["wrong_warned"] == {"loose_calibration": 1, "roundabout": 1}
+    assert (
+        bench.warning_kind("intersection.corners[3]: no reading fits") == "intersection.corners[#]"
+    )
