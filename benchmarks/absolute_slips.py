@@ -124,6 +124,18 @@ HELD_OUT_2_SKIP = 30
 (``unseen_cities.py --n 30`` locates the 30 nearest)."""
 HELD_OUT_2_SEED = 39
 """The second held-out set's seed."""
+HELD_OUT_3_PLACES = [
+    ("liechtenstein.osm.pbf", 47.1410, 9.5215, 1500.0),
+    ("leeds_centre.osm.gz", 53.79891, -1.53450, 600.0),
+    ("nyc_manhattan.osm.pbf", 40.73618, -74.00535, 1500.0),
+]
+"""``--set held-out-3``: fixed (stop 40) before any result on it. Three cities no benchmark
+had sampled (Vaduz/Schaan, Leeds centre, Manhattan; ``data/osm/SOURCES.md``), every oracle
+junction within the radius (the centres are the median of Leeds' and Manhattan's oracle
+junctions, and Vaduz's town hall square), by junction class, seed :data:`HELD_OUT_3_SEED`,
+150 cameras, the 22 slips. Measured once, at the end."""
+HELD_OUT_3_SEED = 40
+"""The third held-out set's seed."""
 
 
 def held_out_2_places() -> list[tuple[str, float, float, float]]:
@@ -721,7 +733,7 @@ def run(
         order = _order_held_out(n, maps)
     elif which == "held-out-2":
         order = _order_held_out(n, maps, skip=HELD_OUT_2_SKIP)
-    elif which == "dev-classes":
+    elif which in ("held-out-3", "dev-classes"):
         order = _order_held_out(n, maps, skip=0)
     else:
         order = _order_dev(n, maps)
@@ -837,6 +849,60 @@ def summarise(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
     return out
 
 
+WARNING_KINDS = [
+    ("rounding", r"4 decimals or fewer"),
+    ("fragile_references", r"^references: the two references are \d+ m apart"),
+    ("references_off_street", r"^references: the two references put the car"),
+    ("one_reference_trusted", r"^references: the best candidate trusts one reference"),
+    ("references_disagree", r"references\[\d+\] and references\[\d+\] disagree"),
+    ("loose_calibration", r"^calibration: the focal length is uncertain"),
+    ("corners_car_off_street", r"^corners: the best candidate puts the car"),
+    ("roundabout", r"is a roundabout"),
+]
+"""Warning kinds the warning-rate summary tells apart (the first pattern that matches);
+any other warning counts under the words before its colon, figures and ids left out."""
+
+
+def warning_kind(w: str) -> str:
+    """The kind of a warning, for :func:`warning_rates`."""
+    for name, pattern in WARNING_KINDS:
+        if re.search(pattern, w):
+            return name
+    head = w.split(":")[0]
+    return re.sub(r"\b[cnw]?\d+\b", "#", re.sub(r"\[\d+\]", "[#]", head)).strip()
+
+
+def warning_rates(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
+    """How often each warning kind fires on right and on wrong answers (top within /
+    beyond :data:`CONFIDENT_M`): per method on the clean runs (one per scene and method),
+    and per slip on the slipped runs. A warning that fires on right answers teaches users to
+    ignore it."""
+
+    def tally(entries: list[dict[str, Any]]) -> dict[str, Any]:
+        out: dict[str, Any] = {"right": 0, "wrong": 0, "right_warned": {}, "wrong_warned": {}}
+        for e in entries:
+            if "n" not in e:
+                continue
+            side = "right" if e["top"] <= CONFIDENT_M else "wrong"
+            out[side] += 1
+            for k in sorted({warning_kind(w) for w in e.get("warnings", [])}):
+                out[f"{side}_warned"][k] = out[f"{side}_warned"].get(k, 0) + 1
+        return out
+
+    clean: dict[str, list[dict[str, Any]]] = {}
+    for r in rows:
+        seen: set[str] = set()
+        for s in slips:
+            meth = SLIPS[s][0]
+            if s in r.get("slips", {}) and meth not in seen:
+                seen.add(meth)
+                clean.setdefault(meth, []).append(r["slips"][s]["clean"])
+    slipped = {
+        s: tally([r["slips"][s]["slipped"] for r in rows if s in r.get("slips", {})]) for s in slips
+    }
+    return {"clean": {m: tally(es) for m, es in clean.items()}, "slipped": slipped}
+
+
 def summarise_by(rows: list[dict[str, Any]], slips: list[str], key: str) -> dict[str, Any]:
     """Per ``place`` or ``class``: every slipped entry pooled, and each method's clean runs
     (one per scene and method)."""
@@ -894,16 +960,20 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=60, help="number of junction cameras")
     ap.add_argument(
-        "--seed", type=int, default=None, help="default 0 (dev), 38 (held-out), 39 (held-out-2)"
+        "--seed",
+        type=int,
+        default=None,
+        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3)",
     )
     ap.add_argument(
         "--set",
-        choices=("dev", "dev-classes", "held-out", "held-out-2"),
+        choices=("dev", "dev-classes", "held-out", "held-out-2", "held-out-3"),
         default="dev",
         help="dev: absolute.py's junctions; dev-classes: DEV_CLASS_PLACES by junction "
         "class; held-out: HELD_OUT_PLACES by junction class (stop 38's; read since: "
         "development now); held-out-2: the unseen cities beyond their 30 nearest "
-        "junctions, by class (measure once, at the end)",
+        "junctions, by class (stop 39's; read since); held-out-3: Vaduz, Leeds and "
+        "Manhattan, every junction, by class (measure once, at the end)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -916,13 +986,18 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         ap.error(f"unknown slips {unknown}; known: {', '.join(SLIPS)}")
     if args.seed is None:
-        args.seed = {"held-out": HELD_OUT_SEED, "held-out-2": HELD_OUT_2_SEED}.get(args.set, 0)
+        args.seed = {
+            "held-out": HELD_OUT_SEED,
+            "held-out-2": HELD_OUT_2_SEED,
+            "held-out-3": HELD_OUT_3_SEED,
+        }.get(args.set, 0)
     t0 = time.perf_counter()
     maps = {}
     places = {
         "held-out": HELD_OUT_PLACES,
         "dev-classes": DEV_CLASS_PLACES,
         "held-out-2": held_out_2_places(),
+        "held-out-3": HELD_OUT_3_PLACES,
     }.get(args.set, PLACES)
     for name, lat, lon, r in places:
         try:
@@ -943,6 +1018,7 @@ def main(argv: list[str] | None = None) -> int:
         "confident_m": CONFIDENT_M,
         "sigma_cover": SIGMA_COVER,
         "summary": summary,
+        "warning_rates": warning_rates(rows, slips),
         "wall_s": time.perf_counter() - t0,
         "scenes": rows,
     }
@@ -970,6 +1046,15 @@ def main(argv: list[str] | None = None) -> int:
             100 * b.get("confidently_wrong", 0),
             b.get("confidently_wrong_n", 0),
             100 * b.get("silently_lost", 0),
+        )
+    for meth, t in doc["warning_rates"]["clean"].items():
+        log.info(
+            "clean %-16s right %3d wrong %3d | warned right: %s | warned wrong: %s",
+            meth,
+            t["right"],
+            t["wrong"],
+            ", ".join(f"{k} {n}" for k, n in sorted(t["right_warned"].items())) or "-",
+            ", ".join(f"{k} {n}" for k, n in sorted(t["wrong_warned"].items())) or "-",
         )
     for key in ("by_place", "by_class"):
         for v, f in doc[key].items():

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -46,6 +46,7 @@ from camloc_geo.absolute._model import (
     LocateResult,
     LocateSettings,
     Match,
+    Observation,
     Tie,
 )
 from camloc_geo.absolute._refine import (
@@ -60,6 +61,7 @@ from camloc_geo.absolute._scoring import (
     car_bearing_deg,
     plausibility_at,
     score,
+    street_angles_under_car,
     unmatched_flags,
 )
 from camloc_geo.absolute._similarity import Similarity2D
@@ -192,7 +194,8 @@ def _locate_once(
         _warn_substituted_landmark(result)
         _warn_landmarks_off_street(ev, result)
         _warn_corners_car_off_street(ev, result)
-        _warn_fragile_references(scene, ev, result)
+        _add_rounding_sigma(scene, ev, settings, result)
+        _warn_fragile_references(scene, ev, settings, result)
         _warn_reference_corner(result)
         _warn_outside_prior(ev, result)
         top_ev = result.candidates[0].evidence if result.candidates else None
@@ -575,15 +578,185 @@ def rounding_m(lat: float, lon: float, max_decimals: int = 4) -> float:
     rounded one (copied from a listing, typed short) is up to 5.6 m off in latitude at 4,
     and 5.6 m times cos(lat) in longitude.
     """
+    east_m, north_m = rounding_steps_m(lat, lon, max_decimals)
+    return float(math.hypot(east_m, north_m))
+
+
+def rounding_steps_m(lat: float, lon: float, max_decimals: int = 4) -> tuple[float, float]:
+    """Half the last step of a lat/lon given with at most ``max_decimals`` decimals, east and
+    north (metres): the box around it where the point it rounds lies; ``(0, 0)`` for a
+    lat/lon with more decimals (:func:`rounding_m` is its diagonal)."""
     for k in range(max_decimals + 1):
         scale = 10.0**k
         if all(abs(v * scale - round(v * scale)) < 1e-6 for v in (lat, lon)):
             half_m = 0.5 / scale * 111_320.0
-            return float(math.hypot(half_m, half_m * math.cos(math.radians(lat))))
-    return 0.0
+            return float(half_m * math.cos(math.radians(lat))), float(half_m)
+    return 0.0, 0.0
 
 
-def _warn_fragile_references(scene: Scene, ev: Evidence, result: LocateResult) -> None:
+ROUNDING_TURN_FREE_DEG = 5.0
+"""How far a real car may point off the map's street under it (parked askew, the map's
+centre line a few degrees off) before the turn says the references turned the camera."""
+ROUNDING_TURN_SIGMA_DEG = 5.0
+"""Beyond :data:`ROUNDING_TURN_FREE_DEG`, a turn of this many degrees counts one standard
+deviation against a reading of a rounded reference (:func:`_rounding_moves_m`)."""
+ROUNDING_GRID = 7
+"""Points per axis over a rounded reference's box (:func:`_rounding_moves_m`)."""
+ROUNDING_CHI2_GAIN = 6.0
+"""A reading of a rounded reference within its box that fits the two references' distance
+apart and the car's street this much better (chi-square) than the rounded lat/lon itself
+says the rounding moved the answer (:func:`_warn_fragile_references`)."""
+
+
+@dataclass
+class RoundingMoves:
+    """How the rounding of two references' lat/lon moves a two-reference candidate
+    (:func:`_rounding_moves_m`), metres: ``rms`` and ``most`` over the rounding boxes, and
+    ``moved``, how far the reading that fits best within them stands from the answer, with
+    ``gain`` (how much better it fits, chi-square) and the reference it moves (``label``)."""
+
+    rms: float
+    most: float
+    moved: float
+    gain: float
+    label: str
+
+
+def _reference_index(obs: Observation) -> int | None:
+    """The scene's index of a reference observation (its label ``references[i]``)."""
+    head, _sep, tail = obs.label.partition("[")
+    if head != "references" or not tail.endswith("]") or not tail[:-1].isdigit():
+        return None
+    return int(tail[:-1])
+
+
+def _rounding_moves_m(
+    cand: Candidate, scene: Scene, ev: Evidence, settings: LocateSettings
+) -> RoundingMoves | None:
+    """How far the rounding of the references' lat/lon moves a two-reference candidate, None
+    when neither is rounded (:func:`rounding_steps_m`).
+
+    A lat/lon with 4 decimals or fewer stands for any point of a box of its half steps. Two
+    references fix the camera exactly (up to the fit's 5 % scale prior), so each point of a
+    rounded reference's box gives its own camera: the similarity that carries the two
+    references' ground points (as the calibrated camera casts their pixels) onto that point
+    and the other reference, computed exactly on a :data:`ROUNDING_GRID` square grid over the
+    box (the camera turns about the other reference, and far from it moves much more than
+    linearly). ``rms`` and ``most`` are the cameras' moves from the one at the rounded
+    lat/lon over the grid (uniform), both references' boxes in turn.
+
+    Two witnesses tell the points of a box apart: the references' distance apart on the map
+    against the ground (the calibration's scale, 5 %, and the pixels' noise), and the car,
+    which stands along its street (:func:`~camloc_geo.absolute._scoring.street_angle_under_car`;
+    :data:`ROUNDING_TURN_FREE_DEG` free, then :data:`ROUNDING_TURN_SIGMA_DEG` per sigma).
+    ``moved`` is how far the camera of the best-fitting point stands from the one at the
+    rounded lat/lon, ``gain`` how much better that point fits (chi-square): what the rounding
+    moved, as far as the map and the pixels can tell.
+    """
+    if len(ev.refs) != 2 or len(scene.references) < 2:
+        return None
+    pts = [np.asarray(q, dtype=float) for _o, q in ev.refs]
+    world = [np.asarray(o.world_xy, dtype=float) for o, _q in ev.refs]
+    cam_w = complex(*np.asarray(cand.enu_from_world.inverse().apply(cand.east_north), float))
+    ground_m = float(np.linalg.norm(world[0] - world[1]))
+    if not math.isfinite(ground_m) or ground_m <= 0.0:
+        return None
+    u = (world[0] - world[1]) / ground_m
+    (oa, _qa), (ob, _qb) = ev.refs
+    var = float(u @ (oa.cov_world + ob.cov_world) @ u) + oa.sigma_map_m**2 + ob.sigma_map_m**2
+    sq: list[float] = []
+    most = 0.0
+    best: RoundingMoves | None = None
+    t = np.linspace(-1.0, 1.0, ROUNDING_GRID)
+    centre = ROUNDING_GRID * ROUNDING_GRID // 2
+    mid_w = 0.5 * (complex(*world[0]) + complex(*world[1]))
+    dw = complex(*world[0]) - complex(*world[1])
+    for k in (0, 1):
+        obs_k = ev.refs[k][0]
+        i = _reference_index(obs_k)
+        if i is None or i >= len(scene.references):
+            continue
+        east_m, north_m = rounding_steps_m(scene.references[i].lat, scene.references[i].lon)
+        if east_m <= 0.0:
+            continue
+        box = (t[:, None] * east_m + 1j * t[None, :] * north_m).ravel()
+        qs = [complex(*pts[0]) + (box if k == 0 else 0.0), complex(*pts[1]) + (box if k else 0.0)]
+        dq = np.asarray(qs[0] - qs[1], dtype=complex)
+        mid_q = 0.5 * (qs[0] + qs[1])
+        ln_s, misfit2 = _scaled_fit(abs(dw), np.abs(dq), var, settings.scale_sigma_rel)
+        ratio = np.exp(ln_s) * dq / np.abs(dq) * abs(dw) / dw  # scale · e^{iθ}
+        cams = mid_q + ratio * (cam_w - mid_w)
+        moves = np.abs(cams - cams[centre])
+        sq += (moves**2).tolist()
+        most += float(moves.max())
+        shift = mid_q - ratio * mid_w
+        sims = [
+            Similarity2D(float(np.angle(r)), np.array([c.real, c.imag]), float(abs(r)))
+            for r, c in zip(ratio, shift, strict=True)
+        ]
+        turns = street_angles_under_car(sims, ev)
+        excess = np.array(
+            [0.0 if a is None else max(0.0, abs(a) - ROUNDING_TURN_FREE_DEG) for a in turns]
+        )
+        chi2 = misfit2 + (excess / ROUNDING_TURN_SIGMA_DEG) ** 2
+        j = int(np.argmin(chi2))
+        here = RoundingMoves(0.0, 0.0, float(moves[j]), float(chi2[centre] - chi2[j]), obs_k.label)
+        if best is None or here.gain > best.gain:
+            best = here
+    if best is None:
+        return None
+    # the boxes' moves add as independent variances, each the mean over its grid
+    best.rms = math.sqrt(float(np.sum(sq)) / (ROUNDING_GRID * ROUNDING_GRID))
+    best.most = most
+    return best
+
+
+def _scaled_fit(
+    ground_m: float, map_m: FloatArray, var_m2: float, scale_sigma_rel: float
+) -> tuple[FloatArray, FloatArray]:
+    """The two-reference fit's log scale and its chi-square, per map distance apart: the
+    references' distance apart on the ground (``ground_m``, as the calibrated camera casts
+    their pixels) scaled by ``s`` against the map's (``map_m``, variance ``var_m2`` of the
+    difference), with the fit's prior on ``ln s`` (``scale_sigma_rel``). The rotation fits
+    exactly and the translation matches the midpoints, so this one number is the fit's;
+    Newton's method on ``ln s`` from 0."""
+    sig2 = max(scale_sigma_rel, 1e-6) ** 2
+    v = max(var_m2, 1e-12)
+    ln_s = np.zeros_like(map_m, dtype=float)
+    for _ in range(8):
+        g = ground_m * np.exp(ln_s)
+        grad = 2.0 * (g - map_m) * g / v + 2.0 * ln_s / sig2
+        hess = 2.0 * g * (2.0 * g - map_m) / v + 2.0 / sig2
+        ln_s = ln_s - grad / np.maximum(hess, 1e-12)
+    g = ground_m * np.exp(ln_s)
+    return ln_s, (g - map_m) ** 2 / v + ln_s**2 / sig2
+
+
+def _add_rounding_sigma(
+    scene: Scene, ev: Evidence, settings: LocateSettings, result: LocateResult
+) -> None:
+    """The rounding of rounded references' lat/lon added to the ``sigma_m`` of two-reference
+    candidates, in place, in quadrature: half the camera's farthest move over the rounding
+    boxes (:func:`_rounding_moves_m`), so that two ``sigma_m`` reach the box's worst corner.
+
+    A lat/lon with 4 decimals is a box 11 m by 11 m cos(lat), not a point measured to 0.5 m,
+    and far from the other reference the camera moves much more than linearly with it: the
+    rms over the box (uniform) left a camera 22 m off at a ``sigma_m`` of 10 m
+    (``absolute_slips.py --set held-out-2`` scene 57, the point near the box's corner).
+    """
+    if len(ev.refs) != 2 or ev.corners or ev.landmarks:
+        return
+    for cand in result.candidates:
+        if cand.method != "two_references" or cand.sigma_m is None:
+            continue
+        got = _rounding_moves_m(cand, scene, ev, settings)
+        if got is not None and got.most > 0.0:
+            cand.sigma_m = math.hypot(cand.sigma_m, 0.5 * got.most)
+
+
+def _warn_fragile_references(
+    scene: Scene, ev: Evidence, settings: LocateSettings, result: LocateResult
+) -> None:
     """Warn when two references alone leave the answer fragile: one reference's lat/lon
     :data:`REFERENCE_SLIP_M` off across their baseline would move the camera farther than
     :data:`WRONG_M` and than two of its ``sigma_m``.
@@ -596,9 +769,13 @@ def _warn_fragile_references(scene: Scene, ev: Evidence, result: LocateResult) -
     decimals) into answers 18-74 m off with sigmas of 4-10 m (``benchmarks/absolute_slips.py``,
     session 38). The warning says how far and what would hold the answer.
 
-    A reference whose lat/lon has 4 decimals or fewer (:func:`rounding_m`) slips by its
-    rounding's half step, 5.6 m at 4 decimals: the 3 m slip left two rounded references
-    unwarned 17-22 m off (``absolute_slips.py --set held-out-2``, ``reference_4_decimals``).
+    A reference whose lat/lon has 4 decimals or fewer (:func:`rounding_m`) stands for a box,
+    not a point: its move is in ``sigma_m`` (:func:`_add_rounding_sigma`), and its own warning
+    fires only where a point of the box that fits the references' distance apart and the
+    car's street better (by :data:`ROUNDING_CHI2_GAIN`) moves the camera beyond
+    :data:`WRONG_M` (:func:`_rounding_moves_m`): what the rounding did move, as far as the
+    pixels and the map can tell. Until stop 40 the rounding's half diagonal was taken as the
+    slip, and the warning fired on 61 of 120 rounded development scenes, 59 of them right.
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
         return
@@ -612,26 +789,31 @@ def _warn_fragile_references(scene: Scene, ev: Evidence, result: LocateResult) -
         return
     cam = top.east_north
     lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
-    rounded = max(
-        (rounding_m(r.lat, r.lon) for r in scene.references[:2]),
-        default=0.0,
-    )
-    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b), rounded)
-    move = slip * lever
     sigma = top.sigma_m if top.sigma_m is not None else 0.0
+    moves = _rounding_moves_m(top, scene, ev, settings)
+    if moves is not None and moves.most > WRONG_M:
+        # the rounding is in sigma_m; say so only where the pixels and the car's street
+        # say that it moved the answer beyond WRONG_M
+        if moves.moved > WRONG_M and moves.gain > ROUNDING_CHI2_GAIN:
+            result.warnings.append(
+                f"references: {moves.label}'s lat/lon has 4 decimals or fewer, a box, not a "
+                f"point: a point within it fits the references' distance apart and the car's "
+                f"street better and moves the camera {moves.moved:.0f} m (up to "
+                f"{moves.most:.0f} m within the box; sigma_m {sigma:.0f} m includes the "
+                "rounding); give the lat/lon with 5 decimals or more, or add a kerb corner"
+            )
+        return
+    slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b))
+    move = slip * lever
     if move <= max(WRONG_M, 2.0 * sigma):
         return
-    why = (
-        "a lat/lon given with 4 decimals or fewer, rounded"
-        if rounded >= slip
-        else "a pixel on the kerb for a point on the centre line, a rounded lat/lon"
-    )
     result.warnings.append(
         f"references: the two references are {baseline:.0f} m apart and the camera "
         f"{lever * baseline:.0f} m from the farther: one reference's lat/lon "
-        f"{slip:.0f} m off across them ({why}) would move the camera about {move:.0f} m, "
-        "beyond its sigma_m; check both, or add a reference farther apart, a kerb corner or a "
-        "landmark"
+        f"{slip:.0f} m off across them (a pixel on the kerb for a point on the centre line, "
+        "a rounded lat/lon) would move the camera about "
+        f"{move:.0f} m, beyond its sigma_m; check both, or add a reference farther apart, "
+        "a kerb corner or a landmark"
     )
 
 
