@@ -2112,10 +2112,11 @@ class AutoVPResult:
         the Manhattan frame is the photo's (falling with fewer than about 60 distinct
         lines), times the structure's support (explained share of the segments' length,
         lines per direction), times, where a third horizontal direction would pair
-        otherwise (:func:`_third_horizontal`, warned), the weaker kept direction's share
-        of the two rival directions' lines. On 216 real photos its ROC AUC for an error
-        over 10 % is 0.90 (``benchmarks/vp_real.py``; stop 40: York Urban 0.90, Strecha
-        0.86, the 82 street photos 0.85).
+        otherwise (:func:`_third_horizontal`, warned; not where the vertical rules that
+        pairing out, :func:`_vertical_rules_out`), the weaker kept direction's share of the
+        two rival directions' lines. On 216 real photos its ROC AUC for an error over 10 %
+        is 0.90 (``benchmarks/vp_real.py``; stop 40: York Urban 0.95, Strecha 0.90, the 82
+        street photos 0.83).
     vertical_identified
         False when another direction could be the vertical one nearly as well (e.g. a
         camera pitched 60 degrees down and one pitched 30 degrees up see the same frame).
