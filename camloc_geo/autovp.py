@@ -1756,6 +1756,44 @@ def _vertical_rules_out(
     return z_rival > _THIRD_VERTICAL_Z and z_frame <= _THIRD_VERTICAL_Z
 
 
+def _rival_pairings(
+    best: _Model,
+    third: _ThirdHorizontal,
+    n_lines: Sequence[int],
+    own_std: float,
+    s: _Segs,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    bias_deg: float,
+) -> list[float]:
+    """The moves of ``log(focal)`` of a third direction's pairings that rival the frame's.
+
+    A pairing counts where its lines fix its focal length as a photo must to be believed
+    (:data:`_LOOSE_FOCAL_STD`) and it lies clearly apart from the kept one (beyond twice
+    their two sigmas together, the frame's own ``own_std``), unless it pairs with a frame
+    direction of fewer than :data:`_THIRD_PAIR_MIN_LINES` distinct lines (``n_lines``: the
+    cross product of the other two, not a direction the photo shows; Strecha's Herz-Jesus
+    photos, read right, had confidence 0.00 from such a pairing) or the vertical rules it
+    out (:func:`_vertical_pairing_logf`, :func:`_vertical_rules_out`).
+    """
+    alt = []
+    for m_alt, e_alt, k_pair in zip(
+        third.log_moves, third.log_move_stds, third.pair_k, strict=True
+    ):
+        if not (e_alt <= _LOOSE_FOCAL_STD and abs(m_alt) > 2.0 * math.hypot(e_alt, own_std)):
+            continue
+        if n_lines[k_pair] < _THIRD_PAIR_MIN_LINES:
+            continue
+        logf_v, std_v = _vertical_pairing_logf(
+            best, k_pair, s, tau_px, f_prior, f_bounds, prior_w, bias_deg
+        )
+        if not _vertical_rules_out(math.log(best.f_n), m_alt, e_alt, logf_v, std_v):
+            alt.append(m_alt)
+    return alt
+
+
 def _curve_share(segs_px: FloatArray, sel: npt.NDArray[np.bool_], diag_rel: float = 0.006) -> float:
     """Share of the selected segments continued at an end by a segment bent by 2-25 degrees."""
     if not sel.any():
@@ -2829,29 +2867,11 @@ def detect_vanishing_points(
         rival_std = _rival_spread(rival_modes, own_std)[0]
         if _THIRD_HORIZONTAL and not has_prior:
             third = _third_horizontal(best, s, segs_px, merge_px, tau, f_bounds)
-            # a pairing counts where its lines fix its focal length as a photo must to be
-            # believed (_LOOSE_FOCAL_STD) and it lies clearly apart from the kept one (beyond
-            # twice their two sigmas together), unless the vertical rules it out
-            alt = []
-            for m_alt, e_alt, k_pair in (
-                zip(third.log_moves, third.log_move_stds, third.pair_k, strict=True)
+            alt = (
+                _rival_pairings(best, third, nl, own_std, s, tau, f_prior, f_bounds, prior_w, bias)
                 if third is not None
-                else ()
-            ):
-                if not (
-                    e_alt <= _LOOSE_FOCAL_STD and abs(m_alt) > 2.0 * math.hypot(e_alt, own_std)
-                ):
-                    continue
-                if nl[k_pair] < _THIRD_PAIR_MIN_LINES:
-                    # a direction of the frame with too few lines to be kept is the cross
-                    # product of the other two, not a direction the photo shows: nothing to
-                    # pair with (Strecha's Herz-Jesus: confidence 0.00 on right answers)
-                    continue
-                logf_v, std_v = _vertical_pairing_logf(
-                    best, k_pair, s, tau, f_prior, f_bounds, prior_w, bias
-                )
-                if not _vertical_rules_out(math.log(best.f_n), m_alt, e_alt, logf_v, std_v):
-                    alt.append(m_alt)
+                else []
+            )
             if third is not None and alt:
                 best.third = third
                 best.third_move = min(alt, key=abs)

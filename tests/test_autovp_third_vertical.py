@@ -148,3 +148,52 @@ def test_strecha_no_pairing_with_a_direction_of_no_lines(monkeypatch: pytest.Mon
     res_without = detect_vanishing_points(path, use_exif=False)
     assert any(_THIRD in w for w in res_without.warnings)
     assert res_without.confidence < 0.05
+
+
+@pytest.mark.parametrize(("n_lines", "expected"), [((20, 20, 20), 1), ((20, 20, 0), 0)])
+def test_no_pairing_with_a_frame_direction_of_too_few_lines(
+    n_lines: tuple[int, int, int], expected: int
+) -> None:
+    """A level camera (its vertical cannot choose): a third direction paired with the
+    road's direction rivals the frame where the road has lines, and not where it has none
+    (left out of the fit: the cross product of the other two)."""
+    segs = two_buildings_segments(20.0, 24, 0)
+    model, s = _frame_labels(segs, 2.0)
+    third = autovp._ThirdHorizontal(14, 10, [-0.4], [0.01], [2])
+    alt = autovp._rival_pairings(
+        model,
+        third,
+        n_lines,
+        0.05,
+        s,
+        2.0,
+        model.f_n,
+        autovp.FOCAL_BOUNDS_REL,
+        None,
+        autovp.BIAS_DEG,
+    )
+    assert alt == [-0.4] * expected
+
+
+def test_a_pairing_the_vertical_rules_out_is_no_rival() -> None:
+    """Pitched 15 degrees down, the vertical with the road's direction fixes the focal
+    length within 4 %: a pairing 0.4 off in log focal is no rival; level, it is."""
+    third = autovp._ThirdHorizontal(14, 10, [-0.4], [0.01], [2])
+    found = []
+    for pitch in (15.0, 2.0):
+        model, s = _frame_labels(two_buildings_segments(20.0, 24, 0, pitch_deg=pitch), pitch)
+        found.append(
+            autovp._rival_pairings(
+                model,
+                third,
+                (20, 20, 20),
+                0.02,
+                s,
+                2.0,
+                model.f_n,
+                autovp.FOCAL_BOUNDS_REL,
+                None,
+                autovp.BIAS_DEG,
+            )
+        )
+    assert found == [[], [-0.4]]
