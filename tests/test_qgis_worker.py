@@ -479,6 +479,6 @@ def test_worker_errors_name_the_processing_parameters_not_cli_options(tmp_path):
     )
     assert r.returncode == 2
     error = json.loads(r.stdout.strip().splitlines()[-1])["error"]
-    assert "give OSM (an OSM extract) or turn NETWORK on" in error
+    assert "give OSM (an OSM extract) or allow Overpass (NETWORK)" in error
     assert "--osm" not in error
     assert "map_source" not in error

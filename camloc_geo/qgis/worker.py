@@ -775,11 +775,14 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
 
 
 _CLI_HINTS = (
-    ("give --osm EXTRACT (map_source=...)", "give OSM (an OSM extract) or turn NETWORK on"),
+    (
+        "give --osm EXTRACT (map_source=...)",
+        "give OSM (an OSM extract) or allow Overpass (NETWORK)",
+    ),
     ("give --osm EXTRACT (a local OSM extract)", "give OSM (a local OSM extract)"),
     (
         "give --osm EXTRACT_OR_FOLDER or allow --network",
-        "give OSM (an extract or a folder of them) or turn NETWORK on",
+        "give OSM (an extract or a folder of them) or allow Overpass (NETWORK)",
     ),
     ("give --osm EXTRACT_OR_FOLDER", "give OSM (an extract or a folder of them)"),
     ("give --osm EXTRACT", "give OSM (an OSM extract)"),
