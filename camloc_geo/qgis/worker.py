@@ -505,7 +505,9 @@ def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any]
         "camera_id": cam_id,
         "title": result.title or None,
         "status": result.status,
-        "reason": result.reason,
+        # (the library's hints in the dialog's words: "give --osm EXTRACT_OR_FOLDER" named
+        # an option the Processing dialog does not have)
+        "reason": processing_words(result.reason) if result.reason else result.reason,
         "lat": _num(result.lat),
         "lon": _num(result.lon),
         "score": score,
