@@ -126,3 +126,15 @@ def test_a_missing_map_is_said_in_the_servers_words(tmp_path: Path) -> None:
     res = process_camera({"id": "c1", "title": "Eastern Ave & S Broadway"}, maps, settings)
     assert "--osm" not in str(res)
     assert "CAMLOC_MAP_DIR" in str(res)
+
+
+def test_a_running_jobs_map_counts_the_cameras_not_done_yet() -> None:
+    """A job's map opened while it ran said "0 of 0 cameras on the map" (only finished
+    cameras were counted): it counts the pending ones and says to reload later."""
+    from camloc_geo.service.routers.jobs import job_summary_page
+
+    page = job_summary_page([], pending=3)
+    assert "<title>camloc summary: 0 of 3 cameras on the map</title>" in page
+    assert "3 cameras not done yet (the job is still running): reload the page later" in page
+    done = job_summary_page([])
+    assert "not done yet" not in done
