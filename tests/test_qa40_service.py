@@ -138,3 +138,37 @@ def test_a_running_jobs_map_counts_the_cameras_not_done_yet() -> None:
     assert "3 cameras not done yet (the job is still running): reload the page later" in page
     done = job_summary_page([])
     assert "not done yet" not in done
+
+
+def test_a_failed_tasks_page_says_why(tmp_path: Path) -> None:
+    """The annotation page of a task whose located merge failed said only that it takes no
+    more work; it says why it could not be located now."""
+    import io
+
+    from PIL import Image
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    buf = io.BytesIO()
+    Image.new("RGB", (64, 48), (90, 90, 90)).save(buf, format="PNG")
+    store = app.state.store
+    task_id = store.create_task(
+        image=buf.getvalue(),
+        image_type="png",
+        width=64,
+        height=48,
+        needed=1,
+        base_scene={"format": "camloc-scene/1", "id": "t", "image": {"width": 64, "height": 48}},
+    )
+    store.set_task_result(task_id, "failed", {"reason": "the annotators marked different cars"})
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get(f"/annotate/{task_id}")
+
+    try:
+        page = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert page.status_code == 200, page.text
+    assert "It could not be located: the annotators marked different cars" in page.text
