@@ -3050,6 +3050,18 @@ def _add_photo_segments(
     if len(segs) == 0:
         return {}
     f, pp, R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    all_labels = np.asarray(res.labels, dtype=int).reshape(-1)  # as the warning counts them
+    support = np.bincount(all_labels[all_labels >= 0], minlength=len(res.vanishing_points))
+    off = _photo_disagreeing_axes(res.vanishing_points, support, f, pp, R)
+    if off:
+        # Two witnesses that clearly disagree on one axis (one of them is off, and which is
+        # not known) do not make each other surer on the others: the photo lends nothing.
+        log.info(
+            "image.path: the photo's %s direction disagrees with the annotators' fit; its "
+            "segments are not used",
+            "/".join(AXES[i] for i in off),
+        )
+        return {}
     # Each of the photo's vanishing points (its own clustering: no choice by the fit) that
     # is within PHOTO_AXIS_TOL_DEG of one of the fit's axes, and the nearest to it, lends
     # that axis its segments.
@@ -3977,6 +3989,56 @@ def _photo_direction_axis(
     i = int(np.argmax(cosines))
     near = math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG
     return i if near else None
+
+
+def _photo_disagreeing_axes(
+    vps_px: npt.ArrayLike,
+    support: npt.ArrayLike,
+    f: float,
+    pp: tuple[float, float],
+    R: FloatArray,
+) -> list[int]:
+    """The axes (indices) on which the photo clearly disagrees with the camera ``(f, pp, R)``.
+
+    As :func:`_photo_disagreement` reports it: among the photo's vanishing points with at
+    least ``PHOTO_MIN_SEGMENTS`` segments (``support``, per point), the direction nearest
+    an axis is within ``PHOTO_AXIS_NEAR_DEG`` of it but more than ``PHOTO_AXIS_TOL_DEG``
+    off.
+
+    Parameters
+    ----------
+    vps_px
+        The photo's vanishing points, ``(k, 3)`` homogeneous pixels.
+    support
+        Segments per vanishing point, ``(k,)``.
+    f, pp, R
+        The fit's focal length (px), principal point (px) and ``cam_from_world`` rotation.
+
+    Returns
+    -------
+    list of int
+        Axis indices (0 length, 1 width, 2 height), ascending; empty where none disagrees.
+    """
+    K_inv = np.linalg.inv(np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]]))
+    vps = np.asarray(vps_px, dtype=float).reshape(-1, 3)
+    counts = np.asarray(support, dtype=float).reshape(-1)
+    dirs = []
+    for k, vp in enumerate(vps):
+        if k >= len(counts) or counts[k] < PHOTO_MIN_SEGMENTS:
+            continue
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if n > 0.0 and np.isfinite(n):
+            dirs.append(d / n)
+    off = []
+    for i in range(3):
+        if not dirs:
+            break
+        a = R[:, i] / np.linalg.norm(R[:, i])
+        best = min(math.degrees(math.acos(min(1.0, abs(float(a @ d))))) for d in dirs)
+        if PHOTO_AXIS_TOL_DEG < best <= PHOTO_AXIS_NEAR_DEG:
+            off.append(i)
+    return off
 
 
 def _photo_rows_lost(
