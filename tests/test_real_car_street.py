@@ -156,8 +156,10 @@ def test_altis_photo_that_disagrees_does_not_make_the_wrong_answer_surer(
         w.startswith("image.path: the photo's lines disagree") and "width" in w
         for w in out["warnings"]
     )
+    assert "photo_segments" not in out  # the photo lent none
     warned = [w.split(":")[0] for w in out["warnings"] if "car's own edges" in w]
     assert warned == ["vp_lines.length", "vp_lines.width"]
+    assert out["focal_px"] == pytest.approx(alone["focal_px"], rel=1e-9)
     assert out["focal_sigma_px"] >= 0.99 * alone["focal_sigma_px"]
     assert out["height_sigma_m"] >= 0.99 * alone["height_sigma_m"]
     assert _sigmas_off(out, ALTIS_FOCAL_PX) < 7.0  # was 12.8
@@ -221,6 +223,7 @@ def test_today_with_its_photo_warns_and_covers(
     905.0 px, +12.3 %)."""
     out = _calibrate(TODAY, tmp_path, capsys, with_photo=True)
     assert any(w.startswith("image.path: the photo's lines disagree") for w in out["warnings"])
+    assert "photo_segments" not in out
     assert _sigmas_off(out, TODAY_FOCAL_PX) < 2.0
     assert abs(out["height_m"] - TODAY_HEIGHT_M) < 0.5
 
