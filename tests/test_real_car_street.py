@@ -248,8 +248,11 @@ def test_photo_disagreeing_axes_names_the_axis_between_4_and_30_degrees() -> Non
     width_off = np.cos(turn) * R[:, 1] + np.sin(turn) * R[:, 2]
     small = math.radians(2.0)
     length_near = np.cos(small) * R[:, 0] + np.sin(small) * R[:, 2]
+    K_inv = np.linalg.inv(np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]]))
     vps = [_vp_of(length_near, f, pp), _vp_of(width_off, f, pp), _vp_of(R[:, 2], f, pp)]
-    assert _photo_disagreeing_axes(vps, [20, 20, 20], f, pp, R) == [1]
-    assert _photo_disagreeing_axes(vps, [20, 3, 20], f, pp, R) == []  # width's too few
+    off = _photo_disagreeing_axes(vps, [20, 20, 20], K_inv, R)
+    assert [i for i, _ in off] == [1]
+    assert off[0][1] == pytest.approx(10.0, abs=1e-6)
+    assert _photo_disagreeing_axes(vps, [20, 3, 20], K_inv, R) == []  # width's too few
     vps_ok = [_vp_of(length_near, f, pp), _vp_of(R[:, 1], f, pp), _vp_of(R[:, 2], f, pp)]
-    assert _photo_disagreeing_axes(vps_ok, [20, 20, 20], f, pp, R) == []
+    assert _photo_disagreeing_axes(vps_ok, [20, 20, 20], K_inv, R) == []
