@@ -6,8 +6,8 @@ clicks), set ``street-photos-held-out-2`` (batch 8, development since stop 39; b
 ``held-out-3``, is not used). The photos stay out of this repository (no licence given);
 ``benchmarks/fetch_real_photos.sh`` fetches them into ``~/.cache/camloc_geo/photos`` (or
 ``CAMLOC_PHOTOS_DIR``). The scenes under ``tests/data/real_car/`` hold only the clicks, read
-by eye off zoomed pixel-grid crops (the Altis one annotator, ``hand-a``; the Today two,
-``hand-a`` and ``hand-b``, from their own crops). The clicks-only tests
+by eye off zoomed pixel-grid crops (two annotators each, ``hand-a`` and ``hand-b``, from
+their own crops). The clicks-only tests
 run everywhere; those with the photo skip without it. See benchmarks/README.md, "real_car".
 """
 
@@ -39,12 +39,14 @@ DATA = Path(__file__).parent / "data" / "real_car"
 # left, ~11 degrees off its length axis. Scene size 4.53 x 1.705 x 1.48 m (the E120 Altis'
 # published length, width and height; +/- 2 %). Truth: EXIF focal plane resolution and
 # focal length, 5201.3 px (1.59x the longer side). Nothing else in the photo is parallel to
-# the car: its length and width lines are its own (tyre contacts, hubs, the sill; the
-# number plate's edges), and its far rear corner (the width end) is hidden by a shrub
-# (clicked where the rear face ends). Camera height, without calibrate: 1.1 +/- 0.3 m (the
-# building's verticals show a level camera within ~1 degree, so the horizon lies near the
-# photo's middle row, y 1224 +/- 90: it crosses the car at 0.77 of its 1.48 m and a woman
-# standing by the porch at about half her height).
+# the car: its length and width lines are its own (hand-a: tyre contacts, hubs, the sill,
+# the number plate's edges; hand-b: the door handles, contacts, hubs, the trunk's crease
+# and the chrome strip), and its far rear corner (the width end) is hidden by a shrub
+# (clicked where the rear face ends). hand-b's clicks alone are refused (their vanishing
+# points lie on one side of the principal point). Camera height, without calibrate:
+# 1.1 +/- 0.3 m (the building's verticals show a level camera within ~1 degree, so the
+# horizon lies near the photo's middle row, y 1224 +/- 90: it crosses the car at 0.77 of
+# its 1.48 m and a woman standing by the porch at about half her height).
 ALTIS = DATA / "street_I1_STD_0034_corolla_altis.json"
 ALTIS_FOCAL_PX = 5201.27
 ALTIS_HEIGHT_M = 1.1
@@ -79,7 +81,7 @@ def _calibrate(
     without (``only``: that annotator's clicks alone): exit 0, no traceback, its JSON."""
     scene = json.loads(path.read_text(encoding="utf-8"))
     names = [a["annotator"] for a in scene["annotations"]]
-    assert names == (["hand-a", "hand-b"] if path == TODAY else ["hand-a"])
+    assert names == ["hand-a", "hand-b"]
     if only is not None:
         scene["annotations"] = [a for a in scene["annotations"] if a["annotator"] == only]
     if with_photo:
@@ -110,9 +112,9 @@ def _sigmas_off(out: dict, truth_px: float) -> float:
 def test_altis_clicks_alone_are_warned_on_both_axes_and_height_within_half_a_metre(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """2391.7 +/- 435.7 px (-54 %, 6.4 sigma), 0.80 +/- 0.30 m. Both length and width rest
-    on the car's own edges, and both are named: the wrong focal length is warned, though its
-    sigma does not cover it (see the xfail below)."""
+    """2344.9 +/- 467.0 px (-54.9 %, 6.1 sigma), 0.77 +/- 0.32 m (hand-a alone 2391.7 +/-
+    435.7, -54 %). Both length and width rest on the car's own edges, and both are named:
+    the wrong focal length is warned, though its sigma does not cover it (the xfail below)."""
     out = _calibrate(ALTIS, tmp_path, capsys, with_photo=False)
     warned = [w.split(":")[0] for w in out["warnings"] if "car's own edges" in w]
     assert warned == ["vp_lines.length", "vp_lines.width"]
@@ -126,9 +128,10 @@ def test_altis_clicks_alone_are_warned_on_both_axes_and_height_within_half_a_met
         "the car stands diagonally in its bay, so only its own lines carry length and width: "
         "the number plate's two 92 px edges (the width; 1.5 and 4.5 px of drop, where the "
         "EXIF focal length asks for ~0.1 px) and its wheels (the length); the width end is "
-        "hidden by a shrub and the height end read off the wheels' scale. The clicks' own "
-        "vanishing points give ~1,600 px, the joint fit 2,392 +/- 436 px (-54 %, 6.4 sigma, "
-        "warned on both axes); with the focal length given the fit moves the clicks by 8-22 px"
+        "hidden by a shrub and the height end read off the wheels' scale. hand-a's own "
+        "vanishing points give ~1,600 px, both annotators' joint fit 2,345 +/- 467 px "
+        "(-55 %, 6.1 sigma, warned on both axes); with the focal length given the fit moves "
+        "hand-a's clicks by 8-22 px"
     ),
 )
 def test_altis_clicks_alone_meet_issue_24(
@@ -144,12 +147,12 @@ def test_altis_clicks_alone_meet_issue_24(
 def test_altis_photo_that_disagrees_does_not_make_the_wrong_answer_surer(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The photo's width direction is 7-11 degrees from the fit's (warned). Its length and
+    """The photo's width direction is 6-11 degrees from the fit's (warned). Its length and
     upright segments used to join all the same (11 and 91 of them): the length no longer
     rested on the car's edges, its warning went, and the wrong answer looked surer,
-    2449 +/- 215 px (-53 %, 12.8 sigma), height 0.86 +/- 0.06 m. Two witnesses that clearly
-    disagree on one axis now lend each other nothing: the clicks' answer, its sigmas and
-    both car-line warnings stand, with the photo's disagreement."""
+    2343.5 +/- 194.7 px (-55 %, 14.7 sigma), height 0.83 +/- 0.06 m. Two witnesses that
+    clearly disagree on one axis now lend each other nothing: the clicks' answer, its sigmas
+    and both car-line warnings stand, with the photo's disagreement."""
     alone = _calibrate(ALTIS, tmp_path, capsys, with_photo=False)
     out = _calibrate(ALTIS, tmp_path, capsys, with_photo=True)
     assert any(
@@ -162,7 +165,19 @@ def test_altis_photo_that_disagrees_does_not_make_the_wrong_answer_surer(
     assert out["focal_px"] == pytest.approx(alone["focal_px"], rel=1e-9)
     assert out["focal_sigma_px"] >= 0.99 * alone["focal_sigma_px"]
     assert out["height_sigma_m"] >= 0.99 * alone["height_sigma_m"]
-    assert _sigmas_off(out, ALTIS_FOCAL_PX) < 7.0  # was 12.8
+    assert _sigmas_off(out, ALTIS_FOCAL_PX) < 7.0  # was 14.7
+
+
+def test_altis_hand_b_alone_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """hand-b's clicks alone give no consistent pair of vanishing points: exit 2 naming
+    camera.focal_px, not an answer."""
+    scene = json.loads(ALTIS.read_text(encoding="utf-8"))
+    scene["annotations"] = [a for a in scene["annotations"] if a["annotator"] == "hand-b"]
+    del scene["image"]["path"]
+    run = tmp_path / "scene.json"
+    run.write_text(json.dumps(scene), encoding="utf-8")
+    assert main(["calibrate", str(run)]) == 2
+    assert "camera.focal_px" in capsys.readouterr().err
 
 
 # --- the Honda Today: street lines along and across, covered but not within 10 % ------------
