@@ -3050,6 +3050,19 @@ def _add_photo_segments(
     if len(segs) == 0:
         return {}
     f, pp, R, _C = prob.unpack(x, R0, pp_fixed, f_fixed)
+    all_labels = np.asarray(res.labels, dtype=int).reshape(-1)  # as the warning counts them
+    support = np.bincount(all_labels[all_labels >= 0], minlength=len(res.vanishing_points))
+    K_inv = np.linalg.inv(np.array([[f, 0.0, pp[0]], [0.0, f, pp[1]], [0.0, 0.0, 1.0]]))
+    off = [i for i, _deg in _photo_disagreeing_axes(res.vanishing_points, support, K_inv, R)]
+    if off:
+        # Two witnesses that clearly disagree on one axis (one of them is off, and which is
+        # not known) do not make each other surer on the others: the photo lends nothing.
+        log.info(
+            "image.path: the photo's %s direction disagrees with the annotators' fit; its "
+            "segments are not used",
+            "/".join(AXES[i] for i in off),
+        )
+        return {}
     # Each of the photo's vanishing points (its own clustering: no choice by the fit) that
     # is within PHOTO_AXIS_TOL_DEG of one of the fit's axes, and the nearest to it, lends
     # that axis its segments.
@@ -3344,27 +3357,12 @@ def _photo_disagreement(scene: Scene, result: CalibrationResult) -> list[str]:
     R = np.asarray(cam.cam_from_world_rotation, dtype=float)
     K_inv = np.linalg.inv(np.asarray(cam.img_from_cam, dtype=float))
     support = np.bincount(np.asarray(res.labels)[np.asarray(res.labels) >= 0], minlength=3)
-    dirs = []
-    for k, vp in enumerate(np.asarray(res.vanishing_points, dtype=float)):
-        if support[k] < PHOTO_MIN_SEGMENTS:
-            continue
-        d = K_inv @ vp
-        n = float(np.linalg.norm(d))
-        if n > 0.0 and np.isfinite(n):
-            dirs.append(d / n)
-    out = []
-    for i, axis in enumerate(AXES):
-        if not dirs:
-            break
-        a = R[:, i] / np.linalg.norm(R[:, i])
-        angles = [math.degrees(math.acos(min(1.0, abs(float(a @ d))))) for d in dirs]
-        best = min(angles)
-        if PHOTO_AXIS_TOL_DEG < best <= PHOTO_AXIS_NEAR_DEG:
-            out.append(
-                f"image.path: the photo's lines disagree with the annotators' fit: its "
-                f"{axis} vanishing direction is {best:.1f} degrees from the fit's "
-                f"(the annotators' lines or the photo's detected lines are off)"
-            )
+    out = [
+        f"image.path: the photo's lines disagree with the annotators' fit: its "
+        f"{AXES[i]} vanishing direction is {best:.1f} degrees from the fit's "
+        f"(the annotators' lines or the photo's detected lines are off)"
+        for i, best in _photo_disagreeing_axes(res.vanishing_points, support, K_inv, R)
+    ]
     rel = _photo_focal_gap(res, result)
     if rel is not None:
         out.append(
@@ -3977,6 +3975,58 @@ def _photo_direction_axis(
     i = int(np.argmax(cosines))
     near = math.degrees(math.acos(min(1.0, float(cosines[i])))) <= PHOTO_AXIS_TOL_DEG
     return i if near else None
+
+
+def _photo_disagreeing_axes(
+    vps_px: npt.ArrayLike,
+    support: npt.ArrayLike,
+    K_inv: FloatArray,
+    R: FloatArray,
+) -> list[tuple[int, float]]:
+    """The axes on which the photo clearly disagrees with a camera, and by how much.
+
+    Among the photo's vanishing points with at least ``PHOTO_MIN_SEGMENTS`` segments
+    (``support``, per point), the direction nearest an axis is within
+    ``PHOTO_AXIS_NEAR_DEG`` of it but more than ``PHOTO_AXIS_TOL_DEG`` off
+    (:func:`_photo_disagreement`'s warning; :func:`_add_photo_segments` then lends nothing).
+
+    Parameters
+    ----------
+    vps_px
+        The photo's vanishing points, ``(k, 3)`` homogeneous pixels.
+    support
+        Segments per vanishing point, ``(k,)``.
+    K_inv
+        The camera's inverse intrinsics, ``(3, 3)`` (pixels to camera rays).
+    R
+        Its ``cam_from_world`` rotation: column ``i`` is world axis ``i`` (length, width,
+        up) in the camera frame.
+
+    Returns
+    -------
+    list of (int, float)
+        ``(axis index, angle in degrees)`` per disagreeing axis (0 length, 1 width,
+        2 height), ascending; empty where none disagrees.
+    """
+    vps = np.asarray(vps_px, dtype=float).reshape(-1, 3)
+    counts = np.asarray(support, dtype=float).reshape(-1)
+    dirs = []
+    for k, vp in enumerate(vps):
+        if k >= len(counts) or counts[k] < PHOTO_MIN_SEGMENTS:
+            continue
+        d = K_inv @ vp
+        n = float(np.linalg.norm(d))
+        if n > 0.0 and np.isfinite(n):
+            dirs.append(d / n)
+    off = []
+    for i in range(3):
+        if not dirs:
+            break
+        a = R[:, i] / np.linalg.norm(R[:, i])
+        best = min(math.degrees(math.acos(min(1.0, abs(float(a @ d))))) for d in dirs)
+        if PHOTO_AXIS_TOL_DEG < best <= PHOTO_AXIS_NEAR_DEG:
+            off.append((i, best))
+    return off
 
 
 def _photo_rows_lost(

@@ -108,9 +108,11 @@ def test_hand_annotated_corolla_height_within_half_a_metre(
     assert abs(out["height_m"] - COROLLA_HEIGHT_M) < 0.5
     # The focal length is not right (below); the user is told, with the photo's own figure,
     # and the stated sigmas are widened so that the wrong answer does not look sure:
-    # 926 +/- 116 px, the truth 2.2 of them away (it was 6.3 at +/- 40 px). The width
-    # direction rests on the rear face's own edges alone: warned, and its shared turn is in
-    # the sigma before the widening (+/- 58 px, then 2.0x; before that term 40 px, 2.9x).
+    # 926 +/- 116 px, the truth 2.2 of them away (it was 6.3 at +/- 40 px); since stop 40
+    # the photo, whose width direction is 12 degrees off, lends no segments: the clicks'
+    # 931 +/- 62 px widened 1.9x, 931 +/- 119 px (2.2 sigma). The width direction rests on
+    # the rear face's own edges alone: warned, and its shared turn is in the sigma before
+    # the widening (+/- 58 px, then 2.0x; before that term 40 px, 2.9x).
     assert any("the photo's lines give a focal length" in w for w in out["warnings"])
     assert any("every stated sigma is widened" in w for w in out["warnings"])
     assert any(w.startswith("vp_lines.width:") and "car's own edges" in w for w in out["warnings"])
@@ -126,7 +128,8 @@ def test_hand_annotated_corolla_height_within_half_a_metre(
         "published camera puts it for a car parallel to the street (596.6, 401.1); the rear "
         "face's 30-65 px width lines read nearly flat. The fit gives 926 +/- 40 px (+37 %; "
         "58 px with the car-line term, the width resting on the rear face, warned; 116 px "
-        "since the sigmas are widened where the photo disagrees); "
+        "since the sigmas are widened where the photo disagrees; 931 +/- 119 px since the "
+        "photo, disagreeing, lends no segments); "
         "with that one click moved it gives 718 +/- 37 px (+6.4 %, inside 2 sigma)"
     ),
 )
