@@ -1557,6 +1557,7 @@ class _ThirdHorizontal:
     n_paired: int  # distinct lines of the weaker of the frame's two horizontal directions
     log_moves: list[float]  # log(f_alt / f) of each pairing with a real focal length
     log_move_stds: list[float]  # how well its lines fix each
+    pair_k: list[int] = field(default_factory=list)  # the frame's direction of each pairing
 
 
 def _third_horizontal(
@@ -1650,13 +1651,14 @@ def _third_horizontal(
         f2 = -(v3[0] * vk[0] + v3[1] * vk[1]) / den  # normalised: f^2 of the pair square
         return 0.5 * math.log(f2) if lo * lo < f2 < hi * hi else math.nan
 
-    moves, move_stds = [], []
+    moves, move_stds, pair_k = [], [], []
     for k in kh:
         m0 = pair_logf(t3, vps[k])
         dm = (pair_logf(t3 + 1e-4, vps[k]) - pair_logf(t3 - 1e-4, vps[k])) / 2e-4
         if math.isfinite(m0):
             moves.append(m0 - math.log(f))
             move_stds.append(abs(dm) * t_std if math.isfinite(dm) else math.inf)
+            pair_k.append(k)
     n_h = [_n_distinct_lines(segs_px[labels == k], merge_px) for k in kh]
     log.debug(
         "third horizontal direction: %d lines (the frame's %s) at %.1f deg; pairings move "
@@ -1667,7 +1669,129 @@ def _third_horizontal(
         ", ".join(f"{m:+.3f} (+/- {e:.3f})" for m, e in zip(moves, move_stds, strict=True))
         or "nothing",
     )
-    return _ThirdHorizontal(n3, min(n_h), moves, move_stds)
+    return _ThirdHorizontal(n3, min(n_h), moves, move_stds, pair_k)
+
+
+def _vertical_pairing_logf(
+    best: _Model,
+    k_pair: int,
+    s: _Segs,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    bias_deg: float,
+) -> tuple[float, float]:
+    """The focal length the vertical gives with one horizontal direction, and its sigma.
+
+    Both pairings of a third horizontal direction (:func:`_third_horizontal`) keep the
+    vertical square to every horizontal direction: the vertical vanishing point and the
+    horizon fix the focal length on their own (``f^2`` = the horizon's offset from the
+    principal point times the vertical point's distance), whichever two horizontal
+    directions are square. The frame is fitted again with its vertical and its horizontal
+    direction ``k_pair`` only (the one both pairings share); the sigma of ``log(focal)``
+    takes in least squares, the segments' systematic bias (:func:`_systematic_logf_std`)
+    and the principal point (:func:`_pp_logf_std`), as the frame's own does. Loose where
+    the vertical vanishing point lies far off (a level camera): there the vertical cannot
+    tell the pairings apart.
+
+    Returns
+    -------
+    float
+        ``log(focal)`` (normalised) of the vertical and direction ``k_pair``.
+    float
+        Its standard deviation (``inf`` where the fit cannot say).
+    """
+    kv = int(np.argmax(np.abs(best.R[1])))
+    labels = np.where((best.labels == kv) | (best.labels == k_pair), best.labels, -1)
+    if np.count_nonzero(labels == kv) < 2 or np.count_nonzero(labels == k_pair) < 2:
+        return math.nan, math.inf
+    R, f, ls_std, _ = _refine(
+        best.R, best.f_n, s, labels, tau_px, True, f_prior, f_bounds, prior_w=prior_w
+    )
+    if not (f > 0 and math.isfinite(ls_std)):
+        return math.nan, math.inf
+    m2 = _Model(R=R, f_n=f, labels=labels, score=best.score, n_lines=best.n_lines)
+    sys_std = _systematic_logf_std(m2, s, tau_px, f_prior, f_bounds, prior_w, bias_deg)
+    pp_std = _pp_logf_std(m2, s, tau_px, f_prior, f_bounds, prior_w, _PP_FOCAL_SIGMA_REL)
+    return math.log(f), math.sqrt(ls_std**2 + sys_std**2 + pp_std**2)
+
+
+#: The vertical rules a third direction's pairing out where the focal length it gives with
+#: the shared horizontal direction lies beyond this many sigmas from the pairing's and
+#: within as many of the frame's (:func:`_vertical_rules_out`).
+_THIRD_VERTICAL_Z = 2.0
+
+#: A third direction pairs only with a horizontal direction of the frame that has at least
+#: this many distinct lines: one of fewer is left out of the fit (:data:`_WEAK_LINES`), its
+#: vanishing point the cross product of the other two, not a direction the photo shows.
+_THIRD_PAIR_MIN_LINES = _WEAK_LINES
+
+
+def _vertical_rules_out(
+    logf: float, log_move: float, log_move_std: float, logf_v: float, logf_v_std: float
+) -> bool:
+    """Whether the vertical tells the frame's pairing from a third direction's.
+
+    ``logf`` is the frame's ``log(focal)``, ``logf + log_move`` (sigma ``log_move_std``)
+    the rival pairing's, ``logf_v`` (sigma ``logf_v_std``) what the vertical gives with
+    the horizontal direction both share (:func:`_vertical_pairing_logf`). The rival is
+    ruled out where the vertical lies more than :data:`_THIRD_VERTICAL_Z` sigmas (the two
+    together) from it and within as many of the frame's: stairs, floor joints or an oblique
+    wing of a photo whose vertical fixes the focal length. Where the vertical agrees with
+    neither, or is too loose to choose, the rival stands.
+    """
+    if not (math.isfinite(logf_v) and math.isfinite(logf_v_std) and logf_v_std > 0.0):
+        return False
+    z_rival = abs(logf + log_move - logf_v) / math.hypot(log_move_std, logf_v_std)
+    z_frame = abs(logf - logf_v) / logf_v_std
+    log.debug(
+        "third direction: the vertical gives log focal %+.3f (+/- %.3f): the rival pairing "
+        "%.1f sigma off, the frame %.1f",
+        logf_v - logf,
+        logf_v_std,
+        z_rival,
+        z_frame,
+    )
+    return z_rival > _THIRD_VERTICAL_Z and z_frame <= _THIRD_VERTICAL_Z
+
+
+def _rival_pairings(
+    best: _Model,
+    third: _ThirdHorizontal,
+    n_lines: Sequence[int],
+    own_std: float,
+    s: _Segs,
+    tau_px: float,
+    f_prior: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+    bias_deg: float,
+) -> list[float]:
+    """The moves of ``log(focal)`` of a third direction's pairings that rival the frame's.
+
+    A pairing counts where its lines fix its focal length as a photo must to be believed
+    (:data:`_LOOSE_FOCAL_STD`) and it lies clearly apart from the kept one (beyond twice
+    their two sigmas together, the frame's own ``own_std``), unless it pairs with a frame
+    direction of fewer than :data:`_THIRD_PAIR_MIN_LINES` distinct lines (``n_lines``: the
+    cross product of the other two, not a direction the photo shows; Strecha's Herz-Jesus
+    photos, read right, had confidence 0.00 from such a pairing) or the vertical rules it
+    out (:func:`_vertical_pairing_logf`, :func:`_vertical_rules_out`).
+    """
+    alt = []
+    for m_alt, e_alt, k_pair in zip(
+        third.log_moves, third.log_move_stds, third.pair_k, strict=True
+    ):
+        if not (e_alt <= _LOOSE_FOCAL_STD and abs(m_alt) > 2.0 * math.hypot(e_alt, own_std)):
+            continue
+        if n_lines[k_pair] < _THIRD_PAIR_MIN_LINES:
+            continue
+        logf_v, std_v = _vertical_pairing_logf(
+            best, k_pair, s, tau_px, f_prior, f_bounds, prior_w, bias_deg
+        )
+        if not _vertical_rules_out(math.log(best.f_n), m_alt, e_alt, logf_v, std_v):
+            alt.append(m_alt)
+    return alt
 
 
 def _curve_share(segs_px: FloatArray, sel: npt.NDArray[np.bool_], diag_rel: float = 0.006) -> float:
@@ -2026,10 +2150,11 @@ class AutoVPResult:
         the Manhattan frame is the photo's (falling with fewer than about 60 distinct
         lines), times the structure's support (explained share of the segments' length,
         lines per direction), times, where a third horizontal direction would pair
-        otherwise (:func:`_third_horizontal`, warned), the weaker kept direction's share
-        of the two rival directions' lines. On 216 real photos its ROC AUC for an error
-        over 10 % is 0.90 (``benchmarks/vp_real.py``; stop 40: York Urban 0.90, Strecha
-        0.86, the 82 street photos 0.85).
+        otherwise (:func:`_third_horizontal`, warned; not where the vertical rules that
+        pairing out, :func:`_vertical_rules_out`), the weaker kept direction's share of the
+        two rival directions' lines. On 216 real photos its ROC AUC for an error over 10 %
+        is 0.90 (``benchmarks/vp_real.py``; stop 40: York Urban 0.95, Strecha 0.90, the 82
+        street photos 0.83).
     vertical_identified
         False when another direction could be the vertical one nearly as well (e.g. a
         camera pitched 60 degrees down and one pitched 30 degrees up see the same frame).
@@ -2742,15 +2867,8 @@ def detect_vanishing_points(
         rival_std = _rival_spread(rival_modes, own_std)[0]
         if _THIRD_HORIZONTAL and not has_prior:
             third = _third_horizontal(best, s, segs_px, merge_px, tau, f_bounds)
-            # a pairing counts where its lines fix its focal length as a photo must to be
-            # believed (_LOOSE_FOCAL_STD) and it lies clearly apart from the kept one (beyond
-            # twice their two sigmas together)
             alt = (
-                [
-                    m
-                    for m, e in zip(third.log_moves, third.log_move_stds, strict=True)
-                    if e <= _LOOSE_FOCAL_STD and abs(m) > 2.0 * math.hypot(e, own_std)
-                ]
+                _rival_pairings(best, third, nl, own_std, s, tau, f_prior, f_bounds, prior_w, bias)
                 if third is not None
                 else []
             )

@@ -2011,6 +2011,7 @@ def build_summary_map(
     verdicts: Sequence[Mapping[str, Any]] | None = None,
     verdict_service: str | None = None,
     tiles_attribution: str | None = None,
+    pending: int = 0,
 ) -> folium.Map:
     """A map of many cameras: the best candidate of each, as a :class:`folium.Map`.
 
@@ -2041,6 +2042,9 @@ def build_summary_map(
     tiles_attribution
         With ``tiles`` a tile URL template (``https://.../{z}/{x}/{y}.png``): its attribution
         (plain text), the layer named "Basemap". Without it ``tiles`` is taken as before.
+    pending
+        Cameras not done yet (a running job's): counted in the page's title and said in its
+        title box (an unfinished job's page said "0 of 0 cameras on the map").
     """
     rows: list[tuple[str, dict[str, Any]]] = []
     missing = []
@@ -2073,7 +2077,7 @@ def build_summary_map(
         ).add_to(fmap)
     else:
         fmap = _new_map(offline, None if offline else tiles, location)
-    n_cameras = len(rows) + len(missing)
+    n_cameras = len(rows) + len(missing) + max(0, int(pending))
     _set_page_title(
         fmap,
         f"camloc summary: {len(rows)} of {n_cameras} camera{'s' * (n_cameras != 1)} on the map",
@@ -2207,6 +2211,11 @@ def build_summary_map(
         title += f"≈ {n_tied} with a tied best candidate (dashed ring)<br>"
     if missing:
         title += _missing_html(missing)
+    if pending > 0:
+        title += (
+            f"⏳ {int(pending)} camera{'s' * (pending != 1)} not done yet (the job is still "
+            "running): reload the page later<br>"
+        )
     title += basemap_note
     _Control(title, position="topleft", css_class="camloc-title camloc-summary-title").add_to(fmap)
     bounds = (
@@ -2533,6 +2542,7 @@ def summary_page(
     verdict_service: str | None = None,
     verdicts: Sequence[Mapping[str, Any]] | None = None,
     map_source: Any = None,
+    pending: int = 0,
 ) -> str:
     """The summary page as one self-contained HTML text, with clusters.
 
@@ -2555,6 +2565,8 @@ def summary_page(
         or a folder) whose streets and buildings around the cameras are drawn as a light
         vector basemap, inlined (:func:`basemap_maps`, :func:`build_summary_map`'s
         ``map_data``); never the network. None: no basemap.
+    pending
+        Cameras not done yet, as :func:`build_summary_map`'s.
 
     Returns
     -------
@@ -2586,6 +2598,7 @@ def summary_page(
         map_data=map_data or None,
         verdicts=verdicts,
         verdict_service=verdict_service,
+        pending=pending,
     )
     page = fmap.get_root().render()
     page = re.sub(

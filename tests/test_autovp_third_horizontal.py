@@ -39,9 +39,14 @@ def _heading(deg: float) -> np.ndarray:
 
 
 def two_buildings_segments(
-    b_off_square_deg: float, n_road: int, seed: int = 0, n_b_rows: int = 50
+    b_off_square_deg: float,
+    n_road: int,
+    seed: int = 0,
+    n_b_rows: int = 50,
+    pitch_deg: float = 2.0,
 ) -> np.ndarray:
-    """A level handheld camera (1.6 m up, 2 degrees down) between two buildings.
+    """A handheld camera (1.6 m up, ``pitch_deg`` down: level by default) between two
+    buildings.
 
     Building A (left, ahead) runs at 45 degrees to the optical axis; building B (right,
     ahead) at ``-45 + b_off_square_deg`` (square to A at 0); ``n_road`` kerb and paving
@@ -49,7 +54,7 @@ def two_buildings_segments(
     """
     rng = np.random.default_rng(seed)
     w, h = SIZE
-    R = cam_from_world(0.0, 2.0)
+    R = cam_from_world(0.0, pitch_deg)
     eye = np.array([0.0, 0.0, 1.6])
     up = np.array([0.0, 0.0, 1.0])
     a_dir, b_dir, c_dir = _heading(45.0), _heading(-45.0 + b_off_square_deg), _heading(-45.0)

@@ -49,3 +49,26 @@ def test_merge_names_a_file_that_adds_nothing(caplog: pytest.LogCaptureFixture) 
     said = [r.getMessage() for r in caplog.records]
     assert len(said) == 1
     assert said[0].startswith("scene 2 (baltimore-eastern-broadway) adds nothing to the merge")
+
+
+def test_a_scene_camera_on_no_map_is_no_map() -> None:
+    """A camera with a scene whose point no extract covers (or with no map source at all)
+    ended ``no_candidates`` ("this scene needs a map ... and no map covers it"), while a
+    titled camera there says ``no_map``: a reader filtering the cameras that need a map
+    missed it (seen in camloc:geocodelist without OSM). It is ``no_map`` now, with why."""
+    import json
+    from pathlib import Path
+
+    from camloc_geo.api import locate_camera
+
+    samples = Path(__file__).resolve().parents[1] / "sample_maps"
+    scene = json.loads((samples / "sample_scene.json").read_text(encoding="utf-8"))
+    row = row_from_mapping({"id": "s1", "scene": scene}, 1)
+    none = locate_camera(row, map_source=None, network=False)
+    assert none.status == "no_map"
+    assert none.reason.startswith("this scene needs a map (intersection corners, landmarks")
+    far = {**scene, "prior": {"lat": 0.5, "lon": -30.0, "radius_m": 150.0}}  # mid-Atlantic
+    far_row = row_from_mapping({"id": "s2", "scene": far}, 2)
+    outside = locate_camera(far_row, map_source=samples, network=False)  # a folder of extracts
+    assert outside.status == "no_map", (outside.status, outside.reason)
+    assert "outside" in outside.reason

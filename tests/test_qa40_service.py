@@ -126,3 +126,49 @@ def test_a_missing_map_is_said_in_the_servers_words(tmp_path: Path) -> None:
     res = process_camera({"id": "c1", "title": "Eastern Ave & S Broadway"}, maps, settings)
     assert "--osm" not in str(res)
     assert "CAMLOC_MAP_DIR" in str(res)
+
+
+def test_a_running_jobs_map_counts_the_cameras_not_done_yet() -> None:
+    """A job's map opened while it ran said "0 of 0 cameras on the map" (only finished
+    cameras were counted): it counts the pending ones and says to reload later."""
+    from camloc_geo.service.routers.jobs import job_summary_page
+
+    page = job_summary_page([], pending=3)
+    assert "<title>camloc summary: 0 of 3 cameras on the map</title>" in page
+    assert "3 cameras not done yet (the job is still running): reload the page later" in page
+    done = job_summary_page([])
+    assert "not done yet" not in done
+
+
+def test_a_failed_tasks_page_says_why(tmp_path: Path) -> None:
+    """The annotation page of a task whose located merge failed said only that it takes no
+    more work; it says why it could not be located now."""
+    import io
+
+    from PIL import Image
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+    buf = io.BytesIO()
+    Image.new("RGB", (64, 48), (90, 90, 90)).save(buf, format="PNG")
+    store = app.state.store
+    task_id = store.create_task(
+        image=buf.getvalue(),
+        image_type="png",
+        width=64,
+        height=48,
+        needed=1,
+        base_scene={"format": "camloc-scene/1", "id": "t", "image": {"width": 64, "height": 48}},
+    )
+    store.set_task_result(task_id, "failed", {"reason": "the annotators marked different cars"})
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get(f"/annotate/{task_id}")
+
+    try:
+        page = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert page.status_code == 200, page.text
+    assert "It could not be located: the annotators marked different cars" in page.text

@@ -479,6 +479,19 @@ def test_worker_errors_name_the_processing_parameters_not_cli_options(tmp_path):
     )
     assert r.returncode == 2
     error = json.loads(r.stdout.strip().splitlines()[-1])["error"]
-    assert "give OSM (an OSM extract) or turn NETWORK on" in error
+    assert "give OSM (an OSM extract) or allow Overpass (NETWORK)" in error
     assert "--osm" not in error
     assert "map_source" not in error
+
+
+def test_geocodelist_reasons_name_the_processing_parameters(tmp_path):
+    """A camera with no map (no OSM, the network off) had the reason "... give --osm
+    EXTRACT_OR_FOLDER" in the QGIS layer; it names the OSM parameter now."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\ncam1,Eastern Ave & S Broadway\n", encoding="utf-8")
+    res = run_job({"task": "geocodelist", "list": str(lst), "out_dir": str(tmp_path)})
+    (cam,) = _read(res["layers"]["cameras"])
+    reason = cam["properties"]["reason"]
+    assert cam["properties"]["status"] == "no_map"
+    assert "give OSM (an extract or a folder of them)" in reason
+    assert "--osm" not in reason

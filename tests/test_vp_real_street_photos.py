@@ -418,7 +418,11 @@ def test_batch2_16_9_phone_truths_come_from_the_sensor() -> None:
     # truth is what the lens focal length over the sensor width gives (before -> after:
     # Note 3 0.822 -> 0.893, Mi A1 1.379 -> 1.498, Galaxy S5 0.823 -> 0.807 of the longer side)
     doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
-    with_truth = {p["camera"]: p for p in doc["photos"] if p.get("truth") and p["batch"] < 9}
+    with_truth = {
+        p["camera"]: p
+        for p in doc["photos"]
+        if p.get("truth") and p["batch"] < 9 and p["camera"] != "iPhone 4S"
+    }
     assert set(with_truth) == {"SAMSUNG-SM-N900A", "SM-G900F", "Mi A1"}
     want = {"SAMSUNG-SM-N900A": 0.893, "SM-G900F": 0.807, "Mi A1": 1.498}
     for camera, p in with_truth.items():
@@ -508,3 +512,19 @@ def test_fetch_script_takes_any_fresh_batch_by_name(tmp_path: Path) -> None:
         "street-photos-held-out-3/me/three.jpg",
     ]
     assert fetched("yud", tmp_path / "none") == []
+
+
+def test_iphone_4s_truths_come_from_the_sensor() -> None:
+    # stop 40: the iPhone 4S writes a 35 mm tag of 35 mm (1.011 times the longer side) where
+    # its 4.28 mm lens on a 3264 x 1.4 um = 4.570 mm wide sensor gives 0.937; all five of its
+    # photos (batches 1-2, both halves) carry the sensor truth, cited, whatever their result
+    doc = json.loads(vp_real.STREET_PHOTOS.read_text(encoding="utf-8"))
+    phones = [p for p in doc["photos"] if p.get("camera") == "iPhone 4S"]
+    assert len(phones) == 5
+    assert {p["half"] for p in phones} == {"dev", "held-out"}
+    for p in phones:
+        t = p["truth"]
+        assert "anandtech" in t["source"]
+        f_px = vp_real.sensor_focal_truth_px(t["focal_mm"], t["sensor_width_mm"], p["size"])
+        assert f_px / max(p["size"]) == pytest.approx(0.937, abs=0.001)
+        assert max(p["size"]) / min(p["size"]) == pytest.approx(4 / 3, abs=0.01)

@@ -400,7 +400,13 @@ def _scene_with_evidence(row: CameraRow, res: CameraResult, match: Any | None) -
     return parse_scene(data, base_dir=sc.base_dir)
 
 
-def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | None) -> None:
+def _locate(
+    row: CameraRow,
+    res: CameraResult,
+    m: MapData | None,
+    match: Any | None,
+    no_map: str | None = None,
+) -> None:
     from camloc_geo.absolute import locate
     from camloc_geo.absolute import view_cone as _view_cone
     from camloc_geo.geodesy import normalize_bearing_deg
@@ -414,6 +420,17 @@ def _locate(row: CameraRow, res: CameraResult, m: MapData | None, match: Any | N
         res.fail("scene_error", f"{where}: {exc}", "scene")
         return
     if m is None and sc.needs_map:
+        if no_map is not None:
+            # its point is on no map (no extract covers it, no map source): no_map, as a
+            # titled camera there says (it was no_candidates, which a reader filtering the
+            # cameras that need a map did not find)
+            res.fail(
+                "no_map",
+                "this scene needs a map (intersection corners, landmarks or street bearings): "
+                + no_map,
+                "map",
+            )
+            return
         res.fail(
             "no_candidates",
             "this scene needs a map (intersection corners, landmarks or street bearings) and "
@@ -498,8 +515,10 @@ def _with_map(
     m: MapData | None,
     matches: list[Any] | None = None,
     extract: str | None = None,
+    no_map: str | None = None,
 ) -> CameraResult:
-    """Place a camera with one map (None: scene evidence only)."""
+    """Place a camera with one map (None: scene evidence only; ``no_map`` says why there is
+    none where the camera's point is on no map)."""
     res.extract = extract or _extract_name(m)
     if matches is None and m is not None and (row.title or row.streets):
         try:
@@ -515,7 +534,7 @@ def _with_map(
         best = matches[0] if matches else None
         res.lat = res.lon = None
         res.cones = []
-        _locate(row, res, m, best)
+        _locate(row, res, m, best, no_map)
         if res.status in ("no_candidates",) and title_status == "title_only" and best is not None:
             # the scene failed: fall back to the title's junction, saying so
             locate_reason = res.reason
@@ -659,7 +678,10 @@ def area_of_row(plan: MapPlan, row: CameraRow) -> Area:
     at_scene = area_row(row)
     if at_scene is not row:
         area = plan.area_of(at_scene)
-        if area[0] != "none":
+        if area[0] != "none" or not (row.title or row.streets):
+            # (a scene's point on no map, and no title to search: that area's "none", so
+            # the camera says no_map and why; searching every extract for nothing ended
+            # no_candidates)
             return area
     return plan.area_of(row)
 
@@ -730,7 +752,7 @@ def _geocode(
     if kind == "none":
         if row.has_scene and not (row.title or row.streets):
             # a scene with references may not need a map at all
-            return _with_map(row, res, None)
+            return _with_map(row, res, None, no_map=str(area[1]) + _swapped_hint(plan, row))
         edge = _edge_extract(plan, row)
         if edge is not None:
             near_res = _at_the_edge(row, res, plan, *edge)

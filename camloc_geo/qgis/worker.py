@@ -505,7 +505,9 @@ def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any]
         "camera_id": cam_id,
         "title": result.title or None,
         "status": result.status,
-        "reason": result.reason,
+        # (the library's hints in the dialog's words: "give --osm EXTRACT_OR_FOLDER" named
+        # an option the Processing dialog does not have)
+        "reason": processing_words(result.reason) if result.reason else result.reason,
         "lat": _num(result.lat),
         "lon": _num(result.lon),
         "score": score,
@@ -775,11 +777,14 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
 
 
 _CLI_HINTS = (
-    ("give --osm EXTRACT (map_source=...)", "give OSM (an OSM extract) or turn NETWORK on"),
+    (
+        "give --osm EXTRACT (map_source=...)",
+        "give OSM (an OSM extract) or allow Overpass (NETWORK)",
+    ),
     ("give --osm EXTRACT (a local OSM extract)", "give OSM (a local OSM extract)"),
     (
         "give --osm EXTRACT_OR_FOLDER or allow --network",
-        "give OSM (an extract or a folder of them) or turn NETWORK on",
+        "give OSM (an extract or a folder of them) or allow Overpass (NETWORK)",
     ),
     ("give --osm EXTRACT_OR_FOLDER", "give OSM (an extract or a folder of them)"),
     ("give --osm EXTRACT", "give OSM (an OSM extract)"),

@@ -166,6 +166,10 @@ async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HT
             )
             if task["status"] == "located":  # where its answer is (the page named none)
                 closed += f" The camera's candidates: /v1/tasks/{task_id}/map"
+            elif task["status"] == "failed":  # and why there is none
+                why = str((task.get("result") or {}).get("reason") or "").strip()
+                if why:
+                    closed += f" It could not be located: {why[:300]}"
         return annotation_page_html(
             store.task_image(task),
             scene=task["base_scene"],

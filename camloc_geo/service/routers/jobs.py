@@ -338,6 +338,7 @@ def job_summary_page(
     tile_attribution: str | None = None,
     *,
     maps: MapStore | None = None,
+    pending: int = 0,
 ) -> str:
     """The summary page of a job's finished cameras, clustered (Leaflet and its cluster
     plug-in inlined), sharing its reviewers' verdicts through ``/v1/verdicts`` when opened
@@ -353,6 +354,7 @@ def job_summary_page(
         tiles_attribution=tile_attribution,
         verdict_service=VERDICTS_PATH,
         map_source=None if maps is None or tile_url else maps.catalogue,
+        pending=pending,
     )
 
 
@@ -364,12 +366,19 @@ async def job_map(
     pick from, clustered with their verdicts counted): one self-contained HTML file whose
     reviewers share their verdicts here; a tile basemap only when ``CAMLOC_TILE_URL`` is
     set, otherwise the server's extracts' streets and buildings around the cameras."""
-    if store.job(job_id) is None:
+    job = store.job(job_id)
+    if job is None:
         raise NotFoundError(f"no job {job_id}")
     results = store.job_results(job_id)
+    # the cameras not done yet are counted and said: a running job's page said "0 of 0
+    # cameras on the map"
+    pending = max(0, int(job.get("total") or 0) - len(results))
     tiles, attribution = settings.tile_url, settings.tile_attribution
     return HTMLResponse(
-        await run_cpu(request, lambda: job_summary_page(results, tiles, attribution, maps=maps))
+        await run_cpu(
+            request,
+            lambda: job_summary_page(results, tiles, attribution, maps=maps, pending=pending),
+        )
     )
 
 
