@@ -25,6 +25,7 @@ segment's endpoints by ``sigma_line_px`` (0.1 %), and a preset object's size is 
 
 from __future__ import annotations
 
+import copy
 import functools
 import logging
 import math
@@ -2789,6 +2790,10 @@ def _calibrate_annotations(
             if not quiet:
                 log.warning("%s", msg)
             result.warnings.append(msg)
+    for msg in _widen_for_border_clicks(result, kept):
+        if not quiet:
+            log.warning("%s", msg)
+        result.warnings.append(msg)
     return result
 
 
@@ -2987,6 +2992,126 @@ def _widen_for_discordant_lines(
             "roof's slope, a line at an angle)?"
         )
     return out
+
+
+# A click within this many pixels of the image's edge is taken as on it (clamped, or an
+# edge's end out of the frame clicked where the edge leaves it).
+BORDER_CLICK_PX = 1.0
+# A fit without the border clicks that moves the focal length or the height by more than
+# this many stated sigmas widens the sigmas by that move and is warned.
+BORDER_CLICK_MOVE = 1.0
+_BORDER_CLICK_FREE = 1e6  # a border click's sigma in the refit, in its own sigmas
+
+
+def _border_clicks(prob: _JointProblem) -> npt.NDArray[np.bool_]:
+    """Which edge-end clicks (``prob.pt_pix``, not the ground corners) lie on the image's edge."""
+    w, h = prob.image_wh
+    u, v = prob.pt_pix[:, 0], prob.pt_pix[:, 1]
+    on_edge = (
+        (u <= BORDER_CLICK_PX)
+        | (u >= w - BORDER_CLICK_PX)
+        | (v <= BORDER_CLICK_PX)
+        | (v >= h - BORDER_CLICK_PX)
+    )
+    end = np.arange(len(u)) % 4 != 0  # each annotator's origin, length, width, height
+    return np.asarray(on_edge & end, dtype=bool)
+
+
+def _widen_for_border_clicks(result: CalibrationResult, kept: list[int]) -> list[str]:
+    """Widen the sigmas where edge ends clicked on the image's edge carry the answer.
+
+    An edge whose far end lies outside the photo can only be clicked where it leaves the
+    frame (or is clamped there when clicked outside): its length in pixels is then cut
+    short, and with the car's size the fit reads that as a longer distance or another focal
+    length. The joint fit cannot tell: every annotator clicks the same border point, so
+    neither the residuals nor the jackknife show it (``benchmarks/calibrate_coverage.py``,
+    seed 20261125, scene 13: a noise-free scene's width end on the right edge, the focal
+    length 24 % short at a stated 4.4 %, 7.0 sigmas).
+
+    The fit is repeated from the answer with those clicks set free (their sigma
+    ``_BORDER_CLICK_FREE`` times theirs: the rest of the evidence decides). Where that moves
+    the focal length or the camera's height by more than ``BORDER_CLICK_MOVE`` stated sigmas,
+    the move ``m`` enters ``parameter_covariance`` as ``m mᵀ`` and the sigmas grow to match
+    (as a discordant line's, :func:`_widen_for_discordant_lines`); the answer does not move.
+    The warning names the clicks (``kept`` maps the fitted annotations to the user's scene's).
+    Returns the warnings.
+    """
+    state = result.joint_state
+    if state is None or result.position_sigma_m is None:
+        return []
+    prob = state.problem
+    border = _border_clicks(prob)
+    if not border.any():
+        return []
+    free = copy.copy(prob)  # the answer's problem stays as it is (absolute refits use it)
+    sigma_each = np.array(prob._sigma_pt_each, dtype=float)
+    sigma_each[border] *= _BORDER_CLICK_FREE
+    free._sigma_pt_each = sigma_each
+    free._memo = {}
+    free._jtj_inverse = None
+    free._ground_corner_steps = None
+    free._ground_corner_edge_sq = None
+    free._set_weights(np.asarray(state.weights, dtype=float))
+    x = np.asarray(state.x, dtype=float)
+    try:
+        res = _fit(free, x.copy(), state.rotation0, state.principal_point, state.focal_px)
+        f_b, pp_b, R_b, C_b = free.unpack(
+            np.asarray(res.x, dtype=float), state.rotation0, state.principal_point, state.focal_px
+        )
+    except (np.linalg.LinAlgError, ValueError):
+        return []
+    M = np.asarray(state.internal_from_output, dtype=float)
+    origin = np.asarray(state.internal_origin, dtype=float)
+    c_b = M.T @ (np.asarray(C_b, dtype=float) - origin)
+    turn = rotvec_from_rotation(
+        (np.asarray(R_b, dtype=float) @ M) @ result.camera.cam_from_world_rotation.T
+    )
+    if not np.all(np.isfinite(c_b)) or _vector_norm(turn) >= math.radians(30.0):
+        return []  # another frame: no comparable camera
+    m = np.zeros(9)
+    m[0] = float(f_b) - result.camera.focal_px
+    m[1:3] = np.subtract(pp_b, result.camera.principal_point)
+    m[3:6] = turn
+    m[6:9] = c_b - result.camera.center_in_world
+    sigma_c = result.position_sigma_m
+    z = abs(m[8]) / max(float(sigma_c[2]), 1e-12)
+    if state.focal_px is None and result.focal_sigma_px:
+        z = max(z, abs(m[0]) / result.focal_sigma_px)
+    if z <= BORDER_CLICK_MOVE:
+        return []
+    if result.parameter_covariance is not None:
+        result.parameter_covariance = np.asarray(
+            result.parameter_covariance, dtype=float
+        ) + np.outer(m, m)
+    if result.focal_sigma_px is not None:
+        result.focal_sigma_px = math.hypot(result.focal_sigma_px, m[0])
+    if result.principal_point_sigma_px is not None and state.principal_point is None:
+        result.principal_point_sigma_px = [
+            math.hypot(float(sd), float(d))
+            for sd, d in zip(result.principal_point_sigma_px, m[1:3], strict=True)
+        ]
+    if result.rotation_sigma_deg is not None:
+        result.rotation_sigma_deg = np.hypot(result.rotation_sigma_deg, np.degrees(m[3:6]))
+    result.position_sigma_m = np.hypot(sigma_c, m[6:9])
+    names = ("origin", "length", "width", "height")
+    where = sorted(
+        {
+            f"annotations[{kept[int(prob.pt_ann[k])]}].axes.{names[k % 4]}"
+            for k in np.flatnonzero(border)
+        }
+    )
+    shown = ", ".join(where[:4]) + (f" and {len(where) - 4} more" if len(where) > 4 else "")
+    focal = (
+        f" the focal length {100.0 * m[0] / result.camera.focal_px:+.0f} %,"
+        if state.focal_px is None
+        else ""
+    )
+    return [
+        f"edge ends clicked on the image's edge ({shown}): the edge probably runs out of the "
+        f"photo, so its length in pixels is cut short; without those clicks{focal} the "
+        f"camera height {m[8]:+.2f} m ({z:.1f} sigmas); the sigmas include that move. Click "
+        "an edge's end only where the car's corner is in the photo, or give camera.focal_px"
+    ]
 
 
 PHOTO_AXIS_TOL_DEG = 4.0  # a photo's direction this far from the fit's axis disagrees
