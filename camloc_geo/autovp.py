@@ -207,6 +207,9 @@ _WIDE_SHORT_REL = 16.0 / 9.0
 _MAX_STATED_STD = 1.0
 #: Above this relative standard deviation of the focal length a warning is given.
 _LOOSE_FOCAL_STD = 0.10
+#: A focal prior read from EXIF and the photo's own well-fixed reading disagree where they
+#: lie more than this many combined sigmas apart (``check_focal_prior``).
+_PRIOR_CHECK_Z = 2.0
 #: Systematic bias of segment directions (degrees) put into the focal length's sigma.
 BIAS_DEG = 0.3
 #: Two readings of the vertical whose costs (``_vertical_cost``) differ by less than this
@@ -2363,6 +2366,7 @@ def detect_vanishing_points(
     distortion_k1: float | None = None,
     estimate_distortion: bool = True,
     default_focal_prior: bool = True,
+    check_focal_prior: bool | None = None,
 ) -> AutoVPResult:
     """Find three orthogonal vanishing points, the focal length, pitch and roll.
 
@@ -2439,6 +2443,18 @@ def detect_vanishing_points(
         focal length, such as ``calibrate`` lending the photo's lines to the annotators'
         fit, needs: the default would move the vanishing points the lines are labelled
         with).
+    check_focal_prior
+        Also read the photo's own focal length without the prior (a second fit on the
+        same segments, the default prior as usual) and, where that reading is well fixed
+        (:data:`_LOOSE_FOCAL_STD` and the prior's sigma or tighter, not decided by the
+        default prior) and disagrees with the prior beyond their combined sigma
+        (``|log(f_photo / f_prior)| > 2 sqrt(sigma_photo^2 + sigma_prior^2)``), state the
+        prior's and the photo's readings as an equal mixture (:func:`_mix_readings`: the
+        focal length between them, its sigma covering both, the confidence lower) and warn
+        naming both. Where they agree nothing changes. Default
+        (None): where the prior was read from EXIF (``use_exif``), not where the caller
+        gave ``focal_prior_px``. A maker's tag can be wrong (a OnePlus 5T's 35 mm tag 12 %
+        low: ``benchmarks/README.md``, stop 40).
 
     Returns
     -------
@@ -2474,6 +2490,7 @@ def detect_vanishing_points(
         raise InputError(
             f"focal_prior_sigma_rel must be a positive number, got {focal_prior_sigma_rel!r}"
         )
+    prior_from_exif = False
     if (
         use_exif
         and focal_px is None
@@ -2484,6 +2501,7 @@ def detect_vanishing_points(
 
         ex = focal_from_exif(image)
         if ex is not None:
+            prior_from_exif = True
             focal_prior_px, focal_prior_sigma_rel, focal_prior_source = (
                 ex.focal_px,
                 ex.sigma_rel,
@@ -2548,6 +2566,9 @@ def detect_vanishing_points(
     prior_sigma = _F_PRIOR_SIGMA
     prior_w: float | None = None
     has_prior = f_fixed is None and focal_prior_px is not None
+    check_prior = has_prior and (
+        prior_from_exif if check_focal_prior is None else bool(check_focal_prior)
+    )
     if has_prior:
         assert focal_prior_px is not None
         f_prior = focal_prior_px / scale
@@ -2674,6 +2695,7 @@ def detect_vanishing_points(
                 distortion_k1=distortion_k1,
                 estimate_distortion=estimate_distortion,
                 default_focal_prior=default_focal_prior,
+                check_focal_prior=check_prior,
             )
         except NotEnoughStructureError:
             # too little is left without them: this reading stands, but its focal length
@@ -2916,6 +2938,58 @@ def detect_vanishing_points(
         # Gaussians in log(focal) instead, as for the default prior. Shortcut: the photo's
         # estimate is the fit with the prior, which counts the prior a little twice.
         best = _with_default_prior(best, s, tau, f_bounds, prior_w, (f_prior, prior_sigma))
+    clash: tuple[float, float, float] | None = None  # the photo's own px, its sigma, delta
+    if check_prior and math.isfinite(best.logf_std):
+        assert focal_prior_px is not None
+        try:
+            own = detect_vanishing_points(
+                None,
+                principal_point=principal_point,
+                seed=seed,
+                max_iterations=max_iterations,
+                segments=segs_detected,
+                image_size=(w, h),
+                inlier_px=inlier_px,
+                focal_bounds_rel=focal_bounds_rel,
+                estimate_principal_point=estimate_principal_point,
+                min_inlier_share=min_inlier_share,
+                axes_hint=axes_hint,
+                bias_deg=bias_deg,
+                distortion_k1=distortion_k1,
+                estimate_distortion=estimate_distortion,
+                check_focal_prior=False,
+            )
+        except NotEnoughStructureError:
+            own = None
+        if own is not None:
+            d_logf = math.log(own.focal_px / focal_prior_px)
+            combined = math.hypot(own.focal_std_rel, prior_sigma)
+            # well fixed: not loose, not decided by the default prior, and at least as
+            # tight as the prior (lines looser than the tag do not overrule it: the fit
+            # above weighed them already)
+            fixed = own.focal_source == "estimated" and own.focal_std_rel <= min(
+                _LOOSE_FOCAL_STD, prior_sigma
+            )
+            log.debug(
+                "prior check: photo %.1f px +/- %.3f, prior %.1f px +/- %.3f: %.3f (%s)",
+                own.focal_px,
+                own.focal_std_rel,
+                focal_prior_px,
+                prior_sigma,
+                d_logf,
+                "fixed" if fixed else "loose",
+            )
+            if fixed and abs(d_logf) > _PRIOR_CHECK_Z * combined:
+                best = _mix_readings(
+                    best,
+                    (f_prior, prior_sigma),
+                    (own.focal_px / scale, own.focal_std_rel),
+                    s,
+                    tau,
+                    f_bounds,
+                    prior_w,
+                )
+                clash = (own.focal_px, own.focal_std_rel, d_logf)
     if (
         default_focal_prior
         and f_fixed is None
@@ -2971,6 +3045,16 @@ def detect_vanishing_points(
         prior_sigma=prior_sigma if has_prior else None,
     )
     result.distortion_std = k1_std
+    if clash is not None:
+        assert focal_prior_px is not None
+        result.warnings.append(
+            f"the {focal_prior_source} focal length ({focal_prior_px:.0f} px +/- "
+            f"{100 * prior_sigma:.0f} %) and the photo's own lines ({clash[0]:.0f} px +/- "
+            f"{100 * clash[1]:.0f} %) disagree by {100 * (math.exp(clash[2]) - 1):+.0f} % "
+            "(a maker's tag can be wrong, or the lines mislead): both readings are kept, "
+            f"{result.focal_px:.0f} px +/- {100 * result.focal_std_rel:.0f} %; give "
+            "--focal-px if it is known"
+        )
     result.pitch_std_deg, result.roll_std_deg = pitch_std, roll_std
     result.focal_std_parts = dict(best.sigma_parts)
     result.line_residual_rms_px = best.residual_rms_px
@@ -3526,6 +3610,40 @@ def _with_default_prior(
         U, _, Vt = np.linalg.svd(R)
         R = U @ Vt
     m.R, m.f_n, m.logf_std = R, f_post, math.sqrt(var)
+    return m
+
+
+def _mix_readings(
+    m: _Model,
+    reading_a: tuple[float, float],
+    reading_b: tuple[float, float],
+    s: _Segs,
+    tau: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> _Model:
+    """Two readings of the focal length that disagree, stated as an equal mixture.
+
+    ``reading_a`` and ``reading_b`` (each the focal length normalised by the longer side
+    and the sigma of ``log(focal)``; here the prior's and the photo's own, without it) each
+    weigh one half: the focal length of ``m`` goes to the mixture's mean in ``log(focal)``
+    (their geometric mean) and its sigma to the mixture's, ``sqrt((s1^2 + s2^2) / 2 +
+    (d / 2)^2)`` for readings ``d`` apart, so that it covers both. The rotation is refitted
+    with the focal length held there (as in :func:`_with_default_prior`). Which reading is
+    right the photo does not say: equal weights are an assumption.
+    """
+    (f_a, s1), (f_b, s2) = reading_a, reading_b
+    d = math.log(f_b / f_a)
+    f_mix = min(max(f_a * math.exp(0.5 * d), f_bounds[0]), f_bounds[1])
+    std = math.sqrt(0.5 * (s1**2 + s2**2) + (0.5 * d) ** 2)
+    R = m.R
+    if abs(math.log(f_mix / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
+        R, _, _, _ = _refine(
+            m.R, f_mix, s, m.labels, tau, False, f_mix, f_bounds, prior_w=prior_w, max_nfev=20
+        )
+        U, _, Vt = np.linalg.svd(R)
+        R = U @ Vt
+    m.R, m.f_n, m.logf_std = R, f_mix, std
     return m
 
 
