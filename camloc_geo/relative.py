@@ -2920,6 +2920,32 @@ def _refit_move(
     return m
 
 
+def _add_move_to_sigmas(result: CalibrationResult, m: FloatArray, free_pp: bool) -> None:
+    """Widen a result's covariance and sigmas by one move of the answer it cannot rule out.
+
+    ``m`` is the move in ``parameter_covariance``'s order (focal length in pixels, principal
+    point in pixels, rotation vector in radians, camera centre in metres): ``m mᵀ`` joins the
+    covariance and each stated sigma grows by its component in quadrature (the principal
+    point's only where it was fitted, ``free_pp``). A discordant line's move
+    (:func:`_widen_for_discordant_lines`) and border clicks' (:func:`_widen_for_border_clicks`).
+    """
+    if result.parameter_covariance is not None:
+        result.parameter_covariance = np.asarray(
+            result.parameter_covariance, dtype=float
+        ) + np.outer(m, m)
+    if result.focal_sigma_px is not None:
+        result.focal_sigma_px = math.hypot(result.focal_sigma_px, m[0])
+    if result.principal_point_sigma_px is not None and free_pp:
+        result.principal_point_sigma_px = [
+            math.hypot(float(sd), float(d))
+            for sd, d in zip(result.principal_point_sigma_px, m[1:3], strict=True)
+        ]
+    if result.rotation_sigma_deg is not None:
+        result.rotation_sigma_deg = np.hypot(result.rotation_sigma_deg, np.degrees(m[3:6]))
+    if result.position_sigma_m is not None:
+        result.position_sigma_m = np.hypot(result.position_sigma_m, m[6:9])
+
+
 def _widen_for_discordant_lines(
     result: CalibrationResult, scene: Scene, settings: CalibrationSettings, kept: list[int]
 ) -> list[str]:
@@ -2965,21 +2991,7 @@ def _widen_for_discordant_lines(
                 z = max(z, abs(m[0]) / sigma_f0)
             if z <= move_min:
                 continue
-        if result.parameter_covariance is not None:
-            result.parameter_covariance = np.asarray(
-                result.parameter_covariance, dtype=float
-            ) + np.outer(m, m)
-        if result.focal_sigma_px is not None:
-            result.focal_sigma_px = math.hypot(result.focal_sigma_px, m[0])
-        if result.principal_point_sigma_px is not None and free_pp:
-            result.principal_point_sigma_px = [
-                math.hypot(float(sd), float(d))
-                for sd, d in zip(result.principal_point_sigma_px, m[1:3], strict=True)
-            ]
-        if result.rotation_sigma_deg is not None:
-            result.rotation_sigma_deg = np.hypot(result.rotation_sigma_deg, np.degrees(m[3:6]))
-        if result.position_sigma_m is not None:
-            result.position_sigma_m = np.hypot(result.position_sigma_m, m[6:9])
+        _add_move_to_sigmas(result, m, free_pp)
         slot, axis = int(prob.seg_ann[row]), AXES[int(prob.seg_axis[row])]
         seg = ", ".join(str(round(float(v))) for v in prob.segments[row])
         focal = f" the focal length {100.0 * m[0] / f:+.0f} %," if n_f else ""
@@ -3079,20 +3091,7 @@ def _widen_for_border_clicks(result: CalibrationResult, kept: list[int]) -> list
         z = max(z, abs(m[0]) / result.focal_sigma_px)
     if z <= BORDER_CLICK_MOVE:
         return []
-    if result.parameter_covariance is not None:
-        result.parameter_covariance = np.asarray(
-            result.parameter_covariance, dtype=float
-        ) + np.outer(m, m)
-    if result.focal_sigma_px is not None:
-        result.focal_sigma_px = math.hypot(result.focal_sigma_px, m[0])
-    if result.principal_point_sigma_px is not None and state.principal_point is None:
-        result.principal_point_sigma_px = [
-            math.hypot(float(sd), float(d))
-            for sd, d in zip(result.principal_point_sigma_px, m[1:3], strict=True)
-        ]
-    if result.rotation_sigma_deg is not None:
-        result.rotation_sigma_deg = np.hypot(result.rotation_sigma_deg, np.degrees(m[3:6]))
-    result.position_sigma_m = np.hypot(sigma_c, m[6:9])
+    _add_move_to_sigmas(result, m, state.principal_point is None)
     names = ("origin", "length", "width", "height")
     where = sorted(
         {
