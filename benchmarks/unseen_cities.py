@@ -12,12 +12,14 @@ held out: no threshold of camloc was chosen on them. Per city:
   camloc's own list) get a synthetic camera each, made as ``benchmarks/absolute.py`` makes
   them (:func:`camloc_geo.testing.synthetic.make_located_scene`, the same noise model, real
   kerbs 1.5 m off the map's corners, the oracle's lat/lon stated as the intersection), and
-  are located with ``corners`` and ``two_references``. Reported: the closest candidate of
-  ``corners`` under 10 / 15 m, its top candidate under 10 m, the top of ``two_references``
-  under 12 m, refusals with their messages, scenes that could not be made (the junction is
-  missing from camloc's model, or has no kerb corners), and **confidently wrong** answers:
-  the top candidate more than 15 m off, not tied, no warning, and two ``sigma_m`` short of
-  the truth.
+  are located with ``corners`` and ``two_references``. The car is stated as
+  ``{"preset": "sedan"}``, as a user who does not know it would (since stop 40;
+  ``--state-size``: the preset's numbers, taken by ``calibrate`` as the car's measured size).
+  Reported: the closest candidate of ``corners`` under 10 / 15 m, its top candidate under
+  10 m, the top of ``two_references`` under 12 m, refusals with their messages, scenes that
+  could not be made (the junction is missing from camloc's model, or has no kerb corners),
+  and **confidently wrong** answers: the top candidate more than 15 m off, not tied, no
+  warning, and two ``sigma_m`` short of the truth.
 - **geocode**: "Street A & Street B" titles made from osmnx's graph names
   (``tests/geocode_reference.py``, the same generator as ``benchmarks/geocode.py``):
   precision and recall within 30 m, negatives.
@@ -92,9 +94,19 @@ def _entry(res: Any, lat: float, lon: float) -> dict[str, Any]:
 
 
 def locate_city(
-    name: str, lat: float, lon: float, radius_m: float, junctions: list[dict[str, Any]], n: int
+    name: str,
+    lat: float,
+    lon: float,
+    radius_m: float,
+    junctions: list[dict[str, Any]],
+    n: int,
+    state_preset: bool = True,
 ) -> dict[str, Any]:
-    """Synthetic cameras at up to ``n`` oracle junctions of one city, located two ways."""
+    """Synthetic cameras at up to ``n`` oracle junctions of one city, located two ways.
+
+    ``state_preset``: the scenes state the car as ``{"preset": "sedan"}`` (default) or as the
+    preset's numbers (``absolute.oracle_scene``).
+    """
     from absolute import oracle_near, oracle_scene  # benchmarks/absolute.py: made alike
 
     from camloc_geo.absolute import apply_cues, locate
@@ -109,7 +121,9 @@ def locate_city(
     rows: list[dict[str, Any]] = []
     for i, oj in enumerate(chosen):
         base = {"oracle": [round(oj["lat"], 7), round(oj["lon"], 7)], "streets": oj["streets"]}
-        inter, ls, reason = oracle_scene(m, oj, np.random.default_rng([0, i]), noise)
+        inter, ls, reason = oracle_scene(
+            m, oj, np.random.default_rng([0, i]), noise, state_preset=state_preset
+        )
         if inter is not None:
             base["intersection"] = inter.id
             base["kind"] = inter.kind
@@ -271,6 +285,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--city", action="append", help="extract names (default: all six)")
     parser.add_argument("--n", type=int, default=12, help="junctions located per city")
     parser.add_argument("--max-junctions", type=int, default=60, help="geocode titles' junctions")
+    parser.add_argument(
+        "--state-size",
+        action="store_true",
+        help="the scenes state the car as the preset's numbers, taken by calibrate as its "
+        'measured size (the scenes before stop 40); default: {"preset": "sedan"}',
+    )
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     logging.getLogger("camloc_geo").setLevel(logging.ERROR)
@@ -281,7 +301,9 @@ def main(argv: list[str] | None = None) -> int:
         t0 = time.perf_counter()
         cov = coverage(name)
         junctions, _g = oracle_junctions(OSM / name)
-        loc = locate_city(name, lat, lon, radius_m, junctions, args.n)
+        loc = locate_city(
+            name, lat, lon, radius_m, junctions, args.n, state_preset=not args.state_size
+        )
         geo = geocode_city(name, args.max_junctions)
         s = loc["summary"]
         print(
@@ -299,6 +321,7 @@ def main(argv: list[str] | None = None) -> int:
         "machine": platform.platform(),
         "python": platform.python_version(),
         "n_per_city": args.n,
+        "car_stated": "size" if args.state_size else "preset",
         "cities": out,
     }
     (OUT / "unseen_cities.json").write_text(json.dumps(result, indent=2), encoding="utf-8")

@@ -922,3 +922,37 @@ def test_warning_rates_count_kinds_on_right_and_wrong_answers() -> None:
     assert (
         bench.warning_kind("intersection.corners[3]: no reading fits") == "intersection.corners[#]"
     )
+
+
+def test_absolute_benchmarks_state_the_car_as_a_user_would(baltimore: MapData) -> None:
+    # Stop 40: the absolute benchmarks' scenes state {"preset": "sedan"} (the drawn car is 5 %
+    # off the preset, which the user does not know); --state-size keeps the preset's numbers
+    # (taken by calibrate as the measured size). Same camera, car and clicks either way.
+    import inspect
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    import absolute
+    import absolute_slips
+    import unseen_cities
+
+    inter = next(i for i in baltimore.intersections if i.kind == "junction" and i.corners)
+    oj = {"lat": inter.lat, "lon": inter.lon}
+    scenes = {}
+    for state_preset in (True, False):
+        matched, ls, reason = absolute.oracle_scene(
+            baltimore, oj, np.random.default_rng([0, 3]), NoiseModel(), state_preset=state_preset
+        )
+        assert matched is not None, reason
+        assert ls is not None, reason
+        scenes[state_preset] = ls
+    default = absolute.oracle_scene(baltimore, oj, np.random.default_rng([0, 3]), NoiseModel())[1]
+    assert default is not None
+    assert default.scene["object"] == {"preset": "sedan"}
+    assert scenes[True].scene["object"] == {"preset": "sedan"}
+    stated = scenes[False].scene["object"]
+    assert (stated["length_m"], stated["width_m"], stated["height_m"]) == (4.6, 1.8, 1.45)
+    assert scenes[True].scene["annotations"] == scenes[False].scene["annotations"]
+    assert scenes[True].camera_enu.focal_px == scenes[False].camera_enu.focal_px
+    for fn in (absolute.run_scenes, absolute_slips.run, unseen_cities.locate_city):
+        assert inspect.signature(fn).parameters["state_preset"].default is True
