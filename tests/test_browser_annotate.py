@@ -283,6 +283,27 @@ def test_existing_scene_saves_unchanged(tab: Tab, files: dict[str, Any]) -> None
     assert tab.save() == files["truth"]
 
 
+def test_save_hint_quotes_a_name_with_a_space(tab: Tab, files: dict[str, Any]) -> None:
+    """A phone photo named "la foto.JPG" saves "la foto.json", and the page's hint said
+    "camloc calibrate la foto.json": copied into a shell, calibrate read "la" (issue 24's
+    graders annotate their own photos). The hint now gives the name as one argument."""
+    import shlex
+
+    scene = dict(files["truth"])
+    scene["id"] = "la foto"
+    path = files["dir"] / "la foto.json"
+    path.write_text(json.dumps(scene))
+    review = files["dir"] / "la foto.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(review), "--scene", str(path)]) == 0
+    tab.open(review)
+    assert tab.save()["id"] == "la foto"
+    assert tab.saved.name == "la foto.json"
+    hint = tab.page.inner_text("#save-status")
+    assert "Check it with: " in hint
+    args = shlex.split(hint.split("Check it with: ", 1)[1])
+    assert args == ["camloc", "calibrate", "la foto.json"]
+
+
 def test_bad_scene_files_say_what_is_wrong(tab: Tab, files: dict[str, Any]) -> None:
     tab.open(files["page"])
     other = dict(files["truth"])

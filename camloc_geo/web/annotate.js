@@ -1307,6 +1307,15 @@
     $("btn-save").disabled = true;
     $("save-status").textContent = msg;
   }
+  /* A file name as one shell argument: a photo "la foto.JPG" saves "la foto.json", and the
+   * hint "camloc calibrate la foto.json" ran calibrate on "la" (issue 24's graders copy it).
+   * Double quotes work in sh, PowerShell and cmd; single quotes where double would not do. */
+  function shellArg(name) {
+    if (/^[A-Za-z0-9._+@%,:=\/-]+$/.test(name)) return name;
+    if (!/["$`\\!]/.test(name)) return '"' + name + '"';
+    return "'" + name.replace(/'/g, "'\\''") + "'";
+  }
+
   function save() {
     var sc = buildScene();
     var miss = missing("save");
@@ -1340,7 +1349,7 @@
     markSaved();
     $("save-status").textContent = miss.length ?
       "Saved " + a.download + ", but incomplete: " + miss.join("; ") + "." :
-      "Saved " + a.download + ". Check it with: camloc calibrate " + a.download;
+      "Saved " + a.download + ". Check it with: camloc calibrate " + shellArg(a.download);
     flash(miss.length ? "Saved, but incomplete: " + miss.join("; ") + "." : "Saved " + a.download + ".", !miss.length);
   }
 
