@@ -1,0 +1,67 @@
+"""Session 40 QA (a grader's walk with their own phone photo): inputs a new user gives.
+
+An iPhone saves its photos as HEIC by default. ``camloc annotate IMG_1234.HEIC`` said "not an
+image this page can show; give a JPEG, PNG or WebP file", ``camloc vp`` "not an image file
+camloc reads", and ``POST /v1/tasks`` "not a readable JPEG, PNG or WebP image": the grader was
+not told that the phone's format is the matter, nor how to get a JPEG.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from camloc_geo import InputError, SceneError
+from camloc_geo._io import heif_kind
+from camloc_geo.cli import main
+from camloc_geo.service.routers.crowd import image_info
+from camloc_geo.web import read_image
+
+# The first bytes of an iPhone's HEIC photo (ISO media: box size, "ftyp", major brand, ...)
+HEIC_HEAD = b"\x00\x00\x00\x18ftypheic\x00\x00\x00\x00mif1heic"
+AVIF_HEAD = b"\x00\x00\x00\x1cftypavif\x00\x00\x00\x00avifmif1miaf"
+
+
+def _photo(tmp_path: Path, head: bytes, name: str) -> Path:
+    path = tmp_path / name
+    path.write_bytes(head + bytes(range(256)) * 8)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("head", "kind"),
+    [(HEIC_HEAD, "HEIC"), (AVIF_HEAD, "AVIF"), (b"\xff\xd8\xff\xe0" + b"\0" * 12, None)],
+)
+def test_heif_kind_reads_the_brand(head: bytes, kind: str | None) -> None:
+    assert heif_kind(head[:16]) == kind
+
+
+def test_annotate_names_a_heic_photo_and_the_way_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    photo = _photo(tmp_path, HEIC_HEAD, "IMG_1234.HEIC")
+    with pytest.raises(InputError) as page:
+        read_image(photo)
+    assert str(page.value).startswith(f"{photo} is a HEIC photo, which the page cannot show")
+    assert "Most Compatible" in str(page.value)
+    assert main(["annotate", str(photo), "-o", str(tmp_path / "p.html")]) == 2
+    err = capsys.readouterr().err
+    assert "is a HEIC photo" in err
+    assert "convert it to JPEG first" in err
+    assert not (tmp_path / "p.html").exists()
+
+
+def test_vp_names_a_heic_photo(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    photo = _photo(tmp_path, HEIC_HEAD, "IMG_1234.HEIC")
+    assert main(["vp", str(photo)]) == 2
+    err = capsys.readouterr().err
+    assert "a HEIC photo, which camloc cannot read" in err
+    assert "truncated" not in err
+
+
+def test_a_task_upload_names_an_avif_photo() -> None:
+    with pytest.raises(SceneError) as upload:
+        image_info(AVIF_HEAD + bytes(2000), 40_000_000)
+    assert "the snapshot is an AVIF photo" in str(upload.value)
+    assert "convert it to JPEG first" in str(upload.value)
