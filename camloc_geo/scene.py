@@ -898,6 +898,15 @@ def load_scene(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"malformed JSON in {p.name}: nested too deeply") from None
     except json.JSONDecodeError as exc:
+        head = text.lstrip()[:100].lower()
+        if head.startswith(("<!doctype html", "<html")):
+            # the page `camloc annotate` wrote, given for the scene it saves (it was
+            # "malformed JSON in cam.html at line 1, column 1: Expecting value")
+            raise SceneError(
+                f"{p.name} is a web page, not a scene file: the page `camloc annotate` "
+                "writes? Open it in a browser, mark the car and lines, click Save, and "
+                "give the .json file it downloads"
+            ) from None
         raise SceneError(
             f"malformed JSON in {p.name} at line {exc.lineno}, column {exc.colno}: {exc.msg}"
         ) from None

@@ -65,3 +65,27 @@ def test_a_task_upload_names_an_avif_photo() -> None:
         image_info(AVIF_HEAD + bytes(2000), 40_000_000)
     assert "the snapshot is an AVIF photo" in str(upload.value)
     assert "convert it to JPEG first" in str(upload.value)
+
+
+def test_calibrate_on_the_annotation_page_says_what_to_give(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``camloc calibrate cam.html`` (the page ``annotate`` wrote, not the scene it saves)
+    said "malformed JSON in cam.html at line 1, column 1: Expecting value"."""
+    from PIL import Image
+
+    snap = tmp_path / "cam.jpg"
+    Image.new("RGB", (64, 48), (90, 90, 90)).save(snap)
+    page = tmp_path / "cam.html"
+    assert main(["annotate", str(snap), "-o", str(page)]) == 0
+    capsys.readouterr()
+    assert main(["calibrate", str(page)]) == 2
+    err = capsys.readouterr().err
+    assert "cam.html is a web page, not a scene file" in err
+    assert "give the .json file it downloads" in err
+    assert "malformed JSON" not in err
+    # other broken JSON keeps its line and column
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "camloc-scene/1",\n oops}')
+    assert main(["calibrate", str(bad)]) == 2
+    assert "malformed JSON in bad.json at line 2, column 2" in capsys.readouterr().err
