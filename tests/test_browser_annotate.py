@@ -283,6 +283,38 @@ def test_existing_scene_saves_unchanged(tab: Tab, files: dict[str, Any]) -> None
     assert tab.save() == files["truth"]
 
 
+def test_undo_goes_to_the_step_it_changes(tab: Tab, files: dict[str, Any]) -> None:
+    """Undoing the car's points from step 2 left the page on step 2: the grader's next click,
+    meant to place the car's corner again, drew half a length line. Undo and redo now go to
+    the step whose clicks they change."""
+    tab.open(files["page"])
+    page = tab.page
+    ann = files["truth"]["annotations"][0]
+    for k in ("origin", "length", "width", "height"):
+        tab.click_image(*ann["axes"][k])
+    assert page.evaluate("camloc.step()") == 1
+    seg = ann["vp_lines"]["length"][0]
+    tab.click_image(seg[0], seg[1])
+    tab.click_image(seg[2], seg[3])
+    page.keyboard.press("Control+z")  # the line: stays on step 2
+    assert tab.state()["lines"]["length"] == []
+    assert page.evaluate("camloc.step()") == 1
+    page.keyboard.press("Control+z")  # the car's top: back to step 1
+    assert tab.state()["axes"]["height"] is None
+    assert page.evaluate("camloc.step()") == 0
+    tab.click_image(*ann["axes"]["height"])  # the click places the car's top again
+    assert tab.state()["axes"]["height"] == pytest.approx(ann["axes"]["height"], abs=0.01)
+    assert tab.state()["lines"]["length"] == []
+    page.keyboard.press("Control+z")
+    page.keyboard.press("Control+z")
+    page.keyboard.press("Control+y")  # redo the top from step 1 (no change of step)...
+    assert page.evaluate("camloc.step()") == 0
+    page.keyboard.press("3")
+    page.keyboard.press("Control+y")  # ...and the car's point again, from step 3: to step 1
+    assert page.evaluate("camloc.step()") == 0
+    assert tab.state()["axes"]["height"] == pytest.approx(ann["axes"]["height"], abs=0.01)
+
+
 def test_save_hint_quotes_a_name_with_a_space(tab: Tab, files: dict[str, Any]) -> None:
     """A phone photo named "la foto.JPG" saves "la foto.json", and the page's hint said
     "camloc calibrate la foto.json": copied into a shell, calibrate read "la" (issue 24's

@@ -463,18 +463,37 @@
     if (undoStack.length > 500) undoStack.shift();
     redoStack = [];
   }
+  /* The first step whose clicks differ between two states, or -1. Undo and redo go there:
+   * undoing the car's points from step 2 left the page on step 2, so the next click drew a
+   * length line where the grader meant to click the car again. */
+  function stepOfChange(a, b) {
+    var parts = [
+      [a.axes, b.axes], [a.lines.length, b.lines.length], [a.lines.width, b.lines.width],
+      [a.lines.height, b.lines.height], [a.corners, b.corners],
+      [[a.references, a.landmarks], [b.references, b.landmarks]]
+    ];
+    for (var i = 0; i < parts.length; i++) {
+      if (JSON.stringify(parts[i][0]) !== JSON.stringify(parts[i][1])) return i;
+    }
+    return -1;
+  }
+  function restore(text) {
+    var before = S;
+    S = JSON.parse(text);
+    var k = stepOfChange(before, S);
+    if (k >= 0 && k !== step) { step = k; pending = null; }
+    changed();
+  }
   function undo() {
     if (pending) { pending = null; render(); return; }
     if (!undoStack.length) return;
     redoStack.push(snapshot());
-    S = JSON.parse(undoStack.pop());
-    changed();
+    restore(undoStack.pop());
   }
   function redo() {
     if (!redoStack.length) return;
     undoStack.push(snapshot());
-    S = JSON.parse(redoStack.pop());
-    changed();
+    restore(redoStack.pop());
   }
 
   // ------------------------------------------------------------------ scene in and out
