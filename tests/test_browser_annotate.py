@@ -315,6 +315,32 @@ def test_undo_goes_to_the_step_it_changes(tab: Tab, files: dict[str, Any]) -> No
     assert tab.state()["axes"]["height"] == pytest.approx(ann["axes"]["height"], abs=0.01)
 
 
+def test_the_last_step_does_not_call_a_warned_scene_all_done(
+    tab: Tab, files: dict[str, Any]
+) -> None:
+    """With a red "Wrong corner?" under Checks, the last step said "Everything required is
+    there." in green: a grader saved and ran calibrate on a scene the page had warned of."""
+    tab.open(files["review"])
+    assert tab.page.evaluate("camloc.step()") == 6
+    assert tab.page.inner_text("#step-missing") == "Everything required is there."
+    assert "ok" in (tab.page.get_attribute("#step-missing", "class") or "")
+    scene = json.loads(json.dumps(files["truth"]))
+    axes = scene["annotations"][0]["axes"]
+    axes["origin"], axes["length"] = axes["length"], axes["origin"]
+    path = files["dir"] / "wrong_corner.json"
+    path.write_text(json.dumps(scene))
+    page_path = files["dir"] / "wrong_corner.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(page_path), "--scene", str(path)]) == 0
+    tab.open(page_path)
+    assert tab.page.evaluate("camloc.step()") == 6
+    assert "Wrong corner?" in tab.page.inner_text("#checks-body")
+    text = tab.page.inner_text("#step-missing")
+    assert text.startswith("Everything required is there, but ")
+    assert "look at" in text
+    assert "ok" not in (tab.page.get_attribute("#step-missing", "class") or "").split()
+    tab.shot("17_save_step_with_a_warning")
+
+
 def test_save_hint_quotes_a_name_with_a_space(tab: Tab, files: dict[str, Any]) -> None:
     """A phone photo named "la foto.JPG" saves "la foto.json", and the page's hint said
     "camloc calibrate la foto.json": copied into a shell, calibrate read "la" (issue 24's

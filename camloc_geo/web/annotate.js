@@ -1051,7 +1051,15 @@
     $("btn-undo").disabled = !undoStack.length && !pending;
     $("btn-redo").disabled = !redoStack.length;
     $("btn-save").textContent = config.mode === "crowd" ? "Submit" : "Save scene";
-    renderChecks();
+    var nBad = renderChecks();  // the red checks (a wrong corner, no focal length)
+    if (key === "save" && !miss.length && nBad) {
+      // it said "Everything required is there." in green beside a red "Wrong corner?"
+      mEl.className = "missing";
+      mEl.textContent = "Everything required is there, but " +
+        (nBad === 1 ? "a check is red" : nBad + " checks are red") +
+        " (under Checks, and over the photo): look at " + (nBad === 1 ? "it" : "them") +
+        " before saving.";
+    }
     var radios = document.querySelectorAll("input[name=xk]");
     Array.prototype.forEach.call(radios, function (r) {
       r.addEventListener("change", function () { extrasKind = r.value; });
@@ -1218,6 +1226,7 @@
     var al = $("alerts");
     al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[2] + "</div>"; }).join("");
     al.hidden = !alerts.length;
+    return alerts.filter(function (c) { return c[0] === "bad"; }).length;
   }
 
   function changed(keepForm) {
