@@ -671,9 +671,17 @@ def _drop_unusable_evidence(scene: Scene) -> Scene:
             )
             photo_scaled = True
         elif problem is not None:
+            where = ""
+            if not photo.exists() and not Path(scene.image.path or "").is_absolute():
+                # the annotation page's Save lands in the browser's downloads, away from the
+                # photo it names by its file name alone (issue 24's graders; session 40)
+                where = (
+                    " (image.path is relative to the scene file's folder: keep the scene "
+                    "beside the photo, or write the photo's full path there)"
+                )
             notes.append(
                 f"image.path: {problem}; the photo is not used (no lines detected in it, no "
-                "background for the overlay)"
+                f"background for the overlay){where}"
             )
             photo_unusable = photo.exists()
 

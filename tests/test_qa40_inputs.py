@@ -89,3 +89,46 @@ def test_calibrate_on_the_annotation_page_says_what_to_give(
     bad.write_text('{"format": "camloc-scene/1",\n oops}')
     assert main(["calibrate", str(bad)]) == 2
     assert "malformed JSON in bad.json at line 2, column 2" in capsys.readouterr().err
+
+
+def test_a_scene_saved_away_from_its_photo_says_where_the_path_is_read(tmp_path: Path) -> None:
+    """The page's Save lands in the browser's downloads folder; the scene names the photo by
+    its file name alone, so ``calibrate`` there warned "'.../Downloads/la foto.JPG' does not
+    exist; the photo is not used" and left the grader to guess why."""
+    import json
+
+    from camloc_geo.scene import load_scene
+
+    scene = {
+        "format": "camloc-scene/1",
+        "id": "la foto",
+        "image": {"width": 1632, "height": 1224, "path": "la foto.JPG"},
+        "annotations": [
+            {
+                "axes": {
+                    "origin": [600, 500],
+                    "length": [800, 520],
+                    "width": [560, 540],
+                    "height": [600, 420],
+                }
+            }
+        ],
+    }
+    downloads = tmp_path / "Downloads"
+    downloads.mkdir()
+    path = downloads / "la foto.json"
+    path.write_text(json.dumps(scene), encoding="utf-8")
+    notes = [w for w in load_scene(path).input_warnings if w.startswith("image.path: ")]
+    assert len(notes) == 1
+    assert "la foto.JPG' does not exist" in notes[0]
+    assert notes[0].endswith(
+        "(image.path is relative to the scene file's folder: keep the scene beside the photo, "
+        "or write the photo's full path there)"
+    )
+    # an absolute path that does not exist: the hint about relative paths does not apply
+    scene["image"]["path"] = str(tmp_path / "gone" / "la foto.JPG")
+    path.write_text(json.dumps(scene), encoding="utf-8")
+    notes = [w for w in load_scene(path).input_warnings if w.startswith("image.path: ")]
+    assert notes[0].endswith(
+        "the photo is not used (no lines detected in it, no background for the overlay)"
+    )
