@@ -848,6 +848,35 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
         context.close()
 
 
+def test_the_step_is_in_sight_on_a_phone(browser: Any, files: dict[str, Any]) -> None:
+    """On a 390x844 phone the list of seven steps under the photo pushed the step's text (what
+    to click, the ground-corner drawing) below the fold (its top at y 900): a grader saw the
+    photo and the list, not which point is meant. The step comes first under the photo now."""
+    context = browser.new_context(
+        viewport={"width": 390, "height": 844}, has_touch=True, is_mobile=True
+    )
+    page = context.new_page()
+    page.route(
+        "**/*",
+        lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+    )
+    try:
+        page.goto(files["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
+        text = page.locator("#step-text").bounding_box()
+        assert text is not None
+        assert text["y"] + 60 <= 844, text  # its first lines are in sight
+        fig = page.locator("#step-text figure#ground-corner svg").bounding_box()
+        assert fig is not None
+        assert fig["y"] < 844, fig  # the drawing starts in sight
+        steps = page.locator("#steps").bounding_box()
+        assert steps is not None
+        assert steps["y"] > text["y"]  # the list of steps after the step
+        assert page.locator("#steps li").count() == 7
+    finally:
+        context.close()
+
+
 def test_next_is_in_sight_on_a_laptop_screen(
     browser: Any, files: dict[str, Any], tmp_path: Path
 ) -> None:
