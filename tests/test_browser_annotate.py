@@ -385,6 +385,14 @@ def test_bad_scene_files_say_what_is_wrong(tab: Tab, files: dict[str, Any]) -> N
     tab.page.set_input_files("#scene-file", str(bad_format))
     tab.wait_js("document.getElementById('banner').textContent.includes('format')")
     assert tab.state()["axes"]["origin"] is None  # nothing loaded
+    # the page itself given as the scene (session 40: "it is not JSON (Unexpected token '<'")
+    tab.page.set_input_files("#scene-file", str(files["page"]))
+    tab.wait_js("document.getElementById('banner').textContent.includes('web page')")
+    assert tab.page.inner_text("#banner") == (
+        "Cannot open page.html: it is a web page (an annotation page?), not a scene file: "
+        "open the .json file that Save scene downloads."
+    )
+    assert tab.state()["axes"]["origin"] is None
 
 
 def test_wrong_corner_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> None:

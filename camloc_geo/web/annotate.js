@@ -1386,6 +1386,13 @@
     reader.onload = function () {
       var sc;
       try { sc = JSON.parse(reader.result); } catch (e) {
+        var head = String(reader.result).replace(/^\s+/, "").slice(0, 100).toLowerCase();
+        if (head.indexOf("<!doctype html") === 0 || head.indexOf("<html") === 0) {
+          // this page itself, or another (it was "it is not JSON (Unexpected token '<'...)")
+          fatal("Cannot open " + file.name + ": it is a web page (an annotation page?), not a " +
+            "scene file: open the .json file that Save scene downloads.");
+          return;
+        }
         fatal("Cannot open " + file.name + ": it is not JSON (" + e.message + ")."); return;
       }
       var err = validateScene(sc);
