@@ -387,6 +387,45 @@ def magic_format(head: bytes) -> str | None:
     return next((name for magic, name in _MAGIC if head.startswith(magic)), None)
 
 
+_HEIF_BRANDS = {
+    b"heic": "HEIC",
+    b"heix": "HEIC",
+    b"hevc": "HEIC",
+    b"hevx": "HEIC",
+    b"heim": "HEIC",
+    b"heis": "HEIC",
+    b"mif1": "HEIF",
+    b"msf1": "HEIF",
+    b"avif": "AVIF",
+    b"avis": "AVIF",
+}
+
+
+def heif_kind(head: bytes) -> str | None:
+    """``HEIC``, ``HEIF`` or ``AVIF`` when the first bytes are an ISO media file of that
+    brand (an iPhone's photo by default is HEIC), else None.
+
+    Pillow reads none of them without a plugin, and the messages said "not an image this
+    page can show" to a grader holding a phone photo (issue 24): they now name the format and
+    the way out (:data:`HEIF_HINT`).
+    """
+    if len(head) < 12 or head[4:8] != b"ftyp":
+        return None
+    return _HEIF_BRANDS.get(head[8:12])
+
+
+def heif_photo(kind: str) -> str:
+    """``a HEIC photo``, ``an AVIF photo``: a :func:`heif_kind` in a sentence."""
+    return f"{'an' if kind == 'AVIF' else 'a'} {kind} photo"
+
+
+HEIF_HINT = (
+    "convert it to JPEG first (an iPhone: Settings > Camera > Formats > Most Compatible, or "
+    "share the photo as JPEG; on a computer, an image editor or `heif-convert`)"
+)
+"""What to do with a HEIC, HEIF or AVIF photo (:func:`heif_kind`)."""
+
+
 _SIMPLE_FORMATS = ("JPEG", "PNG", "GIF", "BMP", "WEBP")
 """Formats OpenCV decodes in every variant: a failure means the file is cut off or corrupt."""
 
@@ -535,6 +574,12 @@ def _decode_image_gray(p: Path) -> Any:
     if (width, height) == (0, 0):
         # Pillow cannot read the header, so the size is not known: OpenCV is not asked (it
         # would allocate what a Radiance HDR or EXR header claims, up to 2^30 pixels)
+        heif = heif_kind(head)
+        if heif is not None:
+            raise InputError(
+                f"cannot decode image {p}: {heif_photo(heif)}, which camloc cannot read; "
+                f"{HEIF_HINT}"
+            )
         raise InputError(
             f"cannot decode image {p}: a truncated or corrupt {fmt} file"
             if fmt

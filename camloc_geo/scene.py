@@ -671,9 +671,17 @@ def _drop_unusable_evidence(scene: Scene) -> Scene:
             )
             photo_scaled = True
         elif problem is not None:
+            where = ""
+            if not photo.exists() and not Path(scene.image.path or "").is_absolute():
+                # the annotation page's Save lands in the browser's downloads, away from the
+                # photo it names by its file name alone (issue 24's graders; session 40)
+                where = (
+                    " (image.path is relative to the scene file's folder: keep the scene "
+                    "beside the photo, or write the photo's full path there)"
+                )
             notes.append(
                 f"image.path: {problem}; the photo is not used (no lines detected in it, no "
-                "background for the overlay)"
+                f"background for the overlay){where}"
             )
             photo_unusable = photo.exists()
 
@@ -898,6 +906,15 @@ def load_scene(path: str | Path) -> Scene:
     except RecursionError:
         raise SceneError(f"malformed JSON in {p.name}: nested too deeply") from None
     except json.JSONDecodeError as exc:
+        head = text.lstrip()[:100].lower()
+        if head.startswith(("<!doctype html", "<html")):
+            # the page `camloc annotate` wrote, given for the scene it saves (it was
+            # "malformed JSON in cam.html at line 1, column 1: Expecting value")
+            raise SceneError(
+                f"{p.name} is a web page, not a scene file: the page `camloc annotate` "
+                "writes? Open it in a browser, mark the car and lines, click Save, and "
+                "give the .json file it downloads"
+            ) from None
         raise SceneError(
             f"malformed JSON in {p.name} at line {exc.lineno}, column {exc.colno}: {exc.msg}"
         ) from None

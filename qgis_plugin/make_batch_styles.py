@@ -64,17 +64,25 @@ def main() -> int:
         L._label(layer, '"id" || \' \' || "status"', priority=10, size=10)
 
     def view_cones(layer: QgsVectorLayer) -> None:  # style_view_cones without "tie"
+        # Only the leading candidates' cones (the table has no tie column: a tied candidate
+        # has over a tenth of its camera's best score): every cone of every candidate, each
+        # with an opaque outline, drew one orange blob around a located camera (12 cones,
+        # scores down to 1e-22; seen on the desktop, session 40).
         sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
         sym.setColor(QColor(255, 190, 0, 70))
         sl = sym.symbolLayer(0)
-        sl.setStrokeColor(QColor(180, 120, 0))
+        sl.setStrokeColor(QColor(180, 120, 0, 160))
         sl.setDataDefinedProperty(
             QgsSymbolLayer.PropertyFillColor,
             QgsProperty.fromExpression(
                 'color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce("score", 0) / 0.5))'
             ),
         )
-        L._rules(layer, [("view cone (faded by score)", None, sym)])
+        leading = (
+            '"rank" = 1 OR coalesce("score", 0) >= 0.05 OR '
+            'coalesce("score", 0) * 10 > maximum("score", group_by:="id")'
+        )
+        L._rules(layer, [("view cone of a leading candidate (faded by score)", leading, sym)])
 
     # the batch's ties: "2,4", NULL without one; the job's: JSON text, "[2, 4]" or "[]"
     batch_tie = '"ambiguous_with" IS NOT NULL'

@@ -283,6 +283,85 @@ def test_existing_scene_saves_unchanged(tab: Tab, files: dict[str, Any]) -> None
     assert tab.save() == files["truth"]
 
 
+def test_undo_goes_to_the_step_it_changes(tab: Tab, files: dict[str, Any]) -> None:
+    """Undoing the car's points from step 2 left the page on step 2: the grader's next click,
+    meant to place the car's corner again, drew half a length line. Undo and redo now go to
+    the step whose clicks they change."""
+    tab.open(files["page"])
+    page = tab.page
+    ann = files["truth"]["annotations"][0]
+    for k in ("origin", "length", "width", "height"):
+        tab.click_image(*ann["axes"][k])
+    assert page.evaluate("camloc.step()") == 1
+    seg = ann["vp_lines"]["length"][0]
+    tab.click_image(seg[0], seg[1])
+    tab.click_image(seg[2], seg[3])
+    page.keyboard.press("Control+z")  # the line: stays on step 2
+    assert tab.state()["lines"]["length"] == []
+    assert page.evaluate("camloc.step()") == 1
+    page.keyboard.press("Control+z")  # the car's top: back to step 1
+    assert tab.state()["axes"]["height"] is None
+    assert page.evaluate("camloc.step()") == 0
+    tab.click_image(*ann["axes"]["height"])  # the click places the car's top again
+    assert tab.state()["axes"]["height"] == pytest.approx(ann["axes"]["height"], abs=0.01)
+    assert tab.state()["lines"]["length"] == []
+    page.keyboard.press("Control+z")
+    page.keyboard.press("Control+z")
+    page.keyboard.press("Control+y")  # redo the top from step 1 (no change of step)...
+    assert page.evaluate("camloc.step()") == 0
+    page.keyboard.press("3")
+    page.keyboard.press("Control+y")  # ...and the car's point again, from step 3: to step 1
+    assert page.evaluate("camloc.step()") == 0
+    assert tab.state()["axes"]["height"] == pytest.approx(ann["axes"]["height"], abs=0.01)
+
+
+def test_the_last_step_does_not_call_a_warned_scene_all_done(
+    tab: Tab, files: dict[str, Any]
+) -> None:
+    """With a red "Wrong corner?" under Checks, the last step said "Everything required is
+    there." in green: a grader saved and ran calibrate on a scene the page had warned of."""
+    tab.open(files["review"])
+    assert tab.page.evaluate("camloc.step()") == 6
+    assert tab.page.inner_text("#step-missing") == "Everything required is there."
+    assert "ok" in (tab.page.get_attribute("#step-missing", "class") or "")
+    scene = json.loads(json.dumps(files["truth"]))
+    axes = scene["annotations"][0]["axes"]
+    axes["origin"], axes["length"] = axes["length"], axes["origin"]
+    path = files["dir"] / "wrong_corner.json"
+    path.write_text(json.dumps(scene))
+    page_path = files["dir"] / "wrong_corner.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(page_path), "--scene", str(path)]) == 0
+    tab.open(page_path)
+    assert tab.page.evaluate("camloc.step()") == 6
+    assert "Wrong corner?" in tab.page.inner_text("#checks-body")
+    text = tab.page.inner_text("#step-missing")
+    assert text.startswith("Everything required is there, but ")
+    assert "look at" in text
+    assert "ok" not in (tab.page.get_attribute("#step-missing", "class") or "").split()
+    tab.shot("17_save_step_with_a_warning")
+
+
+def test_save_hint_quotes_a_name_with_a_space(tab: Tab, files: dict[str, Any]) -> None:
+    """A phone photo named "la foto.JPG" saves "la foto.json", and the page's hint said
+    "camloc calibrate la foto.json": copied into a shell, calibrate read "la" (issue 24's
+    graders annotate their own photos). The hint now gives the name as one argument."""
+    import shlex
+
+    scene = dict(files["truth"])
+    scene["id"] = "la foto"
+    path = files["dir"] / "la foto.json"
+    path.write_text(json.dumps(scene))
+    review = files["dir"] / "la foto.html"
+    assert main(["annotate", str(files["snap"]), "-o", str(review), "--scene", str(path)]) == 0
+    tab.open(review)
+    assert tab.save()["id"] == "la foto"
+    assert tab.saved.name == "la foto.json"
+    hint = tab.page.inner_text("#save-status")
+    assert "Check it with: " in hint
+    args = shlex.split(hint.split("Check it with: ", 1)[1])
+    assert args == ["camloc", "calibrate", "la foto.json"]
+
+
 def test_bad_scene_files_say_what_is_wrong(tab: Tab, files: dict[str, Any]) -> None:
     tab.open(files["page"])
     other = dict(files["truth"])
@@ -306,6 +385,14 @@ def test_bad_scene_files_say_what_is_wrong(tab: Tab, files: dict[str, Any]) -> N
     tab.page.set_input_files("#scene-file", str(bad_format))
     tab.wait_js("document.getElementById('banner').textContent.includes('format')")
     assert tab.state()["axes"]["origin"] is None  # nothing loaded
+    # the page itself given as the scene (session 40: "it is not JSON (Unexpected token '<'")
+    tab.page.set_input_files("#scene-file", str(files["page"]))
+    tab.wait_js("document.getElementById('banner').textContent.includes('web page')")
+    assert tab.page.inner_text("#banner") == (
+        "Cannot open page.html: it is a web page (an annotation page?), not a scene file: "
+        "open the .json file that Save scene downloads."
+    )
+    assert tab.state()["axes"]["origin"] is None
 
 
 def test_wrong_corner_warning(tab: Tab, files: dict[str, Any], tmp_path: Path) -> None:
@@ -765,6 +852,35 @@ def test_the_page_on_a_phone(browser: Any, files: dict[str, Any], tmp_path: Path
         ARTIFACTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / "16_phone.png"))
         assert errors == []
+    finally:
+        context.close()
+
+
+def test_the_step_is_in_sight_on_a_phone(browser: Any, files: dict[str, Any]) -> None:
+    """On a 390x844 phone the list of seven steps under the photo pushed the step's text (what
+    to click, the ground-corner drawing) below the fold (its top at y 900): a grader saw the
+    photo and the list, not which point is meant. The step comes first under the photo now."""
+    context = browser.new_context(
+        viewport={"width": 390, "height": 844}, has_touch=True, is_mobile=True
+    )
+    page = context.new_page()
+    page.route(
+        "**/*",
+        lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+    )
+    try:
+        page.goto(files["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
+        text = page.locator("#step-text").bounding_box()
+        assert text is not None
+        assert text["y"] + 60 <= 844, text  # its first lines are in sight
+        fig = page.locator("#step-text figure#ground-corner svg").bounding_box()
+        assert fig is not None
+        assert fig["y"] < 844, fig  # the drawing starts in sight
+        steps = page.locator("#steps").bounding_box()
+        assert steps is not None
+        assert steps["y"] > text["y"]  # the list of steps after the step
+        assert page.locator("#steps li").count() == 7
     finally:
         context.close()
 

@@ -31,7 +31,15 @@ from pathlib import Path
 from typing import Any, Literal
 
 from camloc_geo._errors import InputError, SceneError
-from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete, magic_format
+from camloc_geo._io import (
+    HEIF_HINT,
+    MIN_IMAGE_SIDE_PX,
+    displayed_size,
+    heif_kind,
+    heif_photo,
+    image_data_complete,
+    magic_format,
+)
 
 __all__ = [
     "MAX_IMAGE_BYTES",
@@ -135,6 +143,12 @@ def read_image(image: bytes | str | os.PathLike[str], *, name: str | None = None
         cut = magic_format(data[:16])
         if cut in SUPPORTED_FORMATS:  # cut off inside its header: it is one, broken
             raise InputError(f"{label} is a truncated or corrupt {cut} file") from None
+        heif = heif_kind(data[:16])
+        if heif is not None:  # an iPhone's photo: say so, and how to get a JPEG
+            raise InputError(
+                f"{label} is {heif_photo(heif)}, which the page cannot show; give a "
+                f"{_SUPPORTED_WORDS} file: {HEIF_HINT}"
+            ) from None
         raise InputError(
             f"{label} is not an image this page can show; give a {_SUPPORTED_WORDS} file"
         ) from None

@@ -463,18 +463,37 @@
     if (undoStack.length > 500) undoStack.shift();
     redoStack = [];
   }
+  /* The first step whose clicks differ between two states, or -1. Undo and redo go there:
+   * undoing the car's points from step 2 left the page on step 2, so the next click drew a
+   * length line where the grader meant to click the car again. */
+  function stepOfChange(a, b) {
+    var parts = [
+      [a.axes, b.axes], [a.lines.length, b.lines.length], [a.lines.width, b.lines.width],
+      [a.lines.height, b.lines.height], [a.corners, b.corners],
+      [[a.references, a.landmarks], [b.references, b.landmarks]]
+    ];
+    for (var i = 0; i < parts.length; i++) {
+      if (JSON.stringify(parts[i][0]) !== JSON.stringify(parts[i][1])) return i;
+    }
+    return -1;
+  }
+  function restore(text) {
+    var before = S;
+    S = JSON.parse(text);
+    var k = stepOfChange(before, S);
+    if (k >= 0 && k !== step) { step = k; pending = null; }
+    changed();
+  }
   function undo() {
     if (pending) { pending = null; render(); return; }
     if (!undoStack.length) return;
     redoStack.push(snapshot());
-    S = JSON.parse(undoStack.pop());
-    changed();
+    restore(undoStack.pop());
   }
   function redo() {
     if (!redoStack.length) return;
     undoStack.push(snapshot());
-    S = JSON.parse(redoStack.pop());
-    changed();
+    restore(redoStack.pop());
   }
 
   // ------------------------------------------------------------------ scene in and out
@@ -1032,7 +1051,15 @@
     $("btn-undo").disabled = !undoStack.length && !pending;
     $("btn-redo").disabled = !redoStack.length;
     $("btn-save").textContent = config.mode === "crowd" ? "Submit" : "Save scene";
-    renderChecks();
+    var nBad = renderChecks();  // the red checks (a wrong corner, no focal length)
+    if (key === "save" && !miss.length && nBad) {
+      // it said "Everything required is there." in green beside a red "Wrong corner?"
+      mEl.className = "missing";
+      mEl.textContent = "Everything required is there, but " +
+        (nBad === 1 ? "a check is red" : nBad + " checks are red") +
+        " (under Checks, and over the photo): look at " + (nBad === 1 ? "it" : "them") +
+        " before saving.";
+    }
     var radios = document.querySelectorAll("input[name=xk]");
     Array.prototype.forEach.call(radios, function (r) {
       r.addEventListener("change", function () { extrasKind = r.value; });
@@ -1199,6 +1226,7 @@
     var al = $("alerts");
     al.innerHTML = alerts.map(function (c) { return "<div class='check " + c[0] + "'>" + c[2] + "</div>"; }).join("");
     al.hidden = !alerts.length;
+    return alerts.filter(function (c) { return c[0] === "bad"; }).length;
   }
 
   function changed(keepForm) {
@@ -1307,6 +1335,15 @@
     $("btn-save").disabled = true;
     $("save-status").textContent = msg;
   }
+  /* A file name as one shell argument: a photo "la foto.JPG" saves "la foto.json", and the
+   * hint "camloc calibrate la foto.json" ran calibrate on "la" (issue 24's graders copy it).
+   * Double quotes work in sh, PowerShell and cmd; single quotes where double would not do. */
+  function shellArg(name) {
+    if (/^[A-Za-z0-9._+@%,:=\/-]+$/.test(name)) return name;
+    if (!/["$`\\!]/.test(name)) return '"' + name + '"';
+    return "'" + name.replace(/'/g, "'\\''") + "'";
+  }
+
   function save() {
     var sc = buildScene();
     var miss = missing("save");
@@ -1340,7 +1377,7 @@
     markSaved();
     $("save-status").textContent = miss.length ?
       "Saved " + a.download + ", but incomplete: " + miss.join("; ") + "." :
-      "Saved " + a.download + ". Check it with: camloc calibrate " + a.download;
+      "Saved " + a.download + ". Check it with: camloc calibrate " + shellArg(a.download);
     flash(miss.length ? "Saved, but incomplete: " + miss.join("; ") + "." : "Saved " + a.download + ".", !miss.length);
   }
 
@@ -1349,6 +1386,13 @@
     reader.onload = function () {
       var sc;
       try { sc = JSON.parse(reader.result); } catch (e) {
+        var head = String(reader.result).replace(/^\s+/, "").slice(0, 100).toLowerCase();
+        if (head.indexOf("<!doctype html") === 0 || head.indexOf("<html") === 0) {
+          // this page itself, or another (it was "it is not JSON (Unexpected token '<'...)")
+          fatal("Cannot open " + file.name + ": it is a web page (an annotation page?), not a " +
+            "scene file: open the .json file that Save scene downloads.");
+          return;
+        }
         fatal("Cannot open " + file.name + ": it is not JSON (" + e.message + ")."); return;
       }
       var err = validateScene(sc);

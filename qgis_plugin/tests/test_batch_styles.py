@@ -52,6 +52,21 @@ def test_a_batch_geopackage_opens_styled(tmp_path):
         if expr.evaluate(ctx):
             starred.append((f["id"], f["rank"]))
     assert sorted(starred) == [("s1", 1), ("s1", 2), ("s1", 3), ("s1", 4)]
+    # Only the leading candidates get a cone: every cone of every candidate drew one orange
+    # blob around the sample's camera (12 cones, scores down to 1e-22; session 40 desktop).
+    cones = QgsVectorLayer(f"{out}|layername=view_cones", "v", "ogr")
+    rules = cones.renderer().rootRule().children()
+    assert [r.label() for r in rules] == ["view cone of a leading candidate (faded by score)"]
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(cones))
+    expr = QgsExpression(rules[0].filterExpression())
+    drawn, left = [], []
+    for f in cones.getFeatures():
+        ctx.setFeature(f)
+        (drawn if expr.evaluate(ctx) else left).append((f["id"], f["rank"]))
+    assert not expr.hasEvalError(), expr.evalErrorString()
+    assert sorted(drawn) == [("s1", 1), ("s1", 2), ("s1", 3), ("s1", 4)]  # the tie's
+    assert len(left) >= 6
+    assert all(r > 4 for _, r in left)
 
 
 def test_a_service_job_geopackage_opens_styled(tmp_path):

@@ -1,23 +1,23 @@
 <!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>
-<qgis readOnly="0" simplifyDrawingTol="1" styleCategories="AllStyleCategories" maxScale="0" minScale="100000000" simplifyLocal="1" symbologyReferenceScale="-1" hasScaleBasedVisibilityFlag="0" version="3.22.16-Białowieża" labelsEnabled="0" simplifyMaxScale="1" simplifyAlgorithm="0" simplifyDrawingHints="1">
+<qgis version="3.22.16-Białowieża" simplifyAlgorithm="0" simplifyDrawingTol="1" labelsEnabled="0" symbologyReferenceScale="-1" hasScaleBasedVisibilityFlag="0" simplifyDrawingHints="1" simplifyMaxScale="1" maxScale="0" readOnly="0" simplifyLocal="1" styleCategories="AllStyleCategories" minScale="100000000">
  <flags>
   <Identifiable>1</Identifiable>
   <Removable>1</Removable>
   <Searchable>1</Searchable>
   <Private>0</Private>
  </flags>
- <temporal durationUnit="min" enabled="0" endField="" startExpression="" fixedDuration="0" durationField="" limitMode="0" accumulate="0" endExpression="" mode="0" startField="">
+ <temporal mode="0" startField="" startExpression="" endField="" limitMode="0" enabled="0" accumulate="0" durationUnit="min" durationField="" fixedDuration="0" endExpression="">
   <fixedRange>
    <start></start>
    <end></end>
   </fixedRange>
  </temporal>
- <renderer-v2 referencescale="-1" forceraster="0" enableorderby="0" type="RuleRenderer" symbollevels="0">
-  <rules key="{99f130f4-5456-4301-ab4d-f1d1f17b9264}">
-   <rule symbol="0" label="view cone (faded by score)" key="{b1e0818b-3356-4187-a426-b3aba9b898d7}" filter="ELSE"/>
+ <renderer-v2 referencescale="-1" forceraster="0" symbollevels="0" enableorderby="0" type="RuleRenderer">
+  <rules key="{c11dc8ee-9174-40e9-b9f3-c5618c569240}">
+   <rule filter="&quot;rank&quot; = 1 OR coalesce(&quot;score&quot;, 0) >= 0.05 OR coalesce(&quot;score&quot;, 0) * 10 > maximum(&quot;score&quot;, group_by:=&quot;id&quot;)" key="{133af54a-c9fd-4a39-b653-f6f87ce1b214}" symbol="0" label="view cone of a leading candidate (faded by score)"/>
   </rules>
   <symbols>
-   <symbol force_rhr="0" name="0" type="fill" alpha="1" clip_to_extent="1">
+   <symbol alpha="1" clip_to_extent="1" name="0" type="fill" force_rhr="0">
     <data_defined_properties>
      <Option type="Map">
       <Option value="" name="name" type="QString"/>
@@ -25,7 +25,7 @@
       <Option value="collection" name="type" type="QString"/>
      </Option>
     </data_defined_properties>
-    <layer enabled="1" locked="0" pass="0" class="SimpleFill">
+    <layer class="SimpleFill" enabled="1" pass="0" locked="0">
      <Option type="Map">
       <Option value="3x:0,0,0,0,0,0" name="border_width_map_unit_scale" type="QString"/>
       <Option value="255,190,0,70" name="color" type="QString"/>
@@ -33,7 +33,7 @@
       <Option value="0,0" name="offset" type="QString"/>
       <Option value="3x:0,0,0,0,0,0" name="offset_map_unit_scale" type="QString"/>
       <Option value="MM" name="offset_unit" type="QString"/>
-      <Option value="180,120,0,255" name="outline_color" type="QString"/>
+      <Option value="180,120,0,160" name="outline_color" type="QString"/>
       <Option value="solid" name="outline_style" type="QString"/>
       <Option value="0.26" name="outline_width" type="QString"/>
       <Option value="MM" name="outline_width_unit" type="QString"/>
@@ -45,7 +45,7 @@
      <prop v="0,0" k="offset"/>
      <prop v="3x:0,0,0,0,0,0" k="offset_map_unit_scale"/>
      <prop v="MM" k="offset_unit"/>
-     <prop v="180,120,0,255" k="outline_color"/>
+     <prop v="180,120,0,160" k="outline_color"/>
      <prop v="solid" k="outline_style"/>
      <prop v="0.26" k="outline_width"/>
      <prop v="MM" k="outline_width_unit"/>
@@ -73,13 +73,13 @@
  <blendMode>0</blendMode>
  <featureBlendMode>0</featureBlendMode>
  <layerOpacity>1</layerOpacity>
- <geometryOptions removeDuplicateNodes="0" geometryPrecision="0">
+ <geometryOptions geometryPrecision="0" removeDuplicateNodes="0">
   <activeChecks type="StringList">
    <Option value="" type="QString"/>
   </activeChecks>
   <checkConfiguration/>
  </geometryOptions>
- <legend type="default-vector" showLabelLegend="0"/>
+ <legend showLabelLegend="0" type="default-vector"/>
  <referencedLayers/>
  <fieldConfiguration>
   <field configurationFlags="None" name="row">
@@ -119,25 +119,25 @@
   </field>
  </fieldConfiguration>
  <aliases>
-  <alias name="" field="row" index="0"/>
-  <alias name="" field="id" index="1"/>
-  <alias name="" field="rank" index="2"/>
-  <alias name="" field="source" index="3"/>
-  <alias name="" field="score" index="4"/>
+  <alias index="0" name="" field="row"/>
+  <alias index="1" name="" field="id"/>
+  <alias index="2" name="" field="rank"/>
+  <alias index="3" name="" field="source"/>
+  <alias index="4" name="" field="score"/>
  </aliases>
  <defaults>
-  <default applyOnUpdate="0" field="row" expression=""/>
-  <default applyOnUpdate="0" field="id" expression=""/>
-  <default applyOnUpdate="0" field="rank" expression=""/>
-  <default applyOnUpdate="0" field="source" expression=""/>
-  <default applyOnUpdate="0" field="score" expression=""/>
+  <default expression="" field="row" applyOnUpdate="0"/>
+  <default expression="" field="id" applyOnUpdate="0"/>
+  <default expression="" field="rank" applyOnUpdate="0"/>
+  <default expression="" field="source" applyOnUpdate="0"/>
+  <default expression="" field="score" applyOnUpdate="0"/>
  </defaults>
  <constraints>
-  <constraint field="row" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
-  <constraint field="id" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
-  <constraint field="rank" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
-  <constraint field="source" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
-  <constraint field="score" unique_strength="0" notnull_strength="0" constraints="0" exp_strength="0"/>
+  <constraint unique_strength="0" constraints="0" field="row" exp_strength="0" notnull_strength="0"/>
+  <constraint unique_strength="0" constraints="0" field="id" exp_strength="0" notnull_strength="0"/>
+  <constraint unique_strength="0" constraints="0" field="rank" exp_strength="0" notnull_strength="0"/>
+  <constraint unique_strength="0" constraints="0" field="source" exp_strength="0" notnull_strength="0"/>
+  <constraint unique_strength="0" constraints="0" field="score" exp_strength="0" notnull_strength="0"/>
  </constraints>
  <constraintExpressions>
   <constraint field="row" exp="" desc=""/>
@@ -148,7 +148,7 @@
  </constraintExpressions>
  <expressionfields/>
  <attributeactions/>
- <attributetableconfig actionWidgetStyle="dropDown" sortExpression="" sortOrder="0">
+ <attributetableconfig sortExpression="" actionWidgetStyle="dropDown" sortOrder="0">
   <columns/>
  </attributetableconfig>
  <conditionalstyles>

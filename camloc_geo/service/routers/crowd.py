@@ -14,7 +14,15 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import HTMLResponse
 
 from camloc_geo import CamlocError, MapDataError, SceneError
-from camloc_geo._io import MIN_IMAGE_SIDE_PX, displayed_size, image_data_complete, magic_format
+from camloc_geo._io import (
+    HEIF_HINT,
+    MIN_IMAGE_SIDE_PX,
+    displayed_size,
+    heif_kind,
+    heif_photo,
+    image_data_complete,
+    magic_format,
+)
 from camloc_geo.service.deps import (
     ApiKey,
     SceneBody,
@@ -67,6 +75,12 @@ def image_info(raw: bytes, max_pixels: int) -> tuple[str, int, int]:
         cut = magic_format(raw[:16])
         if cut in IMAGE_TYPES:  # cut off inside its header (an upload interrupted early)
             raise SceneError(f"the snapshot is a truncated or corrupt {cut} file", "body") from None
+        heif = heif_kind(raw[:16])
+        if heif is not None:  # an iPhone's photo
+            raise SceneError(
+                f"the snapshot is {heif_photo(heif)}, not a JPEG, PNG or WebP image; {HEIF_HINT}",
+                "body",
+            ) from None
         raise SceneError("the snapshot is not a readable JPEG, PNG or WebP image", "body") from None
     except Image.DecompressionBombError:
         raise LimitError("the snapshot has too many pixels", "body") from None
