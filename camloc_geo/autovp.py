@@ -2217,8 +2217,16 @@ class AutoVPResult:
         """Index (1 or 2) of the horizontal vanishing point taken for the street.
 
         The horizontal direction nearer the optical axis: a street camera or a photo taken
-        in a street looks along it more than across it.
+        in a street looks along it more than across it. Except where only one of the two is
+        a direction the photo shows (at least :data:`_WEAK_LINES` distinct lines, the other
+        fewer: the cross product of the other two): a street shows its own direction (kerbs,
+        lane markings, facades), so that one is the street. A level phone photo down a
+        street whose kerbs and lane lines meet off the frame took the unsupported point
+        nearer the centre for the street (stop 40).
         """
+        n1, n2 = (int(n) for n in self.n_lines[1:3])
+        if (n1 >= _WEAK_LINES) != (n2 >= _WEAK_LINES):
+            return 1 if n1 >= _WEAK_LINES else 2
         d = self.directions_in_cam
         return 1 if abs(float(d[1, 2])) >= abs(float(d[2, 2])) else 2
 
