@@ -3610,14 +3610,29 @@ def _with_default_prior(
     var = 1.0 / (w_data + w_prior)
     log_f = var * (w_data * math.log(m.f_n) + w_prior * math.log(centre))
     f_post = min(max(math.exp(log_f), f_bounds[0]), f_bounds[1])
+    return _hold_focal(m, f_post, math.sqrt(var), s, tau, f_bounds, prior_w)
+
+
+def _hold_focal(
+    m: _Model,
+    f_n: float,
+    logf_std: float,
+    s: _Segs,
+    tau: float,
+    f_bounds: tuple[float, float],
+    prior_w: float | None,
+) -> _Model:
+    """Set ``m``'s focal length to ``f_n`` (sigma ``logf_std`` in ``log(focal)``), its rotation
+    refitted with the focal length held there where it moved by more than 0.5 %
+    (:func:`_with_default_prior`, :func:`_mix_readings`)."""
     R = m.R
-    if abs(math.log(f_post / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
+    if abs(math.log(f_n / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
         R, _, _, _ = _refine(
-            m.R, f_post, s, m.labels, tau, False, f_post, f_bounds, prior_w=prior_w, max_nfev=20
+            m.R, f_n, s, m.labels, tau, False, f_n, f_bounds, prior_w=prior_w, max_nfev=20
         )
         U, _, Vt = np.linalg.svd(R)
         R = U @ Vt
-    m.R, m.f_n, m.logf_std = R, f_post, math.sqrt(var)
+    m.R, m.f_n, m.logf_std = R, f_n, logf_std
     return m
 
 
@@ -3644,15 +3659,7 @@ def _mix_readings(
     d = math.log(f_b / f_a)
     f_mix = min(max(f_a * math.exp(0.5 * d), f_bounds[0]), f_bounds[1])
     std = math.sqrt(0.5 * (s1**2 + s2**2) + (0.5 * d) ** 2)
-    R = m.R
-    if abs(math.log(f_mix / m.f_n)) > 0.005 and np.count_nonzero(m.labels >= 0) >= 4:
-        R, _, _, _ = _refine(
-            m.R, f_mix, s, m.labels, tau, False, f_mix, f_bounds, prior_w=prior_w, max_nfev=20
-        )
-        U, _, Vt = np.linalg.svd(R)
-        R = U @ Vt
-    m.R, m.f_n, m.logf_std = R, f_mix, std
-    return m
+    return _hold_focal(m, f_mix, std, s, tau, f_bounds, prior_w)
 
 
 def _updown(pitch_deg: float) -> str:
