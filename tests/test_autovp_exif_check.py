@@ -99,3 +99,33 @@ def test_check_is_on_by_default_for_an_exif_prior_only(
     typed = _fit(segs, size, F_WRONG_TAG_PX, check=None)
     assert not typed.warnings
     assert typed.focal_px < 0.88 * F_TRUE_PX  # the caller's prior holds, as before
+
+
+def test_camloc_vp_checks_the_exif_tag_it_reads(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # `camloc vp` reads the EXIF itself and passes it as focal_prior_px, where the check's
+    # default is off: it must ask for the check, as detect_vanishing_points(use_exif=True)
+    # does (stop 40: the CLI's OnePlus 5T photo stayed -12 % at 3.9 %, unwarned)
+    import camloc_geo.cli.vp as cli_vp
+    import camloc_geo.exif as exif
+    from camloc_geo.cli import main
+
+    photo = tmp_path / "p.jpg"
+    photo.write_bytes(b"not read")
+    monkeypatch.setattr(
+        exif, "focal_from_exif", lambda path: exif.ExifFocal(555.0, 0.04, "exif-35mm")
+    )
+    seen: dict[str, object] = {}
+
+    class _StopError(Exception):
+        pass
+
+    def fake(args: object, options: dict[str, object]) -> None:
+        seen.update(options)
+        raise _StopError
+
+    monkeypatch.setattr(cli_vp, "_vanishing_points", fake)
+    assert main(["vp", str(photo)]) != 0  # the stand-in stops the run once it has seen
+    assert seen["focal_prior_px"] == 555.0
+    assert seen["check_focal_prior"] is True

@@ -116,6 +116,7 @@ def run(args: argparse.Namespace) -> int:
                 focal_prior_px=ex.focal_px,
                 focal_prior_sigma_rel=ex.sigma_rel,
                 focal_prior_source=ex.source,
+                check_focal_prior=True,  # a maker's tag can be wrong: checked against the lines
             )
     try:
         res = _vanishing_points(args, options)
