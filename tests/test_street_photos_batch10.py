@@ -193,3 +193,40 @@ def test_fetched_batch_10_matches_the_manifest() -> None:
     for r in rows:
         w, h = r["size"]
         assert 0.6 < r["f"] / max(w, h) < 2.6
+
+
+def test_run_loads_batch_10_only_by_its_own_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # vp_real.main: "--sets street-photos-held-out-4" hands exactly batch 10's photos to the
+    # estimation (stubbed: nothing is estimated), named by view; the other sets' names do not
+    photos = tmp_path / "photos"
+    u = _jpeg(photos / SET / "y" / "u.jpg", (640, 480), {0xA405: 35})
+    v = _jpeg(photos / "street-photos-held-out-3" / "z" / "v.jpg", (640, 480), {0xA405: 26})
+    entries = [
+        {"file": f"{SET}/y/u.jpg", "sha256": _sha(u), "half": HALF, "view": "looking-up"},
+        {
+            "file": "street-photos-held-out-3/z/v.jpg",
+            "sha256": _sha(v),
+            "half": "held-out-3",
+            "view": "level",
+        },
+    ]
+    manifest = tmp_path / "m.json"
+    manifest.write_text(json.dumps({"photos": entries}), encoding="utf-8")
+
+    class LoadedError(Exception):
+        pass
+
+    def stub(data: list[dict[str, object]], use_exif: bool, **_: object) -> None:
+        raise LoadedError([str(t["name"]) for t in data])
+
+    monkeypatch.setattr(vp_real, "run", stub)
+    args = ["--drive-photos", str(photos), "--street-photos", str(manifest)]
+    args += ["--out", str(tmp_path / "out")]
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", SET])
+    assert got.value.args[0] == [f"{SET}/looking-up/u.jpg"]
+    with pytest.raises(LoadedError) as got:
+        vp_real.main([*args, "--sets", "street-photos-held-out-3"])
+    assert got.value.args[0] == ["street-photos-held-out-3/level/v.jpg"]
