@@ -56,8 +56,12 @@
 #   LycheeOrg/Lychee, albert-cwkuo/GT-CS6476-Fall2017, asethi2/CS4476, bojunyang24/CS6476,
 #   drewnoakes/metadata-extractor-images, elizazhi/computational-photography,
 #   jingdao/Computational-Photography, muhabgadir/CS194-26, kernelmurton/prnu,
-#   Rwik2000/Panorama-Stitching, rzhu9/Computational-Photography, stevenfluo/mosaics
-#                                    29 compact, DSLR and phone photos (batch 10, set
+#   Rwik2000/Panorama-Stitching, rzhu9/Computational-Photography, stevenfluo/mosaics,
+#   Darfune/ORB-Image-Stitching, Derrick-M99/panorama-stitching-algorithms,
+#   ImageStitching/Image-Stitching, SomeoneDistant/Panoramic-Image-Stitching,
+#   cml391/computational-photography, maryamdarei/Computational-Photography,
+#   seu-hrzhang/image-stitching
+#                                    40 compact, DSLR and phone photos (batch 10, set
 #                                    street-photos-held-out-4, into street-photos-held-out-4/):
 #                                    test data, course data and SUN-database scene photos,
 #                                    no licence given for the photos, so kept out

@@ -90,7 +90,7 @@ The photos (none of them is in this repository; their licences keep them out):
     Batch 9 (stop 40): a further fresh batch held out whole in the same way (files under
     ``street-photos-held-out-3/``), phones first, to be measured once; summarised by view.
 ``street-photos-held-out-4`` (only when ``--sets`` names it)
-    Batch 10 (stop 41): 29 more photos no one has run ``camloc vp`` on, held out whole
+    Batch 10 (stop 41): 40 more photos no one has run ``camloc vp`` on, held out whole
     (files under ``street-photos-held-out-4/``): compacts, DSLRs and phones (a Galaxy S8's
     in-camera 1:1 mode at 1.0 times the side), to be measured once; summarised by view.
     Eight of them carry a lens focal length but no 35 mm tag and no focal-plane
