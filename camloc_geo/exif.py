@@ -42,7 +42,7 @@ Each of these the photo's tags give is read:
     ``f35 * longer_side_px * frame_diagonal / frame_width / 43.27``. Where it is not known,
     a photo 16:10 or wider reads the tag both ways (on its own diagonal and on the 4:3
     frame, or 3:2 where the tag's frame is 15 mm across or more) and takes their equal
-    mixture, its sigma covering both (about 6 %), noted in ``ExifFocal.warnings``.
+    mixture, its sigma covering both (about 6 %), said in ``ExifFocal.notes`` (and the log).
 
 How they combine
 ----------------
@@ -54,7 +54,8 @@ combined sigma from it (``|log(f_a / f_b)| > 2 sqrt(s_a^2 + s_b^2)``), the tags 
 each other and the photo does not say which is right: the prior is the equal mixture of the
 first reading and the farthest one (their geometric mean, sigma
 ``sqrt((s_a^2 + s_b^2) / 2 + (log(f_a / f_b) / 2)^2)``, so that it covers both), named
-``exif-conflict``, with a warning naming both (logged, and in ``ExifFocal.warnings``).
+``exif-conflict``, with a warning naming both (logged, and in ``ExifFocal.warnings``, which
+``detect_vanishing_points(use_exif=True)`` puts first in the result's ``warnings``).
 Readings that agree leave the first reading and its sigma as they are (they are not
 independent: both rest on the same ``FocalLength``).
 
@@ -161,8 +162,11 @@ class ExifFocal:
     readings
         Every reading the tags gave, ``(source, focal_px, sigma_rel)``, the one used first.
     warnings
-        What a user should know about the reading (a conflict, a 16:9 photo's tag read
-        two ways), in words.
+        Readings that contradict each other (``exif-conflict``), in words: what a user should
+        act on (give the focal length if it is known).
+    notes
+        How the tags were read where it is not the plain rule (a 16:9 photo's tag read on
+        its sensor's 4:3 frame, or both ways; a table reading left out), in words.
     """
 
     focal_px: float
@@ -170,6 +174,7 @@ class ExifFocal:
     source: str
     readings: tuple[tuple[str, float, float], ...] = ()
     warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 def _num(v: Any) -> float | None:
@@ -434,7 +439,7 @@ def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal
     if not far:
         for note in notes:
             log.info("%s: %s", name, note)
-        return ExifFocal(first.focal_px, first.sigma_rel, first.source, table, tuple(notes))
+        return ExifFocal(first.focal_px, first.sigma_rel, first.source, table, (), tuple(notes))
     other = max(far, key=gap)
     d = math.log(other.focal_px / first.focal_px)
     f_mix = first.focal_px * math.exp(0.5 * d)
@@ -446,7 +451,9 @@ def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal
         "(exif-conflict); give --focal-px if it is known"
     )
     log.warning("%s: %s", name, msg)
-    return ExifFocal(f_mix, sigma, "exif-conflict", table, (*notes, msg))
+    for note in notes:
+        log.info("%s: %s", name, note)
+    return ExifFocal(f_mix, sigma, "exif-conflict", table, (msg,), tuple(notes))
 
 
 def _readings(

@@ -190,7 +190,8 @@ def test_a_16_9_photo_of_a_4_3_sensor_reads_the_tag_on_the_4_3_frame() -> None:
     tag = {s: f for s, f, _ in ex.readings}["exif-35mm"]
     assert tag == pytest.approx(29 * w * 1.25 / FULL_FRAME_DIAGONAL_MM)
     assert tag / ex.focal_px == pytest.approx(1.0, abs=0.02)
-    assert any("4:3 frame" in n for n in ex.warnings)
+    assert any("4:3 frame" in n for n in ex.notes)
+    assert ex.warnings == ()
 
 
 def test_a_16_9_photo_of_an_unknown_sensor_reads_the_tag_both_ways() -> None:
@@ -204,7 +205,8 @@ def test_a_16_9_photo_of_an_unknown_sensor_reads_the_tag_both_ways() -> None:
     assert ex.focal_px == pytest.approx(math.sqrt(f_own * f_43))
     assert ex.sigma_rel == pytest.approx(math.hypot(SIGMA_35MM, 0.5 * math.log(f_43 / f_own)))
     assert ex.sigma_rel > 0.055
-    assert any("4:3 frame" in n for n in ex.warnings)
+    assert any("4:3 frame" in n for n in ex.notes)
+    assert ex.warnings == ()
     # a 4:3 photo's tag is read on its own diagonal, as before
     ex43 = focal_from_tags(tags, 1600, 1200)
     assert ex43 is not None
@@ -240,3 +242,23 @@ def test_the_bundled_table_is_attributed() -> None:
     assert "BSD 3-clause" in notice
     assert "ETH Zurich and UNC Chapel Hill" in notice
     assert "Camera Sensor Size Database authors" in notice  # openMVG's MIT notice
+
+
+def test_the_conflict_reaches_the_vanishing_point_result(tmp_path: Path) -> None:
+    # detect_vanishing_points(use_exif=True) names the conflict in focal_source and puts its
+    # warning first among the result's warnings (the JSON's, not only the log)
+    from test_autovp_failure_modes import corner_segments
+
+    from camloc_geo.autovp import detect_vanishing_points
+
+    segs, (w, h) = corner_segments(0, 0.0, seed=0)  # a corner seen at 700 px
+    f_lens_mm = round(0.9 * 700.0 / max(w, h) * 4.54, 2)  # 0.9 x on the iPhone 4's sensor
+    f35 = round(1.12 * 700.0 * FULL_FRAME_DIAGONAL_MM / math.hypot(w, h))  # 1.12 x
+    tags = {FOCAL: f_lens_mm, F35: f35, MAKE: "Apple", MODEL: "iPhone 4"}
+    p = _jpeg(tmp_path / "corner.jpg", (w, h), tags)
+    res = detect_vanishing_points(p, segments=segs, use_exif=True)
+    assert res.focal_source == "exif-conflict"
+    assert res.warnings[0].startswith("the EXIF tags disagree")
+    assert abs(math.log(res.focal_px / 700.0)) < 2.0 * res.focal_std_rel
+    plain = detect_vanishing_points(p, segments=segs, use_exif=False)
+    assert not any("EXIF tags" in x for x in plain.warnings)
