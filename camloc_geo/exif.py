@@ -25,11 +25,13 @@ Each of these the photo's tags give is read:
     CORPORATION`` + ``NIKON D40``, ``SAMSUNG-SM-N900A``); a maker's company name
     (``CASIO COMPUTER CO.,LTD.``, ``EASTMAN KODAK COMPANY``) finds its make. Only an exact
     model matches (after a trailing ``ZOOM DIGITAL CAMERA`` or ``DIGITAL CAMERA`` is
-    dropped): an unknown model gives no reading (logged), and so does one the bundled table
-    gives two widths for (more than 2 % apart; logged as a warning), or whose widths are for
-    other aspect ratios than the photo's (a multi-aspect sensor's rows, ``4:3``, ``3:2``,
-    ``16:9``, are the only ones used for it). A near-square photo (narrower than 4:3)
-    gets no table reading: its longer side may be the sensor's height.
+    dropped, or with the maker's series name the table writes before some models and EXIF
+    does not: ``DMC-TZ2`` is the table's ``lumixdmctz2``): an unknown model gives no
+    reading (logged), and so does one the bundled table gives two widths for (more than
+    2 % apart; logged as a warning), or whose widths are for other aspect ratios than the
+    photo's (a multi-aspect sensor's rows, ``4:3``, ``3:2``, ``16:9``, are the only ones
+    used for it). A near-square photo (narrower than 4:3) gets no table reading: its
+    longer side may be the sensor's height.
 ``exif-35mm``
     ``FocalLengthIn35mmFilm`` (tag 0xA405). The CIPA/EXIF definition matches the angle of
     view of the diagonal, so ``focal_px = f35 * diagonal_px / 43.27``. The tag is an
@@ -144,6 +146,20 @@ _MAKE_ALIASES = {
 }
 #: What some makers append to the model in EXIF and the table leaves out (squashed).
 _MODEL_SUFFIXES = ("zoomdigitalcamera", "digitalcamera")
+#: Series names the table puts before a model where the camera's EXIF ``Model`` may not
+#: (``DMC-TZ2`` is the table's ``lumixdmctz2``, ``EX-Z850`` its ``exilimexz850``).
+_MODEL_SERIES = {
+    "panasonic": ("lumix",),
+    "casio": ("exilim",),
+    "sony": ("alpha", "cybershot"),
+    "kodak": ("easyshare",),
+    "pentax": ("optio",),
+    "fujifilm": ("finepix",),
+    "nikon": ("coolpix",),
+    "canon": ("powershot",),
+    "ricoh": ("caplio",),
+    "samsung": ("digimax",),
+}
 
 
 @dataclass(frozen=True)
@@ -319,7 +335,12 @@ def sensor_width_mm(
     table = _bundled_widths()
     makes = _table_makes(make, table)
     keys = _model_keys(make, model, makes)
-    hits = [hit for m in makes for k in keys for hit in table[m].get(k, [])]
+    hits = [
+        hit
+        for m in makes
+        for k in keys | {series + k for series in _MODEL_SERIES.get(m, ()) for k in keys}
+        for hit in table[m].get(k, [])
+    ]
     if any(a is not None for _, a in hits):
         # a width per aspect ratio (a multi-aspect sensor): the photo's, and only that
         aspect = math.nan

@@ -57,13 +57,15 @@ def test_a_photo_with_only_focal_length_and_model_gets_the_bundled_width(tmp_pat
     [
         ("NIKON CORPORATION", "NIKON D40", 23.7),  # company name, make repeated in the model
         ("Canon", "Canon Canon EOS 5D", 35.8),  # the make written twice
-        ("CASIO COMPUTER CO.,LTD.", "EX-Z55 ", 5.72),  # hyphen, trailing space
+        ("CASIO COMPUTER CO.,LTD.", "EX-Z55 ", 5.735),  # exz55 5.72, exilimexz55 5.75: mean
         ("apple", "IPHONE  6", 4.89),  # case, double space
         ("Apple\x00", "iPhone 6\x00", 4.89),  # NUL-padded strings
-        ("EASTMAN KODAK COMPANY", "KODAK CX6330 ZOOM DIGITAL CAMERA", 5.25),  # maker's suffix
+        ("EASTMAN KODAK COMPANY", "KODAK EASYSHARE C875 ZOOM DIGITAL CAMERA", 7.11),  # suffix
         ("SAMSUNG", "SAMSUNG-Galaxy-Note8", 5.72),
         ("LG Electronics", "Nexus 5", 4.54),  # table make "lge"
         ("Apple", "iPhone SE (2nd generation)", 4.89),
+        ("Panasonic", "DMC-TZ2", 6.08),  # the table's "lumixdmctz2": series name added
+        ("CASIO COMPUTER CO.,LTD.", "EX-Z850   ", 7.11),  # the table's "exilimexz850"
     ],
 )
 def test_make_and_model_variants_match(make: str, model: str, width_mm: float) -> None:
@@ -221,14 +223,30 @@ def test_a_near_square_photo_gets_no_table_reading() -> None:
     assert focal_from_tags(tags, 3264, 2448) is not None
 
 
-def test_a_wrong_table_width_is_a_conflict_not_a_prior() -> None:
-    # the bundled table's Panasonic DMC-LX3 width (6.51 mm) puts 5.1 mm at 0.78 x the
-    # longer side; its 24 mm tag says 0.67: neither is taken alone
+def test_a_camera_the_table_lists_twice_gets_the_tag_alone(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    # COLMAP's table lists the Panasonic DMC-LX3 as "dmclx3" (6.51 mm) and as
+    # "lumixdmclx3" (7.85 mm): no width is taken, the 24 mm tag decides
     tags = {FOCAL: 5.1, F35: 24, MAKE: "Panasonic", MODEL: "DMC-LX3"}
     ex = focal_from_tags(tags, 3776, 2520)
     assert ex is not None
+    assert ex.source == "exif-35mm"
+    assert ex.focal_px == pytest.approx(24 * math.hypot(3776, 2520) / FULL_FRAME_DIAGONAL_MM)
+    assert "ambiguous in the sensor table (6.51, 7.85 mm)" in caplog.text
+
+
+def test_a_wrong_table_width_is_a_conflict_not_a_prior(tmp_path: Path) -> None:
+    # a user's table with the LX3's wrong 6.51 mm puts 5.1 mm at 0.78 x the longer side;
+    # its 24 mm tag says 0.67: neither is taken alone
+    db = tmp_path / "sensors.txt"
+    db.write_text("Panasonic DMC-LX3;6.51\n", encoding="utf-8")
+    tags = {FOCAL: 5.1, F35: 24, MAKE: "Panasonic", MODEL: "DMC-LX3"}
+    ex = focal_from_tags(tags, 3776, 2520, sensor_db=str(db))
+    assert ex is not None
     assert ex.source == "exif-conflict"
     assert ex.sigma_rel > 0.08
+    assert [r[0] for r in ex.readings] == ["exif-sensor-table", "exif-35mm"]
 
 
 def test_the_bundled_table_is_attributed() -> None:
