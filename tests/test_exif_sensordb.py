@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import pytest
+from test_exif import _jpeg  # a grey JPEG with chosen EXIF tags (Make/Model in IFD0)
 
 from camloc_geo.exif import (
     FULL_FRAME_DIAGONAL_MM,
@@ -17,7 +18,7 @@ from camloc_geo.exif import (
     sensor_width_mm,
 )
 
-PIL_Image = pytest.importorskip("PIL.Image")
+pytest.importorskip("PIL.Image")
 
 FOCAL, F35, MAKE, MODEL = 0x920A, 0xA405, 0x010F, 0x0110
 
@@ -25,20 +26,6 @@ FOCAL, F35, MAKE, MODEL = 0x920A, 0xA405, 0x010F, 0x0110
 @pytest.fixture(autouse=True)
 def _no_user_table(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("CAMLOC_SENSOR_DB", raising=False)
-
-
-def _jpeg(path: Path, size: tuple[int, int], tags: dict[int, object]) -> Path:
-    """A grey JPEG whose EXIF carries ``tags`` (Make/Model in IFD0, the rest in the EXIF IFD)."""
-    im = PIL_Image.new("RGB", size, (128, 128, 128))
-    exif = PIL_Image.Exif()
-    sub = exif.get_ifd(0x8769)
-    for k, v in tags.items():
-        if k in (MAKE, MODEL):
-            exif[k] = v
-        else:
-            sub[k] = v
-    im.save(path, exif=exif)
-    return path
 
 
 def test_a_photo_with_only_focal_length_and_model_gets_the_bundled_width(tmp_path: Path) -> None:
