@@ -615,7 +615,9 @@ def test_real_photo_with_exif_and_barrel_distortion() -> None:
     distortion is found."""
     f_true = float(np.loadtxt(SCEAUX / "K.txt")[0, 0])
     res = detect_vanishing_points(str(SCEAUX / "100_7100.JPG"), use_exif=True)
-    assert res.focal_source == "exif-35mm"
+    # the Kodak Z612 is the bundled table's EasyShare Z612 since stop 41 (its lens over the
+    # table's width; the 35 mm tag agrees within the sigmas)
+    assert res.focal_source == "exif-sensor-table"
     assert abs(res.focal_px - f_true) / f_true < 0.10
     assert res.distortion < 0.0
     assert abs(res.distortion) > 2 * res.distortion_std
