@@ -227,7 +227,10 @@ def _bundled_widths() -> dict[str, dict[str, list[tuple[float, float | None]]]]:
     """The bundled table: make -> model -> ``[(width_mm, aspect or None), ...]``."""
     table: dict[str, dict[str, list[tuple[float, float | None]]]] = {}
     try:
-        text = resources.files("camloc_geo").joinpath(*BUNDLED_SENSOR_TABLE).read_text("utf-8")
+        ref = resources.files("camloc_geo")
+        for part in BUNDLED_SENSOR_TABLE:  # one part a call: Python 3.10's Traversable
+            ref = ref / part
+        text = ref.read_text("utf-8")
     except OSError as exc:  # pragma: no cover - package data missing from an install
         log.warning("bundled sensor-width table not read: %s", exc)
         return table

@@ -239,7 +239,7 @@ def test_a_wrong_table_width_is_a_conflict_not_a_prior(tmp_path: Path) -> None:
 def test_the_bundled_table_is_attributed() -> None:
     from importlib import resources
 
-    folder = resources.files("camloc_geo").joinpath("data", "sensor_widths")
+    folder = resources.files("camloc_geo") / "data" / "sensor_widths"
     csv_head = folder.joinpath("sensor_widths.csv").read_text("utf-8")[:400]
     notice = folder.joinpath("NOTICE.md").read_text("utf-8")
     assert "5d968cf38aa2574fd284b0dc86c3d58d124940b3" in csv_head
