@@ -267,3 +267,38 @@ def test_the_conflict_reaches_the_vanishing_point_result(tmp_path: Path) -> None
     assert abs(math.log(res.focal_px / 700.0)) < 2.0 * res.focal_std_rel
     plain = detect_vanishing_points(p, segments=segs, use_exif=False)
     assert not any("EXIF tags" in x for x in plain.warnings)
+
+
+def test_the_converter_reads_colmaps_table() -> None:
+    # data/sensor_widths/from_colmap.py: per-aspect models split, a model with a comma
+    # quoted, a repeated row kept once
+    import csv
+    import importlib.util
+
+    path = Path(__file__).parents[1] / "data" / "sensor_widths" / "from_colmap.py"
+    spec = importlib.util.spec_from_file_location("from_colmap", path)
+    assert spec is not None
+    assert spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    specs_cc = """
+    {
+      auto& make_specs = specs["konica-minolta"];
+      make_specs.emplace_back("dimage7", 8.8000f);
+      make_specs.emplace_back("dimage7", 8.8000f);
+    }
+    {
+      auto& make_specs = specs["apple"];
+      make_specs.emplace_back("iphone4,1", 4.5700f);
+      make_specs.emplace_back("powershotg7x(4:3)", 11.7700f);
+    }
+    """
+    text = mod.convert(specs_cc, "abc123")
+    assert "abc123" in text.splitlines()[1]
+    rows = list(csv.reader(ln for ln in text.splitlines() if not ln.startswith("#")))
+    assert rows == [
+        ["make", "model", "width_mm", "aspect"],
+        ["konicaminolta", "dimage7", "8.8", ""],
+        ["apple", "iphone4,1", "4.57", ""],
+        ["apple", "powershotg7x", "11.77", "4:3"],
+    ]
