@@ -311,9 +311,10 @@ def _stored_size(path: Path) -> tuple[int, int]:
 def exif_focal_truth(path: Path) -> tuple[Any, tuple[int, int]] | None:
     """The focal-length truth of a photo from its EXIF, and its stored size.
 
-    The focal length from the focal-plane resolution or a sensor table
-    (:func:`camloc_geo.exif.focal_from_tags` without ``FocalLengthIn35mmFilm``) is
-    preferred to the 35 mm tag (a whole number of millimetres, and the crop it assumes).
+    The focal length from the focal-plane resolution or the ``CAMLOC_SENSOR_DB`` table
+    (:func:`camloc_geo.exif.focal_from_tags` without ``FocalLengthIn35mmFilm`` and without
+    the bundled table the EXIF prior reads) is preferred to the 35 mm tag on the photo's
+    diagonal (a whole number of millimetres, and the crop it assumes).
 
     Parameters
     ----------
@@ -329,7 +330,7 @@ def exif_focal_truth(path: Path) -> tuple[Any, tuple[int, int]] | None:
     """
     from PIL import Image
 
-    from camloc_geo.exif import focal_from_exif, focal_from_tags
+    from camloc_geo.exif import FULL_FRAME_DIAGONAL_MM, ExifFocal, focal_from_tags
 
     try:
         with Image.open(path) as im:
@@ -340,7 +341,13 @@ def exif_focal_truth(path: Path) -> tuple[Any, tuple[int, int]] | None:
     except (OSError, ValueError, SyntaxError):
         return None
     no35 = {k: v for k, v in tags.items() if k != 0xA405}
-    ex = focal_from_tags(no35, w, h) or focal_from_exif(path)
+    # The camera's own tags only, as before the sensor table was bundled (stop 41): the
+    # prior reads that table, so a truth from it would grade the prior against itself.
+    ex = focal_from_tags(no35, w, h, bundled_table=False)
+    f35 = tags.get(0xA405)
+    if ex is None and isinstance(f35, (int, float)) and 8 <= f35 <= 2000:
+        # the 35 mm tag on the photo's own diagonal, not exif.py's frame reading
+        ex = ExifFocal(f35 * math.hypot(w, h) / FULL_FRAME_DIAGONAL_MM, 0.04, "exif-35mm")
     return None if ex is None else (ex, (w, h))
 
 

@@ -2426,7 +2426,9 @@ def detect_vanishing_points(
     use_exif
         When ``image`` is a path and neither ``focal_px`` nor ``focal_prior_px`` is
         given, read the focal length from the photo's EXIF (:mod:`camloc_geo.exif`) and
-        use it as the prior (``focal_source`` then names the EXIF source).
+        use it as the prior (``focal_source`` then names the EXIF source; where two EXIF
+        readings contradict each other, ``exif-conflict``, its warning comes first in
+        ``warnings``).
     bias_deg
         Systematic bias of segment directions (degrees) propagated into the focal
         length's standard deviation (see ``_systematic_logf_std``); default
@@ -2499,6 +2501,7 @@ def detect_vanishing_points(
             f"focal_prior_sigma_rel must be a positive number, got {focal_prior_sigma_rel!r}"
         )
     prior_from_exif = False
+    exif_warnings: tuple[str, ...] = ()  # EXIF readings that contradict each other
     if (
         use_exif
         and focal_px is None
@@ -2516,6 +2519,7 @@ def detect_vanishing_points(
                 ex.source,
             )
             log.info("focal length prior from EXIF (%s): %.1f px", ex.source, ex.focal_px)
+            exif_warnings = ex.warnings
     if principal_point is not None and not (
         np.shape(principal_point) == (2,) and np.all(np.isfinite(principal_point))
     ):
@@ -3080,6 +3084,7 @@ def detect_vanishing_points(
         n_ax = len(segs_px) - len(segs_photo)  # annotated axes are not distorted pixels
         result.segments = np.vstack([segs_px[:n_ax], segs_photo]) if n_ax else segs_photo
         result.distortion = float(distortion_k1)
+    result.warnings[:0] = exif_warnings
     return result
 
 

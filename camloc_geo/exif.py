@@ -2,48 +2,103 @@
 
 Read with Pillow (``PIL.Image.getexif``); nothing here touches the network.
 
-Sources, best first:
+Readings
+--------
+Each of these the photo's tags give is read:
 
-``exif-35mm``
-    ``FocalLengthIn35mmFilm`` (tag 0xA405). The CIPA/EXIF definition matches the angle of
-    view of the diagonal, so ``focal_px = f35 * diagonal_px / 43.27``. The tag is an
-    integer number of millimetres and ignores digital zoom and crops: relative sigma 4 %.
 ``exif-focal-plane``
     ``FocalLength`` (0x920A) with ``FocalPlaneXResolution`` (0xA20E) and its unit
     (0xA210), scaled by ``width / PixelXDimension`` when the photo was resized: sigma 5 %
     (some cameras write the resolution of a sensor crop).
 ``exif-sensor-table``
-    ``FocalLength`` with the sensor width of ``Make`` + ``Model`` in a sensor-width table:
-    the file named by ``CAMLOC_SENSOR_DB`` in the format of openMVG's maintained
-    ``sensor_width_camera_database.txt`` (``Make Model;width_mm`` a line; e.g.
-    https://github.com/openMVG/CameraSensorSizeDatabase). No table is bundled. Sigma 5 %.
+    ``FocalLength`` with the sensor width of ``Make`` + ``Model`` in a sensor-width table,
+    ``focal_px = FocalLength / width_mm * longer_side_px`` (the photo's longer side spans the
+    sensor's width: a 4:3 photo, or a 16:9 one cut from a 4:3 sensor): sigma 5 % (tables
+    give the nominal optical format, a few per cent off the active area). The table is the
+    file named by ``CAMLOC_SENSOR_DB`` where it has the camera (its lines ``Make Model;width_mm``
+    as in openMVG's ``sensor_width_camera_database.txt``, or ``Make,Model,width_mm`` as in
+    openMVG's ``sensor_database.csv``; its first matching line wins), else the bundled table,
+    ``camloc_geo/data/sensor_widths/sensor_widths.csv``: COLMAP's camera table (BSD 3-clause;
+    4400 cameras, phones to the iPhone 16; source commit and licence in the ``NOTICE.md``
+    beside it). Make and model are matched in lower case without spaces or hyphens, with a
+    maker's name the model repeats removed (``Canon`` + ``Canon EOS 5D``, ``NIKON
+    CORPORATION`` + ``NIKON D40``, ``SAMSUNG-SM-N900A``); a maker's company name
+    (``CASIO COMPUTER CO.,LTD.``, ``EASTMAN KODAK COMPANY``) finds its make. Only an exact
+    model matches (after a trailing ``ZOOM DIGITAL CAMERA`` or ``DIGITAL CAMERA`` is
+    dropped, or with the maker's series name the table writes before some models and EXIF
+    does not: ``DMC-TZ2`` is the table's ``lumixdmctz2``): an unknown model gives no
+    reading (logged), and so does one the bundled table gives two widths for (more than
+    2 % apart; logged as a warning), or whose widths are for other aspect ratios than the
+    photo's (a multi-aspect sensor's rows, ``4:3``, ``3:2``, ``16:9``, are the only ones
+    used for it). A near-square photo (narrower than 4:3) gets no table reading: its
+    longer side may be the sensor's height.
+``exif-35mm``
+    ``FocalLengthIn35mmFilm`` (tag 0xA405). The CIPA/EXIF definition matches the angle of
+    view of the diagonal, so ``focal_px = f35 * diagonal_px / 43.27``. The tag is an
+    integer number of millimetres and ignores digital zoom and crops: relative sigma 4 %.
+    Phones write it for the sensor's 4:3 frame also in their 16:9 mode, where the diagonal
+    rule reads it 8 % low (stop 40: Galaxy Note 3, S21 Ultra, Mi A1). Where the sensor's
+    width is known (either reading above), the tag's own crop factor tells the frame it was
+    written for (``43.27 * FocalLength / f35`` is that frame's diagonal in millimetres): a
+    photo wider than a 4:3 or 3:2 frame the tag fits (within 4 %) is read on that frame,
+    ``f35 * longer_side_px * frame_diagonal / frame_width / 43.27``. Where it is not known,
+    a photo 16:10 or wider reads the tag both ways (on its own diagonal and on the 4:3
+    frame, or 3:2 where the tag's frame is 15 mm across or more) and takes their equal
+    mixture, its sigma covering both (about 6 %), said in ``ExifFocal.notes`` (and the log).
+
+How they combine
+----------------
+The lens and the sensor come first: ``exif-focal-plane``, then ``exif-sensor-table``, then
+``exif-35mm`` (a figure the maker's firmware derives from the lens and a crop factor it
+assumes; stop 40 found it 8-19 % off on an iPhone 4 and 4S and a OnePlus 5T). The first
+reading is the prior; the others check it. Where one of them lies more than twice the
+combined sigma from it (``|log(f_a / f_b)| > 2 sqrt(s_a^2 + s_b^2)``), the tags contradict
+each other and the photo does not say which is right: the prior is the equal mixture of the
+first reading and the farthest one (their geometric mean, sigma
+``sqrt((s_a^2 + s_b^2) / 2 + (log(f_a / f_b) / 2)^2)``, so that it covers both), named
+``exif-conflict``, with a warning naming both (logged, and in ``ExifFocal.warnings``, which
+``detect_vanishing_points(use_exif=True)`` puts first in the result's ``warnings``).
+Readings that agree leave the first reading and its sigma as they are (they are not
+independent: both rest on the same ``FocalLength``).
 
 A focal length outside ``PLAUSIBLE_FOCAL_REL`` times the longer image side (the range the
 vanishing-point fit searches, :data:`camloc_geo._limits.FOCAL_BOUNDS_REL`) is a broken tag
-(``FocalLength`` 5000 mm on a phone, ``FocalLengthIn35mmFilm`` 2000): it is ignored with a
-warning, since as a prior it would pin the fit to the bound of that range.
+(``FocalLength`` 5000 mm on a phone, ``FocalLengthIn35mmFilm`` 2000): that reading is
+ignored with a warning, since as a prior it would pin the fit to the bound of that range.
 
 The sigmas are for the prior; the vanishing points may still pull the focal length away
 from it where they fix it well (see :func:`camloc_geo.autovp.detect_vanishing_points`).
 A tag can be wrong (a OnePlus 5T's 35 mm tag reads 12 % low): ``detect_vanishing_points``
 checks an EXIF focal length against the photo's own lines (``check_focal_prior``) and, where
 they disagree beyond their combined sigma, states both readings and warns.
+
+Limits: a phone's second and third cameras (telephoto, ultra-wide) write the phone's model
+with their own ``FocalLength``; a table has the main camera's sensor only, so such a photo's
+table reading is wrong, and shows as an ``exif-conflict`` with its 35 mm tag where the photo
+has one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
+whose tags imply 5.6-5.7 mm: 7 %, within the 2 sigmas that make a conflict). A 16:9 photo of
+a natively 16:9 sensor the table lacks (a Galaxy S5) gets the mixture, 4 % off its own
+diagonal's right reading. A near-square photo's 35 mm tag is read on its own diagonal (a 1:1
+crop of a 4:3 sensor reads it about 15 % low). ``DigitalZoomRatio`` is not applied.
 """
 
 from __future__ import annotations
 
+import csv
+import functools
 import logging
 import math
 import os
 import struct
 import warnings
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
 from camloc_geo._limits import FOCAL_BOUNDS_REL
 
-__all__ = ["ExifFocal", "focal_from_exif", "focal_from_tags"]
+__all__ = ["ExifFocal", "focal_from_exif", "focal_from_tags", "sensor_width_mm"]
 
 log = logging.getLogger(__name__)
 
@@ -67,6 +122,48 @@ PLAUSIBLE_FOCAL_REL = FOCAL_BOUNDS_REL
 F35_PLAUSIBLE_MM = (8.0, 2000.0)
 """A ``FocalLengthIn35mmFilm`` outside this is ignored (with a warning when nothing else gives
 the focal length): a fisheye's 8 mm to a 2000 mm telephoto."""
+SENSOR_WIDTH_PLAUSIBLE_MM = (1.0, 60.0)
+"""A sensor width outside this (a tiny phone sensor to medium format) is not used."""
+#: The bundled sensor-width table (package data; see NOTICE.md beside it).
+BUNDLED_SENSOR_TABLE = ("data", "sensor_widths", "sensor_widths.csv")
+#: Two widths of one camera further apart than this (relative) make its model ambiguous.
+TABLE_WIDTH_SPREAD = 0.02
+#: A table width given for an aspect ratio holds for photos within this of it (relative).
+_ASPECT_TOL = 0.03
+#: Frames a 35 mm tag may be written for besides the photo's own: diagonal / width.
+_FRAME_RATIOS = {"4:3": 1.25, "3:2": math.hypot(3.0, 2.0) / 3.0}
+#: How far (relative) the tag's own crop factor may be from a frame it is read on.
+_FRAME_TOL = 0.04
+#: A photo at least this wide (longer / shorter side) may be a crop of a 4:3 or 3:2 sensor.
+_WIDE_ASPECT = 1.6
+#: A photo narrower than this (near square) gets no sensor-table reading.
+_TABLE_MIN_ASPECT = 1.3
+#: A 35 mm tag whose frame is at least this wide (diagonal, mm) reads a wide photo on 3:2.
+_LARGE_SENSOR_DIAGONAL_MM = 15.0
+#: Makes whose EXIF name does not begin with, or contain, the table's name.
+_MAKE_ALIASES = {
+    "fujiphotofilm": "fujifilm",
+    "hewlettpackard": "hp",
+    "omdigitalsolutions": "omsystem",
+    "asahioptical": "pentax",
+    "generalimaging": "ge",
+}
+#: What some makers append to the model in EXIF and the table leaves out (squashed).
+_MODEL_SUFFIXES = ("zoomdigitalcamera", "digitalcamera")
+#: Series names the table puts before a model where the camera's EXIF ``Model`` may not
+#: (``DMC-TZ2`` is the table's ``lumixdmctz2``, ``EX-Z850`` its ``exilimexz850``).
+_MODEL_SERIES = {
+    "panasonic": ("lumix",),
+    "casio": ("exilim",),
+    "sony": ("alpha", "cybershot"),
+    "kodak": ("easyshare",),
+    "pentax": ("optio",),
+    "fujifilm": ("finepix",),
+    "nikon": ("coolpix",),
+    "canon": ("powershot",),
+    "ricoh": ("caplio",),
+    "samsung": ("digimax",),
+}
 
 
 @dataclass(frozen=True)
@@ -80,12 +177,24 @@ class ExifFocal:
     sigma_rel
         Relative standard deviation to give the prior.
     source
-        ``"exif-35mm"``, ``"exif-focal-plane"`` or ``"exif-sensor-table"``.
+        ``"exif-focal-plane"``, ``"exif-sensor-table"``, ``"exif-35mm"``, or
+        ``"exif-conflict"`` where two readings disagree (see the module's docstring).
+    readings
+        Every reading the tags gave, ``(source, focal_px, sigma_rel)``, the one used first.
+    warnings
+        Readings that contradict each other (``exif-conflict``), in words: what a user should
+        act on (give the focal length if it is known).
+    notes
+        How the tags were read where it is not the plain rule (a 16:9 photo's tag read on
+        its sensor's 4:3 frame, or both ways; a table reading left out), in words.
     """
 
     focal_px: float
     sigma_rel: float
     source: str
+    readings: tuple[tuple[str, float, float], ...] = ()
+    warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
 
 
 def _num(v: Any) -> float | None:
@@ -96,22 +205,183 @@ def _num(v: Any) -> float | None:
     return x if math.isfinite(x) and x > 0 else None
 
 
-def _sensor_width_mm(make: str, model: str, db_path: str | os.PathLike[str]) -> float | None:
-    """Sensor width from an openMVG-format table (``Make Model;width_mm``)."""
+def _text(v: Any) -> str:
+    if isinstance(v, bytes):
+        v = v.decode("latin-1", errors="replace")
+    return str(v).replace("\x00", " ").strip() if v is not None else ""
+
+
+def _squash(s: str) -> str:
+    """Lower case without white space or hyphens (COLMAP's key for make and model)."""
+    return "".join(s.lower().split()).replace("-", "")
+
+
+def _aspect_ratio(text: str) -> float | None:
+    a, sep, b = text.partition(":")
+    num, den = _num(a), _num(b)
+    return num / den if sep and num and den else None
+
+
+@functools.lru_cache(maxsize=1)
+def _bundled_widths() -> dict[str, dict[str, list[tuple[float, float | None]]]]:
+    """The bundled table: make -> model -> ``[(width_mm, aspect or None), ...]``."""
+    table: dict[str, dict[str, list[tuple[float, float | None]]]] = {}
+    try:
+        ref = resources.files("camloc_geo")
+        for part in BUNDLED_SENSOR_TABLE:  # one part a call: Python 3.10's Traversable
+            ref = ref / part
+        text = ref.read_text("utf-8")
+    except OSError as exc:  # pragma: no cover - package data missing from an install
+        log.warning("bundled sensor-width table not read: %s", exc)
+        return table
+    lines = [ln for ln in text.splitlines() if ln and not ln.startswith("#")]
+    for row in csv.DictReader(lines):
+        width = _num(row.get("width_mm"))
+        if width is None or not row.get("make") or not row.get("model"):
+            continue
+        aspect = _aspect_ratio(row.get("aspect") or "")
+        table.setdefault(row["make"], {}).setdefault(row["model"], []).append((width, aspect))
+    return table
+
+
+def _table_makes(make: str, makes: Any) -> set[str]:
+    """The table's makes an EXIF ``Make`` names (``NIKON CORPORATION`` -> ``nikon``)."""
+    sq = _squash(make)
+    if not sq:
+        return set()
+    found = {m for m in makes if sq.startswith(m) or (len(m) >= 4 and m in sq)}
+    found |= {m for alias, m in _MAKE_ALIASES.items() if alias in sq and m in makes}
+    return found
+
+
+def _model_keys(make: str, model: str, prefixes: set[str]) -> set[str]:
+    """``model`` squashed, and again with each maker's name it begins with removed."""
+    words = make.lower().replace(",", " ").split()
+    prefixes = {p for p in prefixes | set(words[:1]) if p}
+    keys = {_squash(model)}
+    todo = list(keys)
+    while todo:  # "Canon Canon EOS 5D" -> "canoncanoneos5d" -> "canoneos5d" -> "eos5d"
+        k = todo.pop()
+        for p in prefixes:
+            if k.startswith(p) and len(k) > len(p) and k[len(p) :] not in keys:
+                keys.add(k[len(p) :])
+                todo.append(k[len(p) :])
+    for k in list(keys):  # "KODAK CX6330 ZOOM DIGITAL CAMERA" -> "cx6330"
+        for suffix in _MODEL_SUFFIXES:
+            if k.endswith(suffix) and len(k) > len(suffix):
+                keys.add(k[: -len(suffix)])
+                break
+    return {k for k in keys if k}
+
+
+def _user_table_width(make: str, model: str, db_path: str | os.PathLike[str]) -> float | None:
+    """Sensor width from a user's table (``Make Model;width_mm`` or ``Make,Model,width_mm``)."""
     try:
         text = Path(db_path).read_text(encoding="utf-8", errors="replace")
     except OSError as exc:
         log.warning("CAMLOC_SENSOR_DB %s: cannot read (%s)", db_path, exc)
         return None
     make_l, model_l = make.strip().lower(), model.strip().lower()
-    keys = {model_l, f"{make_l} {model_l}"}
-    if model_l.startswith(make_l):
-        keys.add(model_l)
+    exact = {model_l, f"{make_l} {model_l}"}
+    keys = _model_keys(make, model, {_squash(make)}) | {_squash(make) + _squash(model)}
     for line in text.splitlines():
         name, sep, width = line.rpartition(";")
-        if sep and name.strip().lower() in keys:
-            return _num(width)
+        names = [name]
+        if not sep:  # openMVG's CSV: Make,Model,width_mm (its model may repeat the make)
+            parts = line.split(",")
+            if len(parts) < 3 or _num(parts[-1]) is None:
+                continue
+            names, width = [" ".join(parts[:-1]), ",".join(parts[1:-1])], parts[-1]
+        for n in names:
+            n_l = n.strip().lower()
+            if n_l in exact or _squash(n_l) in keys:
+                return _num(width)
     return None
+
+
+def sensor_width_mm(
+    make: str,
+    model: str,
+    size_px: tuple[int, int] | None = None,
+    sensor_db: str | None = None,
+    *,
+    bundled: bool = True,
+) -> tuple[float, str] | None:
+    """The sensor width of a camera, from ``CAMLOC_SENSOR_DB`` or the bundled table.
+
+    Parameters
+    ----------
+    make, model
+        The EXIF ``Make`` and ``Model`` as written (any case, spacing, repeated maker).
+    size_px
+        The photo's ``(width, height)``: picks the width a table gives per aspect ratio
+        (a camera whose photos of each aspect span a different part of its sensor).
+    sensor_db
+        Path of a user table; default ``CAMLOC_SENSOR_DB`` (an empty string: none).
+    bundled
+        Also look in the bundled table (COLMAP's) where the user's has no line. Where it
+        gives the camera a width per aspect ratio, only the photo's aspect counts (no
+        width without ``size_px``, or for an aspect it does not list).
+
+    Returns
+    -------
+    tuple or None
+        ``(width_mm, origin)``, origin ``"CAMLOC_SENSOR_DB"`` or ``"bundled table"``; None
+        for an unknown or ambiguous camera (logged).
+    """
+    make, model = _text(make), _text(model)
+    if not model:
+        return None
+    db = sensor_db if sensor_db is not None else os.environ.get("CAMLOC_SENSOR_DB")
+    if db:
+        w = _user_table_width(make, model, db)
+        if w is not None:
+            return w, "CAMLOC_SENSOR_DB"
+    if not bundled:
+        return None
+    table = _bundled_widths()
+    makes = _table_makes(make, table)
+    keys = _model_keys(make, model, makes)
+    hits = [
+        hit
+        for m in makes
+        for k in keys | {series + k for series in _MODEL_SERIES.get(m, ()) for k in keys}
+        for hit in table[m].get(k, [])
+    ]
+    if any(a is not None for _, a in hits):
+        # a width per aspect ratio (a multi-aspect sensor): the photo's, and only that
+        aspect = math.nan
+        if size_px is not None:
+            aspect = max(size_px) / max(min(size_px), 1)
+        hits = [
+            (w, a) for w, a in hits if a is not None and abs(math.log(aspect / a)) < _ASPECT_TOL
+        ]
+    widths = sorted({w for w, _ in hits})
+    if not widths:
+        log.info(
+            "sensor width of %r %r not in the sensor table%s: no sensor-table reading",
+            make,
+            model,
+            "" if makes else " (make unknown)",
+        )
+        return None
+    if widths[-1] / widths[0] - 1.0 > TABLE_WIDTH_SPREAD:
+        log.warning(
+            "sensor width of %r %r is ambiguous in the sensor table (%s mm): not used",
+            make,
+            model,
+            ", ".join(f"{w:g}" for w in widths),
+        )
+        return None
+    return sum(widths) / len(widths), "bundled table"
+
+
+@dataclass(frozen=True)
+class _Reading:
+    source: str
+    focal_px: float
+    sigma_rel: float
+    what: str  # in words, for a warning
 
 
 def focal_from_tags(
@@ -121,6 +391,7 @@ def focal_from_tags(
     sensor_db: str | None = None,
     *,
     name: str = "photo",
+    bundled_table: bool = True,
 ) -> ExifFocal | None:
     """Focal length in pixels from EXIF tags (tag number -> value).
 
@@ -132,9 +403,12 @@ def focal_from_tags(
         Size of the image as stored (the orientation does not matter: the diagonal and
         the longer side are used).
     sensor_db
-        Path of a sensor-width table; default: ``CAMLOC_SENSOR_DB``.
+        Path of a sensor-width table; default: ``CAMLOC_SENSOR_DB``. It takes precedence
+        over the bundled table.
     name
-        The photo, for the warning about an implausible focal length.
+        The photo, for the warnings.
+    bundled_table
+        Use the bundled sensor-width table where ``sensor_db`` has no line for the camera.
 
     Returns
     -------
@@ -142,10 +416,32 @@ def focal_from_tags(
         None when the tags do not give the focal length, or give one outside
         ``PLAUSIBLE_FOCAL_REL`` times the longer side (then with a warning).
     """
-    found = _focal_from_tags(tags, width_px, height_px, sensor_db)
-    if found is None:
+    readings, notes = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    lo, hi = PLAUSIBLE_FOCAL_REL
+    longer = max(width_px, height_px, 1)
+    kept = []
+    for r in readings:
+        rel = r.focal_px / longer
+        if lo <= rel <= hi:
+            kept.append(r)
+            continue
+        log.warning(
+            "%s: EXIF focal length ignored: %s gives %.0f px, %.2g times the image's longer "
+            "side (plausible: %g to %g)",
+            name,
+            r.source,
+            r.focal_px,
+            rel,
+            lo,
+            hi,
+        )
+    if not kept:
         f35 = _num(tags.get(_TAG_FOCAL_35MM))
-        if f35 is not None and f35 > 0.0 and not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+        if (
+            not readings
+            and f35 is not None
+            and not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]
+        ):
             # 0 is EXIF's "unknown"; anything else the photo does carry: say why it is not used
             log.warning(
                 "%s: EXIF focal length ignored: FocalLengthIn35mmFilm is %g mm (plausible: %g to "
@@ -155,62 +451,164 @@ def focal_from_tags(
                 *F35_PLAUSIBLE_MM,
             )
         return None
-    lo, hi = PLAUSIBLE_FOCAL_REL
-    rel = found.focal_px / max(width_px, height_px, 1)
-    if not lo <= rel <= hi:
-        log.warning(
-            "%s: EXIF focal length ignored: %s gives %.0f px, %.2g times the image's longer side "
-            "(plausible: %g to %g)",
-            name,
-            found.source,
-            found.focal_px,
-            rel,
-            lo,
-            hi,
-        )
-        return None
-    return found
+    return _combine(kept, notes, name)
 
 
-def _focal_from_tags(
-    tags: dict[int, Any], width_px: int, height_px: int, sensor_db: str | None
-) -> ExifFocal | None:
-    diag_px = math.hypot(width_px, height_px)
+def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal:
+    """The first reading, or the equal mixture of it and the farthest that disagrees."""
+    first = readings[0]
+    table = tuple((r.source, r.focal_px, r.sigma_rel) for r in readings)
+
+    def gap(r: _Reading) -> float:
+        return abs(math.log(r.focal_px / first.focal_px))
+
+    far = [r for r in readings[1:] if gap(r) > 2.0 * math.hypot(r.sigma_rel, first.sigma_rel)]
+    if not far:
+        for note in notes:
+            log.info("%s: %s", name, note)
+        return ExifFocal(first.focal_px, first.sigma_rel, first.source, table, (), tuple(notes))
+    other = max(far, key=gap)
+    d = math.log(other.focal_px / first.focal_px)
+    f_mix = first.focal_px * math.exp(0.5 * d)
+    sigma = math.sqrt(0.5 * (first.sigma_rel**2 + other.sigma_rel**2) + (0.5 * d) ** 2)
+    msg = (
+        f"the EXIF tags disagree: {first.what} gives {first.focal_px:.0f} px, {other.what} "
+        f"{other.focal_px:.0f} px ({100 * (math.exp(d) - 1):+.0f} %); which is right the "
+        f"tags do not say: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} % "
+        "(exif-conflict); give --focal-px if it is known"
+    )
+    log.warning("%s: %s", name, msg)
+    for note in notes:
+        log.info("%s: %s", name, note)
+    return ExifFocal(f_mix, sigma, "exif-conflict", table, (msg,), tuple(notes))
+
+
+def _readings(
+    tags: dict[int, Any],
+    width_px: int,
+    height_px: int,
+    sensor_db: str | None,
+    bundled: bool,
+) -> tuple[list[_Reading], list[str]]:
+    """Every reading the tags give, the lens and the sensor first, and notes in words."""
+    longer = float(max(width_px, height_px))
+    shorter = float(max(min(width_px, height_px), 1))
+    aspect = longer / shorter
+    own_ratio = math.hypot(width_px, height_px) / max(longer, 1.0)  # diagonal / longer side
+    out: list[_Reading] = []
+    notes: list[str] = []
+    width_mm: float | None = None  # the sensor width the photo's longer side spans
+    f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
+    lo_w, hi_w = SENSOR_WIDTH_PLAUSIBLE_MM
+    if f_mm is not None:
+        xres = _num(tags.get(_TAG_FP_XRES))
+        unit_mm = _FP_UNIT_MM.get(int(_num(tags.get(_TAG_FP_UNIT)) or 2))
+        if xres is not None and unit_mm is not None:
+            px_per_mm = xres / unit_mm
+            orig_w = _num(tags.get(_TAG_PIXEL_X))
+            orig_h = _num(tags.get(_TAG_PIXEL_Y))
+            scale = 1.0
+            if orig_w and orig_h:
+                # the resolution refers to the stored size at capture; undo a resize
+                scale = longer / max(orig_w, orig_h)
+            sensor_w = max(orig_w or width_px, orig_h or height_px) / px_per_mm
+            if lo_w <= sensor_w <= hi_w:
+                width_mm = sensor_w
+                out.append(
+                    _Reading(
+                        "exif-focal-plane",
+                        f_mm * px_per_mm * scale,
+                        SIGMA_FOCAL_PLANE,
+                        f"FocalLength {f_mm:g} mm on the focal-plane resolution's "
+                        f"{sensor_w:.2f} mm sensor",
+                    )
+                )
+        make, model = _text(tags.get(_TAG_MAKE)), _text(tags.get(_TAG_MODEL))
+        if model:
+            got = sensor_width_mm(make, model, (width_px, height_px), sensor_db, bundled=bundled)
+            if got is not None and lo_w <= got[0] <= hi_w:
+                sw, origin = got
+                if aspect < _TABLE_MIN_ASPECT:
+                    notes.append(
+                        f"no sensor-table reading: a {width_px}x{height_px} photo is narrower "
+                        "than 4:3, so its longer side need not span the sensor's width"
+                    )
+                else:
+                    width_mm = width_mm or sw
+                    out.append(
+                        _Reading(
+                            "exif-sensor-table",
+                            f_mm / sw * longer,
+                            SIGMA_SENSOR_TABLE,
+                            f"FocalLength {f_mm:g} mm on the {sw:g} mm sensor of "
+                            f"{make} {model} ({origin})",
+                        )
+                    )
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
     if f35 is not None and F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
-        return ExifFocal(f35 * diag_px / FULL_FRAME_DIAGONAL_MM, SIGMA_35MM, "exif-35mm")
-    f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
-    if f_mm is None:
-        return None
-    xres = _num(tags.get(_TAG_FP_XRES))
-    unit_mm = _FP_UNIT_MM.get(int(_num(tags.get(_TAG_FP_UNIT)) or 2))
-    if xres is not None and unit_mm is not None:
-        px_per_mm = xres / unit_mm
-        orig_w = _num(tags.get(_TAG_PIXEL_X))
-        orig_h = _num(tags.get(_TAG_PIXEL_Y))
-        scale = 1.0
-        if orig_w and orig_h:
-            # the resolution refers to the stored size at capture; undo a resize
-            scale = max(width_px, height_px) / max(orig_w, orig_h)
-        sensor_w = max(orig_w or width_px, orig_h or height_px) / px_per_mm
-        if 1.0 <= sensor_w <= 60.0:  # a plausible sensor: tiny phone to medium format
-            return ExifFocal(f_mm * px_per_mm * scale, SIGMA_FOCAL_PLANE, "exif-focal-plane")
-    db = sensor_db if sensor_db is not None else os.environ.get("CAMLOC_SENSOR_DB")
-    make, model = tags.get(_TAG_MAKE), tags.get(_TAG_MODEL)
-    if db and make and model:
-        sw = _sensor_width_mm(str(make), str(model), db)
-        if sw:
-            return ExifFocal(
-                f_mm / sw * max(width_px, height_px), SIGMA_SENSOR_TABLE, "exif-sensor-table"
+        out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
+    return out, notes
+
+
+def _reading_35mm(
+    f35: float,
+    f_mm: float | None,
+    width_mm: float | None,
+    longer: float,
+    aspect: float,
+    own_ratio: float,
+    notes: list[str],
+) -> list[_Reading]:
+    """The 35 mm tag read on the frame it was written for (see the module's docstring)."""
+
+    def on(ratio: float) -> float:
+        return f35 * longer * ratio / FULL_FRAME_DIAGONAL_MM
+
+    what = f"FocalLengthIn35mmFilm {f35:g} mm"
+    frame_mm = FULL_FRAME_DIAGONAL_MM * f_mm / f35 if f_mm is not None else None
+    if width_mm is not None and frame_mm is not None:
+        k = frame_mm / width_mm  # the tag's frame: diagonal / width
+        cands = {"own": own_ratio, **_FRAME_RATIOS}
+        best = min(cands, key=lambda c: abs(math.log(k / cands[c])))
+        if (
+            best != "own"
+            and abs(math.log(k / cands[best])) < _FRAME_TOL
+            and cands[best] > own_ratio * 1.01
+            and abs(math.log(k / own_ratio)) > _FRAME_TOL
+        ):
+            notes.append(
+                f"the {f35:g} mm 35 mm tag is written for the sensor's {best} frame (its crop "
+                f"factor and the {width_mm:.2f} mm sensor say so), not for this photo's "
+                f"{aspect:.2f}:1 crop: read on that frame"
             )
-    return None
+            return [_Reading("exif-35mm", on(cands[best]), SIGMA_35MM, f"{what} ({best} frame)")]
+        return [_Reading("exif-35mm", on(own_ratio), SIGMA_35MM, what)]
+    if aspect >= _WIDE_ASPECT:
+        large = frame_mm is not None and frame_mm >= _LARGE_SENSOR_DIAGONAL_MM
+        name = "3:2" if large else "4:3"
+        f_a, f_b = on(own_ratio), on(_FRAME_RATIOS[name])
+        d = math.log(f_b / f_a)
+        sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
+        notes.append(
+            f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the "
+            f"sensor's {name} frame ({f_b:.0f} px) or for the photo's own ({f_a:.0f} px); "
+            f"the sensor's width is not known: the prior covers both, "
+            f"{math.sqrt(f_a * f_b):.0f} px +/- {100 * sigma:.0f} %"
+        )
+        return [_Reading("exif-35mm", math.sqrt(f_a * f_b), sigma, f"{what} (read two ways)")]
+    return [_Reading("exif-35mm", on(own_ratio), SIGMA_35MM, what)]
 
 
-def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) -> ExifFocal | None:
+def focal_from_exif(
+    path: str | os.PathLike[str],
+    sensor_db: str | None = None,
+    *,
+    bundled_table: bool = True,
+) -> ExifFocal | None:
     """Focal length in pixels from a photo's EXIF, or None (no EXIF, or not enough of it).
 
     Never raises on a file Pillow cannot read, and reads only regular files: the EXIF
-    is optional.
+    is optional. ``sensor_db`` and ``bundled_table`` as in :func:`focal_from_tags`.
     """
     try:
         from PIL import Image, UnidentifiedImageError
@@ -237,4 +635,6 @@ def focal_from_exif(path: str | os.PathLike[str], sensor_db: str | None = None) 
     ) as exc:
         log.debug("no EXIF read from %s: %s", path, exc)
         return None
-    return focal_from_tags(tags, width, height, sensor_db, name=str(path))
+    return focal_from_tags(
+        tags, width, height, sensor_db, name=str(path), bundled_table=bundled_table
+    )
