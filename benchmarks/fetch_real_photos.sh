@@ -53,6 +53,18 @@
 #                                    phone photos (batch 9, set street-photos-held-out-3,
 #                                    into street-photos-held-out-3/): course and test data,
 #                                    no licence given for the photos, so kept out
+#   LycheeOrg/Lychee, albert-cwkuo/GT-CS6476-Fall2017, asethi2/CS4476, bojunyang24/CS6476,
+#   drewnoakes/metadata-extractor-images, elizazhi/computational-photography,
+#   jingdao/Computational-Photography, muhabgadir/CS194-26, kernelmurton/prnu,
+#   Rwik2000/Panorama-Stitching, rzhu9/Computational-Photography, stevenfluo/mosaics,
+#   Darfune/ORB-Image-Stitching, Derrick-M99/panorama-stitching-algorithms,
+#   ImageStitching/Image-Stitching, SomeoneDistant/Panoramic-Image-Stitching,
+#   cml391/computational-photography, maryamdarei/Computational-Photography,
+#   seu-hrzhang/image-stitching
+#                                    40 compact, DSLR and phone photos (batch 10, set
+#                                    street-photos-held-out-4, into street-photos-held-out-4/):
+#                                    test data, course data and SUN-database scene photos,
+#                                    no licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -61,8 +73,8 @@
 # files are copied out one by one, blob by blob); with none of them, GitHub is tried.
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
 # "street-photos" for all the handheld street photos of benchmarks/street_photos.json, or
-# "street-photos-held-out-2" for batch 8 alone, "street-photos-held-out-3" for batch 9 alone)
-# to fetch fewer.
+# "street-photos-held-out-2" for batch 8 alone, "street-photos-held-out-3" for batch 9 alone,
+# "street-photos-held-out-4" for batch 10 alone) to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
@@ -115,7 +127,8 @@ done
 # The handheld street photos: single files of many repositories (some of them large), from
 # the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
 # "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder),
-# "street-photos-held-out-3" only batch 9 (either or both).
+# "street-photos-held-out-3" only batch 9, "street-photos-held-out-4" only batch 10 (any of
+# them, or several).
 street_only=""
 if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]]; then
   for s in $CAMLOC_PHOTO_SETS; do
@@ -153,7 +166,7 @@ for p in json.load(open(sys.argv[1]))["photos"]:
         continue
     print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' \
     "$manifest" "$street_only")
-  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/, street-photos-held-out-3/)"
+  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/ ... street-photos-held-out-4/)"
   [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
 fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"

@@ -8,8 +8,8 @@ Usage::
                                  (lund-dev, lund-held-out: one half of the Lund scenes;
                                   street-photos-dev, street-photos-held-out: one half of
                                   the handheld street photos; street-photos-held-out-2,
-                                  street-photos-held-out-3: the fresh batches 8 and 9,
-                                  each only when named;
+                                  street-photos-held-out-3, street-photos-held-out-4:
+                                  the fresh batches 8, 9 and 10, each only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
     python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
@@ -89,6 +89,13 @@ The photos (none of them is in this repository; their licences keep them out):
 ``street-photos-held-out-3`` (only when ``--sets`` names it)
     Batch 9 (stop 40): a further fresh batch held out whole in the same way (files under
     ``street-photos-held-out-3/``), phones first, to be measured once; summarised by view.
+``street-photos-held-out-4`` (only when ``--sets`` names it)
+    Batch 10 (stop 41): 40 more photos no one has run ``camloc vp`` on, held out whole
+    (files under ``street-photos-held-out-4/``): compacts, DSLRs and phones (a Galaxy S8's
+    in-camera 1:1 mode at 1.0 times the side), to be measured once; summarised by view.
+    Eight of them carry a lens focal length but no 35 mm tag and no focal-plane
+    resolution: their manifest ``truth`` (the lens over a sensor width of openMVG's table)
+    is their truth, with or without ``CAMLOC_SENSOR_DB``.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
     (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
@@ -293,6 +300,14 @@ def load_sceaux(root: Path) -> list[dict[str, Any]]:
 _PHOTO_SUFFIXES = {".jpg", ".jpeg"}
 
 
+def _stored_size(path: Path) -> tuple[int, int]:
+    """The photo's ``(width, height)`` as stored (before the EXIF orientation)."""
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return int(im.size[0]), int(im.size[1])
+
+
 def exif_focal_truth(path: Path) -> tuple[Any, tuple[int, int]] | None:
     """The focal-length truth of a photo from its EXIF, and its stored size.
 
@@ -389,6 +404,7 @@ SCENE_SETS = (  # and the fresh street photos by view
     "lund",
     "street-photos-held-out-2",
     "street-photos-held-out-3",
+    "street-photos-held-out-4",
 )
 #: The Lund scenes split by building, so that a change tuned on some is checked on others:
 #: the development half (looked at, its debug drawings read) and the held-out half (only
@@ -648,7 +664,7 @@ def load_drive_set(
 
 
 #: Handheld street photos (sets ``street-photos``, ``street-photos-dev``,
-#: ``street-photos-held-out``, ``street-photos-held-out-2``, ``street-photos-held-out-3``):
+#: ``street-photos-held-out``, ``street-photos-held-out-2`` ... ``street-photos-held-out-4``):
 #: file, sha256, source, half; truth from their EXIF, or from the lens focal length and the
 #: sensor's published width where the manifest gives a ``truth`` (see
 #: :func:`sensor_focal_truth_px`).
@@ -659,8 +675,9 @@ STREET_PHOTO_HALVES = ("dev", "held-out")
 #: Fresh held-out batches, each its own set (``street-photos-<half>``), loaded only when
 #: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
 #: one had run ``camloc vp`` on, measured once at the end of stop 39 (development since), and
-#: batch 9 (stop 40, ``held-out-3``), fresh again, to be measured once.
-STREET_PHOTO_FRESH_HALVES = ("held-out-2", "held-out-3")
+#: batch 9 (stop 40, ``held-out-3``), measured once at the end of stop 40, and batch 10
+#: (stop 41, ``held-out-4``), fresh again, to be measured once.
+STREET_PHOTO_FRESH_HALVES = ("held-out-2", "held-out-3", "held-out-4")
 
 
 def sensor_focal_truth_px(focal_mm: float, sensor_width_mm: float, size: tuple[int, int]) -> float:
@@ -741,7 +758,7 @@ def load_street_photos(
         :func:`sensor_focal_truth_px`).
     halves
         Which halves to load (``"dev"``, ``"held-out"``, ``"held-out-2"``,
-        ``"held-out-3"``).
+        ``"held-out-3"``, ``"held-out-4"``).
 
     Returns
     -------
@@ -752,7 +769,9 @@ def load_street_photos(
         carries it: ``street-photos-held-out-2/looking-up/IMG_8729.JPG``, so the run
         summarises each view; ``f_source`` is ``"exif-focal-mm+sensor-width"`` where the
         manifest gives the truth); a photo missing, with another content or without a usable
-        EXIF focal length is skipped and counted in the log.
+        EXIF focal length and no manifest ``truth`` is skipped and counted in the log (one
+        with a lens focal length alone, no 35 mm tag and no focal-plane resolution, loads
+        when the manifest gives its ``truth``).
     """
     import hashlib
 
@@ -770,11 +789,15 @@ def load_street_photos(
             changed += 1
             continue
         got = exif_focal_truth(path)
-        if got is None:
+        if got is None and not ph.get("truth"):
             no_exif += 1
             continue
-        ex, (w, h) = got
-        f_px, f_source = ex.focal_px, ex.source
+        if got is None:  # a lens focal length alone (no 35 mm tag, no focal-plane resolution)
+            w, h = _stored_size(path)
+            f_px, f_source = 0.0, ""
+        else:
+            ex, (w, h) = got
+            f_px, f_source = ex.focal_px, ex.source
         if ph.get("truth"):  # the lens and the sensor, where the 35 mm tag does not fit
             t = ph["truth"]
             f_px = sensor_focal_truth_px(float(t["focal_mm"]), float(t["sensor_width_mm"]), (w, h))

@@ -37,7 +37,11 @@ def test_manifest_halves_follow_the_fixed_rule() -> None:
         assert [p["half"] for p in ordered] == [
             "dev" if i % 2 == 0 else "held-out" for i in range(len(ordered))
         ]
-    fresh_folder = {8: "street-photos-held-out-2/", 9: "street-photos-held-out-3/"}
+    fresh_folder = {
+        8: "street-photos-held-out-2/",
+        9: "street-photos-held-out-3/",
+        10: "street-photos-held-out-4/",
+    }
     for p in photos:
         assert len(p["commit"]) == 40
         folder = "street-photos/" if p["batch"] < 8 else fresh_folder[p["batch"]]
