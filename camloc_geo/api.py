@@ -842,6 +842,8 @@ def vanishing_points(
         focal_px = focal[0]
     options = _exif_prior(image, focal_px, options)
     img = load_image(image)
+    if principal_point is not None:
+        principal_point = _principal_point_in(principal_point, img.shape[1], img.shape[0])
     mask = None
     if ignore_boxes_px:
         h, w = img.shape[:2]
@@ -871,6 +873,24 @@ def vanishing_points(
         axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes] or None,
         **options,
     )
+
+
+def _principal_point_in(point: object, width: int, height: int) -> tuple[float, float]:
+    """``point`` as two finite pixels inside the ``width`` x ``height`` image, or an
+    :class:`InputError` naming it.
+
+    A principal point far off the image was taken as given: ``--principal-point 1e9 3`` gave
+    a focal length at a stated 0.0 % with confidence 0.94 and no warning (stop 41, qa3).
+    """
+    px = _finite_numbers(point, 2, "principal_point must be two finite numbers x y")
+    x, y = px
+    if not (0.0 <= x <= width and 0.0 <= y <= height):
+        raise InputError(
+            f"principal_point ({x:g}, {y:g}) lies outside the {width}x{height} image; it is "
+            f"where the lens axis meets the photo, near its centre ({width / 2:g}, "
+            f"{height / 2:g})"
+        )
+    return x, y
 
 
 def _exif_prior(image: object, focal_px: float | None, options: dict[str, Any]) -> dict[str, Any]:

@@ -1,0 +1,65 @@
+"""Stop 41 (qa3): bad input through the real clients gets a clear error naming it.
+
+Each test failed before its fix.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from camloc_geo import api
+from camloc_geo._errors import InputError
+
+REPO = Path(__file__).resolve().parents[1]
+BALTIMORE = REPO / "sample_maps" / "baltimore.osm.pbf"
+
+
+def _camloc(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "camloc_geo.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+    )
+
+
+@pytest.mark.parametrize("point", [(1e9, 3.0), (-5.0, 10.0), (10.0, 601.0)])
+def test_vp_refuses_a_principal_point_off_the_image(point: tuple[float, float]) -> None:
+    """``camloc vp --principal-point 1e9 3`` answered a focal length at a stated 0.0 % with
+    confidence 0.94 and no warning."""
+    img = np.zeros((600, 800), np.uint8)
+    with pytest.raises(InputError, match=r"lies outside the 800x600 image"):
+        api.vanishing_points(img, principal_point=point)
+
+
+def test_vp_cli_names_the_principal_point(tmp_path: Path) -> None:
+    import cv2
+
+    path = tmp_path / "p.png"
+    assert cv2.imwrite(str(path), np.zeros((60, 80), np.uint8))
+    r = _camloc("vp", str(path), "--principal-point", "1e9", "3", cwd=tmp_path)
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr
+    assert "principal_point (1e+09, 3) lies outside the 80x60 image" in r.stderr
+
+
+@pytest.mark.parametrize("content", ["id,title\n", "id,title\n\n\n"])
+def test_geocode_refuses_a_list_without_rows(tmp_path: Path, content: str) -> None:
+    """A list with a header and no row printed an empty FeatureCollection, exit 0, where
+    ``camloc batch`` refuses it."""
+    lst = tmp_path / "cams.csv"
+    lst.write_text(content)
+    out = tmp_path / "out.geojson"
+    r = _camloc(
+        "geocode", "--osm", str(BALTIMORE), "--list", str(lst), "-o", str(out), cwd=tmp_path
+    )
+    assert r.returncode == 2, r.stderr
+    assert "holds no title (no row under its header)" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not out.exists()
