@@ -789,7 +789,7 @@ def parse_scene(data: Any, *, base_dir: str | Path | None = None) -> Scene:
     if not isinstance(data, dict):
         raise SceneError(f"a scene is a JSON object, got {type(data).__name__}")
     if "format" not in data:
-        raise SceneError(f"missing; expected {SCENE_FORMAT!r}", "format")
+        raise SceneError(f"missing; expected {SCENE_FORMAT!r}{_what_else(data)}", "format")
     known = set(Scene.model_fields)
     for key in data:
         if key not in known:
@@ -866,6 +866,26 @@ def _near_miss_fields(model: BaseModel, path: str, depth: int = 0) -> list[str]:
                 at = f"{path}{name}[{i}]." if isinstance(value, (list, tuple)) else f"{path}{name}."
                 out += _near_miss_fields(item, at, depth + 1)
     return out
+
+
+def _what_else(data: dict[str, Any]) -> str:
+    """What a JSON object without ``format`` looks like, when it is another camloc document.
+
+    ``camloc locate``'s GeoJSON or ``calibrate``'s output given where the scene belongs said
+    only "format: missing" (stop 41, qa3: the CLI and the service alike).
+    """
+    kind = data.get("type")
+    if kind in ("FeatureCollection", "Feature"):
+        return (
+            f": this is a GeoJSON {kind} (camloc locate's, geocode's or batch's output?), not "
+            "a scene; give the scene file the annotation page saved"
+        )
+    if "cam_from_world" in data and "focal_px" in data:
+        return (
+            ": this is camloc calibrate's output, not a scene; give the scene file it was "
+            "computed from"
+        )
+    return ""
 
 
 def _looks_swapped(loc: tuple[Any, ...], err: Any) -> bool:

@@ -63,3 +63,24 @@ def test_geocode_refuses_a_list_without_rows(tmp_path: Path, content: str) -> No
     assert "holds no title (no row under its header)" in r.stderr
     assert "Traceback" not in r.stderr
     assert not out.exists()
+
+
+def test_a_locate_output_given_as_a_scene_is_named(tmp_path: Path) -> None:
+    """``camloc calibrate cands.geojson`` (and ``POST /v1/calibrate`` with it) said only
+    "format: missing; expected 'camloc-scene/1'"."""
+    from camloc_geo.scene import SceneError, parse_scene
+
+    fc = {"type": "FeatureCollection", "features": []}
+    with pytest.raises(SceneError, match="this is a GeoJSON FeatureCollection"):
+        parse_scene(fc)
+    calibration = {"scene": "s", "focal_px": 1000.0, "cam_from_world": [[1, 0, 0, 0]]}
+    with pytest.raises(SceneError, match="this is camloc calibrate's output"):
+        parse_scene(calibration)
+    with pytest.raises(SceneError) as plain:
+        parse_scene({"a": 1})
+    assert str(plain.value) == "format: missing; expected 'camloc-scene/1'"
+    path = tmp_path / "cands.geojson"
+    path.write_text('{"type": "FeatureCollection", "features": []}')
+    r = _camloc("calibrate", str(path), cwd=tmp_path)
+    assert r.returncode == 2
+    assert "not a scene; give the scene file the annotation page saved" in r.stderr
