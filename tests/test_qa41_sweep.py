@@ -8,6 +8,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -84,3 +85,42 @@ def test_a_locate_output_given_as_a_scene_is_named(tmp_path: Path) -> None:
     r = _camloc("calibrate", str(path), cwd=tmp_path)
     assert r.returncode == 2
     assert "not a scene; give the scene file the annotation page saved" in r.stderr
+
+
+def _service_get(tmp_path: Path, path: str) -> Any:
+    import asyncio
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get(path)
+
+    try:
+        return asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+
+
+@pytest.mark.parametrize(
+    ("path", "said"),
+    [
+        ("/v1/jobs/nope", "job_id: 'nope' is not an id of this service (32 hex digits"),
+        ("/annotate/ABC", "task_id: 'ABC' is not an id of this service (32 hex digits"),
+        ("/v1/verdicts/summary/zz", "identity: 'zz' is not a page identity (16 hex digits"),
+    ],
+)
+def test_a_malformed_id_is_named_in_words(tmp_path: Path, path: str, said: str) -> None:
+    """A job, task or page id of the wrong shape was answered "String should match pattern
+    '^[0-9a-f]{32}$'": a regular expression for an analyst who pasted half an id."""
+    r = _service_get(tmp_path, path)
+    assert r.status_code == 422, r.text
+    message = r.json()["error"]["message"]
+    assert said in message
+    assert "pattern" not in message
