@@ -70,3 +70,50 @@ def test_a_located_cameras_title_junction_holds_no_share(baltimore: MapData) -> 
     assert all(c["score"] == 0.0 for c in title)  # was 1.0, above the best located one
     assert all(c["match_score"] == 1.0 for c in title)
     assert max(c["score"] for c in res.candidates) == located[0]["score"] == res.score
+
+
+def test_a_journal_written_before_reads_on_the_one_scale(tmp_path: Path) -> None:
+    """A resumed run rebuilds its GeoPackage and summary map from every record: a journal of
+    the old scale (no ``match_score``) would have mixed the two scales in one layer."""
+    from camloc_geo.batch._journal import Journal
+
+    def title(rank: int, score: float) -> dict:
+        return {"rank": rank, "source": "title", "score": score, "lat": 39.28, "lon": -76.59}
+
+    old = [
+        {  # an ambiguous title: two exact junctions
+            "row": 1,
+            "id": "a",
+            "status": "ambiguous",
+            "method": "title",
+            "score": 1.0,
+            "candidates": [title(1, 1.0), title(2, 1.0)],
+        },
+        {  # a located camera and its title's junction
+            "row": 2,
+            "id": "b",
+            "status": "located",
+            "method": "locate",
+            "score": 0.48,
+            "candidates": [
+                {"rank": 1, "source": "locate", "score": 0.48, "lat": 39.28, "lon": -76.59},
+                {"rank": 2, "source": "locate", "score": 0.52, "lat": 39.28, "lon": -76.59},
+                title(3, 0.97),
+            ],
+        },
+        {"row": 3, "id": "c", "status": "no_evidence", "candidates": []},
+    ]
+    j = Journal(tmp_path / "j.sqlite")
+    try:
+        j.write(old)
+        a, b, c = list(j.records())
+    finally:
+        j.close()
+    assert [x["score"] for x in a["candidates"]] == [0.5, 0.5]
+    assert [x["match_score"] for x in a["candidates"]] == [1.0, 1.0]
+    assert a["score"] == 0.5
+    assert a["match_score"] == 1.0
+    assert [x["score"] for x in b["candidates"]] == [0.48, 0.52, 0.0]
+    assert b["candidates"][2]["match_score"] == 0.97
+    assert b["score"] == 0.48
+    assert c == old[2]
