@@ -124,3 +124,45 @@ def test_a_malformed_id_is_named_in_words(tmp_path: Path, path: str, said: str) 
     message = r.json()["error"]["message"]
     assert said in message
     assert "pattern" not in message
+
+
+def _candidates_file(tmp_path: Path, score: object) -> Path:
+    import json
+
+    fc = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]},
+                "properties": {"kind": "candidate", "rank": 1, "score": score},
+            }
+        ],
+    }
+    path = tmp_path / "cands.geojson"
+    path.write_text(json.dumps(fc))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("score", "code", "said"),
+    [
+        ("high", 2, "feature 0: score 'high' is not a number from 0 to 1: skipped"),
+        ([0.3], 2, "feature 0: score [0.3] is not a number from 0 to 1: skipped"),
+        (None, 0, ""),  # as a candidate without a score
+        ("0.37", 0, ""),  # a GIS's text for the number
+    ],
+)
+def test_summary_map_of_a_candidate_with_a_bad_score(
+    tmp_path: Path, score: object, code: int, said: str
+) -> None:
+    """A candidate's score of text or null failed with 'TypeError: must be real number, not
+    str' (exit 1, an internal failure) or 'unsupported format string passed to
+    NoneType.__format__'."""
+    path = _candidates_file(tmp_path, score)
+    r = _camloc("summary-map", str(path), "-o", str(tmp_path / "m.html"), cwd=tmp_path)
+    assert r.returncode == code, r.stderr
+    assert "TypeError" not in r.stderr
+    assert said in r.stderr
+    if code == 0 and score == "0.37":
+        assert "0.37" in (tmp_path / "m.html").read_text()
