@@ -126,7 +126,7 @@ def test_a_malformed_id_is_named_in_words(tmp_path: Path, path: str, said: str) 
     assert "pattern" not in message
 
 
-def _candidates_file(tmp_path: Path, score: object) -> Path:
+def _candidates_file(tmp_path: Path, score: object, **more: object) -> Path:
     import json
 
     fc = {
@@ -135,7 +135,7 @@ def _candidates_file(tmp_path: Path, score: object) -> Path:
             {
                 "type": "Feature",
                 "geometry": {"type": "Point", "coordinates": [-76.59, 39.28]},
-                "properties": {"kind": "candidate", "rank": 1, "score": score},
+                "properties": {"kind": "candidate", "rank": 1, "score": score, **more},
             }
         ],
     }
@@ -166,3 +166,12 @@ def test_summary_map_of_a_candidate_with_a_bad_score(
     assert said in r.stderr
     if code == 0 and score == "0.37":
         assert "0.37" in (tmp_path / "m.html").read_text()
+
+
+def test_summary_map_of_a_candidate_with_a_heading_in_words(tmp_path: Path) -> None:
+    """``"heading_deg": "north"`` failed with 'TypeError: must be real number, not str'."""
+    path = _candidates_file(tmp_path, 0.5, heading_deg="north", height_m="7.5")
+    r = _camloc("summary-map", str(path), "-o", str(tmp_path / "m.html"), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "feature 0: heading_deg 'north' is not a number: drawn without it" in r.stderr
+    assert "height_m" not in r.stderr  # numeric text is read

@@ -127,6 +127,9 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
             if score != fp.get("score"):  # text a GIS wrote for the number ("0.37")
                 fp = {**fp, "score": score}
                 f = {**f, "properties": fp}
+        if fp.get("kind") == "candidate":
+            fp = _numbers_of(fp, path, i)
+            f = {**f, "properties": fp}
         if fp.get("kind") == "candidate" and not is_lat_lon(fp.get("lat"), fp.get("lon")):
             point = _point_of(f.get("geometry"))
             if point is not None:  # the feature's own Point (lat/lon columns dropped in
@@ -145,6 +148,48 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
         kept.append(f)
     scene_id = str(props.get("scene") or Path(path).stem)
     return scene_id, {**data, "properties": props, "features": kept}, skipped
+
+
+_NUMBER_FIELDS = (
+    "heading_deg",
+    "pitch_deg",
+    "roll_deg",
+    "height_m",
+    "sigma_m",
+    "focal_px",
+    "residual_m",
+)
+"""A candidate's numbers the page draws or prints besides its score and position."""
+
+
+def _numbers_of(props: dict[str, Any], path: str, index: int) -> dict[str, Any]:
+    """``props`` with numeric text read as numbers and other non-numbers left out (warned).
+
+    ``"heading_deg": "north"`` failed with "TypeError: must be real number, not str", exit 1
+    (stop 41, qa3); the page draws a candidate without a heading or height as it draws
+    ``locate``'s title-only ones.
+    """
+    out = dict(props)
+    for key in _NUMBER_FIELDS:
+        value = out.get(key)
+        if value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)):
+            if isinstance(value, float) and not math.isfinite(value):
+                out.pop(key)
+            continue
+        number = None
+        if isinstance(value, str):
+            try:
+                number = float(value.strip())
+            except ValueError:
+                number = None
+        if number is not None and math.isfinite(number):
+            out[key] = number
+            continue
+        log.warning(
+            "%s: feature %d: %s %r is not a number: drawn without it", path, index, key, value
+        )
+        out.pop(key)
+    return out
 
 
 def _score_of(value: Any) -> float | None:
