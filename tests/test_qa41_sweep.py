@@ -175,3 +175,46 @@ def test_summary_map_of_a_candidate_with_a_heading_in_words(tmp_path: Path) -> N
     assert r.returncode == 0, r.stderr
     assert "feature 0: heading_deg 'north' is not a number: drawn without it" in r.stderr
     assert "height_m" not in r.stderr  # numeric text is read
+
+
+def test_an_extract_copied_into_the_services_folder_serves_without_a_restart(
+    tmp_path: Path,
+) -> None:
+    """The service listed CAMLOC_MAP_DIR once, at start-up: an extract copied in later (as
+    its own error message asks the operator to do) served nothing until a restart."""
+    import asyncio
+    import shutil
+
+    import httpx
+
+    from camloc_geo.service import create_app
+    from camloc_geo.service.settings import Settings
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    shutil.copy(REPO / "data" / "osm" / "monaco.osm.pbf", maps)
+    app = create_app(Settings(data_dir=tmp_path / "d", map_dir=maps, workers=0))
+    params = {"lat": "39.2856", "lon": "-76.5935", "radius_m": "80"}
+
+    async def corners() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.get("/v1/corners", params=params)
+
+    async def health() -> dict[str, Any]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return (await client.get("/healthz")).json()
+
+    try:
+        before = asyncio.run(corners())
+        assert before.status_code == 422, before.text
+        assert before.json()["error"]["type"] == "map_data"
+        assert asyncio.run(health())["extracts"] == 1
+        shutil.copy(BALTIMORE, maps)
+        after = asyncio.run(corners())
+        assert after.status_code == 200, after.text
+        assert any(f["properties"].get("kind") == "intersection" for f in after.json()["features"])
+        assert asyncio.run(health())["extracts"] == 2
+    finally:
+        app.state.compute.shutdown()
