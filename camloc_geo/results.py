@@ -710,6 +710,7 @@ _JOB_FIELDS = (
     "uncertainty_m",
     "method",
     "match_status",
+    "match_score",
     "heading_deg",
     "height_m",
     "extract",

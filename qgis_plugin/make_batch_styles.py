@@ -26,15 +26,7 @@ _TYPES = {"int64": "int", "float64": "double", "bool": "bool", "object": "string
 
 def main() -> int:
     """Write the styles; 0 on success."""
-    from qgis.core import (
-        QgsApplication,
-        QgsProperty,
-        QgsSymbol,
-        QgsSymbolLayer,
-        QgsVectorLayer,
-        QgsWkbTypes,
-    )
-    from qgis.PyQt.QtGui import QColor
+    from qgis.core import QgsApplication, QgsVectorLayer
     from qgis.PyQt.QtXml import QDomDocument
 
     app = QgsApplication([], False)
@@ -43,50 +35,18 @@ def main() -> int:
 
     from camloc_geo.batch import _run
 
-    def candidates(layer: QgsVectorLayer, tie: str) -> None:  # style_list_candidates
-        no_tie = f"NOT ({tie})"
-        L._rules(
-            layer,
-            [
-                ("★ " + L.TIE_WORDS, tie, L._marker("#d7191c", "Star", 5.0)),
-                (
-                    "a camera's best candidate",
-                    no_tie + ' AND "rank" = 1',
-                    L._marker("#fdae61", "Circle", 3.2),
-                ),
-                ("other candidates", None, L._marker("#2c7bb6", "Circle", 2.2, 0.6)),
-            ],
-        )
-        L._label(layer, f'CASE WHEN "rank" > 1 OR {tie} THEN concat(\'#\', "rank") END', 1)
-
-    def cameras(layer: QgsVectorLayer) -> None:  # style_cameras, "id" for "camera_id"
-        L._rules(layer, [("camera placed", None, L._marker("#d7191c", "Triangle", 4.5))])
-        L._label(layer, '"id" || \' \' || "status"', priority=10, size=10)
-
-    def view_cones(layer: QgsVectorLayer) -> None:  # style_view_cones without "tie"
-        # Only the leading candidates' cones (the table has no tie column: a tied candidate
-        # has over a tenth of its camera's best score): every cone of every candidate, each
-        # with an opaque outline, drew one orange blob around a located camera (12 cones,
-        # scores down to 1e-22; seen on the desktop, session 40).
-        sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
-        sym.setColor(QColor(255, 190, 0, 70))
-        sl = sym.symbolLayer(0)
-        sl.setStrokeColor(QColor(180, 120, 0, 160))
-        sl.setDataDefinedProperty(
-            QgsSymbolLayer.PropertyFillColor,
-            QgsProperty.fromExpression(
-                'color_rgba(255, 190, 0, 25 + 90 * min(1, coalesce("score", 0) / 0.5))'
-            ),
-        )
-        leading = (
-            '"rank" = 1 OR coalesce("score", 0) >= 0.05 OR '
-            'coalesce("score", 0) * 10 > maximum("score", group_by:="id")'
-        )
-        L._rules(layer, [("view cone of a leading candidate (faded by score)", leading, sym)])
-
     # the batch's ties: "2,4", NULL without one; the job's: JSON text, "[2, 4]" or "[]"
     batch_tie = '"ambiguous_with" IS NOT NULL'
     job_tie = "coalesce(\"ambiguous_with\", '[]') NOT IN ('', '[]')"
+
+    # the plugin's styles themselves, given these layers' tie expressions and id column
+    # (session 41: this file drew its own copies; the cones' lacked the tie's red outline)
+    def cones(layer: QgsVectorLayer) -> None:
+        L.style_view_cones(layer, batch_tie)
+
+    def cameras(layer: QgsVectorLayer) -> None:
+        L.style_cameras(layer, id_field="id")
+
     job_cameras = {"id": "object", "status": "object", "title": "object", "score": "float64"}
     job_candidates = {
         "camera_id": "object",
@@ -96,10 +56,15 @@ def main() -> int:
     }
     jobs = [
         ("batch_cameras", "Point", _run._CAMERA_COLUMNS, cameras),
-        ("batch_candidates", "Point", _run._CANDIDATE_COLUMNS, lambda x: candidates(x, batch_tie)),
-        ("batch_view_cones", "MultiPolygon", _run._CONE_COLUMNS, view_cones),
+        (
+            "batch_candidates",
+            "Point",
+            _run._CANDIDATE_COLUMNS,
+            lambda x: L.style_list_candidates(x, batch_tie),
+        ),
+        ("batch_view_cones", "MultiPolygon", _run._CONE_COLUMNS, cones),
         ("job_cameras", "Point", job_cameras, cameras),
-        ("job_candidates", "Point", job_candidates, lambda x: candidates(x, job_tie)),
+        ("job_candidates", "Point", job_candidates, lambda x: L.style_list_candidates(x, job_tie)),
     ]
     OUT.mkdir(parents=True, exist_ok=True)
     for name, geometry, columns, style in jobs:

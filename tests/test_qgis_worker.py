@@ -140,6 +140,15 @@ def test_geocodelist_job_isolates_bad_rows(tmp_path):
     assert cams["f"]["properties"]["n_candidates"] == 0
     assert cams["a"]["properties"]["n_candidates"] >= 2
     assert res["layers"]["candidates"]["count"] >= 13
+    # one score scale (stop 41): a title-only camera's junction holds the whole share, its
+    # name match in match_score; a located camera's candidates share 1
+    d = cams["d"]["properties"]
+    assert d["score"] == 1.0
+    assert 0.0 < d["match_score"] <= 1.0
+    cands = [f["properties"] for f in _read(res["layers"]["candidates"])]
+    located = [c for c in cands if c["camera_id"] == "a" and c["source"] == "locate"]
+    assert sum(c["score"] for c in located) == pytest.approx(1.0)
+    assert all(c["match_score"] is None for c in located)
 
 
 def test_geocodelist_names_duplicate_camera_ids(tmp_path):

@@ -217,5 +217,43 @@ class Journal:
             if not rows:
                 return
             for _r, rec in rows:
-                yield json.loads(rec)
+                yield rescaled_title_scores(json.loads(rec))
             last = rows[-1][0]
+
+
+def rescaled_title_scores(record: dict[str, Any]) -> dict[str, Any]:
+    """A camera's record of a journal written before session 41, its title candidates'
+    scores put on the candidates' scale (as :mod:`camloc_geo.cameras` now writes them).
+
+    A title candidate's ``score`` was the name-match score (an ambiguous title's two
+    junctions 1.0 each; a located camera's title junction 1.0 beside its best 0.48); it is
+    now the candidate's share of the camera's evidence and the match score ``match_score``.
+    A resumed run rebuilds its GeoPackage and summary map from every record, old ones
+    included, so they are rescaled when read. Records that have ``match_score`` are returned
+    as they are.
+    """
+    cands = record.get("candidates") or []
+    title = [c for c in cands if isinstance(c, dict) and c.get("source") == "title"]
+    if not title or any("match_score" in c for c in title):
+        return record
+    from camloc_geo.cameras._camera import _share_title_scores
+
+    cands = [dict(c) if isinstance(c, dict) else c for c in cands]
+    title = [c for c in cands if isinstance(c, dict) and c.get("source") == "title"]
+    for c in title:
+        c["match_score"] = c.get("score")
+    out = {**record, "candidates": cands, "match_score": title[0]["match_score"]}
+    if any(isinstance(c, dict) and c.get("source") == "locate" for c in cands):
+        for c in title:
+            c["score"] = 0.0
+        return out
+    _share_title_scores(title)
+    if out.get("method") == "title":
+        out["score"] = cands[0]["score"] if isinstance(cands[0], dict) else out.get("score")
+        out["cones"] = [
+            {**k, "score": out["score"]}
+            if isinstance(k, dict) and k.get("source") == "title"
+            else k
+            for k in out.get("cones") or []
+        ]
+    return out

@@ -822,6 +822,7 @@ _CAMERA_COLUMNS: dict[str, str] = {
     "method": "object",
     "n_candidates": "int64",
     "match_status": "object",
+    "match_score": "float64",
     "names_read": "object",
     "names_matched": "object",
     "match_kinds": "object",
@@ -841,6 +842,7 @@ _CANDIDATE_COLUMNS: dict[str, str] = {
     "source": "object",
     "status": "object",
     "score": "float64",
+    "match_score": "float64",
     "lat": "float64",
     "lon": "float64",
     "uncertainty_m": "float64",
@@ -858,6 +860,7 @@ _CONE_COLUMNS = {
     "rank": "int64",
     "source": "object",
     "score": "float64",
+    "ambiguous_with": "object",
 }
 _ERROR_COLUMNS = {
     "row": "int64",
@@ -951,8 +954,15 @@ def _layers_of(
             ties = c.get("ambiguous_with") or []
             cands.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": _ranks_text(ties)})
             cand_xy.append((c.get("lon"), c.get("lat")))
+        # a cone's ties are its candidate's (the core's rule), for the one cone style's red
+        # outline and "leading" rule (``layers.style_view_cones``)
+        ties_of = {
+            (c.get("source"), c.get("rank")): c.get("ambiguous_with") or []
+            for c in r.get("candidates") or []
+        }
         for c in r.get("cones") or []:
-            cones.append({**c, "row": r["row"], "id": r["id"]})
+            tie_text = _ranks_text(ties_of.get((c.get("source"), c.get("rank")), []))
+            cones.append({**c, "row": r["row"], "id": r["id"], "ambiguous_with": tie_text})
             cone_g.append(Polygon(c["lonlat"]))
         for e in errors:
             errs.append({**e, "row": r["row"], "id": r["id"], "status": r["status"]})

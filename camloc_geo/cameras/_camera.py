@@ -113,7 +113,14 @@ class CameraResult:
     lat, lon
         The camera's point (None when not placed).
     score
-        The best candidate's score (locate: normalised over candidates; title: match score).
+        The best candidate's score: its share of the evidence over the camera's candidates
+        (they sum to 1), located or title alike. A title's places share it in proportion to
+        their name-match scores (since session 41: a title's candidates carried the match
+        score itself, on another scale: two exact matches summed to 2, and a located
+        camera's title junction at 1.0 outranked its best candidate's 0.48).
+    match_score
+        The title's best name-match score in [0, 1] (``geocode_title``'s ``score``: 1 for
+        exact names); None without a title match.
     uncertainty_m
         Radius of the point's uncertainty, metres (located: 1-sigma of the best candidate;
         title: the junction's size).
@@ -155,6 +162,7 @@ class CameraResult:
     names_read: list[str] = field(default_factory=list)
     names_matched: list[str] = field(default_factory=list)
     match_status: str | None = None
+    match_score: float | None = None
     match_kinds: list[str] = field(default_factory=list)
     view_text: str | None = None
     view_bearing_deg: float | None = None
@@ -257,12 +265,14 @@ def _cone(lat: float, lon: float, bearing_deg: float, half_deg: float) -> list[l
 
 
 def _match_candidate(match: Any, rank: int, extract: str | None) -> dict[str, Any]:
+    """A title match as a candidate; its ``score`` is set by :func:`_share_title_scores`."""
     inter = getattr(match, "intersection", None)
     return {
         "rank": rank,
         "source": "title",
         "status": match.status,
         "score": _finite(match.score),
+        "match_score": _finite(match.score),
         "lat": _finite(match.lat),
         "lon": _finite(match.lon),
         "uncertainty_m": _finite(match.uncertainty_m),
@@ -273,6 +283,20 @@ def _match_candidate(match: Any, rank: int, extract: str | None) -> dict[str, An
         "intersection": getattr(inter, "id", None),
         "extract": extract,
     }
+
+
+def _share_title_scores(cands: list[dict[str, Any]]) -> None:
+    """The title's candidates' ``score``: each place's share of the name-match scores.
+
+    The candidates' scale (shares summing to 1, as ``locate``'s are); ``match_score`` keeps
+    the name match. A candidate without a point (``not_found``) has no share.
+    """
+    placed = [c for c in cands if c.get("lat") is not None and (c.get("match_score") or 0.0) > 0.0]
+    total = sum(float(c["match_score"]) for c in placed)
+    for c in cands:
+        c["score"] = 0.0
+    for c in placed:
+        c["score"] = float(c["match_score"]) / total
 
 
 def _title_matches(row: CameraRow, m: MapData, res: CameraResult) -> tuple[list[Any], str | None]:
@@ -314,9 +338,11 @@ def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> 
     res.names_matched = [str(n) for n in (best.names_matched or [])]
     res.match_kinds = [str(k) for k in (best.match_kinds or [])]
     res.candidates = [_match_candidate(mt, k, extract) for k, mt in enumerate(matches, start=1)]
+    _share_title_scores(res.candidates)
     # a not_found match says why nothing was found: it is no candidate
     res.n_candidates = 0 if best.status == "not_found" else len(res.candidates)
-    res.score = _finite(best.score)
+    res.score = res.candidates[0]["score"]
+    res.match_score = _finite(best.score)
     status = best.status
     with_point = [mt for mt in matches if _finite(mt.lat) is not None]
     tie = status == "ambiguous" or (
@@ -485,9 +511,11 @@ def _locate(
                 "lonlat": [[round(float(a), 8), round(float(b), 8)] for a, b in ll],
             }
         )
-    # keep the title's matches after the located candidates
+    # keep the title's matches after the located candidates: the located ones share the
+    # evidence (the title's junction among it), so the title's places hold no share of their
+    # own (score 0; their name match stays in match_score)
     for k, tc in enumerate(title_cands, start=len(res.candidates) + 1):
-        res.candidates.append({**tc, "rank": k})
+        res.candidates.append({**tc, "rank": k, "score": 0.0})
     res.n_candidates = len(r.candidates)
     warnings = list(r.warnings) + list(r.calibration.warnings)
     if not r.candidates:
@@ -629,8 +657,10 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
             for one in mt:
                 k += 1
                 res.candidates.append(_match_candidate(one, k, name))
+        _share_title_scores(res.candidates)
         res.n_candidates = len(res.candidates)
-        res.score = _finite(placed[0][1][0].score)
+        res.score = res.candidates[0]["score"]
+        res.match_score = _finite(placed[0][1][0].score)
         return res.fail(
             "ambiguous", "the title matches in several extracts: " + ", ".join(names), "title"
         )

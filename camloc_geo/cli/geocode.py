@@ -148,6 +148,26 @@ def _rows(path: Path) -> Iterator[tuple[int, str | None, str, tuple[float, float
     return _data_rows(fh, reader, header, title_col)
 
 
+def _non_empty(rows: Iterator[_Row], path: Path) -> Iterator[_Row]:
+    """``rows``, or an :class:`InputError` when the list holds none (read before any output).
+
+    A list with a header and no row printed an empty FeatureCollection, exit 0, where
+    ``camloc batch`` refuses it (stop 41, qa3).
+    """
+    from camloc_geo._errors import InputError
+
+    first = next(rows, None)
+    if first is None:
+        raise InputError(
+            f"the list {path} holds no title (no row under its header); a list is CSV with a "
+            "header naming a title column, or GeoJSON"
+        )
+    return itertools.chain([first], rows)
+
+
+_Row = tuple[int, str | None, str, tuple[float, float] | None]
+
+
 def _geojson_rows(
     path: Path,
 ) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
@@ -325,7 +345,7 @@ def run(args: argparse.Namespace) -> int:
 
     paths = extract_paths(args.osm)
     out = json_path(args.output, inputs=[args.list, *paths], what="GeoJSON")
-    rows = _rows(Path(args.list)) if args.list else None
+    rows = _non_empty(_rows(Path(args.list)), Path(args.list)) if args.list else None
     maps = [whole_map(p) for p in paths]
 
     def matches_of(title: str, point: tuple[float, float] | None) -> list[dict[str, Any]]:

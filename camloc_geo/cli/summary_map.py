@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 from pathlib import Path
 from typing import Any
 
@@ -105,6 +106,30 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
             log.warning("%s: feature %d has no properties: skipped", path, i)
             skipped += 1
             continue
+        if fp.get("kind") == "candidate" and "score" in fp and fp["score"] is None:
+            # null: as a candidate without a score (drawn in the lowest score's colour); it
+            # failed with "unsupported format string passed to NoneType.__format__", exit 1
+            fp = {k: v for k, v in fp.items() if k != "score"}
+            f = {**f, "properties": fp}
+        if fp.get("kind") == "candidate" and "score" in fp:
+            score = _score_of(fp.get("score"))
+            if score is None:
+                # 'high', or a list: the page failed with "TypeError: must be real number,
+                # not str", exit 1 (stop 41, qa3)
+                log.warning(
+                    "%s: feature %d: score %r is not a number from 0 to 1: skipped",
+                    path,
+                    i,
+                    fp.get("score"),
+                )
+                skipped += 1
+                continue
+            if score != fp.get("score"):  # text a GIS wrote for the number ("0.37")
+                fp = {**fp, "score": score}
+                f = {**f, "properties": fp}
+        if fp.get("kind") == "candidate":
+            fp = _numbers_of(fp, path, i)
+            f = {**f, "properties": fp}
         if fp.get("kind") == "candidate" and not is_lat_lon(fp.get("lat"), fp.get("lon")):
             point = _point_of(f.get("geometry"))
             if point is not None:  # the feature's own Point (lat/lon columns dropped in
@@ -123,6 +148,62 @@ def clean_candidates(path: str, data: Any) -> tuple[str, dict[str, Any], int]:
         kept.append(f)
     scene_id = str(props.get("scene") or Path(path).stem)
     return scene_id, {**data, "properties": props, "features": kept}, skipped
+
+
+_NUMBER_FIELDS = (
+    "heading_deg",
+    "pitch_deg",
+    "roll_deg",
+    "height_m",
+    "sigma_m",
+    "focal_px",
+    "residual_m",
+)
+"""A candidate's numbers the page draws or prints besides its score and position."""
+
+
+def _numbers_of(props: dict[str, Any], path: str, index: int) -> dict[str, Any]:
+    """``props`` with numeric text read as numbers and other non-numbers left out (warned).
+
+    ``"heading_deg": "north"`` failed with "TypeError: must be real number, not str", exit 1
+    (stop 41, qa3); the page draws a candidate without a heading or height as it draws
+    ``locate``'s title-only ones.
+    """
+    out = dict(props)
+    for key in _NUMBER_FIELDS:
+        value = out.get(key)
+        if value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)):
+            if isinstance(value, float) and not math.isfinite(value):
+                out.pop(key)
+            continue
+        number = None
+        if isinstance(value, str):
+            try:
+                number = float(value.strip())
+            except ValueError:
+                number = None
+        if number is not None and math.isfinite(number):
+            out[key] = number
+            continue
+        log.warning(
+            "%s: feature %d: %s %r is not a number: drawn without it", path, index, key, value
+        )
+        out.pop(key)
+    return out
+
+
+def _score_of(value: Any) -> float | None:
+    """A candidate's score as a number in [0, 1] (numeric text read), None if it is none."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())
+        except ValueError:
+            return None
+    if not isinstance(value, (int, float)) or not math.isfinite(value):
+        return None
+    return float(value) if 0.0 <= value <= 1.0 else None
 
 
 def run(args: argparse.Namespace) -> int:

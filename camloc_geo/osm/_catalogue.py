@@ -1,7 +1,8 @@
 """The map catalogue: which map serves a point, for every front end.
 
 A :class:`MapCatalogue` knows where maps come from: extract files (one file or a folder,
-each extract's bounds read once, from its header box or one scan of its nodes), Overpass
+each extract's bounds read once, from its header box or one scan of its nodes, and kept in an
+index the catalogue asks per point, rebuilt when the extracts' folder changes), Overpass
 through osmnx and its cache (``network=True``), or nothing. One rule chooses the map for a
 point (:meth:`MapCatalogue.area_for_point`):
 
@@ -29,6 +30,7 @@ import logging
 import math
 import os
 import threading
+import time
 from collections import OrderedDict
 from dataclasses import dataclass
 from functools import lru_cache
@@ -152,6 +154,104 @@ def _cell_centre(i: int, j: int) -> tuple[float, float]:
     return (i + 0.5) * d, (j + 0.5) * d
 
 
+INDEX_RECHECK_S = 2.0
+"""How often (seconds) a catalogue's index re-stats each of its extracts (an extract rewritten
+in place, which leaves its folder's modification time alone); files added, removed or
+renamed change the folder's, which every question checks."""
+
+
+@dataclass(frozen=True)
+class _IndexEntry:
+    path: str
+    south: float
+    west: float
+    north: float
+    east: float
+
+
+@dataclass(frozen=True)
+class _ExtractIndex:
+    """A catalogue's extracts, read once: bounds smallest first, and their sizes.
+
+    ``folders`` is the signature of the extracts' folders (their modification times) and
+    ``files`` that of the extracts themselves (modification time and size), taken when the
+    index was built; ``checked`` the :func:`time.monotonic` of the last look at ``files``.
+    """
+
+    folders: tuple[int, ...]
+    files: tuple[tuple[int, int], ...]
+    checked: float
+    entries: tuple[_IndexEntry, ...]
+    sizes: dict[str, int]
+
+    def whole(self, path: str) -> bool:
+        """Is the extract loaded whole (up to :data:`WHOLE_EXTRACT_MAX_BYTES`; unknown: yes)."""
+        size = self.sizes.get(path, -1)
+        return size < 0 or size <= WHOLE_EXTRACT_MAX_BYTES
+
+
+_INDEXES: dict[tuple[str, ...], _ExtractIndex] = {}
+_INDEX_LOCK = threading.Lock()
+_MAX_INDEXES = 64
+
+
+def _stat_sig(path: str) -> tuple[int, int]:
+    try:
+        st = os.stat(path)
+    except OSError:
+        return (-1, -1)
+    return (st.st_mtime_ns, st.st_size)
+
+
+@lru_cache(maxsize=_MAX_INDEXES)
+def _folders_of(files: tuple[str, ...]) -> tuple[str, ...]:
+    return tuple(sorted({os.path.dirname(f) for f in files}))
+
+
+def _build_index(files: tuple[str, ...], folders: tuple[int, ...]) -> _ExtractIndex:
+    sigs = tuple(_stat_sig(f) for f in files)
+    rows: list[tuple[float, str, _IndexEntry]] = []
+    for f in files:
+        try:
+            s, w, n, e = extract_bounds(f)
+        except MapDataError as exc:  # said once per change of the folder, not per point
+            log.warning("%s", exc)
+            continue
+        rows.append(((n - s) * (e - w), f, _IndexEntry(f, s, w, n, e)))
+    rows.sort(key=lambda r: (r[0], r[1]))
+    sizes = {f: sig[1] for f, sig in zip(files, sigs, strict=True)}
+    return _ExtractIndex(folders, sigs, time.monotonic(), tuple(r[2] for r in rows), sizes)
+
+
+def _extract_index(files: tuple[str, ...]) -> _ExtractIndex:
+    """The index of a catalogue's extracts, built once and kept per process.
+
+    Rebuilt when a folder holding them changes (a file added, removed or renamed: one stat
+    per folder per question), or when an extract's modification time or size changed (looked
+    at every :data:`INDEX_RECHECK_S` seconds). Before session 41 every question stat-ed and
+    normalised every extract's path: 128 µs a point over ``data/osm``'s 26 extracts, about
+    0.4-2 s for a 3000-camera list (``benchmarks/catalogue.py``).
+    """
+    folders = tuple(_stat_sig(d)[0] for d in _folders_of(files))
+    index = _INDEXES.get(files)
+    if index is not None and index.folders == folders:
+        if time.monotonic() - index.checked < INDEX_RECHECK_S:
+            return index
+        if tuple(_stat_sig(f) for f in files) == index.files:
+            fresh = _ExtractIndex(
+                index.folders, index.files, time.monotonic(), index.entries, index.sizes
+            )
+            with _INDEX_LOCK:
+                _INDEXES[files] = fresh
+            return fresh
+    index = _build_index(files, folders)
+    with _INDEX_LOCK:
+        if len(_INDEXES) >= _MAX_INDEXES and files not in _INDEXES:
+            _INDEXES.pop(next(iter(_INDEXES)))
+        _INDEXES[files] = index
+    return index
+
+
 @dataclass(frozen=True)
 class MapCatalogue:
     """Where maps come from: extract files, Overpass, or nothing (a pure, picklable value).
@@ -229,17 +329,19 @@ class MapCatalogue:
         return tuple(f for f in self.files if key in Path(f).name.lower())
 
     def covering(self, lat: float, lon: float, *, name: str | None = None) -> list[str]:
-        """The extracts whose bounds cover a point, smallest first (``name`` preferred)."""
-        covering = []
-        for f in self._named(name) or self.files:
-            try:
-                s, w, n, e = extract_bounds(f)
-            except MapDataError as exc:
-                log.warning("%s", exc)
-                continue
-            if s <= lat <= n and w <= lon <= e:
-                covering.append(((n - s) * (e - w), f))
-        return [f for _size, f in sorted(covering)]
+        """The extracts whose bounds cover a point, smallest first (``name`` preferred).
+
+        Reads the catalogue's index (:func:`_extract_index`: every extract's bounds and size
+        read once, re-read when its folder changes), not every extract's file per point.
+        """
+        entries = _extract_index(self.files).entries
+        wanted = self._named(name) if name else ()
+        if wanted:
+            keep = set(wanted)
+            chosen = [x for x in entries if x.path in keep]
+        else:
+            chosen = list(entries)
+        return [x.path for x in chosen if x.south <= lat <= x.north and x.west <= lon <= x.east]
 
     def area_for_point(self, lat: float, lon: float, *, name: str | None = None) -> Area:
         """The area whose map serves a point (the module's one rule)."""
@@ -253,7 +355,7 @@ class MapCatalogue:
                     f"lat={lat:.6f}, lon={lon:.6f} is outside every extract ({names}{more})",
                 )
             f = covering[0]
-            if self._whole(f):
+            if _extract_index(self.files).whole(f):
                 return ("file", f)
             return ("cell", f, *_cell_of(lat, lon))
         if self.network:

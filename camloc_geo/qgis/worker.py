@@ -119,6 +119,7 @@ CAMERA_FIELDS: list[Field] = [
     ("heading_deg", "double"),
     ("method", "string"),
     ("names_matched", "string"),
+    ("match_score", "double"),
     ("extract", "string"),
 ]
 LIST_CANDIDATE_FIELDS: list[Field] = [
@@ -136,6 +137,7 @@ LIST_CANDIDATE_FIELDS: list[Field] = [
     ("sigma_m", "double"),
     ("flags", "string"),
     ("source", "string"),
+    ("match_score", "double"),
     ("extract", "string"),
 ]
 STREET_FIELDS: list[Field] = [
@@ -496,6 +498,7 @@ def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any]
                     "sigma_m": _num(c.get("uncertainty_m")),
                     "flags": c.get("detail"),
                     "source": c.get("source"),
+                    "match_score": _num(c.get("match_score")),
                     "extract": c.get("extract"),
                 },
             )
@@ -519,6 +522,7 @@ def _camera_rows(result: Any) -> tuple[dict[str, Any], list[tuple[dict[str, Any]
         "heading_deg": _num(result.heading_deg),
         "method": result.method,
         "names_matched": " & ".join(result.names_matched) or None,
+        "match_score": _num(getattr(result, "match_score", None)),
         "extract": result.extract,
     }
     return props, rows

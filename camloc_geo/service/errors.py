@@ -142,6 +142,15 @@ async def _unexpected(request: Request, exc: Exception) -> JSONResponse:
     return error_response(500, "internal", f"internal error (request id {rid})", None, rid)
 
 
+_ID_WORDS = {
+    r"^[0-9a-f]{32}$": (
+        "an id of this service (32 hex digits, 0-9 and a-f, as the POST that made it answered)"
+    ),
+    r"^[0-9a-f]{16}$": "a page identity (16 hex digits, 0-9 and a-f, as the review page shows it)",
+}
+"""What the service's id patterns mean, for a refused path value (stop 41, qa3)."""
+
+
 def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
     """One line for FastAPI's validation errors (``lat: Input should be ... (got 95)``) and
     the field of the first."""
@@ -159,6 +168,13 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
         field = field or name
         got = err.get("input")
         got_text = f" (got {got!r})" if isinstance(got, (str, int, float)) else ""
+        pattern = (
+            (err.get("ctx") or {}).get("pattern") if isinstance(err.get("ctx"), dict) else None
+        )
+        if err.get("type") == "string_pattern_mismatch" and pattern in _ID_WORDS:
+            # "String should match pattern '^[0-9a-f]{32}$'" named a regular expression
+            parts.append(f"{name}: {got!r} is not {_ID_WORDS[pattern]}")
+            continue
         parts.append(f"{name}: {err.get('msg', 'invalid')}{got_text}")
     return "; ".join(parts) or "invalid request", field
 

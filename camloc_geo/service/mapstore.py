@@ -7,6 +7,8 @@ Overpass around a point. Which map serves a point is the catalogue's one rule, t
 
 from __future__ import annotations
 
+import os
+import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -23,25 +25,62 @@ class MapStore:
     """The maps a service instance uses: a thin adapter over its catalogue (thread-safe)."""
 
     def __init__(self, settings: Settings) -> None:
-        from camloc_geo.osm import MapCatalogue, extract_files
-
         self._settings = settings
-        files: tuple[str, ...] = ()
+        self._folder: Path | None = None
         if settings.map_dir is not None:
             folder = Path(settings.map_dir)
             if not folder.is_dir():
                 raise MapDataError(f"CAMLOC_MAP_DIR {folder} is not a folder")
+            self._folder = folder
+        self._lock = threading.Lock()
+        self._folder_ns: int | None = None
+        self._catalogue = self._listed()
+
+    def _listed(self) -> MapCatalogue:
+        """The catalogue of the folder's extracts as they are now."""
+        from camloc_geo.osm import MapCatalogue, extract_files
+
+        files: tuple[str, ...] = ()
+        if self._folder is not None:
             try:
-                files = extract_files(folder)
+                self._folder_ns = os.stat(self._folder).st_mtime_ns
+            except OSError:
+                self._folder_ns = None
+            try:
+                files = extract_files(self._folder)
             except MapDataError:
                 files = ()  # an empty folder: no extract, the network may still serve
-        self.catalogue: MapCatalogue = MapCatalogue(
+        settings = self._settings
+        return MapCatalogue(
             files=files,
             network=bool(settings.network),
             cache_folder=None if settings.cache_folder is None else str(settings.cache_folder),
             overpass_url=settings.overpass_url,
         )
-        self.extracts: list[Path] = [Path(f) for f in files]
+
+    @property
+    def catalogue(self) -> MapCatalogue:
+        """The catalogue of ``CAMLOC_MAP_DIR``'s extracts, listed again when the folder changes.
+
+        The extracts were listed once, at start-up: one copied in later (as the service's
+        "its operator adds extracts to CAMLOC_MAP_DIR" asks) served nothing until a restart
+        (stop 41, qa3). One stat of the folder per request.
+        """
+        if self._folder is not None:
+            try:
+                ns: int | None = os.stat(self._folder).st_mtime_ns
+            except OSError:
+                ns = self._folder_ns
+            if ns != self._folder_ns:
+                with self._lock:
+                    if ns != self._folder_ns:
+                        self._catalogue = self._listed()
+        return self._catalogue
+
+    @property
+    def extracts(self) -> list[Path]:
+        """The extracts the service's map data comes from (``CAMLOC_MAP_DIR``'s, as now)."""
+        return [Path(f) for f in self.catalogue.files]
 
     @property
     def settings(self) -> Settings:

@@ -97,6 +97,20 @@ MAX_SCENE_BYTES = 10_000_000
 plugin does not import camloc_geo (keep the two equal)."""
 
 
+STALE_PROPERTY = "camloc/stale"
+"""Custom property of a result group and its layers left from a run before one that failed."""
+STALE_PREFIX = "stale · "
+"""What a stale layer's name starts with."""
+STALE_OPACITY = 0.35
+"""A stale layer's opacity (drawn faded under the analyst's next results)."""
+
+
+def stale_name(group: str) -> str:
+    """The name of result group ``group`` once a later run of its camera failed."""
+    suffix = " (stale: a later run failed)"
+    return group if group.endswith(suffix) else group + suffix
+
+
 def _output_problem(path: str, what: str) -> str | None:
     """Why ``path`` cannot be written as a ``what`` (one line), or None.
 
@@ -1175,18 +1189,31 @@ class CamlocDock(QDockWidget):
         self.progress.setVisible(False)
         if not ok:
             restore, self._restore = self._restore, None
+            canceled = task.error in (None, "canceled")
+            group = f"camloc: {self.annotation.scene_id}"
             if restore is not None:  # the tables were not replaced: the last results come back
-                self._load_layers(restore[0], restore[1], None, self._restore_extent)
+                group = restore[0]
+                self._load_layers(
+                    restore[0], restore[1], None, self._restore_extent, stale=not canceled
+                )
                 self._result_key = (os.path.abspath(task.gpkg), task.prefix)
-            if task.error in (None, "canceled"):
-                self.set_status("Canceled.")
+            if canceled:
+                kept = " The map keeps the last run's layers." if restore is not None else ""
+                self.set_status("Canceled." + kept)
                 return
             line = " ".join(str(task.error).split())  # one line, whatever the library wrote
-            self.set_status(f"camloc: {line}")
+            # the last run's layers of this camera (put back, or of another GeoPackage) are
+            # marked stale: shown unmarked, they were taken for this run's answer
+            marked = self._mark_stale(group) if restore is None else stale_name(group)
+            if marked:
+                about = f" The layers on the map are the last run's, marked stale ('{marked}')."
+            else:
+                about = " No layer on the map is this run's."
+            self.set_status(f"camloc: {line}{about}")
             # QGIS's message bar too: the run may have been started long ago, the dock hidden
             if self.iface is not None:
                 self.iface.messageBar().pushMessage(
-                    "camloc", f"the camera was not located: {line}", Qgis.Critical, 15
+                    "camloc", f"the camera was not located: {line}{about}", Qgis.Critical, 15
                 )
             return
         self._load_results(task)
@@ -1221,11 +1248,13 @@ class CamlocDock(QDockWidget):
         uris: dict[str, str],
         task: LocateTask | None,
         extent: Any = None,
+        stale: bool = False,
     ) -> None:
         """Load layers one per event-loop turn (each turn a few tens of ms, so the GUI never
         stalls for the whole batch) into the group ``name``, candidates on top; then report
         ``task`` (None: layers put back after a failed run, nothing to report) or set the
-        canvas back to ``extent`` (a QgsRectangle, None: left as it is)."""
+        canvas back to ``extent`` (a QgsRectangle, None: left as it is). ``stale``: the
+        layers are a failed run's predecessors, marked so (:meth:`_mark_stale`)."""
         from qgis.PyQt.QtCore import QTimer
 
         root = QgsProject.instance().layerTreeRoot()
@@ -1239,6 +1268,8 @@ class CamlocDock(QDockWidget):
         def next_layer() -> None:
             if not todo:
                 self._loading = False
+                if stale:
+                    self._mark_stale(name)
                 if task is not None:
                     self._report(task)
                 elif extent is not None and self.iface is not None:
@@ -1347,14 +1378,50 @@ class CamlocDock(QDockWidget):
 
     def _remove_results(self) -> None:
         project = QgsProject.instance()
+        root = project.layerTreeRoot()
+        emptied = []
         for old in self.result_layers:
             try:
                 layer_id = old.id()
             except RuntimeError:  # deleted with the project
                 continue
+            node = root.findLayer(layer_id)
+            if node is not None and node.parent() is not None:
+                emptied.append(node.parent())
             if project.mapLayer(layer_id) is not None:
                 project.removeMapLayer(layer_id)
         self.result_layers = []
+        for group in emptied:  # a stale group emptied: the new run makes its own
+            try:
+                if group.customProperty(STALE_PROPERTY) and not group.children():
+                    parent = group.parent()
+                    if parent is not None:
+                        parent.removeChildNode(group)
+            except RuntimeError:
+                continue
+
+    def _mark_stale(self, name: str) -> str | None:
+        """Mark the result group ``name`` and its layers stale (a run of its camera failed):
+        the group's and the layers' names say so and the layers are drawn faded. Returns the
+        group's new name (None: no such group, or it holds no layer)."""
+        root = QgsProject.instance().layerTreeRoot()
+        group = root.findGroup(name)
+        if group is None:
+            group = root.findGroup(stale_name(name))
+        if group is None or not group.findLayers():
+            return None
+        new = stale_name(name)
+        group.setName(new)
+        group.setCustomProperty(STALE_PROPERTY, True)
+        for node in group.findLayers():
+            layer = node.layer()
+            if layer is None or layer.customProperty(STALE_PROPERTY):
+                continue
+            layer.setCustomProperty(STALE_PROPERTY, True)
+            layer.setName(f"{STALE_PREFIX}{layer.name()}")
+            layer.setOpacity(STALE_OPACITY)
+            layer.triggerRepaint()
+        return new
 
     def refuse(self, text: str) -> None:
         """Say why an action was refused: the status line, and QGIS's message bar (a warning,

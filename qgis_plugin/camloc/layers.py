@@ -250,30 +250,59 @@ def style_candidates(layer: QgsVectorLayer) -> None:
     layer.triggerRepaint()
 
 
-def style_list_candidates(layer: QgsVectorLayer) -> None:
-    """A list's candidates: small, unlabelled but for ties, under the cameras' labels."""
+def style_list_candidates(layer: QgsVectorLayer, tie_expr: str = '"tie"') -> None:
+    """A list's candidates: small, unlabelled but for ties, under the cameras' labels.
+
+    ``tie_expr`` is a QGIS expression true for a tied candidate: the plugin's ``"tie"``; the
+    batch GeoPackage's and the job result's read their ``ambiguous_with``
+    (``qgis_plugin/make_batch_styles.py``).
+    """
+    # the plugin's boolean may be NULL; the GeoPackages' expressions never are (and their SLD
+    # export can say NOT (...), not coalesce)
+    no_tie = _NO_TIE if tie_expr == '"tie"' else f"NOT ({tie_expr})"
     _rules(
         layer,
         [
-            ("★ " + TIE_WORDS, '"tie"', _marker("#d7191c", "Star", 5.0)),
+            ("★ " + TIE_WORDS, tie_expr, _marker("#d7191c", "Star", 5.0)),
             (
                 "a camera's best candidate",
-                _NO_TIE + ' AND "rank" = 1',
+                no_tie + ' AND "rank" = 1',
                 _marker("#fdae61", "Circle", 3.2),
             ),
             ("other candidates", None, _marker("#2c7bb6", "Circle", 2.2, 0.6)),
         ],
     )
-    _label(layer, 'CASE WHEN "rank" > 1 OR "tie" THEN concat(\'#\', "rank") END', priority=1)
+    _label(
+        layer, f'CASE WHEN "rank" > 1 OR ({tie_expr}) THEN concat(\'#\', "rank") END', priority=1
+    )
     layer.triggerRepaint()
 
 
-def style_view_cones(layer: QgsVectorLayer) -> None:
-    """Cones of the leading candidates only (best, tied, score >= 0.05), faded by score."""
+VIEW_CONE_TIE_EXPR = '"tie"'
+"""The plugin's view cones' tie column (a boolean); :func:`style_view_cones` takes another."""
+
+
+def leading_expr(tie_expr: str = VIEW_CONE_TIE_EXPR) -> str:
+    """A candidate worth a view cone: best, tied (``tie_expr``), or score >= 0.05."""
+    return f'"rank" = 1 OR ({tie_expr}) OR coalesce("score", 0) >= 0.05'
+
+
+def style_view_cones(layer: QgsVectorLayer, tie_expr: str = VIEW_CONE_TIE_EXPR) -> None:
+    """Cones of the leading candidates only (best, tied, score >= 0.05), faded by score.
+
+    Parameters
+    ----------
+    layer
+        The cones layer (``rank``, ``score`` and the tie column ``tie_expr`` reads).
+    tie_expr
+        A QGIS expression true for a tied candidate's cone: the plugin's ``"tie"``; the batch
+        GeoPackage's ``"ambiguous_with" IS NOT NULL`` (``qgis_plugin/make_batch_styles.py``
+        draws its cones with this one style, the tie's red outline included).
+    """
     sym = QgsSymbol.defaultSymbol(QgsWkbTypes.PolygonGeometry)
     sym.setColor(QColor(255, 190, 0, 70))
     sl = sym.symbolLayer(0)
-    sl.setStrokeColor(QColor(180, 120, 0))
+    sl.setStrokeColor(QColor(180, 120, 0, 160))  # as the expression's ELSE (the SLD's colour)
     sl.setDataDefinedProperty(
         QgsSymbolLayer.PropertyFillColor,
         QgsProperty.fromExpression(
@@ -283,12 +312,12 @@ def style_view_cones(layer: QgsVectorLayer) -> None:
     sl.setDataDefinedProperty(
         QgsSymbolLayer.PropertyStrokeColor,
         QgsProperty.fromExpression(
-            "CASE WHEN \"tie\" THEN '#d7191c' ELSE color_rgba(180, 120, 0, 160) END"
+            f"CASE WHEN {tie_expr} THEN '#d7191c' ELSE color_rgba(180, 120, 0, 160) END"
         ),
     )
     _rules(
         layer,
-        [("view cone of a leading candidate (faded by score)", LEADING_EXPR, sym)],
+        [("view cone of a leading candidate (faded by score)", leading_expr(tie_expr), sym)],
     )
     layer.triggerRepaint()
 
@@ -339,15 +368,18 @@ def style_matched(layer: QgsVectorLayer) -> None:
     layer.triggerRepaint()
 
 
-def style_cameras(layer: QgsVectorLayer) -> None:
-    """A list's cameras: their labels win over the candidates' (highest priority)."""
+def style_cameras(layer: QgsVectorLayer, id_field: str = "camera_id") -> None:
+    """A list's cameras: their labels win over the candidates' (highest priority).
+
+    ``id_field`` names the camera's id column (the batch GeoPackage's is ``id``).
+    """
     _rules(
         layer,
         [
             ("camera placed", None, _marker("#d7191c", "Triangle", 4.5)),
         ],
     )
-    _label(layer, '"camera_id" || \' \' || "status"', priority=10, size=10)
+    _label(layer, f'"{id_field}" || \' \' || "status"', priority=10, size=10)
     layer.triggerRepaint()
 
 

@@ -399,9 +399,17 @@ def test_geocodelist_one_row_per_camera_with_status(provider, tmp_path):
     assert cams["cam4"]["n_candidates"] == 0
     assert cams["cam4"].geometry().isEmpty()  # not placed (GeoPackage: POINT EMPTY)
     assert cams["cam5"]["status"] == "title_only"
+    # one score scale (session 41): the title's junction holds the camera's whole share, its
+    # name match is match_score; a located camera's title junction holds none
+    assert cams["cam5"]["score"] == 1.0
+    assert 0.0 < cams["cam5"]["match_score"] <= 1.0
     cands = _layer(res["CANDIDATES"])
     assert cands.featureCount() >= 1
     assert "cam1" in {f["camera_id"] for f in cands.getFeatures()}
+    cam1 = [f for f in cands.getFeatures() if f["camera_id"] == "cam1"]
+    located = [f["score"] for f in cam1 if f["source"] == "locate"]
+    assert sum(located) == pytest.approx(1.0)
+    assert all(f["score"] == 0.0 for f in cam1 if f["source"] == "title")
     # the camera labels win over the candidates' (label priority)
     from camloc.layers import apply_style
 

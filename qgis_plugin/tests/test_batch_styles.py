@@ -67,6 +67,24 @@ def test_a_batch_geopackage_opens_styled(tmp_path):
     assert sorted(drawn) == [("s1", 1), ("s1", 2), ("s1", 3), ("s1", 4)]  # the tie's
     assert len(left) >= 6
     assert all(r > 4 for _, r in left)
+    # the plugin's one cone style (session 41: make_batch_styles.py drew a copy without the
+    # tie's red outline): a tied candidate's cone is outlined red, the others brown
+    from qgis.core import QgsSymbolLayer
+
+    stroke = (
+        rules[0]
+        .symbol()
+        .symbolLayer(0)
+        .dataDefinedProperties()
+        .property(QgsSymbolLayer.PropertyStrokeColor)
+    )
+    assert stroke.isActive()
+    outline = {}
+    for f in cones.getFeatures():
+        ctx.setFeature(f)
+        outline[f["rank"]] = str(stroke.value(ctx, "")[0])
+    assert {outline[r] for r in (1, 2, 3, 4)} == {"#d7191c"}
+    assert all(outline[r] != "#d7191c" for _, r in left)
 
 
 def test_a_service_job_geopackage_opens_styled(tmp_path):

@@ -940,6 +940,56 @@ def test_a_failed_run_says_why_in_the_message_bar_in_one_line(dock, qgis_iface, 
     assert "fremantle.osm" in said[0], said
     assert "outside" in said[0], said
     assert "\n" not in dock.status.text()
+    # ... marked stale (session 41: shown as they were, an analyst took the last run's
+    # answer for this run's): the group's and the layers' names say so, the layers faded
+    from camloc.dock import STALE_OPACITY, STALE_PREFIX
+
+    assert group.name() == "camloc: snapshot (stale: a later run failed)"
+    assert all(lyr.name().startswith(STALE_PREFIX) for lyr in dock.result_layers)
+    assert all(lyr.opacity() == pytest.approx(STALE_OPACITY) for lyr in dock.result_layers)
+    assert "marked stale ('camloc: snapshot (stale: a later run failed)')" in said[0], said
+    assert "stale" in dock.status.text()
+    # a successful run replaces them: no stale group, no stale layer left
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    assert dock.run() is not None
+    assert dock.wait()
+    root = QgsProject.instance().layerTreeRoot()
+    assert root.findGroup("camloc: snapshot (stale: a later run failed)") is None
+    fresh = root.findGroup("camloc: snapshot")
+    assert len(fresh.findLayers()) == 4
+    assert not any(n.layer().name().startswith(STALE_PREFIX) for n in fresh.findLayers())
+    assert all(lyr.opacity() == 1.0 for lyr in dock.result_layers)
+
+
+def test_a_failed_run_into_another_geopackage_marks_the_cameras_layers_stale(
+    dock, qgis_iface, tmp_path
+):
+    """The camera's layers of another GeoPackage stayed unmarked after a failed run."""
+    from camloc.dock import STALE_PREFIX
+    from qgis.core import Qgis
+
+    assert dock.open_snapshot(str(_snapshot(tmp_path / "snapshot.png")))
+    _annotate(dock)
+    _pick_on_canvas(dock, qgis_iface)
+    dock.osm_edit.setText(str(SAMPLE_OSM))
+    dock.gpkg_edit.setText(str(tmp_path / "r.gpkg"))
+    assert dock.run() is not None
+    assert dock.wait()
+    root = QgsProject.instance().layerTreeRoot()
+    group = root.findGroup("camloc: snapshot")
+    dock.osm_edit.setText(str(SAMPLE_OSM.parent / "fremantle.osm"))
+    dock.gpkg_edit.setText(str(tmp_path / "other.gpkg"))
+    bar = qgis_iface.messageBar()
+    bar.clear_messages()
+    assert dock.run() is not None
+    assert dock.wait()
+    assert group.name() == "camloc: snapshot (stale: a later run failed)"
+    names = [n.layer().name() for n in group.findLayers()]
+    assert len(names) == 4
+    assert all(n.startswith(STALE_PREFIX) for n in names), names
+    said = bar.get_messages(Qgis.Critical)
+    assert len(said) == 1, said
+    assert "marked stale" in said[0], said
 
 
 def test_a_second_camera_leaves_the_first_cameras_layers(dock, qgis_iface, tmp_path):
