@@ -44,6 +44,10 @@ covariance, the ground-corner, preset-shape, car-line, principal-point, size or 
 term, or the jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
 JSON).
 
+``--parts`` (implies ``--terms``; the crowd sets) calibrates each scene three more times with
+the same clicks and lines, stating the car's true size, the true principal point, and both,
+and compares each part of the error (the size's, the principal point's, the clicks' and
+lines' own) with the covariance terms that state it (``by_part`` in the JSON; stop 41).
 ``--sets crowd`` runs only the named sets (comma-separated); ``--variance-groups`` turns on
 ``CalibrationSettings.variance_groups`` (one residual variance factor per row group, off by
 default); ``--settings NAME=VALUE,...`` sets any other ``CalibrationSettings`` field (a
@@ -53,6 +57,7 @@ Usage::
 
     python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--no-jackknife-leverage]
     python benchmarks/calibrate_coverage.py --n 60 --sets crowd --settings discordant_line_t=0
+    python benchmarks/calibrate_coverage.py --n 60 --sets crowd --parts
 """
 
 from __future__ import annotations
