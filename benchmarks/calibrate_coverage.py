@@ -44,6 +44,10 @@ covariance, the ground-corner, preset-shape, car-line, principal-point, size or 
 term, or the jackknife where it is the larger) and reports the coverage per term (``by_term`` in the
 JSON).
 
+``--parts`` (implies ``--terms``; the crowd sets) calibrates each scene three more times with
+the same clicks and lines, stating the car's true size, the true principal point, and both,
+and compares each part of the error (the size's, the principal point's, the clicks' and
+lines' own) with the covariance terms that state it (``by_part`` in the JSON; stop 41).
 ``--sets crowd`` runs only the named sets (comma-separated); ``--variance-groups`` turns on
 ``CalibrationSettings.variance_groups`` (one residual variance factor per row group, off by
 default); ``--settings NAME=VALUE,...`` sets any other ``CalibrationSettings`` field (a
@@ -53,11 +57,13 @@ Usage::
 
     python benchmarks/calibrate_coverage.py --n 60 [--located 400] [--no-jackknife-leverage]
     python benchmarks/calibrate_coverage.py --n 60 --sets crowd --settings discordant_line_t=0
+    python benchmarks/calibrate_coverage.py --n 60 --sets crowd --parts
 """
 
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import logging
 import math
@@ -193,12 +199,19 @@ def _dominant_terms(res: Any) -> dict[str, str] | None:
     return out
 
 
-def scene_errors(syn: Any) -> dict[str, Any] | None:
-    """Errors and stated sigmas of one scene, or None when ``calibrate`` refuses it."""
+def scene_errors(syn: Any, terms: bool = True) -> dict[str, Any] | None:
+    """Errors and stated sigmas of one scene, or None when ``calibrate`` refuses it
+    (``terms`` False: the ``--terms`` record is left for the caller's own scene)."""
+    if not terms:
+        saved = dict(_TERMS)
     try:
         res = calibrate(parse_scene(syn.scene), SETTINGS)
     except InputError:
         return None
+    finally:
+        if not terms:
+            _TERMS.clear()
+            _TERMS.update(saved)
     truth = syn.camera
     cam = res.camera
     out: dict[str, Any] = {"method": res.intrinsics_method}
@@ -233,8 +246,96 @@ def scene_errors(syn: Any) -> dict[str, Any] | None:
     out["sigma"] = sig
     if _TERMS:
         out["dominant_term"] = _dominant_terms(res)
+        if PARTS:
+            terms = _TERMS.get(id(res.parameter_covariance))
+            out["term_variance"] = terms
         _TERMS.clear()
     out["principal_point_error_px"] = float(np.hypot(*pp_err))
+    return out
+
+
+PARTS = False
+"""``--parts``: each crowd scene calibrated again with the truth stated (see :func:`parts`)."""
+PARTS_SETS = ("crowd", "crowd_pp_prior")
+PART_SCENES = {
+    "size_given": (True, False),
+    "pp_given": (False, True),
+    "both_given": (True, True),
+}
+
+
+def part_errors(syn: Any) -> dict[str, dict[str, float] | None]:
+    """The scene's errors when it states the car's true size, the true principal point, or
+    both (the same clicks and lines): ``{variant: {quantity: error} or None}``."""
+    out: dict[str, dict[str, float] | None] = {}
+    scene = syn.scene
+    for name, (size, pp) in PART_SCENES.items():
+        stated = copy.deepcopy(scene)
+        if size:
+            t = syn.true_size
+            stated["object"] = {
+                "length_m": t.length_m,
+                "width_m": t.width_m,
+                "height_m": t.height_m,
+            }
+        if pp:
+            stated["camera"] = {"principal_point": [float(v) for v in syn.camera.principal_point]}
+        syn.scene = stated
+        try:
+            row = scene_errors(syn, terms=False)
+        finally:
+            syn.scene = scene
+        out[name] = None if row is None else row["error"]
+    return out
+
+
+PART_TERMS = {
+    # part: (its error, the terms of the full scene's covariance that state it)
+    "size": ("preset_shape", "size", "car_class"),
+    "principal_point": ("principal_point",),
+    "noise": ("fit", "ground_corner", "car_lines"),
+    "noise_fit_only": ("fit",),
+}
+
+
+def parts(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """``--parts``: each part of the error against the terms that state it.
+
+    Per scene, the error of the car's size (the full scene's error less that of the same
+    clicks stating the true size), of the principal point (less that stating the true
+    principal point) and of the clicks and lines (the error stating both) is compared with
+    the full scene's covariance terms for it (``PART_TERMS``): 1σ / 2σ coverage and the
+    median error/σ per quantity of ``TERM_QUANTITIES``. The jackknife is in none of them.
+    """
+    out: dict[str, Any] = {}
+    for q, k in TERM_QUANTITIES.items():
+        unit = math.degrees(1.0) if q.startswith("rot") else 1.0
+        z: dict[str, list[float]] = {p: [] for p in PART_TERMS}
+        for r in rows:
+            tv, pe = r.get("term_variance"), r.get("parts")
+            if not tv or not pe or any(v is None for v in pe.values()):
+                continue
+            e = r["error"][q]
+            err = {
+                "size": e - pe["size_given"][q],
+                "principal_point": e - pe["pp_given"][q],
+                "noise": pe["both_given"][q],
+                "noise_fit_only": pe["both_given"][q],
+            }
+            for p, names in PART_TERMS.items():
+                var = sum(max(tv[n][k], 0.0) for n in names)
+                if var > 0.0:
+                    z[p].append(abs(err[p]) / (math.sqrt(var) * unit))
+        out[q] = {
+            p: {
+                "n": len(v),
+                "cover_1sigma": float(np.mean(np.array(v) <= 1.0)),
+                "cover_2sigma": float(np.mean(np.array(v) <= 2.0)),
+                "median_z": float(np.median(v)),
+            }
+            for p, v in z.items()
+            if v
+        }
     return out
 
 
@@ -468,6 +569,13 @@ def main(argv: list[str] | None = None) -> int:
         "coverage per term (a diagnostic: wraps a private helper of calibrate)",
     )
     parser.add_argument(
+        "--parts",
+        action="store_true",
+        help="also calibrate each crowd scene again stating the true size, the true principal "
+        "point and both, and compare each part of the error with the terms that state it "
+        "(implies --terms; ~4x the crowd sets' time)",
+    )
+    parser.add_argument(
         "--variance-groups",
         action=argparse.BooleanOptionalAction,
         default=CalibrationSettings().variance_groups,
@@ -485,7 +593,9 @@ def main(argv: list[str] | None = None) -> int:
     unknown = sorted(set(sets) - set(SETS))
     if unknown:
         parser.error(f"unknown set(s) {', '.join(unknown)}; known: {', '.join(SETS)}")
-    if args.terms:
+    global PARTS
+    PARTS = args.parts
+    if args.terms or args.parts:
         _record_terms()
     global SETTINGS
     SETTINGS = settings_from_args(args, variance_groups=args.variance_groups)
@@ -515,6 +625,8 @@ def main(argv: list[str] | None = None) -> int:
             if row is None:
                 refused[name] += 1
                 continue
+            if PARTS and name in PARTS_SETS:
+                row["parts"] = part_errors(syn)
             row["index"] = i
             rows.append(row)
         by_set[name] = rows
@@ -541,8 +653,12 @@ def main(argv: list[str] | None = None) -> int:
         "cpu_count": os.cpu_count(),
         "rows": by_set,
     }
-    if args.terms:
+    if args.terms or args.parts:
         result["by_term"] = {name: coverage_by_term(rows) for name, rows in by_set.items()}
+    if args.parts:
+        result["by_part"] = {
+            name: parts(rows) for name, rows in by_set.items() if name in PARTS_SETS
+        }
     if args.located > 0:
         result["located"] = located_coverage(args.located, args.seed)
     (args.out / "calibrate_coverage.json").write_text(json.dumps(result, indent=1))
@@ -575,6 +691,14 @@ def main(argv: list[str] | None = None) -> int:
                 f"{t} {g['n']}, {g['cover_1sigma']:.0%} / {g['cover_2sigma']:.0%}, "
                 f"{g['median_z']:.2f}"
                 for t, g in groups.items()
+            )
+            print(f"  {q:6s} {line}")
+    for name, per_q in result.get("by_part", {}).items():
+        print(f"{name}: each part of the error against the terms that state it (1σ, 2σ, median)")
+        for q, groups in per_q.items():
+            line = "; ".join(
+                f"{p} {g['cover_1sigma']:.0%} / {g['cover_2sigma']:.0%}, {g['median_z']:.2f}"
+                for p, g in groups.items()
             )
             print(f"  {q:6s} {line}")
     for variant in ("as_made", "preset"):
