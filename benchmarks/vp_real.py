@@ -12,6 +12,10 @@ Usage::
                                   each only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
+    python benchmarks/vp_real.py --sets street-photos --prior-at-truth [--no-exif-kept]
+                                 (also the EXIF-stripped photos with the default focal
+                                  prior centred on each one's truth: a simulation of a
+                                  camera the default prior matches, its own labelled run)
     python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
 
 The photos (none of them is in this repository; their licences keep them out):
