@@ -65,3 +65,18 @@ def test_plain_run_keeps_the_default_prior(monkeypatch: pytest.MonkeyPatch) -> N
 def test_prior_at_truth_is_its_own_labelled_run() -> None:
     assert "SIMULATION" in vp_real.PRIOR_AT_TRUTH_RUN
     assert vp_real.PRIOR_AT_TRUTH_RUN != "no EXIF"
+
+
+def test_main_reports_the_simulation_as_its_own_run_and_bars(tmp_path: Path) -> None:
+    import json
+
+    out = tmp_path / "out"
+    argv = ["--sets", "street-synth-dev", "--synth-photos", "1", "--prior-at-truth"]
+    assert vp_real.main([*argv, "--no-exif-kept", "--out", str(out)]) == 0
+    doc = json.loads((out / "vp_real.json").read_text(encoding="utf-8"))
+    assert set(doc["per_image"]) == {"no EXIF", vp_real.PRIOR_AT_TRUTH_RUN}
+    sim = doc["summary"][vp_real.PRIOR_AT_TRUTH_RUN]["street-synth"]
+    bars = doc["summary"][vp_real.SIM_BARS]["street-synth"]
+    assert bars["stripped_within_10pct"]["value"] == sim["share_focal_within_10pct"]
+    assert bars["kept_within_10pct"]["met"] is None  # the simulation is EXIF-stripped only
+    assert "street-synth" in doc["summary"]["issue 24 bars"]  # the headline's, apart
