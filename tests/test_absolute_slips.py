@@ -887,6 +887,30 @@ def test_held_out_3_is_three_cities_no_other_set_samples() -> None:
     assert bench.HELD_OUT_3_SEED not in (0, bench.HELD_OUT_SEED, bench.HELD_OUT_2_SEED)
 
 
+def test_held_out_4_is_three_new_cities_no_other_set_samples() -> None:
+    bench = _bench()
+    from unseen_cities import CITIES
+
+    names = [p[0] for p in bench.HELD_OUT_4_PLACES]
+    assert [n.split("_")[0].split(".")[0] for n in names] == [
+        "seattle",
+        "seattle",
+        "seattle",
+        "london",
+        "london",
+        "neudrossenfeld",
+    ]
+    used = {p[0] for p in bench.PLACES} | {p[0] for p in bench.HELD_OUT_PLACES}
+    used |= {c[0] for c in CITIES} | {p[0] for p in bench.HELD_OUT_3_PLACES}
+    assert not used & set(names)
+    sources = (OSM / "SOURCES.md").read_text(encoding="utf-8")
+    for name in names:
+        assert (OSM / name).is_file()
+        assert f"`{name}`" in sources
+    seeds = (0, bench.HELD_OUT_SEED, bench.HELD_OUT_2_SEED, bench.HELD_OUT_3_SEED)
+    assert bench.HELD_OUT_4_SEED not in seeds
+
+
 def test_warning_rates_count_kinds_on_right_and_wrong_answers() -> None:
     bench = _bench()
     right = {
