@@ -1044,3 +1044,39 @@ def test_a_same_shaped_junction_a_block_away_that_fits_a_third_as_well_is_warned
     assert errs[0] < 15.0 or res.candidates[0].ambiguous_with or warned
     if errs[0] > 15.0 and not res.candidates[0].ambiguous_with:
         assert "n42453472" in warned[0]
+
+
+@pytest.mark.parametrize(
+    ("osm", "centre", "inter_id", "rng", "before_m"),
+    [
+        # absolute_slips --set held-out-3 scenes 81 (a Leeds dual carriageway) and 79
+        # (Manhattan's 8th Avenue & Horatio Street, skewed)
+        ("leeds_centre.osm.gz", (53.79891, -1.53450, 600.0), "c342579580", [40, 81], 45.4),
+        ("nyc_manhattan.osm.pbf", (40.73618, -74.00535, 1500.0), "n42431497", [40, 79], 16.6),
+    ],
+)
+def test_the_cross_streets_bearing_is_named_tied_with_the_map_street_it_may_be(
+    osm: str, centre: tuple[float, float, float], inter_id: str, rng: list[int], before_m: float
+) -> None:
+    # One reference and the cross street's street_bearing_deg (the car stands in the other
+    # street). Before: the stated bearing's reading put the car on the cross street too, so
+    # it was taken at its word: the answer stood before_m off, untied and unwarned. The map's
+    # other street now competes as a rival at its odds (0.2), and the tie rule names it.
+    bench = _bench()
+    from absolute import _variant
+
+    m, ls = _replayed(osm, centre, inter_id, rng)
+    base = _variant(ls, "one_reference")
+    assert base is not None
+    ctx = bench.Ctx(m, m.intersection(inter_id), ls, np.random.default_rng([*rng, 7, 20]))
+    scene = bench.slip_bearing_cross(json.loads(json.dumps(base)), ctx)
+    assert scene is not None
+    res = locate(parse_scene(scene), m)
+    errs = _errors(res, ls)
+    assert min(errs) < 5.0
+    top = res.candidates[0]
+    if errs[0] > 15.0:
+        assert abs(errs[0] - before_m) < 2.0
+        right = next(c for c, e in zip(res.candidates, errs, strict=True) if e < 5.0)
+        assert right.rank in top.ambiguous_with
+        assert any("cross street's bearing" in t.why for t in res.ties)

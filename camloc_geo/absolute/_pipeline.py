@@ -355,21 +355,43 @@ def _map_bearing_candidates(
 
     A crowd states the cross street's bearing as readily as the car's street's (the car in
     the other street: ``benchmarks/absolute_slips.py``); then the map's streets, and the
-    car-parallel test, decide. A stated bearing that some candidate's car lies along is
-    taken at its word (the scene's candidates stay exactly its own).
+    car-parallel test, decide.
+
+    Where some candidate's car lies along the stated bearing, the map's other readings are
+    kept only as rivals (:data:`RIVAL_BEARING`): those whose car stands plausibly on its
+    street and that come within the tie rule's odds of the best candidate, their prior odds
+    in and kept through refinement, so that the tie rule names them. Before stop 41 the
+    stated bearing was then taken at its word, and where the cross street's reading put the
+    car on a street too the answer stood 16-73 m off with no tie and no warning
+    (``bearing_cross_street``: 2 of 109 development scenes, 2 of 133 of held-out-3); a
+    one-reference answer's own half turn is tied already in nearly every scene, so the
+    rivals add a tie to 2 of 108 right control answers (``control_bearing``).
     """
     if ev.stated_bearing is None or not ev.map_bearings or not cands:
-        return []
-    # (A car beside its street counted as plausible here: control_bearing warned 4 -> 2 %,
-    # but bearing_cross_street lost closest < 15 m 74 -> 65 %: not kept.)
-    if any(not ({f.kind for f in c.flags} & _IMPLAUSIBLE) for c in cands):
         return []
     ev_map = replace(ev, street_bearings=list(ev.map_bearings))
     hyps = bearing_hypotheses(ev_map, settings)
     odds = math.log(UNSTATED_BEARING_PRIOR)
     for h in hyps:
         h.log_prior += odds
-    return score_hypotheses(hyps, world_cam, ev_map, settings)
+    # (A car beside its street counted as plausible here: control_bearing warned 4 -> 2 %,
+    # but bearing_cross_street lost closest < 15 m 74 -> 65 %: not kept.)
+    if not any(not ({f.kind for f in c.flags} & _IMPLAUSIBLE) for c in cands):
+        return score_hypotheses(hyps, world_cam, ev_map, settings)
+    floor = max(map(_weight, cands)) + math.log(settings.tie_score_ratio)
+    rivals = [
+        c
+        for c in score_hypotheses(hyps, world_cam, ev_map, settings)
+        if _weight(c) >= floor and not ({f.kind for f in c.flags} & _IMPLAUSIBLE)
+    ]
+    for c in rivals:
+        c.log_prior_odds = odds
+        c.rival = RIVAL_BEARING
+    return rivals
+
+
+RIVAL_BEARING = "map bearing"
+"""``Candidate.rival`` of a reading along another street of the map than the stated bearing."""
 
 
 NEIGHBOUR_BUILDING_PRIOR = 0.1
@@ -2025,6 +2047,12 @@ def _tie_why(group: list[Candidate], default: str) -> str:
             f"{label} read as different kerb corners of its junction (at its stated lat/lon "
             "or another corner's) fit alike: check that reference's lat/lon, or add a third "
             "reference, a corner or a landmark"
+        )
+    if any(c.rival == RIVAL_BEARING for c in group) and any(c.rival is None for c in group):
+        return (
+            "the car along the stated street_bearing_deg and along another street of the map "
+            "(the cross street's bearing?) fit alike: check the bearing, or add a second "
+            "reference"
         )
     if (
         any(c.rival == RIVAL_NEIGHBOUR for c in group)
