@@ -1080,3 +1080,22 @@ def test_the_cross_streets_bearing_is_named_tied_with_the_map_street_it_may_be(
         right = next(c for c, e in zip(res.candidates, errs, strict=True) if e < 5.0)
         assert right.rank in top.ambiguous_with
         assert any("cross street's bearing" in t.why for t in res.ties)
+
+
+def test_an_unrefined_rival_that_fitted_as_well_is_tied_with_the_refined_top() -> None:
+    # absolute_slips --set held-out-3 scene 82, corners_ccw: two corners of a Leeds
+    # roundabout listed counter-clockwise. Before: the top 75 m off at a sigma_m of 10 m, and
+    # the right reading (2.9 m) at 0.085 of it: the top had been refined, the right reading
+    # not, and refinement alone put it under the tie rule's 0.1. Weighed like for like (the
+    # top's weight before refinement), the two tie.
+    m, ls = _replayed("leeds_centre.osm.gz", (53.79891, -1.53450, 600.0), "c643907", [40, 82])
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("references", None)
+    scene["intersection"]["corners"] = scene["intersection"]["corners"][::-1]
+    res = locate(parse_scene(scene), m)
+    errs = _errors(res, ls)
+    top = res.candidates[0]
+    right = [c for c, e in zip(res.candidates, errs, strict=True) if e < 5.0]
+    assert right
+    assert errs[0] < 5.0 or any(c.rank in top.ambiguous_with for c in right)
+    assert top.refined or errs[0] < 5.0
