@@ -1018,7 +1018,7 @@ def main(argv: list[str] | None = None) -> int:
         "junctions, by class (stop 39's; read since); held-out-3: Vaduz, Leeds and "
         "Manhattan, every junction, by class (stop 40's; read since); held-out-4: "
         "Seattle, London (Southwark) and Neudrossenfeld, every junction, by class "
-        "(stop 41's: measure once, at the end)",
+        "(stop 41's; measured once)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)

@@ -363,7 +363,7 @@ def _map_bearing_candidates(
     in and kept through refinement, so that the tie rule names them. Before stop 41 the
     stated bearing was then taken at its word, and where the cross street's reading put the
     car on a street too the answer stood 16-73 m off with no tie and no warning
-    (``bearing_cross_street``: 2 of 109 development scenes, 2 of 133 of held-out-3); a
+    (``bearing_cross_street``: 2 of 109 development scenes, 2 of 143 of held-out-3); a
     one-reference answer's own half turn is tied already in nearly every scene, so the
     rivals add a tie to 2 of 108 right control answers (``control_bearing``).
     """
@@ -398,7 +398,7 @@ def _apart(
     rival within it is the same answer at the accuracy the tie rule asks (it names no tie),
     and kept, it moved the weights of the candidates it stood by (three right one-reference
     answers of ``absolute_slips.py``'s held-out-2 ``control_bearing`` flipped, within their
-    ties, to a reading 48-76 m off)."""
+    ties, to a reading 48-76 m off; left out, two of them no longer do)."""
     if not rivals or not cands:
         return rivals
     here = np.array([c.east_north for c in cands], dtype=float)
