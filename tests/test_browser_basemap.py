@@ -419,7 +419,7 @@ def _under_a_box(page: Any, selector: str) -> list[str]:
 def test_first_view_keeps_markers_clear_of_the_boxes(
     browser: Any, tied_page: Path, tmp_path: Path, size: tuple[int, int]
 ) -> None:
-    """No candidate of the sample (12, spread 70 m) and no camera of a summary page whose
+    """No candidate of the sample (13, spread 70 m) and no camera of a summary page whose
     cameras sit at the corners of their bounds opens under the legend, the title box, the
     banner, the layer list or the verdicts' counter."""
     corners = [
@@ -447,7 +447,7 @@ def test_first_view_keeps_markers_clear_of_the_boxes(
             page.goto(path.resolve().as_uri(), wait_until="load")
             page.wait_for_selector(selector, timeout=30000)
             page.wait_for_timeout(300)  # the phone's folds run after the page's script
-            assert page.locator(selector).count() == (12 if path == tied_page else 4)
+            assert page.locator(selector).count() == (13 if path == tied_page else 4)
             assert _under_a_box(page, selector) == []
             assert blocked == []
         finally:

@@ -35,7 +35,7 @@ def pages(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
     samples = Path(__file__).resolve().parents[1] / "sample_maps"
     tie = locate_scene(samples / "sample_scene.json", map_source=samples / "baltimore.osm.pbf")
-    assert tie.result.candidates[0].ambiguous_with == [2, 4]
+    assert tie.result.candidates[0].ambiguous_with == [2, 4, 5]
     tied = maps.candidates_map(
         tie.result, tie.map_data, out / "tied.html", offline=True, scene=tie.scene
     )
@@ -196,7 +196,7 @@ def test_tied_candidates_are_marked_and_explained(
     assert banner.count() == 1
     assert banner.is_visible()
     text = banner.inner_text()
-    assert "Ambiguous: candidates 1, 2, 3 and 4 all fit the evidence" in text
+    assert "Ambiguous: candidates 1, 2, 3, 4 and 5 all fit the evidence" in text
     assert "symmetric junction" in text
     assert "view_hint" in text
     # the two tied markers: different fill colours, both in the dashed ring with the badge
@@ -219,7 +219,7 @@ def test_tied_candidates_are_marked_and_explained(
         assert style == "dashed"
         # the page is fitted so that the banner hides neither tied candidate
         assert not _overlap(_box(page, f'[data-rank="{rank}"]'), _box(page, ".camloc-banner"))
-    assert page.locator('.camloc-tied:has([data-rank="5"])').count() == 0  # negligible score
+    assert page.locator('.camloc-tied:has([data-rank="6"])').count() == 0  # negligible score
     ARTIFACTS.mkdir(exist_ok=True)
     shot = tmp_path / "tied_map.png"
     page.screenshot(path=str(shot))
@@ -254,7 +254,7 @@ def test_summary_map_rings_a_tied_camera(tab: _Page, pages: dict[str, Any], tmp_
     assert page.locator(".camloc-summary-marker .camloc-tied-arrow").count() == 1
     tab.click_for_popup(page.locator(".camloc-summary-marker .camloc-tied-arrow"))
     text = tab.popup_text()
-    assert "tied with candidates 2 and 4" in text
+    assert "tied with candidates 2, 4 and 5" in text
     assert "odds under 10 to 1" in text
     assert "tied-cam" in text
     assert tab.blocked == []

@@ -330,9 +330,11 @@ def tied() -> Any:
 
     out = locate_scene(BALTIMORE_SCENE, map_source=SAMPLES / "baltimore.osm.pbf")
     res = out.result
-    # 1 and 2 face each other across the junction; 3 and 4 are their near twins (odds 2-8 to 1)
-    assert res.candidates[0].ambiguous_with == [2, 4]
-    assert res.candidates[1].ambiguous_with == [1, 3]
+    # 1 and 2 face each other across the junction; 3 and 4 are their near twins (odds 2-8 to 1);
+    # 5 stands at a same-shaped junction a block away where only one named street meets (stop 41)
+    assert res.candidates[0].ambiguous_with == [2, 4, 5]
+    assert res.candidates[1].ambiguous_with == [1, 3, 5]
+    assert res.candidates[4].rival == "neighbour junction"
     assert any(w.startswith("ambiguous: candidates 1 and 2") for w in res.warnings)
     return out
 
@@ -341,11 +343,13 @@ def test_ties_are_data_decided_in_the_core(tied: Any) -> None:
     """The tie is a field of the result and of its GeoJSON, not only words in a warning."""
     res = tied.result
     assert res.leaders_tie
-    assert [t.ranks for t in res.ties] == [[1, 2, 3, 4]]
+    assert [t.ranks for t in res.ties] == [[1, 2, 3, 4, 5]]
     assert f"ambiguous: {res.ties[0].text}" in res.warnings
     doc = tied.to_geojson()
-    assert doc["properties"]["ties"][0]["ranks"] == [1, 2, 3, 4]
+    assert doc["properties"]["ties"][0]["ranks"] == [1, 2, 3, 4, 5]
     assert "symmetric junction" in doc["properties"]["ties"][0]["why"]
+    # the rival joins the leaders' tie without taking over its reason (stop 41)
+    assert "and candidate 5, at a junction where only some" in doc["properties"]["ties"][0]["why"]
 
 
 @pytest.fixture(scope="module")
@@ -393,15 +397,15 @@ def test_rank_colours_are_distinct_okabe_ito() -> None:
 
 
 def test_tied_candidates_differ_in_colour_and_wear_the_tie_ring(tied_page: str, tied: Any) -> None:
-    one, two, five = (candidate_icon(tied_page, r) for r in (1, 2, 5))
+    one, two, five = (candidate_icon(tied_page, r) for r in (1, 2, 6))
     assert f"background:{maps.rank_colour(1)}" in one
     assert f"background:{maps.rank_colour(2)}" in two
     assert maps.rank_colour(1) != maps.rank_colour(2)
-    assert 'class="camloc-tied" data-tied-with="2,4"' in one
-    assert 'class="camloc-tied" data-tied-with="1,3"' in two
+    assert 'class="camloc-tied" data-tied-with="2,4,5"' in one
+    assert 'class="camloc-tied" data-tied-with="1,3,5"' in two
     assert "camloc-badge" in one
     assert "camloc-badge" in two
-    assert tied.result.candidates[4].ambiguous_with == []  # rank 5: a negligible score
+    assert tied.result.candidates[5].ambiguous_with == []  # rank 6: a negligible score
     assert "camloc-tied" not in five
     assert "camloc-badge" not in five
     # the view cones of ranks 1 and 2 are drawn in their candidate's colour
@@ -417,8 +421,8 @@ def test_tie_banner_says_which_why_and_what_decides(tied_page: str, tied: Any) -
     css, text = banner.split("|", 1)
     assert css == "camloc-banner"
     # 1 and 2 across the junction, each with a near twin (3 beside 1, 4 beside 2): one group
-    assert "Ambiguous: candidates 1, 2, 3 and 4 all fit the evidence" in text
-    scores = [c.score for c in tied.result.candidates[:4]]
+    assert "Ambiguous: candidates 1, 2, 3, 4 and 5 all fit the evidence" in text
+    scores = [c.score for c in tied.result.candidates[:5]]
     assert f"score ratio {min(scores) / max(scores):.2f}" in text
     assert " vs ".join(f"{s:.3f}" for s in scores) in text
     # why: the engine's own warning, and the candidates' (empty) flags
@@ -435,11 +439,13 @@ def test_tie_banner_says_which_why_and_what_decides(tied_page: str, tied: Any) -
     from camloc_geo.maps import _compass
 
     c1, c2 = tied.result.candidates[:2]
-    assert f"{_compass(c1.heading_deg % 360)} or {_compass(c2.heading_deg % 360)}" in text
+    hint = text.split("does it look", 1)[1]  # the directions the hint chooses between
+    assert _compass(c1.heading_deg % 360) in hint
+    assert _compass(c2.heading_deg % 360) in hint
     assert _compass(c1.heading_deg % 360) != _compass(c2.heading_deg % 360)
     # candidates of negligible score tie with nobody (no "also tied" line, no rings)
     assert "Also tied" not in text
-    assert all(not c.ambiguous_with for c in tied.result.candidates[4:])
+    assert all(not c.ambiguous_with for c in tied.result.candidates[5:])
 
 
 def test_tied_popups_name_the_ranks_and_why(tied_page: str, tied: Any) -> None:
@@ -453,8 +459,8 @@ def test_tied_popups_name_the_ranks_and_why(tied_page: str, tied: Any) -> None:
     assert f"Tied with candidates</b> <b>1</b> (score {c1.score:.3f}" in two
     assert f"{gap:.0f} m away, looking {_compass(c1.heading_deg % 360)}" in two
     assert "a symmetric junction cannot tell them apart" in two
-    assert "<tr><th>ambiguous_with</th><td>1, 3</td></tr>" in two
-    five = popup_of(tied_page, 5)
+    assert "<tr><th>ambiguous_with</th><td>1, 3, 5</td></tr>" in two
+    five = popup_of(tied_page, 6)
     assert "Tied with" not in five
     assert "<tr><th>ambiguous_with</th><td>none</td></tr>" in five
 
@@ -537,12 +543,12 @@ def test_summary_map_marks_a_tied_best_candidate(tmp_path: Path, tied: Any) -> N
     icons = div_icons(page, "camloc-summary-marker")
     assert len(icons) == 3
     assert sum("camloc-tied-arrow" in h and "stroke-dasharray" in h for h in icons) == 2
-    assert "≈ <b>tied with candidates 2 and 4</b>" in page
+    assert "≈ <b>tied with candidates 2, 4 and 5</b>" in page
     assert "tied with another candidate: two places match the title equally well" in page
-    assert "cam-tied (0.37) ≈ tied with candidates 2 and 4" in page  # tooltip
+    assert "cam-tied (0.36) ≈ tied with candidates 2, 4 and 5" in page  # tooltip
     assert "2 with a tied best candidate" in page
-    assert "cam-clear (0.37)" in page
-    assert "cam-clear (0.37) ≈" not in page
+    assert "cam-clear (0.36)" in page
+    assert "cam-clear (0.36) ≈" not in page
 
 
 def test_summary_map_heading_tells_located_from_title_only(tmp_path: Path, tied: Any) -> None:
@@ -571,13 +577,13 @@ def test_tiny_scores_are_not_printed_as_zero(tied_page: str, tied: Any) -> None:
     score read as an impossible one. It is now written as 1.1e-15; the leaders keep 0.375."""
     # the legend sits in a script string: <, > and quotes are escaped there
     page = tied_page.replace("\\u003c", "<").replace("\\u003e", ">").replace('\\"', '"')
-    score5 = tied.result.candidates[4].score
+    score5 = tied.result.candidates[5].score
     assert 0 < score5 < 1e-6
-    assert f'data-legend-rank="5">5: {score5:.1e}' in page
-    assert 'data-legend-rank="5">5: 0.000' not in page
+    assert f'data-legend-rank="6">6: {score5:.1e}' in page
+    assert 'data-legend-rank="6">6: 0.000' not in page
     score1 = tied.result.candidates[0].score
     assert f'data-legend-rank="1">1: {score1:.3f}' in page
-    assert f"#5 score {score5:.1e}" in page  # the marker's tooltip
+    assert f"#6 score {score5:.1e}" in page  # the marker's tooltip
 
 
 def test_review_map_names_the_annotators_left_out(

@@ -33,9 +33,9 @@ def test_locate_job_writes_flat_typed_layers(tmp_path):
     )
     layers = res["layers"]
     assert {k: v["count"] for k, v in layers.items()} == {
-        "candidates": 12,
-        "view_cones": 12,
-        "matched_corners": 36,
+        "candidates": 13,
+        "view_cones": 13,
+        "matched_corners": 39,
         "intersection": 5,
     }
     assert layers["candidates"]["fields"] == [list(f) for f in CANDIDATE_FIELDS]
@@ -45,9 +45,10 @@ def test_locate_job_writes_flat_typed_layers(tmp_path):
         for name, typ in CANDIDATE_FIELDS:
             v = f["properties"][name]
             assert v is None or type(v) is types[typ], (name, v)
-    # 1 and 2 across the junction, 3 and 4 their near twins; 5 on scores nothing
-    assert [f["properties"]["tie"] for f in feats[:5]] == [True, True, True, True, False]
-    assert feats[1]["properties"]["ambiguous_with"] == "1,3"
+    # 1 and 2 across the junction, 3 and 4 their near twins, 5 a same-shaped junction a block
+    # away (stop 41); 6 on scores nothing
+    assert [f["properties"]["tie"] for f in feats[:6]] == [True] * 5 + [False]
+    assert feats[1]["properties"]["ambiguous_with"] == "1,3,5"
     assert any("ambiguous" in w for w in res["warnings"])
 
 

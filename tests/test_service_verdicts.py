@@ -1025,8 +1025,9 @@ def test_cli_page_from_a_file_shares_with_the_service(
         page.wait_for_function(
             f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
         )
-        page.locator('.camloc-candidate [data-rank="3"]').click()
-        box = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="3"]')
+        # rank 5 (stop 41: the rival junction a block away) stands clear; 3 sits under 1
+        page.locator('.camloc-candidate [data-rank="5"]').click()
+        box = page.locator('.leaflet-popup-content .camloc-verdict[data-verdict-key="5"]')
         box.locator('button[data-verdict="unsure"]').wait_for(timeout=30000)
         box.locator('button[data-verdict="unsure"]').click()
         keybox = page.locator(".camloc-verdicts form.camloc-vkey")
@@ -1040,7 +1041,7 @@ def test_cli_page_from_a_file_shares_with_the_service(
         page.wait_for_function(
             f"document.querySelector('{share}').textContent.startsWith('shared')", timeout=30000
         )
-        assert client.get(url).json()["items"]["3"]["verdict"] == "unsure"
+        assert client.get(url).json()["items"]["5"]["verdict"] == "unsure"
         assert any(s.startswith("POST ") for s in sent)
         # the same page from an origin the service does not allow: refused, and said
         page.goto(other + "/review.html", wait_until="load")

@@ -2106,6 +2106,20 @@ def _tie_why(group: list[Candidate], default: str) -> str:
         any(c.rival == RIVAL_NEIGHBOUR for c in group)
         and len({c.intersection_id for c in group}) > 1
     ):
+        lead = group[:2]
+        if (
+            all(c.rival is None for c in lead)
+            and lead[0].intersection_id == lead[1].intersection_id
+        ):
+            # the leaders tie at the named junction (a symmetric one); the rival only joins them
+            ranks = [str(c.rank) for c in group if c.rival == RIVAL_NEIGHBOUR]
+            which = ("candidate " if len(ranks) == 1 else "candidates ") + ", ".join(ranks)
+            return (
+                f"{default}; and {which}, at a junction where only some of the named streets "
+                f"meet (a cross street a block away, of the same shape), "
+                f"{'fits' if len(ranks) == 1 else 'fit'} nearly as well: check the cross "
+                "street's name"
+            )
         return (
             "the junction where the named streets meet and a junction where only some of "
             "them meet (a cross street a block away, of the same shape) fit alike: check the "

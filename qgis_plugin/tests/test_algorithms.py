@@ -62,8 +62,8 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     res = _locate(tmp_path)
     cands = _layer(res["CANDIDATES"])
     assert cands.crs().authid() == "EPSG:4326"
-    assert cands.featureCount() == 12
-    assert res["N_CANDIDATES"] == 12
+    assert cands.featureCount() == 13
+    assert res["N_CANDIDATES"] == 13
     types = _types(cands)
     assert types["rank"] in (QVariant.Int, QVariant.LongLong)
     assert types["score"] == QVariant.Double
@@ -72,14 +72,14 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     assert types["flags"] == QVariant.String
     assert types["ambiguous_with"] == QVariant.String
     feats = sorted(cands.getFeatures(), key=lambda f: f["rank"])
-    assert [f["rank"] for f in feats] == list(range(1, 13))
+    assert [f["rank"] for f in feats] == list(range(1, 14))
     scores = [f["score"] for f in feats]
     assert scores == sorted(scores, reverse=True)
     # the sample's symmetric junction: candidates 1 and 2 tie across it (3 and 4 are their
-    # near twins), and say so; 5 on score nothing
-    assert [f["tie"] for f in feats[:5]] == [True, True, True, True, False]
-    assert feats[0]["ambiguous_with"] == "2,4"
-    assert feats[1]["ambiguous_with"] == "1,3"
+    # near twins, 5 a same-shaped junction a block away: stop 41), and say so; 6 on score nothing
+    assert [f["tie"] for f in feats[:6]] == [True] * 5 + [False]
+    assert feats[0]["ambiguous_with"] == "2,4,5"
+    assert feats[1]["ambiguous_with"] == "1,3,5"
     t = truth()
     dists = [
         metres_between(f.geometry().asPoint().y(), f.geometry().asPoint().x(), t["lat"], t["lon"])
@@ -87,9 +87,9 @@ def test_locate_layers_counts_types_and_accuracy(provider, tmp_path):
     ]
     assert min(dists) < 5.0
     assert dists[0] < 5.0  # the best candidate is the true position (to 5 m)
-    assert _layer(res["VIEW_CONES"]).featureCount() == 12
+    assert _layer(res["VIEW_CONES"]).featureCount() == 13
     matched = _layer(res["MATCHED_CORNERS"])
-    assert matched.featureCount() == 36
+    assert matched.featureCount() == 39
     # every layer of a camera names it: cones and matched points merged from several runs
     # (Merge vector layers, one GeoPackage per city) could not be told apart
     sid = json.loads(SAMPLE_SCENE.read_text())["id"]
@@ -448,9 +448,9 @@ def test_outputs_sharing_one_geopackage_each_get_their_table(provider, tmp_path)
     ds = ogr.Open(str(gpkg))
     names = {ds.GetLayer(i).GetName() for i in range(ds.GetLayerCount())}
     assert {"candidates", "view_cones"} <= names
-    assert ds.GetLayerByName("candidates").GetFeatureCount() == 12
-    assert ds.GetLayerByName("view_cones").GetFeatureCount() == 12
-    assert _layer(res["CANDIDATES"]).featureCount() == 12
+    assert ds.GetLayerByName("candidates").GetFeatureCount() == 13
+    assert ds.GetLayerByName("view_cones").GetFeatureCount() == 13
+    assert _layer(res["CANDIDATES"]).featureCount() == 13
     assert _layer(res["VIEW_CONES"]).wkbType() != _layer(res["CANDIDATES"]).wkbType()
     # outputs in files of their own keep QGIS's naming (the table is the file's name)
     assert Path(res["INTERSECTION"].split("|")[0]).name == "intersection.gpkg"
@@ -472,7 +472,7 @@ def test_geopackage_outputs_carry_their_style_when_opened_later(provider, tmp_pa
     assert isinstance(cones.renderer(), QgsRuleBasedRenderer)
     assert cones.customProperty("camloc/kind") == "view_cones"
     # the feature tables are untouched
-    assert cands.featureCount() == 12
+    assert cands.featureCount() == 13
 
 
 def test_every_optional_input_says_what_empty_means(provider):
@@ -525,12 +525,12 @@ def test_run_and_load_again_into_the_same_geopackage(provider, tmp_path):
     }
     for _ in range(3):
         res = processing.runAndLoadResults("camloc:locate", params)
-        assert res["N_CANDIDATES"] == 12
+        assert res["N_CANDIDATES"] == 13
     assert any(lyr.source().startswith(str(tmp_path)) for lyr in project.mapLayers().values())
     fresh = QgsVectorLayer(res["CANDIDATES"], "fresh", "ogr")  # its default style, once more
     assert isinstance(fresh.renderer(), QgsRuleBasedRenderer)
     assert fresh.customProperty("camloc/kind") == "candidates"
-    assert fresh.featureCount() == 12
+    assert fresh.featureCount() == 13
     project.clear()
 
 
@@ -564,7 +564,7 @@ def test_run_and_load_into_named_files_styles_every_layer(provider, artifacts, e
         res = processing.runAndLoadResults("camloc:locate", params)
     finally:
         settings.setValue(key, before) if before is not None else settings.remove(key)
-    assert res["N_CANDIDATES"] == 12
+    assert res["N_CANDIDATES"] == 13
     sid = json.loads(SAMPLE_SCENE.read_text())["id"]
     loaded = {lyr.customProperty("camloc/kind"): lyr for lyr in project.mapLayers().values()}
     assert set(loaded) == {"candidates", "view_cones", "matched_corners", "intersection"}
@@ -573,7 +573,7 @@ def test_run_and_load_into_named_files_styles_every_layer(provider, artifacts, e
         assert isinstance(lyr.renderer(), QgsRuleBasedRenderer), kind
         assert lyr.name().endswith(f"({sid})"), lyr.name()
     cands = loaded["candidates"]
-    assert cands.featureCount() == 12
+    assert cands.featureCount() == 13
     assert cands.labelsEnabled()
     assert cands.renderer().rootRule().children()[0].filterExpression() == '"tie"'
     order = [n.layer().customProperty("camloc/kind") for n in project.layerTreeRoot().findLayers()]

@@ -50,7 +50,7 @@ def test_batch_rows_load_styled_layers_named_after_their_scene(provider, tmp_pat
         context = dataobjects.createContext(feedback)
         results, ok = alg.run(params, context, feedback)
         assert ok, results
-        assert results["N_CANDIDATES"] == 12
+        assert results["N_CANDIDATES"] == 13
         assert "MATCHED_CORNERS" not in results
         assert handleAlgorithmResults(alg, context, feedback, False, params)
     layers = {lyr.name(): lyr for lyr in project.mapLayers().values()}
@@ -60,7 +60,7 @@ def test_batch_rows_load_styled_layers_named_after_their_scene(provider, tmp_pat
     for i, sid in enumerate(ids):
         cands = layers[f"Camera candidates ({sid})"]
         assert cands.source().startswith(str(tmp_path / f"row{i}_candidates.gpkg"))
-        assert cands.featureCount() == 12
+        assert cands.featureCount() == 13
         assert {f["scene"] for f in cands.getFeatures()} == {sid}
         assert isinstance(cands.renderer(), QgsRuleBasedRenderer)
         assert cands.labelsEnabled()
@@ -85,7 +85,7 @@ def test_model_locate_feeds_corners_and_a_native_filter(provider, tmp_path):
         },
     )
     cands = QgsVectorLayer(res["locate:candidates"], "c", "ogr")
-    assert cands.featureCount() == 12
+    assert cands.featureCount() == 13
     # the GeoPackage a child wrote carries camloc's default style
     assert isinstance(cands.renderer(), QgsRuleBasedRenderer)
     best = list(QgsVectorLayer(res["best:best"], "b", "ogr").getFeatures())
@@ -124,7 +124,7 @@ def test_model_outputs_loaded_keep_the_model_names_and_camloc_styles(provider, t
     assert sorted(layers) == ["best", "candidates", "corners"]
     assert layers["candidates"].customProperty("camloc/kind") == "candidates"
     assert isinstance(layers["candidates"].renderer(), QgsRuleBasedRenderer)
-    assert layers["candidates"].featureCount() == 12
+    assert layers["candidates"].featureCount() == 13
     assert layers["corners"].customProperty("camloc/kind") == "corners"
     assert layers["best"].featureCount() == 1
     project.clear()
@@ -149,7 +149,7 @@ def test_model_with_camloc_options_left_unset_validates_and_runs(provider, tmp_p
             "best:best": str(tmp_path / "best.gpkg"),
         },
     )
-    assert QgsVectorLayer(res["locate:candidates"], "c", "ogr").featureCount() == 12
+    assert QgsVectorLayer(res["locate:candidates"], "c", "ogr").featureCount() == 13
     assert QgsVectorLayer(res["best:best"], "b", "ogr").featureCount() == 1
     corners = QgsVectorLayer(res["corners:corners"], "k", "ogr")
     assert [f["kind"] for f in corners.getFeatures()].count("intersection") >= 1

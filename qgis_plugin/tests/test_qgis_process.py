@@ -76,12 +76,12 @@ def test_qgis_process_runs_locate_on_the_sample(profile_home, tmp_path):
         timeout=300,
     )
     assert r.returncode == 0, r.stdout + r.stderr
-    assert "N_CANDIDATES:\t12" in r.stdout
+    assert "N_CANDIDATES:\t13" in r.stdout
     from osgeo import ogr
 
     ds = ogr.Open(str(out))
     layer = ds.GetLayer(0)
-    assert layer.GetFeatureCount() == 12
+    assert layer.GetFeatureCount() == 13
     defn = layer.GetLayerDefn()
     types = {
         defn.GetFieldDefn(i).GetName(): defn.GetFieldDefn(i).GetTypeName()
@@ -190,7 +190,7 @@ def test_qgis_process_reads_relative_paths_from_the_shell_folder(profile_home, t
     from osgeo import ogr
 
     cand_ds = ogr.Open(str(tmp_path / "cand.gpkg"))  # keep the dataset: its layer needs it
-    assert cand_ds.GetLayer(0).GetFeatureCount() == 12
+    assert cand_ds.GetLayer(0).GetFeatureCount() == 13
     cams_ds = ogr.Open(str(tmp_path / "cams.gpkg"))
     assert [f.GetField("status") for f in cams_ds.GetLayer(0)] == ["title_only"]
 
@@ -231,7 +231,7 @@ def test_qgis_process_runs_a_model_chaining_camloc_algorithms(
         return [f.items() for f in ds.GetLayer(0)], ds
 
     cands, ds = rows("c.gpkg")
-    assert len(cands) == 12
+    assert len(cands) == 13
     assert ds.GetLayerByName("layer_styles").GetFeatureCount() == 1  # camloc's default style
     best, _ = rows("b.gpkg")
     first = next(c for c in cands if c["rank"] == 1)
