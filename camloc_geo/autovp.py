@@ -3072,8 +3072,11 @@ def detect_vanishing_points(
         # The k1 term joins the stated sigma last: it says how far the answer would move
         # were the bowing not the lens's, so it neither weighs the rival frames nor calls in
         # the default prior (which would pull a right k1 fit's answer toward what cameras
-        # are: a -0.15 barrel lens's focal length from +4 % to +10 %).
-        best.logf_std = min(math.hypot(best.logf_std, k1_move), _MAX_STATED_STD)
+        # are: a -0.15 barrel lens's focal length from +4 % to +10 %). It widens the sigma
+        # up to the default prior's (what cameras are) at most: a move beyond it says no
+        # more (a photo of 2-4 lines in two directions moved by the bounds).
+        cap = max(best.logf_std, _default_focal_prior(float(w), float(h))[1])
+        best.logf_std = min(math.hypot(best.logf_std, k1_move), cap, _MAX_STATED_STD)
     info: dict[str, Any] = {}
     if np.count_nonzero(best.labels >= 0) >= 4:
         _refine(
@@ -3145,8 +3148,9 @@ def detect_vanishing_points(
         if k1_move > _K1_MOVE_WARN:
             result.warnings.append(
                 f"the lens distortion fitted (k1 = {k1_est:+.3f}) moves the focal length by "
-                f"{100 * k1_move:.0f} % from the straight-lens reading (k1 = 0), which the "
-                "sigma includes: edges that are not straight can pose as lens distortion; "
+                f"{100 * math.expm1(k1_move):.0f} % from the straight-lens reading (k1 = 0), "
+                "which the sigma includes: edges that are not straight can pose as lens "
+                "distortion; "
                 "give --distortion 0 for a phone (which corrects its lens), or "
                 "--distortion K1 or --focal-px if known"
             )
