@@ -18,6 +18,7 @@ _TERMS = {
     "few_lines",
     "principal_point",
     "rival",
+    "distortion",
 }
 
 
