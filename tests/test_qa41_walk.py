@@ -32,3 +32,25 @@ def test_summary_map_given_a_batch_geopackage_names_batch_map(
     assert "camloc batch itself, with --map SUMMARY.html" in err
     assert "Traceback" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("name", "tie"), [("batch_cameras", '"tie"'), ("job_cameras", '"ambiguous"')]
+)
+def test_a_tied_camera_is_drawn_apart_in_the_stored_styles(name: str, tie: str) -> None:
+    """A list's cameras were all one red triangle labelled 'a located', a camera whose best
+    candidate ties with another 61 m away as sure-looking as any (the batch GeoPackage and the
+    job's, in the QGIS desktop). The stored styles (``make_batch_styles.py``) now draw a tied
+    camera apart and end its label with '≈ tie'; QGIS itself checks the drawing in
+    ``qgis_plugin/tests/test_batch_styles.py``."""
+    import xml.etree.ElementTree as ET
+
+    qml = ET.parse(REPO / "camloc_geo" / "data" / "qgis_styles" / f"{name}.qml").getroot()
+    rules = [(r.get("filter"), r.get("label")) for r in qml.iter("rule")]
+    assert rules[0][0] == tie
+    assert rules[0][1].startswith("camera placed at a tied candidate")
+    assert rules[1] == ("ELSE", "camera placed")
+    labels = [s.get("fieldName") for s in qml.iter("text-style")]
+    assert any(f"CASE WHEN {tie} THEN ' ≈ tie'" in (x or "") for x in labels), labels
+    sld = (REPO / "camloc_geo" / "data" / "qgis_styles" / f"{name}.sld").read_text("utf-8")
+    assert "<ogc:PropertyName>" + tie.strip('"') + "</ogc:PropertyName>" in sld
