@@ -54,3 +54,20 @@ def test_a_tied_camera_is_drawn_apart_in_the_stored_styles(name: str, tie: str) 
     assert any(f"CASE WHEN {tie} THEN ' ≈ tie'" in (x or "") for x in labels), labels
     sld = (REPO / "camloc_geo" / "data" / "qgis_styles" / f"{name}.sld").read_text("utf-8")
     assert "<ogc:PropertyName>" + tie.strip('"') + "</ogc:PropertyName>" in sld
+
+
+@pytest.mark.parametrize("cluster", [True, False])
+def test_a_tied_cameras_popup_says_where_to_choose(tmp_path: Path, cluster: bool) -> None:
+    """A summary page's popup of a tied best candidate said "see the camera's review page",
+    a page a job's summary (``GET /v1/jobs/{id}/map``) or a batch's has not, while the popup
+    itself offers the other candidates ('or the camera is candidate…')."""
+    located = tmp_path / "cam.geojson"
+    scene = REPO / "sample_maps" / "sample_scene.json"
+    osm = REPO / "sample_maps" / "baltimore.osm.pbf"
+    assert main(["locate", str(scene), "--osm", str(osm), "--offline", "-o", str(located)]) == 0
+    out = tmp_path / "s.html"
+    args = ["summary-map", str(located), "-o", str(out), "--offline"]
+    assert main(args if cluster else [*args, "--no-cluster"]) == 0
+    page = out.read_text(encoding="utf-8")
+    assert "the camera may stand at a tied candidate instead" in page
+    assert "see the camera's review page" not in page
