@@ -71,3 +71,42 @@ def test_a_tied_cameras_popup_says_where_to_choose(tmp_path: Path, cluster: bool
     page = out.read_text(encoding="utf-8")
     assert "the camera may stand at a tied candidate instead" in page
     assert "see the camera's review page" not in page
+
+
+def test_a_list_run_without_any_map_says_so_once(tmp_path: Path) -> None:
+    """``camloc batch`` (and QGIS's geocodelist) without an extract and with the network off
+    ended every camera no_map, exit 0, with the reason only per camera in the GeoPackage
+    (session 41 QA): the run now says it once, in the summary's warnings (stderr, the
+    Processing log)."""
+    from camloc_geo.batch import run_batch
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title,lat,lon\na,Eastern Ave & Broadway,39.2857,-76.5933\n", "utf-8")
+    summary = run_batch(lst, out_gpkg=tmp_path / "o.gpkg", progress=False, workers=1)
+    assert summary.statuses == {"no_map": 1}
+    said = [w for w in summary.warnings if "this run had no map" in w]
+    assert said == [
+        "1 camera(s) no_map: this run had no map (no extract, the network off): give --osm "
+        "EXTRACT_OR_FOLDER or allow --network"
+    ]
+    # with an extract: no such warning
+    osm = REPO / "sample_maps" / "baltimore.osm.pbf"
+    again = run_batch(lst, out_gpkg=tmp_path / "p.gpkg", map_source=osm, progress=False, workers=1)
+    assert not [w for w in again.warnings if "no map" in w]
+
+
+def test_a_geojson_list_without_a_feature_is_named_as_geojson(tmp_path: Path) -> None:
+    """It said "no row under its header", a CSV's words, of a GeoJSON list."""
+    from camloc_geo import InputError
+    from camloc_geo.batch import run_batch
+
+    lst = tmp_path / "cams.geojson"
+    lst.write_text('\ufeff {"type": "FeatureCollection", "features": []}', "utf-8")
+    with pytest.raises(
+        InputError, match=r"holds no camera \(no feature in its FeatureCollection\)"
+    ):
+        run_batch(lst, out_gpkg=tmp_path / "o.gpkg", progress=False, workers=1)
+    csv = tmp_path / "cams.csv"
+    csv.write_text("id,title\n", "utf-8")
+    with pytest.raises(InputError, match=r"no row under its header"):
+        run_batch(csv, out_gpkg=tmp_path / "c.gpkg", progress=False, workers=1)

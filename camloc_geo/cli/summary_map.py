@@ -213,8 +213,11 @@ def _refuse_a_batch_geopackage(path: str) -> None:
     file (camloc locate output) (a GeoPackage or SQLite database)", with no word of the page
     ``camloc batch --map`` writes (session 41 QA).
     """
+    p = Path(path)
     try:
-        with open(path, "rb") as fh:
+        if not p.is_file():  # a pipe (<(...)), a device: read once, by read_json_file
+            return
+        with open(p, "rb") as fh:
             head = fh.read(64)
     except OSError:
         return  # read_json_file names it
