@@ -141,6 +141,26 @@ junctions, and Vaduz's town hall square), by junction class, seed :data:`HELD_OU
 150 cameras, the 22 slips. Measured once, at the end."""
 HELD_OUT_3_SEED = 40
 """The third held-out set's seed."""
+HELD_OUT_4_PLACES = [
+    ("seattle_roosevelt.osm.gz", 47.66569, -122.31744, 1500.0),
+    ("seattle_northgate.osm.gz", 47.70862, -122.32511, 1500.0),
+    ("seattle_montlake.osm.gz", 47.64405, -122.30376, 1500.0),
+    ("london_st_georges.osm.gz", 51.49570, -0.10344, 1500.0),
+    ("london_borough.osm.gz", 51.50100, -0.09274, 1500.0),
+    ("neudrossenfeld.osm.pbf", 50.01600, 11.50500, 1500.0),
+]
+"""``--set held-out-4``: fixed (stop 41) before any result on it. Three places of different
+kinds that no benchmark had sampled (``data/osm/SOURCES.md``): Seattle (a US arterial grid:
+Roosevelt Way, Northgate Way's dual carriageway, Montlake Boulevard by the SR 520 ramps),
+London south of the river (St George's Circus, Elephant and Castle, Borough High Street:
+left-hand traffic, dual carriageways) and Neudrossenfeld (a Franconian village and its
+hamlets north-west of Bayreuth: T junctions on country roads). Every oracle junction within
+the radius (the centres are the median of each extract's oracle junctions; Neudrossenfeld's
+is the village), by junction class, seed :data:`HELD_OUT_4_SEED`, ``--n 150`` (as many
+cameras as there are junctions, up to 150), the 22 slips. Measured once, at the end, with
+main's code and the branch's."""
+HELD_OUT_4_SEED = 41
+"""The fourth held-out set's seed."""
 
 
 def held_out_2_places() -> list[tuple[str, float, float, float]]:
@@ -748,7 +768,7 @@ def run(
         order = _order_held_out(n, maps)
     elif which == "held-out-2":
         order = _order_held_out(n, maps, skip=HELD_OUT_2_SKIP)
-    elif which in ("held-out-3", "dev-classes"):
+    elif which in ("held-out-3", "held-out-4", "dev-classes"):
         order = _order_held_out(n, maps, skip=0)
     else:
         order = _order_dev(n, maps)
@@ -986,17 +1006,19 @@ def main(argv: list[str] | None = None) -> int:
         "--seed",
         type=int,
         default=None,
-        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3)",
+        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3), 41 (held-out-4)",
     )
     ap.add_argument(
         "--set",
-        choices=("dev", "dev-classes", "held-out", "held-out-2", "held-out-3"),
+        choices=("dev", "dev-classes", "held-out", "held-out-2", "held-out-3", "held-out-4"),
         default="dev",
         help="dev: absolute.py's junctions; dev-classes: DEV_CLASS_PLACES by junction "
         "class; held-out: HELD_OUT_PLACES by junction class (stop 38's; read since: "
         "development now); held-out-2: the unseen cities beyond their 30 nearest "
         "junctions, by class (stop 39's; read since); held-out-3: Vaduz, Leeds and "
-        "Manhattan, every junction, by class (measure once, at the end)",
+        "Manhattan, every junction, by class (stop 40's; read since); held-out-4: "
+        "Seattle, London (Southwark) and Neudrossenfeld, every junction, by class "
+        "(stop 41's; measured once)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -1020,6 +1042,7 @@ def main(argv: list[str] | None = None) -> int:
             "held-out": HELD_OUT_SEED,
             "held-out-2": HELD_OUT_2_SEED,
             "held-out-3": HELD_OUT_3_SEED,
+            "held-out-4": HELD_OUT_4_SEED,
         }.get(args.set, 0)
     t0 = time.perf_counter()
     maps = {}
@@ -1028,6 +1051,7 @@ def main(argv: list[str] | None = None) -> int:
         "dev-classes": DEV_CLASS_PLACES,
         "held-out-2": held_out_2_places(),
         "held-out-3": HELD_OUT_3_PLACES,
+        "held-out-4": HELD_OUT_4_PLACES,
     }.get(args.set, PLACES)
     for name, lat, lon, r in places:
         try:

@@ -12,6 +12,10 @@ Usage::
                                   the fresh batches 8, 9 and 10, each only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
+    python benchmarks/vp_real.py --sets street-photos --prior-at-truth [--no-exif-kept]
+                                 (also the EXIF-stripped photos with the default focal
+                                  prior centred on each one's truth: a simulation of a
+                                  camera the default prior matches, its own labelled run)
     python benchmarks/vp_real.py --sets street-synth-dev [--synth-photos 40]
 
 The photos (none of them is in this repository; their licences keep them out):
@@ -191,6 +195,7 @@ Writes ``benchmarks/out/vp_real.json`` and ``vp_real_*.png``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import logging
 import math
@@ -208,7 +213,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from vp_yud import horizon_auc, load_yud
 
 from camloc_geo import NotEnoughStructureError, autovp
-from camloc_geo.autovp import detect_vanishing_points, horizon_from_up, pitch_roll_from_up
+from camloc_geo.autovp import (
+    detect_vanishing_points,
+    horizon_from_up,
+    load_image,
+    pitch_roll_from_up,
+)
 
 log = logging.getLogger("vp_real")
 
@@ -672,6 +682,11 @@ STREET_PHOTOS = HERE / "street_photos.json"
 #: The halves of the street photos of batches 1-7 (set ``street-photos``), fixed by a rule
 #: before any result was read.
 STREET_PHOTO_HALVES = ("dev", "held-out")
+#: The ``--prior-at-truth`` run's name: EXIF stripped, the default focal prior centred on
+#: each photo's truth (a simulation of a camera the default prior matches, not a headline).
+PRIOR_AT_TRUTH_RUN = "SIMULATION prior at truth, no EXIF"
+#: Issue 24's EXIF-stripped bars judged on that run (``vp_real.json``'s summary key).
+SIM_BARS = "issue 24 bars, SIMULATION prior at truth"
 #: Fresh held-out batches, each its own set (``street-photos-<half>``), loaded only when
 #: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
 #: one had run ``camloc vp`` on, measured once at the end of stop 39 (development since), and
@@ -977,7 +992,58 @@ def rival_calibration(rows: list[dict[str, Any]], min_d: float = 0.03) -> dict[s
     return {"n_beyond_own": n, "expected_at_rival": expected, "observed_nearer": observed}
 
 
-def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict[str, Any]]:
+class _PriorAtTruth:
+    """Centres ``autovp``'s default focal prior on one photo's true focal length while a
+    ``detect_vanishing_points`` call runs (a diagnostic: ``--prior-at-truth``).
+
+    Both the wide prior the hypotheses are scored with (``_F_PRIOR_REL``) and the default
+    prior a loose photo is combined with (``_default_focal_prior``: its centre only, the
+    sigma kept) are moved. What misses remain are the ones the photo's lines make: a
+    simulation of a camera whose focal length the default prior matches (issue 24's phone
+    at 0.97 times the longer side sits near ``_F_PRIOR_REL`` = 1.0), never a headline.
+    """
+
+    def __init__(self, focal_rel: float) -> None:
+        self.focal_rel = float(focal_rel)
+
+    def __enter__(self) -> _PriorAtTruth:
+        self._rel, self._default = autovp._F_PRIOR_REL, autovp._default_focal_prior
+        focal_rel, default = self.focal_rel, self._default
+
+        def at_truth(width_px: float, height_px: float) -> tuple[float, float]:
+            return focal_rel, default(width_px, height_px)[1]
+
+        vars(autovp)["_F_PRIOR_REL"] = focal_rel
+        vars(autovp)["_default_focal_prior"] = at_truth
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        vars(autovp)["_F_PRIOR_REL"] = self._rel
+        vars(autovp)["_default_focal_prior"] = self._default
+
+
+def run(
+    data: list[dict[str, Any]], use_exif: bool, prior_at_truth: bool = False, **options: Any
+) -> list[dict[str, Any]]:
+    """Run ``detect_vanishing_points`` on each photo and compare it with the truth.
+
+    Parameters
+    ----------
+    data
+        Truth records (the loaders').
+    use_exif
+        Read the photo's EXIF focal length as a prior.
+    prior_at_truth
+        Centre the default focal prior on each photo's true focal length (same sigma;
+        :class:`_PriorAtTruth`): a diagnostic that leaves only the misses the lines make.
+    **options
+        Passed to ``detect_vanishing_points``.
+
+    Returns
+    -------
+    list of dict
+        One row a photo.
+    """
     rows = []
     for t in data:
         t0 = time.perf_counter()
@@ -991,8 +1057,14 @@ def run(data: list[dict[str, Any]], use_exif: bool, **options: Any) -> list[dict
             row["half"] = t["half"]
         if t["up"] is not None:
             row["pitch_true_deg"] = pitch_roll_from_up(t["up"])[0]
+        size = t.get("size")
+        if prior_at_truth and size is None:
+            size = load_image(t["path"]).shape[1::-1]
+        focal_rel = t["f"] / max(size) if prior_at_truth and size is not None else None
         try:
-            with _RivalRecorder() as rec:
+            with _RivalRecorder() as rec, contextlib.ExitStack() as stack:
+                if focal_rel is not None:
+                    stack.enter_context(_PriorAtTruth(focal_rel))
                 res = detect_vanishing_points(t["path"], seed=0, use_exif=use_exif, **options)
         except NotEnoughStructureError as exc:
             row.update(error=str(exc), time_s=time.perf_counter() - t0)
@@ -1376,6 +1448,19 @@ def main(argv: list[str] | None = None) -> int:
         default=STREET_PHOTOS,
         help="the handheld street photos' manifest (files relative to --drive-photos)",
     )
+    ap.add_argument(
+        "--prior-at-truth",
+        action="store_true",
+        help="also run EXIF stripped with the default focal prior centred on each photo's "
+        "true focal length (same sigma): a diagnostic simulation of a camera the default "
+        "prior matches (issue 24's phone), leaving the misses the lines make; its own row, "
+        "never the headline",
+    )
+    ap.add_argument(
+        "--no-exif-kept",
+        action="store_true",
+        help="skip the run with the EXIF prior (only the EXIF-stripped runs)",
+    )
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     wanted = set(args.sets.split(","))
@@ -1435,7 +1520,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.bias_deg is not None:
         opts["bias_deg"] = args.bias_deg
     runs = {"no EXIF": run(data, use_exif=False, **opts)}
-    exif_data = [t for t in data if t.get("exif")]
+    if args.prior_at_truth:
+        runs[PRIOR_AT_TRUTH_RUN] = run(data, use_exif=False, prior_at_truth=True, **opts)
+    exif_data = [t for t in data if t.get("exif")] if not args.no_exif_kept else []
     if exif_data:
         runs["EXIF prior"] = run(exif_data, use_exif=True, **opts)
     summary: dict[str, Any] = {}
@@ -1485,6 +1572,14 @@ def main(argv: list[str] | None = None) -> int:
             )
     if bars:
         summary["issue 24 bars"] = bars
+    # the same bars on the simulation (EXIF stripped only), under its own label
+    sim_bars = {
+        key: issue24_bars(summary[PRIOR_AT_TRUTH_RUN].get(key), None)
+        for key in bars
+        if PRIOR_AT_TRUTH_RUN in summary
+    }
+    if sim_bars:
+        summary[SIM_BARS] = sim_bars
     args.out.mkdir(parents=True, exist_ok=True)
     with open(args.out / "vp_real.json", "w", encoding="utf-8") as fh:
         json.dump({"summary": summary, "per_image": runs}, fh, indent=1, default=float)
@@ -1510,16 +1605,16 @@ def main(argv: list[str] | None = None) -> int:
         ("roll_median_err_over_sigma", "r err/sig", "{:.2f}"),
         ("n_refused", "refused", "{}"),
     ]
-    lines = [f"{'run / set':40s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
+    lines = [f"{'run / set':60s} " + " ".join(f"{k[1]:>12s}" for k in keys)]
     for tag, per in summary.items():
-        if tag == "issue 24 bars":
+        if tag in ("issue 24 bars", SIM_BARS):
             continue
         for s, sm in per.items():
             cells = []
             for k, _, fmt in keys:
                 v = sm.get(k)
                 cells.append(f"{'-' if v is None else fmt.format(v):>12s}")
-            lines.append(f"{(tag + ' / ' + s):40s} " + " ".join(cells))
+            lines.append(f"{(tag + ' / ' + s):60s} " + " ".join(cells))
     for s, sm in summary.get("no EXIF", {}).items():
         if sm.get("n_vertical_bias"):
             conv_rms = sm.get("vertical_convergence_rms_deg")
@@ -1543,14 +1638,15 @@ def main(argv: list[str] | None = None) -> int:
                 + "; median "
                 + ", ".join(f"{k} {v:.3f}" for k, v in st["median"].items())
             )
-    for key, judged in bars.items():
-        for name, b in judged.items():
-            if b["value"] is None:
-                continue
-            verdict = "met" if b["met"] else "NOT met"
-            lines.append(
-                f"issue 24 bar / {key} / {name}: {b['value']:.3f} (bar {b['bar']:.3f}) {verdict}"
-            )
+    for label, judged_bars in (("issue 24 bar", bars), ("issue 24 bar, SIMULATION", sim_bars)):
+        for key, judged in judged_bars.items():
+            for name, b in judged.items():
+                if b["value"] is None:
+                    continue
+                verdict = "met" if b["met"] else "NOT met"
+                lines.append(
+                    f"{label} / {key} / {name}: {b['value']:.3f} (bar {b['bar']:.3f}) {verdict}"
+                )
     log.info("\n".join(lines))
     return 0
 

@@ -45,6 +45,12 @@ Each of these the photo's tags give is read:
     a photo 16:10 or wider reads the tag both ways (on its own diagonal and on the 4:3
     frame, or 3:2 where the tag's frame is 15 mm across or more) and takes their equal
     mixture, its sigma covering both (about 6 %), said in ``ExifFocal.notes`` (and the log).
+    A photo narrower than 4:3 (a phone's 1:1 mode, 5:4) is cut from the sensor at its full
+    height, and phones write the tag for the whole frame: on the square's own diagonal it
+    reads 15 % low (a Galaxy S8's square photos; found on stop 41's held-out batch 10 after
+    its one run). Where the table gives the sensor's width and the tag's crop factor fits
+    its 4:3 or 3:2 frame, the tag is read on that frame, its height the photo's shorter
+    side; otherwise both readings make an equal mixture (about 9 % for a square).
 
 How they combine
 ----------------
@@ -78,8 +84,9 @@ table reading is wrong, and shows as an ``exif-conflict`` with its 35 mm tag whe
 has one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
 whose tags imply 5.6-5.7 mm: 7 %, within the 2 sigmas that make a conflict). A 16:9 photo of
 a natively 16:9 sensor the table lacks (a Galaxy S5) gets the mixture, 4 % off its own
-diagonal's right reading. A near-square photo's 35 mm tag is read on its own diagonal (a 1:1
-crop of a 4:3 sensor reads it about 15 % low). ``DigitalZoomRatio`` is not applied.
+diagonal's right reading. A photo of a natively square (or 5:4) frame whose sensor the
+table lacks gets the near-square mixture below, 8 % off its own diagonal's right reading.
+``DigitalZoomRatio`` is not applied.
 """
 
 from __future__ import annotations
@@ -498,6 +505,7 @@ def _readings(
     out: list[_Reading] = []
     notes: list[str] = []
     width_mm: float | None = None  # the sensor width the photo's longer side spans
+    square_sensor_mm: float | None = None  # a near-square photo's camera's sensor width
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
     lo_w, hi_w = SENSOR_WIDTH_PLAUSIBLE_MM
     if f_mm is not None:
@@ -529,6 +537,7 @@ def _readings(
             if got is not None and lo_w <= got[0] <= hi_w:
                 sw, origin = got
                 if aspect < _TABLE_MIN_ASPECT:
+                    square_sensor_mm = sw
                     notes.append(
                         f"no sensor-table reading: a {width_px}x{height_px} photo is narrower "
                         "than 4:3, so its longer side need not span the sensor's width"
@@ -546,7 +555,12 @@ def _readings(
                     )
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
     if f35 is not None and F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
-        out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
+        if aspect < _TABLE_MIN_ASPECT:
+            out.extend(
+                _reading_35mm_square(f35, f_mm, square_sensor_mm, longer, shorter, own_ratio, notes)
+            )
+        else:
+            out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
     return out, notes
 
 
@@ -597,6 +611,58 @@ def _reading_35mm(
         )
         return [_Reading("exif-35mm", math.sqrt(f_a * f_b), sigma, f"{what} (read two ways)")]
     return [_Reading("exif-35mm", on(own_ratio), SIGMA_35MM, what)]
+
+
+def _reading_35mm_square(
+    f35: float,
+    f_mm: float | None,
+    sensor_w_mm: float | None,
+    longer: float,
+    shorter: float,
+    own_ratio: float,
+    notes: list[str],
+) -> list[_Reading]:
+    """The 35 mm tag of a photo narrower than 4:3 (a phone's square mode, 5:4), read on the
+    frame it was written for.
+
+    Such a photo is usually cut from a 4:3 (or 3:2) sensor at its full height, and phones
+    write the tag for the sensor's whole frame: on the square's own diagonal it reads 15 %
+    low (a Galaxy S8's 1:1 photos, stop 41). Where the table gives the sensor's width and the
+    tag's crop factor (``43.27 * FocalLength / f35``, its frame's diagonal in millimetres)
+    fits that sensor's 4:3 or 3:2 frame, the tag is read on that frame, its height the
+    photo's shorter side. Where it cannot be told, both readings (the photo's own diagonal,
+    and the 4:3 frame at full height, or 3:2 for a frame 15 mm across or more) make an
+    equal mixture whose sigma covers both.
+    """
+    D = FULL_FRAME_DIAGONAL_MM
+    own = f35 * longer * own_ratio / D  # on the photo's own diagonal
+    aspect = longer / shorter
+    full_height = {"4:3": 5.0 / 3.0, "3:2": math.hypot(3.0, 2.0) / 2.0}  # diagonal / height
+    what = f"FocalLengthIn35mmFilm {f35:g} mm"
+    frame_mm = D * f_mm / f35 if f_mm is not None else None
+    if frame_mm is not None and sensor_w_mm is not None:
+        k = frame_mm / sensor_w_mm  # the tag's frame on this sensor: diagonal / width
+        best = min(_FRAME_RATIOS, key=lambda c: abs(math.log(k / _FRAME_RATIOS[c])))
+        if abs(math.log(k / _FRAME_RATIOS[best])) < _FRAME_TOL:
+            notes.append(
+                f"the {f35:g} mm 35 mm tag is written for the {sensor_w_mm:g} mm sensor's "
+                f"{best} frame (its crop factor says so), not for this photo's "
+                f"{aspect:.2f}:1 crop: read on that frame at the photo's height"
+            )
+            f = f35 * shorter * full_height[best] / D
+            return [_Reading("exif-35mm", f, SIGMA_35MM, f"{what} ({best} frame)")]
+    large = frame_mm is not None and frame_mm >= _LARGE_SENSOR_DIAGONAL_MM
+    name = "3:2" if large else "4:3"
+    f_b = f35 * shorter * full_height[name] / D
+    d = math.log(f_b / own)
+    sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
+    notes.append(
+        f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the "
+        f"sensor's {name} frame at the photo's height ({f_b:.0f} px) or for the photo's own "
+        f"({own:.0f} px); the sensor's width is not known: the prior covers both, "
+        f"{math.sqrt(own * f_b):.0f} px +/- {100 * sigma:.0f} %"
+    )
+    return [_Reading("exif-35mm", math.sqrt(own * f_b), sigma, f"{what} (read two ways)")]
 
 
 def focal_from_exif(

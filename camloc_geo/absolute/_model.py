@@ -268,6 +268,9 @@ class Candidate:
     intersection_id: str | None = None  # the junction a corners hypothesis stands at
     log_prior_odds: float = 0.0  # the hypothesis' prior odds (an alternative reading), in
     # log_likelihood: kept when the candidate is refined and scored again
+    rival: str | None = None  # what kind of rival reading it is, for the tie's words
+    unrefined_log_weight: float | None = None  # a refined candidate's weight before it was
+    # refined (the tie rule weighs an unrefined rival against it)
     evidence: Any = field(default=None, repr=False, compare=False)  # what it was scored on
 
     @property
