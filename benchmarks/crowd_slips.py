@@ -366,6 +366,32 @@ SLIPS: dict[str, Slip] = {
 
 
 # --------------------------------------------------------------------------- scoring
+def names_annotator(warning: str, who: str, index: int) -> bool:
+    """Whether ``warning`` names the annotator ``who`` at ``annotations[index]``.
+
+    A warning names an annotator either by its id, quoted (``'w2'``) or in brackets
+    (``(w2)``), or by its place in the scene (``annotations[1]``, ``annotations[1].vp_lines``);
+    either counts. ``annotations[1]`` does not name ``annotations[10]``.
+
+    Parameters
+    ----------
+    warning : str
+        One of the calibration's warnings.
+    who : str
+        The annotator's id (``"anonymous"`` where the scene gives none).
+    index : int
+        The annotator's index in the scene's ``annotations``.
+
+    Returns
+    -------
+    bool
+        True where the warning names this annotator.
+    """
+    if f"'{who}'" in warning or f"({who})" in warning:
+        return True
+    return f"annotations[{index}]" in warning
+
+
 def classify(syn: SyntheticScene, slipped: int | None) -> dict[str, Any]:
     """Calibrate the slipped scene and sort the outcome (see the module docstring)."""
     names = [a.get("annotator", "anonymous") for a in syn.scene["annotations"]]
@@ -396,7 +422,11 @@ def classify(syn: SyntheticScene, slipped: int | None) -> dict[str, Any]:
         said = bool(res.warnings)
     else:
         who = names[slipped]
-        said = who in named or any(f"'{who}'" in w or f"({who})" in w for w in res.warnings)
+        said = (
+            who in named
+            or any(e.get("index") == slipped for e in res.excluded_annotators)
+            or any(names_annotator(w, who, slipped) for w in res.warnings)
+        )
     row["warned"] = said
     if not any(outside.values()):
         row["outcome"] = "ok"

@@ -134,6 +134,14 @@ deficiencies. Neighbouring ranks never share a colour."""
 RANK_OTHER = "#999999"
 """Colour of ranks beyond :data:`RANK_PALETTE` (grey)."""
 
+TIE_CHOICE_WORDS = (
+    "the camera may stand at a tied candidate instead: choose it under 'or the camera is "
+    "candidate…' below (its review page, camloc locate --map, draws them all)"
+)
+"""A summary page's popup of a tied best candidate: what to do. It said "see the camera's
+review page", a page a job's summary (``GET /v1/jobs/{id}/map``) or a batch's has not
+(session 41 QA), while the popup itself offers the choice."""
+
 TIE_RING = "#111111"
 """Colour of the dashed ring and the "≈" badge of a tied candidate."""
 
@@ -2145,7 +2153,7 @@ def build_summary_map(
             note = (
                 f'<div class="camloc-tie">≈ <b>{html.escape(tie)}</b>: the evidence does not '
                 "favour the best candidate firmly (odds under "
-                f"{1 / TIE_SCORE_RATIO:g} to 1); see the camera's review page</div>"
+                f"{1 / TIE_SCORE_RATIO:g} to 1): {html.escape(TIE_CHOICE_WORDS)}</div>"
             )
         popup = folium.Popup(
             f'<div class="camloc-popup"><b>{html.escape(str(scene_id))}</b>{note}'
@@ -2298,6 +2306,7 @@ class _DataMarkers(MacroElement):
     var words = {{ this.words|tojson }};
     var rows = {{ this.rows|tojson }};
     var ring = {{ this.ring|tojson }}, odds = {{ this.odds|tojson }};
+    var tieChoice = {{ this.tie_choice|tojson }};
     function esc(x) {
         return String(x).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/>/g, "&gt;")
             .replace(/"/g, "&quot;").replace(/'/g, "&#x27;");
@@ -2343,7 +2352,7 @@ class _DataMarkers(MacroElement):
         }).join("");
         var note = r[5] === null ? "" : '<div class="camloc-tie">\u2248 <b>' + esc(r[5]) +
             "</b>: the evidence does not favour the best candidate firmly (odds under " +
-            odds + " to 1); see the camera's review page</div>";
+            odds + " to 1): " + tieChoice + "</div>";
         return '<div class="camloc-popup"><b>' + esc(r[1]) + "</b>" + note + "<table>" +
             body + '</table><div class="camloc-verdict" data-verdict-key="c' + r[0] +
             '"></div></div>';
@@ -2378,6 +2387,7 @@ class _DataMarkers(MacroElement):
         self.words = words
         self.ring = TIE_RING
         self.odds = f"{1 / TIE_SCORE_RATIO:g}"
+        self.tie_choice = html.escape(TIE_CHOICE_WORDS)
 
 
 _FIT_CLEAR_JS = """

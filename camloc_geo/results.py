@@ -852,11 +852,12 @@ def write_layer_styles(gpkg: str | os.PathLike[str], styles: Mapping[str, str]) 
 
 
 _JOB_STYLED_COLUMNS = {
-    "cameras": ("id", "status"),
+    "cameras": ("id", "status", "ambiguous"),
     "candidates": ("camera_id", "rank", "ambiguous_with"),
 }
 """Columns a job GeoPackage's layer always has once it has features: its QGIS style reads
-them (a job of title-placed cameras has no ``ambiguous_with`` of its own)."""
+them (a job of title-placed cameras has no ``ambiguous_with`` of its own; the cameras' style
+reads ``ambiguous`` since session 41, null where a stored camera has none)."""
 
 
 def job_result_geopackage(collection: dict[str, Any]) -> bytes:

@@ -44,10 +44,21 @@ def main() -> int:
     def cones(layer: QgsVectorLayer) -> None:
         L.style_view_cones(layer, batch_tie)
 
+    # a tied camera: a plain column, as the SLD export can state it (not coalesce())
     def cameras(layer: QgsVectorLayer) -> None:
-        L.style_cameras(layer, id_field="id")
+        L.style_cameras(layer, id_field="id", tie_expr='"tie"')
 
-    job_cameras = {"id": "object", "status": "object", "title": "object", "score": "float64"}
+    def job_cameras_style(layer: QgsVectorLayer) -> None:
+        # the job result's cameras call the tie 'ambiguous' (camloc_geo.results)
+        L.style_cameras(layer, id_field="id", tie_expr='"ambiguous"')
+
+    job_cameras = {
+        "id": "object",
+        "status": "object",
+        "title": "object",
+        "score": "float64",
+        "ambiguous": "bool",
+    }
     job_candidates = {
         "camera_id": "object",
         "rank": "int64",
@@ -63,7 +74,7 @@ def main() -> int:
             lambda x: L.style_list_candidates(x, batch_tie),
         ),
         ("batch_view_cones", "MultiPolygon", _run._CONE_COLUMNS, cones),
-        ("job_cameras", "Point", job_cameras, cameras),
+        ("job_cameras", "Point", job_cameras, job_cameras_style),
         ("job_candidates", "Point", job_candidates, lambda x: L.style_list_candidates(x, job_tie)),
     ]
     OUT.mkdir(parents=True, exist_ok=True)

@@ -522,12 +522,14 @@ def test_cli_batch_warns_of_duplicate_camera_ids(
     assert dup["message"].tolist()[0] == "camera id 'cam1' is also used by row(s) 3, 6 of the list"
     assert dup["message"].tolist()[3] == "camera id 'cam2' is also used by row(s) 2 of the list"
     summary = run_batch(lst, out_gpkg=out, progress=False, workers=1)  # resumed: still warned
-    assert len(summary.warnings) == 1
-    assert "'cam1' on rows 1, 3, 6" in summary.warnings[0]
+    # (this run has no map: since session 41 the run says so too, a line of its own)
+    dups = [w for w in summary.warnings if "this run had no map" not in w]
+    assert len(dups) == 1
+    assert "'cam1' on rows 1, 3, 6" in dups[0]
     assert summary.to_dict()["warnings"] == summary.warnings
     lst.write_text("id,title\ncam1,A & B\ncam2,C & D\n", encoding="utf-8")
     clean = run_batch(lst, out_gpkg=tmp_path / "c.gpkg", progress=False, workers=1)
-    assert clean.warnings == []
+    assert [w for w in clean.warnings if "this run had no map" not in w] == []
 
 
 def test_a_spreadsheet_s_windows_1252_list_with_decimal_commas_is_read(

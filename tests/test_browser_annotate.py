@@ -914,3 +914,52 @@ def test_next_is_in_sight_on_a_laptop_screen(
         assert page.evaluate("camloc.step()") == 4
     finally:
         context.close()
+
+
+def test_the_warnings_over_the_photo_leave_a_phone_its_photo(browser: Any, tmp_path: Path) -> None:
+    """The bundled sample scene's two car-line warnings, three lines each over the photo,
+    covered 31 % of a 390x844 phone's photo and 33 % of an 844x390 one's, where they also ran
+    to the screen's edge (session 41 QA, Chromium screenshots). On a small screen each is one
+    line now, whole after a tap; a laptop's keep their whole text."""
+    from PIL import Image
+
+    snap = tmp_path / "hd.png"
+    Image.new("RGB", (1920, 1080), (120, 130, 140)).save(snap)
+    page_path = tmp_path / "page.html"
+    scene = Path(__file__).resolve().parent.parent / "sample_maps" / "sample_scene.json"
+    assert main(["annotate", str(snap), "-o", str(page_path), "--scene", str(scene)]) == 0
+    for viewport, small in (
+        ({"width": 390, "height": 844}, True),
+        ({"width": 844, "height": 390}, True),
+        ({"width": 1366, "height": 800}, False),
+    ):
+        context = browser.new_context(viewport=viewport, has_touch=small, is_mobile=small)
+        page = context.new_page()
+        page.route(
+            "**/*",
+            lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+        )
+        try:
+            page.goto(page_path.resolve().as_uri(), wait_until="load")
+            page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
+            checks = page.locator("#alerts .check")
+            assert checks.count() == 2
+            assert "own edges" in checks.first.inner_text()
+            canvas = page.locator("#canvas").bounding_box()
+            alerts = page.locator("#alerts").bounding_box()
+            assert canvas is not None
+            assert alerts is not None
+            # inside the photo's area, 10 px from its right edge
+            assert alerts["x"] + alerts["width"] <= canvas["x"] + canvas["width"] - 9, viewport
+            heights = [checks.nth(i).bounding_box()["height"] for i in range(2)]
+            if small:
+                assert max(heights) < 30, (viewport, heights)  # one line each
+                assert alerts["height"] / canvas["height"] < 0.2, (viewport, alerts)
+                page.tap("#alerts")
+                assert checks.first.bounding_box()["height"] > 30  # the whole text
+                page.tap("#alerts")
+                assert checks.first.bounding_box()["height"] < 30
+            else:
+                assert min(heights) > 30, heights  # a laptop's show the whole text
+        finally:
+            context.close()

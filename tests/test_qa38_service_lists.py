@@ -14,6 +14,7 @@ from pathlib import Path
 import httpx
 import pytest
 
+from camloc_geo import SceneError
 from camloc_geo.service import create_app
 from camloc_geo.service.routers.jobs import camera_records, csv_encoding_warning
 from camloc_geo.service.settings import Settings
@@ -103,3 +104,23 @@ def test_a_csv_no_camera_can_be_placed_by_is_refused(tmp_path: Path, body: bytes
 def test_a_csv_with_one_placeable_row_is_taken(tmp_path: Path) -> None:
     body = b"id,title\nc1,\nc2,Eastern Ave & S Broadway\n"
     assert [c["id"] for c in camera_records(body, "text/csv", 10)] == ["c1", "c2"]
+
+
+@pytest.mark.parametrize("body", [b"", b"\n\n", b"id,title,lat,lon\n", b"\xef\xbb\xbfid,title\r\n"])
+def test_a_csv_without_a_camera_names_the_body(tmp_path: Path, body: bytes) -> None:
+    """Session 41 QA: a CSV body without a row was 'cameras: the list holds no camera', field
+    ``cameras``, a JSON field a CSV body has not."""
+    r = _post_jobs(tmp_path, body)
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["field"] == "body"
+    assert "the CSV list holds no camera" in err["message"]
+
+
+def test_an_empty_feature_collection_names_its_features(tmp_path: Path) -> None:
+    with pytest.raises(SceneError) as err:
+        camera_records(b'{"type": "FeatureCollection", "features": []}', "application/json", 10)
+    assert err.value.field == "features"
+    assert "FeatureCollection holds no camera" in str(err.value)
+    # a JSON list keeps its own field ('cameras: the list holds no camera', POST /v1/jobs)
+    assert camera_records(b'{"cameras": []}', "application/json", 10) == []

@@ -442,6 +442,16 @@ def _chunks(
             yield a, g
 
 
+def _looks_like_json(path: Path) -> bool:
+    """Whether the file's first character past blanks and a byte-order mark is ``{``."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return False
+    return head.lstrip(b"\xef\xbb\xbf").lstrip()[:1] == b"{"
+
+
 def _check_has_cameras(list_p: Path) -> None:
     """Refuse a list without a single camera (as ``POST /v1/jobs`` does): an empty file, a
     header alone, or a file that is no list (a photo, a text) used to end in an empty
@@ -456,6 +466,8 @@ def _check_has_cameras(list_p: Path) -> None:
     if first is None:
         size = list_p.stat().st_size
         what = "an empty file" if size == 0 else "no row under its header"
+        if size and _looks_like_json(list_p):  # a GeoJSON list has no header (session 41 QA)
+            what = "no feature in its FeatureCollection"
         raise InputError(
             f"the camera list {list_p.name} holds no camera ({what}); a list is CSV with a "
             "header (id,title and optional lat,lon,radius_m,streets,scene) or GeoJSON"
@@ -679,6 +691,13 @@ def run_batch(
             )
             stage["summary_map"] += time.perf_counter() - t
         statuses = journal.status_counts()
+        if map_source is None and not network and statuses.get("no_map"):
+            # a list run without any map: every camera no_map, exit 0, the one reason given
+            # per camera only (session 41 QA, camloc batch and QGIS's geocodelist)
+            warnings.append(
+                f"{statuses['no_map']} camera(s) no_map: this run had no map (no extract, "
+                "the network off): give --osm EXTRACT_OR_FOLDER or allow --network"
+            )
     finally:
         journal.close()
         lock.release()

@@ -206,6 +206,31 @@ def _score_of(value: Any) -> float | None:
     return float(value) if 0.0 <= value <= 1.0 else None
 
 
+def _refuse_a_batch_geopackage(path: str) -> None:
+    """Refuse a GeoPackage given where a locate GeoJSON belongs, saying what gives its page.
+
+    A batch team gives ``camloc summary-map`` the batch's GeoPackage: it was "not a GeoJSON
+    file (camloc locate output) (a GeoPackage or SQLite database)", with no word of the page
+    ``camloc batch --map`` writes (session 41 QA).
+    """
+    p = Path(path)
+    try:
+        if not p.is_file():  # a pipe (<(...)), a device: read once, by read_json_file
+            return
+        with open(p, "rb") as fh:
+            head = fh.read(64)
+    except OSError:
+        return  # read_json_file names it
+    if not head.startswith(b"SQLite format 3\x00"):
+        return
+    raise InputError(
+        f"{path}: a GeoPackage (camloc batch's output?), not a GeoJSON file (camloc locate "
+        "output): a batch's summary page is written by camloc batch itself, with --map "
+        "SUMMARY.html (run the same command again with it: the cameras already done are read "
+        "from the batch's journal, not computed again)"
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``camloc summary-map``."""
     from camloc_geo.cli import atomic_output, page_path, read_json_file
@@ -218,6 +243,8 @@ def run(args: argparse.Namespace) -> int:
     if out is None:
         raise InputError("-o: give an HTML file name (a page cannot go to stdout)")
     inputs = _once_each(args.inputs)
+    for p in inputs:
+        _refuse_a_batch_geopackage(p)
     cleaned = [
         clean_candidates(p, read_json_file(p, what="GeoJSON file (camloc locate output)"))
         for p in inputs

@@ -37,7 +37,7 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from camloc_geo import InputError
+from camloc_geo import InputError, MapDataError
 from camloc_geo.results import TIE_DISTANCE_M, TIE_SCORE_RATIO
 
 __all__ = [
@@ -447,19 +447,65 @@ def _task_locate(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     }
 
 
+_EXTRACT_COVERS = re.compile(
+    r"is outside the extract .*cover lat (-?[\d.]+)\.\.(-?[\d.]+), lon (-?[\d.]+)\.\.(-?[\d.]+)\)"
+)
+
+
+def swapped_point_hint(message: str, lat: float, lon: float) -> str | None:
+    """The hint for a point given as lat,lon where QGIS reads x,y (lon,lat), or None.
+
+    ``qgis_process run camloc:corners --POINT="39.2857,-76.5933 [EPSG:4326]"`` (lat first, as
+    people write a place) reached the library as lat -76.59, lon 39.29 and was refused as
+    "outside the extract" with no word that the two were swapped (session 41 QA). Where the
+    library's message says the point is outside an extract and the point with its latitude and
+    longitude swapped is inside it, this names the point as QGIS wants it.
+
+    Parameters
+    ----------
+    message : str
+        The library's error (``camloc_geo.osm``'s "point lat=..., lon=... is outside the
+        extract NAME (its streets and buildings cover lat S..N, lon W..E)").
+    lat, lon : float
+        The point as the job gave it (degrees).
+
+    Returns
+    -------
+    str or None
+        The hint, or None where the message is another or the swapped point is outside too.
+    """
+    m = _EXTRACT_COVERS.search(message)
+    if m is None:
+        return None
+    south, north, west, east = (float(v) for v in m.groups())
+    if not (south <= lon <= north and west <= lat <= east):
+        return None
+    return (
+        f"latitude and longitude swapped? A POINT is x,y, longitude first: "
+        f"'{lat:.6f},{lon:.6f} [EPSG:4326]' is lat={lon:.6f}, lon={lat:.6f}, inside the extract"
+    )
+
+
 def _task_corners(job: dict[str, Any], out_dir: Path) -> dict[str, Any]:
     """``lat``, ``lon``, ``radius_m``, ``osm``, ``network``, ``streets`` (``"A & B"`` or null)."""
     from camloc_geo.api import corners_near
 
     _progress(5, "reading the map")
-    gj = corners_near(
-        lat=float(job["lat"]),
-        lon=float(job["lon"]),
-        radius_m=float(job.get("radius_m") or 150.0),
-        map_source=job.get("osm") or None,
-        network=bool(job.get("network", False)),
-        streets=job.get("streets") or None,
-    )
+    lat, lon = float(job["lat"]), float(job["lon"])
+    try:
+        gj = corners_near(
+            lat=lat,
+            lon=lon,
+            radius_m=float(job.get("radius_m") or 150.0),
+            map_source=job.get("osm") or None,
+            network=bool(job.get("network", False)),
+            streets=job.get("streets") or None,
+        )
+    except MapDataError as exc:
+        hint = swapped_point_hint(str(exc), lat, lon)
+        if hint is None:
+            raise
+        raise MapDataError(f"{exc}; {hint}") from exc
     _progress(80, "writing the layers")
     layer = _write_layer(
         out_dir, "corners", "Point", INTERSECTION_FIELDS, _intersection_rows(gj["features"])

@@ -1528,6 +1528,8 @@
   $("btn-zoom-out").addEventListener("click", function () { var r = canvas.getBoundingClientRect(); zoomAt(0.8, r.width / 2, r.height / 2); });
   $("btn-fit").addEventListener("click", fit);
   // a touch screen has no Delete key and no hover: tap a point, then this button
+  // a warning over the photo is one line on a small screen: a tap shows it whole, another folds it
+  $("alerts").addEventListener("click", function () { this.classList.toggle("open"); });
   $("btn-delete").addEventListener("click", function () {
     var t = selected || hover;
     if (t) deleteTarget(t);

@@ -24,6 +24,7 @@ from qgis.core import (
     Qgis,
     QgsApplication,
     QgsCoordinateTransform,
+    QgsExpression,
     QgsMessageLog,
     QgsProject,
     QgsTask,
@@ -109,6 +110,40 @@ def stale_name(group: str) -> str:
     """The name of result group ``group`` once a later run of its camera failed."""
     suffix = " (stale: a later run failed)"
     return group if group.endswith(suffix) else group + suffix
+
+
+def _mark_labels_stale(layer: Any) -> None:
+    """A stale layer's labels say so and are drawn faded.
+
+    A layer's opacity does not reach its labels: the stale candidates' '#1 0.37 (tie with
+    #2, #4)' stood on the map as a fresh run's (seen in the desktop under Xvfb, session 41).
+    Each label starts with :data:`STALE_PREFIX` (a feature without a label keeps none) and
+    its text takes :data:`STALE_OPACITY`.
+    """
+    from qgis.core import QgsPalLayerSettings, QgsVectorLayerSimpleLabeling
+
+    if not isinstance(layer, QgsVectorLayer) or not layer.labelsEnabled():
+        return
+    labeling = layer.labeling()
+    if not isinstance(labeling, QgsVectorLayerSimpleLabeling):
+        return
+    pal = QgsPalLayerSettings(labeling.settings())
+    text = pal.fieldName if pal.isExpression else QgsExpression.quotedColumnRef(pal.fieldName)
+    if not text:
+        return
+    # '||' keeps a NULL label NULL (concat() would label every feature 'stale · ')
+    pal.fieldName = f"'{STALE_PREFIX}' || ({text})"
+    pal.isExpression = True
+    fmt = pal.format()
+    fmt.setOpacity(STALE_OPACITY)
+    pal.setFormat(fmt)
+    layer.setLabeling(QgsVectorLayerSimpleLabeling(pal))
+
+
+def _sentence(text: str) -> str:
+    """``text`` ended as a sentence (a full stop added where it ends without one)."""
+    text = text.rstrip()
+    return text if not text or text[-1] in ".!?" else text + "."
 
 
 def _output_problem(path: str, what: str) -> str | None:
@@ -1201,7 +1236,9 @@ class CamlocDock(QDockWidget):
                 kept = " The map keeps the last run's layers." if restore is not None else ""
                 self.set_status("Canceled." + kept)
                 return
-            line = " ".join(str(task.error).split())  # one line, whatever the library wrote
+            # one line, whatever the library wrote, ended as a sentence before what follows
+            # ('unexpected EOF The layers on the map...' ran the two together)
+            line = _sentence(" ".join(str(task.error).split()))
             # the last run's layers of this camera (put back, or of another GeoPackage) are
             # marked stale: shown unmarked, they were taken for this run's answer
             marked = self._mark_stale(group) if restore is None else stale_name(group)
@@ -1420,6 +1457,7 @@ class CamlocDock(QDockWidget):
             layer.setCustomProperty(STALE_PROPERTY, True)
             layer.setName(f"{STALE_PREFIX}{layer.name()}")
             layer.setOpacity(STALE_OPACITY)
+            _mark_labels_stale(layer)
             layer.triggerRepaint()
         return new
 

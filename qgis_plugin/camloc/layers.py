@@ -368,18 +368,50 @@ def style_matched(layer: QgsVectorLayer) -> None:
     layer.triggerRepaint()
 
 
-def style_cameras(layer: QgsVectorLayer, id_field: str = "camera_id") -> None:
+CAMERA_TIE_EXPR = '"tie"'
+"""A list's camera whose best candidate ties with another: the plugin's and the batch
+GeoPackage's ``tie``; the service job's GeoPackage calls it ``ambiguous``."""
+
+CAMERA_TIE_WORDS = "camera placed at a tied candidate (≈): another fits nearly as well"
+"""The legend's words for a tied camera (the candidates' stars say which)."""
+
+
+def style_cameras(
+    layer: QgsVectorLayer, id_field: str = "camera_id", tie_expr: str = CAMERA_TIE_EXPR
+) -> None:
     """A list's cameras: their labels win over the candidates' (highest priority).
 
-    ``id_field`` names the camera's id column (the batch GeoPackage's is ``id``).
+    A camera placed at a tied candidate is drawn apart (a hollow triangle, "≈ tie" after its
+    status): all cameras were one red triangle labelled "a located", so a camera whose best
+    candidate ties with one 61 m away looked as sure as any (session 41 QA, the QGIS desktop).
+
+    Parameters
+    ----------
+    layer
+        The cameras layer.
+    id_field
+        The camera's id column (the batch GeoPackage's and the job's is ``id``).
+    tie_expr
+        A QGIS expression true for a tied camera: :data:`CAMERA_TIE_EXPR` (the plugin's and
+        the batch GeoPackage's ``tie``); the job result's reads ``ambiguous``. A camera it is
+        not true for (false, NULL) is drawn by the "camera placed" rule, an ELSE rule.
     """
+    tied = _marker("#ffffff", "Triangle", 4.5)
+    tied.symbolLayer(0).setStrokeColor(QColor("#d7191c"))
+    tied.symbolLayer(0).setStrokeWidth(0.6)
     _rules(
         layer,
         [
+            (CAMERA_TIE_WORDS, tie_expr, tied),
             ("camera placed", None, _marker("#d7191c", "Triangle", 4.5)),
         ],
     )
-    _label(layer, f'"{id_field}" || \' \' || "status"', priority=10, size=10)
+    _label(
+        layer,
+        f"\"{id_field}\" || ' ' || \"status\" || CASE WHEN {tie_expr} THEN ' ≈ tie' ELSE '' END",
+        priority=10,
+        size=10,
+    )
     layer.triggerRepaint()
 
 

@@ -492,6 +492,38 @@ def test_every_optional_input_says_what_empty_means(provider):
     assert silent == []
 
 
+def test_geocodelist_a_tied_camera_is_drawn_apart(provider, tmp_path):
+    """Session 41 QA (the QGIS desktop): every camera was one red triangle, the sample's
+    camera labelled 'a located' while its best candidate ties with one 61 m away, as
+    sure-looking as the untied title-placed camera beside it."""
+    import processing
+    from camloc.layers import CAMERA_TIE_WORDS, apply_style
+    from qgis.core import QgsExpression, QgsExpressionContext, QgsExpressionContextUtils
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text(f"id,title,scene\ns1,,{SAMPLE_SCENE}\nc1,Eastern Ave & S Broadway,\n")
+    res = processing.run(
+        "camloc:geocodelist",
+        {"LIST": str(lst), "OSM": str(SAMPLE_OSM), "CAMERAS": str(tmp_path / "cameras.gpkg")},
+    )
+    layer = _layer(res["CAMERAS"])
+    apply_style(layer, "cameras")
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    label = QgsExpression(layer.labeling().settings().fieldName)
+    drawn, labels, ties = {}, {}, {}
+    for f in layer.getFeatures():
+        ctx.setFeature(f)
+        ties[f["camera_id"]] = bool(f["tie"])
+        labels[f["camera_id"]] = label.evaluate(ctx)
+        for rule in layer.renderer().rootRule().children():
+            if rule.isElse() or QgsExpression(rule.filterExpression()).evaluate(ctx):
+                drawn[f["camera_id"]] = rule.label()
+                break
+    assert ties == {"s1": True, "c1": False}
+    assert drawn == {"s1": CAMERA_TIE_WORDS, "c1": "camera placed"}
+    assert labels == {"s1": "s1 located ≈ tie", "c1": "c1 title_only"}
+
+
 def test_geocodelist_layers_loaded_name_their_list(provider, tmp_path):
     import processing
     from qgis.core import QgsProject

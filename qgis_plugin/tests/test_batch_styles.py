@@ -37,7 +37,14 @@ def test_a_batch_geopackage_opens_styled(tmp_path):
             assert layer.labelsEnabled(), name
     assert seen["candidates"][0].startswith("★ tie:")
     assert seen["candidates"][1:] == ["a camera's best candidate", "other candidates"]
-    assert seen["cameras"] == ["camera placed"]
+    from camloc.layers import CAMERA_TIE_WORDS
+
+    # a camera at a tied candidate is drawn apart (session 41 QA: every camera was one red
+    # triangle labelled 'a located', a tied one as sure-looking as any)
+    assert seen["cameras"] == [CAMERA_TIE_WORDS, "camera placed"]
+    cams = QgsVectorLayer(f"{out}|layername=cameras", "k", "ogr")
+    assert _drawn_by(cams) == {"s1": CAMERA_TIE_WORDS, "c1": "camera placed"}
+    assert _labels(cams) == {"s1": "s1 located ≈ tie", "c1": "c1 title_only"}
     # the sample's tie (ranks 1-5; 5 a junction a block away, stop 41) is drawn by the star
     # rule, the rest by the others
     layer = QgsVectorLayer(f"{out}|layername=candidates", "c", "ogr")
@@ -98,7 +105,7 @@ def test_a_service_job_geopackage_opens_styled(tmp_path):
         "'coordinates': [-76.5935 + rank * 1e-4, 39.2855]}, 'properties': {'kind': "
         "'candidate', 'rank': rank, 'score': 0.4 / rank, 'ambiguous_with': tie}}\n"
         "cam = {'id': 'k1', 'row': 1, 'status': 'located', 'lat': 39.2855, 'lon': -76.5935,"
-        " 'candidates': [c(1, [2]), c(2, [1]), c(3, [])]}\n"
+        " 'ambiguous': True, 'candidates': [c(1, [2]), c(2, [1]), c(3, [])]}\n"
         "open(sys.argv[1], 'wb').write(job_result_geopackage(job_result_geojson('j', [cam])))\n"
     )
     subprocess.run([sys.executable, "-c", code, str(out)], check=True, timeout=300)
@@ -121,3 +128,36 @@ def test_a_service_job_geopackage_opens_styled(tmp_path):
     cams = QgsVectorLayer(f"{out}|layername=cameras", "k", "ogr")
     assert isinstance(cams.renderer(), QgsRuleBasedRenderer)
     assert cams.labelsEnabled()
+    # the job's tie is its camera's 'ambiguous' (session 41 QA)
+    from camloc.layers import CAMERA_TIE_WORDS
+
+    assert _drawn_by(cams) == {"k1": CAMERA_TIE_WORDS}
+    assert _labels(cams) == {"k1": "k1 located ≈ tie"}
+
+
+def _drawn_by(layer):
+    """Camera id -> the label of the first rule that draws it."""
+    from qgis.core import QgsExpression, QgsExpressionContext, QgsExpressionContextUtils
+
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    out = {}
+    for f in layer.getFeatures():
+        ctx.setFeature(f)
+        for rule in layer.renderer().rootRule().children():
+            if rule.isElse() or QgsExpression(rule.filterExpression()).evaluate(ctx):
+                out[f["id"]] = rule.label()
+                break
+    return out
+
+
+def _labels(layer):
+    """Camera id -> its label's text."""
+    from qgis.core import QgsExpression, QgsExpressionContext, QgsExpressionContextUtils
+
+    expr = QgsExpression(layer.labeling().settings().fieldName)
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    out = {}
+    for f in layer.getFeatures():
+        ctx.setFeature(f)
+        out[f["id"]] = expr.evaluate(ctx)
+    return out

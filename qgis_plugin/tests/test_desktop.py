@@ -262,6 +262,7 @@ def test_dock_run_on_a_cut_extract_is_one_line_in_the_message_bar(desktop):
 
 def test_dock_run_canceled_at_once_keeps_the_last_results(desktop):
     canceled = desktop["dock_canceled"]
+    # (since c413eb7, stop 41: the status also says the layers on the map are the last run's)
     assert canceled["status"] == "Canceled. The map keeps the last run's layers."
     kinds = {lyr["kind"]: lyr["features"] for lyr in canceled["layers"]}
     assert kinds == DOCK_KINDS

@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import HERE, SAMPLE_OSM, SAMPLE_SCENE, metres_between, truth
@@ -19,7 +20,7 @@ from qgis.core import (
     QgsPointXY,
     QgsProject,
 )
-from qgis.PyQt.QtCore import QPointF, QSize, Qt
+from qgis.PyQt.QtCore import NULL, QPointF, QSize, Qt
 from qgis.PyQt.QtGui import QColor, QImage, QPainter, QPen, QPolygonF
 from qgis.PyQt.QtTest import QTest
 from qgis.PyQt.QtWidgets import QApplication
@@ -949,6 +950,20 @@ def test_a_failed_run_says_why_in_the_message_bar_in_one_line(dock, qgis_iface, 
     assert all(lyr.opacity() == pytest.approx(STALE_OPACITY) for lyr in dock.result_layers)
     assert "marked stale ('camloc: snapshot (stale: a later run failed)')" in said[0], said
     assert "stale" in dock.status.text()
+    # the error is a sentence of its own: '... 115.75793) The layers' ran on (session 41)
+    assert "). The layers on the map are the last run's" in said[0], said
+    assert "). The layers on the map are the last run's" in dock.status.text()
+    # ... and so are their labels, which the layer's opacity does not reach (session 41 QA:
+    # the stale candidates' '#1 0.37 (tie with #2)' stood on the map as fresh ones)
+    labelled = [lyr for lyr in dock.result_layers if lyr.labelsEnabled()]
+    assert labelled
+    for lyr in labelled:
+        pal = lyr.labeling().settings()
+        assert pal.format().opacity() == pytest.approx(STALE_OPACITY), lyr.name()
+    texts = _label_texts(_layer_of_kind(dock, "candidates"))
+    assert any(t is not None and t.startswith(f"{STALE_PREFIX}#1 ") for t in texts), texts
+    assert all(t is None or t.startswith(STALE_PREFIX) for t in texts), texts
+    assert None in texts  # the unlikely candidates stay unlabelled
     # a successful run replaces them: no stale group, no stale layer left
     dock.osm_edit.setText(str(SAMPLE_OSM))
     assert dock.run() is not None
@@ -959,6 +974,28 @@ def test_a_failed_run_says_why_in_the_message_bar_in_one_line(dock, qgis_iface, 
     assert len(fresh.findLayers()) == 4
     assert not any(n.layer().name().startswith(STALE_PREFIX) for n in fresh.findLayers())
     assert all(lyr.opacity() == 1.0 for lyr in dock.result_layers)
+    texts = _label_texts(_layer_of_kind(dock, "candidates"))
+    assert any(t is not None and t.startswith("#1 ") for t in texts), texts
+    assert not any(t is not None and "stale" in t for t in texts), texts
+
+
+def _layer_of_kind(dock: Any, kind: str) -> Any:
+    return next(lyr for lyr in dock.result_layers if lyr.customProperty("camloc/kind") == kind)
+
+
+def _label_texts(layer: Any) -> list[Any]:
+    """The label each feature of ``layer`` gets (None: unlabelled)."""
+    from qgis.core import QgsExpression, QgsExpressionContext, QgsExpressionContextUtils
+
+    pal = layer.labeling().settings()
+    expr = QgsExpression(pal.fieldName if pal.isExpression else f'"{pal.fieldName}"')
+    ctx = QgsExpressionContext(QgsExpressionContextUtils.globalProjectLayerScopes(layer))
+    out = []
+    for feat in layer.getFeatures():
+        ctx.setFeature(feat)
+        value = expr.evaluate(ctx)
+        out.append(None if value is None or value == NULL else str(value))
+    return out
 
 
 def test_a_failed_run_into_another_geopackage_marks_the_cameras_layers_stale(

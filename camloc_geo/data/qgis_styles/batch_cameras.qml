@@ -1,76 +1,135 @@
 <!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>
-<qgis simplifyDrawingTol="1" labelsEnabled="1" simplifyLocal="1" simplifyDrawingHints="1" simplifyAlgorithm="0" simplifyMaxScale="1" symbologyReferenceScale="-1" minScale="100000000" version="3.22.16-Białowieża" styleCategories="AllStyleCategories" hasScaleBasedVisibilityFlag="0" maxScale="0" readOnly="0">
+<qgis styleCategories="AllStyleCategories" version="3.22.16-Białowieża" minScale="100000000" symbologyReferenceScale="-1" simplifyDrawingHints="1" readOnly="0" simplifyLocal="1" hasScaleBasedVisibilityFlag="0" maxScale="0" labelsEnabled="1" simplifyDrawingTol="1" simplifyMaxScale="1" simplifyAlgorithm="0">
  <flags>
   <Identifiable>1</Identifiable>
   <Removable>1</Removable>
   <Searchable>1</Searchable>
   <Private>0</Private>
  </flags>
- <temporal limitMode="0" startField="" durationField="" enabled="0" endExpression="" startExpression="" durationUnit="min" fixedDuration="0" accumulate="0" mode="0" endField="">
+ <temporal startField="" endField="" startExpression="" accumulate="0" endExpression="" enabled="0" fixedDuration="0" durationUnit="min" mode="0" limitMode="0" durationField="">
   <fixedRange>
    <start></start>
    <end></end>
   </fixedRange>
  </temporal>
- <renderer-v2 type="RuleRenderer" referencescale="-1" enableorderby="0" forceraster="0" symbollevels="0">
-  <rules key="{bb2192cf-40d3-4395-a0de-e4b5513e3eda}">
-   <rule filter="ELSE" symbol="0" label="camera placed" key="{5ab75d55-ec0a-42fe-8eea-b0881b69f66e}"/>
+ <renderer-v2 symbollevels="0" type="RuleRenderer" forceraster="0" referencescale="-1" enableorderby="0">
+  <rules key="{8957e442-24bd-438f-8226-714663d9a597}">
+   <rule filter="&quot;tie&quot;" key="{b1a1353b-be37-4409-8246-7051c7553225}" symbol="0" label="camera placed at a tied candidate (≈): another fits nearly as well"/>
+   <rule filter="ELSE" key="{4a1505ea-f67e-43b3-8892-044bcf53d845}" symbol="1" label="camera placed"/>
   </rules>
   <symbols>
-   <symbol type="marker" force_rhr="0" clip_to_extent="1" alpha="1" name="0">
+   <symbol type="marker" force_rhr="0" alpha="1" name="0" clip_to_extent="1">
     <data_defined_properties>
      <Option type="Map">
-      <Option type="QString" name="name" value=""/>
+      <Option value="" type="QString" name="name"/>
       <Option name="properties"/>
-      <Option type="QString" name="type" value="collection"/>
+      <Option value="collection" type="QString" name="type"/>
      </Option>
     </data_defined_properties>
-    <layer class="SimpleMarker" enabled="1" locked="0" pass="0">
+    <layer class="SimpleMarker" locked="0" pass="0" enabled="1">
      <Option type="Map">
-      <Option type="QString" name="angle" value="0"/>
-      <Option type="QString" name="cap_style" value="square"/>
-      <Option type="QString" name="color" value="215,25,28,255"/>
-      <Option type="QString" name="horizontal_anchor_point" value="1"/>
-      <Option type="QString" name="joinstyle" value="bevel"/>
-      <Option type="QString" name="name" value="triangle"/>
-      <Option type="QString" name="offset" value="0,0"/>
-      <Option type="QString" name="offset_map_unit_scale" value="3x:0,0,0,0,0,0"/>
-      <Option type="QString" name="offset_unit" value="MM"/>
-      <Option type="QString" name="outline_color" value="0,0,0,255"/>
-      <Option type="QString" name="outline_style" value="solid"/>
-      <Option type="QString" name="outline_width" value="0"/>
-      <Option type="QString" name="outline_width_map_unit_scale" value="3x:0,0,0,0,0,0"/>
-      <Option type="QString" name="outline_width_unit" value="MM"/>
-      <Option type="QString" name="scale_method" value="diameter"/>
-      <Option type="QString" name="size" value="4.5"/>
-      <Option type="QString" name="size_map_unit_scale" value="3x:0,0,0,0,0,0"/>
-      <Option type="QString" name="size_unit" value="MM"/>
-      <Option type="QString" name="vertical_anchor_point" value="1"/>
+      <Option value="0" type="QString" name="angle"/>
+      <Option value="square" type="QString" name="cap_style"/>
+      <Option value="255,255,255,255" type="QString" name="color"/>
+      <Option value="1" type="QString" name="horizontal_anchor_point"/>
+      <Option value="bevel" type="QString" name="joinstyle"/>
+      <Option value="triangle" type="QString" name="name"/>
+      <Option value="0,0" type="QString" name="offset"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="offset_map_unit_scale"/>
+      <Option value="MM" type="QString" name="offset_unit"/>
+      <Option value="215,25,28,255" type="QString" name="outline_color"/>
+      <Option value="solid" type="QString" name="outline_style"/>
+      <Option value="0.6" type="QString" name="outline_width"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="outline_width_map_unit_scale"/>
+      <Option value="MM" type="QString" name="outline_width_unit"/>
+      <Option value="diameter" type="QString" name="scale_method"/>
+      <Option value="4.5" type="QString" name="size"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="size_map_unit_scale"/>
+      <Option value="MM" type="QString" name="size_unit"/>
+      <Option value="1" type="QString" name="vertical_anchor_point"/>
      </Option>
-     <prop k="angle" v="0"/>
-     <prop k="cap_style" v="square"/>
-     <prop k="color" v="215,25,28,255"/>
-     <prop k="horizontal_anchor_point" v="1"/>
-     <prop k="joinstyle" v="bevel"/>
-     <prop k="name" v="triangle"/>
-     <prop k="offset" v="0,0"/>
-     <prop k="offset_map_unit_scale" v="3x:0,0,0,0,0,0"/>
-     <prop k="offset_unit" v="MM"/>
-     <prop k="outline_color" v="0,0,0,255"/>
-     <prop k="outline_style" v="solid"/>
-     <prop k="outline_width" v="0"/>
-     <prop k="outline_width_map_unit_scale" v="3x:0,0,0,0,0,0"/>
-     <prop k="outline_width_unit" v="MM"/>
-     <prop k="scale_method" v="diameter"/>
-     <prop k="size" v="4.5"/>
-     <prop k="size_map_unit_scale" v="3x:0,0,0,0,0,0"/>
-     <prop k="size_unit" v="MM"/>
-     <prop k="vertical_anchor_point" v="1"/>
+     <prop v="0" k="angle"/>
+     <prop v="square" k="cap_style"/>
+     <prop v="255,255,255,255" k="color"/>
+     <prop v="1" k="horizontal_anchor_point"/>
+     <prop v="bevel" k="joinstyle"/>
+     <prop v="triangle" k="name"/>
+     <prop v="0,0" k="offset"/>
+     <prop v="3x:0,0,0,0,0,0" k="offset_map_unit_scale"/>
+     <prop v="MM" k="offset_unit"/>
+     <prop v="215,25,28,255" k="outline_color"/>
+     <prop v="solid" k="outline_style"/>
+     <prop v="0.6" k="outline_width"/>
+     <prop v="3x:0,0,0,0,0,0" k="outline_width_map_unit_scale"/>
+     <prop v="MM" k="outline_width_unit"/>
+     <prop v="diameter" k="scale_method"/>
+     <prop v="4.5" k="size"/>
+     <prop v="3x:0,0,0,0,0,0" k="size_map_unit_scale"/>
+     <prop v="MM" k="size_unit"/>
+     <prop v="1" k="vertical_anchor_point"/>
      <data_defined_properties>
       <Option type="Map">
-       <Option type="QString" name="name" value=""/>
+       <Option value="" type="QString" name="name"/>
        <Option name="properties"/>
-       <Option type="QString" name="type" value="collection"/>
+       <Option value="collection" type="QString" name="type"/>
+      </Option>
+     </data_defined_properties>
+    </layer>
+   </symbol>
+   <symbol type="marker" force_rhr="0" alpha="1" name="1" clip_to_extent="1">
+    <data_defined_properties>
+     <Option type="Map">
+      <Option value="" type="QString" name="name"/>
+      <Option name="properties"/>
+      <Option value="collection" type="QString" name="type"/>
+     </Option>
+    </data_defined_properties>
+    <layer class="SimpleMarker" locked="0" pass="0" enabled="1">
+     <Option type="Map">
+      <Option value="0" type="QString" name="angle"/>
+      <Option value="square" type="QString" name="cap_style"/>
+      <Option value="215,25,28,255" type="QString" name="color"/>
+      <Option value="1" type="QString" name="horizontal_anchor_point"/>
+      <Option value="bevel" type="QString" name="joinstyle"/>
+      <Option value="triangle" type="QString" name="name"/>
+      <Option value="0,0" type="QString" name="offset"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="offset_map_unit_scale"/>
+      <Option value="MM" type="QString" name="offset_unit"/>
+      <Option value="0,0,0,255" type="QString" name="outline_color"/>
+      <Option value="solid" type="QString" name="outline_style"/>
+      <Option value="0" type="QString" name="outline_width"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="outline_width_map_unit_scale"/>
+      <Option value="MM" type="QString" name="outline_width_unit"/>
+      <Option value="diameter" type="QString" name="scale_method"/>
+      <Option value="4.5" type="QString" name="size"/>
+      <Option value="3x:0,0,0,0,0,0" type="QString" name="size_map_unit_scale"/>
+      <Option value="MM" type="QString" name="size_unit"/>
+      <Option value="1" type="QString" name="vertical_anchor_point"/>
+     </Option>
+     <prop v="0" k="angle"/>
+     <prop v="square" k="cap_style"/>
+     <prop v="215,25,28,255" k="color"/>
+     <prop v="1" k="horizontal_anchor_point"/>
+     <prop v="bevel" k="joinstyle"/>
+     <prop v="triangle" k="name"/>
+     <prop v="0,0" k="offset"/>
+     <prop v="3x:0,0,0,0,0,0" k="offset_map_unit_scale"/>
+     <prop v="MM" k="offset_unit"/>
+     <prop v="0,0,0,255" k="outline_color"/>
+     <prop v="solid" k="outline_style"/>
+     <prop v="0" k="outline_width"/>
+     <prop v="3x:0,0,0,0,0,0" k="outline_width_map_unit_scale"/>
+     <prop v="MM" k="outline_width_unit"/>
+     <prop v="diameter" k="scale_method"/>
+     <prop v="4.5" k="size"/>
+     <prop v="3x:0,0,0,0,0,0" k="size_map_unit_scale"/>
+     <prop v="MM" k="size_unit"/>
+     <prop v="1" k="vertical_anchor_point"/>
+     <data_defined_properties>
+      <Option type="Map">
+       <Option value="" type="QString" name="name"/>
+       <Option name="properties"/>
+       <Option value="collection" type="QString" name="type"/>
       </Option>
      </data_defined_properties>
     </layer>
@@ -79,96 +138,96 @@
  </renderer-v2>
  <labeling type="simple">
   <settings calloutType="simple">
-   <text-style fieldName="&quot;id&quot; || ' ' || &quot;status&quot;" fontWeight="50" useSubstitutions="0" capitalization="0" fontSizeMapUnitScale="3x:0,0,0,0,0,0" textOrientation="horizontal" legendString="Aa" textColor="0,0,0,255" fontSize="10" fontUnderline="0" fontStrikeout="0" fontLetterSpacing="0" textOpacity="1" blendMode="0" fontItalic="0" fontWordSpacing="0" fontSizeUnit="Point" previewBkgrdColor="255,255,255,255" fontKerning="1" fontFamily="DejaVu LGC Sans" allowHtml="0" isExpression="1" namedStyle="" multilineHeight="1">
+   <text-style multilineHeight="1" fontSize="10" fontLetterSpacing="0" fontFamily="DejaVu LGC Sans" fontSizeUnit="Point" fontUnderline="0" previewBkgrdColor="255,255,255,255" textColor="0,0,0,255" fontWeight="50" fontItalic="0" isExpression="1" fontStrikeout="0" fontKerning="1" textOrientation="horizontal" allowHtml="0" fontSizeMapUnitScale="3x:0,0,0,0,0,0" blendMode="0" legendString="Aa" fontWordSpacing="0" textOpacity="1" capitalization="0" useSubstitutions="0" namedStyle="" fieldName="&quot;id&quot; || ' ' || &quot;status&quot; || CASE WHEN &quot;tie&quot; THEN ' ≈ tie' ELSE '' END">
     <families/>
-    <text-buffer bufferJoinStyle="128" bufferSize="1" bufferSizeMapUnitScale="3x:0,0,0,0,0,0" bufferDraw="1" bufferBlendMode="0" bufferNoFill="1" bufferColor="255,255,255,255" bufferOpacity="1" bufferSizeUnits="MM"/>
-    <text-mask maskOpacity="1" maskedSymbolLayers="" maskSizeUnits="MM" maskJoinStyle="128" maskType="0" maskSizeMapUnitScale="3x:0,0,0,0,0,0" maskEnabled="0" maskSize="1.5"/>
-    <background shapeDraw="0" shapeRadiiX="0" shapeOpacity="1" shapeRadiiY="0" shapeOffsetMapUnitScale="3x:0,0,0,0,0,0" shapeFillColor="255,255,255,255" shapeBorderWidth="0" shapeSizeMapUnitScale="3x:0,0,0,0,0,0" shapeRadiiMapUnitScale="3x:0,0,0,0,0,0" shapeBorderWidthUnit="MM" shapeRotationType="0" shapeSVGFile="" shapeJoinStyle="64" shapeBorderColor="128,128,128,255" shapeBorderWidthMapUnitScale="3x:0,0,0,0,0,0" shapeRotation="0" shapeType="0" shapeOffsetUnit="MM" shapeRadiiUnit="MM" shapeOffsetX="0" shapeSizeX="0" shapeOffsetY="0" shapeSizeY="0" shapeBlendMode="0" shapeSizeUnit="MM" shapeSizeType="0">
-     <symbol type="fill" force_rhr="0" clip_to_extent="1" alpha="1" name="fillSymbol">
+    <text-buffer bufferBlendMode="0" bufferSizeMapUnitScale="3x:0,0,0,0,0,0" bufferSizeUnits="MM" bufferJoinStyle="128" bufferSize="1" bufferOpacity="1" bufferColor="255,255,255,255" bufferDraw="1" bufferNoFill="1"/>
+    <text-mask maskType="0" maskSizeMapUnitScale="3x:0,0,0,0,0,0" maskOpacity="1" maskEnabled="0" maskSizeUnits="MM" maskSize="1.5" maskJoinStyle="128" maskedSymbolLayers=""/>
+    <background shapeRotationType="0" shapeRadiiUnit="MM" shapeRotation="0" shapeBlendMode="0" shapeOffsetMapUnitScale="3x:0,0,0,0,0,0" shapeSizeUnit="MM" shapeBorderWidthUnit="MM" shapeRadiiY="0" shapeRadiiX="0" shapeSizeMapUnitScale="3x:0,0,0,0,0,0" shapeSVGFile="" shapeFillColor="255,255,255,255" shapeBorderWidthMapUnitScale="3x:0,0,0,0,0,0" shapeOffsetY="0" shapeDraw="0" shapeJoinStyle="64" shapeOpacity="1" shapeOffsetUnit="MM" shapeOffsetX="0" shapeBorderColor="128,128,128,255" shapeType="0" shapeBorderWidth="0" shapeSizeY="0" shapeSizeX="0" shapeRadiiMapUnitScale="3x:0,0,0,0,0,0" shapeSizeType="0">
+     <symbol type="fill" force_rhr="0" alpha="1" name="fillSymbol" clip_to_extent="1">
       <data_defined_properties>
        <Option type="Map">
-        <Option type="QString" name="name" value=""/>
+        <Option value="" type="QString" name="name"/>
         <Option name="properties"/>
-        <Option type="QString" name="type" value="collection"/>
+        <Option value="collection" type="QString" name="type"/>
        </Option>
       </data_defined_properties>
-      <layer class="SimpleFill" enabled="1" locked="0" pass="0">
+      <layer class="SimpleFill" locked="0" pass="0" enabled="1">
        <Option type="Map">
-        <Option type="QString" name="border_width_map_unit_scale" value="3x:0,0,0,0,0,0"/>
-        <Option type="QString" name="color" value="255,255,255,255"/>
-        <Option type="QString" name="joinstyle" value="bevel"/>
-        <Option type="QString" name="offset" value="0,0"/>
-        <Option type="QString" name="offset_map_unit_scale" value="3x:0,0,0,0,0,0"/>
-        <Option type="QString" name="offset_unit" value="MM"/>
-        <Option type="QString" name="outline_color" value="128,128,128,255"/>
-        <Option type="QString" name="outline_style" value="no"/>
-        <Option type="QString" name="outline_width" value="0"/>
-        <Option type="QString" name="outline_width_unit" value="MM"/>
-        <Option type="QString" name="style" value="solid"/>
+        <Option value="3x:0,0,0,0,0,0" type="QString" name="border_width_map_unit_scale"/>
+        <Option value="255,255,255,255" type="QString" name="color"/>
+        <Option value="bevel" type="QString" name="joinstyle"/>
+        <Option value="0,0" type="QString" name="offset"/>
+        <Option value="3x:0,0,0,0,0,0" type="QString" name="offset_map_unit_scale"/>
+        <Option value="MM" type="QString" name="offset_unit"/>
+        <Option value="128,128,128,255" type="QString" name="outline_color"/>
+        <Option value="no" type="QString" name="outline_style"/>
+        <Option value="0" type="QString" name="outline_width"/>
+        <Option value="MM" type="QString" name="outline_width_unit"/>
+        <Option value="solid" type="QString" name="style"/>
        </Option>
-       <prop k="border_width_map_unit_scale" v="3x:0,0,0,0,0,0"/>
-       <prop k="color" v="255,255,255,255"/>
-       <prop k="joinstyle" v="bevel"/>
-       <prop k="offset" v="0,0"/>
-       <prop k="offset_map_unit_scale" v="3x:0,0,0,0,0,0"/>
-       <prop k="offset_unit" v="MM"/>
-       <prop k="outline_color" v="128,128,128,255"/>
-       <prop k="outline_style" v="no"/>
-       <prop k="outline_width" v="0"/>
-       <prop k="outline_width_unit" v="MM"/>
-       <prop k="style" v="solid"/>
+       <prop v="3x:0,0,0,0,0,0" k="border_width_map_unit_scale"/>
+       <prop v="255,255,255,255" k="color"/>
+       <prop v="bevel" k="joinstyle"/>
+       <prop v="0,0" k="offset"/>
+       <prop v="3x:0,0,0,0,0,0" k="offset_map_unit_scale"/>
+       <prop v="MM" k="offset_unit"/>
+       <prop v="128,128,128,255" k="outline_color"/>
+       <prop v="no" k="outline_style"/>
+       <prop v="0" k="outline_width"/>
+       <prop v="MM" k="outline_width_unit"/>
+       <prop v="solid" k="style"/>
        <data_defined_properties>
         <Option type="Map">
-         <Option type="QString" name="name" value=""/>
+         <Option value="" type="QString" name="name"/>
          <Option name="properties"/>
-         <Option type="QString" name="type" value="collection"/>
+         <Option value="collection" type="QString" name="type"/>
         </Option>
        </data_defined_properties>
       </layer>
      </symbol>
     </background>
-    <shadow shadowRadiusMapUnitScale="3x:0,0,0,0,0,0" shadowRadiusAlphaOnly="0" shadowOffsetUnit="MM" shadowOffsetGlobal="1" shadowUnder="0" shadowOpacity="0.69999999999999996" shadowColor="0,0,0,255" shadowDraw="0" shadowOffsetMapUnitScale="3x:0,0,0,0,0,0" shadowRadius="1.5" shadowScale="100" shadowOffsetAngle="135" shadowBlendMode="6" shadowOffsetDist="1" shadowRadiusUnit="MM"/>
+    <shadow shadowRadiusUnit="MM" shadowUnder="0" shadowOffsetUnit="MM" shadowOffsetAngle="135" shadowOffsetDist="1" shadowOpacity="0.69999999999999996" shadowDraw="0" shadowOffsetMapUnitScale="3x:0,0,0,0,0,0" shadowRadiusMapUnitScale="3x:0,0,0,0,0,0" shadowColor="0,0,0,255" shadowOffsetGlobal="1" shadowScale="100" shadowBlendMode="6" shadowRadiusAlphaOnly="0" shadowRadius="1.5"/>
     <dd_properties>
      <Option type="Map">
-      <Option type="QString" name="name" value=""/>
+      <Option value="" type="QString" name="name"/>
       <Option name="properties"/>
-      <Option type="QString" name="type" value="collection"/>
+      <Option value="collection" type="QString" name="type"/>
      </Option>
     </dd_properties>
     <substitutions/>
    </text-style>
-   <text-format placeDirectionSymbol="0" plussign="0" formatNumbers="0" rightDirectionSymbol=">" multilineAlign="3" reverseDirectionSymbol="0" useMaxLineLengthForAutoWrap="1" decimals="3" wrapChar="" autoWrapLength="0" leftDirectionSymbol="&lt;" addDirectionSymbol="0"/>
-   <placement placementFlags="10" rotationUnit="AngleDegrees" rotationAngle="0" yOffset="0" xOffset="0" overrunDistanceMapUnitScale="3x:0,0,0,0,0,0" overrunDistance="0" geometryGeneratorEnabled="0" layerType="UnknownGeometry" labelOffsetMapUnitScale="3x:0,0,0,0,0,0" lineAnchorClipping="0" placement="6" repeatDistanceMapUnitScale="3x:0,0,0,0,0,0" lineAnchorPercent="0.5" geometryGenerator="" maxCurvedCharAngleIn="25" geometryGeneratorType="PointGeometry" preserveRotation="1" distMapUnitScale="3x:0,0,0,0,0,0" quadOffset="4" centroidInside="0" maxCurvedCharAngleOut="-25" overrunDistanceUnit="MM" polygonPlacementFlags="2" distUnits="MM" predefinedPositionOrder="TR,TL,BR,BL,R,L,TSR,BSR" lineAnchorType="0" offsetType="1" repeatDistanceUnits="MM" repeatDistance="0" fitInPolygonOnly="0" centroidWhole="0" dist="0.80000000000000004" offsetUnits="MM" priority="10"/>
-   <rendering upsidedownLabels="0" unplacedVisibility="0" obstacleType="1" displayAll="0" scaleMin="0" zIndex="0" scaleVisibility="0" minFeatureSize="0" fontLimitPixelSize="0" drawLabels="1" limitNumLabels="0" labelPerPart="0" maxNumLabels="2000" obstacle="1" fontMaxPixelSize="10000" scaleMax="0" obstacleFactor="1" fontMinPixelSize="0" mergeLines="0"/>
+   <text-format useMaxLineLengthForAutoWrap="1" addDirectionSymbol="0" leftDirectionSymbol="&lt;" multilineAlign="3" rightDirectionSymbol=">" placeDirectionSymbol="0" autoWrapLength="0" reverseDirectionSymbol="0" formatNumbers="0" wrapChar="" plussign="0" decimals="3"/>
+   <placement repeatDistanceUnits="MM" offsetType="1" rotationAngle="0" lineAnchorClipping="0" placementFlags="10" maxCurvedCharAngleOut="-25" repeatDistance="0" layerType="UnknownGeometry" priority="10" maxCurvedCharAngleIn="25" geometryGeneratorEnabled="0" placement="6" labelOffsetMapUnitScale="3x:0,0,0,0,0,0" distMapUnitScale="3x:0,0,0,0,0,0" overrunDistanceUnit="MM" overrunDistance="0" dist="0.80000000000000004" polygonPlacementFlags="2" overrunDistanceMapUnitScale="3x:0,0,0,0,0,0" lineAnchorType="0" offsetUnits="MM" xOffset="0" repeatDistanceMapUnitScale="3x:0,0,0,0,0,0" lineAnchorPercent="0.5" geometryGenerator="" centroidWhole="0" quadOffset="4" rotationUnit="AngleDegrees" distUnits="MM" centroidInside="0" predefinedPositionOrder="TR,TL,BR,BL,R,L,TSR,BSR" fitInPolygonOnly="0" preserveRotation="1" yOffset="0" geometryGeneratorType="PointGeometry"/>
+   <rendering zIndex="0" fontLimitPixelSize="0" upsidedownLabels="0" unplacedVisibility="0" mergeLines="0" obstacle="1" obstacleType="1" scaleMin="0" scaleMax="0" scaleVisibility="0" obstacleFactor="1" minFeatureSize="0" fontMaxPixelSize="10000" drawLabels="1" labelPerPart="0" displayAll="0" limitNumLabels="0" maxNumLabels="2000" fontMinPixelSize="0"/>
    <dd_properties>
     <Option type="Map">
-     <Option type="QString" name="name" value=""/>
+     <Option value="" type="QString" name="name"/>
      <Option name="properties"/>
-     <Option type="QString" name="type" value="collection"/>
+     <Option value="collection" type="QString" name="type"/>
     </Option>
    </dd_properties>
    <callout type="simple">
     <Option type="Map">
-     <Option type="QString" name="anchorPoint" value="pole_of_inaccessibility"/>
-     <Option type="int" name="blendMode" value="0"/>
+     <Option value="pole_of_inaccessibility" type="QString" name="anchorPoint"/>
+     <Option value="0" type="int" name="blendMode"/>
      <Option type="Map" name="ddProperties">
-      <Option type="QString" name="name" value=""/>
+      <Option value="" type="QString" name="name"/>
       <Option name="properties"/>
-      <Option type="QString" name="type" value="collection"/>
+      <Option value="collection" type="QString" name="type"/>
      </Option>
-     <Option type="bool" name="drawToAllParts" value="false"/>
-     <Option type="QString" name="enabled" value="0"/>
-     <Option type="QString" name="labelAnchorPoint" value="point_on_exterior"/>
-     <Option type="QString" name="lineSymbol" value="&lt;symbol type=&quot;line&quot; force_rhr=&quot;0&quot; clip_to_extent=&quot;1&quot; alpha=&quot;1&quot; name=&quot;symbol&quot;>&lt;data_defined_properties>&lt;Option type=&quot;Map&quot;>&lt;Option type=&quot;QString&quot; name=&quot;name&quot; value=&quot;&quot;/>&lt;Option name=&quot;properties&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;type&quot; value=&quot;collection&quot;/>&lt;/Option>&lt;/data_defined_properties>&lt;layer class=&quot;SimpleLine&quot; enabled=&quot;1&quot; locked=&quot;0&quot; pass=&quot;0&quot;>&lt;Option type=&quot;Map&quot;>&lt;Option type=&quot;QString&quot; name=&quot;align_dash_pattern&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;capstyle&quot; value=&quot;square&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;customdash&quot; value=&quot;5;2&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;customdash_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;customdash_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;dash_pattern_offset&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;dash_pattern_offset_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;dash_pattern_offset_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;draw_inside_polygon&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;joinstyle&quot; value=&quot;bevel&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;line_color&quot; value=&quot;60,60,60,255&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;line_style&quot; value=&quot;solid&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;line_width&quot; value=&quot;0.3&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;line_width_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;offset&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;offset_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;offset_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;ring_filter&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_end&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_end_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_end_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_start&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_start_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;trim_distance_start_unit&quot; value=&quot;MM&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;tweak_dash_pattern_on_corners&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;use_custom_dash&quot; value=&quot;0&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;width_map_unit_scale&quot; value=&quot;3x:0,0,0,0,0,0&quot;/>&lt;/Option>&lt;prop k=&quot;align_dash_pattern&quot; v=&quot;0&quot;/>&lt;prop k=&quot;capstyle&quot; v=&quot;square&quot;/>&lt;prop k=&quot;customdash&quot; v=&quot;5;2&quot;/>&lt;prop k=&quot;customdash_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;prop k=&quot;customdash_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;dash_pattern_offset&quot; v=&quot;0&quot;/>&lt;prop k=&quot;dash_pattern_offset_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;prop k=&quot;dash_pattern_offset_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;draw_inside_polygon&quot; v=&quot;0&quot;/>&lt;prop k=&quot;joinstyle&quot; v=&quot;bevel&quot;/>&lt;prop k=&quot;line_color&quot; v=&quot;60,60,60,255&quot;/>&lt;prop k=&quot;line_style&quot; v=&quot;solid&quot;/>&lt;prop k=&quot;line_width&quot; v=&quot;0.3&quot;/>&lt;prop k=&quot;line_width_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;offset&quot; v=&quot;0&quot;/>&lt;prop k=&quot;offset_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;prop k=&quot;offset_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;ring_filter&quot; v=&quot;0&quot;/>&lt;prop k=&quot;trim_distance_end&quot; v=&quot;0&quot;/>&lt;prop k=&quot;trim_distance_end_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;prop k=&quot;trim_distance_end_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;trim_distance_start&quot; v=&quot;0&quot;/>&lt;prop k=&quot;trim_distance_start_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;prop k=&quot;trim_distance_start_unit&quot; v=&quot;MM&quot;/>&lt;prop k=&quot;tweak_dash_pattern_on_corners&quot; v=&quot;0&quot;/>&lt;prop k=&quot;use_custom_dash&quot; v=&quot;0&quot;/>&lt;prop k=&quot;width_map_unit_scale&quot; v=&quot;3x:0,0,0,0,0,0&quot;/>&lt;data_defined_properties>&lt;Option type=&quot;Map&quot;>&lt;Option type=&quot;QString&quot; name=&quot;name&quot; value=&quot;&quot;/>&lt;Option name=&quot;properties&quot;/>&lt;Option type=&quot;QString&quot; name=&quot;type&quot; value=&quot;collection&quot;/>&lt;/Option>&lt;/data_defined_properties>&lt;/layer>&lt;/symbol>"/>
-     <Option type="double" name="minLength" value="0"/>
-     <Option type="QString" name="minLengthMapUnitScale" value="3x:0,0,0,0,0,0"/>
-     <Option type="QString" name="minLengthUnit" value="MM"/>
-     <Option type="double" name="offsetFromAnchor" value="0"/>
-     <Option type="QString" name="offsetFromAnchorMapUnitScale" value="3x:0,0,0,0,0,0"/>
-     <Option type="QString" name="offsetFromAnchorUnit" value="MM"/>
-     <Option type="double" name="offsetFromLabel" value="0"/>
-     <Option type="QString" name="offsetFromLabelMapUnitScale" value="3x:0,0,0,0,0,0"/>
-     <Option type="QString" name="offsetFromLabelUnit" value="MM"/>
+     <Option value="false" type="bool" name="drawToAllParts"/>
+     <Option value="0" type="QString" name="enabled"/>
+     <Option value="point_on_exterior" type="QString" name="labelAnchorPoint"/>
+     <Option value="&lt;symbol type=&quot;line&quot; force_rhr=&quot;0&quot; alpha=&quot;1&quot; name=&quot;symbol&quot; clip_to_extent=&quot;1&quot;>&lt;data_defined_properties>&lt;Option type=&quot;Map&quot;>&lt;Option value=&quot;&quot; type=&quot;QString&quot; name=&quot;name&quot;/>&lt;Option name=&quot;properties&quot;/>&lt;Option value=&quot;collection&quot; type=&quot;QString&quot; name=&quot;type&quot;/>&lt;/Option>&lt;/data_defined_properties>&lt;layer class=&quot;SimpleLine&quot; locked=&quot;0&quot; pass=&quot;0&quot; enabled=&quot;1&quot;>&lt;Option type=&quot;Map&quot;>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;align_dash_pattern&quot;/>&lt;Option value=&quot;square&quot; type=&quot;QString&quot; name=&quot;capstyle&quot;/>&lt;Option value=&quot;5;2&quot; type=&quot;QString&quot; name=&quot;customdash&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;customdash_map_unit_scale&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;customdash_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;dash_pattern_offset&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;dash_pattern_offset_map_unit_scale&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;dash_pattern_offset_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;draw_inside_polygon&quot;/>&lt;Option value=&quot;bevel&quot; type=&quot;QString&quot; name=&quot;joinstyle&quot;/>&lt;Option value=&quot;60,60,60,255&quot; type=&quot;QString&quot; name=&quot;line_color&quot;/>&lt;Option value=&quot;solid&quot; type=&quot;QString&quot; name=&quot;line_style&quot;/>&lt;Option value=&quot;0.3&quot; type=&quot;QString&quot; name=&quot;line_width&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;line_width_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;offset&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;offset_map_unit_scale&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;offset_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;ring_filter&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;trim_distance_end&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;trim_distance_end_map_unit_scale&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;trim_distance_end_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;trim_distance_start&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;trim_distance_start_map_unit_scale&quot;/>&lt;Option value=&quot;MM&quot; type=&quot;QString&quot; name=&quot;trim_distance_start_unit&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;tweak_dash_pattern_on_corners&quot;/>&lt;Option value=&quot;0&quot; type=&quot;QString&quot; name=&quot;use_custom_dash&quot;/>&lt;Option value=&quot;3x:0,0,0,0,0,0&quot; type=&quot;QString&quot; name=&quot;width_map_unit_scale&quot;/>&lt;/Option>&lt;prop v=&quot;0&quot; k=&quot;align_dash_pattern&quot;/>&lt;prop v=&quot;square&quot; k=&quot;capstyle&quot;/>&lt;prop v=&quot;5;2&quot; k=&quot;customdash&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;customdash_map_unit_scale&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;customdash_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;dash_pattern_offset&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;dash_pattern_offset_map_unit_scale&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;dash_pattern_offset_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;draw_inside_polygon&quot;/>&lt;prop v=&quot;bevel&quot; k=&quot;joinstyle&quot;/>&lt;prop v=&quot;60,60,60,255&quot; k=&quot;line_color&quot;/>&lt;prop v=&quot;solid&quot; k=&quot;line_style&quot;/>&lt;prop v=&quot;0.3&quot; k=&quot;line_width&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;line_width_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;offset&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;offset_map_unit_scale&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;offset_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;ring_filter&quot;/>&lt;prop v=&quot;0&quot; k=&quot;trim_distance_end&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;trim_distance_end_map_unit_scale&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;trim_distance_end_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;trim_distance_start&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;trim_distance_start_map_unit_scale&quot;/>&lt;prop v=&quot;MM&quot; k=&quot;trim_distance_start_unit&quot;/>&lt;prop v=&quot;0&quot; k=&quot;tweak_dash_pattern_on_corners&quot;/>&lt;prop v=&quot;0&quot; k=&quot;use_custom_dash&quot;/>&lt;prop v=&quot;3x:0,0,0,0,0,0&quot; k=&quot;width_map_unit_scale&quot;/>&lt;data_defined_properties>&lt;Option type=&quot;Map&quot;>&lt;Option value=&quot;&quot; type=&quot;QString&quot; name=&quot;name&quot;/>&lt;Option name=&quot;properties&quot;/>&lt;Option value=&quot;collection&quot; type=&quot;QString&quot; name=&quot;type&quot;/>&lt;/Option>&lt;/data_defined_properties>&lt;/layer>&lt;/symbol>" type="QString" name="lineSymbol"/>
+     <Option value="0" type="double" name="minLength"/>
+     <Option value="3x:0,0,0,0,0,0" type="QString" name="minLengthMapUnitScale"/>
+     <Option value="MM" type="QString" name="minLengthUnit"/>
+     <Option value="0" type="double" name="offsetFromAnchor"/>
+     <Option value="3x:0,0,0,0,0,0" type="QString" name="offsetFromAnchorMapUnitScale"/>
+     <Option value="MM" type="QString" name="offsetFromAnchorUnit"/>
+     <Option value="0" type="double" name="offsetFromLabel"/>
+     <Option value="3x:0,0,0,0,0,0" type="QString" name="offsetFromLabelMapUnitScale"/>
+     <Option value="MM" type="QString" name="offsetFromLabelUnit"/>
     </Option>
    </callout>
   </settings>
@@ -179,13 +238,13 @@
  <blendMode>0</blendMode>
  <featureBlendMode>0</featureBlendMode>
  <layerOpacity>1</layerOpacity>
- <geometryOptions geometryPrecision="0" removeDuplicateNodes="0">
+ <geometryOptions removeDuplicateNodes="0" geometryPrecision="0">
   <activeChecks type="StringList">
-   <Option type="QString" value=""/>
+   <Option value="" type="QString"/>
   </activeChecks>
   <checkConfiguration/>
  </geometryOptions>
- <legend type="default-vector" showLabelLegend="0"/>
+ <legend showLabelLegend="0" type="default-vector"/>
  <referencedLayers/>
  <fieldConfiguration>
   <field name="row" configurationFlags="None">
@@ -279,6 +338,13 @@
     </config>
    </editWidget>
   </field>
+  <field name="match_score" configurationFlags="None">
+   <editWidget type="">
+    <config>
+     <Option/>
+    </config>
+   </editWidget>
+  </field>
   <field name="names_read" configurationFlags="None">
    <editWidget type="">
     <config>
@@ -358,112 +424,116 @@
   </field>
  </fieldConfiguration>
  <aliases>
-  <alias name="" field="row" index="0"/>
-  <alias name="" field="id" index="1"/>
-  <alias name="" field="title" index="2"/>
-  <alias name="" field="status" index="3"/>
-  <alias name="" field="reason" index="4"/>
-  <alias name="" field="lat" index="5"/>
-  <alias name="" field="lon" index="6"/>
-  <alias name="" field="score" index="7"/>
-  <alias name="" field="uncertainty_m" index="8"/>
-  <alias name="" field="tie" index="9"/>
-  <alias name="" field="method" index="10"/>
-  <alias name="" field="n_candidates" index="11"/>
-  <alias name="" field="match_status" index="12"/>
-  <alias name="" field="names_read" index="13"/>
-  <alias name="" field="names_matched" index="14"/>
-  <alias name="" field="match_kinds" index="15"/>
-  <alias name="" field="view_text" index="16"/>
-  <alias name="" field="view_bearing_deg" index="17"/>
-  <alias name="" field="heading_deg" index="18"/>
-  <alias name="" field="height_m" index="19"/>
-  <alias name="" field="extract" index="20"/>
-  <alias name="" field="list_lat" index="21"/>
-  <alias name="" field="list_lon" index="22"/>
-  <alias name="" field="n_errors" index="23"/>
+  <alias index="0" field="row" name=""/>
+  <alias index="1" field="id" name=""/>
+  <alias index="2" field="title" name=""/>
+  <alias index="3" field="status" name=""/>
+  <alias index="4" field="reason" name=""/>
+  <alias index="5" field="lat" name=""/>
+  <alias index="6" field="lon" name=""/>
+  <alias index="7" field="score" name=""/>
+  <alias index="8" field="uncertainty_m" name=""/>
+  <alias index="9" field="tie" name=""/>
+  <alias index="10" field="method" name=""/>
+  <alias index="11" field="n_candidates" name=""/>
+  <alias index="12" field="match_status" name=""/>
+  <alias index="13" field="match_score" name=""/>
+  <alias index="14" field="names_read" name=""/>
+  <alias index="15" field="names_matched" name=""/>
+  <alias index="16" field="match_kinds" name=""/>
+  <alias index="17" field="view_text" name=""/>
+  <alias index="18" field="view_bearing_deg" name=""/>
+  <alias index="19" field="heading_deg" name=""/>
+  <alias index="20" field="height_m" name=""/>
+  <alias index="21" field="extract" name=""/>
+  <alias index="22" field="list_lat" name=""/>
+  <alias index="23" field="list_lon" name=""/>
+  <alias index="24" field="n_errors" name=""/>
  </aliases>
  <defaults>
-  <default expression="" field="row" applyOnUpdate="0"/>
-  <default expression="" field="id" applyOnUpdate="0"/>
-  <default expression="" field="title" applyOnUpdate="0"/>
-  <default expression="" field="status" applyOnUpdate="0"/>
-  <default expression="" field="reason" applyOnUpdate="0"/>
-  <default expression="" field="lat" applyOnUpdate="0"/>
-  <default expression="" field="lon" applyOnUpdate="0"/>
-  <default expression="" field="score" applyOnUpdate="0"/>
-  <default expression="" field="uncertainty_m" applyOnUpdate="0"/>
-  <default expression="" field="tie" applyOnUpdate="0"/>
-  <default expression="" field="method" applyOnUpdate="0"/>
-  <default expression="" field="n_candidates" applyOnUpdate="0"/>
-  <default expression="" field="match_status" applyOnUpdate="0"/>
-  <default expression="" field="names_read" applyOnUpdate="0"/>
-  <default expression="" field="names_matched" applyOnUpdate="0"/>
-  <default expression="" field="match_kinds" applyOnUpdate="0"/>
-  <default expression="" field="view_text" applyOnUpdate="0"/>
-  <default expression="" field="view_bearing_deg" applyOnUpdate="0"/>
-  <default expression="" field="heading_deg" applyOnUpdate="0"/>
-  <default expression="" field="height_m" applyOnUpdate="0"/>
-  <default expression="" field="extract" applyOnUpdate="0"/>
-  <default expression="" field="list_lat" applyOnUpdate="0"/>
-  <default expression="" field="list_lon" applyOnUpdate="0"/>
-  <default expression="" field="n_errors" applyOnUpdate="0"/>
+  <default expression="" applyOnUpdate="0" field="row"/>
+  <default expression="" applyOnUpdate="0" field="id"/>
+  <default expression="" applyOnUpdate="0" field="title"/>
+  <default expression="" applyOnUpdate="0" field="status"/>
+  <default expression="" applyOnUpdate="0" field="reason"/>
+  <default expression="" applyOnUpdate="0" field="lat"/>
+  <default expression="" applyOnUpdate="0" field="lon"/>
+  <default expression="" applyOnUpdate="0" field="score"/>
+  <default expression="" applyOnUpdate="0" field="uncertainty_m"/>
+  <default expression="" applyOnUpdate="0" field="tie"/>
+  <default expression="" applyOnUpdate="0" field="method"/>
+  <default expression="" applyOnUpdate="0" field="n_candidates"/>
+  <default expression="" applyOnUpdate="0" field="match_status"/>
+  <default expression="" applyOnUpdate="0" field="match_score"/>
+  <default expression="" applyOnUpdate="0" field="names_read"/>
+  <default expression="" applyOnUpdate="0" field="names_matched"/>
+  <default expression="" applyOnUpdate="0" field="match_kinds"/>
+  <default expression="" applyOnUpdate="0" field="view_text"/>
+  <default expression="" applyOnUpdate="0" field="view_bearing_deg"/>
+  <default expression="" applyOnUpdate="0" field="heading_deg"/>
+  <default expression="" applyOnUpdate="0" field="height_m"/>
+  <default expression="" applyOnUpdate="0" field="extract"/>
+  <default expression="" applyOnUpdate="0" field="list_lat"/>
+  <default expression="" applyOnUpdate="0" field="list_lon"/>
+  <default expression="" applyOnUpdate="0" field="n_errors"/>
  </defaults>
  <constraints>
-  <constraint unique_strength="0" exp_strength="0" field="row" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="id" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="title" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="status" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="reason" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="lat" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="lon" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="score" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="uncertainty_m" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="tie" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="method" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="n_candidates" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="match_status" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="names_read" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="names_matched" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="match_kinds" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="view_text" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="view_bearing_deg" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="heading_deg" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="height_m" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="extract" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="list_lat" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="list_lon" notnull_strength="0" constraints="0"/>
-  <constraint unique_strength="0" exp_strength="0" field="n_errors" notnull_strength="0" constraints="0"/>
+  <constraint notnull_strength="0" constraints="0" field="row" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="id" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="title" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="status" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="reason" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="lat" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="lon" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="score" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="uncertainty_m" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="tie" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="method" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="n_candidates" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="match_status" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="match_score" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="names_read" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="names_matched" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="match_kinds" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="view_text" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="view_bearing_deg" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="heading_deg" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="height_m" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="extract" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="list_lat" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="list_lon" unique_strength="0" exp_strength="0"/>
+  <constraint notnull_strength="0" constraints="0" field="n_errors" unique_strength="0" exp_strength="0"/>
  </constraints>
  <constraintExpressions>
-  <constraint desc="" field="row" exp=""/>
-  <constraint desc="" field="id" exp=""/>
-  <constraint desc="" field="title" exp=""/>
-  <constraint desc="" field="status" exp=""/>
-  <constraint desc="" field="reason" exp=""/>
-  <constraint desc="" field="lat" exp=""/>
-  <constraint desc="" field="lon" exp=""/>
-  <constraint desc="" field="score" exp=""/>
-  <constraint desc="" field="uncertainty_m" exp=""/>
-  <constraint desc="" field="tie" exp=""/>
-  <constraint desc="" field="method" exp=""/>
-  <constraint desc="" field="n_candidates" exp=""/>
-  <constraint desc="" field="match_status" exp=""/>
-  <constraint desc="" field="names_read" exp=""/>
-  <constraint desc="" field="names_matched" exp=""/>
-  <constraint desc="" field="match_kinds" exp=""/>
-  <constraint desc="" field="view_text" exp=""/>
-  <constraint desc="" field="view_bearing_deg" exp=""/>
-  <constraint desc="" field="heading_deg" exp=""/>
-  <constraint desc="" field="height_m" exp=""/>
-  <constraint desc="" field="extract" exp=""/>
-  <constraint desc="" field="list_lat" exp=""/>
-  <constraint desc="" field="list_lon" exp=""/>
-  <constraint desc="" field="n_errors" exp=""/>
+  <constraint field="row" exp="" desc=""/>
+  <constraint field="id" exp="" desc=""/>
+  <constraint field="title" exp="" desc=""/>
+  <constraint field="status" exp="" desc=""/>
+  <constraint field="reason" exp="" desc=""/>
+  <constraint field="lat" exp="" desc=""/>
+  <constraint field="lon" exp="" desc=""/>
+  <constraint field="score" exp="" desc=""/>
+  <constraint field="uncertainty_m" exp="" desc=""/>
+  <constraint field="tie" exp="" desc=""/>
+  <constraint field="method" exp="" desc=""/>
+  <constraint field="n_candidates" exp="" desc=""/>
+  <constraint field="match_status" exp="" desc=""/>
+  <constraint field="match_score" exp="" desc=""/>
+  <constraint field="names_read" exp="" desc=""/>
+  <constraint field="names_matched" exp="" desc=""/>
+  <constraint field="match_kinds" exp="" desc=""/>
+  <constraint field="view_text" exp="" desc=""/>
+  <constraint field="view_bearing_deg" exp="" desc=""/>
+  <constraint field="heading_deg" exp="" desc=""/>
+  <constraint field="height_m" exp="" desc=""/>
+  <constraint field="extract" exp="" desc=""/>
+  <constraint field="list_lat" exp="" desc=""/>
+  <constraint field="list_lon" exp="" desc=""/>
+  <constraint field="n_errors" exp="" desc=""/>
  </constraintExpressions>
  <expressionfields/>
  <attributeactions/>
- <attributetableconfig sortOrder="0" sortExpression="" actionWidgetStyle="dropDown">
+ <attributetableconfig actionWidgetStyle="dropDown" sortOrder="0" sortExpression="">
   <columns/>
  </attributetableconfig>
  <conditionalstyles>

@@ -1,10 +1,34 @@
 <?xml version="1.0" encoding="UTF-8"?>
-<StyledLayerDescriptor xmlns="http://www.opengis.net/sld" xmlns:se="http://www.opengis.net/se" xsi:schemaLocation="http://www.opengis.net/sld http://schemas.opengis.net/sld/1.1.0/StyledLayerDescriptor.xsd" xmlns:ogc="http://www.opengis.net/ogc" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xmlns:xlink="http://www.w3.org/1999/xlink" version="1.1.0">
+<StyledLayerDescriptor xmlns="http://www.opengis.net/sld" version="1.1.0" xsi:schemaLocation="http://www.opengis.net/sld http://schemas.opengis.net/sld/1.1.0/StyledLayerDescriptor.xsd" xmlns:se="http://www.opengis.net/se" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xmlns:xlink="http://www.w3.org/1999/xlink" xmlns:ogc="http://www.opengis.net/ogc">
  <NamedLayer>
   <se:Name>job_cameras</se:Name>
   <UserStyle>
    <se:Name>job_cameras</se:Name>
    <se:FeatureTypeStyle>
+    <se:Rule>
+     <se:Name>camera placed at a tied candidate (≈): another fits nearly as well</se:Name>
+     <se:Description>
+      <se:Title>camera placed at a tied candidate (≈): another fits nearly as well</se:Title>
+     </se:Description>
+     <ogc:Filter xmlns:ogc="http://www.opengis.net/ogc">
+      <ogc:PropertyName>ambiguous</ogc:PropertyName>
+     </ogc:Filter>
+     <se:PointSymbolizer>
+      <se:Graphic>
+       <se:Mark>
+        <se:WellKnownName>triangle</se:WellKnownName>
+        <se:Fill>
+         <se:SvgParameter name="fill">#ffffff</se:SvgParameter>
+        </se:Fill>
+        <se:Stroke>
+         <se:SvgParameter name="stroke">#d7191c</se:SvgParameter>
+         <se:SvgParameter name="stroke-width">2</se:SvgParameter>
+        </se:Stroke>
+       </se:Mark>
+       <se:Size>16</se:Size>
+      </se:Graphic>
+     </se:PointSymbolizer>
+    </se:Rule>
     <se:Rule>
      <se:Name>camera placed</se:Name>
      <se:Description>
@@ -31,7 +55,7 @@ syntax error, unexpected ELSE - Expression was: ELSE-->
     <se:Rule>
      <se:TextSymbolizer>
       <se:Label>
-       <!--SE Export for id || ' ' || status not implemented yet-->Placeholder</se:Label>
+       <!--SE Export for id || ' ' || status || CASE WHEN ambiguous THEN ' ≈ tie' ELSE '' END not implemented yet-->Placeholder</se:Label>
       <se:Font>
        <se:SvgParameter name="font-family">DejaVu LGC Sans</se:SvgParameter>
        <se:SvgParameter name="font-size">13</se:SvgParameter>

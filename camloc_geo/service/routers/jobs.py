@@ -168,6 +168,14 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
                     break
         except csv.Error as exc:
             raise SceneError(f"malformed CSV list: {exc}", "body") from None
+        if not out:
+            # the body's own words: 'cameras: the list holds no camera' named a JSON field a
+            # CSV body has not (session 41 QA)
+            raise SceneError(
+                "the CSV list holds no camera (no row under its header): a header row "
+                "(id,title,lat,lon,radius_m) and one camera a row",
+                "body",
+            )
         if out and not placeable and len(out) <= max_cameras:  # (over it: the limit's 413)
             # as camloc batch refuses it: a list of titles without a header row (its first
             # title read as the header), another table; every camera was no_evidence
@@ -180,7 +188,12 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
         return out
     data = parse_json(raw)
     if isinstance(data, dict) and data.get("type") == "FeatureCollection":
-        return _feature_records(data, max_cameras)
+        records = _feature_records(data, max_cameras)
+        if not records:
+            raise SceneError(
+                "the GeoJSON FeatureCollection holds no camera: one Feature a camera", "features"
+            )
+        return records
     try:
         cameras = JobList.model_validate(data).cameras
     except ValidationError:
