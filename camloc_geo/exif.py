@@ -600,16 +600,8 @@ def _reading_35mm(
     if aspect >= _WIDE_ASPECT:
         large = frame_mm is not None and frame_mm >= _LARGE_SENSOR_DIAGONAL_MM
         name = "3:2" if large else "4:3"
-        f_a, f_b = on(own_ratio), on(_FRAME_RATIOS[name])
-        d = math.log(f_b / f_a)
-        sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
-        notes.append(
-            f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the "
-            f"sensor's {name} frame ({f_b:.0f} px) or for the photo's own ({f_a:.0f} px); "
-            f"the sensor's width is not known: the prior covers both, "
-            f"{math.sqrt(f_a * f_b):.0f} px +/- {100 * sigma:.0f} %"
-        )
-        return [_Reading("exif-35mm", math.sqrt(f_a * f_b), sigma, f"{what} (read two ways)")]
+        frame = f"sensor's {name} frame"
+        return _two_ways(f35, aspect, on(own_ratio), on(_FRAME_RATIOS[name]), frame, notes)
     return [_Reading("exif-35mm", on(own_ratio), SIGMA_35MM, what)]
 
 
@@ -654,15 +646,26 @@ def _reading_35mm_square(
     large = frame_mm is not None and frame_mm >= _LARGE_SENSOR_DIAGONAL_MM
     name = "3:2" if large else "4:3"
     f_b = f35 * shorter * full_height[name] / D
-    d = math.log(f_b / own)
+    frame = f"sensor's {name} frame at the photo's height"
+    return _two_ways(f35, aspect, own, f_b, frame, notes)
+
+
+def _two_ways(
+    f35: float, aspect: float, f_own: float, f_frame: float, frame: str, notes: list[str]
+) -> list[_Reading]:
+    """The 35 mm tag read on the photo's own diagonal and on a sensor frame, where the
+    sensor's width cannot tell which it was written for: their equal mixture, its sigma
+    covering both, said in ``notes``."""
+    d = math.log(f_frame / f_own)
     sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
+    f_mix = math.sqrt(f_own * f_frame)
     notes.append(
-        f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the "
-        f"sensor's {name} frame at the photo's height ({f_b:.0f} px) or for the photo's own "
-        f"({own:.0f} px); the sensor's width is not known: the prior covers both, "
-        f"{math.sqrt(own * f_b):.0f} px +/- {100 * sigma:.0f} %"
+        f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the {frame} "
+        f"({f_frame:.0f} px) or for the photo's own ({f_own:.0f} px); the sensor's width is "
+        f"not known: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} %"
     )
-    return [_Reading("exif-35mm", math.sqrt(own * f_b), sigma, f"{what} (read two ways)")]
+    what = f"FocalLengthIn35mmFilm {f35:g} mm (read two ways)"
+    return [_Reading("exif-35mm", f_mix, sigma, what)]
 
 
 def focal_from_exif(
