@@ -1337,12 +1337,38 @@ def _dot_icon(
     )
 
 
-def _corner_icon(text: str, colour: str, *, above: bool = False) -> folium.DivIcon:
-    """A small label; below the point (map corners) or above it (matched scene corners)."""
+_LABEL_W_PX, _LABEL_H_PX, _LABEL_GAP_PX = 34, 16, 4
+"""A corner label's box and its gap from its point and from the label stacked beside it."""
+
+
+def _outward(lat: float, lon: float, centre: tuple[float, float] | None) -> tuple[bool, bool]:
+    """``(right, down)``: the side of ``centre`` (lat, lon) a point lies on, on screen; its
+    labels go that way, away from the junction (no centre: right and down)."""
+    if centre is None:
+        return True, True
+    return lon >= centre[1], lat < centre[0]
+
+
+def _corner_icon(
+    text: str, colour: str, *, right: bool = True, down: bool = True, tier: int = 0
+) -> folium.DivIcon:
+    """A small label beside its point, on the side ``right``/``down`` says; ``tier`` 1 is the
+    second label of one point (a matched scene corner's over a map corner's), stacked further
+    out.
+
+    The labels of a junction's corners point away from its centre (:func:`_outward`): a map
+    corner's label below its point and a scene corner's above the next point overlapped where
+    two corners stood close, "m0" over "2" on the bundled sample's review page (stop 41).
+    """
     inner = f'<div style="background:{colour}">{html.escape(text)}</div>'
-    anchor = (-4, 20) if above else (-4, -4)
+    step = _LABEL_H_PX + _LABEL_GAP_PX // 2
+    x_px = _LABEL_GAP_PX if right else -_LABEL_GAP_PX - _LABEL_W_PX
+    y_px = _LABEL_GAP_PX + tier * step if down else -_LABEL_GAP_PX - _LABEL_H_PX - tier * step
     return folium.DivIcon(
-        html=inner, icon_size=(34, 16), icon_anchor=anchor, class_name="camloc-corner-label"
+        html=inner,
+        icon_size=(_LABEL_W_PX, _LABEL_H_PX),
+        icon_anchor=(-x_px, -y_px),
+        class_name="camloc-corner-label",
     )
 
 
@@ -1522,7 +1548,20 @@ def build_candidates_map(
     if len(cones) > _CONES_SHOWN:
         fg_cones_rest.add_to(fmap)
 
-    # Map kerb corners, in map order.
+    # Map kerb corners, in map order; their labels (and the scene corners' matched to them)
+    # point away from the junction's centre
+    centre = (
+        (
+            sum(f["geometry"]["coordinates"][1] for f in corners) / len(corners),
+            sum(f["geometry"]["coordinates"][0] for f in corners) / len(corners),
+        )
+        if corners
+        else None
+    )
+    corner_points = {
+        (round(f["geometry"]["coordinates"][0], 7), round(f["geometry"]["coordinates"][1], 7))
+        for f in corners
+    }
     if corners:
         fg_corners = folium.FeatureGroup(name="Map kerb corners (m = clockwise order)", show=True)
         for f in corners:
@@ -1542,8 +1581,11 @@ def build_candidates_map(
                 fill_opacity=1.0,
                 tooltip=tip,
             ).add_to(fg_corners)
+            right, down = _outward(lat, lon, centre)
             folium.Marker(
-                [lat, lon], icon=_corner_icon(f"m{p['order']}", _STYLE["corner"]), tooltip=tip
+                [lat, lon],
+                icon=_corner_icon(f"m{p['order']}", _STYLE["corner"], right=right, down=down),
+                tooltip=tip,
             ).add_to(fg_corners)
         fg_corners.add_to(fmap)
 
@@ -1570,9 +1612,15 @@ def build_candidates_map(
                 dash_array="3 4",
                 interactive=False,
             ).add_to(fg)
+            right, down = _outward(mlat, mlon, centre)
+            # on a map corner: stacked beyond its "m" label; elsewhere (a reference, a
+            # landmark) beside the point
+            on_corner = (round(mlon, 7), round(mlat, 7)) in corner_points
             folium.Marker(
                 [mlat, mlon],
-                icon=_corner_icon(text, _STYLE["match"], above=True),
+                icon=_corner_icon(
+                    text, _STYLE["match"], right=right, down=down, tier=1 if on_corner else 0
+                ),
                 tooltip=html.escape(
                     f"candidate {rank}: {label} → "
                     f"{m.get('map_corner', 'map point')}, misfit "
@@ -1679,6 +1727,8 @@ def build_candidates_map(
         title += f"<br><b>no candidates</b>: {html.escape(why)}"
     _Control(title, position="topleft", css_class="camloc-title").add_to(fmap)
 
+    if corners or any(f["properties"].get("matches") for f in cands[:_MATCH_LAYERS]):
+        _LabelsClear().add_to(fmap)  # before the fit: its zoom places the labels
     pts = [[f["properties"]["lat"], f["properties"]["lon"]] for f in cands[:6]]
     for f in corners:
         pts.append([f["geometry"]["coordinates"][1], f["geometry"]["coordinates"][0]])
@@ -2439,6 +2489,92 @@ function camlocFitClear(map, bounds, maxZoom, beforeFit) {
 """.replace("SMALL_PX", str(SMALL_SCREEN_PX))
 """A page's first view: its markers fitted clear of the boxes over the map (a legend at the
 bottom left covered the candidates there)."""
+
+
+_LABELS_CLEAR_JS = """
+function camlocLabelsClear(map, W, H, G) {
+    // Each corner label (a map corner's "m0", a matched scene corner's "2") takes the first
+    // of its places (its own side of the junction first, then the other sides, then stacked
+    // further out) that covers no candidate marker, no corner point and no label placed
+    // before it; none clear: the least covered. Redone at every zoom and layer toggle.
+    function overlap(a, b) {
+        var w = Math.min(a.x + a.w, b.x + b.w) - Math.max(a.x, b.x);
+        var h = Math.min(a.y + a.h, b.y + b.h) - Math.max(a.y, b.y);
+        return w > 0 && h > 0 ? w * h : 0;
+    }
+    function place() {
+        var box = map.getContainer().getBoundingClientRect(), taken = [], labels = [];
+        document.querySelectorAll(".camloc-candidate").forEach(function (e) {
+            if (!e.offsetWidth) { return; }
+            var r = e.getBoundingClientRect();
+            taken.push({x: r.left - box.left, y: r.top - box.top, w: r.width, h: r.height});
+        });
+        map.eachLayer(function (l) {
+            var o = l.options && l.options.icon && l.options.icon.options;
+            if (l._icon && o && o.className === "camloc-corner-label") { labels.push(l); }
+        });
+        labels.forEach(function (l) {  // the corner points
+            var p = map.latLngToContainerPoint(l.getLatLng());
+            taken.push({x: p.x - G, y: p.y - G, w: 2 * G, h: 2 * G});
+        });
+        labels.sort(function (a, b) {  // map corners' labels (next to the point) first
+            return Math.abs(a.options.icon.options.iconAnchor[1]) -
+                Math.abs(b.options.icon.options.iconAnchor[1]);
+        });
+        labels.forEach(function (l) {
+            var p = map.latLngToContainerPoint(l.getLatLng());
+            var a = l.options.icon.options.iconAnchor, x0 = -a[0], y0 = -a[1];
+            var right = x0 >= 0, down = y0 >= 0, tier0 = Math.abs(y0) > G + H ? 1 : 0;
+            var places = [], best = null, bestCost = Infinity;
+            var xs = [right ? G : -G - W, right ? -G - W : G, -W / 2];  // beside, centred
+            for (var tier = tier0; tier < tier0 + 4; tier++) {
+                [down, !down].forEach(function (d) {
+                    xs.forEach(function (x) {
+                        places.push([x, d ? G + tier * (H + 2) : -G - H - tier * (H + 2)]);
+                    });
+                });
+            }
+            places.forEach(function (o) {
+                if (bestCost === 0) { return; }
+                var r = {x: p.x + o[0], y: p.y + o[1], w: W, h: H}, cost = 0;
+                taken.forEach(function (t) { cost += overlap(r, t); });
+                if (cost < bestCost) { bestCost = cost; best = o; }
+            });
+            l._icon.style.marginLeft = best[0] + "px";
+            l._icon.style.marginTop = best[1] + "px";
+            taken.push({x: p.x + best[0], y: p.y + best[1], w: W, h: H});
+        });
+    }
+    map.on("zoomend overlayadd overlayremove", place);
+    map.whenReady(function () { setTimeout(place, 0); });
+}
+"""
+
+
+class _LabelsClear(MacroElement):
+    """Corner labels placed clear of the candidates and of each other
+    (:data:`_LABELS_CLEAR_JS`); added after the markers.
+
+    The labels' own places (:func:`_corner_icon`) are fixed offsets, and at the bundled
+    sample's opening zoom "m0" and a matched scene corner's "2" overlapped (stop 41).
+    """
+
+    _template = Template(
+        """
+{% macro script(this, kwargs) %}
+(function () {
+    {{ this.js }}
+    camlocLabelsClear({{ this._parent.get_name() }}, {{ this.w }}, {{ this.h }}, {{ this.g }});
+})();
+{% endmacro %}
+"""
+    )
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._name = "CamlocLabelsClear"
+        self.js = _LABELS_CLEAR_JS
+        self.w, self.h, self.g = _LABEL_W_PX, _LABEL_H_PX, _LABEL_GAP_PX
 
 
 class _FitClear(MacroElement):

@@ -11,6 +11,7 @@ import sqlite3
 import subprocess
 import sys
 import time
+from contextlib import closing
 from pathlib import Path
 from typing import Any
 
@@ -488,13 +489,33 @@ def test_cli_batch_outputs_never_overwrite_the_list(
         (["-o", str(lst)], "-o " + str(lst) + ": would overwrite the input"),
         (["-o", gpkg, "--map", str(lst)], "would overwrite the input"),
         (["-o", gpkg, "--map", gpkg], "the same file as -o"),
-        (["-o", str(tmp_path / "o.geojson")], "writes a GeoPackage; name it .gpkg"),
+        (["-o", str(tmp_path / "o.geojson")], "writes a GeoPackage, not .geojson; name it .gpkg"),
+        # stop 41: a name without a suffix wrote a GeoPackage named "o"
+        (["-o", str(tmp_path / "o")], "and the name has no suffix; name it .gpkg (as o.gpkg"),
     ]
     for extra, message in cases:
         assert main(["batch", str(lst), *extra, "--workers", "1", "--no-progress"]) == 2
         assert message in capsys.readouterr().err
         assert lst.read_text(encoding="utf-8") == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cams.csv"]  # no journal either
+
+
+def test_cli_batch_still_resumes_a_run_begun_under_a_name_without_suffix(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o o`` is refused since stop 41, but a run begun under that name before (its journal
+    ``o.camloc-batch.sqlite`` is there) still continues."""
+    from camloc_geo.batch._journal import Journal, journal_path
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text("id,title\n1,A & B\n", encoding="utf-8")
+    out = tmp_path / "o"
+    Journal(journal_path(out)).close()
+    assert main(["batch", str(lst), "-o", str(out), "--workers", "1", "--no-progress"]) == 0
+    assert "name it .gpkg" not in capsys.readouterr().err
+    # read as SQLite: GDAL warns of a GeoPackage "with non conformant file extension"
+    with closing(sqlite3.connect(out)) as db:
+        assert [str(r[0]) for r in db.execute("SELECT id FROM cameras")] == ["1"]
 
 
 def test_cli_batch_warns_of_duplicate_camera_ids(

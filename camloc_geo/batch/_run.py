@@ -14,6 +14,7 @@ import contextlib
 import hashlib
 import json
 import logging
+import math
 import multiprocessing
 import os
 import sys
@@ -867,6 +868,7 @@ _CANDIDATE_COLUMNS: dict[str, str] = {
     "uncertainty_m": "float64",
     "heading_deg": "float64",
     "height_m": "float64",
+    "residual_m": "float64",
     "method": "object",
     "detail": "object",
     "intersection": "object",
@@ -913,6 +915,16 @@ def _best_ties(r: dict[str, Any]) -> list[int]:
     if cands and "ambiguous_with" in cands[0]:
         return [int(o) for o in cands[0].get("ambiguous_with") or []]
     return [2] if r.get("tie") and r.get("status") == "located" else []
+
+
+def _best_residual_m(r: dict[str, Any]) -> float | None:
+    """The camera's best located candidate's ``residual_m`` (None: a title's place, or a
+    journal of a run before stop 41, whose candidates did not keep it)."""
+    cands = r.get("candidates") or []
+    if not cands or cands[0].get("source") != "locate":
+        return None
+    value = cands[0].get("residual_m")
+    return float(value) if isinstance(value, (int, float)) and math.isfinite(value) else None
 
 
 def _ranks_text(ranks: list[Any]) -> str | None:
@@ -1165,6 +1177,8 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
             "method": f"{r.get('method')} ({r['status']})",
             "heading_deg": heading,
             "height_m": r.get("height_m"),
+            # the best located candidate's misfit (the camera's row has none): "—" before
+            "residual_m": _best_residual_m(r),
             "sigma_m": r.get("uncertainty_m"),
             "flags": ([r["status"]] + (["tie"] if r.get("tie") else [])),
             # the best candidate's ties, as the engine decided them (the core's rule)

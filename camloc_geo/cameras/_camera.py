@@ -493,6 +493,9 @@ def _locate(
                 "uncertainty_m": _finite(c.sigma_m),
                 "heading_deg": heading,
                 "height_m": _finite(c.camera.height_m),
+                # the RMS misfit of the map features it matched (locate's residual_m): the
+                # job and batch summary pages' popups showed "—" for it (stop 41)
+                "residual_m": _finite(c.residual_m),
                 "method": c.method,
                 "detail": ", ".join(str(f) for f in c.flags) or None,
                 "intersection": getattr(r.intersection, "id", None),

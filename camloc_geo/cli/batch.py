@@ -81,11 +81,17 @@ def run(args: argparse.Namespace) -> int:
     # page used to overwrite the list with --map LIST.csv), nor on each other
     inputs = [args.list, args.osm]
     out = output_path(args.output, inputs=inputs)
-    if out is not None and out.suffix.lower() not in ("", ".gpkg"):
-        raise InputError(
-            f"-o {args.output}: camloc batch writes a GeoPackage; name it .gpkg "
-            "(its layers: cameras, candidates, view_cones, errors)"
-        )
+    if out is not None and out.suffix.lower() != ".gpkg":
+        from camloc_geo.batch import journal_path
+
+        # a name without a suffix wrote a GeoPackage no file manager or QGIS browser knew
+        # (stop 41); a run begun under such a name before then still resumes (its journal)
+        if out.suffix or not journal_path(out).exists():
+            got = f"not {out.suffix}" if out.suffix else "and the name has no suffix"
+            raise InputError(
+                f"-o {args.output}: camloc batch writes a GeoPackage, {got}; name it .gpkg "
+                f"(as {out.stem}.gpkg; its layers: cameras, candidates, view_cones, errors)"
+            )
     if args.map is not None:
         page = output_path(args.map, inputs=inputs, option="--map")
         if page is not None and out is not None and page.resolve() == out.resolve():

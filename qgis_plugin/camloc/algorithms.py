@@ -129,6 +129,50 @@ def _option_bool(name: str, label: str) -> QgsProcessingParameterBoolean:
     return QgsProcessingParameterBoolean(name, label, defaultValue=False, optional=True)
 
 
+# QgsProcessingParameterNumber's minimum/maximum when none was given (-DBL_MAX, DBL_MAX)
+_UNBOUNDED = 1e300
+
+
+def _number_range_text(param: QgsProcessingParameterNumber) -> str:
+    """The values ``param`` takes, in words: 'a whole number of at least 1', 'at least 10'."""
+    low, high = param.minimum(), param.maximum()
+    whole = param.dataType() == QgsProcessingParameterNumber.Integer
+    kind = "a whole number" if whole else "a number"
+    if low > -_UNBOUNDED and high < _UNBOUNDED:
+        return f"{kind} from {low:g} to {high:g}"
+    if low > -_UNBOUNDED:
+        return f"{kind} of at least {low:g}"
+    if high < _UNBOUNDED:
+        return f"{kind} of at most {high:g}"
+    return kind
+
+
+def number_out_of_range(param: QgsProcessingParameterNumber, value: Any) -> str | None:
+    """Why ``value`` is refused for ``param``, naming it and its range; None when it is taken.
+
+    QGIS's own check says only "Incorrect parameter value for MAX_CANDIDATES" (qgis_process,
+    ``processing.run``): this names the parameter, its label, the range and the value given.
+    Unset values and model expressions (``QgsProperty``) are left to QGIS.
+    """
+    if value is None or value == "" or isinstance(value, QgsProperty):
+        return None
+    rng = _number_range_text(param)
+    where = f"camloc: {param.name()} ({param.description()}) must be {rng}"
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return f"{where}; got {value!r}"
+    whole = param.dataType() == QgsProcessingParameterNumber.Integer
+    if (
+        number != number  # NaN
+        or number < param.minimum()
+        or number > param.maximum()
+        or (whole and not number.is_integer())
+    ):
+        return f"{where}; got {value}"
+    return None
+
+
 class _CamlocAlgorithm(QgsProcessingAlgorithm):
     """Shared parts: group, help, the worker call and the typed sinks."""
 
@@ -153,6 +197,17 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
 
     def createInstance(self):
         return type(self)()
+
+    def checkParameterValues(
+        self, parameters: dict[str, Any], context: QgsProcessingContext
+    ) -> tuple[bool, str]:
+        """Refuse a number out of its range with a message naming it and the range."""
+        for param in self.parameterDefinitions():
+            if isinstance(param, QgsProcessingParameterNumber):
+                message = number_out_of_range(param, parameters.get(param.name()))
+                if message:
+                    return False, message
+        return super().checkParameterValues(parameters, context)
 
     def _add_map_params(self, folder: bool = False) -> None:
         if folder:

@@ -702,3 +702,44 @@ def test_a_wrong_file_is_one_processing_error_line_naming_it(provider, tmp_path)
             assert file_name in text, (name, text)
     assert not unblocker.used  # nothing opened the FIFO
     assert len(said) == 7
+
+
+@pytest.mark.parametrize(
+    ("alg", "name", "value", "words"),
+    [
+        ("camloc:locate", "MAX_CANDIDATES", 0, "a whole number of at least 1; got 0"),
+        ("camloc:locate", "MAX_CANDIDATES", "2.5", "a whole number of at least 1; got 2.5"),
+        ("camloc:locate", "RADIUS_M", -5, "a number of at least 10; got -5"),
+        ("camloc:corners", "RADIUS_M", "-5", "a number of at least 1; got -5"),
+    ],
+)
+def test_a_number_out_of_range_names_the_parameter_and_its_range(
+    provider, tmp_path, alg, name, value, words
+):
+    # QGIS's own check said only "Incorrect parameter value for MAX_CANDIDATES" (stop 41)
+    import processing
+
+    params = {
+        "SCENE": str(SAMPLE_SCENE),
+        "OSM": str(SAMPLE_OSM),
+        "CANDIDATES": str(tmp_path / "c.gpkg"),
+        "POINT": "-76.5935,39.2851 [EPSG:4326]",
+        "CORNERS": str(tmp_path / "k.gpkg"),
+        name: value,
+    }
+    with pytest.raises(QgsProcessingException) as err:
+        processing.run(alg, params)
+    assert f"camloc: {name} (" in str(err.value)
+    assert words in str(err.value)
+
+
+def test_numbers_in_range_pass_the_check(provider):
+    from qgis.core import QgsApplication, QgsProcessingContext
+
+    alg = QgsApplication.processingRegistry().createAlgorithmById("camloc:locate")
+    context = QgsProcessingContext()
+    base = {"SCENE": str(SAMPLE_SCENE), "OSM": str(SAMPLE_OSM), "CANDIDATES": "memory:"}
+    ok, message = alg.checkParameterValues({**base, "MAX_CANDIDATES": 1, "RADIUS_M": 10}, context)
+    assert ok, message
+    ok, message = alg.checkParameterValues(base, context)
+    assert ok, message

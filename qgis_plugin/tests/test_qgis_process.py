@@ -238,3 +238,28 @@ def test_qgis_process_runs_a_model_chaining_camloc_algorithms(
     assert [(b["rank"], b["lat"], b["lon"]) for b in best] == [(1, first["lat"], first["lon"])]
     corners, _ = rows("k.gpkg")
     assert [c["kind"] for c in corners].count("intersection") >= 1
+
+
+def test_qgis_process_names_a_number_out_of_range(profile_home, tmp_path):
+    # stop 41: "Incorrect parameter value for MAX_CANDIDATES", no range
+    r = subprocess.run(
+        [
+            QGIS_PROCESS,
+            "run",
+            "camloc:locate",
+            f"--SCENE={SAMPLE_SCENE}",
+            f"--OSM={SAMPLE_OSM}",
+            f"--CANDIDATES={tmp_path / 'c.gpkg'}",
+            "--MAX_CANDIDATES=0",
+        ],
+        capture_output=True,
+        text=True,
+        env=_env(profile_home),
+        timeout=300,
+    )
+    assert r.returncode != 0
+    assert (
+        "camloc: MAX_CANDIDATES (At most this many candidates) must be a whole number of at "
+        "least 1; got 0" in r.stdout + r.stderr
+    )
+    assert not (tmp_path / "c.gpkg").exists()
