@@ -376,19 +376,24 @@ def _map_bearing_candidates(
         h.log_prior += odds
     # (A car beside its street counted as plausible here: control_bearing warned 4 -> 2 %,
     # but bearing_cross_street lost closest < 15 m 74 -> 65 %: not kept.)
-    if not any(not ({f.kind for f in c.flags} & _IMPLAUSIBLE) for c in cands):
+    if not any(map(_plausible, cands)):
         return score_hypotheses(hyps, world_cam, ev_map, settings)
     floor = max(map(_weight, cands)) + math.log(settings.tie_score_ratio)
     rivals = [
         c
         for c in score_hypotheses(hyps, world_cam, ev_map, settings)
-        if _weight(c) >= floor and not ({f.kind for f in c.flags} & _IMPLAUSIBLE)
+        if _weight(c) >= floor and _plausible(c)
     ]
     rivals = _apart(rivals, cands, settings)
     for c in rivals:
         c.log_prior_odds = odds
         c.rival = RIVAL_BEARING
     return rivals
+
+
+def _plausible(c: Candidate) -> bool:
+    """No flag of ``c`` says the map finds its car implausible (:data:`_IMPLAUSIBLE`)."""
+    return not ({f.kind for f in c.flags} & _IMPLAUSIBLE)
 
 
 def _apart(
@@ -1990,14 +1995,17 @@ def _tie(
     b: Candidate,
     settings: LocateSettings,
     positions: dict[int, FloatArray] | None = None,
+    scores: tuple[float, float] | None = None,
 ) -> bool:
-    """The tie rule for two candidates (``positions``: their ``east_north`` by ``id``)."""
+    """The tie rule for two candidates (``positions``: their ``east_north`` by ``id``;
+    ``scores``: what to weigh instead of their ``score``)."""
     ea = a.east_north if positions is None else positions[id(a)]
     eb = b.east_north if positions is None else positions[id(b)]
     gap = ea - eb
+    sa, sb = (a.score, b.score) if scores is None else scores
     return is_tie(
-        a.score,
-        b.score,
+        sa,
+        sb,
         math.sqrt(float(gap @ gap)),  # np.linalg.norm's own products
         score_ratio=settings.tie_score_ratio,
         distance_m=settings.tie_distance_m,
@@ -2019,15 +2027,8 @@ def _tie_unrefined(
         return False
     wa = a.unrefined_log_weight if a.unrefined_log_weight is not None else _weight(a)
     wb = b.unrefined_log_weight if b.unrefined_log_weight is not None else _weight(b)
-    gap = positions[id(a)] - positions[id(b)]
-    return is_tie(
-        math.exp(min(wa - wb, 0.0)),
-        math.exp(min(wb - wa, 0.0)),
-        math.sqrt(float(gap @ gap)),
-        score_ratio=settings.tie_score_ratio,
-        distance_m=settings.tie_distance_m,
-        merge_distance_m=settings.merge_distance_m,
-    )
+    scores = (math.exp(min(wa - wb, 0.0)), math.exp(min(wb - wa, 0.0)))
+    return _tie(a, b, settings, positions, scores)
 
 
 def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
