@@ -151,6 +151,11 @@ _ID_WORDS = {
 """What the service's id patterns mean, for a refused path value (stop 41, qa3)."""
 
 
+_ECHO_CHARS = 80
+"""Longest input quoted back in a validation message (a 200-character query value was
+quoted whole, twice)."""
+
+
 def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
     """One line for FastAPI's validation errors (``lat: Input should be ... (got 95)``) and
     the field of the first."""
@@ -167,6 +172,8 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
         name = ".".join(loc) or "request"
         field = field or name
         got = err.get("input")
+        if isinstance(got, str) and len(got) > _ECHO_CHARS:
+            got = got[:_ECHO_CHARS] + "..."
         got_text = f" (got {got!r})" if isinstance(got, (str, int, float)) else ""
         pattern = (
             (err.get("ctx") or {}).get("pattern") if isinstance(err.get("ctx"), dict) else None
@@ -175,7 +182,14 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
             # "String should match pattern '^[0-9a-f]{32}$'" named a regular expression
             parts.append(f"{name}: {got!r} is not {_ID_WORDS[pattern]}")
             continue
-        parts.append(f"{name}: {err.get('msg', 'invalid')}{got_text}")
+        msg = str(err.get("msg", "invalid"))
+        if err.get("type") == "value_error":
+            # our own validators' words ("give two street names, as "A & B" (got 'X')"):
+            # pydantic's "Value error, " prefix dropped, and the value not quoted twice
+            msg = msg.removeprefix("Value error, ")
+            if "(got " in msg:
+                got_text = ""
+        parts.append(f"{name}: {msg}{got_text}")
     return "; ".join(parts) or "invalid request", field
 
 
