@@ -8,6 +8,7 @@ import asyncio
 from pathlib import Path
 
 import httpx
+import pytest
 
 from camloc_geo.service import create_app
 from camloc_geo.service.settings import Settings
@@ -45,3 +46,52 @@ def test_a_long_bad_value_is_quoted_short(tmp_path: Path) -> None:
     assert msg.startswith("streets: String should have at most 200 characters (got 'xxx")
     assert len(msg) < 200, msg
     assert msg.endswith("...')")
+
+
+@pytest.mark.parametrize(
+    ("lat", "lon", "want"),
+    [
+        ("60.1697 N", "24.9455 E", (60.1697, 24.9455)),
+        ("N 60.1697", "E24.9455", (60.1697, 24.9455)),
+        ("60.1697°", "24.9455°", (60.1697, 24.9455)),
+        ("39°17'8.2\"N", "76°35'36.6\"W", (39.285611, -76.5935)),
+        ("39° 17.137' N", "76° 35.61' W", (39.285617, -76.5935)),
+        ("33°51′54″S", "151°12′36″E", (-33.865, 151.21)),
+        ("60,1697 N", "24,9455 E", (60.1697, 24.9455)),
+    ],
+)
+def test_a_list_point_written_with_hemisphere_letters_is_read(
+    lat: str, lon: str, want: tuple[float, float]
+) -> None:
+    """A webcam list copied from a map site (``60.1697 N``, ``76°35'36.6"W``): every such
+    point was "lat '60.1697 N' is not a number", the camera searched by its title alone
+    (``camloc batch``, ``POST /v1/jobs``, QGIS ``camloc:geocodelist``, ``camloc geocode
+    --list``)."""
+    from camloc_geo.cameras._list import row_from_mapping
+    from camloc_geo.cli.geocode import _point_of
+
+    row = row_from_mapping({"id": "c", "title": "A & B", "lat": lat, "lon": lon}, 1)
+    assert not row.problems, row.problems
+    assert (row.lat, row.lon) == pytest.approx(want, abs=1e-5)
+    point, problem = _point_of(lat, lon)
+    assert problem is None
+    assert point == pytest.approx(want, abs=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("lat", "lon", "words"),
+    [
+        ("24.9455 E", "60.1697 N", "is a longitude (E/W), not a latitude: are the list's lat"),
+        ("60.1697", "-24.9 W", "has both a sign and the hemisphere W"),
+        ("60°75'N", "24.9", "has minutes or seconds of 60 or more"),
+        ("N 60.1 N", "24.9", "has two hemisphere letters"),
+        ("sixty", "24.9", "is not a number"),
+    ],
+)
+def test_a_coordinate_near_a_written_one_says_what_is_wrong(lat: str, lon: str, words: str) -> None:
+    from camloc_geo.cameras._list import row_from_mapping
+
+    row = row_from_mapping({"id": "c", "title": "A & B", "lat": lat, "lon": lon}, 1)
+    assert row.lat is None
+    assert row.lon is None
+    assert any(words in p for p in row.problems), row.problems
