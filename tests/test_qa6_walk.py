@@ -13,9 +13,13 @@ import pytest
 from camloc_geo.service import create_app
 from camloc_geo.service.settings import Settings
 
+REPO = Path(__file__).resolve().parent.parent
 
-def _get(tmp_path: Path, path: str, params: dict[str, str]) -> httpx.Response:
-    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+def _get(
+    tmp_path: Path, path: str, params: dict[str, str], map_dir: Path | None = None
+) -> httpx.Response:
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0, map_dir=map_dir))
 
     async def run() -> httpx.Response:
         transport = httpx.ASGITransport(app=app)
@@ -95,3 +99,29 @@ def test_a_coordinate_near_a_written_one_says_what_is_wrong(lat: str, lon: str, 
     assert row.lat is None
     assert row.lon is None
     assert any(words in p for p in row.problems), row.problems
+
+
+@pytest.mark.parametrize("path", ["/v1/corners", "/v1/streets"])
+def test_a_swapped_point_is_named_by_the_service(tmp_path: Path, path: str) -> None:
+    """``GET /v1/corners?lat=24.9455&lon=60.1699`` (Helsinki, lat and lon the other way
+    round) answered only "no map data configured on this server covers lat=24.945500,
+    lon=60.169900", where ``camloc batch`` names the swap."""
+    import shutil
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    shutil.copy(REPO / "data" / "osm" / "helsinki.osm.pbf", maps)
+    r = _get(tmp_path, path, {"lat": "24.9455", "lon": "60.1699"}, map_dir=maps)
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["type"] == "map_data"
+    assert err["message"] == (
+        "no map data configured on this server covers lat=24.945500, lon=60.169900; with lat "
+        "and lon swapped, lat=60.169900, lon=24.945500 lies in a map (in helsinki.osm.pbf): "
+        "are lat and lon the other way round?"
+    )
+    # a point in no map either way is answered as before
+    r = _get(tmp_path, path, {"lat": "10.0", "lon": "20.0"}, map_dir=maps)
+    assert r.json()["error"]["message"] == (
+        "no map data configured on this server covers lat=10.000000, lon=20.000000"
+    )
