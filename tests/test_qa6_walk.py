@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import asyncio
 from pathlib import Path
+from typing import Any
 
 import httpx
 import pytest
@@ -125,3 +126,70 @@ def test_a_swapped_point_is_named_by_the_service(tmp_path: Path, path: str) -> N
     assert r.json()["error"]["message"] == (
         "no map data configured on this server covers lat=10.000000, lon=20.000000"
     )
+
+
+def _page_config(html: str) -> dict[str, Any]:
+    import json
+    import re
+
+    m = re.search(r'<script id="camloc-config" type="application/json">(.*?)</script>', html, re.S)
+    assert m is not None
+    return dict(json.loads(m.group(1)))
+
+
+def test_a_crowd_tasks_page_shows_its_junction(tmp_path: Path) -> None:
+    """``POST /v1/tasks?lat=&lon=`` at a junction the server's maps hold: its page
+    (``GET /annotate/{task}``) had no map, where ``camloc annotate --osm --lat --lon`` shows
+    the junction with its kerb corners numbered. Annotators were asked for the corners
+    "clockwise" with nothing to see them on, and the scene they sent named no junction."""
+    import json
+    import shutil
+
+    import cv2
+    import numpy as np
+
+    scene = json.loads((REPO / "sample_maps" / "sample_scene.json").read_text())
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    shutil.copy(REPO / "sample_maps" / "baltimore.osm.pbf", maps)
+    w, h = scene["image"]["width"], scene["image"]["height"]
+    ok, buf = cv2.imencode(".png", np.full((h, w, 3), 128, np.uint8))
+    assert ok
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0, map_dir=maps))
+
+    async def run() -> tuple[dict[str, Any], dict[str, Any]]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            pages = []
+            for params in (
+                {
+                    "annotations": "1",
+                    "lat": str(scene["prior"]["lat"]),
+                    "lon": str(scene["prior"]["lon"]),
+                },
+                {"annotations": "1"},
+            ):
+                r = await client.post(
+                    "/v1/tasks",
+                    content=bytes(buf.tobytes()),
+                    headers={"content-type": "image/png"},
+                    params=params,
+                )
+                assert r.status_code == 201, r.text
+                page = await client.get(r.json()["annotate_url"])
+                assert page.status_code == 200, page.text
+                pages.append(_page_config(page.text))
+            return pages[0], pages[1]
+
+    try:
+        with_point, without = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    feats = with_point["corners"]["features"]
+    kinds = [f["properties"]["kind"] for f in feats]
+    assert kinds[0] == "intersection"
+    assert len(feats[0]["properties"]["streets"]) >= 2
+    # the junction nearest the task's point, as camloc annotate --osm --lat --lon draws it
+    assert kinds.count("corner") >= 2
+    assert "street" in kinds
+    assert without["corners"] is None  # no point: no map, as before
