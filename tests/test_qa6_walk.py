@@ -193,3 +193,31 @@ def test_a_crowd_tasks_page_shows_its_junction(tmp_path: Path) -> None:
     assert kinds.count("corner") >= 2
     assert "street" in kinds
     assert without["corners"] is None  # no point: no map, as before
+
+
+def test_a_scheduler_address_where_nothing_answers_says_so(tmp_path: Path) -> None:
+    """``camloc batch --scheduler tcp://127.0.0.1:9999`` with no scheduler there ended after
+    30 s with "failed: OSError: Timed out trying to connect to tcp://127.0.0.1:9999 after 30
+    s" and no word of what to do."""
+    import socket
+
+    dask = pytest.importorskip("dask")
+    pytest.importorskip("distributed")
+    from camloc_geo.batch import run_batch
+
+    with socket.socket() as s:  # a port where nothing listens
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    cams = tmp_path / "cams.csv"
+    cams.write_text("id,title\nc1,A & B\n", encoding="utf-8")
+    with (
+        dask.config.set({"distributed.comm.timeouts.connect": "1s"}),
+        pytest.raises(OSError, match=r"no Dask scheduler answered at tcp://127\.0\.0\.1:") as err,
+    ):
+        run_batch(
+            cams,
+            out_gpkg=tmp_path / "out.gpkg",
+            scheduler=f"tcp://127.0.0.1:{port}",
+            progress=False,
+        )
+    assert "leave --scheduler out to run on local processes" in str(err.value)
