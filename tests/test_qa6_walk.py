@@ -221,3 +221,38 @@ def test_a_scheduler_address_where_nothing_answers_says_so(tmp_path: Path) -> No
             progress=False,
         )
     assert "leave --scheduler out to run on local processes" in str(err.value)
+
+
+def test_a_body_without_a_content_type_is_named_as_such(tmp_path: Path) -> None:
+    """A CSV list posted with no Content-Type (httpx's ``content=``) was "content type 'none'
+    not supported here", and ``curl --data-binary @cams.csv`` (form-urlencoded) gave no hint of
+    the header to add."""
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> list[httpx.Response]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            body = b"id,title\nc1,A & B\n"
+            return [
+                await client.post("/v1/jobs", content=body),
+                await client.post(
+                    "/v1/jobs",
+                    content=body,
+                    headers={"content-type": "application/x-www-form-urlencoded"},
+                ),
+            ]
+
+    try:
+        none, form = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert none.status_code == 415
+    assert none.json()["error"]["message"] == (
+        "the request has no Content-Type header; send application/json or text/csv (curl: "
+        "-H 'Content-Type: application/json' or -H 'Content-Type: text/csv')"
+    )
+    assert form.status_code == 415
+    assert form.json()["error"]["message"].endswith(
+        "(curl's --data and --data-binary send application/x-www-form-urlencoded unless given "
+        "-H 'Content-Type: application/json' or -H 'Content-Type: text/csv')"
+    )
