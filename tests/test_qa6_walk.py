@@ -256,3 +256,37 @@ def test_a_body_without_a_content_type_is_named_as_such(tmp_path: Path) -> None:
         "(curl's --data and --data-binary send application/x-www-form-urlencoded unless given "
         "-H 'Content-Type: application/json' or -H 'Content-Type: text/csv')"
     )
+
+
+@pytest.mark.parametrize(
+    ("command", "osm", "where"),
+    [
+        ("corners", "helsinki.osm.pbf", "the extract"),
+        ("streets", "helsinki.osm.pbf", "the extract"),
+        ("corners", "", "helsinki.osm.pbf"),
+    ],
+)
+def test_swapped_lat_lon_on_the_command_line_are_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, osm: str, where: str
+) -> None:
+    """``camloc corners --lat 24.9455 --lon 60.1699 --osm helsinki.osm.pbf`` (lon first, as
+    GeoJSON writes it): "outside the extract" with no word that the other way round it is
+    inside, as ``camloc batch``, the service and QGIS say."""
+    import shutil
+
+    from camloc_geo.cli import main
+
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    shutil.copy(REPO / "data" / "osm" / "helsinki.osm.pbf", maps)
+    shutil.copy(REPO / "sample_maps" / "fremantle.osm", maps)
+    source = maps / osm if osm else maps
+    assert main([command, "--lat", "24.9455", "--lon", "60.1699", "--osm", str(source)]) == 2
+    err = capsys.readouterr().err
+    assert err.rstrip().endswith(
+        f"; with --lat and --lon swapped (--lat 60.1699 --lon 24.9455) the point lies in "
+        f"{where}: are they the other way round?"
+    ), err
+    # a point in no map either way: no hint
+    assert main([command, "--lat", "10", "--lon", "20", "--osm", str(source)]) == 2
+    assert "swapped" not in capsys.readouterr().err
