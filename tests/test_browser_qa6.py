@@ -92,3 +92,61 @@ def test_car_points_in_the_wrong_order_are_named_at_once(
     assert page.evaluate("camloc.step()") == 1
     assert page.evaluate("camloc.analysis().topBelow") is False
     assert "wrong order" not in page.inner_text("#checks-body")
+
+
+def test_the_summary_title_box_leaves_the_map_to_the_cameras(browser: Any, tmp_path: Any) -> None:
+    """A batch summary (``camloc batch --map``) with four cameras not placed: its title box
+    ran across the window over the top of the map (1248 px of a 1280-px window on a 12-camera
+    list; 613 px here), and a cluster zoomed into lay under it (a click on it was taken by the
+    box). The box now wraps at 560 px."""
+    from camloc_geo import maps
+
+    located = {
+        "type": "FeatureCollection",
+        "features": [
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [24.9452, 60.1706]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": 1,
+                    "score": 0.9,
+                    "method": "corners",
+                    "lat": 60.1706,
+                    "lon": 24.9452,
+                },
+            }
+        ],
+    }
+    missing = [
+        (
+            name,
+            {
+                "type": "FeatureCollection",
+                "features": [],
+                "properties": {"reason": f"not_found: '{title}' is neither a street nor a place"},
+            },
+        )
+        for name, title in [
+            ("mos-1", "ул. Академика Королёва / Останкинская ул."),
+            ("bad-1", "Mikonkatu / Kaisaniemenkatu"),
+            ("bad-2", "Some camera on the corner of the market square"),
+            ("bad-3", "Obere Landstraße & Untere Landstraße looking north"),
+        ]
+    ]
+    page_path = maps.summary_map([("hel-1", located), *missing], tmp_path / "s.html", offline=True)
+    context = browser.new_context(viewport={"width": 1280, "height": 800})
+    try:
+        page = context.new_page()
+        page.route(
+            "**/*",
+            lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+        )
+        page.goto(page_path.resolve().as_uri(), wait_until="load")
+        page.wait_for_selector(".camloc-summary-title", state="attached", timeout=30000)
+        box = page.locator(".camloc-summary-title").bounding_box()
+        assert box is not None
+        assert box["width"] <= 560 + 1, box
+        assert "4 without candidates" in page.inner_text(".camloc-summary-title")
+    finally:
+        context.close()
