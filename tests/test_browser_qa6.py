@@ -150,3 +150,35 @@ def test_the_summary_title_box_leaves_the_map_to_the_cameras(browser: Any, tmp_p
         assert "4 without candidates" in page.inner_text(".camloc-summary-title")
     finally:
         context.close()
+
+
+def test_a_tap_that_selects_a_car_point_says_to_zoom_in(browser: Any, case: dict[str, Any]) -> None:
+    """On a 390x844 phone the whole photo shows the car some 30 px long: a crowd worker's tap
+    for the third car point, 4 px from the second, selected the second instead, and nothing
+    said why no point came. The page now says so, and to zoom in."""
+    context = browser.new_context(
+        viewport={"width": 390, "height": 844}, has_touch=True, is_mobile=True
+    )
+    try:
+        page = context.new_page()
+        page.route(
+            "**/*",
+            lambda r: r.continue_() if r.request.url.startswith(("file:", "data:")) else r.abort(),
+        )
+        page.goto(case["page"].resolve().as_uri(), wait_until="load")
+        page.wait_for_selector("body[data-ready]", state="attached", timeout=30000)
+        box = page.locator("#canvas").bounding_box()
+        axes = case["axes"]
+        taps = [axes["origin"], axes["length"]]
+        for x, y in taps:
+            sx, sy = _screen(page, x, y)
+            page.tap("#canvas", position={"x": sx - box["x"], "y": sy - box["y"]})
+        lx, ly = _screen(page, *axes["length"])
+        page.tap("#canvas", position={"x": lx + 3 - box["x"], "y": ly - 2 - box["y"]})
+        state = page.evaluate("camloc.state()")["axes"]
+        assert state["width"] is None  # no third point placed
+        banner = page.inner_text("#banner")
+        assert banner.startswith("That tap selected point 2 (length), 4 px away, instead of")
+        assert "placing point 3: zoom in (+, or pinch)" in banner
+    finally:
+        context.close()

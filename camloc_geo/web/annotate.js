@@ -1514,7 +1514,19 @@
     if (!d) return;
     if (d.target) {
       if (d.moved) { setTarget(d.target, toImage(sp[0], sp[1])); changed(); }
-      else { undoStack.pop(); hover = d.target; selected = d.target; render(); }
+      else {
+        undoStack.pop(); hover = d.target; selected = d.target; render();
+        if (STEPS[step].key === "car" && !carComplete() && d.target.kind === "axis") {
+          // a tap meant as the next car point but within 9 px of a placed one selected that
+          // point, and nothing said why no point came (a car 30 px long on a phone's photo)
+          var nextKey = AXIS_POINTS.filter(function (k) { return !S.axes[k]; })[0];
+          var q = toScreen(d.target.p), away = Math.round(Math.hypot(q[0] - sp[0], q[1] - sp[1]));
+          flash("That tap selected point " + (AXIS_POINTS.indexOf(d.target.key) + 1) + " (" +
+            d.target.key + "), " + away + " px away, instead of placing point " +
+            (AXIS_POINTS.indexOf(nextKey) + 1) + ": zoom in (+, or pinch) so the points stand " +
+            "apart, then tap again.");
+        }
+      }
       return;
     }
     if (!d.moved && d.button === 0) place(toImage(sp[0], sp[1]));
