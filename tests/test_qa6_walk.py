@@ -290,3 +290,31 @@ def test_swapped_lat_lon_on_the_command_line_are_named(
     # a point in no map either way: no hint
     assert main([command, "--lat", "10", "--lon", "20", "--osm", str(source)]) == 2
     assert "swapped" not in capsys.readouterr().err
+
+
+def test_a_verdict_key_of_the_wrong_shape_is_explained(tmp_path: Path) -> None:
+    """``POST /v1/verdicts/candidates/{identity}`` with an item key ``x`` (schemathesis): the
+    answer quoted a regular expression, "items.x.[key]: String should match pattern
+    '^c?[0-9]{1,6}$' (got 'x')"."""
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.post(
+                "/v1/verdicts/candidates/0123456789abcdef",
+                json={"items": {"rank1": {"verdict": "yes"}}},
+            )
+
+    try:
+        r = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert r.status_code == 422, r.text
+    err = r.json()["error"]
+    assert err["message"] == (
+        "items: 'rank1' is not a key of the page's items: a candidate's rank on a review page "
+        "('1', '2', ...) or 'c' and a camera's index on a summary page ('c0', 'c1', ...), as its "
+        "export gives them"
+    )
+    assert err["field"] == "items.rank1.[key]"  # as before

@@ -147,6 +147,10 @@ _ID_WORDS = {
         "an id of this service (32 hex digits, 0-9 and a-f, as the POST that made it answered)"
     ),
     r"^[0-9a-f]{16}$": "a page identity (16 hex digits, 0-9 and a-f, as the review page shows it)",
+    r"^c?[0-9]{1,6}$": (
+        "a key of the page's items: a candidate's rank on a review page ('1', '2', ...) or "
+        "'c' and a camera's index on a summary page ('c0', 'c1', ...), as its export gives them"
+    ),
 }
 """What the service's id patterns mean, for a refused path value (stop 41, qa3)."""
 
@@ -180,6 +184,8 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
         )
         if err.get("type") == "string_pattern_mismatch" and pattern in _ID_WORDS:
             # "String should match pattern '^[0-9a-f]{32}$'" named a regular expression
+            if loc and loc[-1] == "[key]":  # a mapping's key: "items.x.[key]" named it twice
+                name = ".".join(loc[:-2]) or name  # (the field stays as it was)
             parts.append(f"{name}: {got!r} is not {_ID_WORDS[pattern]}")
             continue
         msg = str(err.get("msg", "invalid"))
