@@ -84,6 +84,7 @@ def test_car_points_in_the_wrong_order_are_named_at_once(
     assert "Points in the wrong order? The top (point 4) is not above point 1" in alerts
     assert "Wrong corner?" not in alerts
     assert page.inner_text("#step-missing").startswith("The four points are placed, but the top")
+    assert "done" not in (page.locator("#steps li").first.get_attribute("class") or "")
     # put right (undo the four, tap them in order): the check goes and the page moves on
     for _ in range(4):
         page.click("#btn-undo")
@@ -91,6 +92,7 @@ def test_car_points_in_the_wrong_order_are_named_at_once(
         page.mouse.click(*_screen(page, *axes[k]))
     assert page.evaluate("camloc.step()") == 1
     assert page.evaluate("camloc.analysis().topBelow") is False
+    assert "done" in (page.locator("#steps li").first.get_attribute("class") or "")
     assert "wrong order" not in page.inner_text("#checks-body")
 
 
