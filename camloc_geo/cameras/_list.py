@@ -279,31 +279,26 @@ def parse_coordinate(text: str, name: str) -> float:
     return value
 
 
-def _coordinate(value: Any, name: str, problems: list[str]) -> float | None:
-    """A lat or lon column's value; text as people write coordinates is read
-    (:func:`parse_coordinate`: ``60.1697 N`` was "not a number" and the camera's point lost)."""
-    if not isinstance(value, str) or not value.strip():
-        return _number(value, name, problems)
-    try:
-        num = parse_coordinate(value[:_MAX_FIELD_CHARS], name)
-    except ValueError as exc:
-        problems.append(f"{name} {_clean(value)[:40]!r} {exc}")
-        return None
-    if not math.isfinite(num):
-        problems.append(f"{name} {value!r} is not a finite number")
-        return None
-    return num
+def _number(
+    value: Any, name: str, problems: list[str], *, coordinate: bool = False
+) -> float | None:
+    """A number column's value (a decimal comma read), or None with the problem named.
 
-
-def _number(value: Any, name: str, problems: list[str]) -> float | None:
+    With ``coordinate``, text is read as people write a latitude or longitude
+    (:func:`parse_coordinate`: ``60.1697 N`` was "not a number" and the camera's point lost).
+    """
     if value is None or (isinstance(value, str) and not value.strip()):
         return None
-    if isinstance(value, str) and _DECIMAL_COMMA.fullmatch(value):
-        value = value.replace(",", ".")
     try:
-        num = float(value)
-    except (TypeError, ValueError):
-        problems.append(f"{name} {_clean(value)[:40]!r} is not a number")
+        if isinstance(value, str) and coordinate:
+            num = parse_coordinate(value[:_MAX_FIELD_CHARS], name)
+        elif isinstance(value, str) and _DECIMAL_COMMA.fullmatch(value):
+            num = float(value.replace(",", "."))
+        else:
+            num = float(value)
+    except (TypeError, ValueError) as exc:
+        why = str(exc) if coordinate and isinstance(value, str) else "is not a number"
+        problems.append(f"{name} {_clean(value)[:40]!r} {why}")
         return None
     if not math.isfinite(num):
         problems.append(f"{name} {value!r} is not a finite number")
@@ -337,8 +332,8 @@ def row_from_mapping(
     problems = list(list_problems)
     ident = _text(_pick(lower, "id"), "id", problems) or f"row-{row}"
     title = _text(_pick(lower, "title"), "title", problems)
-    lat = _coordinate(_pick(lower, "lat"), "lat", problems)
-    lon = _coordinate(_pick(lower, "lon"), "lon", problems)
+    lat = _number(_pick(lower, "lat"), "lat", problems, coordinate=True)
+    lon = _number(_pick(lower, "lon"), "lon", problems, coordinate=True)
     if lat is None and lon is None and point is not None:
         lat, lon = point
     if (lat is None) != (lon is None):
