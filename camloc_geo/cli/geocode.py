@@ -240,7 +240,7 @@ def _point_of(lat_text: str, lon_text: str) -> tuple[tuple[float, float] | None,
         return None, None
     if not lat_text.strip() or not lon_text.strip():
         return None, "give both lat and lon, or neither"
-    from camloc_geo.cameras._list import parse_coordinate
+    from camloc_geo.cameras import parse_coordinate
 
     # as camloc batch reads them: a decimal comma, ``60.1697 N``, ``76°35'36.6"W``
     try:
