@@ -28,6 +28,7 @@ from qgis.core import (
     QgsVectorLayer,
 )
 from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QTimer
 
 from .layers import (
     TIE_WORDS,
@@ -35,6 +36,7 @@ from .layers import (
     fields_of,
     order_camloc_layers,
     save_style_in_gpkg,
+    use_local_crs,
     wgs84,
     wkb_of,
     write_to_sink,
@@ -69,6 +71,11 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
             node = project.layerTreeRoot().findLayer(layer.id())
             if node is not None and node.parent() is not None:
                 order_camloc_layers(node.parent())
+            # a project of camloc layers alone: its place's UTM zone, not a stretched 4326;
+            # again once the event loop runs (the QGIS desktop gives an empty project its
+            # first layer's CRS after the layers are loaded, undoing it)
+            use_local_crs(project)
+            QTimer.singleShot(0, lambda: use_local_crs(project))
 
 
 def _gpkg_path(dest: str) -> str | None:

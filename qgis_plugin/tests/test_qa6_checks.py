@@ -63,3 +63,24 @@ def test_an_output_in_a_missing_folder_is_refused_before_the_work(provider, tmp_
     assert f"camloc: {name} (" in text
     assert f"the folder {tmp_path / 'nope'} does not exist" in text
     assert "Creation of data source failed" not in text
+
+
+def test_camloc_layers_alone_get_their_places_utm_zone(provider, tmp_path):
+    # The layers are EPSG:4326 and an empty project took the first layer's CRS: a plate carree
+    # drawing Helsinki (60 N) twice as wide as tall, a cone facing 45 degrees drawn at 63
+    import processing
+    from qgis.core import QgsProject, QgsVectorLayer
+
+    project = QgsProject.instance()
+    project.clear()
+    params = {"SCENE": str(SAMPLE_SCENE), "OSM": str(SAMPLE_OSM), "CANDIDATES": "TEMPORARY_OUTPUT"}
+    processing.runAndLoadResults("camloc:locate", params)
+    assert project.crs().authid() == "EPSG:32618"  # Baltimore, -76.6 E: UTM zone 18 N
+    project.clear()
+    # a project with the analyst's own layer keeps its CRS
+    own = QgsVectorLayer("Point?crs=EPSG:4326", "my cameras", "memory")
+    project.addMapLayer(own)
+    project.setCrs(own.crs())
+    processing.runAndLoadResults("camloc:locate", params)
+    assert project.crs().authid() == "EPSG:4326"
+    project.clear()
