@@ -318,3 +318,46 @@ def test_a_verdict_key_of_the_wrong_shape_is_explained(tmp_path: Path) -> None:
         "export gives them"
     )
     assert err["field"] == "items.rank1.[key]"  # as before
+
+
+def test_a_crowd_page_whose_junction_is_slow_comes_without_its_map(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The junction map of a task's page is looked up under the request's time limit; past
+    it (a large extract read cold), the page comes as before, without the map, not a 503."""
+    import time
+
+    import cv2
+    import numpy as np
+
+    from camloc_geo.service.routers import crowd
+
+    def slow(maps: Any, lat: float, lon: float) -> None:
+        time.sleep(1.0)
+
+    monkeypatch.setattr(crowd, "junction_work", slow)
+    ok, buf = cv2.imencode(".png", np.full((64, 64, 3), 128, np.uint8))
+    assert ok
+    # network on: the task is accepted without an extract (the slow lookup stands in for one)
+    app = create_app(
+        Settings(data_dir=tmp_path / "d", workers=0, network=True, request_timeout_s=0.2)
+    )
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            r = await client.post(
+                "/v1/tasks",
+                content=bytes(buf.tobytes()),
+                headers={"content-type": "image/png"},
+                params={"annotations": "1", "lat": "60.17", "lon": "24.945"},
+            )
+            assert r.status_code == 201, r.text
+            return await client.get(r.json()["annotate_url"])
+
+    try:
+        page = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert page.status_code == 200, page.text
+    assert _page_config(page.text)["corners"] is None

@@ -33,7 +33,7 @@ from camloc_geo.service.deps import (
     raw_body,
     run_cpu,
 )
-from camloc_geo.service.errors import LimitError, NotFoundError
+from camloc_geo.service.errors import LimitError, NotFoundError, ServiceError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.models import HTML_ROUTE_ERRORS, TaskId, TaskQuery
 from camloc_geo.service.routers.scenes import review_work, scene_body_doc
@@ -192,7 +192,10 @@ async def annotate(
     prior = (task["base_scene"] or {}).get("prior") or {}
     corners = None
     if task["status"] == "collecting" and is_lat_lon(prior.get("lat"), prior.get("lon")):
-        corners = await workers.run(junction_work, float(prior["lat"]), float(prior["lon"]))
+        try:
+            corners = await workers.run(junction_work, float(prior["lat"]), float(prior["lon"]))
+        except ServiceError:  # the time limit, a lost worker: the page without its map
+            corners = None
 
     def work() -> str:
         from camloc_geo.web import annotation_page_html
