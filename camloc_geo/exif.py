@@ -78,10 +78,23 @@ A tag can be wrong (a OnePlus 5T's 35 mm tag reads 12 % low): ``detect_vanishing
 checks an EXIF focal length against the photo's own lines (``check_focal_prior``) and, where
 they disagree beyond their combined sigma, states both readings and warns.
 
-Limits: a phone's second and third cameras (telephoto, ultra-wide) write the phone's model
-with their own ``FocalLength``; a table has the main camera's sensor only, so such a photo's
-table reading is wrong, and shows as an ``exif-conflict`` with its 35 mm tag where the photo
-has one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
+A phone's other cameras
+-----------------------
+A phone's telephoto, ultra-wide and front cameras write the phone's ``Make`` and ``Model``
+with their own ``FocalLength``; a table has the main back camera's sensor only. Where
+``LensModel`` names a phone's camera (\"iPhone 11 Pro back triple camera 6mm f/2\") and says
+it is another one (front, selfie, TrueDepth, tele..., ultra wide, macro, periscope), or one
+of several (dual, triple or quad, or a ``LensSpecification`` range, or none to tell) whose
+``FocalLength`` on the table's sensor would be a 35 mm equivalent outside
+:data:`MAIN_CAMERA_EQ_MM` (the iPhone 11 Pro's 6 mm telephoto: 36 mm on the main camera's
+5.76 mm sensor), the table's reading is not used, with a warning that says why; the 35 mm
+tag, which the phone writes for that camera, is the prior, and without one there is none.
+A conflict between the table and the 35 mm tag on a phone of several cameras is still an
+``exif-conflict``; its warning names the ``LensModel`` as a likely cause.
+
+Limits: a phone's other camera that writes no ``LensModel`` (most Android phones) still
+gets the main camera's table reading, an ``exif-conflict`` with its 35 mm tag where it has
+one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
 whose tags imply 5.6-5.7 mm: 7 %, within the 2 sigmas that make a conflict). A 16:9 photo of
 a natively 16:9 sensor the table lacks (a Galaxy S5) gets the mixture, 4 % off its own
 diagonal's right reading. A photo of a natively square (or 5:4) frame whose sensor the
@@ -96,9 +109,10 @@ import functools
 import logging
 import math
 import os
+import re
 import struct
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -120,6 +134,8 @@ _TAG_PIXEL_Y = 0xA003
 _TAG_MAKE = 0x010F
 _TAG_MODEL = 0x0110
 _TAG_EXIF_IFD = 0x8769
+_TAG_LENS_SPEC = 0xA432
+_TAG_LENS_MODEL = 0xA434
 _FP_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 1e-3}  # EXIF FocalPlaneResolutionUnit -> mm
 SIGMA_35MM = 0.04
 SIGMA_FOCAL_PLANE = 0.05
@@ -147,6 +163,13 @@ _WIDE_ASPECT = 1.6
 _TABLE_MIN_ASPECT = 1.3
 #: A 35 mm tag whose frame is at least this wide (diagonal, mm) reads a wide photo on 3:2.
 _LARGE_SENSOR_DIAGONAL_MM = 15.0
+MAIN_CAMERA_EQ_MM = (20.0, 32.0)
+"""35 mm equivalents (mm) of a phone's main back camera: 23-28 mm on the phones with several
+back cameras (2016 on). A ``FocalLength`` that would be outside this on the table's sensor is
+another camera's (an ultra-wide's 13-16 mm, a telephoto's 36 mm and up on the main sensor)."""
+_FRONT_WORDS = re.compile(r"\b(front|selfie|truedepth)\b")
+_OTHER_WORDS = re.compile(r"\b(tele\w*|ultra[ -]?wide|macro|periscope)\b")
+_MULTI_WORDS = re.compile(r"\b(dual|triple|quad)\b")
 #: Makes whose EXIF name does not begin with, or contain, the table's name.
 _MAKE_ALIASES = {
     "fujiphotofilm": "fujifilm",
@@ -423,7 +446,7 @@ def focal_from_tags(
         None when the tags do not give the focal length, or give one outside
         ``PLAUSIBLE_FOCAL_REL`` times the longer side (then with a warning).
     """
-    readings, notes = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    readings, said = _readings(tags, width_px, height_px, sensor_db, bundled_table)
     lo, hi = PLAUSIBLE_FOCAL_REL
     longer = max(width_px, height_px, 1)
     kept = []
@@ -443,6 +466,8 @@ def focal_from_tags(
             hi,
         )
     if not kept:
+        for w in said.warnings:
+            log.warning("%s: %s", name, w)
         f35 = _num(tags.get(_TAG_FOCAL_35MM))
         if (
             not readings
@@ -458,13 +483,16 @@ def focal_from_tags(
                 *F35_PLAUSIBLE_MM,
             )
         return None
-    return _combine(kept, notes, name)
+    return _combine(kept, said, name)
 
 
-def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal:
+def _combine(readings: list[_Reading], said: _Said, name: str) -> ExifFocal:
     """The first reading, or the equal mixture of it and the farthest that disagrees."""
     first = readings[0]
     table = tuple((r.source, r.focal_px, r.sigma_rel) for r in readings)
+    notes = tuple(said.notes)
+    for w in said.warnings:
+        log.warning("%s: %s", name, w)
 
     def gap(r: _Reading) -> float:
         return abs(math.log(r.focal_px / first.focal_px))
@@ -473,21 +501,29 @@ def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal
     if not far:
         for note in notes:
             log.info("%s: %s", name, note)
-        return ExifFocal(first.focal_px, first.sigma_rel, first.source, table, (), tuple(notes))
+        return ExifFocal(
+            first.focal_px, first.sigma_rel, first.source, table, tuple(said.warnings), notes
+        )
     other = max(far, key=gap)
     d = math.log(other.focal_px / first.focal_px)
     f_mix = first.focal_px * math.exp(0.5 * d)
     sigma = math.sqrt(0.5 * (first.sigma_rel**2 + other.sigma_rel**2) + (0.5 * d) ** 2)
+    cause = ""
+    if said.table_cause and "exif-sensor-table" in (first.source, other.source):
+        cause = (
+            f" (LensModel {said.table_cause!r} names one of several cameras: the table's "
+            "width is the main camera's, and this may be another's)"
+        )
     msg = (
         f"the EXIF tags disagree: {first.what} gives {first.focal_px:.0f} px, {other.what} "
-        f"{other.focal_px:.0f} px ({100 * (math.exp(d) - 1):+.0f} %); which is right the "
-        f"tags do not say: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} % "
+        f"{other.focal_px:.0f} px ({100 * (math.exp(d) - 1):+.0f} %){cause}; which is right "
+        f"the tags do not say: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} % "
         "(exif-conflict); give --focal-px if it is known"
     )
     log.warning("%s: %s", name, msg)
     for note in notes:
         log.info("%s: %s", name, note)
-    return ExifFocal(f_mix, sigma, "exif-conflict", table, (msg,), tuple(notes))
+    return ExifFocal(f_mix, sigma, "exif-conflict", table, (*said.warnings, msg), notes)
 
 
 def _readings(
@@ -496,14 +532,15 @@ def _readings(
     height_px: int,
     sensor_db: str | None,
     bundled: bool,
-) -> tuple[list[_Reading], list[str]]:
-    """Every reading the tags give, the lens and the sensor first, and notes in words."""
+) -> tuple[list[_Reading], _Said]:
+    """Every reading the tags give, the lens and the sensor first, and what was said."""
     longer = float(max(width_px, height_px))
     shorter = float(max(min(width_px, height_px), 1))
     aspect = longer / shorter
     own_ratio = math.hypot(width_px, height_px) / max(longer, 1.0)  # diagonal / longer side
     out: list[_Reading] = []
-    notes: list[str] = []
+    said = _Said()
+    notes = said.notes
     width_mm: float | None = None  # the sensor width the photo's longer side spans
     square_sensor_mm: float | None = None  # a near-square photo's camera's sensor width
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
@@ -536,7 +573,10 @@ def _readings(
             got = sensor_width_mm(make, model, (width_px, height_px), sensor_db, bundled=bundled)
             if got is not None and lo_w <= got[0] <= hi_w:
                 sw, origin = got
-                if aspect < _TABLE_MIN_ASPECT:
+                other = _other_camera(tags, f_mm, sw)
+                if other is not None:
+                    said.warnings.append(other)
+                elif aspect < _TABLE_MIN_ASPECT:
                     square_sensor_mm = sw
                     notes.append(
                         f"no sensor-table reading: a {width_px}x{height_px} photo is narrower "
@@ -544,6 +584,7 @@ def _readings(
                     )
                 else:
                     width_mm = width_mm or sw
+                    said.table_cause = _several_cameras(tags)
                     out.append(
                         _Reading(
                             "exif-sensor-table",
@@ -561,7 +602,78 @@ def _readings(
             )
         else:
             out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
-    return out, notes
+    return out, said
+
+
+@dataclass
+class _Said:
+    """What the readings say besides their values: notes, warnings, a conflict's cause."""
+
+    notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    table_cause: str = ""  # why a table reading may be wrong (named if it conflicts)
+
+
+def _lens_model(tags: dict[int, Any]) -> str:
+    """``LensModel`` where it names a phone's camera (\"iPhone 11 Pro back triple camera
+    6mm f/2\", \"Pixel 7 Pro front camera 2.74mm f/2.2\"), else \"\" (a lens's name)."""
+    lens = _text(tags.get(_TAG_LENS_MODEL))
+    return lens if "camera" in lens.lower() else ""
+
+
+def _several_cameras(tags: dict[int, Any]) -> str:
+    """The ``LensModel`` of a phone camera that may be one of several, else \"\".
+
+    One of several: its ``LensModel`` says a dual, triple or quad camera, or
+    ``LensSpecification`` spans more than one focal length (phones write the range of all
+    their back cameras), or there is no ``LensSpecification`` to tell (a Pixel)."""
+    lens = _lens_model(tags)
+    if not lens:
+        return ""
+    if _MULTI_WORDS.search(lens.lower()):
+        return lens
+    spec = tags.get(_TAG_LENS_SPEC)
+    try:
+        f_lo, f_hi = _num(spec[0]), _num(spec[1])  # type: ignore[index]
+    except (TypeError, IndexError, KeyError):
+        return lens
+    if f_lo is None or f_hi is None:
+        return lens
+    return lens if f_hi > f_lo * 1.02 else ""
+
+
+def _other_camera(tags: dict[int, Any], f_mm: float, sensor_w_mm: float) -> str | None:
+    """Why the table's sensor width, a phone's main back camera's, is not this photo's
+    camera's (a warning), or None.
+
+    A phone's other cameras (front, ultra-wide, telephoto) write the phone's ``Make`` and
+    ``Model`` with their own ``FocalLength``; the table gives the main camera's sensor.
+    ``LensModel`` tells them apart: the words front, selfie, TrueDepth, tele..., ultra
+    wide, macro or periscope, or one camera of several (:func:`_several_cameras`) whose
+    ``FocalLength`` on the table's sensor (its 4:3 frame) would be a 35 mm equivalent
+    outside :data:`MAIN_CAMERA_EQ_MM` (the iPhone 11 Pro's 6 mm telephoto: 36 mm on the
+    main camera's 5.76 mm sensor, where its own 52 mm tag is right).
+    """
+    lens = _lens_model(tags)
+    if not lens:
+        return None
+    low = lens.lower()
+    main = f"the table's {sensor_w_mm:g} mm width is the main back camera's: not used"
+    word = _FRONT_WORDS.search(low) or _OTHER_WORDS.search(low)
+    if word is not None:
+        return f"LensModel {lens!r} says the {word.group(0)} camera; {main}"
+    if not _several_cameras(tags):
+        return None  # the phone's one back camera: the table's
+    eq_mm = f_mm * FULL_FRAME_DIAGONAL_MM / (sensor_w_mm * _FRAME_RATIOS["4:3"])
+    lo, hi = MAIN_CAMERA_EQ_MM
+    if lo <= eq_mm <= hi:
+        return None
+    kind = "an ultra-wide" if eq_mm < lo else "a telephoto"
+    return (
+        f"LensModel {lens!r} names one camera of several, and FocalLength {f_mm:g} mm on "
+        f"the table's {sensor_w_mm:g} mm sensor would be a {eq_mm:.0f} mm equivalent, "
+        f"outside a main camera's {lo:g}-{hi:g} mm: {kind} camera's photo; {main}"
+    )
 
 
 def _reading_35mm(
