@@ -78,6 +78,16 @@ A tag can be wrong (a OnePlus 5T's 35 mm tag reads 12 % low): ``detect_vanishing
 checks an EXIF focal length against the photo's own lines (``check_focal_prior``) and, where
 they disagree beyond their combined sigma, states both readings and warns.
 
+Digital zoom
+------------
+A ``DigitalZoomRatio`` above 1 (up to :data:`DIGITAL_ZOOM_MAX`; 0, 0/0 and 1 are no zoom)
+means the stored photo spans ``1 / ratio`` of the lens's frame: the lens readings
+(``exif-focal-plane``, ``exif-sensor-table``) are multiplied by it. Makers differ on the
+35 mm tag: an iPhone's includes the zoom (an iPhone SE at 1.951x writes 55 mm for its 28 mm;
+Hugin bug 2064625), other phones' leave it out. Where a lens reading is there, the tag is
+read the way (with the zoom, or times it) that lies nearer to it, said in the notes; where
+none is, both ways make an equal mixture whose sigma covers both.
+
 A phone's other cameras
 -----------------------
 A phone's telephoto, ultra-wide and front cameras write the phone's ``Make`` and ``Model``
@@ -99,7 +109,6 @@ whose tags imply 5.6-5.7 mm: 7 %, within the 2 sigmas that make a conflict). A 1
 a natively 16:9 sensor the table lacks (a Galaxy S5) gets the mixture, 4 % off its own
 diagonal's right reading. A photo of a natively square (or 5:4) frame whose sensor the
 table lacks gets the near-square mixture below, 8 % off its own diagonal's right reading.
-``DigitalZoomRatio`` is not applied.
 """
 
 from __future__ import annotations
@@ -112,7 +121,7 @@ import os
 import re
 import struct
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -135,6 +144,7 @@ _TAG_MAKE = 0x010F
 _TAG_MODEL = 0x0110
 _TAG_EXIF_IFD = 0x8769
 _TAG_LENS_SPEC = 0xA432
+_TAG_DIGITAL_ZOOM = 0xA404
 _TAG_LENS_MODEL = 0xA434
 _FP_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 1e-3}  # EXIF FocalPlaneResolutionUnit -> mm
 SIGMA_35MM = 0.04
@@ -163,6 +173,8 @@ _WIDE_ASPECT = 1.6
 _TABLE_MIN_ASPECT = 1.3
 #: A 35 mm tag whose frame is at least this wide (diagonal, mm) reads a wide photo on 3:2.
 _LARGE_SENSOR_DIAGONAL_MM = 15.0
+DIGITAL_ZOOM_MAX = 20.0
+"""A ``DigitalZoomRatio`` above this is taken for a broken tag (not applied)."""
 MAIN_CAMERA_EQ_MM = (20.0, 32.0)
 """35 mm equivalents (mm) of a phone's main back camera: 23-28 mm on the phones with several
 back cameras (2016 on). A ``FocalLength`` that would be outside this on the table's sensor is
@@ -545,6 +557,8 @@ def _readings(
     square_sensor_mm: float | None = None  # a near-square photo's camera's sensor width
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
     lo_w, hi_w = SENSOR_WIDTH_PLAUSIBLE_MM
+    zoom = _digital_zoom(tags)  # the stored photo spans 1 / zoom of the lens's frame
+    zoom_words = f" times the {zoom:g}x digital zoom" if zoom != 1.0 else ""
     if f_mm is not None:
         xres = _num(tags.get(_TAG_FP_XRES))
         unit_mm = _FP_UNIT_MM.get(int(_num(tags.get(_TAG_FP_UNIT)) or 2))
@@ -562,10 +576,10 @@ def _readings(
                 out.append(
                     _Reading(
                         "exif-focal-plane",
-                        f_mm * px_per_mm * scale,
+                        f_mm * px_per_mm * scale * zoom,
                         SIGMA_FOCAL_PLANE,
                         f"FocalLength {f_mm:g} mm on the focal-plane resolution's "
-                        f"{sensor_w:.2f} mm sensor",
+                        f"{sensor_w:.2f} mm sensor{zoom_words}",
                     )
                 )
         make, model = _text(tags.get(_TAG_MAKE)), _text(tags.get(_TAG_MODEL))
@@ -588,21 +602,72 @@ def _readings(
                     out.append(
                         _Reading(
                             "exif-sensor-table",
-                            f_mm / sw * longer,
+                            f_mm / sw * longer * zoom,
                             SIGMA_SENSOR_TABLE,
                             f"FocalLength {f_mm:g} mm on the {sw:g} mm sensor of "
-                            f"{make} {model} ({origin})",
+                            f"{make} {model} ({origin}){zoom_words}",
                         )
                     )
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
-    if f35 is not None and F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+    if f35 is None or not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+        return out, said
+
+    def tag(f35_optical: float, notes: list[str]) -> list[_Reading]:
+        """The tag read as the lens's own 35 mm equivalent, times the digital zoom."""
         if aspect < _TABLE_MIN_ASPECT:
-            out.extend(
-                _reading_35mm_square(f35, f_mm, square_sensor_mm, longer, shorter, own_ratio, notes)
+            got = _reading_35mm_square(
+                f35_optical, f_mm, square_sensor_mm, longer, shorter, own_ratio, notes
             )
         else:
-            out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
+            got = _reading_35mm(f35_optical, f_mm, width_mm, longer, aspect, own_ratio, notes)
+        return [replace(r, focal_px=r.focal_px * zoom, what=r.what + zoom_words) for r in got]
+
+    if zoom == 1.0:
+        out.extend(tag(f35, notes))
+        return out, said
+    # Makers differ: an iPhone's tag includes the digital zoom, other phones' do not (Hugin
+    # bug 2064625). The lens reading, where there is one, tells which; else both, mixed.
+    notes_with: list[str] = []
+    notes_without: list[str] = []
+    with_zoom = tag(f35 / zoom, notes_with)
+    without = tag(f35, notes_without)
+    if out:
+        ref = out[0].focal_px
+
+        def miss(rs: list[_Reading]) -> float:
+            return abs(math.log(rs[0].focal_px / ref))
+
+        included = miss(with_zoom) <= miss(without)
+        notes.extend(notes_with if included else notes_without)
+        notes.append(
+            f"the {f35:g} mm 35 mm tag {'includes' if included else 'leaves out'} the "
+            f"{zoom:g}x digital zoom (so the lens reading says): read so"
+        )
+        out.extend(with_zoom if included else without)
+        return out, said
+    a, b = without[0], with_zoom[0]
+    d = math.log(a.focal_px / b.focal_px)
+    sigma = math.sqrt(0.5 * (a.sigma_rel**2 + b.sigma_rel**2) + (0.5 * d) ** 2)
+    f_mix = math.sqrt(a.focal_px * b.focal_px)
+    notes.extend(notes_with)
+    notes.append(
+        f"the {f35:g} mm 35 mm tag may include the {zoom:g}x digital zoom (as an iPhone's "
+        f"does: {b.focal_px:.0f} px) or leave it out ({a.focal_px:.0f} px); no lens reading "
+        f"tells which: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} %"
+    )
+    what = f"FocalLengthIn35mmFilm {f35:g} mm with or without the {zoom:g}x digital zoom"
+    out.append(_Reading("exif-35mm", f_mix, sigma, what))
     return out, said
+
+
+def _digital_zoom(tags: dict[int, Any]) -> float:
+    """``DigitalZoomRatio`` where it zooms (above 1, up to :data:`DIGITAL_ZOOM_MAX`), else 1.
+
+    0 (EXIF's "not used"), 0/0, 1 and anything implausible read as no zoom."""
+    r = _num(tags.get(_TAG_DIGITAL_ZOOM))
+    if r is None or r <= 1.0 + 1e-3 or r > DIGITAL_ZOOM_MAX:
+        return 1.0
+    return r
 
 
 @dataclass
