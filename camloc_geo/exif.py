@@ -9,7 +9,14 @@ Each of these the photo's tags give is read:
 ``exif-focal-plane``
     ``FocalLength`` (0x920A) with ``FocalPlaneXResolution`` (0xA20E) and its unit
     (0xA210), scaled by ``width / PixelXDimension`` when the photo was resized: sigma 5 %
-    (some cameras write the resolution of a sensor crop).
+    (some cameras write the resolution of a sensor crop). The resolution refers to the frame
+    the camera stored; a tool that resized the photo and rewrote (or dropped)
+    ``PixelXDimension`` leaves it on the old frame, so it gives a sensor too small by the
+    resize. Where the table's width (or the 35 mm tag's crop factor, on the photo's own
+    diagonal) is more than :data:`FOCAL_PLANE_SHRUNK` times wider than the resolution's, the
+    reading is not used, with a warning saying why. The photo's orientation does not matter
+    (``Orientation`` 6 or 8, pixels turned or not, pixel sizes swapped or not): the longer
+    side and the diagonal are used.
 ``exif-sensor-table``
     ``FocalLength`` with the sensor width of ``Make`` + ``Model`` in a sensor-width table,
     ``focal_px = FocalLength / width_mm * longer_side_px`` (the photo's longer side spans the
@@ -175,6 +182,9 @@ _TABLE_MIN_ASPECT = 1.3
 _LARGE_SENSOR_DIAGONAL_MM = 15.0
 DIGITAL_ZOOM_MAX = 20.0
 """A ``DigitalZoomRatio`` above this is taken for a broken tag (not applied)."""
+FOCAL_PLANE_SHRUNK = 1.3
+"""A focal-plane sensor width this many times smaller than the table's (or the 35 mm tag's)
+is a resized photo's: its resolution is for the frame before the resize (not used)."""
 MAIN_CAMERA_EQ_MM = (20.0, 32.0)
 """35 mm equivalents (mm) of a phone's main back camera: 23-28 mm on the phones with several
 back cameras (2016 on). A ``FocalLength`` that would be outside this on the table's sensor is
@@ -554,6 +564,8 @@ def _readings(
     said = _Said()
     notes = said.notes
     width_mm: float | None = None  # the sensor width the photo's longer side spans
+    fp_width_mm: float | None = None  # the sensor width of the focal-plane resolution
+    table_width_mm: float | None = None  # the sensor width of the table's reading
     square_sensor_mm: float | None = None  # a near-square photo's camera's sensor width
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
     lo_w, hi_w = SENSOR_WIDTH_PLAUSIBLE_MM
@@ -572,7 +584,7 @@ def _readings(
                 scale = longer / max(orig_w, orig_h)
             sensor_w = max(orig_w or width_px, orig_h or height_px) / px_per_mm
             if lo_w <= sensor_w <= hi_w:
-                width_mm = sensor_w
+                width_mm = fp_width_mm = sensor_w
                 out.append(
                     _Reading(
                         "exif-focal-plane",
@@ -598,6 +610,7 @@ def _readings(
                     )
                 else:
                     width_mm = width_mm or sw
+                    table_width_mm = sw
                     said.table_cause = _several_cameras(tags)
                     out.append(
                         _Reading(
@@ -609,7 +622,24 @@ def _readings(
                         )
                     )
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
-    if f35 is None or not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+    if f35 is not None and not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+        f35 = None
+    if fp_width_mm is not None and f_mm is not None:
+        # the sensor the focal-plane resolution gives, against the table's or the tag's
+        ref_mm, ref_what = table_width_mm, "the sensor table's width"
+        if ref_mm is None and f35 is not None and zoom == 1.0:
+            ref_mm = FULL_FRAME_DIAGONAL_MM * f_mm / f35 / own_ratio
+            ref_what = f"the {f35:g} mm 35 mm tag's crop factor: a width of"
+        if ref_mm is not None and fp_width_mm * FOCAL_PLANE_SHRUNK < ref_mm:
+            out = [r for r in out if r.source != "exif-focal-plane"]
+            width_mm = table_width_mm
+            said.warnings.append(
+                f"FocalPlaneXResolution gives a {fp_width_mm:.2f} mm wide sensor for the "
+                f"{_pixel_size(tags, width_px, height_px)} frame, {ref_what} {ref_mm:.2f} mm: "
+                "the resolution is for a larger frame than the EXIF's pixel size (a photo "
+                "resized after capture, its PixelXDimension rewritten or gone): not used"
+            )
+    if f35 is None:
         return out, said
 
     def tag(f35_optical: float, notes: list[str]) -> list[_Reading]:
@@ -658,6 +688,14 @@ def _readings(
     what = f"FocalLengthIn35mmFilm {f35:g} mm with or without the {zoom:g}x digital zoom"
     out.append(_Reading("exif-35mm", f_mix, sigma, what))
     return out, said
+
+
+def _pixel_size(tags: dict[int, Any], width_px: int, height_px: int) -> str:
+    """``PixelXDimension`` x ``PixelYDimension``, or the stored size where they are not."""
+    w, h = _num(tags.get(_TAG_PIXEL_X)), _num(tags.get(_TAG_PIXEL_Y))
+    if w and h:
+        return f"{w:.0f}x{h:.0f} (PixelXDimension)"
+    return f"stored {width_px}x{height_px}"
 
 
 def _digital_zoom(tags: dict[int, Any]) -> float:
