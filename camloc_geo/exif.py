@@ -16,7 +16,11 @@ Each of these the photo's tags give is read:
     diagonal) is more than :data:`FOCAL_PLANE_SHRUNK` times wider than the resolution's, the
     reading is not used, with a warning saying why. The photo's orientation does not matter
     (``Orientation`` 6 or 8, pixels turned or not, pixel sizes swapped or not): the longer
-    side and the diagonal are used.
+    side and the diagonal are used. A photo whose shape differs from the frame its
+    ``PixelXDimension`` and ``PixelYDimension`` describe (by more than 2 %) was cropped
+    after capture: every reading is made on that frame and scaled by the crop's resize,
+    which is not known: between the least that fits the crop in the frame and none
+    (:func:`_capture_frame`), the prior's sigma covering that range (said in the notes).
 ``exif-sensor-table``
     ``FocalLength`` with the sensor width of ``Make`` + ``Model`` in a sensor-width table,
     ``focal_px = FocalLength / width_mm * longer_side_px`` (the photo's longer side spans the
@@ -170,6 +174,8 @@ BUNDLED_SENSOR_TABLE = ("data", "sensor_widths", "sensor_widths.csv")
 TABLE_WIDTH_SPREAD = 0.02
 #: A table width given for an aspect ratio holds for photos within this of it (relative).
 _ASPECT_TOL = 0.03
+#: A photo whose aspect ratio is this far (log) from its EXIF pixel size's was cropped.
+_CROP_ASPECT_TOL = 0.02
 #: Frames a 35 mm tag may be written for besides the photo's own: diagonal / width.
 _FRAME_RATIOS = {"4:3": 1.25, "3:2": math.hypot(3.0, 2.0) / 3.0}
 #: How far (relative) the tag's own crop factor may be from a frame it is read on.
@@ -468,7 +474,30 @@ def focal_from_tags(
         None when the tags do not give the focal length, or give one outside
         ``PLAUSIBLE_FOCAL_REL`` times the longer side (then with a warning).
     """
-    readings, said = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    frame = _capture_frame(tags, width_px, height_px)
+    if frame is None:
+        readings, said = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    else:
+        # cropped after capture: read on the frame the EXIF describes, then scaled by the
+        # crop's unknown resize, between the least that fits the crop in it and none
+        cap_w, cap_h, s_lo, s_hi = frame
+        readings, said = _readings(tags, cap_w, cap_h, sensor_db, bundled_table)
+        mid, spread = math.sqrt(s_lo * s_hi), 0.5 * math.log(s_hi / s_lo)
+        readings = [
+            replace(
+                r,
+                focal_px=r.focal_px * mid,
+                sigma_rel=math.hypot(r.sigma_rel, spread),
+                what=f"{r.what} (on the {cap_w}x{cap_h} frame, scaled)",
+            )
+            for r in readings
+        ]
+        said.notes.append(
+            f"the {width_px}x{height_px} photo is not the shape of the {cap_w}x{cap_h} frame "
+            "its EXIF describes (PixelXDimension, PixelYDimension): cropped after capture. "
+            f"Read on that frame and scaled by {s_lo:.3g}-{s_hi:.3g} (the crop's resize is "
+            f"not known): +/- {100 * spread:.0f} % more"
+        )
     lo, hi = PLAUSIBLE_FOCAL_REL
     longer = max(width_px, height_px, 1)
     kept = []
@@ -506,6 +535,29 @@ def focal_from_tags(
             )
         return None
     return _combine(kept, said, name)
+
+
+def _capture_frame(
+    tags: dict[int, Any], width_px: int, height_px: int
+) -> tuple[int, int, float, float] | None:
+    """The frame the EXIF describes, where the photo was cropped to another shape, else None.
+
+    Returns ``(width, height, s_lo, s_hi)``: ``PixelXDimension`` and ``PixelYDimension``
+    turned to the photo's orientation, and the range of the crop's resize. A crop
+    ``w x h`` of a ``W x H`` frame resized by ``s`` fits in it, ``w <= s W`` and
+    ``h <= s H``, so ``s >= max(w / W, h / H)``; up to 1 (no enlargement), or that least
+    ``s`` where the photo was enlarged. A photo of the frame's shape (within
+    :data:`_CROP_ASPECT_TOL`) is a plain resize (or an unseen crop): None.
+    """
+    cap_w, cap_h = _num(tags.get(_TAG_PIXEL_X)), _num(tags.get(_TAG_PIXEL_Y))
+    if not cap_w or not cap_h or width_px < 1 or height_px < 1:
+        return None
+    if (cap_w >= cap_h) != (width_px >= height_px):
+        cap_w, cap_h = cap_h, cap_w  # a turned photo whose tags were not turned
+    if abs(math.log((width_px / height_px) / (cap_w / cap_h))) <= _CROP_ASPECT_TOL:
+        return None
+    s_lo = max(width_px / cap_w, height_px / cap_h)
+    return round(cap_w), round(cap_h), s_lo, max(1.0, s_lo)
 
 
 def _combine(readings: list[_Reading], said: _Said, name: str) -> ExifFocal:

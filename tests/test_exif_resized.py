@@ -85,3 +85,27 @@ def test_a_rotated_photo_reads_the_same_focal_length(tmp_path: Path, orientation
     got = focal_from_exif(path, sensor_db="")
     assert got is not None
     assert got.focal_px == pytest.approx(want, rel=1e-4)
+
+
+def test_a_photo_cropped_to_another_shape_covers_the_crops_unknown_resize() -> None:
+    # a 4:3 crop of the 30D's 3:2 frame at its full height (3115 x 2336), resized to
+    # 1200 x 900: the true scale is 900 / 2336; read as a resize of the whole frame
+    # (1200 / 3504), the focal-plane reading was 11 % short at a stated 5 %
+    tags = {**EOS_30D, 0xA002: FULL_W, 0xA003: FULL_H}
+    truth = _truth(FULL_W) * 900 / FULL_H
+    got = focal_from_tags(tags, 1200, 900, sensor_db="")
+    assert got is not None
+    assert got.source == "exif-focal-plane"
+    assert abs(math.log(got.focal_px / truth)) <= got.sigma_rel  # within one sigma
+    # and a crop at full resolution (no resize) too: the range's other end
+    assert abs(math.log(got.focal_px / _truth(FULL_W))) <= got.sigma_rel
+    assert any("cropped after capture" in n for n in got.notes)
+
+
+def test_a_crop_that_keeps_the_scale_is_read_on_the_frame() -> None:
+    # a 3000 x 2336 crop at full resolution: s between 2336 / 2336 and 1, exact
+    tags = {**EOS_30D, 0xA002: FULL_W, 0xA003: FULL_H, 0x0112: 6}
+    got = focal_from_tags(tags, 2336, 3000, sensor_db="")  # stored turned, too
+    assert got is not None
+    assert got.focal_px == pytest.approx(_truth(FULL_W))
+    assert got.sigma_rel == pytest.approx(0.05)
