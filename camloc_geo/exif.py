@@ -46,7 +46,7 @@ Each of these the photo's tags give is read:
 ``exif-35mm``
     ``FocalLengthIn35mmFilm`` (tag 0xA405). The CIPA/EXIF definition matches the angle of
     view of the diagonal, so ``focal_px = f35 * diagonal_px / 43.27``. The tag is an
-    integer number of millimetres and ignores digital zoom and crops: relative sigma 4 %.
+    integer number of millimetres and ignores crops (digital zoom: below): relative sigma 4 %.
     Phones write it for the sensor's 4:3 frame also in their 16:9 mode, where the diagonal
     rule reads it 8 % low (stop 40: Galaxy Note 3, S21 Ultra, Mi A1). Where the sensor's
     width is known (either reading above), the tag's own crop factor tells the frame it was
