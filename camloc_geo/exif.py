@@ -197,7 +197,7 @@ back cameras (2016 on). A ``FocalLength`` that would be outside this on the tabl
 another camera's (an ultra-wide's 13-16 mm, a telephoto's 36 mm and up on the main sensor)."""
 _FRONT_WORDS = re.compile(r"\b(front|selfie|truedepth)\b")
 _OTHER_WORDS = re.compile(r"\b(tele\w*|ultra[ -]?wide|macro|periscope)\b")
-_MULTI_WORDS = re.compile(r"\b(dual|triple|quad)\b")
+_MULTI_WORDS = re.compile(r"\b(dual|duo|triple|quad)\b")
 #: Makes whose EXIF name does not begin with, or contain, the table's name.
 _MAKE_ALIASES = {
     "fujiphotofilm": "fujifilm",
@@ -679,7 +679,8 @@ def _readings(
     if fp_width_mm is not None and f_mm is not None:
         # the sensor the focal-plane resolution gives, against the table's or the tag's
         ref_mm, ref_what = table_width_mm, "the sensor table's width"
-        if ref_mm is None and f35 is not None and zoom == 1.0:
+        if ref_mm is None and f35 is not None and zoom == 1.0 and aspect >= _TABLE_MIN_ASPECT:
+            # (a near-square photo's longer side may be the sensor's height: not compared)
             ref_mm = FULL_FRAME_DIAGONAL_MM * f_mm / f35 / own_ratio
             ref_what = f"the {f35:g} mm 35 mm tag's crop factor: a width of"
         if ref_mm is not None and fp_width_mm * FOCAL_PLANE_SHRUNK < ref_mm:
@@ -779,7 +780,7 @@ def _lens_model(tags: dict[int, Any]) -> str:
 def _several_cameras(tags: dict[int, Any]) -> str:
     """The ``LensModel`` of a phone camera that may be one of several, else \"\".
 
-    One of several: its ``LensModel`` says a dual, triple or quad camera, or
+    One of several: its ``LensModel`` says a dual, duo, triple or quad camera, or
     ``LensSpecification`` spans more than one focal length (phones write the range of all
     their back cameras), or there is no ``LensSpecification`` to tell (a Pixel)."""
     lens = _lens_model(tags)

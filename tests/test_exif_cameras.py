@@ -122,3 +122,21 @@ def test_the_lens_model_is_read_from_a_photo(tmp_path: Path) -> None:
     assert got.source == "exif-35mm"
     assert got.focal_px == pytest.approx(_on_diagonal(52) / 8, rel=1e-6)
     assert "telephoto camera" in got.warnings[0]
+
+
+def test_a_duo_camera_named_alone_is_still_one_of_two() -> None:
+    # an iPhone 7 Plus's telephoto as some apps write it: "iSight Duo", its own focal length
+    # alone in LensSpecification; 6.6 mm on the main 4.89 mm sensor would be 47 mm
+    tags = {
+        0x010F: "Apple",
+        0x0110: "iPhone 7 Plus",
+        0x920A: 6.6,
+        0xA405: 56,
+        0xA434: "iPhone 7 Plus back iSight Duo camera 6.6mm f/2.8",
+        0xA432: (6.6, 6.6, 2.8, 2.8),
+    }
+    got = focal_from_tags(tags, W, H, sensor_db="")
+    assert got is not None
+    assert got.source == "exif-35mm"
+    assert got.focal_px == pytest.approx(_on_diagonal(56))
+    assert "a telephoto camera's photo" in got.warnings[0]
