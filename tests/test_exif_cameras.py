@@ -140,3 +140,26 @@ def test_a_duo_camera_named_alone_is_still_one_of_two() -> None:
     assert got.source == "exif-35mm"
     assert got.focal_px == pytest.approx(_on_diagonal(56))
     assert "a telephoto camera's photo" in got.warnings[0]
+
+
+def test_the_warning_reaches_the_vanishing_point_result(tmp_path: Path) -> None:
+    # detect_vanishing_points(use_exif=True): the 35 mm tag is the prior, and the reason the
+    # table was left out comes first among the result's warnings
+    from test_autovp_failure_modes import corner_segments
+
+    from camloc_geo.autovp import detect_vanishing_points
+
+    segs, (w, h) = corner_segments(0, 0.0, seed=0)  # a corner seen at 700 px
+    f35 = round(700.0 * FULL_FRAME_DIAGONAL_MM / math.hypot(w, h))
+    im = PIL_Image.new("RGB", (w, h), (128, 128, 128))
+    exif = PIL_Image.Exif()
+    exif[0x010F], exif[0x0110] = "Apple", "iPhone 11 Pro"
+    sub = exif.get_ifd(0x8769)
+    sub[0x920A], sub[0xA405], sub[0xA434] = 6.0, f35, TELE[0xA434]
+    sub[0xA432] = (1.54, 6.0, 1.8, 2.4)
+    path = tmp_path / "tele.jpg"
+    im.save(path, exif=exif)
+    res = detect_vanishing_points(path, segments=segs, use_exif=True)
+    assert res.focal_source == "exif-35mm"
+    assert res.warnings[0].startswith("LensModel 'iPhone 11 Pro back triple camera 6mm f/2'")
+    assert abs(math.log(res.focal_px / 700.0)) < 2.0 * res.focal_std_rel
