@@ -560,6 +560,14 @@ def _capture_frame(
     return round(cap_w), round(cap_h), s_lo, max(1.0, s_lo)
 
 
+def _equal_mixture(a: _Reading, b: _Reading) -> tuple[float, float]:
+    """The equal mixture of two readings in ``log(focal)``: their geometric mean, and a
+    sigma covering both, ``sqrt((s_a^2 + s_b^2) / 2 + (log(f_a / f_b) / 2)^2)``."""
+    half_gap = 0.5 * math.log(a.focal_px / b.focal_px)
+    sigma = math.sqrt(0.5 * (a.sigma_rel**2 + b.sigma_rel**2) + half_gap**2)
+    return math.sqrt(a.focal_px * b.focal_px), sigma
+
+
 def _combine(readings: list[_Reading], said: _Said, name: str) -> ExifFocal:
     """The first reading, or the equal mixture of it and the farthest that disagrees."""
     first = readings[0]
@@ -580,8 +588,7 @@ def _combine(readings: list[_Reading], said: _Said, name: str) -> ExifFocal:
         )
     other = max(far, key=gap)
     d = math.log(other.focal_px / first.focal_px)
-    f_mix = first.focal_px * math.exp(0.5 * d)
-    sigma = math.sqrt(0.5 * (first.sigma_rel**2 + other.sigma_rel**2) + (0.5 * d) ** 2)
+    f_mix, sigma = _equal_mixture(first, other)
     cause = ""
     if said.table_cause and "exif-sensor-table" in (first.source, other.source):
         cause = (
@@ -729,9 +736,7 @@ def _readings(
         out.extend(with_zoom if included else without)
         return out, said
     a, b = without[0], with_zoom[0]
-    d = math.log(a.focal_px / b.focal_px)
-    sigma = math.sqrt(0.5 * (a.sigma_rel**2 + b.sigma_rel**2) + (0.5 * d) ** 2)
-    f_mix = math.sqrt(a.focal_px * b.focal_px)
+    f_mix, sigma = _equal_mixture(a, b)
     notes.extend(notes_with)
     notes.append(
         f"the {f35:g} mm 35 mm tag may include the {zoom:g}x digital zoom (as an iPhone's "
@@ -924,9 +929,9 @@ def _two_ways(
     """The 35 mm tag read on the photo's own diagonal and on a sensor frame, where the
     sensor's width cannot tell which it was written for: their equal mixture, its sigma
     covering both, said in ``notes``."""
-    d = math.log(f_frame / f_own)
-    sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
-    f_mix = math.sqrt(f_own * f_frame)
+    f_mix, sigma = _equal_mixture(
+        _Reading("exif-35mm", f_own, SIGMA_35MM, ""), _Reading("exif-35mm", f_frame, SIGMA_35MM, "")
+    )
     notes.append(
         f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the {frame} "
         f"({f_frame:.0f} px) or for the photo's own ({f_own:.0f} px); the sensor's width is "
