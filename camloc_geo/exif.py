@@ -103,7 +103,8 @@ A phone's other cameras
 -----------------------
 A phone's telephoto, ultra-wide and front cameras write the phone's ``Make`` and ``Model``
 with their own ``FocalLength``; a table has the main back camera's sensor only. Where
-``LensModel`` names a phone's camera (\"iPhone 11 Pro back triple camera 6mm f/2\") and says
+``LensModel`` names a phone's back, rear or front camera (\"iPhone 11 Pro back triple
+camera 6mm f/2\"; a lens's name, \"EF-S18-55mm f/3.5-5.6 IS\", is not read) and says
 it is another one (front, selfie, TrueDepth, tele..., ultra wide, macro, periscope), or one
 of several (dual, triple or quad, or a ``LensSpecification`` range, or none to tell) whose
 ``FocalLength`` on the table's sensor would be a 35 mm equivalent outside
@@ -197,6 +198,7 @@ back cameras (2016 on). A ``FocalLength`` that would be outside this on the tabl
 another camera's (an ultra-wide's 13-16 mm, a telephoto's 36 mm and up on the main sensor)."""
 _FRONT_WORDS = re.compile(r"\b(front|selfie|truedepth)\b")
 _OTHER_WORDS = re.compile(r"\b(tele\w*|ultra[ -]?wide|macro|periscope)\b")
+_PHONE_CAMERA = re.compile(r"\b(back|rear|front)\b.*\bcamera\b")
 _MULTI_WORDS = re.compile(r"\b(dual|duo|triple|quad)\b")
 #: Makes whose EXIF name does not begin with, or contain, the table's name.
 _MAKE_ALIASES = {
@@ -777,9 +779,10 @@ class _Said:
 
 def _lens_model(tags: dict[int, Any]) -> str:
     """``LensModel`` where it names a phone's camera (\"iPhone 11 Pro back triple camera
-    6mm f/2\", \"Pixel 7 Pro front camera 2.74mm f/2.2\"), else \"\" (a lens's name)."""
+    6mm f/2\", \"Pixel 7 Pro front camera 2.74mm f/2.2\": a back, rear or front camera),
+    else \"\" (a lens's name, \"EF-S18-55mm f/3.5-5.6 IS\", or another camera's words)."""
     lens = _text(tags.get(_TAG_LENS_MODEL))
-    return lens if "camera" in lens.lower() else ""
+    return lens if _PHONE_CAMERA.search(lens.lower()) else ""
 
 
 def _several_cameras(tags: dict[int, Any]) -> str:

@@ -163,3 +163,15 @@ def test_the_warning_reaches_the_vanishing_point_result(tmp_path: Path) -> None:
     assert res.focal_source == "exif-35mm"
     assert res.warnings[0].startswith("LensModel 'iPhone 11 Pro back triple camera 6mm f/2'")
     assert abs(math.log(res.focal_px / 700.0)) < 2.0 * res.focal_std_rel
+
+
+def test_a_camera_that_is_not_a_phone_keeps_the_table(tmp_path: Path) -> None:
+    # a compact's zoom at its long end (105 mm equivalent on its sensor), its LensModel
+    # naming no back or front camera: the table's width is its own
+    db = tmp_path / "sensors.txt"
+    db.write_text("ACME Zoom 9;6.4\n", encoding="utf-8")
+    tags = {0x010F: "ACME", 0x0110: "Zoom 9", 0x920A: 19.4, 0xA434: "ACME camera zoom lens"}
+    got = focal_from_tags(tags, 1600, 1200, sensor_db=str(db), bundled_table=False)
+    assert got is not None
+    assert got.source == "exif-sensor-table"
+    assert got.focal_px == pytest.approx(19.4 / 6.4 * 1600)
