@@ -175,3 +175,32 @@ def test_a_camera_that_is_not_a_phone_keeps_the_table(tmp_path: Path) -> None:
     assert got is not None
     assert got.source == "exif-sensor-table"
     assert got.focal_px == pytest.approx(19.4 / 6.4 * 1600)
+
+
+def test_the_warning_reaches_the_api_result(tmp_path: Path) -> None:
+    # api.vanishing_points(use_exif=True) reads the EXIF from the file before loading it; the
+    # readings' warnings were dropped there (stop 42): the telephoto's reason must reach the
+    # result's warnings, first, as detect_vanishing_points puts it given the path
+    import cv2
+    import numpy as np
+    from test_autovp_failure_modes import corner_segments
+
+    from camloc_geo import api
+
+    segs, (w, h) = corner_segments(0, 0.0, seed=0)
+    f35 = round(700.0 * FULL_FRAME_DIAGONAL_MM / math.hypot(w, h))
+    canvas = np.full((h, w, 3), 200, np.uint8)
+    for x0, y0, x1, y1 in np.asarray(segs, float):
+        cv2.line(canvas, (round(x0), round(y0)), (round(x1), round(y1)), (20, 20, 20), 2)
+    im = PIL_Image.fromarray(canvas)
+    exif = PIL_Image.Exif()
+    exif[0x010F], exif[0x0110] = "Apple", "iPhone 11 Pro"
+    sub = exif.get_ifd(0x8769)
+    sub[0x920A], sub[0xA405], sub[0xA434] = 6.0, f35, TELE[0xA434]
+    sub[0xA432] = (1.54, 6.0, 1.8, 2.4)
+    path = tmp_path / "tele.jpg"
+    im.save(path, exif=exif, quality=95)
+    res = api.vanishing_points(path, use_exif=True)
+    assert res.focal_source == "exif-35mm"
+    assert res.warnings[0].startswith("LensModel 'iPhone 11 Pro back triple camera 6mm f/2'")
+    assert sum("LensModel" in w for w in res.warnings) == 1
