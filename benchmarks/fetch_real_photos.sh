@@ -71,8 +71,9 @@
 #   kondukberna/Image_Stitching, Shimion100/autostitch, xyg-coder/panorama_stitching,
 #   winswang/image_stitching, Deemsy/image_stitching, XuchenWang/Image_Stitching,
 #   fantashi099/Panorama-Stitching, dominathan/Photos-for-Calvin, kernelmurton/prnu,
-#   lilinwang/CS5670-Computer-Vision
-#                                    30 phone, compact, DSLR and mirrorless photos (batch 11,
+#   lilinwang/CS5670-Computer-Vision, Yunodoctor/TNM089-HDR-tone-mapping,
+#   GiuliaBertazzini/Image-EXIF-Viewer, kevingrasso/Exif-Viewer, tomoima525/exif-extractor
+#                                    34 phone, compact, DSLR and mirrorless photos (batch 11,
 #                                    set street-photos-held-out-5, into
 #                                    street-photos-held-out-5/): HDR, stitching and course
 #                                    sets, one frame of middle brightness per exposure

@@ -102,7 +102,7 @@ The photos (none of them is in this repository; their licences keep them out):
     resolution: their manifest ``truth`` (the lens over a sensor width of openMVG's table)
     is their truth, with or without ``CAMLOC_SENSOR_DB``.
 ``street-photos-held-out-5`` (only when ``--sets`` names it)
-    Batch 11 (stop 42): 30 more photos no one has run ``camloc vp`` on, held out whole
+    Batch 11 (stop 42): 34 more photos no one has run ``camloc vp`` on, held out whole
     (files under ``street-photos-held-out-5/``): phones (iPhone 4S photos of the SPHP
     stitching set at 0.94 times the longer side), compacts near 1.0, DSLRs and a
     mirrorless, to be measured once; summarised by view.

@@ -29,7 +29,10 @@ PHONES = {
     "iPhone 7",
     "iPhone 13",
     "iPhone 13 Pro",
+    "iPhone 11 Pro",
     "SM-A528B",
+    "ONEPLUS A3003",
+    "Pixel 3",
 }
 #: Compact cameras of batch 11 (EXIF ``Model``).
 COMPACTS = {
@@ -101,6 +104,7 @@ def test_batch_11_views_cameras_and_sources() -> None:
     cameras = [str(p["camera"]) for p in fresh]
     assert set(cameras) <= PHONES | COMPACTS | {
         "ILCE-6400",
+        "ILCE-6000",
         "NIKON D90",
         "NIKON D7000",
         "Canon EOS Kiss X4",
