@@ -101,6 +101,9 @@ def test_batch_11_views_cameras_and_sources() -> None:
     assert views.count("level") >= len(fresh) // 2  # the case first
     assert views.count("looking-up") >= 5  # the second check
     assert views.count("looking-down") >= 3
+    subjects = [p["subject"] for p in fresh]  # also read from the photo before any result
+    assert set(subjects) == {"street", "building", "city"}
+    assert subjects.count("street") >= 10  # a street, square or path, looked along
     cameras = [str(p["camera"]) for p in fresh]
     assert set(cameras) <= PHONES | COMPACTS | {
         "ILCE-6400",
