@@ -65,6 +65,19 @@
 #                                    street-photos-held-out-4, into street-photos-held-out-4/):
 #                                    test data, course data and SUN-database scene photos,
 #                                    no licence given for the photos, so kept out
+#   Kim9878/VFX-Project-1-HDR-Imaging, irisowo/HDR-Imaging, trungnguyencs/HDR-Imaging,
+#   allen1759/NTU104-2_Digital-Visual-Effects, felipegb94/hdr_imaging, MercuryYen/HDR-Imaging,
+#   WangJ509/vfx_hw1, s4816577/VFX_hw1_HDR, knowhow07/image_stitching,
+#   kondukberna/Image_Stitching, Shimion100/autostitch, xyg-coder/panorama_stitching,
+#   winswang/image_stitching, Deemsy/image_stitching, XuchenWang/Image_Stitching,
+#   fantashi099/Panorama-Stitching, dominathan/Photos-for-Calvin, kernelmurton/prnu,
+#   lilinwang/CS5670-Computer-Vision, Yunodoctor/TNM089-HDR-tone-mapping,
+#   GiuliaBertazzini/Image-EXIF-Viewer, kevingrasso/Exif-Viewer, tomoima525/exif-extractor
+#                                    34 phone, compact, DSLR and mirrorless photos (batch 11,
+#                                    set street-photos-held-out-5, into
+#                                    street-photos-held-out-5/): HDR, stitching and course
+#                                    sets, one frame of middle brightness per exposure
+#                                    bracket, no licence given for the photos, so kept out
 # York Urban (research use only) is not fetched: get it from York University and set
 # CAMLOC_YUD_DIR.
 # Each repository is cloned from a local mirror when CAMLOC_MIRROR_DIR names one (laid out as
@@ -74,7 +87,8 @@
 # Set CAMLOC_PHOTO_SETS to a space-separated subset of the repositories above (and
 # "street-photos" for all the handheld street photos of benchmarks/street_photos.json, or
 # "street-photos-held-out-2" for batch 8 alone, "street-photos-held-out-3" for batch 9 alone,
-# "street-photos-held-out-4" for batch 10 alone) to fetch fewer.
+# "street-photos-held-out-4" for batch 10 alone, "street-photos-held-out-5" for batch 11 alone)
+# to fetch fewer.
 set -euo pipefail
 dest="${CAMLOC_PHOTOS_DIR:-$HOME/.cache/camloc_geo/photos}"
 default_mirror=""
@@ -127,8 +141,8 @@ done
 # The handheld street photos: single files of many repositories (some of them large), from
 # the mirror's blobs where it holds them, else GitHub's raw files at the pinned commit.
 # "street-photos" fetches every one; "street-photos-held-out-2" only batch 8 (its folder),
-# "street-photos-held-out-3" only batch 9, "street-photos-held-out-4" only batch 10 (any of
-# them, or several).
+# "street-photos-held-out-3" only batch 9, "street-photos-held-out-4" only batch 10,
+# "street-photos-held-out-5" only batch 11 (any of them, or several).
 street_only=""
 if [ -n "${CAMLOC_PHOTO_SETS:-}" ] && [[ " $CAMLOC_PHOTO_SETS " != *" street-photos "* ]]; then
   for s in $CAMLOC_PHOTO_SETS; do
@@ -166,7 +180,7 @@ for p in json.load(open(sys.argv[1]))["photos"]:
         continue
     print("\t".join((p["file"], p["repo"], p["commit"], p["path"], p["sha256"])))' \
     "$manifest" "$street_only")
-  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/ ... street-photos-held-out-4/)"
+  echo "street-photos: $got photos in $dest (street-photos/, street-photos-held-out-2/ ... street-photos-held-out-5/)"
   [ "$failed" -eq 0 ] || echo "street-photos: $failed not fetched (no mirror, no network?)" >&2
 fi
 echo "photos in $dest; run: python benchmarks/vp_real.py"

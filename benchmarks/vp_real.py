@@ -8,8 +8,9 @@ Usage::
                                  (lund-dev, lund-held-out: one half of the Lund scenes;
                                   street-photos-dev, street-photos-held-out: one half of
                                   the handheld street photos; street-photos-held-out-2,
-                                  street-photos-held-out-3, street-photos-held-out-4:
-                                  the fresh batches 8, 9 and 10, each only when named;
+                                  street-photos-held-out-3, street-photos-held-out-4,
+                                  street-photos-held-out-5: the fresh batches 8, 9, 10
+                                  and 11, each only when named;
                                   drive, drive-dev, drive-held-out: the driving frames)
     python benchmarks/vp_real.py --sets street [--street-frames 30]
     python benchmarks/vp_real.py --sets street-photos --prior-at-truth [--no-exif-kept]
@@ -100,6 +101,11 @@ The photos (none of them is in this repository; their licences keep them out):
     Eight of them carry a lens focal length but no 35 mm tag and no focal-plane
     resolution: their manifest ``truth`` (the lens over a sensor width of openMVG's table)
     is their truth, with or without ``CAMLOC_SENSOR_DB``.
+``street-photos-held-out-5`` (only when ``--sets`` names it)
+    Batch 11 (stop 42): 34 more photos no one has run ``camloc vp`` on, held out whole
+    (files under ``street-photos-held-out-5/``): phones (iPhone 4S photos of the SPHP
+    stitching set at 0.94 times the longer side), compacts near 1.0, DSLRs and a
+    mirrorless, to be measured once; summarised by view.
 ``exif``
     Any further folders of outdoor photos whose EXIF gives the focal length
     (``--exif-dir DIR``, repeatable, or ``CAMLOC_EXIF_PHOTO_DIRS``, ``os.pathsep``
@@ -415,6 +421,7 @@ SCENE_SETS = (  # and the fresh street photos by view
     "street-photos-held-out-2",
     "street-photos-held-out-3",
     "street-photos-held-out-4",
+    "street-photos-held-out-5",
 )
 #: The Lund scenes split by building, so that a change tuned on some is checked on others:
 #: the development half (looked at, its debug drawings read) and the held-out half (only
@@ -674,7 +681,7 @@ def load_drive_set(
 
 
 #: Handheld street photos (sets ``street-photos``, ``street-photos-dev``,
-#: ``street-photos-held-out``, ``street-photos-held-out-2`` ... ``street-photos-held-out-4``):
+#: ``street-photos-held-out``, ``street-photos-held-out-2`` ... ``street-photos-held-out-5``):
 #: file, sha256, source, half; truth from their EXIF, or from the lens focal length and the
 #: sensor's published width where the manifest gives a ``truth`` (see
 #: :func:`sensor_focal_truth_px`).
@@ -691,8 +698,9 @@ SIM_BARS = "issue 24 bars, SIMULATION prior at truth"
 #: ``--sets`` names that set (never by ``street-photos``): batch 8 (stop 39), 42 photos no
 #: one had run ``camloc vp`` on, measured once at the end of stop 39 (development since), and
 #: batch 9 (stop 40, ``held-out-3``), measured once at the end of stop 40, and batch 10
-#: (stop 41, ``held-out-4``), fresh again, to be measured once.
-STREET_PHOTO_FRESH_HALVES = ("held-out-2", "held-out-3", "held-out-4")
+#: (stop 41, ``held-out-4``), measured once at the end of stop 41, and batch 11 (stop 42,
+#: ``held-out-5``), fresh again, to be measured once.
+STREET_PHOTO_FRESH_HALVES = ("held-out-2", "held-out-3", "held-out-4", "held-out-5")
 
 
 def sensor_focal_truth_px(focal_mm: float, sensor_width_mm: float, size: tuple[int, int]) -> float:
@@ -773,7 +781,7 @@ def load_street_photos(
         :func:`sensor_focal_truth_px`).
     halves
         Which halves to load (``"dev"``, ``"held-out"``, ``"held-out-2"``,
-        ``"held-out-3"``, ``"held-out-4"``).
+        ``"held-out-3"``, ``"held-out-4"``, ``"held-out-5"``).
 
     Returns
     -------

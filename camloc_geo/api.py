@@ -840,7 +840,7 @@ def vanishing_points(
         if isinstance(focal_px, bool) or not focal[0] > 0:
             raise InputError(f"focal_px must be a positive number of pixels, got {focal_px!r}")
         focal_px = focal[0]
-    options = _exif_prior(image, focal_px, options)
+    options, exif_warnings = _exif_prior(image, focal_px, options)
     img = load_image(image)
     if principal_point is not None:
         principal_point = _principal_point_in(principal_point, img.shape[1], img.shape[0])
@@ -863,7 +863,7 @@ def vanishing_points(
     unknown = sorted(set(options) - set(known))
     if unknown:
         raise InputError(f"unknown vanishing-point option(s): {', '.join(unknown)}")
-    return detect_vanishing_points(
+    result = detect_vanishing_points(
         img,
         focal_px=focal_px,
         principal_point=principal_point,
@@ -873,6 +873,10 @@ def vanishing_points(
         axes_hint=[((a[0], a[1]), (a[2], a[3])) for a in axes] or None,
         **options,
     )
+    # The EXIF readings' own warnings (a conflict, a phone's telephoto camera, a resize) come
+    # first, as detect_vanishing_points puts them when it reads the path itself (stop 42).
+    result.warnings[:0] = [w for w in exif_warnings if w not in result.warnings]
+    return result
 
 
 def _principal_point_in(point: object, width: int, height: int) -> tuple[float, float]:
@@ -893,8 +897,11 @@ def _principal_point_in(point: object, width: int, height: int) -> tuple[float, 
     return x, y
 
 
-def _exif_prior(image: object, focal_px: float | None, options: dict[str, Any]) -> dict[str, Any]:
-    """``options`` with ``use_exif`` turned into the EXIF focal-length prior it asks for.
+def _exif_prior(
+    image: object, focal_px: float | None, options: dict[str, Any]
+) -> tuple[dict[str, Any], tuple[str, ...]]:
+    """``options`` with ``use_exif`` turned into the EXIF focal-length prior it asks for, and
+    the EXIF readings' warnings.
 
     :func:`vanishing_points` loads the photo into an array before the fit, and an array has
     no EXIF: ``use_exif=True`` passed through did nothing (the fit's own reader only reads a
@@ -902,17 +909,19 @@ def _exif_prior(image: object, focal_px: float | None, options: dict[str, Any]) 
     sigma and ``focal_source``) and ``check_focal_prior`` (default on, as the fit does for
     its own EXIF prior: a maker's tag can be wrong). A known ``focal_px`` or a given
     ``focal_prior_px`` wins, as in the fit; an array or a photo without the tags leaves the
-    options as they were.
+    options as they were. The readings' warnings (``ExifFocal.warnings``: readings in
+    conflict, a phone's other camera, a resized photo) were dropped here until stop 42; they
+    are returned for the result.
     """
     if not options.get("use_exif") or focal_px is not None:
-        return options
+        return options, ()
     if options.get("focal_prior_px") is not None or not isinstance(image, (str, os.PathLike)):
-        return options
+        return options, ()
     from camloc_geo.exif import focal_from_exif
 
     ex = focal_from_exif(image)
     if ex is None:
-        return options
+        return options, ()
     out = dict(options)
     out.update(
         focal_prior_px=ex.focal_px,
@@ -921,7 +930,7 @@ def _exif_prior(image: object, focal_px: float | None, options: dict[str, Any]) 
     )
     if out.get("check_focal_prior") is None:
         out["check_focal_prior"] = True
-    return out
+    return out, tuple(ex.warnings)
 
 
 def _finite_numbers(values: object, count: int, message: str) -> list[float]:

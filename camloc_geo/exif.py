@@ -9,7 +9,18 @@ Each of these the photo's tags give is read:
 ``exif-focal-plane``
     ``FocalLength`` (0x920A) with ``FocalPlaneXResolution`` (0xA20E) and its unit
     (0xA210), scaled by ``width / PixelXDimension`` when the photo was resized: sigma 5 %
-    (some cameras write the resolution of a sensor crop).
+    (some cameras write the resolution of a sensor crop). The resolution refers to the frame
+    the camera stored; a tool that resized the photo and rewrote (or dropped)
+    ``PixelXDimension`` leaves it on the old frame, so it gives a sensor too small by the
+    resize. Where the table's width (or the 35 mm tag's crop factor, on the photo's own
+    diagonal) is more than :data:`FOCAL_PLANE_SHRUNK` times wider than the resolution's, the
+    reading is not used, with a warning saying why. The photo's orientation does not matter
+    (``Orientation`` 6 or 8, pixels turned or not, pixel sizes swapped or not): the longer
+    side and the diagonal are used. A photo whose shape differs from the frame its
+    ``PixelXDimension`` and ``PixelYDimension`` describe (by more than 2 %) was cropped
+    after capture: every reading is made on that frame and scaled by the crop's resize,
+    which is not known: between the least that fits the crop in the frame and none
+    (:func:`_capture_frame`), the prior's sigma covering that range (said in the notes).
 ``exif-sensor-table``
     ``FocalLength`` with the sensor width of ``Make`` + ``Model`` in a sensor-width table,
     ``focal_px = FocalLength / width_mm * longer_side_px`` (the photo's longer side spans the
@@ -35,7 +46,7 @@ Each of these the photo's tags give is read:
 ``exif-35mm``
     ``FocalLengthIn35mmFilm`` (tag 0xA405). The CIPA/EXIF definition matches the angle of
     view of the diagonal, so ``focal_px = f35 * diagonal_px / 43.27``. The tag is an
-    integer number of millimetres and ignores digital zoom and crops: relative sigma 4 %.
+    integer number of millimetres and ignores crops (digital zoom: below): relative sigma 4 %.
     Phones write it for the sensor's 4:3 frame also in their 16:9 mode, where the diagonal
     rule reads it 8 % low (stop 40: Galaxy Note 3, S21 Ultra, Mi A1). Where the sensor's
     width is known (either reading above), the tag's own crop factor tells the frame it was
@@ -78,15 +89,38 @@ A tag can be wrong (a OnePlus 5T's 35 mm tag reads 12 % low): ``detect_vanishing
 checks an EXIF focal length against the photo's own lines (``check_focal_prior``) and, where
 they disagree beyond their combined sigma, states both readings and warns.
 
-Limits: a phone's second and third cameras (telephoto, ultra-wide) write the phone's model
-with their own ``FocalLength``; a table has the main camera's sensor only, so such a photo's
-table reading is wrong, and shows as an ``exif-conflict`` with its 35 mm tag where the photo
-has one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
+Digital zoom
+------------
+A ``DigitalZoomRatio`` above 1 (up to :data:`DIGITAL_ZOOM_MAX`; 0, 0/0 and 1 are no zoom)
+means the stored photo spans ``1 / ratio`` of the lens's frame: the lens readings
+(``exif-focal-plane``, ``exif-sensor-table``) are multiplied by it. Makers differ on the
+35 mm tag: an iPhone's includes the zoom (an iPhone SE at 1.951x writes 55 mm for its 28 mm;
+Hugin bug 2064625), other phones' leave it out. Where a lens reading is there, the tag is
+read the way (with the zoom, or times it) that lies nearer to it, said in the notes; where
+none is, both ways make an equal mixture whose sigma covers both.
+
+A phone's other cameras
+-----------------------
+A phone's telephoto, ultra-wide and front cameras write the phone's ``Make`` and ``Model``
+with their own ``FocalLength``; a table has the main back camera's sensor only. Where
+``LensModel`` names a phone's back, rear or front camera (\"iPhone 11 Pro back triple
+camera 6mm f/2\"; a lens's name, \"EF-S18-55mm f/3.5-5.6 IS\", is not read) and says
+it is another one (front, selfie, TrueDepth, tele..., ultra wide, macro, periscope), or one
+of several (dual, triple or quad, or a ``LensSpecification`` range, or none to tell) whose
+``FocalLength`` on the table's sensor would be a 35 mm equivalent outside
+:data:`MAIN_CAMERA_EQ_MM` (the iPhone 11 Pro's 6 mm telephoto: 36 mm on the main camera's
+5.76 mm sensor), the table's reading is not used, with a warning that says why; the 35 mm
+tag, which the phone writes for that camera, is the prior, and without one there is none.
+A conflict between the table and the 35 mm tag on a phone of several cameras is still an
+``exif-conflict``; its warning names the ``LensModel`` as a likely cause.
+
+Limits: a phone's other camera that writes no ``LensModel`` (most Android phones) still
+gets the main camera's table reading, an ``exif-conflict`` with its 35 mm tag where it has
+one. A table's widths are nominal optical formats (6.08 mm for two Panasonic compacts
 whose tags imply 5.6-5.7 mm: 7 %, within the 2 sigmas that make a conflict). A 16:9 photo of
 a natively 16:9 sensor the table lacks (a Galaxy S5) gets the mixture, 4 % off its own
 diagonal's right reading. A photo of a natively square (or 5:4) frame whose sensor the
 table lacks gets the near-square mixture below, 8 % off its own diagonal's right reading.
-``DigitalZoomRatio`` is not applied.
 """
 
 from __future__ import annotations
@@ -96,9 +130,10 @@ import functools
 import logging
 import math
 import os
+import re
 import struct
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -120,6 +155,9 @@ _TAG_PIXEL_Y = 0xA003
 _TAG_MAKE = 0x010F
 _TAG_MODEL = 0x0110
 _TAG_EXIF_IFD = 0x8769
+_TAG_LENS_SPEC = 0xA432
+_TAG_DIGITAL_ZOOM = 0xA404
+_TAG_LENS_MODEL = 0xA434
 _FP_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 1e-3}  # EXIF FocalPlaneResolutionUnit -> mm
 SIGMA_35MM = 0.04
 SIGMA_FOCAL_PLANE = 0.05
@@ -137,6 +175,8 @@ BUNDLED_SENSOR_TABLE = ("data", "sensor_widths", "sensor_widths.csv")
 TABLE_WIDTH_SPREAD = 0.02
 #: A table width given for an aspect ratio holds for photos within this of it (relative).
 _ASPECT_TOL = 0.03
+#: A photo whose aspect ratio is this far (log) from its EXIF pixel size's was cropped.
+_CROP_ASPECT_TOL = 0.02
 #: Frames a 35 mm tag may be written for besides the photo's own: diagonal / width.
 _FRAME_RATIOS = {"4:3": 1.25, "3:2": math.hypot(3.0, 2.0) / 3.0}
 #: How far (relative) the tag's own crop factor may be from a frame it is read on.
@@ -147,6 +187,19 @@ _WIDE_ASPECT = 1.6
 _TABLE_MIN_ASPECT = 1.3
 #: A 35 mm tag whose frame is at least this wide (diagonal, mm) reads a wide photo on 3:2.
 _LARGE_SENSOR_DIAGONAL_MM = 15.0
+DIGITAL_ZOOM_MAX = 20.0
+"""A ``DigitalZoomRatio`` above this is taken for a broken tag (not applied)."""
+FOCAL_PLANE_SHRUNK = 1.3
+"""A focal-plane sensor width this many times smaller than the table's (or the 35 mm tag's)
+is a resized photo's: its resolution is for the frame before the resize (not used)."""
+MAIN_CAMERA_EQ_MM = (20.0, 32.0)
+"""35 mm equivalents (mm) of a phone's main back camera: 23-28 mm on the phones with several
+back cameras (2016 on). A ``FocalLength`` that would be outside this on the table's sensor is
+another camera's (an ultra-wide's 13-16 mm, a telephoto's 36 mm and up on the main sensor)."""
+_FRONT_WORDS = re.compile(r"\b(front|selfie|truedepth)\b")
+_OTHER_WORDS = re.compile(r"\b(tele\w*|ultra[ -]?wide|macro|periscope)\b")
+_PHONE_CAMERA = re.compile(r"\b(back|rear|front)\b.*\bcamera\b")
+_MULTI_WORDS = re.compile(r"\b(dual|duo|triple|quad)\b")
 #: Makes whose EXIF name does not begin with, or contain, the table's name.
 _MAKE_ALIASES = {
     "fujiphotofilm": "fujifilm",
@@ -423,7 +476,30 @@ def focal_from_tags(
         None when the tags do not give the focal length, or give one outside
         ``PLAUSIBLE_FOCAL_REL`` times the longer side (then with a warning).
     """
-    readings, notes = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    frame = _capture_frame(tags, width_px, height_px)
+    if frame is None:
+        readings, said = _readings(tags, width_px, height_px, sensor_db, bundled_table)
+    else:
+        # cropped after capture: read on the frame the EXIF describes, then scaled by the
+        # crop's unknown resize, between the least that fits the crop in it and none
+        cap_w, cap_h, s_lo, s_hi = frame
+        readings, said = _readings(tags, cap_w, cap_h, sensor_db, bundled_table)
+        mid, spread = math.sqrt(s_lo * s_hi), 0.5 * math.log(s_hi / s_lo)
+        readings = [
+            replace(
+                r,
+                focal_px=r.focal_px * mid,
+                sigma_rel=math.hypot(r.sigma_rel, spread),
+                what=f"{r.what} (on the {cap_w}x{cap_h} frame, scaled)",
+            )
+            for r in readings
+        ]
+        said.notes.append(
+            f"the {width_px}x{height_px} photo is not the shape of the {cap_w}x{cap_h} frame "
+            "its EXIF describes (PixelXDimension, PixelYDimension): cropped after capture. "
+            f"Read on that frame and scaled by {s_lo:.3g}-{s_hi:.3g} (the crop's resize is "
+            f"not known): +/- {100 * spread:.0f} % more"
+        )
     lo, hi = PLAUSIBLE_FOCAL_REL
     longer = max(width_px, height_px, 1)
     kept = []
@@ -443,6 +519,8 @@ def focal_from_tags(
             hi,
         )
     if not kept:
+        for w in said.warnings:
+            log.warning("%s: %s", name, w)
         f35 = _num(tags.get(_TAG_FOCAL_35MM))
         if (
             not readings
@@ -458,13 +536,47 @@ def focal_from_tags(
                 *F35_PLAUSIBLE_MM,
             )
         return None
-    return _combine(kept, notes, name)
+    return _combine(kept, said, name)
 
 
-def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal:
+def _capture_frame(
+    tags: dict[int, Any], width_px: int, height_px: int
+) -> tuple[int, int, float, float] | None:
+    """The frame the EXIF describes, where the photo was cropped to another shape, else None.
+
+    Returns ``(width, height, s_lo, s_hi)``: ``PixelXDimension`` and ``PixelYDimension``
+    turned to the photo's orientation, and the range of the crop's resize. A crop
+    ``w x h`` of a ``W x H`` frame resized by ``s`` fits in it, ``w <= s W`` and
+    ``h <= s H``, so ``s >= max(w / W, h / H)``; up to 1 (no enlargement), or that least
+    ``s`` where the photo was enlarged. A photo of the frame's shape (within
+    :data:`_CROP_ASPECT_TOL`) is a plain resize (or an unseen crop): None.
+    """
+    cap_w, cap_h = _num(tags.get(_TAG_PIXEL_X)), _num(tags.get(_TAG_PIXEL_Y))
+    if not cap_w or not cap_h or width_px < 1 or height_px < 1:
+        return None
+    if (cap_w >= cap_h) != (width_px >= height_px):
+        cap_w, cap_h = cap_h, cap_w  # a turned photo whose tags were not turned
+    if abs(math.log((width_px / height_px) / (cap_w / cap_h))) <= _CROP_ASPECT_TOL:
+        return None
+    s_lo = max(width_px / cap_w, height_px / cap_h)
+    return round(cap_w), round(cap_h), s_lo, max(1.0, s_lo)
+
+
+def _equal_mixture(a: _Reading, b: _Reading) -> tuple[float, float]:
+    """The equal mixture of two readings in ``log(focal)``: their geometric mean, and a
+    sigma covering both, ``sqrt((s_a^2 + s_b^2) / 2 + (log(f_a / f_b) / 2)^2)``."""
+    half_gap = 0.5 * math.log(a.focal_px / b.focal_px)
+    sigma = math.sqrt(0.5 * (a.sigma_rel**2 + b.sigma_rel**2) + half_gap**2)
+    return math.sqrt(a.focal_px * b.focal_px), sigma
+
+
+def _combine(readings: list[_Reading], said: _Said, name: str) -> ExifFocal:
     """The first reading, or the equal mixture of it and the farthest that disagrees."""
     first = readings[0]
     table = tuple((r.source, r.focal_px, r.sigma_rel) for r in readings)
+    notes = tuple(said.notes)
+    for w in said.warnings:
+        log.warning("%s: %s", name, w)
 
     def gap(r: _Reading) -> float:
         return abs(math.log(r.focal_px / first.focal_px))
@@ -473,21 +585,28 @@ def _combine(readings: list[_Reading], notes: list[str], name: str) -> ExifFocal
     if not far:
         for note in notes:
             log.info("%s: %s", name, note)
-        return ExifFocal(first.focal_px, first.sigma_rel, first.source, table, (), tuple(notes))
+        return ExifFocal(
+            first.focal_px, first.sigma_rel, first.source, table, tuple(said.warnings), notes
+        )
     other = max(far, key=gap)
     d = math.log(other.focal_px / first.focal_px)
-    f_mix = first.focal_px * math.exp(0.5 * d)
-    sigma = math.sqrt(0.5 * (first.sigma_rel**2 + other.sigma_rel**2) + (0.5 * d) ** 2)
+    f_mix, sigma = _equal_mixture(first, other)
+    cause = ""
+    if said.table_cause and "exif-sensor-table" in (first.source, other.source):
+        cause = (
+            f" (LensModel {said.table_cause!r} names one of several cameras: the table's "
+            "width is the main camera's, and this may be another's)"
+        )
     msg = (
         f"the EXIF tags disagree: {first.what} gives {first.focal_px:.0f} px, {other.what} "
-        f"{other.focal_px:.0f} px ({100 * (math.exp(d) - 1):+.0f} %); which is right the "
-        f"tags do not say: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} % "
+        f"{other.focal_px:.0f} px ({100 * (math.exp(d) - 1):+.0f} %){cause}; which is right "
+        f"the tags do not say: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} % "
         "(exif-conflict); give --focal-px if it is known"
     )
     log.warning("%s: %s", name, msg)
     for note in notes:
         log.info("%s: %s", name, note)
-    return ExifFocal(f_mix, sigma, "exif-conflict", table, (msg,), tuple(notes))
+    return ExifFocal(f_mix, sigma, "exif-conflict", table, (*said.warnings, msg), notes)
 
 
 def _readings(
@@ -496,18 +615,23 @@ def _readings(
     height_px: int,
     sensor_db: str | None,
     bundled: bool,
-) -> tuple[list[_Reading], list[str]]:
-    """Every reading the tags give, the lens and the sensor first, and notes in words."""
+) -> tuple[list[_Reading], _Said]:
+    """Every reading the tags give, the lens and the sensor first, and what was said."""
     longer = float(max(width_px, height_px))
     shorter = float(max(min(width_px, height_px), 1))
     aspect = longer / shorter
     own_ratio = math.hypot(width_px, height_px) / max(longer, 1.0)  # diagonal / longer side
     out: list[_Reading] = []
-    notes: list[str] = []
+    said = _Said()
+    notes = said.notes
     width_mm: float | None = None  # the sensor width the photo's longer side spans
+    fp_width_mm: float | None = None  # the sensor width of the focal-plane resolution
+    table_width_mm: float | None = None  # the sensor width of the table's reading
     square_sensor_mm: float | None = None  # a near-square photo's camera's sensor width
     f_mm = _num(tags.get(_TAG_FOCAL_LENGTH))
     lo_w, hi_w = SENSOR_WIDTH_PLAUSIBLE_MM
+    zoom = _digital_zoom(tags)  # the stored photo spans 1 / zoom of the lens's frame
+    zoom_words = f" times the {zoom:g}x digital zoom" if zoom != 1.0 else ""
     if f_mm is not None:
         xres = _num(tags.get(_TAG_FP_XRES))
         unit_mm = _FP_UNIT_MM.get(int(_num(tags.get(_TAG_FP_UNIT)) or 2))
@@ -521,14 +645,14 @@ def _readings(
                 scale = longer / max(orig_w, orig_h)
             sensor_w = max(orig_w or width_px, orig_h or height_px) / px_per_mm
             if lo_w <= sensor_w <= hi_w:
-                width_mm = sensor_w
+                width_mm = fp_width_mm = sensor_w
                 out.append(
                     _Reading(
                         "exif-focal-plane",
-                        f_mm * px_per_mm * scale,
+                        f_mm * px_per_mm * scale * zoom,
                         SIGMA_FOCAL_PLANE,
                         f"FocalLength {f_mm:g} mm on the focal-plane resolution's "
-                        f"{sensor_w:.2f} mm sensor",
+                        f"{sensor_w:.2f} mm sensor{zoom_words}",
                     )
                 )
         make, model = _text(tags.get(_TAG_MAKE)), _text(tags.get(_TAG_MODEL))
@@ -536,7 +660,10 @@ def _readings(
             got = sensor_width_mm(make, model, (width_px, height_px), sensor_db, bundled=bundled)
             if got is not None and lo_w <= got[0] <= hi_w:
                 sw, origin = got
-                if aspect < _TABLE_MIN_ASPECT:
+                other = _other_camera(tags, f_mm, sw)
+                if other is not None:
+                    said.warnings.append(other)
+                elif aspect < _TABLE_MIN_ASPECT:
                     square_sensor_mm = sw
                     notes.append(
                         f"no sensor-table reading: a {width_px}x{height_px} photo is narrower "
@@ -544,24 +671,173 @@ def _readings(
                     )
                 else:
                     width_mm = width_mm or sw
+                    table_width_mm = sw
+                    said.table_cause = _several_cameras(tags)
                     out.append(
                         _Reading(
                             "exif-sensor-table",
-                            f_mm / sw * longer,
+                            f_mm / sw * longer * zoom,
                             SIGMA_SENSOR_TABLE,
                             f"FocalLength {f_mm:g} mm on the {sw:g} mm sensor of "
-                            f"{make} {model} ({origin})",
+                            f"{make} {model} ({origin}){zoom_words}",
                         )
                     )
     f35 = _num(tags.get(_TAG_FOCAL_35MM))
-    if f35 is not None and F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+    if f35 is not None and not F35_PLAUSIBLE_MM[0] <= f35 <= F35_PLAUSIBLE_MM[1]:
+        f35 = None
+    if fp_width_mm is not None and f_mm is not None:
+        # the sensor the focal-plane resolution gives, against the table's or the tag's
+        ref_mm, ref_what = table_width_mm, "the sensor table's width"
+        if ref_mm is None and f35 is not None and zoom == 1.0 and aspect >= _TABLE_MIN_ASPECT:
+            # (a near-square photo's longer side may be the sensor's height: not compared)
+            ref_mm = FULL_FRAME_DIAGONAL_MM * f_mm / f35 / own_ratio
+            ref_what = f"the {f35:g} mm 35 mm tag's crop factor: a width of"
+        if ref_mm is not None and fp_width_mm * FOCAL_PLANE_SHRUNK < ref_mm:
+            out = [r for r in out if r.source != "exif-focal-plane"]
+            width_mm = table_width_mm
+            said.warnings.append(
+                f"FocalPlaneXResolution gives a {fp_width_mm:.2f} mm wide sensor for the "
+                f"{_pixel_size(tags, width_px, height_px)} frame, {ref_what} {ref_mm:.2f} mm: "
+                "the resolution is for a larger frame than the EXIF's pixel size (a photo "
+                "resized after capture, its PixelXDimension rewritten or gone): not used"
+            )
+    if f35 is None:
+        return out, said
+
+    def tag(f35_optical: float, notes: list[str]) -> list[_Reading]:
+        """The tag read as the lens's own 35 mm equivalent, times the digital zoom."""
         if aspect < _TABLE_MIN_ASPECT:
-            out.extend(
-                _reading_35mm_square(f35, f_mm, square_sensor_mm, longer, shorter, own_ratio, notes)
+            got = _reading_35mm_square(
+                f35_optical, f_mm, square_sensor_mm, longer, shorter, own_ratio, notes
             )
         else:
-            out.extend(_reading_35mm(f35, f_mm, width_mm, longer, aspect, own_ratio, notes))
-    return out, notes
+            got = _reading_35mm(f35_optical, f_mm, width_mm, longer, aspect, own_ratio, notes)
+        return [replace(r, focal_px=r.focal_px * zoom, what=r.what + zoom_words) for r in got]
+
+    if zoom == 1.0:
+        out.extend(tag(f35, notes))
+        return out, said
+    # Makers differ: an iPhone's tag includes the digital zoom, other phones' do not (Hugin
+    # bug 2064625). The lens reading, where there is one, tells which; else both, mixed.
+    notes_with: list[str] = []
+    notes_without: list[str] = []
+    with_zoom = tag(f35 / zoom, notes_with)
+    without = tag(f35, notes_without)
+    if out:
+        ref = out[0].focal_px
+
+        def miss(rs: list[_Reading]) -> float:
+            return abs(math.log(rs[0].focal_px / ref))
+
+        included = miss(with_zoom) <= miss(without)
+        notes.extend(notes_with if included else notes_without)
+        notes.append(
+            f"the {f35:g} mm 35 mm tag {'includes' if included else 'leaves out'} the "
+            f"{zoom:g}x digital zoom (so the lens reading says): read so"
+        )
+        out.extend(with_zoom if included else without)
+        return out, said
+    a, b = without[0], with_zoom[0]
+    f_mix, sigma = _equal_mixture(a, b)
+    notes.extend(notes_with)
+    notes.append(
+        f"the {f35:g} mm 35 mm tag may include the {zoom:g}x digital zoom (as an iPhone's "
+        f"does: {b.focal_px:.0f} px) or leave it out ({a.focal_px:.0f} px); no lens reading "
+        f"tells which: the prior covers both, {f_mix:.0f} px +/- {100 * sigma:.0f} %"
+    )
+    what = f"FocalLengthIn35mmFilm {f35:g} mm with or without the {zoom:g}x digital zoom"
+    out.append(_Reading("exif-35mm", f_mix, sigma, what))
+    return out, said
+
+
+def _pixel_size(tags: dict[int, Any], width_px: int, height_px: int) -> str:
+    """``PixelXDimension`` x ``PixelYDimension``, or the stored size where they are not."""
+    w, h = _num(tags.get(_TAG_PIXEL_X)), _num(tags.get(_TAG_PIXEL_Y))
+    if w and h:
+        return f"{w:.0f}x{h:.0f} (PixelXDimension)"
+    return f"stored {width_px}x{height_px}"
+
+
+def _digital_zoom(tags: dict[int, Any]) -> float:
+    """``DigitalZoomRatio`` where it zooms (above 1, up to :data:`DIGITAL_ZOOM_MAX`), else 1.
+
+    0 (EXIF's "not used"), 0/0, 1 and anything implausible read as no zoom."""
+    r = _num(tags.get(_TAG_DIGITAL_ZOOM))
+    if r is None or r <= 1.0 + 1e-3 or r > DIGITAL_ZOOM_MAX:
+        return 1.0
+    return r
+
+
+@dataclass
+class _Said:
+    """What the readings say besides their values: notes, warnings, a conflict's cause."""
+
+    notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    table_cause: str = ""  # why a table reading may be wrong (named if it conflicts)
+
+
+def _lens_model(tags: dict[int, Any]) -> str:
+    """``LensModel`` where it names a phone's camera (\"iPhone 11 Pro back triple camera
+    6mm f/2\", \"Pixel 7 Pro front camera 2.74mm f/2.2\": a back, rear or front camera),
+    else \"\" (a lens's name, \"EF-S18-55mm f/3.5-5.6 IS\", or another camera's words)."""
+    lens = _text(tags.get(_TAG_LENS_MODEL))
+    return lens if _PHONE_CAMERA.search(lens.lower()) else ""
+
+
+def _several_cameras(tags: dict[int, Any]) -> str:
+    """The ``LensModel`` of a phone camera that may be one of several, else \"\".
+
+    One of several: its ``LensModel`` says a dual, duo, triple or quad camera, or
+    ``LensSpecification`` spans more than one focal length (phones write the range of all
+    their back cameras), or there is no ``LensSpecification`` to tell (a Pixel)."""
+    lens = _lens_model(tags)
+    if not lens:
+        return ""
+    if _MULTI_WORDS.search(lens.lower()):
+        return lens
+    spec = tags.get(_TAG_LENS_SPEC)
+    try:
+        f_lo, f_hi = _num(spec[0]), _num(spec[1])  # type: ignore[index]
+    except (TypeError, IndexError, KeyError):
+        return lens
+    if f_lo is None or f_hi is None:
+        return lens
+    return lens if f_hi > f_lo * 1.02 else ""
+
+
+def _other_camera(tags: dict[int, Any], f_mm: float, sensor_w_mm: float) -> str | None:
+    """Why the table's sensor width, a phone's main back camera's, is not this photo's
+    camera's (a warning), or None.
+
+    A phone's other cameras (front, ultra-wide, telephoto) write the phone's ``Make`` and
+    ``Model`` with their own ``FocalLength``; the table gives the main camera's sensor.
+    ``LensModel`` tells them apart: the words front, selfie, TrueDepth, tele..., ultra
+    wide, macro or periscope, or one camera of several (:func:`_several_cameras`) whose
+    ``FocalLength`` on the table's sensor (its 4:3 frame) would be a 35 mm equivalent
+    outside :data:`MAIN_CAMERA_EQ_MM` (the iPhone 11 Pro's 6 mm telephoto: 36 mm on the
+    main camera's 5.76 mm sensor, where its own 52 mm tag is right).
+    """
+    lens = _lens_model(tags)
+    if not lens:
+        return None
+    low = lens.lower()
+    main = f"the table's {sensor_w_mm:g} mm width is the main back camera's: not used"
+    word = _FRONT_WORDS.search(low) or _OTHER_WORDS.search(low)
+    if word is not None:
+        return f"LensModel {lens!r} says the {word.group(0)} camera; {main}"
+    if not _several_cameras(tags):
+        return None  # the phone's one back camera: the table's
+    eq_mm = f_mm * FULL_FRAME_DIAGONAL_MM / (sensor_w_mm * _FRAME_RATIOS["4:3"])
+    lo, hi = MAIN_CAMERA_EQ_MM
+    if lo <= eq_mm <= hi:
+        return None
+    kind = "an ultra-wide" if eq_mm < lo else "a telephoto"
+    return (
+        f"LensModel {lens!r} names one camera of several, and FocalLength {f_mm:g} mm on "
+        f"the table's {sensor_w_mm:g} mm sensor would be a {eq_mm:.0f} mm equivalent, "
+        f"outside a main camera's {lo:g}-{hi:g} mm: {kind} camera's photo; {main}"
+    )
 
 
 def _reading_35mm(
@@ -656,9 +932,9 @@ def _two_ways(
     """The 35 mm tag read on the photo's own diagonal and on a sensor frame, where the
     sensor's width cannot tell which it was written for: their equal mixture, its sigma
     covering both, said in ``notes``."""
-    d = math.log(f_frame / f_own)
-    sigma = math.sqrt(SIGMA_35MM**2 + (0.5 * d) ** 2)
-    f_mix = math.sqrt(f_own * f_frame)
+    f_mix, sigma = _equal_mixture(
+        _Reading("exif-35mm", f_own, SIGMA_35MM, ""), _Reading("exif-35mm", f_frame, SIGMA_35MM, "")
+    )
     notes.append(
         f"the {f35:g} mm 35 mm tag of a {aspect:.2f}:1 photo may be written for the {frame} "
         f"({f_frame:.0f} px) or for the photo's own ({f_own:.0f} px); the sensor's width is "

@@ -292,7 +292,11 @@ def test_street_camera_looking_down_at_a_road_at_an_angle_is_not_warned_as_looki
     52-58 degrees.)"""
     segs = lane_marking_segments(pitch_deg, yaw_deg, n_poles=n_poles, seed=seed)
     res = detect_vanishing_points(None, segments=segs, image_size=(1024, 768))
-    assert res.pitch_deg == pytest.approx(pitch_deg, abs=1.0)
+    # 1.5 degrees: the focal length is loose here (no vertical line) and the default prior
+    # (1024 px) joins; since stop 42 it weighs the reading as a wrong frame's with a chance
+    # of 0.17 (``_WRONG_FRAME_MAX``), which pulls this 800 px camera's 837 px to 850 px and
+    # its 30 degrees from 29.0 to 28.6 read (29.1 to 28.8 at 25 degrees of yaw)
+    assert res.pitch_deg == pytest.approx(pitch_deg, abs=1.5)
     assert not [w for w in res.warnings if "or up" in w]
     assert res.n_lines[0] < 12  # few poles: the old rule's case
 

@@ -93,16 +93,25 @@ def test_the_term_scales_with_the_clicks_excess_over_the_lines_precision() -> No
         r[n_seg:] = click_px / np.tile(prob._sigma_pt_each, 2)
         return _ground_corner_evidence(prob, r)
 
+    # The settings' clicks are 1.5x worse than their line ends (sigma_point_rel 0.0015,
+    # sigma_line_rel 0.0010): clicks that much worse show no excess (stop 42; before, the
+    # clicks were compared with the line ends at equal precision).
+    k = prob.ground_corner_click_ratio
+    assert k == pytest.approx(1.5)
     assert evidence(0.0, 0.0) == GROUND_CORNER_FLOOR
     assert evidence(1.0, 1.0) == GROUND_CORNER_FLOOR  # clicks as precise as the lines
+    assert evidence(1.0, k) == GROUND_CORNER_FLOOR  # clicks as precise as the settings say
     assert evidence(0.0, 1000.0) == 1.0
     # an excess of half the term's sigma: about half the term
     clicks = prob.pt_pix.reshape(-1, 4, 2)
     edge_sq = np.sum((clicks[:, 1:3] - clicks[:, :1]) ** 2, axis=(1, 2))
     term_sd = 0.025 * math.sqrt(float(np.mean(edge_sq)) / 2.0)
-    half = evidence(1.0, math.hypot(1.0, 0.5 * term_sd))
+    half = evidence(1.0, math.hypot(k, 0.5 * term_sd))
     assert half == pytest.approx(0.5, abs=0.1)
-    assert evidence(1.0, math.hypot(1.0, 0.25 * term_sd)) < half
+    assert evidence(1.0, math.hypot(k, 0.25 * term_sd)) < half
+    # At equal precision (stop 41's comparison) the clicks' own 1.5x counts as an excess.
+    prob.ground_corner_click_ratio = 1.0
+    assert evidence(1.0, k) > 2.0 * GROUND_CORNER_FLOOR
 
 
 def test_exact_clicks_leave_only_the_floor_of_the_term(monkeypatch: pytest.MonkeyPatch) -> None:
