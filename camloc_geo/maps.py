@@ -362,7 +362,8 @@ _PAGE_CSS = """
   border-radius: 5px; box-shadow: 0 1px 5px rgba(0,0,0,0.4); font: 12px/1.35 sans-serif;
   color: #222; }
 .camloc-legend { max-width: 260px; }
-.camloc-summary-title { max-height: 40vh; overflow-y: auto; }
+.camloc-summary-title { max-height: 40vh; overflow-y: auto; box-sizing: border-box;
+  max-width: min(560px, calc(100vw - 20px)); }
 .camloc-title { overflow-wrap: anywhere; }
 .camloc-title:not(.camloc-summary-title) { max-width: min(290px, calc(100vw - 80px)); }
 .camloc-more summary { cursor: pointer; color: #124; }

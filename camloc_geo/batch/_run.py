@@ -280,6 +280,13 @@ class _DaskRunner:
                     f"--scheduler {scheduler!r} is not a Dask scheduler address "
                     f"(tcp://HOST:PORT): {exc}"
                 ) from None
+            except OSError as exc:  # nothing answers there (Dask's "Timed out trying to
+                # connect to tcp://...:9999 after 30 s" was all the user read)
+                raise OSError(
+                    f"no Dask scheduler answered at {scheduler} ({exc}): start one there "
+                    "(dask scheduler), check the address and port, or leave --scheduler out "
+                    "to run on local processes"
+                ) from None
             self.own = True
         else:
             self.client = scheduler

@@ -51,6 +51,7 @@ __all__ = [
     "COLUMN_VARIANTS",
     "CameraRow",
     "count_camera_rows",
+    "parse_coordinate",
     "read_camera_csv",
     "read_camera_list",
     "row_from_mapping",
@@ -205,15 +206,99 @@ def _text(value: Any, name: str, problems: list[str]) -> str:
     return _clean(value)
 
 
-def _number(value: Any, name: str, problems: list[str]) -> float | None:
+_NUM = r"\d+(?:[.,]\d+)?"
+_COORDINATE = re.compile(
+    rf"""(?P<h1>[NSEW])?\s*(?P<sign>[+-])?\s*(?P<deg>{_NUM})\s*[°º˚]?\s*
+    (?:(?P<min>{_NUM})\s*['′’]\s*(?:(?P<sec>{_NUM})\s*(?:"|″|”|''|′′)?\s*)?)?
+    (?P<h2>[NSEW])?""",
+    re.IGNORECASE | re.VERBOSE,
+)
+"""A coordinate as a GPS, a map site or a person writes it: ``60.1697 N``, ``N 60.1697``,
+``60.1697°``, ``76°35'36.6"W``, ``60° 10.18' N`` (degrees, minutes, seconds; a hemisphere
+letter before or after)."""
+
+_AXIS_OF = {"N": "lat", "S": "lat", "E": "lon", "W": "lon"}
+
+
+def parse_coordinate(text: str, name: str) -> float:
+    """A latitude or longitude cell in decimal degrees, read as people write them.
+
+    Parameters
+    ----------
+    text : str
+        The cell: ``60.1697``, ``60,1697`` (a decimal comma), ``60.1697 N``, ``N60.1697``,
+        ``60.1697°``, ``76°35'36.6"W``, ``60° 10.18' N``.
+    name : str
+        ``"lat"`` or ``"lon"``: which hemisphere letters belong to it (N/S, E/W).
+
+    Returns
+    -------
+    float
+        Decimal degrees, negative in the south and the west.
+
+    Raises
+    ------
+    ValueError
+        The text is no coordinate; the message says why when it is close to one (a
+        hemisphere letter of the other axis, minutes of 60 or more, a sign and a letter).
+    """
+    cleaned = text.strip()
+    if _DECIMAL_COMMA.fullmatch(cleaned):
+        cleaned = cleaned.replace(",", ".")
+    try:
+        return float(cleaned)
+    except ValueError:
+        pass
+    # a coordinate is short: a long cell is not searched (bounded regular-expression work)
+    m = _COORDINATE.fullmatch(cleaned) if len(cleaned) <= 40 else None
+    if m is None:
+        raise ValueError("is not a number")
+    h1, h2 = m.group("h1"), m.group("h2")
+    if h1 and h2:
+        raise ValueError("has two hemisphere letters")
+    letter = (h1 or h2 or "").upper()
+    if letter and _AXIS_OF[letter] != name:
+        other = "latitude (N/S)" if _AXIS_OF[letter] == "lat" else "longitude (E/W)"
+        raise ValueError(
+            f"is a {other}, not a {'latitude' if name == 'lat' else 'longitude'}: are the "
+            "list's lat and lon columns the other way round?"
+        )
+    if letter and m.group("sign"):
+        raise ValueError(f"has both a sign and the hemisphere {letter}: give one")
+
+    def part(key: str) -> float:
+        got = m.group(key) if m is not None else None
+        return float(got.replace(",", ".")) if got else 0.0
+
+    minutes, seconds = part("min"), part("sec")
+    if minutes >= 60 or seconds >= 60:
+        raise ValueError("has minutes or seconds of 60 or more")
+    value = part("deg") + minutes / 60.0 + seconds / 3600.0
+    if m.group("sign") == "-" or letter in ("S", "W"):
+        value = -value
+    return value
+
+
+def _number(
+    value: Any, name: str, problems: list[str], *, coordinate: bool = False
+) -> float | None:
+    """A number column's value (a decimal comma read), or None with the problem named.
+
+    With ``coordinate``, text is read as people write a latitude or longitude
+    (:func:`parse_coordinate`: ``60.1697 N`` was "not a number" and the camera's point lost).
+    """
     if value is None or (isinstance(value, str) and not value.strip()):
         return None
-    if isinstance(value, str) and _DECIMAL_COMMA.fullmatch(value):
-        value = value.replace(",", ".")
     try:
-        num = float(value)
-    except (TypeError, ValueError):
-        problems.append(f"{name} {_clean(value)[:40]!r} is not a number")
+        if isinstance(value, str) and coordinate:
+            num = parse_coordinate(value[:_MAX_FIELD_CHARS], name)
+        elif isinstance(value, str) and _DECIMAL_COMMA.fullmatch(value):
+            num = float(value.replace(",", "."))
+        else:
+            num = float(value)
+    except (TypeError, ValueError) as exc:
+        why = str(exc) if coordinate and isinstance(value, str) else "is not a number"
+        problems.append(f"{name} {_clean(value)[:40]!r} {why}")
         return None
     if not math.isfinite(num):
         problems.append(f"{name} {value!r} is not a finite number")
@@ -247,8 +332,8 @@ def row_from_mapping(
     problems = list(list_problems)
     ident = _text(_pick(lower, "id"), "id", problems) or f"row-{row}"
     title = _text(_pick(lower, "title"), "title", problems)
-    lat = _number(_pick(lower, "lat"), "lat", problems)
-    lon = _number(_pick(lower, "lon"), "lon", problems)
+    lat = _number(_pick(lower, "lat"), "lat", problems, coordinate=True)
+    lon = _number(_pick(lower, "lon"), "lon", problems, coordinate=True)
     if lat is None and lon is None and point is not None:
         lat, lon = point
     if (lat is None) != (lon is None):

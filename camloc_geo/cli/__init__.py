@@ -33,6 +33,7 @@ import gc
 import importlib
 import json
 import logging
+import re
 import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -403,7 +404,9 @@ def _main(argv: Sequence[str] | None) -> int:
     except InputError as exc:
         if args.debug:
             raise
-        sys.stderr.write(f"camloc {args.command}: error: {_one_line(exc)}\n")
+        sys.stderr.write(
+            f"camloc {args.command}: error: {_one_line(exc)}{_swapped_hint(args, exc)}\n"
+        )
         return 2
     except KeyboardInterrupt as exc:
         if isinstance(exc, Terminated):
@@ -465,6 +468,49 @@ def _drop_stdout() -> None:
         os.close(devnull)
     except (OSError, ValueError, AttributeError):  # stdout without a descriptor (a test's)
         pass
+
+
+_EXTRACT_COVERS = re.compile(
+    r"is outside the extract .*cover lat (-?[\d.]+)\.\.(-?[\d.]+), lon (-?[\d.]+)\.\.(-?[\d.]+)\)"
+)
+
+
+def _swapped_hint(args: argparse.Namespace, exc: BaseException) -> str:
+    """A hint when ``--lat``/``--lon`` outside the map lie in it the other way round.
+
+    ``camloc corners --lat 24.9455 --lon 60.1699 --osm helsinki.osm.pbf`` (the two swapped,
+    as GeoJSON and QGIS write lon first) was refused as outside the extract with no word that
+    the swapped point is inside it (``camloc batch``, the service and QGIS say so).
+    """
+    lat, lon, osm = (
+        getattr(args, "lat", None),
+        getattr(args, "lon", None),
+        getattr(args, "osm", None),
+    )
+    if not isinstance(lat, float) or not isinstance(lon, float) or not -90.0 <= lon <= 90.0:
+        return ""
+    message = str(exc)
+    where = ""
+    m = _EXTRACT_COVERS.search(message)
+    if m is not None:
+        south, north, west, east = (float(v) for v in m.groups())
+        if south <= lon <= north and west <= lat <= east:
+            where = "the extract"
+    elif "is outside every extract" in message and osm:
+        try:
+            from camloc_geo.osm import MapCatalogue
+
+            covering = MapCatalogue.from_source(osm).covering(lon, lat)
+        except Exception:  # a hint only
+            covering = []
+        if covering:
+            where = Path(covering[0]).name
+    if not where:
+        return ""
+    return (
+        f"; with --lat and --lon swapped (--lat {lon:g} --lon {lat:g}) the point lies in "
+        f"{where}: are they the other way round?"
+    )
 
 
 def _one_line(exc: BaseException) -> str:

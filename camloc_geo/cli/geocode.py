@@ -6,6 +6,7 @@ import argparse
 import csv
 import itertools
 import json
+import math
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -195,14 +196,6 @@ def _geojson_rows(
     return rows()
 
 
-def _coordinate(text: str) -> float:
-    """A coordinate of a CSV cell; a decimal comma (``39,2851``) is read as a point."""
-    text = text.strip()
-    if text.count(",") == 1 and "." not in text:
-        text = text.replace(",", ".")
-    return float(text)
-
-
 def _data_rows(
     fh: IO[str], reader: Any, header: list[str], title_col: str
 ) -> Iterator[tuple[int, str | None, str, tuple[float, float] | None]]:
@@ -247,14 +240,19 @@ def _point_of(lat_text: str, lon_text: str) -> tuple[tuple[float, float] | None,
         return None, None
     if not lat_text.strip() or not lon_text.strip():
         return None, "give both lat and lon, or neither"
+    from camloc_geo.cameras import parse_coordinate
+
+    # as camloc batch reads them: a decimal comma, ``60.1697 N``, ``76°35'36.6"W``
     try:
-        lat = _coordinate(lat_text)
-    except ValueError:
-        return None, f"lat {lat_text.strip()[:40]!r} is not a number"
+        lat = parse_coordinate(lat_text, "lat")
+    except ValueError as exc:
+        return None, f"lat {lat_text.strip()[:40]!r} {exc}"
     try:
-        lon = _coordinate(lon_text)
-    except ValueError:
-        return None, f"lon {lon_text.strip()[:40]!r} is not a number"
+        lon = parse_coordinate(lon_text, "lon")
+    except ValueError as exc:
+        return None, f"lon {lon_text.strip()[:40]!r} {exc}"
+    if not (math.isfinite(lat) and math.isfinite(lon)):
+        return None, f"lat/lon {lat_text.strip()[:40]},{lon_text.strip()[:40]} is not finite"
     if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0):
         return None, f"lat/lon {lat:g},{lon:g} is out of range"
     return (lat, lon), None

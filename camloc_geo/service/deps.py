@@ -109,6 +109,23 @@ def content_type(request: Request) -> str:
     return request.headers.get("content-type", "").split(";")[0].strip().lower()
 
 
+def unsupported_media_message(ctype: str, kinds: tuple[str, ...]) -> str:
+    """The 415's words: the content type given (or none at all) and what to send.
+
+    A body with no ``Content-Type`` was "content type 'none' not supported here", and
+    ``curl --data-binary @cams.csv`` (which sends ``application/x-www-form-urlencoded``) gave
+    no hint of the header to add.
+    """
+    send = " or ".join(kinds)
+    header = " or ".join(f"-H 'Content-Type: {k}'" for k in kinds)
+    if not ctype:
+        return f"the request has no Content-Type header; send {send} (curl: {header})"
+    text = f"content type {ctype!r} not supported here; send {send}"
+    if ctype == "application/x-www-form-urlencoded":
+        text += f" (curl's --data and --data-binary send {ctype} unless given {header})"
+    return text
+
+
 async def raw_body(request: Request, kinds: tuple[str, ...]) -> bytes:
     """The body, when its content type is one of ``kinds``.
 
@@ -119,10 +136,7 @@ async def raw_body(request: Request, kinds: tuple[str, ...]) -> bytes:
     """
     ctype = content_type(request)
     if ctype not in kinds:
-        raise UnsupportedMediaError(
-            f"content type {ctype or 'none'!r} not supported here; send {' or '.join(kinds)}",
-            "content-type",
-        )
+        raise UnsupportedMediaError(unsupported_media_message(ctype, kinds), "content-type")
     encoding = request.headers.get("content-encoding", "").strip().lower()
     if encoding not in ("", "identity"):  # a gzip body read as JSON: "can't decode byte 0x8b"
         raise UnsupportedMediaError(

@@ -147,8 +147,17 @@ _ID_WORDS = {
         "an id of this service (32 hex digits, 0-9 and a-f, as the POST that made it answered)"
     ),
     r"^[0-9a-f]{16}$": "a page identity (16 hex digits, 0-9 and a-f, as the review page shows it)",
+    r"^c?[0-9]{1,6}$": (
+        "a key of the page's items: a candidate's rank on a review page ('1', '2', ...) or "
+        "'c' and a camera's index on a summary page ('c0', 'c1', ...), as its export gives them"
+    ),
 }
 """What the service's id patterns mean, for a refused path value (stop 41, qa3)."""
+
+
+_ECHO_CHARS = 80
+"""Longest input quoted back in a validation message (a 200-character query value was
+quoted whole, twice)."""
 
 
 def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
@@ -167,15 +176,26 @@ def _validation_message(errors: list[dict[str, Any]]) -> tuple[str, str | None]:
         name = ".".join(loc) or "request"
         field = field or name
         got = err.get("input")
+        if isinstance(got, str) and len(got) > _ECHO_CHARS:
+            got = got[:_ECHO_CHARS] + "..."
         got_text = f" (got {got!r})" if isinstance(got, (str, int, float)) else ""
         pattern = (
             (err.get("ctx") or {}).get("pattern") if isinstance(err.get("ctx"), dict) else None
         )
         if err.get("type") == "string_pattern_mismatch" and pattern in _ID_WORDS:
             # "String should match pattern '^[0-9a-f]{32}$'" named a regular expression
+            if loc and loc[-1] == "[key]":  # a mapping's key: "items.x.[key]" named it twice
+                name = ".".join(loc[:-2]) or name  # (the field stays as it was)
             parts.append(f"{name}: {got!r} is not {_ID_WORDS[pattern]}")
             continue
-        parts.append(f"{name}: {err.get('msg', 'invalid')}{got_text}")
+        msg = str(err.get("msg", "invalid"))
+        if err.get("type") == "value_error":
+            # our own validators' words ("give two street names, as "A & B" (got 'X')"):
+            # pydantic's "Value error, " prefix dropped, and the value not quoted twice
+            msg = msg.removeprefix("Value error, ")
+            if "(got " in msg:
+                got_text = ""
+        parts.append(f"{name}: {msg}{got_text}")
     return "; ".join(parts) or "invalid request", field
 
 

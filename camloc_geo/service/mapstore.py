@@ -97,12 +97,32 @@ class MapStore:
         MapSourceError
             Overpass failed.
         """
-        area = self.catalogue.area_for_point(lat, lon)
+        catalogue = self.catalogue
+        area = catalogue.area_for_point(lat, lon)
         if area[0] == "none":
             raise MapDataError(
                 f"no map data configured on this server covers lat={lat:.6f}, lon={lon:.6f}"
+                + self._swapped_hint(catalogue, lat, lon)
             )
-        return self.catalogue.map_for_area(area)
+        return catalogue.map_for_area(area)
+
+    @staticmethod
+    def _swapped_hint(catalogue: MapCatalogue, lat: float, lon: float) -> str:
+        """A hint when the point, outside every extract, lies in one with lat and lon swapped
+        (``?lat=24.9455&lon=60.1699`` for Helsinki was only "no map data ... covers", where
+        ``camloc batch`` names the swap)."""
+        if not -90.0 <= lon <= 90.0 or not catalogue.files:
+            return ""
+        try:
+            covering = catalogue.covering(lon, lat)
+        except Exception:  # a hint only
+            return ""
+        if not covering:
+            return ""
+        return (
+            f"; with lat and lon swapped, lat={lon:.6f}, lon={lat:.6f} lies in a map (in "
+            f"{Path(covering[0]).name}): are lat and lon the other way round?"
+        )
 
 
 def distance_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:

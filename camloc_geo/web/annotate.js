@@ -369,10 +369,15 @@
     return out;
   }
 
+  /* The car's top (point 4) not above its ground corner (point 1) on screen: the four points
+     clicked in another order. The top is straight above the corner, and a street camera does
+     not roll by 90 degrees. */
+  function topNotAbove(ax) { return !!(ax.origin && ax.height && ax.height[1] >= ax.origin[1] - 1); }
+
   /* Everything the checks panel shows, from an annotation state (pure: tests call it). */
   function analyse(st, width, height, hints) {
     var diag = Math.hypot(width, height);
-    var out = { vps: {}, intrinsics: null, horizon: null, messages: [], wrongCorner: null,
+    var out = { vps: {}, intrinsics: null, horizon: null, messages: [], wrongCorner: null, topBelow: false,
       carOutline: carOutline(st.axes), carLines: carLines(st) };
     var hv = {};
     AXES.forEach(function (k) {
@@ -387,6 +392,11 @@
       var h = cross(hv.length, hv.width);
       if (Math.hypot(h[0], h[1]) > 1e-12 * Math.abs(h[2])) out.horizon = h;
     }
+    // Points in the wrong order: a top clicked at or below the first point (the four clicked
+    // in another order: the top first, or the ground corner last) was said nothing of until
+    // lines were drawn, and then only as "Wrong corner?" of the length end (session 42 QA, a
+    // real photo on a phone).
+    out.topBelow = topNotAbove(st.axes);
     // Wrong corner: moving from the origin along an axis away from the camera moves the
     // image toward that axis' vanishing point (a point at infinity ahead of the camera).
     var ax = st.axes;
@@ -767,7 +777,9 @@
       if (!next) { flash("The four car points are placed: drag one to move it, or go to the next step."); return; }
       commit();
       S.axes[next] = p;
-      if (carComplete() && step === 0) step = 1;
+      // moves on by itself, unless the four points are plainly in the wrong order (the top
+      // not above the ground corner): then the step stays, its red check over the photo
+      if (carComplete() && step === 0 && !topNotAbove(S.axes)) step = 1;
     } else if (AXES.indexOf(key) >= 0) {
       if (!pending) { pending = p; render(); return; }
       var sp = toScreen(pending), sq = toScreen(p);
@@ -1010,6 +1022,8 @@
       var li = document.createElement("li");
       var m = missing(s.key);
       var done = s.key === "save" ? false : (optional(s.key) ? stepState(i) !== "optional" && !m.length : !m.length);
+      // four car points in the wrong order are not a done step (it showed a green tick)
+      if (s.key === "car" && topNotAbove(S.axes)) done = false;
       li.className = (i === step ? "current " : "") + (done ? "done" : "");
       li.dataset.step = String(i);
       li.innerHTML = "<span class='num'>" + (done ? "&#10003;" : i + 1) + "</span><span>" + s.title +
@@ -1037,6 +1051,12 @@
       mEl.className = "missing ok";
       mEl.textContent = key === "save" ? "Everything required is there." :
         (key === "car" ? "Done. Drag a point to adjust it, or go on with Next." : "Done. Go on with Next, or add more.");
+    }
+    if (key === "car" && carComplete() && topNotAbove(S.axes)) {
+      // it said "Done." in green beside the red "Points in the wrong order?"
+      mEl.className = "missing";
+      mEl.textContent = "The four points are placed, but the top (point 4) is not above the " +
+        "ground corner (point 1): drag them into this order, or undo and click them again.";
     }
     if (key === "car" && !carComplete()) {
       var next = AXIS_POINTS.filter(function (k) { return !S.axes[k]; })[0];
@@ -1211,7 +1231,13 @@
       }
     }
     if (a.horizon) h += check("info", "The dashed light-blue line is the horizon: it should run at the camera's eye level, through distant street ends.");
-    if (a.wrongCorner) {
+    if (a.topBelow) {
+      h += check("bad", "&#9888; Points in the wrong order? The <b>top</b> (point 4) is not above the first point. " +
+        "Click in this order: 1 the car's ground corner nearest the camera, 2 the far end of its length edge, " +
+        "3 the far end of its width edge, 4 its top straight above point 1 (drag the points or undo).",
+        "&#9888; Points in the wrong order? The top (point 4) is not above point 1, the ground corner: drag them or undo.");
+    }
+    if (a.wrongCorner && !a.topBelow) {
       h += check("bad", "&#9888; Wrong corner? The " + a.wrongCorner + " end you clicked looks nearer to the camera than the " +
         "origin. Click the car's ground corner <b>nearest the camera</b> first (drag the points or undo).");
     }
@@ -1490,7 +1516,19 @@
     if (!d) return;
     if (d.target) {
       if (d.moved) { setTarget(d.target, toImage(sp[0], sp[1])); changed(); }
-      else { undoStack.pop(); hover = d.target; selected = d.target; render(); }
+      else {
+        undoStack.pop(); hover = d.target; selected = d.target; render();
+        if (STEPS[step].key === "car" && !carComplete() && d.target.kind === "axis") {
+          // a tap meant as the next car point but within 9 px of a placed one selected that
+          // point, and nothing said why no point came (a car 30 px long on a phone's photo)
+          var nextKey = AXIS_POINTS.filter(function (k) { return !S.axes[k]; })[0];
+          var q = toScreen(d.target.p), away = Math.round(Math.hypot(q[0] - sp[0], q[1] - sp[1]));
+          flash("That tap selected point " + (AXIS_POINTS.indexOf(d.target.key) + 1) + " (" +
+            d.target.key + "), " + away + " px away, instead of placing point " +
+            (AXIS_POINTS.indexOf(nextKey) + 1) + ": zoom in (+, or pinch) so the points stand " +
+            "apart, then tap again.");
+        }
+      }
       return;
     }
     if (!d.moved && d.button === 0) place(toImage(sp[0], sp[1]));

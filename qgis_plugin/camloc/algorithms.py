@@ -28,6 +28,7 @@ from qgis.core import (
     QgsVectorLayer,
 )
 from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QTimer
 
 from .layers import (
     TIE_WORDS,
@@ -35,6 +36,7 @@ from .layers import (
     fields_of,
     order_camloc_layers,
     save_style_in_gpkg,
+    use_local_crs,
     wgs84,
     wkb_of,
     write_to_sink,
@@ -69,6 +71,11 @@ class _Styler(QgsProcessingLayerPostProcessorInterface):
             node = project.layerTreeRoot().findLayer(layer.id())
             if node is not None and node.parent() is not None:
                 order_camloc_layers(node.parent())
+            # a project of camloc layers alone: its place's UTM zone, not a stretched 4326;
+            # again once the event loop runs (the QGIS desktop gives an empty project its
+            # first layer's CRS after the layers are loaded, undoing it)
+            use_local_crs(project)
+            QTimer.singleShot(0, lambda: use_local_crs(project))
 
 
 def _gpkg_path(dest: str) -> str | None:
@@ -173,6 +180,52 @@ def number_out_of_range(param: QgsProcessingParameterNumber, value: Any) -> str 
     return None
 
 
+def file_parameter_problem(param: QgsProcessingParameterFile, value: Any) -> str | None:
+    """Why a file parameter's value is refused, naming the parameter; None when it is taken.
+
+    A folder given where one file is wanted (``--OSM=data/osm`` to ``camloc:locate`` or
+    ``camloc:corners``, as ``camloc locate --osm FOLDER`` and ``camloc:geocodelist`` take it)
+    was QGIS's "Incorrect parameter value for OSM", with no word of what is wrong.
+    """
+    if value is None or value == "" or isinstance(value, QgsProperty):
+        return None
+    if param.behavior() != QgsProcessingParameterFile.File or not isinstance(value, str):
+        return None
+    if not os.path.isdir(value):
+        return None
+    where = f"camloc: {param.name()} ({param.description()})"
+    if param.name() == "OSM":
+        return (
+            f"{where} is a folder, {value}: this algorithm takes one extract file (.osm, "
+            ".osm.pbf, .osm.bz2, .osm.gz): give the extract covering the place (camloc:"
+            "geocodelist and camloc batch take a folder)"
+        )
+    return f"{where} is a folder, {value}: give a file"
+
+
+def sink_folder_problem(param: QgsProcessingParameterFeatureSink, value: Any) -> str | None:
+    """Why an output's destination cannot be written, before any work; None when it can.
+
+    An output in a folder that does not exist (``--CANDIDATES=/nonexistent/c.gpkg``) was
+    refused by QGIS only after the whole computation ("Could not create layer ...:
+    sqlite3_open(...) failed: unable to open database file").
+    """
+    if isinstance(value, QgsProcessingOutputLayerDefinition):
+        value = value.sink.staticValue() if hasattr(value.sink, "staticValue") else None
+    if not isinstance(value, str) or not value or value.startswith(("memory:", "ogr:")):
+        return None
+    if value.startswith(("postgres:", "spatialite:", "TEMPORARY_OUTPUT", "postgis:")):
+        return None
+    path = value.split("|", 1)[0]
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(folder):
+        return None
+    return (
+        f"camloc: {param.name()} ({param.description()}): the folder {folder} does not "
+        "exist: make it first or write the output elsewhere"
+    )
+
+
 class _CamlocAlgorithm(QgsProcessingAlgorithm):
     """Shared parts: group, help, the worker call and the typed sinks."""
 
@@ -201,12 +254,19 @@ class _CamlocAlgorithm(QgsProcessingAlgorithm):
     def checkParameterValues(
         self, parameters: dict[str, Any], context: QgsProcessingContext
     ) -> tuple[bool, str]:
-        """Refuse a number out of its range with a message naming it and the range."""
+        """Refuse a number out of its range with a message naming it and the range, a folder
+        given for a file and an output in a folder that does not exist, naming them."""
         for param in self.parameterDefinitions():
+            value = parameters.get(param.name())
+            message = None
             if isinstance(param, QgsProcessingParameterNumber):
-                message = number_out_of_range(param, parameters.get(param.name()))
-                if message:
-                    return False, message
+                message = number_out_of_range(param, value)
+            elif isinstance(param, QgsProcessingParameterFile):
+                message = file_parameter_problem(param, value)
+            elif isinstance(param, QgsProcessingParameterFeatureSink):
+                message = sink_folder_problem(param, value)
+            if message:
+                return False, message
         return super().checkParameterValues(parameters, context)
 
     def _add_map_params(self, folder: bool = False) -> None:

@@ -63,6 +63,7 @@ from .layers import (
     extent_with_room,
     label_room_px,
     style_qml,
+    use_local_crs,
     wgs84,
     write_gpkg_layer,
     write_gpkg_styles,
@@ -1308,6 +1309,15 @@ class CamlocDock(QDockWidget):
                 if stale:
                     self._mark_stale(name)
                 if task is not None:
+                    # a project of camloc layers alone: its place's UTM zone, not a stretched
+                    # EPSG:4326 (before the canvas zooms to the candidates)
+                    canvas = self.iface.mapCanvas() if self.iface is not None else None
+                    drawn = canvas.mapSettings().destinationCrs() if canvas is not None else None
+                    plate_carree = (
+                        drawn is None or not drawn.isValid() or drawn.authid() == "EPSG:4326"
+                    )
+                    if plate_carree and use_local_crs(QgsProject.instance()) and canvas is not None:
+                        canvas.setDestinationCrs(QgsProject.instance().crs())
                     self._report(task)
                 elif extent is not None and self.iface is not None:
                     canvas = self.iface.mapCanvas()

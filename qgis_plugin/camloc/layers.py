@@ -736,3 +736,44 @@ def order_camloc_layers(group: QgsLayerTreeGroup) -> None:
         group.insertChildNode(first + k, node.clone())
     for node in nodes:
         group.removeChildNode(node)
+
+
+def use_local_crs(project: Any) -> str | None:
+    """Give a project of camloc layers alone, drawn in EPSG:4326, the UTM zone of its place.
+
+    The plugin's layers are in EPSG:4326, and QGIS gives an empty project the first layer's
+    CRS: a plate carrée that, at Helsinki (60° N), draws the map twice as wide as it is
+    tall, so a view cone facing 45° looked to face 63° and round cones were ellipses (session
+    42 QA, the QGIS desktop under Xvfb). A project with any other layer, or another CRS, is
+    left as it is (the analyst's choice).
+
+    Parameters
+    ----------
+    project : QgsProject
+        The project the layers were added to.
+
+    Returns
+    -------
+    str or None
+        The CRS set (``EPSG:326zz`` north, ``EPSG:327zz`` south), or None where none was.
+    """
+    crs = project.crs()
+    if crs.isValid() and crs.authid() != "EPSG:4326":
+        return None
+    layers = list(project.mapLayers().values())
+    if not layers or any(not lyr.customProperty(KIND_PROPERTY) for lyr in layers):
+        return None
+    centre = None
+    for lyr in layers:
+        if lyr.isSpatial() and lyr.crs().authid() == "EPSG:4326" and not lyr.extent().isEmpty():
+            centre = lyr.extent().center()
+            break
+    if centre is None:
+        return None
+    lon, lat = centre.x(), centre.y()
+    if not (-180.0 <= lon <= 180.0 and -80.0 <= lat <= 84.0):  # UTM's range
+        return None
+    zone = int((lon + 180.0) // 6.0) % 60 + 1
+    authid = f"EPSG:{(32600 if lat >= 0 else 32700) + zone}"
+    project.setCrs(QgsCoordinateReferenceSystem(authid))
+    return authid

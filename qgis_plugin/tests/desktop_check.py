@@ -99,12 +99,18 @@ def _shot(name: str) -> None:
 def _zoom_to_candidates() -> None:
     """As the dock zooms after a run: the candidates with room for their labels."""
     from camloc.layers import extent_with_room, label_room_px
+    from qgis.core import QgsCoordinateTransform
 
     canvas = iface.mapCanvas()
     for lyr in QgsProject.instance().mapLayers().values():
         if lyr.customProperty("camloc/kind") == "candidates":
             ext = lyr.extent()
             ext.grow(0.0002)
+            # the canvas may be in the place's UTM zone (camloc.layers.use_local_crs)
+            xform = QgsCoordinateTransform(
+                lyr.crs(), canvas.mapSettings().destinationCrs(), QgsProject.instance()
+            )
+            ext = xform.transformBoundingBox(ext)
             room = label_room_px(lyr, canvas.mapSettings().outputDpi())
             canvas.setExtent(extent_with_room(ext, canvas.width(), canvas.height(), room))
             canvas.refresh()

@@ -21,6 +21,7 @@ from camloc_geo._io import (
     heif_kind,
     heif_photo,
     image_data_complete,
+    is_lat_lon,
     magic_format,
 )
 from camloc_geo.service.deps import (
@@ -32,7 +33,7 @@ from camloc_geo.service.deps import (
     raw_body,
     run_cpu,
 )
-from camloc_geo.service.errors import LimitError, NotFoundError
+from camloc_geo.service.errors import LimitError, NotFoundError, ServiceError
 from camloc_geo.service.mapstore import MapStore
 from camloc_geo.service.models import HTML_ROUTE_ERRORS, TaskId, TaskQuery
 from camloc_geo.service.routers.scenes import review_work, scene_body_doc
@@ -164,10 +165,37 @@ def _task(store: Store, task_id: str) -> dict[str, Any]:
     return task
 
 
+def junction_work(maps: MapStore, lat: float, lon: float) -> dict[str, Any] | None:
+    """The junction nearest a task's point, for the page's small map (runs on a worker); None
+    where the server's maps have none (the page is then made without the map, as before).
+
+    A task's page had no map where ``camloc annotate --osm --lat --lon`` has one: its
+    annotators were asked for the kerb corners "clockwise" with no junction to see them on,
+    and the scene they sent named none (session 42 QA)."""
+    from camloc_geo.cli.annotate import junction_geojson
+
+    try:
+        if maps.catalogue.area_for_point(lat, lon)[0] not in ("file", "cell"):
+            return None  # the configured extracts only: a page view never calls Overpass
+        m = maps.map_for_point(lat=lat, lon=lon)
+        return junction_geojson(lat=lat, lon=lon, map_source=m)
+    except CamlocError:
+        return None
+
+
 @router.get("/annotate/{task_id}", response_class=HTMLResponse, responses=HTML_ROUTE_ERRORS)
-async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HTMLResponse:
+async def annotate(
+    request: Request, task_id: TaskId, store: ServiceStore, workers: Workers
+) -> HTMLResponse:
     """The annotation page in crowd mode: a submit button instead of a download."""
     task = _task(store, task_id)
+    prior = (task["base_scene"] or {}).get("prior") or {}
+    corners = None
+    if task["status"] == "collecting" and is_lat_lon(prior.get("lat"), prior.get("lon")):
+        try:
+            corners = await workers.run(junction_work, float(prior["lat"]), float(prior["lon"]))
+        except ServiceError:  # the time limit, a lost worker: the page without its map
+            corners = None
 
     def work() -> str:
         from camloc_geo.web import annotation_page_html
@@ -190,6 +218,7 @@ async def annotate(request: Request, task_id: TaskId, store: ServiceStore) -> HT
             mode="crowd",
             submit_url=f"/v1/tasks/{task_id}/annotations",
             closed=closed,
+            corners_geojson=corners,
         )
 
     return HTMLResponse(await run_cpu(request, work))

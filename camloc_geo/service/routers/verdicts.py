@@ -14,7 +14,7 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi.responses import JSONResponse, Response
 from starlette.concurrency import run_in_threadpool
 
-from camloc_geo.service.deps import ApiKey, content_type
+from camloc_geo.service.deps import ApiKey, content_type, unsupported_media_message
 from camloc_geo.service.errors import UnsupportedMediaError
 from camloc_geo.service.models import VerdictIdentity, VerdictPage, VerdictPost, VerdictsQuery
 from camloc_geo.service.verdicts import VerdictStore, export_csv, export_geojson
@@ -89,8 +89,7 @@ async def _json_body(request: Request) -> None:
     ctype = content_type(request)
     if ctype != "application/json" and not ctype.endswith("+json"):
         raise UnsupportedMediaError(
-            f"content type {ctype or 'none'!r} not supported here; send application/json",
-            "content-type",
+            unsupported_media_message(ctype, ("application/json",)), "content-type"
         )
 
 
