@@ -2324,6 +2324,9 @@ class AutoVPResult:
                 ),
             ],
             "street_vanishing_point": self.street_index,
+            # which vanishing points no line supports: implied by the other two and the focal
+            # length (orthogonality), not seen (stop 42)
+            "vanishing_point_implied": [int(n) == 0 for n in self.n_inliers],
             "vanishing_points_homogeneous": [
                 [float(x) for x in _unit(np.asarray(v, dtype=np.float64))]
                 for v in self.vanishing_points
@@ -3943,17 +3946,26 @@ def draw_segments(
     names = {1: "horizontal-1", 2: "horizontal-2"}
     names[res.street_index] += " (street)"
     names[3 - res.street_index] += " (across)"
+    # A direction no line supports was drawn in the legend as if seen: it is implied by the
+    # other two and the focal length (orthogonality), so the legend says so (stop 42, qa6).
+    vnames = {0: "vertical", 1: names[1], 2: names[2]}
+    for k in range(3):
+        if int(res.n_inliers[k]) == 0:
+            vnames[k] += ": no lines, implied"
     entries = [
-        ((0, 0, 255), "vertical"),
-        ((0, 200, 0), names[1]),
-        ((255, 64, 0), names[2]),
+        ((0, 0, 255), vnames[0]),
+        ((0, 200, 0), vnames[1]),
+        ((255, 64, 0), vnames[2]),
         ((160, 160, 160), "outliers"),
         ((0, 220, 255), "horizon"),
     ]
     h_img = canvas.shape[0]
     fs = max(0.35, min(1.2, h_img / 1000.0))
     line_h = round(22 * fs / 0.5)
-    box_w = round(250 * fs / 0.5)
+    text_w = max(
+        cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, fs, 1)[0][0] for _, text in entries
+    )
+    box_w = max(round(250 * fs / 0.5), 16 + line_h + text_w + 8)
     cv2.rectangle(canvas, (4, 4), (4 + box_w, 8 + line_h * len(entries)), (0, 0, 0), -1)
     for i, (col, text) in enumerate(entries):
         y = 4 + line_h * (i + 1) - line_h // 3

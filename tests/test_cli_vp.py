@@ -227,3 +227,35 @@ def test_vp_reports_tilt_sigmas(scene_png: Path, capsys: pytest.CaptureFixture[s
     # the truth (pitch 8, roll -3) within 3 sigma (rendered lines: a tiny sigma is fine)
     assert abs(out["pitch_deg"] - 8.0) <= 3 * out["pitch_std_deg"] + 0.2
     assert abs(out["roll_deg"] + 3.0) <= 3 * out["roll_std_deg"] + 0.2
+
+
+def test_a_direction_no_line_supports_is_named_implied(tmp_path: Path) -> None:
+    """A vanishing point with no inlier is implied by the other two and the focal length: the
+    JSON says so (``vanishing_point_implied``) and ``--draw``'s legend says "no lines,
+    implied" in a box wide enough for it (stop 42: the legend named such a point as if seen)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_autovp_failure_modes import corner_segments
+
+    from camloc_geo.autovp import detect_vanishing_points, draw_segments
+
+    segs, (w, h) = corner_segments(0, 0.0, seed=0)
+    grey = np.full((h, w), 128, np.uint8)
+    full = detect_vanishing_points(grey, segments=segs, focal_px=700.0)
+    keep = np.asarray(full.labels) != 2  # leave one horizontal family out
+    res = detect_vanishing_points(grey, segments=np.asarray(segs)[keep], focal_px=700.0)
+    implied = res.to_json()["vanishing_point_implied"]
+    assert implied == [n == 0 for n in res.n_inliers]
+    assert implied.count(True) == 1
+    assert implied[0] is False
+    assert full.to_json()["vanishing_point_implied"] == [False, False, False]
+    drawing = tmp_path / "implied.png"
+    draw_segments(grey, res, drawing)
+    img = cv2.imread(str(drawing))
+    top = img[5, 4:].max(axis=1) < 20  # the legend box's top row, black from x = 4
+    width = int(np.argmin(top)) if not top.all() else top.size
+    # wider than the old fixed box (384 px at this size: 250 px at font scale 0.5) to hold
+    # the longer text (388 px of text after the 34 px colour line)
+    assert width > 430
+    assert (img[5:, :4].max(axis=2) >= 20).any()  # the photo, not the box, left of it
