@@ -161,6 +161,22 @@ cameras as there are junctions, up to 150), the 22 slips. Measured once, at the 
 main's code and the branch's."""
 HELD_OUT_4_SEED = 41
 """The fourth held-out set's seed."""
+HELD_OUT_5_PLACES = [
+    ("beatty.osm.gz", 36.90728, -116.76259, 1500.0),
+    ("cobb_county.osm.pbf", 33.84933, -84.59488, 1500.0),
+    ("oslo_east.osm.pbf", 59.91316, 10.77163, 1500.0),
+]
+"""``--set held-out-5``: fixed (stop 42) before any result on it. Three places of kinds no
+benchmark had sampled (``data/osm/SOURCES.md``): Beatty, Nevada (a Mojave desert town on
+US 95: a loose grid of dirt and paved streets, wide empty lots), south Cobb County, Georgia
+(Atlanta's suburban sprawl by Austell and Mableton: curving subdivision streets,
+cul-de-sacs, arterials with turn lanes, no buildings in the extract) and east Oslo (Grønland,
+Tøyen, Gamlebyen, Grünerløkka: a hilly Nordic inner city with tram streets, Norwegian
+names). Every oracle junction within the radius (the centres are the median of each
+extract's oracle junctions), by junction class, seed :data:`HELD_OUT_5_SEED`, ``--n 150``,
+the 22 slips. Measured once, at the end, with main's code and the branch's."""
+HELD_OUT_5_SEED = 42
+"""The fifth held-out set's seed."""
 
 
 def held_out_2_places() -> list[tuple[str, float, float, float]]:
@@ -768,7 +784,7 @@ def run(
         order = _order_held_out(n, maps)
     elif which == "held-out-2":
         order = _order_held_out(n, maps, skip=HELD_OUT_2_SKIP)
-    elif which in ("held-out-3", "held-out-4", "dev-classes"):
+    elif which in ("held-out-3", "held-out-4", "held-out-5", "dev-classes"):
         order = _order_held_out(n, maps, skip=0)
     else:
         order = _order_dev(n, maps)
@@ -1006,11 +1022,20 @@ def main(argv: list[str] | None = None) -> int:
         "--seed",
         type=int,
         default=None,
-        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3), 41 (held-out-4)",
+        help="default 0 (dev), 38 (held-out), 39 (held-out-2), 40 (held-out-3), 41 (held-out-4), "
+        "42 (held-out-5)",
     )
     ap.add_argument(
         "--set",
-        choices=("dev", "dev-classes", "held-out", "held-out-2", "held-out-3", "held-out-4"),
+        choices=(
+            "dev",
+            "dev-classes",
+            "held-out",
+            "held-out-2",
+            "held-out-3",
+            "held-out-4",
+            "held-out-5",
+        ),
         default="dev",
         help="dev: absolute.py's junctions; dev-classes: DEV_CLASS_PLACES by junction "
         "class; held-out: HELD_OUT_PLACES by junction class (stop 38's; read since: "
@@ -1018,7 +1043,8 @@ def main(argv: list[str] | None = None) -> int:
         "junctions, by class (stop 39's; read since); held-out-3: Vaduz, Leeds and "
         "Manhattan, every junction, by class (stop 40's; read since); held-out-4: "
         "Seattle, London (Southwark) and Neudrossenfeld, every junction, by class "
-        "(stop 41's; measured once)",
+        "(stop 41's; read since); held-out-5: Beatty (Nevada), south Cobb County "
+        "(Georgia) and east Oslo, every junction, by class (stop 42's; measured once)",
     )
     ap.add_argument("--slips", default=",".join(SLIPS), help="comma-separated slip names")
     ap.add_argument("--out", type=Path, default=OUT)
@@ -1043,6 +1069,7 @@ def main(argv: list[str] | None = None) -> int:
             "held-out-2": HELD_OUT_2_SEED,
             "held-out-3": HELD_OUT_3_SEED,
             "held-out-4": HELD_OUT_4_SEED,
+            "held-out-5": HELD_OUT_5_SEED,
         }.get(args.set, 0)
     t0 = time.perf_counter()
     maps = {}
@@ -1052,6 +1079,7 @@ def main(argv: list[str] | None = None) -> int:
         "held-out-2": held_out_2_places(),
         "held-out-3": HELD_OUT_3_PLACES,
         "held-out-4": HELD_OUT_4_PLACES,
+        "held-out-5": HELD_OUT_5_PLACES,
     }.get(args.set, PLACES)
     for name, lat, lon, r in places:
         try:

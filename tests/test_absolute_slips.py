@@ -911,6 +911,30 @@ def test_held_out_4_is_three_new_cities_no_other_set_samples() -> None:
     assert bench.HELD_OUT_4_SEED not in seeds
 
 
+def test_held_out_5_is_three_new_places_no_other_set_samples() -> None:
+    bench = _bench()
+    from unseen_cities import CITIES
+
+    names = [p[0] for p in bench.HELD_OUT_5_PLACES]
+    assert names == ["beatty.osm.gz", "cobb_county.osm.pbf", "oslo_east.osm.pbf"]
+    used = {p[0] for p in bench.PLACES} | {p[0] for p in bench.HELD_OUT_PLACES}
+    used |= {c[0] for c in CITIES} | {p[0] for p in bench.HELD_OUT_3_PLACES}
+    used |= {p[0] for p in bench.HELD_OUT_4_PLACES}
+    assert not used & set(names)
+    sources = (OSM / "SOURCES.md").read_text(encoding="utf-8")
+    for name in names:
+        assert (OSM / name).is_file()
+        assert f"`{name}`" in sources
+    seeds = (
+        0,
+        bench.HELD_OUT_SEED,
+        bench.HELD_OUT_2_SEED,
+        bench.HELD_OUT_3_SEED,
+        bench.HELD_OUT_4_SEED,
+    )
+    assert bench.HELD_OUT_5_SEED not in seeds
+
+
 def test_warning_rates_count_kinds_on_right_and_wrong_answers() -> None:
     bench = _bench()
     right = {
