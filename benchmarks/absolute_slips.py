@@ -708,7 +708,100 @@ def _entry(res: LocateResult | None, err: str, ls: LocatedScene, clean_keys: set
         ),
         "wrong_uncovered": bool(errs[0] > CONFIDENT_M and not covered),
         "silently_lost": bool(min(errs) > CONFIDENT_M and not new),
+        "tie": _tie_of(res, errs),
     }
+
+
+def _tie_of(res: LocateResult, errs: list[float]) -> dict[str, Any] | None:
+    """Why the top is named tied: its strongest tied partner's kind (:func:`tie_kind`), score
+    ratio, how much worse it fits the clicks (``d_fit``: twice the log likelihood ratio with
+    the prior odds left out, squared Mahalanobis units of the stated noise), the top's map
+    plausibility over the partner's, the partner's prior odds, and whether it is right
+    (within :data:`CONFIDENT_M`). None when the top is not tied."""
+    top = res.candidates[0]
+    by_rank = {c.rank: (c, e) for c, e in zip(res.candidates, errs, strict=True)}
+    tied = [by_rank[r] for r in top.ambiguous_with if r in by_rank]
+    if not tied:
+        return None
+    c, e = max(tied, key=lambda ce: ce[0].score)
+    d_fit = 2.0 * (
+        (top.log_likelihood - top.log_prior_odds) - (c.log_likelihood - c.log_prior_odds)
+    )
+    return {
+        "kind": tie_kind(top, c),
+        "ratio": round(c.score / max(top.score, 1e-300), 4),
+        "d_fit": round(d_fit, 3),
+        "plaus_ratio": round(top.prior / max(c.prior, 1e-300), 3),
+        "odds": round(math.exp(c.log_prior_odds - top.log_prior_odds), 3),
+        "partner_right": bool(e <= CONFIDENT_M),
+    }
+
+
+def tie_kind(top: Any, other: Any) -> str:
+    """What a tied partner of the top is: a ``rival`` reading (``neighbour junction``, ``map
+    bearing``), the top being one (``top is <rival>``), another method's reading (``other
+    method``), a reading at another junction (``other junction``), else a reading of the same
+    evidence at the same place (``symmetric``: a symmetric junction, a landmark's other
+    building corners, a reference's half turn)."""
+    if other.rival:
+        return str(other.rival)
+    if top.rival:
+        return f"top is {top.rival}"
+    if top.method != other.method:
+        return "other method"
+    if top.intersection_id != other.intersection_id:
+        return "other junction"
+    return "symmetric"
+
+
+TIE_RATIO_BINS = (0.1, 0.15, 0.2, 0.3, 0.5, 0.8, 1.01)
+"""Score-ratio bins of :func:`tie_why`'s calibration table."""
+
+
+def tie_why(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
+    """Why the tops of the slipped runs are named tied (:func:`_tie_of`), and whether the
+    ratio the tie rule reads is honest.
+
+    ``right``: per partner kind, the right tops tied, the median score ratio, how many
+    partners fit the clicks within 1 (``d_fit`` < 1: the clicks do not tell them apart) and
+    the median plausibility ratio (what the map says). ``calibration``: per score-ratio bin
+    of the strongest partner, how often that partner is the right one where one of the two
+    is (a calibrated posterior gives ratio / (1 + ratio)): untying a bin is safe only where
+    the partner is rarely right."""
+    entries = [r["slips"][s]["slipped"] for r in rows for s in slips if s in r.get("slips", {})]
+    right: dict[str, dict[str, Any]] = {}
+    bins = [[0, 0] for _ in TIE_RATIO_BINS]
+    for e in entries:
+        t = e.get("tie")
+        if not t:
+            continue
+        top_right = e["top"] <= CONFIDENT_M
+        if top_right:
+            k = right.setdefault(t["kind"], {"n": 0, "ratio": [], "clicks_alike": 0, "plaus": []})
+            k["n"] += 1
+            k["ratio"].append(t["ratio"])
+            k["clicks_alike"] += t["d_fit"] < 1.0
+            k["plaus"].append(t["plaus_ratio"])
+        if top_right != t["partner_right"]:
+            i = next(i for i, b in enumerate(TIE_RATIO_BINS) if t["ratio"] < b)
+            bins[i][0] += 1
+            bins[i][1] += t["partner_right"]
+    out_right = {
+        kind: {
+            "tied": k["n"],
+            "median_ratio": round(float(np.median(k["ratio"])), 3),
+            "clicks_alike": k["clicks_alike"],
+            "median_plausibility_ratio": round(float(np.median(k["plaus"])), 2),
+        }
+        for kind, k in sorted(right.items(), key=lambda kv: -kv[1]["n"])
+    }
+    lo = (0.0, *TIE_RATIO_BINS[:-1])
+    calibration = [
+        {"ratio": [a, min(b, 1.0)], "pairs": n, "partner_right": m}
+        for a, b, (n, m) in zip(lo, TIE_RATIO_BINS, bins, strict=True)
+        if n
+    ]
+    return {"right": out_right, "calibration": calibration}
 
 
 def junction_class(inter: Any) -> str:
@@ -1102,6 +1195,7 @@ def main(argv: list[str] | None = None) -> int:
         "sigma_cover": SIGMA_COVER,
         "summary": summary,
         "warning_rates": warning_rates(rows, slips),
+        "tie_why": tie_why(rows, slips),
         "wall_s": time.perf_counter() - t0,
         "scenes": rows,
     }
@@ -1138,6 +1232,24 @@ def main(argv: list[str] | None = None) -> int:
             t["wrong"],
             ", ".join(f"{k} {n}" for k, n in sorted(t["right_warned"].items())) or "-",
             ", ".join(f"{k} {n}" for k, n in sorted(t["wrong_warned"].items())) or "-",
+        )
+    for kind, k in doc["tie_why"]["right"].items():
+        log.info(
+            "right tops tied, partner %-20s %4d  median ratio %.2f  clicks alike %d  "
+            "median plausibility ratio %.2f",
+            kind,
+            k["tied"],
+            k["median_ratio"],
+            k["clicks_alike"],
+            k["median_plausibility_ratio"],
+        )
+    for b in doc["tie_why"]["calibration"]:
+        log.info(
+            "tied pairs, one right, ratio %.2f-%.2f: %4d, the weaker right %d",
+            b["ratio"][0],
+            b["ratio"][1],
+            b["pairs"],
+            b["partner_right"],
         )
     for key in ("by_place", "by_class"):
         for v, f in doc[key].items():

@@ -1123,3 +1123,87 @@ def test_an_unrefined_rival_that_fitted_as_well_is_tied_with_the_refined_top() -
     assert right
     assert errs[0] < 5.0 or any(c.rank in top.ambiguous_with for c in right)
     assert top.refined or errs[0] < 5.0
+
+
+def test_tie_why_names_the_partner_and_checks_the_ratio_against_the_truth() -> None:
+    bench = _bench()
+    from types import SimpleNamespace
+
+    top = SimpleNamespace(rival=None, method="corners", intersection_id="c1")
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="corners", intersection_id="c1")
+    ) == ("symmetric")
+    assert bench.tie_kind(top, SimpleNamespace(rival="neighbour junction", method="corners")) == (
+        "neighbour junction"
+    )
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="corners", intersection_id="c2")
+    ) == ("other junction")
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="one_reference", intersection_id=None)
+    ) == ("other method")
+
+    def entry(top_m: float, kind: str, ratio: float, d_fit: float, right: bool) -> dict:
+        tie = {"kind": kind, "ratio": ratio, "d_fit": d_fit, "plaus_ratio": 4.0}
+        return {"top": top_m, "tie": {**tie, "odds": 1.0, "partner_right": right}}
+
+    rows = [
+        {"slips": {"corners_ccw": {"slipped": entry(2.0, "symmetric", 0.12, 0.1, False)}}},
+        {"slips": {"corners_ccw": {"slipped": entry(3.0, "symmetric", 0.5, 2.0, False)}}},
+        {"slips": {"corners_ccw": {"slipped": entry(60.0, "symmetric", 0.13, 0.0, True)}}},
+        {"slips": {"corners_ccw": {"slipped": {"top": 1.0, "tie": None}}}},
+    ]
+    got = bench.tie_why(rows, ["corners_ccw"])
+    assert got["right"] == {
+        "symmetric": {
+            "tied": 2,
+            "median_ratio": 0.31,
+            "clicks_alike": 1,
+            "median_plausibility_ratio": 4.0,
+        }
+    }
+    # ratio 0.12 and 0.13 share the 0.1-0.15 bin: one of the two pairs' weaker is right
+    assert got["calibration"] == [
+        {"ratio": [0.1, 0.15], "pairs": 2, "partner_right": 1},
+        {"ratio": [0.5, 0.8], "pairs": 1, "partner_right": 0},
+    ]
+
+
+def test_a_reading_the_map_rules_out_beyond_its_noise_is_not_named_tied() -> None:
+    # absolute_slips (development, seed 0) scene 32, control_bearing: one reference and the
+    # car's own street_bearing_deg at a Moscow junction. The right top (0.9 m) was tied with
+    # its half turn (86 m off, 0.19 of the top): the reference fits both exactly, and the
+    # half turn's car stands 24 m beyond every modelled carriageway, which the map's flat
+    # floor (0.15) weighed as a car beside its street might be. Weighed in units of its noise
+    # (3 x hypot(1.5 m, sigma_m / sqrt 2) beyond a parked car's 6 m), the map rules it out:
+    # not tied (stop 42).
+    bench = _bench()
+    from absolute import _variant
+
+    from camloc_geo.absolute._pipeline import map_rules_out
+
+    m, ls = _replayed("moscow_ostankino.osm.gz", (55.815, 37.605, 1000.0), "c312298956", [0, 32])
+    base = _variant(ls, "one_reference")
+    assert base is not None
+    ctx = bench.Ctx(m, m.intersection("c312298956"), ls, np.random.default_rng([0, 32, 7, 15]))
+    scene = bench.control_bearing(json.loads(json.dumps(base)), ctx)
+    assert scene is not None
+    res = locate(parse_scene(scene), m)
+    errs = _errors(res, ls)
+    top, half_turn = res.candidates[0], res.candidates[1]
+    assert errs[0] < 5.0
+    assert errs[1] > 60.0
+    assert half_turn.score >= 0.1 * top.score  # within the score rule's odds ...
+    why = map_rules_out(half_turn, res.calibration.camera, bench_settings())
+    assert why is not None
+    assert "beyond every modelled carriageway" in why
+    assert map_rules_out(top, res.calibration.camera, bench_settings()) is None
+    assert top.ambiguous_with == []
+    assert half_turn.ambiguous_with == []
+    assert not res.ties
+
+
+def bench_settings() -> Any:
+    from camloc_geo.absolute import LocateSettings
+
+    return LocateSettings()
