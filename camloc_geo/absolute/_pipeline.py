@@ -79,6 +79,7 @@ __all__ = [
     "apply_cues",
     "bundle_leaders",
     "locate",
+    "map_rules_out",
     "mark_ties",
     "normalise_and_merge",
     "prior_gate",
@@ -2130,15 +2131,21 @@ def _ruled_out_weaker(
     world_cam: Camera | None,
     settings: LocateSettings,
 ) -> bool:
-    """Whether the weaker of ``a`` and ``b`` (by score) is ruled out by the map
-    (:func:`map_rules_out`, memoised in ``ruled`` by id) and the stronger is not. A stronger
-    reading the map rules out and a weaker one it does not still tie: the map and the
-    scores disagree."""
+    """Whether the map separates ``a`` and ``b``: it rules the weaker (by score) out
+    (:func:`map_rules_out`, memoised in ``ruled`` by id) and finds the stronger plausible (no
+    car off or across its street, no camera inside a building: :func:`_plausible`).
+
+    Where the map doubts the stronger too, the pair still ties: untied, a wrong top whose
+    car stood off every street lost its tie with another wrong reading the map ruled out,
+    and looked sure (``absolute_slips.py --set held-out-3``, ``bearing_cross_street`` at a
+    Vaduz dual carriageway: 43 m off, no right candidate, no word). A stronger reading the
+    map rules out and a weaker one it does not still tie: the map and the scores disagree."""
     weak, strong = (a, b) if a.score <= b.score else (b, a)
-    for c in (weak, strong):
-        if id(c) not in ruled:
-            ruled[id(c)] = map_rules_out(c, world_cam, settings)
-    return ruled[id(weak)] is not None and ruled[id(strong)] is None
+    if not _plausible(strong):
+        return False
+    if id(weak) not in ruled:
+        ruled[id(weak)] = map_rules_out(weak, world_cam, settings)
+    return ruled[id(weak)] is not None
 
 
 def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
