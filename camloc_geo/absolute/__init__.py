@@ -83,7 +83,7 @@ from camloc_geo.absolute._model import (
     Observation,
     Tie,
 )
-from camloc_geo.absolute._pipeline import apply_cues, locate, map_rules_out, mark_ties
+from camloc_geo.absolute._pipeline import apply_cues, locate, mark_ties
 from camloc_geo.absolute._similarity import Similarity2D
 
 __all__ = [
@@ -106,7 +106,6 @@ __all__ = [
     "apply_cues",
     "cue_log_likelihood",
     "locate",
-    "map_rules_out",
     "mark_ties",
     "view_cone",
     "view_cones",

@@ -79,7 +79,6 @@ __all__ = [
     "apply_cues",
     "bundle_leaders",
     "locate",
-    "map_rules_out",
     "mark_ties",
     "normalise_and_merge",
     "prior_gate",
@@ -2032,122 +2031,6 @@ def _tie_unrefined(
     return _tie(a, b, settings, positions, scores)
 
 
-MAP_RULES_OUT_SIGMAS = 3.0
-"""How many standard deviations beyond the map's allowances a reading's car or camera must
-stand for the map to rule it out of a tie (:func:`map_rules_out`): a one-sided 3-sigma test,
-0.13 % of right readings under Gaussian noise."""
-
-INSIDE_BUILDING_DEPTH_M = 2.0
-"""How deep inside a building footprint a camera stands before the map finds it implausible
-(the ``inside_building`` flag's depth: a camera behind a window or on a façade stands in the
-footprint's edge)."""
-
-
-def map_rules_out(c: Candidate, world_cam: Camera | None, settings: LocateSettings) -> str | None:
-    """Why the map rules candidate ``c``'s reading out beyond its noise, or None.
-
-    The click evidence rarely tells a symmetric junction's readings apart (on
-    ``absolute_slips.py``'s development set the tied readings of right answers fit the clicks
-    within 1 in squared Mahalanobis units in 96 % of the pairs); the map does, through the
-    plausibility factors, but those are floors (0.15 for a car off every street or a camera
-    deep in a building, whatever the distance), which leave a reading 30 m into a block
-    tied with the right one. Here the distance is weighed in units of its noise,
-    ``s = hypot(sigma_corner_m, sigma_m / sqrt(2))`` (the map's own error, as for a modelled
-    kerb corner, and the reading's position sigma per axis: its ``sigma_m``, else the fit's
-    covariance at it), and the reading is ruled out when, by more than
-    :data:`MAP_RULES_OUT_SIGMAS` ``s``:
-
-    - its car stands beyond every modelled carriageway farther than a parked car may
-      (:data:`BESIDE_STREET_M`);
-    - its car stands inside a building footprint;
-    - its camera stands deeper inside a building footprint than
-      :data:`INSIDE_BUILDING_DEPTH_M`.
-
-    None without the map's streets and buildings, or without a position sigma.
-    """
-    ev = c.evidence
-    if ev is None or world_cam is None:
-        return None
-    sigma = c.sigma_m
-    if sigma is None:
-        sigma = position_sigma_m(c, world_cam, ev, settings)
-    if sigma is None or not math.isfinite(sigma):
-        return None
-    s = math.hypot(settings.sigma_corner_m, sigma / math.sqrt(2.0))
-    margin = MAP_RULES_OUT_SIGMAS * s
-    import shapely
-
-    car = c.enu_from_world.apply(np.asarray(ev.car_center_world, dtype=float))
-    streets = ev.streets
-    if streets is not None and streets.tree is not None:
-        reach = BESIDE_STREET_M + margin
-        box = shapely.box(
-            car[0] - reach - 60.0,
-            car[1] - reach - 60.0,
-            car[0] + reach + 60.0,
-            car[1] + reach + 60.0,
-        )
-        idx = streets.tree.query(box)
-        pt = shapely.points(car[0], car[1])
-        beyond = (
-            float(
-                np.min(
-                    shapely.distance(streets.tree.geometries[idx], pt) - streets.values_array[idx]
-                )
-            )
-            if len(idx)
-            else math.inf
-        )
-        if beyond > reach:
-            return (
-                f"its car stands {beyond:.0f} m beyond every modelled carriageway "
-                f"(a parked car {BESIDE_STREET_M:g} m, plus {MAP_RULES_OUT_SIGMAS:g} x {s:.1f} m)"
-            )
-    tree = ev.buildings_tree
-    if tree is not None:
-        for what, xy, allowed in (
-            ("its car", car, margin),
-            ("its camera", c.east_north, INSIDE_BUILDING_DEPTH_M + margin),
-        ):
-            pt = shapely.points(float(xy[0]), float(xy[1]))
-            hit = tree.query(pt, predicate="within")
-            if not len(hit):
-                continue
-            depth = float(
-                np.max(shapely.distance(shapely.get_exterior_ring(tree.geometries[hit]), pt))
-            )
-            if depth > allowed:
-                return (
-                    f"{what} stands {depth:.0f} m inside a building footprint "
-                    f"(allowed {allowed:.1f} m: {MAP_RULES_OUT_SIGMAS:g} x {s:.1f} m)"
-                )
-    return None
-
-
-def _ruled_out_weaker(
-    a: Candidate,
-    b: Candidate,
-    ruled: dict[int, str | None],
-    world_cam: Camera | None,
-    settings: LocateSettings,
-) -> bool:
-    """Whether the map separates ``a`` and ``b``: it rules the weaker (by score) out
-    (:func:`map_rules_out`, memoised in ``ruled`` by id) and finds the stronger plausible (no
-    car off or across its street, no camera inside a building: :func:`_plausible`).
-
-    Where the map doubts the stronger too, the pair still ties: untied, a wrong top whose
-    car stood off every street lost its tie with another wrong reading the map ruled out,
-    and looked sure (``absolute_slips.py --set held-out-3``, ``bearing_cross_street`` at a
-    Vaduz dual carriageway: 43 m off, no right candidate, no word). A stronger reading the
-    map rules out and a weaker one it does not still tie: the map and the scores disagree."""
-    weak, strong = (a, b) if a.score <= b.score else (b, a)
-    if not _plausible(strong):
-        return False
-    if id(weak) not in ruled:
-        ruled[id(weak)] = map_rules_out(weak, world_cam, settings)
-    return ruled[id(weak)] is not None
-
-
 def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateResult) -> None:
     """Name the candidates that tie: ``ambiguous_with``, and a warning for the two leaders.
 
@@ -2155,12 +2038,8 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     stronger (:data:`~camloc_geo._ties.TIE_SCORE_RATIO`: the evidence favours the
     stronger by less than 10 to 1) and at least :data:`~camloc_geo._ties.TIE_MIN_SCORE`, yet
     they stand more than ``tie_distance_m`` apart (a symmetric junction: the evidence cannot
-    tell them apart); the rule is :func:`camloc_geo._ties.is_tie`. Since stop 42 a pair whose
-    weaker reading the map rules out beyond its noise (:func:`map_rules_out`: its car
-    standing far beyond every street or inside a building, its camera deep inside one, by
-    more than three standard deviations of the map and of its position) while the stronger
-    stands clear does not tie: the scores weigh such a reading with a flat floor, whatever
-    the distance. Earlier marks and the earlier warning are replaced.
+    tell them apart); the rule is :func:`camloc_geo._ties.is_tie`.
+    Earlier marks and the earlier warning are replaced.
     """
     positions = {id(c): c.east_north for c in cands}
     for c in cands:
@@ -2168,12 +2047,8 @@ def mark_ties(cands: list[Candidate], settings: LocateSettings, result: LocateRe
     # A tie needs both scores at least TIE_MIN_SCORE (is_tie's rule): the pairs of the rest
     # need no test.
     contenders = [c for c in cands if c.score >= TIE_MIN_SCORE]
-    ruled: dict[int, str | None] = {}  # map_rules_out of each contender tested, by id
-    world_cam: Camera | None = getattr(getattr(result, "calibration", None), "camera", None)
     for a, b in itertools.combinations(contenders, 2):
-        if (
-            _tie(a, b, settings, positions) or _tie_unrefined(a, b, settings, positions)
-        ) and not _ruled_out_weaker(a, b, ruled, world_cam, settings):
+        if _tie(a, b, settings, positions) or _tie_unrefined(a, b, settings, positions):
             a.ambiguous_with.append(b.rank)
             b.ambiguous_with.append(a.rank)
     for c in cands:
