@@ -47,7 +47,9 @@ Per slip: the top and closest candidates under 10 / 15 m, refusals (a clear erro
 answers, and **confidently wrong** answers: the top candidate more than 15 m off, not tied,
 no warning the clean run did not give, and a ``sigma_m`` whose two sigmas do not reach the
 truth. Also **silently lost**: no candidate within 15 m and no new warning (a tie between
-wrong candidates is not confident, but it is no help either). Results go to
+wrong candidates is not confident, but it is no help either). Each entry whose top is named
+tied says why (``tie``: its strongest tied partner's kind, score ratio, click fit and map
+plausibility, and whether it is right), summed in ``tie_why`` (stop 42). Results go to
 ``benchmarks/out/absolute_slips.json`` and ``absolute_slips.png``::
 
     python benchmarks/absolute_slips.py [--n 60] [--seed 0] [--slips corners_ccw,...]
