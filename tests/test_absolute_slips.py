@@ -911,6 +911,30 @@ def test_held_out_4_is_three_new_cities_no_other_set_samples() -> None:
     assert bench.HELD_OUT_4_SEED not in seeds
 
 
+def test_held_out_5_is_three_new_places_no_other_set_samples() -> None:
+    bench = _bench()
+    from unseen_cities import CITIES
+
+    names = [p[0] for p in bench.HELD_OUT_5_PLACES]
+    assert names == ["beatty.osm.gz", "cobb_county.osm.pbf", "oslo_east.osm.pbf"]
+    used = {p[0] for p in bench.PLACES} | {p[0] for p in bench.HELD_OUT_PLACES}
+    used |= {c[0] for c in CITIES} | {p[0] for p in bench.HELD_OUT_3_PLACES}
+    used |= {p[0] for p in bench.HELD_OUT_4_PLACES}
+    assert not used & set(names)
+    sources = (OSM / "SOURCES.md").read_text(encoding="utf-8")
+    for name in names:
+        assert (OSM / name).is_file()
+        assert f"`{name}`" in sources
+    seeds = (
+        0,
+        bench.HELD_OUT_SEED,
+        bench.HELD_OUT_2_SEED,
+        bench.HELD_OUT_3_SEED,
+        bench.HELD_OUT_4_SEED,
+    )
+    assert bench.HELD_OUT_5_SEED not in seeds
+
+
 def test_warning_rates_count_kinds_on_right_and_wrong_answers() -> None:
     bench = _bench()
     right = {
@@ -1099,3 +1123,47 @@ def test_an_unrefined_rival_that_fitted_as_well_is_tied_with_the_refined_top() -
     assert right
     assert errs[0] < 5.0 or any(c.rank in top.ambiguous_with for c in right)
     assert top.refined or errs[0] < 5.0
+
+
+def test_tie_why_names_the_partner_and_checks_the_ratio_against_the_truth() -> None:
+    bench = _bench()
+    from types import SimpleNamespace
+
+    top = SimpleNamespace(rival=None, method="corners", intersection_id="c1")
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="corners", intersection_id="c1")
+    ) == ("symmetric")
+    assert bench.tie_kind(top, SimpleNamespace(rival="neighbour junction", method="corners")) == (
+        "neighbour junction"
+    )
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="corners", intersection_id="c2")
+    ) == ("other junction")
+    assert bench.tie_kind(
+        top, SimpleNamespace(rival=None, method="one_reference", intersection_id=None)
+    ) == ("other method")
+
+    def entry(top_m: float, kind: str, ratio: float, d_fit: float, right: bool) -> dict:
+        tie = {"kind": kind, "ratio": ratio, "d_fit": d_fit, "plaus_ratio": 4.0}
+        return {"top": top_m, "tie": {**tie, "odds": 1.0, "partner_right": right}}
+
+    rows = [
+        {"slips": {"corners_ccw": {"slipped": entry(2.0, "symmetric", 0.12, 0.1, False)}}},
+        {"slips": {"corners_ccw": {"slipped": entry(3.0, "symmetric", 0.5, 2.0, False)}}},
+        {"slips": {"corners_ccw": {"slipped": entry(60.0, "symmetric", 0.13, 0.0, True)}}},
+        {"slips": {"corners_ccw": {"slipped": {"top": 1.0, "tie": None}}}},
+    ]
+    got = bench.tie_why(rows, ["corners_ccw"])
+    assert got["right"] == {
+        "symmetric": {
+            "tied": 2,
+            "median_ratio": 0.31,
+            "clicks_alike": 1,
+            "median_plausibility_ratio": 4.0,
+        }
+    }
+    # ratio 0.12 and 0.13 share the 0.1-0.15 bin: one of the two pairs' weaker is right
+    assert got["calibration"] == [
+        {"ratio": [0.1, 0.15], "pairs": 2, "partner_right": 1},
+        {"ratio": [0.5, 0.8], "pairs": 1, "partner_right": 0},
+    ]
