@@ -825,6 +825,12 @@ def _warn_fragile_references(
     :data:`WRONG_M` (:func:`_rounding_moves_m`): what the rounding did move, as far as the
     pixels and the map can tell. Until stop 40 the rounding's half diagonal was taken as the
     slip, and the warning fired on 61 of 120 rounded development scenes, 59 of them right.
+
+    A ``one_reference`` top (the pair's joint fit put the car off or across its street, or
+    they disagree, so each was tried alone) gets the same lever test, worded for it: two
+    references that close cannot tell that reading from the street's other readings either
+    (stop 42: ``absolute_slips.py --set held-out-5`` scene 113, a reading 34 m off at a
+    ``sigma_m`` of 7 m, untied, had no warning).
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
         return
