@@ -1006,6 +1006,11 @@ def summarise(rows: list[dict[str, Any]], slips: list[str]) -> dict[str, Any]:
 WARNING_KINDS = [
     ("rounding", r"4 decimals or fewer"),
     ("fragile_references", r"^references: the two references are \d+ m apart"),
+    (
+        "fragile_references",
+        r"^references: the best candidate trusts one reference alone, [^:]*, and the two "
+        r"references are \d+ m apart",
+    ),
     ("references_off_street", r"^references: the two references put the car"),
     ("one_reference_trusted", r"^references: the best candidate trusts one reference"),
     ("references_disagree", r"references\[\d+\] and references\[\d+\] disagree"),

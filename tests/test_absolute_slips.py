@@ -20,6 +20,7 @@ from camloc_geo import MapDataError
 from camloc_geo.absolute import LocateResult, locate
 from camloc_geo.geodesy import distance_m
 from camloc_geo.osm import MapData, load_map
+from camloc_geo.relative import calibrate
 from camloc_geo.scene import parse_scene
 from camloc_geo.testing.synthetic import LocatedScene, NoiseModel, make_located_scene
 
@@ -1167,3 +1168,45 @@ def test_tie_why_names_the_partner_and_checks_the_ratio_against_the_truth() -> N
         {"ratio": [0.1, 0.15], "pairs": 2, "partner_right": 1},
         {"ratio": [0.5, 0.8], "pairs": 1, "partner_right": 0},
     ]
+
+
+def test_one_reference_top_of_two_close_references_is_warned_fragile() -> None:
+    # absolute_slips --set held-out-5 scene 113 (Beatty, Nevada, a crossing; seed 42,
+    # reference_kerb): two references 4 m apart, the camera 29 m away; the first clicked on
+    # the kerb while its lat/lon is the street's centre line. Their joint fit put the car off
+    # its street, so each was tried alone; a one_reference reading 34 m off (sigma_m 7 m)
+    # won, untied. The fragile-references warning, which the clean two-reference answer gets,
+    # was skipped because the top was not a two_references candidate: nothing warned.
+    m = load_map(OSM / "beatty.osm.gz", 36.90728, -116.76259, radius_m=1500.0)
+    ls = make_located_scene(
+        m,
+        m.intersection("n141038980"),
+        np.random.default_rng([42, 113]),
+        noise=NoiseModel(),
+        corner_sigma_m=1.5,
+        n_references=2,
+        max_corners=4,
+        state_preset=True,
+    )
+    assert ls is not None
+    cal = calibrate(parse_scene(ls.scene))  # as the benchmark: the whole scene's
+    scene = json.loads(json.dumps(ls.scene))
+    scene.pop("intersection")
+    scene.pop("landmarks", None)
+    scene["references"] = scene["references"][:2]
+    clean = locate(parse_scene(scene), m, calibration=cal)
+    assert _errors(clean, ls)[0] < 5.0
+    assert [w for w in clean.warnings if w.startswith("references: the two references are 4 m")]
+    # the benchmark's slip: the first reference's pixel half a carriageway across the street
+    scene["references"][0]["pixel"] = [1547.0217031537632, 540.2678528616606]
+    res = locate(parse_scene(scene), m, calibration=cal)
+    top = res.candidates[0]
+    err = _errors(res, ls)[0]
+    assert top.method == "one_reference"
+    assert err > 15.0  # still wrong: two references 4 m apart cannot pick the reading...
+    assert not top.ambiguous_with
+    assert top.sigma_m is not None
+    assert 2.0 * top.sigma_m < err
+    got = [w for w in res.warnings if w.startswith("references: the best candidate trusts one")]
+    assert got, res.warnings  # ...but the answer no longer looks sure
+    assert re.search(r"references are 4 m apart and the camera \d+ m from the farther", got[0])

@@ -825,11 +825,17 @@ def _warn_fragile_references(
     :data:`WRONG_M` (:func:`_rounding_moves_m`): what the rounding did move, as far as the
     pixels and the map can tell. Until stop 40 the rounding's half diagonal was taken as the
     slip, and the warning fired on 61 of 120 rounded development scenes, 59 of them right.
+
+    A ``one_reference`` top (the pair's joint fit put the car off or across its street, or
+    they disagree, so each was tried alone) gets the same lever test, worded for it: two
+    references that close cannot tell that reading from the street's other readings either
+    (stop 42: ``absolute_slips.py --set held-out-5`` scene 113, a reading 34 m off at a
+    ``sigma_m`` of 7 m, untied, had no warning).
     """
     if len(ev.refs) != 2 or ev.corners or ev.landmarks or not result.candidates:
         return
     top = result.candidates[0]
-    if top.method != "two_references":
+    if top.method not in ("two_references", "one_reference"):
         return
     (_o0, q0), (_o1, q1) = ev.refs
     a, b = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
@@ -839,7 +845,7 @@ def _warn_fragile_references(
     cam = top.east_north
     lever = max(float(np.linalg.norm(cam - a)), float(np.linalg.norm(cam - b))) / baseline
     sigma = top.sigma_m if top.sigma_m is not None else 0.0
-    moves = _rounding_moves_m(top, scene, ev, settings)
+    moves = _rounding_moves_m(top, scene, ev, settings) if top.method == "two_references" else None
     if moves is not None and moves.most > WRONG_M:
         # the rounding is in sigma_m; say so only where the pixels and the car's street
         # say that it moved the answer beyond WRONG_M
@@ -855,6 +861,17 @@ def _warn_fragile_references(
     slip = max(REFERENCE_SLIP_M, _half_carriageway_m(ev, a), _half_carriageway_m(ev, b))
     move = slip * lever
     if move <= max(WRONG_M, 2.0 * sigma):
+        return
+    if top.method == "one_reference":
+        result.warnings.append(
+            f"references: the best candidate trusts one reference alone, with the car along "
+            f"a street, and the two references are {baseline:.0f} m apart and the camera "
+            f"{lever * baseline:.0f} m from the farther: one reference's lat/lon {slip:.0f} m "
+            "off across them (a pixel on the kerb for a point on the centre line, a rounded "
+            f"lat/lon) would move their joint fit about {move:.0f} m, beyond its sigma_m, so "
+            "they cannot tell the car's readings apart; check both, or add a reference farther "
+            "apart, a kerb corner or a landmark"
+        )
         return
     result.warnings.append(
         f"references: the two references are {baseline:.0f} m apart and the camera "
