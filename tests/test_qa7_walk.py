@@ -1,0 +1,71 @@
+"""Stop 42 qa7: a second walk through the real clients (an HTTP client against the service,
+``camloc batch`` and its GeoPackage, the pages in Chromium), the faults found (each test fails
+without its fix)."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import shutil
+from pathlib import Path
+from typing import Any
+
+import httpx
+
+from camloc_geo.service import create_app
+from camloc_geo.service.settings import Settings
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def test_a_crowd_task_located_nowhere_says_why(tmp_path: Path) -> None:
+    """A crowd task whose merged scene the server's maps cannot place (its prior in a city no
+    configured extract covers, no junction) was ``located`` with an empty FeatureCollection;
+    a client polling ``GET /v1/tasks/{id}`` for ``located`` found a ``map_url`` and nothing
+    said there was no answer (the reason lay in ``result.candidates.properties``), and the
+    annotation page linked "The camera's candidates" to an empty map. The status stays
+    ``located`` (a new value would break the pollers); ``n_candidates`` and ``reason`` say it."""
+    import cv2
+    import numpy as np
+
+    scene = json.loads((REPO / "sample_maps" / "sample_scene.json").read_text())
+    scene["prior"] = {"lat": 60.17, "lon": 24.94, "radius_m": 150}  # Helsinki: no map here
+    scene.pop("intersection", None)
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    shutil.copy(REPO / "sample_maps" / "baltimore.osm.pbf", maps)
+    w, h = scene["image"]["width"], scene["image"]["height"]
+    ok, buf = cv2.imencode(".png", np.full((h, w, 3), 128, np.uint8))
+    assert ok
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0, map_dir=maps))
+
+    async def run() -> tuple[dict[str, Any], dict[str, Any], str]:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            r = await client.post(
+                "/v1/tasks",
+                content=bytes(buf.tobytes()),
+                headers={"content-type": "image/png"},
+                params={"annotations": "1"},
+            )
+            assert r.status_code == 201, r.text
+            task = r.json()
+            sub = await client.post(f"/v1/tasks/{task['id']}/annotations", json=scene)
+            assert sub.status_code == 200, sub.text
+            status = await client.get(task["status_url"])
+            assert status.status_code == 200, status.text
+            page = await client.get(task["annotate_url"])
+            assert page.status_code == 200, page.text
+            return sub.json(), status.json(), page.text
+
+    try:
+        submitted, status, page = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert status["status"] == "located"  # unchanged: pollers keep working
+    assert status["n_candidates"] == 0
+    assert status["reason"].startswith("no geographic evidence"), status
+    assert submitted["status"] == "located"
+    assert submitted["reason"] == status["reason"]
+    assert "located with no candidate: no geographic evidence" in page
+    assert "The camera's candidates:" not in page
