@@ -69,3 +69,30 @@ def test_a_crowd_task_located_nowhere_says_why(tmp_path: Path) -> None:
     assert submitted["reason"] == status["reason"]
     assert "located with no candidate: no geographic evidence" in page
     assert "The camera's candidates:" not in page
+
+
+def test_a_title_found_in_no_extract_of_a_folder_names_where_its_miss_is(tmp_path: Path) -> None:
+    """``camloc batch`` (and ``camloc geocode --osm FOLDER``) searching a title without a point
+    in a folder of extracts said "'Nowhere' is not a street name of this map (closest: Willow
+    Street, ...)": the most telling miss of the 35 extracts, West Oakland's, as if it were the
+    only map; a reader looked for the Krems camera among Oakland's streets."""
+    from camloc_geo.batch import geocode_camera
+    from camloc_geo.cameras import row_from_mapping
+    from camloc_geo.geocode._maps import geocode_title_in_maps, whole_map
+
+    folder = tmp_path / "osm"
+    folder.mkdir()
+    for name in ("baltimore.osm.pbf", "krems.osm.gz"):
+        shutil.copy(REPO / "data" / "osm" / name, folder)
+    row = row_from_mapping({"id": "x", "title": "Nowhere & Nothing"}, 1)
+    res = geocode_camera(row, map_source=str(folder))
+    assert res.status == "not_found"
+    assert res.reason.startswith("found in none of the 2 extracts searched; the nearest miss is in")
+    assert "this map (closest:" in res.reason  # the miss's own words follow, its extract named
+    maps = [whole_map(folder / n) for n in ("baltimore.osm.pbf", "krems.osm.gz")]
+    got = geocode_title_in_maps("Nowhere & Nothing", maps)
+    assert got[0].status == "not_found"
+    assert got[0].reason.startswith("found in none of the 2 extracts searched; the nearest miss")
+    # one extract: its own words, as before
+    one = geocode_title_in_maps("Nowhere & Nothing", maps[1:])
+    assert one[0].reason.startswith("'Nowhere' is not a street name of this map")

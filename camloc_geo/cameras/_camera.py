@@ -606,7 +606,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.geocode._maps import miss_rank, one_place
+    from camloc_geo.geocode._maps import folder_miss, miss_rank, one_place
     from camloc_geo.osm import area_map
 
     if not (row.title or row.streets) and row.has_scene:
@@ -636,7 +636,7 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         if matches and matches[0].status not in ("not_found",):
             found.append((m, matches, os.path.basename(f)))
         elif matches:
-            misses.append((miss_rank(matches[0]), matches[0].reason or ""))
+            misses.append((miss_rank(matches[0]), matches[0].reason or "", os.path.basename(f)))
     placed = [
         (m, mt, name)
         for m, mt, name in found
@@ -670,11 +670,11 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     if placed or found:
         m, matches, name = (placed or found)[0]
         return _with_map(row, res, m, matches, extract=name)
-    reason = (
-        min(misses, key=lambda x: x[0])[1]
-        if misses
-        else "the title names no street found in any extract"
-    )
+    if misses:
+        _rank, why, where = min(misses, key=lambda x: x[0])
+        reason = folder_miss(why, where, len(misses))
+    else:
+        reason = "the title names no street found in any extract"
     return res.fail(
         "not_found", reason or "the title names no street found in any extract", "title"
     )

@@ -55,6 +55,21 @@ def miss_rank(match: TitleMatch) -> tuple[float, int]:
     return (-(match.score if match.score == match.score else 0.0), -found)
 
 
+def folder_miss(reason: str, extract: str, n_searched: int) -> str:
+    """A title's miss in every one of several extracts, worded as such.
+
+    The reason of the most telling miss (:func:`miss_rank`) says "this map", where it
+    is one extract of the many searched: the reader of a folder search took West Oakland's
+    closest street names for the only map's (qa7). With one extract the reason is kept.
+    """
+    if n_searched < 2 or not reason:
+        return reason
+    return (
+        f"found in none of the {n_searched} extracts searched; the nearest miss is in "
+        f"{extract}: {reason}"
+    )
+
+
 def extract_paths(path: str | os.PathLike[str]) -> list[Path]:
     """The OSM extract itself, or every extract in a folder (sorted by name).
 
@@ -194,4 +209,7 @@ def _in_maps(
     if placed:
         return placed[0]
     ranked = sorted(results, key=lambda r: miss_rank(r[0]))
-    return ranked[0]
+    best = ranked[0]
+    if best and best[0].status == "not_found" and best[0].source:
+        best[0].reason = folder_miss(best[0].reason, Path(best[0].source).name, len(results))
+    return best
