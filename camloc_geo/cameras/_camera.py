@@ -621,7 +621,7 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         res.errors.append({"stage": "input", "message": res.reason})
         return res
     found: list[tuple[Any, list[Any], str]] = []
-    misses: list[tuple[tuple[float, int], str]] = []
+    misses: list[tuple[tuple[float, int], str, str]] = []
     for f in files:
         try:
             m = area_map(("file", f))

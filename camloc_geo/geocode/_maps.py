@@ -209,7 +209,7 @@ def _in_maps(
     if placed:
         return placed[0]
     ranked = sorted(results, key=lambda r: miss_rank(r[0]))
-    best = ranked[0]
-    if best and best[0].status == "not_found" and best[0].source:
-        best[0].reason = folder_miss(best[0].reason, Path(best[0].source).name, len(results))
-    return best
+    miss = ranked[0]
+    if miss and miss[0].status == "not_found" and miss[0].source:
+        miss[0].reason = folder_miss(miss[0].reason, Path(miss[0].source).name, len(results))
+    return miss
