@@ -96,3 +96,24 @@ def test_a_title_found_in_no_extract_of_a_folder_names_where_its_miss_is(tmp_pat
     # one extract: its own words, as before
     one = geocode_title_in_maps("Nowhere & Nothing", maps[1:])
     assert one[0].reason.startswith("'Nowhere' is not a street name of this map")
+
+
+def test_a_camera_whose_title_meets_twice_says_why_it_is_ambiguous() -> None:
+    """Leeds, "Mabgate & Regent Street" with the list's point 13 m from one of the two
+    places those streets meet (79 m apart, both inside the point's radius): the camera was
+    ``ambiguous`` with the reason "junction of the map's model, at the nodes the two streets
+    share", which names one place and no doubt (``camloc batch``, ``POST /v1/jobs``)."""
+    from camloc_geo.batch import geocode_camera
+    from camloc_geo.cameras import row_from_mapping
+
+    row = row_from_mapping(
+        {"id": "L2", "title": "Mabgate & Regent Street", "lat": "53.7994", "lon": "-1.5347"}, 1
+    )
+    res = geocode_camera(row, map_source=str(REPO / "data" / "osm" / "leeds_centre.osm.gz"))
+    assert res.status == "ambiguous"
+    assert res.n_candidates == 2
+    assert res.reason.startswith(
+        "2 places fit the title equally well (Mabgate & Regent Street), up to 79 m apart; "
+        "from the list's point 13 m, 91 m: a radius_m holding one alone"
+    ), res.reason
+    assert res.reason.endswith("junction of the map's model, at the nodes the two streets share")

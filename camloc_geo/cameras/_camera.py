@@ -330,6 +330,40 @@ def _read_title(row: CameraRow, res: CameraResult) -> None:
     res.view_bearing_deg = _compass(row.view) if row.view else _finite(parsed.view_bearing_deg)
 
 
+def _equal_places(res: CameraResult, places: list[Any]) -> str:
+    """Why a title placed at equal scores is ``ambiguous``: how many places, how far apart,
+    how far from the list's point, and what decides.
+
+    A camera "Mabgate & Regent Street" (two streets meeting twice, 61 m apart, both within
+    the list point's radius) was ``ambiguous`` with the reason "junction of the map's model,
+    at the nodes the two streets share", which says nothing of a second place.
+    """
+    from camloc_geo.geodesy import great_circle_m
+
+    top = _finite(places[0].score)
+    level = [mt for mt in places if _finite(mt.score) == top] or places[:2]
+    pts = [(float(mt.lat), float(mt.lon)) for mt in level]
+    apart = max(
+        great_circle_m(lat1=a[0], lon1=a[1], lat2=b[0], lon2=b[1])
+        for i, a in enumerate(pts)
+        for b in pts[i + 1 :]
+    )
+    names = " & ".join(res.names_matched) or "the title's streets"
+    text = f"{len(pts)} places fit the title equally well ({names}), up to {apart:.0f} m apart"
+    if res.list_lat is not None and res.list_lon is not None:
+        dists = [
+            great_circle_m(lat1=res.list_lat, lon1=res.list_lon, lat2=p[0], lon2=p[1]) for p in pts
+        ]
+        text += (
+            "; from the list's point "
+            + ", ".join(f"{d:.0f} m" for d in dists)
+            + ": a radius_m holding one alone, a view or a scene decides"
+        )
+    else:
+        text += ": a point (lat, lon, radius_m), a view or a scene decides"
+    return text
+
+
 def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> None:
     """Fill a title-only result from title matches."""
     best = matches[0]
@@ -355,6 +389,8 @@ def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> 
     if status == "ambiguous" or tie:
         res.status = "ambiguous"
         res.reason = best.reason or "two places match the title equally well"
+        if status != "ambiguous":  # a junction's reason alone did not say why (qa7)
+            res.reason = _equal_places(res, with_point) + "; " + res.reason
         return
     if status in ("junction", "address", "landmark") and _finite(best.lat) is not None:
         res.status = "title_only"
