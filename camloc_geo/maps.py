@@ -1977,6 +1977,9 @@ def _arrow_icon(
 _PLACED_ONLY = {
     "title_only": "at the junction its title names",
     "street_only": "on the street its title names",
+    # a camera two places fit equally, drawn at the first in its dashed ring: it was
+    # counted "located" on the service's job page (qa7)
+    "ambiguous": "two places fit equally: drawn at the first, dashed; see its popup",
 }
 
 

@@ -117,3 +117,65 @@ def test_a_camera_whose_title_meets_twice_says_why_it_is_ambiguous() -> None:
         "from the list's point 13 m, 91 m: a radius_m holding one alone"
     ), res.reason
     assert res.reason.endswith("junction of the map's model, at the nodes the two streets share")
+
+
+_LEEDS_LIST = (
+    "id;title;lat;lon\n"
+    "L1;Regent St / New York Rd looking N;53,8001;-1,5344\n"
+    "L2;Mabgate & Regent Street;53.7994;-1.5347\n"
+)
+
+
+def _heading(page: str) -> str:
+    """The summary page's heading box, its markup unescaped."""
+    text = page.replace("\\u003c", "<").replace("\\u003e", ">")
+    start = text.index("camera(s) on the map")
+    return text[start : start + 400]
+
+
+def test_an_ambiguous_camera_is_counted_as_such_on_the_job_page(tmp_path: Path) -> None:
+    """``POST /v1/jobs`` then ``GET /v1/jobs/{id}/map`` (a live ``camloc serve``, by hand):
+    Leeds' "Mabgate & Regent Street" (ambiguous between two junctions) was drawn at its first
+    place with no ring and the heading said "1 located" in a job where no camera was
+    located. The job's cameras as the service computes them, and its page."""
+    from camloc_geo.service.mapstore import MapStore
+    from camloc_geo.service.routers.jobs import job_summary_page
+    from camloc_geo.service.work import process_camera
+
+    maps_dir = tmp_path / "maps"
+    maps_dir.mkdir()
+    shutil.copy(REPO / "data" / "osm" / "leeds_centre.osm.gz", maps_dir)
+    settings = Settings(data_dir=tmp_path / "d", workers=0, map_dir=maps_dir)
+    maps = MapStore(settings)
+    cams = [
+        {"id": "L1", "title": "Regent St / New York Rd looking N", "lat": 53.8001, "lon": -1.5344},
+        {"id": "L2", "title": "Mabgate & Regent Street", "lat": 53.7994, "lon": -1.5347},
+    ]
+    results = [process_camera(c, maps, settings) for c in cams]
+    assert [r["status"] for r in results] == ["title_only", "ambiguous"]
+    head = _heading(job_summary_page(results))
+    assert "located" not in head.split("<br>")[0], head
+    assert "1 ambiguous (two places fit equally" in head, head
+    assert "1 with a tied best candidate" in head, head
+
+
+def test_an_ambiguous_camera_is_drawn_on_the_batch_page(tmp_path: Path) -> None:
+    """``camloc batch --map``: the same camera, with its two candidates in the GeoPackage,
+    was listed "1 without candidates (1 ambiguous)" and not drawn; the job page drew it (two
+    clients, two answers). Both now draw it at its first place in a dashed ring."""
+    from camloc_geo.batch import run_batch
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text(_LEEDS_LIST, encoding="utf-8")
+    run_batch(
+        lst,
+        out_gpkg=tmp_path / "cams.gpkg",
+        map_source=str(REPO / "data" / "osm" / "leeds_centre.osm.gz"),
+        summary_map=tmp_path / "summary.html",
+        progress=False,
+        workers=1,
+    )
+    head = _heading((tmp_path / "summary.html").read_text(encoding="utf-8"))
+    assert head.startswith("camera(s) on the map"), head
+    assert "1 ambiguous (two places fit equally" in head, head
+    assert "without candidates" not in head, head

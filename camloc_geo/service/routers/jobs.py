@@ -311,7 +311,12 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
                     },
                 }
             ]
-        if r.get("status") in _PLACED_BY_TITLE:
+        if r.get("status") == "ambiguous" and feats:
+            # drawn at its first place, tied (dashed ring), counted as ambiguous: it read as
+            # "1 located" in the heading, a title the engine would not place (qa7)
+            feats = [_status_first(f, "ambiguous") for f in feats]
+            feats = [_tied(f) for f in feats]
+        elif r.get("status") in _PLACED_BY_TITLE:
             # the status leads the flags, as in camloc batch --map's page: the heading then
             # says "on the map: 1 title_only (at the junction its title names)", not "1
             # camera(s) located" (a title's candidates carried no status: located, they read)
@@ -335,6 +340,15 @@ def _with_sigma(feature: dict[str, Any]) -> dict[str, Any]:
     if props.get("sigma_m") is not None or props.get("uncertainty_m") is None:
         return feature
     return {**feature, "properties": {**props, "sigma_m": props["uncertainty_m"]}}
+
+
+def _tied(feature: dict[str, Any]) -> dict[str, Any]:
+    """A copy of a candidate feature flagged ``tie`` (the page's dashed ring)."""
+    props = dict(feature.get("properties") or {})
+    flags = list(props.get("flags") or [])
+    if "tie" not in flags:
+        props["flags"] = [*flags, "tie"]
+    return {**feature, "properties": props}
 
 
 def _status_first(feature: dict[str, Any], status: str) -> dict[str, Any]:
