@@ -179,3 +179,29 @@ def test_an_ambiguous_camera_is_drawn_on_the_batch_page(tmp_path: Path) -> None:
     assert head.startswith("camera(s) on the map"), head
     assert "1 ambiguous (two places fit equally" in head, head
     assert "without candidates" not in head, head
+
+
+def test_a_csv_list_sent_as_json_says_to_send_it_as_csv(tmp_path: Path) -> None:
+    """``curl -H 'Content-Type: application/json' --data-binary @cams.csv .../v1/jobs`` (the
+    header kept from the JSON call before): "body: the body is not valid JSON: Expecting value:
+    line 1 column 1 (char 0)", which says nothing of what to change."""
+    app = create_app(Settings(data_dir=tmp_path / "d", workers=0))
+
+    async def run() -> httpx.Response:
+        transport = httpx.ASGITransport(app=app)
+        async with httpx.AsyncClient(transport=transport, base_url="http://t") as client:
+            return await client.post(
+                "/v1/jobs", content=_LEEDS_LIST, headers={"content-type": "application/json"}
+            )
+
+    try:
+        r = asyncio.run(run())
+    finally:
+        app.state.compute.shutdown()
+    assert r.status_code == 422, r.text
+    msg = r.json()["error"]["message"]
+    assert msg.startswith("body: the body is not valid JSON: Expecting value"), msg
+    assert msg.endswith(
+        "it looks like a CSV list (its first row 'id;title;lat;lon'): send it with the header "
+        "Content-Type: text/csv"
+    ), msg

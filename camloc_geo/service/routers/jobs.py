@@ -11,6 +11,7 @@ import codecs
 import csv
 import io
 import logging
+import re
 import threading
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict
@@ -186,7 +187,14 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
                 "body",
             )
         return out
-    data = parse_json(raw)
+    try:
+        data = parse_json(raw)
+    except SceneError as exc:
+        hint = _csv_sent_as_json(raw)
+        if hint:  # the type told the server JSON; the body is the list as CSV (qa7)
+            said = str(exc).removeprefix(f"{exc.field}: ") if exc.field else str(exc)
+            raise SceneError(f"{said}{hint}", exc.field or "body") from None
+        raise
     if isinstance(data, dict) and data.get("type") == "FeatureCollection":
         records = _feature_records(data, max_cameras)
         if not records:
@@ -281,6 +289,24 @@ async def job_result(
         data,
         media_type="application/geopackage+sqlite3",
         headers={"Content-Disposition": f'attachment; filename="camloc-{job_id}.gpkg"'},
+    )
+
+
+_CSV_HEADER_WORDS = re.compile(
+    r"^\ufeff?\"?(id|title|name|camera|camera_id|lat|latitude|lon|lng|streets|description)\"?"
+    r"\s*[,;\t|]",
+    re.IGNORECASE,
+)
+
+
+def _csv_sent_as_json(raw: bytes) -> str:
+    """A hint when a body that is not JSON starts like a camera list's CSV header row."""
+    head = raw[:200].decode("utf-8", errors="replace").lstrip()
+    if not _CSV_HEADER_WORDS.match(head):
+        return ""
+    return (
+        "; it looks like a CSV list (its first row "
+        f"{head.splitlines()[0][:60]!r}): send it with the header Content-Type: text/csv"
     )
 
 
