@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import httpx
+import pytest
 
 from camloc_geo.service import create_app
 from camloc_geo.service.settings import Settings
@@ -205,3 +206,32 @@ def test_a_csv_list_sent_as_json_says_to_send_it_as_csv(tmp_path: Path) -> None:
         "it looks like a CSV list (its first row 'id;title;lat;lon'): send it with the header "
         "Content-Type: text/csv"
     ), msg
+
+
+@pytest.mark.parametrize(
+    ("extract", "kind"),
+    [
+        ("sample_maps/baltimore.osm.pbf", "an OSM extract (.osm.pbf)"),
+        ("data/osm/krems.osm.gz", "a gzip-compressed file (an .osm.gz extract?)"),
+        ("data/osm/West-Oakland.osm.bz2", "a bzip2-compressed file (an .osm.bz2 extract?)"),
+    ],
+)
+def test_an_extract_given_as_the_scene_or_the_list_is_named(extract: str, kind: str) -> None:
+    """``camloc locate EXTRACT --osm SCENE`` (the two swapped) said "it is not UTF-8 text
+    (byte 0x95 at position 16)"; ``camloc batch EXTRACT ...`` said the list "is not a text
+    file (it holds NUL bytes)" and to export the cameras from QGIS (a .osm.bz2 was read as
+    Windows-1252 text)."""
+    from camloc_geo import InputError
+    from camloc_geo.batch import read_camera_list
+    from camloc_geo.scene import load_scene
+
+    path = REPO / extract
+    with pytest.raises(InputError) as scene_err:
+        load_scene(path)
+    assert f"it is {kind}; a scene is camloc-scene/1 JSON text" in str(scene_err.value)
+    with pytest.raises(InputError) as list_err:
+        list(read_camera_list(path))
+    assert str(list_err.value) == (
+        f"the camera list {path.name} is {kind}, not a CSV or GeoJSON list of cameras: give "
+        "the extract (or its folder) after --osm and the camera list first"
+    )
