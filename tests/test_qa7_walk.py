@@ -235,3 +235,45 @@ def test_an_extract_given_as_the_scene_or_the_list_is_named(extract: str, kind: 
         f"the camera list {path.name} is {kind}, not a CSV or GeoJSON list of cameras: give "
         "the extract (or its folder) after --osm and the camera list first"
     )
+
+
+def _dock_annotation() -> Any:
+    """The QGIS dock's scene model (``qgis_plugin/camloc/annotation.py``: plain Python, no
+    QGIS import), loaded from its file."""
+    import importlib.util
+
+    path = REPO / "qgis_plugin" / "camloc" / "annotation.py"
+    spec = importlib.util.spec_from_file_location("camloc_dock_annotation", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.Annotation
+
+
+def test_the_dock_locates_a_loaded_scene_as_camloc_locate_does() -> None:
+    """QGIS dock, *Load scene…* the bundled sample, *Run* (``desktop_check.py`` under Xvfb):
+    12 candidates, "#1 tie with #2, #4", where ``camloc locate`` on the same file gives 13,
+    #1 tied with 2, 4 and 5, and warns of candidate 5 at a cross street a block away. The
+    dock wrote the scene's prior point into ``intersection.lat/lon``, which pins the search to
+    the junction nearest that point; the scene gave none."""
+    from camloc_geo.api import locate_scene
+
+    scene = json.loads((REPO / "sample_maps" / "sample_scene.json").read_text())
+    assert "lat" not in scene["intersection"]
+    dock = _dock_annotation().from_scene(scene)
+    sent = dock.to_scene()
+    assert "lat" not in sent["intersection"]
+    assert "lon" not in sent["intersection"]
+    assert sent["prior"]["lat"] == scene["prior"]["lat"]
+    osm = REPO / "sample_maps" / "baltimore.osm.pbf"
+    cli = locate_scene(scene, map_source=osm).to_geojson()["features"]
+    got = locate_scene(sent, map_source=osm).to_geojson()["features"]
+    assert len(got) == len(cli)
+    assert [f["properties"]["score"] for f in got[:5]] == pytest.approx(
+        [f["properties"]["score"] for f in cli[:5]], rel=1e-9
+    )
+    # a junction picked on the map is still sent as the junction's point
+    dock.set_location(lat=39.28556, lon=-76.59349)
+    picked = dock.to_scene()["intersection"]
+    assert (picked["lat"], picked["lon"]) == (39.28556, -76.59349)
