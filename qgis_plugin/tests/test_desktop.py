@@ -187,11 +187,11 @@ def test_batch_dialog_loads_each_rows_layers_named_after_its_scene(desktop):
 
 def test_dock_run_lists_the_candidates_best_first_and_loads_its_layers(desktop):
     dock = desktop["dock"]
-    assert dock["status"].startswith("12 candidate(s) in dock_results.gpkg; best first.")
+    assert dock["status"].startswith("13 candidate(s) in dock_results.gpkg; best first.")
     assert "★ marks a tie" in dock["status"]
     rows = dock["candidates"]
-    assert [row.split()[0] for row in rows] == [f"#{i}" for i in range(1, 13)]
-    assert rows[0].startswith("#1  0.37  ★ tie with #2, #4")
+    assert [row.split()[0] for row in rows] == [f"#{i}" for i in range(1, 14)]
+    assert rows[0].startswith("#1  0.36  ★ tie with #2, #4, #5")
     assert all("m up, facing" in row for row in rows)
     kinds = {lyr["kind"]: lyr for lyr in dock["layers"]}
     assert {k: v["features"] for k, v in kinds.items()} == DOCK_KINDS
