@@ -176,10 +176,14 @@ def test_an_ambiguous_camera_is_drawn_on_the_batch_page(tmp_path: Path) -> None:
         progress=False,
         workers=1,
     )
-    head = _heading((tmp_path / "summary.html").read_text(encoding="utf-8"))
+    page = (tmp_path / "summary.html").read_text(encoding="utf-8")
+    head = _heading(page)
     assert head.startswith("camera(s) on the map"), head
     assert "1 ambiguous (two places fit equally" in head, head
     assert "without candidates" not in head, head
+    # its popup says "choose it under 'or the camera is candidate…'": the list is there (a
+    # tied camera of this page had none, the job page's had), its second place to pick
+    assert '"others": [[2, 53.7999831, -1.5337234, "0.500"]]' in page
 
 
 def test_a_csv_list_sent_as_json_says_to_send_it_as_csv(tmp_path: Path) -> None:

@@ -1209,19 +1209,50 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
             # the best candidate's ties, as the engine decided them (the core's rule)
             "ambiguous_with": _best_ties(r),
         }
+        best = {
+            "type": "Feature",
+            "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
+            "properties": props,
+        }
         yield (
             label,
             {
                 "features": [
-                    {
-                        "type": "Feature",
-                        "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
-                        "properties": props,
-                    }
+                    best,
+                    *(_other_candidates(r) if props["ambiguous_with"] or r.get("tie") else []),
                 ],
                 "properties": {"reason": r.get("reason")},
             },
         )
+
+
+def _other_candidates(r: dict[str, Any]) -> list[dict[str, Any]]:
+    """A tied camera's candidates after its best, with a point: the page's "or the camera is
+    candidate…" list (the job page had it; this page's popup promised it and had none, qa7)."""
+    out = []
+    for c in (r.get("candidates") or [])[1:]:
+        lat, lon, rank = c.get("lat"), c.get("lon"), c.get("rank")
+        numbers = isinstance(lat, (int, float)) and isinstance(lon, (int, float))
+        if not (numbers and math.isfinite(lat) and math.isfinite(lon)) or rank is None:
+            continue
+        out.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [lon, lat]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": int(rank),
+                    "lat": lat,
+                    "lon": lon,
+                    "score": c.get("score") or 0.0,
+                    "method": str(c.get("method") or ""),
+                    "heading_deg": c.get("heading_deg"),
+                    "height_m": c.get("height_m"),
+                    "sigma_m": c.get("uncertainty_m"),
+                },
+            }
+        )
+    return out
 
 
 def _markercluster_assets() -> tuple[str, str]:
