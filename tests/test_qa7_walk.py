@@ -281,3 +281,26 @@ def test_the_dock_locates_a_loaded_scene_as_camloc_locate_does() -> None:
     dock.set_location(lat=39.28556, lon=-76.59349)
     picked = dock.to_scene()["intersection"]
     assert (picked["lat"], picked["lon"]) == (39.28556, -76.59349)
+
+
+def test_geocode_best_says_when_it_left_out_a_match_as_good(tmp_path: Path) -> None:
+    """``camloc geocode --list cams.csv --osm leeds_centre.osm.gz --best``: "Mabgate & Regent
+    Street" came out a plain ``junction`` at one of the two places those streets meet (79 m
+    apart, equal scores); the other was dropped without a word, the answer looked sure."""
+    from camloc_geo.cli import main
+
+    lst = tmp_path / "cams.csv"
+    lst.write_text(_LEEDS_LIST, encoding="utf-8")
+    out = tmp_path / "out.geojson"
+    osm = REPO / "data" / "osm" / "leeds_centre.osm.gz"
+    assert main(["geocode", "--list", str(lst), "--osm", str(osm), "--best", "-o", str(out)]) == 0
+    by_id = {
+        f["properties"]["id"]: f["properties"]
+        for f in json.loads(out.read_text(encoding="utf-8"))["features"]
+    }
+    assert by_id["L2"]["status"] == "junction"  # unchanged
+    assert by_id["L2"]["reason"].endswith(
+        "; --best left out 1 match of the same score, up to 79 m away (without --best all are "
+        "listed)"
+    )
+    assert "--best left out" not in by_id["L1"]["reason"]  # one place: as before
