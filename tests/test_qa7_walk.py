@@ -304,3 +304,20 @@ def test_geocode_best_says_when_it_left_out_a_match_as_good(tmp_path: Path) -> N
         "listed)"
     )
     assert "--best left out" not in by_id["L1"]["reason"]  # one place: as before
+
+
+def test_geocode_names_a_list_point_with_lat_and_lon_swapped() -> None:
+    """``camloc geocode --list`` with a row ``-1.5337;53.7991`` (lat and lon the other way
+    round): "7,971 km from the point given (-1.53370,53.79910): is it this camera's point?",
+    where ``camloc batch`` names the swap; the swapped point lies 2 m from the match."""
+    from camloc_geo.geocode._maps import geocode_title_in_maps, whole_map
+
+    m = whole_map(REPO / "data" / "osm" / "leeds_centre.osm.gz")
+    got = geocode_title_in_maps("Quarry Hill at Playhouse Sq", [m], near=(-1.5337, 53.7991))
+    assert got[0].status == "junction"
+    assert got[0].reason.endswith(
+        "With lat and lon swapped it lies 2 m from this match: are the list's lat and lon "
+        "columns the other way round?"
+    ), got[0].reason
+    far = geocode_title_in_maps("Quarry Hill at Playhouse Sq", [m], near=(53.70, -1.60))
+    assert "swapped" not in far[0].reason  # far, but not swapped: as before

@@ -150,6 +150,13 @@ def geocode_title_in_maps(
                     f"; {far} from the point given ({near[0]:.5f},{near[1]:.5f}): is it this "
                     "camera's point?"
                 )
+                if abs(near[1]) <= 90:  # the point with lat and lon swapped is here (qa7)
+                    back = great_circle_m(lat1=near[1], lon1=near[0], lat2=m.lat, lon2=m.lon)
+                    if back <= FAR_FROM_POINT_M:
+                        m.reason += (
+                            f" With lat and lon swapped it lies {back:,.0f} m from this match: "
+                            "are the list's lat and lon columns the other way round?"
+                        )
     return found
 
 
