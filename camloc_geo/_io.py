@@ -255,6 +255,20 @@ BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
 """What a file's first bytes say it is when it is no text (a camera list, a scene, JSON)."""
 
 
+def map_file_kind(raw: bytes) -> str | None:
+    """What a file's first bytes say when it is an OSM extract or a compressed one (None:
+    neither): a scene or a list given where the extract goes, and the other way round, was
+    "not UTF-8 text (byte 0x95 at position 16)" (``camloc locate EXTRACT --osm SCENE``, qa7).
+    """
+    if raw[4:15] == b"\n\tOSMHeader":
+        return "an OSM extract (.osm.pbf)"
+    if raw.startswith(b"\x1f\x8b"):
+        return "a gzip-compressed file (an .osm.gz extract?)"
+    if raw.startswith(b"BZh"):
+        return "a bzip2-compressed file (an .osm.bz2 extract?)"
+    return None
+
+
 class NotTextError(ValueError):
     """Bytes that are no text a JSON reader takes; the message says what they look like."""
 
@@ -282,6 +296,7 @@ def json_text(raw: bytes) -> str:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         kind = next((k for magic, k in BINARY_KINDS if raw.startswith(magic)), None)
+        kind = kind or map_file_kind(raw[:16])
         image = magic_format(raw[:16])
         if kind is None and image is not None:
             kind = f"a {image} image"

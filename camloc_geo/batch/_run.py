@@ -924,6 +924,19 @@ def _best_ties(r: dict[str, Any]) -> list[int]:
     return [2] if r.get("tie") and r.get("status") == "located" else []
 
 
+def _first_place(r: dict[str, Any]) -> tuple[float, float] | None:
+    """``(lat, lon)`` of an ambiguous camera's first candidate (None: not ambiguous, placed
+    already, or no candidate with a point)."""
+    if r.get("status") != "ambiguous" or r.get("lat") is not None:
+        return None
+    for c in r.get("candidates") or []:
+        lat, lon = c.get("lat"), c.get("lon")
+        numbers = isinstance(lat, (int, float)) and isinstance(lon, (int, float))
+        if numbers and math.isfinite(lat) and math.isfinite(lon):
+            return float(lat), float(lon)
+    return None
+
+
 def _best_residual_m(r: dict[str, Any]) -> float | None:
     """The camera's best located candidate's ``residual_m`` (None: a title's place, or a
     journal of a run before stop 41, whose candidates did not keep it)."""
@@ -1160,6 +1173,11 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
     n = 0
     for r in journal.records():
         label = f"{r['id']} {r.get('title') or ''}".strip()
+        first = _first_place(r)
+        if first is not None:
+            # ambiguous: drawn at its first place, tied (dashed ring), as the service's job
+            # page draws it; it was listed "without candidates" though it had them (qa7)
+            r = {**r, "lat": first[0], "lon": first[1], "tie": True}
         if r.get("lat") is None or r.get("lon") is None:
             yield (
                 label,
@@ -1191,19 +1209,50 @@ def _summary_items(journal: Journal) -> Iterator[tuple[str, dict[str, Any]]]:
             # the best candidate's ties, as the engine decided them (the core's rule)
             "ambiguous_with": _best_ties(r),
         }
+        best = {
+            "type": "Feature",
+            "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
+            "properties": props,
+        }
         yield (
             label,
             {
                 "features": [
-                    {
-                        "type": "Feature",
-                        "geometry": {"type": "Point", "coordinates": [r["lon"], r["lat"]]},
-                        "properties": props,
-                    }
+                    best,
+                    *(_other_candidates(r) if props["ambiguous_with"] or r.get("tie") else []),
                 ],
                 "properties": {"reason": r.get("reason")},
             },
         )
+
+
+def _other_candidates(r: dict[str, Any]) -> list[dict[str, Any]]:
+    """A tied camera's candidates after its best, with a point: the page's "or the camera is
+    candidate…" list (the job page had it; this page's popup promised it and had none, qa7)."""
+    out = []
+    for c in (r.get("candidates") or [])[1:]:
+        lat, lon, rank = c.get("lat"), c.get("lon"), c.get("rank")
+        numbers = isinstance(lat, (int, float)) and isinstance(lon, (int, float))
+        if not (numbers and math.isfinite(lat) and math.isfinite(lon)) or rank is None:
+            continue
+        out.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [lon, lat]},
+                "properties": {
+                    "kind": "candidate",
+                    "rank": int(rank),
+                    "lat": lat,
+                    "lon": lon,
+                    "score": c.get("score") or 0.0,
+                    "method": str(c.get("method") or ""),
+                    "heading_deg": c.get("heading_deg"),
+                    "height_m": c.get("height_m"),
+                    "sigma_m": c.get("uncertainty_m"),
+                },
+            }
+        )
+    return out
 
 
 def _markercluster_assets() -> tuple[str, str]:

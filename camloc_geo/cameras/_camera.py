@@ -330,6 +330,40 @@ def _read_title(row: CameraRow, res: CameraResult) -> None:
     res.view_bearing_deg = _compass(row.view) if row.view else _finite(parsed.view_bearing_deg)
 
 
+def _equal_places(res: CameraResult, places: list[Any]) -> str:
+    """Why a title placed at equal scores is ``ambiguous``: how many places, how far apart,
+    how far from the list's point, and what decides.
+
+    A camera "Mabgate & Regent Street" (two streets meeting twice, 61 m apart, both within
+    the list point's radius) was ``ambiguous`` with the reason "junction of the map's model,
+    at the nodes the two streets share", which says nothing of a second place.
+    """
+    from camloc_geo.geodesy import great_circle_m
+
+    top = _finite(places[0].score)
+    level = [mt for mt in places if _finite(mt.score) == top] or places[:2]
+    pts = [(float(mt.lat), float(mt.lon)) for mt in level]
+    apart = max(
+        great_circle_m(lat1=a[0], lon1=a[1], lat2=b[0], lon2=b[1])
+        for i, a in enumerate(pts)
+        for b in pts[i + 1 :]
+    )
+    names = " & ".join(res.names_matched) or "the title's streets"
+    text = f"{len(pts)} places fit the title equally well ({names}), up to {apart:.0f} m apart"
+    if res.list_lat is not None and res.list_lon is not None:
+        dists = [
+            great_circle_m(lat1=res.list_lat, lon1=res.list_lon, lat2=p[0], lon2=p[1]) for p in pts
+        ]
+        text += (
+            "; from the list's point "
+            + ", ".join(f"{d:.0f} m" for d in dists)
+            + ": a radius_m holding one alone, a view or a scene decides"
+        )
+    else:
+        text += ": a point (lat, lon, radius_m), a view or a scene decides"
+    return text
+
+
 def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> None:
     """Fill a title-only result from title matches."""
     best = matches[0]
@@ -355,6 +389,8 @@ def _apply_match(res: CameraResult, matches: list[Any], extract: str | None) -> 
     if status == "ambiguous" or tie:
         res.status = "ambiguous"
         res.reason = best.reason or "two places match the title equally well"
+        if status != "ambiguous":  # a junction's reason alone did not say why (qa7)
+            res.reason = _equal_places(res, with_point) + "; " + res.reason
         return
     if status in ("junction", "address", "landmark") and _finite(best.lat) is not None:
         res.status = "title_only"
@@ -606,7 +642,7 @@ def _note_problems(row: CameraRow, res: CameraResult) -> CameraResult:
 
 def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> CameraResult:
     """A camera without a point: its title searched in every extract."""
-    from camloc_geo.geocode._maps import miss_rank, one_place
+    from camloc_geo.geocode._maps import folder_miss, miss_rank, one_place
     from camloc_geo.osm import area_map
 
     if not (row.title or row.streets) and row.has_scene:
@@ -621,7 +657,7 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         res.errors.append({"stage": "input", "message": res.reason})
         return res
     found: list[tuple[Any, list[Any], str]] = []
-    misses: list[tuple[tuple[float, int], str]] = []
+    misses: list[tuple[tuple[float, int], str, str]] = []
     for f in files:
         try:
             m = area_map(("file", f))
@@ -636,7 +672,7 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
         if matches and matches[0].status not in ("not_found",):
             found.append((m, matches, os.path.basename(f)))
         elif matches:
-            misses.append((miss_rank(matches[0]), matches[0].reason or ""))
+            misses.append((miss_rank(matches[0]), matches[0].reason or "", os.path.basename(f)))
     placed = [
         (m, mt, name)
         for m, mt, name in found
@@ -670,11 +706,11 @@ def _search(row: CameraRow, res: CameraResult, files: tuple[str, ...]) -> Camera
     if placed or found:
         m, matches, name = (placed or found)[0]
         return _with_map(row, res, m, matches, extract=name)
-    reason = (
-        min(misses, key=lambda x: x[0])[1]
-        if misses
-        else "the title names no street found in any extract"
-    )
+    if misses:
+        _rank, why, where = min(misses, key=lambda x: x[0])
+        reason = folder_miss(why, where, len(misses))
+    else:
+        reason = "the title names no street found in any extract"
     return res.fail(
         "not_found", reason or "the title names no street found in any extract", "title"
     )

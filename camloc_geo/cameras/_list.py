@@ -409,6 +409,15 @@ def _check_text_list(path: Path, head: bytes) -> None:
     header's bytes as the list's header row. Text lists (CSV, GeoJSON; UTF-8, UTF-8 with a
     byte-order mark, Windows-1252) never hold a NUL byte.
     """
+    from camloc_geo._io import map_file_kind
+
+    extract = map_file_kind(head[:16])
+    if extract is not None:  # the extract given as the list (qa7): "holds NUL bytes" and
+        # advice to export the cameras from QGIS; a .osm.bz2 was even read as text
+        raise InputError(
+            f"the camera list {path.name} is {extract}, not a CSV or GeoJSON list of cameras: "
+            "give the extract (or its folder) after --osm and the camera list first"
+        )
     what = binary_list_kind(head)
     if what is None:
         return

@@ -67,6 +67,37 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(func=run)
 
 
+def _best_of(found: list[Any]) -> list[Any]:
+    """``--best``: the first match, its reason saying when another placed match scores as
+    well. Leeds' "Mabgate & Regent Street" (two junctions 79 m apart, equal scores) came out
+    a plain ``junction`` at one of them, the other dropped without a word (qa7)."""
+    import math
+
+    from camloc_geo.geodesy import great_circle_m
+
+    if not found:
+        return found
+    best = found[0]
+    same = [
+        m
+        for m in found[1:]
+        if m.lat is not None
+        and best.lat is not None
+        and m.score == best.score
+        and math.isfinite(float(m.score))
+    ]
+    if same:
+        far = max(
+            great_circle_m(lat1=best.lat, lon1=best.lon, lat2=m.lat, lon2=m.lon) for m in same
+        )
+        word = "match" if len(same) == 1 else "matches"
+        best.reason = (
+            f"{best.reason}; --best left out {len(same)} {word} of the same score, up to "
+            f"{far:.0f} m away (without --best all are listed)"
+        )
+    return [best]
+
+
 def _parse_near(text: str | None) -> tuple[float, float] | None:
     from camloc_geo._errors import InputError
 
@@ -351,7 +382,7 @@ def run(args: argparse.Namespace) -> int:
             title, maps, near=point or near, radius_m=args.radius_m, area=args.area
         )
         if args.best:
-            found = found[:1]
+            found = _best_of(found)
         return [m.to_feature() for m in found]
 
     with _feature_writer(out) as write:

@@ -55,6 +55,21 @@ def miss_rank(match: TitleMatch) -> tuple[float, int]:
     return (-(match.score if match.score == match.score else 0.0), -found)
 
 
+def folder_miss(reason: str, extract: str, n_searched: int) -> str:
+    """A title's miss in every one of several extracts, worded as such.
+
+    The reason of the most telling miss (:func:`miss_rank`) says "this map", where it
+    is one extract of the many searched: the reader of a folder search took West Oakland's
+    closest street names for the only map's (qa7). With one extract the reason is kept.
+    """
+    if n_searched < 2 or not reason:
+        return reason
+    return (
+        f"found in none of the {n_searched} extracts searched; the nearest miss is in "
+        f"{extract}: {reason}"
+    )
+
+
 def extract_paths(path: str | os.PathLike[str]) -> list[Path]:
     """The OSM extract itself, or every extract in a folder (sorted by name).
 
@@ -135,6 +150,13 @@ def geocode_title_in_maps(
                     f"; {far} from the point given ({near[0]:.5f},{near[1]:.5f}): is it this "
                     "camera's point?"
                 )
+                if abs(near[1]) <= 90:  # the point with lat and lon swapped is here (qa7)
+                    back = great_circle_m(lat1=near[1], lon1=near[0], lat2=m.lat, lon2=m.lon)
+                    if back <= FAR_FROM_POINT_M:
+                        m.reason += (
+                            f" With lat and lon swapped it lies {back:,.0f} m from this match: "
+                            "are the list's lat and lon columns the other way round?"
+                        )
     return found
 
 
@@ -194,4 +216,7 @@ def _in_maps(
     if placed:
         return placed[0]
     ranked = sorted(results, key=lambda r: miss_rank(r[0]))
-    return ranked[0]
+    miss = ranked[0]
+    if miss and miss[0].status == "not_found" and miss[0].source:
+        miss[0].reason = folder_miss(miss[0].reason, Path(miss[0].source).name, len(results))
+    return miss

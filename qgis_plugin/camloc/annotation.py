@@ -64,6 +64,9 @@ class Annotation:
         self.streets: list[str] = []
         self.lat: float | None = None
         self.lon: float | None = None
+        # the point is the scene's prior only (not a junction picked on the map or named by
+        # the scene's intersection): written back as the prior, never as the junction (qa7)
+        self.point_is_prior = False
         self.radius_m = 150.0
         self.view_hint: str = ""
         self.step = STEP_KEYS[0]
@@ -100,6 +103,11 @@ class Annotation:
         lat, lon = inter.get("lat", prior.get("lat")), inter.get("lon", prior.get("lon"))
         if lat is not None and lon is not None:
             a.set_location(lat=lat, lon=lon)
+            # a scene whose intersection gives no point keeps it so: the prior's point written
+            # as the junction's pinned the search to the junction nearest it, and the dock
+            # lost the sample's candidate at the cross street a block away that camloc locate
+            # gives (13 candidates there, 12 in the dock, and a surer-looking tie)
+            a.point_is_prior = inter.get("lat") is None or inter.get("lon") is None
         if prior.get("radius_m"):
             a.radius_m = float(prior["radius_m"])
         hint = scene.get("view_hint") or {}
@@ -160,6 +168,7 @@ class Annotation:
         """The intersection's position picked on the map (degrees WGS 84)."""
         self.lat = round(float(lat), 7)
         self.lon = round(float(lon), 7)
+        self.point_is_prior = False
 
     # --- checks and output ---------------------------------------------------------------
     def problems(self) -> list[str]:
@@ -210,7 +219,7 @@ class Annotation:
                 **(scene.get("intersection") or {}),
                 "corners": [list(c) for c in self.corners],
             }
-            if self.lat is not None and self.lon is not None:
+            if self.lat is not None and self.lon is not None and not self.point_is_prior:
                 inter["lat"] = self.lat
                 inter["lon"] = self.lon
             if self.streets:

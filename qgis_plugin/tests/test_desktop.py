@@ -34,10 +34,12 @@ LOCATE_KINDS = {  # kind: features, on the bundled sample
     "view_cones": 13,
 }
 LEADING_RANKS = [1, 2, 3, 4, 5]  # the sample's ties (scores 0.36, 0.36, 0.20, 0.04, 0.04)
-# The dock writes the intersection's lat/lon it shows into the scene it runs: with the junction
-# given, the same-shaped junction a block away (the toolbox's candidate 5, stop 41) is not tried.
-DOCK_KINDS = {**LOCATE_KINDS, "candidates": 12, "matched_corners": 36, "view_cones": 12}
-DOCK_LEADING_RANKS = [1, 2, 3, 4]
+# The dock runs a loaded scene as camloc locate does (since stop 42, qa7): it wrote the prior's
+# point into the scene's intersection, which pinned the search to the junction nearest it, and
+# the same-shaped junction a block away (the toolbox's candidate 5) was not tried (12
+# candidates, 36 matched corners, ties 1-4).
+DOCK_KINDS = dict(LOCATE_KINDS)
+DOCK_LEADING_RANKS = list(LEADING_RANKS)
 
 pytestmark = pytest.mark.skipif(
     XVFB_RUN is None or QGIS is None,
@@ -185,11 +187,11 @@ def test_batch_dialog_loads_each_rows_layers_named_after_its_scene(desktop):
 
 def test_dock_run_lists_the_candidates_best_first_and_loads_its_layers(desktop):
     dock = desktop["dock"]
-    assert dock["status"].startswith("12 candidate(s) in dock_results.gpkg; best first.")
+    assert dock["status"].startswith("13 candidate(s) in dock_results.gpkg; best first.")
     assert "★ marks a tie" in dock["status"]
     rows = dock["candidates"]
-    assert [row.split()[0] for row in rows] == [f"#{i}" for i in range(1, 13)]
-    assert rows[0].startswith("#1  0.37  ★ tie with #2, #4")
+    assert [row.split()[0] for row in rows] == [f"#{i}" for i in range(1, 14)]
+    assert rows[0].startswith("#1  0.36  ★ tie with #2, #4, #5")
     assert all("m up, facing" in row for row in rows)
     kinds = {lyr["kind"]: lyr for lyr in dock["layers"]}
     assert {k: v["features"] for k, v in kinds.items()} == DOCK_KINDS

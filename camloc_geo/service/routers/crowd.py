@@ -206,7 +206,10 @@ async def annotate(
                 f"This task has all its {task['needed']} annotations already: it takes no "
                 "more work. Thank you!"
             )
-            if task["status"] == "located":  # where its answer is (the page named none)
+            nowhere = _no_candidate_reason(task)
+            if nowhere is not None:  # located with no candidate: why, not a link to none
+                closed += f" It was located with no candidate: {nowhere[:300]}"
+            elif task["status"] == "located":  # where its answer is (the page named none)
                 closed += f" The camera's candidates: /v1/tasks/{task_id}/map"
             elif task["status"] == "failed":  # and why there is none
                 why = str((task.get("result") or {}).get("reason") or "").strip()
@@ -285,9 +288,29 @@ async def submit(
         store.set_task_result(task_id, status, result)
     got = cast(dict[str, Any], store.task(task_id))
     answer = {"annotations": n, "needed": task["needed"], "status": got["status"]}
+    why = _no_candidate_reason(got)
+    if why is not None:
+        answer["reason"] = why
     if not new:  # an identical submission raced this one in
         answer["duplicate"] = True
     return answer
+
+
+def _no_candidate_reason(task: dict[str, Any]) -> str | None:
+    """Why a located task has no candidate (the locate's reason), or ``None`` if it has one.
+
+    A crowd task whose merged scene holds no geographic evidence the server's maps can use
+    (a prior where no configured extract lies, no junction, no references) is ``located``
+    with an empty FeatureCollection: the status stays (a new value would break clients
+    polling for ``located``), and this reason is given beside it.
+    """
+    if task.get("status") != "located":
+        return None
+    cands = (task.get("result") or {}).get("candidates") or {}
+    if cands.get("features"):
+        return None
+    why = str((cands.get("properties") or {}).get("reason") or "").strip()
+    return " ".join(why.split()) or "the scene gave no candidate"
 
 
 @router.get("/v1/tasks/{task_id}")
@@ -304,6 +327,11 @@ async def task_status(task_id: TaskId, store: ServiceStore) -> dict[str, Any]:
     }
     if task["status"] == "located":
         answer["map_url"] = f"/v1/tasks/{task_id}/map"
+        feats = ((task["result"] or {}).get("candidates") or {}).get("features") or []
+        answer["n_candidates"] = len(feats)
+        why = _no_candidate_reason(task)
+        if why is not None:  # located, yet nowhere: say so beside the status (qa7)
+            answer["reason"] = why
     return answer
 
 

@@ -11,6 +11,7 @@ import codecs
 import csv
 import io
 import logging
+import re
 import threading
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict
@@ -186,7 +187,14 @@ def camera_records(raw: bytes, ctype: str, max_cameras: int) -> list[Any]:
                 "body",
             )
         return out
-    data = parse_json(raw)
+    try:
+        data = parse_json(raw)
+    except SceneError as exc:
+        hint = _csv_sent_as_json(raw)
+        if hint:  # the type told the server JSON; the body is the list as CSV (qa7)
+            said = str(exc).removeprefix(f"{exc.field}: ") if exc.field else str(exc)
+            raise SceneError(f"{said}{hint}", exc.field or "body") from None
+        raise
     if isinstance(data, dict) and data.get("type") == "FeatureCollection":
         records = _feature_records(data, max_cameras)
         if not records:
@@ -284,6 +292,24 @@ async def job_result(
     )
 
 
+_CSV_HEADER_WORDS = re.compile(
+    r"^\ufeff?\"?(id|title|name|camera|camera_id|lat|latitude|lon|lng|streets|description)\"?"
+    r"\s*[,;\t|]",
+    re.IGNORECASE,
+)
+
+
+def _csv_sent_as_json(raw: bytes) -> str:
+    """A hint when a body that is not JSON starts like a camera list's CSV header row."""
+    head = raw[:200].decode("utf-8", errors="replace").lstrip()
+    if not _CSV_HEADER_WORDS.match(head):
+        return ""
+    return (
+        "; it looks like a CSV list (its first row "
+        f"{head.splitlines()[0][:60]!r}): send it with the header Content-Type: text/csv"
+    )
+
+
 def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, Any]]]:
     """A job's cameras as the summary page takes them: each camera's candidates (a
     title-only camera: its point as its one candidate; none placed: its status and reason),
@@ -311,7 +337,12 @@ def _summary_items(results: list[dict[str, Any]]) -> list[tuple[str, dict[str, A
                     },
                 }
             ]
-        if r.get("status") in _PLACED_BY_TITLE:
+        if r.get("status") == "ambiguous" and feats:
+            # drawn at its first place, tied (dashed ring), counted as ambiguous: it read as
+            # "1 located" in the heading, a title the engine would not place (qa7)
+            feats = [_status_first(f, "ambiguous") for f in feats]
+            feats = [_tied(f) for f in feats]
+        elif r.get("status") in _PLACED_BY_TITLE:
             # the status leads the flags, as in camloc batch --map's page: the heading then
             # says "on the map: 1 title_only (at the junction its title names)", not "1
             # camera(s) located" (a title's candidates carried no status: located, they read)
@@ -335,6 +366,15 @@ def _with_sigma(feature: dict[str, Any]) -> dict[str, Any]:
     if props.get("sigma_m") is not None or props.get("uncertainty_m") is None:
         return feature
     return {**feature, "properties": {**props, "sigma_m": props["uncertainty_m"]}}
+
+
+def _tied(feature: dict[str, Any]) -> dict[str, Any]:
+    """A copy of a candidate feature flagged ``tie`` (the page's dashed ring)."""
+    props = dict(feature.get("properties") or {})
+    flags = list(props.get("flags") or [])
+    if "tie" not in flags:
+        props["flags"] = [*flags, "tie"]
+    return {**feature, "properties": props}
 
 
 def _status_first(feature: dict[str, Any], status: str) -> dict[str, Any]:
