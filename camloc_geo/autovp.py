@@ -3637,7 +3637,7 @@ def _finish(
     # lines a non-orthogonal facade, a roof slope or paving may have been taken for a
     # direction. Share of such model errors measured on 216 real photos: 17 % with 40-60
     # distinct lines, 4 % with 60-80, none above 80 (benchmarks/vp_real.py).
-    c_model = 1.0 - min(1.0, (_MODEL_ERROR_LINES / max(1.0, float(srt.sum()))) ** 3)
+    c_model = 1.0 - _model_error_chance(float(srt.sum()))
     confidence = float(
         np.clip(c_support * c_count * c_vert * c_focal * c_model * c_pairing, 0.0, 1.0)
     )
@@ -3713,8 +3713,13 @@ def _wrong_frame_chance(n_lines: Sequence[int] | None) -> float:
     """
     if n_lines is None:
         return 0.0
-    chance = (_MODEL_ERROR_LINES / max(1.0, float(sum(n_lines)))) ** 3
-    return min(_WRONG_FRAME_MAX, chance)
+    return min(_WRONG_FRAME_MAX, _model_error_chance(float(sum(n_lines))))
+
+
+def _model_error_chance(n_distinct_lines: float) -> float:
+    """``(_MODEL_ERROR_LINES / lines) ** 3``, at most 1: the chance of a wrong Manhattan
+    frame on so many distinct lines (the confidence's model term is one less it)."""
+    return min(1.0, (_MODEL_ERROR_LINES / max(1.0, n_distinct_lines)) ** 3)
 
 
 def _with_default_prior(
