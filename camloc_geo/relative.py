@@ -1330,13 +1330,10 @@ class _JointProblem:
         )
         self.ground_corner_sigma_rel = settings.ground_corner_sigma_rel
         ratio = settings.ground_corner_click_ratio
-        self.ground_corner_click_ratio = (
-            settings.sigma_point_rel / settings.sigma_line_rel
-            if ratio is None and settings.sigma_line_rel > 0.0
-            else 1.0
-            if ratio is None
-            else ratio
-        )
+        if ratio is None:  # the settings' own ratio of click to line-end sigmas
+            line_rel = settings.sigma_line_rel
+            ratio = settings.sigma_point_rel / line_rel if line_rel > 0.0 else 1.0
+        self.ground_corner_click_ratio = ratio
         self.variance_groups = settings.variance_groups
         self.n_annotators = len(indices)
         self._z_min = 0.05
